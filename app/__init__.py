@@ -1,0 +1,1 @@
+"""Hairtool Studio: the Qt desktop view over the ``hairtool`` library."""

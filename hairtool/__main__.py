@@ -1,0 +1,3 @@
+from hairtool.cli import entry
+
+entry()

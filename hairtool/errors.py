@@ -1,0 +1,31 @@
+"""Errors that reach the user as one line, never as a traceback."""
+
+from __future__ import annotations
+
+import os
+
+
+class HairtoolError(Exception):
+    """Base of every error the CLI and the studio report as a message."""
+
+
+class FormatError(HairtoolError):
+    """A file could not be read or written; the message names the file."""
+
+    def __init__(self, path: str | os.PathLike[str], reason: str) -> None:
+        self.path = os.fspath(path)
+        self.reason = reason
+        super().__init__(f"{self.path}: {reason}")
+
+
+class ParameterError(HairtoolError, ValueError):
+    """A parameter is out of range; the message names it and its valid range."""
+
+    def __init__(self, name: str, value: object, expected: str) -> None:
+        self.name = name
+        self.value = value
+        super().__init__(f"{name}={value!r} is invalid: expected {expected}")
+
+
+class GroomError(HairtoolError, ValueError):
+    """Arrays do not describe a valid groom or animation."""

@@ -1,0 +1,384 @@
+"""The strand model: a groom (static strands) and an animation (the same strands over frames).
+
+Strands are stored the way USD's BasisCurves and the HAIR format store them: one float32
+``(V, 3)`` array of points, strand after strand from root to tip, and the vertex count of each
+strand. Every per-vertex quantity is a flat ``(V,)`` or ``(V, 3)`` array in the same order, so
+kernels work on whole grooms at once instead of looping over Python lists of strands.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from hairtool.errors import GroomError
+
+F32 = NDArray[np.float32]
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
+
+
+class Topology:
+    """Per-strand vertex counts and the index arrays derived from them (shared, immutable)."""
+
+    def __init__(self, counts: ArrayLike) -> None:
+        c = np.asarray(counts)
+        if c.ndim != 1:
+            raise GroomError(f"strand counts must be a 1-D array, got shape {c.shape}")
+        if c.size == 0:
+            raise GroomError("a groom needs at least one strand")
+        if not np.issubdtype(c.dtype, np.integer):
+            if not np.all(np.isfinite(c)) or not np.all(c == np.round(c)):
+                raise GroomError("strand counts must be whole numbers")
+        c = c.astype(np.int64)
+        if c.min() < 2:
+            bad = int(np.argmin(c))
+            raise GroomError(f"strand {bad} has {int(c[bad])} vertices; every strand needs at least 2")
+        self.counts: I64 = _frozen(c)
+
+    @property
+    def strand_count(self) -> int:
+        return int(self.counts.size)
+
+    @cached_property
+    def offsets(self) -> I64:
+        """``(S+1,)``: strand s owns vertices ``offsets[s]:offsets[s+1]``."""
+        off = np.zeros(self.counts.size + 1, dtype=np.int64)
+        np.cumsum(self.counts, out=off[1:])
+        return _frozen(off)
+
+    @property
+    def vertex_count(self) -> int:
+        return int(self.offsets[-1])
+
+    @cached_property
+    def strand_index(self) -> I64:
+        """``(V,)``: the strand each vertex belongs to."""
+        return _frozen(np.repeat(np.arange(self.counts.size, dtype=np.int64), self.counts))
+
+    @cached_property
+    def index_in_strand(self) -> I64:
+        """``(V,)``: 0 at each root, N_s − 1 at each tip."""
+        return _frozen(np.arange(self.vertex_count, dtype=np.int64) - self.offsets[self.strand_index])
+
+    @cached_property
+    def vertex_param(self) -> F32:
+        """``(V,)``: root-to-tip parameter t = i / (N_s − 1)."""
+        t = self.index_in_strand / (self.counts[self.strand_index] - 1)
+        return _frozen(t.astype(np.float32))
+
+    @cached_property
+    def root_indices(self) -> I64:
+        return _frozen(self.offsets[:-1].copy())
+
+    @cached_property
+    def tip_indices(self) -> I64:
+        return _frozen(self.offsets[1:] - 1)
+
+    @cached_property
+    def segment_end(self) -> I64:
+        """``(V−S,)``: the vertex at the far end of each segment (every non-root vertex)."""
+        mask = np.ones(self.vertex_count, dtype=bool)
+        mask[self.root_indices] = False
+        return _frozen(np.flatnonzero(mask).astype(np.int64))
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Topology) and np.array_equal(self.counts, other.counts)
+
+    def __hash__(self) -> int:
+        return hash(self.counts.tobytes())
+
+
+def _check_points(points: ArrayLike, vertex_count: int, what: str) -> F32:
+    p = np.asarray(points)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise GroomError(f"{what} must have shape (V, 3), got {p.shape}")
+    if p.shape[0] != vertex_count:
+        raise GroomError(f"{what} has {p.shape[0]} vertices but the strand counts add up to {vertex_count}")
+    if not np.all(np.isfinite(p)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(p), axis=1))[0])
+        raise GroomError(f"{what} has a non-finite coordinate at vertex {bad}")
+    return np.array(p, dtype=np.float32, copy=True)
+
+
+def _check_attribute(values: ArrayLike | None, vertex_count: int, width: int, name: str) -> F32 | None:
+    if values is None:
+        return None
+    a = np.array(values, dtype=np.float32, copy=True)
+    shape = (vertex_count,) if width == 1 else (vertex_count, width)
+    if a.shape != shape:
+        raise GroomError(f"{name} must have shape {shape}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise GroomError(f"{name} has non-finite values")
+    return _frozen(a)
+
+
+class _Attributes:
+    """Optional per-vertex thickness, transparency and colour, shared by Groom and Animation."""
+
+    thickness: F32 | None
+    transparency: F32 | None
+    colors: F32 | None
+
+    def _set_attributes(self, thickness, transparency, colors, vertex_count: int) -> None:
+        self.thickness = _check_attribute(thickness, vertex_count, 1, "thickness")
+        self.transparency = _check_attribute(transparency, vertex_count, 1, "transparency")
+        self.colors = _check_attribute(colors, vertex_count, 3, "colors")
+
+    def _attributes(self) -> dict[str, F32 | None]:
+        return {"thickness": self.thickness, "transparency": self.transparency, "colors": self.colors}
+
+
+class Groom(_Attributes):
+    """S strands of varying vertex counts; positions are float32 and immutable.
+
+    Build a new groom with :meth:`with_points` rather than writing into ``points``: engines
+    return new positions and the topology (and its cached index arrays) is shared.
+    """
+
+    def __init__(
+        self,
+        points: ArrayLike,
+        counts: ArrayLike | Topology,
+        *,
+        thickness: ArrayLike | None = None,
+        transparency: ArrayLike | None = None,
+        colors: ArrayLike | None = None,
+    ) -> None:
+        self.topology = counts if isinstance(counts, Topology) else Topology(counts)
+        self.points: F32 = _frozen(_check_points(points, self.topology.vertex_count, "points"))
+        self._set_attributes(thickness, transparency, colors, self.topology.vertex_count)
+
+    @classmethod
+    def from_strands(cls, strands: Sequence[ArrayLike], **attributes: ArrayLike | None) -> Groom:
+        """Build from a list of ``(N_s, 3)`` polylines (2-D ``(N_s, 2)`` ones get z = 0)."""
+        if len(strands) == 0:
+            raise GroomError("a groom needs at least one strand")
+        arrays = []
+        for i, s in enumerate(strands):
+            a = np.asarray(s, dtype=np.float64)
+            if a.ndim != 2 or a.shape[1] not in (2, 3):
+                raise GroomError(f"strand {i} must have shape (N, 2) or (N, 3), got {a.shape}")
+            if a.shape[1] == 2:
+                a = np.column_stack([a, np.zeros(len(a))])
+            arrays.append(a)
+        counts = [len(a) for a in arrays]
+        return cls(np.concatenate(arrays), counts, **attributes)
+
+    def with_points(self, points: ArrayLike) -> Groom:
+        """The same strands and attributes at new positions."""
+        return Groom(points, self.topology, **self._attributes())
+
+    # -- sizes -------------------------------------------------------------------------
+    @property
+    def counts(self) -> I64:
+        return self.topology.counts
+
+    @property
+    def offsets(self) -> I64:
+        return self.topology.offsets
+
+    @property
+    def strand_count(self) -> int:
+        return self.topology.strand_count
+
+    @property
+    def vertex_count(self) -> int:
+        return self.topology.vertex_count
+
+    def __len__(self) -> int:
+        return self.strand_count
+
+    def __repr__(self) -> str:
+        return f"Groom({self.strand_count} strands, {self.vertex_count} vertices)"
+
+    # -- per-strand --------------------------------------------------------------------
+    @property
+    def roots(self) -> F32:
+        return self.points[self.topology.root_indices]
+
+    @property
+    def tips(self) -> F32:
+        return self.points[self.topology.tip_indices]
+
+    def strand(self, s: int) -> F32:
+        """Read-only ``(N_s, 3)`` view of one strand."""
+        o = self.offsets
+        return self.points[o[s] : o[s + 1]]
+
+    def strands(self) -> Iterator[F32]:
+        for s in range(self.strand_count):
+            yield self.strand(s)
+
+    def subset(self, strand_ids: ArrayLike) -> Groom:
+        """A groom of the chosen strands, in the given order."""
+        ids = np.asarray(strand_ids, dtype=np.int64).reshape(-1)
+        if ids.size == 0:
+            raise GroomError("a subset needs at least one strand")
+        if ids.min() < 0 or ids.max() >= self.strand_count:
+            raise GroomError(f"strand ids must lie in [0, {self.strand_count})")
+        vids = vertex_ids_of(self.topology, ids)
+        pick = {k: (None if v is None else v[vids]) for k, v in self._attributes().items()}
+        return Groom(self.points[vids], self.counts[ids], **pick)
+
+    # -- per-vertex --------------------------------------------------------------------
+    @property
+    def vertex_param(self) -> F32:
+        """``(V,)`` t = i / (N_s − 1): 0 at the root, 1 at the tip."""
+        return self.topology.vertex_param
+
+    @cached_property
+    def segment_vectors(self) -> F32:
+        """``(V−S, 3)``: p[i] − p[i−1] for every non-root vertex, in vertex order."""
+        end = self.topology.segment_end
+        return _frozen(self.points[end] - self.points[end - 1])
+
+    @cached_property
+    def segment_lengths(self) -> F64:
+        """``(V−S,)`` in float64, so arc lengths of long strands do not lose precision."""
+        d = self.segment_vectors.astype(np.float64)
+        return _frozen(np.sqrt(np.einsum("ij,ij->i", d, d)))
+
+    @cached_property
+    def arc_length(self) -> F64:
+        """``(V,)`` distance from the strand's root along the strand."""
+        u = np.zeros(self.vertex_count, dtype=np.float64)
+        u[self.topology.segment_end] = self.segment_lengths
+        u = np.cumsum(u)
+        u -= u[self.topology.root_indices][self.topology.strand_index]
+        return _frozen(u)
+
+    @cached_property
+    def strand_lengths(self) -> F64:
+        return _frozen(self.arc_length[self.topology.tip_indices].copy())
+
+    @cached_property
+    def arc_param(self) -> F64:
+        """``(V,)`` arc length normalised to [0, 1] per strand (t where a strand has no length)."""
+        length = self.strand_lengths[self.topology.strand_index]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            u = np.where(length > 0, self.arc_length / length, self.vertex_param)
+        return _frozen(u)
+
+    @property
+    def bounds(self) -> tuple[F32, F32]:
+        """Axis-aligned bounding box ``(min, max)``."""
+        return self.points.min(axis=0), self.points.max(axis=0)
+
+    @property
+    def is_planar(self) -> bool:
+        """True for 2-D grooms: z is 0 everywhere."""
+        return not np.any(self.points[:, 2])
+
+
+def vertex_ids_of(topology: Topology, strand_ids: NDArray[np.int64]) -> I64:
+    """Vertex indices of the given strands, concatenated in the given order."""
+    counts = topology.counts[strand_ids]
+    starts = topology.offsets[strand_ids]
+    local = np.arange(int(counts.sum()), dtype=np.int64) - np.repeat(np.cumsum(counts) - counts, counts)
+    return np.repeat(starts, counts) + local
+
+
+class Animation(_Attributes):
+    """The same strands over F frames: ``frames`` is float32 ``(F, V, 3)``, ``fps`` frames/s."""
+
+    def __init__(
+        self,
+        frames: ArrayLike,
+        counts: ArrayLike | Topology,
+        fps: float = 24.0,
+        *,
+        thickness: ArrayLike | None = None,
+        transparency: ArrayLike | None = None,
+        colors: ArrayLike | None = None,
+    ) -> None:
+        self.topology = counts if isinstance(counts, Topology) else Topology(counts)
+        f = np.asarray(frames)
+        v = self.topology.vertex_count
+        if f.ndim != 3 or f.shape[2] != 3:
+            raise GroomError(f"animation frames must have shape (F, V, 3), got {f.shape}")
+        if f.shape[0] < 1:
+            raise GroomError("an animation needs at least one frame")
+        if f.shape[1] != v:
+            raise GroomError(
+                f"animation frames have {f.shape[1]} vertices but the strand counts add up to {v}"
+            )
+        if not np.all(np.isfinite(f)):
+            bad = int(np.flatnonzero(~np.all(np.isfinite(f), axis=(1, 2)))[0])
+            raise GroomError(f"animation frame {bad} has a non-finite coordinate")
+        fps = float(fps)
+        if not np.isfinite(fps) or fps <= 0:
+            raise GroomError(f"frame rate must be a positive number, got {fps}")
+        self.frames: F32 = _frozen(np.array(f, dtype=np.float32, copy=True))
+        self.fps = fps
+        self._set_attributes(thickness, transparency, colors, v)
+
+    @classmethod
+    def from_grooms(cls, grooms: Sequence[Groom], fps: float = 24.0) -> Animation:
+        """Stack grooms of one topology into frames; attributes come from the first."""
+        if len(grooms) == 0:
+            raise GroomError("an animation needs at least one frame")
+        top = grooms[0].topology
+        for i, g in enumerate(grooms):
+            if g.topology != top:
+                raise GroomError(f"frame {i} has a different strand topology from frame 0")
+        return cls(np.stack([g.points for g in grooms]), top, fps, **grooms[0]._attributes())
+
+    def with_frames(self, frames: ArrayLike, fps: float | None = None) -> Animation:
+        return Animation(frames, self.topology, self.fps if fps is None else fps, **self._attributes())
+
+    @property
+    def counts(self) -> I64:
+        return self.topology.counts
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.frames.shape[0])
+
+    @property
+    def strand_count(self) -> int:
+        return self.topology.strand_count
+
+    @property
+    def vertex_count(self) -> int:
+        return self.topology.vertex_count
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the first frame to the last."""
+        return (self.n_frames - 1) / self.fps
+
+    @property
+    def times(self) -> F64:
+        return np.arange(self.n_frames, dtype=np.float64) / self.fps
+
+    def frame(self, f: int) -> Groom:
+        """Frame ``f`` as a groom (negative indices count from the end)."""
+        if not -self.n_frames <= f < self.n_frames:
+            raise IndexError(f"frame {f} is outside 0..{self.n_frames - 1}")
+        return Groom(self.frames[f], self.topology, **self._attributes())
+
+    @property
+    def rest(self) -> Groom:
+        return self.frame(0)
+
+    @property
+    def bounds(self) -> tuple[F32, F32]:
+        return self.frames.min(axis=(0, 1)), self.frames.max(axis=(0, 1))
+
+    def __len__(self) -> int:
+        return self.n_frames
+
+    def __repr__(self) -> str:
+        return (
+            f"Animation({self.n_frames} frames at {self.fps:g} fps, "
+            f"{self.strand_count} strands, {self.vertex_count} vertices)"
+        )

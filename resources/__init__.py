@@ -1,0 +1,1 @@
+"""Data files the studio ships (installed as ``app.resources``)."""

@@ -1,0 +1,1 @@
+"""GLSL programs of the studio, one per file (installed as ``app.shaders``)."""

@@ -1,0 +1,61 @@
+"""Suite-wide set-up: a virtual X display for the GUI tests when none is given, and data paths."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+SHARED_DATA = ROOT.parent / "shared" / "data"
+GROOMS = SHARED_DATA / "grooms"
+MOTION = SHARED_DATA / "motion"
+
+_xvfb: subprocess.Popen | None = None
+
+
+def _start_xvfb() -> None:
+    """Start ``Xvfb -displayfd`` and export DISPLAY, so plain ``pytest`` runs the GUI tests."""
+    global _xvfb
+    if os.environ.get("DISPLAY") or shutil.which("Xvfb") is None:
+        return
+    read_fd, write_fd = os.pipe()
+    _xvfb = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
+        pass_fds=(write_fd,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    os.close(write_fd)
+    with os.fdopen(read_fd) as f:
+        number = f.readline().strip()
+    if not number:
+        raise RuntimeError("Xvfb did not report a display number")
+    os.environ["DISPLAY"] = f":{number}"
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    _start_xvfb()
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    if _xvfb is not None:
+        _xvfb.terminate()
+        _xvfb.wait(timeout=10)
+
+
+@pytest.fixture(scope="session")
+def grooms_dir() -> Path:
+    if not GROOMS.is_dir():
+        pytest.fail(f"real grooms are expected in {GROOMS}")
+    return GROOMS
+
+
+@pytest.fixture(scope="session")
+def motion_dir() -> Path:
+    if not MOTION.is_dir():
+        pytest.fail(f"motion captures are expected in {MOTION}")
+    return MOTION
