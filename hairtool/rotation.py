@@ -1,0 +1,43 @@
+"""Axis-angle rotations (Rodrigues' formula), batched over rows, in float64."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+EPS = 1e-12
+
+
+def normalize(v: ArrayLike, eps: float = EPS) -> NDArray[np.float64]:
+    """Unit vectors along the rows of ``v``; rows shorter than ``eps`` stay zero."""
+    a = np.asarray(v, dtype=np.float64)
+    n = np.linalg.norm(a, axis=-1, keepdims=True)
+    return np.where(n > eps, a / np.maximum(n, eps), 0.0)
+
+
+def any_perpendicular(v: ArrayLike) -> NDArray[np.float64]:
+    """A unit vector perpendicular to each row of ``v`` (a fixed, deterministic choice)."""
+    a = np.asarray(v, dtype=np.float64)
+    # Cross with the coordinate axis least aligned with v: never near-parallel.
+    helper = np.zeros_like(a)
+    helper[np.arange(len(a)) if a.ndim == 2 else ..., np.argmin(np.abs(a), axis=-1)] = 1.0
+    return normalize(np.cross(a, helper))
+
+
+def rotate(vectors: ArrayLike, axes: ArrayLike, angles: ArrayLike) -> NDArray[np.float64]:
+    """Rotate each row of ``vectors`` about the unit row of ``axes`` by ``angles`` (radians).
+
+    Rodrigues: v cosθ + (a × v) sinθ + a (a·v)(1 − cosθ). Shapes broadcast row-wise.
+    """
+    v = np.asarray(vectors, dtype=np.float64)
+    a = np.asarray(axes, dtype=np.float64)
+    th = np.asarray(angles, dtype=np.float64)[..., None]
+    c, s = np.cos(th), np.sin(th)
+    return v * c + np.cross(a, v) * s + a * np.sum(a * v, axis=-1, keepdims=True) * (1.0 - c)
+
+
+def axis_angle_matrix(axis: ArrayLike, angle: float) -> NDArray[np.float64]:
+    """3×3 rotation matrix about a unit ``axis`` by ``angle`` radians."""
+    a = np.asarray(axis, dtype=np.float64)
+    k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
