@@ -1,0 +1,177 @@
+"""Wavefront OBJ: strands as polylines (``l`` records) and head meshes (``f`` records) for display.
+
+A groom is written as ``v`` records with ``%.9g`` (enough digits that every float32 reads back
+bit-exact) and one ``l`` record per strand with 1-based indices. Reading takes every ``l``
+record as one strand; ``read_mesh`` triangulates polygons (as fans) for drawing a head or scalp.
+Indices may be negative (relative to the vertices read so far) and may carry ``/vt/vn`` parts.
+Parsing splits lines once and converts whole columns with numpy; no per-vertex arithmetic in
+Python.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from hairtool.errors import FormatError
+from hairtool.groom import Animation, Groom
+from hairtool.io.atomic import atomic_open
+from hairtool.io.binary import require_finite, require_strand_counts
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """A triangle mesh: ``vertices`` float32 (n, 3), ``faces`` int32 (m, 3), ``normals`` float32 (n, 3).
+
+    Normals are unit length; a vertex that no face touches has a zero normal.
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    normals: np.ndarray
+
+
+class _Records:
+    """The ``v``, ``vn``, ``l`` and ``f`` records of an OBJ file, as split tokens."""
+
+    def __init__(self, path: Path) -> None:
+        # latin-1 never fails to decode; every token we parse is ASCII anyway.
+        text = path.read_bytes().decode("latin-1")
+        if not text.strip():
+            raise FormatError(path, "the file is empty")
+        self.path = path
+        v: list[str] = []  # whole lines: split and converted together below
+        vn: list[str] = []
+        self.lines: list[tuple[int, list[str]]] = []  # (vertices so far, index tokens)
+        self.faces: list[tuple[int, int, list[str]]] = []  # (vertices so far, normals so far, corners)
+        for number, line in enumerate(text.splitlines(), 1):
+            if line.startswith("v "):
+                v.append(line)
+                continue
+            parts = line.split()
+            if not parts:
+                continue
+            key = parts[0]
+            if key == "v":
+                v.append(line)
+            elif key == "vn":
+                vn.append(line)
+            elif key == "l":
+                self.lines.append((len(v), parts[1:]))
+            elif key == "f":
+                if len(parts) < 4:
+                    raise FormatError(path, f"line {number}: a face needs at least 3 corners")
+                self.faces.append((len(v), len(vn), parts[1:]))
+        self.vertices = _floats(path, v, "v")
+        self.vertex_normals = _floats(path, vn, "vn")
+
+
+def _floats(path: Path, lines: list[str], key: str) -> np.ndarray:
+    """x y z of ``v`` / ``vn`` lines as float64 (n, 3); extra columns (w, colours) are ignored."""
+    n = len(lines)
+    if n == 0:
+        return np.zeros((0, 3), dtype=np.float64)
+    tokens = " ".join(lines).split()
+    try:
+        if len(tokens) == 4 * n and tokens[::4].count(key) == n:  # fast path: exactly "key x y z"
+            flat = [float(t) for t in tokens[1::4] + tokens[2::4] + tokens[3::4]]
+            a = np.array(flat, dtype=np.float64).reshape(3, n).T.copy()
+        else:
+            rows = [ln.split() for ln in lines]
+            if min(len(r) for r in rows) < 4:
+                raise FormatError(path, f"a '{key}' record needs x y z")
+            a = np.array([[float(t) for t in r[1:4]] for r in rows], dtype=np.float64)
+    except ValueError:
+        raise FormatError(path, f"a '{key}' record has a coordinate that is not a number") from None
+    require_finite(path, a, f"'{key}' coordinates")
+    return a
+
+
+def _indices(path: Path, tokens: list[str], known: np.ndarray, total: int, what: str) -> np.ndarray:
+    """0-based indices from OBJ tokens: 1-based, or negative = relative to ``known`` read so far."""
+    try:
+        i = np.array([int(t) for t in tokens], dtype=np.int64)
+    except (ValueError, OverflowError):
+        raise FormatError(path, f"a {what} index is not a whole number") from None
+    if np.any(i == 0):
+        raise FormatError(path, f"{what} index 0 (OBJ indices start at 1)")
+    idx = np.where(i > 0, i - 1, known + i)
+    if idx.size and (idx.min() < 0 or idx.max() >= total):
+        raise FormatError(path, f"a {what} index is out of range (the file has {total})")
+    return idx
+
+
+def read(path: Path) -> Groom:
+    """Every ``l`` record is one strand (at least 2 points)."""
+    rec = _Records(path)
+    if not rec.lines:
+        hint = " (it holds faces: a mesh, see read_mesh)" if rec.faces else ""
+        raise FormatError(path, f"no polylines ('l' records){hint}")
+    counts = np.array([len(t) for _, t in rec.lines], dtype=np.int64)
+    require_strand_counts(path, counts)
+    tokens = [t.split("/", 1)[0] for _, ts in rec.lines for t in ts]
+    known = np.repeat(np.array([k for k, _ in rec.lines], dtype=np.int64), counts)
+    idx = _indices(path, tokens, known, len(rec.vertices), "vertex")
+    return Groom(rec.vertices[idx].astype(np.float32), counts)
+
+
+def read_mesh(path: str | os.PathLike[str]) -> Mesh:
+    """A head or scalp mesh for display: polygons fan-triangulated, normals per vertex.
+
+    Normals come from the file's ``vn`` records (averaged per vertex) when every face corner
+    names one; otherwise they are computed, area-weighted, from the triangles.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise FormatError(p, "no such file")
+    rec = _Records(p)
+    if not rec.faces:
+        raise FormatError(p, "no faces ('f' records)")
+    if len(rec.vertices) > np.iinfo(np.int32).max:
+        raise FormatError(p, "too many vertices for int32 face indices")
+    corners = [c.split("/") for _, _, cs in rec.faces for c in cs]
+    sizes = np.array([len(cs) for _, _, cs in rec.faces], dtype=np.int64)
+    known_v = np.repeat(np.array([k for k, _, _ in rec.faces], dtype=np.int64), sizes)
+    vid = _indices(p, [c[0] for c in corners], known_v, len(rec.vertices), "vertex")
+    # Fan triangulation: corners (0, j, j+1) of each polygon, j = 1 .. k−2.
+    start = np.cumsum(sizes) - sizes
+    n_tri = sizes - 2
+    first = np.repeat(start, n_tri)
+    j = np.arange(int(n_tri.sum()), dtype=np.int64) - np.repeat(np.cumsum(n_tri) - n_tri, n_tri) + 1
+    tri_corners = np.stack([first, first + j, first + j + 1], axis=1)
+    faces = vid[tri_corners]
+    vertices = rec.vertices
+
+    has_normals = len(rec.vertex_normals) > 0 and all(len(c) >= 3 and c[2] for c in corners)
+    if has_normals:
+        known_n = np.repeat(np.array([k for _, k, _ in rec.faces], dtype=np.int64), sizes)
+        nid = _indices(p, [c[2] for c in corners], known_n, len(rec.vertex_normals), "normal")
+        summed = _scatter_sum(vid, rec.vertex_normals[nid], len(vertices))
+    else:
+        a, b, c = (vertices[faces[:, k]] for k in range(3))
+        face_normals = np.cross(b - a, c - a)  # length = twice the area: area weighting for free
+        summed = _scatter_sum(faces.reshape(-1), np.repeat(face_normals, 3, axis=0), len(vertices))
+    length = np.linalg.norm(summed, axis=1, keepdims=True)
+    normals = np.divide(summed, length, out=np.zeros_like(summed), where=length > 0)
+    return Mesh(vertices.astype(np.float32), faces.astype(np.int32), normals.astype(np.float32))
+
+
+def _scatter_sum(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """Sum rows of ``values`` into ``n`` bins (float64)."""
+    return np.stack([np.bincount(index, weights=values[:, k], minlength=n) for k in range(3)], axis=1)
+
+
+def write(path: Path, obj: Groom | Animation) -> None:
+    """Vertices with ``%.9g`` (float32 round-trips exactly), then one ``l`` record per strand."""
+    groom = obj.rest if isinstance(obj, Animation) else obj
+    v = groom.vertex_count
+    numbers = [str(i) for i in range(1, v + 1)]
+    off = groom.offsets.tolist()
+    with atomic_open(path, "w", encoding="ascii", newline="\n") as f:
+        f.write(f"# hairtool groom: {groom.strand_count} strands, {v} vertices\n")
+        f.write(("v %.9g %.9g %.9g\n" * v) % tuple(groom.points.ravel().tolist()))
+        f.write("".join(f"l {' '.join(numbers[a:b])}\n" for a, b in itertools.pairwise(off)))

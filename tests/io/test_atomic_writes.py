@@ -1,0 +1,51 @@
+"""A writer that fails part-way leaves no file behind and never destroys the previous one."""
+
+from __future__ import annotations
+
+import pytest
+
+from hairtool.errors import FormatError
+from hairtool.io import atomic, read, usd, write
+
+WRITABLE = ("hair", "obj", "npz", "usda", "usdc", "usd")
+
+
+class Boom(RuntimeError):
+    pass
+
+
+def _fail_mid_write(monkeypatch, ext):
+    def boom(*args, **kwargs):
+        raise Boom("simulated failure mid-write")
+
+    if ext.startswith("usd"):
+        monkeypatch.setattr(usd, "_extent", boom)  # runs after the stage exists, before it is saved
+    else:
+        monkeypatch.setattr(atomic.os, "fsync", boom)  # after every byte is written, before the rename
+
+
+@pytest.mark.parametrize("ext", WRITABLE)
+def test_failed_write_keeps_the_old_file(tmp_path, monkeypatch, groom, ext):
+    target = tmp_path / f"groom.{ext}"
+    write(target, groom.subset([0, 1]))
+    before = target.read_bytes()
+    _fail_mid_write(monkeypatch, ext)
+    with pytest.raises(Boom):
+        write(target, groom)
+    assert target.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == [target.name]
+    monkeypatch.undo()
+    assert read(target).strand_count == 2
+
+
+@pytest.mark.parametrize("ext", WRITABLE)
+def test_failed_write_leaves_no_file(tmp_path, monkeypatch, groom, ext):
+    _fail_mid_write(monkeypatch, ext)
+    with pytest.raises(Boom):
+        write(tmp_path / f"new.{ext}", groom)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unwritable_folder_is_a_format_error(tmp_path, groom):
+    with pytest.raises(FormatError, match="cannot write"):
+        write(tmp_path / "missing" / "g.hair", groom)

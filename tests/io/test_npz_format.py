@@ -1,0 +1,125 @@
+"""hairtool's .npz cache: lossless grooms and animations, every member validated before use."""
+
+from __future__ import annotations
+
+import io
+import zipfile
+
+import numpy as np
+import pytest
+
+from hairtool.errors import FormatError
+from hairtool.groom import Animation, Groom
+from hairtool.io import npz, read, write
+
+
+def test_groom_round_trip_keeps_everything(tmp_path, groom):
+    p = tmp_path / "g.npz"
+    write(p, groom)
+    back = read(p)
+    assert isinstance(back, Groom)
+    assert back.points.tobytes() == groom.points.tobytes()
+    np.testing.assert_array_equal(back.counts, groom.counts)
+    for name in ("thickness", "transparency", "colors"):
+        assert getattr(back, name).tobytes() == getattr(groom, name).tobytes()
+    with np.load(p, allow_pickle=False) as z:
+        assert int(z["format_version"]) == npz.FORMAT_VERSION and str(z["kind"]) == "groom"
+
+
+def test_animation_round_trip_keeps_frames_and_fps(tmp_path, animation):
+    p = tmp_path / "a.npz"
+    write(p, animation)
+    back = read(p)
+    assert isinstance(back, Animation)
+    assert back.frames.tobytes() == animation.frames.tobytes()
+    assert back.fps == animation.fps
+    assert back.colors.tobytes() == animation.colors.tobytes()
+    assert back.transparency is None
+
+
+def _write_members(path, **arrays):
+    with open(path, "wb") as f:
+        np.savez(f, **arrays)
+
+
+def _valid(**changes):
+    base = {
+        "format_version": np.array(1),
+        "kind": np.array("groom"),
+        "counts": np.array([2, 3]),
+        "points": np.zeros((5, 3), np.float32),
+    }
+    base.update(changes)
+    return {k: v for k, v in base.items() if v is not None}
+
+
+@pytest.mark.parametrize(
+    ("members", "reason"),
+    [
+        (_valid(format_version=np.array(99)), "version 99"),
+        (_valid(format_version=None), "missing 'format_version'"),
+        (_valid(kind=np.array("mesh")), "kind is 'mesh'"),
+        (_valid(kind=np.array(3)), "'kind' must be"),
+        (_valid(counts=np.array([2, 1])), "at least 2"),
+        (_valid(counts=np.array([2.0, 3.0])), "'counts' must be"),
+        (_valid(points=np.zeros((4, 3), np.float32)), "'points' has shape"),
+        (_valid(points=np.full((5, 3), np.nan, np.float32)), "non-finite"),
+        (_valid(thickness=np.ones(4, np.float32)), "'thickness' has shape"),
+        (_valid(colors=np.ones((5, 3), complex)), "'colors' must be"),
+        (_valid(extra=np.ones(3)), "unexpected member"),
+        (_valid(kind=np.array("animation"), frames=np.zeros((2, 5, 3), np.float32)), "missing 'fps'"),
+        (
+            _valid(kind=np.array("animation"), frames=np.zeros((2, 5, 3), np.float32), fps=np.array(-1.0)),
+            "fps is -1",
+        ),
+        (
+            _valid(kind=np.array("animation"), frames=np.zeros((0, 5, 3), np.float32), fps=np.array(24.0)),
+            "F>=1",
+        ),
+    ],
+)
+def test_invalid_members_raise_format_error(tmp_path, members, reason):
+    p = tmp_path / "bad.npz"
+    _write_members(p, **members)
+    with pytest.raises(FormatError, match=reason):
+        read(p)
+
+
+def _npy_header(shape: tuple[int, ...]) -> bytes:
+    """A hand-made .npy 1.0 header for a float32 array of ``shape`` (no data follows)."""
+    text = f"{{'descr': '<f4', 'fortran_order': False, 'shape': {shape}, }}"
+    pad = 64 - (10 + len(text) + 1) % 64
+    body = (text + " " * pad + "\n").encode("latin-1")
+    return b"\x93NUMPY\x01\x00" + len(body).to_bytes(2, "little") + body
+
+
+def test_member_claiming_a_huge_shape_is_refused_before_allocating(tmp_path):
+    p = tmp_path / "huge.npz"
+    with zipfile.ZipFile(p, "w", compression=zipfile.ZIP_DEFLATED) as z:
+        z.writestr("format_version.npy", _npy(np.array(1)))
+        z.writestr("kind.npy", _npy(np.array("groom")))
+        z.writestr("counts.npy", _npy(np.array([2_000_000_000])))
+        z.writestr("points.npy", _npy_header((2_000_000_000, 3)) + b"\0" * 60)
+    with pytest.raises(FormatError, match="does not match its stored size"):
+        read(p)
+
+
+def _npy(a) -> bytes:
+    buf = io.BytesIO()
+    np.lib.format.write_array(buf, a)
+    return buf.getvalue()
+
+
+def test_pickled_members_are_refused(tmp_path):
+    p = tmp_path / "pickle.npz"
+    _write_members(p, **_valid(kind=np.array([{"a": 1}], dtype=object)))
+    with pytest.raises(FormatError, match="Python objects"):
+        read(p)
+
+
+@pytest.mark.parametrize("data", [b"", b"PK\x03\x04garbage", b"\x93NUMPY" + b"\0" * 20, b"not a zip at all"])
+def test_non_npz_bytes_raise_format_error(tmp_path, data):
+    p = tmp_path / "junk.npz"
+    p.write_bytes(data)
+    with pytest.raises(FormatError):
+        read(p)

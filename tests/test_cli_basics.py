@@ -1,0 +1,102 @@
+"""``hairtool info``, ``convert`` and ``sample``: output, exit codes, one-line errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from hairtool.cli import main
+from hairtool.groom import Animation
+from hairtool.io import hairfile, read, write
+from hairtool.samples import scalp
+
+
+def test_sample_then_info_json(tmp_path, capsys):
+    out = tmp_path / "s.hair"
+    assert main(["sample", "scalp", str(out), "--strands", "30", "--vertices", "7", "--seed", "3"]) == 0
+    assert "30 strands" in capsys.readouterr().out
+    np.testing.assert_array_equal(read(out).points, scalp(30, 7, seed=3).points)
+    assert main(["info", str(out), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["format"].startswith("HAIR") and info["kind"] == "groom"
+    assert (info["strands"], info["vertices"]) == (30, 210)
+    assert info["vertices_per_strand"] == {"min": 7, "mean": 7.0, "max": 7}
+    g = scalp(30, 7, seed=3)
+    assert info["bounds"]["min"] == pytest.approx(g.points.min(axis=0).tolist())
+    assert info["attributes"] == [] and "frames" not in info
+
+
+def test_info_text_for_an_animation_and_a_real_groom(tmp_path, capsys, grooms_dir):
+    g = scalp(10, 5)
+    a = Animation(np.stack([g.points] * 4), g.topology, 25, thickness=np.ones(g.vertex_count))
+    write(tmp_path / "a.npz", a)
+    assert main(["info", str(tmp_path / "a.npz")]) == 0
+    text = capsys.readouterr().out
+    assert "frames      4 at 25 fps" in text and "thickness" in text
+    assert main(["info", str(grooms_dir / "ponytail_tail.tfx"), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert (info["strands"], info["vertices"]) == (474, 474 * 16)
+
+
+def test_convert_keeps_animations_where_it_can_and_warns_where_it_cannot(tmp_path, capsys):
+    g = scalp(10, 5)
+    a = Animation(np.stack([g.points, g.points + 1, g.points + 2]), g.topology, 30)
+    write(tmp_path / "a.npz", a)
+    assert main(["convert", str(tmp_path / "a.npz"), str(tmp_path / "a.usdc")]) == 0
+    assert read(tmp_path / "a.usdc").frames.tobytes() == a.frames.tobytes()
+    assert capsys.readouterr().err == ""
+    assert main(["convert", str(tmp_path / "a.usdc"), str(tmp_path / "a.obj")]) == 0
+    captured = capsys.readouterr()
+    assert "warning" in captured.err and "dropping 2 of 3 frames" in captured.err
+    assert read(tmp_path / "a.obj").points.tobytes() == g.points.tobytes()
+
+
+def test_convert_hair_to_hair_keeps_the_info_string(tmp_path):
+    hairfile.write(tmp_path / "in.hair", scalp(5, 4), info="scanned by hand")
+    assert main(["convert", str(tmp_path / "in.hair"), str(tmp_path / "out.hair")]) == 0
+    assert hairfile.read_header(tmp_path / "out.hair").info == "scanned by hand"
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["info", "{tmp}/absent.hair"], "no such file"),
+        (["info", "{tmp}/x.xyz"], "cannot read '.xyz'"),
+        (["info", "{tmp}/bad.hair"], "not a HAIR file"),
+        (["convert", "{tmp}/bad.hair", "{tmp}/out.tfx"], "cannot write '.tfx'"),
+        (["convert", "{tmp}/absent.npz", "{tmp}/out.obj"], "no such file"),
+        (["sample", "braid", "{tmp}/s.hair"], "kind='braid'"),
+        (["sample", "scalp", "{tmp}/s.hair", "--vertices", "1"], "vertices=1"),
+        (["sample", "scalp", "{tmp}/s.png"], "cannot write '.png'"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, message):
+    (tmp_path / "bad.hair").write_bytes(b"NOPE" + b"\0" * 200)
+    (tmp_path / "x.xyz").write_text("x")
+    assert main([a.format(tmp=tmp_path) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert err.count("\n") == 1 and "Traceback" not in err
+
+
+def test_bad_input_from_a_real_process_has_no_traceback(tmp_path):
+    bad = tmp_path / "bad.tfx"
+    bad.write_bytes(b"\0\0\x80\x40" + b"\xff" * 300)
+    r = subprocess.run(
+        [sys.executable, "-m", "hairtool", "info", str(bad)], capture_output=True, text=True, timeout=60
+    )
+    assert r.returncode == 2
+    assert r.stdout == ""
+    assert r.stderr.startswith("hairtool info: error: ") and r.stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize("command", ["info", "convert", "sample"])
+def test_help(command, capsys):
+    with pytest.raises(SystemExit) as e:
+        main([command, "--help"])
+    assert e.value.code == 0
+    assert "usage: hairtool" in capsys.readouterr().out
