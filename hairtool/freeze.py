@@ -1,0 +1,266 @@
+"""FreezeDeform (Kim 2026, eqs. 2–7): stiffness-limited random stretch and bend of every segment.
+
+Frozen hair barely stretches or bends; the method perturbs each rest segment by a small random
+length change (alpha_s = 1/k_s) and a small random rotation (alpha_b·theta_max = theta_max/k_b),
+rebuilding the strand from the root. The noise is a hash of (seed, strand, vertex), never a
+running generator, so a strand's look does not depend on the thread count, on other strands, or
+on how often the groom was updated. :func:`freeze` is the numba kernel, :func:`freeze_reference`
+its plain numpy twin.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+from numpy.typing import ArrayLike, NDArray
+
+from hairtool.errors import ParameterError
+from hairtool.groom import Groom
+from hairtool.rotation import any_perpendicular, normalize, rotate
+
+EPS = 1e-12  # the papers' epsilon in denominators (float64)
+AXIS_EPS = 1e-6  # |t̂[i−1] × t̂[i]| below this: the tangents are parallel, the cross gives no axis
+MAX_STIFFNESS = 1e9
+MAX_VARIATION = 4.0
+
+# Noise channels: one independent uniform stream per use of the hash.
+CH_STRETCH = 1
+CH_BEND = 2
+CH_STRAND = 3
+CH_DRAW = 4
+CH_CLUMP = 5
+
+_M1 = np.uint64(0xBF58476D1CE4E5B9)
+_M2 = np.uint64(0x94D049BB133111EB)
+_GOLD = np.uint64(0x9E3779B97F4A7C15)
+_S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(11)
+_INV53 = 1.0 / 9007199254740992.0  # 2**-53
+
+
+def _mix_py(z):
+    """splitmix64's finaliser: works on numba uint64 scalars and on numpy uint64 arrays alike."""
+    z = (z ^ (z >> _S30)) * _M1
+    z = (z ^ (z >> _S27)) * _M2
+    return z ^ (z >> _S31)
+
+
+def _hash_py(seed, a, b, channel):
+    h = _mix_py(seed ^ _mix_py(channel ^ _GOLD))
+    h = _mix_py(h ^ _mix_py(a + _GOLD))
+    return _mix_py(h ^ b)
+
+
+_mix = njit(cache=True, inline="always")(_mix_py)
+
+
+@njit(cache=True, inline="always")
+def hash_u01_nb(seed: np.uint64, a: int, b: int, channel: int) -> float:
+    """Uniform [0, 1) from (seed, a, b, channel) inside kernels."""
+    h = _mix(seed ^ _mix(np.uint64(channel) ^ _GOLD))
+    h = _mix(h ^ _mix(np.uint64(a) + _GOLD))
+    h = _mix(h ^ np.uint64(b))
+    return float(h >> _S11) * _INV53
+
+
+def hash_u01(seed: int, a: ArrayLike, b: ArrayLike, channel: int) -> NDArray[np.float64]:
+    """The numpy twin of :func:`hash_u01_nb`: uniform [0, 1) per (a, b), broadcast."""
+    a64, b64 = np.broadcast_arrays(np.atleast_1d(np.asarray(a, np.int64)), np.atleast_1d(np.asarray(b)))
+    h = _hash_py(
+        np.full(a64.shape, seed_u64(seed), np.uint64),
+        a64.astype(np.uint64),
+        b64.astype(np.int64).astype(np.uint64),
+        np.full(a64.shape, channel, np.uint64),
+    )
+    return (h >> _S11).astype(np.float64) * _INV53
+
+
+def seed_u64(seed: int) -> np.uint64:
+    return np.uint64(int(seed) & 0xFFFFFFFFFFFFFFFF)
+
+
+def draw_seed(seed: int, draw: int) -> int:
+    """The seed of the ``draw``-th noise redraw (draw 0 is ``seed`` itself)."""
+    if draw == 0:
+        return int(seed)
+    return int(hash_u01(seed, [draw], [0], CH_DRAW)[0] * 2.0**53)
+
+
+def check_seed(seed: object) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not 0 <= int(seed) < 2**63:
+        raise ParameterError("seed", seed, "a whole number in [0, 2**63)")
+    return int(seed)
+
+
+def strand_multipliers(strand_count: int, variation: float | ArrayLike, seed: int = 0) -> NDArray[np.float64]:
+    """``(S,)`` per-strand stiffness multipliers (the paper's strand-wise intensity variation).
+
+    A number is a spread: multiplier = 2**(spread·U(−1,1)), seeded per strand (spread 1 gives
+    ×0.5 … ×2). An array gives the multipliers directly (positive, one per strand).
+    """
+    if np.ndim(variation) == 0:
+        spread = float(variation)  # type: ignore[arg-type]
+        if not np.isfinite(spread) or not 0.0 <= spread <= MAX_VARIATION:
+            raise ParameterError("strand_variation", variation, f"a number in [0, {MAX_VARIATION:g}]")
+        if spread == 0.0:
+            return np.ones(strand_count)
+        u = hash_u01(seed, np.arange(strand_count), 0, CH_STRAND)
+        return np.exp2(spread * (2.0 * u - 1.0))
+    m = np.asarray(variation, dtype=np.float64)
+    if m.shape != (strand_count,):
+        raise ParameterError("strand_variation", f"array of shape {m.shape}", f"shape ({strand_count},)")
+    if not np.all(np.isfinite(m)) or np.any(m <= 0):
+        raise ParameterError("strand_variation", "array", "positive finite multipliers")
+    return m.copy()
+
+
+def check_freeze_params(stretch_stiffness: float, bend_stiffness: float, max_bend_angle: float) -> None:
+    ks, kb, th = float(stretch_stiffness), float(bend_stiffness), float(max_bend_angle)
+    if not np.isfinite(ks) or not 1.0 <= ks <= MAX_STIFFNESS:
+        # Below 1 a target length l0·(1 + eta/k_s) could turn negative.
+        raise ParameterError("stretch_stiffness", stretch_stiffness, f"a number in [1, {MAX_STIFFNESS:g}]")
+    if not np.isfinite(kb) or not 0.0 < kb <= MAX_STIFFNESS:
+        raise ParameterError("bend_stiffness", bend_stiffness, f"a number in (0, {MAX_STIFFNESS:g}]")
+    if not np.isfinite(th) or not 0.0 <= th <= np.pi:
+        raise ParameterError("max_bend_angle", max_bend_angle, "an angle in [0, pi] radians")
+
+
+def _effective(groom, stretch_stiffness, bend_stiffness, max_bend_angle, seed, strand_variation):
+    check_freeze_params(stretch_stiffness, bend_stiffness, max_bend_angle)
+    seed = check_seed(seed)
+    m = strand_multipliers(groom.strand_count, strand_variation, seed)
+    # k_s·m is kept ≥ 1 so that 1 + alpha_s·eta never goes below 0.
+    return np.maximum(float(stretch_stiffness) * m, 1.0), float(bend_stiffness) * m, seed
+
+
+@njit(cache=True, parallel=True)
+def _freeze_kernel(rest, offsets, ks, kb, theta_max, seed, planar, out):
+    s_count = offsets.size - 1
+    for s in prange(s_count):
+        o = offsets[s]
+        n = offsets[s + 1] - o
+        alpha_s = 1.0 / (ks[s] + EPS)  # (3)
+        alpha_b = 1.0 / (kb[s] + EPS)  # (4)
+        px = np.float64(rest[o, 0])
+        py = np.float64(rest[o, 1])
+        pz = np.float64(rest[o, 2])
+        out[o, 0], out[o, 1], out[o, 2] = rest[o, 0], rest[o, 1], rest[o, 2]
+        qx = qy = qz = 0.0  # t̂[i−1]
+        for i in range(1, n):
+            dx = np.float64(rest[o + i, 0]) - np.float64(rest[o + i - 1, 0])  # (2)
+            dy = np.float64(rest[o + i, 1]) - np.float64(rest[o + i - 1, 1])
+            dz = np.float64(rest[o + i, 2]) - np.float64(rest[o + i - 1, 2])
+            l0 = np.sqrt(dx * dx + dy * dy + dz * dz)
+            tx, ty, tz = dx / (l0 + EPS), dy / (l0 + EPS), dz / (l0 + EPS)
+            eta = 2.0 * hash_u01_nb(seed, s, i, CH_STRETCH) - 1.0
+            xi = 2.0 * hash_u01_nb(seed, s, i, CH_BEND) - 1.0
+            lstar = l0 * (1.0 + alpha_s * eta)  # (3)
+            theta = theta_max * alpha_b * xi  # (4)
+            # axis â = t̂[i−1] × t̂[i] / |…| (4), or a fallback where the tangents are parallel
+            ax = qy * tz - qz * ty
+            ay = qz * tx - qx * tz
+            az = qx * ty - qy * tx
+            an = np.sqrt(ax * ax + ay * ay + az * az)
+            if i > 1 and an > AXIS_EPS:
+                ax, ay, az = ax / an, ay / an, az / an
+            elif planar:
+                ax, ay, az = 0.0, 0.0, 1.0
+            else:
+                # t̂ × e_k with k the axis least aligned with t̂ (as rotation.any_perpendicular)
+                k = 0
+                if abs(ty) < abs(tx):
+                    k = 1
+                if abs(tz) < min(abs(tx), abs(ty)):
+                    k = 2
+                if k == 0:
+                    ax, ay, az = 0.0, tz, -ty
+                elif k == 1:
+                    ax, ay, az = -tz, 0.0, tx
+                else:
+                    ax, ay, az = ty, -tx, 0.0
+                an = np.sqrt(ax * ax + ay * ay + az * az)
+                if an > 0.0:
+                    ax, ay, az = ax / an, ay / an, az / an
+                else:
+                    ax, ay, az = 0.0, 0.0, 1.0
+            # Rodrigues (5)–(6): d̃ = d cosθ + (â × d) sinθ + â (â·d)(1 − cosθ)
+            c = np.cos(theta)
+            sn = np.sin(theta)
+            ad = ax * dx + ay * dy + az * dz
+            rx = dx * c + (ay * dz - az * dy) * sn + ax * ad * (1.0 - c)
+            ry = dy * c + (az * dx - ax * dz) * sn + ay * ad * (1.0 - c)
+            rz = dz * c + (ax * dy - ay * dx) * sn + az * ad * (1.0 - c)
+            rn = np.sqrt(rx * rx + ry * ry + rz * rz)
+            scale = lstar / (rn + EPS)  # (7)
+            px += scale * rx
+            py += scale * ry
+            pz += scale * rz
+            out[o + i, 0] = px
+            out[o + i, 1] = py
+            out[o + i, 2] = pz
+            qx, qy, qz = tx, ty, tz
+
+
+def freeze(
+    groom: Groom,
+    stretch_stiffness: float = 7.0,
+    bend_stiffness: float = 7.0,
+    max_bend_angle: float = np.radians(30.0),
+    seed: int = 0,
+    strand_variation: float | ArrayLike = 0.0,
+) -> Groom:
+    """FreezeDeform: the groom with every segment randomly stretched by at most 1/k_s of its rest
+    length and turned by at most max_bend_angle/k_b (radians), rebuilt from the fixed roots.
+
+    ``strand_variation`` scales both stiffnesses per strand (see :func:`strand_multipliers`).
+    The result depends only on the inputs: same seed, same bytes.
+    """
+    ks, kb, seed = _effective(
+        groom, stretch_stiffness, bend_stiffness, max_bend_angle, seed, strand_variation
+    )
+    out = np.empty_like(groom.points)
+    _freeze_kernel(
+        groom.points, groom.offsets, ks, kb, float(max_bend_angle), seed_u64(seed), groom.is_planar, out
+    )
+    return groom.with_points(out)
+
+
+def freeze_reference(
+    groom: Groom,
+    stretch_stiffness: float = 7.0,
+    bend_stiffness: float = 7.0,
+    max_bend_angle: float = np.radians(30.0),
+    seed: int = 0,
+    strand_variation: float | ArrayLike = 0.0,
+) -> Groom:
+    """Plain numpy twin of :func:`freeze` (same noise, same fallbacks), for tests and benchmarks."""
+    ks, kb, seed = _effective(
+        groom, stretch_stiffness, bend_stiffness, max_bend_angle, seed, strand_variation
+    )
+    top = groom.topology
+    p = groom.points.astype(np.float64)
+    end = top.segment_end
+    s, i = top.strand_index[end], top.index_in_strand[end]
+    d = p[end] - p[end - 1]  # (2)
+    l0 = np.linalg.norm(d, axis=1)
+    t = d / (l0[:, None] + EPS)
+    eta = 2.0 * hash_u01(seed, s, i, CH_STRETCH) - 1.0
+    xi = 2.0 * hash_u01(seed, s, i, CH_BEND) - 1.0
+    lstar = l0 * (1.0 + eta / (ks[s] + EPS))  # (3)
+    theta = float(max_bend_angle) * xi / (kb[s] + EPS)  # (4)
+    t_prev = np.roll(t, 1, axis=0)  # segment k−1 is the previous one of the same strand when i > 1
+    cross = np.cross(t_prev, t)
+    cn = np.linalg.norm(cross, axis=1)
+    has_axis = (i > 1) & (cn > AXIS_EPS)
+    if groom.is_planar:
+        fallback = np.tile([0.0, 0.0, 1.0], (len(t), 1))
+    else:
+        fallback = any_perpendicular(t)
+        fallback[np.linalg.norm(fallback, axis=1) == 0] = [0.0, 0.0, 1.0]
+    axis = np.where(has_axis[:, None], normalize(cross), fallback)
+    dt = rotate(d, axis, theta)  # (5)–(6)
+    step = lstar[:, None] * dt / (np.linalg.norm(dt, axis=1)[:, None] + EPS)  # (7)
+    out = p.copy()
+    for k in range(1, int(top.counts.max())):  # root outwards, all strands at once
+        sel = i == k
+        out[end[sel]] = out[end[sel] - 1] + step[sel]
+    return groom.with_points(out)

@@ -1,0 +1,292 @@
+"""The interactive frozen-hair pipeline: FreezeDeform → UserAlign → ClumpWithGaps (Kim 2026).
+
+Built for dragging in the studio:
+
+- FreezeDeform always starts from the rest groom with noise hashed from (seed, strand, vertex),
+  and is cached until a freeze parameter changes; it never feeds on its own output.
+- Alignment persists: each align sample (one mouse move) is applied to the cached aligned state
+  and appended to a log. When the frozen groom changes (new k_s, k_b, seed …) the log is
+  replayed on it, so strokes survive parameter changes.
+- Clumping is recomputed from the aligned state at every update and never accumulates.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field, fields, replace
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from hairtool.align import align, check_align_params
+from hairtool.clump import ClumpWorkspace, check_clump_params, clump_points
+from hairtool.errors import ParameterError
+from hairtool.freeze import (
+    MAX_VARIATION,
+    check_freeze_params,
+    check_seed,
+    draw_seed,
+    freeze,
+    strand_multipliers,
+)
+from hairtool.groom import Groom
+from hairtool.strand_clumps import auto_clump_radius, strand_components
+
+
+@dataclass(frozen=True, eq=False)
+class FrozenParams:
+    """Everything the pipeline needs besides the strokes. Angles in radians, lengths in groom units.
+
+    ``strand_variation``: spread of the per-strand stiffness multiplier (0 … 4) or an ``(S,)``
+    array of multipliers. ``clump_radius`` None: :func:`~hairtool.strand_clumps.auto_clump_radius`.
+    ``clump_step`` None: :func:`~hairtool.clump.auto_step`. ``redraw_noise``: new freeze noise at
+    every :meth:`update` (the paper's behaviour; flickers while dragging).
+    """
+
+    stretch_stiffness: float = 7.0
+    bend_stiffness: float = 7.0
+    max_bend_angle: float = float(np.radians(30.0))
+    seed: int = 0
+    strand_variation: float | np.ndarray = 0.0
+    freeze: bool = True
+    clump: bool = True
+    clump_radius: float | None = None
+    clump_iterations: int = 3
+    clump_step: float | None = None
+    gap_mode: str = "printed"
+    redraw_noise: bool = False
+    _key: tuple = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        sv = self.strand_variation
+        sv_key = float(sv) if np.ndim(sv) == 0 else np.asarray(sv, np.float64).tobytes()
+        values = tuple(
+            sv_key if f.name == "strand_variation" else getattr(self, f.name) for f in fields(self)[:-1]
+        )
+        object.__setattr__(self, "_key", values)
+
+    def validate(self) -> FrozenParams:
+        """Raise :class:`~hairtool.errors.ParameterError` naming the first bad parameter."""
+        check_freeze_params(self.stretch_stiffness, self.bend_stiffness, self.max_bend_angle)
+        check_seed(self.seed)
+        if np.ndim(self.strand_variation) == 0:
+            v = float(self.strand_variation)
+            if not np.isfinite(v) or not 0 <= v <= MAX_VARIATION:
+                raise ParameterError("strand_variation", v, f"a number in [0, {MAX_VARIATION:g}] or an array")
+        check_clump_params(
+            1.0 if self.clump_radius is None else self.clump_radius,
+            self.clump_iterations,
+            self.clump_step,
+            self.gap_mode,
+        )
+        return self
+
+    def freeze_key(self) -> tuple:
+        """What the frozen groom depends on."""
+        return (self.freeze, *self._key[:5]) if self.freeze else (False,)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, FrozenParams) and self._key == other._key
+
+    def __hash__(self) -> int:
+        return hash(self._key)
+
+    def replace(self, **changes) -> FrozenParams:
+        return replace(self, **changes)
+
+
+class AlignSample(NamedTuple):
+    cursor: tuple[float, float, float]
+    radius: float
+    intensity: float
+    mode: str
+
+
+@dataclass(frozen=True)
+class FrozenSnapshot:
+    """Undo/redo state: the stroke log and the aligned points it produced (shared, read-only)."""
+
+    log: tuple[AlignSample, ...]
+    aligned: Groom
+    freeze_key: tuple
+    draw: int
+
+
+class FrozenPipeline:
+    """FreezeDeform → UserAlign → ClumpWithGaps on a rest groom, for interactive use."""
+
+    def __init__(self, rest: Groom, params: FrozenParams | None = None) -> None:
+        self._rest = rest
+        self._params = (params or FrozenParams()).validate()
+        strand_multipliers(rest.strand_count, self._params.strand_variation)  # shape check
+        self._auto_h: float | None = None
+        self._log: list[AlignSample] = []
+        self._draw = 0
+        self._workspace = ClumpWorkspace()
+        self._timings = {"freeze": 0.0, "align": 0.0, "clump": 0.0, "total": 0.0}
+        self._freeze_key: tuple | None = None
+        self._frozen: Groom = rest
+        self._aligned: Groom = rest
+        self._result: Groom = rest
+        self._refreeze()
+        self._reclump()
+
+    # -- state ---------------------------------------------------------------------------
+    @property
+    def rest(self) -> Groom:
+        return self._rest
+
+    @property
+    def params(self) -> FrozenParams:
+        return self._params
+
+    @property
+    def result(self) -> Groom:
+        return self._result
+
+    @property
+    def frozen(self) -> Groom:
+        """The FreezeDeform output (before any stroke)."""
+        return self._frozen
+
+    @property
+    def aligned(self) -> Groom:
+        """The aligned state (frozen + strokes), before clumping."""
+        return self._aligned
+
+    @property
+    def strokes(self) -> tuple[AlignSample, ...]:
+        return tuple(self._log)
+
+    @property
+    def timings(self) -> dict[str, float]:
+        """Milliseconds spent by the last update in each stage, and in total."""
+        return dict(self._timings)
+
+    @property
+    def clump_radius(self) -> float:
+        """h in use: the parameter, or 2× the median distance between neighbouring roots."""
+        if self._params.clump_radius is not None:
+            return float(self._params.clump_radius)
+        if self._auto_h is None:
+            self._auto_h = auto_clump_radius(self._rest)
+        return self._auto_h
+
+    @property
+    def clump_step(self) -> float:
+        """Δt²/m used by the last clumping (the parameter, or the automatic step)."""
+        return self._workspace.step
+
+    @property
+    def mean_neighbours(self) -> float:
+        """Mean number of other-strand vertices within h per moving vertex in the last clumping."""
+        return self._workspace.mean_neighbours
+
+    # -- operations ----------------------------------------------------------------------
+    def set_params(self, params: FrozenParams) -> Groom:
+        """New parameters; the frozen groom is re-derived only if a freeze parameter changed,
+        and the strokes are replayed on it."""
+        params.validate()
+        strand_multipliers(self._rest.strand_count, params.strand_variation)
+        self._params = params
+        self._timings = dict.fromkeys(self._timings, 0.0)
+        self._refreeze()
+        self._reclump()
+        return self._result
+
+    def align(self, cursor: ArrayLike, radius: float, intensity: float = 0.8, mode: str = "paper") -> Groom:
+        """One align sample (one mouse move); it persists. Returns the updated result."""
+        c = check_align_params(cursor, radius, intensity, mode)
+        sample = AlignSample((float(c[0]), float(c[1]), float(c[2])), float(radius), float(intensity), mode)
+        self._timings = dict.fromkeys(self._timings, 0.0)
+        t0 = time.perf_counter()
+        self._aligned = align(self._aligned, c, radius, intensity, mode)
+        self._log.append(sample)
+        self._timings["align"] = (time.perf_counter() - t0) * 1e3
+        self._reclump()
+        return self._result
+
+    def update(self) -> Groom:
+        """Re-run the pipeline (with ``redraw_noise``: new freeze noise, strokes replayed)."""
+        self._timings = dict.fromkeys(self._timings, 0.0)
+        if self._params.redraw_noise and self._params.freeze:
+            self._draw += 1
+            self._freeze_key = None
+            self._refreeze()
+        self._reclump()
+        return self._result
+
+    def reset_strokes(self) -> Groom:
+        """Forget every stroke: back to the frozen groom (clumped)."""
+        self._log = []
+        self._aligned = self._frozen
+        self._timings = dict.fromkeys(self._timings, 0.0)
+        self._reclump()
+        return self._result
+
+    def snapshot(self) -> FrozenSnapshot:
+        """Cheap state for undo/redo (no copies: grooms are immutable)."""
+        return FrozenSnapshot(tuple(self._log), self._aligned, self._freeze_key or (), self._draw)
+
+    def restore(self, snapshot: FrozenSnapshot) -> Groom:
+        """Back to a snapshot's strokes; replayed on the current frozen groom if it has changed."""
+        self._log = list(snapshot.log)
+        self._timings = dict.fromkeys(self._timings, 0.0)
+        if snapshot.freeze_key == self._freeze_key and snapshot.draw == self._draw:
+            self._aligned = snapshot.aligned
+        else:
+            self._replay()
+        self._reclump()
+        return self._result
+
+    def clump_ids(self) -> np.ndarray:
+        """``(S,)`` clump of each strand in the last result: connected components of strands
+        linked by vertex pairs closer than h, numbered in order of their first strand."""
+        return strand_components(self._result, self.clump_radius)
+
+    # -- internals -----------------------------------------------------------------------
+    def _refreeze(self) -> None:
+        p = self._params
+        key = (*p.freeze_key(), self._draw)
+        if key == self._freeze_key:
+            return
+        t0 = time.perf_counter()
+        if p.freeze:
+            seed = draw_seed(p.seed, self._draw)
+            self._frozen = freeze(
+                self._rest, p.stretch_stiffness, p.bend_stiffness, p.max_bend_angle, seed, p.strand_variation
+            )
+        else:
+            self._frozen = self._rest
+        self._freeze_key = key
+        t1 = time.perf_counter()
+        self._timings["freeze"] = (t1 - t0) * 1e3
+        self._replay()
+        self._timings["align"] = (time.perf_counter() - t1) * 1e3
+
+    def _replay(self) -> None:
+        g = self._frozen
+        for s in self._log:
+            g = align(g, s.cursor, s.radius, s.intensity, s.mode)
+        self._aligned = g
+
+    def _reclump(self) -> None:
+        p = self._params
+        t0 = time.perf_counter()
+        if p.clump and p.clump_iterations > 0:
+            pts = clump_points(
+                self._aligned,
+                self.clump_radius,
+                p.clump_iterations,
+                p.clump_step,
+                p.gap_mode,
+                draw_seed(p.seed, self._draw),
+                self._workspace,
+            )
+            self._result = self._rest.with_points(pts)
+        else:
+            self._workspace.mean_neighbours = 0.0
+            self._result = self._aligned
+        self._timings["clump"] = (time.perf_counter() - t0) * 1e3
+        self._timings["total"] = self._timings["freeze"] + self._timings["align"] + self._timings["clump"]

@@ -1,0 +1,146 @@
+"""ClumpWithGaps (eqs. 14–19): adhesion toward other strands, gaps, kernels vs numpy twins."""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import pytest
+
+from hairtool import samples
+from hairtool.clump import ClumpWorkspace, clump, clump_reference
+from hairtool.errors import ParameterError
+from hairtool.groom import Groom
+from hairtool.io import read_groom
+from hairtool.spatial import pairs_within_reference
+from hairtool.strand_clumps import auto_clump_radius
+
+
+def _nearest_other(g: Groom, reach: float) -> np.ndarray:
+    """Distance of each non-root vertex to the nearest vertex of another strand (inf beyond reach)."""
+    i, j = pairs_within_reference(g.points, g.topology.strand_index, reach)
+    d = np.linalg.norm(g.points[j].astype(np.float64) - g.points[i], axis=1)
+    out = np.full(g.vertex_count, np.inf)
+    np.minimum.at(out, i, d)
+    return np.delete(out, g.topology.root_indices)
+
+
+def test_two_close_strands_pull_together_and_an_isolated_strand_stays():
+    a = np.linspace([0, 0, 0], [0, -1, 0], 11)
+    b = a + np.array([0.05, 0, 0])
+    far = a + np.array([5.0, 0, 0])
+    g = Groom.from_strands([a, b, far])
+    out = clump(g, radius=0.1, iterations=3, step=0.05, gap_mode="off")
+    gap_before = np.linalg.norm(g.strand(1) - g.strand(0), axis=1)[1:]
+    gap_after = np.linalg.norm(out.strand(1) - out.strand(0), axis=1)[1:]
+    assert np.all(gap_after < gap_before - 1e-4)
+    np.testing.assert_array_equal(out.strand(2), g.strand(2))
+    np.testing.assert_array_equal(out.roots, g.roots)
+
+
+def test_a_single_step_is_formula_15_16():
+    p = np.array([[0, 0, 0], [0, -1, 0.0]])
+    q = p + np.array([0.3, 0, 0])
+    g = Groom.from_strands([p, q])
+    h, step = 0.5, 0.1
+    out = clump(g, h, iterations=1, step=step, gap_mode="off")
+    force = (1 - 0.3 / h) ** 2  # g(r) (14), unit direction (15)
+    np.testing.assert_allclose(out.points[1], [step * force, -1, 0], atol=1e-6)
+    np.testing.assert_allclose(out.points[3], [0.3 - step * force, -1, 0], atol=1e-6)
+
+
+def test_vertices_of_the_same_strand_do_not_attract_each_other():
+    curl = np.array([[0, 0, 0], [0.1, -0.1, 0], [0, -0.2, 0], [0.1, -0.3, 0.0]])
+    g = Groom.from_strands([curl])
+    np.testing.assert_array_equal(clump(g, 1.0, 5, 0.1, "off").points, g.points)
+
+
+def test_gap_correction_keeps_more_space_than_plain_adhesion():
+    for g in (samples.scalp(600, 20, seed=1), read_groom_or_scalp()):
+        h = auto_clump_radius(g)
+        before = np.median(_nearest_other(g, 3 * h))
+        off = np.median(_nearest_other(clump(g, h, 3, None, "off", 0), 3 * h))
+        printed = np.median(_nearest_other(clump(g, h, 3, None, "printed", 0), 3 * h))
+        text = np.median(_nearest_other(clump(g, h, 3, None, "text", 0), 3 * h))
+        assert off < before  # adhesion pulls strands together
+        assert printed > 1.1 * off and text > 1.1 * off
+
+
+def read_groom_or_scalp() -> Groom:
+    return samples.comb(400, 20, seed=3, spacing=0.05)
+
+
+def _random_groom(seed: int) -> Groom:
+    rng = np.random.default_rng(seed)
+    counts = rng.integers(2, 12, 150)
+    roots = rng.uniform(-1, 1, (150, 3))
+    pts = np.concatenate(
+        [r + np.cumsum(rng.normal(size=(c, 3)) * 0.08, axis=0) for r, c in zip(roots, counts, strict=True)]
+    )
+    pts[np.r_[0, np.cumsum(counts)[:-1]]] = roots
+    return Groom(pts, counts)
+
+
+@pytest.mark.parametrize("gap_mode", ["printed", "text", "off"])
+@pytest.mark.parametrize(
+    "make", [lambda: _random_groom(2), lambda: samples.portrait(200, 20), lambda: samples.comb(100, 10)]
+)
+def test_kernel_matches_numpy_twin(gap_mode, make):
+    g = make()
+    h = auto_clump_radius(g) * 1.5
+    a = clump(g, h, 4, None, gap_mode, seed=3)
+    b = clump_reference(g, h, 4, None, gap_mode, seed=3)
+    np.testing.assert_allclose(a.points, b.points, atol=1e-6)
+    assert np.abs(a.points - g.points).max() > 1e-3 * h
+
+
+@pytest.mark.parametrize("name", ["sintel_hair.tfx", "ponytail_back.tfx", "ratboy_mohawk.tfx"])
+def test_kernel_matches_numpy_twin_on_real_grooms(grooms_dir, name):
+    g = read_groom(grooms_dir / name)
+    h = auto_clump_radius(g)
+    ws = ClumpWorkspace()
+    a = clump(g, h, 3, None, "printed", 1, ws)
+    b = clump_reference(g, h, 3, None, "printed", 1)
+    np.testing.assert_allclose(a.points, b.points, atol=1e-5 * h)
+    assert ws.mean_neighbours > 1
+    assert np.abs(a.points - g.points).max() > 0.05 * h
+
+
+def test_planar_grooms_stay_planar_and_roots_stay():
+    g = samples.portrait(300, 20)
+    out = clump(g, 3 * auto_clump_radius(g), 3)
+    assert out.is_planar
+    np.testing.assert_array_equal(out.roots, g.roots)
+
+
+def test_same_seed_same_bytes_and_thread_count_does_not_matter():
+    g = samples.scalp(800, 20, seed=4)
+    h = auto_clump_radius(g)
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = clump(g, h, 3, None, "printed", 7).points.tobytes()
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        two = clump(g, h, 3, None, "printed", 7).points.tobytes()
+    finally:
+        numba.set_num_threads(before)
+    assert one == two
+    assert clump(g, h, 3, None, "printed", 8).points.tobytes() != one
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [
+        ({"radius": 0.0}, "clump_radius"),
+        ({"radius": -1.0}, "clump_radius"),
+        ({"radius": float("inf")}, "clump_radius"),
+        ({"radius": 1.0, "iterations": 101}, "clump_iterations"),
+        ({"radius": 1.0, "iterations": -1}, "clump_iterations"),
+        ({"radius": 1.0, "iterations": 2.5}, "clump_iterations"),
+        ({"radius": 1.0, "step": -0.1}, "clump_step"),
+        ({"radius": 1.0, "gap_mode": "wide"}, "gap_mode"),
+        ({"radius": 1e-12}, "clump_radius"),
+    ],
+)
+def test_bad_parameters_are_refused_by_name(kwargs, name):
+    with pytest.raises(ParameterError, match=name):
+        clump(samples.comb(9, 5), **kwargs)
