@@ -1,0 +1,111 @@
+"""Keyframe selection speed: features, the Gram cost table and the all-K DP, against the direct
+O(n³D) table (where it finishes in a minute) and one float64 X @ X.T of the same matrix.
+
+Feature arrays are random walks, except D = 96,000 which is a swaying hair animation of 2,000
+strands resampled to 16 points (the features step is timed there).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from hairtool.errors import ParameterError
+
+HELP = "keyframes: cost table + DP for all K vs the direct O(n^3 D) table and one X @ X.T"
+
+SIZES = ((300, 69), (1300, 69), (1000, 3000), (1000, 96000))
+QUICK = ((40, 6), (120, 48))
+DIRECT_LIMIT_S = 60.0
+HAIR_SAMPLES = 16
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--quick", action="store_true", help="tiny sizes (for tests)")
+    parser.add_argument("--sizes", help="comma-separated FRAMESxDIMS, e.g. 300x69,1300x69")
+    parser.add_argument("--max-keys", type=int, default=100, help="DP for every K up to this")
+    parser.add_argument("--interp", choices=("linear", "hermite"), default="linear")
+    parser.add_argument("--no-direct", action="store_true", help="skip the direct O(n^3 D) table")
+
+
+def _parse_sizes(text: str) -> list[tuple[int, int]]:
+    out = []
+    for part in text.split(","):
+        try:
+            n, d = (int(v) for v in part.lower().split("x"))
+        except ValueError:
+            raise ParameterError("sizes", text, "comma-separated FRAMESxDIMS like 300x69") from None
+        if n < 3 or d < 1:
+            raise ParameterError("sizes", part, "at least 3 frames and 1 dimension")
+        out.append((n, d))
+    return out
+
+
+def _features(n: int, d: int) -> tuple[np.ndarray, float | None]:
+    """Frame features and the seconds spent computing them (None for a raw random walk)."""
+    if d >= 48_000 and d % (3 * HAIR_SAMPLES) == 0:
+        from hairtool import samples
+        from hairtool.features import FeatureOptions, hair_features
+        from hairtool.sway import sway_animation
+
+        anim = sway_animation(samples.scalp(d // (3 * HAIR_SAMPLES), 24, seed=0), n, flick_frame=n // 2)
+        t0 = time.perf_counter()
+        x = hair_features(anim, FeatureOptions(samples=HAIR_SAMPLES))
+        return x, time.perf_counter() - t0
+    rng = np.random.default_rng(n * 100_003 + d)
+    return np.cumsum(rng.normal(size=(n, d)), axis=0), None
+
+
+def _time(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return out, time.perf_counter() - t0
+
+
+def run(args: argparse.Namespace) -> list[dict]:
+    from hairtool.keyframes import solve_layers
+    from hairtool.segment_cost import cost_table
+    from hairtool.segment_direct import direct_cost_table
+
+    sizes = QUICK if args.quick else (_parse_sizes(args.sizes) if args.sizes else SIZES)
+    # compile (or load) the kernels outside the timings
+    warm = np.cumsum(np.random.default_rng(0).normal(size=(8, 2)), axis=0)
+    solve_layers(cost_table(warm, args.interp), 4)
+    from hairtool.features import resample_frames
+
+    frozen = np.zeros((1, 4, 3), dtype=np.float32)
+    frozen.flags.writeable = False  # Animation frames are read-only: numba's signature differs
+    resample_frames(frozen, [2, 2], 3)
+    rows = []
+    for n, d in sizes:
+        x, features_s = _features(n, d)
+        _, gram_s = _time(lambda x=x: x @ x.T)
+        table, table_s = _time(lambda x=x: cost_table(x, args.interp))
+        kmax = min(args.max_keys, n)
+        _, dp_s = _time(lambda t=table, k=kmax: solve_layers(t, k))
+        select_s = table_s + dp_s
+        direct_s, agree = None, None
+        if not args.no_direct:
+            m = min(n, 40)
+            _, probe = _time(lambda x=x, m=m: direct_cost_table(x[:m], args.interp))
+            if probe * (n / m) ** 3 <= DIRECT_LIMIT_S:
+                direct, direct_s = _time(lambda x=x: direct_cost_table(x, args.interp))
+                agree = float(np.abs(table - direct).max() / max(np.abs(direct).max(), 1e-300))
+        rows.append(
+            {
+                "frames": n,
+                "dims": d,
+                "features_s": features_s,
+                "table_s": table_s,
+                "dp_s": dp_s,
+                "select_s": select_s,
+                "gram_s": gram_s,
+                "select_over_gram": select_s / gram_s if gram_s > 0 else None,
+                "direct_s": direct_s,
+                "direct_over_select": None if direct_s is None else direct_s / select_s,
+                "table_rel_diff": agree,
+            }
+        )
+    return rows

@@ -1,0 +1,193 @@
+"""Rebuild every frame from key poses, measure position errors, and describe where keys fall.
+
+Works on the original vertices (scene units), not on the features: ``frames`` is any
+``(F, ...)`` array, usually an Animation's ``(F, V, 3)``. Hermite tangents at a key are the
+averaged neighbouring differences of the original samples (seed 003), stored with the key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from hairtool.errors import ParameterError
+from hairtool.groom import Animation
+from hairtool.keyframes import uniform_keys
+from hairtool.segment_cost import INTERPOLATIONS
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+
+_CHUNK_VALUES = 8_000_000  # float64 values rebuilt per chunk of frames
+
+
+def check_keys(keys: ArrayLike, n_frames: int) -> I64:
+    """Strictly increasing whole frame numbers from 0 to n_frames − 1."""
+    k = np.asarray(keys)
+    if k.ndim != 1 or k.size < 2:
+        raise ParameterError("keys", k.tolist() if k.size < 8 else "array", "at least 2 frame numbers")
+    if not np.issubdtype(k.dtype, np.integer):
+        if not np.all(np.isfinite(k)) or np.any(k != np.round(k)):
+            raise ParameterError("keys", k.tolist(), "whole frame numbers")
+    k = k.astype(np.int64)
+    if k[0] != 0 or k[-1] != n_frames - 1 or np.any(np.diff(k) <= 0):
+        raise ParameterError("keys", k.tolist(), f"strictly increasing frames from 0 to {n_frames - 1}")
+    return k
+
+
+@dataclass
+class KeyPoses:
+    """Key frames, their poses ``(K, ...)`` and, for Hermite, tangents ``(K, ...)`` per frame."""
+
+    keys: I64
+    poses: F64
+    tangents: F64 | None
+    n_frames: int
+    interp: str
+
+    def with_pose(self, key_frame: int, pose: ArrayLike) -> KeyPoses:
+        """A copy with the pose at ``key_frame`` (a frame number that is a key) replaced."""
+        hit = np.flatnonzero(self.keys == key_frame)
+        if hit.size == 0:
+            raise ParameterError("key_frame", key_frame, f"one of the keys {self.keys.tolist()}")
+        p = np.asarray(pose, dtype=np.float64)
+        if p.shape != self.poses.shape[1:] or not np.all(np.isfinite(p)):
+            raise ParameterError("pose", f"shape {p.shape}", f"finite values of shape {self.poses.shape[1:]}")
+        poses = self.poses.copy()
+        poses[hit[0]] = p
+        return KeyPoses(self.keys, poses, self.tangents, self.n_frames, self.interp)
+
+
+def key_poses(frames: ArrayLike, keys: ArrayLike, interp: str = "linear") -> KeyPoses:
+    """Take the key poses (and Hermite tangents) out of the full-rate frames."""
+    if interp not in INTERPOLATIONS:
+        raise ParameterError("interp", interp, " or ".join(INTERPOLATIONS))
+    f = np.asarray(frames)
+    k = check_keys(keys, f.shape[0])
+    tangents = None
+    if interp == "hermite":
+        lo = np.clip(k - 1, 0, f.shape[0] - 1)
+        hi = np.clip(k + 1, 0, f.shape[0] - 1)
+        w = np.where((k == 0) | (k == f.shape[0] - 1), 1.0, 0.5)
+        tangents = (f[hi].astype(np.float64) - f[lo]) * w.reshape((-1,) + (1,) * (f.ndim - 1))
+    return KeyPoses(k, f[k].astype(np.float64), tangents, int(f.shape[0]), interp)
+
+
+def interpolate_keys(kp: KeyPoses, dtype: type = np.float64) -> NDArray:
+    """``(F, ...)`` frames rebuilt from the key poses; exact at the keys."""
+    n = kp.n_frames
+    shape = kp.poses.shape[1:]
+    out = np.empty((n, *shape), dtype=dtype)
+    size = max(1, int(np.prod(shape)))
+    chunk = max(1, _CHUNK_VALUES // size)
+    flat_p = kp.poses.reshape(kp.keys.size, -1)
+    flat_m = None if kp.tangents is None else kp.tangents.reshape(kp.keys.size, -1)
+    for f0 in range(0, n, chunk):
+        t = np.arange(f0, min(n, f0 + chunk))
+        a = np.clip(np.searchsorted(kp.keys, t, side="right") - 1, 0, kp.keys.size - 2)
+        el = (kp.keys[a + 1] - kp.keys[a]).astype(np.float64)
+        s = ((t - kp.keys[a]) / el)[:, None]
+        if flat_m is None:
+            v = (1.0 - s) * flat_p[a] + s * flat_p[a + 1]
+        else:
+            h00 = 2 * s**3 - 3 * s**2 + 1
+            h10 = (s**3 - 2 * s**2 + s) * el[:, None]
+            h01 = -2 * s**3 + 3 * s**2
+            h11 = (s**3 - s**2) * el[:, None]
+            v = h00 * flat_p[a] + h10 * flat_m[a] + h01 * flat_p[a + 1] + h11 * flat_m[a + 1]
+        out[t] = v.reshape(t.size, *shape)
+    return out
+
+
+def reconstruct(animation: Animation, keys: ArrayLike, interp: str = "linear") -> Animation:
+    """The full-rate animation rebuilt from its key poses (all original vertices)."""
+    kp = key_poses(animation.frames, keys, interp)
+    return animation.with_frames(interpolate_keys(kp, np.float32))
+
+
+@dataclass
+class PositionErrors:
+    """Vertex distances |p − p̂| in scene units, per frame and per vertex."""
+
+    per_frame_mean: F64  # (F,)
+    per_frame_max: F64  # (F,)
+    per_frame_tip: F64  # (F,) mean over strand tips
+    per_vertex_mean: F64  # (V,) mean over frames
+    per_vertex_max: F64  # (V,)
+
+    def summary(self) -> dict:
+        return {
+            "mean": float(self.per_frame_mean.mean()),
+            "max": float(self.per_frame_max.max()),
+            "tip_mean": float(self.per_frame_tip.mean()),
+            "tip_max_frame": float(self.per_frame_tip.max()),
+        }
+
+
+def position_errors(original: Animation, rebuilt: Animation | ArrayLike) -> PositionErrors:
+    """Distances between every original vertex and its rebuilt position (float64)."""
+    b = rebuilt.frames if isinstance(rebuilt, Animation) else np.asarray(rebuilt)
+    if b.shape != original.frames.shape:
+        raise ParameterError("rebuilt", f"shape {b.shape}", f"{original.frames.shape}")
+    d = np.sqrt(np.sum((original.frames.astype(np.float64) - b) ** 2, axis=2))  # (F, V)
+    tips = original.topology.tip_indices
+    return PositionErrors(
+        d.mean(axis=1), d.max(axis=1), d[:, tips].mean(axis=1), d.mean(axis=0), d.max(axis=0)
+    )
+
+
+def compare_with_uniform(animation: Animation, keys: ArrayLike, interp: str = "linear") -> dict:
+    """Position errors of the given keys and of uniform keys of the same count."""
+    k = check_keys(keys, animation.n_frames)
+    uni = uniform_keys(animation.n_frames, k.size)
+    out = {}
+    for name, kk in (("keys", k), ("uniform", uni)):
+        err = position_errors(animation, reconstruct(animation, kk, interp))
+        out[name] = {"keys": kk.tolist(), **err.summary()}
+    return out
+
+
+def motion_speed(frames: ArrayLike, fps: float = 1.0) -> F64:
+    """``(F,)`` mean speed of all points per second (central differences, one-sided at the ends), units/s."""
+    f = np.asarray(frames, dtype=np.float64)
+    # (F, V, 3) points; a flat (F, D) feature array counts every dimension as a point on a line
+    f = f.reshape(f.shape[0], -1, 3) if f.ndim == 3 else f.reshape(f.shape[0], -1, 1)
+    v = np.empty(f.shape[:2])
+    v[1:-1] = np.linalg.norm(f[2:] - f[:-2], axis=2) / 2.0
+    v[0] = np.linalg.norm(f[1] - f[0], axis=1)
+    v[-1] = np.linalg.norm(f[-1] - f[-2], axis=1)
+    return v.mean(axis=1) * fps
+
+
+def key_distribution(frames: ArrayLike, keys: ArrayLike, fps: float = 1.0, window: int | None = None) -> dict:
+    """Where keys fall against the motion: data for the timeline to draw.
+
+    ``speed`` per frame, the ``motion`` covered so far (cumulative path, 0 → 1), the fraction
+    of motion at each key, and key density (keys per frame) in sliding windows; a good key
+    set has keys where ``speed`` is high, and key fractions that track the motion fraction.
+    """
+    f = np.asarray(frames)
+    k = check_keys(keys, f.shape[0])
+    speed = motion_speed(f, fps)
+    path = np.concatenate([[0.0], np.cumsum((speed[1:] + speed[:-1]) / 2.0)])
+    motion = path / path[-1] if path[-1] > 0 else np.linspace(0.0, 1.0, f.shape[0])
+    n = f.shape[0]
+    window = int(window or max(3, n // 20))
+    is_key = np.zeros(n)
+    is_key[k] = 1.0
+    density = np.convolve(is_key, np.ones(window) / window, mode="same")
+    uni = uniform_keys(n, k.size)
+    return {
+        "frames": n,
+        "keys": k.tolist(),
+        "uniform_keys": uni.tolist(),
+        "speed": speed.tolist(),
+        "motion": motion.tolist(),
+        "key_motion": motion[k].tolist(),
+        "density": density.tolist(),
+        "window": window,
+        # mean speed at the keys over mean speed overall: > 1 when keys gather where things move
+        "speed_at_keys": float(speed[k].mean() / speed.mean()) if speed.mean() > 0 else 1.0,
+    }

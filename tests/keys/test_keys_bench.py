@@ -1,0 +1,24 @@
+"""``hairtool bench keys --quick`` runs and reports every column the lead reads."""
+
+from __future__ import annotations
+
+import json
+
+from hairtool.cli import main
+
+
+def test_quick_bench_rows(capsys):
+    assert main(["bench", "keys", "--quick", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [(r["frames"], r["dims"]) for r in rows] == [(40, 6), (120, 48)]
+    for r in rows:
+        for key in ("select_s", "gram_s", "table_s", "dp_s", "direct_s", "features_s"):
+            assert key in r
+        assert r["select_s"] > 0 and r["gram_s"] > 0
+        assert r["direct_s"] is not None and r["table_rel_diff"] < 1e-9
+
+
+def test_sizes_option(capsys):
+    assert main(["bench", "keys", "--sizes", "20x3", "--no-direct", "--max-keys", "5"]) == 0
+    assert "frames" in capsys.readouterr().out
+    assert main(["bench", "keys", "--sizes", "20by3"]) == 2

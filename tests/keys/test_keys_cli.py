@@ -1,0 +1,131 @@
+"""``hairtool keys``: inputs (animation, raw X, BVH), modes, --json, --out, --export, bad input."""
+
+from __future__ import annotations
+
+import itertools
+import json
+
+import numpy as np
+import pytest
+
+from hairtool import samples
+from hairtool.cli import main
+from hairtool.io import write
+from hairtool.sway import sway_animation
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("keys")
+    anim = sway_animation(samples.scalp(40, 10, seed=0), 36, flick_frame=25)
+    write(d / "anim.npz", anim)
+    x = np.cumsum(np.random.default_rng(0).normal(size=(30, 3)), axis=0)
+    np.savez(d / "x.npz", X=x)
+    one = anim.with_frames(anim.frames[:1])
+    write(d / "one.npz", one)
+    bad = x.copy()
+    bad[4, 1] = np.nan
+    np.savez(d / "nan.npz", X=bad)
+    return d, x
+
+
+def run_json(capsys, *argv):
+    assert main(["keys", *map(str, argv), "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_raw_x_cost_is_the_sum_of_squared_errors(files, capsys):
+    d, x = files
+    out = run_json(capsys, d / "x.npz", "--keys", 6)
+    keys = out["keys"]
+    assert len(keys) == 6 and keys[0] == 0 and keys[-1] == 29
+    sse = 0.0
+    for a, b in itertools.pairwise(keys):
+        for k in range(a + 1, b):
+            s = (k - a) / (b - a)
+            sse += np.sum((x[k] - (1 - s) * x[a] - s * x[b]) ** 2)
+    assert out["cost"] == pytest.approx(sse, rel=1e-9)
+    assert len(out["uniform"]["keys"]) == 6 and out["uniform"]["cost"] >= out["cost"]
+    assert out["curve"][0][0] == 2 and [k for k, _ in out["curve"]] == list(range(2, 31))
+    assert dict(out["curve"])[6] == pytest.approx(out["cost"])
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--penalty", "2"],
+        ["--budget", "10"],
+        ["--max-error", "1"],
+        ["--keys", "5", "--objective", "worst", "--interp", "hermite"],
+        ["--keys", "5", "--curvature", "0.5"],
+    ],
+)
+def test_every_mode_runs_on_raw_features(files, capsys, argv):
+    d, _ = files
+    out = run_json(capsys, d / "x.npz", *argv)
+    assert out["keys"][0] == 0 and out["keys"][-1] == 29
+
+
+def test_animation_with_out_and_usd_export(files, capsys):
+    d, _ = files
+    out = run_json(
+        capsys,
+        d / "anim.npz",
+        "--keys",
+        7,
+        "--samples",
+        8,
+        "--tip-weight",
+        3,
+        "--interp",
+        "hermite",
+        "--out",
+        d / "keys.json",
+        "--export",
+        d / "keys.usda",
+    )
+    assert out["params"]["features"]["samples"] == 8 and out["params"]["features"]["tip_weight"] == 3.0
+    assert set(out["position_errors"]) == {"keys", "uniform"}
+    record = json.loads((d / "keys.json").read_text())
+    assert [k["frame"] for k in record["keys"]] == out["keys"]
+    assert record["keys"][1]["time"] == pytest.approx(out["keys"][1] / 24.0)
+    assert record["params"]["interp"] == "hermite"
+    from pxr import Usd, UsdGeom
+
+    stage = Usd.Stage.Open(str(d / "keys.usda"))
+    curves = next(UsdGeom.BasisCurves(p) for p in stage.Traverse() if p.IsA(UsdGeom.BasisCurves))
+    assert [int(t) for t in curves.GetPointsAttr().GetTimeSamples()] == out["keys"]
+
+
+def test_per_channel(files, capsys):
+    d, _ = files
+    out = run_json(capsys, d / "x.npz", "--per-channel", "--penalty", "1")
+    assert len(out["channels"]) == 3 and all(c[0] == 0 and c[-1] == 29 for c in out["channels"])
+
+
+def test_bvh_input(motion_dir, capsys):
+    out = run_json(capsys, motion_dir / "freebvh.bvh", "--keys", 10)
+    assert len(out["keys"]) == 10 and out["frames"] == 69
+    assert out["position_errors"]["keys"]["mean"] <= out["position_errors"]["uniform"]["mean"] * 1.5
+    q = run_json(capsys, motion_dir / "freebvh.bvh", "--keys", 10, "--bvh-features", "quaternion")
+    assert len(q["keys"]) == 10
+
+
+@pytest.mark.parametrize(
+    "name,argv,needle",
+    [
+        ("x.npz", ["--keys", "1"], "keys=1"),
+        ("x.npz", ["--keys", "31"], "keys=31"),
+        ("x.npz", ["--penalty", "-1"], "penalty"),
+        ("one.npz", ["--keys", "2"], "frame"),
+        ("nan.npz", ["--keys", "3"], "non-finite"),
+        ("missing.npz", [], "no such file"),
+        ("x.npz", ["--per-channel", "--keys", "3"], "penalty"),
+        ("x.npz", ["--export", "out.usda"], "export"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(files, capsys, name, argv, needle):
+    d, _ = files
+    assert main(["keys", str(d / name), *argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and needle in err
