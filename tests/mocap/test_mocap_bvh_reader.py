@@ -1,0 +1,149 @@
+"""BVH reading: the real captures, hand-worked forward kinematics, malformed files, round trips."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hairtool.bvh import read_bvh, write_bvh
+from hairtool.errors import FormatError
+
+from .conftest import CHAIN
+
+REAL = [
+    ("mocapbank_walk.bvh", 455, 30, 19, 60, 5),
+    ("freebvh.bvh", 69, 30, 55, 168, 15),
+    ("pymo_walk.bvh", 1064, 120, 23, 72, 7),
+]
+
+
+@pytest.mark.parametrize(("name", "frames", "fps", "joints", "channels", "ends"), REAL)
+def test_real_captures_load_with_their_published_counts(
+    motion_dir, name, frames, fps, joints, channels, ends
+):
+    m = read_bvh(motion_dir / name)
+    assert (m.n_frames, m.n_joints, m.n_channels) == (frames, joints, channels)
+    assert m.fps == fps
+    assert len(m.end_parents) == ends
+    assert m.parents[0] == -1 and np.all(m.parents[1:] < np.arange(1, joints))
+    assert m.local_rotations().shape == (frames, joints, 4)
+    assert m.joint_positions().shape == (frames, joints, 3)
+    assert m.joint_positions(end_sites=True).shape == (frames, joints + ends, 3)
+    np.testing.assert_allclose(np.linalg.norm(m.local_rotations(), axis=-1), 1.0, atol=1e-12)
+    # Bones keep their lengths in every frame: FK is rigid.
+    p = m.joint_positions()
+    child = np.arange(1, joints)
+    bone = np.linalg.norm(p[:, child] - p[:, m.parents[child]], axis=-1)
+    np.testing.assert_allclose(
+        bone, np.broadcast_to(np.linalg.norm(m.offsets[child], axis=1), bone.shape), atol=1e-6
+    )
+
+
+def test_two_joint_chain_by_hand(chain_bvh):
+    m = read_bvh(chain_bvh)
+    assert m.joint_names == ["hips", "knee"]
+    assert m.channels[0][3:] == ["Zrotation", "Xrotation", "Yrotation"]
+    np.testing.assert_array_equal(m.depths(), [0, 1])
+    p = m.joint_positions(end_sites=True)
+    # Frame 0: rest. hips at origin, knee at (0,2,0), end at (0,3,0).
+    np.testing.assert_allclose(p[0], [[0, 0, 0], [0, 2, 0], [0, 3, 0]], atol=1e-12)
+    # Frame 1: the position channels replace the offset; 90° about z turns +y into −x.
+    np.testing.assert_allclose(p[1], [[1, 2, 3], [-1, 2, 3], [-2, 2, 3]], atol=1e-12)
+    # Frame 2: the knee adds −90° about z: the end site points back along +y from the knee.
+    np.testing.assert_allclose(p[2], [[0, 0, 0], [-2, 0, 0], [-2, 1, 0]], atol=1e-12)
+    np.testing.assert_allclose(m.root_translation()[1], [1, 2, 3])
+
+
+def test_channel_order_is_applied_intrinsically(tmp_path):
+    # One joint rotated Z 90 then X 90 (R = Rz·Rx): its child offset (0,1,0) → Rx: (0,0,1) → Rz: (0,0,1).
+    # The other order (R = Rx·Rz): (0,1,0) → Rz: (−1,0,0) → Rx: (−1,0,0).
+    def make(order):
+        return (
+            "HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 2 " + order + "\n"
+            " End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n90 90\n"
+        )
+
+    (tmp_path / "zx.bvh").write_text(make("Zrotation Xrotation"))
+    (tmp_path / "xz.bvh").write_text(make("Xrotation Zrotation"))
+    zx = read_bvh(tmp_path / "zx.bvh").joint_positions(end_sites=True)[0, 1]
+    xz = read_bvh(tmp_path / "xz.bvh").joint_positions(end_sites=True)[0, 1]
+    np.testing.assert_allclose(zx, [0, 0, 1], atol=1e-12)
+    np.testing.assert_allclose(xz, [-1, 0, 0], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("edit", "reason"),
+    [
+        (lambda t: t.replace("0 0 0 90 0 0 -90 0 0\n", ""), "truncated"),
+        (lambda t: t.replace("1 2 3 90 0 0 0 0 0", "1 2 3 90 0 0 0 0"), "has 8 values"),
+        (lambda t: t.replace("1 2 3 90 0 0 0 0 0", "1 2 3 90 0 0 0 0 x"), "not a number"),
+        (lambda t: t.replace("1 2 3 90 0 0 0 0 0", "1 2 3 90 nan 0 0 0 0"), "non-finite"),
+        (lambda t: t.replace("Frames: 3", "Frames: 99999999999"), "too large"),
+        (lambda t: t.replace("Frames: 3", "Frames: -1"), "positive whole"),
+        (lambda t: t.replace("Frame Time: 0.04", "Frame Time: 0"), "Frame Time"),
+        (lambda t: t.replace("CHANNELS 3 Zrotation", "CHANNELS 3 Wrotation"), "unknown channel"),
+        (lambda t: t.replace("CHANNELS 3", "CHANNELS 9"), "channel count"),
+        (lambda t: t.replace("OFFSET 0 2 0", "OFFSET 0 two 0"), "not a number"),
+        (lambda t: t.split("MOTION")[0], "no MOTION"),
+        (lambda t: t.replace("HIERARCHY", "HELLO"), "not a BVH"),
+        (lambda t: t[: t.index("End Site")] + "MOTION\n", "file ends"),
+        (lambda t: t.replace("Frames: 3\n", ""), "Frames:"),
+    ],
+)
+def test_malformed_files_raise_format_error_naming_the_file(tmp_path, edit, reason):
+    p = tmp_path / "bad.bvh"
+    p.write_text(edit(CHAIN))
+    with pytest.raises(FormatError, match=reason) as e:
+        read_bvh(p)
+    assert e.value.path == str(p)
+
+
+def test_missing_file_and_binary_garbage(tmp_path):
+    with pytest.raises(FormatError, match="cannot read"):
+        read_bvh(tmp_path / "nope.bvh")
+    p = tmp_path / "noise.bvh"
+    p.write_bytes(np.random.default_rng(0).bytes(300))
+    with pytest.raises(FormatError):
+        read_bvh(p)
+
+
+def test_crlf_and_tabs_are_read(tmp_path, chain_bvh):
+    p = tmp_path / "crlf.bvh"
+    p.write_bytes(CHAIN.replace("\n", "\r\n").replace("  ", "\t").encode())
+    np.testing.assert_array_equal(read_bvh(p).values, read_bvh(chain_bvh).values)
+
+
+@pytest.mark.parametrize("name", ["mocapbank_walk.bvh", "freebvh.bvh"])
+def test_write_read_round_trip(tmp_path, motion_dir, name):
+    m = read_bvh(motion_dir / name)
+    out = tmp_path / "copy.bvh"
+    write_bvh(out, m)
+    back = read_bvh(out)
+    assert back.joint_names == m.joint_names and back.channels == m.channels
+    np.testing.assert_array_equal(back.parents, m.parents)
+    np.testing.assert_allclose(back.values, m.values, atol=1e-6)
+    np.testing.assert_allclose(back.offsets, m.offsets, atol=1e-6)
+    np.testing.assert_allclose(back.end_offsets, m.end_offsets, atol=1e-6)
+    np.testing.assert_array_equal(back.end_parents, m.end_parents)
+    assert back.frame_time == pytest.approx(m.frame_time, rel=1e-6)
+
+
+def test_fps_snaps_only_printed_whole_rates(tmp_path):
+    ntsc = CHAIN.replace("Frame Time: 0.04", "Frame Time: 0.0417083")
+    (tmp_path / "ntsc.bvh").write_text(ntsc)
+    assert read_bvh(tmp_path / "ntsc.bvh").fps == pytest.approx(23.976, abs=1e-3)
+    (tmp_path / "thirty.bvh").write_text(CHAIN.replace("Frame Time: 0.04", "Frame Time: 0.033333"))
+    assert read_bvh(tmp_path / "thirty.bvh").fps == 30.0
+
+
+def test_motion_checks_its_skeleton():
+    from hairtool.bvh import Motion
+    from hairtool.errors import ParameterError
+
+    chans = [["Xrotation"], ["Xrotation"]]
+    with pytest.raises(ParameterError, match="parents"):
+        Motion(["a", "b"], [-1, 1], np.zeros((2, 3)), chans, np.zeros((1, 2)), 0.1)
+    with pytest.raises(ParameterError, match="values"):
+        Motion(["a", "b"], [-1, 0], np.zeros((2, 3)), chans, np.zeros((1, 3)), 0.1)
+    with pytest.raises(ParameterError, match="frame_time"):
+        Motion(["a", "b"], [-1, 0], np.zeros((2, 3)), chans, np.zeros((1, 2)), 0.0)
