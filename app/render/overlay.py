@@ -1,0 +1,76 @@
+"""Screen-space overlays over the 3-D scene: the brush circle (program ``shaders/overlay.glsl``)."""
+
+from __future__ import annotations
+
+import math
+
+import moderngl
+import numpy as np
+
+from app.render.shaders import load_program
+from hairtool.errors import ParameterError
+
+CIRCLE_SEGMENTS = 96
+RING_WIDTH_PX = 1.5
+CIRCLE_COLOR = (1.0, 0.55, 0.1, 0.95)
+
+
+def ring_strip(center: tuple[float, float], radius: float, width: float, segments: int) -> np.ndarray:
+    """``(2·(segments+1), 2)`` float32 TRIANGLE_STRIP vertices of a ring, in pixels."""
+    a = np.linspace(0.0, 2.0 * math.pi, segments + 1)
+    unit = np.column_stack([np.cos(a), np.sin(a)])
+    inner = np.asarray(center) + unit * max(radius - width / 2.0, 0.0)
+    outer = np.asarray(center) + unit * (radius + width / 2.0)
+    return np.stack([inner, outer], axis=1).reshape(-1, 2).astype(np.float32)
+
+
+class CircleOverlay:
+    """A ring of ``radius_px`` at ``center_px`` (pixels of a viewport of ``viewport_size``, y down)."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self.program = load_program(ctx, "overlay")
+        self.vbo = ctx.buffer(reserve=2 * (CIRCLE_SEGMENTS + 1) * 2 * 4, dynamic=True)
+        self.vao = ctx.vertex_array(self.program, [(self.vbo, "2f", "in_px")])
+        self.color = CIRCLE_COLOR
+        self.visible = False
+        self.viewport_size = (1.0, 1.0)
+
+    def set(
+        self, center_px: tuple[float, float] | None, radius_px: float, viewport_size: tuple[float, float]
+    ) -> None:
+        if center_px is None:
+            self.visible = False
+            return
+        c = tuple(float(x) for x in center_px)
+        r = float(radius_px)
+        w, h = (float(x) for x in viewport_size)
+        if not (math.isfinite(r) and r >= 0):
+            raise ParameterError("radius_px", radius_px, "a finite radius >= 0 in pixels")
+        if not (w > 0 and h > 0 and all(math.isfinite(x) for x in c)):
+            raise ParameterError("viewport_size", viewport_size, "a positive (width, height)")
+        self.vbo.write(ring_strip(c, r, RING_WIDTH_PX, CIRCLE_SEGMENTS).tobytes())
+        self.viewport_size = (w, h)
+        self.visible = True
+
+    def render(self) -> None:
+        if not self.visible:
+            return
+        self.program["u_viewport_size"].value = self.viewport_size
+        self.program["u_color"].value = self.color
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        self.ctx.enable(moderngl.BLEND)
+        # Straight alpha over the scene; alpha itself accumulates (transparent exports stay correct).
+        self.ctx.blend_func = (
+            moderngl.SRC_ALPHA,
+            moderngl.ONE_MINUS_SRC_ALPHA,
+            moderngl.ONE,
+            moderngl.ONE_MINUS_SRC_ALPHA,
+        )
+        self.vao.render(moderngl.TRIANGLE_STRIP)
+        self.ctx.disable(moderngl.BLEND)
+
+    def release(self) -> None:
+        self.vao.release()
+        self.vbo.release()
+        self.program.release()

@@ -1,0 +1,83 @@
+"""The figure scripts' sheet helpers and the anime figure run end to end (small panels)."""
+
+from __future__ import annotations
+
+import itertools
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from app.figures import anime
+from app.figures.sheet import GAP, LABEL_HEIGHT, grid, label, main_guard
+from hairtool.errors import HairtoolError, ParameterError
+
+
+def test_grid_places_panels_in_rows_with_gaps():
+    a = np.zeros((10, 20, 4), np.uint8)
+    b = np.full((10, 20, 4), 200, np.uint8)
+    sheet = grid([a, b, a], columns=2)
+    assert sheet.shape == (2 * 10 + 3 * GAP, 2 * 20 + 3 * GAP, 4)
+    assert np.all(sheet[GAP : GAP + 10, 2 * GAP + 20 : 2 * GAP + 40] == 200)
+    assert np.all(sheet[0, :] == 255)  # white margin
+    with pytest.raises(HairtoolError):
+        grid([])
+
+
+def test_label_adds_a_caption_band_with_text():
+    img = np.zeros((40, 120, 4), np.uint8)
+    img[..., 3] = 255
+    out = label(img, "stiffness 7")
+    assert out.shape == (40 + LABEL_HEIGHT, 120, 4)
+    np.testing.assert_array_equal(out[:40], img)
+    band = out[40:, :, :3]
+    assert band.min() < 100 and band.max() == 255  # dark glyphs on white
+
+
+def test_main_guard_turns_errors_into_status_2(capsys):
+    def bad():
+        raise ParameterError("stiffness", -1, "a positive number")
+
+    assert main_guard(bad) == 2
+    assert "stiffness" in capsys.readouterr().err
+    assert main_guard(lambda: None) == 0
+
+
+def test_anime_figure_writes_frames_sheet_and_envelope(tmp_path, capsys):
+    anime.make([str(tmp_path), "--size", "96"])
+    frames = sorted(tmp_path.glob("anime_picture_*.png"))
+    assert len(frames) >= 4
+    images = [iio.imread(f) for f in frames]
+    assert all(img.shape == (96, 96, 4) for img in images)
+    # Consecutive pictures differ: the hair moves through the cycle.
+    for a, b in itertools.pairwise(images):
+        assert np.abs(a.astype(int) - b.astype(int)).max() > 100
+    assert (tmp_path / "anime_contact_sheet.png").is_file()
+    assert (tmp_path / "anime_envelope.png").is_file()
+    assert str(tmp_path / "anime_contact_sheet.png") in capsys.readouterr().out
+
+
+def _differing(a: np.ndarray, b: np.ndarray) -> float:
+    return float((np.abs(a.astype(int) - b.astype(int)).max(axis=2) > 60).mean())
+
+
+def test_frozen_figures_show_the_papers_comparisons(tmp_path):
+    from app.figures import frozen
+
+    frozen.make([str(tmp_path), "--size", "128"])
+    for sheet in ("frozen_fig1_intensity", "frozen_fig2_stiffness", "frozen_fig3_clumping"):
+        assert (tmp_path / f"{sheet}.png").is_file()
+    fig1a = iio.imread(tmp_path / "frozen_fig1a_intensity_0.8.png")
+    fig1b = iio.imread(tmp_path / "frozen_fig1b_intensity_0.2.png")
+    assert _differing(fig1a, fig1b) > 0.005
+    # Fig. 1 colours roots red and tips blue, as the paper does.
+    assert ((fig1a[..., 0] > 180) & (fig1a[..., 2] < 90)).any()
+    assert ((fig1a[..., 2] > 180) & (fig1a[..., 0] < 90)).any()
+    original = iio.imread(tmp_path / "frozen_fig2a_original.png")
+    stiff = iio.imread(tmp_path / "frozen_fig2b_stiffness_7.png")
+    soft = iio.imread(tmp_path / "frozen_fig2c_stiffness_3.png")
+    # Lower stiffness departs further from the original shape.
+    assert _differing(original, soft) > _differing(original, stiff) > 0.005
+    unclumped = iio.imread(tmp_path / "frozen_fig3b_aligned_and_frozen_no_clumping.png")
+    clumped = iio.imread(tmp_path / "frozen_fig3d_clump_radius_0.12.png")
+    assert _differing(unclumped, clumped) > 0.005
