@@ -1,0 +1,183 @@
+"""Studio responsiveness: time from a mouse-move event to the finished frame, while dragging hair.
+
+``python -m app.bench [--json]`` (or ``hairtool-studio --bench``). Each row is one groom: the
+sample grooms and a 5,000 strands × 20 vertices scalp. A real window with a real GL viewport
+receives a left-drag of QMouseEvents; per move we time the event (the frozen-hair pipeline runs
+in the handler) plus a synchronous paintGL with glFinish after upload and after draw, so the
+draw time is the GPU's (llvmpipe's) real time; Qt's compositing of the widget onto the screen
+is not included. Numbers are medians over the moves.
+Target: total under 33 ms (30 frames/s) for the 5,000-strand groom. The viewport draws without
+MSAA unless HAIRTOOL_MSAA is set (the ``msaa`` column says which ran).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+HELP = "time from mouse move to finished frame in the studio (pipeline / upload / draw)"
+TARGET_MS = 33.0
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--moves", type=int, default=30, help="mouse moves per groom (default 30)")
+    parser.add_argument("--strands", type=int, default=5000, help="strands of the large groom (default 5000)")
+    parser.add_argument("--vertices", type=int, default=20, help="vertices per strand of the large groom")
+    parser.add_argument("--size", type=int, nargs=2, default=(1024, 768), metavar=("W", "H"), help="window")
+    parser.add_argument(
+        "--only", choices=["samples", "large"], help="run only the samples or the large groom"
+    )
+    parser.add_argument("--no-clump", action="store_true", help="ClumpWithGaps off (align, freeze only)")
+    parser.add_argument("--json", action="store_true", help="print the rows as JSON")
+
+
+def _ensure_display() -> subprocess.Popen | None:
+    """Start ``Xvfb -displayfd`` when no display is set (headless machines, CI)."""
+    if os.environ.get("DISPLAY") or shutil.which("Xvfb") is None:
+        return None
+    read_fd, write_fd = os.pipe()
+    proc = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
+        pass_fds=(write_fd,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    os.close(write_fd)
+    with os.fdopen(read_fd) as f:
+        os.environ["DISPLAY"] = f":{f.readline().strip()}"
+    return proc
+
+
+def _grooms(args: argparse.Namespace) -> list[tuple[str, object]]:
+    from hairtool import samples
+
+    out: list[tuple[str, object]] = []
+    if args.only != "large":
+        out += [(name, samples.sample(name)) for name in samples.SAMPLES]
+    if args.only != "samples":
+        out.append((f"scalp {args.strands}x{args.vertices}", samples.scalp(args.strands, args.vertices)))
+    return out
+
+
+def _drag_path(window, moves: int) -> np.ndarray:
+    """Widget positions: from the tip nearest the view's centre, a loop of ``moves`` steps around it."""
+    v = window.viewport
+    tips = v.project(window.scene.result.tips)
+    centre = np.array([v.width() / 2.0, v.height() / 2.0])
+    start = tips[np.argmin(np.linalg.norm(tips - centre, axis=1))]
+    a = np.linspace(0.0, 2.0 * np.pi, moves + 1)
+    radius = 0.12 * min(v.width(), v.height())
+    return start + radius * np.column_stack([np.sin(a), 1.0 - np.cos(a)])
+
+
+def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> dict:
+    from PySide6.QtCore import QEvent, QPointF, Qt
+    from PySide6.QtGui import QMouseEvent, QSurfaceFormat
+
+    from app.ui.window import MainWindow
+
+    window = MainWindow(groom=groom, settings=settings)
+    if args.no_clump:
+        window.scene.set_params(window.scene.params.replace(clump=False))
+    window.resize(*args.size)
+    window.show()
+    for _ in range(20):
+        app.processEvents()
+    v = window.viewport
+    v.finish_frames = True
+    left, none = Qt.MouseButton.LeftButton, Qt.MouseButton.NoButton
+
+    def send(kind, p, button, buttons) -> None:
+        local = QPointF(float(p[0]), float(p[1]))
+        app.sendEvent(
+            v, QMouseEvent(kind, local, v.mapToGlobal(local), button, buttons, Qt.KeyboardModifier.NoModifier)
+        )
+
+    def frame() -> None:
+        # Draw now, synchronously, into the widget's framebuffer (Qt's own repaint may be
+        # deferred); paintGL finishes the GL work, so the frame is complete when this returns.
+        v.makeCurrent()
+        v.paintGL()
+        v.doneCurrent()
+
+    path = _drag_path(window, args.moves)
+    send(QEvent.Type.MouseButtonPress, path[0], left, left)
+    frame()  # the first update compiles kernels and allocates: not timed
+    totals, pipeline, upload, draw, stages = [], [], [], [], []
+    for p in path[1:]:
+        t0 = time.perf_counter()
+        send(QEvent.Type.MouseMove, p, none, left)
+        frame()
+        totals.append((time.perf_counter() - t0) * 1e3)
+        pipeline.append(window.scene.last_update_ms)
+        upload.append(v.last_upload_ms)
+        draw.append(v.last_draw_ms)
+        stages.append(window.scene.pipeline.timings)
+    send(QEvent.Type.MouseButtonRelease, path[-1], left, none)
+    clump = window.scene.params.clump
+    window.close()
+    window.deleteLater()
+    app.processEvents()
+    row = {
+        "groom": name,
+        "strands": groom.strand_count,
+        "vertices": groom.vertex_count,
+        "moves": len(totals),
+        "clump": clump,
+        "total_ms": statistics.median(totals),
+        "pipeline_ms": statistics.median(pipeline),
+        "upload_ms": statistics.median(upload),
+        "draw_ms": statistics.median(draw),
+        "p90_total_ms": float(np.percentile(totals, 90)),
+    }
+    for stage in ("freeze", "align", "clump"):
+        row[f"{stage}_ms"] = statistics.median(float(t.get(stage, 0.0)) for t in stages)
+    row["msaa"] = max(QSurfaceFormat.defaultFormat().samples(), 0)
+    row["under_target"] = row["total_ms"] < TARGET_MS
+    return row
+
+
+def run(args: argparse.Namespace) -> list[dict]:
+    from app.main import configure_gl
+
+    xvfb = _ensure_display()
+    try:
+        configure_gl()
+        from PySide6.QtCore import QSettings
+        from PySide6.QtWidgets import QApplication
+
+        app = QApplication.instance() or QApplication(sys.argv[:1])
+        with tempfile.TemporaryDirectory() as tmp:
+            settings = QSettings(os.path.join(tmp, "bench.ini"), QSettings.Format.IniFormat)
+            return [_time_groom(app, name, groom, args, settings) for name, groom in _grooms(args)]
+    finally:
+        if xvfb is not None:
+            xvfb.terminate()
+            xvfb.wait(timeout=10)
+
+
+def main(argv: list[str] | None = None) -> int:
+    from hairtool.bench import format_table
+
+    parser = argparse.ArgumentParser(prog="python -m app.bench", description=HELP)
+    add_arguments(parser)
+    args = parser.parse_args(argv)
+    if args.moves < 2 or args.strands < 1 or not 2 <= args.vertices <= 1024:
+        print("app.bench: --moves >= 2, --strands >= 1 and --vertices in [2, 1024] please", file=sys.stderr)
+        return 2
+    rows = run(args)
+    print(json.dumps(rows, indent=2) if args.json else format_table(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,63 @@
+"""Undo steps: one per align stroke, one per (merged) parameter edit."""
+
+from __future__ import annotations
+
+from PySide6.QtGui import QUndoCommand
+
+from app.ui.scene import Scene
+from hairtool.frozen import FrozenParams
+
+_PARAM_ID_BASE = 1000
+_PARAM_IDS: dict[str, int] = {}
+
+
+class StrokeCommand(QUndoCommand):
+    """A whole left-drag, already applied while dragging: pushing it does not apply it again."""
+
+    def __init__(self, scene: Scene, before: object, after: object) -> None:
+        super().__init__("Align strands")
+        self._scene = scene
+        self._before = before
+        self._after = after
+        self._applied = True
+
+    def redo(self) -> None:
+        if self._applied:  # the first redo() comes from QUndoStack.push: the drag already did it
+            self._applied = False
+            return
+        self._scene.restore(self._after)
+
+    def undo(self) -> None:
+        self._scene.restore(self._before)
+
+
+class ParamCommand(QUndoCommand):
+    """A change of one engine parameter; slider drags on the same field merge into one step."""
+
+    def __init__(
+        self, scene: Scene, name: str, before: FrozenParams, after: FrozenParams, drag: int | None = None
+    ) -> None:
+        """``drag``: an id shared by the edits of one slider drag (None: never merge)."""
+        super().__init__(f"Change {name.replace('_', ' ')}")
+        self._scene = scene
+        self.name = name
+        self.drag = drag
+        self._before = before
+        self._after = after
+
+    def id(self) -> int:
+        return _PARAM_IDS.setdefault(self.name, _PARAM_ID_BASE + len(_PARAM_IDS))
+
+    def mergeWith(self, other: QUndoCommand) -> bool:
+        if not isinstance(other, ParamCommand) or other.name != self.name:
+            return False
+        if self.drag is None or other.drag != self.drag:
+            return False
+        self._after = other._after
+        return True
+
+    def redo(self) -> None:
+        self._scene.set_params(self._after)
+
+    def undo(self) -> None:
+        self._scene.set_params(self._before)

@@ -1,0 +1,269 @@
+"""The GL viewport: moderngl inside a QOpenGLWidget, camera navigation and the align brush.
+
+Navigation follows Blender/Maya: middle-drag or Alt+left-drag orbits (pans in 2-D), Shift with
+either pans, the wheel zooms, Ctrl+wheel resizes the brush. A plain left-drag is the align tool:
+the cursor is unprojected onto the plane through the groom's centre facing the camera, and
+every move runs the frozen-hair pipeline. The view is told what changed by the scene's signals
+and uploads it at the next paint (positions only while dragging).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Iterator
+
+import moderngl
+import numpy as np
+from PySide6.QtCore import QPointF, Qt, Signal
+from PySide6.QtGui import QMouseEvent, QWheelEvent
+from PySide6.QtOpenGLWidgets import QOpenGLWidget
+
+from app.render.camera import Camera
+from app.render.strands import StrandRenderer
+from app.ui.colouring import vertex_colors
+from app.ui.scene import Scene
+
+BRUSH_STEP = 1.1  # radius factor per wheel notch or [ / ] press
+
+
+class Viewport(QOpenGLWidget):
+    """Draws the scene's current groom; emits a finished stroke as (before, after) snapshots."""
+
+    stroke_finished = Signal(object, object)
+    cursor_moved = Signal(object)  # (3,) float array on the interaction plane, or None
+    frame_drawn = Signal()
+
+    def __init__(self, scene: Scene, parent=None) -> None:
+        super().__init__(parent)
+        self.scene = scene
+        self.camera = self._fresh_camera()
+        self.ctx: moderngl.Context | None = None
+        self.renderer: StrandRenderer | None = None
+        self.finish_frames = False  # glFinish after upload and draw, so timings are real (benchmark)
+        self.last_upload_ms = 0.0
+        self.last_draw_ms = 0.0
+        self._dirty = {"groom", "colors", "display", "mesh"}
+        self._drag: str | None = None  # "align" | "orbit" | "pan" while a button is held
+        self._drag_button = Qt.MouseButton.NoButton
+        self._last_pos = QPointF()
+        self._stroke_before: object | None = None
+        self._hover: QPointF | None = None
+        self._auto_frame = True  # follow the widget's size with frame-all until the user navigates
+        self.setMouseTracking(True)
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+        self.setMinimumSize(200, 150)
+        scene.groom_loaded.connect(self._on_groom_loaded)
+        scene.points_changed.connect(self._on_points_changed)
+        scene.params_changed.connect(lambda _p: self._mark("colors"))
+        scene.display_changed.connect(lambda: self._mark("display", "colors"))
+        scene.mesh_changed.connect(lambda: self._mark("mesh"))
+        scene.tool_changed.connect(self.update)
+
+    # -- scene → view ----------------------------------------------------------------------
+    def _mark(self, *what: str) -> None:
+        self._dirty.update(what)
+        self.update()
+
+    def _aspect(self) -> float:
+        return max(self.width(), 1) / max(self.height(), 1)
+
+    def _fresh_camera(self) -> Camera:
+        """Front orthographic view for planar grooms (2-D), a three-quarter perspective otherwise."""
+        lo, hi = self.scene.result.bounds
+        return Camera.for_bounds(lo, hi, ortho=self.scene.is_planar, aspect=self._aspect())
+
+    def _on_groom_loaded(self) -> None:
+        self.camera = self._fresh_camera()
+        self._auto_frame = True
+        self._mark("groom", "colors")
+
+    def _on_points_changed(self) -> None:
+        self._dirty.add("points")
+        if self.scene.colour_mode in ("displacement", "clump"):
+            self._dirty.add("colors")
+        self.update()
+
+    def frame_all(self) -> None:
+        """Fit the groom (and the head mesh) in view; planar grooms get the 2-D orthographic camera."""
+        lo, hi = self.scene.result.bounds
+        if self.scene.mesh is not None:
+            v = np.asarray(self.scene.mesh.vertices, dtype=np.float32)
+            if v.size:
+                lo, hi = np.minimum(lo, v.min(axis=0)), np.maximum(hi, v.max(axis=0))
+        self.camera.frame(lo, hi, aspect=self._aspect())
+        self._auto_frame = True
+        self.update()
+
+    def set_ortho(self, on: bool) -> None:
+        """2-D (orthographic, front view) or 3-D (perspective) view, framed again."""
+        if self.camera.ortho != on:
+            if on:
+                self.camera.ortho = True
+            else:
+                self.camera = Camera.for_bounds(*self.scene.result.bounds, ortho=False, aspect=self._aspect())
+            self.frame_all()
+
+    # -- GL ----------------------------------------------------------------------------------
+    def initializeGL(self) -> None:
+        self.ctx = moderngl.create_context()
+        self.renderer = StrandRenderer(self.ctx)
+        self._dirty = {"groom", "colors", "display", "mesh"}
+
+    def _upload(self) -> None:
+        r, s, dirty = self.renderer, self.scene, self._dirty
+        if "groom" in dirty:
+            r.set_groom(s.result)
+            dirty.discard("points")
+        if "points" in dirty:
+            r.update_points(s.result.points)
+        if "display" in dirty:
+            r.set_ramp(s.ramp)
+            r.line_width = s.line_width
+        if "colors" in dirty:
+            r.set_vertex_colors(vertex_colors(s))
+        if "mesh" in dirty:
+            r.set_mesh(s.mesh)
+        dirty.clear()
+
+    def _overlay(self, w: int, h: int) -> None:
+        if self._hover is None or self._drag not in (None, "align"):
+            self.renderer.set_overlay_circle(None, 0.0, (w, h))
+            return
+        dpr = self.devicePixelRatioF()
+        radius_px = self.scene.radius * self.camera.pixels_per_unit_at(self.scene.centre, h)
+        centre = (self._hover.x() * dpr, self._hover.y() * dpr)
+        self.renderer.set_overlay_circle(centre, radius_px, (w, h))
+
+    def resizeGL(self, w: int, h: int) -> None:
+        if self._auto_frame and w > 1 and h > 1:
+            self.frame_all()
+
+    def paintGL(self) -> None:
+        if self.renderer is None:
+            return
+        t0 = time.perf_counter()
+        self._upload()
+        if self.finish_frames:
+            self.ctx.finish()
+        t1 = time.perf_counter()
+        dpr = self.devicePixelRatioF()
+        w, h = max(1, round(self.width() * dpr)), max(1, round(self.height() * dpr))
+        self._overlay(w, h)
+        # Qt's framebuffer id changes on every resize: look it up each time, never draw to 0.
+        fbo = self.ctx.detect_framebuffer(self.defaultFramebufferObject())
+        self.renderer.render(fbo, self.camera, (w, h))
+        if self.finish_frames:
+            self.ctx.finish()
+        t2 = time.perf_counter()
+        self.last_upload_ms = (t1 - t0) * 1e3
+        self.last_draw_ms = (t2 - t1) * 1e3
+        self.frame_drawn.emit()
+
+    @contextlib.contextmanager
+    def current_context(self) -> Iterator[moderngl.Context | None]:
+        """This widget's context made current (None before the first paint), for offscreen draws:
+        the studio keeps to one GL context, since a second (EGL) one beside Qt's is unreliable."""
+        if self.ctx is None:
+            yield None
+            return
+        self.makeCurrent()
+        try:
+            yield self.ctx
+        finally:
+            self.doneCurrent()
+
+    def release_gl(self) -> None:
+        """Free the GL objects while the context still exists (called when the window closes)."""
+        if self.renderer is not None and self.ctx is not None:
+            self.makeCurrent()
+            self.renderer.release()
+            self.renderer = None
+            self.doneCurrent()
+
+    # -- picking -------------------------------------------------------------------------------
+    def cursor_on_plane(self, pos: QPointF) -> np.ndarray:
+        """The 3-D point under ``pos`` (widget pixels) on the plane through the groom's centre."""
+        return np.asarray(
+            self.camera.unproject_to_plane(pos.x(), pos.y(), self.width(), self.height(), self.scene.centre),
+            dtype=np.float64,
+        )
+
+    def project(self, points: np.ndarray) -> np.ndarray:
+        """``(n, 2)`` widget pixel positions of 3-D points (tests check pixels there)."""
+        return np.asarray(self.camera.project(np.asarray(points), self.width(), self.height()))
+
+    # -- input -----------------------------------------------------------------------------------
+    def _navigation(self, event: QMouseEvent) -> str | None:
+        button, mods = event.button(), event.modifiers()
+        shift = bool(mods & Qt.KeyboardModifier.ShiftModifier)
+        alt = bool(mods & Qt.KeyboardModifier.AltModifier)
+        if button == Qt.MouseButton.MiddleButton or (button == Qt.MouseButton.LeftButton and alt):
+            return "pan" if shift or self.camera.ortho else "orbit"
+        if button == Qt.MouseButton.LeftButton and shift:
+            return "pan"
+        if button == Qt.MouseButton.LeftButton:
+            return "align"
+        return None
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        if self._drag is not None:
+            return
+        self._drag = self._navigation(event)
+        self._drag_button = event.button()
+        self._last_pos = event.position()
+        if self._drag == "align":
+            self._stroke_before = self.scene.snapshot()
+            self._align_at(event.position())
+        event.accept()
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        pos = event.position()
+        self._hover = pos
+        dx, dy = pos.x() - self._last_pos.x(), pos.y() - self._last_pos.y()
+        self._last_pos = pos
+        if self._drag == "align":
+            self._align_at(pos)
+        elif self._drag == "orbit":
+            self._auto_frame = False
+            self.camera.orbit(dx, dy)
+        elif self._drag == "pan":
+            self._auto_frame = False
+            self.camera.pan(dx, dy, self.height())
+        else:
+            self.cursor_moved.emit(self.cursor_on_plane(pos))
+        self.update()
+
+    def _align_at(self, pos: QPointF) -> None:
+        cursor = self.cursor_on_plane(pos)
+        self.cursor_moved.emit(cursor)
+        self.scene.align(cursor)
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        if self._drag is None or event.button() != self._drag_button:
+            return
+        drag, self._drag = self._drag, None
+        if drag == "align" and self._stroke_before is not None:
+            before, self._stroke_before = self._stroke_before, None
+            self.stroke_finished.emit(before, self.scene.snapshot())
+        self.update()
+
+    def wheelEvent(self, event: QWheelEvent) -> None:
+        steps = event.angleDelta().y() / 120.0
+        if steps == 0:
+            return
+        if event.modifiers() & Qt.KeyboardModifier.ControlModifier:
+            self.scale_brush(BRUSH_STEP**steps)
+        else:
+            self._auto_frame = False
+            self.camera.zoom(steps)
+        self.update()
+        event.accept()
+
+    def scale_brush(self, factor: float) -> None:
+        self.scene.set_radius(self.scene.radius * factor)
+
+    def leaveEvent(self, event) -> None:
+        self._hover = None
+        self.cursor_moved.emit(None)
+        self.update()

@@ -1,0 +1,370 @@
+"""The studio's main window: viewport in the centre, tool dock, status bar, menus and shortcuts.
+
+Every modal dialog goes through one small ``ask_*`` / ``show_error`` method, so tests replace
+them (monkeypatch) and never block.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from PySide6.QtCore import QSettings, Qt
+from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QKeySequence, QUndoStack
+from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QWidget
+
+from app.ui import export
+from app.ui.commands import ParamCommand, StrokeCommand
+from app.ui.dialogs import StillOptions, ask_still_options
+from app.ui.scene import COLOUR_MODES, Scene
+from app.ui.tool_dock import ToolDock
+from app.ui.viewport import BRUSH_STEP, Viewport
+from hairtool import io, samples
+from hairtool.errors import HairtoolError
+from hairtool.groom import Groom
+
+MAX_RECENT = 10
+SETTINGS_ORG, SETTINGS_APP = "hairtool", "Hairtool Studio"
+
+
+def _filters(kind: str) -> str:
+    """File-dialog filters for the readable or writable formats."""
+    formats = [f for f in io.FORMATS if getattr(f, kind)]
+    parts = [f"{f.name} ({' '.join('*' + e for e in f.extensions)})" for f in formats]
+    every = " ".join("*" + e for f in formats for e in f.extensions)
+    return ";;".join([f"All supported ({every})", *parts])
+
+
+class MainWindow(QMainWindow):
+    """``MainWindow(path)`` opens ``path``, or the bundled sample groom when None."""
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str] | None = None,
+        *,
+        settings: QSettings | None = None,
+        groom: Groom | None = None,
+        parent: QWidget | None = None,
+    ) -> None:
+        super().__init__(parent)
+        self.setObjectName("HairtoolStudio")
+        self.settings = settings if settings is not None else QSettings(SETTINGS_ORG, SETTINGS_APP)
+        self.undo_stack = QUndoStack(self)
+        start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
+        self.scene = Scene(start, parent=self)
+        self.viewport = Viewport(self.scene, self)
+        self.setCentralWidget(self.viewport)
+        self.dock = ToolDock(self.scene, self)
+        self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
+        self._build_status_bar()
+        self._build_menus()
+        self.setAcceptDrops(True)
+        self.resize(1280, 800)
+
+        self.viewport.stroke_finished.connect(self._on_stroke_finished)
+        self.viewport.cursor_moved.connect(self._on_cursor_moved)
+        self.viewport.frame_drawn.connect(self._update_frame_time)
+        self.dock.param_edited.connect(self._on_param_edited)
+        self.scene.groom_loaded.connect(self._update_counts)
+        self.scene.path_changed.connect(self._update_title)
+        self.undo_stack.cleanChanged.connect(self._update_title)
+        self._update_counts()
+        self._update_title()
+        self._restore_layout()
+        if path is not None:
+            self.open_path(path)
+
+    # -- dialogs (tests replace these) ------------------------------------------------------
+    def show_error(self, title: str, message: str) -> None:
+        QMessageBox.critical(self, title, message)
+
+    def ask_open_path(self, title: str = "Open groom", filters: str | None = None) -> str | None:
+        path, _ = QFileDialog.getOpenFileName(self, title, self.last_dir(), filters or _filters("readable"))
+        return path or None
+
+    def ask_save_path(self, title: str, filters: str, suggested: str = "") -> str | None:
+        start = str(Path(self.last_dir()) / suggested) if suggested else self.last_dir()
+        path, _ = QFileDialog.getSaveFileName(self, title, start, filters)
+        return path or None
+
+    def ask_still_options(self) -> StillOptions | None:
+        return ask_still_options(self, self.viewport_pixel_size(), self.scene.is_planar, self.last_dir())
+
+    # -- settings ----------------------------------------------------------------------------
+    def last_dir(self) -> str:
+        return str(self.settings.value("last_dir", str(Path.home())))
+
+    def _remember_dir(self, path: str | os.PathLike[str]) -> None:
+        self.settings.setValue("last_dir", str(Path(path).resolve().parent))
+
+    def recent_files(self) -> list[str]:
+        value = self.settings.value("recent", [])
+        if isinstance(value, str):  # QSettings gives a str for a one-element list
+            value = [value]
+        return [str(v) for v in value or []]
+
+    def _add_recent(self, path: str | os.PathLike[str]) -> None:
+        p = str(Path(path).resolve())
+        recent = [p, *(r for r in self.recent_files() if r != p)][:MAX_RECENT]
+        self.settings.setValue("recent", recent)
+        self._remember_dir(p)
+
+    def _restore_layout(self) -> None:
+        geometry = self.settings.value("geometry")
+        if geometry is not None:
+            self.restoreGeometry(geometry)
+        state = self.settings.value("window_state")
+        if state is not None:
+            self.restoreState(state)
+
+    def save_layout(self) -> None:
+        self.settings.setValue("geometry", self.saveGeometry())
+        self.settings.setValue("window_state", self.saveState())
+        self.settings.sync()
+
+    def closeEvent(self, event) -> None:
+        self.save_layout()
+        self.viewport.release_gl()
+        super().closeEvent(event)
+
+    # -- menus -------------------------------------------------------------------------------
+    def _action(self, menu, text: str, slot, shortcut=None, *, checkable: bool = False) -> QAction:
+        action = QAction(text, self)
+        if shortcut is not None:
+            keys = shortcut if isinstance(shortcut, list) else [shortcut]
+            action.setShortcuts([QKeySequence(k) for k in keys])
+        action.setCheckable(checkable)
+        action.triggered.connect(slot)
+        menu.addAction(action)
+        return action
+
+    def _build_menus(self) -> None:
+        bar = self.menuBar()
+        file = bar.addMenu("&File")
+        new = file.addMenu("&New from sample")
+        for i, kind in enumerate(samples.SAMPLES):
+            key = QKeySequence.StandardKey.New if i == 0 else None
+            self._action(new, kind.capitalize(), lambda _=False, k=kind: self.new_from_sample(k), key)
+        self._action(file, "&Open…", self.open_dialog, QKeySequence.StandardKey.Open)
+        self.recent_menu = file.addMenu("Open &Recent")
+        self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
+        file.addSeparator()
+        self._action(file, "&Save", self.save, QKeySequence.StandardKey.Save)
+        self._action(file, "Save &As…", self.save_as, QKeySequence.StandardKey.SaveAs)
+        file.addSeparator()
+        self._action(file, "&Export still…", self.export_still_dialog, "Ctrl+E")
+        self._action(file, "Export &groom…", self.export_groom_dialog, "Ctrl+Shift+E")
+        file.addSeparator()
+        self._action(file, "Load head &mesh…", self.load_mesh_dialog)
+        self._action(file, "&Clear head mesh", lambda: self.scene.set_mesh(None))
+        file.addSeparator()
+        self._action(file, "&Quit", self.close, QKeySequence.StandardKey.Quit)
+
+        edit = bar.addMenu("&Edit")
+        undo = self.undo_stack.createUndoAction(self, "&Undo")
+        undo.setShortcut(QKeySequence.StandardKey.Undo)
+        redo = self.undo_stack.createRedoAction(self, "&Redo")
+        redo.setShortcuts([QKeySequence.StandardKey.Redo, QKeySequence("Ctrl+Y")])
+        edit.addAction(undo)
+        edit.addAction(redo)
+
+        view = bar.addMenu("&View")
+        self._action(view, "&Frame all", self.viewport.frame_all, ["F", "Home"])
+        self.ortho_action = self._action(view, "&2-D view", self.toggle_ortho, "5", checkable=True)
+        view.aboutToShow.connect(self._sync_view_menu)
+        colour = view.addMenu("&Colour by")
+        group = QActionGroup(self)
+        self.colour_actions: dict[str, QAction] = {}
+        for i, (key, label) in enumerate(COLOUR_MODES.items()):
+            a = self._action(colour, label, lambda _=False, k=key: self.scene.set_colour_mode(k),
+                             f"Alt+{i + 1}", checkable=True)  # fmt: skip
+            group.addAction(a)
+            self.colour_actions[key] = a
+        colour.aboutToShow.connect(lambda: self.colour_actions[self.scene.colour_mode].setChecked(True))
+        view.addSeparator()
+        view.addAction(self.dock.toggleViewAction())
+
+        brush = bar.addMenu("&Brush")
+        self._action(brush, "&Smaller", lambda: self.viewport.scale_brush(1.0 / BRUSH_STEP), "[")
+        self._action(brush, "&Bigger", lambda: self.viewport.scale_brush(BRUSH_STEP), "]")
+
+    def toggle_ortho(self) -> None:
+        """2-D (orthographic front view) ⇄ 3-D (perspective), whatever the menu's check mark says."""
+        self.viewport.set_ortho(not self.viewport.camera.ortho)
+        self._sync_view_menu()
+
+    def _sync_view_menu(self) -> None:
+        self.ortho_action.setChecked(self.viewport.camera.ortho)
+
+    def _fill_recent_menu(self) -> None:
+        self.recent_menu.clear()
+        for path in self.recent_files():
+            self.recent_menu.addAction(path, lambda p=path: self.open_path(p))
+        self.recent_menu.setEnabled(True)
+
+    # -- status bar --------------------------------------------------------------------------
+    def _build_status_bar(self) -> None:
+        bar = self.statusBar()
+        self.counts_label = QLabel()
+        self.frame_label = QLabel()
+        self.cursor_label = QLabel()
+        bar.addWidget(self.counts_label)
+        bar.addWidget(self.frame_label)
+        bar.addPermanentWidget(self.cursor_label)
+
+    def _update_counts(self) -> None:
+        g = self.scene.result
+        self.counts_label.setText(f"{g.strand_count:,} strands · {g.vertex_count:,} vertices")
+
+    def _update_frame_time(self) -> None:
+        v, s = self.viewport, self.scene
+        total = s.last_update_ms + v.last_upload_ms + v.last_draw_ms
+        self.frame_label.setText(
+            f"update {total:.1f} ms (pipeline {s.last_update_ms:.1f}, upload {v.last_upload_ms:.1f}, "
+            f"draw {v.last_draw_ms:.1f})"
+        )
+
+    def _on_cursor_moved(self, cursor) -> None:
+        if cursor is None:
+            self.cursor_label.setText("")
+        else:
+            self.cursor_label.setText("cursor ({:.3f}, {:.3f}, {:.3f})".format(*cursor))
+
+    def _update_title(self) -> None:
+        name = self.scene.path.name if self.scene.path is not None else "untitled"
+        dirty = "" if self.undo_stack.isClean() else " *"
+        self.setWindowTitle(f"{name}{dirty} — Hairtool Studio")
+
+    # -- editing -------------------------------------------------------------------------------
+    def _on_stroke_finished(self, before: object, after: object) -> None:
+        self.undo_stack.push(StrokeCommand(self.scene, before, after))
+
+    def _on_param_edited(self, name: str, value: object, drag: object) -> None:
+        before = self.scene.params
+        try:
+            after = self.scene.with_param(name, value)
+        except HairtoolError as e:
+            self.show_error("Invalid parameter", str(e))
+            self.dock.refresh_params()
+            return
+        if after != before:
+            self.undo_stack.push(ParamCommand(self.scene, name, before, after, drag))
+
+    # -- files ----------------------------------------------------------------------------------
+    def set_groom(self, groom: Groom, path: str | os.PathLike[str] | None = None) -> None:
+        """Show a new groom; its strokes start afresh, so the undo history is cleared."""
+        self.undo_stack.clear()
+        self.scene.load(groom, path)
+        self.undo_stack.setClean()
+        self._update_title()
+
+    def new_from_sample(self, kind: str) -> None:
+        self.set_groom(samples.sample(kind))
+
+    def open_dialog(self) -> None:
+        path = self.ask_open_path()
+        if path:
+            self.open_path(path)
+
+    def open_path(self, path: str | os.PathLike[str]) -> bool:
+        """Open any readable groom (an animation's first frame); on failure the scene is kept."""
+        try:
+            groom = io.read_groom(path)
+        except HairtoolError as e:
+            self.show_error("Cannot open file", str(e))
+            return False
+        self.set_groom(groom, path)
+        self._add_recent(path)
+        return True
+
+    def save(self) -> bool:
+        path = self.scene.path
+        if path is None or not any(path.suffix.lower() in f.extensions and f.writable for f in io.FORMATS):
+            return self.save_as()
+        return self._write_groom(path, adopt=True)
+
+    def save_as(self) -> bool:
+        stem = self.scene.path.stem if self.scene.path is not None else "groom"
+        path = self.ask_save_path("Save groom as", _filters("writable"), f"{stem}.usda")
+        return bool(path) and self._write_groom(path, adopt=True)
+
+    def export_groom_dialog(self) -> bool:
+        stem = self.scene.path.stem if self.scene.path is not None else "groom"
+        path = self.ask_save_path("Export edited groom", _filters("writable"), f"{stem}_edited.usda")
+        return bool(path) and self.export_groom(path)
+
+    def export_groom(self, path: str | os.PathLike[str]) -> bool:
+        """Write the edited groom to any writable format; the current file stays the same."""
+        return self._write_groom(path, adopt=False)
+
+    def _write_groom(self, path: str | os.PathLike[str], *, adopt: bool) -> bool:
+        try:
+            io.write(path, self.scene.result)
+        except HairtoolError as e:
+            self.show_error("Cannot write file", str(e))
+            return False
+        self._remember_dir(path)
+        if adopt:
+            self.scene.set_path(path)
+            self.undo_stack.setClean()
+            self._add_recent(path)
+        self.statusBar().showMessage(f"wrote {path}", 5000)
+        return True
+
+    def load_mesh_dialog(self) -> None:
+        path = self.ask_open_path("Load head mesh", "Wavefront OBJ (*.obj)")
+        if path:
+            self.load_mesh(path)
+
+    def load_mesh(self, path: str | os.PathLike[str]) -> bool:
+        from hairtool.io.obj import read_mesh
+
+        try:
+            mesh = read_mesh(path)
+        except HairtoolError as e:
+            self.show_error("Cannot load head mesh", str(e))
+            return False
+        self._remember_dir(path)
+        self.scene.set_mesh(mesh)
+        return True
+
+    # -- stills ----------------------------------------------------------------------------------
+    def viewport_pixel_size(self) -> tuple[int, int]:
+        dpr = self.viewport.devicePixelRatioF()
+        return max(1, round(self.viewport.width() * dpr)), max(1, round(self.viewport.height() * dpr))
+
+    def export_still_dialog(self) -> bool:
+        options = self.ask_still_options()
+        return options is not None and self.export_still(options.path, options.size, options.transparent)
+
+    def export_still(
+        self, path: str | os.PathLike[str], size: tuple[int, int] | None = None, transparent: bool = False
+    ) -> bool:
+        """PNG (any groom) or SVG (2-D grooms) of the current view; ``size`` defaults to the viewport's."""
+        try:
+            with self.viewport.current_context() as ctx:
+                export.export_still(
+                    path,
+                    self.scene,
+                    self.viewport.camera,
+                    size or self.viewport_pixel_size(),
+                    transparent,
+                    ctx=ctx,
+                )
+        except HairtoolError as e:
+            self.show_error("Cannot export still", str(e))
+            return False
+        self._remember_dir(path)
+        self.statusBar().showMessage(f"wrote {path}", 5000)
+        return True
+
+    # -- drag and drop ---------------------------------------------------------------------------
+    def dragEnterEvent(self, event: QDragEnterEvent) -> None:
+        if any(u.isLocalFile() for u in event.mimeData().urls()):
+            event.acceptProposedAction()
+
+    def dropEvent(self, event: QDropEvent) -> None:
+        files = [u.toLocalFile() for u in event.mimeData().urls() if u.isLocalFile()]
+        if files:
+            event.acceptProposedAction()
+            self.open_path(files[0])

@@ -1,0 +1,112 @@
+"""GUI fixtures: a 3.3 core GL surface before the QApplication exists, isolated settings, and a
+window factory that closes what it made and fails a test that leaves a window open."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QSettings
+from PySide6.QtWidgets import QApplication
+
+from app.main import configure_gl
+
+configure_gl()  # pytest-qt makes the QApplication later, on the first use of ``qapp``
+
+
+@pytest.fixture
+def settings_path(tmp_path):
+    return str(tmp_path / "studio.ini")
+
+
+@pytest.fixture
+def make_window(qapp, qtbot, settings_path):
+    """``make_window(path=None, groom=None)`` → a shown MainWindow whose dialogs never block.
+
+    Errors that would pop up a dialog are collected in ``window.errors`` instead.
+    """
+    from app.ui.window import MainWindow
+
+    made = []
+
+    def make(path=None, *, groom=None, size=(900, 600)):
+        settings = QSettings(settings_path, QSettings.Format.IniFormat)
+        window = MainWindow(None, settings=settings, groom=groom)
+        window.errors = []
+        window.show_error = lambda title, message: window.errors.append((title, message))
+        window.resize(*size)
+        window.show()
+        qtbot.waitExposed(window)
+        if path is not None:
+            window.open_path(path)
+        window.viewport.frame_all()
+        made.append(window)
+        return window
+
+    yield make
+    for window in made:
+        window.close()
+        window.deleteLater()
+    QApplication.processEvents()
+    leaked = [w for w in QApplication.topLevelWidgets() if w.isVisible()]
+    assert not leaked, f"windows left open: {leaked}"
+
+
+def grab(viewport) -> np.ndarray:
+    """The viewport's framebuffer as ``(H, W, 3)`` uint8 (paints first if anything changed)."""
+    from PySide6.QtGui import QImage
+
+    image = viewport.grabFramebuffer().convertToFormat(QImage.Format.Format_RGB888)
+    w, h = image.width(), image.height()
+    data = np.frombuffer(image.constBits(), dtype=np.uint8, count=image.bytesPerLine() * h)
+    return data.reshape(h, image.bytesPerLine())[:, : w * 3].reshape(h, w, 3).copy()
+
+
+def send_mouse(widget, kind: str, pos, button=None, buttons=None, modifiers=None) -> None:
+    """Deliver one mouse event synchronously: ``kind`` "press" | "move" | "release"; pos in widget px."""
+    from PySide6.QtCore import QEvent, QPointF, Qt
+    from PySide6.QtGui import QMouseEvent
+
+    types = {
+        "press": QEvent.Type.MouseButtonPress,
+        "move": QEvent.Type.MouseMove,
+        "release": QEvent.Type.MouseButtonRelease,
+    }
+    button = Qt.MouseButton.NoButton if button is None else button
+    buttons = Qt.MouseButton.NoButton if buttons is None else buttons
+    modifiers = Qt.KeyboardModifier.NoModifier if modifiers is None else modifiers
+    local = QPointF(float(pos[0]), float(pos[1]))
+    event = QMouseEvent(types[kind], local, widget.mapToGlobal(local), button, buttons, modifiers)
+    QApplication.sendEvent(widget, event)
+
+
+def drag(widget, start, end, steps: int = 8, button=None, modifiers=None) -> None:
+    """Press at ``start``, move in ``steps`` to ``end`` with the button held, release there."""
+    from PySide6.QtCore import Qt
+
+    button = Qt.MouseButton.LeftButton if button is None else button
+    send_mouse(widget, "press", start, button, button, modifiers)
+    for f in np.linspace(0.0, 1.0, steps + 1)[1:]:
+        p = (1.0 - f) * np.asarray(start, float) + f * np.asarray(end, float)
+        send_mouse(widget, "move", p, None, button, modifiers)
+    send_mouse(widget, "release", end, button, None, modifiers)
+
+
+def leave(widget) -> None:
+    """The cursor leaves the viewport: the brush circle is hidden (for image comparisons)."""
+    from PySide6.QtCore import QEvent
+
+    QApplication.sendEvent(widget, QEvent(QEvent.Type.Leave))
+
+
+def hair_mask(image: np.ndarray, background=(0.16, 0.17, 0.19)) -> np.ndarray:
+    """Pixels that differ clearly from the background colour."""
+    bg = np.round(np.asarray(background) * 255.0)
+    return np.abs(image[..., :3].astype(np.float64) - bg).max(axis=-1) > 24
+
+
+@pytest.fixture
+def ui():
+    """The helpers above, for test modules (importlib import mode cannot import conftest)."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(grab=grab, drag=drag, leave=leave, send_mouse=send_mouse, hair_mask=hair_mask)

@@ -1,0 +1,129 @@
+"""The scene model and the undo commands without a window: signals only on change, clear errors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from app.ui.commands import ParamCommand, StrokeCommand
+from app.ui.scene import Scene
+from hairtool import samples
+from hairtool.errors import ParameterError
+
+
+@pytest.fixture
+def scene(qapp):
+    return Scene(samples.portrait(strands=20, vertices=8))
+
+
+def _count(signal) -> list:
+    seen = []
+    signal.connect(lambda *a: seen.append(a))
+    return seen
+
+
+def test_setters_emit_only_when_the_value_changes(scene):
+    tool, display, params = (
+        _count(scene.tool_changed),
+        _count(scene.display_changed),
+        _count(scene.params_changed),
+    )
+    scene.set_radius(scene.radius)
+    scene.set_intensity(scene.intensity)
+    scene.set_colour_mode(scene.colour_mode)
+    scene.set_params(scene.params)
+    assert tool == [] and display == [] and params == []
+    scene.set_radius(0.5)
+    scene.set_align_mode("preserve-length")
+    scene.set_colour_mode("clump")
+    scene.set_params(scene.with_param("seed", 3))
+    assert len(tool) == 2 and len(display) == 1 and len(params) == 1
+
+
+@pytest.mark.parametrize(
+    ("setter", "value"),
+    [("set_radius", 0.0), ("set_radius", float("nan")), ("set_intensity", 1.5), ("set_align_mode", "x"),
+     ("set_colour_mode", "rainbow"), ("set_line_width", 0.0)],
+)  # fmt: skip
+def test_bad_values_raise_parameter_errors(scene, setter, value):
+    with pytest.raises(ParameterError):
+        getattr(scene, setter)(value)
+
+
+def test_bad_engine_parameter_is_named(scene):
+    with pytest.raises(ParameterError, match="stretch_stiffness"):
+        scene.with_param("stretch_stiffness", 0.5)
+
+
+def test_stroke_command_is_applied_by_the_drag_not_by_push(scene):
+    from PySide6.QtGui import QUndoStack
+
+    stack = QUndoStack()
+    before_points = scene.result.points.copy()
+    before = scene.snapshot()
+    tip = scene.result.tips[3].astype(np.float64)
+    scene.align(tip + np.array([0.5, 0.3, 0.0]))
+    after_points = scene.result.points.copy()
+    stack.push(StrokeCommand(scene, before, scene.snapshot()))
+    assert np.array_equal(scene.result.points, after_points)  # push did not re-apply
+    stack.undo()
+    assert np.array_equal(scene.result.points, before_points)
+    stack.redo()
+    assert np.array_equal(scene.result.points, after_points)
+
+
+def test_param_commands_merge_within_one_drag_only(scene):
+    from PySide6.QtGui import QUndoStack
+
+    stack = QUndoStack()
+    p0 = scene.params
+    for i, k in enumerate((8.0, 9.0, 10.0)):
+        before = scene.params
+        stack.push(
+            ParamCommand(scene, "bend_stiffness", before, scene.with_param("bend_stiffness", k), drag=1)
+        )
+        assert stack.count() == 1, i
+    before = scene.params
+    stack.push(
+        ParamCommand(scene, "bend_stiffness", before, scene.with_param("bend_stiffness", 11.0), drag=2)
+    )
+    stack.push(ParamCommand(scene, "seed", scene.params, scene.with_param("seed", 5), drag=None))
+    assert stack.count() == 3 and scene.params.seed == 5
+    stack.undo()
+    stack.undo()
+    assert scene.params.bend_stiffness == 10.0
+    stack.undo()
+    assert scene.params == p0
+
+
+def test_displacement_is_zero_at_rest_and_grows_with_a_stroke(scene):
+    scene.set_params(scene.params.replace(freeze=False, clump=False))
+    assert np.all(scene.displacement() == 0.0)
+    scene.align(scene.result.tips[0].astype(np.float64) + np.array([0.6, 0.0, 0.0]))
+    d = scene.displacement()
+    assert d.max() > 0.01 and np.all(d[scene.rest.topology.root_indices] == 0.0)
+
+
+def test_cli_help_and_bad_arguments(capsys):
+    from app.main import main
+
+    with pytest.raises(SystemExit) as e:
+        main(["--help"])
+    assert e.value.code == 0
+    assert main(["groom.hair", "--nonsense"]) == 2
+    assert "unrecognised" in capsys.readouterr().err
+
+
+@pytest.mark.gui
+def test_benchmark_runs_and_reports_the_breakdown(qapp, capsys):
+    from app.main import main
+
+    argv = ["--bench", "--only", "large", "--strands", "30", "--vertices", "6", "--moves", "3", "--json"]
+    assert main(argv) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert len(rows) == 1 and rows[0]["strands"] == 30 and rows[0]["moves"] == 3
+    for key in ("total_ms", "pipeline_ms", "upload_ms", "draw_ms"):
+        assert rows[0][key] >= 0.0
+    assert rows[0]["total_ms"] >= rows[0]["draw_ms"]
