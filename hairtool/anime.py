@@ -249,4 +249,4 @@ def cycle_animation(
         )
     b = make_bunches(groom, **variation) if bunches is None else bunches
     pictures = pose_pictures(groom, params, sched.picture_times, b).astype(np.float32)
-    return Animation(pictures[exposure], groom.topology, sched.fps, **groom._attributes())
+    return Animation(pictures[exposure], groom.topology, sched.fps, **groom.attributes)

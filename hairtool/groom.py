@@ -133,7 +133,14 @@ class _Attributes:
         self.transparency = _check_attribute(transparency, vertex_count, 1, "transparency")
         self.colors = _check_attribute(colors, vertex_count, 3, "colors")
 
-    def _attributes(self) -> dict[str, F32 | None]:
+    @property
+    def attributes(self) -> dict[str, F32 | None]:
+        """The optional per-vertex arrays by keyword: ``thickness`` and ``transparency`` ``(V,)``,
+        ``colors`` ``(V, 3)``, float32 and read-only, or None where absent.
+
+        The keys are the constructors' keywords, so ``Groom(points, topology, **g.attributes)``
+        carries them over; a new dict each time, the arrays shared (not copied).
+        """
         return {"thickness": self.thickness, "transparency": self.transparency, "colors": self.colors}
 
 
@@ -175,7 +182,7 @@ class Groom(_Attributes):
 
     def with_points(self, points: ArrayLike) -> Groom:
         """The same strands and attributes at new positions."""
-        return Groom(points, self.topology, **self._attributes())
+        return Groom(points, self.topology, **self.attributes)
 
     # -- sizes -------------------------------------------------------------------------
     @property
@@ -226,7 +233,7 @@ class Groom(_Attributes):
         if ids.min() < 0 or ids.max() >= self.strand_count:
             raise GroomError(f"strand ids must lie in [0, {self.strand_count})")
         vids = vertex_ids_of(self.topology, ids)
-        pick = {k: (None if v is None else v[vids]) for k, v in self._attributes().items()}
+        pick = {k: (None if v is None else v[vids]) for k, v in self.attributes.items()}
         return Groom(self.points[vids], self.counts[ids], **pick)
 
     # -- per-vertex --------------------------------------------------------------------
@@ -330,10 +337,10 @@ class Animation(_Attributes):
         for i, g in enumerate(grooms):
             if g.topology != top:
                 raise GroomError(f"frame {i} has a different strand topology from frame 0")
-        return cls(np.stack([g.points for g in grooms]), top, fps, **grooms[0]._attributes())
+        return cls(np.stack([g.points for g in grooms]), top, fps, **grooms[0].attributes)
 
     def with_frames(self, frames: ArrayLike, fps: float | None = None) -> Animation:
-        return Animation(frames, self.topology, self.fps if fps is None else fps, **self._attributes())
+        return Animation(frames, self.topology, self.fps if fps is None else fps, **self.attributes)
 
     @property
     def counts(self) -> I64:
@@ -364,7 +371,7 @@ class Animation(_Attributes):
         """Frame ``f`` as a groom (negative indices count from the end)."""
         if not -self.n_frames <= f < self.n_frames:
             raise IndexError(f"frame {f} is outside 0..{self.n_frames - 1}")
-        return Groom(self.frames[f], self.topology, **self._attributes())
+        return Groom(self.frames[f], self.topology, **self.attributes)
 
     @property
     def rest(self) -> Groom:

@@ -148,6 +148,7 @@ def simulate(
     head_radius: float = 1.0,
     seed: int = 0,
     backend: str = "numba",
+    progress: Callable[[int, int], object] | None = None,
 ) -> Animation:
     """Simulate ``groom`` (its pose at time 0) on a moving head; returns ``frames`` frames at ``fps``.
 
@@ -160,6 +161,8 @@ def simulate(
         (:func:`gust_schedule`) or explicit :class:`Gust` objects.
     collide: keep vertices outside the head sphere (centre, radius at t = 0, moving with the head);
         a vertex whose rest pose is closer to the centre than the radius is held at that distance.
+    progress: called as ``progress(done, frames)`` after every frame, so a studio can show how far
+        the run is; an exception raised from it stops the simulation (how a studio cancels).
     """
     frames = _whole("frames", frames, 1, 1_000_000)
     substeps = _whole("substeps", substeps, 1, 1000)
@@ -251,7 +254,9 @@ def simulate(
                 decay,
             )
             out[f] = x
-    return Animation(out, groom.topology, fps, **groom._attributes())
+            if progress is not None:
+                progress(f + 1, frames)
+    return Animation(out, groom.topology, fps, **groom.attributes)
 
 
 def simulate_reference(groom: Groom, **kwargs) -> Animation:

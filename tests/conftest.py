@@ -59,3 +59,28 @@ def motion_dir() -> Path:
     if not MOTION.is_dir():
         pytest.fail(f"motion captures are expected in {MOTION}")
     return MOTION
+
+
+@pytest.fixture
+def quick_bench(capsys):
+    """``quick_bench(NAME, *ARGS, times=COLUMNS)``: the JSON rows of ``hairtool bench NAME --quick
+    --json ARGS``, each of ``times`` checked to be a positive finite number or None (not run).
+
+    Benchmark tests check what a bench reports, never how fast it ran.
+    """
+    import json
+    import math
+
+    from hairtool.cli import main
+
+    def run(name: str, *args: str, times: tuple[str, ...] = ()) -> list[dict]:
+        assert main(["bench", name, "--quick", "--json", *args]) == 0
+        rows = json.loads(capsys.readouterr().out)
+        assert rows, f"bench {name} returned no rows"
+        for row in rows:
+            for key in times:
+                v = row[key]
+                assert v is None or (math.isfinite(v) and v > 0), f"{key} = {v!r} in {row}"
+        return rows
+
+    return run

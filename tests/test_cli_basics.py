@@ -100,3 +100,29 @@ def test_help(command, capsys):
         main([command, "--help"])
     assert e.value.code == 0
     assert "usage: hairtool" in capsys.readouterr().out
+
+
+def test_shared_input_module_is_not_a_command():
+    from hairtool.cli import command_names
+
+    names = command_names()
+    assert "_inputs" not in names and {"anime", "simulate", "info"} <= set(names)
+
+
+def test_groom_input_spec(tmp_path):
+    from hairtool.cli._inputs import load_groom, parse_vector
+    from hairtool.errors import FormatError, ParameterError
+
+    assert load_groom("sample:scalp:12:5").points.tobytes() == scalp(12, 5).points.tobytes()
+    assert load_groom("sample:comb").strand_count > 0
+    write(tmp_path / "g.npz", scalp(3, 4))
+    assert load_groom(str(tmp_path / "g.npz")).vertex_count == 12
+    for bad in ("sample:", "sample:scalp:1:2:3", "sample:scalp:x", "sample:braid"):
+        with pytest.raises(ParameterError):
+            load_groom(bad)
+    with pytest.raises(FormatError):
+        load_groom(str(tmp_path / "absent.npz"))
+    assert parse_vector("wind", "1,-2.5,3e1") == (1.0, -2.5, 30.0)
+    for bad in ("1,2", "a,b,c", "1,2,3,4", ""):
+        with pytest.raises(ParameterError, match="three numbers"):
+            parse_vector("wind", bad)

@@ -47,6 +47,15 @@ def test_with_points_shares_topology_and_attributes():
     np.testing.assert_array_equal(h.thickness, [1, 2, 3, 4])
 
 
+def test_attributes_name_the_constructor_keywords():
+    g = Groom(np.zeros((4, 3)), [2, 2], thickness=[1, 2, 3, 4])
+    assert list(g.attributes) == ["thickness", "transparency", "colors"]
+    assert g.attributes["thickness"] is g.thickness and g.attributes["colors"] is None
+    a = Animation(np.zeros((2, 4, 3)), g.topology, **g.attributes)
+    assert a.attributes["thickness"] is not None and a.frame(1).attributes["thickness"] is not None
+    np.testing.assert_array_equal(Groom(g.points, g.topology, **g.attributes).thickness, g.thickness)
+
+
 def test_subset_keeps_order_and_attributes():
     g = Groom(np.arange(15).reshape(5, 3), [3, 2], colors=np.eye(5, 3))
     s = g.subset([1, 0])

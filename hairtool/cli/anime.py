@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from hairtool.cli._inputs import GROOM_INPUT_HELP, load_groom, parse_vector
 from hairtool.errors import ParameterError
 
 HELP = "anime hair cycles: limited-animation schedule, wave poses, errors against a reference"
@@ -24,7 +25,7 @@ HELP = "anime hair cycles: limited-animation schedule, wave poses, errors agains
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
-    parser.add_argument("input", nargs="?", metavar="IN", help="groom/animation file or sample:NAME[:S[:V]]")
+    parser.add_argument("input", nargs="?", metavar="IN", help=GROOM_INPUT_HELP)
     parser.add_argument("output", nargs="?", metavar="OUT", help="write the animation here (.npz, .usda, …)")
     t = parser.add_argument_group("timing")
     t.add_argument("--period", type=float, default=0.45, help="T: seconds per cycle (default 0.45)")
@@ -63,34 +64,6 @@ def parse_ids(text: str) -> list[int]:
     return ids
 
 
-def parse_vector(name: str, text: str) -> tuple[float, float, float]:
-    try:
-        v = tuple(float(c) for c in text.split(","))
-    except ValueError:
-        v = ()
-    if len(v) != 3:
-        raise ParameterError(name, text, "three numbers x,y,z")
-    return v  # type: ignore[return-value]
-
-
-def load_input(spec: str):
-    """A groom from a file or ``sample:NAME[:STRANDS[:VERTICES]]`` (samples use their seed 0)."""
-    if spec.startswith("sample:"):
-        from hairtool.samples import sample
-
-        parts = spec.split(":")[1:]
-        if not 1 <= len(parts) <= 3:
-            raise ParameterError("IN", spec, "sample:NAME[:STRANDS[:VERTICES]]")
-        try:
-            sizes = [int(p) for p in parts[1:]]
-        except ValueError:
-            raise ParameterError("IN", spec, "whole numbers for STRANDS and VERTICES") from None
-        return sample(parts[0], *sizes)
-    from hairtool.io import read_groom
-
-    return read_groom(spec)
-
-
 def run(args: argparse.Namespace) -> int:
     from hairtool.anime import WaveParams, cycle_animation
     from hairtool.anime_schedule import schedule, write_sheet
@@ -120,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
 
         if args.output is not None:
             out_fmt = format_for(args.output, writing=True)  # refuse a bad extension before posing
-        groom = load_input(args.input)
+        groom = load_groom(args.input)
         variation = {
             "guides": None if args.guides is None else parse_ids(args.guides),
             "sway": None if args.sway is None else parse_vector("sway", args.sway),

@@ -36,7 +36,7 @@ def summary(path: str) -> dict:
             "max": int(counts.max()),
         },
         "bounds": {"min": [float(x) for x in lo], "max": [float(x) for x in hi]},
-        "attributes": [name for name, a in obj._attributes().items() if a is not None],
+        "attributes": [name for name, a in obj.attributes.items() if a is not None],
     }
     if isinstance(obj, Animation):
         out["frames"] = obj.n_frames

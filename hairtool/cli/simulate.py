@@ -15,7 +15,7 @@ import argparse
 import json
 import time
 
-from hairtool.errors import ParameterError
+from hairtool.cli._inputs import GROOM_INPUT_HELP, load_groom, parse_vector
 
 HELP = "simulate hair dynamics on a moving head (turn, nod, shake, hop, wind gusts)"
 
@@ -24,7 +24,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from hairtool.simulate import GRAVITY
 
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
-    parser.add_argument("input", metavar="IN", help="groom/animation file or sample:NAME[:S[:V]]")
+    parser.add_argument("input", metavar="IN", help=GROOM_INPUT_HELP)
     parser.add_argument("output", metavar="OUT", help="animation file (.npz, .usda, …; others keep frame 0)")
     m = parser.add_argument_group("motion")
     m.add_argument(
@@ -49,34 +49,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print a JSON object")
 
 
-def _vector(name: str, text: str) -> tuple[float, float, float]:
-    try:
-        v = tuple(float(c) for c in text.split(","))
-    except ValueError:
-        v = ()
-    if len(v) != 3:
-        raise ParameterError(name, text, "three numbers x,y,z")
-    return v  # type: ignore[return-value]
-
-
-def load_groom(spec: str):
-    """A groom from a file or ``sample:NAME[:STRANDS[:VERTICES]]``."""
-    if spec.startswith("sample:"):
-        from hairtool.samples import sample
-
-        parts = spec.split(":")[1:]
-        if not 1 <= len(parts) <= 3:
-            raise ParameterError("IN", spec, "sample:NAME[:STRANDS[:VERTICES]]")
-        try:
-            sizes = [int(p) for p in parts[1:]]
-        except ValueError:
-            raise ParameterError("IN", spec, "whole numbers for STRANDS and VERTICES") from None
-        return sample(parts[0], *sizes)
-    from hairtool.io import read_groom
-
-    return read_groom(spec)
-
-
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -88,10 +60,10 @@ def run(args: argparse.Namespace) -> int:
     motion = parse_motion(args.motion)
     wind = None
     if args.wind is not None:
-        w = np.asarray(_vector("wind", args.wind))
+        w = np.asarray(parse_vector("wind", args.wind))
         strength = float(np.linalg.norm(w))
         wind = (w if strength > 0 else (0.0, 0.0, 1.0), strength)
-    centre = _vector("head-center", args.head_center)
+    centre = parse_vector("head-center", args.head_center)
     groom = load_groom(args.input)
     t0 = time.perf_counter()
     anim = simulate(

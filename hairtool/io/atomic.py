@@ -1,12 +1,53 @@
-"""Writes that never leave a half file: write beside the target, then rename over it."""
+"""Writes that never leave a half file: write beside the target, then rename over it.
+
+The renamed file gets the permissions a plain ``open(path, "w")`` would give it: the mode of the
+file it replaces, or 0o666 less the process umask for a new file (a ``mkstemp`` file is 0o600,
+which would leave the user's groom unreadable to the rest of the studio).
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
+import secrets
+import stat
 from collections.abc import Iterator
 from pathlib import Path
+
+_CREATE_FLAGS = (
+    os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOFOLLOW", 0)
+)
+
+
+def _create_temp(target: Path) -> tuple[Path, int]:
+    """A new empty file beside ``target`` and the mode a new file gets here (umask applied).
+
+    The file is created with mode 0o666 and the system takes the umask (and any default ACL)
+    off, as for any new file; reading that mode back avoids ``os.umask``, whose set-and-restore
+    would briefly change the umask of every thread in the process.
+    """
+    folder = target.parent if str(target.parent) else Path(".")
+    for _ in range(100):
+        tmp = folder / f".{target.name}.{secrets.token_hex(4)}.tmp{target.suffix}"
+        try:
+            fd = os.open(tmp, _CREATE_FLAGS, 0o666)
+        except FileExistsError:
+            continue
+        try:
+            mode = stat.S_IMODE(os.fstat(fd).st_mode)
+        finally:
+            os.close(fd)
+        return tmp, mode
+    raise FileExistsError(f"no free temporary name beside {target}")
+
+
+def _final_mode(target: Path, new_file_mode: int) -> int:
+    """The mode of the file being replaced (permission bits only), else that of a new file."""
+    try:
+        st = os.stat(target)
+    except OSError:
+        return new_file_mode
+    return stat.S_IMODE(st.st_mode) & 0o777 if stat.S_ISREG(st.st_mode) else new_file_mode
 
 
 @contextlib.contextmanager
@@ -14,15 +55,15 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a temporary path in the target's folder (same suffix); rename it over ``path`` on success.
 
     For writers that need a file name (usd-core, imageio). On any exception the temporary file
-    is removed and the previous ``path``, if any, is untouched.
+    is removed and the previous ``path``, if any, is untouched. The result keeps the mode of the
+    file it replaces; a new file gets 0o666 less the umask.
     """
     target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=f".tmp{target.suffix}", dir=folder)
-    os.close(fd)
-    tmp_path = Path(tmp)
+    tmp_path, new_file_mode = _create_temp(target)
     try:
         yield tmp_path
+        # After the writer: some (usd-core) replace the file at tmp_path with their own.
+        os.chmod(tmp_path, _final_mode(target, new_file_mode))
         os.replace(tmp_path, target)
     except BaseException:
         with contextlib.suppress(OSError):

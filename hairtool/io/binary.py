@@ -15,13 +15,22 @@ import numpy as np
 from hairtool.errors import FormatError
 
 
-def read_bytes(path: Path, min_size: int, what: str) -> bytes:
-    """The whole file; an empty file, or one shorter than its fixed header, is a FormatError."""
-    data = path.read_bytes()
+def require_size(path: str | os.PathLike[str], data: bytes, min_size: int, what: str) -> None:
+    """An empty file, or one shorter than its ``what`` header of ``min_size`` bytes, is a FormatError."""
     if not data:
         raise FormatError(path, "the file is empty")
     if len(data) < min_size:
         raise FormatError(path, f"the file has {len(data)} bytes, too short for a {what} header ({min_size})")
+
+
+def read_bytes(path: Path, min_size: int, what: str, limit: int | None = None) -> bytes:
+    """The whole file (its first ``limit`` bytes with ``limit``), checked by :func:`require_size`."""
+    if limit is None:
+        data = path.read_bytes()
+    else:
+        with open(path, "rb") as f:
+            data = f.read(limit)
+    require_size(path, data, min_size, what)
     return data
 
 

@@ -98,13 +98,7 @@ def _parse_header(path: Path, data: bytes) -> HairHeader:
 def read_header(path: str | os.PathLike[str]) -> HairHeader:
     """The header alone: counts, array flags, defaults for absent arrays and the info string."""
     p = Path(path)
-    with open(p, "rb") as f:
-        data = f.read(HEADER_SIZE)
-    if not data:
-        raise FormatError(p, "the file is empty")
-    if len(data) < HEADER_SIZE:
-        raise FormatError(p, f"the file has {len(data)} bytes, too short for a HAIR header ({HEADER_SIZE})")
-    return _parse_header(p, data)
+    return _parse_header(p, read_bytes(p, HEADER_SIZE, "HAIR", limit=HEADER_SIZE))
 
 
 def read(path: Path) -> Groom:

@@ -50,7 +50,7 @@ def write(path: Path, obj: Groom | Animation) -> None:
         arrays.update(kind=np.array("animation"), frames=obj.frames, fps=np.array(obj.fps, dtype=np.float64))
     else:
         arrays.update(kind=np.array("groom"), points=obj.points)
-    for name, a in obj._attributes().items():
+    for name, a in obj.attributes.items():
         if a is not None:
             arrays[name] = a
     with atomic_open(path, "wb") as f:
@@ -88,19 +88,21 @@ def _check_members(path: Path, zf: zipfile.ZipFile, file_size: int) -> None:
             raise FormatError(path, f"member {name!r}: shape {shape} does not match its stored size")
 
 
-def _scalar(path: Path, z, name: str, kind: str) -> object:
+def _member(path: Path, z, name: str) -> np.ndarray:
     if name not in z.files:
         raise FormatError(path, f"missing {name!r}")
-    a = z[name]
+    return z[name]
+
+
+def _scalar(path: Path, z, name: str, kind: str) -> object:
+    a = _member(path, z, name)
     if a.shape != () or a.dtype.kind not in kind:
         raise FormatError(path, f"{name!r} must be a scalar of kind {kind!r}, got {a.dtype} {a.shape}")
     return a.item()
 
 
 def _array(path: Path, z, name: str, ndim: int, kind: str) -> np.ndarray:
-    if name not in z.files:
-        raise FormatError(path, f"missing {name!r}")
-    a = z[name]
+    a = _member(path, z, name)
     if a.ndim != ndim or a.dtype.kind not in kind:
         raise FormatError(
             path, f"{name!r} must be a {ndim}-D array of kind {kind!r}, got {a.dtype} {a.shape}"

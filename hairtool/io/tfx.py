@@ -23,7 +23,7 @@ import numpy as np
 
 from hairtool.errors import FormatError
 from hairtool.groom import Groom
-from hairtool.io.binary import array_at, read_bytes, require_finite
+from hairtool.io.binary import array_at, read_bytes, require_finite, require_size
 
 V4_HEADER_SIZE = 160
 V3_OFFSETS_AT = 144
@@ -60,8 +60,7 @@ def _optional(path: Path, data: bytes, offset: int, dtype: str, count: int) -> n
 
 
 def _read_v4(path: Path, data: bytes) -> Groom:
-    if len(data) < V4_HEADER_SIZE:
-        raise FormatError(path, f"{len(data)} bytes, too short for a TressFX 4 header ({V4_HEADER_SIZE})")
+    require_size(path, data, V4_HEADER_SIZE, "TressFX 4")
     h = [int(x) for x in np.frombuffer(data, "<u4", count=7, offset=4)]
     strands, per_strand = _sizes(path, h[0], h[1])
     off_pos, _off_suv, _off_vuv, off_thick, off_color = h[2:7]
@@ -84,8 +83,7 @@ def _read_v4(path: Path, data: bytes) -> Groom:
 
 
 def _read_v3(path: Path, data: bytes) -> Groom:
-    if len(data) < V3_HEADER_SIZE:
-        raise FormatError(path, f"{len(data)} bytes, too short for a TressFX 3 header ({V3_HEADER_SIZE})")
+    require_size(path, data, V3_HEADER_SIZE, "TressFX 3")
     strands_raw, per_strand_raw = (int(x) for x in np.frombuffer(data, "<u4", count=2, offset=4))
     strands, per_strand = _sizes(path, strands_raw, per_strand_raw)
     off_pos = int(np.frombuffer(data, "<u4", count=1, offset=V3_OFFSETS_AT)[0])
