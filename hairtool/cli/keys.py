@@ -164,10 +164,9 @@ def run(args: argparse.Namespace) -> int:
     if args.export is not None:
         if kind != "animation":
             raise ParameterError("export", str(args.export), "an animation input (hair strands)")
-        from hairtool.io import usd
+        from hairtool.keys_export import write_key_poses
 
-        poses = data.with_frames(data.frames[sel.keys])
-        usd.write(args.export, poses, time_codes=sel.keys.tolist())
+        write_key_poses(args.export, data, sel.keys)
     line = (
         f"{sel.n_keys} keys of {n} frames, {sel.objective} error {sel.cost:.6g} "
         f"(uniform {sel.uniform_cost:.6g}): {' '.join(map(str, sel.keys.tolist()))}"
@@ -177,17 +176,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _emit(args: argparse.Namespace, result: dict, line: str) -> int:
     if args.out is not None:
-        from hairtool.io.atomic import atomic_open
+        from hairtool.keys_export import keys_record, write_keys_json
 
-        keys = result.get("keys", result.get("union", []))
-        record = {
-            "input": str(args.input),
-            "frames": result["frames"],
-            "fps": result["fps"],
-            "keys": [{"frame": int(k), "time": int(k) / result["fps"]} for k in keys],
-            **{k: v for k, v in result.items() if k not in ("keys", "frames", "fps", "curve")},
-        }
-        with atomic_open(args.out, "w", encoding="utf-8") as f:
-            json.dump(record, f, indent=1)
+        write_keys_json(args.out, keys_record(result, args.input))
     print(json.dumps(result) if args.json else line)
     return 0

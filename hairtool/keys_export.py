@@ -1,0 +1,229 @@
+"""Keys leave hairtool in three forms: a JSON record, a CSV key sheet, and USD key poses.
+
+- JSON (``write_keys_json``/``read_keys_json``): frame numbers and times of the keys, the solve's
+  parameters and costs, for pipelines and for reopening a solve.
+- CSV (``write_key_sheet``): one row per frame, like an animator's exposure sheet: whether the
+  frame is a key, which keys it lies between and its interpolation weight, so a reader can
+  rebuild every in-between without hairtool.
+- USD (``write_key_poses``): only the key poses as time samples at their frame numbers; USD
+  readers interpolate linearly between samples, so the file plays back as the linear
+  reconstruction in any USD viewer.
+
+The CLI (``hairtool keys --out/--export``) and the studio both write through this module.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from hairtool.errors import FormatError, ParameterError
+from hairtool.groom import Animation
+from hairtool.io.atomic import atomic_open
+
+FORMAT = "hairtool keys"
+FORMAT_VERSION = 1
+JSON_SUFFIXES = (".json",)
+CSV_SUFFIXES = (".csv",)
+USD_SUFFIXES = (".usd", ".usda", ".usdc")
+# Results that are large or only useful on screen; the record keeps everything else.
+_NOT_RECORDED = ("keys", "frames", "fps", "curve")
+
+
+def _check_keys(keys: ArrayLike, n_frames: int) -> NDArray[np.int64]:
+    k = np.asarray(keys)
+    if k.ndim != 1 or k.size == 0:
+        raise ParameterError("keys", k.tolist() if k.size < 8 else f"{k.size} values", "a 1-D list of frames")
+    if not np.issubdtype(k.dtype, np.integer):
+        if not np.all(np.isfinite(k)) or np.any(k != np.round(k)):
+            raise ParameterError("keys", k.tolist()[:8], "whole frame numbers")
+    k = k.astype(np.int64)
+    if np.any(np.diff(k) <= 0) or k[0] < 0 or k[-1] >= n_frames:
+        raise ParameterError("keys", k.tolist()[:8], f"strictly increasing frames in [0, {n_frames})")
+    return k
+
+
+def _plain(value: Any) -> Any:
+    """JSON-ready copy: numpy scalars and arrays become Python numbers and lists."""
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def keys_record(result: Mapping[str, Any], source: str | os.PathLike[str] | None = None) -> dict:
+    """The JSON record of one solve.
+
+    ``result``: ``{"frames": n, "fps": fps, **Selection.to_dict(), ...}`` as ``hairtool keys
+    --json`` prints it (per-channel results carry ``union`` instead of ``keys``). The record
+    keeps everything but the cost curve, and lists each key as ``{"frame", "time"}``.
+    """
+    try:
+        n, fps = int(result["frames"]), float(result["fps"])
+    except (KeyError, TypeError, ValueError):
+        raise ParameterError("result", sorted(result), "a mapping with frames and fps") from None
+    if not (math.isfinite(fps) and fps > 0):
+        raise ParameterError("fps", fps, "a positive frame rate")
+    keys = _check_keys(result.get("keys", result.get("union", [])), n)
+    return {
+        "format": FORMAT,
+        "version": FORMAT_VERSION,
+        "input": None if source is None else str(source),
+        "frames": n,
+        "fps": fps,
+        "keys": [{"frame": int(k), "time": int(k) / fps} for k in keys],
+        **{k: _plain(v) for k, v in result.items() if k not in _NOT_RECORDED},
+    }
+
+
+def record_keys(record: Mapping[str, Any]) -> NDArray[np.int64]:
+    """The key frame numbers of a record, as int64."""
+    return np.array([k["frame"] for k in record["keys"]], dtype=np.int64)
+
+
+def write_keys_json(path: str | os.PathLike[str], record: Mapping[str, Any]) -> None:
+    """Write a record from :func:`keys_record`, atomically."""
+    try:
+        with atomic_open(path, "w", encoding="utf-8") as f:
+            json.dump(_plain(record), f, indent=1, allow_nan=False)
+            f.write("\n")
+    except ValueError as e:  # a NaN or infinity in the costs
+        raise FormatError(path, f"cannot write the keys: {e}") from None
+    except OSError as e:
+        raise FormatError(path, f"cannot write: {e}") from None
+
+
+def read_keys_json(path: str | os.PathLike[str]) -> dict:
+    """Read and check a keys record; :class:`FormatError` names the file on any bad input.
+
+    Records written before the format field existed (``hairtool keys --out`` of version 0.1)
+    are accepted when their keys, frames and fps are valid.
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise FormatError(path, f"cannot read: {e}") from None
+    try:
+        record = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise FormatError(path, f"not JSON: {e}") from None
+    if not isinstance(record, dict):
+        raise FormatError(path, "a keys record is a JSON object")
+    if record.get("format", FORMAT) != FORMAT:
+        raise FormatError(path, f"format is {record.get('format')!r}, not {FORMAT!r}")
+    version = record.get("version", FORMAT_VERSION)
+    if version != FORMAT_VERSION:
+        raise FormatError(path, f"keys format version {version!r}; this hairtool reads {FORMAT_VERSION}")
+    n, fps, keys = record.get("frames"), record.get("fps"), record.get("keys")
+    if not isinstance(n, int) or isinstance(n, bool) or n < 1:
+        raise FormatError(path, f"'frames' is {n!r}; expected a whole number ≥ 1")
+    if not isinstance(fps, (int, float)) or isinstance(fps, bool) or not (math.isfinite(fps) and fps > 0):
+        raise FormatError(path, f"'fps' is {fps!r}; expected a positive number")
+    if not isinstance(keys, list) or not all(
+        isinstance(k, dict) and isinstance(k.get("frame"), int) and not isinstance(k.get("frame"), bool)
+        for k in keys
+    ):
+        raise FormatError(path, '\'keys\' must be a list of {"frame": int, "time": seconds}')
+    try:
+        _check_keys([k["frame"] for k in keys], n)
+    except ParameterError as e:
+        raise FormatError(path, str(e)) from None
+    return record
+
+
+def sheet_rows(
+    n_frames: int, fps: float, keys: ArrayLike, uniform_keys: ArrayLike | None = None
+) -> list[list[Any]]:
+    """Rows of the key sheet (header first): frame, time, key, key number, previous and next
+    key, interpolation weight s (frame = (1 − s)·previous + s·next), and the uniform key column
+    when ``uniform_keys`` is given."""
+    k = _check_keys(keys, n_frames)
+    header = ["frame", "time", "key", "key_number", "previous_key", "next_key", "weight"]
+    uni = None
+    if uniform_keys is not None:
+        uni = set(_check_keys(uniform_keys, n_frames).tolist())
+        header.append("uniform_key")
+    rows: list[list[Any]] = [header]
+    frames = np.arange(n_frames)
+    right = np.clip(np.searchsorted(k, frames, side="left"), 0, k.size - 1)
+    for f in frames.tolist():
+        j = int(right[f])
+        is_key = k[j] == f
+        if is_key:
+            prev = nxt = f
+            weight = 0.0
+        elif f < k[0] or f > k[-1]:  # outside the keyed range: held at the nearest key
+            prev = nxt = int(k[0] if f < k[0] else k[-1])
+            weight = 0.0
+        else:
+            prev, nxt = int(k[j - 1]), int(k[j])
+            weight = (f - prev) / (nxt - prev)
+        row = [f, repr(round(f / fps, 9)), int(is_key), j + 1 if is_key else "", prev, nxt]
+        row.append(repr(round(weight, 9)))
+        if uni is not None:
+            row.append(int(f in uni))
+        rows.append(row)
+    return rows
+
+
+def write_key_sheet(path: str | os.PathLike[str], record: Mapping[str, Any]) -> None:
+    """Write the CSV key sheet of a record (one row per frame), atomically."""
+    uniform = record.get("uniform", {}).get("keys") if isinstance(record.get("uniform"), dict) else None
+    rows = sheet_rows(int(record["frames"]), float(record["fps"]), record_keys(record), uniform)
+    try:
+        with atomic_open(path, "w", newline="", encoding="utf-8") as f:
+            csv.writer(f).writerows(rows)
+    except OSError as e:
+        raise FormatError(path, f"cannot write: {e}") from None
+
+
+def write_key_poses(
+    path: str | os.PathLike[str], animation: Animation, keys: Sequence[int] | ArrayLike
+) -> None:
+    """Write USD with only the key poses, each at its frame number as time code (atomically)."""
+    from hairtool.io import usd
+
+    k = _check_keys(keys, animation.n_frames)
+    if Path(path).suffix.lower() not in USD_SUFFIXES:
+        raise FormatError(path, f"key poses are written as USD ({', '.join(USD_SUFFIXES)})")
+    poses = animation.with_frames(animation.frames[k])
+    try:
+        usd.write(Path(path), poses, time_codes=k.tolist())
+    except OSError as e:
+        raise FormatError(path, f"cannot write: {e}") from None
+
+
+def export_keys(
+    path: str | os.PathLike[str], record: Mapping[str, Any], animation: Animation | None = None
+) -> None:
+    """Write keys in the format the suffix names: .json record, .csv sheet, .usd/.usda/.usdc poses."""
+    suffix = Path(path).suffix.lower()
+    if suffix in JSON_SUFFIXES:
+        write_keys_json(path, record)
+    elif suffix in CSV_SUFFIXES:
+        write_key_sheet(path, record)
+    elif suffix in USD_SUFFIXES:
+        if animation is None:
+            raise FormatError(path, "key poses need the animation the keys were chosen from")
+        if animation.n_frames != int(record["frames"]):
+            raise FormatError(
+                path, f"the keys are for {record['frames']} frames but the animation has {animation.n_frames}"
+            )
+        write_key_poses(path, animation, record_keys(record))
+    else:
+        usd = ", ".join(USD_SUFFIXES)
+        raise FormatError(path, f"keys are written as .json, .csv or {usd}, not '{suffix}'")

@@ -1,0 +1,420 @@
+"""A studio project in one file: the groom, its strokes, every setting and the animation.
+
+The file (``.hairproj``) is a zip archive: ``manifest.json`` (format, version, engine
+parameters, brush, display, key and other settings, and the list of array members) and one
+``.npy`` member per array (rest groom, stroke log, the aligned state of the stroke snapshot,
+the animation's frames). A zip keeps the manifest readable with any tool, the arrays exact
+(float32/float64 bit for bit), lets a reader check every member's size and checksum before
+it trusts it, and loads with ``allow_pickle=False``.
+
+Saving writes a temporary file beside the target and renames it, so an interrupted save never
+harms the previous project. Loading checks everything and raises one
+:class:`~hairtool.errors.FormatError` naming the file for a truncated, corrupt, foreign or
+newer-version file.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import json
+import math
+import os
+import struct
+import time
+import zipfile
+import zlib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import hairtool
+from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterError
+from hairtool.frozen import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
+from hairtool.groom import Animation, Groom
+from hairtool.io.atomic import atomic_open
+from hairtool.io.binary import require_finite, require_strand_counts
+
+FORMAT = "hairtool project"
+FORMAT_VERSION = 1
+SUFFIX = ".hairproj"
+MANIFEST = "manifest.json"
+MAX_MANIFEST_BYTES = 64 * 1024**2
+_MAX_DEFLATE_RATIO = 1100  # zlib never expands more than about 1032:1; more is a corrupt header
+_ATTRIBUTES = ("thickness", "transparency", "colors")
+_PARAM_FIELDS = tuple(f.name for f in dataclasses.fields(FrozenParams) if f.init)
+_READ_ERRORS = (
+    ValueError,
+    OSError,
+    EOFError,
+    KeyError,
+    TypeError,
+    IndexError,
+    zipfile.BadZipFile,
+    zlib.error,
+    struct.error,
+    UnicodeDecodeError,
+    NotImplementedError,
+    RuntimeError,
+    OverflowError,
+    HairtoolError,
+)
+
+
+@dataclass(frozen=True, eq=False)
+class Project:
+    """Everything the studio needs to reopen a session.
+
+    ``strokes`` and ``aligned`` are the frozen pipeline's stroke snapshot: the align log and the
+    aligned points it produced (None: replay the log on load). ``brush``, ``display``,
+    ``key_settings`` and ``settings`` are plain JSON objects the studio fills and reads back
+    (the core only checks that they are JSON). ``animation_source`` says where the animation
+    came from ("anime", "simulate", a file name …).
+    """
+
+    rest: Groom
+    params: FrozenParams = field(default_factory=FrozenParams)
+    strokes: tuple[AlignSample, ...] = ()
+    aligned: Groom | None = None
+    brush: dict = field(default_factory=dict)
+    display: dict = field(default_factory=dict)
+    animation: Animation | None = None
+    animation_source: str = ""
+    key_settings: dict = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)
+    groom_source: str | None = None
+
+    @classmethod
+    def from_pipeline(cls, pipeline: FrozenPipeline, **fields: Any) -> Project:
+        """A project of the pipeline's rest groom, parameters and stroke snapshot."""
+        snap = pipeline.snapshot()
+        return cls(
+            rest=pipeline.rest, params=pipeline.params, strokes=snap.log, aligned=snap.aligned, **fields
+        )
+
+    def stroke_snapshot(self, pipeline: FrozenPipeline) -> FrozenSnapshot:
+        """The stroke snapshot to ``restore`` on a pipeline built from this project's rest and params.
+
+        With ``aligned`` the snapshot matches the pipeline's fresh frozen state, so no stroke is
+        replayed; without it the log is replayed.
+        """
+        current = pipeline.snapshot()
+        if self.aligned is None:
+            return FrozenSnapshot(self.strokes, pipeline.rest, ("replay",), -1)
+        return FrozenSnapshot(self.strokes, self.aligned, current.freeze_key, current.draw)
+
+    def pipeline(self) -> FrozenPipeline:
+        """A pipeline in the saved state: rest, parameters and strokes."""
+        p = FrozenPipeline(self.rest, self.params)
+        p.restore(self.stroke_snapshot(p))
+        return p
+
+
+# -- writing ---------------------------------------------------------------------------------
+def _params_json(params: FrozenParams, arrays: dict[str, np.ndarray]) -> dict:
+    out: dict[str, Any] = {}
+    for name in _PARAM_FIELDS:
+        value = getattr(params, name)
+        if name == "strand_variation" and np.ndim(value) != 0:
+            arrays["params/strand_variation.npy"] = np.asarray(value, dtype=np.float64)
+            value = {"array": "params/strand_variation.npy"}
+        elif isinstance(value, (np.generic,)):
+            value = value.item()
+        out[name] = value
+    return out
+
+
+def _groom_arrays(prefix: str, obj: Groom | Animation, arrays: dict[str, np.ndarray]) -> dict:
+    arrays[f"{prefix}/counts.npy"] = np.asarray(obj.counts, dtype=np.int64)
+    if isinstance(obj, Animation):
+        arrays[f"{prefix}/frames.npy"] = obj.frames
+    else:
+        arrays[f"{prefix}/points.npy"] = obj.points
+    attrs = []
+    for name in _ATTRIBUTES:
+        value = getattr(obj, name)
+        if value is not None:
+            arrays[f"{prefix}/{name}.npy"] = value
+            attrs.append(name)
+    return {"attributes": attrs}
+
+
+def _json_object(name: str, value: Any) -> dict:
+    if not isinstance(value, Mapping):
+        raise ParameterError(name, type(value).__name__, "a dict of plain JSON values")
+    return dict(value)
+
+
+def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
+    """The manifest (JSON-ready) and the arrays, by member name, that :func:`save` writes."""
+    arrays: dict[str, np.ndarray] = {}
+    manifest: dict[str, Any] = {
+        "format": FORMAT,
+        "version": FORMAT_VERSION,
+        "writer": f"hairtool {hairtool.__version__}",
+        "saved": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        "groom": {"source": project.groom_source, **_groom_arrays("groom", project.rest, arrays)},
+        "params": _params_json(project.params, arrays),
+    }
+    modes = sorted({s.mode for s in project.strokes})
+    n = len(project.strokes)
+    arrays["strokes/cursor.npy"] = np.array([s.cursor for s in project.strokes], np.float64).reshape(n, 3)
+    arrays["strokes/radius.npy"] = np.array([s.radius for s in project.strokes], np.float64)
+    arrays["strokes/intensity.npy"] = np.array([s.intensity for s in project.strokes], np.float64)
+    arrays["strokes/mode.npy"] = np.array([modes.index(s.mode) for s in project.strokes], np.int64)
+    manifest["strokes"] = {"count": n, "modes": modes, "aligned": project.aligned is not None}
+    if project.aligned is not None:
+        if project.aligned.topology != project.rest.topology:
+            raise GroomError("the aligned state must have the rest groom's strands")
+        arrays["strokes/aligned.npy"] = project.aligned.points
+    if project.animation is not None:
+        info = _groom_arrays("animation", project.animation, arrays)
+        manifest["animation"] = {"fps": project.animation.fps, "source": project.animation_source, **info}
+    else:
+        manifest["animation"] = None
+    for name in ("brush", "display", "key_settings", "settings"):
+        manifest[name] = _json_object(name, getattr(project, name))
+    manifest["arrays"] = sorted(arrays)
+    return manifest, arrays
+
+
+def save(path: str | os.PathLike[str], project: Project, *, compress: bool = False) -> None:
+    """Write ``project`` to ``path`` atomically (temporary file, then rename).
+
+    ``compress``: deflate the arrays too. Off by default: float coordinates barely compress
+    (8 % on a 2,000-strand groom with a 44-frame animation) while deflating made the save
+    about 9× slower (1.4 s against 0.16 s). On any error the previous file is untouched.
+    """
+    manifest, arrays = manifest_and_arrays(project)
+    try:
+        text = json.dumps(manifest, indent=1, allow_nan=False)
+    except (TypeError, ValueError) as e:
+        raise FormatError(path, f"the settings are not plain JSON: {e}") from None
+    method = zipfile.ZIP_DEFLATED if compress else zipfile.ZIP_STORED
+    try:
+        with atomic_open(path, "wb") as f, zipfile.ZipFile(f, "w", method, compresslevel=1) as zf:
+            zf.writestr(MANIFEST, text, compress_type=zipfile.ZIP_DEFLATED)
+            for name, array in arrays.items():
+                info = zipfile.ZipInfo(name, date_time=time.localtime()[:6])
+                info.compress_type = method
+                with zf.open(info, "w", force_zip64=array.nbytes > 2**31) as member:
+                    np.lib.format.write_array(member, np.ascontiguousarray(array), allow_pickle=False)
+    except OSError as e:
+        raise FormatError(path, f"cannot write: {e}") from None
+
+
+# -- reading ---------------------------------------------------------------------------------
+class _Reader:
+    """Checked access to the members of one project archive."""
+
+    def __init__(self, path: Path, zf: zipfile.ZipFile, file_size: int) -> None:
+        self.path, self.zf = path, zf
+        infos = zf.infolist()
+        names = [i.filename for i in infos]
+        if len(set(names)) != len(names):
+            raise FormatError(path, "the archive names a member twice")
+        self.infos = {i.filename: i for i in infos}
+        for info in infos:
+            if info.compress_size > file_size:
+                raise FormatError(path, f"member {info.filename!r} claims more bytes than the file has")
+            limit = (
+                info.compress_size
+                if info.compress_type == zipfile.ZIP_STORED
+                else _MAX_DEFLATE_RATIO * info.compress_size + 1024
+            )
+            if info.file_size > limit:
+                raise FormatError(path, f"member {info.filename!r} claims an impossible size")
+
+    def manifest(self) -> dict:
+        info = self.infos.get(MANIFEST)
+        if info is None:
+            raise FormatError(self.path, "not a hairtool project (no manifest.json)")
+        if info.file_size > MAX_MANIFEST_BYTES:
+            raise FormatError(self.path, "manifest.json is too large")
+        try:
+            manifest = json.loads(self.zf.read(MANIFEST).decode("utf-8"))
+        except json.JSONDecodeError as e:
+            raise FormatError(self.path, f"manifest.json is not JSON: {e}") from None
+        if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
+            raise FormatError(self.path, "not a hairtool project (manifest has no project format)")
+        version = manifest.get("version")
+        if version != FORMAT_VERSION:
+            raise FormatError(
+                self.path, f"project format version {version!r}; this hairtool reads version {FORMAT_VERSION}"
+            )
+        listed = manifest.get("arrays")
+        if not isinstance(listed, list) or not all(isinstance(n, str) for n in listed):
+            raise FormatError(self.path, "manifest.json has no list of arrays")
+        extra = set(self.infos) - set(listed) - {MANIFEST}
+        if extra:
+            raise FormatError(self.path, f"unexpected member {sorted(extra)[0]!r}")
+        self.listed = set(listed)
+        return manifest
+
+    def array(self, name: str, ndim: int, kinds: str) -> np.ndarray:
+        if name not in self.listed or name not in self.infos:
+            raise FormatError(self.path, f"missing member {name!r}")
+        info = self.infos[name]
+        with self.zf.open(info) as f:
+            version = np.lib.format.read_magic(f)
+            if version == (1, 0):
+                shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
+            elif version in ((2, 0), (3, 0)):
+                shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
+            else:
+                raise FormatError(self.path, f"member {name!r} has .npy version {version}")
+            if dtype.hasobject:
+                raise FormatError(self.path, f"member {name!r} holds Python objects")
+            nbytes = math.prod(shape) * dtype.itemsize
+            if f.tell() + nbytes != info.file_size:
+                raise FormatError(self.path, f"member {name!r}: shape {shape} does not match its stored size")
+            if len(shape) != ndim or dtype.kind not in kinds:
+                raise FormatError(
+                    self.path, f"member {name!r} must be {ndim}-D of kind {kinds!r}, got {dtype} {shape}"
+                )
+            data = f.read(nbytes)
+            if len(data) != nbytes or f.read(1):  # the last read also checks the member's CRC
+                raise FormatError(self.path, f"member {name!r} is truncated")
+        order = "F" if fortran else "C"
+        return np.frombuffer(data, dtype=dtype).reshape(shape, order=order)
+
+
+def _section(path: Path, manifest: dict, name: str, kind: type) -> Any:
+    value = manifest.get(name)
+    if not isinstance(value, kind):
+        raise FormatError(path, f"manifest.json: {name!r} must be a JSON {kind.__name__}")
+    return value
+
+
+def _read_groom(r: _Reader, prefix: str, info: dict, frames_fps: float | None = None) -> Groom | Animation:
+    counts = r.array(f"{prefix}/counts.npy", 1, "iu").astype(np.int64)
+    require_strand_counts(r.path, counts)
+    v = int(counts.sum())
+    attrs: dict[str, np.ndarray] = {}
+    names = info.get("attributes", [])
+    if not isinstance(names, list) or not set(names) <= set(_ATTRIBUTES):
+        raise FormatError(r.path, f"manifest.json: bad attribute list for {prefix}")
+    for name in names:
+        a = r.array(f"{prefix}/{name}.npy", 2 if name == "colors" else 1, "f")
+        want = (v, 3) if name == "colors" else (v,)
+        if a.shape != want:
+            raise FormatError(r.path, f"{prefix} {name} has shape {a.shape}, expected {want}")
+        require_finite(r.path, a, f"{prefix} {name}")
+        attrs[name] = a
+    if frames_fps is None:
+        points = r.array(f"{prefix}/points.npy", 2, "f")
+        if points.shape != (v, 3):
+            raise FormatError(r.path, f"{prefix} points have shape {points.shape}, expected {(v, 3)}")
+        require_finite(r.path, points, f"{prefix} points")
+        return Groom(points, counts, **attrs)
+    frames = r.array(f"{prefix}/frames.npy", 3, "f")
+    if frames.shape[0] < 1 or frames.shape[1:] != (v, 3):
+        raise FormatError(r.path, f"animation frames have shape {frames.shape}, expected (F≥1, {v}, 3)")
+    require_finite(r.path, frames.reshape(-1, 3), "animation frames")
+    return Animation(frames, counts, frames_fps, **attrs)
+
+
+def _read_params(r: _Reader, raw: dict) -> FrozenParams:
+    unknown = set(raw) - set(_PARAM_FIELDS)
+    if unknown:
+        raise FormatError(r.path, f"unknown engine parameter {sorted(unknown)[0]!r}")
+    values = dict(raw)
+    sv = values.get("strand_variation")
+    if isinstance(sv, dict):
+        values["strand_variation"] = r.array(sv.get("array", ""), 1, "f").astype(np.float64)
+    try:
+        return FrozenParams(**values).validate()
+    except (HairtoolError, TypeError, ValueError) as e:
+        raise FormatError(r.path, f"engine parameters: {e}") from None
+
+
+def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple[AlignSample, ...], Groom | None]:
+    n, modes = info.get("count"), info.get("modes")
+    if not isinstance(n, int) or n < 0 or not isinstance(modes, list):
+        raise FormatError(r.path, "manifest.json: bad 'strokes' section")
+    cursor = r.array("strokes/cursor.npy", 2, "f")
+    radius = r.array("strokes/radius.npy", 1, "f")
+    intensity = r.array("strokes/intensity.npy", 1, "f")
+    mode = r.array("strokes/mode.npy", 1, "iu")
+    if cursor.shape != (n, 3) or radius.shape != (n,) or intensity.shape != (n,) or mode.shape != (n,):
+        raise FormatError(r.path, f"the stroke arrays do not all hold {n} strokes")
+    if n and (mode.min() < 0 or mode.max() >= len(modes)):
+        raise FormatError(r.path, "a stroke names an unknown align mode")
+    for name, a in (("stroke cursor", cursor), ("stroke radius", radius), ("stroke intensity", intensity)):
+        require_finite(r.path, a, name)
+    columns = (cursor.tolist(), radius.tolist(), intensity.tolist(), mode.tolist())
+    strokes = tuple(
+        AlignSample((float(c[0]), float(c[1]), float(c[2])), float(rad), float(i), str(modes[m]))
+        for c, rad, i, m in zip(*columns, strict=True)
+    )
+    aligned = None
+    if info.get("aligned"):
+        pts = r.array("strokes/aligned.npy", 2, "f")
+        if pts.shape != rest.points.shape:
+            raise FormatError(r.path, f"aligned points have shape {pts.shape}, expected {rest.points.shape}")
+        require_finite(r.path, pts, "aligned points")
+        aligned = rest.with_points(pts)
+    return strokes, aligned
+
+
+def _build(r: _Reader) -> Project:
+    manifest = r.manifest()
+    path = r.path
+    groom_info = _section(path, manifest, "groom", dict)
+    rest = _read_groom(r, "groom", groom_info)
+    source = groom_info.get("source")
+    params = _read_params(r, _section(path, manifest, "params", dict))
+    sv = params.strand_variation
+    if np.ndim(sv) != 0 and np.shape(sv) != (rest.strand_count,):
+        raise FormatError(path, f"strand_variation has {np.size(sv)} values for {rest.strand_count} strands")
+    strokes, aligned = _read_strokes(r, _section(path, manifest, "strokes", dict), rest)
+    animation, anim_source = None, ""
+    anim_info = manifest.get("animation")
+    if anim_info is not None:
+        if not isinstance(anim_info, dict):
+            raise FormatError(path, "manifest.json: 'animation' must be an object or null")
+        fps = anim_info.get("fps")
+        if not isinstance(fps, (int, float)) or isinstance(fps, bool) or not (math.isfinite(fps) and fps > 0):
+            raise FormatError(path, f"animation fps is {fps!r}; expected a positive number")
+        animation = _read_groom(r, "animation", anim_info, float(fps))
+        anim_source = str(anim_info.get("source") or "")
+    return Project(
+        rest=rest,
+        params=params,
+        strokes=strokes,
+        aligned=aligned,
+        brush=_section(path, manifest, "brush", dict),
+        display=_section(path, manifest, "display", dict),
+        animation=animation,
+        animation_source=anim_source,
+        key_settings=_section(path, manifest, "key_settings", dict),
+        settings=_section(path, manifest, "settings", dict),
+        groom_source=source if isinstance(source, str) else None,
+    )
+
+
+def load(path: str | os.PathLike[str]) -> Project:
+    """Read a project; :class:`FormatError` naming the file for anything but a valid project."""
+    p = Path(path)
+    if not p.is_file():
+        raise FormatError(path, "no such file" if not p.exists() else "not a regular file")
+    try:
+        data = p.read_bytes()
+    except OSError as e:
+        raise FormatError(path, f"cannot read: {e}") from None
+    if not data:
+        raise FormatError(path, "the file is empty")
+    if not zipfile.is_zipfile(io.BytesIO(data)):
+        raise FormatError(path, "not a hairtool project (not a zip archive; truncated?)")
+    try:
+        with zipfile.ZipFile(io.BytesIO(data)) as zf:
+            return _build(_Reader(p, zf, len(data)))
+    except FormatError:
+        raise
+    except _READ_ERRORS as e:
+        raise FormatError(path, f"not a readable project ({type(e).__name__}: {e})") from None
+    except MemoryError:
+        raise FormatError(path, "too large to read into memory") from None
