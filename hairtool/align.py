@@ -61,6 +61,9 @@ def _align_kernel(p, offsets, c, radius, x, preserve, planar, out):
         n = offsets[s + 1] - o
         for i in range(n):
             out[o + i, 0], out[o + i, 1], out[o + i, 2] = p[o + i, 0], p[o + i, 1], p[o + i, 2]
+        ex, ey, ez = np.float64(p[o + n - 1, 0]), np.float64(p[o + n - 1, 1]), np.float64(p[o + n - 1, 2])
+        if (ex - c[0]) ** 2 + (ey - c[1]) ** 2 + (ez - c[2]) ** 2 > radius * radius:  # (10)
+            continue  # most strands, while a brush drags: nothing more to compute
         mx = my = mz = 0.0
         for i in range(n):
             mx += p[o + i, 0]
@@ -68,9 +71,6 @@ def _align_kernel(p, offsets, c, radius, x, preserve, planar, out):
             mz += p[o + i, 2]
         mx, my, mz = mx / n, my / n, mz / n  # p̄ (8)
         bx, by, bz = np.float64(p[o, 0]), np.float64(p[o, 1]), np.float64(p[o, 2])
-        ex, ey, ez = np.float64(p[o + n - 1, 0]), np.float64(p[o + n - 1, 1]), np.float64(p[o + n - 1, 2])
-        if (ex - c[0]) ** 2 + (ey - c[1]) ** 2 + (ez - c[2]) ** 2 > radius * radius:  # (10)
-            continue
         vx, vy, vz = ex - mx, ey - my, ez - mz  # v (8)
         ux, uy, uz = c[0] - bx, c[1] - by, c[2] - bz  # u (9)
         nv = np.sqrt(vx * vx + vy * vy + vz * vz)

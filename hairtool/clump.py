@@ -26,7 +26,7 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.errors import ParameterError
-from hairtool.freeze import CH_CLUMP, EPS, check_seed, hash_u01, hash_u01_nb, seed_u64
+from hairtool.freeze import CH_CLUMP, EPS, check_seed, hash_head_nb, hash_tail_u01_nb, hash_u01, seed_u64
 from hairtool.groom import Groom
 from hairtool.spatial import NeighbourList, pairs_within_reference
 
@@ -49,8 +49,39 @@ def check_clump_params(radius: float, iterations: int, step: float | None, gap_m
         raise ParameterError("gap_mode", gap_mode, " or ".join(GAP_MODES))
 
 
+@njit(cache=True, inline="always")
+def _pull(P, flat, a, b, px, py, pz, sorig, h, inv_h, acc):
+    """Add the pulls of the list entries ``flat[a:b]`` on p to ``acc`` = (fx, fy, fz, Σg, within h,
+    nearest r, its index, its original index)."""
+    fx, fy, fz, wsum, c, br, bj, bo = acc
+    for n in range(a, b):
+        j = flat[n]
+        ex = P[j, 0] - px
+        ey = P[j, 1] - py
+        ez = P[j, 2] - pz
+        r = np.sqrt(ex * ex + ey * ey + ez * ez)
+        # Branch-free: list entries beyond h (the margin) get g = 0.
+        t = max(1.0 - r * inv_h, 0.0)
+        g = t * t  # (14)
+        s = g / (r + EPS)  # (15)
+        fx += s * ex
+        fy += s * ey
+        fz += s * ez
+        c += np.int64(r < h)
+        wsum += g
+        oj = sorig[j]
+        better = (r < br) | ((r == br) & (oj < bo))  # selects, not branches: unpredictable
+        br = r if better else br
+        bj = j if better else bj
+        bo = oj if better else bo
+    return fx, fy, fz, wsum, c, br, bj, bo
+
+
 @njit(cache=True, parallel=True)
-def _force_kernel(P, nbr, cnt, sroot, sorig, h, dp, best, count, weight):
+def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, dp, best, count, weight):
+    """f (15) of every vertex from its two list runs, its nearest neighbour within h (ties:
+    lower original index), how many are within h and Σg."""
+    inv_h = 1.0 / h
     for i in prange(P.shape[0]):
         dp[i, 0] = dp[i, 1] = dp[i, 2] = 0.0
         best[i] = -1
@@ -58,39 +89,25 @@ def _force_kernel(P, nbr, cnt, sroot, sorig, h, dp, best, count, weight):
         weight[i] = 0.0
         if sroot[i]:
             continue
-        fx = fy = fz = 0.0
-        br = np.inf
-        bj = -1
-        c = 0
-        wsum = 0.0
-        inv_h = 1.0 / h
-        for n in range(cnt[i]):
-            j = nbr[i, n]
-            ex = P[j, 0] - P[i, 0]
-            ey = P[j, 1] - P[i, 1]
-            ez = P[j, 2] - P[i, 2]
-            r = np.sqrt(ex * ex + ey * ey + ez * ez)
-            # Branch-free: list entries beyond h (the margin) get g = 0.
-            g = max(1.0 - r * inv_h, 0.0) ** 2  # (14)
-            s = g / (r + EPS)  # (15)
-            fx += s * ex
-            fy += s * ey
-            fz += s * ez
-            c += np.int64(r < h)
-            wsum += g
-            if r < br or (r == br and sorig[j] < sorig[bj]):
-                br = r
-                bj = j
-        if br >= h:
-            bj = -1
+        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
+        acc = (0.0, 0.0, 0.0, 0.0, np.int64(0), np.inf, np.int64(-1), np.iinfo(np.int64).max)
+        acc = _pull(P, aflat, aoff[i], aoff[i] + acnt[i], px, py, pz, sorig, h, inv_h, acc)
+        acc = _pull(P, bflat, bstart[i], bstart[i + 1], px, py, pz, sorig, h, inv_h, acc)
+        fx, fy, fz, wsum, c, br, bj, _ = acc
         dp[i, 0], dp[i, 1], dp[i, 2] = fx, fy, fz  # f (15); Δp = step·f (16)
-        best[i] = bj
+        best[i] = bj if br < h else -1
         count[i] = c
         weight[i] = wsum
 
 
 @njit(cache=True, parallel=True)
-def _gap_kernel(P, f, step, best, sorig, h, gap, seed, it, Pout):
+def _hash_heads(sorig, seed, heads):
+    for i in prange(sorig.size):
+        heads[i] = hash_head_nb(seed, sorig[i], CH_CLUMP)
+
+
+@njit(cache=True, parallel=True)
+def _gap_kernel(P, f, step, best, heads, h, gap, it, Pout):
     for i in prange(P.shape[0]):
         lam = 1.0
         j = best[i]
@@ -101,7 +118,7 @@ def _gap_kernel(P, f, step, best, sorig, h, gap, seed, it, Pout):
             ey += step * (f[j, 1] - f[i, 1])
             ez += step * (f[j, 2] - f[i, 2])
             r1 = np.sqrt(ex * ex + ey * ey + ez * ez)
-            zeta = hash_u01_nb(seed, sorig[i], it, CH_CLUMP)
+            zeta = hash_tail_u01_nb(heads[i], it)  # = hash_u01(seed, original index, it, CH_CLUMP)
             if gap == 0:
                 delta = min(max((r1 - r0) / h, 0.0), 1.0)  # (17)
                 lam = (1.0 - delta) * zeta + delta  # (18)
@@ -110,6 +127,63 @@ def _gap_kernel(P, f, step, best, sorig, h, gap, seed, it, Pout):
                 lam = (1.0 - delta) * zeta
         for a in range(3):
             Pout[i, a] = P[i, a] + lam * (step * f[i, a])  # (16), (19)
+
+
+@njit(cache=True, parallel=True)
+def _load(x, y, z, P):
+    for k in prange(x.size):
+        P[k, 0] = x[k]
+        P[k, 1] = y[k]
+        P[k, 2] = z[k]
+
+
+@njit(cache=True)
+def _first_stats(count, weight, sroot):
+    """Pairs within h, moving vertices, and Σg over the vertices with neighbours (for auto_step)."""
+    pairs = 0
+    moving = 0
+    w_sum = 0.0
+    w_count = 0
+    for i in range(count.size):
+        pairs += count[i]
+        if not sroot[i]:
+            moving += 1
+        if count[i] > 0:
+            w_sum += weight[i]
+            w_count += 1
+    return pairs, moving, w_sum, w_count
+
+
+@njit(cache=True, parallel=True)
+def _scatter(order, P, out):
+    for k in prange(order.size):
+        for a in range(3):
+            out[order[k], a] = P[k, a]
+
+
+@njit(cache=True)
+def _clump_run(x, y, z, order, lists, sroot, h, iterations, step, gap, seed, bufs, out):
+    """The k Jacobi iterations on the cell-sorted list, one call (no Python between kernels).
+    ``step`` < 0: automatic. Writes the result to ``out`` (original order, float32); returns
+    (mean neighbours within h per moving vertex, the step used)."""
+    P, Pn, dp, best, count, weight, heads = bufs
+    aflat, aoff, acnt, bflat, bstart = lists
+    _load(x, y, z, P)
+    if gap != 2:
+        _hash_heads(order, seed, heads)
+    mean_nb = 0.0
+    k_step = step
+    for it in range(iterations):
+        _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, order, h, dp, best, count, weight)
+        if it == 0:
+            pairs, moving, w_sum, w_count = _first_stats(count, weight, sroot)
+            mean_nb = pairs / max(moving, 1)
+            if step < 0.0:
+                k_step = STEP_FRACTION * h / max(w_sum / max(w_count, 1), 1.0)
+        _gap_kernel(P, dp, k_step, best, heads, h, gap, it, Pn)
+        P, Pn = Pn, P
+    _scatter(order, P, out)
+    return mean_nb, k_step
 
 
 def auto_step(h: float, weight: np.ndarray, count: np.ndarray) -> float:
@@ -140,7 +214,7 @@ class ClumpWorkspace:
         return self._mask
 
     def buffers(self, v: int) -> tuple:
-        """Iterates (2), Δp, nearest neighbour, counts and weights for V vertices, reused."""
+        """Iterates (2), Δp, nearest neighbour, counts, weights and hash heads for V vertices, reused."""
         if not self._buffers or len(self._buffers[0]) != v:
             self._buffers = (
                 np.empty((v, 3)),
@@ -149,6 +223,7 @@ class ClumpWorkspace:
                 np.empty(v, np.int64),
                 np.empty(v, np.int64),
                 np.empty(v),
+                np.empty(v, np.uint64),
             )
         return self._buffers
 
@@ -180,48 +255,14 @@ def clump_points(
         ws.built_for = None
         nl.build(groom.points, top.strand_index, is_root, key[1])
         ws.built_for = key
-    order = nl.order
-    sroot, sorig = nl.skip, order
-    P, Pn, dp, best, count, weight = ws.buffers(groom.vertex_count)
-    P[:] = nl.points
-    su = seed_u64(seed)
-    gap = _GAP_CODE[gap_mode]
-    for it in range(iterations):
-        _force_kernel(P, nl.nbr, nl.cnt, sroot, sorig, h, dp, best, count, weight)
-        if it == 0:
-            pairs, moving, w_sum, w_count = _first_stats(count, weight, sroot)
-            ws.mean_neighbours = pairs / max(moving, 1)
-            auto = STEP_FRACTION * h / max(w_sum / max(w_count, 1), 1.0)
-            ws.step = k_step = auto if step is None else float(step)
-        _gap_kernel(P, dp, k_step, best, sorig, h, gap, su, it, Pn)
-        P, Pn = Pn, P
-    out = np.empty((len(P), 3), np.float32)
-    _scatter(order, P, out)
+    out = np.empty((groom.vertex_count, 3), np.float32)
+    lists = (nl.aflat, nl.aoff, nl.acnt, nl.bflat, nl.bstart)
+    ws.mean_neighbours, ws.step = _clump_run(
+        nl.x, nl.y, nl.z, nl.order, lists, nl.skip, h, int(iterations),
+        -1.0 if step is None else float(step), _GAP_CODE[gap_mode], seed_u64(seed),
+        ws.buffers(groom.vertex_count), out,
+    )  # fmt: skip
     return out
-
-
-@njit(cache=True)
-def _first_stats(count, weight, sroot):
-    """Pairs within h, moving vertices, and Σg over the vertices with neighbours (for auto_step)."""
-    pairs = 0
-    moving = 0
-    w_sum = 0.0
-    w_count = 0
-    for i in range(count.size):
-        pairs += count[i]
-        if not sroot[i]:
-            moving += 1
-        if count[i] > 0:
-            w_sum += weight[i]
-            w_count += 1
-    return pairs, moving, w_sum, w_count
-
-
-@njit(cache=True, parallel=True)
-def _scatter(order, P, out):
-    for k in prange(order.size):
-        for a in range(3):
-            out[order[k], a] = P[k, a]
 
 
 def clump(

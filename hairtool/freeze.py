@@ -54,12 +54,24 @@ _mix = njit(cache=True, inline="always")(_mix_py)
 
 
 @njit(cache=True, inline="always")
+def hash_head_nb(seed: np.uint64, a: int, channel: int) -> np.uint64:
+    """The part of :func:`hash_u01_nb` that depends on (seed, a, channel) only: kernels that
+    draw many b for one a (a strand's vertices, a vertex's iterations) compute it once."""
+    h = _mix(seed ^ _mix(np.uint64(channel) ^ _GOLD))
+    return _mix(h ^ _mix(np.uint64(a) + _GOLD))
+
+
+@njit(cache=True, inline="always")
+def hash_tail_u01_nb(head: np.uint64, b: int) -> float:
+    """Uniform [0, 1) from a :func:`hash_head_nb` and b: ``hash_u01_nb(seed, a, b, channel)``."""
+    h = _mix(head ^ np.uint64(b))
+    return float(h >> _S11) * _INV53
+
+
+@njit(cache=True, inline="always")
 def hash_u01_nb(seed: np.uint64, a: int, b: int, channel: int) -> float:
     """Uniform [0, 1) from (seed, a, b, channel) inside kernels."""
-    h = _mix(seed ^ _mix(np.uint64(channel) ^ _GOLD))
-    h = _mix(h ^ _mix(np.uint64(a) + _GOLD))
-    h = _mix(h ^ np.uint64(b))
-    return float(h >> _S11) * _INV53
+    return hash_tail_u01_nb(hash_head_nb(seed, a, channel), b)
 
 
 def hash_u01(seed: int, a: ArrayLike, b: ArrayLike, channel: int) -> NDArray[np.float64]:
@@ -140,6 +152,8 @@ def _freeze_kernel(rest, offsets, ks, kb, theta_max, seed, planar, out):
         n = offsets[s + 1] - o
         alpha_s = 1.0 / (ks[s] + EPS)  # (3)
         alpha_b = 1.0 / (kb[s] + EPS)  # (4)
+        head_s = hash_head_nb(seed, s, CH_STRETCH)  # per strand; one mix per vertex below
+        head_b = hash_head_nb(seed, s, CH_BEND)
         px = np.float64(rest[o, 0])
         py = np.float64(rest[o, 1])
         pz = np.float64(rest[o, 2])
@@ -151,8 +165,8 @@ def _freeze_kernel(rest, offsets, ks, kb, theta_max, seed, planar, out):
             dz = np.float64(rest[o + i, 2]) - np.float64(rest[o + i - 1, 2])
             l0 = np.sqrt(dx * dx + dy * dy + dz * dz)
             tx, ty, tz = dx / (l0 + EPS), dy / (l0 + EPS), dz / (l0 + EPS)
-            eta = 2.0 * hash_u01_nb(seed, s, i, CH_STRETCH) - 1.0
-            xi = 2.0 * hash_u01_nb(seed, s, i, CH_BEND) - 1.0
+            eta = 2.0 * hash_tail_u01_nb(head_s, i) - 1.0
+            xi = 2.0 * hash_tail_u01_nb(head_b, i) - 1.0
             lstar = l0 * (1.0 + alpha_s * eta)  # (3)
             theta = theta_max * alpha_b * xi  # (4)
             # axis â = t̂[i−1] × t̂[i] / |…| (4), or a fallback where the tangents are parallel

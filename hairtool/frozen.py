@@ -31,7 +31,7 @@ from hairtool.freeze import (
     strand_multipliers,
 )
 from hairtool.groom import Groom
-from hairtool.strand_clumps import auto_clump_radius, strand_components
+from hairtool.strand_clumps import auto_clump_radius, strand_clumps
 
 
 @dataclass(frozen=True, eq=False)
@@ -241,9 +241,10 @@ class FrozenPipeline:
         return self._result
 
     def clump_ids(self) -> np.ndarray:
-        """``(S,)`` clump of each strand in the last result: connected components of strands
-        linked by vertex pairs closer than h, numbered in order of their first strand."""
-        return strand_components(self._result, self.clump_radius)
+        """``(S,)`` clump of each strand in the last result at the scale h (density basins of
+        the strands' adhesion, :func:`~hairtool.strand_clumps.strand_clumps`), numbered in
+        order of their first strand."""
+        return strand_clumps(self._result, self.clump_radius)
 
     # -- internals -----------------------------------------------------------------------
     def _refreeze(self) -> None:

@@ -3,10 +3,13 @@
 The usual path groups vertices into rows along x (a 2-D grid of cells r wide over y and z,
 counting sort) and sorts each row by x; a vertex then scans the non-empty rows of the 3 × 3
 around it that come within r, each only over the x-window where the sphere of radius r
-crosses that row, with sweep pointers that only move forward. Grooms in a box too large for a
-row table fall back to a spatial hash of 3-D cells (~2V buckets; a candidate counts only if
-its exact cell matches, so collisions never count twice). Lists come in the same order
-whatever the thread count. :func:`pairs_within_reference` is the plain numpy twin.
+crosses that row, with sweep pointers that only move forward. Only the forward half of the
+pairs is searched (in parallel over chunks of rows balanced by vertex count); a serial pass
+mirrors them into one compact list (CSR: ``start``/``cnt`` into ``flat``), small enough to stay
+in cache while ClumpWithGaps iterates over it. Grooms in a box too large for a row table fall
+back to a spatial hash of 3-D cells (~2V buckets; a candidate counts only if its exact cell
+matches, so collisions never count twice). Lists come in the same order whatever the thread
+count or the chunking. :func:`pairs_within_reference` is the plain numpy twin.
 Clump radius and clump membership helpers live in :mod:`hairtool.strand_clumps`.
 """
 
@@ -20,6 +23,8 @@ from hairtool.errors import ParameterError
 _BITS = 21  # bits per cell coordinate in a packed 64-bit cell key
 _MAXC = (1 << _BITS) - 2
 _HASH = np.uint64(0x9E3779B97F4A7C15)
+_CHUNKS = 64  # search tasks (the lists do not depend on them): many, so that threads stay balanced
+_CHUNK_MIN = 256  # vertices per task at least
 
 
 @njit(cache=True)
@@ -34,6 +39,7 @@ def _bounds(p):
     return lo, hi
 
 
+# -- the hashed fallback (sparse hair in a huge box) ---------------------------------------------
 @njit(cache=True, parallel=True)
 def _cell_keys(p, lo, inv_cell, shift, keys, buckets):
     for i in prange(p.shape[0]):
@@ -60,17 +66,26 @@ def _counting_sort(buckets, n_buckets, start, order):
 
 
 @njit(cache=True, parallel=True)
-def _neighbour_kernel(sp, skey, sstrand, sskip, start, shift, r2, nbr, cnt):
-    v_count = sp.shape[0]
+def _gather_hashed(order, points, strand, skip, keys, sx, sy, sz, sstrand, sskip, skeys):
+    for k in prange(order.size):
+        i = order[k]
+        sx[k] = points[i, 0]
+        sy[k] = points[i, 1]
+        sz[k] = points[i, 2]
+        sstrand[k] = strand[i]
+        sskip[k] = skip[i]
+        skeys[k] = keys[i]
+
+
+@njit(cache=True, parallel=True)
+def _hashed_kernel(sx, sy, sz, skey, sstrand, start, shift, r2, nbr, cnt):
+    """All pairs of a vertex from the 27 hashed cells around it, into padded rows of ``nbr``."""
     cap = nbr.shape[1]
     mask = np.int64((1 << _BITS) - 1)
-    for i in prange(v_count):
-        if sskip[i]:
-            cnt[i] = 0
-            continue
+    for i in prange(sx.size):
         k = skey[i]
         cx, cy, cz = k & mask, (k >> _BITS) & mask, k >> (2 * _BITS)
-        px, py, pz = np.float64(sp[i, 0]), np.float64(sp[i, 1]), np.float64(sp[i, 2])
+        px, py, pz = sx[i], sy[i], sz[i]
         si = sstrand[i]
         n = 0
         for dz in range(-1, 2):
@@ -90,9 +105,9 @@ def _neighbour_kernel(sp, skey, sstrand, sskip, start, shift, r2, nbr, cnt):
                     for j in range(start[b], start[b + 1]):
                         if skey[j] != nk or sstrand[j] == si:
                             continue
-                        ex = np.float64(sp[j, 0]) - px
-                        ey = np.float64(sp[j, 1]) - py
-                        ez = np.float64(sp[j, 2]) - pz
+                        ex = sx[j] - px
+                        ey = sy[j] - py
+                        ez = sz[j] - pz
                         if ex * ex + ey * ey + ez * ez < r2:
                             if n < cap:
                                 nbr[i, n] = j
@@ -100,139 +115,244 @@ def _neighbour_kernel(sp, skey, sstrand, sskip, start, shift, r2, nbr, cnt):
         cnt[i] = n
 
 
-@njit(cache=True, parallel=True)
-def _row_keys(p, lo, inv_cell, ny, nz, keys):
-    for i in prange(p.shape[0]):
+@njit(cache=True)
+def _compact_padded(nbr, cnt, start, flat):
+    """Padded rows → CSR (``start`` (V+1,) filled here, ``flat`` large enough)."""
+    start[0] = 0
+    for i in range(cnt.size):
+        start[i + 1] = start[i] + cnt[i]
+        for n in range(cnt[i]):
+            flat[start[i] + n] = nbr[i, n]
+
+
+# -- the row grid (the usual path) ---------------------------------------------------------------
+@njit(cache=True)
+def _row_sort(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx, start, order, tmp):
+    """Vertices by row ``cz·ny + cy``, inside a row by x quantised to ``nq`` steps over the box:
+    two stable counting sorts (quantised x, then row), no comparisons. ``start``: row offsets."""
+    n_rows = ny * nz
+    v = p.shape[0]
+    count = np.zeros(nq + 1, np.int64)
+    for i in range(v):
         cy = min(np.int64(np.floor((p[i, 1] - lo[1]) * inv_cell)), ny - 1)
         cz = min(np.int64(np.floor((p[i, 2] - lo[2]) * inv_cell)), nz - 1)
         keys[i] = cz * ny + cy
+        q = min(np.int64(np.floor((p[i, 0] - lo[0]) * inv_q)), nq - 1)
+        qx[i] = q
+        count[q + 1] += 1
+    for q in range(nq):
+        count[q + 1] += count[q]
+    for i in range(v):
+        q = qx[i]
+        tmp[count[q]] = i
+        count[q] += 1
+    start[: n_rows + 1] = 0
+    for i in range(v):
+        start[keys[i] + 1] += 1
+    for r in range(n_rows):
+        start[r + 1] += start[r]
+    for k in range(v):  # start[r] runs ahead while filling, then is shifted back
+        i = tmp[k]
+        r = keys[i]
+        order[start[r]] = i
+        start[r] += 1
+    for r in range(n_rows, 0, -1):
+        start[r] = start[r - 1]
+    start[0] = 0
 
 
 @njit(cache=True, parallel=True)
-def _sort_rows_by_x(order, start, x):
-    """Inside each row's run of ``order``, sort by x (stable, so ties keep vertex order)."""
-    for r in prange(start.size - 1):
-        a, b = start[r], start[r + 1]
-        if b - a > 32:
-            seg = order[a:b].copy()
-            idx = np.argsort(x[seg], kind="mergesort")
-            for k in range(b - a):
-                order[a + k] = seg[idx[k]]
-        else:
-            for i in range(a + 1, b):  # insertion sort: rows are short
-                v = order[i]
-                xv = x[v]
-                j = i - 1
-                while j >= a and x[order[j]] > xv:
-                    order[j + 1] = order[j]
-                    j -= 1
-                order[j + 1] = v
-
-
-@njit(cache=True, parallel=True)
-def _gather(order, points, strand, skip, keys, sp, sx, sstrand, sskip, skeys):
+def _gather(order, points, strand, skip, sx, sy, sz, sstrand, sskip):
+    """The sorted coordinates (float64), strands and skip flags."""
     for k in prange(order.size):
         i = order[k]
-        for a in range(3):
-            sp[k, a] = points[i, a]
-        sx[k] = np.float64(sp[k, 0])
+        sx[k] = points[i, 0]
+        sy[k] = points[i, 1]
+        sz[k] = points[i, 2]
         sstrand[k] = strand[i]
         sskip[k] = skip[i]
-        skeys[k] = keys[i]
+
+
+@njit(cache=True, inline="always")
+def _scan_row(
+    sx, sy, sz, sstrand, j, end, px, py, pz, si, sweep, ylo, yhi, zlo, zhi, r2, jmin, grow, flat, pos, lim
+):
+    """One row for vertex p: move the row's sweep pointer ``j`` past the entries left of
+    ``sweep``, then test the entries of [max(j, jmin), …) up to the x-window where the sphere of
+    radius r crosses the row's (y, z) square. Returns (pointer, write position)."""
+    while j < end and sx[j] <= sweep:  # monotone in p's x: never moves back
+        j += 1
+    dy = max(ylo - py, py - yhi, 0.0)
+    dz = max(zlo - pz, pz - zhi, 0.0)
+    rest = r2 - dy * dy - dz * dz
+    if rest > 0.0:
+        xb = px + np.sqrt(rest) * (1.0 + 1e-6) + grow  # entries right of it fail the test below
+        k = max(j, jmin)
+        # Branch-free body (the test outcome is unpredictable): always write, count hits.
+        while k < end and sx[k] < xb:
+            ex = sx[k] - px
+            ey = sy[k] - py
+            ez = sz[k] - pz
+            hit = (ex * ex + ey * ey + ez * ez < r2) & (sstrand[k] != si)
+            flat[min(pos, lim)] = k
+            pos += np.int64(hit)
+            k += 1
+    return j, pos
 
 
 @njit(cache=True, parallel=True)
-def _row_neighbour_kernel(sp, sx, sstrand, start, ny, nz, lo, cell, r2, nbr, cnt):
-    """Forward half of the pairs: rows of cells along x (a 2-D grid over y, z), each sorted by x;
-    vertex i (sorted position) finds the j > i within r: in its own row to its right and in the
-    4 rows after it, each only over the x-window where the sphere of radius r crosses the row.
-    The vertices of a row are visited in x order, so per row a pointer to the window's start
-    only moves forward (a sweep line). One task per row: deterministic."""
-    cap = nbr.shape[1]
-    reach = np.sqrt(r2) * (1.0 + 1e-6) + 1e-12 * cell
-    for r in prange(start.size - 1):
-        a0, b0 = start[r], start[r + 1]
-        if a0 == b0:
-            continue
-        cy = r % ny
-        cz = r // ny
-        rows = np.empty(5, np.int64)
-        ptr = np.empty(5, np.int64)
-        slab = np.empty((5, 4))  # y and z bounds of each row, a little wider for rounding
-        m = 0
-        for z in range(cz, min(cz + 2, nz)):
-            for y in range(max(cy - 1, 0), min(cy + 2, ny)):
-                row = z * ny + y
-                if row < r or start[row] == start[row + 1]:
-                    continue  # rows before this one (their pairs come from them) or empty
-                rows[m] = row
-                ptr[m] = start[row]
-                slab[m, 0] = lo[1] + y * cell - 1e-7 * cell
-                slab[m, 1] = lo[1] + (y + 1) * cell + 1e-7 * cell
-                slab[m, 2] = lo[2] + z * cell - 1e-7 * cell
-                slab[m, 3] = lo[2] + (z + 1) * cell + 1e-7 * cell
-                m += 1
-        for i in range(a0, b0):
-            px, py, pz = sx[i], np.float64(sp[i, 1]), np.float64(sp[i, 2])
-            si = sstrand[i]
-            n = 0
-            for q in range(m):
-                # distance from p to the row's (y, z) square (0 inside)
-                dy = max(slab[q, 0] - py, py - slab[q, 1], 0.0)
-                dz = max(slab[q, 2] - pz, pz - slab[q, 3], 0.0)
-                rest = r2 - dy * dy - dz * dz
-                if rest <= 0.0:
-                    continue
-                row = rows[q]
-                end = start[row + 1]
-                j = ptr[q]
-                while j < end and sx[j] <= px - reach:  # monotone in px: never moves back
-                    j += 1
-                ptr[q] = j
-                if row == r:
-                    j = max(j, i + 1)  # own row: only the vertices after i
-                w = np.sqrt(rest) * (1.0 + 1e-6) + 1e-12 * cell  # x half-window, a hair wide
-                xb = px + w  # entries left of px − w fail the distance test below
-                # Branch-free body (the test outcome is unpredictable): always write, count hits.
-                while j < end and sx[j] < xb:
-                    ex = sx[j] - px
-                    ey = np.float64(sp[j, 1]) - py
-                    ez = np.float64(sp[j, 2]) - pz
-                    hit = (ex * ex + ey * ey + ez * ez < r2) & (sstrand[j] != si)
-                    nbr[i, min(n, cap - 1)] = j
-                    n += np.int64(hit)
-                    j += 1
-            cnt[i] = n
+def _forward_kernel(
+    sx, sy, sz, sstrand, start, ny, nz, lo, cell, r2, slack, chunks, base, limit, flat, fcnt, used
+):
+    """Forward half of the pairs: vertex i (sorted position) finds the j > i within r: in its
+    own row to its right and in the 4 rows after it ((y+1, z), (y−1..y+1, z+1)), each only over
+    the x-window where the sphere of radius r crosses the row. The vertices of a row come in
+    x order (to within ``slack``, the quantisation of the sort), so per row a pointer to the
+    window's start only moves forward (a sweep line). One task per chunk of rows; vertex i's
+    entries go to ``flat[base[c] + …]`` in the order found, ``fcnt[i]`` of them; ``used[c]``
+    counts what chunk c needed (it overflowed when that exceeds its room)."""
+    grow = 2.0 * slack  # windows a little longer, for the quantised order
+    reach = np.sqrt(r2) * (1.0 + 1e-6) + grow + 1e-12 * cell
+    e = 1e-7 * cell  # rows a little wider for rounding
+    for c in prange(chunks.size - 1):
+        pos = base[c]
+        lim = limit[c]  # the last slot is scratch for the branch-free writes
+        for r in range(chunks[c], chunks[c + 1]):
+            a0, b0 = start[r], start[r + 1]
+            if a0 == b0:
+                continue
+            cy = r % ny
+            cz = r // ny
+            y0 = lo[1] + cy * cell
+            z0 = lo[2] + cz * cell
+            # Missing rows (outside the grid) are empty runs [0, 0).
+            r1 = r + 1 if cy + 1 < ny else -1
+            r2_ = r + ny - 1 if cz + 1 < nz and cy >= 1 else -1
+            r3 = r + ny if cz + 1 < nz else -1
+            r4 = r + ny + 1 if cz + 1 < nz and cy + 1 < ny else -1
+            j1, e1 = (start[r1], start[r1 + 1]) if r1 >= 0 else (0, 0)
+            j2, e2 = (start[r2_], start[r2_ + 1]) if r2_ >= 0 else (0, 0)
+            j3, e3 = (start[r3], start[r3 + 1]) if r3 >= 0 else (0, 0)
+            j4, e4 = (start[r4], start[r4 + 1]) if r4 >= 0 else (0, 0)
+            for i in range(a0, b0):
+                px, py, pz = sx[i], sy[i], sz[i]
+                si = sstrand[i]
+                p0 = pos
+                sw = px - reach
+                _, pos = _scan_row(
+                    sx, sy, sz, sstrand, i + 1, b0, px, py, pz, si, -np.inf,
+                    y0 - e, y0 + cell + e, z0 - e, z0 + cell + e, r2, i + 1, grow, flat, pos, lim,
+                )  # fmt: skip
+                j1, pos = _scan_row(
+                    sx, sy, sz, sstrand, j1, e1, px, py, pz, si, sw,
+                    y0 + cell - e, y0 + 2 * cell + e, z0 - e, z0 + cell + e, r2, 0, grow, flat, pos, lim,
+                )  # fmt: skip
+                j2, pos = _scan_row(
+                    sx, sy, sz, sstrand, j2, e2, px, py, pz, si, sw,
+                    y0 - cell - e, y0 + e, z0 + cell - e, z0 + 2 * cell + e, r2, 0, grow, flat, pos, lim,
+                )  # fmt: skip
+                j3, pos = _scan_row(
+                    sx, sy, sz, sstrand, j3, e3, px, py, pz, si, sw,
+                    y0 - e, y0 + cell + e, z0 + cell - e, z0 + 2 * cell + e, r2, 0, grow, flat, pos, lim,
+                )  # fmt: skip
+                j4, pos = _scan_row(
+                    sx, sy, sz, sstrand, j4, e4, px, py, pz, si, sw,
+                    y0 + cell - e, y0 + 2 * cell + e, z0 + cell - e, z0 + 2 * cell + e, r2, 0, grow,
+                    flat, pos, lim,
+                )  # fmt: skip
+                fcnt[i] = pos - p0
+        used[c] = pos - base[c]
 
 
 @njit(cache=True)
-def _mirror_pairs(nbr, cnt, sskip):
-    """Complete the forward lists: each pair (i, j > i) is added to j's list after j's own
-    forward entries, in increasing i (deterministic). Skipped vertices end with no list."""
-    cap = nbr.shape[1]
-    forward = cnt.copy()
-    for i in range(cnt.size):
-        for n in range(min(forward[i], cap - 1)):
-            j = nbr[i, n]
-            if not sskip[j]:
-                if cnt[j] < cap - 1:
-                    nbr[j, cnt[j]] = i
-                cnt[j] += 1
-    for i in range(cnt.size):
-        if sskip[i]:
-            cnt[i] = 0
+def _transpose(chunks, start, base, fflat, fcnt, bstart, bflat):
+    """The backward lists: every i that found j (i < j), in increasing i (deterministic), as CSR
+    ``bstart`` (V+1,) into ``bflat``. Returns the number of entries (``bflat`` must hold them)."""
+    v = fcnt.size
+    bstart[:] = 0
+    for c in range(chunks.size - 1):
+        p = base[c]
+        for i in range(start[chunks[c]], start[chunks[c + 1]]):
+            for n in range(p, p + fcnt[i]):
+                bstart[fflat[n] + 1] += 1
+            p += fcnt[i]
+    for i in range(v):
+        bstart[i + 1] += bstart[i]
+    total = bstart[v]
+    if bflat.size < total:
+        return total
+    fill = bstart[:-1].copy()
+    for c in range(chunks.size - 1):
+        p = base[c]
+        for i in range(start[chunks[c]], start[chunks[c + 1]]):
+            for n in range(p, p + fcnt[i]):
+                j = fflat[n]
+                bflat[fill[j]] = i
+                fill[j] += 1
+            p += fcnt[i]
+    return total
+
+
+def _chunk_rows(start: np.ndarray, vertex_count: int) -> np.ndarray:
+    """Row boundaries of chunks of about equal vertex counts (the lists do not depend on them)."""
+    n = max(1, min(_CHUNKS, vertex_count // _CHUNK_MIN))
+    targets = np.linspace(0, vertex_count, n + 1)
+    rows = np.searchsorted(start, targets, side="left")
+    rows[0], rows[-1] = 0, start.size - 1
+    return np.unique(rows).astype(np.int64)
 
 
 class NeighbourList:
     """Vertices of other strands within ``radius``, in cell-sorted order.
 
-    ``order[k]``: the original vertex at sorted position k; ``nbr[k, :cnt[k]]``: sorted positions
-    of its neighbours. Vertices flagged in ``skip`` get no list (they still appear as neighbours).
+    ``order[k]``: the original vertex at sorted position k. Its neighbours (sorted positions)
+    come in two runs: ``aflat[aoff[k] : aoff[k] + acnt[k]]`` (found from k: the forward half)
+    then ``bflat[bstart[k] : bstart[k + 1]]`` (those that found k), see :meth:`of`. ``x``, ``y``,
+    ``z``, ``strand``, ``skip``: the sorted coordinates (float64) and attributes. Vertices flagged
+    in ``skip`` still have lists, and appear in others'; kernels skip them. Buffers are reused
+    while the vertex count stays, so a build per mouse move allocates (almost) nothing.
     """
 
     def __init__(self) -> None:
-        self.capacity = 16  # list slots per vertex; grows (and shrinks) with the densest vertex
-        self.nbr = np.empty((0, self.capacity), np.int32)
+        self._v = -1
+        self._per_vertex = 8.0  # forward entries per vertex to reserve room for (adapts)
+        self.aflat = np.empty(0, np.int32)
+        self.bflat = np.empty(0, np.int32)
+        self.capacity = 16  # padded row width of the hashed path; grows with the densest vertex
+        self._nbr = np.empty((0, self.capacity), np.int32)
+        self._start = np.empty(0, np.int64)
+
+    def of(self, k: int) -> np.ndarray:
+        """Sorted positions of the neighbours of the vertex at sorted position ``k``."""
+        a = self.aflat[self.aoff[k] : self.aoff[k] + self.acnt[k]]
+        return np.concatenate([a, self.bflat[self.bstart[k] : self.bstart[k + 1]]])
+
+    @property
+    def cnt(self) -> np.ndarray:
+        """``(V,)`` list length of each sorted position."""
+        return self.acnt + np.diff(self.bstart)
+
+    @property
+    def pairs(self) -> int:
+        """Entries in all lists (each pair twice)."""
+        return int(self.acnt.sum() + self.bstart[-1])
+
+    def _buffers(self, v: int) -> None:
+        if self._v == v:
+            return
+        self._v = v
+        self.keys = np.empty(v, np.int64)
+        self._qx = np.empty(v, np.int64)
+        self._tmp = np.empty(v, np.int64)
+        self.order = np.empty(v, np.int64)
+        self.x = np.empty(v)
+        self.y = np.empty(v)
+        self.z = np.empty(v)
+        self.strand = np.empty(v, np.int64)
+        self.skip = np.empty(v, np.bool_)
+        self.acnt = np.empty(v, np.int64)
+        self.aoff = np.empty(v, np.int64)
+        self.bstart = np.zeros(v + 1, np.int64)
 
     def build(
         self,
@@ -242,79 +362,110 @@ class NeighbourList:
         radius: float,
         dense: bool | None = None,
     ) -> None:
-        """``dense``: force the dense grid (True) or the hashed one (False); None picks by size."""
+        """``dense``: force the row grid (True) or the hashed one (False); None picks by size."""
         v = points.shape[0]
         lo, hi = _bounds(points)
         extent = float((hi - lo).max())
         if not np.isfinite(radius) or radius <= 0 or extent / radius >= _MAXC:
             raise ParameterError("clump_radius", radius, f"a distance above {extent / _MAXC:.3g}")
-        inv = 1.0 / radius
-        dims = (np.floor((hi - lo) * inv).astype(np.int64) + 1).tolist()
-        row_cell = float(radius)  # rows are r wide in y and z (2r: fewer rows, longer sorts: slower)
-        row_dims = (np.floor((hi - lo) / row_cell).astype(np.int64) + 1).tolist()
-        if getattr(self, "_v", -1) != v:  # buffers reused while the size stays
-            self._v = v
-            self._keys = np.empty(v, np.int64)
-            self.order = np.empty(v, np.int64)
-            self.points = np.empty((v, 3), np.float32)
-            self.sx = np.empty(v, np.float64)
-            self.strand = np.empty(v, np.int64)
-            self.skip = np.empty(v, np.bool_)
-            self.keys = np.empty(v, np.int64)
-            self.cnt = np.empty(v, np.int32)
-        keys, order = self._keys, self.order
-        self.dense = row_dims[1] * row_dims[2] <= max(8 * v, 1 << 16) if dense is None else dense
-        if self.dense:
-            # Rows along x over the bounding box's (y, z) cells (the usual case).
-            dims = row_dims
-            n_rows = dims[1] * dims[2]
-            _row_keys(points, lo, 1.0 / row_cell, dims[1], dims[2], keys)
-            start = np.empty(n_rows + 1, np.int64)
-            _counting_sort(keys, n_rows, start, order)
-            _sort_rows_by_x(order, start, points[:, 0])
-            shift = np.uint64(0)
-        else:
-            # Sparse hair in a large box: hash the 3-D cells into ~2V buckets.
-            bits = max(6, int(np.ceil(np.log2(2 * v))))
-            shift = np.uint64(64 - bits)
-            buckets = np.empty(v, np.int64)
-            _cell_keys(points, lo, inv, shift, keys, buckets)
-            start = np.empty((1 << bits) + 1, np.int64)
-            _counting_sort(buckets, 1 << bits, start, order)
-        self.dims = dims
-        _gather(order, points, strand, skip, keys, self.points, self.sx, self.strand, self.skip, self.keys)
-        self.start = start
+        self._buffers(v)
         self.radius = float(radius)
-        r2 = float(radius) ** 2
+        row_cell = float(radius)  # rows are r wide in y and z
+        dims = (np.floor((hi - lo) / row_cell).astype(np.int64) + 1).tolist()
+        self.dense = dims[1] * dims[2] <= max(8 * v, 1 << 16) if dense is None else dense
+        if self.dense:
+            self._build_rows(points, strand, skip, lo, hi, dims, row_cell)
+        else:
+            self._build_hashed(points, strand, skip, lo, float(radius))
+
+    def _build_rows(self, points, strand, skip, lo, hi, dims, cell) -> None:
+        v = points.shape[0]
+        n_rows = dims[1] * dims[2]
+        if self._start.size < n_rows + 1:
+            self._start = np.empty(max(n_rows + 1, 2 * self._start.size), np.int64)
+        start = self._start[: n_rows + 1]
+        # x quantised to 1/64 of a cell (at most 2**16 steps): the sweep allows for that slack.
+        nq = int(min(1 << 16, max(64 * dims[0], 1)))
+        width = max(float(hi[0] - lo[0]), 1e-300)
+        _row_sort(
+            points, lo, 1.0 / cell, dims[1], dims[2], nq / width, nq, self.keys, self._qx, start, self.order,
+            self._tmp,
+        )  # fmt: skip
+        _gather(self.order, points, strand, skip, self.x, self.y, self.z, self.strand, self.skip)
+        slack = width / nq
+        chunks = _chunk_rows(start, v)
+        per_chunk = np.diff(start[chunks])
+        r2 = self.radius**2
         while True:
-            if self.nbr.shape[0] < v or self.nbr.shape[1] != self.capacity:
-                self.nbr = np.empty((v, self.capacity), np.int32)
-            if self.dense:
-                _row_neighbour_kernel(
-                    self.points,
-                    self.sx,
-                    self.strand,
-                    start,
-                    dims[1],
-                    dims[2],
-                    lo,
-                    row_cell,
-                    r2,
-                    self.nbr,
-                    self.cnt,
-                )
-                if int(self.cnt.max()) < self.capacity:  # else: grow and redo below
-                    _mirror_pairs(self.nbr, self.cnt, self.skip)
-            else:
-                _neighbour_kernel(
-                    self.points, self.keys, self.strand, self.skip, start, shift, r2, self.nbr, self.cnt
-                )
-            most = int(self.cnt.max()) if v else 0
-            if most < self.capacity:  # the last slot is scratch for the branch-free writes
-                if 2 * (most + 1) < self.capacity and self.capacity > 16:
-                    self.capacity = max(16, (most + 16) // 16 * 16)  # next build: smaller rows
+            room = (per_chunk * self._per_vertex).astype(np.int64) + 64
+            base = np.zeros(room.size, np.int64)
+            np.cumsum(room[:-1], out=base[1:])
+            total = int(base[-1] + room[-1])
+            if self.aflat.size < total:
+                self.aflat = np.empty(int(total * 1.25), np.int32)
+            used = np.empty(room.size, np.int64)
+            _forward_kernel(
+                self.x, self.y, self.z, self.strand, start, dims[1], dims[2], lo, cell, r2, slack,
+                chunks, base, base + room - 1, self.aflat, self.acnt, used,
+            )  # fmt: skip
+            need = float(np.max(used / np.maximum(per_chunk, 1)))
+            if np.all(used < room):  # the last slot of each room is scratch
+                # Room for next time: what this build needed plus a margin (shrinks slowly).
+                self._per_vertex = max(0.8 * self._per_vertex, 1.3 * need + 1.0)
+                break
+            self._per_vertex = 1.5 * need + 2.0
+        _vertex_offsets(chunks, start, base, self.acnt, self.aoff)
+        while True:
+            total = _transpose(chunks, start, base, self.aflat, self.acnt, self.bstart, self.bflat)
+            if self.bflat.size >= total:
+                break
+            self.bflat = np.empty(int(total * 1.25) + 16, np.int32)
+        self.dims = dims
+        self.start = start
+
+    def _build_hashed(self, points, strand, skip, lo, radius) -> None:
+        # Sparse hair in a large box: hash the 3-D cells into ~2V buckets.
+        v = points.shape[0]
+        bits = max(6, int(np.ceil(np.log2(2 * v))))
+        shift = np.uint64(64 - bits)
+        buckets = np.empty(v, np.int64)
+        _cell_keys(points, lo, 1.0 / radius, shift, self.keys, buckets)
+        start = np.empty((1 << bits) + 1, np.int64)
+        _counting_sort(buckets, 1 << bits, start, self.order)
+        skeys = np.empty(v, np.int64)
+        _gather_hashed(
+            self.order, points, strand, skip, self.keys, self.x, self.y, self.z, self.strand, self.skip, skeys
+        )
+        self.dims = None
+        self.start = start
+        cnt = self.acnt
+        while True:
+            if self._nbr.shape[0] < v or self._nbr.shape[1] != self.capacity:
+                self._nbr = np.empty((v, self.capacity), np.int32)
+            _hashed_kernel(
+                self.x, self.y, self.z, skeys, self.strand, start, shift, radius**2, self._nbr, cnt
+            )  # fmt: skip
+            most = int(cnt.max()) if v else 0
+            if most <= self.capacity:
                 break
             self.capacity = (most + 16) // 16 * 16
+        total = int(cnt.sum())
+        if self.aflat.size < total:
+            self.aflat = np.empty(int(total * 1.25) + 16, np.int32)
+        offsets = np.empty(v + 1, np.int64)
+        _compact_padded(self._nbr, cnt, offsets, self.aflat)
+        self.aoff[:] = offsets[:-1]
+        self.bstart[:] = 0  # the hashed lists are complete
+
+
+@njit(cache=True)
+def _vertex_offsets(chunks, start, base, fcnt, off):
+    """Where each vertex's forward entries start in the chunked buffer."""
+    for c in range(chunks.size - 1):
+        p = base[c]
+        for i in range(start[chunks[c]], start[chunks[c + 1]]):
+            off[i] = p
+            p += fcnt[i]
 
 
 def neighbour_list(

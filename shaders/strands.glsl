@@ -1,12 +1,15 @@
 #version 330 core
 // Strands: one LINE_STRIP draw with primitive restart; the geometry stage widens every segment
 // into a screen-space quad of u_width pixels, since core-profile contexts (Qt's) refuse
-// glLineWidth > 1. Colour: per-vertex, or the ramp texture sampled at t = i / (N_s - 1).
+// glLineWidth > 1. Colour: per-vertex, the ramp texture sampled at t = i / (N_s - 1), or one
+// flat RGBA (the ghost groom drawn translucent under the strands).
 
 #if defined VERTEX_SHADER
 
 uniform mat4 u_mvp;             // pyrr row-major view @ proj, written as is
 uniform bool u_use_vertex_color;
+uniform bool u_use_flat_color;  // ghost: every vertex u_flat_color
+uniform vec4 u_flat_color;     // its alpha is the fragments' alpha
 uniform sampler2D u_ramp;       // (256 x 1) RGB ramp, root (t = 0) to tip (t = 1)
 
 in vec3 in_position;
@@ -17,7 +20,8 @@ out vec3 v_color;
 
 void main() {
     gl_Position = u_mvp * vec4(in_position, 1.0);
-    v_color = u_use_vertex_color ? in_color : texture(u_ramp, vec2(clamp(in_t, 0.0, 1.0), 0.5)).rgb;
+    vec3 rgb = u_use_vertex_color ? in_color : texture(u_ramp, vec2(clamp(in_t, 0.0, 1.0), 0.5)).rgb;
+    v_color = u_use_flat_color ? u_flat_color.rgb : rgb;
 }
 
 #elif defined GEOMETRY_SHADER
@@ -62,11 +66,14 @@ void main() {
 
 #elif defined FRAGMENT_SHADER
 
+uniform bool u_use_flat_color;
+uniform vec4 u_flat_color;
+
 in vec3 g_color;
 out vec4 f_color;
 
 void main() {
-    f_color = vec4(g_color, 1.0);
+    f_color = vec4(g_color, u_use_flat_color ? u_flat_color.a : 1.0);
 }
 
 #endif

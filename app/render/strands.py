@@ -3,11 +3,27 @@
 It takes a ``moderngl.Context`` and draws into whatever framebuffer it is handed, so the same
 code serves the widget (Qt's framebuffer, looked up again every paint) and tests/exports.
 
-Two update speeds (as pygfx does): :meth:`StrandRenderer.update_points` rewrites the position
-buffer in place while a brush drags; :meth:`StrandRenderer.set_groom` rebuilds the buffers only
-when the topology changes. All strands are one ``LINE_STRIP`` draw: a ``u4`` index buffer with
-the primitive-restart index 0xFFFFFFFF after each strand; ``shaders/strands.glsl`` widens the
-segments into screen-space quads (core-profile GL, as Qt creates it, allows only 1-px lines).
+Two update speeds (as pygfx does): :meth:`StrandRenderer.update_points` rewrites the positions in
+place while a brush drags; :meth:`StrandRenderer.set_groom` rebuilds the buffers only when the
+topology changes. All strands are one draw call, in one of three ways
+(:meth:`StrandRenderer.line_method`):
+
+- ``"thin"`` (widths up to 1.5 px, or ``fast_lines``): plain 1-px ``LINES``, two indices per
+  segment (``shaders/strands_thin.glsl``) — the cheapest draw, about half the time of the wide
+  ones on llvmpipe (5,000 × 20 strands at 1024 × 768: ≈ 40 ms against ≈ 80 ms);
+- ``"geometry"`` (wider lines, the default): a geometry shader widens each segment of a
+  ``LINE_STRIP`` (a primitive restart after each strand) into a screen-space quad of
+  ``line_width`` pixels (``shaders/strands.glsl``);
+- ``"quads"``: the same quads, pixel for pixel, without a geometry stage: four vertices per
+  segment whose vertex shader pulls the segment's ends from a texture
+  (``shaders/strands_quads.glsl``), for drivers without (fast) geometry shaders. On llvmpipe it
+  is about 5 % slower than the geometry shader (one instance per segment was 1.5× slower).
+
+Core-profile GL, as Qt creates it, allows only 1-px lines, hence the quads for wider ones.
+On llvmpipe a draw costs about 0.2 µs per primitive (line or triangle) whatever the stages,
+plus the pixels it covers: fewer primitives, not a cheaper shader, is what makes it faster.
+An optional ghost (:meth:`StrandRenderer.set_ghost_points`) draws the same strands at other
+positions first, in one flat translucent colour.
 """
 
 from __future__ import annotations
@@ -23,23 +39,19 @@ from app.render.mesh_layer import MeshLayer
 from app.render.overlay import CircleOverlay
 from app.render.ramps import DEFAULT_RAMP, ramp_stops, ramp_texture
 from app.render.shaders import load_program
+from app.render.strand_gpu import RESTART_INDEX, PointSet, StrandGPU, strip_indices
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Groom, Topology
 
-RESTART_INDEX = 0xFFFFFFFF
+__all__ = ["RESTART_INDEX", "StrandRenderer", "strip_indices", "strip_indices_reference"]
+
+THIN_MAX_WIDTH = 1.5  # px: up to this width strands are drawn as plain 1-px lines
+WIDE_LINES = ("geometry", "quads")
+_PROGRAMS = {"thin": "strands_thin", "quads": "strands_quads", "geometry": "strands"}
+_INDEX_KIND = {"thin": "lines", "quads": "quads", "geometry": "strip"}
 RAMP_TEXELS = 256
 DEFAULT_BACKGROUND = (0.16, 0.17, 0.19, 1.0)
-
-
-def strip_indices(topology: Topology) -> NDArray[np.uint32]:
-    """``(V + S,)`` u4: each strand's vertex indices followed by the restart index.
-
-    Vertex i of strand s lands at position i + s, so the restarts fall at offsets[s+1] + s.
-    """
-    idx = np.full(topology.vertex_count + topology.strand_count, RESTART_INDEX, dtype=np.uint32)
-    v = np.arange(topology.vertex_count, dtype=np.int64)
-    idx[v + topology.strand_index] = v
-    return idx
+DEFAULT_GHOST_RGBA = (0.55, 0.75, 1.0, 0.35)
 
 
 def strip_indices_reference(topology: Topology) -> NDArray[np.uint32]:
@@ -56,8 +68,10 @@ class StrandRenderer:
 
     def __init__(self, ctx: moderngl.Context) -> None:
         self.ctx = ctx
-        self.program = load_program(ctx, "strands")
+        self.programs = {method: load_program(ctx, name) for method, name in _PROGRAMS.items()}
         self.line_width = 2.0
+        self.fast_lines = False  # the artist's "fast lines": 1-px lines whatever the width
+        self.wide_lines = "geometry"  # how widths above THIN_MAX_WIDTH are drawn: "geometry" or "quads"
         self.background: tuple[float, float, float, float] = DEFAULT_BACKGROUND
         self.ramp = DEFAULT_RAMP
         self.ramp_texture = ctx.texture((RAMP_TEXELS, 1), 3, dtype="f4")
@@ -68,40 +82,97 @@ class StrandRenderer:
         self.overlay = CircleOverlay(ctx)
         self.topology: Topology | None = None
         self.bounds: tuple[NDArray[np.float32], NDArray[np.float32]] | None = None
-        self.position_buffer: moderngl.Buffer | None = None
-        self.param_buffer: moderngl.Buffer | None = None
-        self.color_buffer: moderngl.Buffer | None = None
-        self.index_buffer: moderngl.Buffer | None = None
-        self.vao: moderngl.VertexArray | None = None
+        self._gpu: StrandGPU | None = None
+        self._main: PointSet | None = None
+        self._ghost: PointSet | None = None
+        self._vaos: dict[tuple[str, bool], moderngl.VertexArray] = {}  # (method, ghost) → VAO
         self.use_vertex_colors = False
+        self.ghost_rgba: tuple[float, float, float, float] = DEFAULT_GHOST_RGBA
+
+    # -- what is drawn and how -------------------------------------------------------
+    def line_method(self) -> str:
+        """How the strands are drawn now: "thin", "quads" or "geometry" (see the module doc)."""
+        if self.fast_lines or float(self.line_width) <= THIN_MAX_WIDTH:
+            return "thin"
+        if self.wide_lines not in WIDE_LINES:
+            raise ParameterError("wide_lines", self.wide_lines, " or ".join(WIDE_LINES))
+        return self.wide_lines
+
+    @property
+    def program(self) -> moderngl.Program:
+        """The program of the current :meth:`line_method`."""
+        return self.programs[self.line_method()]
+
+    @property
+    def position_buffer(self) -> moderngl.Buffer | None:
+        """The groom's vertex buffer of positions (``"thin"`` and ``"geometry"`` draws), up to
+        date (while the quads draw is in use it is uploaded only when asked for: here)."""
+        return None if self._main is None else self._main.vertex_buffer(draw=False)
+
+    @property
+    def param_buffer(self) -> moderngl.Buffer | None:
+        return None if self._gpu is None else self._gpu.param_buffer
+
+    @property
+    def color_buffer(self) -> moderngl.Buffer | None:
+        return None if self._gpu is None else self._gpu.color_buffer
+
+    @property
+    def index_buffer(self) -> moderngl.Buffer | None:
+        """The index buffer of the current :meth:`line_method` (None without a groom)."""
+        return None if self._gpu is None else self._gpu.index_buffer(_INDEX_KIND[self.line_method()])
+
+    @property
+    def vao(self) -> moderngl.VertexArray | None:
+        """The strands' vertex array for the current :meth:`line_method` (None without a groom)."""
+        return None if self._main is None else self._vao(self.line_method(), ghost=False)
+
+    @property
+    def ghost_buffer(self) -> moderngl.Buffer | None:
+        """The ghost's vertex buffer of positions, up to date (as :attr:`position_buffer`)."""
+        return None if self._ghost is None else self._ghost.vertex_buffer(draw=False)
+
+    @property
+    def ghost_points(self) -> NDArray[np.float32] | None:
+        """The ghost's positions (read-only view), or None without a ghost."""
+        return None if self._ghost is None else self._ghost.points
+
+    def _vao(self, method: str, ghost: bool) -> moderngl.VertexArray:
+        # The quads draw reads no attributes (its points come from textures): one VAO serves both.
+        key = (method, ghost and method != "quads")
+        vao = self._vaos.get(key)
+        if vao is None:
+            gpu, prog = self._gpu, self.programs[method]
+            index = gpu.index_buffer(_INDEX_KIND[method])
+            if method == "quads":
+                content = []
+            else:
+                points = (self._ghost if ghost else self._main).buffer
+                content = [(points, "3f", "in_position"), (gpu.param_buffer, "1f", "in_t")]
+                content.append((gpu.color_buffer, "3f", "in_color"))
+            vao = self._vaos[key] = self.ctx.vertex_array(
+                prog, content, index_buffer=index, index_element_size=4
+            )
+        return vao
 
     # -- content ---------------------------------------------------------------------
     def set_groom(self, groom: Groom) -> None:
-        """Upload a groom: positions, t = i/(N_s−1), the strip index buffer (and the groom's colours)."""
+        """Upload a groom: positions, t = i/(N_s−1) (and the groom's colours); index buffers
+        follow when a line method first needs them. A ghost of the same topology is kept."""
         top = groom.topology
+        ghost = self._ghost_points_if_same(top)
         self._free_groom()
         self.topology = top
-        v = top.vertex_count
-        self.position_buffer = self.ctx.buffer(np.ascontiguousarray(groom.points, np.float32), dynamic=True)
-        self.param_buffer = self.ctx.buffer(np.ascontiguousarray(top.vertex_param, np.float32))
-        self.color_buffer = self.ctx.buffer(reserve=v * 12, dynamic=True)
-        self.index_buffer = self.ctx.buffer(strip_indices(top))
-        self.vao = self.ctx.vertex_array(
-            self.program,
-            [
-                (self.position_buffer, "3f", "in_position"),
-                (self.param_buffer, "1f", "in_t"),
-                (self.color_buffer, "3f", "in_color"),
-            ],
-            index_buffer=self.index_buffer,
-            index_element_size=4,
-        )
+        self._gpu = StrandGPU(self.ctx, top)
+        self._main = PointSet(self._gpu, np.ascontiguousarray(groom.points, np.float32))
         self.bounds = groom.bounds
         self.set_vertex_colors(groom.colors)
+        if ghost is not None:
+            self.set_ghost_points(ghost, self.ghost_rgba)
 
     def update_points(self, points: ArrayLike) -> None:
         """Rewrite only the positions (same strands), e.g. every mouse move of a brush stroke."""
-        if self.topology is None or self.position_buffer is None:
+        if self.topology is None or self._main is None:
             raise GroomError("update_points needs a groom: call set_groom first")
         p = np.ascontiguousarray(points, dtype=np.float32)
         v = self.topology.vertex_count
@@ -109,15 +180,64 @@ class StrandRenderer:
             raise GroomError(f"points must have shape ({v}, 3) like the groom, got {p.shape}")
         if not np.all(np.isfinite(p)):
             raise GroomError("points have a non-finite coordinate")
-        self.position_buffer.write(p)
+        self._main.write(p)
         self.bounds = (p.min(axis=0), p.max(axis=0))
+
+    def set_ghost_points(
+        self, points: ArrayLike | None, rgba: tuple[float, float, float, float] = DEFAULT_GHOST_RGBA
+    ) -> None:
+        """A second copy of the groom's strands at ``points`` (``(V, 3)``, same topology), drawn
+        before the strands in one flat translucent ``rgba`` (each in [0, 1]); None removes it.
+
+        E.g. a keyframe reconstruction shown under the original. Same line width as the strands;
+        it is depth-tested against the head mesh but writes no depth, so the strands always draw
+        over it. Calling it again with the same topology only rewrites the positions;
+        :meth:`set_groom` keeps the ghost while the topology stays the same and drops it otherwise.
+        """
+        if points is None:
+            self._free_ghost()
+            return
+        if self.topology is None or self._gpu is None:
+            raise GroomError("set_ghost_points needs a groom: call set_groom first")
+        try:
+            c = tuple(float(x) for x in rgba)
+        except (TypeError, ValueError):
+            raise ParameterError("rgba", rgba, "(r, g, b, a) in [0, 1]") from None
+        if len(c) != 4 or not all(0.0 <= x <= 1.0 for x in c):
+            raise ParameterError("rgba", rgba, "(r, g, b, a) in [0, 1]")
+        p = np.ascontiguousarray(points, dtype=np.float32)
+        v = self.topology.vertex_count
+        if p.shape != (v, 3):
+            raise GroomError(f"ghost points must have shape ({v}, 3) like the groom, got {p.shape}")
+        if not np.all(np.isfinite(p)):
+            raise GroomError("ghost points have a non-finite coordinate")
+        self.ghost_rgba = c  # type: ignore[assignment]
+        if self._ghost is None:
+            self._ghost = PointSet(self._gpu, p)
+        else:
+            self._ghost.write(p)
+
+    def _ghost_points_if_same(self, top: Topology) -> NDArray[np.float32] | None:
+        old = self.topology
+        if self._ghost is None or old is None:
+            return None
+        if old.vertex_count != top.vertex_count or not np.array_equal(old.offsets, top.offsets):
+            return None
+        return self._ghost.points.copy()
+
+    def _free_ghost(self) -> None:
+        for key in [k for k in self._vaos if k[1]]:
+            self._vaos.pop(key).release()
+        if self._ghost is not None:
+            self._ghost.release()
+            self._ghost = None
 
     def set_vertex_colors(self, colors: ArrayLike | None) -> None:
         """``(V, 3)`` RGB in [0, 1] per vertex, or None to colour by the ramp along t."""
         if colors is None:
             self.use_vertex_colors = False
             return
-        if self.topology is None or self.color_buffer is None:
+        if self.topology is None or self._gpu is None:
             raise GroomError("set_vertex_colors needs a groom: call set_groom first")
         c = np.ascontiguousarray(colors, dtype=np.float32)
         v = self.topology.vertex_count
@@ -125,7 +245,7 @@ class StrandRenderer:
             raise ParameterError("colors", c.shape, f"shape ({v}, 3) (one RGB per vertex)")
         if not np.all(np.isfinite(c)):
             raise ParameterError("colors", "non-finite", "finite RGB values in [0, 1]")
-        self.color_buffer.write(np.clip(c, 0.0, 1.0))
+        self._gpu.write_colors(np.clip(c, 0.0, 1.0))
         self.use_vertex_colors = True
 
     def set_ramp(self, name: str) -> None:
@@ -164,6 +284,7 @@ class StrandRenderer:
         width = float(self.line_width)
         if not np.isfinite(width) or width <= 0:
             raise ParameterError("line_width", self.line_width, "a positive width in pixels")
+        method = self.line_method()
         ctx = self.ctx
         fbo.use()
         ctx.viewport = (0, 0, w, h)
@@ -173,24 +294,66 @@ class StrandRenderer:
         view = camera.view_matrix()
         mvp = (view @ camera.projection_matrix(w / h)).astype(np.float32)
         self.mesh.render(mvp, view)
-        if self.vao is not None:
-            prog = self.program
+        if self._main is not None:
+            prog = self.programs[method]
             prog["u_mvp"].write(mvp.tobytes())
-            prog["u_viewport"].value = (float(w), float(h))
-            prog["u_width"].value = width
-            prog["u_use_vertex_color"].value = self.use_vertex_colors
             self.ramp_texture.use(location=0)
-            prog["u_ramp"].value = 0
-            self.vao.render(moderngl.LINE_STRIP)
+            for name, value in (
+                ("u_viewport", (float(w), float(h))),
+                ("u_width", width),
+                ("u_use_vertex_color", self.use_vertex_colors),
+                ("u_ramp", 0),
+                ("u_points", 1),
+                ("u_colors", 2),
+            ):
+                if name in prog:
+                    prog[name].value = value
+            if method == "quads" and self.use_vertex_colors:
+                self._gpu.color_texture().use(location=2)
+            if self._ghost is not None:
+                self._render_ghost(fbo, method)
+            prog["u_use_flat_color"].value = False
+            self._draw(method, self._main, ghost=False)
         self.overlay.render()
         ctx.disable(moderngl.DEPTH_TEST)
 
+    def _draw(self, method: str, points: PointSet, ghost: bool) -> None:
+        if method == "quads":
+            points.texture().use(location=1)
+            self._vao(method, ghost).render(moderngl.TRIANGLES)
+        else:
+            points.vertex_buffer()  # up to date
+            self._vao(method, ghost).render(moderngl.LINES if method == "thin" else moderngl.LINE_STRIP)
+
+    def _render_ghost(self, fbo: moderngl.Framebuffer, method: str) -> None:
+        """The ghost strands: flat colour, blended over what is drawn, depth-tested, no depth write."""
+        ctx, prog = self.ctx, self.programs[method]
+        prog["u_use_flat_color"].value = True
+        prog["u_flat_color"].value = self.ghost_rgba
+        ctx.enable(moderngl.BLEND)
+        # Alpha accumulates as "over" too, so a transparent background stays premultiplied.
+        ctx.blend_func = (
+            moderngl.SRC_ALPHA,
+            moderngl.ONE_MINUS_SRC_ALPHA,
+            moderngl.ONE,
+            moderngl.ONE_MINUS_SRC_ALPHA,
+        )
+        fbo.depth_mask = False
+        try:
+            self._draw(method, self._ghost, ghost=True)
+        finally:
+            fbo.depth_mask = True
+            ctx.disable(moderngl.BLEND)
+
     def _free_groom(self) -> None:
-        for name in ("vao", "index_buffer", "color_buffer", "param_buffer", "position_buffer"):
-            obj = getattr(self, name)
-            if obj is not None:
-                obj.release()
-                setattr(self, name, None)
+        self._free_ghost()
+        for vao in self._vaos.values():
+            vao.release()
+        self._vaos.clear()
+        for part in (self._main, self._gpu):
+            if part is not None:
+                part.release()
+        self._main = self._gpu = None
         self.topology = None
         self.bounds = None
         self.use_vertex_colors = False
@@ -201,4 +364,5 @@ class StrandRenderer:
         self.mesh.release()
         self.overlay.release()
         self.ramp_texture.release()
-        self.program.release()
+        for prog in self.programs.values():
+            prog.release()

@@ -3,8 +3,10 @@
 Sizes: the paper's Table 1 (100, 300, 500 strands × 20), 5,000 and 50,000 × 20 scalp samples,
 and the real grooms. Clump radius h = 2× the median root spacing, k = 3. ``pipeline_ms``: rest
 groom → result (freeze + one align sample + clump); ``update_ms``: one mouse move in the studio
-(align + clump, freeze cached); ``reference_ms``: the same chain with the numpy twins (null
-above ``--reference-limit`` vertices).
+(align + clump, freeze cached); ``list_ms``: building ClumpWithGaps' neighbour list alone (part
+of ``clump_ms``); ``reference_ms``: the same chain with the numpy twins (null above
+``--reference-limit`` vertices). ``mean_neighbours``: other-strand vertices within h per moving
+vertex; ``threads``: numba threads.
 """
 
 from __future__ import annotations
@@ -77,7 +79,7 @@ def run(args: argparse.Namespace) -> list[dict]:
 
     from hairtool.align import align, align_reference
     from hairtool.bench import median_ms
-    from hairtool.clump import ClumpWorkspace, clump, clump_reference
+    from hairtool.clump import MARGIN, ClumpWorkspace, clump, clump_reference
     from hairtool.errors import ParameterError
     from hairtool.freeze import freeze, freeze_reference
     from hairtool.frozen import FrozenPipeline
@@ -114,6 +116,12 @@ def run(args: argparse.Namespace) -> list[dict]:
             "align_ms": median_ms(lambda f=frozen, c=c, r=r: align(f, c, r, 0.8), repeat),
             "clump_ms": median_ms(
                 lambda a=aligned, h=h, ws=ws: clump(a, h, 3, None, "printed", 0, _fresh(ws)), repeat
+            ),
+            "list_ms": median_ms(
+                lambda a=aligned, h=h, ws=ws: ws.neighbours.build(
+                    a.points, a.topology.strand_index, ws.roots_mask(a.topology), h * (1.0 + MARGIN)
+                ),
+                repeat,
             ),
             "pipeline_ms": median_ms(pipeline, repeat),
             "update_ms": median_ms(lambda p=pipe, c=c, r=r: p.align(c, r, 0.8), repeat),

@@ -11,7 +11,7 @@ from hairtool.clump import clump
 from hairtool.errors import ParameterError
 from hairtool.freeze import freeze
 from hairtool.frozen import FrozenParams, FrozenPipeline
-from hairtool.strand_clumps import auto_clump_radius, strand_components_reference
+from hairtool.strand_clumps import auto_clump_radius, strand_clumps_reference
 
 CURSOR = np.array([2.0, 0.5, 0.5])
 
@@ -136,11 +136,11 @@ def test_planar_grooms_stay_planar_through_the_pipeline():
     np.testing.assert_array_equal(out.roots, rest.roots)
 
 
-def test_clump_ids_match_components(rest):
+def test_clump_ids_are_the_density_basins_of_the_result(rest):
     pipe = FrozenPipeline(rest, FrozenParams(clump_radius=0.03))
     ids = pipe.clump_ids()
     assert ids.shape == (rest.strand_count,)
-    np.testing.assert_array_equal(ids, strand_components_reference(pipe.result, 0.03))
+    np.testing.assert_array_equal(ids, strand_clumps_reference(pipe.result, 0.03))
     assert ids.max() > 0
 
 

@@ -6,12 +6,15 @@ import numpy as np
 import pytest
 
 from hairtool import samples
+from hairtool.frozen import FrozenPipeline
 from hairtool.groom import Groom
 from hairtool.io import read_groom
 from hairtool.spatial import neighbour_list, pairs_within_reference
 from hairtool.strand_clumps import (
     auto_clump_radius,
     median_root_spacing,
+    strand_clumps,
+    strand_clumps_reference,
     strand_components,
     strand_components_reference,
 )
@@ -20,8 +23,8 @@ from hairtool.strand_clumps import (
 def _pairs_of(nl) -> set[tuple[int, int]]:
     out = set()
     for k in range(len(nl.order)):
-        for n in range(nl.cnt[k]):
-            out.add((int(nl.order[k]), int(nl.order[nl.nbr[k, n]])))
+        for j in nl.of(k):
+            out.add((int(nl.order[k]), int(nl.order[j])))
     return out
 
 
@@ -44,14 +47,21 @@ def test_neighbour_list_finds_exactly_the_pairs_within_radius(dense):
     assert len(expect) > 100
 
 
-def test_neighbour_list_grows_its_capacity():
+@pytest.mark.parametrize("dense", [True, False])
+def test_neighbour_list_grows_its_capacity(dense):
     # 200 strands through one point: every vertex there has 199 neighbours
     pts = np.zeros((200, 2, 3))
     pts[:, 1, 1] = np.linspace(1, 2, 200)
     g = Groom(pts.reshape(-1, 3), np.full(200, 2))
-    nl = neighbour_list(g.points, g.topology.strand_index, 0.5)
-    assert nl.capacity >= 199
+    nl = neighbour_list(g.points, g.topology.strand_index, 0.5, dense=dense)
+    assert int(nl.cnt.max()) == 199
+    assert dense or nl.capacity >= 199
     assert _pairs_of(nl) == _brute_pairs(g.points, g.topology.strand_index, 0.5)
+    # The same list object rebuilt for a sparse groom of the same size shrinks its reserve
+    # and still finds exactly the pairs.
+    spread = g.points + np.repeat(np.linspace(0, 50, 200), 2)[:, None] * np.float32([1, 0, 0])
+    nl.build(spread, g.topology.strand_index, np.zeros(400, bool), 0.5, dense)
+    assert _pairs_of(nl) == _brute_pairs(spread, g.topology.strand_index, 0.5)
 
 
 def test_auto_clump_radius_is_twice_the_median_root_spacing():
@@ -85,3 +95,47 @@ def test_strand_components_of_separated_groups():
     strands = [a + np.array([dx, 0.0, 0.0]) for dx in (0.0, 0.01, 3.0, 3.01, 9.0)]
     ids = strand_components(Groom.from_strands(strands), 0.05)
     np.testing.assert_array_equal(ids, [0, 0, 1, 1, 2])
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: samples.scalp(300, 10, seed=2),
+        lambda: samples.portrait(200, 12),
+        lambda: samples.comb(120, 8, seed=1),
+    ],
+    ids=["scalp", "portrait", "comb"],
+)
+def test_strand_clumps_match_numpy_twin(make):
+    g = make()
+    for radius in (0.5, 1.0, 2.0):
+        h = radius * auto_clump_radius(g)
+        np.testing.assert_array_equal(strand_clumps(g, h), strand_clumps_reference(g, h))
+
+
+def test_strand_clumps_of_separated_groups():
+    # Three tight groups of three strands, far apart: three clumps, numbered by first strand.
+    a = np.linspace([0, 0, 0], [0, -1, 0], 6)
+    strands = [a + np.array([gx + dx, 0.0, 0.0]) for gx in (0.0, 5.0, 10.0) for dx in (0.0, 0.02, 0.04)]
+    ids = strand_clumps(Groom.from_strands(strands), 0.05)
+    np.testing.assert_array_equal(ids, [0, 0, 0, 1, 1, 1, 2, 2, 2])
+
+
+@pytest.mark.parametrize(
+    "name", ["sintel_hair.tfx", "ratboy_mohawk.tfx", "ponytail_back.tfx", "ponytail_front_top.tfx"]
+)
+def test_real_grooms_give_many_clumps_of_sensible_size(grooms_dir, name):
+    # The studio colours the pipeline's result by clump: it must not be one colour (connected
+    # components at h percolate through the roots into one clump) nor one colour per strand.
+    g = read_groom(grooms_dir / name)
+    pipe = FrozenPipeline(g)
+    ids = pipe.clump_ids()
+    np.testing.assert_array_equal(ids, strand_clumps_reference(pipe.result, pipe.clump_radius))
+    sizes = np.bincount(ids)
+    assert len(sizes) >= max(10, g.strand_count // 60), f"{len(sizes)} clumps"
+    assert sizes.max() <= 0.25 * g.strand_count, f"largest clump {sizes.max()} of {g.strand_count}"
+    assert np.median(sizes) >= 3
+    assert np.mean(sizes == 1) <= 0.15
+    # What the old membership gave: one component holding (nearly) everything.
+    components = np.bincount(strand_components(pipe.result, pipe.clump_radius))
+    assert components.max() >= 0.5 * g.strand_count
