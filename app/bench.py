@@ -37,6 +37,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--only", choices=["samples", "large"], help="run only the samples or the large groom"
     )
     parser.add_argument("--no-clump", action="store_true", help="ClumpWithGaps off (align, freeze only)")
+    parser.add_argument("--line-width", type=float, help="strand width in pixels (default: the studio's)")
+    parser.add_argument(
+        "--fast-lines", action="store_true", help="the renderer's 1-px fast lines, whatever the width"
+    )
     parser.add_argument("--json", action="store_true", help="print the rows as JSON")
 
 
@@ -88,11 +92,15 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     window = MainWindow(groom=groom, settings=settings)
     if args.no_clump:
         window.scene.set_params(window.scene.params.replace(clump=False))
+    if args.line_width is not None:
+        window.scene.set_line_width(args.line_width)
     window.resize(*args.size)
     window.show()
     for _ in range(20):
         app.processEvents()
     v = window.viewport
+    if args.fast_lines and v.renderer is not None:
+        v.renderer.fast_lines = True
     v.finish_frames = True
     left, none = Qt.MouseButton.LeftButton, Qt.MouseButton.NoButton
 
@@ -124,6 +132,8 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
         stages.append(window.scene.pipeline.timings)
     send(QEvent.Type.MouseButtonRelease, path[-1], left, none)
     clump = window.scene.params.clump
+    lines = v.renderer.line_method() if v.renderer is not None else "-"
+    window.ask_save_changes = lambda: "discard"  # the benchmark's strokes are not work to keep
     window.close()
     window.deleteLater()
     app.processEvents()
@@ -142,6 +152,7 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     for stage in ("freeze", "align", "clump"):
         row[f"{stage}_ms"] = statistics.median(float(t.get(stage, 0.0)) for t in stages)
     row["msaa"] = max(QSurfaceFormat.defaultFormat().samples(), 0)
+    row["lines"] = lines
     row["under_target"] = row["total_ms"] < TARGET_MS
     return row
 

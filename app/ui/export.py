@@ -6,6 +6,7 @@ import os
 from pathlib import Path
 
 import moderngl
+import numpy as np
 
 from app.render.camera import Camera
 from app.render.offscreen import render_image, save_png
@@ -25,16 +26,20 @@ def export_still(
     size: tuple[int, int],
     transparent: bool = False,
     ctx: moderngl.Context | None = None,
+    points: np.ndarray | None = None,
+    point_colors: np.ndarray | None = None,
 ) -> None:
     """Write what the viewport shows (without the brush circle) at ``size`` pixels.
 
-    ``ctx``: the (current) context to draw in; None uses the headless one.
+    ``ctx``: the (current) context to draw in; None uses the headless one. ``points`` (and
+    ``point_colors``): an animation frame shown instead of the scene's groom, same strands.
     """
     suffix = Path(path).suffix.lower()
-    colors = vertex_colors(scene)
+    colors = point_colors if point_colors is not None else vertex_colors(scene)
+    groom = scene.result if points is None else scene.result.with_points(points)
     if suffix == ".png":
         image = render_image(
-            scene.result,
+            groom,
             size=size,
             camera=camera,
             ramp=scene.ramp,
@@ -50,7 +55,7 @@ def export_still(
             raise FormatError(path, "SVG export is for 2-D (planar) grooms; export a PNG instead")
         save_svg(
             path,
-            scene.result,
+            groom,
             camera,
             size,
             ramp=scene.ramp,

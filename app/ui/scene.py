@@ -62,13 +62,23 @@ class Scene(QObject):
         extent = float(np.max(hi - lo))
         self.radius = 0.25 * extent if extent > 0 else 1.0
 
-    def load(self, groom: Groom, path: str | Path | None = None) -> None:
-        """Replace the groom being edited (strokes are dropped; the parameters stay)."""
-        self._set_groom(groom)
+    def load(self, groom: Groom, path: str | Path | None = None, params: FrozenParams | None = None) -> None:
+        """Replace the groom being edited (strokes are dropped; the parameters stay unless
+        ``params`` gives new ones, e.g. a project's, which may only fit the new strands)."""
+        old_params = self._params
+        if params is not None:
+            self._params = params
+        try:
+            self._set_groom(groom)
+        except BaseException:
+            self._params = old_params
+            raise
         self.path = None if path is None else Path(path)
         self.groom_loaded.emit()
         self.tool_changed.emit()
         self.path_changed.emit()
+        if params is not None and params != old_params:
+            self.params_changed.emit(params)
 
     def set_path(self, path: str | Path | None) -> None:
         p = None if path is None else Path(path)

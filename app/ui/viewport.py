@@ -5,6 +5,10 @@ either pans, the wheel zooms, Ctrl+wheel resizes the brush. A plain left-drag is
 the cursor is unprojected onto the plane through the groom's centre facing the camera, and
 every move runs the frozen-hair pipeline. The view is told what changed by the scene's signals
 and uploads it at the next paint (positions only while dragging).
+
+With an animation loaded the window shows one of its frames instead of the scene's groom
+(:meth:`Viewport.show_frame`: positions, optional per-vertex colours and a ghost, all for the
+groom's strands), and a ``brush_target`` may take over the left-drag (editing a key pose).
 """
 
 from __future__ import annotations
@@ -12,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Iterator
+from typing import Protocol
 
 import moderngl
 import numpy as np
@@ -25,12 +30,25 @@ from app.ui.colouring import vertex_colors
 from app.ui.scene import Scene
 
 BRUSH_STEP = 1.1  # radius factor per wheel notch or [ / ] press
+GHOST_RGBA = (0.55, 0.75, 1.0, 0.35)  # the reconstruction under the original: flat, translucent
+
+
+class BrushTarget(Protocol):
+    """Takes over the align drag (e.g. editing an animation's key pose instead of the groom)."""
+
+    def begin(self, cursor: np.ndarray) -> bool:
+        """A left press at ``cursor`` (on the interaction plane); False leaves the drag unused."""
+
+    def move(self, cursor: np.ndarray) -> None: ...
+
+    def end(self) -> None: ...
 
 
 class Viewport(QOpenGLWidget):
     """Draws the scene's current groom; emits a finished stroke as (before, after) snapshots."""
 
     stroke_finished = Signal(object, object)
+    stroke_started = Signal()  # a left-drag on the scene's groom begins (before its first align)
     cursor_moved = Signal(object)  # (3,) float array on the interaction plane, or None
     frame_drawn = Signal()
 
@@ -50,6 +68,15 @@ class Viewport(QOpenGLWidget):
         self._stroke_before: object | None = None
         self._hover: QPointF | None = None
         self._auto_frame = True  # follow the widget's size with frame-all until the user navigates
+        # an animation frame shown instead of the scene's groom (see show_frame)
+        self.frame_points: np.ndarray | None = None
+        self.frame_colors: np.ndarray | None = None
+        self.ghost_points: np.ndarray | None = None
+        self.shown_frame: int | None = None  # the frame number uploaded at the last paint
+        self._pending_frame: int | None = None
+        self.brush_target: BrushTarget | None = None
+        self.extra_bounds: tuple[np.ndarray, np.ndarray] | None = None  # e.g. a whole animation's box
+        self._drag_target: BrushTarget | None = None  # the target that took the current drag
         self.setMouseTracking(True)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMinimumSize(200, 150)
@@ -79,14 +106,46 @@ class Viewport(QOpenGLWidget):
         self._mark("groom", "colors")
 
     def _on_points_changed(self) -> None:
+        if self.frame_points is not None:
+            return  # an animation frame is on screen; the groom's edits show when it goes
         self._dirty.add("points")
         if self.scene.colour_mode in ("displacement", "clump"):
             self._dirty.add("colors")
         self.update()
 
+    def show_frame(
+        self,
+        points: np.ndarray,
+        colors: np.ndarray | None = None,
+        ghost: np.ndarray | None = None,
+        frame: int | None = None,
+    ) -> None:
+        """Draw ``points`` ``(V, 3)`` (the groom's strands) instead of the scene's groom, with
+        optional per-vertex ``colors`` (None: the scene's colouring) and a ``ghost`` drawn under
+        them; uploaded at the next paint, so calls faster than the screen refreshes cost nothing."""
+        had_colors, had_ghost = self.frame_colors is not None, self.ghost_points is not None
+        self.frame_points, self.frame_colors, self.ghost_points = points, colors, ghost
+        self._pending_frame = frame
+        self._dirty.add("points")
+        if colors is not None or had_colors:
+            self._dirty.add("colors")
+        if ghost is not None or had_ghost:
+            self._dirty.add("ghost")
+        self.update()
+
+    def clear_frame(self) -> None:
+        """Back to drawing the scene's groom."""
+        if self.frame_points is None and self.ghost_points is None:
+            return
+        self.frame_points = self.frame_colors = self.ghost_points = None
+        self._pending_frame = None
+        self._mark("points", "colors", "ghost")
+
     def frame_all(self) -> None:
         """Fit the groom (and the head mesh) in view; planar grooms get the 2-D orthographic camera."""
         lo, hi = self.scene.result.bounds
+        if self.extra_bounds is not None:
+            lo, hi = np.minimum(lo, self.extra_bounds[0]), np.maximum(hi, self.extra_bounds[1])
         if self.scene.mesh is not None:
             v = np.asarray(self.scene.mesh.vertices, dtype=np.float32)
             if v.size:
@@ -112,16 +171,25 @@ class Viewport(QOpenGLWidget):
 
     def _upload(self) -> None:
         r, s, dirty = self.renderer, self.scene, self._dirty
+        shown = self.frame_points is not None and len(self.frame_points) == s.result.vertex_count
         if "groom" in dirty:
             r.set_groom(s.result)
             dirty.discard("points")
+            dirty.update(("ghost", "points") if shown or self.ghost_points is not None else ())
         if "points" in dirty:
-            r.update_points(s.result.points)
+            r.update_points(self.frame_points if shown else s.result.points)
+            self.shown_frame = self._pending_frame if shown else None
         if "display" in dirty:
             r.set_ramp(s.ramp)
             r.line_width = s.line_width
         if "colors" in dirty:
-            r.set_vertex_colors(vertex_colors(s))
+            own = shown and self.frame_colors is not None
+            r.set_vertex_colors(self.frame_colors if own else vertex_colors(s))
+        if "ghost" in dirty:
+            if shown and self.ghost_points is not None:
+                r.set_ghost_points(self.ghost_points, GHOST_RGBA)
+            else:
+                r.set_ghost_points(None)
         if "mesh" in dirty:
             r.set_mesh(s.mesh)
         dirty.clear()
@@ -212,8 +280,15 @@ class Viewport(QOpenGLWidget):
         self._drag = self._navigation(event)
         self._drag_button = event.button()
         self._last_pos = event.position()
+        self._drag_target = self.brush_target if self._drag == "align" else None
+        if self._drag_target is not None:
+            if not self._drag_target.begin(self._cursor_at(event.position())):
+                self._drag, self._drag_target = None, None
+            event.accept()
+            return
         if self._drag == "align":
             self._stroke_before = self.scene.snapshot()
+            self.stroke_started.emit()
             self._align_at(event.position())
         event.accept()
 
@@ -222,7 +297,9 @@ class Viewport(QOpenGLWidget):
         self._hover = pos
         dx, dy = pos.x() - self._last_pos.x(), pos.y() - self._last_pos.y()
         self._last_pos = pos
-        if self._drag == "align":
+        if self._drag == "align" and self._drag_target is not None:
+            self._drag_target.move(self._cursor_at(pos))
+        elif self._drag == "align":
             self._align_at(pos)
         elif self._drag == "orbit":
             self._auto_frame = False
@@ -234,16 +311,22 @@ class Viewport(QOpenGLWidget):
             self.cursor_moved.emit(self.cursor_on_plane(pos))
         self.update()
 
-    def _align_at(self, pos: QPointF) -> None:
+    def _cursor_at(self, pos: QPointF) -> np.ndarray:
         cursor = self.cursor_on_plane(pos)
         self.cursor_moved.emit(cursor)
-        self.scene.align(cursor)
+        return cursor
+
+    def _align_at(self, pos: QPointF) -> None:
+        self.scene.align(self._cursor_at(pos))
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         if self._drag is None or event.button() != self._drag_button:
             return
         drag, self._drag = self._drag, None
-        if drag == "align" and self._stroke_before is not None:
+        if drag == "align" and self._drag_target is not None:
+            target, self._drag_target = self._drag_target, None
+            target.end()
+        elif drag == "align" and self._stroke_before is not None:
             before, self._stroke_before = self._stroke_before, None
             self.stroke_finished.emit(before, self.scene.snapshot())
         self.update()

@@ -14,14 +14,20 @@ from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QK
 from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QWidget
 
 from app.ui import export
+from app.ui.animation_io import open_filters, read_any
+from app.ui.animation_model import AnimationModel
+from app.ui.animation_ui import AnimationController
 from app.ui.commands import ParamCommand, StrokeCommand
 from app.ui.dialogs import StillOptions, ask_still_options
+from app.ui.jobs import JobRunner, JobStatus
 from app.ui.scene import COLOUR_MODES, Scene
+from app.ui.simulate_dialog import SimulateOptions, ask_simulate_options
+from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
 from app.ui.viewport import BRUSH_STEP, Viewport
 from hairtool import io, samples
 from hairtool.errors import HairtoolError
-from hairtool.groom import Groom
+from hairtool.groom import Animation, Groom
 
 MAX_RECENT = 10
 SETTINGS_ORG, SETTINGS_APP = "hairtool", "Hairtool Studio"
@@ -50,6 +56,8 @@ class MainWindow(QMainWindow):
         self.setObjectName("HairtoolStudio")
         self.settings = settings if settings is not None else QSettings(SETTINGS_ORG, SETTINGS_APP)
         self.undo_stack = QUndoStack(self)
+        # long work (key solves, simulation, video export): window.jobs.run(title, fn, on_done)
+        self.jobs = JobRunner(lambda title, message: self.show_error(title, message), self)
         start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
         self.scene = Scene(start, parent=self)
         self.viewport = Viewport(self.scene, self)
@@ -58,6 +66,8 @@ class MainWindow(QMainWindow):
         self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
         self._build_status_bar()
         self._build_menus()
+        self._build_animation_ui()
+        self._build_part2_menus()
         self.setAcceptDrops(True)
         self.resize(1280, 800)
 
@@ -79,7 +89,7 @@ class MainWindow(QMainWindow):
         QMessageBox.critical(self, title, message)
 
     def ask_open_path(self, title: str = "Open groom", filters: str | None = None) -> str | None:
-        path, _ = QFileDialog.getOpenFileName(self, title, self.last_dir(), filters or _filters("readable"))
+        path, _ = QFileDialog.getOpenFileName(self, title, self.last_dir(), filters or open_filters())
         return path or None
 
     def ask_save_path(self, title: str, filters: str, suggested: str = "") -> str | None:
@@ -123,6 +133,11 @@ class MainWindow(QMainWindow):
         self.settings.sync()
 
     def closeEvent(self, event) -> None:
+        if not self.project.confirm_discard():  # unsaved changes: the user chose Cancel
+            event.ignore()
+            return
+        self.jobs.shutdown()
+        self.project.shutdown()
         self.save_layout()
         self.viewport.release_gl()
         super().closeEvent(event)
@@ -169,7 +184,7 @@ class MainWindow(QMainWindow):
         edit.addAction(redo)
 
         view = bar.addMenu("&View")
-        self._action(view, "&Frame all", self.viewport.frame_all, ["F", "Home"])
+        self._action(view, "&Frame all", self.viewport.frame_all, "F")  # Home: first frame
         self.ortho_action = self._action(view, "&2-D view", self.toggle_ortho, "5", checkable=True)
         view.aboutToShow.connect(self._sync_view_menu)
         colour = view.addMenu("&Colour by")
@@ -187,6 +202,83 @@ class MainWindow(QMainWindow):
         brush = bar.addMenu("&Brush")
         self._action(brush, "&Smaller", lambda: self.viewport.scale_brush(1.0 / BRUSH_STEP), "[")
         self._action(brush, "&Bigger", lambda: self.viewport.scale_brush(BRUSH_STEP), "]")
+
+    # -- animation (timeline, playback, keys, recording) ---------------------------------------
+    def _build_animation_ui(self) -> None:
+        """``self.animation`` (the model other docks load animations into), the timeline dock,
+        the Animation menu and the fps read-out in the status bar."""
+        self.animation = AnimationModel(self.jobs, self)
+        self.animation_ui = AnimationController(self, self.animation)
+        actions = self.animation_ui.build_menu()
+        self.timeline = TimelineDock(self.animation, actions, lambda t, m: self.show_error(t, m), self)
+        self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.timeline)
+        self.animation_ui.bind_transport_keys(self.viewport, self.timeline)
+        self.statusBar().addPermanentWidget(self.animation_ui.fps_label)
+        view = next(a.menu() for a in self.menuBar().actions() if a.text() == "&View")
+        view.addAction(self.timeline.toggleViewAction())
+
+    # -- part 2: projects, anime dock, simulation, animation and keys export -----------------
+    def _build_part2_menus(self) -> None:
+        """``self.project`` (save/open, autosave, recovery), ``self.sources`` (anime dock,
+        simulation), ``self.exporter`` (animation and keys export) and their menu entries."""
+        from app.ui.animation_export import AnimationExporter
+        from app.ui.animation_sources import AnimationSources
+        from app.ui.project_ui import ProjectController
+
+        self.sources = AnimationSources(self)
+        self.exporter = AnimationExporter(self)
+        self.project = ProjectController(self)
+        menus = {a.text(): a.menu() for a in self.menuBar().actions()}
+        file = menus["&File"]
+        quit_action = file.actions()[-1]
+        for text, slot, key in (
+            ("Open &Project…", self.project.open_project_dialog, "Ctrl+Shift+O"),
+            ("Save Pro&ject", self.project.save_project, "Ctrl+Alt+S"),
+            ("Save Project As…", self.project.save_project_as, None),
+            (None, None, None),
+            ("Export &Animation…", self.exporter.export_animation_dialog, "Ctrl+Alt+E"),
+            ("Export &Keys…", self.exporter.export_keys_dialog, None),
+            (None, None, None),
+        ):
+            if text is None:
+                file.insertSeparator(quit_action)
+                continue
+            action = QAction(text, self)
+            if key is not None:
+                action.setShortcut(QKeySequence(key))
+            action.triggered.connect(lambda _=False, f=slot: f())
+            file.insertAction(quit_action, action)
+        animation = menus["&Animation"]
+        animation.addSeparator()
+        self._action(animation, "&Simulate…", self.sources.simulate_dialog, "Ctrl+Alt+M")
+        menus["&View"].addAction(self.sources.dock.toggleViewAction())
+
+    def ask_save_changes(self) -> str:
+        """The answer to unsaved changes: "save", "discard" or "cancel" (tests replace this)."""
+        box = QMessageBox.question(
+            self,
+            "Unsaved changes",
+            "The project has unsaved changes. Save them first?",
+            QMessageBox.StandardButton.Save
+            | QMessageBox.StandardButton.Discard
+            | QMessageBox.StandardButton.Cancel,
+        )
+        return {QMessageBox.StandardButton.Save: "save", QMessageBox.StandardButton.Discard: "discard"}.get(
+            box, "cancel"
+        )
+
+    def ask_restore_recovery(self, path: str) -> bool:
+        """Restore the autosave a crashed session left? (tests replace this)"""
+        answer = QMessageBox.question(
+            self,
+            "Restore autosaved work",
+            f"Hairtool Studio did not close properly last time. Restore the autosaved session?\n{path}",
+        )
+        return answer == QMessageBox.StandardButton.Yes
+
+    def ask_simulate_options(self, options: SimulateOptions) -> SimulateOptions | None:
+        """The Simulate… dialog: SimulateOptions or None (tests replace this)."""
+        return ask_simulate_options(self, options)
 
     def toggle_ortho(self) -> None:
         """2-D (orthographic front view) ⇄ 3-D (perspective), whatever the menu's check mark says."""
@@ -211,6 +303,8 @@ class MainWindow(QMainWindow):
         bar.addWidget(self.counts_label)
         bar.addWidget(self.frame_label)
         bar.addPermanentWidget(self.cursor_label)
+        self.job_status = JobStatus(self.jobs)
+        bar.addPermanentWidget(self.job_status)
 
     def _update_counts(self) -> None:
         g = self.scene.result
@@ -252,7 +346,9 @@ class MainWindow(QMainWindow):
 
     # -- files ----------------------------------------------------------------------------------
     def set_groom(self, groom: Groom, path: str | os.PathLike[str] | None = None) -> None:
-        """Show a new groom; its strokes start afresh, so the undo history is cleared."""
+        """Show a new groom; its strokes start afresh, so the undo history is cleared (and an
+        animation on the timeline is closed)."""
+        self.animation.clear()
         self.undo_stack.clear()
         self.scene.load(groom, path)
         self.undo_stack.setClean()
@@ -267,13 +363,19 @@ class MainWindow(QMainWindow):
             self.open_path(path)
 
     def open_path(self, path: str | os.PathLike[str]) -> bool:
-        """Open any readable groom (an animation's first frame); on failure the scene is kept."""
+        """Open any readable groom, or an animation (USD time samples, ``.npz``, BVH as a
+        skeleton) into the timeline on its first frame; on failure the scene is kept."""
         try:
-            groom = io.read_groom(path)
+            obj = read_any(path)
         except HairtoolError as e:
             self.show_error("Cannot open file", str(e))
             return False
-        self.set_groom(groom, path)
+        if isinstance(obj, Animation):
+            self.set_groom(obj.rest, path)
+            if obj.n_frames > 1:
+                self.animation.load_animation(obj, str(path))
+        else:
+            self.set_groom(obj, path)
         self._add_recent(path)
         return True
 
@@ -350,6 +452,8 @@ class MainWindow(QMainWindow):
                     size or self.viewport_pixel_size(),
                     transparent,
                     ctx=ctx,
+                    points=self.viewport.frame_points,  # an animation frame, when one is shown
+                    point_colors=self.viewport.frame_colors,
                 )
         except HairtoolError as e:
             self.show_error("Cannot export still", str(e))

@@ -22,7 +22,8 @@ def settings_path(tmp_path):
 def make_window(qapp, qtbot, settings_path):
     """``make_window(path=None, groom=None)`` → a shown MainWindow whose dialogs never block.
 
-    Errors that would pop up a dialog are collected in ``window.errors`` instead.
+    Errors that would pop up a dialog are collected in ``window.errors`` instead. The settings
+    (and the autosave recovery file beside them) live in the test's ``tmp_path``.
     """
     from app.ui.window import MainWindow
 
@@ -33,6 +34,10 @@ def make_window(qapp, qtbot, settings_path):
         window = MainWindow(None, settings=settings, groom=groom)
         window.errors = []
         window.show_error = lambda title, message: window.errors.append((title, message))
+        # questions never block: close without saving, decline a recovery file (tests that
+        # need other answers replace these again)
+        window.ask_save_changes = lambda: "discard"
+        window.ask_restore_recovery = lambda path: False
         window.resize(*size)
         window.show()
         qtbot.waitExposed(window)

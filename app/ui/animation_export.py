@@ -1,0 +1,422 @@
+"""Exporting the animation (USD, ``.npz``, MP4, GIF, a PNG sequence) and its keys (JSON, CSV, USD).
+
+Video frames are drawn like the viewport draws them, in the viewport's own GL context (the
+studio keeps to one context): a worker thread encodes while the GUI thread renders each frame
+on request (:class:`GuiFrameSource`), so the window keeps drawing and Cancel works between
+frames. Every file is written beside its target and renamed at the end: a cancelled or failed
+export leaves no partial file (a PNG sequence appears all at once, from a temporary folder).
+
+API for the window: :class:`AnimationExporter` (``export_animation(path)``,
+``export_keys(path)``, the two ``*_dialog`` methods); the functions below work without Qt
+widgets and are what the tests drive.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import queue
+import shutil
+import tempfile
+from collections.abc import Callable, Iterable, Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+from PySide6.QtCore import QObject, Qt, QThread, Signal, Slot
+
+from app.render.camera import Camera
+from app.render.offscreen import render_image
+from app.ui.colouring import vertex_colors
+from app.ui.jobs import Job, JobCancelled
+from hairtool import io
+from hairtool.errors import FormatError, HairtoolError, ParameterError
+from hairtool.groom import Animation
+from hairtool.io.atomic import atomic_path
+from hairtool.keys_export import export_keys as write_keys
+from hairtool.keys_export import keys_record
+
+if TYPE_CHECKING:
+    from app.ui.window import MainWindow
+
+DATA_SUFFIXES = (".usd", ".usda", ".usdc", ".npz")
+VIDEO_SUFFIXES = (".mp4", ".gif")
+SEQUENCE_SUFFIXES = (".png",)
+KEY_SUFFIXES = (".json", ".csv", ".usda", ".usdc", ".usd")
+ANIMATION_FILTERS = ";;".join(
+    [
+        "USD animation (*.usda *.usdc *.usd)",
+        "hairtool cache (*.npz)",
+        "MP4 video (*.mp4)",
+        "GIF animation (*.gif)",
+        "PNG sequence (*.png)",
+    ]
+)
+KEY_FILTERS = "Keys record (*.json);;Key sheet (*.csv);;USD key poses (*.usda *.usdc *.usd)"
+MP4_QUALITY = 8  # imageio-ffmpeg's 0..10 scale: visually clean thin hair lines, small files
+
+Progress = Callable[..., None]
+Cancelled = Callable[[], bool]
+
+
+def _never() -> bool:
+    return False
+
+
+def _ignore(*_: object) -> None:
+    return None
+
+
+def even_size(size: tuple[int, int]) -> tuple[int, int]:
+    """The size rounded down to even numbers (H.264 in yuv420p needs them), at least 2×2."""
+    w, h = (int(v) for v in size)
+    return max(2, w - w % 2), max(2, h - h % 2)
+
+
+def _rgb(image: NDArray) -> NDArray[np.uint8]:
+    img = np.asarray(image)
+    if img.dtype != np.uint8 or img.ndim != 3 or img.shape[2] not in (3, 4):
+        raise ParameterError("frame", f"{img.dtype} {img.shape}", "(H, W, 3 or 4) uint8")
+    return np.ascontiguousarray(img[..., :3])
+
+
+def _frames_checked(
+    frames: Iterable[NDArray], n_frames: int, progress: Progress, cancelled: Cancelled
+) -> Iterator[NDArray[np.uint8]]:
+    """RGB frames with progress after each and a cancel check before each."""
+    count = 0
+    for count, image in enumerate(frames, 1):
+        if cancelled():
+            raise JobCancelled
+        yield _rgb(image)
+        progress(count / max(n_frames, 1), f"frame {count}/{n_frames}")
+    if cancelled():
+        raise JobCancelled
+    if count != n_frames:
+        raise ParameterError("frames", count, f"{n_frames} frames")
+
+
+def write_video(
+    path: str | os.PathLike[str],
+    frames: Iterable[NDArray],
+    n_frames: int,
+    fps: float,
+    *,
+    progress: Progress = _ignore,
+    cancelled: Cancelled = _never,
+) -> None:
+    """Encode ``n_frames`` RGB(A) uint8 frames as MP4 (H.264) or GIF, atomically.
+
+    :class:`JobCancelled` (raised when ``cancelled()`` turns True) leaves no file behind. GIF:
+    Pillow merges identical consecutive frames into one longer frame (pictures held on twos
+    play the same, in fewer GIF frames); delays are whole centiseconds, as GIF stores them.
+    """
+    suffix = Path(path).suffix.lower()
+    if suffix not in VIDEO_SUFFIXES:
+        raise FormatError(path, f"videos are written as {' or '.join(VIDEO_SUFFIXES)}, not '{suffix}'")
+    if not (np.isfinite(fps) and 0 < fps <= 1000):
+        raise ParameterError("fps", fps, "a frame rate in (0, 1000]")
+    checked = _frames_checked(frames, n_frames, progress, cancelled)
+    try:
+        with atomic_path(path) as tmp:
+            if suffix == ".mp4":
+                _write_mp4(tmp, checked, fps)
+            else:
+                _write_gif(tmp, checked, fps)
+    except OSError as e:
+        raise FormatError(path, f"cannot write: {e}") from None
+
+
+def _write_mp4(tmp: Path, frames: Iterator[NDArray[np.uint8]], fps: float) -> None:
+    import imageio.v2 as imageio
+
+    writer = imageio.get_writer(
+        tmp,
+        format="FFMPEG",
+        mode="I",
+        fps=fps,
+        codec="libx264",
+        quality=MP4_QUALITY,
+        pixelformat="yuv420p",
+        macro_block_size=1,
+        ffmpeg_log_level="error",
+    )
+    try:
+        for image in frames:
+            h, w = image.shape[:2]
+            writer.append_data(image[: h - h % 2, : w - w % 2])
+    finally:
+        writer.close()
+
+
+def _write_gif(tmp: Path, frames: Iterator[NDArray[np.uint8]], fps: float) -> None:
+    from PIL import Image
+
+    images = (Image.fromarray(image) for image in frames)
+    first = next(images, None)
+    if first is None:
+        raise ParameterError("frames", 0, "at least one frame")
+    first.save(tmp, format="GIF", save_all=True, append_images=images, duration=1000.0 / fps, loop=0)
+
+
+def sequence_paths(path: str | os.PathLike[str], n_frames: int) -> list[Path]:
+    """``shot.png`` → ``shot_0000.png`` … (at least 4 digits, more for long shots)."""
+    p = Path(path)
+    digits = max(4, len(str(max(n_frames - 1, 0))))
+    return [p.with_name(f"{p.stem}_{i:0{digits}d}{p.suffix}") for i in range(n_frames)]
+
+
+def write_png_sequence(
+    path: str | os.PathLike[str],
+    frames: Iterable[NDArray],
+    n_frames: int,
+    *,
+    progress: Progress = _ignore,
+    cancelled: Cancelled = _never,
+) -> list[Path]:
+    """Write ``shot_0000.png`` … beside ``path``: into a temporary folder first, moved into
+    place only when every frame is written, so a cancel leaves nothing behind."""
+    import imageio.v3 as iio
+
+    if Path(path).suffix.lower() not in SEQUENCE_SUFFIXES:
+        raise FormatError(path, "a PNG sequence is named like shot.png (frames become shot_0000.png …)")
+    targets = sequence_paths(path, n_frames)
+    folder = targets[0].parent if targets else Path(path).parent
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=f".{Path(path).stem}.", suffix=".tmp", dir=folder))
+    except OSError as e:
+        raise FormatError(path, f"cannot write: {e}") from None
+    try:
+        for target, image in zip(
+            targets, _frames_checked(frames, n_frames, progress, cancelled), strict=False
+        ):
+            iio.imwrite(tmp / target.name, image, extension=".png")
+        for target in targets:
+            os.replace(tmp / target.name, target)
+    except OSError as e:
+        raise FormatError(path, f"cannot write: {e}") from None
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return targets
+
+
+def write_animation_data(path: str | os.PathLike[str], animation: Animation) -> None:
+    """USD time samples or the ``.npz`` cache (atomic, through :mod:`hairtool.io`)."""
+    if Path(path).suffix.lower() not in DATA_SUFFIXES:
+        raise FormatError(path, f"animations are written as {', '.join(DATA_SUFFIXES)}")
+    io.write(path, animation)
+
+
+class FrameRenderer:
+    """Draws an animation's frames as the viewport shows the groom: camera, ramp, colours,
+    line width and head mesh fixed when the export starts."""
+
+    def __init__(
+        self,
+        animation: Animation,
+        camera: Camera,
+        size: tuple[int, int],
+        *,
+        ramp: str = "root-tip",
+        colors: NDArray | None = None,
+        line_width: float = 2.0,
+        mesh: object | None = None,
+    ) -> None:
+        self.animation, self.size = animation, even_size(size)
+        self.camera = Camera(
+            camera.target,
+            camera.distance,
+            camera.yaw,
+            camera.pitch,
+            camera.fov_y,
+            camera.ortho,
+            camera.ortho_height,
+        )
+        lo, hi = animation.bounds
+        self.camera.set_scene(lo, hi)  # near and far planes enclose the whole motion
+        self.ramp, self.colors, self.line_width, self.mesh = ramp, colors, line_width, mesh
+
+    def render(self, frame: int, ctx: object | None = None) -> NDArray[np.uint8]:
+        """``(H, W, 4)`` uint8 of one frame (``ctx``: a current moderngl context; None: headless)."""
+        return render_image(
+            self.animation.frame(frame),
+            size=self.size,
+            camera=self.camera,
+            ramp=self.ramp,
+            colors=self.colors,
+            line_width=self.line_width,
+            mesh=self.mesh,
+            ctx=ctx,
+        )
+
+
+class GuiFrameSource(QObject):
+    """Frames rendered on the GUI thread for a worker thread that asks for them one by one.
+
+    Create it on the GUI thread. :meth:`frames` yields the rendered frames; called on the GUI
+    thread itself it renders directly (synchronous exports and tests).
+    """
+
+    _requested = Signal(int)
+
+    def __init__(self, render: Callable[[int], NDArray]) -> None:
+        super().__init__()
+        self._render = render
+        self._answers: queue.Queue = queue.Queue()
+        self._requested.connect(self._on_request, Qt.ConnectionType.QueuedConnection)
+
+    @Slot(int)
+    def _on_request(self, frame: int) -> None:
+        try:
+            self._answers.put((frame, self._render(frame), None))
+        except BaseException as e:  # handed to the worker, which raises it
+            self._answers.put((frame, None, e))
+
+    def frame(self, index: int, cancelled: Cancelled = _never) -> NDArray:
+        if QThread.currentThread() == self.thread():
+            return self._render(index)
+        self._requested.emit(index)
+        while True:
+            try:
+                frame, image, error = self._answers.get(timeout=0.05)
+            except queue.Empty:
+                if cancelled():
+                    raise JobCancelled from None
+                continue
+            if frame != index:  # a late answer to an earlier, abandoned request
+                continue
+            if error is not None:
+                raise error
+            return image
+
+    def frames(self, n_frames: int, cancelled: Cancelled = _never) -> Iterator[NDArray]:
+        for i in range(n_frames):
+            yield self.frame(i, cancelled)
+
+
+def keys_result(model: object) -> dict:
+    """The keys on the timeline as a ``hairtool keys`` result: frames, fps, DP keys and their
+    cost, the uniform keys of the same count and theirs, the key settings and, when measured,
+    the mean/tip/max position errors of both reconstructions."""
+    from hairtool.keyframes import keys_cost
+
+    anim, solve, keys = model.animation, model.key_solve, model.dp_keys
+    if anim is None or keys is None or solve is None:
+        raise HairtoolError(
+            "no keys to export: make or open an animation first (the timeline solves its keys)"
+        )
+    uni = model.uniform_keys
+    objective = solve.objective
+    result = {
+        "frames": anim.n_frames,
+        "fps": anim.fps,
+        "keys": np.asarray(keys).tolist(),
+        "cost": keys_cost(solve.table, keys, objective),
+        "objective": objective,
+        "mode": model.settings.mode,
+        "uniform": {"keys": np.asarray(uni).tolist(), "cost": keys_cost(solve.table, uni, objective)},
+        "params": dataclasses.asdict(model.settings),
+    }
+    if model.analysis is not None:
+        result["position_errors"] = {
+            "keys": model.analysis.dp.summary(),
+            "uniform": model.analysis.uniform.summary(),
+        }
+    return result
+
+
+class AnimationExporter(QObject):
+    """File → Export Animation / Export Keys for the window (errors go to ``window.show_error``)."""
+
+    exported = Signal(str)  # the path, once a file (or sequence) is complete
+
+    def __init__(self, window: MainWindow) -> None:
+        super().__init__(window)
+        self.window = window
+        self.job: Job | None = None
+
+    def export_animation_dialog(self) -> bool:
+        if self.window.animation.animation is None:
+            self.window.show_error("Cannot export animation", "No animation: make or open one first")
+            return False
+        path = self.window.ask_save_path("Export animation", ANIMATION_FILTERS, "animation.mp4")
+        return bool(path) and self.export_animation(path) is not False
+
+    def export_keys_dialog(self) -> bool:
+        path = self.window.ask_save_path("Export keys", KEY_FILTERS, "keys.json")
+        return bool(path) and self.export_keys(path)
+
+    def export_keys(self, path: str | os.PathLike[str]) -> bool:
+        """JSON record, CSV sheet or USD key poses of the timeline's DP keys."""
+        model = self.window.animation
+        try:
+            record = keys_record(keys_result(model), model.source or None)
+            write_keys(path, record, model.animation)
+        except HairtoolError as e:
+            self.window.show_error("Cannot export keys", str(e))
+            return False
+        self._done(path)
+        return True
+
+    def renderer(self, animation: Animation, size: tuple[int, int] | None = None) -> FrameRenderer:
+        w, scene = self.window, self.window.scene
+        colors = None
+        if animation.vertex_count == scene.result.vertex_count and scene.colour_mode in ("strand", "clump"):
+            colors = vertex_colors(scene)  # per-strand colours stay valid on every frame
+        return FrameRenderer(
+            animation,
+            w.viewport.camera,
+            size or w.viewport_pixel_size(),
+            ramp=scene.ramp,
+            colors=colors,
+            line_width=scene.line_width,
+            mesh=scene.mesh,
+        )
+
+    def export_animation(
+        self, path: str | os.PathLike[str], size: tuple[int, int] | None = None
+    ) -> bool | Job:
+        """Data formats are written at once (True/False); video and PNG sequences start a job
+        in ``window.jobs`` and return it (False when refused before starting)."""
+        w = self.window
+        anim = w.animation.animation
+        suffix = Path(path).suffix.lower()
+        try:
+            if anim is None:
+                raise HairtoolError("no animation: make or open one first")
+            if suffix in DATA_SUFFIXES:
+                write_animation_data(path, anim)
+                self._done(path)
+                return True
+            if suffix not in VIDEO_SUFFIXES + SEQUENCE_SUFFIXES:
+                raise FormatError(
+                    path, "animations are written as .usda/.usdc/.usd, .npz, .mp4, .gif or .png"
+                )
+            renderer = self.renderer(anim, size)
+        except HairtoolError as e:
+            w.show_error("Cannot export animation", str(e))
+            return False
+
+        def render(i: int) -> NDArray:
+            with w.viewport.current_context() as ctx:
+                return renderer.render(i, ctx)
+
+        source = GuiFrameSource(render)
+        n = anim.n_frames
+
+        def work(progress: Progress, cancelled: Cancelled) -> str:
+            frames = source.frames(n, cancelled)
+            if suffix in VIDEO_SUFFIXES:
+                write_video(path, frames, n, anim.fps, progress=progress, cancelled=cancelled)
+            else:
+                write_png_sequence(path, frames, n, progress=progress, cancelled=cancelled)
+            return str(path)
+
+        self.job = w.jobs.run(f"Exporting {Path(path).name}", work, on_done=lambda p: self._done(p))
+        return self.job
+
+    def _done(self, path: str | os.PathLike[str]) -> None:
+        self.window._remember_dir(path)
+        self.window.statusBar().showMessage(f"wrote {path}", 5000)
+        self.exported.emit(str(path))

@@ -1,0 +1,52 @@
+"""Opening files as the studio shows them: grooms, animations, and BVH captures as skeletons.
+
+A BVH capture becomes an :class:`Animation` of line segments: every bone (joint → parent, and
+each End Site → its joint) is one 2-vertex strand, root at the parent. Bones rather than whole
+chains keep branching skeletons exact (a chain would have to repeat joints at each branch), and
+the root-to-tip colour ramp then shows each bone's direction.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from hairtool import io
+from hairtool.bvh import Motion, read_bvh
+from hairtool.errors import FormatError
+from hairtool.groom import Animation, Groom
+
+BVH_EXTENSIONS = (".bvh",)
+
+
+def skeleton_animation(motion: Motion) -> Animation:
+    """``(F, 2·B, 3)`` frames of the B bones of a capture, at its frame rate."""
+    pos = motion.joint_positions(end_sites=True)  # (F, J + E, 3), End Sites last
+    parents = np.concatenate([motion.parents, motion.end_parents])
+    child = np.flatnonzero(parents >= 0)
+    if child.size == 0:
+        raise FormatError("<bvh>", "the skeleton has a single joint and no End Site: no bones to draw")
+    ends = np.column_stack([parents[child], child]).reshape(-1)  # parent, child for each bone
+    return Animation(pos[:, ends], np.full(child.size, 2), motion.fps)
+
+
+def read_any(path: str | os.PathLike[str]) -> Groom | Animation:
+    """A groom or an animation from any readable format, BVH included (as a skeleton)."""
+    if Path(path).suffix.lower() in BVH_EXTENSIONS:
+        motion = read_bvh(path)
+        try:
+            return skeleton_animation(motion)
+        except FormatError as e:
+            raise FormatError(path, e.reason) from None
+    return io.read(path)
+
+
+def open_filters() -> str:
+    """File-dialog filters: every readable groom/animation format and BVH."""
+    formats = [(f.name, f.extensions) for f in io.FORMATS if f.readable]
+    formats.append(("BVH motion capture (skeleton)", BVH_EXTENSIONS))
+    parts = [f"{name} ({' '.join('*' + e for e in exts)})" for name, exts in formats]
+    every = " ".join("*" + e for _, exts in formats for e in exts)
+    return ";;".join([f"All supported ({every})", *parts])

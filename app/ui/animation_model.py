@@ -1,0 +1,529 @@
+"""The studio's animation model: the loaded animation, playback, and the keyframe state.
+
+No widgets: the timeline dock and the viewport listen to its signals, which fire only when a
+value really changes. Key work follows the timeline's needs: one solve per animation and
+table setting (features, cost table, layered DP) gives the keys of every count, so the
+key-count slider answers at once; per-frame errors of the DP keys and of uniform keys of the
+same count follow. Work on large animations runs through the window's :class:`JobRunner`; a
+job the user cancels leaves the previous keys, settings and curves as they were.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from PySide6.QtCore import QObject, Qt, QTimer, Signal
+
+from app.render.ramps import ramp_colors
+from app.ui import key_state as ks
+from app.ui.jobs import Job, JobRunner
+from hairtool.errors import GroomError, ParameterError
+from hairtool.groom import Animation
+from hairtool.keyframes import uniform_keys
+from hairtool.reconstruct import KeyPoses
+
+VIEW_MODES = {
+    "original": "Original",
+    "reconstruction": "Reconstruction from keys",
+    "ghost": "Both (reconstruction as ghost)",
+    "error": "Colour by key error",
+}
+INLINE_VALUES = 3_000_000  # animations up to this many coordinates are solved on the GUI thread
+
+
+@dataclass
+class Display:
+    """What the viewport draws for the current frame: points, optional colours and ghost."""
+
+    frame: int
+    points: np.ndarray
+    colors: np.ndarray | None = None
+    ghost: np.ndarray | None = None
+
+
+@dataclass
+class _Committed:
+    """The last complete key state (settings, solve, keys, errors): what a cancel returns to."""
+
+    settings: ks.KeySettings
+    solve: ks.KeySolve | None
+    dp_keys: np.ndarray | None
+    analysis: ks.Analysis | None
+
+
+class AnimationModel(QObject):
+    """The current animation (or None), its frame, playback, keys and view mode."""
+
+    animation_changed = Signal()  # a new animation (or None): everything else was reset
+    frames_edited = Signal(int, int)  # first and last frame a key edit changed
+    frame_changed = Signal(int)
+    playing_changed = Signal(bool)
+    loop_changed = Signal(bool)
+    fps_changed = Signal(float)
+    settings_changed = Signal(object)  # KeySettings
+    keys_changed = Signal()  # DP keys (and the uniform keys of the same count)
+    curve_changed = Signal()  # the error-vs-key-count curve (a new solve)
+    analysis_changed = Signal()  # per-frame errors of both reconstructions and the speed
+    view_mode_changed = Signal(str)
+    display_changed = Signal()  # what is drawn at the current frame changed (not the frame)
+    busy_changed = Signal(bool)  # a solve or an error pass is running in the background
+
+    def __init__(self, runner: JobRunner | None = None, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self.runner = runner
+        self.inline_values = INLINE_VALUES  # tests set 0 to send every solve through the runner
+        self.clock: Callable[[], float] = time.perf_counter
+        self.animation: Animation | None = None
+        self.source = ""
+        self.generation = 0  # counts loaded animations (undo steps of an older one do nothing)
+        self.frame = 0
+        self.fps = 24.0
+        self.playing = False
+        self.loop = True
+        self.settings = ks.KeySettings()
+        self.view_mode = "original"
+        self._clear_keys()
+        self._committed: _Committed | None = None
+        self._solve_job: Job | None = None
+        self._analysis_job: Job | None = None
+        self._preview: tuple[int, np.ndarray] | None = None
+        self._timer = QTimer(self)
+        self._timer.setTimerType(Qt.TimerType.PreciseTimer)
+        self._timer.timeout.connect(self._tick)
+        self._play_start = (0.0, 0)
+
+    def _clear_keys(self) -> None:
+        self.key_solve: ks.KeySolve | None = None
+        self.solve_stale = False  # the animation was edited after the solve
+        self.dp_keys: np.ndarray | None = None
+        self.uniform_keys: np.ndarray | None = None
+        self.dp_poses: KeyPoses | None = None
+        self.uniform_poses: KeyPoses | None = None
+        self.analysis: ks.Analysis | None = None
+
+    # -- the animation -------------------------------------------------------------------
+    @property
+    def n_frames(self) -> int:
+        return 0 if self.animation is None else self.animation.n_frames
+
+    @property
+    def last_frame(self) -> int:
+        return max(self.n_frames - 1, 0)
+
+    def load_animation(
+        self, animation: Animation, source: str = "", *, settings: ks.KeySettings | None = None
+    ) -> None:
+        """Show ``animation`` in the timeline and viewport and solve its keys.
+
+        ``source`` says where it came from (a path, "recording", "anime cycle", …); the other
+        docks call this through ``window.animation.load_animation``. Frame 0, playback stopped,
+        playback rate the animation's. The key settings stay, except the count, which goes back
+        to a tenth of the frames; a reopened project passes its saved ``settings`` instead (one
+        solve, with those). ParameterError for invalid settings, before anything changes.
+        """
+        if not isinstance(animation, Animation):
+            raise GroomError(f"expected an Animation, got {type(animation).__name__}")
+        new_settings = settings.validate() if settings is not None else self.settings.replace(count=0)
+        self.pause()
+        self._cancel_jobs()
+        self.generation += 1
+        self.animation = animation
+        self.source = str(source)
+        self.frame = 0
+        self._preview = None
+        self._clear_keys()
+        self._committed = None
+        if new_settings != self.settings:
+            self.settings = new_settings
+            self.settings_changed.emit(new_settings)
+        if animation.fps != self.fps:
+            self.fps = float(animation.fps)
+            self.fps_changed.emit(self.fps)
+        self.animation_changed.emit()
+        self.frame_changed.emit(0)
+        self.keys_changed.emit()
+        self.curve_changed.emit()
+        self.analysis_changed.emit()
+        self.display_changed.emit()
+        if animation.n_frames >= 2:
+            self.request_solve()
+
+    def clear(self) -> None:
+        """No animation: the viewport shows the scene's groom again."""
+        if self.animation is None:
+            return
+        self.pause()
+        self._cancel_jobs()
+        self.generation += 1
+        self.animation, self.source, self.frame, self._preview = None, "", 0, None
+        self._clear_keys()
+        self._committed = None
+        self.animation_changed.emit()
+        self.frame_changed.emit(0)
+        self.keys_changed.emit()
+        self.curve_changed.emit()
+        self.analysis_changed.emit()
+        self.display_changed.emit()
+
+    def replace_frames(self, start: int, block: np.ndarray) -> None:
+        """Frames ``start .. start + len(block) − 1`` get new poses (a key edit or its undo).
+
+        The keys stay; their poses and the error curves are refreshed; the cost table is marked
+        stale and is solved again on the next change of the key settings.
+        """
+        anim = self.animation
+        if anim is None:
+            raise GroomError("no animation to edit")
+        frames = np.array(anim.frames)
+        frames[start : start + len(block)] = block
+        self.animation = anim.with_frames(frames)
+        self.solve_stale = self.key_solve is not None
+        if self.dp_keys is not None:
+            self._set_key_poses()
+            self.request_analysis()
+        self.frames_edited.emit(int(start), int(start + len(block) - 1))
+        self.display_changed.emit()
+
+    # -- frames and playback --------------------------------------------------------------
+    def set_frame(self, frame: int) -> None:
+        """Go to a frame (clamped to the animation); during playback, play on from there."""
+        f = self._go(frame)
+        if self.playing:
+            self._play_start = (self.clock(), f)
+
+    def _go(self, frame: int) -> int:
+        f = int(min(max(int(frame), 0), self.last_frame))
+        if f != self.frame:
+            self.frame = f
+            self.frame_changed.emit(f)
+        return f
+
+    def step(self, delta: int) -> None:
+        """Step by ``delta`` frames; with loop on, stepping past an end wraps around."""
+        if self.n_frames == 0:
+            return
+        f = self.frame + int(delta)
+        self.set_frame(f % self.n_frames if self.loop else f)
+
+    def first(self) -> None:
+        self.set_frame(0)
+
+    def last(self) -> None:
+        self.set_frame(self.last_frame)
+
+    def next_key(self) -> None:
+        """The next DP key after the current frame (the last frame when there is none)."""
+        keys = self.dp_keys if self.dp_keys is not None else np.array([self.last_frame])
+        later = keys[keys > self.frame]
+        self.set_frame(int(later[0]) if later.size else self.last_frame)
+
+    def previous_key(self) -> None:
+        keys = self.dp_keys if self.dp_keys is not None else np.array([0])
+        earlier = keys[keys < self.frame]
+        self.set_frame(int(earlier[-1]) if earlier.size else 0)
+
+    def is_key(self, frame: int | None = None) -> bool:
+        f = self.frame if frame is None else frame
+        return self.dp_keys is not None and bool(np.any(self.dp_keys == f))
+
+    def set_fps(self, fps: float) -> None:
+        """Playback (and recording) rate in frames per second."""
+        if not np.isfinite(fps) or not 0.1 <= fps <= 1000:
+            raise ParameterError("fps", fps, "a frame rate in [0.1, 1000]")
+        if fps != self.fps:
+            self.fps = float(fps)
+            self._play_start = (self.clock(), self.frame)
+            if self.playing:
+                self._timer.start(self._interval_ms())
+            self.fps_changed.emit(self.fps)
+
+    def set_loop(self, on: bool) -> None:
+        if bool(on) != self.loop:
+            self.loop = bool(on)
+            self.loop_changed.emit(self.loop)
+
+    def play(self) -> None:
+        """Start playback at the animation's rate; the frame follows the wall clock, so a slow
+        redraw drops frames instead of slowing the animation down."""
+        if self.playing or self.n_frames < 2:
+            return
+        if self.frame >= self.last_frame and not self.loop:
+            self.set_frame(0)
+        self._play_start = (self.clock(), self.frame)
+        self.playing = True
+        self._timer.start(self._interval_ms())
+        self.playing_changed.emit(True)
+
+    def _interval_ms(self) -> int:
+        return max(1, int(500.0 / self.fps))  # two ticks per frame, so each frame shows on time
+
+    def pause(self) -> None:
+        if self.playing:
+            self.playing = False
+            self._timer.stop()
+            self.playing_changed.emit(False)
+
+    def toggle_play(self) -> None:
+        if self.playing:
+            self.pause()
+        else:
+            self.play()
+
+    def _tick(self) -> None:
+        t0, f0 = self._play_start
+        target = f0 + int((self.clock() - t0) * self.fps)
+        if target > self.last_frame:
+            if self.loop:
+                target %= self.n_frames
+            else:
+                self._go(self.last_frame)
+                self.pause()
+                return
+        self._go(target)
+
+    # -- key settings ----------------------------------------------------------------------
+    def set_settings(self, **changes: object) -> None:
+        """Change key settings (ParameterError for a bad value); keys follow at once where the
+        existing solve covers them, else a new solve starts."""
+        new = self.settings.replace(**changes)
+        if new == self.settings:
+            return
+        self.settings = new
+        self.settings_changed.emit(new)
+        if self.n_frames < 2:
+            return
+        if self.key_solve is None or self.solve_stale or new.table_key != self.key_solve.table_key:
+            self.request_solve()
+            return
+        if self._solve_job is not None:  # back to the solved table: the pending solve is moot
+            job, self._solve_job = self._solve_job, None
+            job.cancel()
+            self._busy_update()
+        self._choose_keys()
+
+    def set_key_count(self, count: int) -> None:
+        """Exactly ``count`` DP keys (switches to the key-count mode)."""
+        self.set_settings(mode="count", count=int(count))
+
+    @property
+    def max_keys(self) -> int:
+        """The largest key count the slider offers (the layered solve's depth)."""
+        if self.key_solve is not None:
+            return self.key_solve.kmax
+        return int(min(self.n_frames, ks.MAX_CURVE_KEYS))
+
+    @property
+    def busy(self) -> bool:
+        return self._solve_job is not None or self._analysis_job is not None
+
+    def _inline(self) -> bool:
+        return self.runner is None or self.animation.frames.size <= self.inline_values
+
+    def request_solve(self) -> None:
+        """Solve keys for the current animation and settings (in the background when large)."""
+        anim, settings = self.animation, self.settings
+        if anim is None or anim.n_frames < 2:
+            return
+        if self._inline():
+            self._apply_solve(anim, ks.solve(anim, settings))
+            return
+
+        def work(progress, cancelled):
+            return ks.solve(anim, settings, progress, cancelled)
+
+        self._solve_job = self.runner.run(
+            f"Solving keys ({anim.n_frames} frames)",
+            work,
+            lambda result: self._solve_landed(job, anim, result),
+            on_cancelled=lambda: self._job_cancelled(job),
+            on_error=lambda e: self._job_failed(job, e),
+            group=f"keys-solve-{id(self)}",
+        )
+        job = self._solve_job
+        self._busy_update()
+
+    def _solve_landed(self, job: Job, anim: Animation, result: ks.KeySolve | None) -> None:
+        if job is not self._solve_job:
+            return
+        self._solve_job = None
+        self._busy_update()
+        if anim is self.animation and result is not None:
+            self._apply_solve(anim, result)
+
+    def _apply_solve(self, anim: Animation, result: ks.KeySolve) -> None:
+        self.key_solve = result
+        self.solve_stale = False
+        self.curve_changed.emit()
+        self._choose_keys(force=True)
+
+    def _choose_keys(self, force: bool = False) -> None:
+        keys = ks.choose_keys(self.key_solve, self.settings)
+        if not force and self.dp_keys is not None and np.array_equal(keys, self.dp_keys):
+            if self.analysis is None and self._analysis_job is None:
+                self.request_analysis()
+            return
+        self.dp_keys = keys
+        self.uniform_keys = uniform_keys(self.n_frames, keys.size)
+        self._set_key_poses()
+        self.keys_changed.emit()
+        if self.view_mode != "original":
+            self.display_changed.emit()
+        self.request_analysis()
+
+    def _set_key_poses(self) -> None:
+        interp = self.key_solve.table_key[1] if self.key_solve is not None else self.settings.interp
+        self.dp_poses = ks.key_poses_of(self.animation, self.dp_keys, interp)
+        self.uniform_poses = ks.key_poses_of(self.animation, self.uniform_keys, interp)
+
+    def request_analysis(self) -> None:
+        """Per-frame errors of both reconstructions and the motion speed for the current keys."""
+        anim, keys = self.animation, self.dp_keys
+        if anim is None or keys is None:
+            return
+        interp = self.dp_poses.interp
+        if self._inline():
+            self._apply_analysis(anim, keys, ks.analyse(anim, keys, interp))
+            return
+
+        def work(progress, cancelled):
+            return ks.analyse(anim, keys, interp, progress=progress, cancelled=cancelled)
+
+        self._analysis_job = self.runner.run(
+            "Measuring key errors",
+            work,
+            lambda result: self._analysis_landed(job, anim, keys, result),
+            on_cancelled=lambda: self._job_cancelled(job),
+            on_error=lambda e: self._job_failed(job, e),
+            group=f"keys-errors-{id(self)}",
+        )
+        job = self._analysis_job
+        self._busy_update()
+
+    def _analysis_landed(
+        self, job: Job, anim: Animation, keys: np.ndarray, result: ks.Analysis | None
+    ) -> None:
+        if job is not self._analysis_job:
+            return
+        self._analysis_job = None
+        self._busy_update()
+        if anim is self.animation and result is not None:
+            self._apply_analysis(anim, keys, result)
+
+    def _apply_analysis(self, anim: Animation, keys: np.ndarray, result: ks.Analysis) -> None:
+        if not np.array_equal(keys, self.dp_keys):
+            return  # the keys moved on while it ran; their own pass is on its way
+        self.analysis = result
+        self._committed = _Committed(self.settings, self.key_solve, self.dp_keys, result)
+        self.analysis_changed.emit()
+        if self.view_mode == "error":
+            self.display_changed.emit()
+
+    def _job_cancelled(self, job: Job) -> None:
+        """A job the user cancelled (not one superseded by a newer one): back to the last
+        complete state, so the keys, settings and curves on screen agree again."""
+        if job is self._solve_job:
+            self._solve_job = None
+        elif job is self._analysis_job:
+            self._analysis_job = None
+        else:
+            return
+        self._busy_update()
+        self._revert()
+
+    def _job_failed(self, job: Job, error: BaseException) -> None:
+        self._job_cancelled(job)
+        if self.runner is not None:
+            self.runner.report_error(job, error)
+
+    def _revert(self) -> None:
+        c = self._committed
+        if c is None:  # nothing complete yet for this animation: no keys
+            if self.dp_keys is not None or self.key_solve is not None:
+                self._clear_keys()
+                self.keys_changed.emit()
+                self.curve_changed.emit()
+                self.analysis_changed.emit()
+                self.display_changed.emit()
+            return
+        if c.settings != self.settings:
+            self.settings = c.settings
+            self.settings_changed.emit(c.settings)
+        if c.solve is not self.key_solve:
+            self.key_solve = c.solve
+            self.curve_changed.emit()
+        if not np.array_equal(c.dp_keys, self.dp_keys):
+            self.dp_keys = c.dp_keys
+            self.uniform_keys = uniform_keys(self.n_frames, c.dp_keys.size)
+            self._set_key_poses()
+            self.keys_changed.emit()
+            self.display_changed.emit()
+        if c.analysis is not self.analysis:
+            self.analysis = c.analysis
+            self.analysis_changed.emit()
+
+    def cancel_work(self) -> None:
+        """Cancel this model's running solve or error pass (as the Cancel button does)."""
+        for job in (self._solve_job, self._analysis_job):
+            if job is not None and self.runner is not None:
+                self.runner.cancel(job)
+
+    def _cancel_jobs(self) -> None:
+        """Drop running work silently (a new animation replaces everything anyway)."""
+        jobs = [j for j in (self._solve_job, self._analysis_job) if j is not None]
+        self._solve_job = self._analysis_job = None
+        for job in jobs:
+            self.runner.cancel(job)
+        if jobs:
+            self._busy_update()
+
+    def _busy_update(self) -> None:
+        self.busy_changed.emit(self.busy)
+
+    # -- view ---------------------------------------------------------------------------------
+    def set_view_mode(self, mode: str) -> None:
+        if mode not in VIEW_MODES:
+            raise ParameterError("view mode", mode, f"one of {', '.join(VIEW_MODES)}")
+        if mode != self.view_mode:
+            self.view_mode = mode
+            self.view_mode_changed.emit(mode)
+            self.display_changed.emit()
+
+    @property
+    def error_scale(self) -> float:
+        """Vertex error shown white-hot in the error view: the DP keys' worst vertex overall."""
+        if self.analysis is not None:
+            return max(float(self.analysis.dp.max.max()), 1e-12)
+        return 0.0
+
+    def set_preview(self, frame: int, points: np.ndarray | None) -> None:
+        """Show ``points`` at ``frame`` instead of the animation (a key pose being dragged)."""
+        self._preview = None if points is None else (int(frame), points)
+        self.display_changed.emit()
+
+    def display(self) -> Display | None:
+        """The points (and colours, ghost) to draw for the current frame and view mode."""
+        anim = self.animation
+        if anim is None:
+            return None
+        f = self.frame
+        if self._preview is not None and self._preview[0] == f:
+            original = self._preview[1]
+        else:
+            original = anim.frames[f]
+        kp = self.dp_poses
+        if self.view_mode == "original" or kp is None:
+            return Display(f, original)
+        if self._preview is not None and self._preview[0] == f:
+            rebuilt = original  # a key pose being dragged: the key curve passes through it
+        else:
+            rebuilt = ks.rebuild_frames(kp, [f])[0]
+        if self.view_mode == "reconstruction":
+            return Display(f, rebuilt)
+        if self.view_mode == "ghost":
+            return Display(f, original, ghost=rebuilt)
+        d = np.sqrt(np.einsum("vi,vi->v", original - rebuilt, original - rebuilt))
+        scale = self.error_scale or max(float(d.max()), 1e-12)
+        return Display(f, original, colors=ramp_colors(d / scale, "heat"))

@@ -1,0 +1,285 @@
+"""Glue between the animation model, the viewport and the window: what the viewport draws for
+the current frame, key edits by dragging (one undo step each), recording drags, the playback
+actions and the fps read-out."""
+
+from __future__ import annotations
+
+import itertools
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import numpy as np
+from PySide6.QtCore import QObject, Qt
+from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QUndoCommand
+from PySide6.QtWidgets import QLabel, QStyle, QWidget
+
+from app.ui.animation_model import VIEW_MODES, AnimationModel
+from app.ui.key_state import key_edit_block
+from app.ui.recording import Recorder
+from hairtool.align import align
+from hairtool.errors import HairtoolError
+from hairtool.groom import Groom
+
+if TYPE_CHECKING:
+    from app.ui.window import MainWindow
+
+
+class KeyEditCommand(QUndoCommand):
+    """A key pose edit spread over the frames between its neighbouring keys; stores only that
+    stretch of frames before and after (not two copies of the whole animation)."""
+
+    def __init__(
+        self,
+        model: AnimationModel,
+        generation: int,
+        frame: int,
+        start: int,
+        before: np.ndarray,
+        after: np.ndarray,
+    ) -> None:
+        super().__init__(f"Edit key {frame}")
+        self.model, self.generation, self.frame = model, generation, frame
+        self.start, self.before, self.after = start, before, after
+
+    def _apply(self, block: np.ndarray) -> None:
+        # an edit of an animation that has since been replaced is a no-op, never a wrong write
+        if self.model.generation == self.generation:
+            self.model.replace_frames(self.start, block)
+
+    def redo(self) -> None:
+        self._apply(self.after)
+
+    def undo(self) -> None:
+        self._apply(self.before)
+
+
+class KeyEditBrush:
+    """The align brush on a key pose: only at a DP key frame, with the scene's radius, intensity
+    and mode (align only: freeze and clump shape static grooms, not captured motion)."""
+
+    def __init__(self, controller: AnimationController) -> None:
+        self.c = controller
+        self.frame: int | None = None
+        self.groom: Groom | None = None
+
+    def begin(self, cursor: np.ndarray) -> bool:
+        m = self.c.model
+        if m.animation is None or not m.is_key():
+            self.c.window.statusBar().showMessage(
+                "Key edits happen at a DP key frame: jump to one with ↑ / ↓", 4000
+            )
+            return False
+        m.pause()
+        self.frame = m.frame
+        self.groom = m.animation.frame(m.frame)
+        self.move(cursor)
+        return True
+
+    def move(self, cursor: np.ndarray) -> None:
+        if self.groom is None:
+            return
+        s = self.c.window.scene
+        t0 = time.perf_counter()
+        self.groom = align(self.groom, cursor, s.radius, s.intensity, s.align_mode)
+        s.last_update_ms = (time.perf_counter() - t0) * 1e3
+        self.c.model.set_preview(self.frame, self.groom.points)
+
+    def end(self) -> None:
+        m, frame, groom = self.c.model, self.frame, self.groom
+        self.frame = self.groom = None
+        if frame is None or groom is None or m.animation is None:
+            return
+        m.set_preview(frame, None)
+        if np.array_equal(groom.points, m.animation.frames[frame]):
+            return
+        try:
+            start, block = key_edit_block(
+                m.animation.frames, m.dp_keys, m.dp_poses.interp, frame, groom.points
+            )
+        except HairtoolError as e:
+            self.c.window.show_error("Cannot edit key", str(e))
+            return
+        before = np.array(m.animation.frames[start : start + len(block)])
+        self.c.window.undo_stack.push(KeyEditCommand(m, m.generation, frame, start, before, block))
+
+
+class AnimationController(QObject):
+    """Owned by the window; see the module docstring."""
+
+    def __init__(self, window: MainWindow, model: AnimationModel) -> None:
+        super().__init__(window)
+        self.window, self.model = window, model
+        self.viewport, self.scene = window.viewport, window.scene
+        self.clock: Callable[[], float] = time.perf_counter
+        self.recorder: Recorder | None = None
+        self.brush = KeyEditBrush(self)
+        self._drawn: deque[tuple[float, int]] = deque(maxlen=240)
+        self.fps_label = QLabel()
+        self.fps_label.setObjectName("FpsLabel")
+        for signal in (model.frame_changed, model.display_changed, model.view_mode_changed):
+            signal.connect(self.refresh_display)
+        model.animation_changed.connect(self._on_animation_changed)
+        model.frame_changed.connect(self._update_fps_label)
+        model.playing_changed.connect(self._on_playing)
+        model.fps_changed.connect(self._update_fps_label)
+        self.viewport.frame_drawn.connect(self._on_frame_drawn)
+        self.viewport.stroke_started.connect(self._on_stroke_started)
+        self.scene.points_changed.connect(self._on_scene_points)
+        self.viewport.stroke_finished.connect(self._on_stroke_finished)
+        self.actions: dict[str, QAction] = {}
+        self._update_fps_label()
+
+    # -- model → viewport ------------------------------------------------------------------
+    def refresh_display(self, *_: object) -> None:
+        d = self.model.display() if self.recorder is None else None
+        if d is None or len(d.points) != self.scene.result.vertex_count:
+            self.viewport.clear_frame()
+        else:
+            self.viewport.show_frame(d.points, d.colors, d.ghost, d.frame)
+
+    def _on_animation_changed(self) -> None:
+        anim = self.model.animation
+        if anim is not None and anim.topology != self.scene.result.topology:
+            # different strands: the scene takes the animation's first frame (its strokes and
+            # their undo steps belong to the old strands, as when a file is opened)
+            self.window.undo_stack.clear()
+            self.scene.load(anim.rest, self.scene.path)
+        self.viewport.brush_target = self.brush if anim is not None and self.recorder is None else None
+        self.viewport.extra_bounds = None if anim is None else anim.bounds
+        if anim is not None:
+            self.viewport.frame_all()  # the whole motion in view
+        self.refresh_display()
+        self._update_fps_label()
+
+    # -- playback read-out ------------------------------------------------------------------
+    def _on_playing(self, playing: bool) -> None:
+        self._drawn.clear()
+        self._update_fps_label()
+
+    def _on_frame_drawn(self) -> None:
+        if self.model.playing and self.viewport.shown_frame is not None:
+            self._drawn.append((self.clock(), self.viewport.shown_frame))
+
+    def measured_fps(self) -> float:
+        """Distinct frames drawn per second over the last second of playback."""
+        if len(self._drawn) < 2:
+            return 0.0
+        now = self._drawn[-1][0]
+        recent = [(t, f) for t, f in self._drawn if now - t <= 1.0]
+        changes = sum(1 for a, b in itertools.pairwise(recent) if a[1] != b[1])
+        span = recent[-1][0] - recent[0][0]
+        return changes / span if span > 0 else 0.0
+
+    def _update_fps_label(self, *_: object) -> None:
+        m = self.model
+        if m.animation is None:
+            self.fps_label.setText("")
+            return
+        text = f"frame {m.frame}/{m.last_frame}"
+        if m.playing:
+            text += f" · ▶ {self.measured_fps():.1f} fps (of {m.fps:g})"
+        else:
+            text += f" · {m.fps:g} fps"
+        self.fps_label.setText(text)
+
+    # -- recording ---------------------------------------------------------------------------
+    @property
+    def recording(self) -> bool:
+        return self.recorder is not None
+
+    def set_recording(self, on: bool) -> None:
+        """Record toggle: on, drags edit the groom and are captured at the model's fps; off,
+        the capture becomes the animation in the timeline."""
+        if on == self.recording:
+            return
+        if on:
+            self.model.pause()
+            self.recorder = Recorder(self.scene.result.topology, self.model.fps)
+            self.viewport.brush_target = None
+            self.refresh_display()
+            self.window.statusBar().showMessage("Recording: drag the hair; toggle Record again to stop")
+        else:
+            rec, self.recorder = self.recorder, None
+            self.window.statusBar().clearMessage()
+            try:
+                anim = rec.animation()
+            except HairtoolError as e:
+                self._on_animation_changed()
+                self.window.show_error("Nothing recorded", str(e))
+            else:
+                self.model.load_animation(anim, "recording")
+        if "record" in self.actions:
+            self.actions["record"].setChecked(self.recording)
+
+    def _on_stroke_started(self) -> None:
+        if self.recorder is not None:
+            self.recorder.begin_stroke(self.clock(), self.scene.result.points)
+
+    def _on_scene_points(self) -> None:
+        if self.recorder is not None:
+            self.recorder.update(self.clock(), self.scene.result.points)
+
+    def _on_stroke_finished(self, *_: object) -> None:
+        if self.recorder is not None:
+            self.recorder.end_stroke(self.clock())
+
+    # -- menu and shortcuts -------------------------------------------------------------------
+    def build_menu(self) -> dict[str, QAction]:
+        """The Animation menu; returns its actions by name (the timeline's buttons show them)."""
+        w, m = self.window, self.model
+        menu = w.menuBar().addMenu("&Animation")
+        a = self.actions
+        a["play"] = w._action(menu, "&Play / Pause", m.toggle_play, "Space")
+        a["loop"] = w._action(menu, "&Loop", lambda on: m.set_loop(on), "Ctrl+L", checkable=True)
+        a["loop"].setChecked(m.loop)
+        m.loop_changed.connect(a["loop"].setChecked)
+        menu.addSeparator()
+        a["step_forward"] = w._action(menu, "Next &frame", lambda: m.step(1), "Right")
+        a["step_back"] = w._action(menu, "Pre&vious frame", lambda: m.step(-1), "Left")
+        a["next_key"] = w._action(menu, "&Next key", m.next_key, "Up")
+        a["previous_key"] = w._action(menu, "P&revious key", m.previous_key, "Down")
+        a["first"] = w._action(menu, "F&irst frame", m.first, ["Home", "Shift+Left"])
+        a["last"] = w._action(menu, "L&ast frame", m.last, ["End", "Shift+Right"])
+        menu.addSeparator()
+        a["record"] = w._action(menu, "&Record drags", self.set_recording, "Shift+R", checkable=True)
+        a["resolve"] = w._action(menu, "Re-&solve keys", m.request_solve)
+        a["clear"] = w._action(menu, "&Close animation", m.clear)
+        view = menu.addMenu("&View")
+        group = QActionGroup(w)
+        for i, (key, label) in enumerate(VIEW_MODES.items()):
+            act = w._action(
+                view, label, lambda _=False, k=key: m.set_view_mode(k), f"Ctrl+{i + 1}", checkable=True
+            )
+            act.setChecked(key == m.view_mode)
+            group.addAction(act)
+            a[f"view_{key}"] = act
+        m.view_mode_changed.connect(lambda k: a[f"view_{k}"].setChecked(True))
+        style, sp = w.style(), QStyle.StandardPixmap
+        icons = {
+            "play": sp.SP_MediaPlay, "step_forward": sp.SP_MediaSeekForward,
+            "step_back": sp.SP_MediaSeekBackward, "first": sp.SP_MediaSkipBackward,
+            "last": sp.SP_MediaSkipForward, "loop": sp.SP_BrowserReload,
+        }  # fmt: skip
+        for name, pixmap in icons.items():
+            a[name].setIcon(style.standardIcon(pixmap))
+        for name, text in {"next_key": "◆▸", "previous_key": "◂◆", "record": "● Rec"}.items():
+            a[name].setIconText(text)
+        play, pause = style.standardIcon(sp.SP_MediaPlay), style.standardIcon(sp.SP_MediaPause)
+        m.playing_changed.connect(lambda on: a["play"].setIcon(pause if on else play))
+        for name in ("step_forward", "step_back", "next_key", "previous_key", "first", "last"):
+            a[name].setShortcutVisibleInContextMenu(True)
+        a["play"].setShortcuts([QKeySequence("Space")])
+        return a
+
+    TRANSPORT_KEYS = ("play", "step_forward", "step_back", "next_key", "previous_key", "first", "last")
+
+    def bind_transport_keys(self, *widgets: QWidget) -> None:
+        """Space, arrows and Home/End drive playback only while the focus is in ``widgets`` (the
+        viewport, the timeline), so the tool dock's sliders keep their own arrow keys."""
+        for name in self.TRANSPORT_KEYS:
+            action = self.actions[name]
+            action.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+            for widget in widgets:
+                widget.addAction(action)

@@ -1,0 +1,306 @@
+"""Projects in the studio: Save Project / Open Project, the unsaved-changes question on close,
+autosave to a recovery file, and the offer to restore it after a crash.
+
+The file format is :mod:`hairtool.project`. Unsaved changes are the ones a user would lose:
+strokes and parameter edits (the undo stack is not clean), and an animation made or edited in
+the studio (anime cycle, simulation, recording, key edits) since the project was last saved or
+opened. The recovery file lives beside the settings file (an INI file, as in tests) or in
+``QStandardPaths.AppDataLocation``; it is written on a timer from a plain thread (the groom and
+animation are immutable arrays, so the GUI never waits for the disk) and removed on a clean
+close. Found at start-up with the last session not marked as closed cleanly, it is offered
+through ``window.ask_restore_recovery`` (tests replace it).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import threading
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from PySide6.QtCore import QObject, QSettings, QStandardPaths, QTimer, Signal
+
+from app.ui.key_state import KeySettings
+from hairtool import project as pf
+from hairtool.errors import FormatError, HairtoolError
+
+if TYPE_CHECKING:
+    from app.ui.window import MainWindow
+
+RECOVERY_NAME = "recovery" + pf.SUFFIX
+AUTOSAVE_MS = 60_000
+MADE_IN_STUDIO = ("anime cycle", "simulation", "recording")
+PROJECT_FILTERS = f"Hairtool project (*{pf.SUFFIX})"
+
+
+def recovery_folder(settings: QSettings) -> Path:
+    """Beside an INI settings file; else the application's data folder."""
+    if settings.format() == QSettings.Format.IniFormat and settings.fileName():
+        return Path(settings.fileName()).resolve().parent
+    return Path(QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation))
+
+
+class ProjectController(QObject):
+    """Owned by the window (``window.project``); see the module docstring."""
+
+    saved = Signal(str)
+    opened = Signal(str)
+
+    def __init__(self, window: MainWindow, autosave_ms: int = AUTOSAVE_MS) -> None:
+        super().__init__(window)
+        self.window = window
+        self.path: Path | None = None
+        self._anim_dirty = False
+        self._changes = 0  # counts edits; autosave writes when it moved since the last autosave
+        self._autosaved_at = 0
+        self._autosave_thread: threading.Thread | None = None
+        self.autosave_error: str | None = None
+        self.recovery_path = recovery_folder(window.settings) / RECOVERY_NAME
+        window.undo_stack.indexChanged.connect(self._changed)
+        model = window.animation
+        model.animation_changed.connect(self._on_animation_changed)
+        model.frames_edited.connect(lambda *_: self._mark_animation())
+        self.timer = QTimer(self)
+        self.timer.setInterval(max(int(autosave_ms), 1000))
+        self.timer.timeout.connect(self.autosave)
+        self.timer.start()
+        self._offer_pending = self._crashed_before()
+        window.settings.setValue("session/clean_exit", False)
+        window.settings.sync()
+        if self._offer_pending:
+            QTimer.singleShot(0, self.offer_recovery)
+
+    # -- changes ---------------------------------------------------------------------------
+    def _changed(self, *_: object) -> None:
+        self._changes += 1
+
+    def _mark_animation(self) -> None:
+        self._anim_dirty = True
+        self._changed()
+
+    def _on_animation_changed(self) -> None:
+        model = self.window.animation
+        if model.animation is not None and model.source in MADE_IN_STUDIO:
+            self._mark_animation()
+        else:
+            self._changed()
+
+    def has_unsaved_changes(self) -> bool:
+        return not self.window.undo_stack.isClean() or self._anim_dirty
+
+    def _mark_saved(self) -> None:
+        self.window.undo_stack.setClean()
+        self._anim_dirty = False
+
+    # -- building and applying -------------------------------------------------------------------
+    def current_project(self) -> pf.Project:
+        """The window's state as a project (cheap: arrays are shared, not copied)."""
+        w = self.window
+        scene, model = w.scene, w.animation
+        source = None if scene.path is None or scene.path.suffix == pf.SUFFIX else str(scene.path)
+        settings: dict = {
+            "timeline": {"frame": model.frame, "view_mode": model.view_mode, "loop": model.loop},
+        }
+        settings.update(w.sources.to_settings())
+        return pf.Project.from_pipeline(
+            scene.pipeline,
+            brush={"radius": scene.radius, "intensity": scene.intensity, "align_mode": scene.align_mode},
+            display={
+                "colour_mode": scene.colour_mode,
+                "ramp": scene.ramp,
+                "line_width": scene.line_width,
+                "ortho": bool(w.viewport.camera.ortho),
+            },
+            animation=model.animation,
+            animation_source=model.source,
+            key_settings=dataclasses.asdict(model.settings),
+            settings=settings,
+            groom_source=source,
+        )
+
+    def apply(self, project: pf.Project, path: str | os.PathLike[str] | None) -> None:
+        """Show a project: groom, parameters, strokes, brush, display, animation, keys, docks."""
+        w = self.window
+        scene, model = w.scene, w.animation
+        for job in w.jobs.active("simulate"):  # its result belongs to the scene being replaced
+            w.jobs.cancel(job)
+        model.clear()
+        w.undo_stack.clear()
+        scene.load(project.rest, path, params=project.params)
+        scene.restore(project.stroke_snapshot(scene.pipeline))
+        _apply_each(
+            w,
+            (
+                lambda: scene.set_radius(float(project.brush["radius"])),
+                lambda: scene.set_intensity(float(project.brush["intensity"])),
+                lambda: scene.set_align_mode(str(project.brush["align_mode"])),
+                lambda: scene.set_colour_mode(str(project.display["colour_mode"])),
+                lambda: scene.set_ramp(str(project.display["ramp"])),
+                lambda: scene.set_line_width(float(project.display["line_width"])),
+                lambda: w.viewport.set_ortho(bool(project.display["ortho"])),
+            ),
+        )
+        if project.animation is not None:
+            model.load_animation(project.animation, project.animation_source)
+            timeline = project.settings.get("timeline", {})
+            _apply_each(
+                w,
+                (
+                    lambda: model.set_settings(**_key_settings(project.key_settings)),
+                    lambda: model.set_view_mode(str(timeline["view_mode"])),
+                    lambda: model.set_loop(bool(timeline["loop"])),
+                    lambda: model.set_frame(int(timeline["frame"])),
+                ),
+            )
+        w.sources.apply_settings(project.settings)
+        self._mark_saved()
+
+    # -- save and open ---------------------------------------------------------------------
+    def save_project(self) -> bool:
+        if self.path is None:
+            return self.save_project_as()
+        return self.save_to(self.path)
+
+    def save_project_as(self) -> bool:
+        stem = self.window.scene.path.stem if self.window.scene.path is not None else "project"
+        path = self.window.ask_save_path("Save project", PROJECT_FILTERS, stem + pf.SUFFIX)
+        if not path:
+            return False
+        if Path(path).suffix.lower() != pf.SUFFIX:
+            path = str(path) + pf.SUFFIX
+        return self.save_to(path)
+
+    def save_to(self, path: str | os.PathLike[str]) -> bool:
+        """Write the project (atomically); the window adopts it as its current file."""
+        try:
+            pf.save(path, self.current_project())
+        except HairtoolError as e:
+            self.window.show_error("Cannot save project", str(e))
+            return False
+        self.path = Path(path)
+        self._mark_saved()
+        self.window.scene.set_path(self.path)
+        self.window._remember_dir(path)
+        self.window.statusBar().showMessage(f"saved {path}", 5000)
+        self.saved.emit(str(path))
+        return True
+
+    def open_project_dialog(self) -> bool:
+        if not self.confirm_discard():
+            return False
+        path = self.window.ask_open_path("Open project", PROJECT_FILTERS)
+        return bool(path) and self.open_project(path)
+
+    def open_project(self, path: str | os.PathLike[str]) -> bool:
+        """Open a project; on a bad file the error names it and the scene stays as it was."""
+        try:
+            project = pf.load(path)
+        except HairtoolError as e:
+            self.window.show_error("Cannot open project", str(e))
+            return False
+        self.apply(project, path)
+        self.path = Path(path)
+        self.window._remember_dir(path)
+        self.opened.emit(str(path))
+        return True
+
+    # -- closing -----------------------------------------------------------------------------
+    def confirm_discard(self) -> bool:
+        """Ask about unsaved changes: True to go on (saved or discarded), False to stay."""
+        if not self.has_unsaved_changes():
+            return True
+        answer = self.window.ask_save_changes()
+        if answer == "save":
+            return self.save_project()
+        return answer == "discard"
+
+    def shutdown(self) -> None:
+        """A clean close: no autosave any more, the recovery file removed, the exit marked clean."""
+        self.timer.stop()
+        self._join_autosave()
+        try:
+            self.recovery_path.unlink(missing_ok=True)
+        except OSError:
+            pass
+        self.window.settings.setValue("session/clean_exit", True)
+        self.window.settings.sync()
+
+    # -- autosave and recovery -----------------------------------------------------------------
+    def _crashed_before(self) -> bool:
+        clean = self.window.settings.value("session/clean_exit", True)
+        clean = clean if isinstance(clean, bool) else str(clean).lower() == "true"
+        return self.recovery_path.is_file() and not clean
+
+    def _join_autosave(self) -> None:
+        t = self._autosave_thread
+        if t is not None:
+            t.join()
+            self._autosave_thread = None
+
+    def autosave(self, wait: bool = False) -> bool:
+        """Write the recovery file if anything changed since the last autosave (in a thread;
+        ``wait`` blocks until it is written). Returns whether a write started."""
+        if self._changes == self._autosaved_at or self._offer_pending:
+            return False  # nothing new, or an unanswered recovery offer must not be overwritten
+        if self._autosave_thread is not None and self._autosave_thread.is_alive():
+            return False  # the previous one is still writing; the next tick catches up
+        project, path, changes = self.current_project(), self.recovery_path, self._changes
+
+        def write() -> None:
+            try:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                pf.save(path, project)
+            except (HairtoolError, OSError) as e:  # reported in the status bar, never a dialog
+                self.autosave_error = str(e)
+            else:
+                self.autosave_error = None
+                self._autosaved_at = changes
+
+        self._join_autosave()
+        self._autosave_thread = threading.Thread(target=write, name="hairtool-autosave", daemon=True)
+        self._autosave_thread.start()
+        if wait:
+            self._join_autosave()
+        return True
+
+    def offer_recovery(self) -> bool:
+        """Offer the recovery file left by a session that did not close cleanly; restore it if
+        accepted, else remove it. Returns whether it was restored."""
+        self._offer_pending = False
+        path = self.recovery_path
+        if not path.is_file():
+            return False
+        if not self.window.ask_restore_recovery(str(path)):
+            path.unlink(missing_ok=True)
+            return False
+        try:
+            project = pf.load(path)
+        except FormatError as e:
+            self.window.show_error("Cannot restore the recovery file", str(e))
+            path.unlink(missing_ok=True)
+            return False
+        self.apply(project, None)
+        self.path = None
+        self._anim_dirty = True  # restored work is not saved anywhere yet
+        self._changed()
+        self.window.statusBar().showMessage("restored the autosaved session; save it as a project", 8000)
+        return True
+
+
+def _key_settings(d: dict) -> dict:
+    fields = {f.name for f in dataclasses.fields(KeySettings)}
+    return {k: v for k, v in d.items() if k in fields}
+
+
+def _apply_each(window: MainWindow, setters) -> None:
+    """Apply saved settings one by one; a value this studio refuses is reported, not fatal."""
+    problems = []
+    for setter in setters:
+        try:
+            setter()
+        except (HairtoolError, KeyError, TypeError, ValueError) as e:
+            if not isinstance(e, KeyError):  # a setting the file does not have: keep ours
+                problems.append(str(e))
+    if problems:
+        window.show_error("Some project settings were not applied", "\n".join(problems))

@@ -1,0 +1,285 @@
+"""The timeline dock: transport buttons, the scrubbable ruler with the DP and uniform key rows
+and the error/speed curves, the key controls and the error-versus-key-count plot.
+
+Widgets write to the :class:`AnimationModel` and are refreshed from its signals with their own
+signals blocked, so nothing echoes. The transport buttons show the window's actions (Space,
+arrows, Home/End), so a button and its shortcut are one thing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDockWidget,
+    QDoubleSpinBox,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QSlider,
+    QSpinBox,
+    QSplitter,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.ui.animation_model import VIEW_MODES, AnimationModel
+from app.ui.key_state import KEY_MODES
+from app.ui.qt_utils import signals_blocked
+from app.ui.timeline_plots import KeyCountPlot, TimelineView
+from app.ui.widgets import SliderSpin
+from hairtool.errors import HairtoolError
+
+TRANSPORT = (
+    "first",
+    "previous_key",
+    "step_back",
+    "play",
+    "step_forward",
+    "next_key",
+    "last",
+    "loop",
+    "record",
+)
+
+
+class KeyControls(QWidget):
+    """Mode (count / tau / budget), the key-count slider, tau, budget, objective, interpolation,
+    feature settings and the view mode."""
+
+    def __init__(
+        self, model: AnimationModel, report: Callable[[str, str], None], parent: QWidget | None = None
+    ) -> None:
+        super().__init__(parent)
+        self.model = model
+        self.report = report
+        form = QFormLayout(self)
+        form.setContentsMargins(4, 2, 4, 2)
+        form.setVerticalSpacing(2)
+        self.mode = QComboBox()
+        for key, label in KEY_MODES.items():
+            self.mode.addItem(label, key)
+        self.count_slider = QSlider(Qt.Orientation.Horizontal)
+        self.count_slider.setObjectName("KeyCountSlider")
+        self.count_spin = QSpinBox()
+        row = QHBoxLayout()
+        row.addWidget(self.count_slider, 3)
+        row.addWidget(self.count_spin, 1)
+        self.tau = SliderSpin(1e-6, 1e3, decimals=6, log=True)
+        self.budget = SliderSpin(1e-6, 1e3, decimals=6, log=True)
+        self.objective = QComboBox()
+        self.objective.addItem("Total error", "total")
+        self.objective.addItem("Worst frame", "worst")
+        self.interp = QComboBox()
+        self.interp.addItem("Linear", "linear")
+        self.interp.addItem("Hermite", "hermite")
+        self.samples = QSpinBox()
+        self.samples.setRange(0, 256)
+        self.samples.setSpecialValueText("vertices")
+        self.samples.setToolTip("points per strand by arc length (seed 000, step 1); 0 keeps the vertices")
+        self.tip_weight = QDoubleSpinBox()
+        self.tip_weight.setRange(0.1, 20.0)
+        self.tip_weight.setSingleStep(0.25)
+        self.tip_weight.setToolTip("root-to-tip weight at the tip (1 at the root): tip motion counts more")
+        self.curvature = QDoubleSpinBox()
+        self.curvature.setDecimals(4)
+        self.curvature.setRange(0.0, 1000.0)
+        self.curvature.setStepType(QDoubleSpinBox.StepType.AdaptiveDecimalStepType)
+        self.curvature.setToolTip("λ of the curvature term: short, sharp deformations cost more to skip")
+        self.view = QComboBox()
+        self.view.setObjectName("ViewMode")
+        for key, label in VIEW_MODES.items():
+            self.view.addItem(label, key)
+        for w in (self.samples, self.tip_weight, self.curvature, self.count_spin):
+            w.setKeyboardTracking(False)
+        form.addRow("Keys by", self.mode)
+        form.addRow("Key count", row)
+        form.addRow("Tau", self.tau)
+        form.addRow("Error budget", self.budget)
+        form.addRow("Objective", self.objective)
+        form.addRow("Interpolation", self.interp)
+        form.addRow("Samples / strand", self.samples)
+        form.addRow("Tip weight", self.tip_weight)
+        form.addRow("Curvature λ", self.curvature)
+        form.addRow("View", self.view)
+        self.summary = QLabel()
+        self.summary.setWordWrap(True)
+        form.addRow(self.summary)
+
+        self.mode.activated.connect(lambda _i: self._set(mode=self.mode.currentData()))
+        self.count_slider.valueChanged.connect(lambda v: self._set(mode="count", count=int(v)))
+        self.count_spin.valueChanged.connect(lambda v: self._set(mode="count", count=int(v)))
+        self.tau.edited.connect(lambda v, _d: self._set(mode="tau", tau=float(v)))
+        self.budget.edited.connect(lambda v, _d: self._set(mode="budget", budget=float(v)))
+        self.objective.activated.connect(lambda _i: self._set(objective=self.objective.currentData()))
+        self.interp.activated.connect(lambda _i: self._set(interp=self.interp.currentData()))
+        self.samples.valueChanged.connect(lambda v: self._set(samples=int(v)))
+        self.tip_weight.valueChanged.connect(lambda v: self._set(tip_weight=float(v)))
+        self.curvature.valueChanged.connect(lambda v: self._set(curvature=float(v)))
+        self.view.activated.connect(lambda _i: self._set_view(self.view.currentData()))
+        for signal in (
+            model.settings_changed,
+            model.keys_changed,
+            model.curve_changed,
+            model.animation_changed,
+        ):
+            signal.connect(self.refresh)
+        model.view_mode_changed.connect(self.refresh)
+        model.analysis_changed.connect(self._refresh_summary)
+        model.busy_changed.connect(self._refresh_summary)
+        self.refresh()
+
+    def _set(self, **changes: object) -> None:
+        try:
+            self.model.set_settings(**changes)
+        except HairtoolError as e:
+            self.report("Invalid key setting", str(e))
+            self.refresh()
+
+    def _set_view(self, mode: str) -> None:
+        self.model.set_view_mode(mode)
+
+    def refresh(self, *_: object) -> None:
+        m, s = self.model, self.model.settings
+        widgets = (
+            self.mode, self.count_slider, self.count_spin, self.tau, self.tau.slider, self.tau.spin,
+            self.budget, self.budget.slider, self.budget.spin, self.objective, self.interp,
+            self.samples, self.tip_weight, self.curvature, self.view,
+        )  # fmt: skip
+        with signals_blocked(*widgets):
+            self.mode.setCurrentIndex(self.mode.findData(s.mode))
+            top = max(m.max_keys, 2)
+            count = m.dp_keys.size if m.dp_keys is not None else s.count_for(max(m.n_frames, 2))
+            for w in (self.count_slider, self.count_spin):
+                w.setRange(2, top)
+                w.setValue(min(count, top))
+            if m.key_solve is not None:  # tau and budget ranges follow the error scale
+                curve = m.key_solve.curve[:, 1]
+                positive = curve[curve > 0]
+                lo = max(float(positive.min()) * 0.1, 1e-9) if positive.size else 1e-6
+                hi = max(float(curve.max()) * 2.0, lo * 10.0)
+                self.tau.set_range(lo, hi)
+                self.budget.set_range(lo, hi)
+            self.tau.set_value(s.tau)
+            self.budget.set_value(s.budget)
+            self.objective.setCurrentIndex(self.objective.findData(s.objective))
+            self.interp.setCurrentIndex(self.interp.findData(s.interp))
+            self.samples.setValue(s.samples)
+            self.tip_weight.setValue(s.tip_weight)
+            self.curvature.setValue(s.curvature)
+            self.view.setCurrentIndex(self.view.findData(m.view_mode))
+        enabled = m.n_frames >= 2
+        for w in widgets:
+            w.setEnabled(enabled)
+        self.view.setEnabled(m.n_frames >= 1)
+        self._refresh_summary()
+
+    def _refresh_summary(self, *_: object) -> None:
+        m = self.model
+        if m.n_frames < 2:
+            self.summary.setText("")
+            return
+        if m.dp_keys is None:
+            self.summary.setText("solving keys…" if m.busy else "no keys")
+            return
+        text = f"{m.dp_keys.size} keys of {m.n_frames} frames"
+        a = m.analysis
+        if a is not None:
+            text += (
+                f" · mean error DP {a.dp.mean.mean():.4g} / uniform {a.uniform.mean.mean():.4g}"
+                f" · tip DP {a.dp.tip.mean():.4g} / uniform {a.uniform.tip.mean():.4g}"
+            )
+        if m.solve_stale:
+            text += " · edited since the solve"
+        if m.busy:
+            text += " · working…"
+        self.summary.setText(text)
+
+
+class TimelineDock(QDockWidget):
+    """Bottom dock: transport row, the timeline view, key controls and the key-count plot."""
+
+    def __init__(
+        self,
+        model: AnimationModel,
+        actions: dict[str, QAction],
+        report: Callable[[str, str], None],
+        parent: QWidget | None = None,
+    ) -> None:
+        super().__init__("Timeline", parent)
+        self.setObjectName("TimelineDock")
+        self.model = model
+        body = QWidget()
+        outer = QVBoxLayout(body)
+        outer.setContentsMargins(2, 2, 2, 2)
+        outer.setSpacing(2)
+
+        transport = QHBoxLayout()
+        self.buttons: dict[str, QToolButton] = {}
+        for name in TRANSPORT:
+            if name in actions:
+                b = QToolButton()
+                b.setDefaultAction(actions[name])
+                b.setObjectName(f"Transport_{name}")
+                self.buttons[name] = b
+                transport.addWidget(b)
+        self.frame_spin = QSpinBox()
+        self.frame_spin.setPrefix("frame ")
+        self.frame_spin.setKeyboardTracking(False)
+        self.fps_spin = QDoubleSpinBox()
+        self.fps_spin.setRange(0.1, 1000.0)
+        self.fps_spin.setDecimals(2)
+        self.fps_spin.setSuffix(" fps")
+        self.fps_spin.setKeyboardTracking(False)
+        self.info = QLabel()
+        transport.addSpacing(8)
+        transport.addWidget(self.frame_spin)
+        transport.addWidget(self.fps_spin)
+        transport.addWidget(self.info, 1)
+        outer.addLayout(transport)
+
+        split = QSplitter(Qt.Orientation.Horizontal)
+        self.view = TimelineView(model)
+        side = QWidget()
+        side_layout = QVBoxLayout(side)
+        side_layout.setContentsMargins(0, 0, 0, 0)
+        self.controls = KeyControls(model, report)
+        self.plot = KeyCountPlot(model)
+        side_layout.addWidget(self.controls)
+        side_layout.addWidget(self.plot, 1)
+        split.addWidget(self.view)
+        split.addWidget(side)
+        split.setStretchFactor(0, 3)
+        split.setStretchFactor(1, 1)
+        outer.addWidget(split, 1)
+        self.setWidget(body)
+
+        self.frame_spin.valueChanged.connect(model.set_frame)
+        self.fps_spin.valueChanged.connect(self._set_fps)
+        self._report = report
+        for signal in (model.animation_changed, model.frame_changed, model.fps_changed):
+            signal.connect(self.refresh)
+        self.refresh()
+
+    def _set_fps(self, fps: float) -> None:
+        try:
+            self.model.set_fps(fps)
+        except HairtoolError as e:
+            self._report("Invalid frame rate", str(e))
+            self.refresh()
+
+    def refresh(self, *_: object) -> None:
+        m = self.model
+        with signals_blocked(self.frame_spin, self.fps_spin):
+            self.frame_spin.setRange(0, m.last_frame)
+            self.frame_spin.setValue(m.frame)
+            self.fps_spin.setValue(m.fps)
+        self.frame_spin.setEnabled(m.n_frames > 0)
+        if m.n_frames:
+            self.info.setText(f"/ {m.last_frame} · {m.frame / m.fps:.2f} s · {m.source}")
+        else:
+            self.info.setText("no animation")

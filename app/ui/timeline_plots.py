@@ -1,0 +1,362 @@
+"""Custom-painted timeline widgets: the scrubbable ruler with both key rows and the per-frame
+curves, and the small error-versus-key-count plot. They read the :class:`AnimationModel` and
+write only the frame (scrubbing) or the key count (clicking the plot) back to it."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from PySide6.QtCore import QPointF, QRect, QRectF, QSize, Qt
+from PySide6.QtGui import (
+    QColor,
+    QFont,
+    QMouseEvent,
+    QPainter,
+    QPainterPath,
+    QPaintEvent,
+    QPen,
+    QPixmap,
+    QPolygonF,
+    QResizeEvent,
+)
+from PySide6.QtWidgets import QSizePolicy, QWidget
+
+from app.ui.animation_model import AnimationModel
+from hairtool.keyframes import keys_cost, uniform_keys
+
+BACKGROUND = QColor(38, 40, 44)
+GRID = QColor(70, 73, 80)
+TEXT = QColor(200, 200, 205)
+DP_COLOUR = QColor(255, 140, 26)  # DP keys and their reconstruction's curves: orange
+UNIFORM_COLOUR = QColor(74, 163, 223)  # uniform keys and theirs: blue
+SPEED_COLOUR = QColor(150, 150, 150, 90)
+PLAYHEAD = QColor(235, 64, 64)
+
+LEFT, RIGHT = 56, 12  # px margins; frames map linearly onto the width between them
+RULER_H, ROW_H = 22, 16
+
+
+def _nice_step(span: float, pixels: float, min_px: float = 50.0) -> int:
+    """A 1/2/5×10^k frame step whose labels are at least ``min_px`` apart."""
+    if span <= 0 or pixels <= 0:
+        return 1
+    raw = span * min_px / pixels
+    base = 10 ** math.floor(math.log10(max(raw, 1.0)))
+    for m in (1, 2, 5, 10):
+        if m * base >= raw:
+            return int(m * base)
+    return int(10 * base)
+
+
+class TimelineView(QWidget):
+    """Ruler, DP and uniform key rows, and the error and speed curves over frames.
+
+    A left press or drag anywhere sets the frame (the viewport follows at once). Everything but
+    the playhead is drawn once into a pixmap and reused until the keys, curves or size change,
+    so a frame change repaints in well under a millisecond.
+    """
+
+    def __init__(self, model: AnimationModel, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.model = model
+        self.setMinimumHeight(150)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        self.setMouseTracking(False)
+        self.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
+        self.setObjectName("TimelineView")
+        self._cache: QPixmap | None = None
+        for signal in (
+            model.animation_changed,
+            model.keys_changed,
+            model.analysis_changed,
+            model.frames_edited,
+            model.busy_changed,
+        ):
+            signal.connect(self.invalidate)
+        model.frame_changed.connect(self.update)
+
+    def invalidate(self, *_: object) -> None:
+        self._cache = None
+        self.update()
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        self._cache = None
+        super().resizeEvent(event)
+
+    def sizeHint(self) -> QSize:
+        return QSize(700, 190)
+
+    # -- geometry (tests use these to find pixels) --------------------------------------------
+    def frame_to_x(self, frame: float) -> float:
+        n = max(self.model.n_frames - 1, 1)
+        return LEFT + (self.width() - LEFT - RIGHT) * float(frame) / n
+
+    def x_to_frame(self, x: float) -> int:
+        n = max(self.model.n_frames - 1, 1)
+        return round((x - LEFT) / max(self.width() - LEFT - RIGHT, 1) * n)
+
+    def row_rect(self, row: str) -> QRect:
+        """ "ruler", "dp", "uniform" or "curves": the band each is drawn in."""
+        top = {"ruler": 0, "dp": RULER_H, "uniform": RULER_H + ROW_H, "curves": RULER_H + 2 * ROW_H}[row]
+        height = {"ruler": RULER_H, "dp": ROW_H, "uniform": ROW_H}.get(row, self.height() - top)
+        return QRect(0, top, self.width(), height)
+
+    @property
+    def drawn_keys(self) -> dict[str, list[int]]:
+        """The frames each key row shows (what the last paint drew)."""
+        m = self.model
+        return {
+            "dp": [] if m.dp_keys is None else m.dp_keys.tolist(),
+            "uniform": [] if m.uniform_keys is None else m.uniform_keys.tolist(),
+        }
+
+    # -- input ----------------------------------------------------------------------------------
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        if event.button() == Qt.MouseButton.LeftButton:
+            self.model.pause()
+            self.model.set_frame(self.x_to_frame(event.position().x()))
+            event.accept()
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        if event.buttons() & Qt.MouseButton.LeftButton:
+            self.model.set_frame(self.x_to_frame(event.position().x()))
+            event.accept()
+
+    # -- painting -------------------------------------------------------------------------------
+    def paintEvent(self, event: QPaintEvent) -> None:
+        if self._cache is None or self._cache.size() != self.size() * self.devicePixelRatioF():
+            self._cache = self._render_static()
+        p = QPainter(self)
+        p.drawPixmap(0, 0, self._cache)
+        if self.model.n_frames:
+            p.setRenderHint(QPainter.RenderHint.Antialiasing, True)
+            x = self.frame_to_x(self.model.frame)
+            p.setPen(QPen(PLAYHEAD, 1.5))
+            p.drawLine(QPointF(x, 0), QPointF(x, self.height()))
+        p.end()
+
+    def _render_static(self) -> QPixmap:
+        """Ruler, key rows and curves (all but the playhead) at the widget's size."""
+        dpr = self.devicePixelRatioF()
+        pixmap = QPixmap(self.size() * dpr)
+        pixmap.setDevicePixelRatio(dpr)
+        pixmap.fill(BACKGROUND)
+        p = QPainter(pixmap)
+        m = self.model
+        if m.n_frames == 0:
+            p.setPen(TEXT)
+            p.drawText(self.rect(), Qt.AlignmentFlag.AlignCenter, "No animation: open one, or record a drag")
+        else:
+            p.setRenderHint(QPainter.RenderHint.Antialiasing, True)
+            self._paint_ruler(p)
+            self._paint_keys(p, "dp", m.dp_keys, DP_COLOUR, filled=True)
+            self._paint_keys(p, "uniform", m.uniform_keys, UNIFORM_COLOUR, filled=False)
+            self._paint_curves(p)
+        p.end()
+        return pixmap
+
+    def _paint_ruler(self, p: QPainter) -> None:
+        m = self.model
+        r = self.row_rect("ruler")
+        span = self.width() - LEFT - RIGHT
+        step = _nice_step(m.n_frames - 1, span)
+        small = span / max(m.n_frames - 1, 1) >= 5
+        font = QFont(p.font())
+        font.setPointSizeF(7.5)
+        p.setFont(font)
+        for f in range(m.n_frames):
+            x = self.frame_to_x(f)
+            if f % step == 0:
+                p.setPen(TEXT)
+                p.drawLine(QPointF(x, r.bottom() - 8), QPointF(x, r.bottom()))
+                p.drawText(QRectF(x - 30, r.top(), 60, 12), Qt.AlignmentFlag.AlignCenter, str(f))
+            elif small:
+                p.setPen(GRID)
+                p.drawLine(QPointF(x, r.bottom() - 4), QPointF(x, r.bottom()))
+        p.setPen(GRID)
+        p.drawLine(LEFT, r.bottom(), self.width() - RIGHT, r.bottom())
+
+    def _paint_keys(self, p: QPainter, row: str, keys, colour: QColor, filled: bool) -> None:
+        r = self.row_rect(row)
+        p.setPen(TEXT)
+        p.drawText(
+            QRect(2, r.top(), LEFT - 6, r.height()),
+            Qt.AlignmentFlag.AlignVCenter,
+            "DP" if filled else "uniform",
+        )
+        if keys is None:
+            return
+        cy = r.center().y() + 0.5
+        half = min(5.0, max(2.5, (self.width() - LEFT - RIGHT) / max(self.model.n_frames, 1) / 2.2))
+        if filled:  # diamonds, solid
+            p.setPen(Qt.PenStyle.NoPen)
+            p.setBrush(colour)
+            for k in keys:
+                x = self.frame_to_x(k)
+                p.drawPolygon(
+                    QPolygonF(
+                        [
+                            QPointF(x, cy - half),
+                            QPointF(x + half, cy),
+                            QPointF(x, cy + half),
+                            QPointF(x - half, cy),
+                        ]
+                    )
+                )
+        else:  # squares, outlined
+            p.setPen(QPen(colour, 1.6))
+            p.setBrush(Qt.BrushStyle.NoBrush)
+            for k in keys:
+                x = self.frame_to_x(k)
+                p.drawRect(QRectF(x - half + 0.8, cy - half + 0.8, 2 * half - 1.6, 2 * half - 1.6))
+        p.setBrush(Qt.BrushStyle.NoBrush)
+
+    def _curve_path(self, values: np.ndarray, top: float, height: float, scale: float) -> QPainterPath:
+        path = QPainterPath()
+        for f, v in enumerate(values):
+            pt = QPointF(self.frame_to_x(f), top + height - height * float(v) / scale)
+            path.lineTo(pt) if f else path.moveTo(pt)
+        return path
+
+    def _paint_curves(self, p: QPainter) -> None:
+        m, r = self.model, self.row_rect("curves")
+        top, height = r.top() + 14.0, max(r.height() - 20.0, 10.0)
+        p.setPen(GRID)
+        p.drawLine(LEFT, int(top + height), self.width() - RIGHT, int(top + height))
+        a = m.analysis
+        if a is None:
+            p.setPen(TEXT)
+            text = "measuring errors…" if m.busy else ""
+            p.drawText(QRect(LEFT, r.top(), 300, 14), Qt.AlignmentFlag.AlignLeft, text)
+            return
+        if a.speed is not None and a.speed.max() > 0:
+            area = self._curve_path(a.speed, top, height, float(a.speed.max()))
+            area.lineTo(self.frame_to_x(m.n_frames - 1), top + height)
+            area.lineTo(self.frame_to_x(0), top + height)
+            area.closeSubpath()
+            p.fillPath(area, SPEED_COLOUR)
+        scale = max(
+            float(max(a.dp.tip.max(), a.dp.mean.max(), a.uniform.tip.max(), a.uniform.mean.max())), 1e-12
+        )
+        for err, colour in ((a.uniform, UNIFORM_COLOUR), (a.dp, DP_COLOUR)):
+            p.setPen(QPen(colour, 1.6))
+            p.drawPath(self._curve_path(err.mean, top, height, scale))
+            p.setPen(QPen(colour, 1.2, Qt.PenStyle.DashLine))
+            p.drawPath(self._curve_path(err.tip, top, height, scale))
+        p.setPen(TEXT)
+        legend = (
+            f"error (max {scale:.3g}): — mean  - - tip   DP {a.dp.mean.mean():.3g}  "
+            f"uniform {a.uniform.mean.mean():.3g} (mean)   ▒ speed"
+        )
+        p.drawText(QRect(LEFT, r.top(), self.width() - LEFT - RIGHT, 14), Qt.AlignmentFlag.AlignLeft, legend)
+
+
+class KeyCountPlot(QWidget):
+    """Optimal error against key count (log scale), with uniform keys' error dashed and the
+    current count marked, so the artist can see the knee; a click picks that count."""
+
+    def __init__(self, model: AnimationModel, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.model = model
+        self.setObjectName("KeyCountPlot")
+        self.setMinimumSize(180, 110)
+        self._uniform: np.ndarray | None = None
+        model.curve_changed.connect(self._on_curve)
+        model.keys_changed.connect(self.update)
+        model.animation_changed.connect(self._on_curve)
+
+    def sizeHint(self) -> QSize:
+        return QSize(240, 130)
+
+    def _on_curve(self) -> None:
+        """Uniform keys' cost from the same table for every count (each O(K): cheap)."""
+        s = self.model.key_solve
+        self._uniform = None
+        if s is not None:
+            n = s.n_frames
+            self._uniform = np.array(
+                [keys_cost(s.table, uniform_keys(n, int(k)), s.objective) for k in s.curve[:, 0]]
+            )
+        self.update()
+
+    def _plot_rect(self) -> QRectF:
+        return QRectF(44, 8, max(self.width() - 52, 10), max(self.height() - 26, 10))
+
+    def _scale(self):
+        s = self.model.key_solve
+        curve = s.curve
+        values = np.concatenate([curve[:, 1], self._uniform if self._uniform is not None else []])
+        positive = values[values > 0]
+        lo = float(positive.min()) if positive.size else 1e-12
+        hi = float(values.max()) if values.size else 1.0
+        lo = min(lo, hi * 0.999) if hi > 0 else 1e-12
+        return curve, math.log10(lo), math.log10(max(hi, lo * 10))
+
+    def count_at(self, x: float) -> int:
+        s = self.model.key_solve
+        r = self._plot_rect()
+        f = (x - r.left()) / r.width()
+        return int(min(max(round(2 + f * (s.kmax - 2)), 2), s.kmax))
+
+    def _point(self, k: float, v: float, lo: float, hi: float) -> QPointF:
+        r, kmax = self._plot_rect(), self.model.key_solve.kmax
+        x = r.left() + r.width() * (k - 2) / max(kmax - 2, 1)
+        y = r.bottom() - r.height() * (math.log10(max(v, 10**lo)) - lo) / (hi - lo)
+        return QPointF(x, y)
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        if event.button() == Qt.MouseButton.LeftButton and self.model.key_solve is not None:
+            self.model.set_key_count(self.count_at(event.position().x()))
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        if event.buttons() & Qt.MouseButton.LeftButton and self.model.key_solve is not None:
+            self.model.set_key_count(self.count_at(event.position().x()))
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        p = QPainter(self)
+        p.fillRect(self.rect(), BACKGROUND)
+        s = self.model.key_solve
+        font = QFont(p.font())
+        font.setPointSizeF(7.5)
+        p.setFont(font)
+        p.setPen(TEXT)
+        if s is None or s.kmax < 3:
+            p.drawText(self.rect(), Qt.AlignmentFlag.AlignCenter, "error vs key count")
+            p.end()
+            return
+        p.setRenderHint(QPainter.RenderHint.Antialiasing, True)
+        curve, lo, hi = self._scale()
+        r = self._plot_rect()
+        p.setPen(GRID)
+        p.drawRect(r)
+        p.setPen(TEXT)
+        p.drawText(QRectF(0, r.top() - 4, 42, 12), Qt.AlignmentFlag.AlignRight, f"{10**hi:.2g}")
+        p.drawText(QRectF(0, r.bottom() - 8, 42, 12), Qt.AlignmentFlag.AlignRight, f"{10**lo:.2g}")
+        p.drawText(QRectF(r.left(), r.bottom() + 2, 40, 12), Qt.AlignmentFlag.AlignLeft, "2")
+        p.drawText(QRectF(r.right() - 40, r.bottom() + 2, 40, 12), Qt.AlignmentFlag.AlignRight, str(s.kmax))
+        p.drawText(
+            QRectF(r.left(), r.bottom() + 2, r.width(), 12), Qt.AlignmentFlag.AlignCenter, "keys (log error)"
+        )
+        if self._uniform is not None:
+            path = QPainterPath()
+            for i, (k, v) in enumerate(zip(curve[:, 0], self._uniform, strict=True)):
+                pt = self._point(k, v, lo, hi)
+                path.lineTo(pt) if i else path.moveTo(pt)
+            p.setPen(QPen(UNIFORM_COLOUR, 1.2, Qt.PenStyle.DashLine))
+            p.drawPath(path)
+        path = QPainterPath()
+        for i, (k, v) in enumerate(curve):
+            pt = self._point(k, v, lo, hi)
+            path.lineTo(pt) if i else path.moveTo(pt)
+        p.setPen(QPen(DP_COLOUR, 1.6))
+        p.drawPath(path)
+        keys = self.model.dp_keys
+        if keys is not None and 2 <= keys.size <= s.kmax:
+            pt = self._point(keys.size, curve[keys.size - 2, 1], lo, hi)
+            p.setPen(QPen(PLAYHEAD, 1.0))
+            p.drawLine(QPointF(pt.x(), r.top()), QPointF(pt.x(), r.bottom()))
+            p.setBrush(PLAYHEAD)
+            p.drawEllipse(pt, 3.0, 3.0)
+            p.drawText(QRectF(pt.x() + 4, r.top(), 60, 12), Qt.AlignmentFlag.AlignLeft, f"K={keys.size}")
+        p.end()

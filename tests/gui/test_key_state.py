@@ -1,0 +1,110 @@
+"""The timeline's numbers (no window, no GL): keys traced from one solve equal the engine's own
+selection, chunked reconstructions and errors equal the core's, a ranged key edit equals
+editing the whole animation."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from app.ui import key_state as ks
+from hairtool import samples
+from hairtool.errors import ParameterError
+from hairtool.features import hair_features
+from hairtool.key_edit import edit_animation
+from hairtool.keyframes import select_keys, uniform_keys
+from hairtool.reconstruct import interpolate_keys, key_poses, motion_speed, position_errors, reconstruct
+from hairtool.segment_cost import cost_table
+from hairtool.sway import sway_animation
+
+
+@pytest.fixture(scope="module")
+def anim():
+    return sway_animation(samples.comb(strands=12, vertices=8), 40, 24.0, flick_frame=27)
+
+
+@pytest.mark.parametrize("interp", ["linear", "hermite"])
+@pytest.mark.parametrize("objective", ["total", "worst"])
+def test_keys_for_every_count_equal_the_engines_selection(anim, interp, objective):
+    settings = ks.KeySettings(interp=interp, objective=objective, tip_weight=3.0, samples=6)
+    solved = ks.solve(anim, settings)
+    table = cost_table(hair_features(anim, settings.feature_options()), interp, 0.0, objective)
+    np.testing.assert_array_equal(solved.table, table)
+    assert solved.kmax == anim.n_frames
+    for k in (2, 3, 5, 9, 17, 40):
+        want = select_keys(table, keys=k, objective=objective)
+        np.testing.assert_array_equal(solved.keys_for_count(k), want.keys)
+        assert solved.curve[k - 2, 1] == pytest.approx(want.cost, rel=1e-12, abs=1e-12)
+
+
+def test_tau_and_budget_keys_equal_the_engines(anim):
+    solved = ks.solve(anim, ks.KeySettings())
+    for tau in (0.0, 0.01, 1.0, 100.0):
+        want = select_keys(solved.table, penalty=tau).keys
+        np.testing.assert_array_equal(ks.choose_keys(solved, ks.KeySettings(mode="tau", tau=tau)), want)
+    for budget in (0.0, 0.05, 1.0, 1e6):
+        want = select_keys(solved.table, budget=budget).keys
+        got = ks.choose_keys(solved, ks.KeySettings(mode="budget", budget=budget))
+        np.testing.assert_array_equal(got, want)
+
+
+def test_default_count_is_a_tenth_of_the_frames(anim):
+    solved = ks.solve(anim, ks.KeySettings())
+    assert ks.choose_keys(solved, ks.KeySettings()).size == 4
+
+
+def test_settings_are_validated():
+    with pytest.raises(ParameterError, match="tau"):
+        ks.KeySettings(mode="tau", objective="worst").validate()
+    with pytest.raises(ParameterError, match="samples"):
+        ks.KeySettings(samples=1).validate()
+    with pytest.raises(ParameterError, match="interpolation"):
+        ks.KeySettings().replace(interp="cubic")
+
+
+@pytest.mark.parametrize("interp", ["linear", "hermite"])
+def test_rebuilt_frames_and_errors_equal_the_core(anim, interp):
+    keys = np.array([0, 7, 12, 30, 39])
+    kp = key_poses(anim.frames, keys, interp)
+    full = interpolate_keys(kp)
+    np.testing.assert_array_equal(ks.rebuild_frames(kp, np.arange(40), np.float64), full)
+    err = ks.frame_errors(anim, kp)
+    ref = position_errors(anim, reconstruct(anim, keys, interp))
+    np.testing.assert_allclose(err.mean, ref.per_frame_mean, rtol=1e-4, atol=1e-6)
+    np.testing.assert_allclose(err.tip, ref.per_frame_tip, rtol=1e-4, atol=1e-6)
+    np.testing.assert_allclose(err.max, ref.per_frame_max, rtol=1e-4, atol=1e-6)
+    assert np.all(err.mean[keys] == 0)
+    d = ks.vertex_errors(anim, ks.key_poses_of(anim, keys, interp), 20)
+    np.testing.assert_allclose(d.mean(), ref.per_frame_mean[20], rtol=1e-4)
+
+
+def test_speed_equals_the_cores(anim):
+    np.testing.assert_allclose(ks.speed(anim), motion_speed(anim.frames, anim.fps), rtol=1e-5)
+
+
+def test_analysis_compares_with_uniform_keys_of_the_same_count(anim):
+    keys = np.array([0, 20, 26, 29, 39])
+    a = ks.analyse(anim, keys, "linear")
+    np.testing.assert_array_equal(a.uniform.keys, uniform_keys(40, 5))
+    np.testing.assert_array_equal(a.dp.keys, keys)
+    assert a.speed.shape == (40,)
+
+
+def test_cancelled_work_returns_none(anim):
+    assert ks.solve(anim, ks.KeySettings(), cancelled=lambda: True) is None
+    assert ks.analyse(anim, [0, 39], "linear", cancelled=lambda: True) is None
+
+
+@pytest.mark.parametrize("interp", ["linear", "hermite"])
+@pytest.mark.parametrize("key_frame", [0, 7, 12, 39])
+def test_ranged_key_edit_equals_editing_the_whole_animation(anim, interp, key_frame):
+    keys = np.array([0, 7, 12, 30, 39])
+    pose = anim.frames[key_frame] + np.float32(0.1)
+    start, block = ks.key_edit_block(anim.frames, keys, interp, key_frame, pose)
+    whole = edit_animation(anim, keys, {key_frame: pose}, interp).frames
+    np.testing.assert_array_equal(whole[start : start + len(block)], block)
+    outside = np.ones(40, bool)
+    outside[start : start + len(block)] = False
+    np.testing.assert_array_equal(whole[outside], anim.frames[outside])
+    with pytest.raises(ParameterError, match="key frame"):
+        ks.key_edit_block(anim.frames, keys, interp, 8, pose)

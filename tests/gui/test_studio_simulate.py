@@ -1,0 +1,66 @@
+"""Animation → Simulate…: the dialog's options, the background job, and cancelling it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hairtool import samples
+from hairtool.simulate import simulate
+
+pytestmark = pytest.mark.gui
+
+
+def test_dialog_round_trips_options_and_refuses_a_bad_motion(qtbot):
+    from app.ui.simulate_dialog import SimulateDialog, SimulateOptions
+
+    o = SimulateOptions(motion="nod,hop", frames=30, fps=30.0, wind=(5.0, 0.0, -2.0), gusts=2, seed=4)
+    dialog = SimulateDialog(None, o)
+    qtbot.addWidget(dialog)
+    assert dialog.options() == o
+    assert dialog.duration.text() == "0.967 s"
+    assert SimulateOptions.from_dict(o.to_dict()) == o
+    kw = o.kwargs()
+    assert kw["motion"] == ["nod", "hop"] and kw["wind"][1] == pytest.approx(np.hypot(5.0, 2.0))
+    assert SimulateOptions().kwargs()["wind"] is None
+    dialog.motion.setText("nod,twirl")
+    dialog._accept()
+    assert "motion" in dialog.error_label.text() and dialog.result() == 0
+
+
+def test_simulation_runs_as_a_job_and_loads_the_result(make_window):
+    from app.ui.simulate_dialog import SOURCE, SimulateOptions
+
+    groom = samples.scalp(12, 6, seed=1)
+    w = make_window(groom=groom)
+    options = SimulateOptions(motion="shake", frames=8, substeps=2, gusts=1, seed=3)
+    w.ask_simulate_options = lambda o: options
+    job = w.sources.simulate_dialog()
+    assert w.jobs.wait(60) and job.state == "done", w.errors
+    anim = w.animation.animation
+    assert w.animation.source == SOURCE and anim.n_frames == 8
+    expect = simulate(w.scene.result, **options.kwargs())
+    np.testing.assert_array_equal(anim.frames, expect.frames)
+    assert w.project.has_unsaved_changes()
+
+
+def test_cancelled_simulation_keeps_the_previous_animation(make_window):
+    from app.ui.jobs import JobCancelled
+    from app.ui.simulate_dialog import SimulateOptions, run_simulation
+
+    groom = samples.scalp(12, 6, seed=1)
+    w = make_window(groom=groom)
+    w.ask_simulate_options = lambda o: None  # the dialog's Cancel: nothing starts
+    assert w.sources.simulate_dialog() is None and w.animation.animation is None
+    assert w.sources.start_simulation(SimulateOptions(frames=4, substeps=1)) is not None
+    assert w.jobs.wait(60)
+    previous = w.animation.animation
+    job = w.sources.start_simulation(SimulateOptions(frames=40, substeps=2, motion="hop"))
+    w.jobs.cancel(job)
+    assert w.jobs.wait(60) and job.state == "cancelled"
+    assert w.animation.animation is previous
+
+    done = []
+    with pytest.raises(JobCancelled):  # the job body stops at the first frame after a cancel
+        run_simulation(groom, SimulateOptions(frames=20), lambda *a: done.append(a), lambda: len(done) > 2)
+    assert len(done) == 3
