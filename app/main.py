@@ -34,7 +34,11 @@ def parse_args(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
         prog="hairtool-studio",
         description="Shape hair grooms interactively with the frozen-hair tools.",
     )
-    parser.add_argument("file", nargs="?", help="a groom to open (any readable format); default: a sample")
+    parser.add_argument(
+        "file",
+        nargs="?",
+        help="a groom or animation to open (any readable format); default: Sintel's hair and head",
+    )
     parser.add_argument(
         "--bench",
         action="store_true",
@@ -63,6 +67,8 @@ def main(argv: list[str] | None = None) -> int:
     app.setOrganizationName("hairtool")
     app.setApplicationName("Hairtool Studio")
     window = MainWindow(args.file)
+    if args.file is None:
+        window.open_bundled_sample()
     window.show()
     return app.exec()
 

@@ -28,3 +28,16 @@ def test_every_python_package_is_declared_in_pyproject():
 def test_shaders_are_package_data():
     files = [f.name for f in resources.files("app.shaders").iterdir() if f.name.endswith(".glsl")]
     assert files, "no GLSL programs found through importlib.resources"
+
+
+def test_the_default_scene_ships_unchanged_with_its_credits():
+    from app import resources as bundled
+
+    for name in (bundled.SINTEL_HAIR, bundled.SINTEL_HEAD):
+        shipped = bundled.path(name)
+        assert shipped.is_file(), f"{name} is not package data"
+        original = ROOT.parent / "shared" / "data" / "grooms" / name
+        if original.is_file():
+            assert shipped.read_bytes() == original.read_bytes()
+    credits = bundled.path("CREDITS-sintel.txt").read_text()
+    assert "Blender Foundation" in credits and "CC BY 3.0" in credits

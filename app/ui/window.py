@@ -157,9 +157,10 @@ class MainWindow(QMainWindow):
         bar = self.menuBar()
         file = bar.addMenu("&File")
         new = file.addMenu("&New from sample")
-        for i, kind in enumerate(samples.SAMPLES):
-            key = QKeySequence.StandardKey.New if i == 0 else None
-            self._action(new, kind.capitalize(), lambda _=False, k=kind: self.new_from_sample(k), key)
+        self._action(new, "Sintel (hair and head)", self.open_bundled_sample, QKeySequence.StandardKey.New)
+        new.addSeparator()
+        for kind in samples.SAMPLES:
+            self._action(new, kind.capitalize(), lambda _=False, k=kind: self.new_from_sample(k))
         self._action(file, "&Open…", self.open_dialog, QKeySequence.StandardKey.Open)
         self.recent_menu = file.addMenu("Open &Recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
@@ -355,7 +356,28 @@ class MainWindow(QMainWindow):
         self._update_title()
 
     def new_from_sample(self, kind: str) -> None:
+        """A procedural sample groom, as a new untitled scene (no head mesh)."""
         self.set_groom(samples.sample(kind))
+        self.scene.set_mesh(None)
+
+    def open_bundled_sample(self) -> bool:
+        """The studio's default scene: Sintel's hair on her head, shipped in ``app.resources``.
+
+        It opens untitled, so Save asks where to write instead of touching the shipped file.
+        """
+        from app import resources
+        from hairtool.io.obj import read_mesh
+
+        try:
+            groom = io.read_groom(resources.path(resources.SINTEL_HAIR))
+            mesh = read_mesh(resources.path(resources.SINTEL_HEAD))
+        except HairtoolError as e:  # a broken installation: say so, keep the scene
+            self.show_error("Cannot open the bundled sample", str(e))
+            return False
+        self.set_groom(groom)
+        self.scene.set_mesh(mesh)
+        self.viewport.frame_all()
+        return True
 
     def open_dialog(self) -> None:
         path = self.ask_open_path()

@@ -128,3 +128,20 @@ def test_a_file_that_fails_at_start_up_leaves_the_sample_open(qtbot, settings_pa
     assert len(errors) == 1 and "nothing.tfx" in errors[0]
     assert window.scene.rest.strand_count == samples.sample(samples.DEFAULT_SAMPLE).strand_count
     assert window.scene.path is None
+
+
+def test_first_run_opens_sintel_on_her_head_untitled(make_window, tmp_path, monkeypatch):
+    from app import resources as bundled
+
+    w = make_window()
+    assert w.open_bundled_sample(), w.errors
+    assert (w.scene.rest.strand_count, w.scene.rest.vertex_count) == (228, 228 * 32)
+    assert w.scene.mesh is not None and len(w.scene.mesh.vertices) > 1000
+    assert w.scene.path is None  # untitled: Save never writes into the installed package
+    target = tmp_path / "sintel.usda"
+    monkeypatch.setattr(w, "ask_save_path", lambda *a, **k: str(target))
+    before = bundled.path(bundled.SINTEL_HAIR).read_bytes()
+    assert w.save() and target.is_file()
+    assert bundled.path(bundled.SINTEL_HAIR).read_bytes() == before
+    w.new_from_sample("portrait")  # a procedural sample is a new scene: no head
+    assert w.scene.mesh is None
