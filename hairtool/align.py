@@ -53,7 +53,7 @@ def check_align_params(cursor: ArrayLike, radius: float, intensity: float, mode:
     return c
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _align_kernel(p, offsets, c, radius, x, preserve, planar, out):
     s_count = offsets.size - 1
     for s in prange(s_count):

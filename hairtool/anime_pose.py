@@ -192,7 +192,7 @@ def pose_numpy(groom: Groom, times: F64, axes: F64, scale: F64, shift: F64, wave
     return bend_chains_cs(groom, axes, np.where(flat, 1.0, dx / h), dy / h)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _pose_kernel(
     points, offsets, x, envelope, cos_x, sin_x, times, axes, scale, shift, a, s, period, out
 ):  # pragma: no cover

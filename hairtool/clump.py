@@ -49,7 +49,7 @@ def check_clump_params(radius: float, iterations: int, step: float | None, gap_m
         raise ParameterError("gap_mode", gap_mode, " or ".join(GAP_MODES))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _pull(P, flat, a, b, px, py, pz, sorig, h, inv_h, acc):
     """Add the pulls of the list entries ``flat[a:b]`` on p to ``acc`` = (fx, fy, fz, Σg, within h,
     nearest r, its index, its original index)."""
@@ -77,7 +77,7 @@ def _pull(P, flat, a, b, px, py, pz, sorig, h, inv_h, acc):
     return fx, fy, fz, wsum, c, br, bj, bo
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, dp, best, count, weight):
     """f (15) of every vertex from its two list runs, its nearest neighbour within h (ties:
     lower original index), how many are within h and Σg."""
@@ -100,13 +100,13 @@ def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, dp, best
         weight[i] = wsum
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _hash_heads(sorig, seed, heads):
     for i in prange(sorig.size):
         heads[i] = hash_head_nb(seed, sorig[i], CH_CLUMP)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _gap_kernel(P, f, step, best, heads, h, gap, it, Pout):
     for i in prange(P.shape[0]):
         lam = 1.0
@@ -129,7 +129,7 @@ def _gap_kernel(P, f, step, best, heads, h, gap, it, Pout):
             Pout[i, a] = P[i, a] + lam * (step * f[i, a])  # (16), (19)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _load(x, y, z, P):
     for k in prange(x.size):
         P[k, 0] = x[k]
@@ -137,7 +137,7 @@ def _load(x, y, z, P):
         P[k, 2] = z[k]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _first_stats(count, weight, sroot):
     """Pairs within h, moving vertices, and Σg over the vertices with neighbours (for auto_step)."""
     pairs = 0
@@ -154,14 +154,14 @@ def _first_stats(count, weight, sroot):
     return pairs, moving, w_sum, w_count
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _scatter(order, P, out):
     for k in prange(order.size):
         for a in range(3):
             out[order[k], a] = P[k, a]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _clump_run(x, y, z, order, lists, sroot, h, iterations, step, gap, seed, bufs, out):
     """The k Jacobi iterations on the cell-sorted list, one call (no Python between kernels).
     ``step`` < 0: automatic. Writes the result to ``out`` (original order, float32); returns

@@ -109,7 +109,7 @@ def resample_frames_numpy(frames: ArrayLike, counts: ArrayLike, m: int) -> F64:
     return out
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _resample_kernel(frames, offsets, q, out):  # pragma: no cover - compiled
     n_frames = frames.shape[0]
     s_count = offsets.size - 1

@@ -53,7 +53,7 @@ def _hash_py(seed, a, b, channel):
 _mix = njit(cache=True, inline="always")(_mix_py)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def hash_head_nb(seed: np.uint64, a: int, channel: int) -> np.uint64:
     """The part of :func:`hash_u01_nb` that depends on (seed, a, channel) only: kernels that
     draw many b for one a (a strand's vertices, a vertex's iterations) compute it once."""
@@ -61,14 +61,14 @@ def hash_head_nb(seed: np.uint64, a: int, channel: int) -> np.uint64:
     return _mix(h ^ _mix(np.uint64(a) + _GOLD))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def hash_tail_u01_nb(head: np.uint64, b: int) -> float:
     """Uniform [0, 1) from a :func:`hash_head_nb` and b: ``hash_u01_nb(seed, a, b, channel)``."""
     h = _mix(head ^ np.uint64(b))
     return float(h >> _S11) * _INV53
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def hash_u01_nb(seed: np.uint64, a: int, b: int, channel: int) -> float:
     """Uniform [0, 1) from (seed, a, b, channel) inside kernels."""
     return hash_tail_u01_nb(hash_head_nb(seed, a, channel), b)
@@ -144,7 +144,7 @@ def _effective(groom, stretch_stiffness, bend_stiffness, max_bend_angle, seed, s
     return np.maximum(float(stretch_stiffness) * m, 1.0), float(bend_stiffness) * m, seed
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _freeze_kernel(rest, offsets, ks, kb, theta_max, seed, planar, out):
     s_count = offsets.size - 1
     for s in prange(s_count):

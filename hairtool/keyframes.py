@@ -37,7 +37,7 @@ _LAYER_BLOCK = 16
 # swept in blocks of 16, row j outermost, so each table row is read once per block from cache
 # instead of once per layer (the table is larger than L2 from n ≈ 600). Serial: a parallel
 # loop over j must synchronise per layer and lost 3x on the shared 2 cores.
-@njit(cache=True, fastmath={"nnan", "nsz", "reassoc"})
+@njit(cache=True, nogil=True, fastmath={"nnan", "nsz", "reassoc"})
 def _layers_kernel(ct, kmax, use_max, stop):  # pragma: no cover - compiled
     """E[K, j], back[K, j] for K = 1..kmax from the transposed table ct[j, i] = C[i, j].
 
@@ -99,7 +99,7 @@ def layers_numpy(c: F64, kmax: int, use_max: bool = False, stop: float = -np.inf
     return e, back, last
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _penalty_kernel(ct, tau):  # pragma: no cover - compiled
     n = ct.shape[0]
     e = np.full(n, np.inf)

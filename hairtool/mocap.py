@@ -158,7 +158,7 @@ def rotation_cost_table_reference(
     return cost + cost.T
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _acos_unit(x):
     """arccos on [0, 1] to 2.2e-8 rad (Abramowitz & Stegun 4.4.46), four times faster than libm.
 
@@ -176,7 +176,7 @@ def _acos_unit(x):
     return np.sqrt(1.0 - x) * p
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _cost_table_kernel(q, p, w, wt, max_span):
     """Upper triangle of the cost table from q ``(J, F, 4)``; pairs farther apart than ``max_span`` get
     +inf. Each row i is computed by one thread, so the result does not depend on the thread count."""
@@ -192,7 +192,7 @@ def _cost_table_kernel(q, p, w, wt, max_span):
     return cost
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True, nogil=True, fastmath=True)
 def _cost_row(q, p, w, wt, i, j_end, out):
     """out[j] = cost[i, j] for i + 1 < j < j_end.
 

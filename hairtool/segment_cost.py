@@ -84,7 +84,7 @@ def _check(g: F64, curv: F64, lam: float) -> tuple[F64, F64]:
 
 
 # -- linear ---------------------------------------------------------------------------------
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _linear_kernel(g, curv, lam):  # pragma: no cover - compiled
     n = g.shape[0]
     a = np.zeros((n, n))

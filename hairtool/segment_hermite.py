@@ -34,7 +34,7 @@ def hermite_quad_weights(n: int) -> F64:
     return q
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _stencil(c, n):  # pragma: no cover - compiled
     if c == 0:
         return 0, 1, 1.0
@@ -43,7 +43,7 @@ def _stencil(c, n):  # pragma: no cover - compiled
     return c - 1, c + 1, 0.5
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _hermite_quad_terms(g, i, j, n):  # pragma: no cover - compiled
     """⟨u_a, u_b⟩ for u = (x_i, L·m_i, x_j, L·m_j): (00, 01, 11, 02, 03, 12, 13, 22, 23, 33)."""
     li, hi, wi = _stencil(i, n)
@@ -65,7 +65,7 @@ def _hermite_quad_terms(g, i, j, n):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _hermite_quad(g, q, i, j, n):  # pragma: no cover - compiled
     """Σ_k |h_k|² = Σ_ab Q_ab⟨u_a, u_b⟩ with Q from :func:`hermite_quad_weights`."""
     u = _hermite_quad_terms(g, i, j, n)
@@ -80,7 +80,7 @@ def _hermite_quad(g, q, i, j, n):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _hermite_kernel(g, curv, lam, q):  # pragma: no cover - compiled
     n = g.shape[0]
     a = np.zeros((n, n))

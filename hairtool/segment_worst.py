@@ -17,7 +17,7 @@ from hairtool.segment_hermite import _hermite_quad_terms, _stencil
 F64 = NDArray[np.float64]
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _worst_kernel(g, curv, lam, hermite):  # pragma: no cover - compiled
     n = g.shape[0]
     out = np.zeros((n, n))

@@ -267,7 +267,7 @@ def simulate_reference(groom: Groom, **kwargs) -> Animation:
 # ---------------------------------------------------------------------------------------
 # One frame of substeps: numba kernel and numpy twin
 # ---------------------------------------------------------------------------------------
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _frame_kernel(
     x, v, rest, offsets, seg_len, coll_r, centre, rot, trans, acc, dt, bend, ftl_damping, decay
 ):

@@ -27,7 +27,7 @@ _CHUNKS = 64  # search tasks (the lists do not depend on them): many, so that th
 _CHUNK_MIN = 256  # vertices per task at least
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _bounds(p):
     lo = np.full(3, np.inf)
     hi = np.full(3, -np.inf)
@@ -40,7 +40,7 @@ def _bounds(p):
 
 
 # -- the hashed fallback (sparse hair in a huge box) ---------------------------------------------
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _cell_keys(p, lo, inv_cell, shift, keys, buckets):
     for i in prange(p.shape[0]):
         cx = np.int64(np.floor((p[i, 0] - lo[0]) * inv_cell))
@@ -51,7 +51,7 @@ def _cell_keys(p, lo, inv_cell, shift, keys, buckets):
         buckets[i] = np.int64((np.uint64(k) * _HASH) >> shift)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _counting_sort(buckets, n_buckets, start, order):
     start[:] = 0
     for i in range(buckets.size):
@@ -65,7 +65,7 @@ def _counting_sort(buckets, n_buckets, start, order):
         fill[b] += 1
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _gather_hashed(order, points, strand, skip, keys, sx, sy, sz, sstrand, sskip, skeys):
     for k in prange(order.size):
         i = order[k]
@@ -77,7 +77,7 @@ def _gather_hashed(order, points, strand, skip, keys, sx, sy, sz, sstrand, sskip
         skeys[k] = keys[i]
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _hashed_kernel(sx, sy, sz, skey, sstrand, start, shift, r2, nbr, cnt):
     """All pairs of a vertex from the 27 hashed cells around it, into padded rows of ``nbr``."""
     cap = nbr.shape[1]
@@ -115,7 +115,7 @@ def _hashed_kernel(sx, sy, sz, skey, sstrand, start, shift, r2, nbr, cnt):
         cnt[i] = n
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _compact_padded(nbr, cnt, start, flat):
     """Padded rows → CSR (``start`` (V+1,) filled here, ``flat`` large enough)."""
     start[0] = 0
@@ -126,7 +126,7 @@ def _compact_padded(nbr, cnt, start, flat):
 
 
 # -- the row grid (the usual path) ---------------------------------------------------------------
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _row_sort(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx, start, order, tmp):
     """Vertices by row ``cz·ny + cy``, inside a row by x quantised to ``nq`` steps over the box:
     two stable counting sorts (quantised x, then row), no comparisons. ``start``: row offsets."""
@@ -161,7 +161,7 @@ def _row_sort(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx, start, order, tmp):
     start[0] = 0
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _gather(order, points, strand, skip, sx, sy, sz, sstrand, sskip):
     """The sorted coordinates (float64), strands and skip flags."""
     for k in prange(order.size):
@@ -173,7 +173,7 @@ def _gather(order, points, strand, skip, sx, sy, sz, sstrand, sskip):
         sskip[k] = skip[i]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _scan_row(
     sx, sy, sz, sstrand, j, end, px, py, pz, si, sweep, ylo, yhi, zlo, zhi, r2, jmin, grow, flat, pos, lim
 ):
@@ -200,7 +200,7 @@ def _scan_row(
     return j, pos
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _forward_kernel(
     sx, sy, sz, sstrand, start, ny, nz, lo, cell, r2, slack, chunks, base, limit, flat, fcnt, used
 ):
@@ -264,7 +264,7 @@ def _forward_kernel(
         used[c] = pos - base[c]
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _transpose(chunks, start, base, fflat, fcnt, bstart, bflat):
     """The backward lists: every i that found j (i < j), in increasing i (deterministic), as CSR
     ``bstart`` (V+1,) into ``bflat``. Returns the number of entries (``bflat`` must hold them)."""
@@ -458,7 +458,7 @@ class NeighbourList:
         self.bstart[:] = 0  # the hashed lists are complete
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _vertex_offsets(chunks, start, base, fcnt, off):
     """Where each vertex's forward entries start in the chunked buffer."""
     for c in range(chunks.size - 1):

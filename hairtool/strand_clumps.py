@@ -57,7 +57,7 @@ def auto_clump_radius(groom: Groom) -> float:
     return 2.0 * seg if seg > 0 else 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _union_components(strand_sorted, aflat, aoff, acnt, strand_count):
     # The forward runs hold every pair once: enough for an undirected union.
     parent = np.arange(strand_count)
@@ -93,7 +93,7 @@ def _union_components(strand_sorted, aflat, aoff, acnt, strand_count):
 STRONG_LINK = 0.5  # a neighbour leads only with at least this share of a strand's strongest link
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _strand_members(sstrand, strand_count):
     """Sorted positions of each strand's vertices: ``start`` (S+1,), ``members`` (V,)."""
     start = np.zeros(strand_count + 1, np.int64)
@@ -109,7 +109,7 @@ def _strand_members(sstrand, strand_count):
     return start, members
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, nogil=True, inline="always")
 def _count_links(flat, a, b, sroot, sstrand, acc, touched, m):
     for n in range(a, b):
         j = flat[n]
@@ -123,7 +123,7 @@ def _count_links(flat, a, b, sroot, sstrand, acc, touched, m):
     return m
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _basins(sstrand, sroot, lists, strand_count, strong):
     aflat, aoff, acnt, bflat, bstart = lists
     start, members = _strand_members(sstrand, strand_count)

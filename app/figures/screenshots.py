@@ -1,0 +1,128 @@
+"""The README's pictures of the studio, made by driving the real window as an artist would.
+
+``python -m app.figures.screenshots OUTDIR`` (needs a display: Xvfb works) writes
+
+- ``screenshot-studio.png``: Sintel's hair on her head, dragged into a frozen, clumped shape
+  with the align brush (three strokes), coloured root to tip;
+- ``screenshot-timeline.png``: an anime cycle on that groom in the timeline — the DP keys against
+  uniform keys of the same count, the error and speed curves, the error-versus-key-count plot —
+  with the anime wave dock beside it and the viewport in ghost mode at a frame between keys.
+
+The strokes are mouse events sent to the viewport, so the pictures show what a user gets.
+Settings go to a temporary file, never to the user's.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+WINDOW_SIZE = (1600, 1000)
+
+
+def _send(widget, kind: str, pos: Sequence[float], buttons: bool) -> None:
+    from PySide6.QtCore import QEvent, QPointF, Qt
+    from PySide6.QtGui import QMouseEvent
+    from PySide6.QtWidgets import QApplication
+
+    types = {
+        "press": QEvent.Type.MouseButtonPress,
+        "move": QEvent.Type.MouseMove,
+        "release": QEvent.Type.MouseButtonRelease,
+    }
+    left, none = Qt.MouseButton.LeftButton, Qt.MouseButton.NoButton
+    button = none if kind == "move" else left
+    local = QPointF(float(pos[0]), float(pos[1]))
+    event = QMouseEvent(
+        types[kind], local, widget.mapToGlobal(local), button, left if buttons else none,
+        Qt.KeyboardModifier.NoModifier,
+    )  # fmt: skip
+    QApplication.sendEvent(widget, event)
+
+
+def stroke(window, start: Sequence[float], end: Sequence[float], steps: int = 24) -> None:
+    """A left-drag across the viewport in fractions of its size (0..1 from the top left)."""
+    from PySide6.QtWidgets import QApplication
+
+    v = window.viewport
+    size = np.array([v.width(), v.height()], dtype=np.float64)
+    a, b = np.asarray(start) * size, np.asarray(end) * size
+    _send(v, "press", a, True)
+    for f in np.linspace(0.0, 1.0, steps + 1)[1:]:
+        _send(v, "move", (1.0 - f) * a + f * b, True)
+        QApplication.processEvents()
+    _send(v, "release", b, False)
+    QApplication.processEvents()
+
+
+def settle(app, rounds: int = 30) -> None:
+    for _ in range(rounds):
+        app.processEvents()
+
+
+def save(window, path: Path) -> None:
+    if not window.grab().save(str(path)):
+        raise OSError(f"could not write {path}")
+    print(f"wrote {path}")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("outdir", type=Path, help="folder for the PNGs (made if missing)")
+    args = parser.parse_args(argv)
+    args.outdir.mkdir(parents=True, exist_ok=True)
+
+    from app.main import configure_gl
+
+    configure_gl()
+    from PySide6.QtCore import QSettings, Qt
+    from PySide6.QtWidgets import QApplication
+
+    from app.ui.window import MainWindow
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    with tempfile.TemporaryDirectory() as tmp:
+        settings = QSettings(str(Path(tmp) / "studio.ini"), QSettings.Format.IniFormat)
+        window = MainWindow(settings=settings)
+        window.ask_save_changes = lambda: "discard"
+        window.resize(*WINDOW_SIZE)
+        window.show()
+        settle(app)
+        if not window.open_bundled_sample():
+            return 1
+        window.timeline.hide()
+        settle(app)
+        # Comb the fringe across the brow, then sweep the ends on both sides out a little.
+        stroke(window, (0.44, 0.30), (0.62, 0.36))
+        stroke(window, (0.62, 0.62), (0.70, 0.56))
+        stroke(window, (0.38, 0.62), (0.32, 0.58))
+        window.viewport.leaveEvent(None)
+        settle(app)
+        save(window, args.outdir / "screenshot-studio.png")
+
+        window.timeline.show()
+        window.sources.dock.raise_()
+        window.sources.apply_anime()
+        model = window.animation
+        window.resizeDocks([window.timeline], [360], Qt.Orientation.Vertical)
+        settle(app)
+        model.set_key_count(max(3, model.n_frames // 3))
+        keys = model.dp_keys
+        gaps = np.diff(keys)
+        between = int(keys[np.argmax(gaps)] + gaps.max() // 2)  # mid-way through the longest gap
+        model.set_view_mode("ghost")
+        model.set_frame(between)
+        settle(app, 60)
+        save(window, args.outdir / "screenshot-timeline.png")
+        window.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
