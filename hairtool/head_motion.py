@@ -1,9 +1,10 @@
 """Procedural head motions for the strand simulator: a rigid 4×4 transform per time in seconds.
 
-Units follow :mod:`hairtool.samples`: head radius 1 at the origin, y up. Each named motion
-starts and ends at the rest pose, so motions chain ("turn,nod") without jumps; all but "hop"
-also start and end at rest velocity. "hop" takes off and lands abruptly: a short event that
-good key frames must not miss.
+Motions are written for the head of :mod:`hairtool.samples` (radius 1 at the origin, y up) and
+placed on any other head sphere by :func:`head_motion`'s ``centre`` and ``radius``, which
+:func:`fit_head` finds from a groom's roots. Each named motion starts and ends at the rest
+pose, so motions chain ("turn,nod") without jumps; all but "hop" also start and end at rest
+velocity. "hop" takes off and lands abruptly: a short event that good key frames must not miss.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.rotation import axis_angle_matrix
@@ -81,21 +82,66 @@ def parse_motion(spec: str | Sequence[str]) -> list[str]:
     return names
 
 
-def head_motion(spec: str | Sequence[str], duration: float) -> HeadMotion:
+def head_motion(
+    spec: str | Sequence[str], duration: float, centre: ArrayLike = (0.0, 0.0, 0.0), radius: float = 1.0
+) -> HeadMotion:
     """A callable t (seconds) → 4×4: the named motions play one after another, equal slots over
-    ``duration``; times outside [0, duration] hold the rest pose."""
+    ``duration``; times outside [0, duration] hold the rest pose.
+
+    ``centre`` and ``radius`` place the unit head's motions on another head: the neck pivot
+    sits at ``centre + radius·PIVOT`` and a hop rises 0.6·``radius``; angles stay the same.
+    """
     names = parse_motion(spec)
     if not (np.isfinite(duration) and duration > 0):
         raise ParameterError("duration", duration, "a positive number of seconds")
+    c = np.asarray(centre, dtype=np.float64)
+    if c.shape != (3,) or not np.all(np.isfinite(c)):
+        raise ParameterError("head centre", centre, "three finite numbers")
+    if not (np.isfinite(radius) and radius > 0):
+        raise ParameterError("head radius", radius, "a positive finite number")
     slot = duration / len(names)
 
     def transform(t: float) -> F64:
         if not 0.0 <= t <= duration:
             return np.eye(4)
         k = min(int(t / slot), len(names) - 1)
-        return MOTIONS[names[k]]((t - k * slot) / slot)
+        m = MOTIONS[names[k]]((t - k * slot) / slot)
+        # x ↦ c + radius·M((x − c)/radius): the same rotation, the translation rescaled.
+        out = m.copy()
+        out[:3, 3] = c - m[:3, :3] @ c + radius * m[:3, 3]
+        return out
 
     return transform
+
+
+def fit_head(roots: ArrayLike) -> tuple[F64, float]:
+    """A head sphere (centre, radius) through a groom's roots, by linear least squares.
+
+    Roots in one plane (a 2-D groom) give the circle in that plane. When the roots do not pin
+    down a sphere (fewer than four, all on a line, or a fit larger than ten times their spread,
+    as for a flat comb), the centre is their centroid and the radius half their spread.
+    """
+    p = np.asarray(roots, dtype=np.float64).reshape(-1, 3)
+    if p.shape[0] == 0 or not np.all(np.isfinite(p)):
+        raise ParameterError("roots", f"{p.shape[0]} points", "at least one finite root")
+    mean = p.mean(axis=0)
+    q = p - mean  # centred, for conditioning
+    spread = float(np.max(np.linalg.norm(q, axis=1)))
+    fallback = (mean, spread / 2.0 if spread > 0 else 1.0)
+    if p.shape[0] < 4 or spread == 0:
+        return fallback
+    sv = np.linalg.svd(q, compute_uv=False)
+    if sv[1] <= 1e-9 * sv[0]:  # all on a line: no circle, no sphere
+        return fallback
+    # |q|² = 2 q·c + d with d = r² − |c|²; a flat axis has a zero column, so lstsq keeps c there 0.
+    a = np.column_stack([2.0 * q, np.ones(len(q))])
+    b = np.einsum("ij,ij->i", q, q)
+    (cx, cy, cz, d), *_ = np.linalg.lstsq(a, b, rcond=1e-10)
+    c = np.array([cx, cy, cz])
+    r2 = d + c @ c
+    if not (np.isfinite(r2) and r2 > 0) or np.sqrt(r2) > 10.0 * spread:
+        return fallback
+    return mean + c, float(np.sqrt(r2))
 
 
 def check_transform(m: object, t: float) -> F64:

@@ -152,8 +152,10 @@ def simulate(
 ) -> Animation:
     """Simulate ``groom`` (its pose at time 0) on a moving head; returns ``frames`` frames at ``fps``.
 
-    motion: names from :mod:`hairtool.head_motion` ("turn,nod" plays them in equal slots), or a
-        callable t (s) → rigid 4×4 head transform (world from head; the groom is posed at t = 0).
+    motion: names from :mod:`hairtool.head_motion` ("turn,nod" plays them in equal slots), placed
+        on the head sphere (``head_center``, ``head_radius``; :func:`~hairtool.head_motion.fit_head`
+        finds one for a real groom), or a callable t (s) → rigid 4×4 head transform (world from
+        head; the groom is posed at t = 0).
     substeps: solver steps per frame. gravity: units/s² along −y. damping: velocity decay per
         second (v ← v·e^(−damping·Δt)). stiffness: fraction of each vertex's distance from its
         rest position in the head frame removed per frame. ftl_damping: s_damping of Müller et al. eq. 9.
@@ -208,7 +210,8 @@ def simulate(
     if callable(motion):
         transform = motion
     else:
-        transform = head_motion(motion, max(duration, 1.0 / fps))
+        scale = head_radius if head_radius > 0 else 1.0  # the named motions sized to the head
+        transform = head_motion(motion, max(duration, 1.0 / fps), centre_world, scale)
     times, mats, m0 = _schedule(transform, frames, fps, substeps)
 
     # Rest pose in the head frame.

@@ -66,7 +66,15 @@ class AnimationSources(QObject):
 
     # -- simulation -----------------------------------------------------------------------------
     def simulate_dialog(self) -> Job | None:
-        options = self.window.ask_simulate_options(self.simulate_options)
+        """Ask for the options and start; until the user has chosen some, the dialog opens with
+        the head fitted to the groom on screen, so a real groom of any scale simulates sensibly."""
+        options = self.simulate_options
+        if options == SimulateOptions():
+            try:
+                options = options.fitted_to(self.window.scene.result)
+            except HairtoolError:
+                pass  # keep the sample head
+        options = self.window.ask_simulate_options(options)
         if options is None:
             return None
         return self.start_simulation(options)

@@ -23,6 +23,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QLineEdit,
+    QPushButton,
     QSpinBox,
     QVBoxLayout,
     QWidget,
@@ -31,7 +32,7 @@ from PySide6.QtWidgets import (
 from app.ui.jobs import JobCancelled
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation, Groom
-from hairtool.head_motion import MOTIONS, parse_motion
+from hairtool.head_motion import MOTIONS, fit_head, parse_motion
 from hairtool.simulate import GRAVITY, simulate
 
 SOURCE = "simulation"
@@ -68,6 +69,21 @@ class SimulateOptions:
 
     def to_dict(self) -> dict:
         return dataclasses.asdict(self)
+
+    def fitted_to(self, groom: Groom) -> SimulateOptions:
+        """The head sphere fitted to ``groom``'s roots, with gravity, wind and gusts scaled by
+        the change of head radius, so the hair moves alike on a head of any size."""
+        centre, radius = fit_head(groom.roots)
+        radius = max(round(radius, 3), 0.001)  # what the dialog's fields hold
+        scale = radius / self.head_radius if self.head_radius > 0 else radius
+        return dataclasses.replace(
+            self,
+            head_center=tuple(round(float(v), 3) for v in centre),
+            head_radius=radius,
+            gravity=self.gravity * scale,
+            gust_strength=self.gust_strength * scale,
+            wind=tuple(float(v) * scale for v in self.wind),
+        )
 
     @classmethod
     def from_dict(cls, d: dict) -> SimulateOptions:
@@ -137,8 +153,14 @@ class _Vector(QWidget):
 class SimulateDialog(QDialog):
     """Modal form; the window asks for options through ``ask_simulate_options`` (tests stub it)."""
 
-    def __init__(self, parent: QWidget | None = None, options: SimulateOptions | None = None) -> None:
+    def __init__(
+        self,
+        parent: QWidget | None = None,
+        options: SimulateOptions | None = None,
+        groom: Groom | None = None,
+    ) -> None:
         super().__init__(parent)
+        self.groom = groom  # for "Fit to groom"
         self.setWindowTitle("Simulate hair dynamics")
         layout = QVBoxLayout(self)
 
@@ -182,9 +204,16 @@ class SimulateDialog(QDialog):
         self.collide = QCheckBox("Keep strands outside the head")
         self.head_center = _Vector(-1e4, 1e4)
         self.head_radius = _spin(0.0, 1e4, 3, 0.1)
+        self.fit_button = QPushButton("Fit to groom")
+        self.fit_button.setToolTip(
+            "Fit the sphere to the groom's roots and scale gravity, wind and gusts with the head size"
+        )
+        self.fit_button.setEnabled(groom is not None)
+        self.fit_button.clicked.connect(self.fit_to_groom)
         h.addRow(self.collide)
         h.addRow("Centre", self.head_center)
         h.addRow("Radius", self.head_radius)
+        h.addRow(self.fit_button)
 
         for box in (motion, forces, head):
             layout.addWidget(box)
@@ -245,6 +274,14 @@ class SimulateDialog(QDialog):
         self.head_radius.setValue(o.head_radius)
         self._update_duration()
 
+    def fit_to_groom(self) -> None:
+        if self.groom is None:
+            return
+        try:
+            self.set_options(self.options().fitted_to(self.groom))
+        except ParameterError as e:
+            self.error_label.setText(str(e))
+
     def _accept(self) -> None:
         try:
             self.options()
@@ -254,9 +291,11 @@ class SimulateDialog(QDialog):
         self.accept()
 
 
-def ask_simulate_options(parent: QWidget, options: SimulateOptions) -> SimulateOptions | None:
+def ask_simulate_options(
+    parent: QWidget, options: SimulateOptions, groom: Groom | None = None
+) -> SimulateOptions | None:
     """Modal: the chosen options, or None when the user cancels."""
-    dialog = SimulateDialog(parent, options)
+    dialog = SimulateDialog(parent, options, groom)
     if dialog.exec() != QDialog.DialogCode.Accepted:
         return None
     return dialog.options()

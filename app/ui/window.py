@@ -279,7 +279,7 @@ class MainWindow(QMainWindow):
 
     def ask_simulate_options(self, options: SimulateOptions) -> SimulateOptions | None:
         """The Simulate… dialog: SimulateOptions or None (tests replace this)."""
-        return ask_simulate_options(self, options)
+        return ask_simulate_options(self, options, self.scene.result)
 
     def toggle_ortho(self) -> None:
         """2-D (orthographic front view) ⇄ 3-D (perspective), whatever the menu's check mark says."""

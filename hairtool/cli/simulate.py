@@ -7,6 +7,8 @@ Motions (comma-separated, played in equal slots): still, turn, nod, shake, hop.
 IN is a groom or animation file (its first frame is the rest pose) or a built-in sample:
 sample:NAME[:STRANDS[:VERTICES]] with NAME portrait, scalp or comb, e.g. sample:scalp:500:24.
 Units: the samples' head has radius 1 at the origin (≈ 10 cm); accelerations in units/s².
+For a real groom, --fit-head fits the head sphere to its roots and reads the accelerations
+in head radii/s², so the defaults move any groom as they move the samples.
 """
 
 from __future__ import annotations
@@ -44,15 +46,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     f.add_argument("--seed", type=int, default=0, help="seed of the gusts (default 0)")
     h = parser.add_argument_group("head")
     h.add_argument("--no-collide", action="store_true", help="let strands pass through the head sphere")
-    h.add_argument("--head-center", metavar="X,Y,Z", default="0,0,0", help="head sphere centre")
-    h.add_argument("--head-radius", type=float, default=1.0, help="head sphere radius (default 1)")
+    h.add_argument("--head-center", metavar="X,Y,Z", help="head sphere centre (default 0,0,0)")
+    h.add_argument("--head-radius", type=float, help="head sphere radius (default 1)")
+    h.add_argument(
+        "--fit-head",
+        action="store_true",
+        help="fit the head sphere to the roots, and read gravity, wind and gusts in head radii/s², "
+        "so a groom of any scale moves as the samples do (instead of --head-center/--head-radius)",
+    )
     parser.add_argument("--json", action="store_true", help="print a JSON object")
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from hairtool.head_motion import parse_motion
+    from hairtool.errors import ParameterError
+    from hairtool.head_motion import fit_head, parse_motion
     from hairtool.io import format_for, write
     from hairtool.simulate import simulate
 
@@ -63,8 +72,18 @@ def run(args: argparse.Namespace) -> int:
         w = np.asarray(parse_vector("wind", args.wind))
         strength = float(np.linalg.norm(w))
         wind = (w if strength > 0 else (0.0, 0.0, 1.0), strength)
-    centre = parse_vector("head-center", args.head_center)
     groom = load_groom(args.input)
+    if args.fit_head:
+        if args.head_center is not None or args.head_radius is not None:
+            raise ParameterError("fit-head", "with --head-center/--head-radius", "one or the other")
+        centre, radius = fit_head(groom.roots)
+        scale = radius  # accelerations were given for a head of radius 1
+    else:
+        centre = parse_vector("head-center", args.head_center or "0,0,0")
+        radius = 1.0 if args.head_radius is None else args.head_radius
+        scale = 1.0
+    if wind is not None:
+        wind = (wind[0], wind[1] * scale)
     t0 = time.perf_counter()
     anim = simulate(
         groom,
@@ -72,16 +91,16 @@ def run(args: argparse.Namespace) -> int:
         frames=args.frames,
         fps=args.fps,
         substeps=args.substeps,
-        gravity=args.gravity,
+        gravity=args.gravity * scale,
         damping=args.damping,
         stiffness=args.stiffness,
         wind=wind,
         gusts=args.gusts,
-        gust_strength=args.gust_strength,
+        gust_strength=args.gust_strength * scale,
         gust_duration=args.gust_duration,
         collide=not args.no_collide,
         head_center=centre,
-        head_radius=args.head_radius,
+        head_radius=radius,
         seed=args.seed,
     )
     seconds = time.perf_counter() - t0
@@ -96,6 +115,8 @@ def run(args: argparse.Namespace) -> int:
         "motion": motion,
         "gusts": args.gusts,
         "seed": args.seed,
+        "head_center": [round(float(v), 6) for v in centre],
+        "head_radius": round(float(radius), 6),
         "seconds": round(seconds, 4),
         "frames_per_second": round((anim.n_frames - 1) / seconds, 2) if anim.n_frames > 1 else None,
     }

@@ -64,3 +64,31 @@ def test_cancelled_simulation_keeps_the_previous_animation(make_window):
     with pytest.raises(JobCancelled):  # the job body stops at the first frame after a cancel
         run_simulation(groom, SimulateOptions(frames=20), lambda *a: done.append(a), lambda: len(done) > 2)
     assert len(done) == 3
+
+
+def test_the_dialog_opens_fitted_to_a_real_groom_and_fits_on_demand(make_window, grooms_dir, qtbot):
+    from app.ui.simulate_dialog import SimulateDialog, SimulateOptions
+    from hairtool.head_motion import fit_head
+
+    w = make_window()
+    assert w.open_path(grooms_dir / "sintel_hair.tfx"), w.errors
+    seen = []
+    w.ask_simulate_options = lambda o: seen.append(o)  # the dialog's Cancel, after a look
+    assert w.sources.simulate_dialog() is None
+    centre, radius = fit_head(w.scene.result.roots)
+    shown = seen[0]
+    assert shown.head_radius == pytest.approx(radius, abs=1e-3) and 5.0 < radius < 15.0
+    np.testing.assert_allclose(shown.head_center, centre, atol=1e-3)
+    base = SimulateOptions()
+    assert shown.gravity == pytest.approx(base.gravity * shown.head_radius)
+    assert shown.gust_strength == pytest.approx(base.gust_strength * shown.head_radius)
+    # options the user chose are kept as they are
+    chosen = SimulateOptions(frames=12)
+    w.sources.simulate_options = chosen
+    w.sources.simulate_dialog()
+    assert seen[-1] == chosen
+    dialog = SimulateDialog(None, chosen, w.scene.result)
+    qtbot.addWidget(dialog)
+    dialog.fit_button.click()
+    assert dialog.options().head_radius == pytest.approx(radius, abs=1e-3)
+    assert not SimulateDialog(None, chosen).fit_button.isEnabled()  # no groom, nothing to fit
