@@ -157,7 +157,9 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     return row
 
 
-def run(args: argparse.Namespace) -> list[dict]:
+def in_studio_app(measure):
+    """``measure(app, settings)`` with a QApplication on a display (Xvfb started when there is
+    none) and throw-away studio settings, so a benchmark never touches the user's."""
     from app.main import configure_gl
 
     xvfb = _ensure_display()
@@ -169,11 +171,17 @@ def run(args: argparse.Namespace) -> list[dict]:
         app = QApplication.instance() or QApplication(sys.argv[:1])
         with tempfile.TemporaryDirectory() as tmp:
             settings = QSettings(os.path.join(tmp, "bench.ini"), QSettings.Format.IniFormat)
-            return [_time_groom(app, name, groom, args, settings) for name, groom in _grooms(args)]
+            return measure(app, settings)
     finally:
         if xvfb is not None:
             xvfb.terminate()
             xvfb.wait(timeout=10)
+
+
+def run(args: argparse.Namespace) -> list[dict]:
+    return in_studio_app(
+        lambda app, settings: [_time_groom(app, name, g, args, settings) for name, g in _grooms(args)]
+    )
 
 
 def main(argv: list[str] | None = None) -> int:

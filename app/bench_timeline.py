@@ -12,10 +12,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
 import sys
-import tempfile
 import time
 
 import numpy as np
@@ -39,23 +37,9 @@ def _timed(fn) -> float:
 
 
 def run(args: argparse.Namespace) -> list[dict]:
-    from app.bench import _ensure_display
-    from app.main import configure_gl
+    from app.bench import in_studio_app
 
-    xvfb = _ensure_display()
-    try:
-        configure_gl()
-        from PySide6.QtCore import QSettings
-        from PySide6.QtWidgets import QApplication
-
-        app = QApplication.instance() or QApplication(sys.argv[:1])
-        with tempfile.TemporaryDirectory() as tmp:
-            settings = QSettings(os.path.join(tmp, "bench.ini"), QSettings.Format.IniFormat)
-            return _measure(app, args, settings)
-    finally:
-        if xvfb is not None:
-            xvfb.terminate()
-            xvfb.wait(timeout=10)
+    return in_studio_app(lambda app, settings: _measure(app, args, settings))
 
 
 def _stall(app, window, m) -> dict:
@@ -92,6 +76,7 @@ def _measure(app, args: argparse.Namespace, settings) -> list[dict]:
     label = f"{args.strands}x{args.vertices}, {args.frames} frames"
     rows: list[dict] = []
     window = MainWindow(groom=groom, settings=settings)
+    window.ask_save_changes = lambda: "discard"  # the benchmark's animation is not work to keep
     window.resize(*args.size)
     window.show()
     for _ in range(20):
@@ -109,7 +94,7 @@ def _measure(app, args: argparse.Namespace, settings) -> list[dict]:
         {
             "what": "key count change (trace)",
             "animation": label,
-            "ms": _timed(lambda: m.key_solve.keys_for_count(30)),
+            "ms": _timed(lambda: m.key_solve.keys_for_count(min(30, m.key_solve.kmax))),
         }
     )
     rows.append(

@@ -142,12 +142,7 @@ class AnimationModel(QObject):
         if animation.fps != self.fps:
             self.fps = float(animation.fps)
             self.fps_changed.emit(self.fps)
-        self.animation_changed.emit()
-        self.frame_changed.emit(0)
-        self.keys_changed.emit()
-        self.curve_changed.emit()
-        self.analysis_changed.emit()
-        self.display_changed.emit()
+        self._announce_new_animation()
         if animation.n_frames >= 2:
             self.request_solve()
 
@@ -161,6 +156,10 @@ class AnimationModel(QObject):
         self.animation, self.source, self.frame, self._preview = None, "", 0, None
         self._clear_keys()
         self._committed = None
+        self._announce_new_animation()
+
+    def _announce_new_animation(self) -> None:
+        """Everything depends on the animation: tell every listener it was reset."""
         self.animation_changed.emit()
         self.frame_changed.emit(0)
         self.keys_changed.emit()
