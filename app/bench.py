@@ -84,9 +84,10 @@ def _drag_path(window, moves: int) -> np.ndarray:
 
 
 def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> dict:
-    from PySide6.QtCore import QEvent, QPointF, Qt
-    from PySide6.QtGui import QMouseEvent, QSurfaceFormat
+    from PySide6.QtCore import Qt
+    from PySide6.QtGui import QSurfaceFormat
 
+    from app.ui.qt_utils import send_mouse
     from app.ui.window import MainWindow
 
     window = MainWindow(groom=groom, settings=settings)
@@ -102,35 +103,22 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     if args.fast_lines and v.renderer is not None:
         v.renderer.fast_lines = True
     v.finish_frames = True
-    left, none = Qt.MouseButton.LeftButton, Qt.MouseButton.NoButton
-
-    def send(kind, p, button, buttons) -> None:
-        local = QPointF(float(p[0]), float(p[1]))
-        app.sendEvent(
-            v, QMouseEvent(kind, local, v.mapToGlobal(local), button, buttons, Qt.KeyboardModifier.NoModifier)
-        )
-
-    def frame() -> None:
-        # Draw now, synchronously, into the widget's framebuffer (Qt's own repaint may be
-        # deferred); paintGL finishes the GL work, so the frame is complete when this returns.
-        v.makeCurrent()
-        v.paintGL()
-        v.doneCurrent()
+    left = Qt.MouseButton.LeftButton
 
     path = _drag_path(window, args.moves)
-    send(QEvent.Type.MouseButtonPress, path[0], left, left)
-    frame()  # the first update compiles kernels and allocates: not timed
+    send_mouse(v, "press", path[0], left, left)
+    v.draw_now()  # the first update compiles kernels and allocates: not timed
     totals, pipeline, upload, draw, stages = [], [], [], [], []
     for p in path[1:]:
         t0 = time.perf_counter()
-        send(QEvent.Type.MouseMove, p, none, left)
-        frame()
+        send_mouse(v, "move", p, None, left)
+        v.draw_now()
         totals.append((time.perf_counter() - t0) * 1e3)
         pipeline.append(window.scene.last_update_ms)
         upload.append(v.last_upload_ms)
         draw.append(v.last_draw_ms)
         stages.append(window.scene.pipeline.timings)
-    send(QEvent.Type.MouseButtonRelease, path[-1], left, none)
+    send_mouse(v, "release", path[-1], left)
     clump = window.scene.params.clump
     lines = v.renderer.line_method() if v.renderer is not None else "-"
     window.ask_save_changes = lambda: "discard"  # the benchmark's strokes are not work to keep

@@ -63,10 +63,10 @@ def _stall(app, window, m) -> dict:
 
 
 def _measure(app, args: argparse.Namespace, settings) -> list[dict]:
-    from PySide6.QtCore import QEvent, QPointF, Qt
-    from PySide6.QtGui import QMouseEvent
+    from PySide6.QtCore import Qt
 
     from app.ui import key_state as ks
+    from app.ui.qt_utils import send_mouse
     from app.ui.window import MainWindow
     from hairtool import samples
     from hairtool.sway import sway_animation
@@ -120,39 +120,25 @@ def _measure(app, args: argparse.Namespace, settings) -> list[dict]:
                  "ms": _timed(lambda: (m.set_frame(m.frame + 1), view.repaint()))})  # fmt: skip
 
     v.finish_frames = True
-    left, none = Qt.MouseButton.LeftButton, Qt.MouseButton.NoButton
+    left = Qt.MouseButton.LeftButton
     y = view.row_rect("curves").center().y()
-
-    def send(kind, x, button, buttons) -> None:
-        local = QPointF(float(x), float(y))
-        app.sendEvent(
-            view,
-            QMouseEvent(
-                kind, local, view.mapToGlobal(local), button, buttons, Qt.KeyboardModifier.NoModifier
-            ),
-        )
-
-    def paint() -> None:
-        v.makeCurrent()
-        v.paintGL()
-        v.doneCurrent()
 
     for mode in ("original", "reconstruction", "ghost", "error"):
         m.set_view_mode(mode)
         xs = np.linspace(view.frame_to_x(0), view.frame_to_x(args.frames - 1), args.moves + 1)
-        send(QEvent.Type.MouseButtonPress, xs[0], left, left)
-        paint()
+        send_mouse(view, "press", (xs[0], y), left, left)
+        v.draw_now()
         totals, events, upload, draw = [], [], [], []
         for x in xs[1:]:
             t0 = time.perf_counter()
-            send(QEvent.Type.MouseMove, x, none, left)
+            send_mouse(view, "move", (x, y), None, left)
             t1 = time.perf_counter()
-            paint()
+            v.draw_now()
             totals.append((time.perf_counter() - t0) * 1e3)
             events.append((t1 - t0) * 1e3)
             upload.append(v.last_upload_ms)
             draw.append(v.last_draw_ms)
-        send(QEvent.Type.MouseButtonRelease, xs[-1], left, none)
+        send_mouse(view, "release", (xs[-1], y), left)
         assert v.shown_frame == m.frame == args.frames - 1
         rows.append(
             {

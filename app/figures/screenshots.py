@@ -24,38 +24,22 @@ import numpy as np
 WINDOW_SIZE = (1600, 1000)
 
 
-def _send(widget, kind: str, pos: Sequence[float], buttons: bool) -> None:
-    from PySide6.QtCore import QEvent, QPointF, Qt
-    from PySide6.QtGui import QMouseEvent
-    from PySide6.QtWidgets import QApplication
-
-    types = {
-        "press": QEvent.Type.MouseButtonPress,
-        "move": QEvent.Type.MouseMove,
-        "release": QEvent.Type.MouseButtonRelease,
-    }
-    left, none = Qt.MouseButton.LeftButton, Qt.MouseButton.NoButton
-    button = none if kind == "move" else left
-    local = QPointF(float(pos[0]), float(pos[1]))
-    event = QMouseEvent(
-        types[kind], local, widget.mapToGlobal(local), button, left if buttons else none,
-        Qt.KeyboardModifier.NoModifier,
-    )  # fmt: skip
-    QApplication.sendEvent(widget, event)
-
-
 def stroke(window, start: Sequence[float], end: Sequence[float], steps: int = 24) -> None:
     """A left-drag across the viewport in fractions of its size (0..1 from the top left)."""
+    from PySide6.QtCore import Qt
     from PySide6.QtWidgets import QApplication
 
+    from app.ui.qt_utils import send_mouse
+
+    left = Qt.MouseButton.LeftButton
     v = window.viewport
     size = np.array([v.width(), v.height()], dtype=np.float64)
     a, b = np.asarray(start) * size, np.asarray(end) * size
-    _send(v, "press", a, True)
+    send_mouse(v, "press", a, left, left)
     for f in np.linspace(0.0, 1.0, steps + 1)[1:]:
-        _send(v, "move", (1.0 - f) * a + f * b, True)
+        send_mouse(v, "move", (1.0 - f) * a + f * b, None, left)
         QApplication.processEvents()
-    _send(v, "release", b, False)
+    send_mouse(v, "release", b, left)
     QApplication.processEvents()
 
 

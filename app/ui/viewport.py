@@ -228,6 +228,13 @@ class Viewport(QOpenGLWidget):
         self.last_draw_ms = (t2 - t1) * 1e3
         self.frame_drawn.emit()
 
+    def draw_now(self) -> None:
+        """Paint synchronously into the widget's framebuffer (Qt's own repaint may be deferred),
+        so a benchmark's frame is complete when this returns (with ``finish_frames`` set)."""
+        self.makeCurrent()
+        self.paintGL()
+        self.doneCurrent()
+
     @contextlib.contextmanager
     def current_context(self) -> Iterator[moderngl.Context | None]:
         """This widget's context made current (None before the first paint), for offscreen draws:

@@ -9,6 +9,7 @@ from PySide6.QtCore import QSettings
 from PySide6.QtWidgets import QApplication
 
 from app.main import configure_gl
+from app.ui.qt_utils import send_mouse
 
 configure_gl()  # pytest-qt makes the QApplication later, on the first use of ``qapp``
 
@@ -66,24 +67,6 @@ def grab(viewport) -> np.ndarray:
     return data.reshape(h, image.bytesPerLine())[:, : w * 3].reshape(h, w, 3).copy()
 
 
-def send_mouse(widget, kind: str, pos, button=None, buttons=None, modifiers=None) -> None:
-    """Deliver one mouse event synchronously: ``kind`` "press" | "move" | "release"; pos in widget px."""
-    from PySide6.QtCore import QEvent, QPointF, Qt
-    from PySide6.QtGui import QMouseEvent
-
-    types = {
-        "press": QEvent.Type.MouseButtonPress,
-        "move": QEvent.Type.MouseMove,
-        "release": QEvent.Type.MouseButtonRelease,
-    }
-    button = Qt.MouseButton.NoButton if button is None else button
-    buttons = Qt.MouseButton.NoButton if buttons is None else buttons
-    modifiers = Qt.KeyboardModifier.NoModifier if modifiers is None else modifiers
-    local = QPointF(float(pos[0]), float(pos[1]))
-    event = QMouseEvent(types[kind], local, widget.mapToGlobal(local), button, buttons, modifiers)
-    QApplication.sendEvent(widget, event)
-
-
 def drag(widget, start, end, steps: int = 8, button=None, modifiers=None) -> None:
     """Press at ``start``, move in ``steps`` to ``end`` with the button held, release there."""
     from PySide6.QtCore import Qt
@@ -103,6 +86,13 @@ def leave(widget) -> None:
     QApplication.sendEvent(widget, QEvent(QEvent.Type.Leave))
 
 
+def record(signal) -> list:
+    """The argument tuples of every emission of ``signal`` from now on."""
+    seen = []
+    signal.connect(lambda *a: seen.append(a))
+    return seen
+
+
 def hair_mask(image: np.ndarray, background=(0.16, 0.17, 0.19)) -> np.ndarray:
     """Pixels that differ clearly from the background colour."""
     bg = np.round(np.asarray(background) * 255.0)
@@ -114,4 +104,6 @@ def ui():
     """The helpers above, for test modules (importlib import mode cannot import conftest)."""
     from types import SimpleNamespace
 
-    return SimpleNamespace(grab=grab, drag=drag, leave=leave, send_mouse=send_mouse, hair_mask=hair_mask)
+    return SimpleNamespace(
+        grab=grab, drag=drag, leave=leave, send_mouse=send_mouse, hair_mask=hair_mask, record=record
+    )

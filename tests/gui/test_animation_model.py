@@ -20,17 +20,11 @@ def model(qapp):
     return m
 
 
-def record(signal) -> list:
-    seen = []
-    signal.connect(lambda *a: seen.append(a))
-    return seen
-
-
-def test_signals_fire_only_on_real_change(model):
+def test_signals_fire_only_on_real_change(ui, model):
     frames, settings, views = (
-        record(model.frame_changed),
-        record(model.settings_changed),
-        record(model.view_mode_changed),
+        ui.record(model.frame_changed),
+        ui.record(model.settings_changed),
+        ui.record(model.view_mode_changed),
     )
     model.set_frame(4)
     model.set_frame(4)

@@ -18,17 +18,11 @@ def scene(qapp):
     return Scene(samples.portrait(strands=20, vertices=8))
 
 
-def _count(signal) -> list:
-    seen = []
-    signal.connect(lambda *a: seen.append(a))
-    return seen
-
-
-def test_setters_emit_only_when_the_value_changes(scene):
+def test_setters_emit_only_when_the_value_changes(ui, scene):
     tool, display, params = (
-        _count(scene.tool_changed),
-        _count(scene.display_changed),
-        _count(scene.params_changed),
+        ui.record(scene.tool_changed),
+        ui.record(scene.display_changed),
+        ui.record(scene.params_changed),
     )
     scene.set_radius(scene.radius)
     scene.set_intensity(scene.intensity)
