@@ -77,6 +77,19 @@ def gust_schedule(
 # ---------------------------------------------------------------------------------------
 # Parameters
 # ---------------------------------------------------------------------------------------
+def scaled_accelerations(
+    factor: float, gravity: float, gust_strength: float, wind: ArrayLike = (0.0, 0.0, 0.0)
+) -> dict:
+    """Gravity, gust strength and the wind vector (units/s²) for a head ``factor`` times larger:
+    they scale with the head, so hair on the larger head moves as it did on the smaller one.
+    The keyword arguments of :func:`simulate` (the wind as a vector) that change with scale."""
+    return {
+        "gravity": float(gravity) * factor,
+        "gust_strength": float(gust_strength) * factor,
+        "wind": tuple(float(v) * factor for v in np.asarray(wind, dtype=np.float64).reshape(3)),
+    }
+
+
 def _vector(name: str, value: ArrayLike) -> F64:
     a = np.asarray(value, dtype=np.float64)
     if a.shape != (3,) or not np.all(np.isfinite(a)):

@@ -33,7 +33,7 @@ from app.ui.jobs import JobCancelled
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation, Groom
 from hairtool.head_motion import MOTIONS, fit_head, parse_motion
-from hairtool.simulate import GRAVITY, simulate
+from hairtool.simulate import GRAVITY, scaled_accelerations, simulate
 
 SOURCE = "simulation"
 
@@ -80,9 +80,7 @@ class SimulateOptions:
             self,
             head_center=tuple(round(float(v), 3) for v in centre),
             head_radius=radius,
-            gravity=self.gravity * scale,
-            gust_strength=self.gust_strength * scale,
-            wind=tuple(float(v) * scale for v in self.wind),
+            **scaled_accelerations(scale, self.gravity, self.gust_strength, self.wind),
         )
 
     @classmethod

@@ -63,15 +63,11 @@ def run(args: argparse.Namespace) -> int:
     from hairtool.errors import ParameterError
     from hairtool.head_motion import fit_head, parse_motion
     from hairtool.io import format_for, write
-    from hairtool.simulate import simulate
+    from hairtool.simulate import scaled_accelerations, simulate
 
     fmt = format_for(args.output, writing=True)  # refuse a bad extension before simulating
     motion = parse_motion(args.motion)
-    wind = None
-    if args.wind is not None:
-        w = np.asarray(parse_vector("wind", args.wind))
-        strength = float(np.linalg.norm(w))
-        wind = (w if strength > 0 else (0.0, 0.0, 1.0), strength)
+    wind = parse_vector("wind", args.wind) if args.wind is not None else (0.0, 0.0, 0.0)
     groom = load_groom(args.input)
     if args.fit_head:
         if args.head_center is not None or args.head_radius is not None:
@@ -82,8 +78,10 @@ def run(args: argparse.Namespace) -> int:
         centre = parse_vector("head-center", args.head_center or "0,0,0")
         radius = 1.0 if args.head_radius is None else args.head_radius
         scale = 1.0
-    if wind is not None:
-        wind = (wind[0], wind[1] * scale)
+    forces = scaled_accelerations(scale, args.gravity, args.gust_strength, wind)
+    w = np.asarray(forces["wind"])
+    strength = float(np.linalg.norm(w))
+    wind_arg = None if args.wind is None else (w if strength > 0 else (0.0, 0.0, 1.0), strength)
     t0 = time.perf_counter()
     anim = simulate(
         groom,
@@ -91,12 +89,12 @@ def run(args: argparse.Namespace) -> int:
         frames=args.frames,
         fps=args.fps,
         substeps=args.substeps,
-        gravity=args.gravity * scale,
+        gravity=forces["gravity"],
         damping=args.damping,
         stiffness=args.stiffness,
-        wind=wind,
+        wind=wind_arg,
         gusts=args.gusts,
-        gust_strength=args.gust_strength * scale,
+        gust_strength=forces["gust_strength"],
         gust_duration=args.gust_duration,
         collide=not args.no_collide,
         head_center=centre,
