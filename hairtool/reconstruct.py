@@ -78,27 +78,35 @@ def key_poses(frames: ArrayLike, keys: ArrayLike, interp: str = "linear") -> Key
 def interpolate_keys(kp: KeyPoses, dtype: type = np.float64) -> NDArray:
     """``(F, ...)`` frames rebuilt from the key poses; exact at the keys."""
     n = kp.n_frames
-    shape = kp.poses.shape[1:]
-    out = np.empty((n, *shape), dtype=dtype)
-    size = max(1, int(np.prod(shape)))
-    chunk = max(1, _CHUNK_VALUES // size)
-    flat_p = kp.poses.reshape(kp.keys.size, -1)
-    flat_m = None if kp.tangents is None else kp.tangents.reshape(kp.keys.size, -1)
+    out = np.empty((n, *kp.poses.shape[1:]), dtype=dtype)
+    chunk = max(1, _CHUNK_VALUES // max(1, int(np.prod(kp.poses.shape[1:]))))
     for f0 in range(0, n, chunk):
         t = np.arange(f0, min(n, f0 + chunk))
-        a = np.clip(np.searchsorted(kp.keys, t, side="right") - 1, 0, kp.keys.size - 2)
-        el = (kp.keys[a + 1] - kp.keys[a]).astype(np.float64)
-        s = ((t - kp.keys[a]) / el)[:, None]
-        if flat_m is None:
-            v = (1.0 - s) * flat_p[a] + s * flat_p[a + 1]
-        else:
-            h00 = 2 * s**3 - 3 * s**2 + 1
-            h10 = (s**3 - 2 * s**2 + s) * el[:, None]
-            h01 = -2 * s**3 + 3 * s**2
-            h11 = (s**3 - s**2) * el[:, None]
-            v = h00 * flat_p[a] + h10 * flat_m[a] + h01 * flat_p[a + 1] + h11 * flat_m[a + 1]
-        out[t] = v.reshape(t.size, *shape)
+        out[t] = interpolate_at(kp, t)
     return out
+
+
+def interpolate_at(kp: KeyPoses, frames: ArrayLike, dtype: type = np.float64) -> NDArray:
+    """``(len(frames), ...)`` the key curve (linear or Hermite) at the given frame numbers only:
+    what a studio scrubbing through a long animation asks for, one frame at a time."""
+    t = np.asarray(frames, dtype=np.int64).reshape(-1)
+    if t.size and (t.min() < 0 or t.max() >= kp.n_frames):
+        raise ParameterError("frames", f"{t.min()}..{t.max()}", f"frame numbers in [0, {kp.n_frames - 1}]")
+    shape = kp.poses.shape[1:]
+    flat_p = kp.poses.reshape(kp.keys.size, -1)
+    a = np.clip(np.searchsorted(kp.keys, t, side="right") - 1, 0, kp.keys.size - 2)
+    el = (kp.keys[a + 1] - kp.keys[a]).astype(np.float64)
+    s = ((t - kp.keys[a]) / el)[:, None]
+    if kp.tangents is None:
+        v = (1.0 - s) * flat_p[a] + s * flat_p[a + 1]
+    else:
+        flat_m = kp.tangents.reshape(kp.keys.size, -1)
+        h00 = 2 * s**3 - 3 * s**2 + 1
+        h10 = (s**3 - 2 * s**2 + s) * el[:, None]
+        h01 = -2 * s**3 + 3 * s**2
+        h11 = (s**3 - s**2) * el[:, None]
+        v = h00 * flat_p[a] + h10 * flat_m[a] + h01 * flat_p[a + 1] + h11 * flat_m[a + 1]
+    return v.reshape(t.size, *shape).astype(dtype, copy=False)
 
 
 def reconstruct(animation: Animation, keys: ArrayLike, interp: str = "linear") -> Animation:

@@ -23,7 +23,7 @@ from app.ui.jobs import Job, JobRunner
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Animation
 from hairtool.keyframes import uniform_keys
-from hairtool.reconstruct import KeyPoses
+from hairtool.reconstruct import KeyPoses, interpolate_at
 
 VIEW_MODES = {
     "original": "Original",
@@ -518,7 +518,7 @@ class AnimationModel(QObject):
         if self._preview is not None and self._preview[0] == f:
             rebuilt = original  # a key pose being dragged: the key curve passes through it
         else:
-            rebuilt = ks.rebuild_frames(kp, [f])[0]
+            rebuilt = interpolate_at(kp, [f], np.float32)[0]
         if self.view_mode == "reconstruction":
             return Display(f, rebuilt)
         if self.view_mode == "ghost":

@@ -21,7 +21,7 @@ from hairtool.features import FeatureOptions, hair_features
 from hairtool.groom import Animation
 from hairtool.key_edit import KeyEditor
 from hairtool.keyframes import select_keys, solve_layers, uniform_keys
-from hairtool.reconstruct import KeyPoses, check_keys, key_poses
+from hairtool.reconstruct import KeyPoses, check_keys, interpolate_at, key_poses
 from hairtool.segment_cost import INTERPOLATIONS, OBJECTIVES, cost_table
 
 F32 = NDArray[np.float32]
@@ -174,30 +174,6 @@ def choose_keys(key_solve: KeySolve, settings: KeySettings) -> I64:
 
 
 # -- reconstruction and errors, chunked ---------------------------------------------------------
-def rebuild_frames(kp: KeyPoses, frames: ArrayLike, dtype: type = np.float32) -> NDArray:
-    """``(len(frames), ...)`` the key curve at the given frame numbers (linear or Hermite).
-
-    The same formula as :func:`hairtool.reconstruct.interpolate_keys`, for a few frames only:
-    the viewport asks for one frame at a time while scrubbing.
-    """
-    t = np.asarray(frames, dtype=np.int64).reshape(-1)
-    keys = kp.keys
-    a = np.clip(np.searchsorted(keys, t, side="right") - 1, 0, keys.size - 2)
-    el = (keys[a + 1] - keys[a]).astype(np.float64)
-    s = ((t - keys[a]) / el).reshape((-1,) + (1,) * (kp.poses.ndim - 1))
-    p0, p1 = kp.poses[a], kp.poses[a + 1]
-    if kp.tangents is None:
-        v = (1.0 - s) * p0 + s * p1
-    else:
-        e = el.reshape(s.shape)
-        h00 = 2 * s**3 - 3 * s**2 + 1
-        h10 = (s**3 - 2 * s**2 + s) * e
-        h01 = -2 * s**3 + 3 * s**2
-        h11 = (s**3 - s**2) * e
-        v = h00 * p0 + h10 * kp.tangents[a] + h01 * p1 + h11 * kp.tangents[a + 1]
-    return v.astype(dtype, copy=False)
-
-
 @dataclass
 class FrameErrors:
     """Per-frame vertex distances |p − p̂| (scene units) of one reconstruction."""
@@ -238,7 +214,7 @@ def frame_errors(
         if cancelled is not None and cancelled():
             return None
         t = np.arange(f0, min(n, f0 + chunk))
-        d = f[t] - rebuild_frames(small, t)
+        d = f[t] - interpolate_at(small, t, np.float32)
         e = np.sqrt(np.einsum("fvi,fvi->fv", d, d))
         mean[t] = e.mean(axis=1, dtype=np.float64)
         tip[t] = e[:, tips].mean(axis=1, dtype=np.float64)
@@ -250,7 +226,7 @@ def frame_errors(
 
 def vertex_errors(animation: Animation, kp: KeyPoses, frame: int) -> F32:
     """``(V,)`` distance of each vertex from the key curve at one frame."""
-    d = animation.frames[frame] - rebuild_frames(kp, [frame])[0]
+    d = animation.frames[frame] - interpolate_at(kp, [frame], np.float32)[0]
     return np.sqrt(np.einsum("vi,vi->v", d, d))
 
 

@@ -10,6 +10,7 @@ from hairtool.errors import ParameterError
 from hairtool.key_search import find_keys
 from hairtool.reconstruct import (
     compare_with_uniform,
+    interpolate_at,
     interpolate_keys,
     key_distribution,
     key_poses,
@@ -43,6 +44,17 @@ def test_linear_motion_is_rebuilt_exactly_from_two_keys():
     kp = key_poses(x, [0, 8])
     np.testing.assert_allclose(interpolate_keys(kp), x, atol=1e-12)
     np.testing.assert_allclose(interpolate_keys(key_poses(x, [0, 8], "hermite")), x, atol=1e-12)
+
+
+@pytest.mark.parametrize("interp", ["linear", "hermite"])
+def test_key_curve_at_a_few_frames_is_those_rows_of_the_whole(anim, interp):
+    kp = key_poses(anim.frames, [0, 10, 31, 50, 71], interp)
+    whole = interpolate_keys(kp)
+    frames = [71, 0, 20, 20, 50]
+    np.testing.assert_array_equal(interpolate_at(kp, frames), whole[frames])
+    assert interpolate_at(kp, [5], np.float32).dtype == np.float32
+    with pytest.raises(ParameterError, match="frames"):
+        interpolate_at(kp, [72])
 
 
 def test_position_errors_in_scene_units(anim):
