@@ -9,6 +9,7 @@ the root-to-tip colour ramp then shows each bone's direction.
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -43,10 +44,19 @@ def read_any(path: str | os.PathLike[str]) -> Groom | Animation:
     return io.read(path)
 
 
-def open_filters() -> str:
-    """File-dialog filters: every readable groom/animation format and BVH."""
-    formats = [(f.name, f.extensions) for f in io.FORMATS if f.readable]
-    formats.append(("BVH motion capture (skeleton)", BVH_EXTENSIONS))
+def dialog_filters(formats: Sequence[tuple[str, Sequence[str]]]) -> str:
+    """File-dialog filters: "All supported (…)" first, then one per (name, extensions)."""
     parts = [f"{name} ({' '.join('*' + e for e in exts)})" for name, exts in formats]
     every = " ".join("*" + e for _, exts in formats for e in exts)
     return ";;".join([f"All supported ({every})", *parts])
+
+
+def open_filters() -> str:
+    """Every readable groom/animation format and BVH."""
+    formats = [(f.name, f.extensions) for f in io.FORMATS if f.readable]
+    return dialog_filters([*formats, ("BVH motion capture (skeleton)", BVH_EXTENSIONS)])
+
+
+def save_filters() -> str:
+    """Every writable groom/animation format."""
+    return dialog_filters([(f.name, f.extensions) for f in io.FORMATS if f.writable])

@@ -14,7 +14,7 @@ from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QK
 from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QWidget
 
 from app.ui import export
-from app.ui.animation_io import open_filters, read_any
+from app.ui.animation_io import open_filters, read_any, save_filters
 from app.ui.animation_model import AnimationModel
 from app.ui.animation_ui import AnimationController
 from app.ui.commands import ParamCommand, StrokeCommand
@@ -33,16 +33,9 @@ MAX_RECENT = 10
 SETTINGS_ORG, SETTINGS_APP = "hairtool", "Hairtool Studio"
 
 
-def _filters(kind: str) -> str:
-    """File-dialog filters for the readable or writable formats."""
-    formats = [f for f in io.FORMATS if getattr(f, kind)]
-    parts = [f"{f.name} ({' '.join('*' + e for e in f.extensions)})" for f in formats]
-    every = " ".join("*" + e for f in formats for e in f.extensions)
-    return ";;".join([f"All supported ({every})", *parts])
-
-
 class MainWindow(QMainWindow):
-    """``MainWindow(path)`` opens ``path``, or the bundled sample groom when None."""
+    """``MainWindow(path)`` opens ``path``, or the procedural portrait when None (the
+    ``hairtool-studio`` entry point then opens the bundled Sintel scene: :meth:`open_bundled_sample`)."""
 
     def __init__(
         self,
@@ -409,12 +402,12 @@ class MainWindow(QMainWindow):
 
     def save_as(self) -> bool:
         stem = self.scene.path.stem if self.scene.path is not None else "groom"
-        path = self.ask_save_path("Save groom as", _filters("writable"), f"{stem}.usda")
+        path = self.ask_save_path("Save groom as", save_filters(), f"{stem}.usda")
         return bool(path) and self._write_groom(path, adopt=True)
 
     def export_groom_dialog(self) -> bool:
         stem = self.scene.path.stem if self.scene.path is not None else "groom"
-        path = self.ask_save_path("Export edited groom", _filters("writable"), f"{stem}_edited.usda")
+        path = self.ask_save_path("Export edited groom", save_filters(), f"{stem}_edited.usda")
         return bool(path) and self.export_groom(path)
 
     def export_groom(self, path: str | os.PathLike[str]) -> bool:
