@@ -14,6 +14,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hairtool.bounds import box
 from hairtool.errors import GroomError
 
 F32 = NDArray[np.float32]
@@ -275,10 +276,11 @@ class Groom(_Attributes):
             u = np.where(length > 0, self.arc_length / length, self.vertex_param)
         return _frozen(u)
 
-    @property
+    @cached_property
     def bounds(self) -> tuple[F32, F32]:
         """Axis-aligned bounding box ``(min, max)``."""
-        return self.points.min(axis=0), self.points.max(axis=0)
+        lo, hi = box(self.points)
+        return _frozen(lo), _frozen(hi)
 
     @property
     def is_planar(self) -> bool:

@@ -18,25 +18,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from hairtool.errors import ParameterError
+from hairtool.bounds import box
+from hairtool.errors import GroomError, ParameterError
 
 _BITS = 21  # bits per cell coordinate in a packed 64-bit cell key
 _MAXC = (1 << _BITS) - 2
 _HASH = np.uint64(0x9E3779B97F4A7C15)
 _CHUNKS = 64  # search tasks (the lists do not depend on them): many, so that threads stay balanced
 _CHUNK_MIN = 256  # vertices per task at least
-
-
-@njit(cache=True, nogil=True)
-def _bounds(p):
-    lo = np.full(3, np.inf)
-    hi = np.full(3, -np.inf)
-    for i in range(p.shape[0]):
-        for a in range(3):
-            x = np.float64(p[i, a])
-            lo[a] = min(lo[a], x)
-            hi[a] = max(hi[a], x)
-    return lo, hi
 
 
 # -- the hashed fallback (sparse hair in a huge box) ---------------------------------------------
@@ -364,8 +353,10 @@ class NeighbourList:
     ) -> None:
         """``dense``: force the row grid (True) or the hashed one (False); None picks by size."""
         v = points.shape[0]
-        lo, hi = _bounds(points)
+        lo, hi = (b.astype(np.float64) for b in box(points))
         extent = float((hi - lo).max())
+        if not np.isfinite(extent):
+            raise GroomError("the points have a non-finite coordinate")
         if not np.isfinite(radius) or radius <= 0 or extent / radius >= _MAXC:
             raise ParameterError("clump_radius", radius, f"a distance above {extent / _MAXC:.3g}")
         self._buffers(v)

@@ -40,6 +40,7 @@ from app.render.overlay import CircleOverlay
 from app.render.ramps import DEFAULT_RAMP, ramp_stops, ramp_texture
 from app.render.shaders import load_program
 from app.render.strand_gpu import RESTART_INDEX, PointSet, StrandGPU, strip_indices
+from hairtool.bounds import box
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Groom, Topology
 
@@ -181,7 +182,7 @@ class StrandRenderer:
         if not np.all(np.isfinite(p)):
             raise GroomError("points have a non-finite coordinate")
         self._main.write(p)
-        self.bounds = (p.min(axis=0), p.max(axis=0))
+        self.bounds = box(p)
 
     def set_ghost_points(
         self, points: ArrayLike | None, rgba: tuple[float, float, float, float] = DEFAULT_GHOST_RGBA
