@@ -13,11 +13,12 @@ the trial step, ζ ~ U(0,1) hashed from (seed, vertex, iteration), Δp ← λ·�
   distance gives a small λ;
 - ``"off"``: λ = 1, plain adhesion (for comparison).
 
-Neighbours (a Verlet list): the vertices of other strands within h·(1 + MARGIN) at the start
-of the update are the candidates for all k iterations; each iteration uses those of them that
-are then within h. (A pair farther apart than 1.1·h at the start never interacts in that
-update.) :func:`clump` runs numba kernels on a cell-sorted list built once per update;
-:func:`clump_reference` is the plain numpy twin of the same definition.
+Neighbours: the vertices of other strands within h·(1 + MARGIN) at the start of the update
+are the candidates for all k iterations; each iteration uses those of them that are then
+within h. (A pair farther apart than 1.1·h at the start never interacts in that update.)
+:func:`clump` runs numba kernels on a cell-sorted list of them, built when the points change
+(an update on the points of the last one, e.g. a clump-only parameter change or a cursor held
+still, reuses it). :func:`clump_reference` is the plain numpy twin of the same definition.
 """
 
 from __future__ import annotations
@@ -49,55 +50,80 @@ def check_clump_params(radius: float, iterations: int, step: float | None, gap_m
         raise ParameterError("gap_mode", gap_mode, " or ".join(GAP_MODES))
 
 
+@njit(cache=True, nogil=True, parallel=True)
+def _gather_points(points, order, P):
+    """The current points (float64) in the list's sorted order."""
+    for k in prange(order.size):
+        i = order[k]
+        for a in range(3):
+            P[k, a] = points[i, a]
+
+
 @njit(cache=True, nogil=True, inline="always")
-def _pull(P, flat, a, b, px, py, pz, sorig, h, inv_h, acc):
-    """Add the pulls of the list entries ``flat[a:b]`` on p to ``acc`` = (fx, fy, fz, Σg, within h,
-    nearest r, its index, its original index)."""
-    fx, fy, fz, wsum, c, br, bj, bo = acc
+def _pull(P, flat, a, b, px, py, pz, h, inv_h, stats, acc):
+    """Add the pulls of the list entries ``flat[a:b]`` on p to ``acc`` = (fx, fy, fz, nearest r,
+    its index, whether another entry is exactly as near, within h, Σg). Selects, not branches,
+    for the nearest (which entry wins is unpredictable); exact ties are settled afterwards by
+    :func:`_lowest_of_nearest`, since looking up original indices here costs 1.5×."""
+    fx, fy, fz, br, bj, tie, c, wsum = acc
     for n in range(a, b):
         j = flat[n]
         ex = P[j, 0] - px
         ey = P[j, 1] - py
         ez = P[j, 2] - pz
         r = np.sqrt(ex * ex + ey * ey + ez * ez)
-        # Branch-free: list entries beyond h (the margin) get g = 0.
-        t = max(1.0 - r * inv_h, 0.0)
+        t = max(1.0 - r * inv_h, 0.0)  # list entries beyond h (the margin): g = 0
         g = t * t  # (14)
         s = g / (r + EPS)  # (15)
         fx += s * ex
         fy += s * ey
         fz += s * ez
-        c += np.int64(r < h)
-        wsum += g
-        oj = sorig[j]
-        better = (r < br) | ((r == br) & (oj < bo))  # selects, not branches: unpredictable
-        br = r if better else br
+        better = r < br
+        tie = (r == br) | (tie & ~better)
         bj = j if better else bj
-        bo = oj if better else bo
-    return fx, fy, fz, wsum, c, br, bj, bo
+        br = min(r, br)
+        if stats:
+            c += np.int64(r < h)
+            wsum += g
+    return fx, fy, fz, br, bj, tie, c, wsum
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _lowest_of_nearest(P, flat, a, b, px, py, pz, br, sorig, bj, bo):
+    """Among the entries ``flat[a:b]`` exactly ``br`` away (the same arithmetic as
+    :func:`_pull`), the one of lowest original index, against the best so far (bj, bo)."""
+    for n in range(a, b):
+        j = flat[n]
+        ex = P[j, 0] - px
+        ey = P[j, 1] - py
+        ez = P[j, 2] - pz
+        if np.sqrt(ex * ex + ey * ey + ez * ez) == br and sorig[j] < bo:
+            bj, bo = j, sorig[j]
+    return bj, bo
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, dp, best, count, weight):
-    """f (15) of every vertex from its two list runs, its nearest neighbour within h (ties:
-    lower original index), how many are within h and Σg."""
+def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, stats, f, best, count, weight):
+    """f (15) of every vertex from its two list runs and its nearest neighbour within h (ties:
+    the lower original index); with ``stats`` (the first iteration) also how many are within h
+    and Σg."""
     inv_h = 1.0 / h
     for i in prange(P.shape[0]):
-        dp[i, 0] = dp[i, 1] = dp[i, 2] = 0.0
-        best[i] = -1
-        count[i] = 0
-        weight[i] = 0.0
-        if sroot[i]:
-            continue
+        acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
         px, py, pz = P[i, 0], P[i, 1], P[i, 2]
-        acc = (0.0, 0.0, 0.0, 0.0, np.int64(0), np.inf, np.int64(-1), np.iinfo(np.int64).max)
-        acc = _pull(P, aflat, aoff[i], aoff[i] + acnt[i], px, py, pz, sorig, h, inv_h, acc)
-        acc = _pull(P, bflat, bstart[i], bstart[i + 1], px, py, pz, sorig, h, inv_h, acc)
-        fx, fy, fz, wsum, c, br, bj, _ = acc
-        dp[i, 0], dp[i, 1], dp[i, 2] = fx, fy, fz  # f (15); Δp = step·f (16)
-        best[i] = bj if br < h else -1
-        count[i] = c
-        weight[i] = wsum
+        a0, a1, b0, b1 = aoff[i], aoff[i] + acnt[i], bstart[i], bstart[i + 1]
+        if not sroot[i]:
+            acc = _pull(P, aflat, a0, a1, px, py, pz, h, inv_h, stats, acc)
+            acc = _pull(P, bflat, b0, b1, px, py, pz, h, inv_h, stats, acc)
+        fx, fy, fz, br, bj, tie, c, wsum = acc
+        if tie and bj >= 0:
+            bj, bo = _lowest_of_nearest(P, aflat, a0, a1, px, py, pz, br, sorig, bj, sorig[bj])
+            bj, bo = _lowest_of_nearest(P, bflat, b0, b1, px, py, pz, br, sorig, bj, bo)
+        f[i, 0], f[i, 1], f[i, 2] = fx, fy, fz  # f (15); Δp = step·f (16)
+        best[i] = bj
+        if stats:
+            count[i] = c
+            weight[i] = wsum
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -129,14 +155,6 @@ def _gap_kernel(P, f, step, best, heads, h, gap, it, Pout):
             Pout[i, a] = P[i, a] + lam * (step * f[i, a])  # (16), (19)
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def _load(x, y, z, P):
-    for k in prange(x.size):
-        P[k, 0] = x[k]
-        P[k, 1] = y[k]
-        P[k, 2] = z[k]
-
-
 @njit(cache=True, nogil=True)
 def _first_stats(count, weight, sroot):
     """Pairs within h, moving vertices, and Σg over the vertices with neighbours (for auto_step)."""
@@ -162,25 +180,34 @@ def _scatter(order, P, out):
 
 
 @njit(cache=True, nogil=True)
-def _clump_run(x, y, z, order, lists, sroot, h, iterations, step, gap, seed, bufs, out):
+def _same_points(points, ref):
+    for i in range(points.shape[0]):
+        for a in range(3):
+            if points[i, a] != ref[i, a]:
+                return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _clump_run(points, order, lists, sroot, h, iterations, step, gap, seed, bufs, out):
     """The k Jacobi iterations on the cell-sorted list, one call (no Python between kernels).
     ``step`` < 0: automatic. Writes the result to ``out`` (original order, float32); returns
     (mean neighbours within h per moving vertex, the step used)."""
-    P, Pn, dp, best, count, weight, heads = bufs
+    P, Pn, f, best, count, weight, heads = bufs
     aflat, aoff, acnt, bflat, bstart = lists
-    _load(x, y, z, P)
+    _gather_points(points, order, P)
     if gap != 2:
         _hash_heads(order, seed, heads)
     mean_nb = 0.0
     k_step = step
     for it in range(iterations):
-        _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, order, h, dp, best, count, weight)
+        _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, order, h, it == 0, f, best, count, weight)
         if it == 0:
             pairs, moving, w_sum, w_count = _first_stats(count, weight, sroot)
             mean_nb = pairs / max(moving, 1)
             if step < 0.0:
                 k_step = STEP_FRACTION * h / max(w_sum / max(w_count, 1), 1.0)
-        _gap_kernel(P, dp, k_step, best, heads, h, gap, it, Pn)
+        _gap_kernel(P, f, k_step, best, heads, h, gap, it, Pn)
         P, Pn = Pn, P
     _scatter(order, P, out)
     return mean_nb, k_step
@@ -195,16 +222,22 @@ def auto_step(h: float, weight: np.ndarray, count: np.ndarray) -> float:
 
 
 class ClumpWorkspace:
-    """Buffers reused between updates, and what the last run saw (for benchmarks and the studio)."""
+    """What survives between updates: buffers, the neighbour list of the last points, and what
+    the last run saw (for benchmarks and the studio)."""
 
     def __init__(self) -> None:
         self.neighbours = NeighbourList()
         self.mean_neighbours = 0.0  # other-strand vertices within h per moving vertex, first iteration
         self.step = 0.0  # Δt²/m used in the last run
+        self.builds = 0  # neighbour lists built so far (the rest of the runs reused one)
         self._mask_for: object = None
         self._mask = np.zeros(0, bool)
         self._buffers: tuple = ()
-        self.built_for: tuple | None = None  # (points, list radius) of the current neighbour list
+        self._built: tuple | None = None  # (topology, list radius, points at the build)
+
+    def invalidate(self) -> None:
+        """Forget the neighbour list: the next run builds one (benchmarks time the build)."""
+        self._built = None
 
     def roots_mask(self, topology) -> np.ndarray:
         if self._mask_for is not topology:
@@ -213,9 +246,27 @@ class ClumpWorkspace:
             self._mask_for = topology
         return self._mask
 
+    def neighbour_list(self, groom: Groom, h: float) -> NeighbourList:
+        """The list of the vertices of other strands within h·(1 + MARGIN), built again only when
+        the points differ from those of the last build. (A Verlet skin that lets a list outlive
+        small moves was measured and left out: in a drag the dragged strands move farther than a
+        skin worth its cost on every move.)"""
+        top = groom.topology
+        radius = h * (1.0 + MARGIN)
+        b = self._built
+        if b is not None and b[0] is top and b[1] == radius:
+            if b[2] is groom.points or _same_points(groom.points, b[2]):
+                return self.neighbours
+        self._built = None
+        self.neighbours.build(groom.points, top.strand_index, self.roots_mask(top), radius)
+        self._built = (top, radius, groom.points.copy())
+        self.builds += 1
+        return self.neighbours
+
     def buffers(self, v: int) -> tuple:
-        """Iterates (2), Δp, nearest neighbour, counts, weights and hash heads for V vertices, reused."""
-        if not self._buffers or len(self._buffers[0]) != v:
+        """Iterates, f, nearest neighbour, counts, Σg and hash heads for V vertices, reused."""
+        b = self._buffers
+        if not b or len(b[0]) != v:
             self._buffers = (
                 np.empty((v, 3)),
                 np.empty((v, 3)),
@@ -242,23 +293,15 @@ def clump_points(
     seed = check_seed(seed)
     ws = workspace or ClumpWorkspace()
     h = float(radius)
-    top = groom.topology
     ws.step = 0.0
     ws.mean_neighbours = 0.0
     if iterations == 0 or groom.strand_count < 2:
         return groom.points.copy()
-    is_root = ws.roots_mask(top)
-    nl = ws.neighbours
-    key = (groom.points, h * (1.0 + MARGIN))
-    if ws.built_for is None or ws.built_for[0] is not key[0] or ws.built_for[1] != key[1]:
-        # Grooms are immutable: the same points object needs no new list (clump-only changes).
-        ws.built_for = None
-        nl.build(groom.points, top.strand_index, is_root, key[1])
-        ws.built_for = key
+    nl = ws.neighbour_list(groom, h)
     out = np.empty((groom.vertex_count, 3), np.float32)
     lists = (nl.aflat, nl.aoff, nl.acnt, nl.bflat, nl.bstart)
     ws.mean_neighbours, ws.step = _clump_run(
-        nl.x, nl.y, nl.z, nl.order, lists, nl.skip, h, int(iterations),
+        groom.points, nl.order, lists, nl.skip, h, int(iterations),
         -1.0 if step is None else float(step), _GAP_CODE[gap_mode], seed_u64(seed),
         ws.buffers(groom.vertex_count), out,
     )  # fmt: skip

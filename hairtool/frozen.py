@@ -179,6 +179,12 @@ class FrozenPipeline:
         return self._workspace.step
 
     @property
+    def neighbour_builds(self) -> int:
+        """ClumpWithGaps neighbour lists built so far (an update reuses the last one while the
+        strands have moved little)."""
+        return self._workspace.builds
+
+    @property
     def mean_neighbours(self) -> float:
         """Mean number of other-strand vertices within h per moving vertex in the last clumping."""
         return self._workspace.mean_neighbours

@@ -2,11 +2,14 @@
 
 Sizes: the paper's Table 1 (100, 300, 500 strands × 20), 5,000 and 50,000 × 20 scalp samples,
 and the real grooms. Clump radius h = 2× the median root spacing, k = 3. ``pipeline_ms``: rest
-groom → result (freeze + one align sample + clump); ``update_ms``: one mouse move in the studio
-(align + clump, freeze cached); ``list_ms``: building ClumpWithGaps' neighbour list alone (part
-of ``clump_ms``); ``reference_ms``: the same chain with the numpy twins (null above
-``--reference-limit`` vertices). ``mean_neighbours``: other-strand vertices within h per moving
-vertex; ``threads``: numba threads.
+groom → result (freeze + one align sample + clump), run again on the same input, so
+ClumpWithGaps keeps its neighbour list; ``cold_ms``: the same with the list built every time;
+``clump_ms``: ClumpWithGaps alone with its list built, ``list_ms`` of it; ``update_ms``: one
+studio mouse move with the cursor held still (align + clump, freeze cached); ``drag_ms``: one
+mouse move of a drag (the cursor moving on a small circle), where the strands move and the list
+is rebuilt on ``drag_builds`` of the moves; ``reference_ms``: the pipeline with the numpy twins
+(null above ``--reference-limit`` vertices). ``mean_neighbours``: other-strand vertices within h
+per moving vertex; ``threads``: numba threads.
 """
 
 from __future__ import annotations
@@ -57,20 +60,39 @@ def _grooms(sizes: list[str]):
 
 
 def _fresh(ws):
-    """The workspace with its neighbour list marked stale, so clump_ms includes building it."""
-    ws.built_for = None
+    """The workspace with its neighbour list forgotten, so the time includes building one."""
+    ws.invalidate()
     return ws
 
 
+def _drag_ms(pipe, c, r, size, moves: int = 40) -> tuple[float, float]:
+    """Median ms per move of a drag around ``c`` and the fraction of moves that built a list."""
+    import numpy as np
+
+    from hairtool.bench import median_ms
+
+    a = np.linspace(0.0, 2.0 * np.pi, moves, endpoint=False)
+    path = c + 0.05 * size * np.column_stack([np.cos(a), np.sin(a), np.zeros(moves)])
+    it = iter(range(10**9))
+
+    def move():
+        pipe.align(path[next(it) % moves], r, 0.8)
+
+    move()
+    builds = pipe.neighbour_builds
+    ms = median_ms(move, moves, warmup=0)
+    return ms, (pipe.neighbour_builds - builds) / moves
+
+
 def _cursor(groom):
+    """A cursor beside the groom that catches about half of the tips: (point, radius, size)."""
     import numpy as np
 
     lo, hi = groom.bounds
     centre = (lo + hi) / 2.0
     size = float(np.linalg.norm(hi - lo))
     offset = np.array([0.6, 0.2, 0.0]) * size
-    # A cursor beside the groom that catches about half of the tips.
-    return centre + offset, 0.7 * size
+    return centre + offset, 0.7 * size, size
 
 
 def run(args: argparse.Namespace) -> list[dict]:
@@ -79,7 +101,7 @@ def run(args: argparse.Namespace) -> list[dict]:
 
     from hairtool.align import align, align_reference
     from hairtool.bench import median_ms
-    from hairtool.clump import MARGIN, ClumpWorkspace, clump, clump_reference
+    from hairtool.clump import ClumpWorkspace, clump, clump_reference
     from hairtool.errors import ParameterError
     from hairtool.freeze import freeze, freeze_reference
     from hairtool.frozen import FrozenPipeline
@@ -95,7 +117,7 @@ def run(args: argparse.Namespace) -> list[dict]:
     theta = float(np.radians(30.0))
     for name, rest in _grooms(sizes):
         h = auto_clump_radius(rest)
-        c, r = _cursor(rest)
+        c, r, size = _cursor(rest)
         ws = ClumpWorkspace()
 
         def pipeline(rest=rest, c=c, r=r, h=h, ws=ws):
@@ -117,15 +139,12 @@ def run(args: argparse.Namespace) -> list[dict]:
             "clump_ms": median_ms(
                 lambda a=aligned, h=h, ws=ws: clump(a, h, 3, None, "printed", 0, _fresh(ws)), repeat
             ),
-            "list_ms": median_ms(
-                lambda a=aligned, h=h, ws=ws: ws.neighbours.build(
-                    a.points, a.topology.strand_index, ws.roots_mask(a.topology), h * (1.0 + MARGIN)
-                ),
-                repeat,
-            ),
+            "list_ms": median_ms(lambda a=aligned, h=h, ws=ws: _fresh(ws).neighbour_list(a, h), repeat),
             "pipeline_ms": median_ms(pipeline, repeat),
+            "cold_ms": median_ms(lambda ws=ws, run=pipeline: (_fresh(ws), run()), repeat),
             "update_ms": median_ms(lambda p=pipe, c=c, r=r: p.align(c, r, 0.8), repeat),
         }
+        row["drag_ms"], row["drag_builds"] = _drag_ms(FrozenPipeline(rest), c, r, size)
         row["mean_neighbours"] = ws.mean_neighbours
         if rest.vertex_count <= args.reference_limit:
             row["reference_ms"] = median_ms(reference, max(1, min(repeat, 3)), warmup=0)
