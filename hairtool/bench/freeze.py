@@ -6,10 +6,10 @@ groom → result (freeze + one align sample + clump), run again on the same inpu
 ClumpWithGaps keeps its neighbour list; ``cold_ms``: the same with the list built every time;
 ``clump_ms``: ClumpWithGaps alone with its list built, ``list_ms`` of it; ``update_ms``: one
 studio mouse move with the cursor held still (align + clump, freeze cached); ``drag_ms``: one
-mouse move of a drag (the cursor moving on a small circle), where the strands move and the list
-is rebuilt on ``drag_builds`` of the moves; ``reference_ms``: the pipeline with the numpy twins
-(null above ``--reference-limit`` vertices). ``mean_neighbours``: other-strand vertices within h
-per moving vertex; ``threads``: numba threads.
+mouse move of a drag with the studio's brush (the cursor circling a tip), where the strands
+move and ClumpWithGaps builds its neighbour list on ``drag_builds`` of the moves;
+``reference_ms``: the pipeline with the numpy twins (null above ``--reference-limit`` vertices).
+``mean_neighbours``: other-strand vertices within h per moving vertex; ``threads``: numba threads.
 """
 
 from __future__ import annotations
@@ -65,18 +65,24 @@ def _fresh(ws):
     return ws
 
 
-def _drag_ms(pipe, c, r, size, moves: int = 40) -> tuple[float, float]:
-    """Median ms per move of a drag around ``c`` and the fraction of moves that built a list."""
+def _drag_ms(pipe, moves: int = 40) -> tuple[float, float]:
+    """Median ms per move of a drag like the studio's (its brush of 0.25× the groom's extent,
+    the cursor circling a tip near the middle) and the share of moves that built a neighbour
+    list."""
     import numpy as np
 
     from hairtool.bench import median_ms
 
+    lo, hi = pipe.rest.bounds
+    extent = float(np.max(hi - lo))
+    tips = pipe.rest.tips.astype(np.float64)
+    tip = tips[np.argmin(np.linalg.norm(tips - (lo + hi) / 2.0, axis=1))]
     a = np.linspace(0.0, 2.0 * np.pi, moves, endpoint=False)
-    path = c + 0.05 * size * np.column_stack([np.cos(a), np.sin(a), np.zeros(moves)])
+    path = tip + 0.1 * extent * np.column_stack([np.cos(a), np.sin(a), np.zeros(moves)])
     it = iter(range(10**9))
 
     def move():
-        pipe.align(path[next(it) % moves], r, 0.8)
+        pipe.align(path[next(it) % moves], 0.25 * extent, 0.8)
 
     move()
     builds = pipe.neighbour_builds
@@ -85,14 +91,14 @@ def _drag_ms(pipe, c, r, size, moves: int = 40) -> tuple[float, float]:
 
 
 def _cursor(groom):
-    """A cursor beside the groom that catches about half of the tips: (point, radius, size)."""
+    """A cursor beside the groom that catches about half of the tips, and its radius."""
     import numpy as np
 
     lo, hi = groom.bounds
     centre = (lo + hi) / 2.0
     size = float(np.linalg.norm(hi - lo))
     offset = np.array([0.6, 0.2, 0.0]) * size
-    return centre + offset, 0.7 * size, size
+    return centre + offset, 0.7 * size
 
 
 def run(args: argparse.Namespace) -> list[dict]:
@@ -117,7 +123,7 @@ def run(args: argparse.Namespace) -> list[dict]:
     theta = float(np.radians(30.0))
     for name, rest in _grooms(sizes):
         h = auto_clump_radius(rest)
-        c, r, size = _cursor(rest)
+        c, r = _cursor(rest)
         ws = ClumpWorkspace()
 
         def pipeline(rest=rest, c=c, r=r, h=h, ws=ws):
@@ -144,7 +150,7 @@ def run(args: argparse.Namespace) -> list[dict]:
             "cold_ms": median_ms(lambda ws=ws, run=pipeline: (_fresh(ws), run()), repeat),
             "update_ms": median_ms(lambda p=pipe, c=c, r=r: p.align(c, r, 0.8), repeat),
         }
-        row["drag_ms"], row["drag_builds"] = _drag_ms(FrozenPipeline(rest), c, r, size)
+        row["drag_ms"], row["drag_builds"] = _drag_ms(FrozenPipeline(rest))
         row["mean_neighbours"] = ws.mean_neighbours
         if rest.vertex_count <= args.reference_limit:
             row["reference_ms"] = median_ms(reference, max(1, min(repeat, 3)), warmup=0)
