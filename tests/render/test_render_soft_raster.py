@@ -1,0 +1,238 @@
+"""The CPU strand rasterizer against its numpy definition: the same bytes, whatever the threads."""
+
+from __future__ import annotations
+
+import itertools
+
+import numba
+import numpy as np
+import pytest
+
+from app.render import soft_raster
+from app.render.camera import Camera
+from app.render.ramps import ramp_texture, sample_linear
+from app.render.soft_raster import StrandRaster, rasterize, rasterize_reference
+from hairtool.errors import ParameterError
+from hairtool.groom import Groom
+
+SIZE = (61, 47)
+
+
+def _perspective(size=SIZE) -> np.ndarray:
+    cam = Camera(distance=3.0, yaw=0.3, pitch=-0.2)
+    cam.set_scene((-1, -1, -1), (1, 1, 1))
+    return cam.view_matrix() @ cam.projection_matrix(size[0] / size[1])
+
+
+def _ortho(size=SIZE) -> np.ndarray:
+    cam = Camera(ortho=True, ortho_height=2.5)
+    cam.set_scene((-1, -1, -1), (1, 1, 1))
+    return cam.view_matrix() @ cam.projection_matrix(size[0] / size[1])
+
+
+def _awkward_segments(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Random strands plus the cases that need care: cut by the near plane, wholly behind the eye,
+    zero length, far off the image, across its border, and exactly horizontal or vertical."""
+    rng = np.random.default_rng(seed)
+    strands = [rng.normal(scale=0.8, size=(rng.integers(2, 7), 3)) for _ in range(40)]
+    eye = np.array([3.0 * np.sin(0.3) * np.cos(0.2), 3.0 * np.sin(0.2), 3.0 * np.cos(0.3) * np.cos(0.2)])
+    strands += [
+        [[0.1, 0.2, 0.0], eye * 1.5],  # through the eye plane
+        [eye * 1.2, eye * 1.4 + 0.1],  # wholly behind the eye
+        [eye * 0.99, [0.0, 0.0, 0.0]],  # from just in front of the eye
+        [[0.2, 0.1, 0.3], [0.2, 0.1, 0.3], [0.5, -0.2, 0.1]],  # zero length, then a segment
+        [[40.0, 0.0, 0.0], [45.0, 3.0, 0.0]],  # far off the image
+        [[-3.0, 0.1, 0.0], [3.0, -0.2, 0.5]],  # across the image, both ends outside
+        [[0.0, -0.5, 0.0], [0.0, 0.5, 0.0]],  # vertical in the orthographic view
+        [[-0.5, 0.25, 0.0], [0.5, 0.25, 0.0]],  # horizontal there
+        [[0.0, 0.0, -50.0], [0.1, 0.0, 50.0]],  # through the near and far planes
+    ]
+    g = Groom.from_strands([np.asarray(s, dtype=np.float64) for s in strands])
+    colors = rng.random((g.vertex_count, 3)).astype(np.float32)
+    colors[:3] = [[-0.5, 2.0, 0.5]]  # out of [0, 1]: clamped
+    return g.points, g.topology.segment_end - 1, colors
+
+
+@pytest.fixture
+def threads():
+    """``threads(n)`` sets numba's thread count for the test; the old count comes back after."""
+    before = numba.get_num_threads()
+    yield lambda n: numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
+    numba.set_num_threads(before)
+
+
+@pytest.mark.parametrize("width", [1.0, 0.5, 2.0, 3.5, 8.0])
+@pytest.mark.parametrize("view", ["perspective", "ortho"])
+@pytest.mark.parametrize("n_threads", [1, 2])
+def test_kernels_give_the_bytes_of_the_numpy_definition(width, view, n_threads, threads):
+    threads(n_threads)
+    mvp = _perspective() if view == "perspective" else _ortho()
+    for seed in range(3):
+        points, starts, colors = _awkward_segments(seed)
+        rgba, depth = rasterize(points, starts, colors, mvp, SIZE, width)
+        ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, width)
+        np.testing.assert_array_equal(rgba, ref_rgba)
+        np.testing.assert_array_equal(depth, ref_depth)
+        drawn = rgba[..., 3] == 255
+        assert drawn.mean() > 0.05 and not drawn.all()  # a picture, not an empty or a full one
+        assert np.all(depth[~drawn] == 1.0) and np.all(rgba[~drawn] == 0)
+        assert np.all((depth[drawn] >= 0.0) & (depth[drawn] <= 1.0))
+
+
+def test_thread_counts_give_the_same_bytes_on_a_dense_groom(threads):
+    from hairtool import samples
+
+    g = samples.scalp(strands=600, vertices=12, seed=4)
+    cam = Camera.for_groom(g, aspect=200 / 150)
+    mvp = cam.view_matrix() @ cam.projection_matrix(200 / 150)
+    colors = np.random.default_rng(0).random((g.vertex_count, 3)).astype(np.float32)
+    for width in (1.0, 2.0):
+        images = []
+        for n in (1, 2):
+            threads(n)
+            rgba, depth = rasterize(g.points, g.topology.segment_end - 1, colors, mvp, (200, 150), width)
+            images.append((rgba.copy(), depth.copy()))
+        np.testing.assert_array_equal(images[0][0], images[1][0])
+        np.testing.assert_array_equal(images[0][1], images[1][1])
+        ref = rasterize_reference(g.points, g.topology.segment_end - 1, colors, mvp, (200, 150), width)
+        np.testing.assert_array_equal(images[0][0], ref[0])
+
+
+@pytest.mark.parametrize("width", [1.0, 2.5])
+def test_any_split_into_bands_gives_the_same_bytes(width):
+    points, starts, colors = _awkward_segments(3)
+    mvp = np.ascontiguousarray(_perspective(), np.float64)
+    ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, width)
+    e, h = len(starts), SIZE[1]
+    seg, lo, hi = np.zeros((e, 12)), np.zeros(e, np.int32), np.zeros(e, np.int32)
+    soft_raster._setup_kernel(points, starts, colors, mvp, SIZE[0], h, 0.75 * width + 1.0, seg, lo, hi)
+    splits = [soft_raster.band_bounds(lo, hi, h, n) for n in (1, 4, 13)]
+    splits += [np.arange(h + 1), np.array([0, 1, 2, 30, h])]  # one row each; uneven
+    for bounds in splits:
+        rgba, depth = np.zeros(SIZE[::-1], np.uint32), np.ones(SIZE[::-1], np.float32)
+        half = 0.0 if width <= 1.0 else width / 2
+        soft_raster.draw_bands(seg, lo, hi, bounds, half, True, np.uint32(0), rgba, depth)
+        np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
+        np.testing.assert_array_equal(depth, ref_depth)
+
+
+def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
+    # What NUMBA_DISABLE_JIT=1 runs: the kernels' Python bodies (helpers still compiled).
+    points, starts, colors = _awkward_segments(7)
+    mvp = np.ascontiguousarray(_perspective(), np.float64)
+    e, (w, h) = len(starts), SIZE
+    out = []
+    for python in (False, True):
+        setup, lines, quads = (
+            k.py_func if python else k
+            for k in (soft_raster._setup_kernel, soft_raster._draw_lines, soft_raster._draw_quads)
+        )
+        seg, lo, hi = np.zeros((e, 12)), np.zeros(e, np.int32), np.zeros(e, np.int32)
+        setup(points, starts, colors, mvp, w, h, 4.0, seg, lo, hi)
+        bounds = soft_raster.band_bounds(lo, hi, h, 3)
+        cover = (soft_raster._cover_steps.py_func if python else soft_raster._cover_steps)(lo, hi, h)
+        images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)]
+        images += [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)]
+        lines(seg, lo, hi, bounds, True, np.uint32(7), *images[:2])
+        quads(seg, lo, hi, bounds, 1.5, True, np.uint32(7), *images[2:])
+        out.append((seg, lo, hi, cover, *images))
+    for compiled, python in zip(*out, strict=True):
+        np.testing.assert_array_equal(compiled, python)
+
+
+def test_band_bounds_split_the_work_evenly():
+    lo = np.array([0, 10, 10, 10, 0, 5], np.int32)
+    hi = np.array([99, 19, 19, 19, -1, 4], np.int32)  # segments 4 and 5 touch no row
+    bounds = soft_raster.band_bounds(lo, hi, 100, 4)
+    assert bounds[0] == 0 and bounds[-1] == 100 and np.all(np.diff(bounds) >= 0)
+    work = np.ones(100) + ((np.arange(100) >= 10) & (np.arange(100) < 20)) * 3 + 1
+    per_band = [work[a:b].sum() for a, b in itertools.pairwise(bounds)]
+    assert max(per_band) - min(per_band) <= work.max()
+    assert soft_raster.band_bounds(lo, hi, 100, 1).tolist() == [0, 100]
+
+
+def test_clear_none_draws_over_the_images_and_a_clear_colour_fills_them():
+    points, starts, colors = _awkward_segments(1)
+    mvp = _ortho()
+    raster = StrandRaster()
+    rgba, depth = raster.images(SIZE)
+    rgba[:] = (10, 20, 30, 40)
+    depth[:] = 0.5  # e.g. a mesh's depth read back: only strands in front of it are drawn
+    raster.draw(points, starts, colors, mvp, SIZE, 2.0, clear=None)
+    ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, 2.0)
+    front = ref_depth < 0.5
+    assert front.any() and (~front & (ref_depth < 1.0)).any()
+    np.testing.assert_array_equal(rgba[front], ref_rgba[front])
+    assert np.all(rgba[~front] == (10, 20, 30, 40)) and np.all(depth[~front] == 0.5)
+    again, _ = raster.draw(points, starts, colors, mvp, SIZE, 2.0, clear=(1, 2, 3, 4))
+    assert again is rgba  # the images are kept between draws
+    assert np.all(rgba[ref_rgba[..., 3] == 0] == (1, 2, 3, 4))
+    bigger, _ = raster.draw(points, starts, colors, mvp, (80, 50), 2.0)
+    assert bigger.shape == (50, 80, 4)
+
+
+def test_one_pixel_lines_step_the_major_axis_and_quads_have_the_width():
+    # 61 px show 2.5·61/47 units across; a horizontal line through row 23's centre, a vertical one.
+    mvp = _ortho()
+    y = (23.5 / SIZE[1] * 2.0 - 1.0) * 1.25
+    g = Groom.from_strands([[[-0.8, y, 0.0], [0.8, y, 0.0]], [[0.1, -0.9, 0.0], [0.1, 0.9, 0.0]]])
+    colors = np.ones((g.vertex_count, 3), np.float32)
+    starts = g.topology.segment_end - 1
+    thin, _ = rasterize(g.points, starts, colors, mvp, SIZE, 1.0)
+    lit = thin[..., 3] > 0
+    assert lit[23].sum() > 30 and lit[22].sum() <= 1 and lit[24].sum() <= 1  # one row
+    column = np.flatnonzero(lit[10])
+    assert len(column) == 1  # the vertical line: one pixel per row
+    assert lit[:, column[0]].sum() > 30
+    for width in (2.0, 4.0):
+        wide, _ = rasterize(g.points, starts, colors, mvp, SIZE, width)
+        assert (wide[10, :, 3] > 0).sum() == width  # across the vertical line
+        assert (wide[:, 20, 3] > 0).sum() == width  # across the horizontal one
+
+
+def test_colour_and_depth_run_along_the_segment():
+    mvp = _ortho()
+    g = Groom.from_strands([[[-1.0, 0.0, 0.5], [1.0, 0.0, -0.5]]])
+    colors = np.float32([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    for width in (1.0, 3.0):
+        rgba, depth = rasterize(g.points, [0], colors, mvp, SIZE, width)
+        row = np.flatnonzero(rgba[:, SIZE[0] // 2, 3])[0]
+        red, blue = rgba[row, :, 0].astype(int), rgba[row, :, 2].astype(int)
+        lit = rgba[row, :, 3] > 0
+        assert np.all(np.diff(red[lit]) <= 0) and np.all(np.diff(blue[lit]) >= 0)
+        assert red[lit][0] > 200 and blue[lit][-1] > 200
+        assert np.all(np.diff(depth[row, lit]) > 0)  # z = 0.5 is nearer the eye than z = −0.5
+
+
+def test_first_drawn_wins_a_tie_and_nearer_wins_otherwise():
+    mvp = _ortho()
+    strands = [[[-0.5, 0.0, 0.0], [0.5, 0.0, 0.0]]] * 2 + [[[-0.5, 0.0, 0.2], [0.5, 0.0, 0.2]]]
+    g = Groom.from_strands(strands)
+    colors = np.float32([[1, 0, 0]] * 2 + [[0, 1, 0]] * 2 + [[0, 0, 1]] * 2)
+    rgba, _ = rasterize(g.points, [0, 2], colors, mvp, SIZE, 2.0)
+    assert set(map(tuple, rgba[rgba[..., 3] > 0][:, :3])) == {(255, 0, 0)}
+    rgba, _ = rasterize(g.points, [0, 2, 4], colors, mvp, SIZE, 2.0)
+    assert set(map(tuple, rgba[rgba[..., 3] > 0][:, :3])) == {(0, 0, 255)}
+
+
+def test_bad_inputs_are_refused():
+    p, c = np.zeros((4, 3)), np.zeros((4, 3))
+    for args, name in (
+        ((np.zeros((4, 2)), [0], c, np.eye(4), SIZE, 1.0), "points"),
+        ((p, [0], c[:3], np.eye(4), SIZE, 1.0), "colors"),
+        ((p, [0], c, np.eye(3), SIZE, 1.0), "mvp"),
+        ((p, [3], c, np.eye(4), SIZE, 1.0), "starts"),
+        ((p, [0], c, np.eye(4), (0, 5), 1.0), "size"),
+        ((p, [0], c, np.eye(4), SIZE, 0.0), "width"),
+    ):
+        with pytest.raises(ParameterError, match=name):
+            rasterize(*args)
+
+
+def test_ramp_sampling_is_gl_linear_filtering_with_clamped_edges():
+    texels = ramp_texture("heat", 256)
+    centres = (np.arange(256) + 0.5) / 256
+    np.testing.assert_allclose(sample_linear(texels, centres), texels, atol=1e-6)
+    np.testing.assert_allclose(sample_linear(texels, [-1.0, 0.0, 1.0, 2.0]), texels[[0, 0, -1, -1]])
+    halfway = sample_linear(texels, [(10 + 1.0) / 256])  # between texels 10 and 11
+    np.testing.assert_allclose(halfway[0], (texels[10] + texels[11]) / 2, atol=1e-6)
