@@ -7,7 +7,8 @@ in the handler) plus a synchronous paintGL with glFinish after upload and after 
 draw time is the GPU's (llvmpipe's) real time; Qt's compositing of the widget onto the screen
 is not included. Numbers are medians over the moves.
 Target: total under 33 ms (30 frames/s) for the 5,000-strand groom. The viewport draws without
-MSAA unless HAIRTOOL_MSAA is set (the ``msaa`` column says which ran).
+MSAA unless HAIRTOOL_MSAA is set (the ``msaa`` column says which ran); the ``lines`` column says
+how strands were drawn (a GL line method, or rasterized on the CPU: ``--strand-raster``).
 """
 
 from __future__ import annotations
@@ -40,6 +41,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--line-width", type=float, help="strand width in pixels (default: the studio's)")
     parser.add_argument(
         "--fast-lines", action="store_true", help="the renderer's 1-px fast lines, whatever the width"
+    )
+    parser.add_argument(
+        "--strand-raster",
+        choices=["auto", "gl", "cpu"],
+        help="draw strands with GL or rasterize them on the CPU (default: HAIRTOOL_STRAND_RASTER, else auto)",
     )
     parser.add_argument("--json", action="store_true", help="print the rows as JSON")
 
@@ -83,6 +89,16 @@ def _drag_path(window, moves: int) -> np.ndarray:
     return start + radius * np.column_stack([np.sin(a), 1.0 - np.cos(a)])
 
 
+def _line_method(renderer) -> str:
+    """The ``lines`` column: the renderer's line method; CPU raster as ``cpu/1px`` or ``cpu/quads``."""
+    if renderer is None:
+        return "-"
+    method = renderer.line_method()
+    if method == "cpu":
+        return "cpu/1px" if renderer.gl_line_method() == "thin" else "cpu/quads"
+    return method
+
+
 def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> dict:
     from PySide6.QtCore import Qt
     from PySide6.QtGui import QSurfaceFormat
@@ -102,6 +118,8 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     v = window.viewport
     if args.fast_lines and v.renderer is not None:
         v.renderer.fast_lines = True
+    if args.strand_raster and v.renderer is not None:
+        v.renderer.strand_raster = args.strand_raster
     v.finish_frames = True
     left = Qt.MouseButton.LeftButton
 
@@ -120,7 +138,7 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
         stages.append(window.scene.pipeline.timings)
     send_mouse(v, "release", path[-1], left)
     clump = window.scene.params.clump
-    lines = v.renderer.line_method() if v.renderer is not None else "-"
+    lines = _line_method(v.renderer)
     window.ask_save_changes = lambda: "discard"  # the benchmark's strokes are not work to keep
     window.close()
     window.deleteLater()

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from app.render.camera import Camera
-from app.render.strands import DEFAULT_BACKGROUND, StrandRenderer
+from app.render.strands import DEFAULT_BACKGROUND, STRAND_RASTERS, StrandRenderer, default_strand_raster
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Groom
 from hairtool.io.atomic import atomic_path
@@ -135,12 +135,15 @@ def render_image(
     transparent: bool = False,
     mesh: Any | None = None,
     ctx: moderngl.Context | None = None,
+    strand_raster: str | None = None,
 ) -> NDArray[np.uint8]:
     """Draw a groom headless; ``(H, W, 4)`` uint8 RGBA, top row first.
 
     ``camera`` None frames groom and mesh (orthographic for planar grooms). ``colors``: ``(V, 3)``
     per-vertex RGB, else the groom's own colours, else ``ramp`` along t. ``transparent`` gives
-    alpha 0 wherever nothing is drawn (straight, not premultiplied, alpha).
+    alpha 0 wherever nothing is drawn (straight, not premultiplied, alpha). ``strand_raster``:
+    ``"gl"``, ``"cpu"`` or ``"auto"`` (see :mod:`app.render.strands`; None: the environment's
+    default); strands rasterized on the CPU are not multisampled.
     """
     w, h = _check_size(size)
     if not np.isfinite(line_width) or not 0 < line_width <= 256:
@@ -150,6 +153,10 @@ def render_image(
         bg = (*bg, 1.0)
     if len(bg) != 4 or not all(0.0 <= c <= 1.0 for c in bg):
         raise ParameterError("background", background, "(r, g, b[, a]) in [0, 1]")
+    if strand_raster is None:
+        strand_raster = default_strand_raster()
+    if strand_raster not in STRAND_RASTERS:
+        raise ParameterError("strand_raster", strand_raster, " or ".join(STRAND_RASTERS))
     own = ctx is not None
     if own:
         return _render_in(
@@ -165,6 +172,7 @@ def render_image(
             bg,
             transparent,
             mesh,
+            strand_raster,
         )
     ctx = shared_context()
     with ctx:  # current for this draw only: Qt may own the current context in the studio
@@ -181,12 +189,16 @@ def render_image(
             bg,
             transparent,
             mesh,
+            strand_raster,
         )
 
 
-def _render_in(ctx, renderer, own, groom, camera, size, ramp, colors, line_width, bg, transparent, mesh):
+def _render_in(
+    ctx, renderer, own, groom, camera, size, ramp, colors, line_width, bg, transparent, mesh, raster
+):
     w, h = size
     try:
+        renderer.strand_raster = raster
         renderer.set_groom(groom)
         renderer.set_ramp(ramp)
         if colors is not None:

@@ -60,6 +60,18 @@ def ramp_texture(name: str, width: int = 256) -> F32:
     return ramp_colors(np.linspace(0.0, 1.0, width), name)
 
 
+def sample_linear(texels: ArrayLike, t: ArrayLike) -> F32:
+    """``(n, 3)`` colours of a ``(width, 3)`` 1-D texture at coordinates ``t`` (clamped to [0, 1]),
+    as GL samples it with LINEAR filtering and CLAMP_TO_EDGE: between texel centres (i + ½)/width."""
+    tex = np.asarray(texels, dtype=np.float64)
+    x = np.clip(np.asarray(t, dtype=np.float64).reshape(-1), 0.0, 1.0) * len(tex) - 0.5
+    i = np.floor(x)
+    f = (x - i)[:, None]
+    i0 = np.clip(i.astype(np.int64), 0, len(tex) - 1)
+    i1 = np.clip(i.astype(np.int64) + 1, 0, len(tex) - 1)
+    return (tex[i0] * (1.0 - f) + tex[i1] * f).astype(np.float32)
+
+
 def per_strand_random_colors(strand_count: int, seed: int = 0) -> F32:
     """``(S, 3)`` bright colours with random hues, reproducible from ``seed``."""
     if int(strand_count) != strand_count or strand_count < 0:

@@ -1,9 +1,10 @@
-"""GPU copies of one groom's strands for the three line methods of :mod:`app.render.strands`.
+"""GPU copies of one groom's strands for the GL line methods of :mod:`app.render.strands`.
 
-Positions live in two forms: a vertex buffer (the ``"thin"`` and ``"geometry"`` draws read it as
-an attribute) and an RGBA32F texture with t in alpha (the ``"quads"`` draw pulls both ends of a
-segment from it). While a brush drags, :meth:`PointSet.write` uploads only the form the last
-draw used and marks the other stale; a draw with the other method refreshes it first. Index
+Positions live in two GPU forms: a vertex buffer (the ``"thin"`` and ``"geometry"`` draws read it
+as an attribute) and an RGBA32F texture with t in alpha (the ``"quads"`` draw pulls both ends of a
+segment from it), besides the float32 copy on the CPU that the ``"cpu"`` method rasterizes. While
+a brush drags, :meth:`PointSet.write` uploads only the form the last draw used (none after a CPU
+draw) and marks the others stale; a draw with another method refreshes its form first. Index
 buffers are made once per topology, when a method first needs them.
 """
 
@@ -84,6 +85,11 @@ class StrandGPU:
             buf = self._index[kind] = self.ctx.buffer(make(self.topology))
         return buf
 
+    @property
+    def colors(self) -> NDArray[np.float32]:
+        """The ``(V, 3)`` vertex colours last written (the CPU's copy)."""
+        return self._colors
+
     def write_colors(self, colors: NDArray[np.float32]) -> None:
         self._colors[:] = colors
         self.color_buffer.write(self._colors)
@@ -118,7 +124,7 @@ class PointSet:
         self._texels[:v, :3] = points
         self._texture: moderngl.Texture | None = None
         self._stale = {"buffer": False, "texture": True}
-        self.last_used = "buffer"  # the form the last draw read: uploaded at once on write
+        self.last_used = "buffer"  # the form the last draw read ("buffer", "texture", "cpu")
 
     @property
     def points(self) -> NDArray[np.float32]:
@@ -130,8 +136,13 @@ class PointSet:
         self._stale = {"buffer": True, "texture": True}
         if self.last_used == "buffer":
             self.vertex_buffer()
-        elif self._texture is not None:
+        elif self.last_used == "texture" and self._texture is not None:
             self.texture()
+
+    def cpu_points(self) -> NDArray[np.float32]:
+        """The positions for a CPU draw (a view, current); later writes upload nothing at once."""
+        self.last_used = "cpu"
+        return self.points
 
     def vertex_buffer(self, draw: bool = True) -> moderngl.Buffer:
         """The vertex buffer, brought up to date (``draw``: a draw reads it, so later writes

@@ -1,12 +1,21 @@
-"""The GL strand renderer, shared by the Qt viewport and offscreen export.
+"""The strand renderer, shared by the Qt viewport and offscreen export.
 
 It takes a ``moderngl.Context`` and draws into whatever framebuffer it is handed, so the same
 code serves the widget (Qt's framebuffer, looked up again every paint) and tests/exports.
 
 Two update speeds (as pygfx does): :meth:`StrandRenderer.update_points` rewrites the positions in
 place while a brush drags; :meth:`StrandRenderer.set_groom` rebuilds the buffers only when the
-topology changes. All strands are one draw call, in one of three ways
-(:meth:`StrandRenderer.line_method`):
+topology changes. The strands are drawn in one of four ways (:meth:`StrandRenderer.line_method`):
+
+- ``"cpu"`` (on software GL: Mesa's llvmpipe, softpipe, swrast): rasterized on the CPU
+  (:mod:`app.render.soft_raster`, the same pixels as the GL methods below to within a pixel) and
+  put into the frame by :mod:`app.render.raster_layer`. llvmpipe's cost is per primitive, not
+  per pixel, so a dense groom of short segments is several times faster this way.
+  ``StrandRenderer.strand_raster`` chooses: ``"auto"`` (the default: "cpu" on software GL, else
+  the GL methods), ``"gl"`` or ``"cpu"``; the environment variable ``HAIRTOOL_STRAND_RASTER``
+  (``auto`` | ``gl`` | ``cpu``) sets the default;
+
+or as one GL draw call, in one of three ways (:meth:`StrandRenderer.gl_line_method`):
 
 - ``"thin"`` (widths up to 1.5 px, or ``fast_lines``): plain 1-px ``LINES``, two indices per
   segment (``shaders/strands_thin.glsl``) — the cheapest draw, about half the time of the wide
@@ -23,11 +32,12 @@ Core-profile GL, as Qt creates it, allows only 1-px lines, hence the quads for w
 On llvmpipe a draw costs about 0.2 µs per primitive (line or triangle) whatever the stages,
 plus the pixels it covers: fewer primitives, not a cheaper shader, is what makes it faster.
 An optional ghost (:meth:`StrandRenderer.set_ghost_points`) draws the same strands at other
-positions first, in one flat translucent colour.
+positions first, in one flat translucent colour (always with a GL method).
 """
 
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import moderngl
@@ -37,14 +47,22 @@ from numpy.typing import ArrayLike, NDArray
 from app.render.camera import Camera
 from app.render.mesh_layer import MeshLayer
 from app.render.overlay import CircleOverlay
-from app.render.ramps import DEFAULT_RAMP, ramp_stops, ramp_texture
+from app.render.ramps import DEFAULT_RAMP, ramp_stops, ramp_texture, sample_linear
+from app.render.raster_layer import RasterLayer
 from app.render.shaders import load_program
 from app.render.strand_gpu import RESTART_INDEX, PointSet, StrandGPU, strip_indices
 from hairtool.bounds import box
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Groom, Topology
 
-__all__ = ["RESTART_INDEX", "StrandRenderer", "strip_indices", "strip_indices_reference"]
+__all__ = [
+    "RESTART_INDEX",
+    "StrandRenderer",
+    "default_strand_raster",
+    "is_software_gl",
+    "strip_indices",
+    "strip_indices_reference",
+]
 
 THIN_MAX_WIDTH = 1.5  # px: up to this width strands are drawn as plain 1-px lines
 WIDE_LINES = ("geometry", "quads")
@@ -53,6 +71,23 @@ _INDEX_KIND = {"thin": "lines", "quads": "quads", "geometry": "strip"}
 RAMP_TEXELS = 256
 DEFAULT_BACKGROUND = (0.16, 0.17, 0.19, 1.0)
 DEFAULT_GHOST_RGBA = (0.55, 0.75, 1.0, 0.35)
+RASTER_ENV = "HAIRTOOL_STRAND_RASTER"
+STRAND_RASTERS = ("auto", "gl", "cpu")
+SOFTWARE_GL = ("llvmpipe", "softpipe", "swrast")
+
+
+def is_software_gl(ctx: moderngl.Context) -> bool:
+    """Whether ``ctx`` is Mesa's software rasterizer (GL_RENDERER names llvmpipe, softpipe or swrast)."""
+    renderer = str(ctx.info.get("GL_RENDERER", "")).lower()
+    return any(name in renderer for name in SOFTWARE_GL)
+
+
+def default_strand_raster() -> str:
+    """``HAIRTOOL_STRAND_RASTER`` (``auto``, ``gl`` or ``cpu``; unset: ``auto``)."""
+    value = os.environ.get(RASTER_ENV, "auto").strip().lower() or "auto"
+    if value not in STRAND_RASTERS:
+        raise ParameterError(RASTER_ENV, value, " or ".join(STRAND_RASTERS))
+    return value
 
 
 def strip_indices_reference(topology: Topology) -> NDArray[np.uint32]:
@@ -73,6 +108,9 @@ class StrandRenderer:
         self.line_width = 2.0
         self.fast_lines = False  # the artist's "fast lines": 1-px lines whatever the width
         self.wide_lines = "geometry"  # how widths above THIN_MAX_WIDTH are drawn: "geometry" or "quads"
+        self.strand_raster = default_strand_raster()  # "auto", "gl" or "cpu" (see the module doc)
+        self.software_gl = is_software_gl(ctx)
+        self.raster: RasterLayer | None = None  # made on the first CPU draw
         self.background: tuple[float, float, float, float] = DEFAULT_BACKGROUND
         self.ramp = DEFAULT_RAMP
         self.ramp_texture = ctx.texture((RAMP_TEXELS, 1), 3, dtype="f4")
@@ -89,10 +127,20 @@ class StrandRenderer:
         self._vaos: dict[tuple[str, bool], moderngl.VertexArray] = {}  # (method, ghost) → VAO
         self.use_vertex_colors = False
         self.ghost_rgba: tuple[float, float, float, float] = DEFAULT_GHOST_RGBA
+        self._segment_starts: NDArray[np.int64] | None = None
+        self._ramp_colors: NDArray[np.float32] | None = None  # the ramp at every vertex, for "cpu"
 
     # -- what is drawn and how -------------------------------------------------------
     def line_method(self) -> str:
-        """How the strands are drawn now: "thin", "quads" or "geometry" (see the module doc)."""
+        """How the strands are drawn now: "cpu", "thin", "quads" or "geometry" (see the module doc)."""
+        if self.strand_raster not in STRAND_RASTERS:
+            raise ParameterError("strand_raster", self.strand_raster, " or ".join(STRAND_RASTERS))
+        if self.strand_raster == "cpu" or (self.strand_raster == "auto" and self.software_gl):
+            return "cpu"
+        return self.gl_line_method()
+
+    def gl_line_method(self) -> str:
+        """The GL draw for the current width: "thin", "quads" or "geometry" (the ghost's too)."""
         if self.fast_lines or float(self.line_width) <= THIN_MAX_WIDTH:
             return "thin"
         if self.wide_lines not in WIDE_LINES:
@@ -101,8 +149,8 @@ class StrandRenderer:
 
     @property
     def program(self) -> moderngl.Program:
-        """The program of the current :meth:`line_method`."""
-        return self.programs[self.line_method()]
+        """The program of the current :meth:`gl_line_method`."""
+        return self.programs[self.gl_line_method()]
 
     @property
     def position_buffer(self) -> moderngl.Buffer | None:
@@ -120,13 +168,13 @@ class StrandRenderer:
 
     @property
     def index_buffer(self) -> moderngl.Buffer | None:
-        """The index buffer of the current :meth:`line_method` (None without a groom)."""
-        return None if self._gpu is None else self._gpu.index_buffer(_INDEX_KIND[self.line_method()])
+        """The index buffer of the current :meth:`gl_line_method` (None without a groom)."""
+        return None if self._gpu is None else self._gpu.index_buffer(_INDEX_KIND[self.gl_line_method()])
 
     @property
     def vao(self) -> moderngl.VertexArray | None:
-        """The strands' vertex array for the current :meth:`line_method` (None without a groom)."""
-        return None if self._main is None else self._vao(self.line_method(), ghost=False)
+        """The strands' vertex array for the current :meth:`gl_line_method` (None without a groom)."""
+        return None if self._main is None else self._vao(self.gl_line_method(), ghost=False)
 
     @property
     def ghost_buffer(self) -> moderngl.Buffer | None:
@@ -166,6 +214,7 @@ class StrandRenderer:
         self.topology = top
         self._gpu = StrandGPU(self.ctx, top)
         self._main = PointSet(self._gpu, np.ascontiguousarray(groom.points, np.float32))
+        self._segment_starts = np.ascontiguousarray(top.segment_end - 1)
         self.bounds = groom.bounds
         self.set_vertex_colors(groom.colors)
         if ghost is not None:
@@ -255,6 +304,7 @@ class StrandRenderer:
         if name != self.ramp:
             self.ramp_texture.write(ramp_texture(name, RAMP_TEXELS).tobytes())
             self.ramp = name
+            self._ramp_colors = None
 
     def set_mesh(self, mesh: Any | None) -> None:
         """A head mesh (``vertices``, ``faces``, optional ``normals``) drawn shaded; None removes it."""
@@ -277,8 +327,20 @@ class StrandRenderer:
         return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
 
     # -- drawing ---------------------------------------------------------------------
-    def render(self, fbo: moderngl.Framebuffer, camera: Camera, size: tuple[int, int]) -> None:
-        """Clear ``fbo`` to the background and draw mesh, strands and overlay at ``size`` pixels."""
+    def render(
+        self,
+        fbo: moderngl.Framebuffer,
+        camera: Camera,
+        size: tuple[int, int],
+        samples: int | None = None,
+    ) -> None:
+        """Clear ``fbo`` to the background and draw mesh, strands and overlay at ``size`` pixels
+        (CPU strands over a bare background write every pixel instead of a clear, leaving the
+        depth buffer as it was: nothing after them is depth-tested).
+
+        ``samples``: the framebuffer's samples per pixel where ``fbo.samples`` does not know them
+        (moderngl reports 0 for framebuffers it did not make, such as Qt's).
+        """
         w, h = int(size[0]), int(size[1])
         if w <= 0 or h <= 0:
             return
@@ -286,37 +348,69 @@ class StrandRenderer:
         if not np.isfinite(width) or width <= 0:
             raise ParameterError("line_width", self.line_width, "a positive width in pixels")
         method = self.line_method()
+        samples = fbo.samples if samples is None else samples
+        # CPU strands blitted over nothing but the background write every pixel: no GL clear.
+        cpu_only = method == "cpu" and samples == 0 and self._main is not None
+        cpu_only = cpu_only and self.mesh.vao is None and self._ghost is None
         ctx = self.ctx
         fbo.use()
         ctx.viewport = (0, 0, w, h)
-        fbo.clear(*self.background, depth=1.0)
+        if not cpu_only:
+            fbo.clear(*self.background, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
         view = camera.view_matrix()
         mvp = (view @ camera.projection_matrix(w / h)).astype(np.float32)
         self.mesh.render(mvp, view)
         if self._main is not None:
-            prog = self.programs[method]
-            prog["u_mvp"].write(mvp.tobytes())
-            self.ramp_texture.use(location=0)
-            for name, value in (
-                ("u_viewport", (float(w), float(h))),
-                ("u_width", width),
-                ("u_use_vertex_color", self.use_vertex_colors),
-                ("u_ramp", 0),
-                ("u_points", 1),
-                ("u_colors", 2),
-            ):
-                if name in prog:
-                    prog[name].value = value
-            if method == "quads" and self.use_vertex_colors:
-                self._gpu.color_texture().use(location=2)
+            gl_method = self.gl_line_method()
+            if method != "cpu" or self._ghost is not None:
+                self._set_uniforms(gl_method, mvp, (w, h), width)
             if self._ghost is not None:
-                self._render_ghost(fbo, method)
-            prog["u_use_flat_color"].value = False
-            self._draw(method, self._main, ghost=False)
+                self._render_ghost(fbo, gl_method)
+            if method == "cpu":
+                width = 1.0 if gl_method == "thin" else width
+                self._render_cpu(fbo, samples, mvp, (w, h), width, self.background if cpu_only else None)
+            else:
+                self.programs[method]["u_use_flat_color"].value = False
+                self._draw(method, self._main, ghost=False)
         self.overlay.render()
         ctx.disable(moderngl.DEPTH_TEST)
+
+    def _set_uniforms(self, method: str, mvp: NDArray, size: tuple[int, int], width: float) -> None:
+        prog = self.programs[method]
+        prog["u_mvp"].write(mvp.tobytes())
+        self.ramp_texture.use(location=0)
+        for name, value in (
+            ("u_viewport", (float(size[0]), float(size[1]))),
+            ("u_width", width),
+            ("u_use_vertex_color", self.use_vertex_colors),
+            ("u_ramp", 0),
+            ("u_points", 1),
+            ("u_colors", 2),
+        ):
+            if name in prog:
+                prog[name].value = value
+        if method == "quads" and self.use_vertex_colors:
+            self._gpu.color_texture().use(location=2)
+
+    def _render_cpu(self, fbo, samples: int, mvp, size: tuple[int, int], width: float, background) -> None:
+        if self.raster is None:
+            self.raster = RasterLayer(self.ctx)
+        points, colors, starts = self._main.cpu_points(), self.cpu_colors(), self._segment_starts
+        mesh = self.mesh.vao is not None
+        self.raster.render(
+            fbo, samples, points, starts, colors, mvp, size, width, background=background, read_depth=mesh
+        )
+
+    def cpu_colors(self) -> NDArray[np.float32]:
+        """``(V, 3)`` the colour of every vertex as the GL draws give it: the vertex colours, or
+        the ramp texture sampled at t (LINEAR, clamped), as the shaders do."""
+        if self.use_vertex_colors:
+            return self._gpu.colors
+        if self._ramp_colors is None:
+            self._ramp_colors = sample_linear(ramp_texture(self.ramp, RAMP_TEXELS), self._gpu.param)
+        return self._ramp_colors
 
     def _draw(self, method: str, points: PointSet, ghost: bool) -> None:
         if method == "quads":
@@ -358,12 +452,16 @@ class StrandRenderer:
         self.topology = None
         self.bounds = None
         self.use_vertex_colors = False
+        self._segment_starts = self._ramp_colors = None
 
     def release(self) -> None:
         """Free every GL object this renderer made (call with its context current)."""
         self._free_groom()
         self.mesh.release()
         self.overlay.release()
+        if self.raster is not None:
+            self.raster.release()
+            self.raster = None
         self.ramp_texture.release()
         for prog in self.programs.values():
             prog.release()

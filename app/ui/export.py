@@ -48,6 +48,7 @@ def export_still(
             transparent=transparent,
             mesh=scene.mesh,
             ctx=ctx,
+            strand_raster="gl",  # a still is made once: GL's multisampled, antialiased strands
         )
         save_png(path, image)
     elif suffix == ".svg":

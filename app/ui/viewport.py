@@ -59,6 +59,9 @@ class Viewport(QOpenGLWidget):
         self.ctx: moderngl.Context | None = None
         self.renderer: StrandRenderer | None = None
         self.finish_frames = False  # glFinish after upload and draw, so timings are real (benchmark)
+        # Samples per pixel of Qt's framebuffer: the requested format's (format() reports the
+        # context's, 0, once GL is up), since moderngl cannot tell for a framebuffer it did not make.
+        self.samples = max(self.format().samples(), 0)
         self.last_upload_ms = 0.0
         self.last_draw_ms = 0.0
         self._dirty = {"groom", "colors", "display", "mesh"}
@@ -220,7 +223,7 @@ class Viewport(QOpenGLWidget):
         self._overlay(w, h)
         # Qt's framebuffer id changes on every resize: look it up each time, never draw to 0.
         fbo = self.ctx.detect_framebuffer(self.defaultFramebufferObject())
-        self.renderer.render(fbo, self.camera, (w, h))
+        self.renderer.render(fbo, self.camera, (w, h), samples=self.samples)
         if self.finish_frames:
             self.ctx.finish()
         t2 = time.perf_counter()

@@ -121,3 +121,6 @@ def test_benchmark_runs_and_reports_the_breakdown(qapp, capsys):
     for key in ("total_ms", "pipeline_ms", "upload_ms", "draw_ms"):
         assert rows[0][key] >= 0.0
     assert rows[0]["total_ms"] >= rows[0]["draw_ms"]
+    assert rows[0]["lines"] == "cpu/quads"  # llvmpipe: strands rasterized on the CPU
+    assert main([*argv, "--strand-raster", "gl", "--line-width", "1"]) == 0
+    assert json.loads(capsys.readouterr().out)[0]["lines"] == "thin"

@@ -1,4 +1,5 @@
-"""The three ways of drawing strands: thin LINE_STRIP, instanced quads, geometry-shader quads."""
+"""The three GL ways of drawing strands: thin LINE_STRIP, instanced quads, geometry-shader quads
+(pinned with ``strand_raster = "gl"``: on llvmpipe the renderer would rasterize on the CPU)."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ BG = (0.0, 0.0, 0.0, 1.0)
 
 
 def _draw(renderer, gl_ctx, groom, camera, *, width, method, ghost=None):
+    renderer.strand_raster = "gl"
     renderer.set_groom(groom)
     renderer.background = BG
     renderer.line_width = width
@@ -29,6 +31,7 @@ def _draw(renderer, gl_ctx, groom, camera, *, width, method, ghost=None):
 
 
 def test_line_method_follows_width_and_fast_lines(renderer):
+    renderer.strand_raster = "gl"
     renderer.line_width = THIN_MAX_WIDTH
     assert renderer.line_method() == "thin"
     renderer.line_width = 2.0
@@ -141,7 +144,8 @@ def test_points_stay_current_in_every_form_while_the_method_changes(renderer, gl
     for method in ("thin", "quads", "geometry"):
         fresh[method] = _draw(renderer, gl_ctx, g.with_points(moved), cam, width=3.0, method=method)
     renderer.set_groom(g)
-    renderer.line_width, renderer.fast_lines = 3.0, False
+    renderer.line_width, renderer.fast_lines, renderer.wide_lines = 3.0, False, "quads"
+    assert renderer.line_method() == "quads"
     read_rgba(gl_ctx, renderer, cam, SIZE)  # quads: the texture is the form in use
     renderer.update_points(moved)
     on_gpu = np.frombuffer(renderer.position_buffer.read(), dtype=np.float32).reshape(-1, 3)

@@ -1,6 +1,8 @@
 """Rendered pictures against small stored references, with a tolerance for rasteriser drift.
 
-The references were made on Mesa llvmpipe (EGL). After an intended change to the look,
+The references were made on Mesa llvmpipe (EGL), with the strands drawn by GL (multisampled) and
+by the CPU rasterizer (``*_cpu.png``, which auto picks on llvmpipe). After an intended change to
+the look,
 regenerate them with::
 
     HAIRTOOL_REGEN_REFERENCES=1 python -m pytest tests/render/test_render_reference_images.py
@@ -73,15 +75,18 @@ def _compare(name: str, actual: np.ndarray) -> None:
         )
 
 
-def test_portrait_root_tip_matches_reference():
+@pytest.mark.parametrize("raster", ["gl", "cpu"])
+def test_portrait_root_tip_matches_reference(raster):
     g = samples.portrait(strands=40, vertices=12, seed=0)
-    _compare("portrait_root_tip", render_image(g, size=SIZE, line_width=2.0))
+    img = render_image(g, size=SIZE, line_width=2.0, strand_raster=raster)
+    _compare("portrait_root_tip" + ("_cpu" if raster == "cpu" else ""), img)
 
 
-def test_scalp_with_head_mesh_matches_reference():
+@pytest.mark.parametrize("raster", ["gl", "cpu"])
+def test_scalp_with_head_mesh_matches_reference(raster):
     g = samples.scalp(strands=300, vertices=10, seed=0)
-    img = render_image(g, size=SIZE, line_width=1.5, mesh=uv_sphere(0.98))
-    _compare("scalp_head_mesh", img)
+    img = render_image(g, size=SIZE, line_width=1.5, mesh=uv_sphere(0.98), strand_raster=raster)
+    _compare("scalp_head_mesh" + ("_cpu" if raster == "cpu" else ""), img)
 
 
 def test_comparison_catches_a_different_picture(monkeypatch, tmp_path):
@@ -90,5 +95,5 @@ def test_comparison_catches_a_different_picture(monkeypatch, tmp_path):
     monkeypatch.setattr(f"{__name__}.FAILURES", tmp_path)
     g = samples.portrait(strands=40, vertices=12, seed=5)
     with pytest.raises(pytest.fail.Exception, match="portrait_root_tip"):
-        _compare("portrait_root_tip", render_image(g, size=SIZE, line_width=2.0))
+        _compare("portrait_root_tip", render_image(g, size=SIZE, line_width=2.0, strand_raster="gl"))
     assert (tmp_path / "portrait_root_tip.diff.png").is_file()

@@ -1,0 +1,115 @@
+"""Strands rasterized on the CPU (:mod:`app.render.soft_raster`) put into the GL frame.
+
+Two ways, by the target framebuffer:
+
+- single-sampled (the viewport): rasterize the strands on the CPU over the background colour
+  (GL need not even clear), or, when GL drew something first (a head mesh, a ghost), over what
+  it drew, read back with its depth; write the colour into a texture and blit it into ``fbo``.
+  On llvmpipe a full-screen textured draw costs several milliseconds, about as much as the
+  strands themselves; reading back and blitting are copies.
+- multisampled (exports; GL can neither read nor blit into it pixel for pixel): strands into
+  cleared images, uploaded as colour and depth textures and drawn by one full-screen triangle
+  (``shaders/strands_raster.glsl``) that skips empty pixels and writes ``gl_FragDepth``.
+
+Blitted, the strands leave the framebuffer's depth as GL left it: nothing after them (the brush
+circle) is depth-tested. Textures and images are kept between frames and remade only on resize.
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+from numpy.typing import ArrayLike
+
+from app.render.shaders import load_program
+from app.render.soft_raster import StrandRaster
+
+COLOR_UNIT, DEPTH_UNIT = 3, 4  # texture units clear of the strand programs' 0–2
+
+
+class RasterLayer:
+    """The CPU strands of one renderer: images, textures and the copy program."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self.raster = StrandRaster()
+        self.program = load_program(ctx, "strands_raster")
+        self.program["u_color"].value = COLOR_UNIT
+        self.program["u_depth"].value = DEPTH_UNIT
+        self.vao = ctx.vertex_array(self.program, [])
+        self.size: tuple[int, int] | None = None
+        self.color_texture: moderngl.Texture | None = None
+        self.depth_texture: moderngl.Texture | None = None
+        self._source: moderngl.Framebuffer | None = None  # the colour texture, to blit from
+
+    def _resize(self, size: tuple[int, int]) -> None:
+        if size == self.size:
+            return
+        self._free_textures()
+        self.color_texture = self.ctx.texture(size, 4, dtype="f1")
+        self.depth_texture = self.ctx.texture(size, 1, dtype="f4")
+        for tex in (self.color_texture, self.depth_texture):
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            tex.repeat_x = tex.repeat_y = False
+        self._source = self.ctx.framebuffer([self.color_texture])
+        self.size = size
+
+    def render(
+        self,
+        fbo: moderngl.Framebuffer,
+        samples: int,
+        points: ArrayLike,
+        starts: ArrayLike,
+        colors: ArrayLike,
+        mvp: ArrayLike,
+        size: tuple[int, int],
+        width: float,
+        *,
+        background: tuple[float, float, float, float] | None = None,
+        read_depth: bool = False,
+    ) -> None:
+        """Draw the strands into ``fbo`` (bound, viewport ``size``, with ``samples`` per pixel).
+
+        Single-sampled, ``background`` (RGBA in [0, 1]) fills every pixel no strand covers, for
+        a frame GL drew nothing into; without it what GL drew is read back, its depth too with
+        ``read_depth`` (the head mesh). Multisampled, strands go over what is there.
+        """
+        self._resize(size)
+        if samples > 0:
+            self._composite(points, starts, colors, mvp, size, width)
+            return
+        if background is not None:
+            clear = tuple(int(np.floor(c * 255.0 + 0.5)) for c in background)  # as GL stores it
+            rgba, _ = self.raster.draw(points, starts, colors, mvp, size, width, clear=clear)
+        else:
+            rgba, depth = self.raster.images(size)
+            viewport = (0, 0, *size)
+            if read_depth:  # first: moderngl leaves the read buffer at GL_NONE after a depth read
+                fbo.read_into(depth, viewport=viewport, attachment=-1, dtype="f4")
+            else:
+                depth.fill(1.0)
+            fbo.read_into(rgba, viewport=viewport, components=4)
+            self.raster.draw(points, starts, colors, mvp, size, width, clear=None)
+        self.color_texture.write(rgba)
+        self.ctx.copy_framebuffer(fbo, self._source)
+        fbo.use()
+
+    def _composite(self, points, starts, colors, mvp, size, width) -> None:
+        rgba, depth = self.raster.draw(points, starts, colors, mvp, size, width)
+        self.color_texture.write(rgba)
+        self.depth_texture.write(depth)
+        self.color_texture.use(location=COLOR_UNIT)
+        self.depth_texture.use(location=DEPTH_UNIT)
+        self.vao.render(moderngl.TRIANGLES, vertices=3)
+
+    def _free_textures(self) -> None:
+        for obj in (self._source, self.color_texture, self.depth_texture):
+            if obj is not None:
+                obj.release()
+        self._source = self.color_texture = self.depth_texture = None
+        self.size = None
+
+    def release(self) -> None:
+        self._free_textures()
+        self.vao.release()
+        self.program.release()
