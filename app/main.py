@@ -29,6 +29,28 @@ def configure_gl() -> None:
     QSurfaceFormat.setDefaultFormat(fmt)
 
 
+def show_splash(app):
+    """A splash screen until the window is up: on a fresh install numba compiles the engine's
+    and the rasterizer's kernels first (about half a minute on two cores, then cached), and a
+    window that takes that long to appear with no sign of life looks hung."""
+    from PySide6.QtCore import Qt
+    from PySide6.QtGui import QColor, QPixmap
+    from PySide6.QtWidgets import QSplashScreen
+
+    pixmap = QPixmap(560, 140)
+    pixmap.fill(QColor(41, 43, 48))
+    splash = QSplashScreen(pixmap)
+    splash.showMessage(
+        "Hairtool Studio\n\nPreparing the engine…\n"
+        "(the first start compiles its kernels: about half a minute)",
+        Qt.AlignmentFlag.AlignCenter,
+        QColor(225, 228, 232),
+    )
+    splash.show()
+    app.processEvents()
+    return splash
+
+
 def parse_args(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
     parser = argparse.ArgumentParser(
         prog="hairtool-studio",
@@ -66,10 +88,12 @@ def main(argv: list[str] | None = None) -> int:
     app = QApplication(sys.argv[:1])
     app.setOrganizationName("hairtool")
     app.setApplicationName("Hairtool Studio")
+    splash = show_splash(app)
     window = MainWindow(args.file)
     if args.file is None:
         window.open_bundled_sample()
     window.show()
+    splash.finish(window)
     return app.exec()
 
 

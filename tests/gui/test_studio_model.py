@@ -124,3 +124,14 @@ def test_benchmark_runs_and_reports_the_breakdown(qapp, capsys):
     assert rows[0]["lines"] == "cpu/quads"  # llvmpipe: strands rasterized on the CPU
     assert main([*argv, "--strand-raster", "gl", "--line-width", "1"]) == 0
     assert json.loads(capsys.readouterr().out)[0]["lines"] == "thin"
+
+
+@pytest.mark.gui
+def test_the_splash_says_what_the_wait_is_for_until_the_window_is_up(qapp, make_window):
+    from app.main import show_splash
+
+    splash = show_splash(qapp)
+    assert splash.isVisible() and "compiles its kernels" in splash.message()
+    window = make_window()
+    splash.finish(window)
+    assert not splash.isVisible()
