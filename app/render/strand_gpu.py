@@ -75,6 +75,7 @@ class StrandGPU:
         self._colors = np.zeros((v, 3), np.float32)
         self._color_texture: moderngl.Texture | None = None
         self._color_texture_stale = False
+        self._color_buffer_stale = False
         self._index: dict[str, moderngl.Buffer] = {}
 
     def index_buffer(self, kind: str) -> moderngl.Buffer:
@@ -91,9 +92,16 @@ class StrandGPU:
         return self._colors
 
     def write_colors(self, colors: NDArray[np.float32]) -> None:
+        """New vertex colours, uploaded when a GL draw reads them (a CPU draw reads
+        :attr:`colors`, so colour modes that change every frame upload nothing there)."""
         self._colors[:] = colors
-        self.color_buffer.write(self._colors)
-        self._color_texture_stale = True
+        self._color_buffer_stale = self._color_texture_stale = True
+
+    def sync_color_buffer(self) -> None:
+        """Bring the colour vertex buffer up to date before a draw that reads it."""
+        if self._color_buffer_stale:
+            self.color_buffer.write(self._colors)
+            self._color_buffer_stale = False
 
     def color_texture(self) -> moderngl.Texture:
         if self._color_texture is None:

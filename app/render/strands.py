@@ -418,6 +418,7 @@ class StrandRenderer:
             self._vao(method, ghost).render(moderngl.TRIANGLES)
         else:
             points.vertex_buffer()  # up to date
+            self._gpu.sync_color_buffer()
             self._vao(method, ghost).render(moderngl.LINES if method == "thin" else moderngl.LINE_STRIP)
 
     def _render_ghost(self, fbo: moderngl.Framebuffer, method: str) -> None:

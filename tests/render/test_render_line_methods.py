@@ -160,3 +160,12 @@ def test_points_stay_current_in_every_form_while_the_method_changes(renderer, gl
     img = read_rgba(gl_ctx, renderer, cam, SIZE)
     lit = img[..., :3].max(axis=2) > 40
     assert lit.mean() > 0.01 and np.all(img[lit][:, 1] < 40)
+    # ... and the colour vertex buffer, uploaded only when a draw that reads it comes.
+    green = np.tile(np.float32([0.0, 1.0, 0.0]), (g.vertex_count, 1))
+    renderer.set_vertex_colors(green)
+    for method in ("thin", "geometry"):
+        renderer.fast_lines = method == "thin"
+        renderer.wide_lines = "geometry"
+        img = read_rgba(gl_ctx, renderer, cam, SIZE)
+        lit = img[..., :3].max(axis=2) > 40
+        assert lit.mean() > 0.01 and np.all(img[lit][:, 0] < 40), method
