@@ -255,7 +255,7 @@ class ClumpWorkspace:
         radius = h * (1.0 + MARGIN)
         b = self._built
         if b is not None and b[0] is top and b[1] == radius:
-            if b[2] is groom.points or _same_points(groom.points, b[2]):
+            if _same_points(groom.points, b[2]):  # against a copy: any array may be passed in
                 return self.neighbours
         self._built = None
         self.neighbours.build(groom.points, top.strand_index, self.roots_mask(top), radius)

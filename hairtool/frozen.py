@@ -180,8 +180,8 @@ class FrozenPipeline:
 
     @property
     def neighbour_builds(self) -> int:
-        """ClumpWithGaps neighbour lists built so far (an update reuses the last one while the
-        strands have moved little)."""
+        """ClumpWithGaps neighbour lists built so far (an update on the points of the last
+        build reuses its list)."""
         return self._workspace.builds
 
     @property

@@ -15,6 +15,7 @@ move and ClumpWithGaps builds its neighbour list on ``drag_builds`` of the moves
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 from pathlib import Path
 
@@ -78,11 +79,10 @@ def _drag_ms(pipe, moves: int = 40) -> tuple[float, float]:
     tips = pipe.rest.tips.astype(np.float64)
     tip = tips[np.argmin(np.linalg.norm(tips - (lo + hi) / 2.0, axis=1))]
     a = np.linspace(0.0, 2.0 * np.pi, moves, endpoint=False)
-    path = tip + 0.1 * extent * np.column_stack([np.cos(a), np.sin(a), np.zeros(moves)])
-    it = iter(range(10**9))
+    path = itertools.cycle(tip + 0.1 * extent * np.column_stack([np.cos(a), np.sin(a), np.zeros(moves)]))
 
     def move():
-        pipe.align(path[next(it) % moves], 0.25 * extent, 0.8)
+        pipe.align(next(path), 0.25 * extent, 0.8)
 
     move()
     builds = pipe.neighbour_builds
