@@ -41,6 +41,7 @@ class RasterLayer:
         self.color_texture: moderngl.Texture | None = None
         self.depth_texture: moderngl.Texture | None = None
         self._source: moderngl.Framebuffer | None = None  # the colour texture, to blit from
+        self._texture_is_image = False  # the colour texture holds the raster's colour image
 
     def _resize(self, size: tuple[int, int]) -> None:
         if size == self.size:
@@ -53,6 +54,7 @@ class RasterLayer:
             tex.repeat_x = tex.repeat_y = False
         self._source = self.ctx.framebuffer([self.color_texture])
         self.size = size
+        self._texture_is_image = False
 
     def render(
         self,
@@ -81,6 +83,7 @@ class RasterLayer:
         if background is not None:
             clear = tuple(int(np.floor(c * 255.0 + 0.5)) for c in background)  # as GL stores it
             rgba, _ = self.raster.draw(points, starts, colors, mvp, size, width, clear=clear)
+            self._upload(rgba, self.raster.changed)
         else:
             rgba, depth = self.raster.images(size)
             viewport = (0, 0, *size)
@@ -90,11 +93,24 @@ class RasterLayer:
                 depth.fill(1.0)
             fbo.read_into(rgba, viewport=viewport, components=4)
             self.raster.draw(points, starts, colors, mvp, size, width, clear=None)
-        self.color_texture.write(rgba)
+            self._upload(rgba, self.raster.changed)
         self.ctx.copy_framebuffer(fbo, self._source)
         fbo.use()
 
+    def _upload(self, rgba: np.ndarray, changed: tuple[int, int, int, int] | None) -> None:
+        """The colour image into the texture: only the rows and columns ``changed`` since the
+        last upload (None: nothing) when the texture holds the last image, else all of it."""
+        if not self._texture_is_image:
+            self.color_texture.write(rgba)
+        elif changed is not None:
+            r0, r1, c0, c1 = changed
+            self.color_texture.write(
+                np.ascontiguousarray(rgba[r0:r1, c0:c1]), viewport=(c0, r0, c1 - c0, r1 - r0)
+            )
+        self._texture_is_image = True
+
     def _composite(self, points, starts, colors, mvp, size, width) -> None:
+        self._texture_is_image = False
         rgba, depth = self.raster.draw(points, starts, colors, mvp, size, width)
         self.color_texture.write(rgba)
         self.depth_texture.write(depth)

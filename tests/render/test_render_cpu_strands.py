@@ -187,6 +187,37 @@ def test_textures_and_images_are_kept_between_frames_and_points_stay_on_the_cpu(
     assert layer.size == (100, 90) and layer.raster.rgba.shape == (90, 100, 4)
 
 
+def test_frames_redrawn_in_part_are_the_frames_drawn_afresh(renderer, gl_ctx):
+    # A brush-like edit: a few tips move each frame. The raster redraws the tiles they touch and
+    # only those rows and columns go to the texture; the frame must be what a new renderer draws.
+    g, cam = _groom_and_camera()
+    size = (320, 240)
+    cam = Camera.for_groom(g, aspect=size[0] / size[1])
+    renderer.set_groom(g)
+    renderer.background = BG
+    renderer.line_width = 2.0
+    _draw(renderer, gl_ctx, cam, raster="cpu", size=size)
+    rng = np.random.default_rng(3)
+    points = g.points.copy()
+    partial = 0
+    for _ in range(4):
+        for s in rng.choice(g.strand_count, size=3, replace=False):
+            points[g.offsets[s + 1] - 3 : g.offsets[s + 1]] += rng.normal(scale=0.03, size=(3, 3)).astype(
+                np.float32
+            )
+        renderer.update_points(points)
+        frame = _draw(renderer, gl_ctx, cam, raster="cpu", size=size)
+        partial += renderer.raster.raster.tiles_redrawn > 0
+        fresh = StrandRenderer(gl_ctx)
+        try:
+            fresh.set_groom(g.with_points(points))
+            fresh.background, fresh.line_width = BG, 2.0
+            np.testing.assert_array_equal(frame, _draw(fresh, gl_ctx, cam, raster="cpu", size=size))
+        finally:
+            fresh.release()
+    assert partial == 4
+
+
 def test_ghost_under_cpu_strands_is_drawn_by_gl(renderer, gl_ctx):
     g = samples.comb(strands=6, vertices=8)
     cam = Camera.for_groom(g, aspect=SIZE[0] / SIZE[1])

@@ -104,14 +104,14 @@ def test_any_split_into_bands_gives_the_same_bytes(width):
     mvp = np.ascontiguousarray(_perspective(), np.float64)
     ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, width)
     e, h = len(starts), SIZE[1]
-    seg, lo, hi = np.zeros((e, 12)), np.zeros(e, np.int32), np.zeros(e, np.int32)
-    soft_raster._setup_kernel(points, starts, colors, mvp, SIZE[0], h, 0.75 * width + 1.0, seg, lo, hi)
-    splits = [soft_raster.band_bounds(lo, hi, h, n) for n in (1, 4, 13)]
+    seg, box = np.zeros((e, 12)), np.zeros((4, e), np.int32)
+    soft_raster._setup_kernel(points, starts, colors, mvp, SIZE[0], h, 0.75 * width + 1.0, seg, box)
+    splits = [soft_raster.band_bounds(box[0], box[1], h, n) for n in (1, 4, 13)]
     splits += [np.arange(h + 1), np.array([0, 1, 2, 30, h])]  # one row each; uneven
     for bounds in splits:
         rgba, depth = np.zeros(SIZE[::-1], np.uint32), np.ones(SIZE[::-1], np.float32)
         half = 0.0 if width <= 1.0 else width / 2
-        soft_raster.draw_bands(seg, lo, hi, bounds, half, True, np.uint32(0), rgba, depth)
+        soft_raster.draw_bands(seg, box, bounds, half, True, np.uint32(0), rgba, depth)
         np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
         np.testing.assert_array_equal(depth, ref_depth)
 
@@ -123,21 +123,35 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
     e, (w, h) = len(starts), SIZE
     out = []
     for python in (False, True):
-        setup, lines, quads = (
+        setup, bands, tiles, cover = (
             k.py_func if python else k
-            for k in (soft_raster._setup_kernel, soft_raster._draw_lines, soft_raster._draw_quads)
+            for k in (
+                soft_raster._setup_kernel,
+                soft_raster._draw_bands,
+                soft_raster._draw_tiles,
+                soft_raster._cover_steps,
+            )
         )
-        seg, lo, hi = np.zeros((e, 12)), np.zeros(e, np.int32), np.zeros(e, np.int32)
-        setup(points, starts, colors, mvp, w, h, 4.0, seg, lo, hi)
-        bounds = soft_raster.band_bounds(lo, hi, h, 3)
-        cover = (soft_raster._cover_steps.py_func if python else soft_raster._cover_steps)(lo, hi, h)
-        images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)]
-        images += [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)]
-        lines(seg, lo, hi, bounds, True, np.uint32(7), *images[:2])
-        quads(seg, lo, hi, bounds, 1.5, True, np.uint32(7), *images[2:])
-        out.append((seg, lo, hi, cover, *images))
+        seg, box = np.zeros((e, 12)), np.zeros((4, e), np.int32)
+        setup(points, starts, colors, mvp, w, h, 4.0, seg, box)
+        bounds = soft_raster.band_bounds(box[0], box[1], h, 3)
+        images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)] * 3
+        images = [a.copy() for a in images]
+        bands(seg, box, bounds, 0.0, True, np.uint32(7), *images[:2])
+        bands(seg, box, bounds, 1.5, True, np.uint32(7), *images[2:4])
+        dirty = np.ones(((h + 15) // 16, (w + 15) // 16), bool)
+        counts = np.zeros(dirty.size + 1, np.int64)
+        near = np.zeros(e, np.int64)
+        total = soft_raster._bin_segments(box, dirty, 4, counts, np.zeros(0, np.int64), near)
+        entries = np.zeros(total, np.int64)
+        soft_raster._bin_segments(box, dirty, 4, counts, entries, near)
+        jobs, job_start = soft_raster._balanced_jobs(np.diff(counts) + 1, 3)
+        tiles(seg, jobs, job_start, counts, entries, 4, 1.5, np.uint32(7), *images[4:])
+        out.append((seg, box, cover(box[0], box[1], h), *images))
     for compiled, python in zip(*out, strict=True):
         np.testing.assert_array_equal(compiled, python)
+    np.testing.assert_array_equal(out[0][-2], out[0][-4])  # the tiles drew what the bands drew
+    np.testing.assert_array_equal(out[0][-1], out[0][-3])
 
 
 def test_band_bounds_split_the_work_evenly():
@@ -236,3 +250,89 @@ def test_ramp_sampling_is_gl_linear_filtering_with_clamped_edges():
     np.testing.assert_allclose(sample_linear(texels, [-1.0, 0.0, 1.0, 2.0]), texels[[0, 0, -1, -1]])
     halfway = sample_linear(texels, [(10 + 1.0) / 256])  # between texels 10 and 11
     np.testing.assert_allclose(halfway[0], (texels[10] + texels[11]) / 2, atol=1e-6)
+
+
+def _scalp_scene(size=(160, 120)):
+    from hairtool import samples
+
+    g = samples.scalp(strands=300, vertices=10, seed=2)
+    cam = Camera.for_groom(g, aspect=size[0] / size[1])
+    mvp = cam.view_matrix() @ cam.projection_matrix(size[0] / size[1])
+    colors = np.random.default_rng(1).random((g.vertex_count, 3)).astype(np.float32)
+    return g, g.topology.segment_end - 1, colors, mvp
+
+
+@pytest.mark.parametrize("width", [1.0, 2.5])
+@pytest.mark.parametrize("n_threads", [1, 2])
+def test_redrawing_the_changed_tiles_gives_the_bytes_of_a_full_draw(width, n_threads, threads):
+    threads(n_threads)
+    size = (320, 240)
+    g, starts, colors, mvp = _scalp_scene(size)
+    rng = np.random.default_rng(5)
+    raster = StrandRaster()
+    points = g.points.copy()
+    before = raster.draw(points, starts, colors, mvp, size, width, clear=(9, 8, 7, 255))[0].copy()
+    partial = 0
+    for step in range(12):
+        if step == 5:  # a change of colour only
+            colors = colors.copy()
+            colors[g.offsets[3] : g.offsets[4]] = (1.0, 0.0, 0.0)
+        else:  # the tips of a few strands move; now and then far, off the image or behind the eye
+            for s in rng.choice(g.strand_count, size=int(rng.integers(1, 4)), replace=False):
+                tip = g.offsets[s + 1]
+                scale = 0.01 if step % 4 else 3.0
+                points[tip - 3 : tip] += rng.normal(scale=scale, size=(3, 3)).astype(np.float32)
+        rgba, depth = raster.draw(points, starts, colors, mvp, size, width, clear=(9, 8, 7, 255))
+        ref_rgba, ref_depth = StrandRaster().draw(
+            points, starts, colors, mvp, size, width, clear=(9, 8, 7, 255)
+        )
+        np.testing.assert_array_equal(rgba, ref_rgba)
+        np.testing.assert_array_equal(depth, ref_depth)
+        if raster.tiles_redrawn > 0:
+            partial += 1
+            r0, r1, c0, c1 = raster.changed
+            outside = np.ones(depth.shape, bool)
+            outside[r0:r1, c0:c1] = False
+            np.testing.assert_array_equal(rgba[outside], before[outside])  # the rest did not change
+            assert (r1 - r0) * (c1 - c0) < depth.size
+        before = rgba.copy()
+    assert partial >= 6  # most of these frames were redrawn in part
+
+
+def test_what_makes_a_full_draw_and_what_draws_nothing():
+    size = (160, 120)
+    g, starts, colors, mvp = _scalp_scene(size)
+    raster = StrandRaster()
+    raster.draw(g.points, starts, colors, mvp, size, 2.0)
+    assert raster.tiles_redrawn == -1 and raster.changed == (0, 120, 0, 160)
+    raster.draw(g.points, starts, colors, mvp, size, 2.0)
+    assert raster.tiles_redrawn == 0 and raster.changed is None  # the same numbers: nothing to do
+    for args in (
+        (g.points, starts, colors, mvp, size, 3.0),  # another width
+        (g.points, starts, colors, mvp @ np.diag([1.0, 1.0, 1.0, 1.01]), size, 3.0),  # the camera moved
+        (g.points, starts, colors, mvp, (150, 120), 3.0),  # another size
+        (g.points, starts[:-1], colors, mvp, (150, 120), 3.0),  # other segments
+    ):
+        raster.draw(*args)
+        assert raster.tiles_redrawn == -1
+    raster.draw(g.points, starts[:-1], colors, mvp, (150, 120), 3.0, clear=(1, 1, 1, 1))
+    assert raster.tiles_redrawn == -1  # another clear colour
+    rgba, _ = raster.images((150, 120))  # handed out to be drawn into: no longer the last frame
+    rgba[:] = 0
+    raster.draw(g.points, starts[:-1], colors, mvp, (150, 120), 3.0, clear=(1, 1, 1, 1))
+    assert raster.tiles_redrawn == -1
+    raster.incremental = False
+    moved = g.points.copy()
+    moved[: g.offsets[1]] += 0.01
+    raster.draw(moved, starts[:-1], colors, mvp, (150, 120), 3.0, clear=(1, 1, 1, 1))
+    assert raster.tiles_redrawn == -1
+
+
+def test_balanced_jobs_split_the_tiles_by_work():
+    work = np.array([0, 5, 1, 1, 0, 9, 1, 1, 1, 0], np.int64)
+    tiles, start = soft_raster._balanced_jobs(work, 2)
+    jobs = [tiles[a:b] for a, b in itertools.pairwise(start)]
+    assert sorted(np.concatenate(jobs).tolist()) == [1, 2, 3, 5, 6, 7, 8]
+    assert all(np.all(np.diff(j) > 0) for j in jobs)
+    loads = [work[j].sum() + 8 * len(j) for j in jobs]
+    assert max(loads) - min(loads) <= 9 + 8
