@@ -132,25 +132,33 @@ def _hash_heads(sorig, seed, heads):
         heads[i] = hash_head_nb(seed, sorig[i], CH_CLUMP)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def gap_lambda(ex, ey, ez, gx, gy, gz, step, zeta, h, gap):
+    """λ (17)–(19) of a vertex whose nearest neighbour lies e away, the two forces differing by
+    g (that neighbour's minus its own); ``gap`` 0 "printed", 1 "text"."""
+    r0 = np.sqrt(ex * ex + ey * ey + ez * ez)
+    ex += step * gx
+    ey += step * gy
+    ez += step * gz
+    r1 = np.sqrt(ex * ex + ey * ey + ez * ez)
+    if gap == 0:
+        delta = min(max((r1 - r0) / h, 0.0), 1.0)  # (17)
+        return (1.0 - delta) * zeta + delta  # (18)
+    delta = min(abs(r1 - r0) / h, 1.0)
+    return (1.0 - delta) * zeta
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def _gap_kernel(P, f, step, best, heads, h, gap, it, Pout):
     for i in prange(P.shape[0]):
         lam = 1.0
         j = best[i]
         if gap != 2 and j >= 0:
-            ex, ey, ez = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
-            r0 = np.sqrt(ex * ex + ey * ey + ez * ez)
-            ex += step * (f[j, 0] - f[i, 0])
-            ey += step * (f[j, 1] - f[i, 1])
-            ez += step * (f[j, 2] - f[i, 2])
-            r1 = np.sqrt(ex * ex + ey * ey + ez * ez)
             zeta = hash_tail_u01_nb(heads[i], it)  # = hash_u01(seed, original index, it, CH_CLUMP)
-            if gap == 0:
-                delta = min(max((r1 - r0) / h, 0.0), 1.0)  # (17)
-                lam = (1.0 - delta) * zeta + delta  # (18)
-            else:
-                delta = min(abs(r1 - r0) / h, 1.0)
-                lam = (1.0 - delta) * zeta
+            lam = gap_lambda(
+                P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2],
+                f[j, 0] - f[i, 0], f[j, 1] - f[i, 1], f[j, 2] - f[i, 2], step, zeta, h, gap,
+            )  # fmt: skip
         for a in range(3):
             Pout[i, a] = P[i, a] + lam * (step * f[i, a])  # (16), (19)
 
@@ -179,6 +187,13 @@ def _scatter(order, P, out):
             out[order[k], a] = P[k, a]
 
 
+@njit(cache=True, nogil=True, parallel=True)
+def _scatter_stats(order, count, weight, out_count, out_weight):
+    for k in prange(order.size):
+        out_count[order[k]] = count[k]
+        out_weight[order[k]] = weight[k]
+
+
 @njit(cache=True, nogil=True)
 def _same_points(points, ref):
     for i in range(points.shape[0]):
@@ -189,28 +204,68 @@ def _same_points(points, ref):
 
 
 @njit(cache=True, nogil=True)
-def _clump_run(points, order, lists, sroot, h, iterations, step, gap, seed, bufs, out):
+def step_from_stats(h, w_sum, w_count):
+    """The automatic Δt²/m from Σg summed over the vertices with neighbours (see :func:`auto_step`)."""
+    return STEP_FRACTION * h / max(w_sum / max(w_count, 1), 1.0)
+
+
+@njit(cache=True, nogil=True)
+def _clump_run(points, order, lists, sroot, h, iterations, step, gap, seed, bufs, out, record):
     """The k Jacobi iterations on the cell-sorted list, one call (no Python between kernels).
     ``step`` < 0: automatic. Writes the result to ``out`` (original order, float32); returns
-    (mean neighbours within h per moving vertex, the step used)."""
+    (mean neighbours within h per moving vertex, the step used). ``record`` = (iterates (k, V, 3),
+    forces (k, V, 3), counts, Σg), in original order, for :mod:`hairtool.clump_region`; empty
+    arrays: not recorded."""
     P, Pn, f, best, count, weight, heads = bufs
     aflat, aoff, acnt, bflat, bstart = lists
+    rec_p, rec_f, rec_count, rec_weight = record
+    keep = rec_p.shape[0] > 0
     _gather_points(points, order, P)
     if gap != 2:
         _hash_heads(order, seed, heads)
     mean_nb = 0.0
     k_step = step
     for it in range(iterations):
+        if keep:
+            _scatter(order, P, rec_p[it])
         _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, order, h, it == 0, f, best, count, weight)
         if it == 0:
             pairs, moving, w_sum, w_count = _first_stats(count, weight, sroot)
             mean_nb = pairs / max(moving, 1)
             if step < 0.0:
-                k_step = STEP_FRACTION * h / max(w_sum / max(w_count, 1), 1.0)
+                k_step = step_from_stats(h, w_sum, w_count)
+        if keep:
+            _scatter(order, f, rec_f[it])
+            if it == 0:
+                _scatter_stats(order, count, weight, rec_count, rec_weight)
         _gap_kernel(P, f, k_step, best, heads, h, gap, it, Pn)
         P, Pn = Pn, P
     _scatter(order, P, out)
     return mean_nb, k_step
+
+
+_NO_RECORD = (np.zeros((0, 0, 3)), np.zeros((0, 0, 3)), np.zeros(0, np.int64), np.zeros(0))
+RECORD_LIMIT = 8_000_000  # vertices × iterations at most in a record (2 × 24 bytes each)
+
+
+class ClumpRecord:
+    """What a run leaves for :mod:`hairtool.clump_region` to redo only where its input changed:
+    its parameters, input and output, and each iteration's points and forces, the first one's
+    neighbour counts and Σg (original vertex order)."""
+
+    def __init__(self, vertices: int, iterations: int) -> None:
+        self.key: tuple = ()
+        self.points = np.empty((vertices, 3), np.float32)
+        self.result = np.empty((vertices, 3), np.float32)
+        self.iterates = np.empty((iterations, vertices, 3))
+        self.forces = np.empty((iterations, vertices, 3))
+        self.count = np.empty(vertices, np.int64)
+        self.weight = np.empty(vertices)
+        self.step = 0.0
+        self.mean_neighbours = 0.0
+
+    def fits(self, vertices: int, iterations: int) -> bool:
+        return self.iterates.shape[:2] == (iterations, vertices)
 
 
 def auto_step(h: float, weight: np.ndarray, count: np.ndarray) -> float:
@@ -230,6 +285,9 @@ class ClumpWorkspace:
         self.mean_neighbours = 0.0  # other-strand vertices within h per moving vertex, first iteration
         self.step = 0.0  # Δt²/m used in the last run
         self.builds = 0  # neighbour lists built so far (the rest of the runs reused one)
+        self.record = False  # keep a ClumpRecord of each run (the studio's updates in a region)
+        self.recorded: ClumpRecord | None = None
+        self.region = None  # hairtool.clump_region's scratch, when it updates this workspace
         self._mask_for: object = None
         self._mask = np.zeros(0, bool)
         self._buffers: tuple = ()
@@ -295,17 +353,35 @@ def clump_points(
     h = float(radius)
     ws.step = 0.0
     ws.mean_neighbours = 0.0
+    last, ws.recorded = ws.recorded, None
     if iterations == 0 or groom.strand_count < 2:
         return groom.points.copy()
     nl = ws.neighbour_list(groom, h)
-    out = np.empty((groom.vertex_count, 3), np.float32)
+    v, k = groom.vertex_count, int(iterations)
+    out = np.empty((v, 3), np.float32)
     lists = (nl.aflat, nl.aoff, nl.acnt, nl.bflat, nl.bstart)
+    rec = None
+    if ws.record and v * k <= RECORD_LIMIT:
+        rec = last if last is not None and last.fits(v, k) else ClumpRecord(v, k)
     ws.mean_neighbours, ws.step = _clump_run(
-        groom.points, nl.order, lists, nl.skip, h, int(iterations),
-        -1.0 if step is None else float(step), _GAP_CODE[gap_mode], seed_u64(seed),
-        ws.buffers(groom.vertex_count), out,
+        groom.points, nl.order, lists, nl.skip, h, k, -1.0 if step is None else float(step),
+        _GAP_CODE[gap_mode], seed_u64(seed), ws.buffers(v), out,
+        _NO_RECORD if rec is None else (rec.iterates, rec.forces, rec.count, rec.weight),
     )  # fmt: skip
+    if rec is not None:
+        rec.key = record_key(groom, h, k, step, gap_mode, seed)
+        rec.points[:] = groom.points
+        rec.result[:] = out
+        rec.step, rec.mean_neighbours = ws.step, ws.mean_neighbours
+        ws.recorded = rec
     return out
+
+
+def record_key(
+    groom: Groom, h: float, iterations: int, step: float | None, gap_mode: str, seed: int
+) -> tuple:
+    """What must be the same for a record to be updated rather than redone."""
+    return (groom.topology, float(h), int(iterations), step, gap_mode, int(seed))
 
 
 def clump(

@@ -20,7 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from hairtool.align import align, check_align_params
-from hairtool.clump import ClumpWorkspace, check_clump_params, clump_points
+from hairtool.clump import ClumpWorkspace, check_clump_params
+from hairtool.clump_region import clump_points_interactive
 from hairtool.errors import ParameterError
 from hairtool.freeze import (
     MAX_VARIATION,
@@ -282,7 +283,7 @@ class FrozenPipeline:
         p = self._params
         t0 = time.perf_counter()
         if p.clump and p.clump_iterations > 0:
-            pts = clump_points(
+            pts = clump_points_interactive(
                 self._aligned,
                 self.clump_radius,
                 p.clump_iterations,

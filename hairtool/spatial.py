@@ -253,6 +253,103 @@ def _forward_kernel(
         used[c] = pos - base[c]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _row_run(start, r, cy, cz, dy, dz, ny, nz):
+    """Row (cy + dy, cz + dz)'s run in sorted order (empty where it lies outside the grid)."""
+    if 0 <= cy + dy < ny and 0 <= cz + dz < nz:
+        rr = r + dz * ny + dy
+        return start[rr], start[rr + 1]
+    return 0, 0
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _region_kernel(
+    sx, sy, sz, sstrand, start, ny, nz, lo, cell, r2, slack, order, positions, chunks, cap, flat, cnt
+):
+    """The lists of the vertices at sorted ``positions`` (increasing) in the order of a full
+    build: what :func:`_forward_kernel` finds (own row to the right, then rows (y+1, z),
+    (y−1, z+1), (y, z+1), (y+1, z+1)), then the vertices that would have found them in
+    increasing sorted position, as :func:`_transpose` leaves them (rows (y−1, z−1), (y, z−1),
+    (y+1, z−1), (y−1, z), then the own row to the left); as original indices, ``cap`` slots per
+    vertex in ``flat`` (the last one scratch). One task per chunk of ``positions``; within a
+    row the window pointers only move forward, as in the forward kernel. The distance test,
+    which decides, is the forward kernel's (a − b = −(b − a) in floating point)."""
+    grow = 2.0 * slack
+    reach = np.sqrt(r2) * (1.0 + 1e-6) + grow + 1e-12 * cell
+    e = 1e-7 * cell
+    inv_cell = 1.0 / cell
+    for c in prange(chunks.size - 1):
+        row = -1
+        j1 = e1 = j2 = e2 = j3 = e3 = j4 = e4 = j5 = e5 = j6 = e6 = j7 = e7 = j8 = e8 = j0 = 0
+        y0 = z0 = 0.0
+        for n in range(chunks[c], chunks[c + 1]):
+            i = positions[n]
+            px, py, pz = sx[i], sy[i], sz[i]
+            cy = min(np.int64(np.floor((py - lo[1]) * inv_cell)), ny - 1)  # as _row_sort
+            cz = min(np.int64(np.floor((pz - lo[2]) * inv_cell)), nz - 1)
+            r = cz * ny + cy
+            if r != row:  # a new row: its neighbour rows' pointers from their starts
+                row = r
+                y0, z0 = lo[1] + cy * cell, lo[2] + cz * cell
+                j1, e1 = _row_run(start, r, cy, cz, 1, 0, ny, nz)
+                j2, e2 = _row_run(start, r, cy, cz, -1, 1, ny, nz)
+                j3, e3 = _row_run(start, r, cy, cz, 0, 1, ny, nz)
+                j4, e4 = _row_run(start, r, cy, cz, 1, 1, ny, nz)
+                j5, e5 = _row_run(start, r, cy, cz, -1, -1, ny, nz)
+                j6, e6 = _row_run(start, r, cy, cz, 0, -1, ny, nz)
+                j7, e7 = _row_run(start, r, cy, cz, 1, -1, ny, nz)
+                j8, e8 = _row_run(start, r, cy, cz, -1, 0, ny, nz)
+                j0 = start[r]
+            si = sstrand[i]
+            pos = n * cap
+            lim = pos + cap - 1
+            sw = px - reach
+            ya, yb, za, zb = y0 - e, y0 + cell + e, z0 - e, z0 + cell + e  # own row's square
+            _, pos = _scan_row(
+                sx, sy, sz, sstrand, i + 1, start[r + 1], px, py, pz, si, -np.inf, ya, yb, za, zb, r2, i + 1,
+                grow, flat, pos, lim,
+            )  # fmt: skip
+            j1, pos = _scan_row(
+                sx, sy, sz, sstrand, j1, e1, px, py, pz, si, sw, ya + cell, yb + cell, za, zb, r2, 0, grow,
+                flat, pos, lim,
+            )  # fmt: skip
+            j2, pos = _scan_row(
+                sx, sy, sz, sstrand, j2, e2, px, py, pz, si, sw, ya - cell, yb - cell, za + cell, zb + cell,
+                r2, 0, grow, flat, pos, lim,
+            )  # fmt: skip
+            j3, pos = _scan_row(
+                sx, sy, sz, sstrand, j3, e3, px, py, pz, si, sw, ya, yb, za + cell, zb + cell, r2, 0, grow,
+                flat, pos, lim,
+            )  # fmt: skip
+            j4, pos = _scan_row(
+                sx, sy, sz, sstrand, j4, e4, px, py, pz, si, sw, ya + cell, yb + cell, za + cell, zb + cell,
+                r2, 0, grow, flat, pos, lim,
+            )  # fmt: skip
+            j5, pos = _scan_row(
+                sx, sy, sz, sstrand, j5, e5, px, py, pz, si, sw, ya - cell, yb - cell, za - cell, zb - cell,
+                r2, 0, grow, flat, pos, lim,
+            )  # fmt: skip
+            j6, pos = _scan_row(
+                sx, sy, sz, sstrand, j6, e6, px, py, pz, si, sw, ya, yb, za - cell, zb - cell, r2, 0, grow,
+                flat, pos, lim,
+            )  # fmt: skip
+            j7, pos = _scan_row(
+                sx, sy, sz, sstrand, j7, e7, px, py, pz, si, sw, ya + cell, yb + cell, za - cell, zb - cell,
+                r2, 0, grow, flat, pos, lim,
+            )  # fmt: skip
+            j8, pos = _scan_row(
+                sx, sy, sz, sstrand, j8, e8, px, py, pz, si, sw, ya - cell, yb - cell, za, zb, r2, 0, grow,
+                flat, pos, lim,
+            )  # fmt: skip
+            j0, pos = _scan_row(
+                sx, sy, sz, sstrand, j0, i, px, py, pz, si, sw, ya, yb, za, zb, r2, 0, grow, flat, pos, lim
+            )  # fmt: skip
+            p0 = n * cap
+            cnt[n] = pos - p0
+            for m in range(p0, p0 + min(pos - p0, cap - 1)):
+                flat[m] = order[flat[m]]
+
+
 @njit(cache=True, nogil=True)
 def _transpose(chunks, start, base, fflat, fcnt, bstart, bflat):
     """The backward lists: every i that found j (i < j), in increasing i (deterministic), as CSR
@@ -352,6 +449,22 @@ class NeighbourList:
         dense: bool | None = None,
     ) -> None:
         """``dense``: force the row grid (True) or the hashed one (False); None picks by size."""
+        lo, hi, dims = self._grid(points, radius, dense)
+        if self.dense:
+            self._sort_rows(points, strand, skip, lo, hi, dims)
+            self._search_rows(points.shape[0], lo)
+        else:
+            self._build_hashed(points, strand, skip, lo, float(radius))
+
+    def sort(self, points: np.ndarray, strand: np.ndarray, skip: np.ndarray, radius: float) -> bool:
+        """Only the row grid's sort (``order``, the sorted coordinates, ``start``), for
+        :meth:`region_lists`; False (and nothing sorted) where the grid would be hashed."""
+        lo, hi, dims = self._grid(points, radius, None)
+        if self.dense:
+            self._sort_rows(points, strand, skip, lo, hi, dims)
+        return self.dense
+
+    def _grid(self, points, radius, dense):
         v = points.shape[0]
         lo, hi = (b.astype(np.float64) for b in box(points))
         extent = float((hi - lo).max())
@@ -361,16 +474,11 @@ class NeighbourList:
             raise ParameterError("clump_radius", radius, f"a distance above {extent / _MAXC:.3g}")
         self._buffers(v)
         self.radius = float(radius)
-        row_cell = float(radius)  # rows are r wide in y and z
-        dims = (np.floor((hi - lo) / row_cell).astype(np.int64) + 1).tolist()
+        dims = (np.floor((hi - lo) / self.radius).astype(np.int64) + 1).tolist()  # rows r wide in y, z
         self.dense = dims[1] * dims[2] <= max(8 * v, 1 << 16) if dense is None else dense
-        if self.dense:
-            self._build_rows(points, strand, skip, lo, hi, dims, row_cell)
-        else:
-            self._build_hashed(points, strand, skip, lo, float(radius))
+        return lo, hi, dims
 
-    def _build_rows(self, points, strand, skip, lo, hi, dims, cell) -> None:
-        v = points.shape[0]
+    def _sort_rows(self, points, strand, skip, lo, hi, dims) -> None:
         n_rows = dims[1] * dims[2]
         if self._start.size < n_rows + 1:
             self._start = np.empty(max(n_rows + 1, 2 * self._start.size), np.int64)
@@ -379,11 +487,17 @@ class NeighbourList:
         nq = int(min(1 << 16, max(64 * dims[0], 1)))
         width = max(float(hi[0] - lo[0]), 1e-300)
         _row_sort(
-            points, lo, 1.0 / cell, dims[1], dims[2], nq / width, nq, self.keys, self._qx, start, self.order,
-            self._tmp,
+            points, lo, 1.0 / self.radius, dims[1], dims[2], nq / width, nq, self.keys, self._qx, start,
+            self.order, self._tmp,
         )  # fmt: skip
         _gather(self.order, points, strand, skip, self.x, self.y, self.z, self.strand, self.skip)
-        slack = width / nq
+        self.slack = width / nq
+        self.dims = dims
+        self.start = start
+        self.lo = lo
+
+    def _search_rows(self, v, lo) -> None:
+        start, dims, cell = self.start, self.dims, self.radius
         chunks = _chunk_rows(start, v)
         per_chunk = np.diff(start[chunks])
         r2 = self.radius**2
@@ -396,7 +510,7 @@ class NeighbourList:
                 self.aflat = np.empty(int(total * 1.25), np.int32)
             used = np.empty(room.size, np.int64)
             _forward_kernel(
-                self.x, self.y, self.z, self.strand, start, dims[1], dims[2], lo, cell, r2, slack,
+                self.x, self.y, self.z, self.strand, start, dims[1], dims[2], lo, cell, r2, self.slack,
                 chunks, base, base + room - 1, self.aflat, self.acnt, used,
             )  # fmt: skip
             need = float(np.max(used / np.maximum(per_chunk, 1)))
@@ -411,8 +525,21 @@ class NeighbourList:
             if self.bflat.size >= total:
                 break
             self.bflat = np.empty(int(total * 1.25) + 16, np.int32)
-        self.dims = dims
-        self.start = start
+
+    def region_lists(self, positions: np.ndarray, capacity: int) -> tuple[np.ndarray, np.ndarray]:
+        """After :meth:`sort`: for the sorted positions ``positions``, their lists as a full
+        :meth:`build` would make them (the forward run, then the backward one, same order), in
+        original vertex indices: ``(nbr (n, capacity) int32, cnt (n,))``; where a count exceeds
+        ``capacity`` − 1 the lists are cut (call again with a larger one)."""
+        n = positions.size
+        flat = np.empty(n * capacity, np.int32)
+        cnt = np.empty(n, np.int64)
+        chunks = np.linspace(0, n, max(1, min(_CHUNKS, n // 64)) + 1).astype(np.int64)
+        _region_kernel(
+            self.x, self.y, self.z, self.strand, self.start, self.dims[1], self.dims[2], self.lo, self.radius,
+            self.radius**2, self.slack, self.order, positions, chunks, capacity, flat, cnt,
+        )  # fmt: skip
+        return flat.reshape(n, capacity), cnt
 
     def _build_hashed(self, points, strand, skip, lo, radius) -> None:
         # Sparse hair in a large box: hash the 3-D cells into ~2V buckets.

@@ -1,0 +1,247 @@
+"""ClumpWithGaps again after an edit, redone only near the vertices whose input changed.
+
+While a brush drags, a few percent of the vertices move per mouse move. After k Jacobi
+iterations a vertex depends only on the vertices within k steps of the candidate graph (pairs
+closer than R = h·(1 + MARGIN) at the start), so on nothing farther than k·R; and its
+neighbour list keeps its order (a full build orders a list by sorted position, and the sort
+keeps the relative order of the vertices that did not move). So a vertex farther than k·R
+from every changed vertex, where it was and where it is, ends exactly where the last run left
+it. :func:`clump_points_interactive` keeps a :class:`~hairtool.clump.ClumpRecord` of each run
+(its input, output, and each iteration's points and forces) and redoes only the region of
+grid cells (at least k·R wide) around the changed ones, reading the record for neighbours
+outside it. The bytes are those of a full run (the tests hold it to that); where the
+automatic step comes out different, too many vertices changed, or the parameters did, it
+runs in full.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from hairtool.clump import (
+    MARGIN,
+    ClumpWorkspace,
+    _first_stats,
+    _lowest_of_nearest,
+    _pull,
+    clump_points,
+    gap_lambda,
+    record_key,
+    step_from_stats,
+)
+from hairtool.freeze import CH_CLUMP, check_seed, hash_head_nb, hash_tail_u01_nb, seed_u64
+from hairtool.groom import Groom
+
+MAX_CHANGED = 0.25  # of the vertices: more changed, and the update runs in full
+MAX_REGION = 0.5  # of the vertices: a larger region runs in full
+MAX_SIDE = 128  # region grid cells per axis at most (the cells grow instead)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _changed(points, last, flags):
+    """Vertices whose coordinates differ from the last input, bit for bit (−0.0 ≠ 0.0)."""
+    a, b = points.view(np.uint32), last.view(np.uint32)
+    for i in prange(points.shape[0]):
+        flags[i] = a[i, 0] != b[i, 0] or a[i, 1] != b[i, 1] or a[i, 2] != b[i, 2]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _cell(p, i, lo, inv, dims):
+    """The grid cell (clamped into the grid) of point i of p, as three indices."""
+    cx = min(max(np.int64(np.floor((p[i, 0] - lo[0]) * inv)), 0), dims[0] - 1)
+    cy = min(max(np.int64(np.floor((p[i, 1] - lo[1]) * inv)), 0), dims[1] - 1)
+    cz = min(max(np.int64(np.floor((p[i, 2] - lo[2]) * inv)), 0), dims[2] - 1)
+    return cx, cy, cz
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _mark_around(c, dims, near):
+    cx, cy, cz = c
+    for z in range(max(cz - 1, 0), min(cz + 2, dims[2])):
+        for y in range(max(cy - 1, 0), min(cy + 2, dims[1])):
+            for x in range(max(cx - 1, 0), min(cx + 2, dims[0])):
+                near[(z * dims[1] + y) * dims[0] + x] = True
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _region(points, last, changed, lo, inv, dims, near, mask):
+    """``mask``: the vertices in the 3 × 3 × 3 cells around a cell that holds a changed vertex,
+    where it is or where it was (cells at least k·R wide: everything within k·R of them; a
+    point outside the grid clamped to its border cell still has all of those around it)."""
+    near[:] = False
+    for i in changed:
+        _mark_around(_cell(points, i, lo, inv, dims), dims, near)
+        _mark_around(_cell(last, i, lo, inv, dims), dims, near)
+    n = 0
+    for i in prange(points.shape[0]):
+        cx, cy, cz = _cell(points, i, lo, inv, dims)
+        mask[i] = near[(cz * dims[1] + cy) * dims[0] + cx]
+        n += mask[i]
+    return n
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _region_force(P, nbr, cnt, region, roots, h, stats, F, best, count, weight, ident):
+    """:func:`hairtool.clump._force_kernel` for the vertices ``region`` (original indices) with
+    their lists in rows of ``nbr``: the same pulls in the same order, so the same numbers.
+    ``P``, ``F``, ``count``, ``weight`` in original order; ``best`` per region vertex."""
+    inv_h = 1.0 / h
+    cap = nbr.shape[1]
+    flat = nbr.reshape(-1)
+    for n in prange(region.size):
+        i = region[n]
+        acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
+        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
+        a0, a1 = n * cap, n * cap + cnt[n]
+        if not roots[i]:
+            acc = _pull(P, flat, a0, a1, px, py, pz, h, inv_h, stats, acc)
+        fx, fy, fz, br, bj, tie, c, wsum = acc
+        if tie and bj >= 0:
+            bj, _ = _lowest_of_nearest(P, flat, a0, a1, px, py, pz, br, ident, bj, bj)
+        F[i, 0], F[i, 1], F[i, 2] = fx, fy, fz
+        best[n] = bj
+        if stats:
+            count[i] = c
+            weight[i] = wsum
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _region_gap(P, F, step, best, region, h, gap, it, seed, out):
+    """:func:`hairtool.clump._gap_kernel` for the vertices ``region``, into ``out`` (the next
+    iterate, or the float32 result after the last iteration)."""
+    for n in prange(region.size):
+        i = region[n]
+        lam = 1.0
+        j = best[n]
+        if gap != 2 and j >= 0:
+            zeta = hash_tail_u01_nb(hash_head_nb(seed, i, CH_CLUMP), it)
+            lam = gap_lambda(
+                P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2],
+                F[j, 0] - F[i, 0], F[j, 1] - F[i, 1], F[j, 2] - F[i, 2], step, zeta, h, gap,
+            )  # fmt: skip
+        for a in range(3):
+            out[i, a] = P[i, a] + lam * (step * F[i, a])
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _sorted_stats(order, count, weight, sorted_count, sorted_weight):
+    for k in prange(order.size):
+        sorted_count[k] = count[order[k]]
+        sorted_weight[k] = weight[order[k]]
+
+
+class RegionScratch:
+    """Buffers of the region updates, kept between them, and what the last one did."""
+
+    def __init__(self) -> None:
+        self.flags = np.zeros(0, np.bool_)
+        self.mask = np.zeros(0, np.bool_)
+        self.near = np.zeros(0, np.bool_)
+        self.ident = np.zeros(0, np.int64)
+        self.capacity = 32  # list slots per region vertex (grows to the longest list + 1)
+        self.updates = 0  # region updates so far
+        self.fraction = 1.0  # share of the vertices the last update redid (1: a full run)
+
+    def sized(self, v: int) -> None:
+        if self.flags.size != v:
+            self.flags = np.empty(v, np.bool_)
+            self.mask = np.empty(v, np.bool_)
+            self.ident = np.arange(v, dtype=np.int64)
+
+
+def _update_region(
+    groom: Groom, h: float, iterations: int, step: float | None, gap_mode: str, seed: int, ws: ClumpWorkspace
+) -> np.ndarray | None:
+    """The result redone near the changed vertices, or None where only a full run will do (the
+    record is then dropped, as this may have begun to rewrite it)."""
+    rec = ws.recorded
+    if rec is None or rec.key != record_key(groom, h, iterations, step, gap_mode, seed):
+        return None
+    sc = ws.region
+    v = groom.vertex_count
+    sc.sized(v)
+    points = groom.points
+    _changed(points, rec.points, sc.flags)
+    changed = np.flatnonzero(sc.flags)
+    if changed.size == 0:
+        ws.step, ws.mean_neighbours = rec.step, rec.mean_neighbours
+        sc.fraction = 0.0
+        return rec.result.copy()
+    if changed.size > MAX_CHANGED * v:
+        return None
+    top = groom.topology
+    roots = ws.roots_mask(top)
+    radius = h * (1.0 + MARGIN)
+    ws.invalidate()  # the sort below replaces the kept list's order
+    nl = ws.neighbours
+    if not nl.sort(points, top.strand_index, roots, radius):
+        return None
+    lo, hi = (b.astype(np.float64) for b in groom.bounds)
+    cell = max(iterations * radius, float((hi - lo).max()) / (MAX_SIDE - 1))
+    dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
+    if sc.near.size < int(np.prod(dims)):
+        sc.near = np.empty(int(np.prod(dims)), np.bool_)
+    n = _region(points, rec.points, changed, lo, 1.0 / cell, dims, sc.near, sc.mask)
+    if n > MAX_REGION * v:
+        return None
+    positions = np.flatnonzero(sc.mask[nl.order])  # the region in sorted order
+    while True:
+        nbr, cnt = nl.region_lists(positions, sc.capacity)
+        longest = int(cnt.max()) if cnt.size else 0
+        if longest < sc.capacity:
+            break
+        sc.capacity = (longest + 16) // 16 * 16
+    region = nl.order[positions]
+    ws.recorded = None  # rewritten from here on
+    rec.iterates[0][region] = points[region]
+    best = np.empty(region.size, np.int64)
+    k_step = 0.0 if step is None else float(step)
+    gap, seed64 = {"printed": 0, "text": 1, "off": 2}[gap_mode], seed_u64(seed)
+    for it in range(iterations):
+        p, f = rec.iterates[it], rec.forces[it]
+        _region_force(p, nbr, cnt, region, roots, h, it == 0, f, best, rec.count, rec.weight, sc.ident)
+        if it == 0:
+            # The sums of a full run, in its (sorted) order: the same bits, or a full run.
+            sorted_count, sorted_weight = np.empty(v, np.int64), np.empty(v)
+            _sorted_stats(nl.order, rec.count, rec.weight, sorted_count, sorted_weight)
+            pairs, moving, w_sum, w_count = _first_stats(sorted_count, sorted_weight, nl.skip)
+            if step is None:
+                k_step = step_from_stats(h, w_sum, w_count)
+                if k_step != rec.step:
+                    return None
+            mean_nb = pairs / max(moving, 1)
+        out = rec.iterates[it + 1] if it + 1 < iterations else rec.result
+        _region_gap(p, f, k_step, best, region, h, gap, it, seed64, out)
+    rec.points[:] = points
+    rec.mean_neighbours = mean_nb
+    ws.recorded = rec
+    ws.step, ws.mean_neighbours = k_step, mean_nb
+    sc.updates += 1
+    sc.fraction = region.size / v
+    return rec.result.copy()
+
+
+def clump_points_interactive(
+    groom: Groom,
+    radius: float,
+    iterations: int = 3,
+    step: float | None = None,
+    gap_mode: str = "printed",
+    seed: int = 0,
+    workspace: ClumpWorkspace | None = None,
+) -> np.ndarray:
+    """:func:`~hairtool.clump.clump_points`, the same bytes, for a workspace that sees one
+    edit after another: redone only near what changed since its last run when it can."""
+    ws = workspace or ClumpWorkspace()
+    ws.record = True
+    if ws.region is None:
+        ws.region = RegionScratch()
+    out = None
+    if iterations > 0 and groom.strand_count >= 2:
+        seed = check_seed(seed)
+        out = _update_region(groom, float(radius), int(iterations), step, gap_mode, seed, ws)
+    if out is None:
+        ws.region.fraction = 1.0
+        out = clump_points(groom, radius, iterations, step, gap_mode, seed, ws)
+    return out
