@@ -47,37 +47,41 @@ def _changed(points, last, flags):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _cell(p, i, lo, inv, dims):
-    """The grid cell (clamped into the grid) of point i of p, as three indices."""
-    cx = min(max(np.int64(np.floor((p[i, 0] - lo[0]) * inv)), 0), dims[0] - 1)
-    cy = min(max(np.int64(np.floor((p[i, 1] - lo[1]) * inv)), 0), dims[1] - 1)
-    cz = min(max(np.int64(np.floor((p[i, 2] - lo[2]) * inv)), 0), dims[2] - 1)
-    return cx, cy, cz
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _mark_around(c, dims, near):
-    cx, cy, cz = c
-    for z in range(max(cz - 1, 0), min(cz + 2, dims[2])):
-        for y in range(max(cy - 1, 0), min(cy + 2, dims[1])):
-            for x in range(max(cx - 1, 0), min(cx + 2, dims[0])):
-                near[(z * dims[1] + y) * dims[0] + x] = True
+def _cell(x, y, z, lo, inv, dims):
+    """The grid cell (clamped into the grid) of (x, y, z), as one index. Scalars and tuples only:
+    an array passed to an inlined helper in a loop is reference-counted at every call."""
+    cx = min(max(np.int64(np.floor((x - lo[0]) * inv)), 0), dims[0] - 1)
+    cy = min(max(np.int64(np.floor((y - lo[1]) * inv)), 0), dims[1] - 1)
+    cz = min(max(np.int64(np.floor((z - lo[2]) * inv)), 0), dims[2] - 1)
+    return (cz * dims[1] + cy) * dims[0] + cx
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _region(points, last, changed, lo, inv, dims, near, mask):
+def _region(points, last, changed, lo3, inv, dims3, near, mask):
     """``mask``: the vertices in the 3 × 3 × 3 cells around a cell that holds a changed vertex,
     where it is or where it was (cells at least k·R wide: everything within k·R of them; a
-    point outside the grid clamped to its border cell still has all of those around it)."""
-    near[:] = False
-    for i in changed:
-        _mark_around(_cell(points, i, lo, inv, dims), dims, near)
-        _mark_around(_cell(last, i, lo, inv, dims), dims, near)
+    point outside the grid clamped to its border cell still has all of those around it).
+    Returns how many."""
+    lo = (lo3[0], lo3[1], lo3[2])
+    dims = (dims3[0], dims3[1], dims3[2])
+    sx, sxy = dims[0], dims[0] * dims[1]
+    near[: sxy * dims[2]] = False
+    for n in range(changed.size):
+        i = changed[n]
+        for c in (
+            _cell(points[i, 0], points[i, 1], points[i, 2], lo, inv, dims),
+            _cell(last[i, 0], last[i, 1], last[i, 2], lo, inv, dims),
+        ):
+            cz, cy, cx = c // sxy, (c // sx) % dims[1], c % sx
+            for z in range(max(cz - 1, 0), min(cz + 2, dims[2])):
+                for y in range(max(cy - 1, 0), min(cy + 2, dims[1])):
+                    for x in range(max(cx - 1, 0), min(cx + 2, dims[0])):
+                        near[z * sxy + y * sx + x] = True
     n = 0
     for i in prange(points.shape[0]):
-        cx, cy, cz = _cell(points, i, lo, inv, dims)
-        mask[i] = near[(cz * dims[1] + cy) * dims[0] + cx]
-        n += mask[i]
+        inside = near[_cell(points[i, 0], points[i, 1], points[i, 2], lo, inv, dims)]
+        mask[i] = inside
+        n += inside
     return n
 
 
@@ -170,13 +174,7 @@ def _update_region(
         return rec.result.copy()
     if changed.size > MAX_CHANGED * v:
         return None
-    top = groom.topology
-    roots = ws.roots_mask(top)
     radius = h * (1.0 + MARGIN)
-    ws.invalidate()  # the sort below replaces the kept list's order
-    nl = ws.neighbours
-    if not nl.sort(points, top.strand_index, roots, radius):
-        return None
     lo, hi = (b.astype(np.float64) for b in groom.bounds)
     cell = max(iterations * radius, float((hi - lo).max()) / (MAX_SIDE - 1))
     dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
@@ -184,6 +182,12 @@ def _update_region(
         sc.near = np.empty(int(np.prod(dims)), np.bool_)
     n = _region(points, rec.points, changed, lo, 1.0 / cell, dims, sc.near, sc.mask)
     if n > MAX_REGION * v:
+        return None
+    top = groom.topology
+    roots = ws.roots_mask(top)
+    ws.invalidate()  # the sort below replaces the kept list's order
+    nl = ws.neighbours
+    if not nl.sort(points, top.strand_index, roots, radius):
         return None
     positions = np.flatnonzero(sc.mask[nl.order])  # the region in sorted order
     while True:
@@ -202,15 +206,14 @@ def _update_region(
         p, f = rec.iterates[it], rec.forces[it]
         _region_force(p, nbr, cnt, region, roots, h, it == 0, f, best, rec.count, rec.weight, sc.ident)
         if it == 0:
-            # The sums of a full run, in its (sorted) order: the same bits, or a full run.
-            sorted_count, sorted_weight = np.empty(v, np.int64), np.empty(v)
-            _sorted_stats(nl.order, rec.count, rec.weight, sorted_count, sorted_weight)
-            pairs, moving, w_sum, w_count = _first_stats(sorted_count, sorted_weight, nl.skip)
-            if step is None:
+            if step is None:  # Σg as a full run sums it, in its (sorted) order: the same bits
+                sorted_count, sorted_weight = np.empty(v, np.int64), np.empty(v)
+                _sorted_stats(nl.order, rec.count, rec.weight, sorted_count, sorted_weight)
+                _, _, w_sum, w_count = _first_stats(sorted_count, sorted_weight, nl.skip)
                 k_step = step_from_stats(h, w_sum, w_count)
                 if k_step != rec.step:
-                    return None
-            mean_nb = pairs / max(moving, 1)
+                    return None  # the record's forces and counts are rewritten: dropped
+            mean_nb = int(rec.count.sum()) / max(v - top.strand_count, 1)  # pairs per moving vertex
         out = rec.iterates[it + 1] if it + 1 < iterations else rec.result
         _region_gap(p, f, k_step, best, region, h, gap, it, seed64, out)
     rec.points[:] = points

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from hairtool.align import align, check_align_params
-from hairtool.clump import ClumpWorkspace, check_clump_params
+from hairtool.clump import ClumpWorkspace, check_clump_params, clump_points
 from hairtool.clump_region import clump_points_interactive
 from hairtool.errors import ParameterError
 from hairtool.freeze import (
@@ -41,8 +41,10 @@ class FrozenParams:
 
     ``strand_variation``: spread of the per-strand stiffness multiplier (0 … 4) or an ``(S,)``
     array of multipliers. ``clump_radius`` None: :func:`~hairtool.strand_clumps.auto_clump_radius`.
-    ``clump_step`` None: :func:`~hairtool.clump.auto_step`. ``redraw_noise``: new freeze noise at
-    every :meth:`update` (the paper's behaviour; flickers while dragging).
+    ``clump_step`` None: :func:`~hairtool.clump.auto_step` of the frozen groom, before any stroke
+    (so that a stroke does not change how strongly the whole groom clumps while it drags, and
+    the studio can redo ClumpWithGaps only near the strands it moves). ``redraw_noise``: new
+    freeze noise at every :meth:`update` (the paper's behaviour; flickers while dragging).
     """
 
     stretch_stiffness: float = 7.0
@@ -122,6 +124,7 @@ class FrozenPipeline:
         self._params = (params or FrozenParams()).validate()
         strand_multipliers(rest.strand_count, self._params.strand_variation)  # shape check
         self._auto_h: float | None = None
+        self._auto_step: tuple[tuple, float] | None = None  # (frozen groom's key, its auto step)
         self._log: list[AlignSample] = []
         self._draw = 0
         self._workspace = ClumpWorkspace()
@@ -176,14 +179,33 @@ class FrozenPipeline:
 
     @property
     def clump_step(self) -> float:
-        """Δt²/m used by the last clumping (the parameter, or the automatic step)."""
+        """Δt²/m used by the last clumping (the parameter, or the frozen groom's automatic step)."""
         return self._workspace.step
+
+    def _step(self) -> float:
+        """The parameter, or :func:`~hairtool.clump.auto_step` of the frozen groom (cached)."""
+        p = self._params
+        if p.clump_step is not None:
+            return float(p.clump_step)
+        key = (self._freeze_key, self.clump_radius)
+        if self._auto_step is None or self._auto_step[0] != key:
+            ws = ClumpWorkspace()  # one iteration gives the step (it is set by the first)
+            clump_points(self._frozen, self.clump_radius, 1, None, "off", 0, ws)
+            self._auto_step = (key, ws.step)
+        return self._auto_step[1]
 
     @property
     def neighbour_builds(self) -> int:
         """ClumpWithGaps neighbour lists built so far (an update on the points of the last
         build reuses its list)."""
         return self._workspace.builds
+
+    @property
+    def clump_redone(self) -> float:
+        """Share of the vertices the last clumping computed (1: all; less: only those near the
+        vertices that changed since the one before, :mod:`hairtool.clump_region`)."""
+        region = self._workspace.region
+        return 1.0 if region is None else region.fraction
 
     @property
     def mean_neighbours(self) -> float:
@@ -287,7 +309,7 @@ class FrozenPipeline:
                 self._aligned,
                 self.clump_radius,
                 p.clump_iterations,
-                p.clump_step,
+                self._step(),
                 p.gap_mode,
                 draw_seed(p.seed, self._draw),
                 self._workspace,

@@ -7,7 +7,7 @@ import pytest
 
 from hairtool import samples
 from hairtool.align import align
-from hairtool.clump import clump
+from hairtool.clump import ClumpWorkspace, clump
 from hairtool.errors import ParameterError
 from hairtool.freeze import freeze
 from hairtool.frozen import FrozenParams, FrozenPipeline
@@ -164,3 +164,30 @@ def test_params_equality_and_validation(rest):
     with pytest.raises(ParameterError, match="intensity"):
         pipe.align(CURSOR, 1.0, 2.0)
     assert pipe.strokes == ()
+
+
+def test_the_automatic_step_is_the_frozen_grooms_and_a_drag_is_redone_near_the_brush():
+    # Dense hair (kernel weights above 1 per vertex): the automatic step depends on the points,
+    # and is taken from the frozen groom, so that strokes leave it be.
+    rest = samples.scalp(900, 12, seed=3)
+    h = 2.0 * auto_clump_radius(rest)
+    pipe = FrozenPipeline(rest, FrozenParams(clump_radius=h))
+    ws = ClumpWorkspace()
+    clump(pipe.frozen, h, 1, None, "off", 0, ws)
+    frozen_step = ws.step
+    assert frozen_step < 0.2 * h  # not the cap: set by the weights
+    lo, hi = rest.bounds
+    tip = rest.tips[np.argmax(rest.tips[:, 1])]
+    redone = []
+    for k in range(6):
+        out = pipe.align(
+            tip + 0.05 * (hi - lo) * np.array([np.cos(k), np.sin(k), 0.0]), 0.1 * float(np.max(hi - lo))
+        )
+        redone.append(pipe.clump_redone)
+    assert pipe.clump_step == frozen_step
+    expect = clump(pipe.aligned, h, 3, frozen_step, "printed", 0)
+    assert out.points.tobytes() == expect.points.tobytes()
+    other = ClumpWorkspace()
+    clump(pipe.aligned, h, 1, None, "off", 0, other)
+    assert other.step != frozen_step  # what the aligned groom alone would have given
+    assert redone[0] < 1.0 and max(redone) < 0.5  # redone near the brush only
