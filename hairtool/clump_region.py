@@ -36,6 +36,7 @@ from hairtool.groom import Groom
 MAX_CHANGED = 0.25  # of the vertices: more changed, and the update runs in full
 MAX_REGION = 0.5  # of the vertices: a larger region runs in full
 MAX_SIDE = 128  # region grid cells per axis at most (the cells grow instead)
+CELLS_PER_REACH = 3  # region grid cells across k·R: the region follows the changed vertices closely
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -56,33 +57,55 @@ def _cell(x, y, z, lo, inv, dims):
     return (cz * dims[1] + cy) * dims[0] + cx
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def _region(points, last, changed, lo3, inv, dims3, near, mask):
-    """``mask``: the vertices in the 3 × 3 × 3 cells around a cell that holds a changed vertex,
-    where it is or where it was (cells at least k·R wide: everything within k·R of them; a
-    point outside the grid clamped to its border cell still has all of those around it).
-    Returns how many."""
-    lo = (lo3[0], lo3[1], lo3[2])
-    dims = (dims3[0], dims3[1], dims3[2])
-    sx, sxy = dims[0], dims[0] * dims[1]
-    near[: sxy * dims[2]] = False
-    for n in range(changed.size):
-        i = changed[n]
+@njit(cache=True, nogil=True)
+def _mark_changed_cells(points, last, changed, lo, inv, dims, cells, marked):
+    """The cells that hold a changed vertex, where it is or where it was, once each (into
+    ``cells``, flagged in ``marked``, which is left all False). Returns how many."""
+    n = 0
+    for k in range(changed.size):
+        i = changed[k]
         for c in (
             _cell(points[i, 0], points[i, 1], points[i, 2], lo, inv, dims),
             _cell(last[i, 0], last[i, 1], last[i, 2], lo, inv, dims),
         ):
-            cz, cy, cx = c // sxy, (c // sx) % dims[1], c % sx
-            for z in range(max(cz - 1, 0), min(cz + 2, dims[2])):
-                for y in range(max(cy - 1, 0), min(cy + 2, dims[1])):
-                    for x in range(max(cx - 1, 0), min(cx + 2, dims[0])):
-                        near[z * sxy + y * sx + x] = True
+            if not marked[c]:
+                marked[c] = True
+                cells[n] = c
+                n += 1
+    for k in range(n):
+        marked[cells[k]] = False
+    return n
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _region(points, lo3, inv, dims3, cells, offsets, near, mask):
+    """``mask``: the vertices of the cells within the ``offsets`` of ``cells``. Returns how many."""
+    lo = (lo3[0], lo3[1], lo3[2])
+    dims = (dims3[0], dims3[1], dims3[2])
+    sx, sxy = dims[0], dims[0] * dims[1]
+    near[: sxy * dims[2]] = False
+    for k in range(cells.size):
+        c = cells[k]
+        cz, cy, cx = c // sxy, (c // sx) % dims[1], c % sx
+        for o in range(offsets.shape[0]):
+            x, y, z = cx + offsets[o, 0], cy + offsets[o, 1], cz + offsets[o, 2]
+            if 0 <= x < dims[0] and 0 <= y < dims[1] and 0 <= z < dims[2]:
+                near[z * sxy + y * sx + x] = True
     n = 0
     for i in prange(points.shape[0]):
         inside = near[_cell(points[i, 0], points[i, 1], points[i, 2], lo, inv, dims)]
         mask[i] = inside
         n += inside
     return n
+
+
+def region_offsets(m: int) -> np.ndarray:
+    """Cell offsets (d, 3) whose cells may hold points nearer than m cells to a point of the cell
+    at 0: the nearest points of cells d apart are cell·√Σ max(|d| − 1, 0)² apart."""
+    d = np.arange(-m, m + 1)
+    grid = np.stack(np.meshgrid(d, d, d, indexing="ij"), -1).reshape(-1, 3)
+    gap = np.maximum(np.abs(grid) - 1, 0)
+    return np.ascontiguousarray(grid[(gap * gap).sum(axis=1) < m * m], np.int64)
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -142,6 +165,8 @@ class RegionScratch:
         self.flags = np.zeros(0, np.bool_)
         self.mask = np.zeros(0, np.bool_)
         self.near = np.zeros(0, np.bool_)
+        self.marked = np.zeros(0, np.bool_)
+        self.offsets = region_offsets(CELLS_PER_REACH)
         self.ident = np.zeros(0, np.int64)
         self.capacity = 32  # list slots per region vertex (grows to the longest list + 1)
         self.updates = 0  # region updates so far
@@ -176,11 +201,17 @@ def _update_region(
         return None
     radius = h * (1.0 + MARGIN)
     lo, hi = (b.astype(np.float64) for b in groom.bounds)
-    cell = max(iterations * radius, float((hi - lo).max()) / (MAX_SIDE - 1))
+    # Cells of k·R / m with the offsets within m cells, or larger ones (then m cells reach farther).
+    cell = max(iterations * radius / CELLS_PER_REACH, float((hi - lo).max()) / (MAX_SIDE - 1))
     dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
-    if sc.near.size < int(np.prod(dims)):
-        sc.near = np.empty(int(np.prod(dims)), np.bool_)
-    n = _region(points, rec.points, changed, lo, 1.0 / cell, dims, sc.near, sc.mask)
+    cells = int(np.prod(dims))
+    if sc.near.size < cells:
+        sc.near, sc.marked = np.empty(cells, np.bool_), np.zeros(cells, np.bool_)
+    marked = np.empty(2 * changed.size, np.int64)
+    marked = marked[
+        : _mark_changed_cells(points, rec.points, changed, lo, 1.0 / cell, dims, marked, sc.marked)
+    ]
+    n = _region(points, lo, 1.0 / cell, dims, marked, sc.offsets, sc.near, sc.mask)
     if n > MAX_REGION * v:
         return None
     top = groom.topology

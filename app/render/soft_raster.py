@@ -291,19 +291,18 @@ def _changed_segments(seg, box, old_seg, old_box, changed):
 
 
 @njit(cache=True, nogil=True)
-def _mark_tiles(boxes, which, dirty, shift):
+def _mark_tiles(bx, which, dirty, shift):
     """Mark the tiles of ``dirty`` (rows × columns of tiles 2**shift pixels wide) under the boxes
-    of the segments ``which``, for each of ``boxes``. Returns how many segments were marked."""
+    ``bx`` of the segments ``which``. Returns how many segments were marked."""
     marked = 0
     for i in range(which.size):
         if not which[i]:
             continue
         marked += 1
-        for bx in boxes:
-            if bx[0, i] <= bx[1, i]:
-                for ty in range(bx[0, i] >> shift, (bx[1, i] >> shift) + 1):
-                    for tx in range(bx[2, i] >> shift, (bx[3, i] >> shift) + 1):
-                        dirty[ty, tx] = True
+        if bx[0, i] <= bx[1, i]:
+            for ty in range(bx[0, i] >> shift, (bx[1, i] >> shift) + 1):
+                for tx in range(bx[2, i] >> shift, (bx[3, i] >> shift) + 1):
+                    dirty[ty, tx] = True
     return marked
 
 
@@ -508,7 +507,8 @@ class StrandRaster:
         _changed_segments(seg, bx, old_seg, old_bx, changed)
         h, w = depth.shape
         dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
-        if _mark_tiles((old_bx, bx), changed, dirty, TILE_SHIFT) == 0:
+        _mark_tiles(old_bx, changed, dirty, TILE_SHIFT)  # where they were and where they are
+        if _mark_tiles(bx, changed, dirty, TILE_SHIFT) == 0:
             self.changed, self.tiles_redrawn = None, 0
             return True
         if self._counts.size != dirty.size + 1:

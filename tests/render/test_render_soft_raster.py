@@ -321,9 +321,19 @@ def test_what_makes_a_full_draw_and_what_draws_nothing():
     rgba[:] = 0
     raster.draw(g.points, starts[:-1], colors, mvp, (150, 120), 3.0, clear=(1, 1, 1, 1))
     assert raster.tiles_redrawn == -1
-    raster.incremental = False
     moved = g.points.copy()
-    moved[: g.offsets[1]] += 0.01
+    moved[g.offsets[1] - 2 : g.offsets[1]] += 0.01
+    # All segments, then fewer (one buffer holds just those, the other more), redrawn in part:
+    fresh = StrandRaster()
+    fresh.draw(g.points, starts, colors, mvp, (150, 120), 3.0)
+    fresh.draw(g.points, starts[:-1], colors, mvp, (150, 120), 3.0)
+    rgba, depth = fresh.draw(moved, starts[:-1], colors, mvp, (150, 120), 3.0)
+    assert fresh.tiles_redrawn > 0
+    want = StrandRaster().draw(moved, starts[:-1], colors, mvp, (150, 120), 3.0)
+    np.testing.assert_array_equal(rgba, want[0])
+    np.testing.assert_array_equal(depth, want[1])
+    raster.incremental = False
+    moved[g.offsets[1] - 2 : g.offsets[1]] += 0.01
     raster.draw(moved, starts[:-1], colors, mvp, (150, 120), 3.0, clear=(1, 1, 1, 1))
     assert raster.tiles_redrawn == -1
 
