@@ -456,17 +456,20 @@ class NeighbourList:
         else:
             self._build_hashed(points, strand, skip, lo, float(radius))
 
-    def sort(self, points: np.ndarray, strand: np.ndarray, skip: np.ndarray, radius: float) -> bool:
+    def sort(
+        self, points: np.ndarray, strand: np.ndarray, skip: np.ndarray, radius: float, bounds=None
+    ) -> bool:
         """Only the row grid's sort (``order``, the sorted coordinates, ``start``), for
-        :meth:`region_lists`; False (and nothing sorted) where the grid would be hashed."""
-        lo, hi, dims = self._grid(points, radius, None)
+        :meth:`region_lists`; False (and nothing sorted) where the grid would be hashed.
+        ``bounds``: the points' box, when the caller has it."""
+        lo, hi, dims = self._grid(points, radius, None, bounds)
         if self.dense:
             self._sort_rows(points, strand, skip, lo, hi, dims)
         return self.dense
 
-    def _grid(self, points, radius, dense):
+    def _grid(self, points, radius, dense, bounds=None):
         v = points.shape[0]
-        lo, hi = (b.astype(np.float64) for b in box(points))
+        lo, hi = (np.asarray(b, np.float64) for b in (box(points) if bounds is None else bounds))
         extent = float((hi - lo).max())
         if not np.isfinite(extent):
             raise GroomError("the points have a non-finite coordinate")
