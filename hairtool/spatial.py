@@ -254,12 +254,23 @@ def _forward_kernel(
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _row_run(start, r, cy, cz, dy, dz, ny, nz):
-    """Row (cy + dy, cz + dz)'s run in sorted order (empty where it lies outside the grid)."""
-    if 0 <= cy + dy < ny and 0 <= cz + dz < nz:
-        rr = r + dz * ny + dy
-        return start[rr], start[rr + 1]
-    return 0, 0
+def _row_run(start, sx, r, cy, cz, dy, dz, ny, nz, sweep):
+    """Row (cy + dy, cz + dz)'s run in sorted order from where its window may start for a vertex
+    whose sweep line is ``sweep`` (empty where the row lies outside the grid). Bisection: on x
+    sorted to within the quantisation slack it ends just past an entry left of ``sweep``, and
+    those before that one lie left of it plus the slack, out of reach."""
+    if not (0 <= cy + dy < ny and 0 <= cz + dz < nz):
+        return 0, 0
+    rr = r + dz * ny + dy
+    a, b = start[rr], start[rr + 1]
+    end = b
+    while a < b:
+        m = (a + b) >> 1
+        if sx[m] <= sweep:
+            a = m + 1
+        else:
+            b = m
+    return a, end
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -288,17 +299,17 @@ def _region_kernel(
             cy = min(np.int64(np.floor((py - lo[1]) * inv_cell)), ny - 1)  # as _row_sort
             cz = min(np.int64(np.floor((pz - lo[2]) * inv_cell)), nz - 1)
             r = cz * ny + cy
-            if r != row:  # a new row: its neighbour rows' pointers from their starts
+            if r != row:  # a new row: its neighbour rows' pointers afresh
                 row = r
                 y0, z0 = lo[1] + cy * cell, lo[2] + cz * cell
-                j1, e1 = _row_run(start, r, cy, cz, 1, 0, ny, nz)
-                j2, e2 = _row_run(start, r, cy, cz, -1, 1, ny, nz)
-                j3, e3 = _row_run(start, r, cy, cz, 0, 1, ny, nz)
-                j4, e4 = _row_run(start, r, cy, cz, 1, 1, ny, nz)
-                j5, e5 = _row_run(start, r, cy, cz, -1, -1, ny, nz)
-                j6, e6 = _row_run(start, r, cy, cz, 0, -1, ny, nz)
-                j7, e7 = _row_run(start, r, cy, cz, 1, -1, ny, nz)
-                j8, e8 = _row_run(start, r, cy, cz, -1, 0, ny, nz)
+                j1, e1 = _row_run(start, sx, r, cy, cz, 1, 0, ny, nz, px - reach)
+                j2, e2 = _row_run(start, sx, r, cy, cz, -1, 1, ny, nz, px - reach)
+                j3, e3 = _row_run(start, sx, r, cy, cz, 0, 1, ny, nz, px - reach)
+                j4, e4 = _row_run(start, sx, r, cy, cz, 1, 1, ny, nz, px - reach)
+                j5, e5 = _row_run(start, sx, r, cy, cz, -1, -1, ny, nz, px - reach)
+                j6, e6 = _row_run(start, sx, r, cy, cz, 0, -1, ny, nz, px - reach)
+                j7, e7 = _row_run(start, sx, r, cy, cz, 1, -1, ny, nz, px - reach)
+                j8, e8 = _row_run(start, sx, r, cy, cz, -1, 0, ny, nz, px - reach)
                 j0 = start[r]
             si = sstrand[i]
             pos = n * cap
