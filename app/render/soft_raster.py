@@ -67,11 +67,14 @@ def _unit(c):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _setup_kernel(points, starts, colors, m, w, h, margin, seg, box):
-    """Window coordinates and colours of every segment's ends, and the rows ``box[0, i] …
-    box[1, i]`` and columns ``box[2, i] … box[3, i]`` it may touch (rows ``0 … −1``: none,
-    e.g. wholly behind the eye or off the image)."""
+def _setup_kernel(points, starts, colors, m, w, h, margin, seg, box, which):
+    """Window coordinates and colours of every segment's ends (or of those flagged in
+    ``which``, when it is not empty), and the rows ``box[0, i] … box[1, i]`` and columns
+    ``box[2, i] … box[3, i]`` it may touch (rows ``0 … −1``: none, e.g. wholly behind the
+    eye or off the image)."""
     for i in prange(starts.size):
+        if which.size and not which[i]:
+            continue
         box[0, i], box[1, i], box[2, i], box[3, i] = 0, -1, 0, -1
         a = starts[i]
         ax, ay, az, aw = _project(points, a, m)
@@ -279,15 +282,30 @@ def draw_bands(seg, box, bounds, half, clear, background, rgba, depth) -> None:
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _changed_segments(seg, box, old_seg, old_box, changed):
-    """Whether each segment projects to other numbers than before (ends, depths, colours, box)."""
-    for i in prange(box.shape[1]):
-        same = True
-        for a in range(_SEG):
-            same &= seg[i, a] == old_seg[i, a]
-        for a in range(4):
-            same &= box[a, i] == old_box[a, i]
-        changed[i] = not same
+def _changed_vertices(points, colors, last_points, last_colors, flags):
+    """Flag the vertices whose position or colour differs from the last, bit for bit, and
+    bring the last ones up to date."""
+    a, b = points.view(np.uint32), last_points.view(np.uint32)
+    c, d = colors.view(np.uint32), last_colors.view(np.uint32)
+    for i in prange(points.shape[0]):
+        differ = False
+        for k in range(3):
+            differ |= (a[i, k] != b[i, k]) | (c[i, k] != d[i, k])
+        flags[i] = differ
+        if differ:
+            for k in range(3):
+                b[i, k], d[i, k] = a[i, k], c[i, k]
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _changed_ends(starts, flags, which):
+    """Flag the segments with an end among the flagged vertices; returns how many."""
+    n = 0
+    for i in prange(starts.size):
+        changed = flags[starts[i]] | flags[starts[i] + 1]
+        which[i] = changed
+        n += changed
+    return n
 
 
 @njit(cache=True, nogil=True)
@@ -391,11 +409,9 @@ def _balanced_jobs(work: NDArray[np.int64], n: int) -> tuple[NDArray[np.int64], 
 
 
 def _check(points, starts, colors, mvp, size, width):
-    p = np.asarray(points)
-    if p.dtype != np.float32:
-        p = p.astype(np.float32)
+    p = np.ascontiguousarray(points, np.float32)
     s = np.ascontiguousarray(starts, np.int64)
-    c = np.asarray(colors, np.float32)
+    c = np.ascontiguousarray(colors, np.float32)
     m = np.ascontiguousarray(mvp, np.float64)
     w, h = (int(v) for v in size)
     if p.ndim != 2 or p.shape[1] != 3 or c.shape != p.shape:
@@ -414,23 +430,30 @@ def _check(points, starts, colors, mvp, size, width):
 class StrandRaster:
     """:meth:`draw` into images kept between calls (made again only when the size changes).
 
-    A draw with a ``clear`` colour after one of the same size, width and colour redraws only
-    the tiles under the segments that changed (where they were and where they are), when those
-    are few: the bytes are those of a full draw (the tests hold it to that). :attr:`changed`
-    says which rows and columns the last draw may have changed, for an upload of just those.
+    A draw with a ``clear`` colour after one of the same segments, camera, size, width and
+    colour redraws only the tiles under the segments with a vertex that moved or changed colour
+    (where they were and where they are), when those are few: the bytes are those of a full
+    draw (the tests hold it to that). :attr:`changed` says which rows and columns the last draw
+    may have changed, for an upload of just those.
     """
 
     def __init__(self) -> None:
         self._rgba32 = np.zeros((0, 0), np.uint32)  # the kernels write whole pixels
         self.rgba = self._rgba32.view(np.uint8).reshape(0, 0, 4)
         self.depth = np.zeros((0, 0), np.float32)
-        self._segs = [np.zeros((0, _SEG)), np.zeros((0, _SEG))]  # this draw's and the last's
-        self._boxes = [np.zeros((4, 0), np.int32), np.zeros((4, 0), np.int32)]
-        self._last: tuple | None = None  # (buffer slot, half, fill, size, segments) of the last clear draw
+        self._seg = np.zeros((0, _SEG))
+        self._box = np.zeros((4, 0), np.int32)
+        self._last: tuple | None = None  # (half, fill, size) of the images' last draw with a clear
+        self._last_mvp = np.zeros((4, 4))
+        self._last_starts = np.zeros(0, np.int64)
+        self._last_points = np.zeros((0, 3), np.float32)
+        self._last_colors = np.zeros((0, 3), np.float32)
+        self._flags = np.zeros(0, np.bool_)
+        self._which = np.zeros(0, np.bool_)
+        self._all = np.zeros(0, np.bool_)  # an empty mask: every segment
         self._counts = np.zeros(1, np.int64)
         self._entries = np.zeros(0, np.int64)
         self._near = np.zeros(0, np.int64)
-        self._changed = np.zeros(0, np.bool_)
         self.incremental = True  # redraw only what changed when it can (False: always all)
         self.changed: tuple[int, int, int, int] | None = None  # (row0, row1, col0, col1) or None
         self.tiles_redrawn = 0  # in the last draw; −1: all of the image
@@ -467,65 +490,78 @@ class StrandRaster:
         Returns :meth:`images`; the next draw overwrites them."""
         p, s, c, m, w, h, width = _check(points, starts, colors, mvp, size, width)
         rgba, depth = self._images((w, h))
-        n = s.size
-        last = self._last
-        self._last = None
-        slot = 1 - last[0] if last is not None else 0
-        seg, bx = self._segment_buffers(n, slot)
         half = 0.0 if width <= 1.0 else 0.5 * width
-        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, seg, bx)
         fill = np.array(clear if clear is not None else (0, 0, 0, 0), np.uint8).view(np.uint32)[0]
-        key = (half, int(fill), (w, h), n)
-        if clear is not None and self.incremental and last is not None and last[1:] == key:
-            done = self._redraw_changed(seg, bx, last[0], half, fill, rgba, depth)
-        else:
-            done = False
-        if not done:
-            # One band per thread: more, smaller bands cut more segments in two, which cost
-            # more than the better balance gained.
-            bounds = band_bounds(bx[0], bx[1], h, numba.get_num_threads())
-            draw_bands(seg, bx, bounds, half, clear is not None, fill, self._rgba32, depth)
-            self.changed, self.tiles_redrawn = (0, h, 0, w), -1
+        key = (half, int(fill), (w, h))
+        same = (
+            clear is not None
+            and self.incremental
+            and self._last == key
+            and self._last_points.shape == p.shape
+            and np.array_equal(self._last_mvp, m)
+            and np.array_equal(self._last_starts, s)
+        )
+        self._last = None
+        if not (same and self._redraw_changed(p, s, c, m, half, fill, rgba, depth)):
+            self._draw_all(p, s, c, m, half, clear is not None, fill, depth)
         if clear is not None:
-            self._last = (slot, *key)
+            self._last = key
         return rgba, depth
 
-    def _segment_buffers(self, n: int, slot: int) -> tuple[NDArray, NDArray]:
-        """The segment and box arrays of ``slot`` (the other holds the last draw's), for n."""
-        if self._segs[slot].shape[0] < n:
-            self._segs[slot] = np.empty((n, _SEG))
-            self._boxes[slot] = np.empty((4, n), np.int32)
-        return self._segs[slot][:n], self._boxes[slot][:, :n]
-
-    def _redraw_changed(self, seg, bx, last_slot, half, fill, rgba, depth) -> bool:
-        """Redraw the tiles the changed segments touch; False when a full draw is cheaper."""
-        n = seg.shape[0]
-        old_seg, old_bx = self._segs[last_slot][:n], self._boxes[last_slot][:, :n]
-        if self._changed.size < n:
-            self._changed = np.empty(n, np.bool_)
-        changed = self._changed[:n]
-        _changed_segments(seg, bx, old_seg, old_bx, changed)
+    def _draw_all(self, p, s, c, m, half, clear, fill, depth) -> None:
         h, w = depth.shape
-        dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
-        _mark_tiles(old_bx, changed, dirty, TILE_SHIFT)  # where they were and where they are
-        if _mark_tiles(bx, changed, dirty, TILE_SHIFT) == 0:
+        n = s.size
+        if self._seg.shape[0] != n:
+            self._seg, self._box = np.empty((n, _SEG)), np.empty((4, n), np.int32)
+        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, self._seg, self._box, self._all)
+        # One band per thread: more, smaller bands cut more segments in two, which cost more
+        # than the better balance gained.
+        bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads())
+        draw_bands(self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth)
+        self.changed, self.tiles_redrawn = (0, h, 0, w), -1
+        self._last_mvp, self._last_starts = m.copy(), s.copy()
+        self._last_points, self._last_colors = p.copy(), c.copy()
+
+    def _redraw_changed(self, p, s, c, m, half, fill, rgba, depth) -> bool:
+        """Redraw the tiles the changed segments touch; False when a full draw is cheaper."""
+        n, v = s.size, p.shape[0]
+        if self._flags.size != v:
+            self._flags = np.empty(v, np.bool_)
+        if self._which.size != n:
+            self._which = np.empty(n, np.bool_)
+        _changed_vertices(p, c, self._last_points, self._last_colors, self._flags)
+        if _changed_ends(s, self._flags, self._which) == 0:
             self.changed, self.tiles_redrawn = None, 0
             return True
+        h, w = depth.shape
+        dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
+        _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # where they were,
+        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, self._seg, self._box, self._which)
+        _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # and where they are
         if self._counts.size != dirty.size + 1:
             self._counts = np.zeros(dirty.size + 1, np.int64)
         if self._near.size < n:
             self._near = np.empty(n, np.int64)
-        total = _bin_segments(bx, dirty, TILE_SHIFT, self._counts, self._entries, self._near)
+        total = _bin_segments(self._box, dirty, TILE_SHIFT, self._counts, self._entries, self._near)
         if total > REDRAW_ALL * n:  # measured: then a full draw is as fast
             return False
         if self._entries.size < total:
             self._entries = np.empty(int(total * 1.5) + 64, np.int64)
-            _bin_segments(bx, dirty, TILE_SHIFT, self._counts, self._entries, self._near)
+            _bin_segments(self._box, dirty, TILE_SHIFT, self._counts, self._entries, self._near)
         work = np.diff(self._counts)
         work[dirty.reshape(-1)] += 1  # a dirty tile without segments is still cleared
         jobs, job_start = _balanced_jobs(work, numba.get_num_threads())
         _draw_tiles(
-            seg, jobs, job_start, self._counts, self._entries, TILE_SHIFT, half, fill, self._rgba32, depth
+            self._seg,
+            jobs,
+            job_start,
+            self._counts,
+            self._entries,
+            TILE_SHIFT,
+            half,
+            fill,
+            self._rgba32,
+            depth,
         )
         rows, cols = np.flatnonzero(dirty.any(axis=1)), np.flatnonzero(dirty.any(axis=0))
         self.changed = (
