@@ -263,6 +263,9 @@ class ClumpRecord:
         self.weight = np.empty(vertices)
         self.step = 0.0
         self.mean_neighbours = 0.0
+        self.lists = np.empty((vertices, 16), np.int32)  # each vertex's list, original indices
+        self.list_count = np.empty(vertices, np.int64)
+        self.dense = False  # the run's lists came from the row grid (the lists above are valid)
 
     def fits(self, vertices: int, iterations: int) -> bool:
         return self.iterates.shape[:2] == (iterations, vertices)
@@ -369,6 +372,9 @@ def clump_points(
         _NO_RECORD if rec is None else (rec.iterates, rec.forces, rec.count, rec.weight),
     )  # fmt: skip
     if rec is not None:
+        rec.dense = nl.dense
+        while rec.dense and nl.padded_lists(rec.lists, rec.list_count) > rec.lists.shape[1]:
+            rec.lists = np.empty((v, 2 * rec.lists.shape[1]), np.int32)
         rec.key = record_key(groom, h, k, step, gap_mode, seed)
         rec.points[:] = groom.points
         rec.result[:] = out

@@ -110,18 +110,17 @@ def region_offsets(m: int) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _region_force(P, nbr, cnt, region, roots, h, stats, F, best, count, weight, ident):
+def _region_force(P, flat, cap, list_count, region, roots, h, stats, F, best, count, weight, ident):
     """:func:`hairtool.clump._force_kernel` for the vertices ``region`` (original indices) with
-    their lists in rows of ``nbr``: the same pulls in the same order, so the same numbers.
-    ``P``, ``F``, ``count``, ``weight`` in original order; ``best`` per region vertex."""
+    vertex i's list at ``flat[i·cap :][: list_count[i]]``: the same pulls in the same order, so
+    the same numbers. ``P``, ``F``, ``count``, ``weight`` in original order; ``best`` per
+    region vertex."""
     inv_h = 1.0 / h
-    cap = nbr.shape[1]
-    flat = nbr.reshape(-1)
     for n in prange(region.size):
         i = region[n]
         acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
         px, py, pz = P[i, 0], P[i, 1], P[i, 2]
-        a0, a1 = n * cap, n * cap + cnt[n]
+        a0, a1 = i * cap, i * cap + list_count[i]
         if not roots[i]:
             acc = _pull(P, flat, a0, a1, px, py, pz, h, inv_h, stats, acc)
         fx, fy, fz, br, bj, tie, c, wsum = acc
@@ -153,6 +152,16 @@ def _region_gap(P, F, step, best, region, h, gap, it, seed, out):
 
 
 @njit(cache=True, nogil=True, parallel=True)
+def _store_lists(lists, list_count, rows, nbr, cnt):
+    """Region lists (rows of ``nbr``) into the record's rows ``rows``."""
+    for n in prange(rows.size):
+        i = rows[n]
+        list_count[i] = cnt[n]
+        for m in range(cnt[n]):
+            lists[i, m] = nbr[n, m]
+
+
+@njit(cache=True, nogil=True, parallel=True)
 def _set_rows(dst, src, rows):
     for n in prange(rows.size):
         for a in range(3):
@@ -164,6 +173,20 @@ def _sorted_stats(order, count, weight, sorted_count, sorted_weight):
     for k in prange(order.size):
         sorted_count[k] = count[order[k]]
         sorted_weight[k] = weight[order[k]]
+
+
+def _within(points, last, changed, lo, hi, reach, sc, mask) -> int:
+    """``mask``: a superset of the vertices within ``reach`` of a changed vertex, where it is or
+    where it was (the cells around the ones that hold them, cells at least ``reach`` wide).
+    Returns how many."""
+    cell = max(reach / CELLS_PER_REACH, float((hi - lo).max()) / (MAX_SIDE - 1))
+    dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
+    cells = int(np.prod(dims))
+    if sc.near.size < cells:
+        sc.near, sc.marked = np.empty(cells, np.bool_), np.zeros(cells, np.bool_)
+    marked = np.empty(2 * changed.size, np.int64)
+    marked = marked[: _mark_changed_cells(points, last, changed, lo, 1.0 / cell, dims, marked, sc.marked)]
+    return _region(points, lo, 1.0 / cell, dims, marked, sc.offsets, sc.near, mask)
 
 
 class RegionScratch:
@@ -184,6 +207,7 @@ class RegionScratch:
         if self.flags.size != v:
             self.flags = np.empty(v, np.bool_)
             self.mask = np.empty(v, np.bool_)
+            self.relist = np.empty(v, np.bool_)
             self.ident = np.arange(v, dtype=np.int64)
 
 
@@ -209,18 +233,10 @@ def _update_region(
         return None
     radius = h * (1.0 + MARGIN)
     lo, hi = (b.astype(np.float64) for b in box(points))
-    # Cells of k·R / m with the offsets within m cells, or larger ones (then m cells reach farther).
-    cell = max(iterations * radius / CELLS_PER_REACH, float((hi - lo).max()) / (MAX_SIDE - 1))
-    dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
-    cells = int(np.prod(dims))
-    if sc.near.size < cells:
-        sc.near, sc.marked = np.empty(cells, np.bool_), np.zeros(cells, np.bool_)
-    marked = np.empty(2 * changed.size, np.int64)
-    marked = marked[
-        : _mark_changed_cells(points, rec.points, changed, lo, 1.0 / cell, dims, marked, sc.marked)
-    ]
-    n = _region(points, lo, 1.0 / cell, dims, marked, sc.offsets, sc.near, sc.mask)
-    if n > MAX_REGION * v:
+    if (
+        not rec.dense
+        or _within(points, rec.points, changed, lo, hi, iterations * radius, sc, sc.mask) > MAX_REGION * v
+    ):
         return None
     top = groom.topology
     roots = ws.roots_mask(top)
@@ -228,22 +244,33 @@ def _update_region(
     nl = ws.neighbours
     if not nl.sort(points, top.strand_index, roots, radius, (lo, hi)):
         return None
-    positions = np.flatnonzero(sc.mask[nl.order])  # the region in sorted order
+    ws.recorded = None  # rewritten from here on
+    # New lists for the vertices within R of a changed one (the others' are those recorded).
+    _within(points, rec.points, changed, lo, hi, radius, sc, sc.relist)
+    positions = np.flatnonzero(sc.relist[nl.order])
     while True:
         nbr, cnt = nl.region_lists(positions, sc.capacity)
         longest = int(cnt.max()) if cnt.size else 0
         if longest < sc.capacity:
             break
         sc.capacity = (longest + 16) // 16 * 16
-    region = nl.order[positions]
-    ws.recorded = None  # rewritten from here on
+    if longest > rec.lists.shape[1]:
+        wider = np.empty((v, sc.capacity), np.int32)
+        wider[:, : rec.lists.shape[1]] = rec.lists
+        rec.lists = wider
+    _store_lists(rec.lists, rec.list_count, nl.order[positions], nbr, cnt)
+    region = nl.order[np.flatnonzero(sc.mask[nl.order])]  # in sorted order
     _set_rows(rec.iterates[0], points, region)  # the first iterate: the points
     best = np.empty(region.size, np.int64)
+    flat = rec.lists.reshape(-1)
     k_step = 0.0 if step is None else float(step)
     gap, seed64 = {"printed": 0, "text": 1, "off": 2}[gap_mode], seed_u64(seed)
     for it in range(iterations):
         p, f = rec.iterates[it], rec.forces[it]
-        _region_force(p, nbr, cnt, region, roots, h, it == 0, f, best, rec.count, rec.weight, sc.ident)
+        _region_force(
+            p, flat, rec.lists.shape[1], rec.list_count, region, roots, h, it == 0, f, best, rec.count,
+            rec.weight, sc.ident,
+        )  # fmt: skip
         if it == 0:
             if step is None:  # Σg as a full run sums it, in its (sorted) order: the same bits
                 sorted_count, sorted_weight = np.empty(v, np.int64), np.empty(v)

@@ -555,6 +555,16 @@ class NeighbourList:
         )  # fmt: skip
         return flat.reshape(n, capacity), cnt
 
+    def padded_lists(self, lists: np.ndarray, counts: np.ndarray) -> int:
+        """After a row-grid :meth:`build`: every vertex's list in original indices, in row
+        ``order[k]`` of ``lists`` (V, cap) for sorted position k, its length in ``counts``.
+        Returns the longest length: when it is not below cap, the rows are cut."""
+        return int(
+            _padded_kernel(
+                self.order, self.aflat, self.aoff, self.acnt, self.bflat, self.bstart, lists, counts
+            )
+        )
+
     def _build_hashed(self, points, strand, skip, lo, radius) -> None:
         # Sparse hair in a large box: hash the 3-D cells into ~2V buckets.
         v = points.shape[0]
@@ -588,6 +598,28 @@ class NeighbourList:
         _compact_padded(self._nbr, cnt, offsets, self.aflat)
         self.aoff[:] = offsets[:-1]
         self.bstart[:] = 0  # the hashed lists are complete
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _padded_kernel(order, aflat, aoff, acnt, bflat, bstart, lists, counts):
+    """The forward then the backward run of each sorted position, in original indices, into the
+    row of its original vertex (cut at the row's width). Returns the longest list."""
+    cap = lists.shape[1]
+    longest = 0
+    for k in prange(order.size):
+        i = order[k]
+        n = 0
+        for e in range(aoff[k], aoff[k] + acnt[k]):
+            if n < cap:
+                lists[i, n] = order[aflat[e]]
+            n += 1
+        for e in range(bstart[k], bstart[k + 1]):
+            if n < cap:
+                lists[i, n] = order[bflat[e]]
+            n += 1
+        counts[i] = n
+        longest = max(longest, n)
+    return longest
 
 
 @njit(cache=True, nogil=True)
