@@ -259,7 +259,7 @@ def _update_region(
         wider[:, : rec.lists.shape[1]] = rec.lists
         rec.lists = wider
     _store_lists(rec.lists, rec.list_count, nl.order[positions], nbr, cnt)
-    region = nl.order[np.flatnonzero(sc.mask[nl.order])]  # in sorted order
+    region = np.flatnonzero(sc.mask)  # in original order: strand by strand, near in memory
     _set_rows(rec.iterates[0], points, region)  # the first iterate: the points
     best = np.empty(region.size, np.int64)
     flat = rec.lists.reshape(-1)

@@ -115,20 +115,26 @@ def _compact_padded(nbr, cnt, start, flat):
 
 
 # -- the row grid (the usual path) ---------------------------------------------------------------
+@njit(cache=True, nogil=True, parallel=True)
+def _row_keys(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx):
+    """Each vertex's row ``cz·ny + cy`` and quantised x."""
+    for i in prange(p.shape[0]):
+        cy = min(np.int64(np.floor((p[i, 1] - lo[1]) * inv_cell)), ny - 1)
+        cz = min(np.int64(np.floor((p[i, 2] - lo[2]) * inv_cell)), nz - 1)
+        keys[i] = cz * ny + cy
+        qx[i] = min(np.int64(np.floor((p[i, 0] - lo[0]) * inv_q)), nq - 1)
+
+
 @njit(cache=True, nogil=True)
 def _row_sort(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx, start, order, tmp):
     """Vertices by row ``cz·ny + cy``, inside a row by x quantised to ``nq`` steps over the box:
     two stable counting sorts (quantised x, then row), no comparisons. ``start``: row offsets."""
     n_rows = ny * nz
     v = p.shape[0]
+    _row_keys(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx)
     count = np.zeros(nq + 1, np.int64)
     for i in range(v):
-        cy = min(np.int64(np.floor((p[i, 1] - lo[1]) * inv_cell)), ny - 1)
-        cz = min(np.int64(np.floor((p[i, 2] - lo[2]) * inv_cell)), nz - 1)
-        keys[i] = cz * ny + cy
-        q = min(np.int64(np.floor((p[i, 0] - lo[0]) * inv_q)), nq - 1)
-        qx[i] = q
-        count[q + 1] += 1
+        count[qx[i] + 1] += 1
     for q in range(nq):
         count[q + 1] += count[q]
     for i in range(v):
