@@ -266,6 +266,7 @@ class ClumpRecord:
         self.lists = np.empty((vertices, 16), np.int32)  # each vertex's list, original indices
         self.list_count = np.empty(vertices, np.int64)
         self.dense = False  # the run's lists came from the row grid (the lists above are valid)
+        self.frame: tuple | None = None  # that grid's corner and size: its lists' order
 
     def fits(self, vertices: int, iterations: int) -> bool:
         return self.iterates.shape[:2] == (iterations, vertices)
@@ -373,6 +374,7 @@ def clump_points(
     )  # fmt: skip
     if rec is not None:
         rec.dense = nl.dense
+        rec.frame = (tuple(nl.lo), tuple(nl.dims)) if nl.dense else None
         while rec.dense and nl.padded_lists(rec.lists, rec.list_count) > rec.lists.shape[1]:
             rec.lists = np.empty((v, 2 * rec.lists.shape[1]), np.int32)
         rec.key = record_key(groom, h, k, step, gap_mode, seed)

@@ -1,17 +1,20 @@
 """ClumpWithGaps again after an edit, redone only near the vertices whose input changed.
 
-While a brush drags, a few percent of the vertices move per mouse move. After k Jacobi
-iterations a vertex depends only on the vertices within k steps of the candidate graph (pairs
-closer than R = h·(1 + MARGIN) at the start), so on nothing farther than k·R; and its
-neighbour list keeps its order (a full build orders a list by sorted position, and the sort
-keeps the relative order of the vertices that did not move). So a vertex farther than k·R
-from every changed vertex, where it was and where it is, ends exactly where the last run left
-it. :func:`clump_points_interactive` keeps a :class:`~hairtool.clump.ClumpRecord` of each run
-(its input, output, and each iteration's points and forces) and redoes only the region of
-grid cells (at least k·R wide) around the changed ones, reading the record for neighbours
-outside it. The bytes are those of a full run (the tests hold it to that); where the
-automatic step comes out different, too many vertices changed, or the parameters did, it
-runs in full.
+While a brush drags, a few percent of the vertices move per mouse move. An iteration moves a
+vertex by the pulls of its list (the other-strand vertices closer than h·(1 + MARGIN) at the
+start) and, for the gap correction, by the force on its nearest neighbour, which comes from
+that one's list: after k iterations a vertex depends only on the vertices within 2k steps of
+the lists (k without the gap correction). A list keeps its order while its vertices stay: a
+full build orders it by sorted position on a grid that small edits leave as it is
+(:data:`hairtool.spatial.SNAP`), and the sort keeps the relative order of the vertices that
+did not move. So a vertex more than 2k steps from every changed vertex, along the lists of the
+last run and of this one, ends exactly where the last run left it. :func:`clump_points_interactive`
+keeps a :class:`~hairtool.clump.ClumpRecord` of each run (its input, output, each iteration's
+points and forces, every vertex's list), makes new lists for the changed vertices and those
+whose lists held or now hold one, and redoes the vertices within 2k steps, reading the record
+for their neighbours outside. The bytes are those of a full run (the tests hold it to that);
+where the automatic step comes out different, too many vertices changed, or the parameters
+did, it runs in full.
 """
 
 from __future__ import annotations
@@ -19,7 +22,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from hairtool.bounds import box
 from hairtool.clump import (
     MARGIN,
     ClumpWorkspace,
@@ -36,8 +38,6 @@ from hairtool.groom import Groom
 
 MAX_CHANGED = 0.25  # of the vertices: more changed, and the update runs in full
 MAX_REGION = 0.5  # of the vertices: a larger region runs in full
-MAX_SIDE = 128  # region grid cells per axis at most (the cells grow instead)
-CELLS_PER_REACH = 1  # grid cells across k·R (3 follow the changes 12 % closer; their 250 offsets cost more)
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -48,65 +48,50 @@ def _changed(points, last, flags):
         flags[i] = a[i, 0] != b[i, 0] or a[i, 1] != b[i, 1] or a[i, 2] != b[i, 2]
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _cell(x, y, z, lo, inv, dims):
-    """The grid cell (clamped into the grid) of (x, y, z), as one index. Scalars and tuples only:
-    an array passed to an inlined helper in a loop is reference-counted at every call."""
-    cx = min(max(np.int64(np.floor((x - lo[0]) * inv)), 0), dims[0] - 1)
-    cy = min(max(np.int64(np.floor((y - lo[1]) * inv)), 0), dims[1] - 1)
-    cz = min(max(np.int64(np.floor((z - lo[2]) * inv)), 0), dims[2] - 1)
-    return (cz * dims[1] + cy) * dims[0] + cx
+@njit(cache=True, nogil=True)
+def _relist(changed, nbr, cnt, lists, list_count, mark):
+    """Flag in ``mark`` the changed vertices and those in their new lists (rows of ``nbr``) or
+    their old ones (``lists``): the vertices whose lists may differ from the last run's."""
+    for n in range(changed.size):
+        mark[changed[n]] = True
+        for m in range(cnt[n]):
+            mark[nbr[n, m]] = True
+        i = changed[n]
+        for m in range(list_count[i]):
+            mark[lists[i, m]] = True
 
 
 @njit(cache=True, nogil=True)
-def _mark_changed_cells(points, last, changed, lo, inv, dims, cells, marked):
-    """The cells that hold a changed vertex, where it is or where it was, once each (into
-    ``cells``, flagged in ``marked``, which is left all False). Returns how many."""
+def _within_steps(k, seeds, lists, list_count, old_row, old_lists, old_count, mask, queue):
+    """``mask`` (all False before): the vertices within k steps of ``seeds`` along the lists, this run's
+    (``lists``) and, for the vertices with ``old_row`` ≥ 0, the last run's. Returns how many."""
     n = 0
-    for k in range(changed.size):
-        i = changed[k]
-        for c in (
-            _cell(points[i, 0], points[i, 1], points[i, 2], lo, inv, dims),
-            _cell(last[i, 0], last[i, 1], last[i, 2], lo, inv, dims),
-        ):
-            if not marked[c]:
-                marked[c] = True
-                cells[n] = c
-                n += 1
-    for k in range(n):
-        marked[cells[k]] = False
+    for s in seeds:
+        if not mask[s]:
+            mask[s] = True
+            queue[n] = s
+            n += 1
+    a = 0
+    for _ in range(k):
+        b = n
+        for q in range(a, b):
+            u = queue[q]
+            for m in range(list_count[u]):
+                w = lists[u, m]
+                if not mask[w]:
+                    mask[w] = True
+                    queue[n] = w
+                    n += 1
+            r = old_row[u]
+            if r >= 0:
+                for m in range(old_count[r]):
+                    w = old_lists[r, m]
+                    if not mask[w]:
+                        mask[w] = True
+                        queue[n] = w
+                        n += 1
+        a = b
     return n
-
-
-@njit(cache=True, nogil=True, parallel=True)
-def _region(points, lo3, inv, dims3, cells, offsets, near, mask):
-    """``mask``: the vertices of the cells within the ``offsets`` of ``cells``. Returns how many."""
-    lo = (lo3[0], lo3[1], lo3[2])
-    dims = (dims3[0], dims3[1], dims3[2])
-    sx, sxy = dims[0], dims[0] * dims[1]
-    near[: sxy * dims[2]] = False
-    for k in range(cells.size):
-        c = cells[k]
-        cz, cy, cx = c // sxy, (c // sx) % dims[1], c % sx
-        for o in range(offsets.shape[0]):
-            x, y, z = cx + offsets[o, 0], cy + offsets[o, 1], cz + offsets[o, 2]
-            if 0 <= x < dims[0] and 0 <= y < dims[1] and 0 <= z < dims[2]:
-                near[z * sxy + y * sx + x] = True
-    n = 0
-    for i in prange(points.shape[0]):
-        inside = near[_cell(points[i, 0], points[i, 1], points[i, 2], lo, inv, dims)]
-        mask[i] = inside
-        n += inside
-    return n
-
-
-def region_offsets(m: int) -> np.ndarray:
-    """Cell offsets (d, 3) whose cells may hold points nearer than m cells to a point of the cell
-    at 0: the nearest points of cells d apart are cell·√Σ max(|d| − 1, 0)² apart."""
-    d = np.arange(-m, m + 1)
-    grid = np.stack(np.meshgrid(d, d, d, indexing="ij"), -1).reshape(-1, 3)
-    gap = np.maximum(np.abs(grid) - 1, 0)
-    return np.ascontiguousarray(grid[(gap * gap).sum(axis=1) < m * m], np.int64)
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -175,29 +160,12 @@ def _sorted_stats(order, count, weight, sorted_count, sorted_weight):
         sorted_weight[k] = weight[order[k]]
 
 
-def _within(points, last, changed, lo, hi, reach, sc, mask) -> int:
-    """``mask``: a superset of the vertices within ``reach`` of a changed vertex, where it is or
-    where it was (the cells around the ones that hold them, cells at least ``reach`` wide).
-    Returns how many."""
-    cell = max(reach / CELLS_PER_REACH, float((hi - lo).max()) / (MAX_SIDE - 1))
-    dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
-    cells = int(np.prod(dims))
-    if sc.near.size < cells:
-        sc.near, sc.marked = np.empty(cells, np.bool_), np.zeros(cells, np.bool_)
-    marked = np.empty(2 * changed.size, np.int64)
-    marked = marked[: _mark_changed_cells(points, last, changed, lo, 1.0 / cell, dims, marked, sc.marked)]
-    return _region(points, lo, 1.0 / cell, dims, marked, sc.offsets, sc.near, mask)
-
-
 class RegionScratch:
     """Buffers of the region updates, kept between them, and what the last one did."""
 
     def __init__(self) -> None:
         self.flags = np.zeros(0, np.bool_)
         self.mask = np.zeros(0, np.bool_)
-        self.near = np.zeros(0, np.bool_)
-        self.marked = np.zeros(0, np.bool_)
-        self.offsets = region_offsets(CELLS_PER_REACH)
         self.ident = np.zeros(0, np.int64)
         self.capacity = 32  # list slots per region vertex (grows to the longest list + 1)
         self.updates = 0  # region updates so far
@@ -206,8 +174,10 @@ class RegionScratch:
     def sized(self, v: int) -> None:
         if self.flags.size != v:
             self.flags = np.empty(v, np.bool_)
-            self.mask = np.empty(v, np.bool_)
-            self.relist = np.empty(v, np.bool_)
+            self.mask = np.zeros(v, np.bool_)
+            self.relist = np.zeros(v, np.bool_)
+            self.old_row = np.full(v, -1, np.int64)
+            self.queue = np.empty(v, np.int64)
             self.ident = np.arange(v, dtype=np.int64)
 
 
@@ -231,34 +201,50 @@ def _update_region(
         return rec.result.copy()
     if changed.size > MAX_CHANGED * v:
         return None
-    radius = h * (1.0 + MARGIN)
-    lo, hi = (b.astype(np.float64) for b in box(points))
-    if (
-        not rec.dense
-        or _within(points, rec.points, changed, lo, hi, iterations * radius, sc, sc.mask) > MAX_REGION * v
-    ):
+    if not rec.dense:
         return None
+    radius = h * (1.0 + MARGIN)
     top = groom.topology
     roots = ws.roots_mask(top)
     ws.invalidate()  # the sort below replaces the kept list's order
     nl = ws.neighbours
-    if not nl.sort(points, top.strand_index, roots, radius, (lo, hi)):
-        return None
+    if not nl.sort(points, top.strand_index, roots, radius) or (tuple(nl.lo), tuple(nl.dims)) != rec.frame:
+        return None  # another grid: every list may come in another order
     ws.recorded = None  # rewritten from here on
-    # New lists for the vertices within R of a changed one (the others' are those recorded).
-    _within(points, rec.points, changed, lo, hi, radius, sc, sc.relist)
-    positions = np.flatnonzero(sc.relist[nl.order])
-    while True:
-        nbr, cnt = nl.region_lists(positions, sc.capacity)
-        longest = int(cnt.max()) if cnt.size else 0
-        if longest < sc.capacity:
-            break
-        sc.capacity = (longest + 16) // 16 * 16
+    # New lists: the changed vertices', then those of the vertices their lists held or hold.
+    nbr_c, cnt_c = _lists(nl, np.flatnonzero(sc.flags[nl.order]), sc)
+    sc.relist[:] = False
+    _relist(changed, nbr_c, cnt_c, rec.lists, rec.list_count, sc.relist)
+    sc.relist[changed] = False
+    nbr_r, cnt_r = _lists(nl, np.flatnonzero(sc.relist[nl.order]), sc)
+    sc.relist[changed] = True
+    redo = np.flatnonzero(sc.relist)
+    old_lists, old_count = rec.lists[redo], rec.list_count[redo]
+    longest = max(int(cnt_c.max(initial=0)), int(cnt_r.max(initial=0)))
     if longest > rec.lists.shape[1]:
         wider = np.empty((v, sc.capacity), np.int32)
         wider[:, : rec.lists.shape[1]] = rec.lists
         rec.lists = wider
-    _store_lists(rec.lists, rec.list_count, nl.order[positions], nbr, cnt)
+    _store_lists(rec.lists, rec.list_count, nl.order[np.flatnonzero(sc.flags[nl.order])], nbr_c, cnt_c)
+    sc.relist[changed] = False
+    _store_lists(rec.lists, rec.list_count, nl.order[np.flatnonzero(sc.relist[nl.order])], nbr_r, cnt_r)
+    # The region: within 2k steps of a changed vertex (k without gaps), along both runs' lists.
+    sc.old_row[redo] = np.arange(redo.size)
+    sc.mask[:] = False
+    n = _within_steps(
+        iterations * (1 if gap_mode == "off" else 2),
+        changed,
+        rec.lists,
+        rec.list_count,
+        sc.old_row,
+        old_lists,
+        old_count,
+        sc.mask,
+        sc.queue,
+    )
+    sc.old_row[redo] = -1
+    if n > MAX_REGION * v:
+        return None
     region = np.flatnonzero(sc.mask)  # in original order: strand by strand, near in memory
     _set_rows(rec.iterates[0], points, region)  # the first iterate: the points
     best = np.empty(region.size, np.int64)
@@ -289,6 +275,15 @@ def _update_region(
     sc.updates += 1
     sc.fraction = region.size / v
     return rec.result.copy()
+
+
+def _lists(nl, positions: np.ndarray, sc: RegionScratch) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`~hairtool.spatial.NeighbourList.region_lists`, wide enough (the width adapts)."""
+    while True:
+        nbr, cnt = nl.region_lists(positions, sc.capacity)
+        if cnt.size == 0 or int(cnt.max()) < sc.capacity:
+            return nbr, cnt
+        sc.capacity = (int(cnt.max()) + 16) // 16 * 16
 
 
 def clump_points_interactive(

@@ -26,6 +26,7 @@ _MAXC = (1 << _BITS) - 2
 _HASH = np.uint64(0x9E3779B97F4A7C15)
 _CHUNKS = 64  # search tasks (the lists do not depend on them): many, so that threads stay balanced
 _CHUNK_MIN = 256  # vertices per task at least
+SNAP = 16  # radii: the grid's corners lie on a lattice this coarse
 
 
 # -- the hashed fallback (sparse hair in a huge box) ---------------------------------------------
@@ -494,6 +495,10 @@ class NeighbourList:
             raise ParameterError("clump_radius", radius, f"a distance above {extent / _MAXC:.3g}")
         self._buffers(v)
         self.radius = float(radius)
+        # The grid on a lattice of SNAP radii around the box: an edit that moves the box a little
+        # leaves the grid, and so the order of every list, as it was (hairtool.clump_region).
+        snap = SNAP * self.radius
+        lo, hi = np.floor(lo / snap) * snap, (np.floor(hi / snap) + 1.0) * snap
         dims = (np.floor((hi - lo) / self.radius).astype(np.int64) + 1).tolist()  # rows r wide in y, z
         self.dense = dims[1] * dims[2] <= max(8 * v, 1 << 16) if dense is None else dense
         return lo, hi, dims
