@@ -51,20 +51,27 @@ def _changed(points, last, flags):
 @njit(cache=True, nogil=True)
 def _relist(changed, nbr, cnt, lists, list_count, mark):
     """Flag in ``mark`` the changed vertices and those in their new lists (rows of ``nbr``) or
-    their old ones (``lists``): the vertices whose lists may differ from the last run's."""
-    for n in range(changed.size):
-        mark[changed[n]] = True
-        for m in range(cnt[n]):
-            mark[nbr[n, m]] = True
-        i = changed[n]
+    their old ones (``lists``): the vertices whose lists may differ from the last run's.
+    Returns how many."""
+    n = 0
+    for k in range(changed.size):
+        i = changed[k]
+        n += not mark[i]
+        mark[i] = True
+        for m in range(cnt[k]):
+            n += not mark[nbr[k, m]]
+            mark[nbr[k, m]] = True
         for m in range(list_count[i]):
+            n += not mark[lists[i, m]]
             mark[lists[i, m]] = True
+    return n
 
 
 @njit(cache=True, nogil=True)
-def _within_steps(k, seeds, lists, list_count, old_row, old_lists, old_count, mask, queue):
-    """``mask`` (all False before): the vertices within k steps of ``seeds`` along the lists, this run's
-    (``lists``) and, for the vertices with ``old_row`` ≥ 0, the last run's. Returns how many."""
+def _within_steps(k, seeds, lists, list_count, old_row, old_lists, old_count, limit, mask, queue):
+    """``mask`` (all False before): the vertices within k steps of ``seeds`` along the lists,
+    this run's (``lists``) and, for the vertices with ``old_row`` ≥ 0, the last run's. Returns
+    how many, or stops once there are more than ``limit``."""
     n = 0
     for s in seeds:
         if not mask[s]:
@@ -73,6 +80,8 @@ def _within_steps(k, seeds, lists, list_count, old_row, old_lists, old_count, ma
             n += 1
     a = 0
     for _ in range(k):
+        if n > limit:
+            break
         b = n
         for q in range(a, b):
             u = queue[q]
@@ -169,6 +178,7 @@ class RegionScratch:
         self.ident = np.zeros(0, np.int64)
         self.capacity = 32  # list slots per region vertex (grows to the longest list + 1)
         self.updates = 0  # region updates so far
+        self.too_many = np.inf  # changed vertices of a try whose region was too large (grows)
         self.fraction = 1.0  # share of the vertices the last update redid (1: a full run)
 
     def sized(self, v: int) -> None:
@@ -199,9 +209,10 @@ def _update_region(
         ws.step, ws.mean_neighbours = rec.step, rec.mean_neighbours
         sc.fraction = 0.0
         return rec.result.copy()
-    if changed.size > MAX_CHANGED * v:
+    if changed.size > MAX_CHANGED * v or not rec.dense:
         return None
-    if not rec.dense:
+    if changed.size >= 0.5 * sc.too_many:  # about as many as made the last try too large:
+        sc.too_many *= 1.25  # try again in a few moves
         return None
     radius = h * (1.0 + MARGIN)
     top = groom.topology
@@ -214,7 +225,9 @@ def _update_region(
     # New lists: the changed vertices', then those of the vertices their lists held or hold.
     nbr_c, cnt_c = _lists(nl, np.flatnonzero(sc.flags[nl.order]), sc)
     sc.relist[:] = False
-    _relist(changed, nbr_c, cnt_c, rec.lists, rec.list_count, sc.relist)
+    if _relist(changed, nbr_c, cnt_c, rec.lists, rec.list_count, sc.relist) > MAX_REGION * v:
+        sc.too_many = changed.size
+        return None  # the region holds these and more
     sc.relist[changed] = False
     nbr_r, cnt_r = _lists(nl, np.flatnonzero(sc.relist[nl.order]), sc)
     sc.relist[changed] = True
@@ -239,11 +252,13 @@ def _update_region(
         sc.old_row,
         old_lists,
         old_count,
+        int(MAX_REGION * v),
         sc.mask,
         sc.queue,
     )
     sc.old_row[redo] = -1
     if n > MAX_REGION * v:
+        sc.too_many = changed.size
         return None
     region = np.flatnonzero(sc.mask)  # in original order: strand by strand, near in memory
     _set_rows(rec.iterates[0], points, region)  # the first iterate: the points
@@ -268,6 +283,7 @@ def _update_region(
             mean_nb = int(rec.count.sum()) / max(v - top.strand_count, 1)  # pairs per moving vertex
         out = rec.iterates[it + 1] if it + 1 < iterations else rec.result
         _region_gap(p, f, k_step, best, region, h, gap, it, seed64, out)
+    sc.too_many = np.inf
     rec.points[:] = points
     rec.mean_neighbours = mean_nb
     ws.recorded = rec
