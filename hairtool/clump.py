@@ -267,6 +267,7 @@ class ClumpRecord:
         self.list_count = np.empty(vertices, np.int64)
         self.dense = False  # the run's lists came from the row grid (the lists above are valid)
         self.frame: tuple | None = None  # that grid's corner and size: its lists' order
+        self.valid = False  # all of the above is one run's (False while being rewritten)
 
     def fits(self, vertices: int, iterations: int) -> bool:
         return self.iterates.shape[:2] == (iterations, vertices)
@@ -290,7 +291,7 @@ class ClumpWorkspace:
         self.step = 0.0  # Δt²/m used in the last run
         self.builds = 0  # neighbour lists built so far (the rest of the runs reused one)
         self.record = False  # keep a ClumpRecord of each run (the studio's updates in a region)
-        self.recorded: ClumpRecord | None = None
+        self.recorded: ClumpRecord | None = None  # kept for its buffers even when not valid
         self.region = None  # hairtool.clump_region's scratch, when it updates this workspace
         self._mask_for: object = None
         self._mask = np.zeros(0, bool)
@@ -357,7 +358,9 @@ def clump_points(
     h = float(radius)
     ws.step = 0.0
     ws.mean_neighbours = 0.0
-    last, ws.recorded = ws.recorded, None
+    last = ws.recorded
+    if last is not None:
+        last.valid = False
     if iterations == 0 or groom.strand_count < 2:
         return groom.points.copy()
     nl = ws.neighbour_list(groom, h)
@@ -381,6 +384,7 @@ def clump_points(
         rec.points[:] = groom.points
         rec.result[:] = out
         rec.step, rec.mean_neighbours = ws.step, ws.mean_neighbours
+        rec.valid = True
         ws.recorded = rec
     return out
 

@@ -195,9 +195,9 @@ def _update_region(
     groom: Groom, h: float, iterations: int, step: float | None, gap_mode: str, seed: int, ws: ClumpWorkspace
 ) -> np.ndarray | None:
     """The result redone near the changed vertices, or None where only a full run will do (the
-    record is then dropped, as this may have begun to rewrite it)."""
+    record is then marked not valid, as this may have begun to rewrite it)."""
     rec = ws.recorded
-    if rec is None or rec.key != record_key(groom, h, iterations, step, gap_mode, seed):
+    if rec is None or not rec.valid or rec.key != record_key(groom, h, iterations, step, gap_mode, seed):
         return None
     sc = ws.region
     v = groom.vertex_count
@@ -221,7 +221,7 @@ def _update_region(
     nl = ws.neighbours
     if not nl.sort(points, top.strand_index, roots, radius) or (tuple(nl.lo), tuple(nl.dims)) != rec.frame:
         return None  # another grid: every list may come in another order
-    ws.recorded = None  # rewritten from here on
+    rec.valid = False  # rewritten from here on
     # New lists: the changed vertices', then those of the vertices their lists held or hold.
     nbr_c, cnt_c = _lists(nl, np.flatnonzero(sc.flags[nl.order]), sc)
     sc.relist[:] = False
@@ -286,7 +286,7 @@ def _update_region(
     sc.too_many = np.inf
     rec.points[:] = points
     rec.mean_neighbours = mean_nb
-    ws.recorded = rec
+    rec.valid = True
     ws.step, ws.mean_neighbours = k_step, mean_nb
     sc.updates += 1
     sc.fraction = region.size / v
