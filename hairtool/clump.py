@@ -265,7 +265,8 @@ class ClumpRecord:
         self.mean_neighbours = 0.0
         self.lists = np.empty((vertices, 16), np.int32)  # each vertex's list, original indices
         self.list_count = np.empty(vertices, np.int64)
-        self.dense = False  # the run's lists came from the row grid (the lists above are valid)
+        self.lists_ready = False
+        self.dense = False  # the run's lists came from the row grid
         self.frame: tuple | None = None  # that grid's corner and size: its lists' order
         self.valid = False  # all of the above is one run's (False while being rewritten)
 
@@ -326,6 +327,10 @@ class ClumpWorkspace:
         self.builds += 1
         return self.neighbours
 
+    def holds_list_of(self, points: np.ndarray) -> bool:
+        """Whether the kept neighbour list is the one built for ``points``."""
+        return self._built is not None and _same_points(points, self._built[2])
+
     def buffers(self, v: int) -> tuple:
         """Iterates, f, nearest neighbour, counts, Σg and hash heads for V vertices, reused."""
         b = self._buffers
@@ -378,8 +383,7 @@ def clump_points(
     if rec is not None:
         rec.dense = nl.dense
         rec.frame = (tuple(nl.lo), tuple(nl.dims)) if nl.dense else None
-        while rec.dense and nl.padded_lists(rec.lists, rec.list_count) > rec.lists.shape[1]:
-            rec.lists = np.empty((v, 2 * rec.lists.shape[1]), np.int32)
+        rec.lists_ready = False  # filled from the workspace's list when an update first needs them
         rec.key = record_key(groom, h, k, step, gap_mode, seed)
         rec.points[:] = groom.points
         rec.result[:] = out

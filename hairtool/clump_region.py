@@ -179,6 +179,7 @@ class RegionScratch:
         self.capacity = 32  # list slots per region vertex (grows to the longest list + 1)
         self.updates = 0  # region updates so far
         self.too_many = np.inf  # changed vertices of a try whose region was too large (grows)
+        self.skipping = False  # the last update did not try
         self.fraction = 1.0  # share of the vertices the last update redid (1: a full run)
 
     def sized(self, v: int) -> None:
@@ -210,10 +211,18 @@ def _update_region(
         sc.fraction = 0.0
         return rec.result.copy()
     if changed.size > MAX_CHANGED * v or not rec.dense:
+        sc.skipping = changed.size > MAX_CHANGED * v  # (a record would not serve the next move either)
         return None
     if changed.size >= 0.5 * sc.too_many:  # about as many as made the last try too large:
         sc.too_many *= 1.25  # try again in a few moves
+        sc.skipping = True  # and meanwhile, run in full without recording
         return None
+    if not rec.lists_ready:  # the lists of the recorded full run, still in the workspace
+        if not ws.holds_list_of(rec.points):
+            return None
+        while ws.neighbours.padded_lists(rec.lists, rec.list_count) > rec.lists.shape[1]:
+            rec.lists = np.empty((v, 2 * rec.lists.shape[1]), np.int32)
+        rec.lists_ready = True
     radius = h * (1.0 + MARGIN)
     top = groom.topology
     roots = ws.roots_mask(top)
@@ -314,14 +323,15 @@ def clump_points_interactive(
     """:func:`~hairtool.clump.clump_points`, the same bytes, for a workspace that sees one
     edit after another: redone only near what changed since its last run when it can."""
     ws = workspace or ClumpWorkspace()
-    ws.record = True
     if ws.region is None:
         ws.region = RegionScratch()
+    ws.region.skipping = False
     out = None
     if iterations > 0 and groom.strand_count >= 2:
         seed = check_seed(seed)
         out = _update_region(groom, float(radius), int(iterations), step, gap_mode, seed, ws)
     if out is None:
         ws.region.fraction = 1.0
+        ws.record = not ws.region.skipping
         out = clump_points(groom, radius, iterations, step, gap_mode, seed, ws)
     return out
