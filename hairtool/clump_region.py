@@ -68,16 +68,19 @@ def _relist(changed, nbr, cnt, lists, list_count, mark):
 
 
 @njit(cache=True, nogil=True)
-def _within_steps(k, seeds, lists, list_count, old_row, old_lists, old_count, limit, mask, queue):
-    """``mask`` (all False before): the vertices within k steps of ``seeds`` along the lists,
-    this run's (``lists``) and, for the vertices with ``old_row`` ≥ 0, the last run's. Returns
-    how many, or stops once there are more than ``limit``."""
+def _within_steps(k, seeds, lists, list_count, new_row, nbr_a, cnt_a, nbr_b, cnt_b, limit, mask, queue):
+    """``mask`` (all False before): the vertices within k steps of ``seeds`` along the last
+    run's lists (``lists``) and this run's: the same, but for the vertices with ``new_row`` r ≥ 0,
+    whose new list is row r of ``nbr_a``, or r − len(nbr_a) of ``nbr_b``. Returns how many, or
+    stops once there are more than ``limit``. (The visits are written out: an inlined helper
+    given the arrays would count references at every call.)"""
     n = 0
     for s in seeds:
         if not mask[s]:
             mask[s] = True
             queue[n] = s
             n += 1
+    na = cnt_a.size
     a = 0
     for _ in range(k):
         if n > limit:
@@ -91,10 +94,11 @@ def _within_steps(k, seeds, lists, list_count, old_row, old_lists, old_count, li
                     mask[w] = True
                     queue[n] = w
                     n += 1
-            r = old_row[u]
+            r = new_row[u]
             if r >= 0:
-                for m in range(old_count[r]):
-                    w = old_lists[r, m]
+                row, cnt = (nbr_a[r], cnt_a[r]) if r < na else (nbr_b[r - na], cnt_b[r - na])
+                for m in range(cnt):
+                    w = row[m]
                     if not mask[w]:
                         mask[w] = True
                         queue[n] = w
@@ -187,7 +191,7 @@ class RegionScratch:
             self.flags = np.empty(v, np.bool_)
             self.mask = np.zeros(v, np.bool_)
             self.relist = np.zeros(v, np.bool_)
-            self.old_row = np.full(v, -1, np.int64)
+            self.new_row = np.full(v, -1, np.int64)
             self.queue = np.empty(v, np.int64)
             self.ident = np.arange(v, dtype=np.int64)
 
@@ -238,37 +242,29 @@ def _update_region(
         sc.too_many = changed.size
         return None  # the region holds these and more
     sc.relist[changed] = False
+    ids_r = nl.order[np.flatnonzero(sc.relist[nl.order])]
     nbr_r, cnt_r = _lists(nl, np.flatnonzero(sc.relist[nl.order]), sc)
-    sc.relist[changed] = True
-    redo = np.flatnonzero(sc.relist)
-    old_lists, old_count = rec.lists[redo], rec.list_count[redo]
+    ids_c = nl.order[np.flatnonzero(sc.flags[nl.order])]
+    # The region: within 2k steps of a changed vertex (k without gaps), along both runs' lists.
+    sc.new_row[ids_c] = np.arange(ids_c.size)
+    sc.new_row[ids_r] = np.arange(ids_c.size, ids_c.size + ids_r.size)
+    sc.mask[:] = False
+    n = _within_steps(
+        iterations * (1 if gap_mode == "off" else 2), changed, rec.lists, rec.list_count, sc.new_row,
+        nbr_c, cnt_c, nbr_r, cnt_r, int(MAX_REGION * v), sc.mask, sc.queue,
+    )  # fmt: skip
+    sc.new_row[ids_c] = -1
+    sc.new_row[ids_r] = -1
+    if n > MAX_REGION * v:
+        sc.too_many = changed.size
+        return None
     longest = max(int(cnt_c.max(initial=0)), int(cnt_r.max(initial=0)))
     if longest > rec.lists.shape[1]:
         wider = np.empty((v, sc.capacity), np.int32)
         wider[:, : rec.lists.shape[1]] = rec.lists
         rec.lists = wider
-    _store_lists(rec.lists, rec.list_count, nl.order[np.flatnonzero(sc.flags[nl.order])], nbr_c, cnt_c)
-    sc.relist[changed] = False
-    _store_lists(rec.lists, rec.list_count, nl.order[np.flatnonzero(sc.relist[nl.order])], nbr_r, cnt_r)
-    # The region: within 2k steps of a changed vertex (k without gaps), along both runs' lists.
-    sc.old_row[redo] = np.arange(redo.size)
-    sc.mask[:] = False
-    n = _within_steps(
-        iterations * (1 if gap_mode == "off" else 2),
-        changed,
-        rec.lists,
-        rec.list_count,
-        sc.old_row,
-        old_lists,
-        old_count,
-        int(MAX_REGION * v),
-        sc.mask,
-        sc.queue,
-    )
-    sc.old_row[redo] = -1
-    if n > MAX_REGION * v:
-        sc.too_many = changed.size
-        return None
+    _store_lists(rec.lists, rec.list_count, ids_c, nbr_c, cnt_c)
+    _store_lists(rec.lists, rec.list_count, ids_r, nbr_r, cnt_r)
     region = np.flatnonzero(sc.mask)  # in original order: strand by strand, near in memory
     _set_rows(rec.iterates[0], points, region)  # the first iterate: the points
     best = np.empty(region.size, np.int64)
