@@ -19,6 +19,7 @@ within h. (A pair farther apart than 1.1·h at the start never interacts in that
 :func:`clump` runs numba kernels on a cell-sorted list of them, built when the points change
 (an update on the points of the last one, e.g. a clump-only parameter change or a cursor held
 still, reuses it). :func:`clump_reference` is the plain numpy twin of the same definition.
+While a brush drags, :mod:`hairtool.clump_region` redoes a run only near what changed.
 """
 
 from __future__ import annotations

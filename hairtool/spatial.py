@@ -9,7 +9,9 @@ mirrors them into one compact list (CSR: ``start``/``cnt`` into ``flat``), small
 in cache while ClumpWithGaps iterates over it. Grooms in a box too large for a row table fall
 back to a spatial hash of 3-D cells (~2V buckets; a candidate counts only if its exact cell
 matches, so collisions never count twice). Lists come in the same order whatever the thread
-count or the chunking. :func:`pairs_within_reference` is the plain numpy twin.
+count or the chunking, and the grid's corners lie on a lattice of :data:`SNAP` radii, so that an
+edit which moves the box a little leaves every list's order as it was. :func:`pairs_within_reference`
+is the plain numpy twin.
 Clump radius and clump membership helpers live in :mod:`hairtool.strand_clumps`.
 """
 
