@@ -103,6 +103,22 @@ def _lowest_of_nearest(P, flat, a, b, px, py, pz, br, sorig, bj, bo):
     return bj, bo
 
 
+@njit(cache=True, nogil=True, inline="always")
+def vertex_force(P, aflat, a0, a1, bflat, b0, b1, px, py, pz, root, h, inv_h, stats, sorig):
+    """f (15) on p from the list entries ``aflat[a0:a1]`` then ``bflat[b0:b1]`` (none for a
+    root), and its nearest neighbour within h (ties: the lower original index ``sorig``):
+    ``(fx, fy, fz, nearest or −1, neighbours within h, Σg)``, the last two with ``stats``."""
+    acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
+    if not root:
+        acc = _pull(P, aflat, a0, a1, px, py, pz, h, inv_h, stats, acc)
+        acc = _pull(P, bflat, b0, b1, px, py, pz, h, inv_h, stats, acc)
+    fx, fy, fz, br, bj, tie, c, wsum = acc
+    if tie and bj >= 0:
+        bj, bo = _lowest_of_nearest(P, aflat, a0, a1, px, py, pz, br, sorig, bj, sorig[bj])
+        bj, bo = _lowest_of_nearest(P, bflat, b0, b1, px, py, pz, br, sorig, bj, bo)
+    return fx, fy, fz, bj, c, wsum
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, stats, f, best, count, weight):
     """f (15) of every vertex from its two list runs and its nearest neighbour within h (ties:
@@ -110,18 +126,11 @@ def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, stats, f
     and Σg."""
     inv_h = 1.0 / h
     for i in prange(P.shape[0]):
-        acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
-        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
-        a0, a1, b0, b1 = aoff[i], aoff[i] + acnt[i], bstart[i], bstart[i + 1]
-        if not sroot[i]:
-            acc = _pull(P, aflat, a0, a1, px, py, pz, h, inv_h, stats, acc)
-            acc = _pull(P, bflat, b0, b1, px, py, pz, h, inv_h, stats, acc)
-        fx, fy, fz, br, bj, tie, c, wsum = acc
-        if tie and bj >= 0:
-            bj, bo = _lowest_of_nearest(P, aflat, a0, a1, px, py, pz, br, sorig, bj, sorig[bj])
-            bj, bo = _lowest_of_nearest(P, bflat, b0, b1, px, py, pz, br, sorig, bj, bo)
+        fx, fy, fz, best[i], c, wsum = vertex_force(
+            P, aflat, aoff[i], aoff[i] + acnt[i], bflat, bstart[i], bstart[i + 1], P[i, 0], P[i, 1], P[i, 2],
+            sroot[i], h, inv_h, stats, sorig,
+        )  # fmt: skip
         f[i, 0], f[i, 1], f[i, 2] = fx, fy, fz  # f (15); Δp = step·f (16)
-        best[i] = bj
         if stats:
             count[i] = c
             weight[i] = wsum

@@ -23,15 +23,15 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.clump import (
+    _GAP_CODE,
     MARGIN,
     ClumpWorkspace,
     _first_stats,
-    _lowest_of_nearest,
-    _pull,
     clump_points,
     gap_lambda,
     record_key,
     step_from_stats,
+    vertex_force,
 )
 from hairtool.freeze import CH_CLUMP, check_seed, hash_head_nb, hash_tail_u01_nb, seed_u64
 from hairtool.groom import Groom
@@ -116,16 +116,11 @@ def _region_force(P, flat, cap, list_count, region, roots, h, stats, F, best, co
     inv_h = 1.0 / h
     for n in prange(region.size):
         i = region[n]
-        acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
-        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
         a0, a1 = i * cap, i * cap + list_count[i]
-        if not roots[i]:
-            acc = _pull(P, flat, a0, a1, px, py, pz, h, inv_h, stats, acc)
-        fx, fy, fz, br, bj, tie, c, wsum = acc
-        if tie and bj >= 0:
-            bj, _ = _lowest_of_nearest(P, flat, a0, a1, px, py, pz, br, ident, bj, bj)
+        fx, fy, fz, best[n], c, wsum = vertex_force(
+            P, flat, a0, a1, flat, a1, a1, P[i, 0], P[i, 1], P[i, 2], roots[i], h, inv_h, stats, ident
+        )
         F[i, 0], F[i, 1], F[i, 2] = fx, fy, fz
-        best[n] = bj
         if stats:
             count[i] = c
             weight[i] = wsum
@@ -234,17 +229,18 @@ def _update_region(
     nl = ws.neighbours
     if not nl.sort(points, top.strand_index, roots, radius) or (tuple(nl.lo), tuple(nl.dims)) != rec.frame:
         return None  # another grid: every list may come in another order
-    rec.valid = False  # rewritten from here on
     # New lists: the changed vertices', then those of the vertices their lists held or hold.
-    nbr_c, cnt_c = _lists(nl, np.flatnonzero(sc.flags[nl.order]), sc)
+    pos_c = np.flatnonzero(sc.flags[nl.order])
+    ids_c = nl.order[pos_c]
+    nbr_c, cnt_c = _lists(nl, pos_c, sc)
     sc.relist[:] = False
     if _relist(changed, nbr_c, cnt_c, rec.lists, rec.list_count, sc.relist) > MAX_REGION * v:
         sc.too_many = changed.size
         return None  # the region holds these and more
     sc.relist[changed] = False
-    ids_r = nl.order[np.flatnonzero(sc.relist[nl.order])]
-    nbr_r, cnt_r = _lists(nl, np.flatnonzero(sc.relist[nl.order]), sc)
-    ids_c = nl.order[np.flatnonzero(sc.flags[nl.order])]
+    pos_r = np.flatnonzero(sc.relist[nl.order])
+    ids_r = nl.order[pos_r]
+    nbr_r, cnt_r = _lists(nl, pos_r, sc)
     # The region: within 2k steps of a changed vertex (k without gaps), along both runs' lists.
     sc.new_row[ids_c] = np.arange(ids_c.size)
     sc.new_row[ids_r] = np.arange(ids_c.size, ids_c.size + ids_r.size)
@@ -258,6 +254,7 @@ def _update_region(
     if n > MAX_REGION * v:
         sc.too_many = changed.size
         return None
+    rec.valid = False  # rewritten from here on
     longest = max(int(cnt_c.max(initial=0)), int(cnt_r.max(initial=0)))
     if longest > rec.lists.shape[1]:
         wider = np.empty((v, sc.capacity), np.int32)
@@ -270,7 +267,7 @@ def _update_region(
     best = np.empty(region.size, np.int64)
     flat = rec.lists.reshape(-1)
     k_step = 0.0 if step is None else float(step)
-    gap, seed64 = {"printed": 0, "text": 1, "off": 2}[gap_mode], seed_u64(seed)
+    gap, seed64 = _GAP_CODE[gap_mode], seed_u64(seed)
     for it in range(iterations):
         p, f = rec.iterates[it], rec.forces[it]
         _region_force(

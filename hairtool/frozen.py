@@ -189,7 +189,10 @@ class FrozenPipeline:
             return float(p.clump_step)
         key = (self._freeze_key, self.clump_radius)
         if self._auto_step is None or self._auto_step[0] != key:
-            ws = ClumpWorkspace()  # one iteration gives the step (it is set by the first)
+            # One iteration gives the step (the first sets it). In the pipeline's own workspace,
+            # without a record: a groom without strokes then reuses this neighbour list.
+            ws = self._workspace
+            ws.record = False
             clump_points(self._frozen, self.clump_radius, 1, None, "off", 0, ws)
             self._auto_step = (key, ws.step)
         return self._auto_step[1]

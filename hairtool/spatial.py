@@ -476,20 +476,17 @@ class NeighbourList:
         else:
             self._build_hashed(points, strand, skip, lo, float(radius))
 
-    def sort(
-        self, points: np.ndarray, strand: np.ndarray, skip: np.ndarray, radius: float, bounds=None
-    ) -> bool:
+    def sort(self, points: np.ndarray, strand: np.ndarray, skip: np.ndarray, radius: float) -> bool:
         """Only the row grid's sort (``order``, the sorted coordinates, ``start``), for
-        :meth:`region_lists`; False (and nothing sorted) where the grid would be hashed.
-        ``bounds``: the points' box, when the caller has it."""
-        lo, hi, dims = self._grid(points, radius, None, bounds)
+        :meth:`region_lists`; False (and nothing sorted) where the grid would be hashed."""
+        lo, hi, dims = self._grid(points, radius, None)
         if self.dense:
             self._sort_rows(points, strand, skip, lo, hi, dims)
         return self.dense
 
-    def _grid(self, points, radius, dense, bounds=None):
+    def _grid(self, points, radius, dense):
         v = points.shape[0]
-        lo, hi = (np.asarray(b, np.float64) for b in (box(points) if bounds is None else bounds))
+        lo, hi = (b.astype(np.float64) for b in box(points))
         extent = float((hi - lo).max())
         if not np.isfinite(extent):
             raise GroomError("the points have a non-finite coordinate")
