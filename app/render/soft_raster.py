@@ -261,9 +261,10 @@ def _segment(seg, i, half, r0, r1, c0, c1, rgba, depth, w):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _draw_bands(seg, box, bounds, half, clear, background, rgba, depth):
-    """Each band of rows: cleared (when ``clear``), then its segments in index order; ``half``
-    the quads' half-width (0: 1-px lines)."""
+def draw_bands(seg, box, bounds, half, clear, background, rgba, depth):
+    """The segments (after :func:`_setup_kernel`) into the images, one task per band of rows:
+    cleared (when ``clear``), then its segments in index order; ``half`` the quads' half-width
+    (0: 1-px lines)."""
     w = depth.shape[1]
     flat_rgba, flat_depth = rgba.reshape(-1), depth.reshape(-1)
     for k in prange(bounds.size - 1):
@@ -274,11 +275,6 @@ def _draw_bands(seg, box, bounds, half, clear, background, rgba, depth):
         for i in range(box.shape[1]):
             if box[0, i] < r1 and box[1, i] >= r0:
                 _segment(seg, i, half, r0, r1, 0, w, flat_rgba, flat_depth, w)
-
-
-def draw_bands(seg, box, bounds, half, clear, background, rgba, depth) -> None:
-    """The segments (after :func:`_setup_kernel`) into the images, one thread per band."""
-    _draw_bands(seg, box, bounds, half, clear, background, rgba, depth)
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -502,18 +498,24 @@ class StrandRaster:
             and np.array_equal(self._last_starts, s)
         )
         self._last = None
-        if not (same and self._redraw_changed(p, s, c, m, half, fill, rgba, depth)):
+        if not (same and self._redraw_changed(p, s, c, m, half, fill, depth)):
             self._draw_all(p, s, c, m, half, clear is not None, fill, depth)
         if clear is not None:
             self._last = key
         return rgba, depth
+
+    def _setup(self, p, s, c, m, half, which) -> None:
+        """The segments' window coordinates, colours and boxes (those flagged in ``which``, or all
+        for an empty mask), the boxes widened for quads of half-width ``half``."""
+        h, w = self.depth.shape
+        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, self._seg, self._box, which)
 
     def _draw_all(self, p, s, c, m, half, clear, fill, depth) -> None:
         h, w = depth.shape
         n = s.size
         if self._seg.shape[0] != n:
             self._seg, self._box = np.empty((n, _SEG)), np.empty((4, n), np.int32)
-        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, self._seg, self._box, self._all)
+        self._setup(p, s, c, m, half, self._all)
         # One band per thread: more, smaller bands cut more segments in two, which cost more
         # than the better balance gained.
         bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads())
@@ -522,7 +524,7 @@ class StrandRaster:
         self._last_mvp, self._last_starts = m.copy(), s.copy()
         self._last_points, self._last_colors = p.copy(), c.copy()
 
-    def _redraw_changed(self, p, s, c, m, half, fill, rgba, depth) -> bool:
+    def _redraw_changed(self, p, s, c, m, half, fill, depth) -> bool:
         """Redraw the tiles the changed segments touch; False when a full draw is cheaper."""
         n, v = s.size, p.shape[0]
         if self._flags.size != v:
@@ -536,7 +538,7 @@ class StrandRaster:
         h, w = depth.shape
         dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
         _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # where they were,
-        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, self._seg, self._box, self._which)
+        self._setup(p, s, c, m, half, self._which)
         _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # and where they are
         if self._counts.size != dirty.size + 1:
             self._counts = np.zeros(dirty.size + 1, np.int64)

@@ -129,7 +129,7 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
             k.py_func if python else k
             for k in (
                 soft_raster._setup_kernel,
-                soft_raster._draw_bands,
+                soft_raster.draw_bands,
                 soft_raster._draw_tiles,
                 soft_raster._cover_steps,
             )
