@@ -69,7 +69,7 @@ def _measure(app, args: argparse.Namespace, settings) -> list[dict]:
     from app.ui.qt_utils import send_mouse
     from app.ui.window import MainWindow
     from hairtool import samples
-    from hairtool.sway import sway_animation
+    from hairtool.simulate.sway import sway_animation
 
     groom = samples.scalp(args.strands, args.vertices)
     anim = sway_animation(groom, args.frames, 24.0, flick_frame=int(args.frames * 0.6))

@@ -33,7 +33,7 @@ import numpy as np
 
 import hairtool
 from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterError
-from hairtool.frozen import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
+from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import require_finite, require_strand_counts

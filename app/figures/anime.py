@@ -19,7 +19,7 @@ from app.render.camera import Camera
 from app.render.offscreen import render_image
 from app.render.ramps import ramp_colors
 from hairtool import samples
-from hairtool.anime import WaveParams, cycle_pictures
+from hairtool.anime.wave import WaveParams, cycle_pictures
 from hairtool.groom import Groom
 
 FIG2 = WaveParams(amplitude=0.8, wavelength=1.0, gravity=1.2, profile=1.0, period=0.45)

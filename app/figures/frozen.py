@@ -120,7 +120,7 @@ def save_figure(outdir, name: str, stem: str, rendered: list[tuple[np.ndarray, s
 
 def make(argv: list[str] | None = None) -> None:
     outdir, args = out_dir(__doc__.splitlines()[0], argv)
-    from hairtool.frozen import FrozenParams, FrozenPipeline
+    from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 
     rest = samples.portrait(strands=160, vertices=20, seed=0)
     size = args.size

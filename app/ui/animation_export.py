@@ -34,8 +34,8 @@ from hairtool import io
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation
 from hairtool.io.atomic import atomic_path
-from hairtool.keys_export import export_keys as write_keys
-from hairtool.keys_export import keys_record
+from hairtool.keys.export import export_keys as write_keys
+from hairtool.keys.export import keys_record
 
 if TYPE_CHECKING:
     from app.ui.window import MainWindow
@@ -299,7 +299,7 @@ def keys_result(model: object) -> dict:
     """The keys on the timeline as a ``hairtool keys`` result: frames, fps, DP keys and their
     cost, the uniform keys of the same count and theirs, the key settings and, when measured,
     the mean/tip/max position errors of both reconstructions."""
-    from hairtool.keyframes import keys_cost
+    from hairtool.keys.dp import keys_cost
 
     anim, solve, keys = model.animation, model.key_solve, model.dp_keys
     if anim is None or keys is None or solve is None:

@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 
 from hairtool import io
-from hairtool.bvh import Motion, read_bvh
 from hairtool.errors import FormatError
 from hairtool.groom import Animation, Groom
+from hairtool.mocap.bvh import Motion, read_bvh
 
 BVH_EXTENSIONS = (".bvh",)
 

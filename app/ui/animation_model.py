@@ -22,8 +22,8 @@ from app.ui import key_state as ks
 from app.ui.jobs import Job, JobRunner
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Animation
-from hairtool.keyframes import uniform_keys
-from hairtool.reconstruct import KeyPoses, interpolate_at
+from hairtool.keys.dp import uniform_keys
+from hairtool.keys.reconstruct import KeyPoses, interpolate_at
 
 VIEW_MODES = {
     "original": "Original",

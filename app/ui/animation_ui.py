@@ -18,8 +18,8 @@ from PySide6.QtWidgets import QLabel, QStyle, QWidget
 from app.ui.animation_model import VIEW_MODES, AnimationModel
 from app.ui.key_state import key_edit_block
 from app.ui.recording import Recorder
-from hairtool.align import align
 from hairtool.errors import HairtoolError
+from hairtool.frozen.align import align
 from hairtool.groom import Groom
 
 if TYPE_CHECKING:

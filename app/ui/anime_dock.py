@@ -41,8 +41,8 @@ from PySide6.QtWidgets import (
 
 from app.ui.qt_utils import signals_blocked
 from app.ui.widgets import SliderSpin
-from hairtool.anime import WaveParams, cycle_animation, wave
-from hairtool.anime_schedule import Schedule, schedule
+from hairtool.anime.schedule import Schedule, schedule
+from hairtool.anime.wave import WaveParams, cycle_animation, wave
 from hairtool.errors import HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom, vertex_ids_of
 

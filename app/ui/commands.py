@@ -5,7 +5,7 @@ from __future__ import annotations
 from PySide6.QtGui import QUndoCommand
 
 from app.ui.scene import Scene
-from hairtool.frozen import FrozenParams
+from hairtool.frozen.pipeline import FrozenParams
 
 _PARAM_ID_BASE = 1000
 _PARAM_IDS: dict[str, int] = {}

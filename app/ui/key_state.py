@@ -17,12 +17,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
-from hairtool.features import FeatureOptions, hair_features
 from hairtool.groom import Animation
-from hairtool.key_edit import KeyEditor
-from hairtool.keyframes import select_keys, solve_layers, uniform_keys
-from hairtool.reconstruct import KeyPoses, check_keys, interpolate_at, key_poses
-from hairtool.segment_cost import INTERPOLATIONS, OBJECTIVES, cost_table
+from hairtool.keys.costs import INTERPOLATIONS, OBJECTIVES, cost_table
+from hairtool.keys.dp import select_keys, solve_layers, uniform_keys
+from hairtool.keys.edit import KeyEditor
+from hairtool.keys.features import FeatureOptions, hair_features
+from hairtool.keys.reconstruct import KeyPoses, check_keys, interpolate_at, key_poses
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -231,7 +231,7 @@ def vertex_errors(animation: Animation, kp: KeyPoses, frame: int) -> F32:
 
 
 def speed(animation: Animation, cancelled: Callable[[], bool] | None = None) -> F64 | None:
-    """``(F,)`` mean vertex speed in units/s: :func:`hairtool.reconstruct.motion_speed`, chunked, float32."""
+    """``(F,)`` mean vertex speed in units/s: :func:`hairtool.keys.reconstruct.motion_speed`, chunked, float32."""
     f = animation.frames
     n, v = f.shape[0], f.shape[1]
     if n < 2:
@@ -288,7 +288,7 @@ def key_edit_block(
     frames: NDArray, keys: ArrayLike, interp: str, key_frame: int, pose: ArrayLike
 ) -> tuple[int, NDArray]:
     """``(start, block)``: the frames ``start .. start + len(block) − 1`` after the pose at
-    ``key_frame`` is replaced, through :class:`hairtool.key_edit.KeyEditor`'s residual scheme.
+    ``key_frame`` is replaced, through :class:`hairtool.keys.edit.KeyEditor`'s residual scheme.
 
     An edit changes only the frames between the key's neighbouring keys, so the editor runs on
     that stretch plus one frame each side (which keeps the Hermite tangents at the neighbouring

@@ -15,7 +15,7 @@ from PySide6.QtCore import QObject, Signal
 
 from app.render.ramps import DEFAULT_RAMP
 from hairtool.errors import ParameterError
-from hairtool.frozen import FrozenParams, FrozenPipeline
+from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.groom import Groom
 
 ALIGN_MODES = ("paper", "preserve-length")

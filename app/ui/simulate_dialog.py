@@ -1,4 +1,4 @@
-"""The Simulate… dialog: the parameters of :func:`hairtool.simulate.simulate` (head motion, wind
+"""The Simulate… dialog: the parameters of :func:`hairtool.simulate.dynamics.simulate` (head motion, wind
 and gusts, timing, forces, head sphere) and the job that runs it.
 
 API: ``SimulateDialog(parent, options)``; ``options() -> SimulateOptions`` (ParameterError for a
@@ -32,15 +32,15 @@ from PySide6.QtWidgets import (
 from app.ui.jobs import JobCancelled
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation, Groom
-from hairtool.head_motion import MOTIONS, fit_head, parse_motion
-from hairtool.simulate import GRAVITY, scaled_accelerations, simulate
+from hairtool.simulate.dynamics import GRAVITY, scaled_accelerations, simulate
+from hairtool.simulate.head_motion import MOTIONS, fit_head, parse_motion
 
 SOURCE = "simulation"
 
 
 @dataclass(frozen=True)
 class SimulateOptions:
-    """The dialog's values; field names follow :func:`hairtool.simulate.simulate`."""
+    """The dialog's values; field names follow :func:`hairtool.simulate.dynamics.simulate`."""
 
     motion: str = "turn"
     frames: int = 72

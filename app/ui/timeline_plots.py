@@ -23,7 +23,7 @@ from PySide6.QtGui import (
 from PySide6.QtWidgets import QSizePolicy, QWidget
 
 from app.ui.animation_model import AnimationModel
-from hairtool.keyframes import keys_cost, uniform_keys
+from hairtool.keys.dp import keys_cost, uniform_keys
 
 BACKGROUND = QColor(38, 40, 44)
 GRID = QColor(70, 73, 80)

@@ -27,7 +27,7 @@ from app.render.ramps import RAMPS
 from app.ui.qt_utils import signals_blocked
 from app.ui.scene import ALIGN_MODES, COLOUR_MODES, Scene
 from app.ui.widgets import SliderSpin
-from hairtool.frozen import FrozenParams
+from hairtool.frozen.pipeline import FrozenParams
 
 
 @dataclass(frozen=True)

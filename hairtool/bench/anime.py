@@ -1,9 +1,9 @@
 """Anime hair cycle speed: the whole cycle per frame, and the numba pose kernel against its numpy twin.
 
 Each groom is posed with the paper's Fig. 2 wave (T 0.45 s at 24 fps on twos: 11 frames, 6
-pictures), every strand its own bunch. ``cycle_ms``: :func:`hairtool.anime.cycle_animation`
+pictures), every strand its own bunch. ``cycle_ms``: :func:`hairtool.anime.wave.cycle_animation`
 end to end (bunches, poses, holds, the Animation); ``pose_ms`` and ``pose_numpy_ms``: the
-pictures alone through ``pose_numba`` and ``pose_numpy`` in the same run.
+pictures alone through ``pose_numba`` and ``pose_reference`` in the same run.
 """
 
 from __future__ import annotations
@@ -27,8 +27,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> list[dict]:
-    from hairtool.anime import WaveParams, cycle_animation, make_bunches, pose_pictures
-    from hairtool.anime_schedule import schedule
+    from hairtool.anime.schedule import schedule
+    from hairtool.anime.wave import WaveParams, cycle_animation, make_bunches, pose_pictures
     from hairtool.bench import grooms, median_ms, ratio, setup, threads
     from hairtool.samples import scalp
 

@@ -7,7 +7,7 @@ ClumpWithGaps keeps its neighbour list; ``cold_ms``: the same with the list buil
 ``clump_ms``: ClumpWithGaps alone with its list built, ``list_ms`` of it; ``update_ms``: one
 studio mouse move with the cursor held still (align + clump, freeze cached); ``drag_ms``: one
 mouse move of a drag with the studio's brush (the cursor circling a tip), where the strands
-move and ClumpWithGaps is redone near them (:mod:`hairtool.clump_region`): on ``drag_redone``
+move and ClumpWithGaps is redone near them (:mod:`hairtool.frozen.clump_region`): on ``drag_redone``
 of the vertices per move (1: a full run);
 ``reference_ms``: the pipeline with the numpy twins (null above ``--reference-limit`` vertices).
 ``mean_neighbours``: other-strand vertices within h per moving vertex; ``threads``: numba threads.
@@ -110,13 +110,13 @@ def run(args: argparse.Namespace) -> list[dict]:
     import numba
     import numpy as np
 
-    from hairtool.align import align, align_reference
     from hairtool.bench import median_ms
-    from hairtool.clump import ClumpWorkspace, clump, clump_reference
     from hairtool.errors import ParameterError
-    from hairtool.freeze import freeze, freeze_reference
-    from hairtool.frozen import FrozenPipeline
-    from hairtool.strand_clumps import auto_clump_radius
+    from hairtool.frozen.align import align, align_reference
+    from hairtool.frozen.clump import ClumpWorkspace, clump, clump_reference
+    from hairtool.frozen.freeze import freeze, freeze_reference
+    from hairtool.frozen.pipeline import FrozenPipeline
+    from hairtool.frozen.strand_clumps import auto_clump_radius
 
     if args.repeat < 1:
         raise ParameterError("repeat", args.repeat, "a whole number ≥ 1")

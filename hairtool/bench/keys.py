@@ -47,8 +47,8 @@ def _features(n: int, d: int) -> tuple[np.ndarray, float | None]:
     """Frame features and the seconds spent computing them (None for a raw random walk)."""
     if d >= 48_000 and d % (3 * HAIR_SAMPLES) == 0:
         from hairtool import samples
-        from hairtool.features import FeatureOptions, hair_features
-        from hairtool.sway import sway_animation
+        from hairtool.keys.features import FeatureOptions, hair_features
+        from hairtool.simulate.sway import sway_animation
 
         anim = sway_animation(samples.scalp(d // (3 * HAIR_SAMPLES), 24, seed=0), n, flick_frame=n // 2)
         t0 = time.perf_counter()
@@ -65,15 +65,15 @@ def _time(fn):
 
 
 def run(args: argparse.Namespace) -> list[dict]:
-    from hairtool.keyframes import solve_layers
-    from hairtool.segment_cost import cost_table
-    from hairtool.segment_direct import direct_cost_table
+    from hairtool.keys.costs import cost_table
+    from hairtool.keys.dp import solve_layers
+    from hairtool.keys.segment_direct import direct_cost_table
 
     sizes = QUICK if args.quick else (_parse_sizes(args.sizes) if args.sizes else SIZES)
     # compile (or load) the kernels outside the timings
     warm = np.cumsum(np.random.default_rng(0).normal(size=(8, 2)), axis=0)
     solve_layers(cost_table(warm, args.interp), 4)
-    from hairtool.features import resample_frames
+    from hairtool.keys.features import resample_frames
 
     frozen = np.zeros((1, 4, 3), dtype=np.float32)
     frozen.flags.writeable = False  # Animation frames are read-only: numba's signature differs

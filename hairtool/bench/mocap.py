@@ -1,7 +1,7 @@
 """Motion-capture key-frame speed on the captures in ``shared/data/motion`` (seed 003's data).
 
 Per capture: reading the BVH; joint-position and quaternion features; seed 003's quaternion
-cost table (:func:`~hairtool.mocap.rotation_cost_table`, O(F³J)); the exact DP for K = a tenth
+cost table (:func:`~hairtool.mocap.costs.rotation_cost_table`, O(F³J)); the exact DP for K = a tenth
 of the frames (with the error curve up to 100 keys) on that table, in numba and in its numpy
 twin; and the default path of ``hairtool keys CAPTURE.bvh``: position features → Gram cost
 table → DP. The quaternion table's numpy twin is a Python loop over the pairs, so both run
@@ -47,11 +47,11 @@ def _captures(args: argparse.Namespace) -> list[Path]:
 
 def run(args: argparse.Namespace) -> list[dict]:
     from hairtool.bench import median_ms, ratio, setup, threads
-    from hairtool.bvh import read_bvh
     from hairtool.errors import ParameterError
-    from hairtool.keyframes import select_keys
-    from hairtool.mocap import motion_features, rotation_cost_table, rotation_cost_table_reference
-    from hairtool.segment_cost import cost_table
+    from hairtool.keys.costs import cost_table
+    from hairtool.keys.dp import select_keys
+    from hairtool.mocap.bvh import read_bvh
+    from hairtool.mocap.costs import motion_features, rotation_cost_table, rotation_cost_table_reference
 
     repeat = setup(args)
     n_ref = (20 if args.quick else 60) if args.reference_frames is None else args.reference_frames

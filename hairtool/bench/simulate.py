@@ -1,8 +1,8 @@
-"""Strand dynamics speed: simulated frames per second of :func:`hairtool.simulate.simulate`.
+"""Strand dynamics speed: simulated frames per second of :func:`hairtool.simulate.dynamics.simulate`.
 
 Each groom runs the CLI's default set-up (head turn, 8 substeps, 24 fps, head collisions) with
 two gusts for ``--frames`` frames; frame 0 is the rest pose, so ``sim_fps`` counts frames − 1.
-The numpy twin (:func:`~hairtool.simulate.simulate_reference`) runs the same set-up for
+The numpy twin (:func:`~hairtool.simulate.dynamics.simulate_reference`) runs the same set-up for
 ``--reference-frames`` frames in the same run, up to ``--reference-limit`` vertices.
 """
 
@@ -32,7 +32,7 @@ def run(args: argparse.Namespace) -> list[dict]:
     from hairtool.bench import grooms, median_ms, ratio, setup, threads
     from hairtool.errors import ParameterError
     from hairtool.samples import scalp
-    from hairtool.simulate import simulate, simulate_reference
+    from hairtool.simulate.dynamics import simulate, simulate_reference
 
     repeat = setup(args)
     frames = (6 if args.quick else 49) if args.frames is None else args.frames

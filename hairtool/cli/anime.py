@@ -65,8 +65,8 @@ def parse_ids(text: str) -> list[int]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from hairtool.anime import WaveParams, cycle_animation
-    from hairtool.anime_schedule import schedule, write_sheet
+    from hairtool.anime.schedule import schedule, write_sheet
+    from hairtool.anime.wave import WaveParams, cycle_animation
 
     params = WaveParams(args.amplitude, args.wavelength, args.gravity, args.profile, args.period)
     sched = schedule(args.period, args.fps, args.hold)
@@ -104,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
         anim = cycle_animation(groom, params, fps=args.fps, hold=args.hold, frames=shot, **variation)
         report.update(input=args.input, strands=anim.strand_count, vertices=anim.vertex_count)
         if args.compare is not None:
-            from hairtool.anime_metrics import compare_cycle
+            from hairtool.anime.metrics import compare_cycle
             from hairtool.io import read
 
             report["compare"] = {

@@ -74,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
 
     from hairtool import io
     from hairtool.errors import ParameterError
-    from hairtool.frozen import FrozenParams, FrozenPipeline
+    from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 
     params = FrozenParams(
         stretch_stiffness=args.stretch_stiffness,
@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
     if not math.isfinite(args.max_bend_angle) or not 0 <= args.max_bend_angle <= 180:
         raise ParameterError("max-bend-angle", args.max_bend_angle, "degrees in [0, 180]")
     params.validate()
-    from hairtool.align import check_align_params
+    from hairtool.frozen.align import check_align_params
 
     check_align_params(
         (0.0, 0.0, 0.0), 1.0 if args.radius is None else args.radius, args.intensity, args.align_mode

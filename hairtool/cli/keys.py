@@ -60,7 +60,7 @@ def _load(args: argparse.Namespace):
         raise FormatError(path, "no such file" if not path.exists() else "not a regular file")
     suffix = path.suffix.lower()
     if suffix == ".bvh":
-        from hairtool.bvh import read_bvh
+        from hairtool.mocap.bvh import read_bvh
 
         motion = read_bvh(path)
         return "bvh", motion, motion.fps
@@ -97,9 +97,9 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from hairtool.errors import ParameterError
-    from hairtool.features import FeatureOptions, frame_features, raw_features
-    from hairtool.keyframes import select_keys
-    from hairtool.segment_cost import cost_table
+    from hairtool.keys.costs import cost_table
+    from hairtool.keys.dp import select_keys
+    from hairtool.keys.features import FeatureOptions, frame_features, raw_features
 
     kind, data, fps = _load(args)
     options = FeatureOptions(
@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
         exponent=args.weight_exponent,
     )
     if kind == "bvh":
-        from hairtool.mocap import motion_features
+        from hairtool.mocap.costs import motion_features
 
         x = motion_features(data, "positions" if args.bvh_features == "positions" else "rotations")
     elif kind == "animation":
@@ -122,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
     n = x.shape[0]
 
     if args.per_channel:
-        from hairtool.key_search import per_channel_keys
+        from hairtool.keys.session import per_channel_keys
 
         if args.penalty is None:
             raise ParameterError("per-channel", True, "a --penalty TAU (seed 003 prices keys per channel)")
@@ -136,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
     mode = _mode(args, n)
     objective = "worst" if args.max_error is not None else args.objective
     if kind == "bvh" and args.bvh_features == "quaternion":
-        from hairtool.mocap import rotation_cost_table
+        from hairtool.mocap.costs import rotation_cost_table
 
         if args.interp != "linear" or args.curvature or objective != "total":
             raise ParameterError("bvh-features", "quaternion", "the linear (slerp) total objective only")
@@ -147,14 +147,14 @@ def run(args: argparse.Namespace) -> int:
     result = {"frames": n, "fps": fps, **sel.to_dict()}
     result["params"].update(interp=args.interp, curvature=args.curvature)
     if kind == "animation":
-        from hairtool.reconstruct import compare_with_uniform, key_distribution
+        from hairtool.keys.reconstruct import compare_with_uniform, key_distribution
 
         result["params"]["features"] = options.to_dict()
         result["position_errors"] = compare_with_uniform(data, sel.keys, args.interp)
         result["speed_at_keys"] = key_distribution(data.frames, sel.keys, fps)["speed_at_keys"]
     elif kind == "bvh":
-        from hairtool.keyframes import uniform_keys
-        from hairtool.mocap import joint_position_errors, reconstruct_motion
+        from hairtool.keys.dp import uniform_keys
+        from hairtool.mocap.costs import joint_position_errors, reconstruct_motion
 
         errs = {}
         for name, k in (("keys", sel.keys), ("uniform", uniform_keys(n, sel.keys.size))):
@@ -164,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
     if args.export is not None:
         if kind != "animation":
             raise ParameterError("export", str(args.export), "an animation input (hair strands)")
-        from hairtool.keys_export import write_key_poses
+        from hairtool.keys.export import write_key_poses
 
         write_key_poses(args.export, data, sel.keys)
     line = (
@@ -176,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _emit(args: argparse.Namespace, result: dict, line: str) -> int:
     if args.out is not None:
-        from hairtool.keys_export import keys_record, write_keys_json
+        from hairtool.keys.export import keys_record, write_keys_json
 
         write_keys_json(args.out, keys_record(result, args.input))
     print(json.dumps(result) if args.json else line)

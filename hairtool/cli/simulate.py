@@ -23,7 +23,7 @@ HELP = "simulate hair dynamics on a moving head (turn, nod, shake, hop, wind gus
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from hairtool.simulate import GRAVITY
+    from hairtool.simulate.dynamics import GRAVITY
 
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
     parser.add_argument("input", metavar="IN", help=GROOM_INPUT_HELP)
@@ -61,9 +61,9 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from hairtool.errors import ParameterError
-    from hairtool.head_motion import fit_head, parse_motion
     from hairtool.io import format_for, write
-    from hairtool.simulate import scaled_accelerations, simulate
+    from hairtool.simulate.dynamics import scaled_accelerations, simulate
+    from hairtool.simulate.head_motion import fit_head, parse_motion
 
     fmt = format_for(args.output, writing=True)  # refuse a bad extension before simulating
     motion = parse_motion(args.motion)

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.anime import WaveParams, make_bunches, pose_pictures
-from hairtool.anime_schedule import schedule
+from hairtool.anime.schedule import schedule
+from hairtool.anime.wave import WaveParams, make_bunches, pose_pictures
 from hairtool.groom import Groom
 
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.anime import WaveParams, cycle_animation
-from hairtool.anime_metrics import chain_errors, compare_cycle, node_angle_errors
+from hairtool.anime.metrics import chain_errors, compare_cycle, node_angle_errors
+from hairtool.anime.wave import WaveParams, cycle_animation
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation, Groom
 from hairtool.rotation import axis_angle_matrix

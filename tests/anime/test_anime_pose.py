@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.anime import (
+from hairtool.anime.pose import bend_axes, bend_chains, bunch_variation, nearest_guide, wave_x
+from hairtool.anime.schedule import schedule
+from hairtool.anime.wave import (
     WaveParams,
     cycle_animation,
     cycle_pictures,
@@ -15,8 +17,6 @@ from hairtool.anime import (
     segment_angles,
     wave,
 )
-from hairtool.anime_pose import bend_axes, bend_chains, bunch_variation, nearest_guide, wave_x
-from hairtool.anime_schedule import schedule
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation, Groom
 

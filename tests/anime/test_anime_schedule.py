@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pytest
 
-from hairtool.anime_schedule import frames_per_cycle, round_half_up, schedule, write_sheet
+from hairtool.anime.schedule import frames_per_cycle, round_half_up, schedule, write_sheet
 from hairtool.errors import ParameterError
 
 # (T, fps, hold) -> N_Frame, N_Pict, K, holds, Δt — each worked by hand from N_Frame = [fps·T],

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from hairtool.anime import WaveParams, node_rotations, segment_angles, wave
+from hairtool.anime.wave import WaveParams, node_rotations, segment_angles, wave
 from hairtool.errors import ParameterError
 from hairtool.groom import Groom
 

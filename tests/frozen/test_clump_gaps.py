@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.clump import ClumpWorkspace, clump, clump_reference
 from hairtool.errors import ParameterError
+from hairtool.frozen.clump import ClumpWorkspace, clump, clump_reference
+from hairtool.frozen.spatial import pairs_within_reference
+from hairtool.frozen.strand_clumps import auto_clump_radius
 from hairtool.groom import Groom
 from hairtool.io import read_groom
-from hairtool.spatial import pairs_within_reference
-from hairtool.strand_clumps import auto_clump_radius
 
 
 def _nearest_other(g: Groom, reach: float) -> np.ndarray:

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.align import align
-from hairtool.clump import ClumpWorkspace, clump_points
-from hairtool.clump_region import clump_points_interactive
+from hairtool.frozen.align import align
+from hairtool.frozen.clump import ClumpWorkspace, clump_points
+from hairtool.frozen.clump_region import clump_points_interactive
+from hairtool.frozen.spatial import NeighbourList
+from hairtool.frozen.strand_clumps import auto_clump_radius
 from hairtool.groom import Groom
-from hairtool.spatial import NeighbourList
-from hairtool.strand_clumps import auto_clump_radius
 
 
 @pytest.fixture

@@ -8,7 +8,8 @@ import pytest
 
 from hairtool import samples
 from hairtool.errors import ParameterError
-from hairtool.freeze import freeze, freeze_reference, hash_u01, strand_multipliers
+from hairtool.frozen.freeze import freeze, freeze_reference, strand_multipliers
+from hairtool.frozen.noise import hash_u01
 from hairtool.groom import Groom
 from hairtool.io import read_groom
 

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.align import align
-from hairtool.clump import ClumpWorkspace, clump
 from hairtool.errors import ParameterError
-from hairtool.freeze import freeze
-from hairtool.frozen import FrozenParams, FrozenPipeline
-from hairtool.strand_clumps import auto_clump_radius, strand_clumps_reference
+from hairtool.frozen.align import align
+from hairtool.frozen.clump import ClumpWorkspace, clump
+from hairtool.frozen.freeze import freeze
+from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps_reference
 
 CURSOR = np.array([2.0, 0.5, 0.5])
 

@@ -6,11 +6,9 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.frozen import FrozenPipeline
-from hairtool.groom import Groom
-from hairtool.io import read_groom
-from hairtool.spatial import neighbour_list, pairs_within_reference
-from hairtool.strand_clumps import (
+from hairtool.frozen.pipeline import FrozenPipeline
+from hairtool.frozen.spatial import neighbour_list, pairs_within_reference
+from hairtool.frozen.strand_clumps import (
     auto_clump_radius,
     median_root_spacing,
     strand_clumps,
@@ -18,6 +16,8 @@ from hairtool.strand_clumps import (
     strand_components,
     strand_components_reference,
 )
+from hairtool.groom import Groom
+from hairtool.io import read_groom
 
 
 def _pairs_of(nl) -> set[tuple[int, int]]:

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.align import align, align_reference
 from hairtool.errors import ParameterError
+from hairtool.frozen.align import align, align_reference
 from hairtool.groom import Groom
 from hairtool.io import read_groom
 

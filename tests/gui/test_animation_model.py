@@ -10,7 +10,7 @@ from app.ui.animation_model import AnimationModel
 from app.ui.key_state import KeySettings
 from hairtool import samples
 from hairtool.errors import GroomError, ParameterError
-from hairtool.sway import sway_animation
+from hairtool.simulate.sway import sway_animation
 
 
 @pytest.fixture

@@ -10,10 +10,11 @@ import pytest
 from app.ui import key_state as ks
 from hairtool import samples
 from hairtool.errors import ParameterError
-from hairtool.features import hair_features
-from hairtool.key_edit import edit_animation
-from hairtool.keyframes import select_keys, uniform_keys
-from hairtool.reconstruct import (
+from hairtool.keys.costs import cost_table
+from hairtool.keys.dp import select_keys, uniform_keys
+from hairtool.keys.edit import edit_animation
+from hairtool.keys.features import hair_features
+from hairtool.keys.reconstruct import (
     interpolate_at,
     interpolate_keys,
     key_poses,
@@ -21,8 +22,7 @@ from hairtool.reconstruct import (
     position_errors,
     reconstruct,
 )
-from hairtool.segment_cost import cost_table
-from hairtool.sway import sway_animation
+from hairtool.simulate.sway import sway_animation
 
 
 @pytest.fixture(scope="module")

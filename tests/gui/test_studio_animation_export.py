@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from hairtool import io, samples
-from hairtool.sway import sway_animation
+from hairtool.simulate.sway import sway_animation
 
 pytestmark = pytest.mark.gui
 
@@ -86,7 +86,7 @@ def test_png_sequence_and_data_formats(window, out):
 def test_exported_keys_read_back_as_json_csv_and_usd(window, out):
     from pxr import Usd, UsdGeom
 
-    from hairtool.keys_export import read_keys_json
+    from hairtool.keys.export import read_keys_json
 
     w = window
     keys = w.animation.dp_keys.tolist()

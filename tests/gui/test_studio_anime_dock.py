@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.anime import WaveParams, cycle_animation, wave
+from hairtool.anime.wave import WaveParams, cycle_animation, wave
 
 pytestmark = pytest.mark.gui
 

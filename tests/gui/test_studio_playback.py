@@ -10,8 +10,8 @@ from PySide6.QtTest import QTest
 
 from app.ui.animation_io import skeleton_animation
 from hairtool import io, samples
-from hairtool.bvh import read_bvh
-from hairtool.sway import sway_animation
+from hairtool.mocap.bvh import read_bvh
+from hairtool.simulate.sway import sway_animation
 
 pytestmark = pytest.mark.gui
 

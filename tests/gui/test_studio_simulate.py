@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from hairtool import samples
-from hairtool.simulate import simulate
+from hairtool.simulate.dynamics import simulate
 
 pytestmark = pytest.mark.gui
 
@@ -68,7 +68,7 @@ def test_cancelled_simulation_keeps_the_previous_animation(make_window):
 
 def test_the_dialog_opens_fitted_to_a_real_groom_and_fits_on_demand(make_window, grooms_dir, qtbot):
     from app.ui.simulate_dialog import SimulateDialog, SimulateOptions
-    from hairtool.head_motion import fit_head
+    from hairtool.simulate.head_motion import fit_head
 
     w = make_window()
     assert w.open_path(grooms_dir / "sintel_hair.tfx"), w.errors

@@ -11,12 +11,12 @@ from PySide6.QtGui import QColor, QImage
 from app.ui import key_state as ks
 from app.ui.timeline_plots import DP_COLOUR, UNIFORM_COLOUR
 from hairtool import samples
-from hairtool.features import hair_features
-from hairtool.key_edit import edit_animation
-from hairtool.keyframes import select_keys, uniform_keys
-from hairtool.reconstruct import interpolate_at, position_errors, reconstruct
-from hairtool.segment_cost import cost_table
-from hairtool.sway import sway_animation
+from hairtool.keys.costs import cost_table
+from hairtool.keys.dp import select_keys, uniform_keys
+from hairtool.keys.edit import edit_animation
+from hairtool.keys.features import hair_features
+from hairtool.keys.reconstruct import interpolate_at, position_errors, reconstruct
+from hairtool.simulate.sway import sway_animation
 
 pytestmark = pytest.mark.gui
 

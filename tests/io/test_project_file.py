@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from hairtool import project, samples
-from hairtool.anime import cycle_animation
+from hairtool.anime.wave import cycle_animation
 from hairtool.errors import FormatError
-from hairtool.frozen import FrozenParams, FrozenPipeline
+from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 
 
 @pytest.fixture(scope="module")

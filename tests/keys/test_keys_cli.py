@@ -11,7 +11,7 @@ import pytest
 from hairtool import samples
 from hairtool.cli import main
 from hairtool.io import write
-from hairtool.sway import sway_animation
+from hairtool.simulate.sway import sway_animation
 
 
 @pytest.fixture(scope="module")

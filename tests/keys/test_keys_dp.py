@@ -8,18 +8,18 @@ import numpy as np
 import pytest
 
 from hairtool.errors import ParameterError
-from hairtool.key_search import find_keys, per_channel_keys
-from hairtool.keyframes import (
+from hairtool.keys.costs import cost_table
+from hairtool.keys.dp import (
     _layers_kernel,
     _penalty_kernel,
     brute_force_keys,
     keys_cost,
-    layers_numpy,
-    penalty_numpy,
+    layers_reference,
+    penalty_reference,
     select_keys,
     uniform_keys,
 )
-from hairtool.segment_cost import cost_table
+from hairtool.keys.session import find_keys, per_channel_keys
 
 
 def walk(n: int, d: int, seed: int = 0) -> np.ndarray:
@@ -54,12 +54,12 @@ def test_kernels_and_numpy_twins_are_bit_identical():
         table[0, n - 1] = table[0, n - 1]  # keep dtype float64
         for use_max in (False, True):
             a = _layers_kernel(np.ascontiguousarray(table.T), n, use_max, -np.inf)
-            b = layers_numpy(table, n, use_max)
+            b = layers_reference(table, n, use_max)
             for u, v in zip(a, b, strict=True):
                 np.testing.assert_array_equal(u, v)
         for tau in (0.0, 0.1, 3.0):
             a = _penalty_kernel(np.ascontiguousarray(table.T), tau)
-            b = penalty_numpy(table, tau)
+            b = penalty_reference(table, tau)
             np.testing.assert_array_equal(a[0], b[0])
             np.testing.assert_array_equal(a[1], b[1])
 

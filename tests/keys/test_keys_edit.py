@@ -7,8 +7,8 @@ import pytest
 
 from hairtool import samples
 from hairtool.errors import ParameterError
-from hairtool.key_edit import KeyEditor, edit_animation
-from hairtool.sway import sway_animation
+from hairtool.keys.edit import KeyEditor, edit_animation
+from hairtool.simulate.sway import sway_animation
 
 
 @pytest.fixture(scope="module")

@@ -10,9 +10,9 @@ import pytest
 
 from hairtool import samples
 from hairtool.errors import FormatError, ParameterError
-from hairtool.features import frame_features
-from hairtool.keyframes import select_keys
-from hairtool.keys_export import (
+from hairtool.keys.costs import cost_table
+from hairtool.keys.dp import select_keys
+from hairtool.keys.export import (
     export_keys,
     keys_record,
     read_keys_json,
@@ -20,8 +20,8 @@ from hairtool.keys_export import (
     sheet_rows,
     write_key_poses,
 )
-from hairtool.segment_cost import cost_table
-from hairtool.sway import sway_animation
+from hairtool.keys.features import frame_features
+from hairtool.simulate.sway import sway_animation
 
 
 @pytest.fixture(scope="module")

@@ -7,10 +7,16 @@ import pytest
 
 from hairtool import samples
 from hairtool.errors import GroomError, ParameterError
-from hairtool.features import FeatureOptions, frame_features, hair_features, raw_features, resample_frames
 from hairtool.groom import Animation
+from hairtool.keys.features import (
+    FeatureOptions,
+    frame_features,
+    hair_features,
+    raw_features,
+    resample_frames,
+)
 from hairtool.resample import resample_points
-from hairtool.sway import sway_animation
+from hairtool.simulate.sway import sway_animation
 
 
 @pytest.fixture(scope="module")
@@ -26,14 +32,15 @@ def test_batched_resampling_matches_the_per_groom_resampler(anim):
 
 
 def test_resampling_kernel_matches_its_numpy_twin(anim):
-    from hairtool.features import resample_frames_numpy
+    from hairtool.keys.features import resample_frames_reference
 
     fast = resample_frames(anim.frames, anim.counts, 9)
-    np.testing.assert_allclose(fast, resample_frames_numpy(anim.frames, anim.counts, 9), rtol=0, atol=1e-12)
+    expected = resample_frames_reference(anim.frames, anim.counts, 9)
+    np.testing.assert_allclose(fast, expected, rtol=0, atol=1e-12)
 
 
 def test_batched_resampling_handles_mixed_counts_and_zero_length_strands(monkeypatch):
-    import hairtool.features as feats
+    import hairtool.keys.features as feats
 
     g = samples.portrait(15, 9, seed=1)
     strands = [s.copy() for s in g.strands()]

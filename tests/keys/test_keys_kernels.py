@@ -6,11 +6,13 @@ import numba
 import numpy as np
 import pytest
 
-from hairtool.features import _resample_kernel
-from hairtool.keyframes import _layers_kernel, _penalty_kernel
-from hairtool.segment_cost import _linear_kernel, centered_gram, cost_table, frame_curvature
-from hairtool.segment_hermite import _hermite_kernel, hermite_quad_weights
-from hairtool.segment_worst import _worst_kernel
+from hairtool.keys.costs import cost_table
+from hairtool.keys.dp import _layers_kernel, _penalty_kernel
+from hairtool.keys.features import _resample_kernel
+from hairtool.keys.gram import centered_gram, frame_curvature
+from hairtool.keys.segment_hermite import _hermite_kernel, hermite_quad_weights
+from hairtool.keys.segment_linear import _linear_kernel
+from hairtool.keys.segment_worst import _worst_kernel
 
 
 def walk(n: int, d: int, seed: int = 0) -> np.ndarray:

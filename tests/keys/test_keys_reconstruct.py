@@ -7,8 +7,7 @@ import pytest
 
 from hairtool import samples
 from hairtool.errors import ParameterError
-from hairtool.key_search import find_keys
-from hairtool.reconstruct import (
+from hairtool.keys.reconstruct import (
     compare_with_uniform,
     interpolate_at,
     interpolate_keys,
@@ -17,8 +16,9 @@ from hairtool.reconstruct import (
     position_errors,
     reconstruct,
 )
-from hairtool.segment_direct import difference_tangents, interpolate_segment
-from hairtool.sway import sway_animation
+from hairtool.keys.segment_direct import difference_tangents, interpolate_segment
+from hairtool.keys.session import find_keys
+from hairtool.simulate.sway import sway_animation
 
 
 @pytest.fixture(scope="module")

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from hairtool.errors import ParameterError
-from hairtool.segment_cost import centered_gram, cost_table, frame_curvature, total_table
-from hairtool.segment_direct import direct_cost_table
-from hairtool.segment_worst import worst_table
+from hairtool.keys.costs import cost_table, total_table
+from hairtool.keys.gram import centered_gram, frame_curvature
+from hairtool.keys.segment_direct import direct_cost_table
+from hairtool.keys.segment_worst import worst_table
 
 
 def walk(n: int, d: int, seed: int = 0, offset: float = 0.0) -> np.ndarray:

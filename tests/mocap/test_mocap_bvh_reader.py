@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hairtool.bvh import read_bvh, write_bvh
 from hairtool.errors import FormatError
+from hairtool.mocap.bvh import read_bvh, write_bvh
 
 from .conftest import CHAIN
 
@@ -137,8 +137,8 @@ def test_fps_snaps_only_printed_whole_rates(tmp_path):
 
 
 def test_motion_checks_its_skeleton():
-    from hairtool.bvh import Motion
     from hairtool.errors import ParameterError
+    from hairtool.mocap.bvh import Motion
 
     chans = [["Xrotation"], ["Xrotation"]]
     with pytest.raises(ParameterError, match="parents"):

@@ -6,10 +6,10 @@ import numba
 import numpy as np
 import pytest
 
-from hairtool import quaternion as quat
-from hairtool.bvh import Motion, read_bvh
 from hairtool.errors import ParameterError
-from hairtool.mocap import (
+from hairtool.mocap import quaternion as quat
+from hairtool.mocap.bvh import Motion, read_bvh
+from hairtool.mocap.costs import (
     bvh_features,
     joint_weights,
     motion_features,

@@ -7,8 +7,8 @@ import itertools
 import numpy as np
 import pytest
 
-from hairtool import quaternion as quat
 from hairtool.errors import ParameterError
+from hairtool.mocap import quaternion as quat
 from hairtool.rotation import axis_angle_matrix
 
 AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}

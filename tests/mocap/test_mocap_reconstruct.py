@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hairtool import quaternion as quat
-from hairtool.bvh import read_bvh
 from hairtool.errors import ParameterError
-from hairtool.mocap import joint_position_errors, reconstruct_motion
+from hairtool.mocap import quaternion as quat
+from hairtool.mocap.bvh import read_bvh
+from hairtool.mocap.costs import joint_position_errors, reconstruct_motion
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +55,7 @@ def test_hermite_follows_a_walk_better_than_linear(walk):
 
 
 def test_rebuilt_motion_round_trips_through_bvh(tmp_path, walk):
-    from hairtool.bvh import write_bvh
+    from hairtool.mocap.bvh import write_bvh
 
     r = reconstruct_motion(walk, [0, 100, 200, 454], "hermite")
     write_bvh(tmp_path / "r.bvh", r)

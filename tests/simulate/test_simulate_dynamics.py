@@ -8,10 +8,10 @@ import pytest
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Groom
-from hairtool.head_motion import head_motion
 from hairtool.rotation import axis_angle_matrix
 from hairtool.samples import scalp
-from hairtool.simulate import Gust, gust_schedule, simulate, simulate_reference
+from hairtool.simulate.dynamics import Gust, gust_schedule, simulate, simulate_reference
+from hairtool.simulate.head_motion import head_motion
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from hairtool.errors import ParameterError
-from hairtool.head_motion import MOTIONS, check_transform, head_motion, parse_motion
+from hairtool.simulate.head_motion import MOTIONS, check_transform, head_motion, parse_motion
 
 
 @pytest.mark.parametrize("name", sorted(MOTIONS))
@@ -63,7 +63,7 @@ def test_motions_placed_on_another_head_are_the_unit_motion_scaled_and_moved(nam
 
 def test_fit_head_finds_the_sphere_the_circle_or_falls_back():
     from hairtool import samples
-    from hairtool.head_motion import fit_head
+    from hairtool.simulate.head_motion import fit_head
 
     rng = np.random.default_rng(3)
     d = rng.normal(size=(200, 3))

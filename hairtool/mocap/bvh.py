@@ -22,9 +22,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hairtool import quaternion as quat
 from hairtool.errors import FormatError, ParameterError
 from hairtool.io.atomic import atomic_open
+from hairtool.mocap import quaternion as quat
 
 F64 = NDArray[np.float64]
 

@@ -12,10 +12,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
-from hairtool.features import FeatureOptions, frame_features, raw_features
 from hairtool.groom import Animation
-from hairtool.keyframes import DEFAULT_CURVE_KEYS, Selection, select_keys
-from hairtool.segment_cost import INTERPOLATIONS, cost_table
+from hairtool.keys.costs import INTERPOLATIONS, cost_table
+from hairtool.keys.dp import DEFAULT_CURVE_KEYS, Selection, select_keys
+from hairtool.keys.features import FeatureOptions, frame_features, raw_features
 
 I64 = NDArray[np.int64]
 

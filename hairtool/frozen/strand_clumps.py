@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from hairtool.frozen.spatial import neighbour_list, pairs_within_reference
 from hairtool.groom import Groom
-from hairtool.spatial import neighbour_list, pairs_within_reference
 
 
 def median_root_spacing(groom: Groom) -> float:

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation
-from hairtool.reconstruct import KeyPoses, interpolate_keys, key_poses
+from hairtool.keys.reconstruct import KeyPoses, interpolate_keys, key_poses
 
 F64 = NDArray[np.float64]
 

@@ -10,8 +10,8 @@ drawn aspect: y = 1 is a third of a chain length) and the angle of each sampled 
 atan2(Δy, Δx), becomes the rotation of that rest segment about the bunch's bend axis. With the
 paper's a = 0.8, s = 1.2, k = 1, p = 1 the segments turn between about +27° and −41° over a
 cycle, and the tip of a horizontal chain rises 4 % and drops 34 % of the chain length: a lively
-but readable wave that sags under its gravity term. Timing is in :mod:`hairtool.anime_schedule`, geometry in
-:mod:`hairtool.anime_pose`, error measures in :mod:`hairtool.anime_metrics`.
+but readable wave that sags under its gravity term. Timing is in :mod:`hairtool.anime.schedule`, geometry in
+:mod:`hairtool.anime.pose`, error measures in :mod:`hairtool.anime.metrics`.
 """
 
 from __future__ import annotations
@@ -23,18 +23,18 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hairtool.anime_pose import (
+from hairtool.anime.pose import (
     bend_axes,
     bunch_variation,
     check_guides,
     check_per_bunch,
     nearest_guide,
     pose_numba,
-    pose_numpy,
+    pose_reference,
     wave_values,
     wave_x,
 )
-from hairtool.anime_schedule import Schedule, schedule
+from hairtool.anime.schedule import Schedule, schedule
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation, Groom
 
@@ -192,7 +192,7 @@ def pose_pictures(
         )
     per = b.of_strand
     wave_args = (params.amplitude, params.wavelength, params.gravity, params.profile, params.period)
-    pose = pose_numba if use_numba else pose_numpy
+    pose = pose_numba if use_numba else pose_reference
     return pose(groom, t, b.axes[per], b.amplitude_scale[per], b.phase[per] * params.period, wave_args)
 
 

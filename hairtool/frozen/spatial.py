@@ -12,7 +12,7 @@ matches, so collisions never count twice). Lists come in the same order whatever
 count or the chunking, and the grid's corners lie on a lattice of :data:`SNAP` radii, so that an
 edit which moves the box a little leaves every list's order as it was. :func:`pairs_within_reference`
 is the plain numpy twin.
-Clump radius and clump membership helpers live in :mod:`hairtool.strand_clumps`.
+Clump radius and clump membership helpers live in :mod:`hairtool.frozen.strand_clumps`.
 """
 
 from __future__ import annotations
@@ -495,7 +495,7 @@ class NeighbourList:
         self._buffers(v)
         self.radius = float(radius)
         # The grid on a lattice of SNAP radii around the box: an edit that moves the box a little
-        # leaves the grid, and so the order of every list, as it was (hairtool.clump_region).
+        # leaves the grid, and so the order of every list, as it was (hairtool.frozen.clump_region).
         snap = SNAP * self.radius
         lo, hi = np.floor(lo / snap) * snap, (np.floor(hi / snap) + 1.0) * snap
         dims = (np.floor((hi - lo) / self.radius).astype(np.int64) + 1).tolist()  # rows r wide in y, z

@@ -19,7 +19,7 @@ within h. (A pair farther apart than 1.1·h at the start never interacts in that
 :func:`clump` runs numba kernels on a cell-sorted list of them, built when the points change
 (an update on the points of the last one, e.g. a clump-only parameter change or a cursor held
 still, reuses it). :func:`clump_reference` is the plain numpy twin of the same definition.
-While a brush drags, :mod:`hairtool.clump_region` redoes a run only near what changed.
+While a brush drags, :mod:`hairtool.frozen.clump_region` redoes a run only near what changed.
 """
 
 from __future__ import annotations
@@ -28,9 +28,17 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.errors import ParameterError
-from hairtool.freeze import CH_CLUMP, EPS, check_seed, hash_head_nb, hash_tail_u01_nb, hash_u01, seed_u64
+from hairtool.frozen.noise import (
+    CH_CLUMP,
+    EPS,
+    check_seed,
+    hash_head_nb,
+    hash_tail_u01_nb,
+    hash_u01,
+    seed_u64,
+)
+from hairtool.frozen.spatial import NeighbourList, pairs_within_reference
 from hairtool.groom import Groom
-from hairtool.spatial import NeighbourList, pairs_within_reference
 
 GAP_MODES = ("printed", "text", "off")
 _GAP_CODE = {"printed": 0, "text": 1, "off": 2}
@@ -224,7 +232,7 @@ def _clump_run(points, order, lists, sroot, h, iterations, step, gap, seed, bufs
     """The k Jacobi iterations on the cell-sorted list, one call (no Python between kernels).
     ``step`` < 0: automatic. Writes the result to ``out`` (original order, float32); returns
     (mean neighbours within h per moving vertex, the step used). ``record`` = (iterates (k, V, 3),
-    forces (k, V, 3), counts, Σg), in original order, for :mod:`hairtool.clump_region`; empty
+    forces (k, V, 3), counts, Σg), in original order, for :mod:`hairtool.frozen.clump_region`; empty
     arrays: not recorded."""
     P, Pn, f, best, count, weight, heads = bufs
     aflat, aoff, acnt, bflat, bstart = lists
@@ -259,7 +267,7 @@ RECORD_LIMIT = 8_000_000  # vertices × iterations at most in a record (2 × 24 
 
 
 class ClumpRecord:
-    """What a run leaves for :mod:`hairtool.clump_region` to redo only where its input changed:
+    """What a run leaves for :mod:`hairtool.frozen.clump_region` to redo only where its input changed:
     its parameters, input and output, and each iteration's points and forces, the first one's
     neighbour counts and Σg (original vertex order)."""
 
@@ -303,7 +311,7 @@ class ClumpWorkspace:
         self.builds = 0  # neighbour lists built so far (the rest of the runs reused one)
         self.record = False  # keep a ClumpRecord of each run (the studio's updates in a region)
         self.recorded: ClumpRecord | None = None  # kept for its buffers even when not valid
-        self.region = None  # hairtool.clump_region's scratch, when it updates this workspace
+        self.region = None  # hairtool.frozen.clump_region's scratch, when it updates this workspace
         self._mask_for: object = None
         self._mask = np.zeros(0, bool)
         self._buffers: tuple = ()

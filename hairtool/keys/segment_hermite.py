@@ -1,7 +1,7 @@
 """Hermite segment costs (seed 003) from the Gram matrix: the kernel and its numpy twin.
 
 h(s) = h00(s)·x_i + h10(s)·L·m_i + h01(s)·x_j + h11(s)·L·m_j with s = (k−i)/L, L = j − i and
-m_c = w_c·(x_{hi_c} − x_{lo_c}) (:func:`hairtool.segment_cost.tangent_stencil`). Σ_k |h_k|² is
+m_c = w_c·(x_{hi_c} − x_{lo_c}) (:func:`hairtool.keys.gram.tangent_stencil`). Σ_k |h_k|² is
 Σ_ab Q_ab(L)·⟨u_a, u_b⟩ with Q from closed-form power sums; the cross terms Σ_k ⟨x_k, h_k⟩ are
 cubic moments Σ_k d^p·G_kc accumulated from i (columns near i) and from j (columns near j).
 """
@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit, prange
 from numpy.typing import NDArray
 
-from hairtool.segment_cost import _HERMITE, frame_errors_numpy
+from hairtool.keys.gram import HERMITE_BASIS, frame_errors_reference
 
 F64 = NDArray[np.float64]
 
@@ -29,13 +29,13 @@ def hermite_quad_weights(n: int) -> F64:
     q = np.zeros((n, 4, 4))
     for a in range(4):
         for b in range(4):
-            conv = np.convolve(_HERMITE[a], _HERMITE[b])  # coefficients of s^0..s^6
+            conv = np.convolve(HERMITE_BASIS[a], HERMITE_BASIS[b])  # coefficients of s^0..s^6
             q[:, a, b] = sums @ conv
     return q
 
 
 @njit(cache=True, nogil=True)
-def _stencil(c, n):  # pragma: no cover - compiled
+def stencil_at(c, n):  # pragma: no cover - compiled
     if c == 0:
         return 0, 1, 1.0
     if c == n - 1:
@@ -44,10 +44,10 @@ def _stencil(c, n):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _hermite_quad_terms(g, i, j, n):  # pragma: no cover - compiled
+def hermite_quad_terms(g, i, j, n):  # pragma: no cover - compiled
     """⟨u_a, u_b⟩ for u = (x_i, L·m_i, x_j, L·m_j): (00, 01, 11, 02, 03, 12, 13, 22, 23, 33)."""
-    li, hi, wi = _stencil(i, n)
-    lj, hj, wj = _stencil(j, n)
+    li, hi, wi = stencil_at(i, n)
+    lj, hj, wj = stencil_at(j, n)
     el = float(j - i)
     ti = el * wi
     tj = el * wj
@@ -68,7 +68,7 @@ def _hermite_quad_terms(g, i, j, n):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _hermite_quad(g, q, i, j, n):  # pragma: no cover - compiled
     """Σ_k |h_k|² = Σ_ab Q_ab⟨u_a, u_b⟩ with Q from :func:`hermite_quad_weights`."""
-    u = _hermite_quad_terms(g, i, j, n)
+    u = hermite_quad_terms(g, i, j, n)
     m = j - i
     return (
         q[m, 0, 0] * u[0]
@@ -86,7 +86,7 @@ def _hermite_kernel(g, curv, lam, q):  # pragma: no cover - compiled
     a = np.zeros((n, n))
     bt = np.zeros((n, n))
     for i in prange(n):
-        li, hi, wi = _stencil(i, n)
+        li, hi, wi = stencil_at(i, n)
         a0 = a2 = a3 = 0.0  # Σ d^p G_ki, d = k − i
         t1 = t2 = t3 = 0.0  # Σ d^p (G_k,hi − G_k,lo)
         dsum = 0.0
@@ -111,7 +111,7 @@ def _hermite_kernel(g, curv, lam, q):  # pragma: no cover - compiled
             cross += el * wi * (t1 * il - 2.0 * t2 * il * il + t3 * il * il * il)
             a[i, j] = dsum - 2.0 * cross + _hermite_quad(g, q, i, j, n) + lam * csum
     for j in prange(n):
-        lj, hj, wj = _stencil(j, n)
+        lj, hj, wj = stencil_at(j, n)
         b0 = b2 = b3 = 0.0  # Σ e^p G_kj, e = j − k, r = e/L = 1 − s
         v1 = v2 = v3 = 0.0
         for i in range(j - 2, -1, -1):
@@ -137,11 +137,16 @@ def _hermite_kernel(g, curv, lam, q):  # pragma: no cover - compiled
     return a
 
 
-def hermite_table_numpy(g: F64, curv: F64, lam: float = 0.0) -> F64:
-    """Numpy twin of the Hermite kernel: per-pair sums of :func:`frame_errors_numpy`."""
+def hermite_table_reference(g: F64, curv: F64, lam: float = 0.0) -> F64:
+    """Numpy twin of the Hermite kernel: per-pair sums of :func:`frame_errors_reference`."""
     n = g.shape[0]
     out = np.zeros((n, n))
     for i in range(n):
         for j in range(i + 2, n):
-            out[i, j] = frame_errors_numpy(g, curv, lam, i, j, "hermite").sum()
+            out[i, j] = frame_errors_reference(g, curv, lam, i, j, "hermite").sum()
     return out
+
+
+def hermite_table(g: F64, curv: F64, lam: float = 0.0) -> F64:
+    """``(n, n)`` Σ-of-frame-costs table for Hermite interpolation (numba)."""
+    return _hermite_kernel(g, curv, float(lam), hermite_quad_weights(max(g.shape[0], 2)))

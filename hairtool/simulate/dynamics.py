@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation, Groom
-from hairtool.head_motion import check_transform, head_motion
+from hairtool.simulate.head_motion import check_transform, head_motion
 
 F64 = NDArray[np.float64]
 
@@ -165,8 +165,8 @@ def simulate(
 ) -> Animation:
     """Simulate ``groom`` (its pose at time 0) on a moving head; returns ``frames`` frames at ``fps``.
 
-    motion: names from :mod:`hairtool.head_motion` ("turn,nod" plays them in equal slots), placed
-        on the head sphere (``head_center``, ``head_radius``; :func:`~hairtool.head_motion.fit_head`
+    motion: names from :mod:`hairtool.simulate.head_motion` ("turn,nod" plays them in equal slots), placed
+        on the head sphere (``head_center``, ``head_radius``; :func:`~hairtool.simulate.head_motion.fit_head`
         finds one for a real groom), or a callable t (s) → rigid 4×4 head transform (world from
         head; the groom is posed at t = 0).
     substeps: solver steps per frame. gravity: units/s² along −y. damping: velocity decay per

@@ -1,7 +1,7 @@
 """The direct O(n³D) segment costs: rebuild every skipped frame of every pair from the features.
 
 Slow on purpose and written from the definitions only (no Gram matrix, no prefix sums): the
-test oracle for :mod:`hairtool.segment_cost` and the baseline its benchmark is timed against.
+test oracle for :mod:`hairtool.keys.costs` and the baseline its benchmark is timed against.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Seed 003 measures poses by the quaternion distance Dist(q1, q2) = arccos(|w|), [w, x, y, z] =
 q2 q1⁻¹ (half the rotation angle, radians), weighted per joint with the trunk heavier than the
-limbs. The key-frame DP (hairtool.keyframes) needs, for every candidate segment i < j, the
+limbs. The key-frame DP (hairtool.keys.dp) needs, for every candidate segment i < j, the
 error of interpolating the frames between keys i and j: :func:`rotation_cost_table`.
 """
 
@@ -14,9 +14,9 @@ import numpy as np
 from numba import njit, prange
 from numpy.typing import ArrayLike, NDArray
 
-from hairtool import quaternion as quat
-from hairtool.bvh import Motion, read_bvh
 from hairtool.errors import ParameterError
+from hairtool.mocap import quaternion as quat
+from hairtool.mocap.bvh import Motion, read_bvh
 
 F64 = NDArray[np.float64]
 

@@ -14,8 +14,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation
-from hairtool.keyframes import uniform_keys
-from hairtool.segment_cost import INTERPOLATIONS
+from hairtool.keys.costs import INTERPOLATIONS
+from hairtool.keys.dp import uniform_keys
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]

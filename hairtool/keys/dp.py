@@ -1,8 +1,8 @@
 """Globally optimal keyframes by dynamic programming over a segment cost table (seeds 000, 003).
 
 One engine, any ``(n, n)`` table C (C[i, j] the cost of keys i < j with nothing between;
-entries i >= j are ignored): the Gram tables of :mod:`hairtool.segment_cost` or the rotation
-table of :mod:`hairtool.mocap`. Keys always include the first and last frame.
+entries i >= j are ignored): the Gram tables of :mod:`hairtool.keys.costs` or the rotation
+table of :mod:`hairtool.mocap.costs`. Keys always include the first and last frame.
 
 - exactly K keys, for every K up to a limit in one solve (the error-versus-key-count curve):
   E_K(j) = min_{i<j} E_{K−1}(i) ⊕ C[i, j], with ⊕ = + (total) or max (worst frame);
@@ -75,7 +75,7 @@ def _layers_kernel(ct, kmax, use_max, stop):  # pragma: no cover - compiled
     return e, back, kmax
 
 
-def layers_numpy(c: F64, kmax: int, use_max: bool = False, stop: float = -np.inf):
+def layers_reference(c: F64, kmax: int, use_max: bool = False, stop: float = -np.inf):
     """Numpy twin of the layered DP (same sums, same first-minimum tie-break)."""
     n = c.shape[0]
     e = np.full((kmax + 1, n), np.inf)
@@ -118,7 +118,7 @@ def _penalty_kernel(ct, tau):  # pragma: no cover - compiled
     return e, back
 
 
-def penalty_numpy(c: F64, tau: float):
+def penalty_reference(c: F64, tau: float):
     """Numpy twin of the per-key-price DP."""
     n = c.shape[0]
     e = np.full(n, np.inf)
@@ -204,7 +204,7 @@ def solve_layers(
     use_max = objective == "worst"
     if use_numba:
         return _layers_kernel(np.ascontiguousarray(c.T), kmax, use_max, float(stop))
-    return layers_numpy(c, kmax, use_max, float(stop))
+    return layers_reference(c, kmax, use_max, float(stop))
 
 
 def select_keys(
@@ -256,7 +256,7 @@ def select_keys(
         _, pb = (
             _penalty_kernel(np.ascontiguousarray(c.T), float(value))
             if use_numba
-            else penalty_numpy(c, float(value))
+            else penalty_reference(c, float(value))
         )
         chosen = _trace(lambda _, j: pb[j], n)
         if curve_keys > 0:

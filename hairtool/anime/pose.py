@@ -176,7 +176,9 @@ def wave_values(x: ArrayLike, t: ArrayLike, a: float, k: float, s: float, p: flo
     return -(a / s) * (x / np.pi) ** p * (np.cos(x / k - 2.0 * np.pi * t / period) + 1.0 / s)
 
 
-def pose_numpy(groom: Groom, times: F64, axes: F64, scale: F64, shift: F64, wave: tuple[float, ...]) -> F64:
+def pose_reference(
+    groom: Groom, times: F64, axes: F64, scale: F64, shift: F64, wave: tuple[float, ...]
+) -> F64:
     """``(P, V, 3)`` float64 poses, plain numpy: the reference for :func:`pose_numba`."""
     top = groom.topology
     x = wave_x(groom)
@@ -228,7 +230,7 @@ def _pose_kernel(
 
 
 def pose_numba(groom: Groom, times: F64, axes: F64, scale: F64, shift: F64, wave: tuple[float, ...]) -> F64:
-    """:func:`pose_numpy` in one pass per strand, parallel over strands (same bits for any thread count)."""
+    """:func:`pose_reference` in one pass per strand, parallel over strands (same bits, any thread count)."""
     a, k, s, p, period = (float(w) for w in wave)
     x = wave_x(groom)
     out = np.empty((times.size, groom.vertex_count, 3))

@@ -11,8 +11,8 @@ import numpy as np
 from numba import njit, prange
 from numpy.typing import NDArray
 
-from hairtool.segment_cost import _check, frame_errors_numpy
-from hairtool.segment_hermite import _hermite_quad_terms, _stencil
+from hairtool.keys.gram import check_gram, frame_errors_reference
+from hairtool.keys.segment_hermite import hermite_quad_terms, stencil_at
 
 F64 = NDArray[np.float64]
 
@@ -22,11 +22,11 @@ def _worst_kernel(g, curv, lam, hermite):  # pragma: no cover - compiled
     n = g.shape[0]
     out = np.zeros((n, n))
     for i in prange(n):
-        li, hi, wi = _stencil(i, n)
+        li, hi, wi = stencil_at(i, n)
         for j in range(i + 2, n):
-            lj, hj, wj = _stencil(j, n)
+            lj, hj, wj = stencil_at(j, n)
             el = float(j - i)
-            u = _hermite_quad_terms(g, i, j, n)
+            u = hermite_quad_terms(g, i, j, n)
             worst = -np.inf
             for k in range(i + 1, j):
                 s = (k - i) / el
@@ -62,19 +62,19 @@ def _worst_kernel(g, curv, lam, hermite):  # pragma: no cover - compiled
     return out
 
 
-def worst_table_numpy(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear") -> F64:
-    """Numpy twin of the worst-frame kernel (per-pair maxima of :func:`frame_errors_numpy`)."""
+def worst_table_reference(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear") -> F64:
+    """Numpy twin of the worst-frame kernel (per-pair maxima of :func:`frame_errors_reference`)."""
     n = g.shape[0]
     out = np.zeros((n, n))
     for i in range(n):
         for j in range(i + 2, n):
-            out[i, j] = frame_errors_numpy(g, curv, lam, i, j, interp).max()
+            out[i, j] = frame_errors_reference(g, curv, lam, i, j, interp).max()
     return out
 
 
 def worst_table(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear", use_numba: bool = True) -> F64:
     """``(n, n)`` worst-frame table from a centred Gram matrix; entries i < j meaningful."""
-    g, curv = _check(g, curv, lam)
+    g, curv = check_gram(g, curv, lam)
     if not use_numba:
-        return worst_table_numpy(g, curv, lam, interp)
+        return worst_table_reference(g, curv, lam, interp)
     return _worst_kernel(g, curv, float(lam), interp == "hermite")

@@ -56,7 +56,7 @@ class FeatureOptions:
         return asdict(self)
 
 
-def resample_frames_numpy(frames: ArrayLike, counts: ArrayLike, m: int) -> F64:
+def resample_frames_reference(frames: ArrayLike, counts: ArrayLike, m: int) -> F64:
     """Numpy twin of :func:`resample_frames`, vectorised over chunks of frames.
 
     ``frames`` is ``(F, V, 3)``. One monotone key over all frames and strands (strand s of
@@ -151,7 +151,7 @@ def resample_frames(frames: ArrayLike, counts: ArrayLike, m: int, use_numba: boo
     One pass per strand (vertices and samples walked together), in parallel over frames.
     """
     if not use_numba:
-        return resample_frames_numpy(frames, counts, m)
+        return resample_frames_reference(frames, counts, m)
     if not np.isfinite(m) or int(m) != m or m < 2:
         raise ParameterError("samples", m, "a whole number of at least 2")
     p = np.ascontiguousarray(frames)

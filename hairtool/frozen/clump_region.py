@@ -6,10 +6,10 @@ start) and, for the gap correction, by the force on its nearest neighbour, which
 that one's list: after k iterations a vertex depends only on the vertices within 2k steps of
 the lists (k without the gap correction). A list keeps its order while its vertices stay: a
 full build orders it by sorted position on a grid that small edits leave as it is
-(:data:`hairtool.spatial.SNAP`), and the sort keeps the relative order of the vertices that
+(:data:`hairtool.frozen.spatial.SNAP`), and the sort keeps the relative order of the vertices that
 did not move. So a vertex more than 2k steps from every changed vertex, along the lists of the
 last run and of this one, ends exactly where the last run left it. :func:`clump_points_interactive`
-keeps a :class:`~hairtool.clump.ClumpRecord` of each run (its input, output, each iteration's
+keeps a :class:`~hairtool.frozen.clump.ClumpRecord` of each run (its input, output, each iteration's
 points and forces, every vertex's list), makes new lists for the changed vertices and those
 whose lists held or now hold one, and redoes the vertices within 2k steps, reading the record
 for their neighbours outside. The bytes are those of a full run (the tests hold it to that);
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from hairtool.clump import (
+from hairtool.frozen.clump import (
     _GAP_CODE,
     MARGIN,
     ClumpWorkspace,
@@ -33,7 +33,7 @@ from hairtool.clump import (
     step_from_stats,
     vertex_force,
 )
-from hairtool.freeze import CH_CLUMP, check_seed, hash_head_nb, hash_tail_u01_nb, seed_u64
+from hairtool.frozen.noise import CH_CLUMP, check_seed, hash_head_nb, hash_tail_u01_nb, seed_u64
 from hairtool.groom import Groom
 
 MAX_CHANGED = 0.25  # of the vertices: more changed, and the update runs in full
@@ -109,7 +109,7 @@ def _within_steps(k, seeds, lists, list_count, new_row, nbr_a, cnt_a, nbr_b, cnt
 
 @njit(cache=True, nogil=True, parallel=True)
 def _region_force(P, flat, cap, list_count, region, roots, h, stats, F, best, count, weight, ident):
-    """:func:`hairtool.clump._force_kernel` for the vertices ``region`` (original indices) with
+    """:func:`hairtool.frozen.clump._force_kernel` for the vertices ``region`` (original indices) with
     vertex i's list at ``flat[i·cap :][: list_count[i]]``: the same pulls in the same order, so
     the same numbers. ``P``, ``F``, ``count``, ``weight`` in original order; ``best`` per
     region vertex."""
@@ -128,7 +128,7 @@ def _region_force(P, flat, cap, list_count, region, roots, h, stats, F, best, co
 
 @njit(cache=True, nogil=True, parallel=True)
 def _region_gap(P, F, step, best, region, h, gap, it, seed, out):
-    """:func:`hairtool.clump._gap_kernel` for the vertices ``region``, into ``out`` (the next
+    """:func:`hairtool.frozen.clump._gap_kernel` for the vertices ``region``, into ``out`` (the next
     iterate, or the float32 result after the last iteration)."""
     for n in prange(region.size):
         i = region[n]
@@ -296,7 +296,7 @@ def _update_region(
 
 
 def _lists(nl, positions: np.ndarray, sc: RegionScratch) -> tuple[np.ndarray, np.ndarray]:
-    """:meth:`~hairtool.spatial.NeighbourList.region_lists`, wide enough (the width adapts)."""
+    """:meth:`~hairtool.frozen.spatial.NeighbourList.region_lists`, wide enough (the width adapts)."""
     while True:
         nbr, cnt = nl.region_lists(positions, sc.capacity)
         if cnt.size == 0 or int(cnt.max()) < sc.capacity:
@@ -313,7 +313,7 @@ def clump_points_interactive(
     seed: int = 0,
     workspace: ClumpWorkspace | None = None,
 ) -> np.ndarray:
-    """:func:`~hairtool.clump.clump_points`, the same bytes, for a workspace that sees one
+    """:func:`~hairtool.frozen.clump.clump_points`, the same bytes, for a workspace that sees one
     edit after another: redone only near what changed since its last run when it can."""
     ws = workspace or ClumpWorkspace()
     if ws.region is None:

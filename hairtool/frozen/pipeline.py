@@ -19,20 +19,14 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from hairtool.align import align, check_align_params
-from hairtool.clump import ClumpWorkspace, check_clump_params, clump_points
-from hairtool.clump_region import clump_points_interactive
 from hairtool.errors import ParameterError
-from hairtool.freeze import (
-    MAX_VARIATION,
-    check_freeze_params,
-    check_seed,
-    draw_seed,
-    freeze,
-    strand_multipliers,
-)
+from hairtool.frozen.align import align, check_align_params
+from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
+from hairtool.frozen.clump_region import clump_points_interactive
+from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
+from hairtool.frozen.noise import check_seed, draw_seed
+from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
 from hairtool.groom import Groom
-from hairtool.strand_clumps import auto_clump_radius, strand_clumps
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,8 +34,8 @@ class FrozenParams:
     """Everything the pipeline needs besides the strokes. Angles in radians, lengths in groom units.
 
     ``strand_variation``: spread of the per-strand stiffness multiplier (0 … 4) or an ``(S,)``
-    array of multipliers. ``clump_radius`` None: :func:`~hairtool.strand_clumps.auto_clump_radius`.
-    ``clump_step`` None: :func:`~hairtool.clump.auto_step` of the frozen groom, before any stroke
+    array of multipliers. ``clump_radius`` None: :func:`~hairtool.frozen.strand_clumps.auto_clump_radius`.
+    ``clump_step`` None: :func:`~hairtool.frozen.clump.auto_step` of the frozen groom, before any stroke
     (so that a stroke does not change how strongly the whole groom clumps while it drags, and
     the studio can redo ClumpWithGaps only near the strands it moves). ``redraw_noise``: new
     freeze noise at every :meth:`update` (the paper's behaviour; flickers while dragging).
@@ -183,7 +177,7 @@ class FrozenPipeline:
         return self._workspace.step
 
     def _step(self) -> float:
-        """The parameter, or :func:`~hairtool.clump.auto_step` of the frozen groom (cached)."""
+        """The parameter, or :func:`~hairtool.frozen.clump.auto_step` of the frozen groom (cached)."""
         p = self._params
         if p.clump_step is not None:
             return float(p.clump_step)
@@ -206,7 +200,7 @@ class FrozenPipeline:
     @property
     def clump_redone(self) -> float:
         """Share of the vertices the last clumping computed (1: all; less: only those near the
-        vertices that changed since the one before, :mod:`hairtool.clump_region`)."""
+        vertices that changed since the one before, :mod:`hairtool.frozen.clump_region`)."""
         region = self._workspace.region
         return 1.0 if region is None else region.fraction
 
@@ -274,7 +268,7 @@ class FrozenPipeline:
 
     def clump_ids(self) -> np.ndarray:
         """``(S,)`` clump of each strand in the last result at the scale h (density basins of
-        the strands' adhesion, :func:`~hairtool.strand_clumps.strand_clumps`), numbered in
+        the strands' adhesion, :func:`~hairtool.frozen.strand_clumps.strand_clumps`), numbered in
         order of their first strand."""
         return strand_clumps(self._result, self.clump_radius)
 

@@ -1,0 +1,55 @@
+"""Segment cost tables for keyframe selection: C[i, j] is the cost of skipping frames i < k < j.
+
+The total (Σ_k e_k) and worst-frame (max_k e_k) tables for linear and Hermite interpolation,
+each in its own module over the shared terms of :mod:`hairtool.keys.gram`. Only entries i < j
+are meaningful; the rest are 0.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hairtool.errors import ParameterError
+from hairtool.keys.gram import centered_gram, check_gram, frame_curvature
+from hairtool.keys.segment_hermite import hermite_table, hermite_table_reference
+from hairtool.keys.segment_linear import linear_table, linear_table_reference
+from hairtool.keys.segment_worst import worst_table
+
+F64 = NDArray[np.float64]
+
+INTERPOLATIONS = ("linear", "hermite")
+OBJECTIVES = ("total", "worst")
+
+
+def total_table(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear", use_numba: bool = True) -> F64:
+    """``(n, n)`` Σ-of-frame-costs table from a centred Gram matrix (see the module docstring)."""
+    g, curv = check_gram(g, curv, lam)
+    if interp == "linear":
+        return linear_table(g, curv, lam) if use_numba else linear_table_reference(g, curv, lam)
+    if interp == "hermite":
+        return hermite_table(g, curv, lam) if use_numba else hermite_table_reference(g, curv, lam)
+    raise ParameterError("interp", interp, " or ".join(INTERPOLATIONS))
+
+
+def cost_table(
+    x: F64,
+    interp: str = "linear",
+    curvature: float = 0.0,
+    objective: str = "total",
+    *,
+    use_numba: bool = True,
+) -> F64:
+    """``(n, n)`` segment costs of ``(n, D)`` features: O(n²D) Gram product, then O(n²) (total)
+    or O(n³) (worst) from the Gram matrix. Entries i < j are meaningful; the rest are 0."""
+    if interp not in INTERPOLATIONS:
+        raise ParameterError("interp", interp, " or ".join(INTERPOLATIONS))
+    if objective not in OBJECTIVES:
+        raise ParameterError("objective", objective, " or ".join(OBJECTIVES))
+    if not np.isfinite(curvature) or curvature < 0:
+        raise ParameterError("curvature", curvature, "a finite weight >= 0")
+    g = centered_gram(x)
+    curv = frame_curvature(x) if curvature > 0 else np.zeros(g.shape[0])
+    if objective == "worst":
+        return worst_table(g, curv, curvature, interp, use_numba)
+    return total_table(g, curv, curvature, interp, use_numba)
