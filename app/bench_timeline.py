@@ -65,10 +65,10 @@ def _stall(app, window, m) -> dict:
 def _measure(app, args: argparse.Namespace, settings) -> list[dict]:
     from PySide6.QtCore import Qt
 
-    from app.ui import key_state as ks
     from app.ui.qt_utils import send_mouse
     from app.ui.window import MainWindow
     from hairtool import samples
+    from hairtool.keys import session as ks
     from hairtool.simulate.sway import sway_animation
 
     groom = samples.scalp(args.strands, args.vertices)

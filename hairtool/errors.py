@@ -29,3 +29,8 @@ class ParameterError(HairtoolError, ValueError):
 
 class GroomError(HairtoolError, ValueError):
     """Arrays do not describe a valid groom or animation."""
+
+
+class Cancelled(Exception):
+    """Raised inside a long call once its ``cancelled()`` callback turned True (a studio job's
+    Cancel button, a superseded job): the work stops and its result is dropped."""

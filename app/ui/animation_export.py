@@ -29,9 +29,9 @@ from PySide6.QtCore import QObject, Qt, QThread, Signal, Slot
 from app.render.camera import Camera
 from app.render.offscreen import render_image
 from app.ui.colouring import vertex_colors
-from app.ui.jobs import Job, JobCancelled
+from app.ui.jobs import Job
 from hairtool import io
-from hairtool.errors import FormatError, HairtoolError, ParameterError
+from hairtool.errors import Cancelled, FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation
 from hairtool.io.atomic import atomic_path
 from hairtool.keys.export import export_keys as write_keys
@@ -57,7 +57,7 @@ KEY_FILTERS = "Keys record (*.json);;Key sheet (*.csv);;USD key poses (*.usda *.
 MP4_QUALITY = 8  # imageio-ffmpeg's 0..10 scale: visually clean thin hair lines, small files
 
 Progress = Callable[..., None]
-Cancelled = Callable[[], bool]
+CancelCheck = Callable[[], bool]
 
 
 def _never() -> bool:
@@ -82,17 +82,17 @@ def _rgb(image: NDArray) -> NDArray[np.uint8]:
 
 
 def _frames_checked(
-    frames: Iterable[NDArray], n_frames: int, progress: Progress, cancelled: Cancelled
+    frames: Iterable[NDArray], n_frames: int, progress: Progress, cancelled: CancelCheck
 ) -> Iterator[NDArray[np.uint8]]:
     """RGB frames with progress after each and a cancel check before each."""
     count = 0
     for count, image in enumerate(frames, 1):
         if cancelled():
-            raise JobCancelled
+            raise Cancelled
         yield _rgb(image)
         progress(count / max(n_frames, 1), f"frame {count}/{n_frames}")
     if cancelled():
-        raise JobCancelled
+        raise Cancelled
     if count != n_frames:
         raise ParameterError("frames", count, f"{n_frames} frames")
 
@@ -104,11 +104,11 @@ def write_video(
     fps: float,
     *,
     progress: Progress = _ignore,
-    cancelled: Cancelled = _never,
+    cancelled: CancelCheck = _never,
 ) -> None:
     """Encode ``n_frames`` RGB(A) uint8 frames as MP4 (H.264) or GIF, atomically.
 
-    :class:`JobCancelled` (raised when ``cancelled()`` turns True) leaves no file behind. GIF:
+    :class:`Cancelled` (raised when ``cancelled()`` turns True) leaves no file behind. GIF:
     Pillow merges identical consecutive frames into one longer frame (pictures held on twos
     play the same, in fewer GIF frames); delays are whole centiseconds, as GIF stores them.
     """
@@ -173,7 +173,7 @@ def write_png_sequence(
     n_frames: int,
     *,
     progress: Progress = _ignore,
-    cancelled: Cancelled = _never,
+    cancelled: CancelCheck = _never,
 ) -> list[Path]:
     """Write ``shot_0000.png`` … beside ``path``: into a temporary folder first, moved into
     place only when every frame is written, so a cancel leaves nothing behind."""
@@ -273,7 +273,7 @@ class GuiFrameSource(QObject):
         except BaseException as e:  # handed to the worker, which raises it
             self._answers.put((frame, None, e))
 
-    def frame(self, index: int, cancelled: Cancelled = _never) -> NDArray:
+    def frame(self, index: int, cancelled: CancelCheck = _never) -> NDArray:
         if QThread.currentThread() == self.thread():
             return self._render(index)
         self._requested.emit(index)
@@ -282,7 +282,7 @@ class GuiFrameSource(QObject):
                 frame, image, error = self._answers.get(timeout=0.05)
             except queue.Empty:
                 if cancelled():
-                    raise JobCancelled from None
+                    raise Cancelled from None
                 continue
             if frame != index:  # a late answer to an earlier, abandoned request
                 continue
@@ -290,7 +290,7 @@ class GuiFrameSource(QObject):
                 raise error
             return image
 
-    def frames(self, n_frames: int, cancelled: Cancelled = _never) -> Iterator[NDArray]:
+    def frames(self, n_frames: int, cancelled: CancelCheck = _never) -> Iterator[NDArray]:
         for i in range(n_frames):
             yield self.frame(i, cancelled)
 
@@ -405,7 +405,7 @@ class AnimationExporter(QObject):
         source = GuiFrameSource(render)
         n = anim.n_frames
 
-        def work(progress: Progress, cancelled: Cancelled) -> str:
+        def work(progress: Progress, cancelled: CancelCheck) -> str:
             frames = source.frames(n, cancelled)
             if suffix in VIDEO_SUFFIXES:
                 write_video(path, frames, n, anim.fps, progress=progress, cancelled=cancelled)

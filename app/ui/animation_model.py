@@ -18,10 +18,10 @@ import numpy as np
 from PySide6.QtCore import QObject, Qt, QTimer, Signal
 
 from app.render.ramps import ramp_colors
-from app.ui import key_state as ks
 from app.ui.jobs import Job, JobRunner
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Animation
+from hairtool.keys import session as ks
 from hairtool.keys.dp import uniform_keys
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at
 
@@ -49,7 +49,7 @@ class _Committed:
     """The last complete key state (settings, solve, keys, errors): what a cancel returns to."""
 
     settings: ks.KeySettings
-    solve: ks.KeySolve | None
+    solve: ks.KeySession | None
     dp_keys: np.ndarray | None
     analysis: ks.Analysis | None
 
@@ -96,7 +96,7 @@ class AnimationModel(QObject):
         self._play_start = (0.0, 0)
 
     def _clear_keys(self) -> None:
-        self.key_solve: ks.KeySolve | None = None
+        self.key_solve: ks.KeySession | None = None
         self.solve_stale = False  # the animation was edited after the solve
         self.dp_keys: np.ndarray | None = None
         self.uniform_keys: np.ndarray | None = None
@@ -344,7 +344,7 @@ class AnimationModel(QObject):
         job = self._solve_job
         self._busy_update()
 
-    def _solve_landed(self, job: Job, anim: Animation, result: ks.KeySolve | None) -> None:
+    def _solve_landed(self, job: Job, anim: Animation, result: ks.KeySession | None) -> None:
         if job is not self._solve_job:
             return
         self._solve_job = None
@@ -352,14 +352,14 @@ class AnimationModel(QObject):
         if anim is self.animation and result is not None:
             self._apply_solve(anim, result)
 
-    def _apply_solve(self, anim: Animation, result: ks.KeySolve) -> None:
+    def _apply_solve(self, anim: Animation, result: ks.KeySession) -> None:
         self.key_solve = result
         self.solve_stale = False
         self.curve_changed.emit()
         self._choose_keys(force=True)
 
     def _choose_keys(self, force: bool = False) -> None:
-        keys = ks.choose_keys(self.key_solve, self.settings)
+        keys = self.key_solve.keys_for(self.settings)
         if not force and self.dp_keys is not None and np.array_equal(keys, self.dp_keys):
             if self.analysis is None and self._analysis_job is None:
                 self.request_analysis()

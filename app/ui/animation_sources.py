@@ -13,11 +13,12 @@ import numpy as np
 from PySide6.QtCore import QObject, Qt
 
 from app.ui.anime_dock import SOURCE as ANIME_SOURCE
-from app.ui.anime_dock import AnimeDock, AnimeSettings, cycle_for_groom
+from app.ui.anime_dock import AnimeDock
 from app.ui.jobs import Job
 from app.ui.simulate_dialog import SOURCE as SIMULATE_SOURCE
-from app.ui.simulate_dialog import SimulateOptions, run_simulation
+from hairtool.anime.settings import AnimeSettings, cycle_for_groom
 from hairtool.errors import HairtoolError
+from hairtool.simulate.options import SimulateOptions, run_simulation
 
 if TYPE_CHECKING:
     from app.ui.window import MainWindow

@@ -16,11 +16,11 @@ from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QUndoCommand
 from PySide6.QtWidgets import QLabel, QStyle, QWidget
 
 from app.ui.animation_model import VIEW_MODES, AnimationModel
-from app.ui.key_state import key_edit_block
 from app.ui.recording import Recorder
 from hairtool.errors import HairtoolError
 from hairtool.frozen.align import align
 from hairtool.groom import Groom
+from hairtool.keys.session import key_edit_block
 
 if TYPE_CHECKING:
     from app.ui.window import MainWindow

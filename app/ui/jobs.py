@@ -5,7 +5,7 @@ Usage (the window owns one runner, ``window.jobs``)::
     def work(progress, cancelled):          # runs in a worker thread: no Qt widgets here
         for i, chunk in enumerate(chunks):
             if cancelled():
-                return None                 # or raise JobCancelled; the result is dropped
+                return None                 # or raise Cancelled; the result is dropped
             ...
             progress((i + 1) / len(chunks), f"chunk {i + 1}")
         return result
@@ -35,17 +35,13 @@ from typing import Any
 from PySide6.QtCore import QElapsedTimer, QObject, QRunnable, Qt, QThreadPool, Signal, Slot
 from PySide6.QtWidgets import QApplication, QHBoxLayout, QLabel, QProgressBar, QToolButton, QWidget
 
-from hairtool.errors import HairtoolError
+from hairtool.errors import Cancelled, HairtoolError
 
 ProgressFn = Callable[..., None]
 CancelledFn = Callable[[], bool]
 JobFn = Callable[[ProgressFn, CancelledFn], Any]
 
 _PROGRESS_INTERVAL_S = 0.05  # at most ~20 progress updates per second reach the GUI
-
-
-class JobCancelled(Exception):
-    """Raise inside a job function to stop it; the runner treats it as a cancel."""
 
 
 @dataclass(eq=False)
@@ -93,7 +89,7 @@ class _Runnable(QRunnable):
         job = self.job
         try:
             result = self.fn(self._progress, lambda: job.cancelled)
-        except JobCancelled:
+        except Cancelled:
             self.bridge.ended.emit(job, "cancel", None)
         except BaseException as e:  # delivered to on_error on the GUI thread
             self.bridge.ended.emit(job, "error", e)
@@ -200,7 +196,7 @@ class JobRunner(QObject):
                 self.report_error(job, payload)
         else:
             job.state = "cancelled"
-            if not was_cancelled:  # raised JobCancelled by itself
+            if not was_cancelled:  # raised Cancelled by itself
                 job.cancel()
                 self.job_finished.emit(job)
             if job.on_cancelled is not None:

@@ -21,9 +21,9 @@ from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, QSettings, QStandardPaths, QTimer, Signal
 
-from app.ui.key_state import KeySettings
 from hairtool import project as pf
 from hairtool.errors import FormatError, HairtoolError
+from hairtool.keys.session import KeySettings
 
 if TYPE_CHECKING:
     from app.ui.window import MainWindow

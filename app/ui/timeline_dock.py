@@ -28,11 +28,14 @@ from PySide6.QtWidgets import (
 )
 
 from app.ui.animation_model import VIEW_MODES, AnimationModel
-from app.ui.key_state import KEY_MODES
 from app.ui.qt_utils import signals_blocked
 from app.ui.timeline_plots import KeyCountPlot, TimelineView
 from app.ui.widgets import SliderSpin
 from hairtool.errors import HairtoolError
+from hairtool.keys.session import KEY_MODES
+
+#: The key modes as the timeline names them.
+MODE_LABELS = {"count": "Key count", "tau": "Price per key (tau)", "budget": "Error budget"}
 
 TRANSPORT = (
     "first",
@@ -61,8 +64,8 @@ class KeyControls(QWidget):
         form.setContentsMargins(4, 2, 4, 2)
         form.setVerticalSpacing(2)
         self.mode = QComboBox()
-        for key, label in KEY_MODES.items():
-            self.mode.addItem(label, key)
+        for key in KEY_MODES:
+            self.mode.addItem(MODE_LABELS[key], key)
         self.count_slider = QSlider(Qt.Orientation.Horizontal)
         self.count_slider.setObjectName("KeyCountSlider")
         self.count_spin = QSpinBox()

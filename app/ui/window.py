@@ -21,13 +21,14 @@ from app.ui.commands import ParamCommand, StrokeCommand
 from app.ui.dialogs import StillOptions, ask_still_options
 from app.ui.jobs import JobRunner, JobStatus
 from app.ui.scene import COLOUR_MODES, Scene
-from app.ui.simulate_dialog import SimulateOptions, ask_simulate_options
+from app.ui.simulate_dialog import ask_simulate_options
 from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
 from app.ui.viewport import BRUSH_STEP, Viewport
 from hairtool import io, samples
 from hairtool.errors import HairtoolError
 from hairtool.groom import Animation, Groom
+from hairtool.simulate.options import SimulateOptions
 
 MAX_RECENT = 10
 SETTINGS_ORG, SETTINGS_APP = "hairtool", "Hairtool Studio"

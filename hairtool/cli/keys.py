@@ -97,9 +97,8 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from hairtool.errors import ParameterError
-    from hairtool.keys.costs import cost_table
-    from hairtool.keys.dp import select_keys
     from hairtool.keys.features import FeatureOptions, frame_features, raw_features
+    from hairtool.keys.session import KeySettings, solve
 
     kind, data, fps = _load(args)
     options = FeatureOptions(
@@ -122,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
     n = x.shape[0]
 
     if args.per_channel:
-        from hairtool.keys.session import per_channel_keys
+        from hairtool.keys.channels import per_channel_keys
 
         if args.penalty is None:
             raise ParameterError("per-channel", True, "a --penalty TAU (seed 003 prices keys per channel)")
@@ -135,17 +134,17 @@ def run(args: argparse.Namespace) -> int:
 
     mode = _mode(args, n)
     objective = "worst" if args.max_error is not None else args.objective
+    table = None
     if kind == "bvh" and args.bvh_features == "quaternion":
         from hairtool.mocap.costs import rotation_cost_table
 
         if args.interp != "linear" or args.curvature or objective != "total":
             raise ParameterError("bvh-features", "quaternion", "the linear (slerp) total objective only")
         table = rotation_cost_table(data)
-    else:
-        table = cost_table(x, args.interp, args.curvature, objective)
-    sel = select_keys(table, objective=objective, curve_keys=args.curve_keys, **mode)
+    settings = KeySettings(objective=objective, interp=args.interp, curvature=args.curvature)
+    session = solve(x, settings, table=table, layers=False)
+    sel = session.select(curve_keys=args.curve_keys, **mode)
     result = {"frames": n, "fps": fps, **sel.to_dict()}
-    result["params"].update(interp=args.interp, curvature=args.curvature)
     if kind == "animation":
         from hairtool.keys.reconstruct import compare_with_uniform, key_distribution
 

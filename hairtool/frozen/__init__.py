@@ -1,0 +1,32 @@
+"""Frozen hair (seed 002): stiffness-based deformation without simulation.
+
+- :mod:`.freeze` FreezeDeform, eqs. 2–7: seeded stretch and bend of every rest segment;
+- :mod:`.align` UserAlign, eqs. 8–13: strands near the cursor turn toward it, root to tip;
+- :mod:`.clump` ClumpWithGaps, eqs. 14–19: the adhesion kernel with the gap-keeping correction,
+  over the neighbour lists of :mod:`.spatial`; :mod:`.clump_region` redoes it only near the
+  strands that moved; :mod:`.strand_clumps` labels clumps and picks the automatic radius;
+- :mod:`.pipeline` the three in order, with the stroke log the studio and the CLI replay;
+- :mod:`.noise` the counter-based noise they share.
+"""
+
+from hairtool.frozen.align import align, align_reference
+from hairtool.frozen.clump import clump, clump_reference
+from hairtool.frozen.freeze import freeze, freeze_reference, strand_multipliers
+from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
+from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
+
+__all__ = [
+    "AlignSample",
+    "FrozenParams",
+    "FrozenPipeline",
+    "FrozenSnapshot",
+    "align",
+    "align_reference",
+    "auto_clump_radius",
+    "clump",
+    "clump_reference",
+    "freeze",
+    "freeze_reference",
+    "strand_clumps",
+    "strand_multipliers",
+]

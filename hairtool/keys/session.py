@@ -1,23 +1,258 @@
-"""Keyframes of an animation or a feature array in one call: features → cost table → exact DP.
+"""The whole keyframe solve, for every caller: ``hairtool keys``, the studio's background jobs,
+scripts and tests.
 
-Also seed 003's per-channel mode, where every degree of freedom is a curve with its own keys
-and its own price per key.
+A :class:`KeySession` is one animation (or ``(frames, D)`` feature array) under one table
+setting: seed 000's features (:mod:`.features`) → the segment cost table (:mod:`.costs`) → the
+layered DP for every key count up to a cap (:mod:`.dp`). After that solve the keys for any count
+are a back-pointer trace (instant: a key-count slider needs no new solve), and the keys for a
+price tau per key (seed 003), an error budget or a worst-frame bound come from the same table.
+Errors of a key set are measured on the original vertices against the key curve, a chunk of
+frames at a time in float64 (:func:`.reconstruct.key_curve_errors`), so nothing of the size of
+a whole reconstruction is ever held.
+
+Long steps take ``progress(fraction, stage)`` and ``cancelled() -> bool`` callbacks; a cancelled
+step returns None instead of its result.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation
-from hairtool.keys.costs import INTERPOLATIONS, cost_table
-from hairtool.keys.dp import DEFAULT_CURVE_KEYS, Selection, select_keys
-from hairtool.keys.features import FeatureOptions, frame_features, raw_features
+from hairtool.keys.costs import INTERPOLATIONS, OBJECTIVES, cost_table
+from hairtool.keys.dp import (
+    DEFAULT_CURVE_KEYS,
+    Selection,
+    check_table,
+    select_keys,
+    solve_layers,
+    uniform_keys,
+)
+from hairtool.keys.edit import KeyEditor
+from hairtool.keys.features import FeatureOptions, frame_features
+from hairtool.keys.reconstruct import (
+    KeyPoses,
+    check_keys,
+    interpolate_at,
+    key_curve_errors,
+    key_poses,
+    motion_speed,
+)
 
+F32 = NDArray[np.float32]
+F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
+
+#: How the keys are chosen: a key count, a price tau per key, or an error budget.
+KEY_MODES = ("count", "tau", "budget")
+MAX_CURVE_KEYS = 200  # the layers (and the error-vs-count curve) cover K = 2..min(frames, this)
+
+Progress = Callable[..., None]
+CancelCheck = Callable[[], bool]
+
+
+@dataclass(frozen=True)
+class KeySettings:
+    """What a caller chose: the mode and its value, the objective, the interpolation, features.
+
+    ``count`` 0 means "a tenth of the frames"; ``samples`` 0 keeps the original vertices instead
+    of resampling M points per strand; ``tip_weight`` is seed 000's root-to-tip weight at the tip
+    (1 at the root); ``curvature`` is its λ. ``budget`` bounds the total feature-space error
+    (objective "total") or the worst frame's (objective "worst").
+    """
+
+    mode: str = "count"
+    count: int = 0
+    tau: float = 1.0
+    budget: float = 1.0
+    objective: str = "total"
+    interp: str = "linear"
+    samples: int = 16
+    tip_weight: float = 2.0
+    curvature: float = 0.0
+
+    def validate(self) -> KeySettings:
+        if self.mode not in KEY_MODES:
+            raise ParameterError("key mode", self.mode, f"one of {', '.join(KEY_MODES)}")
+        if self.objective not in OBJECTIVES:
+            raise ParameterError("objective", self.objective, " or ".join(OBJECTIVES))
+        if self.interp not in INTERPOLATIONS:
+            raise ParameterError("interpolation", self.interp, " or ".join(INTERPOLATIONS))
+        if self.mode == "tau" and self.objective != "total":
+            raise ParameterError("tau", self.tau, "the total-error objective (a price per key adds up)")
+        if int(self.count) != self.count or self.count < 0:
+            raise ParameterError("key count", self.count, "a whole number >= 2 (0: a tenth of the frames)")
+        for name in ("tau", "budget", "curvature"):
+            v = getattr(self, name)
+            if not np.isfinite(v) or v < 0:
+                raise ParameterError(name, v, "a finite number >= 0")
+        if int(self.samples) != self.samples or self.samples == 1 or self.samples < 0:
+            raise ParameterError("samples", self.samples, "a whole number >= 2 (0: the original vertices)")
+        if not np.isfinite(self.tip_weight) or self.tip_weight <= 0:
+            raise ParameterError("tip weight", self.tip_weight, "a finite number > 0")
+        return self
+
+    def replace(self, **changes: object) -> KeySettings:
+        return replace(self, **changes).validate()
+
+    @property
+    def table_key(self) -> tuple:
+        """The settings a cost table depends on: a change here needs a new :func:`solve`."""
+        return (self.objective, self.interp, self.samples, self.tip_weight, self.curvature)
+
+    def feature_options(self) -> FeatureOptions:
+        return FeatureOptions(samples=self.samples or None, tip_weight=float(self.tip_weight))
+
+    def count_for(self, n_frames: int) -> int:
+        k = self.count or max(2, round(n_frames / 10))
+        return int(min(max(k, 2), n_frames))
+
+
+class KeySession:
+    """A segment cost table and, once :meth:`layers` ran, its layered DP: ``energy[K, n−1]`` is
+    the best error with exactly K keys, ``back`` the back-pointers that trace those keys."""
+
+    def __init__(
+        self,
+        table: ArrayLike,
+        *,
+        objective: str = "total",
+        interp: str = "linear",
+        curvature: float = 0.0,
+        kmax: int = MAX_CURVE_KEYS,
+        table_key: tuple = (),
+    ) -> None:
+        self.table = check_table(table)
+        if objective not in OBJECTIVES:
+            raise ParameterError("objective", objective, " or ".join(OBJECTIVES))
+        self.objective, self.interp, self.curvature = objective, interp, float(curvature)
+        self.kmax = int(min(self.n_frames, max(2, kmax)))
+        self.table_key = table_key or (objective, interp, None, None, self.curvature)
+        self.energy: F64 | None = None  # (kmax + 1, n)
+        self.back: I64 | None = None  # (kmax + 1, n)
+
+    @property
+    def n_frames(self) -> int:
+        return int(self.table.shape[0])
+
+    def layers(self) -> KeySession:
+        """Solve the DP for every K up to ``kmax`` (once; later calls return at once)."""
+        if self.energy is None:
+            self.energy, self.back, _ = solve_layers(self.table, self.kmax, self.objective)
+        return self
+
+    @property
+    def curve(self) -> F64:
+        """``(m, 2)`` rows (K, optimal error with K keys) for K = 2..kmax (feature units)."""
+        self.layers()
+        ks = np.arange(2, self.kmax + 1)
+        return np.column_stack([ks, self.energy[ks, self.n_frames - 1]])
+
+    def keys_for_count(self, k: int) -> I64:
+        """The DP keys for exactly ``k`` keys, traced back through the stored layers."""
+        if not 2 <= k <= self.kmax:
+            raise ParameterError("key count", k, f"a whole number in [2, {self.kmax}]")
+        self.layers()
+        keys = [self.n_frames - 1]
+        for depth in range(k, 1, -1):
+            keys.append(int(self.back[depth, keys[-1]]))
+        return np.array(keys[::-1], dtype=np.int64)
+
+    def keys_for_tau(self, tau: float) -> I64:
+        """Seed 003's keys with a price tau per key (total objective only)."""
+        return select_keys(self.table, penalty=float(tau), curve_keys=0).keys
+
+    def keys_for_budget(self, budget: float) -> I64:
+        """The fewest keys whose error (total, or worst frame) is within ``budget``."""
+        self.layers()
+        e = self.energy[2 : self.kmax + 1, self.n_frames - 1]
+        fits = np.flatnonzero(e <= budget)
+        if fits.size:
+            return self.keys_for_count(int(fits[0]) + 2)
+        bound = {"budget": budget} if self.objective == "total" else {"max_error": budget}
+        return select_keys(self.table, objective=self.objective, curve_keys=0, **bound).keys
+
+    def keys_for(self, settings: KeySettings) -> I64:
+        """The DP keys the settings ask for (count, tau or budget)."""
+        if settings.mode == "tau":
+            return self.keys_for_tau(settings.tau)
+        if settings.mode == "budget":
+            return self.keys_for_budget(settings.budget)
+        return self.keys_for_count(min(settings.count_for(self.n_frames), self.kmax))
+
+    def select(
+        self,
+        *,
+        keys: int | None = None,
+        penalty: float | None = None,
+        budget: float | None = None,
+        max_error: float | None = None,
+        curve_keys: int = DEFAULT_CURVE_KEYS,
+    ) -> Selection:
+        """Exactly one of ``keys``, ``penalty``, ``budget``, ``max_error`` (see
+        :func:`hairtool.keys.dp.select_keys`), with uniform keys of the same count and the
+        error-vs-count curve up to ``curve_keys``: the record ``hairtool keys`` prints."""
+        sel = select_keys(
+            self.table,
+            keys=keys,
+            penalty=penalty,
+            budget=budget,
+            max_error=max_error,
+            objective=self.objective,
+            curve_keys=curve_keys,
+        )
+        sel.params.update(interp=self.interp, curvature=self.curvature)
+        return sel
+
+
+def solve(
+    source: Animation | ArrayLike,
+    settings: KeySettings,
+    progress: Progress | None = None,
+    cancelled: CancelCheck | None = None,
+    *,
+    features: FeatureOptions | None = None,
+    table: ArrayLike | None = None,
+    layers: bool = True,
+    kmax: int = MAX_CURVE_KEYS,
+) -> KeySession | None:
+    """Features, cost table and (with ``layers``) the layered DP; None once ``cancelled()``.
+
+    ``source`` is an Animation (seed 000's features, ``features`` or the settings' own) or an
+    ``(frames, D)`` feature array used as is; ``table`` replaces the Gram cost table by one the
+    caller built (seed 003's quaternion-distance table of a BVH capture).
+    """
+    settings.validate()
+    progress = progress or (lambda *a, **k: None)
+    cancelled = cancelled or (lambda: False)
+    if table is None:
+        progress(0.0, "features")
+        x = frame_features(source, features or settings.feature_options())
+        if cancelled():
+            return None
+        progress(0.3, "cost table")
+        table = cost_table(x, settings.interp, settings.curvature, settings.objective)
+        del x
+        if cancelled():
+            return None
+    session = KeySession(
+        table,
+        objective=settings.objective,
+        interp=settings.interp,
+        curvature=settings.curvature,
+        kmax=kmax,
+        table_key=settings.table_key,
+    )
+    if layers:
+        progress(0.9, "dynamic programming")
+        session.layers()
+    progress(1.0, "")
+    return session
 
 
 def find_keys(
@@ -32,76 +267,122 @@ def find_keys(
     curvature: float = 0.0,
     features: FeatureOptions | None = None,
     curve_keys: int = DEFAULT_CURVE_KEYS,
+    table: ArrayLike | None = None,
 ) -> Selection:
-    """Exact keys of an Animation (seed 000 features) or an ``(n_frames, D)`` array (as is).
+    """Exact keys of an Animation (seed 000 features) or an ``(n_frames, D)`` array, in one call.
 
-    Exactly one of ``keys``, ``penalty``, ``budget``, ``max_error`` (see :func:`select_keys`).
+    Exactly one of ``keys``, ``penalty``, ``budget``, ``max_error`` (which implies the worst-frame
+    objective); ``table`` as in :func:`solve`.
     """
-    x = frame_features(source, features)
     if max_error is not None:
         objective = "worst"
-    table = cost_table(x, interp, curvature, objective)
-    sel = select_keys(
-        table,
-        keys=keys,
-        penalty=penalty,
-        budget=budget,
-        max_error=max_error,
-        objective=objective,
-        curve_keys=curve_keys,
-    )
-    sel.params.update(interp=interp, curvature=curvature)
-    return sel
+    settings = KeySettings(objective=objective, interp=interp, curvature=curvature)
+    session = solve(source, settings, features=features or FeatureOptions(), table=table, layers=False)
+    mode = dict(keys=keys, penalty=penalty, budget=budget, max_error=max_error)
+    return session.select(curve_keys=curve_keys, **mode)
+
+
+# -- errors of a key set, chunked ---------------------------------------------------------------
+@dataclass
+class FrameErrors:
+    """Per-frame vertex distances |p − p̂| (scene units) of one reconstruction."""
+
+    keys: I64
+    mean: F64  # (F,) mean over all vertices
+    tip: F64  # (F,) mean over strand tips
+    max: F64  # (F,) worst vertex
+
+    def summary(self) -> dict:
+        return {"mean": float(self.mean.mean()), "tip": float(self.tip.mean()), "max": float(self.max.max())}
 
 
 @dataclass
-class ChannelKeys:
-    """Per-channel keys (seed 003): ``keys[d]`` are channel d's knots, ``costs[d]`` its error."""
+class Analysis:
+    """Both reconstructions' errors (the DP keys and uniform keys of the same count) and the speed."""
 
-    keys: list[I64]
-    costs: NDArray[np.float64]
-    penalties: NDArray[np.float64]
-
-    @property
-    def key_counts(self) -> I64:
-        return np.array([k.size for k in self.keys], dtype=np.int64)
-
-    def union(self) -> I64:
-        """Frames that are a key of at least one channel."""
-        return np.unique(np.concatenate(self.keys))
-
-    def to_dict(self) -> dict:
-        return {
-            "channels": [k.tolist() for k in self.keys],
-            "costs": self.costs.tolist(),
-            "penalties": self.penalties.tolist(),
-            "union": self.union().tolist(),
-        }
+    dp: FrameErrors
+    uniform: FrameErrors
+    speed: F64 | None = None
+    extra: dict = field(default_factory=dict)
 
 
-def per_channel_keys(
-    x: ArrayLike,
-    penalty: float | ArrayLike,
+def frame_errors(
+    animation: Animation,
+    kp: KeyPoses,
+    cancelled: CancelCheck | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> FrameErrors | None:
+    """Mean, tip-mean and max vertex error per frame of the key curve."""
+    err = key_curve_errors(animation, kp, cancelled=cancelled, progress=progress)
+    if err is None:
+        return None
+    return FrameErrors(kp.keys, err.per_frame_mean, err.per_frame_tip, err.per_frame_max)
+
+
+def vertex_errors(animation: Animation, kp: KeyPoses, frame: int) -> F32:
+    """``(V,)`` distance of each vertex from the key curve at one frame."""
+    d = animation.frames[frame].astype(np.float64) - interpolate_at(kp, [frame])[0]
+    return np.sqrt(np.einsum("vi,vi->v", d, d)).astype(np.float32)
+
+
+def speed(animation: Animation, cancelled: CancelCheck | None = None) -> F64 | None:
+    """``(F,)`` mean vertex speed in units/s (:func:`hairtool.keys.reconstruct.motion_speed`)."""
+    return motion_speed(animation.frames, animation.fps, cancelled)
+
+
+def analyse(
+    animation: Animation,
+    dp_keys: ArrayLike,
+    interp: str,
     *,
-    interp: str = "hermite",
-    curvature: float = 0.0,
-) -> ChannelKeys:
-    """Every column of ``(n_frames, D)`` features keyed on its own, at its own price tau_d per key."""
-    x = raw_features(x)
-    d = x.shape[1]
-    if interp not in INTERPOLATIONS:
-        raise ParameterError("interp", interp, " or ".join(INTERPOLATIONS))
-    tau = np.broadcast_to(np.asarray(penalty, dtype=np.float64), (d,)) if np.ndim(penalty) == 0 else None
-    if tau is None:
-        tau = np.asarray(penalty, dtype=np.float64)
-        if tau.shape != (d,):
-            raise ParameterError("penalty", f"shape {tau.shape}", f"one number or one per channel ({d},)")
-    if not np.all(np.isfinite(tau)) or np.any(tau < 0):
-        raise ParameterError("penalty", tau.tolist() if tau.size < 8 else "array", "finite numbers >= 0")
-    keys, costs = [], np.zeros(d)
-    for c in range(d):
-        table = cost_table(x[:, c : c + 1], interp, curvature)
-        sel = select_keys(table, penalty=float(tau[c]), curve_keys=0)
-        keys.append(sel.keys)
-        costs[c] = sel.cost
-    return ChannelKeys(keys=keys, costs=costs, penalties=np.array(tau, dtype=np.float64))
+    with_speed: bool = True,
+    progress: Progress | None = None,
+    cancelled: CancelCheck | None = None,
+) -> Analysis | None:
+    """Errors of the DP keys and of uniform keys of the same count (and the motion speed)."""
+    k = check_keys(dp_keys, animation.n_frames)
+    uni = uniform_keys(animation.n_frames, k.size)
+    parts = []
+    for i, keys in enumerate((k, uni)):
+        step = (lambda x, i=i: progress(0.45 * (i + x), "errors")) if progress is not None else None
+        err = frame_errors(animation, key_poses(animation.frames, keys, interp), cancelled, step)
+        if err is None:
+            return None
+        parts.append(err)
+    v = speed(animation, cancelled) if with_speed else None
+    if with_speed and v is None:
+        return None
+    return Analysis(parts[0], parts[1], v)
+
+
+def key_poses_of(animation: Animation, keys: ArrayLike, interp: str) -> KeyPoses:
+    """Key poses (and Hermite tangents) of an animation, stored as float32 to halve their size
+    (a studio holds two sets for the whole session); evaluated in float64 all the same."""
+    kp = key_poses(animation.frames, keys, interp)
+    tangents = None if kp.tangents is None else kp.tangents.astype(np.float32)
+    return KeyPoses(kp.keys, kp.poses.astype(np.float32), tangents, kp.n_frames, kp.interp)
+
+
+def key_edit_block(
+    frames: NDArray, keys: ArrayLike, interp: str, key_frame: int, pose: ArrayLike
+) -> tuple[int, NDArray]:
+    """``(start, block)``: the frames ``start .. start + len(block) − 1`` after the pose at
+    ``key_frame`` is replaced, through :class:`hairtool.keys.edit.KeyEditor`'s residual scheme.
+
+    An edit changes only the frames between the key's neighbouring keys, so the editor runs on
+    that stretch plus one frame each side (which keeps the Hermite tangents at the neighbouring
+    keys those of the whole animation): the result equals editing the whole animation.
+    """
+    n = frames.shape[0]
+    k = check_keys(keys, n)
+    hit = np.flatnonzero(k == key_frame)
+    if hit.size == 0:
+        raise ParameterError("key frame", key_frame, f"one of the keys {k.tolist()}")
+    a = int(hit[0])
+    lo = int(k[a - 1]) if a > 0 else int(key_frame)
+    hi = int(k[a + 1]) if a < k.size - 1 else int(key_frame)
+    s0, s1 = max(lo - 1, 0), min(hi + 1, n - 1)
+    sub_keys = np.array(sorted({s0, lo, int(key_frame), hi, s1}), dtype=np.int64) - s0
+    editor = KeyEditor(frames[s0 : s1 + 1], sub_keys, interp)
+    editor.set_key_pose(int(key_frame) - s0, pose)
+    return s0, editor.frames(frames.dtype)

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from app.ui.animation_model import AnimationModel
-from app.ui.key_state import KeySettings
 from hairtool import samples
 from hairtool.errors import GroomError, ParameterError
+from hairtool.keys.session import KeySettings
 from hairtool.simulate.sway import sway_animation
 
 

@@ -7,8 +7,8 @@ import threading
 
 from PySide6.QtCore import QThread
 
-from app.ui.jobs import JobCancelled, JobRunner, JobStatus
-from hairtool.errors import ParameterError
+from app.ui.jobs import JobRunner, JobStatus
+from hairtool.errors import Cancelled, ParameterError
 
 
 def test_result_arrives_on_the_gui_thread_with_progress(qapp):
@@ -58,7 +58,7 @@ def test_errors_become_one_message_and_job_cancelled_is_a_cancel(qapp):
         raise ParameterError("tau", -1, "a number >= 0")
 
     def stop(progress, cancelled):
-        raise JobCancelled
+        raise Cancelled
 
     runner.run("Solve", bad)
     stopped = runner.run("Stop", stop, lambda r: errors.append("should not run"))

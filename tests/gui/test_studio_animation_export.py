@@ -113,12 +113,11 @@ def test_keys_without_an_animation_are_one_clear_error(make_window, out):
 
 def test_write_video_cancelled_mid_way_and_bad_frames(tmp_path):
     from app.ui.animation_export import write_video
-    from app.ui.jobs import JobCancelled
-    from hairtool.errors import FormatError, ParameterError
+    from hairtool.errors import Cancelled, FormatError, ParameterError
 
     frames = [np.full((32, 48, 3), i * 20, np.uint8) for i in range(8)]
     seen = []
-    with pytest.raises(JobCancelled):
+    with pytest.raises(Cancelled):
         write_video(
             tmp_path / "c.gif",
             frames,

@@ -12,7 +12,8 @@ pytestmark = pytest.mark.gui
 
 
 def test_dock_shows_one_curve_per_picture_and_the_papers_holds(qtbot):
-    from app.ui.anime_dock import AnimeDock, AnimeSettings
+    from app.ui.anime_dock import AnimeDock
+    from hairtool.anime.settings import AnimeSettings
 
     dock = AnimeDock(settings=AnimeSettings(wave=WaveParams(period=0.45), fps=24.0, hold=2, cycles=1))
     qtbot.addWidget(dock)
@@ -54,7 +55,8 @@ def test_parameters_update_live_and_bad_timing_is_explained_in_the_dock(qtbot):
 
 
 def test_settings_round_trip_without_echo(qtbot):
-    from app.ui.anime_dock import AnimeDock, AnimeSettings
+    from app.ui.anime_dock import AnimeDock
+    from hairtool.anime.settings import AnimeSettings
 
     dock = AnimeDock()
     qtbot.addWidget(dock)
@@ -69,7 +71,8 @@ def test_settings_round_trip_without_echo(qtbot):
 
 
 def test_apply_to_groom_loads_the_cycle_into_the_animation_model(make_window):
-    from app.ui.anime_dock import SOURCE, AnimeSettings
+    from app.ui.anime_dock import SOURCE
+    from hairtool.anime.settings import AnimeSettings
 
     groom = samples.portrait(strands=12, vertices=8)
     w = make_window(groom=groom)
@@ -85,7 +88,7 @@ def test_apply_to_groom_loads_the_cycle_into_the_animation_model(make_window):
 
 
 def test_apply_to_selected_strands_moves_only_those(make_window):
-    from app.ui.anime_dock import AnimeSettings, cycle_for_groom
+    from hairtool.anime.settings import AnimeSettings, cycle_for_groom
 
     groom = samples.portrait(strands=10, vertices=6)
     anim = cycle_for_groom(groom, AnimeSettings(cycles=1), [2, 5])

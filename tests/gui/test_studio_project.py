@@ -15,7 +15,7 @@ pytestmark = pytest.mark.gui
 
 def _edit(ui, w):
     """A stroke, a parameter change, display settings and an anime cycle: a scene worth saving."""
-    from app.ui.anime_dock import AnimeSettings
+    from hairtool.anime.settings import AnimeSettings
 
     v, scene = w.viewport, w.scene
     w._on_param_edited("seed", 11, None)

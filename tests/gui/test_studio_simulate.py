@@ -12,7 +12,8 @@ pytestmark = pytest.mark.gui
 
 
 def test_dialog_round_trips_options_and_refuses_a_bad_motion(qtbot):
-    from app.ui.simulate_dialog import SimulateDialog, SimulateOptions
+    from app.ui.simulate_dialog import SimulateDialog
+    from hairtool.simulate.options import SimulateOptions
 
     o = SimulateOptions(motion="nod,hop", frames=30, fps=30.0, wind=(5.0, 0.0, -2.0), gusts=2, seed=4)
     dialog = SimulateDialog(None, o)
@@ -29,7 +30,8 @@ def test_dialog_round_trips_options_and_refuses_a_bad_motion(qtbot):
 
 
 def test_simulation_runs_as_a_job_and_loads_the_result(make_window):
-    from app.ui.simulate_dialog import SOURCE, SimulateOptions
+    from app.ui.simulate_dialog import SOURCE
+    from hairtool.simulate.options import SimulateOptions
 
     groom = samples.scalp(12, 6, seed=1)
     w = make_window(groom=groom)
@@ -45,8 +47,8 @@ def test_simulation_runs_as_a_job_and_loads_the_result(make_window):
 
 
 def test_cancelled_simulation_keeps_the_previous_animation(make_window):
-    from app.ui.jobs import JobCancelled
-    from app.ui.simulate_dialog import SimulateOptions, run_simulation
+    from hairtool.errors import Cancelled
+    from hairtool.simulate.options import SimulateOptions, run_simulation
 
     groom = samples.scalp(12, 6, seed=1)
     w = make_window(groom=groom)
@@ -61,14 +63,15 @@ def test_cancelled_simulation_keeps_the_previous_animation(make_window):
     assert w.animation.animation is previous
 
     done = []
-    with pytest.raises(JobCancelled):  # the job body stops at the first frame after a cancel
+    with pytest.raises(Cancelled):  # the job body stops at the first frame after a cancel
         run_simulation(groom, SimulateOptions(frames=20), lambda *a: done.append(a), lambda: len(done) > 2)
     assert len(done) == 3
 
 
 def test_the_dialog_opens_fitted_to_a_real_groom_and_fits_on_demand(make_window, grooms_dir, qtbot):
-    from app.ui.simulate_dialog import SimulateDialog, SimulateOptions
+    from app.ui.simulate_dialog import SimulateDialog
     from hairtool.simulate.head_motion import fit_head
+    from hairtool.simulate.options import SimulateOptions
 
     w = make_window()
     assert w.open_path(grooms_dir / "sintel_hair.tfx"), w.errors

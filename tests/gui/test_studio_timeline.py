@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from PySide6.QtGui import QColor, QImage
 
-from app.ui import key_state as ks
 from app.ui.timeline_plots import DP_COLOUR, UNIFORM_COLOUR
 from hairtool import samples
+from hairtool.keys import session as ks
 from hairtool.keys.costs import cost_table
 from hairtool.keys.dp import select_keys, uniform_keys
 from hairtool.keys.edit import edit_animation

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from hairtool.errors import ParameterError
+from hairtool.keys.channels import per_channel_keys
 from hairtool.keys.costs import cost_table
 from hairtool.keys.dp import (
     _layers_kernel,
@@ -19,7 +20,7 @@ from hairtool.keys.dp import (
     select_keys,
     uniform_keys,
 )
-from hairtool.keys.session import find_keys, per_channel_keys
+from hairtool.keys.session import find_keys
 
 
 def walk(n: int, d: int, seed: int = 0) -> np.ndarray:

@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.ui import key_state as ks
 from hairtool import samples
 from hairtool.errors import ParameterError
+from hairtool.keys import session as ks
 from hairtool.keys.costs import cost_table
 from hairtool.keys.dp import select_keys, uniform_keys
 from hairtool.keys.edit import edit_animation
@@ -48,16 +48,16 @@ def test_tau_and_budget_keys_equal_the_engines(anim):
     solved = ks.solve(anim, ks.KeySettings())
     for tau in (0.0, 0.01, 1.0, 100.0):
         want = select_keys(solved.table, penalty=tau).keys
-        np.testing.assert_array_equal(ks.choose_keys(solved, ks.KeySettings(mode="tau", tau=tau)), want)
+        np.testing.assert_array_equal(solved.keys_for(ks.KeySettings(mode="tau", tau=tau)), want)
     for budget in (0.0, 0.05, 1.0, 1e6):
         want = select_keys(solved.table, budget=budget).keys
-        got = ks.choose_keys(solved, ks.KeySettings(mode="budget", budget=budget))
+        got = solved.keys_for(ks.KeySettings(mode="budget", budget=budget))
         np.testing.assert_array_equal(got, want)
 
 
 def test_default_count_is_a_tenth_of_the_frames(anim):
     solved = ks.solve(anim, ks.KeySettings())
-    assert ks.choose_keys(solved, ks.KeySettings()).size == 4
+    assert solved.keys_for(ks.KeySettings()).size == 4
 
 
 def test_settings_are_validated():
