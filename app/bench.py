@@ -166,7 +166,7 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
 def in_studio_app(measure):
     """``measure(app, settings)`` with a QApplication on a display (Xvfb started when there is
     none) and throw-away studio settings, so a benchmark never touches the user's."""
-    from app.main import configure_gl
+    from app.surface import configure_gl
 
     xvfb = _ensure_display()
     try:

@@ -3,30 +3,16 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 
-MSAA_ENV = "HAIRTOOL_MSAA"  # samples per pixel of the viewport; 0 (default) keeps llvmpipe interactive
+STUDIO_PACKAGES = ("PySide6", "moderngl", "pyrr", "imageio", "PIL")
 
 
-def configure_gl() -> None:
-    """A 3.3 core default surface with depth; must run before the QApplication exists.
+def missing_studio_packages() -> list[str]:
+    """The studio's packages this environment lacks (``pip install hairtool`` has none of them)."""
+    import importlib.util
 
-    Multisampling is off unless ``HAIRTOOL_MSAA`` asks for it: on Mesa's llvmpipe 4× MSAA
-    makes every viewport frame about 3–4× slower (stills are always rendered with 4×).
-    """
-    from PySide6.QtGui import QSurfaceFormat
-
-    fmt = QSurfaceFormat()
-    fmt.setVersion(3, 3)
-    fmt.setProfile(QSurfaceFormat.OpenGLContextProfile.CoreProfile)
-    fmt.setDepthBufferSize(24)
-    try:
-        samples = int(os.environ.get(MSAA_ENV, "0"))
-    except ValueError:
-        samples = 0
-    fmt.setSamples(min(max(samples, 0), 16))
-    QSurfaceFormat.setDefaultFormat(fmt)
+    return [name for name in STUDIO_PACKAGES if importlib.util.find_spec(name) is None]
 
 
 def show_splash(app):
@@ -80,6 +66,16 @@ def main(argv: list[str] | None = None) -> int:
     if rest:
         print(f"hairtool-studio: unrecognised arguments: {' '.join(rest)}", file=sys.stderr)
         return 2
+    missing = missing_studio_packages()
+    if missing:
+        print(
+            f"hairtool-studio: the studio needs {', '.join(missing)}, which this install lacks: "
+            'pip install "hairtool[studio]"',
+            file=sys.stderr,
+        )
+        return 2
+    from app.surface import configure_gl
+
     configure_gl()
     from PySide6.QtWidgets import QApplication
 

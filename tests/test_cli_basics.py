@@ -110,8 +110,9 @@ def test_shared_input_module_is_not_a_command():
 
 
 def test_groom_input_spec(tmp_path):
-    from hairtool.cli._inputs import load_groom, parse_vector
+    from hairtool.cli._inputs import parse_vector
     from hairtool.errors import FormatError, ParameterError
+    from hairtool.io.specs import load_groom
 
     assert load_groom("sample:scalp:12:5").points.tobytes() == scalp(12, 5).points.tobytes()
     assert load_groom("sample:comb").strand_count > 0

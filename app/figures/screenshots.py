@@ -62,7 +62,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     args.outdir.mkdir(parents=True, exist_ok=True)
 
-    from app.main import configure_gl
+    from app.surface import configure_gl
 
     configure_gl()
     from PySide6.QtCore import QSettings, Qt

@@ -38,7 +38,7 @@ from hairtool.keys.export import export_keys as write_keys
 from hairtool.keys.export import keys_record
 
 if TYPE_CHECKING:
-    from app.ui.window import MainWindow
+    from app.ui.host import StudioHost
 
 DATA_SUFFIXES = (".usd", ".usda", ".usdc", ".npz")
 VIDEO_SUFFIXES = (".mp4", ".gif")
@@ -331,7 +331,7 @@ class AnimationExporter(QObject):
 
     exported = Signal(str)  # the path, once a file (or sequence) is complete
 
-    def __init__(self, window: MainWindow) -> None:
+    def __init__(self, window: StudioHost) -> None:
         super().__init__(window)
         self.window = window
         self.job: Job | None = None
@@ -417,6 +417,6 @@ class AnimationExporter(QObject):
         return self.job
 
     def _done(self, path: str | os.PathLike[str]) -> None:
-        self.window._remember_dir(path)
+        self.window.remember_dir(path)
         self.window.statusBar().showMessage(f"wrote {path}", 5000)
         self.exported.emit(str(path))

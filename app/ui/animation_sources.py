@@ -21,13 +21,13 @@ from hairtool.errors import HairtoolError
 from hairtool.simulate.options import SimulateOptions, run_simulation
 
 if TYPE_CHECKING:
-    from app.ui.window import MainWindow
+    from app.ui.host import StudioHost
 
 
 class AnimationSources(QObject):
     """Owned by the window (``window.sources``): the anime dock and the simulation job."""
 
-    def __init__(self, window: MainWindow) -> None:
+    def __init__(self, window: StudioHost) -> None:
         super().__init__(window)
         self.window = window
         self.simulate_options = SimulateOptions()

@@ -16,6 +16,7 @@ from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QUndoCommand
 from PySide6.QtWidgets import QLabel, QStyle, QWidget
 
 from app.ui.animation_model import VIEW_MODES, AnimationModel
+from app.ui.qt_utils import add_action
 from app.ui.recording import Recorder
 from hairtool.errors import HairtoolError
 from hairtool.frozen.align import align
@@ -23,7 +24,7 @@ from hairtool.groom import Groom
 from hairtool.keys.session import key_edit_block
 
 if TYPE_CHECKING:
-    from app.ui.window import MainWindow
+    from app.ui.host import StudioHost
 
 
 class KeyEditCommand(QUndoCommand):
@@ -108,7 +109,7 @@ class KeyEditBrush:
 class AnimationController(QObject):
     """Owned by the window; see the module docstring."""
 
-    def __init__(self, window: MainWindow, model: AnimationModel) -> None:
+    def __init__(self, window: StudioHost, model: AnimationModel) -> None:
         super().__init__(window)
         self.window, self.model = window, model
         self.viewport, self.scene = window.viewport, window.scene
@@ -231,25 +232,25 @@ class AnimationController(QObject):
         w, m = self.window, self.model
         menu = w.menuBar().addMenu("&Animation")
         a = self.actions
-        a["play"] = w._action(menu, "&Play / Pause", m.toggle_play, "Space")
-        a["loop"] = w._action(menu, "&Loop", lambda on: m.set_loop(on), "Ctrl+L", checkable=True)
+        a["play"] = add_action(w, menu, "&Play / Pause", m.toggle_play, "Space")
+        a["loop"] = add_action(w, menu, "&Loop", lambda on: m.set_loop(on), "Ctrl+L", checkable=True)
         a["loop"].setChecked(m.loop)
         m.loop_changed.connect(a["loop"].setChecked)
         menu.addSeparator()
-        a["step_forward"] = w._action(menu, "Next &frame", lambda: m.step(1), "Right")
-        a["step_back"] = w._action(menu, "Pre&vious frame", lambda: m.step(-1), "Left")
-        a["next_key"] = w._action(menu, "&Next key", m.next_key, "Up")
-        a["previous_key"] = w._action(menu, "P&revious key", m.previous_key, "Down")
-        a["first"] = w._action(menu, "F&irst frame", m.first, ["Home", "Shift+Left"])
-        a["last"] = w._action(menu, "L&ast frame", m.last, ["End", "Shift+Right"])
+        a["step_forward"] = add_action(w, menu, "Next &frame", lambda: m.step(1), "Right")
+        a["step_back"] = add_action(w, menu, "Pre&vious frame", lambda: m.step(-1), "Left")
+        a["next_key"] = add_action(w, menu, "&Next key", m.next_key, "Up")
+        a["previous_key"] = add_action(w, menu, "P&revious key", m.previous_key, "Down")
+        a["first"] = add_action(w, menu, "F&irst frame", m.first, ["Home", "Shift+Left"])
+        a["last"] = add_action(w, menu, "L&ast frame", m.last, ["End", "Shift+Right"])
         menu.addSeparator()
-        a["record"] = w._action(menu, "&Record drags", self.set_recording, "Shift+R", checkable=True)
-        a["resolve"] = w._action(menu, "Re-&solve keys", m.request_solve)
-        a["clear"] = w._action(menu, "&Close animation", m.clear)
+        a["record"] = add_action(w, menu, "&Record drags", self.set_recording, "Shift+R", checkable=True)
+        a["resolve"] = add_action(w, menu, "Re-&solve keys", m.request_solve)
+        a["clear"] = add_action(w, menu, "&Close animation", m.clear)
         view = menu.addMenu("&View")
         group = QActionGroup(w)
         for i, (key, label) in enumerate(VIEW_MODES.items()):
-            act = w._action(
+            act = add_action(w,
                 view, label, lambda _=False, k=key: m.set_view_mode(k), f"Ctrl+{i + 1}", checkable=True
             )
             act.setChecked(key == m.view_mode)

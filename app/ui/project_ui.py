@@ -26,7 +26,8 @@ from hairtool.errors import FormatError, HairtoolError
 from hairtool.keys.session import KeySettings
 
 if TYPE_CHECKING:
-    from app.ui.window import MainWindow
+    from app.ui.animation_sources import AnimationSources
+    from app.ui.host import StudioHost
 
 RECOVERY_NAME = "recovery" + pf.SUFFIX
 AUTOSAVE_MS = 60_000
@@ -47,9 +48,11 @@ class ProjectController(QObject):
     saved = Signal(str)
     opened = Signal(str)
 
-    def __init__(self, window: MainWindow, autosave_ms: int = AUTOSAVE_MS) -> None:
+    def __init__(
+        self, window: StudioHost, sources: AnimationSources, autosave_ms: int = AUTOSAVE_MS
+    ) -> None:
         super().__init__(window)
-        self.window = window
+        self.window, self.sources = window, sources
         self.path: Path | None = None
         self._anim_dirty = False
         self._changes = 0  # counts edits; autosave writes when it moved since the last autosave
@@ -102,7 +105,7 @@ class ProjectController(QObject):
         settings: dict = {
             "timeline": {"frame": model.frame, "view_mode": model.view_mode, "loop": model.loop},
         }
-        settings.update(w.sources.to_settings())
+        settings.update(self.sources.to_settings())
         return pf.Project.from_pipeline(
             scene.pipeline,
             brush={"radius": scene.radius, "intensity": scene.intensity, "align_mode": scene.align_mode},
@@ -153,7 +156,7 @@ class ProjectController(QObject):
                     lambda: model.set_frame(int(timeline["frame"])),
                 ),
             )
-        w.sources.apply_settings(project.settings)
+        self.sources.apply_settings(project.settings)
         self._mark_saved()
 
     # -- save and open ---------------------------------------------------------------------
@@ -181,7 +184,7 @@ class ProjectController(QObject):
         self.path = Path(path)
         self._mark_saved()
         self.window.scene.set_path(self.path)
-        self.window._remember_dir(path)
+        self.window.remember_dir(path)
         self.window.statusBar().showMessage(f"saved {path}", 5000)
         self.saved.emit(str(path))
         return True
@@ -201,7 +204,7 @@ class ProjectController(QObject):
             return False
         self.apply(project, path)
         self.path = Path(path)
-        self.window._remember_dir(path)
+        self.window.remember_dir(path)
         self.opened.emit(str(path))
         return True
 
@@ -293,7 +296,7 @@ def _key_settings(d: dict) -> dict:
     return {k: v for k, v in d.items() if k in fields}
 
 
-def _apply_each(window: MainWindow, setters) -> None:
+def _apply_each(window: StudioHost, setters) -> None:
     """Apply saved settings one by one; a value this studio refuses is reported, not fatal."""
     problems = []
     for setter in setters:

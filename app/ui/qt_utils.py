@@ -6,7 +6,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 from PySide6.QtCore import QEvent, QObject, QPointF, Qt
-from PySide6.QtGui import QMouseEvent
+from PySide6.QtGui import QAction, QKeySequence, QMouseEvent
 from PySide6.QtWidgets import QApplication, QWidget
 
 _MOUSE_EVENTS = {
@@ -48,3 +48,15 @@ def send_mouse(
         Qt.KeyboardModifier.NoModifier if modifiers is None else modifiers,
     )
     QApplication.sendEvent(widget, event)
+
+
+def add_action(owner: QObject, menu, text: str, slot, shortcut=None, *, checkable: bool = False) -> QAction:
+    """A menu entry calling ``slot``, with one shortcut or a list of them (owned by ``owner``)."""
+    action = QAction(text, owner)
+    if shortcut is not None:
+        keys = shortcut if isinstance(shortcut, list) else [shortcut]
+        action.setShortcuts([QKeySequence(k) for k in keys])
+    action.setCheckable(checkable)
+    action.triggered.connect(slot)
+    menu.addAction(action)
+    return action

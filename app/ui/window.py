@@ -20,6 +20,7 @@ from app.ui.animation_ui import AnimationController
 from app.ui.commands import ParamCommand, StrokeCommand
 from app.ui.dialogs import StillOptions, ask_still_options
 from app.ui.jobs import JobRunner, JobStatus
+from app.ui.qt_utils import add_action
 from app.ui.scene import COLOUR_MODES, Scene
 from app.ui.simulate_dialog import ask_simulate_options
 from app.ui.timeline_dock import TimelineDock
@@ -98,7 +99,7 @@ class MainWindow(QMainWindow):
     def last_dir(self) -> str:
         return str(self.settings.value("last_dir", str(Path.home())))
 
-    def _remember_dir(self, path: str | os.PathLike[str]) -> None:
+    def remember_dir(self, path: str | os.PathLike[str]) -> None:
         self.settings.setValue("last_dir", str(Path(path).resolve().parent))
 
     def recent_files(self) -> list[str]:
@@ -111,7 +112,7 @@ class MainWindow(QMainWindow):
         p = str(Path(path).resolve())
         recent = [p, *(r for r in self.recent_files() if r != p)][:MAX_RECENT]
         self.settings.setValue("recent", recent)
-        self._remember_dir(p)
+        self.remember_dir(p)
 
     def _restore_layout(self) -> None:
         geometry = self.settings.value("geometry")
@@ -137,38 +138,29 @@ class MainWindow(QMainWindow):
         super().closeEvent(event)
 
     # -- menus -------------------------------------------------------------------------------
-    def _action(self, menu, text: str, slot, shortcut=None, *, checkable: bool = False) -> QAction:
-        action = QAction(text, self)
-        if shortcut is not None:
-            keys = shortcut if isinstance(shortcut, list) else [shortcut]
-            action.setShortcuts([QKeySequence(k) for k in keys])
-        action.setCheckable(checkable)
-        action.triggered.connect(slot)
-        menu.addAction(action)
-        return action
-
     def _build_menus(self) -> None:
         bar = self.menuBar()
         file = bar.addMenu("&File")
         new = file.addMenu("&New from sample")
-        self._action(new, "Sintel (hair and head)", self.open_bundled_sample, QKeySequence.StandardKey.New)
+        sintel = self.open_bundled_sample
+        add_action(self, new, "Sintel (hair and head)", sintel, QKeySequence.StandardKey.New)
         new.addSeparator()
         for kind in samples.SAMPLES:
-            self._action(new, kind.capitalize(), lambda _=False, k=kind: self.new_from_sample(k))
-        self._action(file, "&Open…", self.open_dialog, QKeySequence.StandardKey.Open)
+            add_action(self, new, kind.capitalize(), lambda _=False, k=kind: self.new_from_sample(k))
+        add_action(self, file, "&Open…", self.open_dialog, QKeySequence.StandardKey.Open)
         self.recent_menu = file.addMenu("Open &Recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
         file.addSeparator()
-        self._action(file, "&Save", self.save, QKeySequence.StandardKey.Save)
-        self._action(file, "Save &As…", self.save_as, QKeySequence.StandardKey.SaveAs)
+        add_action(self, file, "&Save", self.save, QKeySequence.StandardKey.Save)
+        add_action(self, file, "Save &As…", self.save_as, QKeySequence.StandardKey.SaveAs)
         file.addSeparator()
-        self._action(file, "&Export still…", self.export_still_dialog, "Ctrl+E")
-        self._action(file, "Export &groom…", self.export_groom_dialog, "Ctrl+Shift+E")
+        add_action(self, file, "&Export still…", self.export_still_dialog, "Ctrl+E")
+        add_action(self, file, "Export &groom…", self.export_groom_dialog, "Ctrl+Shift+E")
         file.addSeparator()
-        self._action(file, "Load head &mesh…", self.load_mesh_dialog)
-        self._action(file, "&Clear head mesh", lambda: self.scene.set_mesh(None))
+        add_action(self, file, "Load head &mesh…", self.load_mesh_dialog)
+        add_action(self, file, "&Clear head mesh", lambda: self.scene.set_mesh(None))
         file.addSeparator()
-        self._action(file, "&Quit", self.close, QKeySequence.StandardKey.Quit)
+        add_action(self, file, "&Quit", self.close, QKeySequence.StandardKey.Quit)
 
         edit = bar.addMenu("&Edit")
         undo = self.undo_stack.createUndoAction(self, "&Undo")
@@ -179,14 +171,14 @@ class MainWindow(QMainWindow):
         edit.addAction(redo)
 
         view = bar.addMenu("&View")
-        self._action(view, "&Frame all", self.viewport.frame_all, "F")  # Home: first frame
-        self.ortho_action = self._action(view, "&2-D view", self.toggle_ortho, "5", checkable=True)
+        add_action(self, view, "&Frame all", self.viewport.frame_all, "F")  # Home: first frame
+        self.ortho_action = add_action(self, view, "&2-D view", self.toggle_ortho, "5", checkable=True)
         view.aboutToShow.connect(self._sync_view_menu)
         colour = view.addMenu("&Colour by")
         group = QActionGroup(self)
         self.colour_actions: dict[str, QAction] = {}
         for i, (key, label) in enumerate(COLOUR_MODES.items()):
-            a = self._action(colour, label, lambda _=False, k=key: self.scene.set_colour_mode(k),
+            a = add_action(self, colour, label, lambda _=False, k=key: self.scene.set_colour_mode(k),
                              f"Alt+{i + 1}", checkable=True)  # fmt: skip
             group.addAction(a)
             self.colour_actions[key] = a
@@ -195,8 +187,8 @@ class MainWindow(QMainWindow):
         view.addAction(self.dock.toggleViewAction())
 
         brush = bar.addMenu("&Brush")
-        self._action(brush, "&Smaller", lambda: self.viewport.scale_brush(1.0 / BRUSH_STEP), "[")
-        self._action(brush, "&Bigger", lambda: self.viewport.scale_brush(BRUSH_STEP), "]")
+        add_action(self, brush, "&Smaller", lambda: self.viewport.scale_brush(1.0 / BRUSH_STEP), "[")
+        add_action(self, brush, "&Bigger", lambda: self.viewport.scale_brush(BRUSH_STEP), "]")
 
     # -- animation (timeline, playback, keys, recording) ---------------------------------------
     def _build_animation_ui(self) -> None:
@@ -222,7 +214,7 @@ class MainWindow(QMainWindow):
 
         self.sources = AnimationSources(self)
         self.exporter = AnimationExporter(self)
-        self.project = ProjectController(self)
+        self.project = ProjectController(self, self.sources)
         menus = {a.text(): a.menu() for a in self.menuBar().actions()}
         file = menus["&File"]
         quit_action = file.actions()[-1]
@@ -245,7 +237,7 @@ class MainWindow(QMainWindow):
             file.insertAction(quit_action, action)
         animation = menus["&Animation"]
         animation.addSeparator()
-        self._action(animation, "&Simulate…", self.sources.simulate_dialog, "Ctrl+Alt+M")
+        add_action(self, animation, "&Simulate…", self.sources.simulate_dialog, "Ctrl+Alt+M")
         menus["&View"].addAction(self.sources.dock.toggleViewAction())
 
     def ask_save_changes(self) -> str:
@@ -421,7 +413,7 @@ class MainWindow(QMainWindow):
         except HairtoolError as e:
             self.show_error("Cannot write file", str(e))
             return False
-        self._remember_dir(path)
+        self.remember_dir(path)
         if adopt:
             self.scene.set_path(path)
             self.undo_stack.setClean()
@@ -442,7 +434,7 @@ class MainWindow(QMainWindow):
         except HairtoolError as e:
             self.show_error("Cannot load head mesh", str(e))
             return False
-        self._remember_dir(path)
+        self.remember_dir(path)
         self.scene.set_mesh(mesh)
         return True
 
@@ -474,7 +466,7 @@ class MainWindow(QMainWindow):
         except HairtoolError as e:
             self.show_error("Cannot export still", str(e))
             return False
-        self._remember_dir(path)
+        self.remember_dir(path)
         self.statusBar().showMessage(f"wrote {path}", 5000)
         return True
 

@@ -123,8 +123,8 @@ def grooms(specs: list[str]) -> Iterator[tuple[str, Groom, Path | None]]:
     """``(name, groom, source file or None)`` for each spec: ``real`` (every ``.tfx`` in
     :data:`GROOMS_DIR`), ``STRANDSxVERTICES`` (a seeded scalp sample), a groom file or
     ``sample:NAME[:S[:V]]``."""
-    from hairtool.cli._inputs import SAMPLE_PREFIX, load_groom
     from hairtool.errors import ParameterError
+    from hairtool.io.specs import SAMPLE_PREFIX, load_groom
     from hairtool.samples import scalp
 
     for spec in specs:

@@ -17,8 +17,9 @@ from __future__ import annotations
 import argparse
 import json
 
-from hairtool.cli._inputs import GROOM_INPUT_HELP, load_groom, parse_vector
+from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
 from hairtool.errors import ParameterError
+from hairtool.io.specs import load_groom
 
 HELP = "anime hair cycles: limited-animation schedule, wave poses, errors against a reference"
 

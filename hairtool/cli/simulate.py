@@ -17,7 +17,8 @@ import argparse
 import json
 import time
 
-from hairtool.cli._inputs import GROOM_INPUT_HELP, load_groom, parse_vector
+from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
+from hairtool.io.specs import load_groom
 
 HELP = "simulate hair dynamics on a moving head (turn, nod, shake, hop, wind gusts)"
 

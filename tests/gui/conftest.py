@@ -8,7 +8,7 @@ import pytest
 from PySide6.QtCore import QSettings
 from PySide6.QtWidgets import QApplication
 
-from app.main import configure_gl
+from app.surface import configure_gl
 from app.ui.qt_utils import send_mouse
 
 configure_gl()  # pytest-qt makes the QApplication later, on the first use of ``qapp``

@@ -41,7 +41,7 @@ def test_dragging_with_cpu_strands_uploads_no_positions(ui, make_window):
 MSAA_SCRIPT = """
 import json, sys, tempfile
 import numpy as np
-from app.main import configure_gl
+from app.surface import configure_gl
 configure_gl()
 from PySide6.QtCore import QSettings
 from PySide6.QtGui import QImage

@@ -20,10 +20,6 @@ def test_dialog_round_trips_options_and_refuses_a_bad_motion(qtbot):
     qtbot.addWidget(dialog)
     assert dialog.options() == o
     assert dialog.duration.text() == "0.967 s"
-    assert SimulateOptions.from_dict(o.to_dict()) == o
-    kw = o.kwargs()
-    assert kw["motion"] == ["nod", "hop"] and kw["wind"][1] == pytest.approx(np.hypot(5.0, 2.0))
-    assert SimulateOptions().kwargs()["wind"] is None
     dialog.motion.setText("nod,twirl")
     dialog._accept()
     assert "motion" in dialog.error_label.text() and dialog.result() == 0
@@ -47,8 +43,7 @@ def test_simulation_runs_as_a_job_and_loads_the_result(make_window):
 
 
 def test_cancelled_simulation_keeps_the_previous_animation(make_window):
-    from hairtool.errors import Cancelled
-    from hairtool.simulate.options import SimulateOptions, run_simulation
+    from hairtool.simulate.options import SimulateOptions
 
     groom = samples.scalp(12, 6, seed=1)
     w = make_window(groom=groom)
@@ -61,11 +56,6 @@ def test_cancelled_simulation_keeps_the_previous_animation(make_window):
     w.jobs.cancel(job)
     assert w.jobs.wait(60) and job.state == "cancelled"
     assert w.animation.animation is previous
-
-    done = []
-    with pytest.raises(Cancelled):  # the job body stops at the first frame after a cancel
-        run_simulation(groom, SimulateOptions(frames=20), lambda *a: done.append(a), lambda: len(done) > 2)
-    assert len(done) == 3
 
 
 def test_the_dialog_opens_fitted_to_a_real_groom_and_fits_on_demand(make_window, grooms_dir, qtbot):
