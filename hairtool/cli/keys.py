@@ -28,6 +28,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--per-channel", action="store_true", help="keys per degree of freedom (needs --penalty)"
     )
     parser.add_argument("--curve-keys", type=int, default=100, metavar="N", help="curve up to N keys")
+    steer = parser.add_argument_group("frames the animator steers (0-based; lists and ranges, e.g. 10,30-34)")
+    steer.add_argument("--pin", metavar="FRAMES", help="frames that must be keys")
+    steer.add_argument("--exclude", metavar="FRAMES", help="frames that must not be keys")
     feat = parser.add_argument_group("hair features (seed 000)")
     feat.add_argument("--samples", type=int, default=16, metavar="M", help="points per strand (arc length)")
     feat.add_argument("--no-resample", action="store_true", help="use the original vertices")
@@ -83,23 +86,26 @@ def _load(args: argparse.Namespace):
     return "animation", obj, obj.fps
 
 
-def _mode(args: argparse.Namespace, n: int) -> dict:
+def _mode(args: argparse.Namespace, n: int, least: int) -> dict:
+    """The one mode asked for; without one, a tenth of the frames (at least ``least`` keys)."""
     if args.penalty is not None:
         return {"penalty": args.penalty}
     if args.budget is not None:
         return {"budget": args.budget}
     if args.max_error is not None:
         return {"max_error": args.max_error}
-    return {"keys": args.keys if args.keys is not None else max(2, round(n / 10))}
+    return {"keys": args.keys if args.keys is not None else min(max(least, round(n / 10)), n)}
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from hairtool.errors import ParameterError
+    from hairtool.keys.constraints import KeyConstraints
     from hairtool.keys.features import FeatureOptions, frame_features, raw_features
     from hairtool.keys.session import KeySettings, solve
 
+    constraints = KeyConstraints.parse(args.pin, args.exclude)
     kind, data, fps = _load(args)
     options = FeatureOptions(
         samples=None if args.no_resample else args.samples,
@@ -125,6 +131,8 @@ def run(args: argparse.Namespace) -> int:
 
         if args.penalty is None:
             raise ParameterError("per-channel", True, "a --penalty TAU (seed 003 prices keys per channel)")
+        if constraints:
+            raise ParameterError("pin", args.pin or args.exclude, "keys of the whole pose, not --per-channel")
         result = {
             "frames": n,
             "fps": fps,
@@ -132,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
         }
         return _emit(args, result, f"{len(result['union'])} frames key at least one of {x.shape[1]} channels")
 
-    mode = _mode(args, n)
+    mode = _mode(args, n, constraints.check(n).key_range(n)[0])
     objective = "worst" if args.max_error is not None else args.objective
     table = None
     if kind == "bvh" and args.bvh_features == "quaternion":
@@ -142,7 +150,7 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError("bvh-features", "quaternion", "the linear (slerp) total objective only")
         table = rotation_cost_table(data)
     settings = KeySettings(objective=objective, interp=args.interp, curvature=args.curvature)
-    session = solve(x, settings, table=table, layers=False)
+    session = solve(x, settings, table=table, layers=False, constraints=constraints)
     sel = session.select(curve_keys=args.curve_keys, **mode)
     result = {"frames": n, "fps": fps, **sel.to_dict()}
     if kind == "animation":

@@ -21,6 +21,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
+from hairtool.keys.constraints import KeyConstraints
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -196,10 +197,22 @@ def check_table(table: ArrayLike) -> F64:
 
 
 def solve_layers(
-    table: ArrayLike, kmax: int, objective: str = "total", stop: float = -np.inf, use_numba: bool = True
+    table: ArrayLike,
+    kmax: int,
+    objective: str = "total",
+    stop: float = -np.inf,
+    use_numba: bool = True,
+    constraints: KeyConstraints | None = None,
 ):
-    """Layered DP: ``(E (kmax+1, n), back, last K computed)``; E[K, n−1] is the curve."""
+    """Layered DP: ``(E (kmax+1, n), back, last K computed)``; E[K, n−1] is the curve (+inf for
+    a count no key set under the constraints reaches)."""
     c = check_table(table)
+    if constraints:
+        c = constraints.apply(c)
+    return _layers(c, kmax, objective, stop, use_numba)
+
+
+def _layers(c: F64, kmax: int, objective: str, stop: float, use_numba: bool):
     kmax = int(min(kmax, c.shape[0]))
     use_max = objective == "worst"
     if use_numba:
@@ -216,15 +229,20 @@ def select_keys(
     max_error: float | None = None,
     objective: str = "total",
     curve_keys: int = DEFAULT_CURVE_KEYS,
+    constraints: KeyConstraints | None = None,
     use_numba: bool = True,
 ) -> Selection:
     """Exact keys for one of: ``keys`` = K, ``penalty`` = tau per key, ``budget`` on the total
     error (fewest keys), ``max_error`` on the worst frame (fewest keys). ``max_error`` implies
     the worst-frame objective (then the table must hold each segment's worst frame cost, as
     ``cost_table(..., objective="worst")`` builds it); the others sum the table's entries.
-    ``curve_keys``: the curve covers K = 2..min(n, curve_keys) (and at least the chosen K)."""
+    ``curve_keys``: the curve covers K = 2..min(n, curve_keys) (and at least the chosen K), the
+    counts no key set under the constraints reaches left out. ``constraints``: pinned frames are
+    keys and excluded frames are not, in an exact optimum (:mod:`hairtool.keys.constraints`)."""
     c = check_table(table)
     n = c.shape[0]
+    cons = (constraints or KeyConstraints()).check(n)
+    lo_k, hi_k = cons.key_range(n)
     given = {
         k: v
         for k, v in dict(keys=keys, penalty=penalty, budget=budget, max_error=max_error).items()
@@ -242,34 +260,36 @@ def select_keys(
     if mode == "penalty" and objective != "total":
         raise ParameterError("penalty", value, "a total-error objective")
     if mode == "keys":
-        if not np.isfinite(value) or int(value) != value or not 2 <= value <= n:
-            raise ParameterError("keys", value, f"a whole number in [2, {n}]")
+        if not np.isfinite(value) or int(value) != value or not lo_k <= value <= hi_k:
+            why = "" if (lo_k, hi_k) == (2, n) else " with these pins and exclusions"
+            raise ParameterError("keys", value, f"a whole number in [{lo_k}, {hi_k}]{why}")
     elif not np.isfinite(value) or value < 0:
         raise ParameterError(mode, value, "a finite number >= 0")
     if not np.isfinite(curve_keys) or int(curve_keys) != curve_keys or curve_keys < 0:
         raise ParameterError("curve_keys", curve_keys, "a whole number >= 0 (0: no curve)")
 
+    dp_table = cons.apply(c)
     kmax = max(2, min(n, int(curve_keys)))
     if mode == "keys":
         kmax = max(kmax, int(value))
     if mode == "penalty":
         _, pb = (
-            _penalty_kernel(np.ascontiguousarray(c.T), float(value))
+            _penalty_kernel(np.ascontiguousarray(dp_table.T), float(value))
             if use_numba
-            else penalty_reference(c, float(value))
+            else penalty_reference(dp_table, float(value))
         )
         chosen = _trace(lambda _, j: pb[j], n)
         if curve_keys > 0:
             kmax = max(kmax, chosen.size)
     stop = value if mode in ("budget", "max_error") else -np.inf
-    e, back, last = solve_layers(
-        c, n if mode in ("budget", "max_error") else kmax, objective, stop, use_numba
-    )
+    layers = n if mode in ("budget", "max_error") else kmax
+    e, back, last = _layers(dp_table, layers, objective, stop, use_numba)
     if mode in ("budget", "max_error"):
-        if e[last, n - 1] > value:  # cannot happen: n keys cost 0
-            raise ParameterError(mode, value, "a bound some key set meets")
+        if e[last, n - 1] > value:  # only under constraints: unconstrained, n keys cost 0
+            best = float(np.min(e[1:, n - 1]))
+            raise ParameterError(mode, value, f"a bound these pins and exclusions can meet (>= {best:.6g})")
         if last < kmax:  # extend the curve to the usual length for the slider
-            e, back, _ = solve_layers(c, kmax, objective, -np.inf, use_numba)
+            e, back, _ = _layers(dp_table, kmax, objective, -np.inf, use_numba)
         k_best = last
     elif mode == "keys":
         k_best = int(value)
@@ -279,6 +299,7 @@ def select_keys(
         chosen = _trace(lambda depth, j: back[k_best - depth + 1, j], n)
     top = max(last, kmax) if mode in ("budget", "max_error") else kmax
     ks = np.arange(2, min(top, e.shape[0] - 1) + 1)
+    ks = ks[np.isfinite(e[ks, n - 1])]  # counts the constraints cannot reach
     curve = np.column_stack([ks, e[ks, n - 1]]) if ks.size else np.zeros((0, 2))
     uni = uniform_keys(n, chosen.size)
     return Selection(
@@ -289,7 +310,7 @@ def select_keys(
         uniform_keys=uni,
         uniform_cost=keys_cost(c, uni, objective),
         curve=curve,
-        params={mode: value, "objective": objective},
+        params={mode: value, "objective": objective, **(cons.to_dict() if cons else {})},
     )
 
 

@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation
+from hairtool.keys.constraints import KeyConstraints
 from hairtool.keys.costs import INTERPOLATIONS, OBJECTIVES, cost_table
 from hairtool.keys.dp import (
     DEFAULT_CURVE_KEYS,
@@ -126,11 +127,13 @@ class KeySession:
         curvature: float = 0.0,
         kmax: int = MAX_CURVE_KEYS,
         table_key: tuple = (),
+        constraints: KeyConstraints | None = None,
     ) -> None:
         self.table = check_table(table)
         if objective not in OBJECTIVES:
             raise ParameterError("objective", objective, " or ".join(OBJECTIVES))
         self.objective, self.interp, self.curvature = objective, interp, float(curvature)
+        self.constraints = (constraints or KeyConstraints()).check(self.n_frames)
         self.kmax = int(min(self.n_frames, max(2, kmax)))
         self.table_key = table_key or (objective, interp, None, None, self.curvature)
         self.energy: F64 | None = None  # (kmax + 1, n)
@@ -140,23 +143,43 @@ class KeySession:
     def n_frames(self) -> int:
         return int(self.table.shape[0])
 
+    def constrain(self, constraints: KeyConstraints | None) -> KeySession:
+        """The same table under other pins and exclusions (the layers are solved again, the
+        table is not rebuilt): what a dope sheet edit asks for."""
+        constraints = (constraints or KeyConstraints()).check(self.n_frames)
+        if constraints != self.constraints:
+            self.constraints, self.energy, self.back = constraints, None, None
+        return self
+
+    @property
+    def key_range(self) -> tuple[int, int]:
+        """The fewest and the most keys the layers offer under the constraints."""
+        lo, hi = self.constraints.key_range(self.n_frames)
+        return lo, min(hi, self.kmax)
+
     def layers(self) -> KeySession:
         """Solve the DP for every K up to ``kmax`` (once; later calls return at once)."""
         if self.energy is None:
-            self.energy, self.back, _ = solve_layers(self.table, self.kmax, self.objective)
+            self.energy, self.back, _ = solve_layers(
+                self.table, self.kmax, self.objective, constraints=self.constraints
+            )
         return self
 
     @property
     def curve(self) -> F64:
-        """``(m, 2)`` rows (K, optimal error with K keys) for K = 2..kmax (feature units)."""
+        """``(m, 2)`` rows (K, optimal error with K keys) for the counts the constraints allow up
+        to kmax (feature units)."""
         self.layers()
-        ks = np.arange(2, self.kmax + 1)
+        lo, hi = self.key_range
+        ks = np.arange(lo, hi + 1)
         return np.column_stack([ks, self.energy[ks, self.n_frames - 1]])
 
     def keys_for_count(self, k: int) -> I64:
         """The DP keys for exactly ``k`` keys, traced back through the stored layers."""
-        if not 2 <= k <= self.kmax:
-            raise ParameterError("key count", k, f"a whole number in [2, {self.kmax}]")
+        lo, hi = self.key_range
+        if not lo <= k <= hi:
+            why = "" if not self.constraints else " with these pins and exclusions"
+            raise ParameterError("key count", k, f"a whole number in [{lo}, {hi}]{why}")
         self.layers()
         keys = [self.n_frames - 1]
         for depth in range(k, 1, -1):
@@ -165,7 +188,7 @@ class KeySession:
 
     def keys_for_tau(self, tau: float) -> I64:
         """Seed 003's keys with a price tau per key (total objective only)."""
-        return select_keys(self.table, penalty=float(tau), curve_keys=0).keys
+        return select_keys(self.table, penalty=float(tau), curve_keys=0, constraints=self.constraints).keys
 
     def keys_for_budget(self, budget: float) -> I64:
         """The fewest keys whose error (total, or worst frame) is within ``budget``."""
@@ -175,7 +198,9 @@ class KeySession:
         if fits.size:
             return self.keys_for_count(int(fits[0]) + 2)
         bound = {"budget": budget} if self.objective == "total" else {"max_error": budget}
-        return select_keys(self.table, objective=self.objective, curve_keys=0, **bound).keys
+        return select_keys(
+            self.table, objective=self.objective, curve_keys=0, constraints=self.constraints, **bound
+        ).keys
 
     def keys_for(self, settings: KeySettings) -> I64:
         """The DP keys the settings ask for (count, tau or budget)."""
@@ -183,7 +208,8 @@ class KeySession:
             return self.keys_for_tau(settings.tau)
         if settings.mode == "budget":
             return self.keys_for_budget(settings.budget)
-        return self.keys_for_count(min(settings.count_for(self.n_frames), self.kmax))
+        lo, hi = self.key_range
+        return self.keys_for_count(min(max(settings.count_for(self.n_frames), lo), hi))
 
     def select(
         self,
@@ -205,6 +231,7 @@ class KeySession:
             max_error=max_error,
             objective=self.objective,
             curve_keys=curve_keys,
+            constraints=self.constraints,
         )
         sel.params.update(interp=self.interp, curvature=self.curvature)
         return sel
@@ -220,12 +247,14 @@ def solve(
     table: ArrayLike | None = None,
     layers: bool = True,
     kmax: int = MAX_CURVE_KEYS,
+    constraints: KeyConstraints | None = None,
 ) -> KeySession | None:
     """Features, cost table and (with ``layers``) the layered DP; None once ``cancelled()``.
 
     ``source`` is an Animation (seed 000's features, ``features`` or the settings' own) or an
     ``(frames, D)`` feature array used as is; ``table`` replaces the Gram cost table by one the
-    caller built (seed 003's quaternion-distance table of a BVH capture).
+    caller built (seed 003's quaternion-distance table of a BVH capture); ``constraints`` pins
+    and excludes frames (:mod:`hairtool.keys.constraints`).
     """
     settings.validate()
     progress = progress or (lambda *a, **k: None)
@@ -247,6 +276,7 @@ def solve(
         curvature=settings.curvature,
         kmax=kmax,
         table_key=settings.table_key,
+        constraints=constraints,
     )
     if layers:
         progress(0.9, "dynamic programming")
@@ -268,16 +298,18 @@ def find_keys(
     features: FeatureOptions | None = None,
     curve_keys: int = DEFAULT_CURVE_KEYS,
     table: ArrayLike | None = None,
+    constraints: KeyConstraints | None = None,
 ) -> Selection:
     """Exact keys of an Animation (seed 000 features) or an ``(n_frames, D)`` array, in one call.
 
     Exactly one of ``keys``, ``penalty``, ``budget``, ``max_error`` (which implies the worst-frame
-    objective); ``table`` as in :func:`solve`.
+    objective); ``table`` and ``constraints`` as in :func:`solve`.
     """
     if max_error is not None:
         objective = "worst"
     settings = KeySettings(objective=objective, interp=interp, curvature=curvature)
-    session = solve(source, settings, features=features or FeatureOptions(), table=table, layers=False)
+    features = features or FeatureOptions()
+    session = solve(source, settings, features=features, table=table, layers=False, constraints=constraints)
     mode = dict(keys=keys, penalty=penalty, budget=budget, max_error=max_error)
     return session.select(curve_keys=curve_keys, **mode)
 

@@ -129,3 +129,34 @@ def test_bad_input_exits_2_with_one_line(files, capsys, name, argv, needle):
     assert main(["keys", str(d / name), *argv]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and needle in err
+
+
+@pytest.mark.parametrize(
+    "mode", [["--keys", "6"], ["--penalty", "2"], ["--budget", "60"], ["--max-error", "30"]]
+)
+def test_pinned_and_excluded_frames_steer_every_mode(files, capsys, mode):
+    d, _ = files
+    out = run_json(capsys, d / "x.npz", *mode, "--pin", "7,20", "--exclude", "10-13")
+    keys = set(out["keys"])
+    assert {7, 20} <= keys and not keys & {10, 11, 12, 13}
+    assert out["params"]["pins"] == [7, 20] and out["params"]["excludes"] == [10, 11, 12, 13]
+    free = run_json(capsys, d / "x.npz", *mode)
+    assert "pins" not in free["params"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "words"),
+    [
+        (["--keys", "3", "--pin", "5,9"], "keys=3"),
+        (["--exclude", "0"], "first (0)"),
+        (["--exclude", "29"], "last (29)"),
+        (["--pin", "4", "--exclude", "4"], "pin"),
+        (["--pin", "x"], "pin"),
+        (["--keys", "5", "--pin", "1-28"], "at least one frame left"),
+    ],
+)
+def test_impossible_constraints_are_one_line(files, capsys, argv, words):
+    d, _ = files
+    assert main(["keys", str(d / "x.npz"), *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err

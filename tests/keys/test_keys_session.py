@@ -115,3 +115,30 @@ def test_ranged_key_edit_equals_editing_the_whole_animation(anim, interp, key_fr
     np.testing.assert_array_equal(whole[outside], anim.frames[outside])
     with pytest.raises(ParameterError, match="key frame"):
         ks.key_edit_block(anim.frames, keys, interp, 8, pose)
+
+
+def test_constraints_steer_every_mode_of_a_session_and_match_the_engine(anim):
+    from hairtool.keys.constraints import KeyConstraints
+
+    cons = KeyConstraints(pins=(5, 30), excludes=(26, 27, 28))
+    solved = ks.solve(anim, ks.KeySettings(), constraints=cons)
+    table = solved.table
+    assert solved.key_range == (4, 37)
+    for k in (4, 6, 9):
+        got = solved.keys_for_count(k)
+        np.testing.assert_array_equal(got, select_keys(table, keys=k, constraints=cons).keys)
+        assert cons.allows(got)
+    assert solved.curve[0, 0] == 4 and np.all(np.isfinite(solved.curve[:, 1]))
+    for tau in (1e-4, 1e-2):
+        assert cons.allows(solved.keys_for(ks.KeySettings(mode="tau", tau=tau)))
+    budget = float(solved.curve[3, 1])
+    got = solved.keys_for(ks.KeySettings(mode="budget", budget=budget))
+    np.testing.assert_array_equal(got, select_keys(table, budget=budget, constraints=cons).keys)
+    # the default count (a tenth of 40 frames) is raised to what the pins need
+    assert solved.keys_for(ks.KeySettings()).size == 4
+    with pytest.raises(ParameterError, match="with these pins"):
+        solved.keys_for_count(3)
+    # new constraints reuse the table: no features, no cost table
+    solved.constrain(None)
+    assert solved.key_range == (2, 40) and not solved.constraints
+    np.testing.assert_array_equal(solved.keys_for_count(5), select_keys(table, keys=5).keys)

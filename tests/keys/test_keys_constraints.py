@@ -1,0 +1,165 @@
+"""Pinned and excluded frames: the DP returns the exact optimum under them, for every mode and
+both objectives (brute force on small inputs, an independent DP on larger ones), and refuses
+constraints no key set can meet with one clear error."""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import numpy as np
+import pytest
+
+from hairtool.errors import ParameterError
+from hairtool.keys.constraints import KeyConstraints, parse_frames
+from hairtool.keys.costs import cost_table
+from hairtool.keys.dp import keys_cost, select_keys
+
+
+def random_table(n: int, seed: int, objective: str = "total") -> np.ndarray:
+    x = np.cumsum(np.random.default_rng(seed).normal(size=(n, 3)), axis=0)
+    return cost_table(x, "linear", 0.0, objective)
+
+
+def feasible_sets(n: int, cons: KeyConstraints):
+    inner = [f for f in range(1, n - 1) if f not in cons.excludes]
+    for r in range(len(inner) + 1):
+        for chosen in combinations(inner, r):
+            keys = (0, *chosen, n - 1)
+            if cons.allows(keys):
+                yield np.array(keys)
+
+
+def brute(table, cons, objective, *, keys=None, penalty=None, budget=None, max_error=None):
+    """The best (cost, count) by enumeration, in each mode's own order of preference."""
+    n = table.shape[0]
+    best = None
+    for k in feasible_sets(n, cons):
+        cost = keys_cost(table, k, objective)
+        if keys is not None:
+            if k.size == keys and (best is None or cost < best[0]):
+                best = (cost, k.size)
+        elif penalty is not None:
+            score = cost + penalty * k.size
+            if best is None or score < best[2]:
+                best = (cost, k.size, score)
+        else:
+            bound = budget if budget is not None else max_error
+            if cost <= bound and (best is None or (k.size, cost) < (best[1], best[0])):
+                best = (cost, k.size)
+    return best
+
+
+CASES = [
+    KeyConstraints(pins=(3,)),
+    KeyConstraints(excludes=(4, 5)),
+    KeyConstraints(pins=(2, 7), excludes=(5,)),
+    KeyConstraints(pins=(1, 8), excludes=(3, 4, 6)),
+]
+
+
+@pytest.mark.parametrize("cons", CASES, ids=str)
+@pytest.mark.parametrize("objective", ["total", "worst"])
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_constrained_optimum_equals_brute_force(cons, objective, seed):
+    n = 10
+    table = random_table(n, seed, objective)
+    lo, hi = cons.key_range(n)
+    for k in range(lo, hi + 1):
+        sel = select_keys(table, keys=k, objective=objective, constraints=cons)
+        assert cons.allows(sel.keys) and sel.keys.size == k
+        assert sel.cost == pytest.approx(brute(table, cons, objective, keys=k)[0], rel=1e-12, abs=1e-12)
+    top = float(np.max(table[np.triu_indices(n, 1)]))
+    for frac in (0.02, 0.1, 0.5):
+        bound = frac * top
+        mode = {"budget": bound} if objective == "total" else {"max_error": bound}
+        want = brute(table, cons, objective, **mode)
+        if want is None:
+            with pytest.raises(ParameterError, match="pins and exclusions"):
+                select_keys(table, objective=objective, constraints=cons, **mode)
+            continue
+        sel = select_keys(table, objective=objective, constraints=cons, **mode)
+        assert cons.allows(sel.keys) and sel.keys.size == want[1]
+        assert sel.cost == pytest.approx(want[0], rel=1e-12, abs=1e-12)
+    if objective == "total":
+        for tau in (0.0, 0.1 * top, 2.0 * top):
+            sel = select_keys(table, penalty=tau, constraints=cons)
+            want = brute(table, cons, objective, penalty=tau)
+            assert cons.allows(sel.keys)
+            assert sel.cost + tau * sel.keys.size == pytest.approx(want[2], rel=1e-12, abs=1e-12)
+
+
+def independent_dp(table: np.ndarray, cons: KeyConstraints, k: int, objective: str) -> float:
+    """E[K][j] over the allowed segments, written from the definition of the constraints."""
+    n = table.shape[0]
+    pins, excl = set(cons.pins), set(cons.excludes)
+
+    def allowed(i: int, j: int) -> bool:
+        return i not in excl and j not in excl and not any(i < p < j for p in pins)
+
+    e = np.full((k + 1, n), np.inf)
+    e[1, 0] = 0.0
+    for kk in range(2, k + 1):
+        for j in range(1, n):
+            for i in range(j):
+                if allowed(i, j) and np.isfinite(e[kk - 1, i]):
+                    v = max(e[kk - 1, i], table[i, j]) if objective == "worst" else e[kk - 1, i] + table[i, j]
+                    e[kk, j] = min(e[kk, j], v)
+    return e[k, n - 1]
+
+
+@pytest.mark.parametrize("objective", ["total", "worst"])
+def test_constrained_optimum_equals_an_independent_dp_on_a_longer_animation(objective):
+    n = 48
+    table = random_table(n, 5, objective)
+    cons = KeyConstraints(pins=(7, 20, 21, 40), excludes=(10, 11, 12, 33))
+    for k in (6, 9, 15):
+        sel = select_keys(table, keys=k, objective=objective, constraints=cons)
+        assert cons.allows(sel.keys)
+        assert sel.cost == pytest.approx(independent_dp(table, cons, k, objective), rel=1e-12)
+        assert sel.params["pins"] == [7, 20, 21, 40] and sel.params["excludes"] == [10, 11, 12, 33]
+    free = select_keys(table, keys=9, objective=objective)
+    assert select_keys(table, keys=9, objective=objective, constraints=cons).cost >= free.cost
+
+
+def test_the_numpy_twins_agree_under_constraints():
+    table = random_table(30, 3)
+    cons = KeyConstraints(pins=(5, 17), excludes=(9, 10))
+    for mode in ({"keys": 7}, {"penalty": 0.5}, {"budget": 5.0}):
+        a = select_keys(table, constraints=cons, **mode)
+        b = select_keys(table, constraints=cons, use_numba=False, **mode)
+        np.testing.assert_array_equal(a.keys, b.keys)
+
+
+def test_no_constraints_change_nothing():
+    table = random_table(25, 4)
+    a = select_keys(table, keys=6)
+    b = select_keys(table, keys=6, constraints=KeyConstraints())
+    np.testing.assert_array_equal(a.keys, b.keys)
+    assert a.to_dict() == b.to_dict()
+
+
+def test_impossible_constraints_are_one_clear_error():
+    table = random_table(12, 0)
+    with pytest.raises(ParameterError, match=r"exclude.*first \(0\) and the last \(11\)"):
+        select_keys(table, keys=4, constraints=KeyConstraints(excludes=(0, 5)))
+    with pytest.raises(ParameterError, match="exclude"):
+        select_keys(table, keys=4, constraints=KeyConstraints(excludes=(11,)))
+    with pytest.raises(ParameterError, match="at least one frame left"):
+        select_keys(table, keys=4, constraints=KeyConstraints(pins=tuple(range(1, 11))))
+    with pytest.raises(ParameterError, match=r"keys=3 .*\[4, 12\] with these pins"):
+        select_keys(table, keys=3, constraints=KeyConstraints(pins=(3, 6)))
+    with pytest.raises(ParameterError, match=r"\[2, 10\]"):
+        select_keys(table, keys=11, constraints=KeyConstraints(excludes=(3, 4)))
+    with pytest.raises(ParameterError, match="pin"):
+        KeyConstraints(pins=(3,), excludes=(3,))
+    with pytest.raises(ParameterError, match="pin"):
+        select_keys(table, keys=4, constraints=KeyConstraints(pins=(12,)))
+
+
+def test_frame_lists_parse_like_the_command_line():
+    assert parse_frames("pin", "10,55") == (10, 55)
+    assert parse_frames("exclude", "30-34, 40") == (30, 31, 32, 33, 34, 40)
+    assert parse_frames("pin", "") == ()
+    for bad in ("a", "5-3", "-2", "1.5"):
+        with pytest.raises(ParameterError):
+            parse_frames("pin", bad)
