@@ -121,12 +121,17 @@ class AnimationModel(QObject):
         ``source`` says where it came from (a path, "recording", "anime cycle", …); the other
         docks call this through ``window.animation.load_animation``. Frame 0, playback stopped,
         playback rate the animation's. The key settings stay, except the count, which goes back
-        to a tenth of the frames; a reopened project passes its saved ``settings`` instead (one
-        solve, with those). ParameterError for invalid settings, before anything changes.
+        to the knee of the error curve, and the pinned and excluded frames, which belonged to the
+        last animation; a reopened project passes its saved ``settings`` instead (one solve, with
+        those). ParameterError for invalid settings, before anything changes.
         """
         if not isinstance(animation, Animation):
             raise GroomError(f"expected an Animation, got {type(animation).__name__}")
-        new_settings = settings.validate() if settings is not None else self.settings.replace(count=0)
+        if settings is not None:
+            new_settings = settings.validate()
+            new_settings.constraints.check(animation.n_frames)
+        else:
+            new_settings = self.settings.replace(count=0, pins=(), excludes=())
         self.pause()
         self._cancel_jobs()
         self.generation += 1
@@ -290,6 +295,8 @@ class AnimationModel(QObject):
         new = self.settings.replace(**changes)
         if new == self.settings:
             return
+        if self.n_frames >= 2:
+            new.constraints.check(self.n_frames)  # before anything changes
         self.settings = new
         self.settings_changed.emit(new)
         if self.n_frames < 2:
@@ -301,7 +308,41 @@ class AnimationModel(QObject):
             job, self._solve_job = self._solve_job, None
             job.cancel()
             self._busy_update()
+        if new.constraints != self.key_solve.constraints:  # the same table, other layers
+            self.key_solve.constrain(new.constraints)
+            self.curve_changed.emit()
         self._choose_keys()
+
+    def steered(
+        self,
+        *,
+        pin: int | None = None,
+        unpin: int | None = None,
+        exclude: int | None = None,
+        move: tuple[int, int] | None = None,
+    ) -> tuple[tuple[int, ...], tuple[int, ...]]:
+        """The pins and exclusions after one dope-sheet edit (not applied): pin or unpin a frame,
+        exclude one (which also unpins it), or move a key from one frame to another (the new
+        frame pinned, the old one excluded). ParameterError when the ends would be excluded."""
+        pins, excl = set(self.settings.pins), set(self.settings.excludes)
+        if pin is not None:
+            pins.add(pin)
+            excl.discard(pin)
+        if unpin is not None:
+            pins.discard(unpin)
+        if exclude is not None:
+            excl.add(exclude)
+            pins.discard(exclude)
+        if move is not None:
+            old, new = move
+            pins.discard(old)
+            excl.discard(new)
+            pins.add(new)
+            if 0 < old < self.last_frame:  # the ends are always keys: moving one only adds a pin
+                excl.add(old)
+        new = self.settings.replace(pins=tuple(pins), excludes=tuple(excl))
+        new.constraints.check(max(self.n_frames, 2))
+        return new.pins, new.excludes
 
     def set_key_count(self, count: int) -> None:
         """Exactly ``count`` DP keys (switches to the key-count mode)."""

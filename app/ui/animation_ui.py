@@ -56,6 +56,26 @@ class KeyEditCommand(QUndoCommand):
         self._apply(self.before)
 
 
+class SteerKeysCommand(QUndoCommand):
+    """A dope-sheet edit: the pinned and excluded frames before and after it."""
+
+    def __init__(self, model: AnimationModel, text: str, before: tuple, after: tuple) -> None:
+        super().__init__(text)
+        self.model, self.generation = model, model.generation
+        self.before, self.after = before, after
+
+    def _apply(self, constraints: tuple) -> None:
+        if self.model.generation == self.generation:  # the pins of a replaced animation mean nothing
+            pins, excludes = constraints
+            self.model.set_settings(pins=pins, excludes=excludes)
+
+    def redo(self) -> None:
+        self._apply(self.after)
+
+    def undo(self) -> None:
+        self._apply(self.before)
+
+
 class KeyEditBrush:
     """The align brush on a key pose: only at a DP key frame, with the scene's radius, intensity
     and mode (align only: freeze and clump shape static grooms, not captured motion)."""
@@ -131,6 +151,22 @@ class AnimationController(QObject):
         self.viewport.stroke_finished.connect(self._on_stroke_finished)
         self.actions: dict[str, QAction] = {}
         self._update_fps_label()
+
+    # -- the dope sheet ----------------------------------------------------------------------
+    def steer_keys(self, text: str, **edit: object) -> bool:
+        """One undoable dope-sheet edit (see :meth:`AnimationModel.steered`); a refused one says
+        why in the status bar and changes nothing."""
+        m = self.model
+        try:
+            after = m.steered(**edit)
+        except HairtoolError as e:
+            self.window.statusBar().showMessage(f"{text}: {e}", 6000)
+            return False
+        before = (m.settings.pins, m.settings.excludes)
+        if after == before:
+            return False
+        self.window.undo_stack.push(SteerKeysCommand(m, text, before, after))
+        return True
 
     # -- model → viewport ------------------------------------------------------------------
     def refresh_display(self, *_: object) -> None:

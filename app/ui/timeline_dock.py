@@ -36,6 +36,7 @@ from hairtool.keys.session import KEY_MODES
 
 #: The key modes as the timeline names them.
 MODE_LABELS = {"count": "Key count", "tau": "Price per key (tau)", "budget": "Error budget"}
+TAU_RANGE = (1e-5, 1.0)  # a key's price as a share of the two-key error
 
 TRANSPORT = (
     "first",
@@ -72,7 +73,7 @@ class KeyControls(QWidget):
         row = QHBoxLayout()
         row.addWidget(self.count_slider, 3)
         row.addWidget(self.count_spin, 1)
-        self.tau = SliderSpin(1e-6, 1e3, decimals=6, log=True)
+        self.tau = SliderSpin(TAU_RANGE[0], TAU_RANGE[1], decimals=6, log=True)
         self.budget = SliderSpin(1e-6, 1e3, decimals=6, log=True)
         self.objective = QComboBox()
         self.objective.addItem("Total error", "total")
@@ -101,7 +102,11 @@ class KeyControls(QWidget):
             w.setKeyboardTracking(False)
         form.addRow("Keys by", self.mode)
         form.addRow("Key count", row)
-        form.addRow("Tau", self.tau)
+        self.tau.setToolTip(
+            "price of one more key, as a share of the error of keying only the first and last frame: "
+            "a key stays when it saves at least that much (seed 003's tau, scaled by the two-key error)"
+        )
+        form.addRow("Price per key", self.tau)
         form.addRow("Error budget", self.budget)
         form.addRow("Objective", self.objective)
         form.addRow("Interpolation", self.interp)
@@ -155,17 +160,16 @@ class KeyControls(QWidget):
         )  # fmt: skip
         with signals_blocked(*widgets):
             self.mode.setCurrentIndex(self.mode.findData(s.mode))
-            top = max(m.max_keys, 2)
-            count = m.dp_keys.size if m.dp_keys is not None else s.count_for(max(m.n_frames, 2))
+            least, top = m.key_solve.key_range if m.key_solve is not None else (2, max(m.max_keys, 2))
+            count = m.dp_keys.size if m.dp_keys is not None else max(s.count, 2)
             for w in (self.count_slider, self.count_spin):
-                w.setRange(2, top)
-                w.setValue(min(count, top))
-            if m.key_solve is not None:  # tau and budget ranges follow the error scale
+                w.setRange(least, top)
+                w.setValue(min(max(count, least), top))
+            if m.key_solve is not None:  # the budget's range follows the error scale; tau is relative
                 curve = m.key_solve.curve[:, 1]
                 positive = curve[curve > 0]
                 lo = max(float(positive.min()) * 0.1, 1e-9) if positive.size else 1e-6
                 hi = max(float(curve.max()) * 2.0, lo * 10.0)
-                self.tau.set_range(lo, hi)
                 self.budget.set_range(lo, hi)
             self.tau.set_value(s.tau)
             self.budget.set_value(s.budget)
@@ -212,7 +216,9 @@ class TimelineDock(QDockWidget):
         actions: dict[str, QAction],
         report: Callable[[str, str], None],
         parent: QWidget | None = None,
+        steer: Callable[..., bool] | None = None,
     ) -> None:
+        """``steer(text, **edit)``: one undoable dope-sheet edit (the animation controller's)."""
         super().__init__("Timeline", parent)
         self.setObjectName("TimelineDock")
         self.model = model
@@ -246,7 +252,7 @@ class TimelineDock(QDockWidget):
         outer.addLayout(transport)
 
         split = QSplitter(Qt.Orientation.Horizontal)
-        self.view = TimelineView(model)
+        self.view = TimelineView(model, steer=steer)
         side = QWidget()
         side_layout = QVBoxLayout(side)
         side_layout.setContentsMargins(0, 0, 0, 0)

@@ -5,6 +5,7 @@ write only the frame (scrubbing) or the key count (clicking the plot) back to it
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRect, QRectF, QSize, Qt
@@ -30,6 +31,8 @@ GRID = QColor(70, 73, 80)
 TEXT = QColor(200, 200, 205)
 DP_COLOUR = QColor(255, 140, 26)  # DP keys and their reconstruction's curves: orange
 UNIFORM_COLOUR = QColor(74, 163, 223)  # uniform keys and theirs: blue
+PIN_COLOUR = QColor(245, 245, 245)  # the ring round a pinned key
+EXCLUDE_COLOUR = QColor(230, 80, 80)  # the cross on a frame that must not be a key
 SPEED_COLOUR = QColor(150, 150, 150, 90)
 PLAYHEAD = QColor(235, 64, 64)
 
@@ -52,14 +55,24 @@ def _nice_step(span: float, pixels: float, min_px: float = 50.0) -> int:
 class TimelineView(QWidget):
     """Ruler, DP and uniform key rows, and the error and speed curves over frames.
 
-    A left press or drag anywhere sets the frame (the viewport follows at once). Everything but
-    the playhead is drawn once into a pixmap and reused until the keys, curves or size change,
-    so a frame change repaints in well under a millisecond.
+    A left press or drag anywhere sets the frame (the viewport follows at once). The DP row is a
+    dope sheet when a ``steer`` callback is given: a click on a key pins or unpins it, dragging a
+    key moves it (the new frame pinned, the old one excluded; the other keys re-solve at once),
+    Delete excludes the current frame and Insert pins it. Everything but the playhead is drawn
+    once into a pixmap and reused until the keys, curves or size change, so a frame change
+    repaints in well under a millisecond.
     """
 
-    def __init__(self, model: AnimationModel, parent: QWidget | None = None) -> None:
+    def __init__(
+        self,
+        model: AnimationModel,
+        parent: QWidget | None = None,
+        steer: Callable[..., bool] | None = None,
+    ) -> None:
         super().__init__(parent)
         self.model = model
+        self.steer = steer
+        self._grab: int | None = None  # the DP key pressed on, while the button is down
         self.setMinimumHeight(150)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
         self.setMouseTracking(False)
@@ -72,6 +85,7 @@ class TimelineView(QWidget):
             model.analysis_changed,
             model.frames_edited,
             model.busy_changed,
+            model.settings_changed,
         ):
             signal.connect(self.invalidate)
         model.frame_changed.connect(self.update)
@@ -111,17 +125,55 @@ class TimelineView(QWidget):
             "uniform": [] if m.uniform_keys is None else m.uniform_keys.tolist(),
         }
 
+    def key_at(self, pos: QPointF) -> int | None:
+        """The DP key drawn under ``pos`` (within its diamond's reach), or None."""
+        m = self.model
+        if m.dp_keys is None or not self.row_rect("dp").contains(pos.toPoint()):
+            return None
+        xs = np.array([self.frame_to_x(k) for k in m.dp_keys])
+        i = int(np.argmin(np.abs(xs - pos.x())))
+        return int(m.dp_keys[i]) if abs(xs[i] - pos.x()) <= max(self._half(), 4.0) else None
+
     # -- input ----------------------------------------------------------------------------------
     def mousePressEvent(self, event: QMouseEvent) -> None:
         if event.button() == Qt.MouseButton.LeftButton:
             self.model.pause()
-            self.model.set_frame(self.x_to_frame(event.position().x()))
+            self._grab = self.key_at(event.position()) if self.steer is not None else None
+            frame = self._grab if self._grab is not None else self.x_to_frame(event.position().x())
+            self.model.set_frame(frame)
             event.accept()
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
         if event.buttons() & Qt.MouseButton.LeftButton:
-            self.model.set_frame(self.x_to_frame(event.position().x()))
+            self.model.set_frame(min(max(self.x_to_frame(event.position().x()), 0), self.model.last_frame))
             event.accept()
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        grabbed, self._grab = self._grab, None
+        if event.button() != Qt.MouseButton.LeftButton or grabbed is None or self.steer is None:
+            return
+        target = min(max(self.x_to_frame(event.position().x()), 0), self.model.last_frame)
+        if target == grabbed:  # a click: pin or unpin
+            if grabbed in self.model.settings.pins:
+                self.steer(f"Unpin key {grabbed}", unpin=grabbed)
+            else:
+                self.steer(f"Pin key {grabbed}", pin=grabbed)
+        else:
+            self.steer(f"Move key {grabbed} to {target}", move=(grabbed, target))
+        event.accept()
+
+    def keyPressEvent(self, event) -> None:
+        frame = self.model.frame
+        if self.steer is not None and self.model.n_frames >= 2:
+            if event.key() in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace):
+                self.steer(f"Exclude frame {frame}", exclude=frame)
+                event.accept()
+                return
+            if event.key() == Qt.Key.Key_Insert:
+                self.steer(f"Pin frame {frame}", pin=frame)
+                event.accept()
+                return
+        super().keyPressEvent(event)
 
     # -- painting -------------------------------------------------------------------------------
     def paintEvent(self, event: QPaintEvent) -> None:
@@ -151,6 +203,7 @@ class TimelineView(QWidget):
             p.setRenderHint(QPainter.RenderHint.Antialiasing, True)
             self._paint_ruler(p)
             self._paint_keys(p, "dp", m.dp_keys, DP_COLOUR, filled=True)
+            self._paint_constraints(p)
             self._paint_keys(p, "uniform", m.uniform_keys, UNIFORM_COLOUR, filled=False)
             self._paint_curves(p)
         p.end()
@@ -177,6 +230,25 @@ class TimelineView(QWidget):
         p.setPen(GRID)
         p.drawLine(LEFT, r.bottom(), self.width() - RIGHT, r.bottom())
 
+    def _half(self) -> float:
+        """Half the size of a key's mark at the current zoom."""
+        return min(5.0, max(2.5, (self.width() - LEFT - RIGHT) / max(self.model.n_frames, 1) / 2.2))
+
+    def _paint_constraints(self, p: QPainter) -> None:
+        """Pinned keys get a ring round their diamond; excluded frames a cross on the DP row."""
+        s, r = self.model.settings, self.row_rect("dp")
+        cy, half = r.center().y() + 0.5, self._half()
+        p.setBrush(Qt.BrushStyle.NoBrush)
+        p.setPen(QPen(PIN_COLOUR, 1.5))
+        for f in s.pins:
+            p.drawEllipse(QPointF(self.frame_to_x(f), cy), half + 2.5, half + 2.5)
+        p.setPen(QPen(EXCLUDE_COLOUR, 1.5))
+        d = half * 0.8
+        for f in s.excludes:
+            x = self.frame_to_x(f)
+            p.drawLine(QPointF(x - d, cy - d), QPointF(x + d, cy + d))
+            p.drawLine(QPointF(x - d, cy + d), QPointF(x + d, cy - d))
+
     def _paint_keys(self, p: QPainter, row: str, keys, colour: QColor, filled: bool) -> None:
         r = self.row_rect(row)
         p.setPen(TEXT)
@@ -188,7 +260,7 @@ class TimelineView(QWidget):
         if keys is None:
             return
         cy = r.center().y() + 0.5
-        half = min(5.0, max(2.5, (self.width() - LEFT - RIGHT) / max(self.model.n_frames, 1) / 2.2))
+        half = self._half()
         if filled:  # diamonds, solid
             p.setPen(Qt.PenStyle.NoPen)
             p.setBrush(colour)
@@ -297,7 +369,8 @@ class KeyCountPlot(QWidget):
         s = self.model.key_solve
         r = self._plot_rect()
         f = (x - r.left()) / r.width()
-        return int(min(max(round(2 + f * (s.kmax - 2)), 2), s.kmax))
+        least, most = s.key_range  # the pins need a few keys at least
+        return int(min(max(round(2 + f * (s.kmax - 2)), least), most))
 
     def _point(self, k: float, v: float, lo: float, hi: float) -> QPointF:
         r, kmax = self._plot_rect(), self.model.key_solve.kmax

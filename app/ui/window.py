@@ -197,7 +197,10 @@ class MainWindow(QMainWindow):
         self.animation = AnimationModel(self.jobs, self)
         self.animation_ui = AnimationController(self, self.animation)
         actions = self.animation_ui.build_menu()
-        self.timeline = TimelineDock(self.animation, actions, lambda t, m: self.show_error(t, m), self)
+        steer = self.animation_ui.steer_keys
+        self.timeline = TimelineDock(
+            self.animation, actions, lambda t, m: self.show_error(t, m), self, steer=steer
+        )
         self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.timeline)
         self.animation_ui.bind_transport_keys(self.viewport, self.timeline)
         self.statusBar().addPermanentWidget(self.animation_ui.fps_label)

@@ -1,8 +1,11 @@
 """Find globally optimal keyframes of an animation, a BVH capture or a feature array.
 
 IN is an animation file (.usd/.usda/.usdc/.npz cache), a .bvh, or an .npz holding an array
-``X`` of shape (frames, dims) used as raw features. Exactly one mode: --keys K (default: a
-tenth of the frames), --penalty TAU, --budget E (total error) or --max-error E (worst frame).
+``X`` of shape (frames, dims) used as raw features. At most one mode: --keys K, --penalty TAU
+(a price per key, as a share of the error of keying only the first and last frame, so it means
+the same on any animation), --penalty-abs TAU (seed 003's absolute price, in squared feature
+units), --budget E (total error) or --max-error E (worst frame). Without one, the key count is
+the knee of the error-vs-count curve: the count past which each key buys less than its share.
 """
 
 from __future__ import annotations
@@ -18,7 +21,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", metavar="IN", help="animation file, .bvh, or .npz with an array X")
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument("--keys", "-k", type=int, metavar="K", help="exactly K keys")
-    mode.add_argument("--penalty", type=float, metavar="TAU", help="price per key (seed 003)")
+    mode.add_argument(
+        "--penalty", type=float, metavar="TAU", help="price per key, a share of the two-key error (0.01: 1%%)"
+    )
+    mode.add_argument(
+        "--penalty-abs", type=float, metavar="TAU", help="price per key in squared feature units (seed 003)"
+    )
     mode.add_argument("--budget", type=float, metavar="E", help="fewest keys with total error <= E")
     mode.add_argument("--max-error", type=float, metavar="E", help="fewest keys with worst frame <= E")
     parser.add_argument("--objective", choices=("total", "worst"), default="total")
@@ -86,15 +94,21 @@ def _load(args: argparse.Namespace):
     return "animation", obj, obj.fps
 
 
-def _mode(args: argparse.Namespace, n: int, least: int) -> dict:
-    """The one mode asked for; without one, a tenth of the frames (at least ``least`` keys)."""
+def _mode(args: argparse.Namespace, session) -> dict:
+    """The one mode asked for, with a relative tau made absolute; without one, the knee."""
     if args.penalty is not None:
-        return {"penalty": args.penalty}
+        if not args.penalty >= 0 or args.penalty == float("inf"):
+            from hairtool.errors import ParameterError
+
+            raise ParameterError("penalty", args.penalty, "a finite share >= 0 of the two-key error")
+        return {"penalty": args.penalty * session.two_key_error}
+    if args.penalty_abs is not None:
+        return {"penalty": args.penalty_abs}
     if args.budget is not None:
         return {"budget": args.budget}
     if args.max_error is not None:
         return {"max_error": args.max_error}
-    return {"keys": args.keys if args.keys is not None else min(max(least, round(n / 10)), n)}
+    return {"keys": args.keys if args.keys is not None else session.knee}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -103,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
     from hairtool.errors import ParameterError
     from hairtool.keys.constraints import KeyConstraints
     from hairtool.keys.features import FeatureOptions, frame_features, raw_features
-    from hairtool.keys.session import KeySettings, solve
+    from hairtool.keys.session import KNEE_KEYS, KeySettings, solve
 
     constraints = KeyConstraints.parse(args.pin, args.exclude)
     kind, data, fps = _load(args)
@@ -129,18 +143,16 @@ def run(args: argparse.Namespace) -> int:
     if args.per_channel:
         from hairtool.keys.channels import per_channel_keys
 
-        if args.penalty is None:
+        if args.penalty is None and args.penalty_abs is None:
             raise ParameterError("per-channel", True, "a --penalty TAU (seed 003 prices keys per channel)")
         if constraints:
             raise ParameterError("pin", args.pin or args.exclude, "keys of the whole pose, not --per-channel")
-        result = {
-            "frames": n,
-            "fps": fps,
-            **per_channel_keys(x, args.penalty, interp=args.interp, curvature=args.curvature).to_dict(),
-        }
+        relative = args.penalty is not None
+        tau = args.penalty if relative else args.penalty_abs
+        channels = per_channel_keys(x, tau, interp=args.interp, curvature=args.curvature, relative=relative)
+        result = {"frames": n, "fps": fps, **channels.to_dict()}
         return _emit(args, result, f"{len(result['union'])} frames key at least one of {x.shape[1]} channels")
 
-    mode = _mode(args, n, constraints.check(n).key_range(n)[0])
     objective = "worst" if args.max_error is not None else args.objective
     table = None
     if kind == "bvh" and args.bvh_features == "quaternion":
@@ -150,9 +162,18 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError("bvh-features", "quaternion", "the linear (slerp) total objective only")
         table = rotation_cost_table(data)
     settings = KeySettings(objective=objective, interp=args.interp, curvature=args.curvature)
-    session = solve(x, settings, table=table, layers=False, constraints=constraints)
+    session = solve(x, settings, table=table, layers=False, constraints=constraints, kmax=KNEE_KEYS)
+    mode = _mode(args, session)
     sel = session.select(curve_keys=args.curve_keys, **mode)
     result = {"frames": n, "fps": fps, **sel.to_dict()}
+    if args.penalty is not None:
+        result["params"]["penalty_share"] = args.penalty  # of the two-key error
+    modes = (args.keys, args.penalty, args.penalty_abs, args.budget, args.max_error)
+    if all(v is None for v in modes):
+        result["params"]["count_rule"] = "knee"
+    note = session.explain(sel)
+    if note:
+        result["note"] = note
     if kind == "animation":
         from hairtool.keys.reconstruct import compare_with_uniform, key_distribution
 
@@ -178,6 +199,8 @@ def run(args: argparse.Namespace) -> int:
         f"{sel.n_keys} keys of {n} frames, {sel.objective} error {sel.cost:.6g} "
         f"(uniform {sel.uniform_cost:.6g}): {' '.join(map(str, sel.keys.tolist()))}"
     )
+    if note:
+        line += f"\n{note}"
     return _emit(args, result, line)
 
 

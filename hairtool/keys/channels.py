@@ -47,8 +47,10 @@ def per_channel_keys(
     *,
     interp: str = "hermite",
     curvature: float = 0.0,
+    relative: bool = False,
 ) -> ChannelKeys:
-    """Every column of ``(n_frames, D)`` features keyed on its own, at its own price tau_d per key."""
+    """Every column of ``(n_frames, D)`` features keyed on its own, at its own price tau_d per key
+    (with ``relative``, tau_d is a share of that channel's two-key error)."""
     x = raw_features(x)
     d = x.shape[1]
     if interp not in INTERPOLATIONS:
@@ -60,10 +62,11 @@ def per_channel_keys(
             raise ParameterError("penalty", f"shape {tau.shape}", f"one number or one per channel ({d},)")
     if not np.all(np.isfinite(tau)) or np.any(tau < 0):
         raise ParameterError("penalty", tau.tolist() if tau.size < 8 else "array", "finite numbers >= 0")
-    keys, costs = [], np.zeros(d)
+    keys, costs, prices = [], np.zeros(d), np.zeros(d)
     for c in range(d):
         table = cost_table(x[:, c : c + 1], interp, curvature)
-        sel = select_keys(table, penalty=float(tau[c]), curve_keys=0)
+        prices[c] = float(tau[c]) * float(table[0, -1]) if relative else float(tau[c])
+        sel = select_keys(table, penalty=prices[c], curve_keys=0)
         keys.append(sel.keys)
         costs[c] = sel.cost
-    return ChannelKeys(keys=keys, costs=costs, penalties=np.array(tau, dtype=np.float64))
+    return ChannelKeys(keys=keys, costs=costs, penalties=prices)

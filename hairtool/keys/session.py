@@ -52,6 +52,7 @@ I64 = NDArray[np.int64]
 #: How the keys are chosen: a key count, a price tau per key, or an error budget.
 KEY_MODES = ("count", "tau", "budget")
 MAX_CURVE_KEYS = 200  # the layers (and the error-vs-count curve) cover K = 2..min(frames, this)
+KNEE_KEYS = 100  # the default count is the knee of the curve up to this many keys
 
 Progress = Callable[..., None]
 CancelCheck = Callable[[], bool]
@@ -61,21 +62,35 @@ CancelCheck = Callable[[], bool]
 class KeySettings:
     """What a caller chose: the mode and its value, the objective, the interpolation, features.
 
-    ``count`` 0 means "a tenth of the frames"; ``samples`` 0 keeps the original vertices instead
-    of resampling M points per strand; ``tip_weight`` is seed 000's root-to-tip weight at the tip
+    ``count`` 0 means the knee of the error-vs-count curve (:func:`knee_count`); ``tau`` is the
+    price of a key as a share of the two-key error (:meth:`KeySession.keys_for_tau`), so it means
+    the same on any animation; ``samples`` 0 keeps the original vertices instead of resampling M
+    points per strand; ``tip_weight`` is seed 000's root-to-tip weight at the tip
     (1 at the root); ``curvature`` is its λ. ``budget`` bounds the total feature-space error
-    (objective "total") or the worst frame's (objective "worst").
+    (objective "total") or the worst frame's (objective "worst"). ``pins`` and ``excludes`` are
+    frames that must and must not be keys (:mod:`hairtool.keys.constraints`), in every mode.
     """
 
     mode: str = "count"
     count: int = 0
-    tau: float = 1.0
+    tau: float = 0.01
     budget: float = 1.0
     objective: str = "total"
     interp: str = "linear"
     samples: int = 16
     tip_weight: float = 2.0
     curvature: float = 0.0
+    pins: tuple[int, ...] = ()
+    excludes: tuple[int, ...] = ()
+
+    def __post_init__(self) -> None:
+        c = KeyConstraints(self.pins, self.excludes)  # sorted, unique, whole frames (a project's lists)
+        object.__setattr__(self, "pins", c.pins)
+        object.__setattr__(self, "excludes", c.excludes)
+
+    @property
+    def constraints(self) -> KeyConstraints:
+        return KeyConstraints(self.pins, self.excludes)
 
     def validate(self) -> KeySettings:
         if self.mode not in KEY_MODES:
@@ -87,7 +102,7 @@ class KeySettings:
         if self.mode == "tau" and self.objective != "total":
             raise ParameterError("tau", self.tau, "the total-error objective (a price per key adds up)")
         if int(self.count) != self.count or self.count < 0:
-            raise ParameterError("key count", self.count, "a whole number >= 2 (0: a tenth of the frames)")
+            raise ParameterError("key count", self.count, "a whole number >= 2 (0: the knee of the curve)")
         for name in ("tau", "budget", "curvature"):
             v = getattr(self, name)
             if not np.isfinite(v) or v < 0:
@@ -109,9 +124,6 @@ class KeySettings:
     def feature_options(self) -> FeatureOptions:
         return FeatureOptions(samples=self.samples or None, tip_weight=float(self.tip_weight))
 
-    def count_for(self, n_frames: int) -> int:
-        k = self.count or max(2, round(n_frames / 10))
-        return int(min(max(k, 2), n_frames))
 
 
 class KeySession:
@@ -186,9 +198,24 @@ class KeySession:
             keys.append(int(self.back[depth, keys[-1]]))
         return np.array(keys[::-1], dtype=np.int64)
 
-    def keys_for_tau(self, tau: float) -> I64:
-        """Seed 003's keys with a price tau per key (total objective only)."""
-        return select_keys(self.table, penalty=float(tau), curve_keys=0, constraints=self.constraints).keys
+    @property
+    def two_key_error(self) -> float:
+        """The error of keying only the first and last frame: the scale of this animation's errors."""
+        return float(self.table[0, self.n_frames - 1])
+
+    def keys_for_tau(self, tau: float, *, relative: bool = True) -> I64:
+        """Seed 003's keys with a price per key (total objective only). ``relative``: tau is a
+        share of :attr:`two_key_error` (a key is kept when it saves at least that share of the
+        error of keying the ends alone), so 0.01 means the same on a sway and on a 10⁸-unit
+        simulation; otherwise tau is seed 003's absolute price, in squared feature units."""
+        price = float(tau) * self.two_key_error if relative else float(tau)
+        return select_keys(self.table, penalty=price, curve_keys=0, constraints=self.constraints).keys
+
+    @property
+    def knee(self) -> int:
+        """The default key count: :func:`knee_count` of the curve up to :data:`KNEE_KEYS` keys."""
+        curve = self.curve
+        return knee_count(curve[curve[:, 0] <= KNEE_KEYS])
 
     def keys_for_budget(self, budget: float) -> I64:
         """The fewest keys whose error (total, or worst frame) is within ``budget``."""
@@ -203,13 +230,44 @@ class KeySession:
         ).keys
 
     def keys_for(self, settings: KeySettings) -> I64:
-        """The DP keys the settings ask for (count, tau or budget)."""
+        """The DP keys the settings ask for (count, tau or budget, under their pins and exclusions)."""
+        self.constrain(settings.constraints)
         if settings.mode == "tau":
             return self.keys_for_tau(settings.tau)
         if settings.mode == "budget":
             return self.keys_for_budget(settings.budget)
         lo, hi = self.key_range
-        return self.keys_for_count(min(max(settings.count_for(self.n_frames), lo), hi))
+        count = settings.count or self.knee
+        return self.keys_for_count(min(max(count, lo), hi))
+
+    def explain(self, sel: Selection) -> str | None:
+        """Why a tau, budget or bound gave one of the two extremes (a key on every frame, or no
+        keys but the ends and pins), in words a user can act on; None otherwise."""
+        if sel.mode == "keys":
+            return None
+        lo, hi = self.constraints.key_range(self.n_frames)
+        value = float(sel.params[sel.mode])
+        n = self.n_frames
+        skip = float(np.diagonal(self.table, 2).min()) if n >= 3 else 0.0
+        what = {
+            "penalty": "the price per key",
+            "budget": "the error budget",
+            "max_error": "the worst-frame bound",
+        }
+        if sel.n_keys == hi and hi > lo:
+            return (
+                f"a key on every frame: {what[sel.mode]} ({value:.6g}) is below what skipping any one frame "
+                f"costs (the least is {skip:.6g})"
+            )
+        if sel.n_keys == lo and hi > lo:
+            ends = "two keys" if lo == 2 else "only the first, last and pinned frames"
+            if sel.mode == "penalty":
+                return (
+                    f"{ends}: no key saves more than its price ({value:.6g}; keying the ends alone "
+                    f"costs {self.two_key_error:.6g})"
+                )
+            return f"{ends}: they already meet {what[sel.mode]} ({value:.6g}; their error is {sel.cost:.6g})"
+        return None
 
     def select(
         self,
@@ -237,6 +295,28 @@ class KeySession:
         return sel
 
 
+def knee_count(curve: ArrayLike) -> int:
+    """The knee of an error-vs-key-count curve: the default key count.
+
+    With x the count scaled to [0, 1] over the curve's range and y the error scaled to [0, 1]
+    (1 at the fewest keys, 0 at the most), the knee is the count whose point lies farthest below
+    the straight line from (0, 1) to (1, 0), i.e. maximises (1 − x) − y (Satopää et al. 2011,
+    "Kneedle"): past it, each added key buys less than its share. A flat or straight curve gives
+    its first count. ``curve``: ``(m, 2)`` rows (K, error), K increasing, errors finite.
+    """
+    c = np.asarray(curve, dtype=np.float64)
+    if c.ndim != 2 or c.shape[0] == 0 or c.shape[1] != 2:
+        raise ParameterError("curve", f"shape {c.shape}", "(m, 2) rows (key count, error)")
+    k, e = c[:, 0], c[:, 1]
+    if c.shape[0] < 3 or not e[0] > e[-1]:
+        return int(k[0])
+    x = (k - k[0]) / (k[-1] - k[0])
+    y = (e - e[-1]) / (e[0] - e[-1])
+    gain = (1.0 - x) - y
+    best = int(np.argmax(gain))
+    return int(k[best]) if gain[best] > 1e-9 else int(k[0])  # a straight line has no knee
+
+
 def solve(
     source: Animation | ArrayLike,
     settings: KeySettings,
@@ -254,7 +334,7 @@ def solve(
     ``source`` is an Animation (seed 000's features, ``features`` or the settings' own) or an
     ``(frames, D)`` feature array used as is; ``table`` replaces the Gram cost table by one the
     caller built (seed 003's quaternion-distance table of a BVH capture); ``constraints`` pins
-    and excludes frames (:mod:`hairtool.keys.constraints`).
+    and excludes frames (:mod:`hairtool.keys.constraints`; default: the settings' own).
     """
     settings.validate()
     progress = progress or (lambda *a, **k: None)
@@ -276,7 +356,7 @@ def solve(
         curvature=settings.curvature,
         kmax=kmax,
         table_key=settings.table_key,
-        constraints=constraints,
+        constraints=constraints if constraints is not None else settings.constraints,
     )
     if layers:
         progress(0.9, "dynamic programming")

@@ -117,7 +117,7 @@ def ui_left():
 def test_key_rows_show_exactly_the_engines_keys(studio):
     w, anim = studio
     m, view = w.animation, w.timeline.view
-    k = ks.KeySettings().count_for(N_FRAMES)
+    k = m.key_solve.knee  # the default count
     want = engine_keys(anim, k)
     np.testing.assert_array_equal(m.dp_keys, want)
     np.testing.assert_array_equal(m.uniform_keys, uniform_keys(N_FRAMES, k))
@@ -130,7 +130,7 @@ def test_key_rows_show_exactly_the_engines_keys(studio):
 def test_key_count_slider_updates_both_rows_and_the_curves(studio):
     w, anim = studio
     m, view, slider = w.animation, w.timeline.view, w.timeline.controls.count_slider
-    assert slider.maximum() == N_FRAMES and slider.value() == 4
+    assert slider.maximum() == N_FRAMES and slider.value() == m.key_solve.knee
     before = image_of(view)
     slider.setValue(9)  # as a drag of the slider does
     want = engine_keys(anim, 9)
@@ -164,7 +164,8 @@ def test_tau_budget_objective_and_interpolation_controls(studio):
     c.mode.activated.emit(c.mode.currentIndex())
     c.tau.spin.setValue(0.05)
     assert m.settings.mode == "tau" and m.settings.tau == pytest.approx(0.05)
-    np.testing.assert_array_equal(m.dp_keys, select_keys(m.key_solve.table, penalty=0.05).keys)
+    table = m.key_solve.table  # tau is a share of the two-key error
+    np.testing.assert_array_equal(m.dp_keys, select_keys(table, penalty=0.05 * table[0, -1]).keys)
     c.interp.setCurrentIndex(c.interp.findData("hermite"))
     c.interp.activated.emit(c.interp.currentIndex())
     assert m.key_solve.table_key[1] == "hermite"
@@ -275,7 +276,8 @@ def test_a_cancelled_solve_leaves_the_old_keys(studio):
     c.interp.setCurrentIndex(c.interp.findData("hermite"))
     c.interp.activated.emit(c.interp.currentIndex())
     assert w.jobs.wait(20)
-    np.testing.assert_array_equal(m.dp_keys, engine_keys(anim, 4, ks.KeySettings(interp="hermite")))
+    knee = m.key_solve.knee  # the default count, on the Hermite table
+    np.testing.assert_array_equal(m.dp_keys, engine_keys(anim, knee, ks.KeySettings(interp="hermite")))
     assert m.analysis is not analysis and not m.busy
 
 

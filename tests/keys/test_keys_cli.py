@@ -160,3 +160,39 @@ def test_impossible_constraints_are_one_line(files, capsys, argv, words):
     assert main(["keys", str(d / "x.npz"), *argv]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and words in err
+
+
+def test_penalty_is_a_share_of_the_two_key_error_and_the_absolute_form_is_seed_003s(files, capsys):
+    d, x = files
+    two_key = run_json(capsys, d / "x.npz", "--keys", 2)["cost"]
+    rel = run_json(capsys, d / "x.npz", "--penalty", 0.02)
+    absolute = run_json(capsys, d / "x.npz", "--penalty-abs", 0.02 * two_key)
+    assert rel["keys"] == absolute["keys"] and 2 < len(rel["keys"]) < 30
+    assert rel["params"]["penalty"] == pytest.approx(0.02 * two_key)
+    assert rel["params"]["penalty_share"] == 0.02 and "penalty_share" not in absolute["params"]
+    # the same share means the same on data a thousand times larger (squared units 10⁶ larger)
+    np.savez(d / "x1000.npz", X=x * 1000.0)
+    assert run_json(capsys, d / "x1000.npz", "--penalty", 0.02)["keys"] == rel["keys"]
+
+
+def test_the_extremes_are_explained(files, capsys):
+    d, _ = files
+    every = run_json(capsys, d / "x.npz", "--penalty-abs", 0)
+    assert len(every["keys"]) == 30 and every["note"].startswith("a key on every frame")
+    two = run_json(capsys, d / "x.npz", "--penalty", 5)
+    assert two["keys"] == [0, 29] and two["note"].startswith("two keys: no key saves more than its price")
+    loose = run_json(capsys, d / "x.npz", "--budget", 1e9)
+    assert loose["keys"] == [0, 29] and "already meet the error budget" in loose["note"]
+    assert "note" not in run_json(capsys, d / "x.npz", "--keys", 5)
+    assert main(["keys", str(d / "x.npz"), "--penalty-abs", "0"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 2 and lines[1].startswith("a key on every frame")
+
+
+def test_the_default_count_is_the_knee(files, capsys):
+    from hairtool.keys.session import knee_count
+
+    d, _ = files
+    out = run_json(capsys, d / "x.npz")
+    assert out["params"]["count_rule"] == "knee"
+    assert len(out["keys"]) == knee_count(np.array(out["curve"]))

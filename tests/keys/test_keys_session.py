@@ -46,18 +46,37 @@ def test_keys_for_every_count_equal_the_engines_selection(anim, interp, objectiv
 
 def test_tau_and_budget_keys_equal_the_engines(anim):
     solved = ks.solve(anim, ks.KeySettings())
-    for tau in (0.0, 0.01, 1.0, 100.0):
-        want = select_keys(solved.table, penalty=tau).keys
+    e2 = solved.table[0, -1]  # tau is a share of the two-key error
+    assert solved.two_key_error == e2 > 0
+    for tau in (0.0, 1e-4, 0.01, 1.0):
+        want = select_keys(solved.table, penalty=tau * e2).keys
         np.testing.assert_array_equal(solved.keys_for(ks.KeySettings(mode="tau", tau=tau)), want)
+        np.testing.assert_array_equal(solved.keys_for_tau(tau * e2, relative=False), want)
     for budget in (0.0, 0.05, 1.0, 1e6):
         want = select_keys(solved.table, budget=budget).keys
         got = solved.keys_for(ks.KeySettings(mode="budget", budget=budget))
         np.testing.assert_array_equal(got, want)
 
 
-def test_default_count_is_a_tenth_of_the_frames(anim):
+def test_default_count_is_the_knee_of_the_error_curve(anim):
     solved = ks.solve(anim, ks.KeySettings())
-    assert solved.keys_for(ks.KeySettings()).size == 4
+    knee = solved.knee
+    assert solved.keys_for(ks.KeySettings()).size == knee == ks.knee_count(solved.curve)
+    curve = solved.curve
+    x = (curve[:, 0] - 2) / (curve[-1, 0] - 2)
+    y = (curve[:, 1] - curve[-1, 1]) / (curve[0, 1] - curve[-1, 1])
+    assert knee == curve[np.argmax(1 - x - y), 0]
+    assert 2 < knee < 40
+
+
+def test_knee_rule():
+    k = np.arange(2, 30)
+    assert ks.knee_count(np.column_stack([k, 1.0 / (k - 1.0) ** 2])) < 6  # a sharp elbow, early
+    assert ks.knee_count(np.column_stack([k, 30.0 - k])) == 2  # a straight line: no knee, fewest
+    assert ks.knee_count(np.column_stack([k, np.zeros(k.size)])) == 2  # nothing to save
+    assert ks.knee_count(np.column_stack([k, np.where(k < 12, 1.0, 0.0)])) == 12  # a step
+    with pytest.raises(ParameterError, match="curve"):
+        ks.knee_count(np.zeros((3, 3)))
 
 
 def test_settings_are_validated():
@@ -121,7 +140,9 @@ def test_constraints_steer_every_mode_of_a_session_and_match_the_engine(anim):
     from hairtool.keys.constraints import KeyConstraints
 
     cons = KeyConstraints(pins=(5, 30), excludes=(26, 27, 28))
-    solved = ks.solve(anim, ks.KeySettings(), constraints=cons)
+    base = ks.KeySettings(pins=[30, 5], excludes=(28, 26, 27))  # as a project file lists them
+    assert base.constraints == cons
+    solved = ks.solve(anim, base)
     table = solved.table
     assert solved.key_range == (4, 37)
     for k in (4, 6, 9):
@@ -130,15 +151,15 @@ def test_constraints_steer_every_mode_of_a_session_and_match_the_engine(anim):
         assert cons.allows(got)
     assert solved.curve[0, 0] == 4 and np.all(np.isfinite(solved.curve[:, 1]))
     for tau in (1e-4, 1e-2):
-        assert cons.allows(solved.keys_for(ks.KeySettings(mode="tau", tau=tau)))
+        assert cons.allows(solved.keys_for(base.replace(mode="tau", tau=tau)))
     budget = float(solved.curve[3, 1])
-    got = solved.keys_for(ks.KeySettings(mode="budget", budget=budget))
+    got = solved.keys_for(base.replace(mode="budget", budget=budget))
     np.testing.assert_array_equal(got, select_keys(table, budget=budget, constraints=cons).keys)
-    # the default count (a tenth of 40 frames) is raised to what the pins need
-    assert solved.keys_for(ks.KeySettings()).size == 4
+    # the default count is the knee of the constrained curve, never fewer keys than the pins need
+    assert solved.keys_for(base).size == solved.knee >= 4
     with pytest.raises(ParameterError, match="with these pins"):
         solved.keys_for_count(3)
     # new constraints reuse the table: no features, no cost table
-    solved.constrain(None)
+    assert solved.keys_for(ks.KeySettings(count=5)).size == 5 and not solved.constraints
     assert solved.key_range == (2, 40) and not solved.constraints
     np.testing.assert_array_equal(solved.keys_for_count(5), select_keys(table, keys=5).keys)

@@ -1,0 +1,132 @@
+"""The DP key row as a dope sheet: a click pins or unpins a key, a drag moves it, Delete
+excludes the current frame and Insert pins it; the keys are the engine's constrained optimum
+at once, every edit is one undo step, and the pins travel in the project file."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import Qt
+from PySide6.QtTest import QTest
+
+from app.ui.timeline_plots import EXCLUDE_COLOUR, PIN_COLOUR
+from hairtool import samples
+from hairtool.keys.constraints import KeyConstraints
+from hairtool.keys.dp import select_keys
+from hairtool.simulate.sway import sway_animation
+
+pytestmark = pytest.mark.gui
+
+N_FRAMES = 40
+LEFT = Qt.MouseButton.LeftButton
+
+
+@pytest.fixture
+def studio(make_window):
+    w = make_window(groom=samples.comb(strands=12, vertices=8), size=(1400, 900))
+    anim = sway_animation(w.scene.result, N_FRAMES, 24.0, flick_frame=27)
+    w.animation.load_animation(anim, "sway")
+    w.animation.set_key_count(6)
+    return w, anim
+
+
+def click(ui, view, frame: int, to: int | None = None) -> None:
+    y = view.row_rect("dp").center().y()
+    ui.send_mouse(view, "press", (view.frame_to_x(frame), y), LEFT, LEFT)
+    if to is not None:
+        ui.send_mouse(view, "move", (view.frame_to_x(to), y), None, LEFT)
+    ui.send_mouse(view, "release", (view.frame_to_x(frame if to is None else to), y), LEFT, None)
+
+
+def engine(w, count: int) -> np.ndarray:
+    s = w.animation.settings
+    return select_keys(w.animation.key_solve.table, keys=count, constraints=s.constraints).keys
+
+
+def colour_near(view, frame: int, colour) -> bool:
+    from PySide6.QtGui import QImage
+
+    image = view.grab().toImage().convertToFormat(QImage.Format.Format_RGB888)
+    h, width = image.height(), image.width()
+    data = np.frombuffer(image.constBits(), np.uint8, count=image.bytesPerLine() * h)
+    rgb = data.reshape(h, image.bytesPerLine())[:, : width * 3].reshape(h, width, 3).astype(float)
+    r, x = view.row_rect("dp"), round(view.frame_to_x(frame))
+    band = rgb[r.top() : r.bottom() + 1, max(x - 9, 0) : x + 10]
+    target = np.array([colour.red(), colour.green(), colour.blue()], float)
+    return bool((np.abs(band - target).max(axis=2) < 40).any())
+
+
+def test_a_click_on_a_key_pins_it_and_undo_unpins_it(ui, studio):
+    w, _ = studio
+    m, view = w.animation, w.timeline.view
+    key = int(m.dp_keys[2])
+    assert not colour_near(view, key, PIN_COLOUR)
+    click(ui, view, key)
+    assert m.settings.pins == (key,) and key in m.dp_keys and m.frame == key
+    assert colour_near(view, key, PIN_COLOUR)
+    assert w.undo_stack.undoText() == f"Pin key {key}"
+    w.undo_stack.undo()
+    assert m.settings.pins == ()
+    w.undo_stack.redo()
+    click(ui, view, key)  # a second click unpins
+    assert m.settings.pins == () and w.undo_stack.undoText() == f"Unpin key {key}"
+
+
+def test_dragging_a_key_moves_it_and_the_rest_re_solve(ui, studio):
+    w, _ = studio
+    m, view = w.animation, w.timeline.view
+    before = m.dp_keys.copy()
+    key = int(before[2])
+    target = next(f for f in range(key + 3, N_FRAMES - 1) if f not in before)
+    click(ui, view, key, to=target)
+    assert m.settings.pins == (target,) and m.settings.excludes == (key,)
+    assert target in m.dp_keys and key not in m.dp_keys and m.dp_keys.size == 6
+    np.testing.assert_array_equal(m.dp_keys, engine(w, 6))
+    assert colour_near(view, key, EXCLUDE_COLOUR)
+    w.undo_stack.undo()
+    np.testing.assert_array_equal(m.dp_keys, before)
+    assert m.settings.pins == () and m.settings.excludes == ()
+
+
+def test_delete_excludes_and_insert_pins_the_current_frame(ui, studio):
+    w, _ = studio
+    m, view = w.animation, w.timeline.view
+    key = int(m.dp_keys[3])
+    m.set_frame(key)
+    view.setFocus()
+    QTest.keyClick(view, Qt.Key.Key_Delete)
+    assert m.settings.excludes == (key,) and key not in m.dp_keys
+    free = next(f for f in range(1, N_FRAMES - 1) if f not in m.dp_keys and f != key)
+    m.set_frame(free)
+    QTest.keyClick(view, Qt.Key.Key_Insert)
+    assert m.settings.pins == (free,) and free in m.dp_keys
+    np.testing.assert_array_equal(m.dp_keys, engine(w, 6))
+    assert KeyConstraints((free,), (key,)).allows(m.dp_keys)
+    w.undo_stack.undo()
+    w.undo_stack.undo()
+    assert m.settings.pins == () and m.settings.excludes == ()
+
+
+def test_the_ends_cannot_be_excluded_and_the_refusal_is_shown(ui, studio):
+    w, _ = studio
+    m, view = w.animation, w.timeline.view
+    m.set_frame(0)
+    view.setFocus()
+    before = w.undo_stack.count()
+    QTest.keyClick(view, Qt.Key.Key_Delete)
+    assert m.settings.excludes == () and w.undo_stack.count() == before
+    assert "first (0)" in w.statusBar().currentMessage()
+
+
+def test_pins_and_exclusions_are_saved_in_the_project(ui, studio, tmp_path, make_window):
+    w, _ = studio
+    m = w.animation
+    key = int(m.dp_keys[2])
+    assert w.animation_ui.steer_keys("Pin", pin=key) and w.animation_ui.steer_keys("Exclude", exclude=5)
+    path = tmp_path / "steered.hairproj"
+    assert w.project.save_to(path)
+    other = make_window()
+    assert other.project.open_project(path), other.errors
+    s = other.animation.settings
+    assert s.pins == (key,) and s.excludes == (5,)
+    np.testing.assert_array_equal(other.animation.dp_keys, m.dp_keys)
