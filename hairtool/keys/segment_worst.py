@@ -19,47 +19,96 @@ F64 = NDArray[np.float64]
 
 @njit(cache=True, nogil=True, parallel=True)
 def _worst_kernel(g, curv, lam, hermite):  # pragma: no cover - compiled
+    # Row i costs ~(n − i)²/2, so each parallel step takes a row from each end (i and n − 1 − i):
+    # the threads get equal work, and each row is one thread's, whatever the thread count.
     n = g.shape[0]
     out = np.zeros((n, n))
-    for i in prange(n):
-        li, hi, wi = stencil_at(i, n)
-        for j in range(i + 2, n):
-            lj, hj, wj = stencil_at(j, n)
-            el = float(j - i)
-            u = hermite_quad_terms(g, i, j, n)
-            worst = -np.inf
-            for k in range(i + 1, j):
-                s = (k - i) / el
-                if hermite:
-                    s2 = s * s
-                    s3 = s2 * s
-                    p0 = 1.0 - 3.0 * s2 + 2.0 * s3
-                    p1 = s - 2.0 * s2 + s3
-                    p2 = 3.0 * s2 - 2.0 * s3
-                    p3 = s3 - s2
-                    ti = el * wi * p1
-                    tj = el * wj * p3
-                    cross = (
-                        p0 * g[k, i] + ti * (g[k, hi] - g[k, li]) + p2 * g[k, j] + tj * (g[k, hj] - g[k, lj])
-                    )
-                    # u = (u00, u01, u11, u02, u03, u12, u13, u22, u23, u33) with L·m scaled in
-                    quad = (
-                        p0 * p0 * u[0]
-                        + p1 * p1 * u[2]
-                        + p2 * p2 * u[7]
-                        + p3 * p3 * u[9]
-                        + 2.0 * (p0 * p1 * u[1] + p0 * p2 * u[3] + p0 * p3 * u[4])
-                        + 2.0 * (p1 * p2 * u[5] + p1 * p3 * u[6] + p2 * p3 * u[8])
-                    )
-                else:
-                    r = 1.0 - s
-                    cross = r * g[k, i] + s * g[k, j]
-                    quad = r * r * g[i, i] + 2.0 * r * s * g[i, j] + s * s * g[j, j]
-                e = g[k, k] - 2.0 * cross + quad + lam * curv[k]
-                if e > worst:
-                    worst = e
-            out[i, j] = worst
+    base = np.empty(n)
+    diag = np.empty(n)
+    for k in range(n):
+        diag[k] = g[k, k]
+        base[k] = g[k, k] + lam * curv[k]
+    for step in prange(n // 2):
+        _worst_row(g, base, diag, hermite, step, out[step])
+        _worst_row(g, base, diag, hermite, n - 1 - step, out[n - 1 - step])
+    if n % 2 == 1:
+        _worst_row(g, base, diag, hermite, n // 2, out[n // 2])
     return out
+
+
+@njit(cache=True, nogil=True)
+def _worst_row(g, base, diag, hermite, i, w):  # pragma: no cover - compiled
+    """w[j] = W[i, j] for every j > i + 1, skipped frame by skipped frame: for each k, the cost
+    of frame k in every segment (i, j > k) at once, kept where it is the largest so far.
+
+    The loop over j reads rows of G (symmetric: G[k, j] is row k), needs no reduction and runs
+    the length of the row, so it vectorises; the maximum is exact in any order, so the table is
+    the numpy twin's whatever the loop order.
+    """
+    n = g.shape[0]
+    gi = g[i]
+    inv = np.zeros(n)
+    for j in range(i + 2, n):
+        inv[j] = 1.0 / (j - i)
+        w[j] = -np.inf
+    if not hermite:
+        gii = gi[i]
+        for k in range(i + 1, n - 1):
+            gk = g[k]
+            a, gik = base[k], gi[k]
+            di = float(k - i)
+            for j in range(k + 1, n):
+                s = di * inv[j]
+                r = 1.0 - s
+                quad = r * r * gii + 2.0 * r * s * gi[j] + s * s * diag[j]
+                w[j] = max(w[j], a - 2.0 * (r * gik + s * gk[j]) + quad)
+        return
+    # Hermite: per j, the ten ⟨u_a, u_b⟩ of hermite_quad_terms; the end tangent's stencil is
+    # (j − 1, j + 1, 1/2) but at the last frame, which gets its own pass so the loop stays plain
+    u = np.empty((10, n))
+    for j in range(i + 2, n):
+        t = hermite_quad_terms(g, i, j, n)
+        for m in range(10):
+            u[m, j] = t[m]
+    li, hi, wi = stencil_at(i, n)
+    for k in range(i + 1, n - 1):
+        gk = g[k]
+        a, gki, gkt = base[k], gk[i], gk[hi] - gk[li]
+        di = float(k - i)
+        for j in range(k + 1, n - 1):
+            e = _hermite_cost(a, gki, gkt, gk[j], gk[j + 1] - gk[j - 1], di, inv[j], j - i, wi, 0.5, u, j)
+            w[j] = max(w[j], e)
+        lj, hj, wj = stencil_at(n - 1, n)
+        last = n - 1
+        e = _hermite_cost(a, gki, gkt, gk[last], gk[hj] - gk[lj], di, inv[last], last - i, wi, wj, u, last)
+        w[last] = max(w[last], e)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _hermite_cost(a, gki, gkt, gkj, gkt_j, di, inv, span, wi, wj, u, j):  # pragma: no cover
+    """e_k of the Hermite segment (i, j) from G's row k (gki = G[k, i], gkt = G[k, hi] − G[k, li],
+    the same at j) and the ten ⟨u_a, u_b⟩ at column j."""
+    el = float(span)
+    s = di * inv
+    s2 = s * s
+    s3 = s2 * s
+    p0 = 1.0 - 3.0 * s2 + 2.0 * s3
+    p1 = s - 2.0 * s2 + s3
+    p2 = 3.0 * s2 - 2.0 * s3
+    p3 = s3 - s2
+    ti = el * wi * p1
+    tj = el * wj * p3
+    cross = p0 * gki + ti * gkt + p2 * gkj + tj * gkt_j
+    # u = (u00, u01, u11, u02, u03, u12, u13, u22, u23, u33) with L·m scaled in
+    quad = (
+        p0 * p0 * u[0, j]
+        + p1 * p1 * u[2, j]
+        + p2 * p2 * u[7, j]
+        + p3 * p3 * u[9, j]
+        + 2.0 * (p0 * p1 * u[1, j] + p0 * p2 * u[3, j] + p0 * p3 * u[4, j])
+        + 2.0 * (p1 * p2 * u[5, j] + p1 * p3 * u[6, j] + p2 * p3 * u[8, j])
+    )
+    return a - 2.0 * cross + quad
 
 
 def worst_table_reference(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear") -> F64:
