@@ -80,7 +80,13 @@ class KeyControls(QWidget):
         self.objective.addItem("Worst frame", "worst")
         self.interp = QComboBox()
         self.interp.addItem("Linear", "linear")
-        self.interp.addItem("Hermite", "hermite")
+        self.interp.addItem("Hermite (tangents from the data)", "hermite")
+        self.interp.addItem("Hermite (fitted handles)", "hermite-fit")
+        self.interp.setToolTip(
+            "how the frames between keys are rebuilt: straight lines (seed 000), cubic Hermite with "
+            "tangents from the neighbouring frames (seed 003), or cubic Hermite with each segment's "
+            "handles fitted by least squares, as a DCC's free Bezier handles"
+        )
         self.samples = QSpinBox()
         self.samples.setRange(0, 256)
         self.samples.setSpecialValueText("vertices")

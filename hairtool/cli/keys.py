@@ -30,7 +30,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     mode.add_argument("--budget", type=float, metavar="E", help="fewest keys with total error <= E")
     mode.add_argument("--max-error", type=float, metavar="E", help="fewest keys with worst frame <= E")
     parser.add_argument("--objective", choices=("total", "worst"), default="total")
-    parser.add_argument("--interp", choices=("linear", "hermite"), default="linear")
+    parser.add_argument(
+        "--interp",
+        choices=("linear", "hermite", "hermite-fit"),
+        default="linear",
+        help="linear, Hermite with data tangents (seed 003), or Hermite with tangents fitted per segment",
+    )
     parser.add_argument("--curvature", type=float, default=0.0, metavar="LAMBDA", help="curvature weight")
     parser.add_argument(
         "--per-channel", action="store_true", help="keys per degree of freedom (needs --penalty)"
@@ -57,6 +62,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     parser.add_argument("--out", type=Path, metavar="KEYS.json", help="write keys, times and parameters")
     parser.add_argument("--export", type=Path, metavar="OUT.usd", help="write the key poses as time samples")
+    parser.add_argument(
+        "--bake", action="store_true", help="with --export: every frame of the key curve, not just the keys"
+    )
 
 
 def _load(args: argparse.Namespace):
@@ -192,9 +200,28 @@ def run(args: argparse.Namespace) -> int:
     if args.export is not None:
         if kind != "animation":
             raise ParameterError("export", str(args.export), "an animation input (hair strands)")
-        from hairtool.keys.export import write_key_poses
+        if args.bake:
+            from hairtool.io import write
+            from hairtool.keys.reconstruct import reconstruct
 
-        write_key_poses(args.export, data, sel.keys)
+            write(args.export, reconstruct(data, sel.keys, args.interp))
+        else:
+            from hairtool.keys.export import write_key_poses
+
+            write_key_poses(args.export, data, sel.keys)
+    elif args.bake:
+        raise ParameterError("bake", True, "an --export path to write the key curve to")
+    if args.interp == "hermite-fit" and kind in ("raw", "bvh"):
+        from hairtool.keys.reconstruct import key_poses
+
+        values = data if kind == "raw" else data.values  # BVH: the file's channels, as a DCC keys them
+        kp = key_poses(np.asarray(values, dtype=np.float64), sel.keys, "hermite-fit")
+        result["tangents"] = {
+            "space": "X columns" if kind == "raw" else "BVH channels",
+            "unit": "per frame",
+            "out": kp.tangents.tolist(),
+            "in": kp.tangents_in.tolist(),
+        }
     line = (
         f"{sel.n_keys} keys of {n} frames, {sel.objective} error {sel.cost:.6g} "
         f"(uniform {sel.uniform_cost:.6g}): {' '.join(map(str, sel.keys.tolist()))}"

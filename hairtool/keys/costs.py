@@ -12,13 +12,15 @@ from numpy.typing import NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.keys.gram import centered_gram, check_gram, frame_curvature
+from hairtool.keys.segment_fit import fit_table, fit_table_reference
 from hairtool.keys.segment_hermite import hermite_table, hermite_table_reference
 from hairtool.keys.segment_linear import linear_table, linear_table_reference
 from hairtool.keys.segment_worst import worst_table
 
 F64 = NDArray[np.float64]
 
-INTERPOLATIONS = ("linear", "hermite")
+#: linear (seed 000), Hermite with data tangents (seed 003), Hermite with fitted tangents
+INTERPOLATIONS = ("linear", "hermite", "hermite-fit")
 OBJECTIVES = ("total", "worst")
 
 
@@ -48,6 +50,11 @@ def cost_table(
         raise ParameterError("objective", objective, " or ".join(OBJECTIVES))
     if not np.isfinite(curvature) or curvature < 0:
         raise ParameterError("curvature", curvature, "a finite weight >= 0")
+    if interp == "hermite-fit":
+        if objective != "total":
+            raise ParameterError("objective", objective, "total with hermite-fit (least-squares handles)")
+        curv = frame_curvature(x) if curvature > 0 else np.zeros(np.shape(x)[0])
+        return fit_table(x, curv, curvature) if use_numba else fit_table_reference(x, curv, curvature)
     g = centered_gram(x)
     curv = frame_curvature(x) if curvature > 0 else np.zeros(g.shape[0])
     if objective == "worst":

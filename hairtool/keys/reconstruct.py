@@ -40,13 +40,19 @@ def check_keys(keys: ArrayLike, n_frames: int) -> I64:
 
 @dataclass
 class KeyPoses:
-    """Key frames, their poses ``(K, ...)`` and, for Hermite, tangents ``(K, ...)`` per frame."""
+    """Key frames, their poses ``(K, ...)`` and, for Hermite, tangents ``(K, ...)`` per frame.
+
+    ``tangents`` leave each key (the start of the segment after it); ``tangents_in`` arrive at
+    each key (the end of the segment before it), for broken handles ("hermite-fit"); None means
+    the same as ``tangents`` (seed 003's data tangents are one per key).
+    """
 
     keys: I64
     poses: F64
     tangents: F64 | None
     n_frames: int
     interp: str
+    tangents_in: F64 | None = None
 
     def with_pose(self, key_frame: int, pose: ArrayLike) -> KeyPoses:
         """A copy with the pose at ``key_frame`` (a frame number that is a key) replaced."""
@@ -58,15 +64,19 @@ class KeyPoses:
             raise ParameterError("pose", f"shape {p.shape}", f"finite values of shape {self.poses.shape[1:]}")
         poses = self.poses.copy()
         poses[hit[0]] = p
-        return KeyPoses(self.keys, poses, self.tangents, self.n_frames, self.interp)
+        return KeyPoses(self.keys, poses, self.tangents, self.n_frames, self.interp, self.tangents_in)
 
 
 def key_poses(frames: ArrayLike, keys: ArrayLike, interp: str = "linear") -> KeyPoses:
-    """Take the key poses (and Hermite tangents) out of the full-rate frames."""
+    """Take the key poses (and Hermite tangents) out of the full-rate frames; "hermite-fit"
+    fits each segment's two handles to its frames by least squares
+    (:func:`hairtool.keys.segment_fit.fit_segment`)."""
     if interp not in INTERPOLATIONS:
         raise ParameterError("interp", interp, " or ".join(INTERPOLATIONS))
     f = np.asarray(frames)
     k = check_keys(keys, f.shape[0])
+    if interp == "hermite-fit":
+        return _fitted_key_poses(f, k)
     tangents = None
     if interp == "hermite":
         lo = np.clip(k - 1, 0, f.shape[0] - 1)
@@ -74,6 +84,23 @@ def key_poses(frames: ArrayLike, keys: ArrayLike, interp: str = "linear") -> Key
         w = np.where((k == 0) | (k == f.shape[0] - 1), 1.0, 0.5)
         tangents = (f[hi].astype(np.float64) - f[lo]) * w.reshape((-1,) + (1,) * (f.ndim - 1))
     return KeyPoses(k, f[k].astype(np.float64), tangents, int(f.shape[0]), interp)
+
+
+def _fitted_key_poses(f: NDArray, k: I64) -> KeyPoses:
+    from hairtool.keys.segment_fit import fit_segment
+
+    flat = f.reshape(f.shape[0], -1)
+    out_t = np.empty((k.size, flat.shape[1]))
+    in_t = np.empty((k.size, flat.shape[1]))
+    for a in range(k.size - 1):
+        el = float(k[a + 1] - k[a])
+        start, end, _ = fit_segment(flat, int(k[a]), int(k[a + 1]))
+        out_t[a], in_t[a + 1] = start / el, end / el
+    out_t[-1], in_t[0] = in_t[-1], out_t[0]  # the ends have one side: both handles the same
+    shape = (k.size, *f.shape[1:])
+    return KeyPoses(
+        k, f[k].astype(np.float64), out_t.reshape(shape), int(f.shape[0]), "hermite-fit", in_t.reshape(shape)
+    )
 
 
 def interpolate_keys(kp: KeyPoses, dtype: type = np.float64) -> NDArray:
@@ -102,11 +129,12 @@ def interpolate_at(kp: KeyPoses, frames: ArrayLike, dtype: type = np.float64) ->
         v = (1.0 - s) * flat_p[a] + s * flat_p[a + 1]
     else:
         flat_m = kp.tangents.reshape(kp.keys.size, -1)
+        flat_in = flat_m if kp.tangents_in is None else kp.tangents_in.reshape(kp.keys.size, -1)
         h00 = 2 * s**3 - 3 * s**2 + 1
         h10 = (s**3 - 2 * s**2 + s) * el[:, None]
         h01 = -2 * s**3 + 3 * s**2
         h11 = (s**3 - s**2) * el[:, None]
-        v = h00 * flat_p[a] + h10 * flat_m[a] + h01 * flat_p[a + 1] + h11 * flat_m[a + 1]
+        v = h00 * flat_p[a] + h10 * flat_m[a] + h01 * flat_p[a + 1] + h11 * flat_in[a + 1]
     return v.reshape(t.size, *shape).astype(dtype, copy=False)
 
 

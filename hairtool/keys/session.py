@@ -101,6 +101,8 @@ class KeySettings:
             raise ParameterError("interpolation", self.interp, " or ".join(INTERPOLATIONS))
         if self.mode == "tau" and self.objective != "total":
             raise ParameterError("tau", self.tau, "the total-error objective (a price per key adds up)")
+        if self.interp == "hermite-fit" and self.objective != "total":
+            raise ParameterError("objective", self.objective, "total with fitted tangents (least squares)")
         if int(self.count) != self.count or self.count < 0:
             raise ParameterError("key count", self.count, "a whole number >= 2 (0: the knee of the curve)")
         for name in ("tau", "budget", "curvature"):
@@ -472,7 +474,8 @@ def key_poses_of(animation: Animation, keys: ArrayLike, interp: str) -> KeyPoses
     (a studio holds two sets for the whole session); evaluated in float64 all the same."""
     kp = key_poses(animation.frames, keys, interp)
     tangents = None if kp.tangents is None else kp.tangents.astype(np.float32)
-    return KeyPoses(kp.keys, kp.poses.astype(np.float32), tangents, kp.n_frames, kp.interp)
+    arriving = None if kp.tangents_in is None else kp.tangents_in.astype(np.float32)
+    return KeyPoses(kp.keys, kp.poses.astype(np.float32), tangents, kp.n_frames, kp.interp, arriving)
 
 
 def key_edit_block(

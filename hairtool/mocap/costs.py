@@ -21,7 +21,7 @@ from hairtool.mocap.bvh import Motion, read_bvh
 F64 = NDArray[np.float64]
 
 KINDS = ("positions", "rotations")
-INTERPS = ("linear", "hermite")
+INTERPS = ("linear", "hermite", "hermite-fit")
 
 
 # ---------------------------------------------------------------------------------------
@@ -324,6 +324,14 @@ def _linear(x: F64, keys: NDArray[np.int64]) -> F64:
     return x[a] + t * (x[b] - x[a])
 
 
+def _fitted(x: F64, keys: NDArray[np.int64]) -> F64:
+    """Hermite with each segment's handles fitted to its samples (:mod:`hairtool.keys.segment_fit`)."""
+    from hairtool.keys.reconstruct import interpolate_keys, key_poses
+
+    flat = x.reshape(len(x), -1)
+    return interpolate_keys(key_poses(flat, keys, "hermite-fit")).reshape(x.shape)
+
+
 def _unwrap_near(angles: F64, reference: F64) -> F64:
     """Shift angles (degrees) by whole turns to lie nearest the original channel values."""
     return angles + 360.0 * np.round((reference - angles) / 360.0)
@@ -336,6 +344,8 @@ def reconstruct_motion(motion: Motion, keys: ArrayLike, interp: str = "linear") 
     - "hermite": seed 003's cubic Hermite (tangents from the neighbouring samples at each key)
       applied to the hemisphere-aligned quaternion components, then renormalised; the same
       Hermite on position channels.
+    - "hermite-fit": the same with each segment's handles fitted to its samples by least squares
+      (keys must then include the first and last frame, as the DP's always do).
     Rotations go back to Euler angles in each joint's channel order (nearest the original values
     by whole turns). Joints with one or two rotation channels interpolate their angles directly.
     Frames before the first key or after the last hold that key.
@@ -352,7 +362,7 @@ def reconstruct_motion(motion: Motion, keys: ArrayLike, interp: str = "linear") 
         start += len(chans)
         rot = [c for c, name in zip(cols, chans, strict=True) if name.endswith("rotation")]
         pos = [c for c, name in zip(cols, chans, strict=True) if name.endswith("position")]
-        interpolate = _hermite if interp == "hermite" else _linear
+        interpolate = {"linear": _linear, "hermite": _hermite, "hermite-fit": _fitted}[interp]
         if pos:
             values[:, pos] = interpolate(motion.values[:, pos], keys)
         if not rot:
@@ -365,7 +375,7 @@ def reconstruct_motion(motion: Motion, keys: ArrayLike, interp: str = "linear") 
         if interp == "linear":
             qr = quat.slerp(q[a], q[b], t)
         else:
-            qr = quat.normalize(_hermite(q, keys))
+            qr = quat.normalize(interpolate(q, keys))
         values[:, rot] = _unwrap_near(quat.to_euler(qr, order), motion.values[:, rot])
     return motion.with_values(values)
 

@@ -130,3 +130,18 @@ def test_pins_and_exclusions_are_saved_in_the_project(ui, studio, tmp_path, make
     s = other.animation.settings
     assert s.pins == (key,) and s.excludes == (5,)
     np.testing.assert_array_equal(other.animation.dp_keys, m.dp_keys)
+
+
+def test_fitted_handles_are_offered_and_solved_like_the_engine(studio):
+    from hairtool.keys.costs import cost_table
+    from hairtool.keys.features import hair_features
+
+    w, anim = studio
+    m, c = w.animation, w.timeline.controls
+    c.interp.setCurrentIndex(c.interp.findData("hermite-fit"))
+    c.interp.activated.emit(c.interp.currentIndex())
+    assert w.jobs.wait(30) and m.key_solve.table_key[1] == "hermite-fit"
+    table = cost_table(hair_features(anim, m.settings.feature_options()), "hermite-fit")
+    np.testing.assert_array_equal(m.dp_keys, select_keys(table, keys=6).keys)
+    assert m.dp_poses.interp == "hermite-fit" and m.dp_poses.tangents_in is not None
+    assert m.analysis is not None and m.analysis.dp.mean.shape == (N_FRAMES,)
