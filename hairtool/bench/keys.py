@@ -2,7 +2,10 @@
 O(n³D) table (where it finishes in a minute) and one float64 X @ X.T of the same matrix.
 
 Feature arrays are random walks, except D = 96,000 which is a swaying hair animation of 2,000
-strands resampled to 16 points (the features step is timed there).
+strands resampled to 16 points (the features step is timed there). After the rows of the chosen
+interpolation come, for the sizes up to 3,000 dimensions, the other objectives and
+interpolations: the worst-frame objective, fitted Hermite handles, and the total objective with
+ten pinned and ten excluded frames (``constrained``), each a table plus the all-K DP.
 """
 
 from __future__ import annotations
@@ -97,6 +100,9 @@ def run(args: argparse.Namespace) -> list[dict]:
             {
                 "frames": n,
                 "dims": d,
+                "objective": "total",
+                "interp": args.interp,
+                "constrained": False,
                 "features_s": features_s,
                 "table_s": table_s,
                 "dp_s": dp_s,
@@ -108,4 +114,43 @@ def run(args: argparse.Namespace) -> list[dict]:
                 "table_rel_diff": agree,
             }
         )
+    for n, d in sizes:
+        if d <= 3000:
+            rows += _other_modes(n, d, min(args.max_keys, n))
     return rows
+
+
+def _other_modes(n: int, d: int, kmax: int) -> list[dict]:
+    """Table + all-K DP for the worst-frame objective, fitted handles, and pins/exclusions."""
+    from hairtool.keys.constraints import KeyConstraints
+    from hairtool.keys.costs import cost_table
+    from hairtool.keys.dp import solve_layers
+
+    x, _ = _features(n, d)
+    frames = np.unique(np.linspace(1, n - 2, min(22, (n - 2) // 3)).round().astype(int))  # distinct
+    cons = KeyConstraints(pins=tuple(frames[::2][:10]), excludes=tuple(frames[1::2][:10]))
+    out = []
+    for objective, interp, constrained in (
+        ("worst", "linear", False),
+        ("worst", "hermite", False),
+        ("total", "hermite-fit", False),
+        ("total", "linear", True),
+    ):
+        warm = x[: min(n, 12)]
+        solve_layers(cost_table(warm, interp, 0.0, objective), 3, objective)
+        table, table_s = _time(lambda i=interp, o=objective: cost_table(x, i, 0.0, o))
+        c = cons if constrained else None
+        _, dp_s = _time(lambda t=table, o=objective, c=c: solve_layers(t, kmax, o, constraints=c))
+        out.append(
+            {
+                "frames": n,
+                "dims": d,
+                "objective": objective,
+                "interp": interp,
+                "constrained": constrained,
+                "table_s": table_s,
+                "dp_s": dp_s,
+                "select_s": table_s + dp_s,
+            }
+        )
+    return out

@@ -10,8 +10,21 @@ from hairtool.cli import main
 def test_quick_bench_rows(capsys):
     assert main(["bench", "keys", "--quick", "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)
-    assert [(r["frames"], r["dims"]) for r in rows] == [(40, 6), (120, 48)]
-    for r in rows:
+    main_rows = [r for r in rows if "gram_s" in r]
+    assert [(r["frames"], r["dims"]) for r in main_rows] == [(40, 6), (120, 48)]
+    modes = {(r["frames"], r["objective"], r["interp"], r["constrained"]) for r in rows if "gram_s" not in r}
+    assert modes == {
+        (n, o, i, c)
+        for n in (40, 120)
+        for o, i, c in (
+            ("worst", "linear", False),
+            ("worst", "hermite", False),
+            ("total", "hermite-fit", False),
+            ("total", "linear", True),
+        )
+    }
+    assert all(r["select_s"] > 0 for r in rows)
+    for r in main_rows:
         for key in ("select_s", "gram_s", "table_s", "dp_s", "direct_s", "features_s"):
             assert key in r
         assert r["select_s"] > 0 and r["gram_s"] > 0
