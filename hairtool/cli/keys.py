@@ -14,6 +14,8 @@ import argparse
 import json
 from pathlib import Path
 
+from hairtool.cli._progress import ProgressBar
+
 HELP = "find globally optimal keyframes (exact DP) and compare with uniform keys"
 
 
@@ -120,7 +122,6 @@ def _mode(args: argparse.Namespace, session) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-    import numpy as np
 
     from hairtool.errors import ParameterError
     from hairtool.keys.constraints import KeyConstraints
@@ -170,9 +171,25 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError("bvh-features", "quaternion", "the linear (slerp) total objective only")
         table = rotation_cost_table(data)
     settings = KeySettings(objective=objective, interp=args.interp, curvature=args.curvature)
-    session = solve(x, settings, table=table, layers=False, constraints=constraints, kmax=KNEE_KEYS)
-    mode = _mode(args, session)
-    sel = session.select(curve_keys=args.curve_keys, **mode)
+    bar = ProgressBar(enabled=None if not args.json else False)
+    try:
+        bar(0.3, "cost table")
+        session = solve(x, settings, table=table, layers=False, constraints=constraints, kmax=KNEE_KEYS)
+        bar(0.7, "keys")
+        mode = _mode(args, session)
+        sel = session.select(curve_keys=args.curve_keys, **mode)
+        bar(0.85, "errors")
+        result = _report(args, kind, data, n, fps, sel, options, session)
+        bar(1.0, "done")
+    finally:
+        bar.close()
+    return _finish(args, kind, data, n, sel, result)
+
+
+def _report(args: argparse.Namespace, kind: str, data, n: int, fps: float, sel, options, session) -> dict:
+    """The result record of ``--json``: keys, costs, curve, params and the position errors."""
+    import numpy as np
+
     result = {"frames": n, "fps": fps, **sel.to_dict()}
     if args.penalty is not None:
         result["params"]["penalty_share"] = args.penalty  # of the two-key error
@@ -197,6 +214,15 @@ def run(args: argparse.Namespace) -> int:
             e = joint_position_errors(data, reconstruct_motion(data, k, args.interp))
             errs[name] = {"mean": float(np.mean(e)), "max": float(np.max(e))}
         result["position_errors"] = errs
+    return result
+
+
+def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict) -> int:
+    """Exports, the handles of fitted tangents, and the printed line (or JSON)."""
+    import numpy as np
+
+    from hairtool.errors import ParameterError
+
     if args.export is not None:
         if kind != "animation":
             raise ParameterError("export", str(args.export), "an animation input (hair strands)")
@@ -226,8 +252,8 @@ def run(args: argparse.Namespace) -> int:
         f"{sel.n_keys} keys of {n} frames, {sel.objective} error {sel.cost:.6g} "
         f"(uniform {sel.uniform_cost:.6g}): {' '.join(map(str, sel.keys.tolist()))}"
     )
-    if note:
-        line += f"\n{note}"
+    if "note" in result:
+        line += f"\n{result['note']}"
     return _emit(args, result, line)
 
 

@@ -196,3 +196,23 @@ def test_the_default_count_is_the_knee(files, capsys):
     out = run_json(capsys, d / "x.npz")
     assert out["params"]["count_rule"] == "knee"
     assert len(out["keys"]) == knee_count(np.array(out["curve"]))
+
+
+def test_a_progress_bar_on_a_terminal_only(files, capsys):
+    import io as text_io
+
+    from hairtool.cli._progress import ProgressBar
+
+    stream = text_io.StringIO()
+    bar = ProgressBar(enabled=True, stream=stream)
+    bar(0.5, "cost table")
+    bar(1.0, "done")
+    bar.close()
+    shown = stream.getvalue()
+    assert "cost table" in shown and "[" + "#" * 14 + "-" * 14 + "]" in shown and shown.endswith("\r")
+    quiet = text_io.StringIO()
+    ProgressBar(stream=quiet)(0.5, "table")  # not a terminal: nothing
+    assert quiet.getvalue() == ""
+    d, _ = files
+    assert main(["keys", str(d / "anim.npz"), "--keys", "5"]) == 0
+    assert capsys.readouterr().err == ""  # piped stderr stays clean
