@@ -242,6 +242,10 @@ class Groom(_Attributes):
         for s in range(self.strand_count):
             yield self.strand(s)
 
+    def with_metadata(self, metadata: Metadata) -> Groom:
+        """The same groom with another source record (up axis, unit, prims)."""
+        return Groom(self.points, self.topology, **self.attributes, metadata=metadata)
+
     def subset(self, strand_ids: ArrayLike) -> Groom:
         """A groom of the chosen strands, in the given order."""
         ids = np.asarray(strand_ids, dtype=np.int64).reshape(-1)
@@ -380,6 +384,10 @@ class Animation(_Attributes):
             **self.attributes,
             metadata=self.metadata.with_(time_codes=codes),
         )
+
+    def with_metadata(self, metadata: Metadata) -> Animation:
+        """The same animation with another source record (up axis, unit, time codes, prims)."""
+        return Animation(self.frames, self.topology, self.fps, **self.attributes, metadata=metadata)
 
     @property
     def counts(self) -> I64:

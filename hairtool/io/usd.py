@@ -87,7 +87,7 @@ def _define_parents(stage, paths: Sequence[str]) -> None:
     from pxr import Sdf, UsdGeom
 
     for p in paths:
-        for parent in reversed(Sdf.Path(p).GetParentPath().GetPrefixes()):
+        for parent in Sdf.Path(p).GetParentPath().GetPrefixes():
             if not stage.GetPrimAtPath(parent):
                 UsdGeom.Xform.Define(stage, parent)
     first_root = Sdf.Path(paths[0]).GetPrefixes()[0]
