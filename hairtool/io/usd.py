@@ -34,6 +34,7 @@ they came from one), transparency ``displayOpacity`` = 1 − transparency.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -200,13 +201,21 @@ def write(path: Path, obj: Groom | Animation, *, time_codes: Sequence[float] | N
 
 
 # -- reading -------------------------------------------------------------------------------
+_PXR_ERROR = re.compile(r"^Error in '.*?' at line \d+ in file .*? : '(.*)'$")
+
+
 def _last_line(error: Exception) -> str:
     """The last line of a pxr error; its message may quote undecodable bytes of the file."""
     try:
         text = str(error).strip()
     except UnicodeDecodeError:
         return "the file is not valid USD (undecodable bytes)"
-    return text.splitlines()[-1].strip() if text else "unknown error"
+    if not text:
+        return "unknown error"
+    line = text.splitlines()[-1].strip()
+    # "Error in 'function' at line N in file F : 'message'": the message is what a user can act on.
+    m = _PXR_ERROR.match(line)
+    return m.group(1) if m else line
 
 
 def _open_stage(path: Path):
