@@ -33,8 +33,10 @@ they came from one), transparency ``displayOpacity`` = 1 − transparency.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -42,7 +44,7 @@ import numpy as np
 
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom
-from hairtool.io import usd_basis
+from hairtool.io import usd_basis, usdc_check
 from hairtool.io.atomic import atomic_path
 from hairtool.io.binary import require_finite, require_strand_counts
 from hairtool.metadata import CurvesPrim, Metadata
@@ -218,11 +220,29 @@ def _last_line(error: Exception) -> str:
     return m.group(1) if m else line
 
 
+def _check_specs(path: Path, layer) -> None:
+    """Refuse a layer whose prim specs a corrupt crate left nameless or missing.
+
+    usd-core reads such a crate (it warns "Invalid prim name") but composing a stage on it can
+    crash the process, so the specs are walked, without recursion, before a stage is made.
+    """
+    from pxr import Sdf
+
+    stack = [layer.pseudoRoot]
+    while stack:
+        spec = stack.pop()
+        for child in spec.nameChildren:
+            if child is None or not Sdf.Path.IsValidIdentifier(child.name):
+                raise FormatError(path, f"a prim under {spec.path} has no valid name (corrupt file?)")
+            stack.append(child)
+
+
 def _open_stage(path: Path):
     from pxr import Sdf, Tf, Usd
 
     if path.stat().st_size == 0:
         raise FormatError(path, "the file is empty")
+    usdc_check.check(path)  # before usd-core allocates from a crate's counts
     try:
         layer = Sdf.Layer.Find(str(path))
         # A layer still cached from an earlier open may be stale: the file can have been replaced.
@@ -230,6 +250,8 @@ def _open_stage(path: Path):
             raise FormatError(path, "usd-core cannot reload it")
         if layer is None:
             layer = Sdf.Layer.FindOrOpen(str(path))
+        if layer is not None:
+            _check_specs(path, layer)
         stage = Usd.Stage.Open(layer) if layer is not None else None
     except Tf.ErrorException as e:
         raise FormatError(path, f"usd-core cannot open it: {_last_line(e)}") from None
@@ -369,6 +391,8 @@ class _Curves:
         self.points = self.curves.GetPointsAttr()
         if not self.points.HasAuthoredValue():
             raise FormatError(path, f"{self.name} has no points")
+        # The counts are checked against the points before anything is sized from them.
+        self._check_length(_value(path, self.points, Usd.TimeCode.EarliestTime(), "vec3[]"))
         self.transform_times = _transform_samples(path, prim)
         kind = _token(path, self.curves.GetTypeAttr(), ("linear", "cubic"), "type")
         basis = _token(path, self.curves.GetBasisAttr(), ("bezier", "bspline", "catmullRom"), "basis")
@@ -381,6 +405,16 @@ class _Curves:
         self.basis, self.wrap = basis, wrap
         self.times = {float(t) for t in self.points.GetTimeSamples()}
 
+    def _check_length(self, value) -> None:
+        if value is None:
+            raise FormatError(self.path, f"{self.name} has no points")
+        if len(value) != self.vertex_count:
+            raise FormatError(
+                self.path,
+                f"{self.name}: curveVertexCounts add up to {self.vertex_count} points "
+                f"but points has {len(value)}",
+            )
+
     def info(self) -> CurvesPrim:
         return CurvesPrim(self.name, int(self.counts.size), self.basis, self.wrap)
 
@@ -388,15 +422,8 @@ class _Curves:
         from pxr import Gf
 
         value = _value(self.path, self.points, time, "vec3[]")
-        if value is None:
-            raise FormatError(self.path, f"{self.name} has no points")
-        p = np.asarray(value, dtype=np.float32)
-        if p.ndim != 2 or p.shape != (self.vertex_count, 3):
-            raise FormatError(
-                self.path,
-                f"{self.name}: curveVertexCounts add up to {self.vertex_count} points "
-                f"but points has {p.shape[0] if p.ndim else 0}",
-            )
+        self._check_length(value)
+        p = np.asarray(value, dtype=np.float32).reshape(self.vertex_count, 3)
         m = xforms.GetLocalToWorldTransform(self.prim)
         if m != Gf.Matrix4d(1.0):
             m = np.asarray(m, dtype=np.float64)
@@ -526,13 +553,36 @@ def _read_stage(path: Path, stage) -> Groom | Animation:
     return Animation(frames, counts, fps, **attrs, metadata=meta)
 
 
+@contextlib.contextmanager
+def _pxr_conversion_noise_hidden():
+    """Hide the stray line usd-core prints when it cannot hand a corrupt value's error to Python.
+
+    Reading a corrupt crate value, usd-core raises its error (which the reader turns into a
+    FormatError) but first reports, through ``sys.excepthook``, a TypeError "No to_python
+    (by-value) converter found" for the value it could not convert. Only that report is hidden,
+    and only while the reader runs; anything else still reaches the previous hook.
+    """
+    previous = sys.excepthook
+
+    def hook(kind, value, tb):
+        if not (kind is TypeError and "to_python" in str(value)):
+            previous(kind, value, tb)
+
+    sys.excepthook = hook
+    try:
+        yield
+    finally:
+        if sys.excepthook is hook:
+            sys.excepthook = previous
+
+
 def read(path: Path) -> Groom | Animation:
     """Merge every BasisCurves prim; time-sampled points or transforms make an Animation."""
     from pxr import Tf
 
-    stage = _open_stage(path)
     try:
-        return _read_stage(path, stage)
+        with _pxr_conversion_noise_hidden():
+            return _read_stage(path, _open_stage(path))
     except HairtoolError:
         raise
     except Tf.ErrorException as e:  # a crate's values are read lazily, inside Get()
@@ -546,9 +596,10 @@ def time_codes(path: str | os.PathLike[str]) -> list[float]:
     from pxr import Tf, UsdGeom
 
     p = Path(path)
-    stage = _open_stage(p)
     try:
-        prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.BasisCurves)]
-        return _sample_times([_Curves(p, q) for q in prims])
+        with _pxr_conversion_noise_hidden():
+            stage = _open_stage(p)
+            prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.BasisCurves)]
+            return _sample_times([_Curves(p, q) for q in prims])
     except Tf.ErrorException as e:
         raise FormatError(p, f"usd-core cannot read it: {_last_line(e)}") from None
