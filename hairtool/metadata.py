@@ -125,6 +125,9 @@ class Metadata:
                 raise ParameterError("time codes", codes[:8], "finite, strictly increasing numbers")
             object.__setattr__(self, "time_codes", codes)
         object.__setattr__(self, "curves", tuple(self.curves))
+        paths = [c.path for c in self.curves]
+        if len(set(paths)) != len(paths):
+            raise ParameterError("prim paths", paths[:8], "one prim per path")
         if self.color_primvar not in ("displayColor", "color"):
             raise ParameterError("colour primvar", self.color_primvar, "displayColor or color")
 

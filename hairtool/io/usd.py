@@ -68,6 +68,11 @@ def _time_codes(obj: Groom | Animation, time_codes: Sequence[float] | None) -> n
     return t
 
 
+def _wrap_for(basis: str, wrap: str) -> str:
+    """The schema defines ``pinned`` for bspline and catmullRom only; elsewhere it is nonperiodic."""
+    return "nonperiodic" if wrap == "pinned" and basis in ("linear", "bezier") else wrap
+
+
 def _extent(points: np.ndarray, half_width: float):
     from pxr import Vt
 
@@ -140,8 +145,9 @@ def _write_prim(stage, prim: CurvesPrim, obj: Groom | Animation, strands: slice,
     else:
         curves.CreateTypeAttr(UsdGeom.Tokens.cubic)
         curves.CreateBasisAttr(basis)
-    if prim.wrap != "nonperiodic" and usd_basis.fits(counts, basis, prim.wrap):
-        curves.CreateWrapAttr(prim.wrap)
+    wrap = _wrap_for(basis, prim.wrap) if usd_basis.fits(counts, basis, prim.wrap) else "nonperiodic"
+    if wrap != "nonperiodic":
+        curves.CreateWrapAttr(wrap)
     curves.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(counts.astype(np.int32)))
     half_width = _write_attributes(curves, obj, vs, obj.metadata.color_primvar)
     points_attr = curves.CreatePointsAttr()
@@ -398,11 +404,9 @@ class _Curves:
         basis = _token(path, self.curves.GetBasisAttr(), ("bezier", "bspline", "catmullRom"), "basis")
         wrap = _token(path, self.curves.GetWrapAttr(), ("nonperiodic", "periodic", "pinned"), "wrap")
         basis = "linear" if kind == "linear" else basis
-        if basis == "bezier" and wrap == "pinned":
-            wrap = "nonperiodic"  # the schema defines pinned for bspline and catmullRom only
-        if not usd_basis.fits(self.counts, basis, wrap):
+        if not usd_basis.fits(self.counts, basis, _wrap_for(basis, wrap)):
             basis = "linear"  # a cubic basis these counts cannot draw: the points as a polyline
-        self.basis, self.wrap = basis, wrap
+        self.basis, self.wrap = basis, _wrap_for(basis, wrap)
         self.times = {float(t) for t in self.points.GetTimeSamples()}
 
     def _check_length(self, value) -> None:
