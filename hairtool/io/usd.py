@@ -209,21 +209,25 @@ def write(path: Path, obj: Groom | Animation, *, time_codes: Sequence[float] | N
 
 
 # -- reading -------------------------------------------------------------------------------
-_PXR_ERROR = re.compile(r"^Error in '.*?' at line \d+ in file .*? : '(.*)'$")
+# One diagnostic of a pxr error: "Error in 'function' at line N in file F : 'message'".
+_PXR_ERROR = re.compile(r"Error in '[^']*' at line \d+ in file \S+ : '(.*?)'\s*(?=Error in '|$)", re.S)
+# A message that says where in the file: "name.usda:4:21: ...".
+_PLACED = re.compile(r":\d+:\d+: ")
 
 
 def _last_line(error: Exception) -> str:
-    """The last line of a pxr error; its message may quote undecodable bytes of the file."""
+    """One line from a pxr error: the message of its diagnostic that says where in the file, else
+    its last one; the message may quote undecodable bytes of the file."""
     try:
         text = str(error).strip()
     except UnicodeDecodeError:
         return "the file is not valid USD (undecodable bytes)"
-    if not text:
-        return "unknown error"
-    line = text.splitlines()[-1].strip()
-    # "Error in 'function' at line N in file F : 'message'": the message is what a user can act on.
-    m = _PXR_ERROR.match(line)
-    return m.group(1) if m else line
+    messages = [" ".join(m.split()) for m in _PXR_ERROR.findall(text)]
+    placed = [m for m in messages if _PLACED.search(m)]
+    if placed or messages:
+        return (placed or messages)[-1]
+    lines = [line.strip() for line in text.splitlines() if line.strip()]
+    return lines[-1] if lines else "unknown error"
 
 
 def _check_specs(path: Path, layer) -> None:

@@ -70,6 +70,10 @@ HOSTILE = [
         ("float xformOp:rotateZ.timeSamples = {1: 0, 2: 30}", "float3 xformOp:rotateZ = (0, 0, 1)"),
     ),
     ("curve type as a number", ('uniform token type = "cubic"', "uniform int type = 3")),
+    ("an unknown transform op", ('["xformOp:translate", "xformOp:rotateZ"]', '["xformOp:banana"]')),
+    ("an infinite rotation sample", ("{1: 0, 2: 30}", "{1: 0, 2: inf}")),
+    ("metersPerUnit as a string", ("metersPerUnit = 1", 'metersPerUnit = "big"')),
+    ("an unknown widths interpolation", ('(interpolation = "uniform")', '(interpolation = "banana")')),
     ("an unknown basis", ('uniform token basis = "catmullRom"', 'uniform token basis = "hermite2"')),
 ]
 
