@@ -33,15 +33,11 @@ def _bvh_summary(path: str) -> dict:
 
 
 def _usd_summary(obj) -> dict:
-    """What the stage said about its space, time and curves."""
-    from hairtool.groom import Animation
-
+    """What the stage said about its space, time code range and curves."""
     m = obj.metadata
     out: dict = {"up_axis": m.up_axis, "meters_per_unit": m.meters_per_unit}
     if m.start_time_code is not None:
         out["time_code_range"] = [m.start_time_code, m.end_time_code]
-    if isinstance(obj, Animation):
-        out["time_codes"] = {"first": float(obj.time_codes[0]), "last": float(obj.time_codes[-1])}
     out["curves"] = [
         {"path": c.path, "strands": c.strands, "basis": c.basis, "wrap": c.wrap, "drawn": c.description}
         for c in m.curves
@@ -78,6 +74,7 @@ def summary(path: str) -> dict:
     if isinstance(obj, Animation):
         out["frames"] = obj.n_frames
         out["fps"] = obj.fps
+        out["time_codes"] = {"first": float(obj.time_codes[0]), "last": float(obj.time_codes[-1])}
     if fmt.module == "usd":
         out["usd"] = _usd_summary(obj)
     if suffix == ".hair":
@@ -101,8 +98,6 @@ def _bvh_text(s: dict) -> str:
 
 def _usd_text(u: dict) -> list[str]:
     lines = [f"space       {u['up_axis']}-up, {u['meters_per_unit']:g} m per unit"]
-    if "time_codes" in u:
-        lines.append(f"time codes  {u['time_codes']['first']:g} … {u['time_codes']['last']:g}")
     for c in u["curves"]:
         lines.append(f"curves      {c['path']}: {c['strands']} strands, {c['drawn']}")
     return lines
@@ -121,7 +116,8 @@ def _text(s: dict) -> str:
         f"bounds      min ({', '.join(f'{x:.6g}' for x in lo)})  max ({', '.join(f'{x:.6g}' for x in hi)})",
     ]
     if "frames" in s:
-        lines.append(f"frames      {s['frames']} at {s['fps']:g} fps")
+        first, last = s["time_codes"]["first"], s["time_codes"]["last"]
+        lines.append(f"frames      {s['frames']} at {s['fps']:g} fps, time codes {first:g} … {last:g}")
     if "usd" in s:
         lines.extend(_usd_text(s["usd"]))
     lines.append(f"attributes  {', '.join(s['attributes']) or 'none'}")

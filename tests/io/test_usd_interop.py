@@ -223,7 +223,7 @@ def test_info_says_which_basis_and_space(interop, capsys):
     assert "Z-up, 1 m per unit" in text and f"{HAIR}: 300 strands, cubic catmullRom, pinned" in text
     assert main(["info", str(interop / "b_gnanim.usdc"), "--json"]) == 0
     info = json.loads(capsys.readouterr().out)
-    assert info["usd"]["time_codes"] == {"first": 1.0, "last": 48.0}
+    assert info["time_codes"] == {"first": 1.0, "last": 48.0}
     assert info["usd"]["curves"][0]["basis"] == "catmullRom"
 
 
