@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.bounds import box
 from hairtool.errors import GroomError
+from hairtool.metadata import Metadata
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -128,11 +129,22 @@ class _Attributes:
     thickness: F32 | None
     transparency: F32 | None
     colors: F32 | None
+    metadata: Metadata
 
     def _set_attributes(self, thickness, transparency, colors, vertex_count: int) -> None:
         self.thickness = _check_attribute(thickness, vertex_count, 1, "thickness")
         self.transparency = _check_attribute(transparency, vertex_count, 1, "transparency")
         self.colors = _check_attribute(colors, vertex_count, 3, "colors")
+
+    def _set_metadata(self, metadata: Metadata | None, strand_count: int) -> None:
+        """Up axis, unit, time codes and prims of the source (:mod:`hairtool.metadata`); defaults if None."""
+        m = Metadata() if metadata is None else metadata
+        if not isinstance(m, Metadata):
+            raise GroomError(f"metadata must be a hairtool.metadata.Metadata, got {type(m).__name__}")
+        held = sum(c.strands for c in m.curves)
+        if m.curves and held != strand_count:
+            raise GroomError(f"the metadata's curve prims hold {held} strands, not {strand_count}")
+        self.metadata = m
 
     @property
     def attributes(self) -> dict[str, F32 | None]:
@@ -160,10 +172,14 @@ class Groom(_Attributes):
         thickness: ArrayLike | None = None,
         transparency: ArrayLike | None = None,
         colors: ArrayLike | None = None,
+        metadata: Metadata | None = None,
     ) -> None:
         self.topology = counts if isinstance(counts, Topology) else Topology(counts)
         self.points: F32 = _frozen(_check_points(points, self.topology.vertex_count, "points"))
         self._set_attributes(thickness, transparency, colors, self.topology.vertex_count)
+        if metadata is not None and metadata.time_codes is not None:
+            metadata = metadata.with_(time_codes=None)
+        self._set_metadata(metadata, self.topology.strand_count)
 
     @classmethod
     def from_strands(cls, strands: Sequence[ArrayLike], **attributes: ArrayLike | None) -> Groom:
@@ -182,8 +198,8 @@ class Groom(_Attributes):
         return cls(np.concatenate(arrays), counts, **attributes)
 
     def with_points(self, points: ArrayLike) -> Groom:
-        """The same strands and attributes at new positions."""
-        return Groom(points, self.topology, **self.attributes)
+        """The same strands, attributes and metadata at new positions."""
+        return Groom(points, self.topology, **self.attributes, metadata=self.metadata)
 
     # -- sizes -------------------------------------------------------------------------
     @property
@@ -226,6 +242,10 @@ class Groom(_Attributes):
         for s in range(self.strand_count):
             yield self.strand(s)
 
+    def with_metadata(self, metadata: Metadata) -> Groom:
+        """The same groom with another source record (up axis, unit, prims)."""
+        return Groom(self.points, self.topology, **self.attributes, metadata=metadata)
+
     def subset(self, strand_ids: ArrayLike) -> Groom:
         """A groom of the chosen strands, in the given order."""
         ids = np.asarray(strand_ids, dtype=np.int64).reshape(-1)
@@ -235,7 +255,7 @@ class Groom(_Attributes):
             raise GroomError(f"strand ids must lie in [0, {self.strand_count})")
         vids = vertex_ids_of(self.topology, ids)
         pick = {k: (None if v is None else v[vids]) for k, v in self.attributes.items()}
-        return Groom(self.points[vids], self.counts[ids], **pick)
+        return Groom(self.points[vids], self.counts[ids], **pick, metadata=self.metadata.with_(curves=()))
 
     # -- per-vertex --------------------------------------------------------------------
     @property
@@ -308,6 +328,7 @@ class Animation(_Attributes):
         thickness: ArrayLike | None = None,
         transparency: ArrayLike | None = None,
         colors: ArrayLike | None = None,
+        metadata: Metadata | None = None,
     ) -> None:
         self.topology = counts if isinstance(counts, Topology) else Topology(counts)
         f = np.asarray(frames)
@@ -329,6 +350,10 @@ class Animation(_Attributes):
         self.frames: F32 = _frozen(np.array(f, dtype=np.float32, copy=True))
         self.fps = fps
         self._set_attributes(thickness, transparency, colors, v)
+        self._set_metadata(metadata, self.topology.strand_count)
+        codes = self.metadata.time_codes
+        if codes is not None and len(codes) != f.shape[0]:
+            raise GroomError(f"the metadata has {len(codes)} time codes for {f.shape[0]} frames")
 
     @classmethod
     def from_grooms(cls, grooms: Sequence[Groom], fps: float = 24.0) -> Animation:
@@ -339,10 +364,30 @@ class Animation(_Attributes):
         for i, g in enumerate(grooms):
             if g.topology != top:
                 raise GroomError(f"frame {i} has a different strand topology from frame 0")
-        return cls(np.stack([g.points for g in grooms]), top, fps, **grooms[0].attributes)
+        first = grooms[0]
+        return cls(
+            np.stack([g.points for g in grooms]), top, fps, **first.attributes, metadata=first.metadata
+        )
 
-    def with_frames(self, frames: ArrayLike, fps: float | None = None) -> Animation:
-        return Animation(frames, self.topology, self.fps if fps is None else fps, **self.attributes)
+    def with_frames(
+        self, frames: ArrayLike, fps: float | None = None, time_codes: ArrayLike | None = None
+    ) -> Animation:
+        """New frames of the same strands; the time codes are kept while the frame count is,
+        else they are ``time_codes`` (None: 0…F−1)."""
+        n = np.shape(frames)[0] if np.ndim(frames) else 0
+        codes = self.metadata.time_codes if time_codes is None and n == self.n_frames else time_codes
+        codes = None if codes is None else tuple(np.asarray(codes, dtype=np.float64).reshape(-1).tolist())
+        return Animation(
+            frames,
+            self.topology,
+            self.fps if fps is None else fps,
+            **self.attributes,
+            metadata=self.metadata.with_(time_codes=codes),
+        )
+
+    def with_metadata(self, metadata: Metadata) -> Animation:
+        """The same animation with another source record (up axis, unit, time codes, prims)."""
+        return Animation(self.frames, self.topology, self.fps, **self.attributes, metadata=metadata)
 
     @property
     def counts(self) -> I64:
@@ -369,11 +414,17 @@ class Animation(_Attributes):
     def times(self) -> F64:
         return np.arange(self.n_frames, dtype=np.float64) / self.fps
 
+    @property
+    def time_codes(self) -> F64:
+        """``(F,)`` the source's time code of each frame (0…F−1 when it had none)."""
+        codes = self.metadata.time_codes
+        return np.arange(self.n_frames, dtype=np.float64) if codes is None else np.array(codes)
+
     def frame(self, f: int) -> Groom:
         """Frame ``f`` as a groom (negative indices count from the end)."""
         if not -self.n_frames <= f < self.n_frames:
             raise IndexError(f"frame {f} is outside 0..{self.n_frames - 1}")
-        return Groom(self.frames[f], self.topology, **self.attributes)
+        return Groom(self.frames[f], self.topology, **self.attributes, metadata=self.metadata)
 
     @property
     def rest(self) -> Groom:

@@ -1,12 +1,15 @@
 """Convert between any readable and any writable format (chosen by the file extensions).
 
 An animation written to a format without time samples keeps its first frame only; a warning
-on stderr says how many frames were dropped.
+on stderr says how many frames were dropped. A USD output keeps the input's up axis, unit, time
+codes and curve prims; ``--up-axis`` and ``--meters-per-unit`` say what the points are in where
+the input cannot (HAIR, OBJ, TressFX) or is wrong — they relabel, they do not move the points.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 HELP = "convert a groom or animation between formats (by extension)"
@@ -15,17 +18,51 @@ HELP = "convert a groom or animation between formats (by extension)"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", help="any readable file: .hair, .tfx, .usda/.usdc/.usd, .npz, .obj")
     parser.add_argument("output", help="any writable file: .hair, .usda/.usdc/.usd, .npz, .obj")
+    parser.add_argument(
+        "--up-axis",
+        type=str.upper,
+        choices=("Y", "Z"),
+        help="the up axis the USD output declares (default: the input's; Y for formats without one)",
+    )
+    parser.add_argument(
+        "--meters-per-unit",
+        type=float,
+        metavar="M",
+        help="metres per unit the USD output declares (default: the input's; 0.01, centimetres, "
+        "for formats without one)",
+    )
+
+
+def _override(args: argparse.Namespace, obj):
+    """The groom with the up axis / unit the command line declares (USD outputs only)."""
+    from hairtool.errors import ParameterError
+    from hairtool.io import format_for
+
+    changes = {}
+    if args.up_axis is not None:
+        changes["up_axis"] = args.up_axis
+    if args.meters_per_unit is not None:
+        changes["meters_per_unit"] = args.meters_per_unit
+    if not changes:
+        return obj
+    if format_for(args.output, writing=True).module != "usd":
+        name = "up-axis" if "up_axis" in changes else "meters-per-unit"
+        raise ParameterError(name, next(iter(changes.values())), "a USD output (.usda, .usdc, .usd)")
+    return obj.with_metadata(obj.metadata.with_(**changes))
 
 
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from hairtool.errors import FormatError
+    from hairtool.errors import FormatError, ParameterError
     from hairtool.groom import Animation
     from hairtool.io import format_for, read, write
 
     out_fmt = format_for(args.output, writing=True)  # fail before reading a large input
-    obj = read(args.input)
+    mpu = args.meters_per_unit
+    if mpu is not None and not (math.isfinite(mpu) and mpu > 0):
+        raise ParameterError("meters-per-unit", mpu, "a positive number of metres")  # before reading
+    obj = _override(args, read(args.input))
     if isinstance(obj, Animation) and not out_fmt.animated and obj.n_frames > 1:
         print(
             f"hairtool convert: warning: {out_fmt.name} holds one pose; keeping frame 0 "

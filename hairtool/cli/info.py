@@ -1,25 +1,58 @@
-"""Print what a groom or animation file holds: format, sizes, bounding box, frames, attributes."""
+"""Print what a groom, animation or motion capture file holds: format, sizes, bounds, frames,
+attributes; for USD its up axis, unit, time codes and curve prims; for BVH its skeleton."""
 
 from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 
-HELP = "summarise a groom or animation file (strands, vertices, bounds, frames, attributes)"
+HELP = "summarise a groom, animation or BVH file (strands, vertices, bounds, frames, attributes)"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("file", help="a .hair, .tfx, .usda/.usdc/.usd, .npz or .obj file")
+    parser.add_argument("file", help="a .hair, .tfx, .usda/.usdc/.usd, .npz, .obj or .bvh file")
     parser.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _bvh_summary(path: str) -> dict:
+    from hairtool.mocap.bvh import read_bvh
+
+    motion = read_bvh(path)
+    return {
+        "file": str(path),
+        "format": "BVH motion capture",
+        "kind": "motion",
+        "joints": motion.n_joints,
+        "channels": motion.n_channels,
+        "frames": motion.n_frames,
+        "frame_time": motion.frame_time,
+        "fps": motion.fps,
+        "root": motion.joint_names[0],
+    }
+
+
+def _usd_summary(obj) -> dict:
+    """What the stage said about its space, time code range and curves."""
+    m = obj.metadata
+    out: dict = {"up_axis": m.up_axis, "meters_per_unit": m.meters_per_unit}
+    if m.start_time_code is not None:
+        out["time_code_range"] = [m.start_time_code, m.end_time_code]
+    out["curves"] = [
+        {"path": c.path, "strands": c.strands, "basis": c.basis, "wrap": c.wrap, "drawn": c.description}
+        for c in m.curves
+    ]
+    return out
 
 
 def summary(path: str) -> dict:
     """The facts ``hairtool info`` prints, as plain JSON-ready values."""
-    from pathlib import Path
-
     from hairtool.groom import Animation
     from hairtool.io import format_for, read
 
+    suffix = Path(path).suffix.lower()
+    if suffix == ".bvh":
+        return _bvh_summary(path)
     fmt = format_for(path)
     obj = read(path)
     counts = obj.counts
@@ -41,14 +74,38 @@ def summary(path: str) -> dict:
     if isinstance(obj, Animation):
         out["frames"] = obj.n_frames
         out["fps"] = obj.fps
-    if Path(path).suffix.lower() == ".hair":
+        out["time_codes"] = {"first": float(obj.time_codes[0]), "last": float(obj.time_codes[-1])}
+    if fmt.module == "usd":
+        out["usd"] = _usd_summary(obj)
+    if suffix == ".hair":
         from hairtool.io.hairfile import read_header
 
         out["hair_info"] = read_header(path).info
     return out
 
 
+def _bvh_text(s: dict) -> str:
+    return "\n".join(
+        [
+            f"file        {s['file']}",
+            f"format      {s['format']}",
+            f"joints      {s['joints']}  (root {s['root']})",
+            f"channels    {s['channels']}",
+            f"frames      {s['frames']} at {s['fps']:g} fps (frame time {s['frame_time']:g} s)",
+        ]
+    )
+
+
+def _usd_text(u: dict) -> list[str]:
+    lines = [f"space       {u['up_axis']}-up, {u['meters_per_unit']:g} m per unit"]
+    for c in u["curves"]:
+        lines.append(f"curves      {c['path']}: {c['strands']} strands, {c['drawn']}")
+    return lines
+
+
 def _text(s: dict) -> str:
+    if s["kind"] == "motion":
+        return _bvh_text(s)
     vps = s["vertices_per_strand"]
     lo, hi = s["bounds"]["min"], s["bounds"]["max"]
     lines = [
@@ -59,7 +116,10 @@ def _text(s: dict) -> str:
         f"bounds      min ({', '.join(f'{x:.6g}' for x in lo)})  max ({', '.join(f'{x:.6g}' for x in hi)})",
     ]
     if "frames" in s:
-        lines.append(f"frames      {s['frames']} at {s['fps']:g} fps")
+        first, last = s["time_codes"]["first"], s["time_codes"]["last"]
+        lines.append(f"frames      {s['frames']} at {s['fps']:g} fps, time codes {first:g} … {last:g}")
+    if "usd" in s:
+        lines.extend(_usd_text(s["usd"]))
     lines.append(f"attributes  {', '.join(s['attributes']) or 'none'}")
     if s.get("hair_info"):
         lines.append(f"info        {s['hair_info']}")

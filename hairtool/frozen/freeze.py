@@ -33,6 +33,7 @@ AXIS_EPS = 1e-6  # |t̂[i−1] × t̂[i]| below this: the tangents are parallel,
 MAX_STIFFNESS = 1e9
 MAX_VARIATION = 4.0
 
+
 def strand_multipliers(strand_count: int, variation: float | ArrayLike, seed: int = 0) -> NDArray[np.float64]:
     """``(S,)`` per-strand stiffness multipliers (the paper's strand-wise intensity variation).
 

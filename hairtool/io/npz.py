@@ -3,8 +3,9 @@
 Members (every one a plain, non-object array, so the file loads with ``allow_pickle=False``):
 ``format_version`` int64 scalar, ``kind`` ``"groom"`` or ``"animation"``, ``counts`` int64 (S,),
 ``points`` float32 (V, 3) for a groom or ``frames`` float32 (F, V, 3) for an animation, ``fps``
-float64 scalar (animations), and optional ``thickness`` (V,), ``transparency`` (V,),
-``colors`` (V, 3) float32.
+float64 scalar and ``time_codes`` float64 (F,) (animations: the source's time code of each frame;
+caches written before it existed read as 0…F−1), and optional ``thickness`` (V,),
+``transparency`` (V,), ``colors`` (V, 3) float32.
 """
 
 from __future__ import annotations
@@ -20,10 +21,11 @@ from hairtool.errors import FormatError
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import require_finite, require_strand_counts
+from hairtool.metadata import Metadata
 
 FORMAT_VERSION = 1
 ATTRIBUTES = ("thickness", "transparency", "colors")
-_KNOWN = {"format_version", "kind", "counts", "points", "frames", "fps", *ATTRIBUTES}
+_KNOWN = {"format_version", "kind", "counts", "points", "frames", "fps", "time_codes", *ATTRIBUTES}
 # zlib's deflate never expands data more than about 1032:1; a member claiming more is corrupt.
 _MAX_DEFLATE_RATIO = 1100
 
@@ -48,6 +50,7 @@ def write(path: Path, obj: Groom | Animation) -> None:
     }
     if isinstance(obj, Animation):
         arrays.update(kind=np.array("animation"), frames=obj.frames, fps=np.array(obj.fps, dtype=np.float64))
+        arrays["time_codes"] = obj.time_codes
     else:
         arrays.update(kind=np.array("groom"), points=obj.points)
     for name, a in obj.attributes.items():
@@ -110,6 +113,15 @@ def _array(path: Path, z, name: str, ndim: int, kind: str) -> np.ndarray:
     return a
 
 
+def _time_codes(path: Path, z, n_frames: int) -> Metadata | None:
+    if "time_codes" not in z.files:
+        return None
+    t = _array(path, z, "time_codes", 1, "fiu").astype(np.float64)
+    if t.shape != (n_frames,) or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise FormatError(path, f"'time_codes' must be {n_frames} finite, strictly increasing numbers")
+    return Metadata(time_codes=tuple(t.tolist()))
+
+
 def read(path: Path) -> Groom | Animation:
     size = path.stat().st_size
     if size == 0:
@@ -157,5 +169,5 @@ def _build(path: Path, z) -> Groom | Animation:
         fps = float(_scalar(path, z, "fps", "fiu"))
         if not (np.isfinite(fps) and fps > 0):
             raise FormatError(path, f"fps is {fps}; expected a positive number")
-        return Animation(frames, counts, fps, **attrs)
+        return Animation(frames, counts, fps, **attrs, metadata=_time_codes(path, z, frames.shape[0]))
     raise FormatError(path, f"kind is {kind!r}; expected 'groom' or 'animation'")

@@ -1,49 +1,76 @@
 """USD ``BasisCurves`` (``.usda`` text, ``.usdc`` crate, ``.usd`` either) through usd-core (``pxr``).
 
-Writing: one linear BasisCurves prim ``/Groom/Strands`` under an Xform that is the default prim;
-an animation's points are time samples (frame f at time code f, or ``time_codes[f]``) with
-``timeCodesPerSecond`` = ``framesPerSecond`` = fps and start/end time codes set. Thickness is
-written as vertex ``widths`` (a diameter, like HAIR's thickness), colours as a vertex
-``displayColor`` primvar, transparency as ``displayOpacity`` = 1 − transparency.
+Reading takes a stage as DCCs write it (Blender 5's exports in ``shared/data/interop`` are the
+test cases):
 
-Reading: every BasisCurves prim on the stage is merged in traversal order, each moved into world
-space by its local-to-world transform (skipped when it is the identity, so round trips are
-bit-exact). Prims with time-sampled points make an Animation sampled at every authored time code
-of the union (a sparse export reads back as its key poses only); the up axis is kept as authored
-(a z-up stage reads z-up). Curve bases other than linear are read as their control points.
+- every BasisCurves prim, merged in traversal order into one groom; each prim's path, strand
+  count, basis and wrap go into the groom's :class:`~hairtool.metadata.Metadata` so that writing
+  it back recreates the same prims;
+- world points: each prim's local-to-world transform at each time (skipped when it is the
+  identity, so round trips are bit-exact). Time-sampled points *or* transforms (hair under a
+  head that turns) make an Animation sampled at every authored time code of the union, and the
+  time codes themselves are kept (a stage sampled at 1…48 stays at 1…48);
+- the stage's ``upAxis``, ``metersPerUnit``, ``timeCodesPerSecond`` and start/end time codes
+  are kept as authored (nothing is rotated or scaled); the time code rate is the frame rate;
+- curves of any basis (linear, cubic bezier / bspline / catmullRom): the control points are the
+  strand's points, the basis is remembered;
+- ``widths`` of every interpolation (see :mod:`hairtool.io.usd_basis`), colour from
+  ``displayColor`` or Blender's ``primvars:color`` (color3f or color4f; its alpha is opacity),
+  opacity from ``displayOpacity``.
+
+Every value is type-checked before it is used and every lazy read of a crate file is guarded, so
+a hostile file ends in one :class:`~hairtool.errors.FormatError`.
+
+Writing: the prims of the metadata (one linear ``/Groom/Strands`` under an Xform by default),
+their parents as plain Xforms, world points; ``upAxis`` and ``metersPerUnit`` always (hairtool's
+defaults: Y-up, 0.01 m per unit); an animation's points as time samples at its time codes with
+``timeCodesPerSecond`` = ``framesPerSecond`` = fps. Widths are vertex ``widths`` (a diameter,
+like HAIR's thickness), colours a vertex ``displayColor`` (or ``primvars:color`` color4f when
+they came from one), transparency ``displayOpacity`` = 1 − transparency.
 
 ``pxr`` is imported inside the functions: usd-core takes a second or more to import.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
+import re
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
-from hairtool.errors import FormatError, ParameterError
+from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom
+from hairtool.io import usd_basis, usdc_check
 from hairtool.io.atomic import atomic_path
 from hairtool.io.binary import require_finite, require_strand_counts
+from hairtool.metadata import CurvesPrim, Metadata
 
 PRIM_PATH = "/Groom/Strands"
 
 
+# -- writing -------------------------------------------------------------------------------
 def _time_codes(obj: Groom | Animation, time_codes: Sequence[float] | None) -> np.ndarray | None:
     if isinstance(obj, Groom):
         if time_codes is not None:
             raise ParameterError("time_codes", time_codes, "None for a static groom")
         return None
     if time_codes is None:
-        return np.arange(obj.n_frames, dtype=np.float64)
+        return obj.time_codes
     t = np.asarray(time_codes, dtype=np.float64).reshape(-1)
     if t.size != obj.n_frames:
         raise ParameterError("time_codes", f"{t.size} values", f"one per frame ({obj.n_frames})")
     if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise ParameterError("time_codes", time_codes, "finite, strictly increasing numbers")
     return t
+
+
+def _wrap_for(basis: str, wrap: str) -> str:
+    """The schema defines ``pinned`` for bspline and catmullRom only; elsewhere it is nonperiodic."""
+    return "nonperiodic" if wrap == "pinned" and basis in ("linear", "bezier") else wrap
 
 
 def _extent(points: np.ndarray, half_width: float):
@@ -54,61 +81,170 @@ def _extent(points: np.ndarray, half_width: float):
     return Vt.Vec3fArray.FromNumpy(np.stack([lo, hi]).astype(np.float32))
 
 
+def _prims(obj: Groom | Animation) -> tuple[CurvesPrim, ...]:
+    from pxr import Sdf
+
+    prims = obj.metadata.for_strands(obj.strand_count).curves
+    if not prims or not all(Sdf.Path.IsValidPathString(c.path) for c in prims):
+        return (CurvesPrim(PRIM_PATH, obj.strand_count),)
+    return prims
+
+
+def _define_parents(stage, paths: Sequence[str]) -> None:
+    """Plain Xforms for every ancestor of the curves prims; the first root is the default prim."""
+    from pxr import Sdf, UsdGeom
+
+    for p in paths:
+        for parent in Sdf.Path(p).GetParentPath().GetPrefixes():
+            if not stage.GetPrimAtPath(parent):
+                UsdGeom.Xform.Define(stage, parent)
+    first_root = Sdf.Path(paths[0]).GetPrefixes()[0]
+    if not stage.GetPrimAtPath(first_root):
+        UsdGeom.Xform.Define(stage, first_root)
+    stage.SetDefaultPrim(stage.GetPrimAtPath(first_root))
+
+
+def _write_attributes(curves, obj: Groom | Animation, vs: slice, color_primvar: str) -> float:
+    """Widths, colour and opacity of one prim's vertices; returns the half width for its extent."""
+    from pxr import Sdf, UsdGeom, Vt
+
+    half_width = 0.0
+    if obj.thickness is not None:
+        curves.CreateWidthsAttr(Vt.FloatArray.FromNumpy(np.ascontiguousarray(obj.thickness[vs])))
+        curves.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
+        half_width = float(np.abs(obj.thickness[vs]).max()) / 2
+    opacity = None if obj.transparency is None else (1.0 - obj.transparency[vs]).astype(np.float32)
+    if obj.colors is not None and color_primvar == "color":
+        rgba = np.ones((obj.colors[vs].shape[0], 4), dtype=np.float32)
+        rgba[:, :3] = obj.colors[vs]
+        if opacity is not None:
+            rgba[:, 3] = opacity
+            opacity = None
+        pv = UsdGeom.PrimvarsAPI(curves.GetPrim()).CreatePrimvar(
+            "color", Sdf.ValueTypeNames.Color4fArray, UsdGeom.Tokens.vertex
+        )
+        pv.Set(Vt.Vec4fArray.FromNumpy(rgba))
+    elif obj.colors is not None:
+        colors = Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(obj.colors[vs]))
+        curves.CreateDisplayColorPrimvar(UsdGeom.Tokens.vertex).Set(colors)
+    if opacity is not None:
+        curves.CreateDisplayOpacityPrimvar(UsdGeom.Tokens.vertex).Set(Vt.FloatArray.FromNumpy(opacity))
+    return half_width
+
+
+def _write_prim(stage, prim: CurvesPrim, obj: Groom | Animation, strands: slice, times) -> None:
+    from pxr import Usd, UsdGeom, Vt
+
+    counts = obj.counts[strands]
+    off = obj.topology.offsets
+    vs = slice(int(off[strands.start]), int(off[strands.stop]))
+    curves = UsdGeom.BasisCurves.Define(stage, prim.path)
+    basis = prim.basis if usd_basis.fits(counts, prim.basis, prim.wrap) else "linear"
+    if basis == "linear":
+        curves.CreateTypeAttr(UsdGeom.Tokens.linear)
+    else:
+        curves.CreateTypeAttr(UsdGeom.Tokens.cubic)
+        curves.CreateBasisAttr(basis)
+    wrap = _wrap_for(basis, prim.wrap) if usd_basis.fits(counts, basis, prim.wrap) else "nonperiodic"
+    if wrap != "nonperiodic":
+        curves.CreateWrapAttr(wrap)
+    curves.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(counts.astype(np.int32)))
+    half_width = _write_attributes(curves, obj, vs, obj.metadata.color_primvar)
+    points_attr = curves.CreatePointsAttr()
+    extent_attr = curves.CreateExtentAttr()
+    if times is None:
+        pts = np.ascontiguousarray(obj.points[vs])
+        points_attr.Set(Vt.Vec3fArray.FromNumpy(pts))
+        extent_attr.Set(_extent(pts, half_width))
+        return
+    for f, t in enumerate(times):
+        code = Usd.TimeCode(float(t))
+        pts = np.ascontiguousarray(obj.frames[f, vs])
+        points_attr.Set(Vt.Vec3fArray.FromNumpy(pts), code)
+        extent_attr.Set(_extent(pts, half_width), code)
+
+
+def _write_stage_metadata(stage, obj: Groom | Animation, times) -> None:
+    from pxr import UsdGeom
+
+    meta = obj.metadata
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z if meta.up_axis == "Z" else UsdGeom.Tokens.y)
+    UsdGeom.SetStageMetersPerUnit(stage, meta.meters_per_unit)
+    start, end = meta.start_time_code, meta.end_time_code
+    if times is not None:
+        start = float(times[0]) if start is None else min(start, float(times[0]))
+        end = float(times[-1]) if end is None else max(end, float(times[-1]))
+        stage.SetTimeCodesPerSecond(obj.fps)
+        stage.SetFramesPerSecond(obj.fps)
+    elif meta.time_codes_per_second is not None:
+        stage.SetTimeCodesPerSecond(meta.time_codes_per_second)
+    if start is not None and end is not None:
+        stage.SetStartTimeCode(start)
+        stage.SetEndTimeCode(end)
+
+
 def write(path: Path, obj: Groom | Animation, *, time_codes: Sequence[float] | None = None) -> None:
     """Write a groom, or an animation as time-sampled points.
 
     ``time_codes``: for an animation, the time code of each frame (F strictly increasing
-    numbers; default 0..F−1) — a keys-only export writes just its key poses at their frame
-    numbers, and USD readers interpolate linearly between them.
+    numbers; default: the animation's own, :attr:`Animation.time_codes`) — a keys-only export
+    writes just its key poses at their time codes, and USD readers interpolate linearly between.
     """
     times = _time_codes(obj, time_codes)
-    from pxr import Usd, UsdGeom, Vt
+    prims = _prims(obj)
+    from pxr import Usd
 
     with atomic_path(path) as tmp:
         stage = Usd.Stage.CreateNew(str(tmp))
         if stage is None:
             raise FormatError(path, "usd-core could not create the stage")
-        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
-        root = UsdGeom.Xform.Define(stage, PRIM_PATH.rsplit("/", 1)[0])
-        stage.SetDefaultPrim(root.GetPrim())
-        curves = UsdGeom.BasisCurves.Define(stage, PRIM_PATH)
-        curves.CreateTypeAttr(UsdGeom.Tokens.linear)
-        curves.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(obj.counts.astype(np.int32)))
-        half_width = 0.0
-        if obj.thickness is not None:
-            curves.CreateWidthsAttr(Vt.FloatArray.FromNumpy(obj.thickness))
-            curves.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
-            half_width = float(np.abs(obj.thickness).max()) / 2
-        if obj.colors is not None:
-            curves.CreateDisplayColorPrimvar(UsdGeom.Tokens.vertex).Set(Vt.Vec3fArray.FromNumpy(obj.colors))
-        if obj.transparency is not None:
-            opacity = (1.0 - obj.transparency).astype(np.float32)
-            curves.CreateDisplayOpacityPrimvar(UsdGeom.Tokens.vertex).Set(Vt.FloatArray.FromNumpy(opacity))
-        points_attr = curves.CreatePointsAttr()
-        extent_attr = curves.CreateExtentAttr()
-        if times is None:
-            points_attr.Set(Vt.Vec3fArray.FromNumpy(obj.points))
-            extent_attr.Set(_extent(obj.points, half_width))
-        else:
-            for f, t in enumerate(times):
-                code = Usd.TimeCode(float(t))
-                points_attr.Set(Vt.Vec3fArray.FromNumpy(obj.frames[f]), code)
-                extent_attr.Set(_extent(obj.frames[f], half_width), code)
-            stage.SetStartTimeCode(float(times[0]))
-            stage.SetEndTimeCode(float(times[-1]))
-            stage.SetTimeCodesPerSecond(obj.fps)
-            stage.SetFramesPerSecond(obj.fps)
+        _write_stage_metadata(stage, obj, times)
+        _define_parents(stage, [c.path for c in prims])
+        first = 0
+        for prim in prims:
+            _write_prim(stage, prim, obj, slice(first, first + prim.strands), times)
+            first += prim.strands
         stage.GetRootLayer().Save()
         del stage
 
 
+# -- reading -------------------------------------------------------------------------------
+# One diagnostic of a pxr error: "Error in 'function' at line N in file F : 'message'".
+_PXR_ERROR = re.compile(r"Error in '[^']*' at line \d+ in file \S+ : '(.*?)'\s*(?=Error in '|$)", re.S)
+# A message that says where in the file: "name.usda:4:21: ...".
+_PLACED = re.compile(r":\d+:\d+: ")
+
+
 def _last_line(error: Exception) -> str:
-    """The last line of a pxr error; its message may quote undecodable bytes of the file."""
+    """One line from a pxr error: the message of its diagnostic that says where in the file, else
+    its last one; the message may quote undecodable bytes of the file."""
     try:
         text = str(error).strip()
     except UnicodeDecodeError:
         return "the file is not valid USD (undecodable bytes)"
-    return text.splitlines()[-1].strip() if text else "unknown error"
+    messages = [" ".join(m.split()) for m in _PXR_ERROR.findall(text)]
+    placed = [m for m in messages if _PLACED.search(m)]
+    if placed or messages:
+        return (placed or messages)[-1]
+    lines = [line.strip() for line in text.splitlines() if line.strip()]
+    return lines[-1] if lines else "unknown error"
+
+
+def _check_specs(path: Path, layer) -> None:
+    """Refuse a layer whose prim specs a corrupt crate left nameless or missing.
+
+    usd-core reads such a crate (it warns "Invalid prim name") but composing a stage on it can
+    crash the process, so the specs are walked, without recursion, before a stage is made.
+    """
+    from pxr import Sdf
+
+    stack = [layer.pseudoRoot]
+    while stack:
+        spec = stack.pop()
+        for child in spec.nameChildren:
+            if child is None or not Sdf.Path.IsValidIdentifier(child.name):
+                raise FormatError(path, f"a prim under {spec.path} has no valid name (corrupt file?)")
+            stack.append(child)
 
 
 def _open_stage(path: Path):
@@ -116,6 +252,7 @@ def _open_stage(path: Path):
 
     if path.stat().st_size == 0:
         raise FormatError(path, "the file is empty")
+    usdc_check.check(path)  # before usd-core allocates from a crate's counts
     try:
         layer = Sdf.Layer.Find(str(path))
         # A layer still cached from an earlier open may be stale: the file can have been replaced.
@@ -123,6 +260,8 @@ def _open_stage(path: Path):
             raise FormatError(path, "usd-core cannot reload it")
         if layer is None:
             layer = Sdf.Layer.FindOrOpen(str(path))
+        if layer is not None:
+            _check_specs(path, layer)
         stage = Usd.Stage.Open(layer) if layer is not None else None
     except Tf.ErrorException as e:
         raise FormatError(path, f"usd-core cannot open it: {_last_line(e)}") from None
@@ -131,121 +270,344 @@ def _open_stage(path: Path):
     return stage
 
 
-def _per_vertex(values, interpolation: str, counts: np.ndarray, width: int) -> np.ndarray | None:
-    """Expand a constant / uniform / vertex primvar to one value per vertex; None if it does not fit."""
-    if values is None:
+_WORDS = {
+    "vec3[]": "an array of 3-vectors",
+    "vec4[]": "an array of 4-vectors",
+    "float[]": "an array of numbers",
+    "int[]": "an array of whole numbers",
+    "vec3": "a 3-vector",
+    "float": "a number",
+    "quat": "a quaternion",
+    "matrix": "a 4×4 matrix",
+    "token": "a token",
+}
+
+
+def _type_names() -> dict[str, set]:
+    """The Tf types (roles aside: vector3d is double3) a transform op or token may be declared as."""
+    from pxr import Sdf
+
+    v = Sdf.ValueTypeNames
+    return {
+        "vec3": {v.Float3.type, v.Double3.type, v.Half3.type},
+        "float": {v.Float.type, v.Double.type, v.Half.type},
+        "quat": {v.Quatf.type, v.Quatd.type, v.Quath.type},
+        "matrix": {v.Matrix4d.type},
+        "token": {v.Token.type},
+    }
+
+
+def _require_type(path: Path, attr, kinds: str) -> None:
+    """A declared type other than ``kinds`` (a string, an unregistered type) is a FormatError."""
+    allowed = _type_names()
+    tn = attr.GetTypeName()
+    ok = bool(tn) and any(tn.type in allowed[k] for k in kinds.split("|"))
+    if not ok:
+        what = str(attr.GetPrim().GetPath()) + "." + attr.GetName()
+        kind = " or ".join(_WORDS[k] for k in kinds.split("|"))
+        raise FormatError(path, f"{what} is declared {str(tn) or 'with an unknown type'}, not {kind}")
+
+
+def _array_classes() -> dict[str, tuple]:
+    from pxr import Vt
+
+    return {
+        "vec3[]": (Vt.Vec3fArray, Vt.Vec3dArray, Vt.Vec3hArray),
+        "vec4[]": (Vt.Vec4fArray, Vt.Vec4dArray, Vt.Vec4hArray),
+        "float[]": (Vt.FloatArray, Vt.DoubleArray, Vt.HalfArray),
+        "int[]": (Vt.IntArray, Vt.Int64Array, Vt.UIntArray),
+    }
+
+
+def _value(path: Path, attr, time, kinds: str):
+    """``attr``'s value at ``time``, which must be an array of one of ``kinds`` (None when unset).
+
+    Schema attributes report their schema's type whatever a file authors, so the value itself is
+    checked: a string or an unregistered type where points, counts or widths belong is refused.
+    """
+    value = attr.Get(time)
+    if value is None:
         return None
-    a = np.asarray(values, dtype=np.float32).reshape(-1, width) if len(values) else None
-    if a is None:
-        return None
-    v, s = int(counts.sum()), counts.size
-    if a.shape[0] == v and interpolation in ("vertex", "varying"):
-        out = a
-    elif a.shape[0] == s and interpolation == "uniform":
-        out = np.repeat(a, counts, axis=0)
-    elif a.shape[0] == 1 and interpolation == "constant":
-        out = np.repeat(a, v, axis=0)
-    else:
-        return None
-    if not np.all(np.isfinite(out)):
-        return None
-    return out if width > 1 else out.reshape(-1)
+    classes = _array_classes()
+    if not any(isinstance(value, classes[k]) for k in kinds.split("|")):
+        what = f"{attr.GetPrim().GetPath()}.{attr.GetName()}"
+        kind = " or ".join(_WORDS[k] for k in kinds.split("|"))
+        raise FormatError(path, f"{what} holds a {type(value).__name__}, not {kind}")
+    return value
+
+
+def _op_kind(op) -> str | None:
+    """The value type a transform op needs, by its op type (None for an invalid op)."""
+    from pxr import UsdGeom
+
+    t, x = op.GetOpType(), UsdGeom.XformOp
+    if t in (x.TypeRotateX, x.TypeRotateY, x.TypeRotateZ):
+        return "float"
+    if t == x.TypeOrient:
+        return "quat"
+    if t == x.TypeTransform:
+        return "matrix"
+    return None if t == x.TypeInvalid else "vec3"
+
+
+def _lineage(prim):
+    """The prim and its ancestors up to (not including) the pseudo-root."""
+    while prim and not prim.IsPseudoRoot():
+        yield prim
+        prim = prim.GetParent()
+
+
+def _transform_samples(path: Path, prim) -> set[float]:
+    """Check every transform op above the hair holds the type its op names; their time samples."""
+    from pxr import UsdGeom
+
+    times: set[float] = set()
+    for p in _lineage(prim):
+        xf = UsdGeom.Xformable(p)
+        if not xf:
+            continue
+        for op in xf.GetOrderedXformOps():
+            kind = _op_kind(op)
+            if kind is None:
+                raise FormatError(path, f"{p.GetPath()} has an invalid transform op {op.GetOpName()!r}")
+            _require_type(path, op.GetAttr(), kind)
+            times.update(float(t) for t in op.GetTimeSamples())
+    return times
+
+
+def _token(path: Path, attr, allowed: Sequence[str], what: str) -> str:
+    _require_type(path, attr, "token")
+    value = str(attr.Get())
+    if value not in allowed:
+        raise FormatError(path, f"{attr.GetPrim().GetPath()}: {what} is {value!r}; expected one of {allowed}")
+    return value
 
 
 class _Curves:
-    """One BasisCurves prim: its topology, points attribute and world transform."""
+    """One BasisCurves prim: its topology, basis, points attribute and transform."""
 
     def __init__(self, path: Path, prim) -> None:
         from pxr import Usd, UsdGeom
 
         self.curves = UsdGeom.BasisCurves(prim)
-        name = str(prim.GetPath())
-        raw = self.curves.GetCurveVertexCountsAttr().Get(Usd.TimeCode.EarliestTime())
+        self.name, self.path, self.prim = str(prim.GetPath()), path, prim
+        counts_attr = self.curves.GetCurveVertexCountsAttr()
+        raw = _value(path, counts_attr, Usd.TimeCode.EarliestTime(), "int[]")
         if raw is None or len(raw) == 0:
-            raise FormatError(path, f"{name} has no curveVertexCounts")
+            raise FormatError(path, f"{self.name} has no curveVertexCounts")
         self.counts = np.asarray(raw, dtype=np.int64)
         require_strand_counts(path, self.counts)
         self.vertex_count = int(self.counts.sum())
         self.points = self.curves.GetPointsAttr()
-        self.times = [float(t) for t in self.points.GetTimeSamples()]
-        self.name, self.path, self.prim = name, path, prim
+        if not self.points.HasAuthoredValue():
+            raise FormatError(path, f"{self.name} has no points")
+        # The counts are checked against the points before anything is sized from them.
+        self._check_length(_value(path, self.points, Usd.TimeCode.EarliestTime(), "vec3[]"))
+        self.transform_times = _transform_samples(path, prim)
+        kind = _token(path, self.curves.GetTypeAttr(), ("linear", "cubic"), "type")
+        basis = _token(path, self.curves.GetBasisAttr(), ("bezier", "bspline", "catmullRom"), "basis")
+        wrap = _token(path, self.curves.GetWrapAttr(), ("nonperiodic", "periodic", "pinned"), "wrap")
+        basis = "linear" if kind == "linear" else basis
+        if not usd_basis.fits(self.counts, basis, _wrap_for(basis, wrap)):
+            basis = "linear"  # a cubic basis these counts cannot draw: the points as a polyline
+        self.basis, self.wrap = basis, _wrap_for(basis, wrap)
+        self.times = {float(t) for t in self.points.GetTimeSamples()}
 
-    def at(self, time) -> np.ndarray:
-        from pxr import Gf, UsdGeom
-
-        value = self.points.Get(time)
+    def _check_length(self, value) -> None:
         if value is None:
             raise FormatError(self.path, f"{self.name} has no points")
-        p = np.asarray(value, dtype=np.float32)
-        if p.ndim != 2 or p.shape != (self.vertex_count, 3):
+        if len(value) != self.vertex_count:
             raise FormatError(
                 self.path,
                 f"{self.name}: curveVertexCounts add up to {self.vertex_count} points "
-                f"but points has {p.shape[0] if p.ndim else 0}",
+                f"but points has {len(value)}",
             )
-        m = UsdGeom.Xformable(self.prim).ComputeLocalToWorldTransform(time)
+
+    def info(self) -> CurvesPrim:
+        return CurvesPrim(self.name, int(self.counts.size), self.basis, self.wrap)
+
+    def at(self, time, xforms) -> np.ndarray:
+        from pxr import Gf
+
+        value = _value(self.path, self.points, time, "vec3[]")
+        self._check_length(value)
+        p = np.asarray(value, dtype=np.float32).reshape(self.vertex_count, 3)
+        m = xforms.GetLocalToWorldTransform(self.prim)
         if m != Gf.Matrix4d(1.0):
             m = np.asarray(m, dtype=np.float64)
+            if not np.all(np.isfinite(m)):
+                raise FormatError(self.path, f"{self.name} has a non-finite transform")
             p = (p.astype(np.float64) @ m[:3, :3] + m[3, :3]).astype(np.float32)
         require_finite(self.path, p, f"{self.name} points")
         return p
 
-    def attributes(self) -> dict[str, np.ndarray | None]:
-        from pxr import UsdGeom
-
-        widths = self.curves.GetWidthsAttr().Get()
-        thickness = _per_vertex(widths, self.curves.GetWidthsInterpolation(), self.counts, 1)
-        pv = UsdGeom.PrimvarsAPI(self.prim)
-        color_pv, opacity_pv = pv.GetPrimvar("displayColor"), pv.GetPrimvar("displayOpacity")
-        colors = opacity = None
-        if color_pv and color_pv.HasValue():
-            colors = _per_vertex(color_pv.ComputeFlattened(), color_pv.GetInterpolation(), self.counts, 3)
-        if opacity_pv and opacity_pv.HasValue():
-            opacity = _per_vertex(
-                opacity_pv.ComputeFlattened(), opacity_pv.GetInterpolation(), self.counts, 1
+    def _primvar(self, values, interpolation: str, width: tuple[int, ...], what: str) -> np.ndarray:
+        need = usd_basis.expected_count(interpolation, self.counts, self.basis, self.wrap)
+        if need is None:
+            raise FormatError(self.path, f"{self.name}: {what} has unknown interpolation {interpolation!r}")
+        a = np.asarray(values if values is not None else [], dtype=np.float64)
+        if a.shape != (need, *width):
+            raise FormatError(
+                self.path,
+                f"{self.name}: {what} has {a.shape[0] if a.ndim else 0} values; "
+                f"{interpolation} interpolation needs {need}",
             )
-        transparency = None if opacity is None else (1.0 - opacity).astype(np.float32)
-        return {"thickness": thickness, "transparency": transparency, "colors": colors}
+        require_finite(self.path, a, f"{self.name} {what}")
+        return usd_basis.per_vertex(a, interpolation, self.counts, self.basis, self.wrap)
+
+    def attributes(self) -> tuple[dict[str, np.ndarray | None], str]:
+        """Thickness, transparency and colours (None where absent), and the colour's primvar name."""
+        from pxr import Usd, UsdGeom
+
+        first = Usd.TimeCode.EarliestTime()
+        out: dict[str, np.ndarray | None] = {"thickness": None, "transparency": None, "colors": None}
+        widths = self.curves.GetWidthsAttr()
+        if widths.HasAuthoredValue():
+            value = _value(self.path, widths, first, "float[]")
+            w = self._primvar(value, self.curves.GetWidthsInterpolation(), (), "widths")
+            out["thickness"] = w.astype(np.float32)
+        pv = UsdGeom.PrimvarsAPI(self.prim)
+        source, alpha = "displayColor", None
+        color = pv.GetPrimvar("displayColor")
+        if not (color and color.HasAuthoredValue()):
+            color, source = pv.GetPrimvar("color"), "color"
+        if color and color.HasAuthoredValue():
+            value = _value(self.path, color.GetAttr(), first, "vec3[]|vec4[]")
+            wide = isinstance(value, _array_classes()["vec4[]"])
+            c = self._primvar(value, color.GetInterpolation(), (4 if wide else 3,), f"primvars:{source}")
+            out["colors"] = c[:, :3].astype(np.float32)
+            if wide and np.any(c[:, 3] != 1.0):
+                alpha = c[:, 3]
+        opacity = pv.GetPrimvar("displayOpacity")
+        if opacity and opacity.HasAuthoredValue():
+            value = _value(self.path, opacity.GetAttr(), first, "float[]")
+            alpha = self._primvar(value, opacity.GetInterpolation(), (), "displayOpacity")
+        if alpha is not None:
+            out["transparency"] = (1.0 - alpha).astype(np.float32)
+        return out, source
 
 
-def _merge_attributes(parts: list[_Curves]) -> dict[str, np.ndarray]:
+def _merge_attributes(parts: list[_Curves]) -> tuple[dict[str, np.ndarray], str]:
     """An attribute survives the merge only if every prim has it."""
-    per_prim = [c.attributes() for c in parts]
+    read = [c.attributes() for c in parts]
     out = {}
     for name in ("thickness", "transparency", "colors"):
-        values = [a[name] for a in per_prim]
+        values = [a[name] for a, _ in read]
         if all(v is not None for v in values):
             out[name] = np.concatenate(values)
+    sources = {s for a, s in read if a["colors"] is not None}
+    return out, ("color" if sources == {"color"} else "displayColor")
+
+
+def _stage_metadata(path: Path, stage) -> dict:
+    from pxr import UsdGeom
+
+    up = str(UsdGeom.GetStageUpAxis(stage))
+    if up not in ("Y", "Z"):
+        raise FormatError(path, f"upAxis is {up!r}; USD allows Y or Z")
+    mpu = float(UsdGeom.GetStageMetersPerUnit(stage))
+    if not (np.isfinite(mpu) and mpu > 0):
+        raise FormatError(path, f"metersPerUnit is {mpu}; expected a positive number")
+    fps = float(stage.GetTimeCodesPerSecond())
+    if not (np.isfinite(fps) and fps > 0):
+        raise FormatError(path, f"timeCodesPerSecond is {fps}; expected a positive number")
+    layer = stage.GetRootLayer()
+    out = {"up_axis": up, "meters_per_unit": mpu, "fps": fps}
+    out["time_codes_per_second"] = (
+        fps if layer.HasTimeCodesPerSecond() or layer.HasFramesPerSecond() else None
+    )
+    if stage.HasAuthoredTimeCodeRange():
+        start, end = float(stage.GetStartTimeCode()), float(stage.GetEndTimeCode())
+        if not (np.isfinite(start) and np.isfinite(end) and start <= end):
+            raise FormatError(path, f"the time code range {start}…{end} is not a range")
+        out.update(start_time_code=start, end_time_code=end)
     return out
 
 
-def read(path: Path) -> Groom | Animation:
-    """Merge every BasisCurves prim; time-sampled points make an Animation at the union of time codes."""
+def _sample_times(parts: list[_Curves]) -> list[float]:
+    """The animation's time codes: every sample of points and transforms; [] for a static groom
+    (no point samples, and transforms set at one time code at most)."""
+    point_times = set().union(*(c.times for c in parts))
+    times = sorted(point_times.union(*(c.transform_times for c in parts)))
+    return times if point_times or len(times) > 1 else []
+
+
+def _read_stage(path: Path, stage) -> Groom | Animation:
     from pxr import Usd, UsdGeom
 
-    stage = _open_stage(path)
     prims = [p for p in stage.Traverse() if p.IsA(UsdGeom.BasisCurves)]
     if not prims:
         raise FormatError(path, "no BasisCurves prim on the stage")
     parts = [_Curves(path, p) for p in prims]
     counts = np.concatenate([c.counts for c in parts])
-    attrs = _merge_attributes(parts)
-    times = sorted(set().union(*(c.times for c in parts)))
+    attrs, color_source = _merge_attributes(parts)
+    stage_meta = _stage_metadata(path, stage)
+    fps = stage_meta.pop("fps")
+    curves = tuple(c.info() for c in parts)
+    times = _sample_times(parts)
     if not times:
-        points = np.concatenate([c.at(Usd.TimeCode.Default()) for c in parts])
-        return Groom(points, counts, **attrs)
-    frames = np.stack([np.concatenate([c.at(Usd.TimeCode(t)) for c in parts]) for t in times])
-    fps = float(stage.GetTimeCodesPerSecond())
-    if not (np.isfinite(fps) and fps > 0):
-        raise FormatError(path, f"timeCodesPerSecond is {fps}; expected a positive number")
-    return Animation(frames, counts, fps, **attrs)
+        once = set().union(*(c.transform_times for c in parts))  # a transform set at one time code
+        code = Usd.TimeCode(once.pop()) if once else Usd.TimeCode.Default()
+        xforms = UsdGeom.XformCache(code)
+        points = np.concatenate([c.at(code, xforms) for c in parts])
+        meta = Metadata(**stage_meta, curves=curves, color_primvar=color_source)
+        return Groom(points, counts, **attrs, metadata=meta)
+    frames = np.empty((len(times), int(counts.sum()), 3), dtype=np.float32)
+    for f, t in enumerate(times):
+        code = Usd.TimeCode(t)
+        xforms = UsdGeom.XformCache(code)
+        frames[f] = np.concatenate([c.at(code, xforms) for c in parts])
+    meta = Metadata(**stage_meta, time_codes=tuple(times), curves=curves, color_primvar=color_source)
+    return Animation(frames, counts, fps, **attrs, metadata=meta)
+
+
+@contextlib.contextmanager
+def _pxr_conversion_noise_hidden():
+    """Hide the stray line usd-core prints when it cannot hand a corrupt value's error to Python.
+
+    Reading a corrupt crate value, usd-core raises its error (which the reader turns into a
+    FormatError) but first reports, through ``sys.excepthook``, a TypeError "No to_python
+    (by-value) converter found" for the value it could not convert. Only that report is hidden,
+    and only while the reader runs; anything else still reaches the previous hook.
+    """
+    previous = sys.excepthook
+
+    def hook(kind, value, tb):
+        if not (kind is TypeError and "to_python" in str(value)):
+            previous(kind, value, tb)
+
+    sys.excepthook = hook
+    try:
+        yield
+    finally:
+        if sys.excepthook is hook:
+            sys.excepthook = previous
+
+
+def read(path: Path) -> Groom | Animation:
+    """Merge every BasisCurves prim; time-sampled points or transforms make an Animation."""
+    from pxr import Tf
+
+    try:
+        with _pxr_conversion_noise_hidden():
+            return _read_stage(path, _open_stage(path))
+    except HairtoolError:
+        raise
+    except Tf.ErrorException as e:  # a crate's values are read lazily, inside Get()
+        raise FormatError(path, f"usd-core cannot read it: {_last_line(e)}") from None
+    except (ValueError, TypeError, OverflowError, MemoryError) as e:
+        raise FormatError(path, f"not readable as hair curves ({type(e).__name__}: {e})") from None
 
 
 def time_codes(path: str | os.PathLike[str]) -> list[float]:
-    """The union of the authored time codes of every BasisCurves prim's points (empty when static)."""
-    from pxr import UsdGeom
+    """The authored time codes of the file's hair: its points' and transforms' samples (empty when static)."""
+    from pxr import Tf, UsdGeom
 
     p = Path(path)
-    stage = _open_stage(p)
-    prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.BasisCurves)]
-    return sorted(set().union(*(UsdGeom.BasisCurves(q).GetPointsAttr().GetTimeSamples() for q in prims)))
+    try:
+        with _pxr_conversion_noise_hidden():
+            stage = _open_stage(p)
+            prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.BasisCurves)]
+            return _sample_times([_Curves(p, q) for q in prims])
+    except Tf.ErrorException as e:
+        raise FormatError(p, f"usd-core cannot read it: {_last_line(e)}") from None

@@ -5,9 +5,13 @@
 - CSV (``write_key_sheet``): one row per frame, like an animator's exposure sheet: whether the
   frame is a key, which keys it lies between and its interpolation weight, so a reader can
   rebuild every in-between without hairtool.
-- USD (``write_key_poses``): only the key poses as time samples at their frame numbers; USD
+- USD (``write_key_poses``): only the key poses as time samples at their time codes; USD
   readers interpolate linearly between samples, so the file plays back as the linear
   reconstruction in any USD viewer.
+
+Keys are frame indices 0…F−1 of the animation; the JSON record and the USD poses also give each
+key's time code in the source (an animation sampled at time codes 1…48 keys its first frame at
+1, not 0), so what is written lands where the source's frames are.
 
 The CLI (``hairtool keys --out/--export``) and the studio both write through this module.
 """
@@ -35,7 +39,7 @@ JSON_SUFFIXES = (".json",)
 CSV_SUFFIXES = (".csv",)
 USD_SUFFIXES = (".usd", ".usda", ".usdc")
 # Results that are large or only useful on screen; the record keeps everything else.
-_NOT_RECORDED = ("keys", "frames", "fps", "curve")
+_NOT_RECORDED = ("keys", "frames", "fps", "curve", "time_codes")
 
 
 def _check_keys(keys: ArrayLike, n_frames: int) -> NDArray[np.int64]:
@@ -64,12 +68,32 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def keys_record(result: Mapping[str, Any], source: str | os.PathLike[str] | None = None) -> dict:
+def _check_time_codes(time_codes: ArrayLike | None, n_frames: int) -> NDArray[np.float64]:
+    if time_codes is None:
+        return np.arange(n_frames, dtype=np.float64)
+    try:
+        t = np.asarray(time_codes, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise ParameterError("time_codes", "not numbers", f"{n_frames} increasing numbers") from None
+    if t.size != n_frames or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        shown = t.tolist()[:8]
+        raise ParameterError("time_codes", shown, f"{n_frames} finite, strictly increasing numbers")
+    return t
+
+
+def keys_record(
+    result: Mapping[str, Any],
+    source: str | os.PathLike[str] | None = None,
+    time_codes: ArrayLike | None = None,
+) -> dict:
     """The JSON record of one solve.
 
     ``result``: ``{"frames": n, "fps": fps, **Selection.to_dict(), ...}`` as ``hairtool keys
     --json`` prints it (per-channel results carry ``union`` instead of ``keys``). The record
-    keeps everything but the cost curve, and lists each key as ``{"frame", "time"}``.
+    keeps everything but the cost curve, and lists each key as ``{"frame", "time_code",
+    "time"}``: its frame index, its time code in the source (``time_codes``, the animation's
+    :attr:`~hairtool.groom.Animation.time_codes`, or ``result["time_codes"]``; default the frame
+    index) and that time code in seconds on the source's clock (time code / fps).
     """
     try:
         n, fps = int(result["frames"]), float(result["fps"])
@@ -78,13 +102,16 @@ def keys_record(result: Mapping[str, Any], source: str | os.PathLike[str] | None
     if not (math.isfinite(fps) and fps > 0):
         raise ParameterError("fps", fps, "a positive frame rate")
     keys = _check_keys(result.get("keys", result.get("union", [])), n)
+    codes = _check_time_codes(time_codes if time_codes is not None else result.get("time_codes"), n)
     return {
         "format": FORMAT,
         "version": FORMAT_VERSION,
         "input": None if source is None else str(source),
         "frames": n,
         "fps": fps,
-        "keys": [{"frame": int(k), "time": int(k) / fps} for k in keys],
+        "keys": [
+            {"frame": int(k), "time_code": float(codes[k]), "time": float(codes[k]) / fps} for k in keys
+        ],
         **{k: _plain(v) for k, v in result.items() if k not in _NOT_RECORDED},
     }
 
@@ -194,15 +221,19 @@ def write_key_sheet(path: str | os.PathLike[str], record: Mapping[str, Any]) -> 
 def write_key_poses(
     path: str | os.PathLike[str], animation: Animation, keys: Sequence[int] | ArrayLike
 ) -> None:
-    """Write USD with only the key poses, each at its frame number as time code (atomically)."""
+    """Write USD with only the key poses, each at its time code in the source (atomically).
+
+    The poses keep the animation's metadata (up axis, unit, curve prims), so they land where
+    the source's frames are."""
     from hairtool.io import usd
 
     k = _check_keys(keys, animation.n_frames)
     if Path(path).suffix.lower() not in USD_SUFFIXES:
         raise FormatError(path, f"key poses are written as USD ({', '.join(USD_SUFFIXES)})")
-    poses = animation.with_frames(animation.frames[k])
+    codes = animation.time_codes[k]
+    poses = animation.with_frames(animation.frames[k], time_codes=codes)
     try:
-        usd.write(Path(path), poses, time_codes=k.tolist())
+        usd.write(Path(path), poses)
     except OSError as e:
         raise FormatError(path, f"cannot write: {e}") from None
 
