@@ -351,7 +351,8 @@ class AnimationExporter(QObject):
         """JSON record, CSV sheet or USD key poses of the timeline's DP keys."""
         model = self.window.animation
         try:
-            record = keys_record(keys_result(model), model.source or None)
+            codes = model.animation.time_codes  # keys at the source's time codes
+            record = keys_record(keys_result(model), model.source or None, time_codes=codes)
             write_keys(path, record, model.animation)
         except HairtoolError as e:
             self.window.show_error("Cannot export keys", str(e))

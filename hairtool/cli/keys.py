@@ -254,13 +254,14 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
     )
     if "note" in result:
         line += f"\n{result['note']}"
-    return _emit(args, result, line)
+    return _emit(args, result, line, data.time_codes if kind == "animation" else None)
 
 
-def _emit(args: argparse.Namespace, result: dict, line: str) -> int:
+def _emit(args: argparse.Namespace, result: dict, line: str, time_codes=None) -> int:
+    """Write ``--out`` (keys at the source's time codes) and print the line or the JSON."""
     if args.out is not None:
         from hairtool.keys.export import keys_record, write_keys_json
 
-        write_keys_json(args.out, keys_record(result, args.input))
+        write_keys_json(args.out, keys_record(result, args.input, time_codes=time_codes))
     print(json.dumps(result) if args.json else line)
     return 0

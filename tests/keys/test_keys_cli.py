@@ -216,3 +216,14 @@ def test_a_progress_bar_on_a_terminal_only(files, capsys):
     d, _ = files
     assert main(["keys", str(d / "anim.npz"), "--keys", "5"]) == 0
     assert capsys.readouterr().err == ""  # piped stderr stays clean
+
+
+def test_the_keys_record_keeps_the_sources_time_codes(tmp_path):
+    from hairtool.bench import SHARED_DATA
+
+    src = SHARED_DATA / "interop" / "b_gnanim.usdc"  # Blender's time codes 1…48
+    assert main(["keys", str(src), "--keys", "5", "--out", str(tmp_path / "k.json")]) == 0
+    record = json.loads((tmp_path / "k.json").read_text())
+    codes = [k["time_code"] for k in record["keys"]]
+    assert codes[0] == 1 and codes[-1] == 48 and len(codes) == 5
+    assert record["keys"][0]["frame"] == 0
