@@ -66,6 +66,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     c.add_argument("--gap-mode", choices=["printed", "text", "off"], default="printed")
     c.add_argument("--no-clump", action="store_true", help="skip ClumpWithGaps")
+    c.add_argument(
+        "--keep-lengths",
+        action="store_true",
+        help="give every segment back its length after clumping (default: as printed, lengths stretch)",
+    )
     parser.add_argument("--json", action="store_true", help="print timings and sizes as JSON")
 
 
@@ -88,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
         clump_iterations=args.clump_iterations,
         clump_step=args.clump_step,
         gap_mode=args.gap_mode,
+        keep_lengths=args.keep_lengths,
     )
     if not math.isfinite(args.max_bend_angle) or not 0 <= args.max_bend_angle <= 180:
         raise ParameterError("max-bend-angle", args.max_bend_angle, "degrees in [0, 180]")

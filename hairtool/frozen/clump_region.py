@@ -33,6 +33,7 @@ from hairtool.frozen.clump import (
     step_from_stats,
     vertex_force,
 )
+from hairtool.frozen.lengths import restore_lengths
 from hairtool.frozen.noise import CH_CLUMP, check_seed, hash_head_nb, hash_tail_u01_nb, seed_u64
 from hairtool.groom import Groom
 
@@ -312,9 +313,12 @@ def clump_points_interactive(
     gap_mode: str = "printed",
     seed: int = 0,
     workspace: ClumpWorkspace | None = None,
+    keep_lengths: bool = False,
 ) -> np.ndarray:
     """:func:`~hairtool.frozen.clump.clump_points`, the same bytes, for a workspace that sees one
-    edit after another: redone only near what changed since its last run when it can."""
+    edit after another: redone only near what changed since its last run when it can. With
+    ``keep_lengths`` the length pass follows the iterations' result in either path (the record
+    keeps the result before it)."""
     ws = workspace or ClumpWorkspace()
     if ws.region is None:
         ws.region = RegionScratch()
@@ -327,4 +331,6 @@ def clump_points_interactive(
         ws.region.fraction = 1.0
         ws.record = not ws.region.skipping
         out = clump_points(groom, radius, iterations, step, gap_mode, seed, ws)
+    if keep_lengths and iterations > 0 and groom.strand_count >= 2:
+        out = restore_lengths(groom.points, out, groom.topology)
     return out
