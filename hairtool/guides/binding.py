@@ -23,7 +23,7 @@ import numpy as np
 
 from hairtool.errors import ParameterError
 from hairtool.frozen.noise import check_seed
-from hairtool.groom import Groom
+from hairtool.groom import Groom, Topology
 from hairtool.guides import children as _children
 from hairtool.guides.nearest import euclidean_nearest, farthest_point_sampling, weights
 from hairtool.guides.scatter import (
@@ -55,7 +55,7 @@ class ChildBinding:
     guide_ids: np.ndarray  # (N, k) int64, nearest first
     weights: np.ndarray  # (N, k) float64, rows sum to 1
     scale: np.ndarray  # (N,) float64 length scale
-    local: np.ndarray  # (V, 3) float64 offsets in the nearest guide's frames (t, n, b)
+    local: np.ndarray | None  # (V, 3) float32 offsets in the nearest guide's frames (t, n, b), or none
     faces: np.ndarray | None = None  # (N,) the scalp triangle of each root, when on a mesh
     exact_points: np.ndarray | None = None  # (V, 3) float32: a dense groom's points …
     exact_blend: np.ndarray | None = None  # … and its float64 blend at rest (see children)
@@ -65,6 +65,7 @@ class ChildBinding:
         self.offsets = np.zeros(len(self.counts) + 1, np.int64)
         np.cumsum(self.counts, out=self.offsets[1:])
         self.vertex_counts = [int(n) for n in np.unique(self.counts)]
+        self.topology = Topology(self.counts)
 
     @property
     def child_count(self) -> int:
@@ -94,7 +95,7 @@ class ChildBinding:
 
     def build(self, guides: Groom | None = None) -> Groom:
         """The children from the guides' current shapes (the rest guides by default)."""
-        return Groom(_children.build_points(self, guides or self.rest_guides), self.counts)
+        return Groom(_children.build_points(self, guides or self.rest_guides), self.topology)
 
 
 def check_k(k: int, guide_count: int) -> int:
@@ -143,9 +144,10 @@ def _bind(
     phase = 2.0 * np.pi * rng.random(count)
     turns = 1.0 + 2.0 * rng.random(count)
     counts = np.full(count, n, np.int64)
-    b = ChildBinding(guides, counts, roots, ids, w, scale, np.zeros((count * n, 3)), faces)
+    b = ChildBinding(guides, counts, roots, ids, w, scale, None, faces)
     if frizz > 0:
         q = _children.build_points(b, guides, np.float64).reshape(count, n, 3)
+        b.local = np.zeros((count * n, 3), np.float32)
         length = np.linalg.norm(np.diff(q, axis=1), axis=2).sum(axis=1)
         u = np.arange(n) / (n - 1)
         a = (frizz * length)[:, None] * u[None, :]
@@ -237,14 +239,15 @@ def bind_dense(
     roots = dense.roots.astype(np.float64)
     ids_k, w = weights(*euclidean_nearest(guides.roots, roots, k), k)
     scale = np.ones(dense.strand_count)
-    b = ChildBinding(guides, dense.counts.copy(), roots, ids_k, w, scale, np.zeros((dense.vertex_count, 3)))
+    b = ChildBinding(guides, dense.counts.copy(), roots, ids_k, w, scale, None)
     q = _children.build_points(b, guides, np.float64)
     tables = _children.GuideTables(guides, b)
     near_row = np.array([tables.base[int(n)] for n in b.counts], np.int64) + ids_k[:, 0] * b.counts
     rows = np.repeat(near_row, b.counts) + dense.topology.index_in_strand
     fr = tables.frames[rows]  # (V, 9): each vertex's frame on its nearest guide
     r = dense.points.astype(np.float64) - q
-    b.local = np.column_stack([np.einsum("ij,ij->i", r, fr[:, 3 * a : 3 * a + 3]) for a in range(3)])
+    local = np.column_stack([np.einsum("ij,ij->i", r, fr[:, 3 * a : 3 * a + 3]) for a in range(3)])
+    b.local = local.astype(np.float32)  # the rest blend below uses these very offsets
     b.exact_blend = _children.build_points(b, guides, np.float64)
     b.exact_points = dense.points
     return guides, b

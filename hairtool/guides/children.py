@@ -68,12 +68,14 @@ class GuideTables:
 def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm, exact_x, exact_y, out):
     k = gid.shape[1]
     exact = exact_x.shape[0] > 0
+    offsets = local.shape[0] > 0
     for c in prange(roots.shape[0]):
         a = coff[c]
         n = coff[c + 1] - a
         tb = tbase[c]
         qx, qy, qz = float(roots[c, 0]), float(roots[c, 1]), float(roots[c, 2])
         near = tb + gid[c, 0] * n
+        sc = scale[c]
         for i in range(n):
             if i > 0:
                 dx = 0.0
@@ -87,7 +89,7 @@ def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm,
                     dy += wm * seg[t, 1]
                     dz += wm * seg[t, 2]
                     length += wm * seglen[t]
-                length *= scale[c]
+                length *= sc
                 d = np.sqrt(dx * dx + dy * dy + dz * dz)
                 if d > TINY:
                     f = length / d
@@ -98,11 +100,13 @@ def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm,
                     qx += frm[near + i, 0] * length
                     qy += frm[near + i, 1] * length
                     qz += frm[near + i, 2] * length
-            fr = frm[near + i]
-            o0, o1, o2 = local[a + i, 0], local[a + i, 1], local[a + i, 2]
-            yx = qx + (o0 * fr[0] + o1 * fr[3] + o2 * fr[6])
-            yy = qy + (o0 * fr[1] + o1 * fr[4] + o2 * fr[7])
-            yz = qz + (o0 * fr[2] + o1 * fr[5] + o2 * fr[8])
+            yx, yy, yz = qx, qy, qz
+            if offsets:
+                r = near + i
+                o0, o1, o2 = float(local[a + i, 0]), float(local[a + i, 1]), float(local[a + i, 2])
+                yx += o0 * frm[r, 0] + o1 * frm[r, 3] + o2 * frm[r, 6]
+                yy += o0 * frm[r, 1] + o1 * frm[r, 4] + o2 * frm[r, 7]
+                yz += o0 * frm[r, 2] + o1 * frm[r, 5] + o2 * frm[r, 8]
             if exact:
                 yx = exact_x[a + i, 0] + (yx - exact_y[a + i, 0])
                 yy = exact_x[a + i, 1] + (yy - exact_y[a + i, 1])
@@ -112,7 +116,7 @@ def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm,
             out[a + i, 2] = yz
 
 
-_NONE32 = np.zeros((0, 3), np.float32)
+_NONE32 = np.zeros((0, 3), np.float32)  # no offsets / not exact
 _NONE64 = np.zeros((0, 3))
 
 
@@ -120,20 +124,21 @@ def build_points(
     binding: ChildBinding,
     guides: Groom,
     dtype: type = np.float32,
-    local: np.ndarray | None = None,
     exact: bool = True,
+    out: np.ndarray | None = None,
 ) -> np.ndarray:
     """``(V, 3)`` child points from the guides' current shapes (``dtype`` float32, or float64
-    for the rest blends the binding keeps). ``local``: offsets other than the binding's;
-    ``exact`` False: y without the dense groom's x + (y − y⁰)."""
+    for the rest blends the binding keeps); ``exact`` False: y without the dense groom's
+    x + (y − y⁰); ``out``: an array to write them into (reused between frames)."""
     binding.check_guides(guides)
     tables = GuideTables(guides, binding)
     tbase = tables.child_base(binding)
-    out = np.empty((binding.vertex_count, 3), dtype)
+    if out is None or out.shape != (binding.vertex_count, 3) or out.dtype != dtype:
+        out = np.empty((binding.vertex_count, 3), dtype)
     use_exact = exact and binding.exact_points is not None
     _children_kernel(
         binding.offsets, tbase, binding.roots, binding.guide_ids, binding.weights, binding.scale,
-        binding.local if local is None else local, tables.seg, tables.seglen, tables.frames,
+        _NONE32 if binding.local is None else binding.local, tables.seg, tables.seglen, tables.frames,
         binding.exact_points if use_exact else _NONE32, binding.exact_blend if use_exact else _NONE64, out,
     )  # fmt: skip
     return out
@@ -159,7 +164,7 @@ def build_points_reference(binding: ChildBinding, guides: Groom) -> np.ndarray:
         )
         step[0] = 0.0
         q = binding.roots[c].astype(np.float64) + np.cumsum(step, axis=0)
-        o = binding.local[a:b]
+        o = np.zeros((n, 3)) if binding.local is None else binding.local[a:b].astype(np.float64)
         y = q + o[:, :1] * fr[:, 0:3] + o[:, 1:2] * fr[:, 3:6] + o[:, 2:3] * fr[:, 6:9]
         if binding.exact_points is not None:
             y = binding.exact_points[a:b] + (y - binding.exact_blend[a:b])

@@ -62,8 +62,7 @@ def _root_normal(tx, ty, tz):
     return nx, ny, nz
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def _frames_kernel(points, rest_tangent, n, out):
+def _frames_py(points, rest_tangent, n, out):
     """``points`` (G·n, 3) float64, guide after guide; ``rest_tangent`` (G, 3) unit rest root
     tangents; ``out`` (G·n, 9) rows t, n, b."""
     for g in prange(points.shape[0] // n):
@@ -94,6 +93,11 @@ def _frames_kernel(points, rest_tangent, n, out):
             o[6], o[7], o[8] = ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx
 
 
+_frames_serial = njit(cache=True, nogil=True)(_frames_py)
+_frames_parallel = njit(cache=True, nogil=True, parallel=True)(_frames_py)
+PARALLEL_FRAMES = 100_000  # frames above which threads pay (below, waking them costs more)
+
+
 def root_tangents(points: np.ndarray, n: int) -> np.ndarray:
     """``(G, 3)`` unit tangents of the first segments of guides of n vertices (x where a first
     segment has no length)."""
@@ -110,7 +114,8 @@ def root_tangents(points: np.ndarray, n: int) -> np.ndarray:
 def frames(points: np.ndarray, rest_tangent: np.ndarray, n: int) -> np.ndarray:
     """``(G·n, 9)`` float64 frames (t, n, b) of guides of n vertices (``points`` (G·n, 3))."""
     out = np.empty((points.shape[0], 9))
-    _frames_kernel(np.ascontiguousarray(points, np.float64), np.ascontiguousarray(rest_tangent), n, out)
+    kernel = _frames_parallel if points.shape[0] > PARALLEL_FRAMES else _frames_serial
+    kernel(np.ascontiguousarray(points, np.float64), np.ascontiguousarray(rest_tangent), n, out)
     return out
 
 
