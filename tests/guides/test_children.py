@@ -56,10 +56,10 @@ def test_a_dense_groom_bound_to_its_guides_comes_back_to_the_bit(grooms_dir):
     # Varying vertex counts, and a planar groom (z = 0 stays 0).
     rng = np.random.default_rng(0)
     mixed = Groom.from_strands([rng.normal(size=(int(n), 3)).cumsum(axis=0) for n in rng.integers(3, 12, 80)])
-    g2, b2 = bind_dense(mixed, 12, k=3, seed=1)
+    _g2, b2 = bind_dense(mixed, 12, k=3, seed=1)
     assert np.array_equal(_bits(b2.build().points), _bits(mixed.points))
     comb = samples.comb(60, 10)
-    g3, b3 = bind_dense(comb, 8, seed=0)
+    _g3, b3 = bind_dense(comb, 8, seed=0)
     assert np.array_equal(_bits(b3.build().points), _bits(comb.points))
 
 
@@ -70,7 +70,9 @@ def test_moving_one_guide_moves_only_the_children_that_weight_it(sintel, grooms_
     g = 17
     pts = guides.points.copy()
     a, e = guides.offsets[g], guides.offsets[g + 1]
-    pts[a + 1 : e] += np.array([0.5, -0.3, 0.2], np.float32) * np.linspace(0, 1, e - a - 1, dtype=np.float32)[:, None]
+    pts[a + 1 : e] += (
+        np.array([0.5, -0.3, 0.2], np.float32) * np.linspace(0, 1, e - a - 1, dtype=np.float32)[:, None]
+    )
     after = b.build(guides.with_points(pts)).points.reshape(b.child_count, -1, 3)
     uses = np.any(b.guide_ids == g, axis=1)
     weighs = np.any((b.guide_ids == g) & (b.weights > 0), axis=1)
@@ -139,7 +141,9 @@ def test_the_same_bytes_at_one_and_two_threads(sintel, grooms_dir, threads):
         moved = guides.with_points(guides.points + np.float32(0.1) * guides.topology.vertex_param[:, None])
         dg, db = bind_dense(dense, 60, seed=1)
         rh = RenderHair(b, ChildClump(iterations=2))
-        runs.append([b.build(moved).points, db.build(dg).points, choose_guides(dense, 60, 1), rh.update().points])
+        runs.append(
+            [b.build(moved).points, db.build(dg).points, choose_guides(dense, 60, 1), rh.update().points]
+        )
     for a, c in zip(*runs, strict=True):
         assert a.tobytes() == c.tobytes()
 

@@ -24,7 +24,9 @@ def sphere(rings: int = 10, segments: int = 16, radius: float = 1.0, jitter: flo
     th = np.linspace(0, np.pi, rings + 1)[1:-1]
     ph = np.linspace(0, 2 * np.pi, segments, endpoint=False)
     t, p = np.meshgrid(th, ph, indexing="ij")
-    v = np.column_stack([np.sin(t).ravel() * np.cos(p).ravel(), np.cos(t).ravel(), np.sin(t).ravel() * np.sin(p).ravel()])
+    v = np.column_stack(
+        [np.sin(t).ravel() * np.cos(p).ravel(), np.cos(t).ravel(), np.sin(t).ravel() * np.sin(p).ravel()]
+    )
     v = np.vstack([[0, 1, 0], v, [0, -1, 0]]) * radius
     v = v + rng.normal(scale=jitter, size=v.shape)
     top, bottom = 0, len(v) - 1
@@ -32,7 +34,10 @@ def sphere(rings: int = 10, segments: int = 16, radius: float = 1.0, jitter: flo
     f = [[top, idx(0, s + 1), idx(0, s)] for s in range(segments)]
     for r in range(rings - 2):
         for s in range(segments):
-            f += [[idx(r, s), idx(r, s + 1), idx(r + 1, s)], [idx(r, s + 1), idx(r + 1, s + 1), idx(r + 1, s)]]
+            f += [
+                [idx(r, s), idx(r, s + 1), idx(r + 1, s)],
+                [idx(r, s + 1), idx(r + 1, s + 1), idx(r + 1, s)],
+            ]
     f += [[bottom, idx(rings - 2, s), idx(rings - 2, s + 1)] for s in range(segments)]
     faces = np.array(f, np.int32)
     return Mesh(v.astype(np.float32), faces, np.zeros_like(v, dtype=np.float32))
@@ -65,7 +70,7 @@ def test_nearest_guides_and_farthest_points_match_their_twins():
     rid, rd = euclidean_nearest_reference(guides, children, 4)
     np.testing.assert_array_equal(ids, rid)
     np.testing.assert_allclose(d, rd, rtol=1e-12)
-    k_ids, w = weights(ids, d, 4)
+    _k_ids, w = weights(ids, d, 4)
     np.testing.assert_allclose(w.sum(axis=1), 1.0)
     assert np.all(np.diff(w, axis=1) <= 1e-15)  # nearest first, heaviest first
     roots = rng.normal(size=(400, 3))
