@@ -144,31 +144,34 @@ def build_points(
     return out
 
 
-def build_points_reference(binding: ChildBinding, guides: Groom) -> np.ndarray:
-    """Numpy twin of :func:`build_points`, child by child with cumulative sums."""
+def build_points_reference(binding: ChildBinding, guides: Groom, chunk: int = 8192) -> np.ndarray:
+    """Numpy twin of :func:`build_points`: the blend over whole arrays of children of one
+    vertex count (``chunk`` at a time), the root-to-tip sum by ``np.cumsum``."""
     binding.check_guides(guides)
     tables = GuideTables(guides, binding, reference=True)
     out = np.empty((binding.vertex_count, 3), np.float32)
-    for c in range(binding.child_count):
-        a, b = binding.offsets[c], binding.offsets[c + 1]
-        n = b - a
-        rows = tables.base[n] + binding.guide_ids[c][:, None] * n + np.arange(n)  # (k, n)
-        w = binding.weights[c][:, None]
-        d = (w[:, :, None] * tables.seg[rows]).sum(axis=0)  # (n, 3)
-        length = binding.scale[c] * (w * tables.seglen[rows]).sum(axis=0)
-        norm = np.linalg.norm(d, axis=1)
-        fr = tables.frames[rows[0]]  # (n, 9): the nearest guide's frames
-        ok = norm > TINY
-        step = np.where(
-            ok[:, None], d * (length / np.where(ok, norm, 1.0))[:, None], fr[:, :3] * length[:, None]
-        )
-        step[0] = 0.0
-        q = binding.roots[c].astype(np.float64) + np.cumsum(step, axis=0)
-        o = np.zeros((n, 3)) if binding.local is None else binding.local[a:b].astype(np.float64)
-        y = q + o[:, :1] * fr[:, 0:3] + o[:, 1:2] * fr[:, 3:6] + o[:, 2:3] * fr[:, 6:9]
-        if binding.exact_points is not None:
-            y = binding.exact_points[a:b] + (y - binding.exact_blend[a:b])
-        out[a:b] = y
+    for n in binding.vertex_counts:
+        group = np.flatnonzero(binding.counts == n)
+        for ids in np.array_split(group, -(-group.size // chunk)):
+            rows = tables.base[n] + binding.guide_ids[ids][:, :, None] * n + np.arange(n)  # (c, k, n)
+            w = binding.weights[ids][:, :, None]
+            d = (w[..., None] * tables.seg[rows]).sum(axis=1)  # (c, n, 3)
+            length = binding.scale[ids][:, None] * (w * tables.seglen[rows]).sum(axis=1)
+            norm = np.linalg.norm(d, axis=2)
+            fr = tables.frames[rows[:, 0]]  # (c, n, 9): the nearest guide's frames
+            ok = norm > TINY
+            along = d * (length / np.where(ok, norm, 1.0))[..., None]
+            step = np.where(ok[..., None], along, fr[..., :3] * length[..., None])
+            step[:, 0] = 0.0
+            y = binding.roots[ids][:, None, :] + np.cumsum(step, axis=1)
+            vids = (binding.offsets[ids][:, None] + np.arange(n)).reshape(-1)
+            if binding.local is not None:
+                o = binding.local[vids].astype(np.float64).reshape(-1, n, 3)
+                y += o[..., :1] * fr[..., 0:3] + o[..., 1:2] * fr[..., 3:6] + o[..., 2:3] * fr[..., 6:9]
+            y = y.reshape(-1, 3)
+            if binding.exact_points is not None:
+                y = binding.exact_points[vids] + (y - binding.exact_blend[vids])
+            out[vids] = y
     return out
 
 
