@@ -93,7 +93,7 @@ def run(args: argparse.Namespace) -> list[dict]:
         result = fn()
         return result, (time.perf_counter() - t0) * 1e3
 
-    count = 10_000 if args.quick else args.children
+    count = min(args.children, 10_000) if args.quick else args.children
     guides = samples.scalp(args.guides, args.vertices, seed=0)
     binding, ms = timed(lambda: bind_roots(guides, count=count, seed=1))
     rows.append(_row(f"scalp {args.guides}x{args.vertices}", guides, binding, ms, repeat, args.clump))
