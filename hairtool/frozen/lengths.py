@@ -18,8 +18,13 @@ from hairtool.groom import Topology
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _restore_kernel(before, after, offsets, out):
-    for s in prange(offsets.size - 1):
+def _restore_kernel(before, after, offsets, strands, out):
+    """The strands ``strands`` (all where it is empty) of ``after``, lengths from ``before``."""
+    count = strands.size if strands.size > 0 else offsets.size - 1
+    for m in prange(count):
+        s = np.int64(m)
+        if strands.size > 0:
+            s = strands[m]
         a, b = offsets[s], offsets[s + 1]
         qx, qy, qz = float(after[a, 0]), float(after[a, 1]), float(after[a, 2])
         out[a, 0], out[a, 1], out[a, 2] = after[a, 0], after[a, 1], after[a, 2]
@@ -44,11 +49,24 @@ def _restore_kernel(before, after, offsets, out):
             out[i, 0], out[i, 1], out[i, 2] = qx, qy, qz
 
 
-def restore_lengths(before: np.ndarray, after: np.ndarray, topology: Topology) -> np.ndarray:
+_ALL = np.zeros(0, np.int64)
+
+
+def restore_lengths(
+    before: np.ndarray,
+    after: np.ndarray,
+    topology: Topology,
+    strands: np.ndarray | None = None,
+    out: np.ndarray | None = None,
+) -> np.ndarray:
     """float32 ``(V, 3)``: ``after`` with every segment set back to its length in ``before``
-    (directions from ``after``; float64 inside, roots as in ``after``)."""
-    out = np.empty((topology.vertex_count, 3), np.float32)
-    _restore_kernel(before, after, topology.offsets, out)
+    (directions from ``after``; float64 inside, roots as in ``after``). With ``strands`` (and
+    ``out`` holding the others) only those strands are written."""
+    if out is None:
+        out = np.empty((topology.vertex_count, 3), np.float32)
+    picked = _ALL if strands is None else np.ascontiguousarray(strands, np.int64)
+    if strands is None or picked.size > 0:
+        _restore_kernel(before, after, topology.offsets, picked, out)
     return out
 
 
