@@ -42,7 +42,10 @@ def add_arguments(parser: argparse.ArgumentParser, *, seed: bool = True) -> argp
         "--frizz", type=float, default=0.01, help="curl radius at the tip / child length, [0, 0.5]"
     )
     g.add_argument(
-        "--region", metavar="FACES", default=None, help="triangles hair grows on (.npy or text indices)"
+        "--region",
+        metavar="SET|FACES",
+        default=None,
+        help="where hair grows: a face set (OBJ group) or triangle indices",
     )
     g.add_argument(
         "--density", metavar="FILE", default=None, help="density per triangle or vertex (.npy or text)"
@@ -118,7 +121,9 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
 
         mesh = read_mesh(args.scalp)
         region = None
-        if args.region is not None:
+        if args.region in mesh.groups and not Path(args.region).is_file():
+            region = args.region  # a face set (group) of the mesh's file
+        elif args.region is not None:
             region = _numbers(args.region, "triangle indices")
             if not np.all(region == np.round(region)):
                 raise ParameterError("region", args.region, "whole triangle indices")

@@ -203,11 +203,11 @@ def bind_scalp(
     seed: int = 0,
     length_variation: float = DEFAULT_LENGTH_VARIATION,
     frizz: float = DEFAULT_FRIZZ,
-    region: np.ndarray | None = None,
+    region: np.ndarray | str | None = None,
     density: np.ndarray | None = None,
 ) -> ChildBinding:
-    """``count`` children scattered on the scalp ``mesh`` (over ``region``: a face mask or
-    indices, default :func:`~hairtool.guides.scatter.default_region`; by area × ``density``),
+    """``count`` children scattered on the scalp ``mesh`` (over ``region``: a face set's name,
+    a face mask or indices, default :func:`~hairtool.guides.scatter.default_region`; by area × ``density``),
     each bound to its k nearest guides along the surface."""
     check_mesh(mesh)
     k = check_k(k, guides.strand_count)

@@ -5,7 +5,8 @@ region where hair grows. The default region is the faces whose corners lie on av
 :data:`DEFAULT_REACH` guide spacings (the median distance between neighbouring guide roots) of a
 guide root along the surface: the scalp the guides cover, not the face or the neck (on Sintel's
 head: 579 of 5,952 triangles, 677 of 2,858 square units, none below her hairline or on her
-neck). Any face set (indices or a mask over the triangles) replaces it. Without a mesh each
+neck). Any face set (the name of a group of the mesh's file, triangle indices or a mask over
+the triangles) replaces it. Without a mesh each
 child takes a guide at random and a point in the disc of one guide spacing around its root,
 across its root tangent.
 
@@ -64,7 +65,12 @@ def default_region(mesh: Mesh, guides: Groom, reach: float = DEFAULT_REACH) -> n
     return d[mesh.faces].mean(axis=1) <= reach * guide_spacing(guides)
 
 
-def _face_mask(mesh: Mesh, region: np.ndarray) -> np.ndarray:
+def _face_mask(mesh: Mesh, region: np.ndarray | str) -> np.ndarray:
+    if isinstance(region, str):
+        if region not in mesh.groups:
+            names = ", ".join(sorted(mesh.groups)) or "none"
+            raise ParameterError("region", region, f"a face set of the mesh ({names})")
+        region = mesh.groups[region]
     r = np.asarray(region)
     nf = len(mesh.faces)
     if r.dtype == bool:
@@ -94,12 +100,12 @@ def scatter_on_mesh(
     mesh: Mesh,
     count: int,
     seed: int,
-    region: np.ndarray,
+    region: np.ndarray | str,
     density: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``count`` roots on the ``region`` faces (mask or indices), uniform by area × density (a
-    per-vertex density is averaged over each triangle's corners): ``(N, 3)`` float64 points and
-    ``(N,)`` their faces."""
+    """``count`` roots on the ``region`` faces (mask, indices or a face set's name), uniform by
+    area × density (a per-vertex density is averaged over each triangle's corners): ``(N, 3)``
+    float64 points and ``(N,)`` their faces."""
     check_mesh(mesh)
     weight = face_areas(mesh) * _face_mask(mesh, region)
     if density is not None:

@@ -184,3 +184,23 @@ def test_bad_input_gives_one_clear_error(sintel):
         b.build(guides.subset(np.arange(10)))
     with pytest.raises(HairtoolError):  # NaN in guides never reaches the kernels
         guides.with_points(np.full_like(guides.points, np.nan))
+
+
+def test_a_face_set_of_the_mesh_file_selects_where_hair_grows(tmp_path):
+    obj = tmp_path / "scalp.obj"
+    grid = [f"v {x} 0 {z}" for z in range(4) for x in range(4)]
+    quads = [(z * 4 + x + 1, z * 4 + x + 2, z * 4 + x + 6, z * 4 + x + 5) for z in range(3) for x in range(3)]
+    lines = [*grid, "g scalp"]
+    lines += [f"f {a} {b} {c} {d}" for a, b, c, d in quads[:3]]
+    lines += ["g neck skin"] + [f"f {a} {b} {c} {d}" for a, b, c, d in quads[3:]]
+    obj.write_text("\n".join(lines) + "\n")
+    mesh = read_mesh(obj)
+    assert set(mesh.groups) == {"scalp", "neck", "skin"}
+    np.testing.assert_array_equal(mesh.groups["scalp"], np.arange(6))  # 3 quads, 6 triangles
+    guides = Groom.from_strands(
+        [[[x + 0.5, 0, z + 0.5], [x + 0.5, 1, z + 0.5]] for x in range(3) for z in range(3)]
+    )
+    b = bind_scalp(guides, mesh, 500, region="scalp", frizz=0.0)
+    assert np.all(b.roots[:, 2] <= 1.0 + 1e-9) and np.all(np.isin(b.faces, mesh.groups["scalp"]))
+    with pytest.raises(ParameterError, match="scalp, skin"):
+        bind_scalp(guides, mesh, 10, region="hat")

@@ -105,6 +105,8 @@ def test_a_mesh_without_faces_and_a_bad_region_file(tmp_path, capsys):
         == 2
     )
     assert "faces.txt" in capsys.readouterr().err
+    assert main(["interpolate", GUIDES, str(out), "--count", "10", "--scalp", HEAD, "--region", "hat"]) == 2
+    assert "GEO-body" in capsys.readouterr().err  # the face sets there are
     region.write_text("0 1 2\n")  # three tiny triangles of her body, far from any guide: still hair
     assert (
         main(["interpolate", GUIDES, str(out), "--count", "10", "--scalp", HEAD, "--region", str(region)])
