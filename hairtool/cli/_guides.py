@@ -121,8 +121,8 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
 
         mesh = read_mesh(args.scalp)
         region = None
-        if args.region in mesh.groups and not Path(args.region).is_file():
-            region = args.region  # a face set (group) of the mesh's file
+        if args.region is not None and not Path(args.region).is_file():
+            region = args.region  # the name of a face set (group) of the mesh's file
         elif args.region is not None:
             region = _numbers(args.region, "triangle indices")
             if not np.all(region == np.round(region)):
