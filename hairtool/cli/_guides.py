@@ -83,6 +83,8 @@ def check(args: argparse.Namespace) -> None:
             raise ParameterError("guides", None, "a number of guides to pick with --from-dense")
         if args.count is not None or args.scalp is not None:
             raise ParameterError("from-dense", "with --count/--scalp", "either --from-dense or --count")
+        if args.vertices is not None:
+            raise ParameterError("vertices", args.vertices, "none with --from-dense (strands keep theirs)")
     elif args.count is None:
         raise ParameterError("count", None, "a number of children (or --from-dense --guides G)")
     io.format_for(args.output, writing=True)

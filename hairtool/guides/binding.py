@@ -95,7 +95,8 @@ class ChildBinding:
 
     def build(self, guides: Groom | None = None) -> Groom:
         """The children from the guides' current shapes (the rest guides by default)."""
-        return Groom(_children.build_points(self, guides or self.rest_guides), self.topology)
+        pose = self.rest_guides if guides is None else guides
+        return Groom(_children.build_points(self, pose), self.topology)
 
 
 def check_k(k: int, guide_count: int) -> int:

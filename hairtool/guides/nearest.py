@@ -4,7 +4,9 @@ and the guides chosen from a dense groom by farthest-point sampling of its roots
 Weights (the guides sorted by distance d₁ ≤ … ≤ d_k, and d_{k+1} the next guide's):
 wⱼ ∝ (1 − dⱼ/R)² with R = d_{k+1}, normalised to sum 1. A guide's weight falls to 0 just as
 it stops being among the k nearest, so children change smoothly across the scalp. With no
-(k+1)-th guide R = 2·d_k; where every dⱼ equals R the weights are equal.
+(k+1)-th guide R = 2·d_k (the farthest reached); where every dⱼ equals R the weights are
+equal. Where fewer than k guides can be reached (a mesh in pieces) the missing ones are the
+nearest again, with weight 0.
 """
 
 from __future__ import annotations
@@ -63,13 +65,18 @@ def weights(guide_ids: np.ndarray, dist: np.ndarray, k: int) -> tuple[np.ndarray
     """``(N, k)`` guides and float64 weights (sum 1) from the k+1 nearest (see the module)."""
     d = dist[:, :k]
     r = dist[:, k] if dist.shape[1] > k else np.full(len(d), np.inf)
-    r = np.where(np.isfinite(r), r, 2.0 * d[:, -1])
+    reached = np.where(np.isfinite(d), d, 0.0).max(axis=1)
+    r = np.where(np.isfinite(r), r, 2.0 * reached)
     with np.errstate(invalid="ignore", divide="ignore"):
         w = np.clip(1.0 - d / r[:, None], 0.0, 1.0) ** 2
     w = np.where(np.isfinite(w), w, 0.0)
+    ids = guide_ids[:, :k]
+    missing = ids < 0  # fewer than k guides reachable (a mesh in pieces): the nearest, weight 0
+    w = np.where(missing, 0.0, w)
     total = w.sum(axis=1, keepdims=True)
-    w = np.where(total > 0, w / np.where(total > 0, total, 1.0), 1.0 / k)
-    return guide_ids[:, :k].copy(), w
+    w = np.where(total > 0, w / np.where(total > 0, total, 1.0), np.where(missing, 0.0, 1.0))
+    w /= w.sum(axis=1, keepdims=True)
+    return np.where(missing, ids[:, :1], ids), w
 
 
 @njit(cache=True, nogil=True, parallel=True)

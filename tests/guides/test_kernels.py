@@ -97,3 +97,12 @@ def test_surface_distances_match_one_dijkstra_per_guide():
     n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     assert np.abs(np.einsum("ij,ij->i", on - v[:, 0], n)).max() < 1e-9
+
+
+def test_weights_where_fewer_guides_are_reached():
+    ids = np.array([[3, 1, -1, -1], [2, 0, 5, 4]])
+    dist = np.array([[0.5, 1.0, np.inf, np.inf], [0.1, 0.2, 0.3, 0.4]])
+    got_ids, w = weights(ids, dist, 3)
+    np.testing.assert_array_equal(got_ids, [[3, 1, 3], [2, 0, 5]])
+    assert w[0, 2] == 0.0 and w[0, 0] > w[0, 1] > 0
+    np.testing.assert_allclose(w.sum(axis=1), 1.0)
