@@ -249,7 +249,7 @@ def bind_dense(
     b = ChildBinding(guides, dense.counts.copy(), roots, ids_k, w, scale, None)
     q = _children.build_points(b, guides, np.float64)
     tables = _children.GuideTables(guides, b)
-    near_row = np.array([tables.base[int(n)] for n in b.counts], np.int64) + ids_k[:, 0] * b.counts
+    near_row = tables.child_base(b) + ids_k[:, 0] * b.counts
     rows = np.repeat(near_row, b.counts) + dense.topology.index_in_strand
     fr = tables.frames[rows]  # (V, 9): each vertex's frame on its nearest guide
     r = dense.points.astype(np.float64) - q
