@@ -169,6 +169,11 @@ def test_bad_input_gives_one_clear_error(sintel):
     empty = Mesh(head.vertices, np.zeros((0, 3), np.int32), head.normals)
     with pytest.raises(ParameterError, match="scalp"):
         bind_scalp(guides, empty, 100)
+    nan_head = Mesh(np.full_like(head.vertices, np.nan), head.faces, head.normals)
+    with pytest.raises(ParameterError, match="scalp"):
+        bind_scalp(guides, nan_head, 100)
+    with pytest.raises(ParameterError, match="density"):
+        bind_scalp(guides, head, 100, density=-np.ones(len(head.vertices)))
     with pytest.raises(ParameterError, match="roots"):
         bind_roots(guides, np.array([[0.0, np.nan, 1.0]]))
     with pytest.raises(ParameterError, match="density"):
