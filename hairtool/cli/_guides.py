@@ -36,10 +36,16 @@ def add_arguments(parser: argparse.ArgumentParser, *, seed: bool = True) -> argp
         )
     g.add_argument("--vertices", type=int, default=None, help="vertices per child (default: the guides')")
     g.add_argument(
-        "--length-variation", type=float, default=0.1, help="child lengths ×[1−v, 1+v], v in [0, 0.9]"
+        "--length-variation",
+        type=float,
+        default=0.1,
+        help="child lengths ×[1−v, 1+v], v in [0, 0.9] (default 0.1)",
     )
     g.add_argument(
-        "--frizz", type=float, default=0.01, help="curl radius at the tip / child length, [0, 0.5]"
+        "--frizz",
+        type=float,
+        default=0.01,
+        help="curl radius at the tip / child length, [0, 0.5] (default 0.01)",
     )
     g.add_argument(
         "--region",
