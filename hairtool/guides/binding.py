@@ -23,7 +23,7 @@ import numpy as np
 
 from hairtool.errors import ParameterError
 from hairtool.frozen.noise import check_seed
-from hairtool.groom import Groom, Topology
+from hairtool.groom import Groom, Topology, vertex_ids_of
 from hairtool.guides import children as _children
 from hairtool.guides.nearest import euclidean_nearest, farthest_point_sampling, weights
 from hairtool.guides.scatter import (
@@ -92,6 +92,25 @@ class ChildBinding:
                 f"{guides.strand_count} strands of {guides.vertex_count} vertices",
                 f"the {self.rest_guides.strand_count} guides the children were bound to, same vertex counts",
             )
+
+    def subset(self, child_ids: np.ndarray) -> ChildBinding:
+        """The children ``child_ids`` only (e.g. every tenth, for a display percentage while
+        dragging): they build to the same points as in the whole binding."""
+        ids = np.asarray(child_ids, np.int64).reshape(-1)
+        if ids.size == 0 or ids.min() < 0 or ids.max() >= self.child_count:
+            raise ParameterError("children", f"{ids.size} ids", f"child indices in [0, {self.child_count})")
+        vids = vertex_ids_of(self.topology, ids)
+
+        def pick(a: np.ndarray | None) -> np.ndarray | None:
+            return None if a is None else a[vids]
+
+        out = ChildBinding(
+            self.rest_guides, self.counts[ids], self.roots[ids], self.guide_ids[ids], self.weights[ids],
+            self.scale[ids], pick(self.local), None if self.faces is None else self.faces[ids],
+            pick(self.exact_points), pick(self.exact_blend),
+        )  # fmt: skip
+        out._tangents = self._tangents
+        return out
 
     def build(self, guides: Groom | None = None) -> Groom:
         """The children from the guides' current shapes (the rest guides by default)."""

@@ -209,3 +209,19 @@ def test_a_face_set_of_the_mesh_file_selects_where_hair_grows(tmp_path):
     assert np.all(b.roots[:, 2] <= 1.0 + 1e-9) and np.all(np.isin(b.faces, mesh.groups["scalp"]))
     with pytest.raises(ParameterError, match="scalp, skin"):
         bind_scalp(guides, mesh, 10, region="hat")
+
+
+def test_a_subset_of_the_children_builds_to_the_same_points(sintel, grooms_dir):
+    guides, head = sintel
+    b = bind_scalp(guides, head, 1000, seed=1)
+    moved = guides.with_points(guides.points + np.float32(0.2) * guides.topology.vertex_param[:, None])
+    every_tenth = np.arange(0, 1000, 10)
+    whole = b.build(moved).points.reshape(1000, -1, 3)
+    part = b.subset(every_tenth).build(moved).points.reshape(100, -1, 3)
+    assert part.tobytes() == whole[every_tenth].tobytes()
+    dense = io.read_groom(grooms_dir / "ponytail_tail.tfx")
+    _, db = bind_dense(dense, 30)
+    ids = np.array([5, 2, 400])
+    assert db.subset(ids).build().points.tobytes() == dense.subset(ids).points.tobytes()
+    with pytest.raises(ParameterError, match="children"):
+        b.subset([1000])
