@@ -3,7 +3,8 @@ subcommand: the leading underscore keeps it out of the command list).
 
 Children come from guides and a scalp mesh (``--scalp``), from guides alone (roots around the
 guide roots), or ``--from-dense``: the input is a dense groom, ``--guides G`` strands of it are
-chosen as guides and every strand is bound to them. Both the render strands and the guides are
+chosen as guides and every strand is bound to them (along the surface of ``--scalp`` if
+given). Both the render strands and the guides are
 written: the render strands to OUT, the guides to ``--guides-out`` (default: OUT with
 ``.guides`` before its extension, ``hair.usda`` → ``hair.guides.usda``).
 """
@@ -87,8 +88,10 @@ def check(args: argparse.Namespace) -> None:
     if args.from_dense:
         if args.guides is None:
             raise ParameterError("guides", None, "a number of guides to pick with --from-dense")
-        if args.count is not None or args.scalp is not None:
-            raise ParameterError("from-dense", "with --count/--scalp", "either --from-dense or --count")
+        if args.count is not None:
+            raise ParameterError("from-dense", "with --count", "either --from-dense or --count")
+        if args.region is not None or args.density is not None:
+            raise ParameterError("from-dense", "with --region/--density", "the dense strands' own roots")
         if args.vertices is not None:
             raise ParameterError("vertices", args.vertices, "none with --from-dense (strands keep theirs)")
     elif args.count is None:
@@ -122,12 +125,14 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
 
     t0 = time.perf_counter()
     k = args.guides_per_child
-    if args.from_dense:
-        guides, binding = bind_dense(groom, args.guides, k=k, seed=args.seed)
-    elif args.scalp is not None:
+    mesh = None
+    if args.scalp is not None:
         from hairtool.io.obj import read_mesh
 
         mesh = read_mesh(args.scalp)
+    if args.from_dense:
+        guides, binding = bind_dense(groom, args.guides, k=k, seed=args.seed, mesh=mesh)
+    elif mesh is not None:
         region = None
         if args.region is not None and not Path(args.region).is_file():
             region = args.region  # the name of a face set (group) of the mesh's file

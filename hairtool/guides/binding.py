@@ -34,7 +34,7 @@ from hairtool.guides.scatter import (
     scatter_around,
     scatter_on_mesh,
 )
-from hairtool.guides.surface import surface_nearest
+from hairtool.guides.surface import closest_points, surface_nearest
 from hairtool.io.obj import Mesh
 
 MAX_CHILDREN = 10_000_000
@@ -182,6 +182,20 @@ def _bind(
     return b
 
 
+def _nearest(guides: Groom, roots: np.ndarray, k: int, mesh: Mesh | None) -> tuple:
+    """The k+1 nearest guides of each root: in space, or along the surface of ``mesh`` (the
+    roots taken to the closest point of their face first; every face tried, so slow for
+    hundreds of thousands of roots on a large mesh)."""
+    if mesh is None:
+        return euclidean_nearest(guides.roots, roots, k), None
+    check_mesh(mesh)
+    on, faces = closest_points(mesh, roots)
+    near = surface_nearest(mesh, guides.roots.astype(np.float64), on, faces, k)
+    if np.any(near[0][:, 0] < 0):
+        raise ParameterError("scalp", "faces no guide root reaches", "a mesh connected to the guides' roots")
+    return near, faces
+
+
 def bind_roots(
     guides: Groom,
     roots: np.ndarray | None = None,
@@ -192,11 +206,12 @@ def bind_roots(
     seed: int = 0,
     length_variation: float = DEFAULT_LENGTH_VARIATION,
     frizz: float = DEFAULT_FRIZZ,
+    mesh: Mesh | None = None,
 ) -> ChildBinding:
     """Children at given ``roots`` ``(N, 3)``, or ``count`` of them around the guide roots,
-    bound to their k nearest guide roots in space; ``vertices`` per child (default: the
-    guides' largest count). The children come in order of their nearest guide (their roots
-    are ``binding.roots``), not in the order of ``roots``."""
+    bound to their k nearest guide roots in space (along the surface of ``mesh`` if given);
+    ``vertices`` per child (default: the guides' largest count). The children come in order
+    of their nearest guide (their roots are ``binding.roots``), not in the order of ``roots``."""
     k = check_k(k, guides.strand_count)
     seed = check_seed(seed)
     _check_variation(length_variation, frizz)
@@ -209,8 +224,8 @@ def bind_roots(
     if not np.all(np.isfinite(roots)):
         raise ParameterError("roots", "non-finite coordinates", "finite child roots")
     check_count(len(roots))
-    near = euclidean_nearest(guides.roots, roots, k)
-    return _bind(guides, roots, near, n, k, seed, length_variation, frizz, None)
+    near, faces = _nearest(guides, roots, k, mesh)
+    return _bind(guides, roots, near, n, k, seed, length_variation, frizz, faces)
 
 
 def bind_scalp(
@@ -240,7 +255,7 @@ def bind_scalp(
     roots, faces = scatter_on_mesh(mesh, count, seed, region, density)
     near = surface_nearest(mesh, guides.roots.astype(np.float64), roots, faces, k)
     if np.any(near[0][:, 0] < 0):
-        raise ParameterError("scalp", "faces no guide root reaches", "a mesh connected to the guides' roots")
+        raise ParameterError("region", "faces no guide root reaches", "faces connected to the guides' roots")
     return _bind(guides, roots, near, n, k, seed, length_variation, frizz, faces)
 
 
@@ -255,17 +270,19 @@ def choose_guides(dense: Groom, guide_count: int, seed: int = 0) -> np.ndarray:
 
 
 def bind_dense(
-    dense: Groom, guide_count: int, *, k: int = DEFAULT_K, seed: int = 0
+    dense: Groom, guide_count: int, *, k: int = DEFAULT_K, seed: int = 0, mesh: Mesh | None = None
 ) -> tuple[Groom, ChildBinding]:
-    """A dense groom as G guides and every strand bound to them: ``(guides, binding)``; the
-    binding built on the guides at rest gives back ``dense``'s points bit for bit."""
+    """A dense groom as G guides and every strand bound to them (guides by root distance, along
+    the surface of ``mesh`` if given): ``(guides, binding)``; the binding built on the guides
+    at rest gives back ``dense``'s points bit for bit."""
     ids = choose_guides(dense, guide_count, seed)
     guides = dense.subset(ids)
     k = check_k(k, guides.strand_count)
     roots = dense.roots.astype(np.float64)
-    ids_k, w = weights(*euclidean_nearest(guides.roots, roots, k), k)
+    near, faces = _nearest(guides, roots, k, mesh)
+    ids_k, w = weights(*near, k)
     scale = np.ones(dense.strand_count)
-    b = ChildBinding(guides, dense.counts.copy(), roots, ids_k, w, scale, None)
+    b = ChildBinding(guides, dense.counts.copy(), roots, ids_k, w, scale, None, faces)
     q = _children.build_points(b, guides, np.float64)
     tables = _children.GuideTables(guides, b)
     near_row = tables.child_base(b) + ids_k[:, 0] * b.counts

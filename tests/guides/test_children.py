@@ -225,3 +225,15 @@ def test_a_subset_of_the_children_builds_to_the_same_points(sintel, grooms_dir):
     assert db.subset(ids).build().points.tobytes() == dense.subset(ids).points.tobytes()
     with pytest.raises(ParameterError, match="children"):
         b.subset([1000])
+
+
+def test_dense_grooms_and_given_roots_bind_along_the_surface(sintel):
+    guides, head = sintel
+    dense = bind_scalp(guides, head, 1500, seed=3).build()  # a dense groom on her head
+    _, db = bind_dense(dense, 120, seed=1, mesh=head)
+    assert db.faces is not None and len(db.faces) == 1500
+    assert db.build().points.tobytes() == dense.points.tobytes()
+    _, flat = bind_dense(dense, 120, seed=1)  # the same guides, by distance in space
+    assert np.any(flat.guide_ids != db.guide_ids)  # across her head, some neighbours differ
+    given = bind_roots(guides, dense.roots[:300], mesh=head, frizz=0.0)
+    np.testing.assert_allclose(build_points(given, guides), build_points_reference(given, guides), atol=1e-5)

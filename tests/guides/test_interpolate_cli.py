@@ -80,6 +80,7 @@ def test_freeze_outputs_render_hair(tmp_path, capsys):
         (["--count", "10", "--guides-per-child", "229"], "guides_per_child"),
         (["--from-dense"], "guides"),
         (["--count", "10", "--from-dense", "--guides", "5"], "from-dense"),
+        (["--from-dense", "--guides", "5", "--region", "scalp"], "from-dense"),
         (["--count", "10", "--region", "nowhere.txt"], "region"),
         (["--count", "10", "--length-variation", "nan"], "length_variation"),
     ],
