@@ -56,7 +56,6 @@ class GuideTables:
         self.seglen = np.concatenate(lens)
         self.frames = np.concatenate(frms)
 
-
     def child_base(self, binding: ChildBinding) -> np.ndarray:
         """``(N,)`` the first table row of each child's vertex count."""
         if len(self.bases) == 1:
