@@ -63,6 +63,12 @@ ENGINE_PARAMS: tuple[ParamSpec, ...] = (
     ParamSpec("clump_iterations", "Iterations k", "int", 0, 100, tip="eq. 16"),
     ParamSpec("clump_step", "Step Δt²/m", "optional", 1e-4, 0.5, log=True, relative=True, tip="eq. 16"),
     ParamSpec("gap_mode", "Gaps", "choice", choices=GAP_MODES, tip="eqs. 17–19: printed formula, text, off"),
+    ParamSpec(
+        "keep_lengths",
+        "Keep lengths",
+        "bool",
+        tip="after clumping, every segment back to its length (ClumpWithGaps as printed stretches them)",
+    ),
 )
 
 

@@ -1,6 +1,9 @@
 """Give a groom the frozen-hair look (Kim 2026): FreezeDeform → UserAlign → ClumpWithGaps.
 
 Align samples (--align, repeatable) are applied in order, like mouse moves in the studio.
+With --count (children grown from the input as guides) or --from-dense --guides G (guides picked
+from the input), the pipeline runs on the guides and OUT receives the render strands
+interpolated from the frozen guides (see ``hairtool interpolate``).
 """
 
 from __future__ import annotations
@@ -8,6 +11,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
+
+from hairtool.cli import _guides
 
 HELP = "freeze a groom: stiff stretch/bend noise, cursor alignment, clumping with gaps"
 
@@ -66,6 +71,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     c.add_argument("--gap-mode", choices=["printed", "text", "off"], default="printed")
     c.add_argument("--no-clump", action="store_true", help="skip ClumpWithGaps")
+    c.add_argument(
+        "--keep-lengths",
+        action="store_true",
+        help="give every segment back its length after clumping (default: as printed, lengths stretch)",
+    )
+    _guides.add_arguments(parser, seed=False)
     parser.add_argument("--json", action="store_true", help="print timings and sizes as JSON")
 
 
@@ -88,6 +99,7 @@ def run(args: argparse.Namespace) -> int:
         clump_iterations=args.clump_iterations,
         clump_step=args.clump_step,
         gap_mode=args.gap_mode,
+        keep_lengths=args.keep_lengths,
     )
     if not math.isfinite(args.max_bend_angle) or not 0 <= args.max_bend_angle <= 180:
         raise ParameterError("max-bend-angle", args.max_bend_angle, "degrees in [0, 180]")
@@ -97,8 +109,13 @@ def run(args: argparse.Namespace) -> int:
     check_align_params(
         (0.0, 0.0, 0.0), 1.0 if args.radius is None else args.radius, args.intensity, args.align_mode
     )
+    render = _guides.wanted(args)
+    if render:
+        _guides.check(args)
     groom = io.read_groom(args.input)
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
+    if render:
+        groom, binding, bind_ms = _guides.bind(args, groom)  # the pipeline runs on the guides
     pipe = FrozenPipeline(groom, params)
     lo, hi = groom.bounds
     radius = float(np.linalg.norm(hi - lo)) if args.radius is None else args.radius
@@ -106,9 +123,15 @@ def run(args: argparse.Namespace) -> int:
     for cursor in args.align:
         pipe.align(cursor, radius, args.intensity, args.align_mode)
         timings.append(pipe.timings)
-    io.write(args.output, pipe.result)
+    report = {}
+    if render:
+        hair = _guides.render(args, binding).update(pipe.result)
+        report = _guides.write(args, hair, pipe.result)
+        report |= {"guides": groom.strand_count, "children": binding.child_count, "bind_ms": bind_ms}
+    else:
+        io.write(args.output, pipe.result)
     if args.json:
-        report = {
+        report |= {
             "strands": groom.strand_count,
             "vertices": groom.vertex_count,
             "clump_radius": pipe.clump_radius,

@@ -20,6 +20,9 @@ within h. (A pair farther apart than 1.1·h at the start never interacts in that
 (an update on the points of the last one, e.g. a clump-only parameter change or a cursor held
 still, reuses it). :func:`clump_reference` is the plain numpy twin of the same definition.
 While a brush drags, :mod:`hairtool.frozen.clump_region` redoes a run only near what changed.
+
+``keep_lengths``: after the k iterations every segment is set back to its length before
+clumping, root to tip, direction kept (:mod:`hairtool.frozen.lengths`); off by default, as printed.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.errors import ParameterError
+from hairtool.frozen.lengths import restore_lengths, restore_lengths_reference
 from hairtool.frozen.noise import (
     CH_CLUMP,
     EPS,
@@ -373,6 +377,7 @@ def clump_points(
     gap_mode: str = "printed",
     seed: int = 0,
     workspace: ClumpWorkspace | None = None,
+    keep_lengths: bool = False,
 ) -> np.ndarray:
     """:func:`clump` returning float32 ``(V, 3)`` points instead of a groom."""
     check_clump_params(radius, iterations, step, gap_mode)
@@ -408,6 +413,8 @@ def clump_points(
         rec.step, rec.mean_neighbours = ws.step, ws.mean_neighbours
         rec.valid = True
         ws.recorded = rec
+    if keep_lengths:  # after the record: it holds the iterations' result, as region updates redo it
+        out = restore_lengths(groom.points, out, groom.topology)
     return out
 
 
@@ -426,14 +433,17 @@ def clump(
     gap_mode: str = "printed",
     seed: int = 0,
     workspace: ClumpWorkspace | None = None,
+    keep_lengths: bool = False,
 ) -> Groom:
     """ClumpWithGaps: vertices pulled toward nearby vertices of other strands; roots stay.
 
     ``radius`` h (groom units), ``iterations`` k ∈ [0, 100], ``step`` Δt²/m (None: :func:`auto_step`),
     ``gap_mode`` "printed" | "text" | "off", ``seed`` for ζ. Pass a ``workspace`` to reuse
-    buffers across updates and read ``mean_neighbours`` afterwards.
+    buffers across updates and read ``mean_neighbours`` afterwards. ``keep_lengths``: segments
+    back to their lengths before clumping afterwards (off: as printed, for the paper's figures).
     """
-    return groom.with_points(clump_points(groom, radius, iterations, step, gap_mode, seed, workspace))
+    pts = clump_points(groom, radius, iterations, step, gap_mode, seed, workspace, keep_lengths)
+    return groom.with_points(pts)
 
 
 def clump_reference(
@@ -443,6 +453,7 @@ def clump_reference(
     step: float | None = None,
     gap_mode: str = "printed",
     seed: int = 0,
+    keep_lengths: bool = False,
 ) -> Groom:
     """Plain numpy twin of :func:`clump`: candidate pairs from the start, filtered each iteration."""
     check_clump_params(radius, iterations, step, gap_mode)
@@ -488,4 +499,6 @@ def clump_reference(
                 delta = np.clip(np.abs(r1 - r0) / h, 0.0, 1.0)
                 lam[pi] = (1.0 - delta) * zeta
         P = P + lam[:, None] * dp  # (19)
+    if keep_lengths and iterations > 0:
+        P = restore_lengths_reference(groom.points, P.astype(np.float32), top)
     return groom.with_points(P)

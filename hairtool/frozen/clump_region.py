@@ -33,6 +33,7 @@ from hairtool.frozen.clump import (
     step_from_stats,
     vertex_force,
 )
+from hairtool.frozen.lengths import restore_lengths
 from hairtool.frozen.noise import CH_CLUMP, check_seed, hash_head_nb, hash_tail_u01_nb, seed_u64
 from hairtool.groom import Groom
 
@@ -180,6 +181,8 @@ class RegionScratch:
         self.too_many = np.inf  # changed vertices of a try whose region was too large (grows)
         self.skipping = False  # the last update did not try
         self.fraction = 1.0  # share of the vertices the last update redid (1: a full run)
+        self.region = np.zeros(0, np.int64)  # the vertices the last region update redid
+        self.kept: np.ndarray | None = None  # the last result with lengths kept (keep_lengths)
 
     def sized(self, v: int) -> None:
         if self.flags.size != v:
@@ -208,6 +211,7 @@ def _update_region(
     if changed.size == 0:
         ws.step, ws.mean_neighbours = rec.step, rec.mean_neighbours
         sc.fraction = 0.0
+        sc.region = changed
         return rec.result.copy()
     if changed.size > MAX_CHANGED * v or not rec.dense:
         sc.skipping = changed.size > MAX_CHANGED * v  # (a record would not serve the next move either)
@@ -292,6 +296,7 @@ def _update_region(
     ws.step, ws.mean_neighbours = k_step, mean_nb
     sc.updates += 1
     sc.fraction = region.size / v
+    sc.region = region
     return rec.result.copy()
 
 
@@ -312,9 +317,12 @@ def clump_points_interactive(
     gap_mode: str = "printed",
     seed: int = 0,
     workspace: ClumpWorkspace | None = None,
+    keep_lengths: bool = False,
 ) -> np.ndarray:
     """:func:`~hairtool.frozen.clump.clump_points`, the same bytes, for a workspace that sees one
-    edit after another: redone only near what changed since its last run when it can."""
+    edit after another: redone only near what changed since its last run when it can. With
+    ``keep_lengths`` the length pass follows the iterations' result in either path (the record
+    keeps the result before it)."""
     ws = workspace or ClumpWorkspace()
     if ws.region is None:
         ws.region = RegionScratch()
@@ -327,4 +335,14 @@ def clump_points_interactive(
         ws.region.fraction = 1.0
         ws.record = not ws.region.skipping
         out = clump_points(groom, radius, iterations, step, gap_mode, seed, ws)
-    return out
+    sc = ws.region
+    if not (keep_lengths and iterations > 0 and groom.strand_count >= 2):
+        sc.kept = None
+        return out
+    top = groom.topology
+    if sc.fraction < 1.0 and sc.kept is not None and sc.kept.shape == out.shape:
+        # Outside the region the input and the result are the last run's: so is their pass.
+        restore_lengths(groom.points, out, top, np.unique(top.strand_index[sc.region]), sc.kept)
+    else:
+        sc.kept = restore_lengths(groom.points, out, top)
+    return sc.kept.copy()

@@ -37,7 +37,9 @@ class FrozenParams:
     array of multipliers. ``clump_radius`` None: :func:`~hairtool.frozen.strand_clumps.auto_clump_radius`.
     ``clump_step`` None: :func:`~hairtool.frozen.clump.auto_step` of the frozen groom, before any stroke
     (so that a stroke does not change how strongly the whole groom clumps while it drags, and
-    the studio can redo ClumpWithGaps only near the strands it moves). ``redraw_noise``: new
+    the studio can redo ClumpWithGaps only near the strands it moves). ``keep_lengths``: after
+ClumpWithGaps every segment goes back to its length before it (off: the paper's printed form,
+which stretches segments). ``redraw_noise``: new
     freeze noise at every :meth:`update` (the paper's behaviour; flickers while dragging).
     """
 
@@ -52,6 +54,7 @@ class FrozenParams:
     clump_iterations: int = 3
     clump_step: float | None = None
     gap_mode: str = "printed"
+    keep_lengths: bool = False
     redraw_noise: bool = False
     _key: tuple = field(init=False, repr=False, compare=False)
 
@@ -310,6 +313,7 @@ class FrozenPipeline:
                 p.gap_mode,
                 draw_seed(p.seed, self._draw),
                 self._workspace,
+                bool(p.keep_lengths),
             )
             self._result = self._rest.with_points(pts)
         else:

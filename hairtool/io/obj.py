@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import itertools
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -27,12 +27,15 @@ from hairtool.io.binary import require_finite, require_strand_counts
 class Mesh:
     """A triangle mesh: ``vertices`` float32 (n, 3), ``faces`` int32 (m, 3), ``normals`` float32 (n, 3).
 
-    Normals are unit length; a vertex that no face touches has a zero normal.
+    Normals are unit length; a vertex that no face touches has a zero normal. ``groups``: the
+    triangles (int64 indices) of each named face set of the file (``g`` and ``o`` records),
+    e.g. the scalp where hair grows.
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     normals: np.ndarray
+    groups: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 class _Records:
@@ -48,6 +51,9 @@ class _Records:
         vn: list[str] = []
         self.lines: list[tuple[int, list[str]]] = []  # (vertices so far, index tokens)
         self.faces: list[tuple[int, int, list[str]]] = []  # (vertices so far, normals so far, corners)
+        self.face_sets: list[int] = []  # per face: its index in self.set_names
+        self.set_names: list[tuple[str, ...]] = [()]  # the g/o names a face is in
+        names: dict[str, tuple[str, ...]] = {"g": (), "o": ()}
         for number, line in enumerate(text.splitlines(), 1):
             if line.startswith("v "):
                 v.append(line)
@@ -66,6 +72,10 @@ class _Records:
                 if len(parts) < 4:
                     raise FormatError(path, f"line {number}: a face needs at least 3 corners")
                 self.faces.append((len(v), len(vn), parts[1:]))
+                self.face_sets.append(len(self.set_names) - 1)
+            elif key in ("g", "o"):
+                names[key] = tuple(parts[1:])
+                self.set_names.append(names["o"] + names["g"])
         self.vertices = _floats(path, v, "v")
         self.vertex_normals = _floats(path, vn, "vn")
 
@@ -157,7 +167,13 @@ def read_mesh(path: str | os.PathLike[str]) -> Mesh:
         summed = _scatter_sum(faces.reshape(-1), np.repeat(face_normals, 3, axis=0), len(vertices))
     length = np.linalg.norm(summed, axis=1, keepdims=True)
     normals = np.divide(summed, length, out=np.zeros_like(summed), where=length > 0)
-    return Mesh(vertices.astype(np.float32), faces.astype(np.int32), normals.astype(np.float32))
+    tri_sets = np.repeat(np.array(rec.face_sets, np.int64), n_tri)
+    groups: dict[str, list[int]] = {}
+    for k in np.unique(tri_sets):
+        for name in rec.set_names[k]:
+            groups.setdefault(name, []).extend(np.flatnonzero(tri_sets == k).tolist())
+    sets = {name: np.unique(np.array(ids, np.int64)) for name, ids in groups.items()}
+    return Mesh(vertices.astype(np.float32), faces.astype(np.int32), normals.astype(np.float32), sets)
 
 
 def _scatter_sum(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:

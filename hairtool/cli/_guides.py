@@ -1,0 +1,178 @@
+"""Render-hair options shared by ``hairtool interpolate`` and ``hairtool freeze`` (not a
+subcommand: the leading underscore keeps it out of the command list).
+
+Children come from guides and a scalp mesh (``--scalp``), from guides alone (roots around the
+guide roots), or ``--from-dense``: the input is a dense groom, ``--guides G`` strands of it are
+chosen as guides and every strand is bound to them (along the surface of ``--scalp`` if
+given). Both the render strands and the guides are
+written: the render strands to OUT, the guides to ``--guides-out`` (default: OUT with
+``.guides`` before its extension, ``hair.usda`` → ``hair.guides.usda``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from hairtool.groom import Groom
+    from hairtool.guides.binding import ChildBinding
+    from hairtool.guides.render import RenderHair
+
+
+def add_arguments(parser: argparse.ArgumentParser, *, seed: bool = True) -> argparse._ArgumentGroup:
+    g = parser.add_argument_group("render hair (children interpolated from guides)")
+    g.add_argument("--count", type=int, default=None, help="children to grow from the guides")
+    g.add_argument("--scalp", metavar="MESH.obj", default=None, help="scalp mesh the children grow on")
+    g.add_argument(
+        "--guides-per-child", type=int, default=4, metavar="K", help="k nearest guides (default 4)"
+    )
+    if seed:
+        g.add_argument(
+            "--seed", type=int, default=0, help="seed of the roots and variation (same seed, same bytes)"
+        )
+    g.add_argument("--vertices", type=int, default=None, help="vertices per child (default: the guides')")
+    g.add_argument(
+        "--length-variation",
+        type=float,
+        default=0.1,
+        help="child lengths ×[1−v, 1+v], v in [0, 0.9] (default 0.1)",
+    )
+    g.add_argument(
+        "--frizz",
+        type=float,
+        default=0.01,
+        help="curl radius at the tip / child length, [0, 0.5] (default 0.01)",
+    )
+    g.add_argument(
+        "--region",
+        metavar="SET|FACES",
+        default=None,
+        help="where hair grows: a face set (OBJ group) or triangle indices",
+    )
+    g.add_argument(
+        "--density", metavar="FILE", default=None, help="density per triangle or vertex (.npy or text)"
+    )
+    g.add_argument("--clump-children", action="store_true", help="ClumpWithGaps among the children")
+    g.add_argument(
+        "--from-dense", action="store_true", help="the input is a dense groom: pick --guides G of it"
+    )
+    g.add_argument("--guides", type=int, default=None, metavar="G", help="guides to pick with --from-dense")
+    g.add_argument(
+        "--guides-out", default=None, metavar="PATH", help="where the guides go (default OUT.guides.EXT)"
+    )
+    return g
+
+
+def wanted(args: argparse.Namespace) -> bool:
+    """Whether the options ask for render hair."""
+    return args.count is not None or args.from_dense
+
+
+def guides_path(args: argparse.Namespace) -> Path:
+    if args.guides_out:
+        return Path(args.guides_out)
+    out = Path(args.output)
+    return out.with_name(f"{out.stem}.guides{out.suffix}")
+
+
+def check(args: argparse.Namespace) -> None:
+    """Refuse contradictory options and unwritable outputs before any work."""
+    from hairtool import io
+    from hairtool.errors import ParameterError
+
+    if args.from_dense:
+        if args.guides is None:
+            raise ParameterError("guides", None, "a number of guides to pick with --from-dense")
+        if args.count is not None:
+            raise ParameterError("from-dense", "with --count", "either --from-dense or --count")
+        if args.region is not None or args.density is not None:
+            raise ParameterError("from-dense", "with --region/--density", "the dense strands' own roots")
+        if args.vertices is not None:
+            raise ParameterError("vertices", args.vertices, "none with --from-dense (strands keep theirs)")
+    elif args.count is None:
+        raise ParameterError("count", None, "a number of children (or --from-dense --guides G)")
+    io.format_for(args.output, writing=True)
+    if args.from_dense:
+        io.format_for(guides_path(args), writing=True)
+
+
+def _numbers(path: str, what: str) -> np.ndarray:
+    import numpy as np
+
+    from hairtool.errors import FormatError
+
+    p = Path(path)
+    if not p.is_file():
+        raise FormatError(p, "no such file")
+    try:
+        a = np.load(p, allow_pickle=False) if p.suffix == ".npy" else np.loadtxt(p, ndmin=1)
+    except (OSError, ValueError) as e:
+        raise FormatError(p, f"cannot read {what}: {e}") from None
+    return np.asarray(a).reshape(-1)
+
+
+def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, float]:
+    """``(guides, binding, milliseconds)`` from the options and the input groom."""
+    import numpy as np
+
+    from hairtool.errors import ParameterError
+    from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp
+
+    t0 = time.perf_counter()
+    k = args.guides_per_child
+    mesh = None
+    if args.scalp is not None:
+        from hairtool.io.obj import read_mesh
+
+        mesh = read_mesh(args.scalp)
+    if args.from_dense:
+        guides, binding = bind_dense(groom, args.guides, k=k, seed=args.seed, mesh=mesh)
+    elif mesh is not None:
+        region = None
+        if args.region is not None and not Path(args.region).is_file():
+            region = args.region  # the name of a face set (group) of the mesh's file
+        elif args.region is not None:
+            region = _numbers(args.region, "triangle indices")
+            if not np.all(region == np.round(region)):
+                raise ParameterError("region", args.region, "whole triangle indices")
+            region = region.astype(np.int64)
+        density = None if args.density is None else _numbers(args.density, "densities")
+        guides = groom
+        binding = bind_scalp(
+            groom, mesh, args.count, k=k, vertices=args.vertices, seed=args.seed,
+            length_variation=args.length_variation, frizz=args.frizz, region=region, density=density,
+        )  # fmt: skip
+    else:
+        if args.region is not None or args.density is not None:
+            raise ParameterError(
+                "region", args.region or args.density, "a --scalp mesh to select triangles of"
+            )
+        guides = groom
+        binding = bind_roots(
+            groom, count=args.count, k=k, vertices=args.vertices, seed=args.seed,
+            length_variation=args.length_variation, frizz=args.frizz,
+        )  # fmt: skip
+    return guides, binding, (time.perf_counter() - t0) * 1e3
+
+
+def render(args: argparse.Namespace, binding: ChildBinding) -> RenderHair:
+    from hairtool.guides.render import ChildClump, RenderHair
+
+    return RenderHair(binding, ChildClump(seed=args.seed) if args.clump_children else None)
+
+
+def write(args: argparse.Namespace, hair: Groom, guides: Groom) -> dict:
+    """Write the render strands (and, from a dense groom, the guides); the report's paths."""
+    from hairtool import io
+
+    io.write(args.output, hair)
+    report = {"output": str(args.output)}
+    if args.from_dense:
+        io.write(guides_path(args), guides)
+        report["guides_output"] = str(guides_path(args))
+    return report

@@ -1,0 +1,296 @@
+"""The child definition: what render strands are made of, without their points.
+
+A :class:`ChildBinding` holds, per child, its root, vertex count, k guides and weights
+(:mod:`hairtool.guides.nearest`), a length scale and local offsets in the nearest guide's
+frames (:mod:`hairtool.guides.children`), and the guides at rest. Three ways to make one:
+
+- :func:`bind_scalp`: guides and a scalp mesh → N children scattered on the region where hair
+  grows (:mod:`hairtool.guides.scatter`), guides by distance along the surface;
+- :func:`bind_roots`: guides and given roots (or, with none, roots around the guide roots);
+- :func:`bind_dense`: a dense groom → G guides by farthest-point sampling of its roots, every
+  strand bound with its offset from the blend, so the guides at rest give back its bytes.
+
+Per-child variation (seeded): length scale s ∈ [1 − v, 1 + v] uniform, and frizz, a curl across
+the strand whose radius grows from 0 at the root to ``frizz`` × the child's length at the tip
+(1 to 3 turns, random phase). With frizz 0 a child is s × the weighted length of its guides.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hairtool.errors import ParameterError
+from hairtool.frozen.noise import check_seed
+from hairtool.groom import Groom, Topology, vertex_ids_of
+from hairtool.guides import children as _children
+from hairtool.guides.nearest import euclidean_nearest, farthest_point_sampling, weights
+from hairtool.guides.scatter import (
+    CH_VARIATION,
+    check_mesh,
+    default_region,
+    generator,
+    scatter_around,
+    scatter_on_mesh,
+)
+from hairtool.guides.surface import closest_points, surface_nearest
+from hairtool.io.obj import Mesh
+
+MAX_CHILDREN = 10_000_000
+MAX_LENGTH_VARIATION = 0.9
+MAX_FRIZZ = 0.5
+DEFAULT_K = 4
+DEFAULT_LENGTH_VARIATION = 0.1
+DEFAULT_FRIZZ = 0.01
+
+
+@dataclass(eq=False)
+class ChildBinding:
+    """N children bound to G guides (arrays as the kernels read them)."""
+
+    rest_guides: Groom
+    counts: np.ndarray  # (N,) int64 vertices per child
+    roots: np.ndarray  # (N, 3) float64
+    guide_ids: np.ndarray  # (N, k) int64, nearest first
+    weights: np.ndarray  # (N, k) float64, rows sum to 1
+    scale: np.ndarray  # (N,) float64 length scale
+    local: np.ndarray | None  # (V, 3) float32 offsets in the nearest guide's frames (t, n, b), or none
+    faces: np.ndarray | None = None  # (N,) the scalp triangle of each root, when on a mesh
+    exact_points: np.ndarray | None = None  # (V, 3) float32: a dense groom's points …
+    exact_blend: np.ndarray | None = None  # … and its float64 blend at rest (see children)
+    _tangents: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        self.offsets = np.zeros(len(self.counts) + 1, np.int64)
+        np.cumsum(self.counts, out=self.offsets[1:])
+        self.vertex_counts = [int(n) for n in np.unique(self.counts)]
+        self.topology = Topology(self.counts)
+
+    @property
+    def child_count(self) -> int:
+        return len(self.counts)
+
+    @property
+    def vertex_count(self) -> int:
+        return int(self.offsets[-1])
+
+    @property
+    def guides_per_child(self) -> int:
+        return int(self.guide_ids.shape[1])
+
+    def rest_tangents(self, n: int) -> np.ndarray:
+        """``(G, 3)`` the rest guides' root tangents at n vertices (cached)."""
+        if n not in self._tangents:
+            self._tangents[n] = _children.root_tangents_of(self.rest_guides, n)
+        return self._tangents[n]
+
+    def check_guides(self, guides: Groom) -> None:
+        if guides.topology != self.rest_guides.topology:
+            raise ParameterError(
+                "guides",
+                f"{guides.strand_count} strands of {guides.vertex_count} vertices",
+                f"the {self.rest_guides.strand_count} guides the children were bound to, same vertex counts",
+            )
+
+    def subset(self, child_ids: np.ndarray) -> ChildBinding:
+        """The children ``child_ids`` only (e.g. every tenth, for a display percentage while
+        dragging): they build to the same points as in the whole binding."""
+        ids = np.asarray(child_ids, np.int64).reshape(-1)
+        if ids.size == 0 or ids.min() < 0 or ids.max() >= self.child_count:
+            raise ParameterError("children", f"{ids.size} ids", f"child indices in [0, {self.child_count})")
+        vids = vertex_ids_of(self.topology, ids)
+
+        def pick(a: np.ndarray | None) -> np.ndarray | None:
+            return None if a is None else a[vids]
+
+        out = ChildBinding(
+            self.rest_guides, self.counts[ids], self.roots[ids], self.guide_ids[ids], self.weights[ids],
+            self.scale[ids], pick(self.local), None if self.faces is None else self.faces[ids],
+            pick(self.exact_points), pick(self.exact_blend),
+        )  # fmt: skip
+        out._tangents = self._tangents
+        return out
+
+    def build(self, guides: Groom | None = None) -> Groom:
+        """The children from the guides' current shapes (the rest guides by default)."""
+        pose = self.rest_guides if guides is None else guides
+        return Groom(_children.build_points(self, pose), self.topology)
+
+
+def check_k(k: int, guide_count: int) -> int:
+    if isinstance(k, bool) or int(k) != k or not 1 <= k <= guide_count:
+        raise ParameterError("guides_per_child", k, f"a whole number in [1, {guide_count}] (the guide count)")
+    return int(k)
+
+
+def check_count(count: int, name: str = "count") -> int:
+    if isinstance(count, bool) or int(count) != count or not 1 <= count <= MAX_CHILDREN:
+        raise ParameterError(name, count, f"a whole number of children in [1, {MAX_CHILDREN}]")
+    return int(count)
+
+
+def _check_variation(length_variation: float, frizz: float) -> None:
+    v = float(length_variation)
+    if not np.isfinite(v) or not 0 <= v <= MAX_LENGTH_VARIATION:
+        raise ParameterError("length_variation", length_variation, f"a number in [0, {MAX_LENGTH_VARIATION}]")
+    f = float(frizz)
+    if not np.isfinite(f) or not 0 <= f <= MAX_FRIZZ:
+        raise ParameterError("frizz", frizz, f"a fraction of the strand length in [0, {MAX_FRIZZ}]")
+
+
+def _vertices(guides: Groom, vertices: int | None) -> int:
+    n = int(guides.counts.max()) if vertices is None else vertices
+    if isinstance(n, bool) or int(n) != n or not 2 <= n <= 1024:
+        raise ParameterError("vertices", vertices, "a whole number of vertices per child in [2, 1024]")
+    return int(n)
+
+
+def _bind(
+    guides: Groom,
+    roots: np.ndarray,
+    near: tuple[np.ndarray, np.ndarray],
+    n: int,
+    k: int,
+    seed: int,
+    length_variation: float,
+    frizz: float,
+    faces: np.ndarray | None,
+) -> ChildBinding:
+    # Children in order of their nearest guide: the kernel then reads the same guide rows
+    # child after child (about 20 % faster on 100,000 children than in scatter order).
+    order = np.argsort(near[0][:, 0], kind="stable")
+    roots, near = roots[order], (near[0][order], near[1][order])
+    faces = None if faces is None else faces[order]
+    ids, w = weights(*near, k)
+    count = len(roots)
+    rng = generator(seed, CH_VARIATION)
+    scale = 1.0 + length_variation * (2.0 * rng.random(count) - 1.0)
+    phase = 2.0 * np.pi * rng.random(count)
+    turns = 1.0 + 2.0 * rng.random(count)
+    counts = np.full(count, n, np.int64)
+    b = ChildBinding(guides, counts, roots, ids, w, scale, None, faces)
+    if frizz > 0:
+        q = _children.build_points(b, guides, np.float64).reshape(count, n, 3)
+        b.local = np.zeros((count * n, 3), np.float32)
+        length = np.linalg.norm(np.diff(q, axis=1), axis=2).sum(axis=1)
+        u = np.arange(n) / (n - 1)
+        a = (frizz * length)[:, None] * u[None, :]
+        ang = 2.0 * np.pi * turns[:, None] * u[None, :] + phase[:, None]
+        b.local[:, 1] = (a * np.cos(ang)).reshape(-1)
+        b.local[:, 2] = (a * np.sin(ang)).reshape(-1)
+    return b
+
+
+def _nearest(guides: Groom, roots: np.ndarray, k: int, mesh: Mesh | None) -> tuple:
+    """The k+1 nearest guides of each root: in space, or along the surface of ``mesh`` (the
+    roots taken to the closest point of their face first; every face tried, so slow for
+    hundreds of thousands of roots on a large mesh)."""
+    if mesh is None:
+        return euclidean_nearest(guides.roots, roots, k), None
+    check_mesh(mesh)
+    on, faces = closest_points(mesh, roots)
+    near = surface_nearest(mesh, guides.roots.astype(np.float64), on, faces, k)
+    if np.any(near[0][:, 0] < 0):
+        raise ParameterError("scalp", "faces no guide root reaches", "a mesh connected to the guides' roots")
+    return near, faces
+
+
+def bind_roots(
+    guides: Groom,
+    roots: np.ndarray | None = None,
+    count: int | None = None,
+    *,
+    k: int = DEFAULT_K,
+    vertices: int | None = None,
+    seed: int = 0,
+    length_variation: float = DEFAULT_LENGTH_VARIATION,
+    frizz: float = DEFAULT_FRIZZ,
+    mesh: Mesh | None = None,
+) -> ChildBinding:
+    """Children at given ``roots`` ``(N, 3)``, or ``count`` of them around the guide roots,
+    bound to their k nearest guide roots in space (along the surface of ``mesh`` if given);
+    ``vertices`` per child (default: the guides' largest count). The children come in order
+    of their nearest guide (their roots are ``binding.roots``), not in the order of ``roots``."""
+    k = check_k(k, guides.strand_count)
+    seed = check_seed(seed)
+    _check_variation(length_variation, frizz)
+    n = _vertices(guides, vertices)
+    if roots is None:
+        roots = scatter_around(guides, check_count(count if count is not None else 0), seed)
+    roots = np.asarray(roots, np.float64)
+    if roots.ndim != 2 or roots.shape[1] != 3 or len(roots) == 0:
+        raise ParameterError("roots", f"shape {roots.shape}", "(N ≥ 1, 3) child roots")
+    if not np.all(np.isfinite(roots)):
+        raise ParameterError("roots", "non-finite coordinates", "finite child roots")
+    check_count(len(roots))
+    near, faces = _nearest(guides, roots, k, mesh)
+    return _bind(guides, roots, near, n, k, seed, length_variation, frizz, faces)
+
+
+def bind_scalp(
+    guides: Groom,
+    mesh: Mesh,
+    count: int,
+    *,
+    k: int = DEFAULT_K,
+    vertices: int | None = None,
+    seed: int = 0,
+    length_variation: float = DEFAULT_LENGTH_VARIATION,
+    frizz: float = DEFAULT_FRIZZ,
+    region: np.ndarray | str | None = None,
+    density: np.ndarray | None = None,
+) -> ChildBinding:
+    """``count`` children scattered on the scalp ``mesh`` (over ``region``: a face set's name,
+    a face mask or indices, default :func:`~hairtool.guides.scatter.default_region`; by area × ``density``),
+    each bound to its k nearest guides along the surface."""
+    check_mesh(mesh)
+    k = check_k(k, guides.strand_count)
+    count = check_count(count)
+    seed = check_seed(seed)
+    _check_variation(length_variation, frizz)
+    n = _vertices(guides, vertices)
+    if region is None:
+        region = default_region(mesh, guides)
+    roots, faces = scatter_on_mesh(mesh, count, seed, region, density)
+    near = surface_nearest(mesh, guides.roots.astype(np.float64), roots, faces, k)
+    if np.any(near[0][:, 0] < 0):
+        raise ParameterError("region", "faces no guide root reaches", "faces connected to the guides' roots")
+    return _bind(guides, roots, near, n, k, seed, length_variation, frizz, faces)
+
+
+def choose_guides(dense: Groom, guide_count: int, seed: int = 0) -> np.ndarray:
+    """``(G,)`` strands of ``dense`` to serve as guides: farthest-point sampling of the roots
+    from a seeded first strand."""
+    s = dense.strand_count
+    if isinstance(guide_count, bool) or int(guide_count) != guide_count or not 1 <= guide_count <= s:
+        raise ParameterError("guides", guide_count, f"a whole number in [1, {s}] (the strand count)")
+    first = int(generator(check_seed(seed), CH_VARIATION).integers(0, s))
+    return farthest_point_sampling(dense.roots, int(guide_count), first)
+
+
+def bind_dense(
+    dense: Groom, guide_count: int, *, k: int = DEFAULT_K, seed: int = 0, mesh: Mesh | None = None
+) -> tuple[Groom, ChildBinding]:
+    """A dense groom as G guides and every strand bound to them (guides by root distance, along
+    the surface of ``mesh`` if given): ``(guides, binding)``; the binding built on the guides
+    at rest gives back ``dense``'s points bit for bit."""
+    ids = choose_guides(dense, guide_count, seed)
+    guides = dense.subset(ids)
+    k = check_k(k, guides.strand_count)
+    roots = dense.roots.astype(np.float64)
+    near, faces = _nearest(guides, roots, k, mesh)
+    ids_k, w = weights(*near, k)
+    scale = np.ones(dense.strand_count)
+    b = ChildBinding(guides, dense.counts.copy(), roots, ids_k, w, scale, None, faces)
+    q = _children.build_points(b, guides, np.float64)
+    tables = _children.GuideTables(guides, b)
+    near_row = tables.child_base(b) + ids_k[:, 0] * b.counts
+    rows = np.repeat(near_row, b.counts) + dense.topology.index_in_strand
+    fr = tables.frames[rows]  # (V, 9): each vertex's frame on its nearest guide
+    r = dense.points.astype(np.float64) - q
+    local = np.column_stack([np.einsum("ij,ij->i", r, fr[:, 3 * a : 3 * a + 3]) for a in range(3)])
+    b.local = local.astype(np.float32)  # the rest blend below uses these very offsets
+    b.exact_blend = _children.build_points(b, guides, np.float64)
+    b.exact_points = dense.points
+    return guides, b

@@ -1,0 +1,173 @@
+"""Guide tables: each guide resampled to a child's vertex count, its segments, their lengths,
+and a rotation-minimising frame at every vertex, so a guide that turns carries what hangs on
+its frames with it.
+
+Frames are rows (t, n, b). The root frame is the rest guide's root frame (t along the first
+segment, n from the world axis least along t) turned by the smallest rotation taking the rest
+root tangent to the current one; along the guide each frame is the previous one turned by the
+smallest rotation from the previous segment's tangent to this one (parallel transport, the
+rotation-minimising frame of Wang et al. 2008 for a polyline). A zero-length segment keeps the
+previous frame. The numba kernel :func:`frames` has the numpy twin :func:`frames_reference`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from hairtool.groom import Groom
+
+TINY = 1e-30
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _turn(vx, vy, vz, ax, ay, az, bx, by, bz):
+    """v turned by the smallest rotation taking unit a to unit b (Rodrigues with k = a × b,
+    c = a·b: v·c + k × v + k (k·v)/(1 + c)); a half turn (c ≈ −1) reflects across a instead."""
+    c = ax * bx + ay * by + az * bz
+    kx = ay * bz - az * by
+    ky = az * bx - ax * bz
+    kz = ax * by - ay * bx
+    if 1.0 + c < 1e-12:
+        d = vx * ax + vy * ay + vz * az
+        return vx - 2.0 * d * ax, vy - 2.0 * d * ay, vz - 2.0 * d * az
+    kv = (kx * vx + ky * vy + kz * vz) / (1.0 + c)
+    return (
+        vx * c + (ky * vz - kz * vy) + kx * kv,
+        vy * c + (kz * vx - kx * vz) + ky * kv,
+        vz * c + (kx * vy - ky * vx) + kz * kv,
+    )
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _unit(x, y, z):
+    d = np.sqrt(x * x + y * y + z * z)
+    if d > TINY:
+        return x / d, y / d, z / d, True
+    return x, y, z, False
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _root_normal(tx, ty, tz):
+    """n of a rest root frame: the world axis least along t, made perpendicular to t."""
+    ax, ay, az = abs(tx), abs(ty), abs(tz)
+    if ax <= ay and ax <= az:
+        ex, ey, ez = 1.0, 0.0, 0.0
+    elif ay <= az:
+        ex, ey, ez = 0.0, 1.0, 0.0
+    else:
+        ex, ey, ez = 0.0, 0.0, 1.0
+    d = ex * tx + ey * ty + ez * tz
+    nx, ny, nz, _ = _unit(ex - d * tx, ey - d * ty, ez - d * tz)
+    return nx, ny, nz
+
+
+def _frames_py(points, rest_tangent, n, out):
+    """``points`` (G·n, 3) float64, guide after guide; ``rest_tangent`` (G, 3) unit rest root
+    tangents; ``out`` (G·n, 9) rows t, n, b."""
+    for g in prange(points.shape[0] // n):
+        a = g * n
+        rx, ry, rz = rest_tangent[g, 0], rest_tangent[g, 1], rest_tangent[g, 2]
+        nx, ny, nz = _root_normal(rx, ry, rz)
+        tx, ty, tz, ok = _unit(
+            points[a + 1, 0] - points[a, 0], points[a + 1, 1] - points[a, 1], points[a + 1, 2] - points[a, 2]
+        )
+        if not ok:
+            tx, ty, tz = rx, ry, rz
+        nx, ny, nz = _turn(nx, ny, nz, rx, ry, rz, tx, ty, tz)  # rest root frame → current
+        for i in range(n):
+            if i >= 2:
+                ux, uy, uz, ok = _unit(
+                    points[a + i, 0] - points[a + i - 1, 0],
+                    points[a + i, 1] - points[a + i - 1, 1],
+                    points[a + i, 2] - points[a + i - 1, 2],
+                )
+                if ok:
+                    nx, ny, nz = _turn(nx, ny, nz, tx, ty, tz, ux, uy, uz)
+                    tx, ty, tz = ux, uy, uz
+            d = nx * tx + ny * ty + nz * tz  # keep n ⟂ t and unit against drift
+            nx, ny, nz, _ = _unit(nx - d * tx, ny - d * ty, nz - d * tz)
+            o = out[a + i]
+            o[0], o[1], o[2] = tx, ty, tz
+            o[3], o[4], o[5] = nx, ny, nz
+            o[6], o[7], o[8] = ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx
+
+
+_frames_serial = njit(cache=True, nogil=True)(_frames_py)
+_frames_parallel = njit(cache=True, nogil=True, parallel=True)(_frames_py)
+PARALLEL_FRAMES = 100_000  # frames above which threads pay (below, waking them costs more)
+
+
+def root_tangents(points: np.ndarray, n: int) -> np.ndarray:
+    """``(G, 3)`` unit tangents of the first segments of guides of n vertices (x where a first
+    segment has no length)."""
+    p = points.reshape(-1, n, 3)
+    t = p[:, 1] - p[:, 0]
+    d = np.linalg.norm(t, axis=1)
+    ok = d > TINY
+    out = np.zeros_like(t)
+    out[:, 0] = 1.0
+    out[ok] = t[ok] / d[ok, None]
+    return out
+
+
+def frames(points: np.ndarray, rest_tangent: np.ndarray, n: int) -> np.ndarray:
+    """``(G·n, 9)`` float64 frames (t, n, b) of guides of n vertices (``points`` (G·n, 3))."""
+    out = np.empty((points.shape[0], 9))
+    kernel = _frames_parallel if points.shape[0] > PARALLEL_FRAMES else _frames_serial
+    kernel(np.ascontiguousarray(points, np.float64), np.ascontiguousarray(rest_tangent), n, out)
+    return out
+
+
+def _turn_ref(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    c = float(a @ b)
+    if 1.0 + c < 1e-12:
+        return v - 2.0 * float(v @ a) * a
+    k = np.cross(a, b)
+    return v * c + np.cross(k, v) + k * float(k @ v) / (1.0 + c)
+
+
+def frames_reference(points: np.ndarray, rest_tangent: np.ndarray, n: int) -> np.ndarray:
+    """Numpy twin of :func:`frames`, one guide and one vertex at a time."""
+    p = np.asarray(points, np.float64).reshape(-1, n, 3)
+    out = np.empty((p.shape[0], n, 9))
+    for g in range(p.shape[0]):
+        r = rest_tangent[g]
+        e = np.eye(3)[int(np.argmin(np.abs(r)))]
+        nrm = e - float(e @ r) * r
+        nrm = nrm / np.linalg.norm(nrm)
+        first = p[g, 1] - p[g, 0]
+        t = first / np.linalg.norm(first) if np.linalg.norm(first) > TINY else r
+        nrm = _turn_ref(nrm, r, t)
+        for i in range(n):
+            if i >= 2:
+                s = p[g, i] - p[g, i - 1]
+                if np.linalg.norm(s) > TINY:
+                    u = s / np.linalg.norm(s)
+                    nrm = _turn_ref(nrm, t, u)
+                    t = u
+            nrm = nrm - float(nrm @ t) * t
+            nrm = nrm / np.linalg.norm(nrm)
+            out[g, i] = np.concatenate([t, nrm, np.cross(t, nrm)])
+    return out.reshape(-1, 9)
+
+
+def resampled(guides: Groom, n: int) -> np.ndarray:
+    """``(G·n, 3)`` float64: every guide at n vertices, evenly in vertex parameter (i/(n−1) of
+    its vertices, linearly between them); a guide of n vertices is taken as it is."""
+    g = guides.strand_count
+    out = np.empty((g, n, 3))
+    pts = guides.points.astype(np.float64)
+    for m in np.unique(guides.counts):
+        ids = np.flatnonzero(guides.counts == m)
+        starts = guides.offsets[ids]
+        if m == n:
+            out[ids] = pts[starts[:, None] + np.arange(n)]
+            continue
+        u = np.arange(n) * ((m - 1) / (n - 1))
+        i0 = np.minimum(np.floor(u).astype(np.int64), m - 2)
+        f = (u - i0)[None, :, None]
+        a = pts[starts[:, None] + i0]
+        b = pts[starts[:, None] + i0 + 1]
+        out[ids] = a + f * (b - a)
+    return out.reshape(-1, 3)

@@ -1,0 +1,257 @@
+"""Distances on a scalp mesh: how far a child's root is from each guide's root *along the
+surface*, so a child behind the ear is not bound to a guide in front of it.
+
+The surface distance is the shortest path along the mesh's edges (Dijkstra), entering and
+leaving the mesh through the corners of the face a root lies on; on one face it is the straight
+line. For each mesh vertex :func:`nearest_sources` keeps the K nearest guide roots (a Dijkstra
+whose heap carries (distance, guide, vertex) and where a vertex takes at most K guides: a guide
+among the K nearest of a vertex is among the K nearest of every vertex on the shortest path to
+it, so the labels are exact). Guide roots that do not lie on the mesh are first moved to its
+closest point (:func:`closest_points`).
+"""
+
+from __future__ import annotations
+
+import heapq
+
+import numpy as np
+from numba import njit, prange
+
+from hairtool.io.obj import Mesh
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _closest_on_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
+    """Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5)."""
+    abx, aby, abz = bx - ax, by - ay, bz - az
+    acx, acy, acz = cx - ax, cy - ay, cz - az
+    apx, apy, apz = px - ax, py - ay, pz - az
+    d1 = abx * apx + aby * apy + abz * apz
+    d2 = acx * apx + acy * apy + acz * apz
+    if d1 <= 0.0 and d2 <= 0.0:
+        return ax, ay, az
+    bpx, bpy, bpz = px - bx, py - by, pz - bz
+    d3 = abx * bpx + aby * bpy + abz * bpz
+    d4 = acx * bpx + acy * bpy + acz * bpz
+    if d3 >= 0.0 and d4 <= d3:
+        return bx, by, bz
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        v = d1 / (d1 - d3)
+        return ax + v * abx, ay + v * aby, az + v * abz
+    cpx, cpy, cpz = px - cx, py - cy, pz - cz
+    d5 = abx * cpx + aby * cpy + abz * cpz
+    d6 = acx * cpx + acy * cpy + acz * cpz
+    if d6 >= 0.0 and d5 <= d6:
+        return cx, cy, cz
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        w = d2 / (d2 - d6)
+        return ax + w * acx, ay + w * acy, az + w * acz
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        return bx + w * (cx - bx), by + w * (cy - by), bz + w * (cz - bz)
+    denom = 1.0 / (va + vb + vc)
+    v = vb * denom
+    w = vc * denom
+    return ax + abx * v + acx * w, ay + aby * v + acy * w, az + abz * v + acz * w
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _closest_kernel(points, vertices, faces, out, face_of):
+    for k in prange(points.shape[0]):
+        px, py, pz = points[k, 0], points[k, 1], points[k, 2]
+        best = np.inf
+        for f in range(faces.shape[0]):
+            a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+            qx, qy, qz = _closest_on_triangle(
+                px, py, pz, vertices[a, 0], vertices[a, 1], vertices[a, 2], vertices[b, 0], vertices[b, 1],
+                vertices[b, 2], vertices[c, 0], vertices[c, 1], vertices[c, 2],
+            )  # fmt: skip
+            d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
+            if d < best:  # ties: the lower face
+                best = d
+                out[k, 0], out[k, 1], out[k, 2] = qx, qy, qz
+                face_of[k] = f
+
+
+def closest_points(mesh: Mesh, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(P, 3)`` float64 closest points on the mesh and ``(P,)`` the face of each (every face
+    tried: meant for guide roots, a few thousand at most)."""
+    pts = np.ascontiguousarray(points, np.float64)
+    out = np.empty_like(pts)
+    face_of = np.empty(len(pts), np.int64)
+    _closest_kernel(pts, mesh.vertices.astype(np.float64), mesh.faces.astype(np.int64), out, face_of)
+    return out, face_of
+
+
+def edge_graph(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The mesh's edges as CSR ``(indptr, neighbours, lengths)`` (float64 lengths, both ways,
+    each vertex's neighbours in increasing order)."""
+    f = mesh.faces.astype(np.int64)
+    e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    e = np.concatenate([e, e[:, ::-1]])
+    e = np.unique(e[e[:, 0] != e[:, 1]], axis=0)  # sorted by (from, to)
+    v = mesh.vertices.astype(np.float64)
+    lengths = np.linalg.norm(v[e[:, 1]] - v[e[:, 0]], axis=1)
+    indptr = np.zeros(len(v) + 1, np.int64)
+    np.cumsum(np.bincount(e[:, 0], minlength=len(v)), out=indptr[1:])
+    return indptr, e[:, 1].copy(), lengths
+
+
+def _seeds(mesh: Mesh, roots: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(vertex, guide, distance) where each guide's root enters the graph: its face's corners."""
+    corners = mesh.faces[faces].astype(np.int64)  # (G, 3)
+    d = np.linalg.norm(mesh.vertices.astype(np.float64)[corners] - roots[:, None, :], axis=2)
+    g = np.repeat(np.arange(len(roots)), 3)
+    return corners.reshape(-1), g, d.reshape(-1)
+
+
+@njit(cache=True, nogil=True)
+def _k_nearest_kernel(indptr, nbr, length, seed_v, seed_g, seed_d, k, label_g, label_d, count):
+    heap = [(seed_d[0], seed_g[0], seed_v[0])]
+    for s in range(1, seed_v.size):
+        heapq.heappush(heap, (seed_d[s], seed_g[s], seed_v[s]))
+    while len(heap) > 0:
+        d, g, v = heapq.heappop(heap)
+        c = count[v]
+        if c >= k:
+            continue
+        seen = False
+        for m in range(c):
+            if label_g[v, m] == g:
+                seen = True
+                break
+        if seen:
+            continue
+        label_g[v, c] = g
+        label_d[v, c] = d
+        count[v] = c + 1
+        for e in range(indptr[v], indptr[v + 1]):
+            u = nbr[e]
+            if count[u] < k:
+                heapq.heappush(heap, (d + length[e], g, u))
+
+
+def nearest_sources(
+    mesh: Mesh, roots: np.ndarray, faces: np.ndarray, k: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """For every mesh vertex its k nearest guides along the surface (ties: the lower guide):
+    ``(Vm, k)`` int64 guides (−1 where fewer are reachable) and float64 distances (inf there)."""
+    indptr, nbr, length = edge_graph(mesh)
+    sv, sg, sd = _seeds(mesh, roots, faces)
+    nv = len(mesh.vertices)
+    label_g = np.full((nv, k), -1, np.int64)
+    label_d = np.full((nv, k), np.inf)
+    _k_nearest_kernel(indptr, nbr, length, sv, sg, sd, k, label_g, label_d, np.zeros(nv, np.int64))
+    return label_g, label_d
+
+
+def nearest_sources_reference(
+    mesh: Mesh, roots: np.ndarray, faces: np.ndarray, k: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Numpy twin of :func:`nearest_sources`: one full Dijkstra per guide, then the k smallest
+    (distance, guide) per vertex."""
+    indptr, nbr, length = edge_graph(mesh)
+    sv, sg, sd = _seeds(mesh, roots, faces)
+    nv, ng = len(mesh.vertices), len(roots)
+    dist = np.full((ng, nv), np.inf)
+    for g in range(ng):
+        heap = [(float(d), int(v)) for v, gg, d in zip(sv, sg, sd, strict=True) if gg == g]
+        heapq.heapify(heap)
+        while heap:
+            d, v = heapq.heappop(heap)
+            if d >= dist[g, v]:
+                continue
+            dist[g, v] = d
+            for e in range(indptr[v], indptr[v + 1]):
+                if d + length[e] < dist[g, nbr[e]]:
+                    heapq.heappush(heap, (d + length[e], int(nbr[e])))
+    order = np.lexsort((np.broadcast_to(np.arange(ng)[:, None], dist.shape), dist), axis=0)[:k].T  # (nv, k)
+    d = np.take_along_axis(dist.T, order, axis=1)
+    return np.where(np.isfinite(d), order, -1), d
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _child_kernel(points, cface, faces, vertices, label_g, label_d, groots, gface, k, out_g, out_d):
+    """Per child: the k+1 nearest guides along the surface through its face's corners (the
+    straight line for a guide on the same face), sorted by (distance, guide)."""
+    kk = out_g.shape[1]
+    lab = label_g.shape[1]
+    for c in prange(points.shape[0]):
+        px, py, pz = points[c, 0], points[c, 1], points[c, 2]
+        for m in range(kk):
+            out_g[c, m] = -1
+            out_d[c, m] = np.inf
+        f = cface[c]
+        for corner in range(3):
+            v = faces[f, corner]
+            dv = np.sqrt((vertices[v, 0] - px) ** 2 + (vertices[v, 1] - py) ** 2 + (vertices[v, 2] - pz) ** 2)
+            for m in range(lab):
+                g = label_g[v, m]
+                if g < 0:
+                    break
+                d = label_d[v, m] + dv
+                if gface[g] == f:
+                    d = np.sqrt(
+                        (groots[g, 0] - px) ** 2 + (groots[g, 1] - py) ** 2 + (groots[g, 2] - pz) ** 2
+                    )
+                _insert(out_g, out_d, c, g, d, kk)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _insert(out_g, out_d, c, g, d, kk):
+    """Put (d, g) into row c's sorted list of the kk best (a guide already there keeps the
+    smaller distance)."""
+    for m in range(kk):
+        if out_g[c, m] == g:
+            if d >= out_d[c, m]:
+                return
+            for q in range(m, kk - 1):  # take it out, then insert again below
+                out_g[c, q] = out_g[c, q + 1]
+                out_d[c, q] = out_d[c, q + 1]
+            out_g[c, kk - 1] = -1
+            out_d[c, kk - 1] = np.inf
+            break
+    pos = kk
+    for m in range(kk):
+        if d < out_d[c, m] or (d == out_d[c, m] and (out_g[c, m] < 0 or g < out_g[c, m])):
+            pos = m
+            break
+    if pos == kk:
+        return
+    for q in range(kk - 1, pos, -1):
+        out_g[c, q] = out_g[c, q - 1]
+        out_d[c, q] = out_d[c, q - 1]
+    out_g[c, pos] = g
+    out_d[c, pos] = d
+
+
+def surface_nearest(
+    mesh: Mesh,
+    guide_roots: np.ndarray,
+    child_roots: np.ndarray,
+    child_faces: np.ndarray,
+    k: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(N, k+1)`` the nearest guides of each child root (on face ``child_faces``) along the
+    surface, and their distances, sorted; −1 / inf where fewer are reachable."""
+    on_mesh, gface = closest_points(mesh, guide_roots)
+    label_g, label_d = nearest_sources(mesh, on_mesh, gface, k + 1)
+    n = len(child_roots)
+    out_g = np.empty((n, k + 1), np.int64)
+    out_d = np.empty((n, k + 1))
+    _child_kernel(
+        np.ascontiguousarray(child_roots, np.float64), child_faces.astype(np.int64),
+        mesh.faces.astype(np.int64), mesh.vertices.astype(np.float64), label_g, label_d, on_mesh, gface,
+        k + 1, out_g, out_d,
+    )  # fmt: skip
+    return out_g, out_d
+
+
+def nearest_guide_distance(mesh: Mesh, guide_roots: np.ndarray) -> np.ndarray:
+    """``(Vm,)`` each mesh vertex's distance along the surface to the nearest guide root."""
+    on_mesh, gface = closest_points(mesh, guide_roots)
+    _, d = nearest_sources(mesh, on_mesh, gface, 1)
+    return d[:, 0]

@@ -1,0 +1,136 @@
+"""`hairtool interpolate`, `hairtool freeze` with render hair, and `hairtool bench interpolate`."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from hairtool import io, samples
+from hairtool.cli import main
+
+RESOURCES = Path(__file__).resolve().parents[2] / "resources"
+GUIDES = str(RESOURCES / "sintel_hair.tfx")
+HEAD = str(RESOURCES / "sintel_head.obj")
+
+
+def test_interpolate_on_the_scalp_writes_children_and_reports_json(tmp_path, capsys):
+    out = tmp_path / "kids.npz"
+    rc = main(["interpolate", GUIDES, str(out), "--count", "2000", "--scalp", HEAD, "--seed", "3", "--json"])
+    assert rc == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["children"] == 2000 and report["guides"] == 228 and report["vertices"] == 2000 * 32
+    kids = io.read_groom(out)
+    assert kids.strand_count == 2000
+    again = tmp_path / "again.npz"
+    assert main(["interpolate", GUIDES, str(again), "--count", "2000", "--scalp", HEAD, "--seed", "3"]) == 0
+    assert io.read_groom(again).points.tobytes() == kids.points.tobytes()
+
+
+def test_from_dense_writes_render_strands_and_guides(tmp_path, grooms_dir):
+    src = grooms_dir / "ponytail_tail.tfx"
+    out = tmp_path / "hair.usda"
+    assert (
+        main(["interpolate", str(src), str(out), "--from-dense", "--guides", "30", "--guides-per-child", "3"])
+        == 0
+    )
+    dense = io.read_groom(src)
+    assert io.read_groom(out).points.tobytes() == dense.points.tobytes()
+    guides = io.read_groom(tmp_path / "hair.guides.usda")
+    assert guides.strand_count == 30
+    chosen = tmp_path / "chosen.npz"
+    assert (
+        main(
+            ["interpolate", str(src), str(out), "--from-dense", "--guides", "30", "--guides-out", str(chosen)]
+        )
+        == 0
+    )
+    assert io.read_groom(chosen).strand_count == 30
+
+
+def test_freeze_outputs_render_hair(tmp_path, capsys):
+    out = tmp_path / "render.npz"
+    args = [
+        "freeze",
+        GUIDES,
+        str(out),
+        "--count",
+        "1500",
+        "--scalp",
+        HEAD,
+        "--keep-lengths",
+        "--clump-children",
+    ]
+    assert main([*args, "--align", "0,50,10", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["children"] == 1500 and report["guides"] == 228
+    hair = io.read_groom(out)
+    assert hair.strand_count == 1500
+    plain = tmp_path / "plain.npz"
+    assert main(["interpolate", GUIDES, str(plain), "--count", "1500", "--scalp", HEAD]) == 0
+    assert np.abs(io.read_groom(plain).points - hair.points).max() > 0.1  # the frozen guides moved them
+
+
+@pytest.mark.parametrize(
+    ("extra", "name"),
+    [
+        (["--count", "0"], "count"),
+        (["--count", "10", "--guides-per-child", "229"], "guides_per_child"),
+        (["--from-dense"], "guides"),
+        (["--count", "10", "--from-dense", "--guides", "5"], "from-dense"),
+        (["--from-dense", "--guides", "5", "--region", "scalp"], "from-dense"),
+        (["--count", "10", "--region", "nowhere.txt"], "region"),
+        (["--count", "10", "--length-variation", "nan"], "length_variation"),
+    ],
+)
+def test_bad_options_give_one_line_and_exit_2(tmp_path, capsys, extra, name):
+    out = tmp_path / "x.npz"
+    assert main(["interpolate", GUIDES, str(out), *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and name in err
+    assert not out.exists()
+
+
+def test_a_mesh_without_faces_and_a_bad_region_file(tmp_path, capsys):
+    mesh = tmp_path / "points.obj"
+    mesh.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\n")
+    out = tmp_path / "x.npz"
+    assert main(["interpolate", GUIDES, str(out), "--count", "10", "--scalp", str(mesh)]) == 2
+    assert "no faces" in capsys.readouterr().err
+    region = tmp_path / "faces.txt"
+    region.write_text("1 2 banana\n")
+    assert (
+        main(["interpolate", GUIDES, str(out), "--count", "10", "--scalp", HEAD, "--region", str(region)])
+        == 2
+    )
+    assert "faces.txt" in capsys.readouterr().err
+    assert main(["interpolate", GUIDES, str(out), "--count", "10", "--scalp", HEAD, "--region", "hat"]) == 2
+    assert "GEO-body" in capsys.readouterr().err  # the face sets there are
+    region.write_text("0 1 2\n")  # three tiny triangles of her body, far from any guide: still hair
+    assert (
+        main(["interpolate", GUIDES, str(out), "--count", "10", "--scalp", HEAD, "--region", str(region)])
+        == 0
+    )
+
+
+def test_bench_interpolate_rows(capsys):
+    assert main(["bench", "interpolate", "--quick", "--json", "--children", "2000", "--guides", "100"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert len(rows) == 2
+    for r in rows:
+        assert {"guides", "children", "vertices", "interpolate_ms", "reference_ms", "threads"} <= set(r)
+        assert r["interpolate_ms"] > 0 and r["reference_ms"] > 0
+    assert rows[0]["guides"] == 100
+
+
+def test_sample_guides_without_a_mesh(tmp_path):
+    src = tmp_path / "g.npz"
+    io.write(src, samples.scalp(50, 8, seed=0))
+    out = tmp_path / "kids.obj"
+    assert (
+        main(["interpolate", str(src), str(out), "--count", "500", "--vertices", "12", "--frizz", "0"]) == 0
+    )
+    kids = io.read_groom(out)
+    assert kids.strand_count == 500 and set(kids.counts) == {12}
