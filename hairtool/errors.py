@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 
 
@@ -25,6 +26,17 @@ class ParameterError(HairtoolError, ValueError):
         self.name = name
         self.value = value
         super().__init__(f"{name}={value!r} is invalid: expected {expected}")
+
+
+def finite_number(name: str, value: object) -> float:
+    """``value`` as a finite float, or a :class:`ParameterError` naming ``name``."""
+    try:
+        v = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, "a finite number") from None
+    if not math.isfinite(v):
+        raise ParameterError(name, value, "a finite number")
+    return v
 
 
 class GroomError(HairtoolError, ValueError):

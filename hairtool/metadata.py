@@ -18,7 +18,7 @@ import itertools
 import math
 from dataclasses import dataclass, replace
 
-from hairtool.errors import ParameterError
+from hairtool.errors import ParameterError, finite_number
 
 UP_AXES = ("Y", "Z")
 DEFAULT_UP_AXIS = "Y"
@@ -41,15 +41,7 @@ def _positive(name: str, value: float | None) -> float | None:
 
 
 def _finite(name: str, value: float | None) -> float | None:
-    if value is None:
-        return None
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(name, value, "a finite number") from None
-    if not math.isfinite(v):
-        raise ParameterError(name, value, "a finite number")
-    return v
+    return None if value is None else finite_number(name, value)
 
 
 @dataclass(frozen=True)

@@ -351,8 +351,9 @@ class AnimationExporter(QObject):
         """JSON record, CSV sheet or USD key poses of the timeline's DP keys."""
         model = self.window.animation
         try:
+            result = keys_result(model)  # a clear error when there are no keys
             codes = model.animation.time_codes  # keys at the source's time codes
-            record = keys_record(keys_result(model), model.source or None, time_codes=codes)
+            record = keys_record(result, model.source or None, time_codes=codes)
             write_keys(path, record, model.animation)
         except HairtoolError as e:
             self.window.show_error("Cannot export keys", str(e))

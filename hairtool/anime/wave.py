@@ -16,7 +16,6 @@ but readable wave that sags under its gravity term. Timing is in :mod:`hairtool.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -35,21 +34,11 @@ from hairtool.anime.pose import (
     wave_x,
 )
 from hairtool.anime.schedule import Schedule, schedule
-from hairtool.errors import ParameterError
+from hairtool.errors import ParameterError, finite_number
 from hairtool.groom import Animation, Groom
 
 F64 = NDArray[np.float64]
 MAX_ANIMATION_BYTES = 4 * 1024**3
-
-
-def _finite(name: str, value: float) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(name, value, "a finite number") from None
-    if not math.isfinite(v):
-        raise ParameterError(name, value, "a finite number")
-    return v
 
 
 @dataclass(frozen=True)
@@ -74,11 +63,11 @@ class WaveParams:
     period: float = 0.45  # T, seconds
 
     def __post_init__(self) -> None:
-        a = _finite("amplitude", self.amplitude)
-        k = _finite("wavelength", self.wavelength)
-        s = _finite("gravity", self.gravity)
-        p = _finite("profile", self.profile)
-        t = _finite("period", self.period)
+        a = finite_number("amplitude", self.amplitude)
+        k = finite_number("wavelength", self.wavelength)
+        s = finite_number("gravity", self.gravity)
+        p = finite_number("profile", self.profile)
+        t = finite_number("period", self.period)
         if k <= 0:
             raise ParameterError("wavelength", self.wavelength, "k > 0")
         if s == 0:

@@ -28,7 +28,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from hairtool.cli._inputs import load_groom
+    from hairtool.io.specs import load_groom
 
     _guides.check(args)
     groom = load_groom(args.input)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from hairtool.guides.surface import _insert
+from hairtool.guides.surface import insert_nearest
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -27,7 +27,7 @@ def _euclid_kernel(groots, croots, kk, out_g, out_d):
         for g in range(groots.shape[0]):
             d = np.sqrt((groots[g, 0] - px) ** 2 + (groots[g, 1] - py) ** 2 + (groots[g, 2] - pz) ** 2)
             if d <= out_d[c, kk - 1]:
-                _insert(out_g, out_d, c, g, d, kk)
+                insert_nearest(out_g, out_d, c, g, d, kk)
 
 
 def euclidean_nearest(

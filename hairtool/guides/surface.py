@@ -197,11 +197,11 @@ def _child_kernel(points, cface, faces, vertices, label_g, label_d, groots, gfac
                     d = np.sqrt(
                         (groots[g, 0] - px) ** 2 + (groots[g, 1] - py) ** 2 + (groots[g, 2] - pz) ** 2
                     )
-                _insert(out_g, out_d, c, g, d, kk)
+                insert_nearest(out_g, out_d, c, g, d, kk)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _insert(out_g, out_d, c, g, d, kk):
+def insert_nearest(out_g, out_d, c, g, d, kk):
     """Put (d, g) into row c's sorted list of the kk best (a guide already there keeps the
     smaller distance)."""
     for m in range(kk):
