@@ -195,3 +195,22 @@ def test_truncated_and_flipped_files_are_format_errors(tmp_path, edited):
         except FormatError as e:
             assert "broken.hairproj" in str(e)
     assert loaded < 30
+
+
+# -- issue 17's hostile classes ------------------------------------------------------------------
+@pytest.mark.parametrize("member", ["groom/points.npy", "groom/thickness.npy", "animation/frames.npy"])
+def test_float64_beyond_float32_is_refused_after_the_cast(tmp_path, member):
+    from .hostile import write_project_beyond_float32
+
+    p = write_project_beyond_float32(tmp_path / "big.hairproj", member)
+    with pytest.raises(FormatError, match="beyond float32") as e:
+        project.load(p)
+    assert e.value.path == str(p)
+
+
+def test_counts_whose_sum_wraps_around_are_refused(tmp_path):
+    from .hostile import write_project_wrapping_counts
+
+    p = write_project_wrapping_counts(tmp_path / "wrap.hairproj")
+    with pytest.raises(FormatError, match="strand 0 claims 4611686018427387904 points"):
+        project.load(p)
