@@ -42,6 +42,8 @@ def _check_keys(keys: ArrayLike, n_frames: int) -> NDArray[np.int64]:
     k = np.asarray(keys)
     if k.ndim != 1 or k.size == 0:
         raise ParameterError("keys", k.tolist() if k.size < 8 else f"{k.size} values", "a 1-D list of frames")
+    if k.dtype.kind not in "iuf":  # e.g. Python ints beyond int64 make an object array
+        raise ParameterError("keys", k.tolist()[:8], f"whole frame numbers in [0, {n_frames})")
     if not np.issubdtype(k.dtype, np.integer):
         if not np.all(np.isfinite(k)) or np.any(k != np.round(k)):
             raise ParameterError("keys", k.tolist()[:8], "whole frame numbers")
@@ -121,6 +123,10 @@ def read_keys_json(path: str | os.PathLike[str]) -> dict:
         record = json.loads(text)
     except json.JSONDecodeError as e:
         raise FormatError(path, f"not JSON: {e}") from None
+    except RecursionError:
+        raise FormatError(path, "not a keys record: JSON nested too deeply") from None
+    except ValueError:  # Python refuses integers of more than 4,300 digits
+        raise FormatError(path, "not a keys record: it holds a number thousands of digits long") from None
     if not isinstance(record, dict):
         raise FormatError(path, "a keys record is a JSON object")
     if record.get("format", FORMAT) != FORMAT:
