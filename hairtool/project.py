@@ -37,6 +37,7 @@ from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, 
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
+from hairtool.io.npz import read_npy_header
 
 FORMAT = "hairtool project"
 FORMAT_VERSION = 1
@@ -259,15 +260,7 @@ class _Reader:
             raise FormatError(self.path, f"missing member {name!r}")
         info = self.infos[name]
         with self.zf.open(info) as f:
-            version = np.lib.format.read_magic(f)
-            if version == (1, 0):
-                shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
-            elif version in ((2, 0), (3, 0)):
-                shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
-            else:
-                raise FormatError(self.path, f"member {name!r} has .npy version {version}")
-            if dtype.hasobject:
-                raise FormatError(self.path, f"member {name!r} holds Python objects")
+            shape, fortran, dtype = read_npy_header(self.path, f, name)
             nbytes = math.prod(shape) * dtype.itemsize
             if f.tell() + nbytes != info.file_size:
                 raise FormatError(self.path, f"member {name!r}: shape {shape} does not match its stored size")

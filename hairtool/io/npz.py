@@ -9,6 +9,7 @@ float64 scalar (animations), and optional ``thickness`` (V,), ``transparency`` (
 
 from __future__ import annotations
 
+import ast
 import os
 import struct
 import zipfile
@@ -27,6 +28,7 @@ ATTRIBUTES = ("thickness", "transparency", "colors")
 _KNOWN = {"format_version", "kind", "counts", "points", "frames", "fps", *ATTRIBUTES}
 # zlib's deflate never expands data more than about 1032:1; a member claiming more is corrupt.
 _MAX_DEFLATE_RATIO = 1100
+_MAX_NPY_HEADER = 10_000  # numpy's own limit on a header's length (max_header_size)
 
 _LOAD_ERRORS = (
     ValueError,
@@ -82,20 +84,46 @@ def _member_header(
     if info.file_size > limit:
         raise FormatError(path, f"member {name!r} claims an impossible size")
     with zf.open(info) as f:
-        version = np.lib.format.read_magic(f)
-        if version == (1, 0):
-            shape, _fortran, dtype = np.lib.format.read_array_header_1_0(f)
-        elif version in ((2, 0), (3, 0)):
-            shape, _fortran, dtype = np.lib.format.read_array_header_2_0(f)
-        else:
-            raise FormatError(path, f"member {name!r} has .npy version {version}")
+        shape, _fortran, dtype = read_npy_header(path, f, name)
         header_len = f.tell()
-    if dtype.hasobject:
-        raise FormatError(path, f"member {name!r} holds Python objects")
     nbytes = int(np.prod(shape, dtype=object)) * dtype.itemsize
     if header_len + nbytes != info.file_size:
         raise FormatError(path, f"member {name!r}: shape {shape} does not match its stored size")
     return shape, dtype
+
+
+def read_npy_header(path: str | os.PathLike[str], f, name: str) -> tuple[tuple[int, ...], bool, np.dtype]:
+    """``(shape, fortran_order, dtype)`` of the ``.npy`` member ``name`` open in ``f``, which is left
+    at the first data byte; any corrupt header, or one holding Python objects, is a FormatError.
+
+    The header's text is parsed here first: numpy falls back to a filter for Python 2 headers
+    when its own parse fails, and that filter warns and lets ``tokenize.TokenError`` escape.
+    """
+    start = f.tell()
+    magic = f.read(8)
+    if len(magic) < 8 or magic[:6] != b"\x93NUMPY":
+        raise FormatError(path, f"member {name!r} is not a .npy array")
+    version = (magic[6], magic[7])
+    if version not in ((1, 0), (2, 0), (3, 0)):
+        raise FormatError(path, f"member {name!r} has .npy version {version}")
+    size_bytes = f.read(2 if version == (1, 0) else 4)
+    header_len = int.from_bytes(size_bytes, "little")
+    if len(size_bytes) < (2 if version == (1, 0) else 4) or header_len > _MAX_NPY_HEADER:
+        raise FormatError(path, f"member {name!r} has a corrupt .npy header")
+    try:
+        header = f.read(header_len).decode("utf-8" if version == (3, 0) else "latin-1")
+        ast.literal_eval(header)
+    except (SyntaxError, ValueError, UnicodeDecodeError, MemoryError, RecursionError):
+        raise FormatError(path, f"member {name!r} has a corrupt .npy header") from None
+    f.seek(start)
+    read_magic = np.lib.format.read_magic(f)
+    if read_magic == (1, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
+    else:
+        shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
+    if dtype.hasobject:
+        raise FormatError(path, f"member {name!r} holds Python objects")
+    return shape, fortran, dtype
 
 
 def _member(path: Path, z, name: str) -> np.ndarray:
@@ -120,16 +148,29 @@ def _array(path: Path, z, name: str, ndim: int, kind: str) -> np.ndarray:
     return a
 
 
+def _load_zip(path: Path, fh, single_npy: str):
+    """numpy's lazy view of the zip archive open in ``fh``; anything else is refused before
+    numpy reads it (a lone ``.npy`` would be read whole, whatever size its header claims)."""
+    magic = fh.read(4)
+    fh.seek(0)
+    if magic.startswith(b"\x93NUM"):
+        raise FormatError(path, single_npy)
+    if magic not in (b"PK\x03\x04", b"PK\x05\x06"):
+        raise FormatError(path, "not an .npz file (not a zip archive)")
+    return np.load(fh, allow_pickle=False)
+
+
 def read(path: Path) -> Groom | Animation:
     size = path.stat().st_size
     if size == 0:
         raise FormatError(path, "the file is empty")
     try:
-        with np.load(path, allow_pickle=False) as z:
-            if not isinstance(z, np.lib.npyio.NpzFile):
-                raise FormatError(path, "a single .npy array, not a hairtool .npz cache")
-            _check_members(path, z.zip, size)
-            return _build(path, z)
+        # numpy leaves a file it opened itself open when the zip is corrupt: open it here.
+        with open(path, "rb") as fh:
+            z = _load_zip(path, fh, "a single .npy array, not a hairtool .npz cache")
+            with z:
+                _check_members(path, z.zip, size)
+                return _build(path, z)
     except FormatError:
         raise
     except _LOAD_ERRORS as e:
@@ -209,17 +250,17 @@ def read_feature_array(path: str | os.PathLike[str]) -> np.ndarray:
         raise FormatError(p, "the file is empty")
     member = f"{FEATURE_MEMBER}.npy"
     try:
-        with np.load(p, allow_pickle=False) as z:
-            if not isinstance(z, np.lib.npyio.NpzFile):
-                raise FormatError(p, "a single .npy array; features are read from an .npz holding X")
-            if member not in z.zip.namelist():
-                raise FormatError(p, f"no array {FEATURE_MEMBER!r} in the file")
-            shape, dtype = _member_header(p, z.zip, z.zip.getinfo(member), size)
-            if dtype.kind not in "fiu":
-                raise FormatError(p, f"{FEATURE_MEMBER!r} must hold numbers, not {dtype}")
-            if len(shape) not in (1, 2):
-                raise FormatError(p, f"{FEATURE_MEMBER!r} has shape {shape}; expected (frames, dims)")
-            x = z[FEATURE_MEMBER]
+        with open(p, "rb") as fh:
+            z = _load_zip(p, fh, "a single .npy array; features are read from an .npz holding X")
+            with z:
+                if member not in z.zip.namelist():
+                    raise FormatError(p, f"no array {FEATURE_MEMBER!r} in the file")
+                shape, dtype = _member_header(p, z.zip, z.zip.getinfo(member), size)
+                if dtype.kind not in "fiu":
+                    raise FormatError(p, f"{FEATURE_MEMBER!r} must hold numbers, not {dtype}")
+                if len(shape) not in (1, 2):
+                    raise FormatError(p, f"{FEATURE_MEMBER!r} has shape {shape}; expected (frames, dims)")
+                x = z[FEATURE_MEMBER]
     except FormatError:
         raise
     except _LOAD_ERRORS as e:

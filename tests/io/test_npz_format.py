@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import io
+import os
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -204,3 +206,45 @@ def test_feature_array_header_is_checked_before_numpy_allocates(tmp_path):
         zf.writestr("X.npy", npy_header((10**6, 10**6)) + bytes(80))
     with pytest.raises(FormatError, match="does not match its stored size"):
         npz.read_feature_array(p)
+
+
+def _npz_with_member(path, name: str, member: bytes):
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr(name, member)
+    return path
+
+
+def test_corrupt_npy_header_is_a_format_error_not_a_token_error(tmp_path):
+    """numpy's fallback parse of a header with an unbalanced bracket let tokenize.TokenError escape."""
+    header = b"{'descr': '<f8', 'fortran_order': False, 'shape': (3, \x0f}"
+    member = b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header + bytes(24)
+    p = _npz_with_member(tmp_path / "x.npz", "X.npy", member)
+    with pytest.raises(FormatError, match=r"corrupt \.npy header"):
+        npz.read_feature_array(p)
+    p = _npz_with_member(tmp_path / "g.npz", "points.npy", member)
+    with pytest.raises(FormatError, match=r"corrupt \.npy header"):
+        read(p)
+
+
+def test_a_lone_npy_is_refused_before_numpy_reads_it(tmp_path):
+    from .hostile import npy_header
+
+    p = tmp_path / "single.npz"  # a .npy under an .npz name, claiming 10^12 values
+    p.write_bytes(npy_header((10**6, 10**6)) + bytes(80))
+    with pytest.raises(FormatError, match=r"a single \.npy array"):
+        read(p)
+    with pytest.raises(FormatError, match=r"a single \.npy array"):
+        npz.read_feature_array(p)
+    assert not npz.holds_feature_array(p)
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd").is_dir(), reason="counts open files in /proc")
+def test_a_corrupt_zip_leaves_no_file_open(tmp_path):
+    """np.load given a path kept its file open when the zip was corrupt (held by the traceback)."""
+    p = tmp_path / "broken.npz"
+    p.write_bytes(b"PK\x03\x04" + bytes(60))
+    for reader in (read, npz.read_feature_array):
+        before = len(os.listdir("/proc/self/fd"))
+        with pytest.raises(FormatError) as e:
+            reader(p)
+        assert len(os.listdir("/proc/self/fd")) == before, e.value
