@@ -34,6 +34,9 @@ FORMAT_VERSION = 1
 JSON_SUFFIXES = (".json",)
 CSV_SUFFIXES = (".csv",)
 USD_SUFFIXES = (".usd", ".usda", ".usdc")
+#: Records nest a few levels (keys, params, uniform); a deeper one read back would make writing
+#: it again (``_plain``, ``json.dump``) recurse past Python's limit.
+MAX_NESTING = 32
 # Results that are large or only useful on screen; the record keeps everything else.
 _NOT_RECORDED = ("keys", "frames", "fps", "curve")
 
@@ -91,6 +94,17 @@ def keys_record(result: Mapping[str, Any], source: str | os.PathLike[str] | None
     }
 
 
+def _nesting(value: Any) -> int:
+    """How deeply lists and objects nest in a JSON value (counted without recursion)."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        v, depth = stack.pop()
+        if isinstance(v, dict | list):
+            deepest = max(deepest, depth)
+            stack.extend((c, depth + 1) for c in (v.values() if isinstance(v, dict) else v))
+    return deepest
+
+
 def record_keys(record: Mapping[str, Any]) -> NDArray[np.int64]:
     """The key frame numbers of a record, as int64."""
     return np.array([k["frame"] for k in record["keys"]], dtype=np.int64)
@@ -129,6 +143,8 @@ def read_keys_json(path: str | os.PathLike[str]) -> dict:
         raise FormatError(path, "not a keys record: it holds a number thousands of digits long") from None
     if not isinstance(record, dict):
         raise FormatError(path, "a keys record is a JSON object")
+    if _nesting(record) > MAX_NESTING:
+        raise FormatError(path, f"not a keys record: its JSON nests deeper than {MAX_NESTING} levels")
     if record.get("format", FORMAT) != FORMAT:
         raise FormatError(path, f"format is {record.get('format')!r}, not {FORMAT!r}")
     version = record.get("version", FORMAT_VERSION)

@@ -139,3 +139,18 @@ def test_hostile_json_is_one_error_naming_the_file(tmp_path, text, needle):
     with pytest.raises(FormatError, match=needle) as e:
         read_keys_json(path)
     assert e.value.path == str(path)
+
+
+def test_a_record_read_back_can_always_be_written_again(tmp_path):
+    """A record nested 900 levels parses, but writing it again would recurse past Python's limit:
+    the reader refuses anything deeper than MAX_NESTING."""
+    from hairtool.keys.export import MAX_NESTING, write_keys_json
+
+    base = '{"frames": 5, "fps": 24, "keys": [{"frame": 1}], "x": '
+    path = tmp_path / "deep.json"
+    path.write_text(base + "[" * 900 + "]" * 900 + "}", encoding="utf-8")
+    with pytest.raises(FormatError, match="nests deeper"):
+        read_keys_json(path)
+    path.write_text(base + "[" * (MAX_NESTING - 1) + "]" * (MAX_NESTING - 1) + "}", encoding="utf-8")
+    write_keys_json(tmp_path / "again.json", read_keys_json(path))
+    assert read_keys_json(tmp_path / "again.json")["x"] == read_keys_json(path)["x"]
