@@ -31,6 +31,7 @@ F64 = NDArray[np.float64]
 CHANNEL_NAMES = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
 _MAX_JOINTS = 100_000
 _MAX_VALUES = 500_000_000  # frames × channels: refuse absurd headers before allocating
+_MIN_POSES = 1_000_000  # frames × joints any file may have; beyond, at most one per byte of the file
 _MIN_FRAME_TIME = 1e-6  # seconds; shorter would make the frame rate overflow (1 / 5e-324 is inf)
 #: Offsets and channel values beyond float32's range are corruption: the key solver squares
 #: differences of positions, which would overflow float64 from about 1.3e154 on.
@@ -346,6 +347,15 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
             p,
             f"MOTION block is truncated: 'Frames:' says {n_frames} frames of {width} values, "
             f"more than its {len(body) - m.end()} characters can hold",
+        )
+    # Forward kinematics holds every joint in every frame (112 bytes a pose): joints without
+    # channels cost no bytes in the file, so bound frames × joints by the file too.
+    poses = n_frames * (len(names) + len(end_parents))
+    if poses > max(len(raw), _MIN_POSES):
+        raise FormatError(
+            p,
+            f"{n_frames} frames of {len(names) + len(end_parents)} joints and End Sites is more "
+            f"than a file of {len(raw)} bytes can describe (joints without channels?)",
         )
 
     lines = [ln for ln in body[m.end() :].splitlines() if ln.strip()]

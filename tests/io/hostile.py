@@ -148,3 +148,14 @@ def _write_project(path: Path, manifest: dict, arrays: dict[str, np.ndarray], ma
 def write_obj_beyond_float32(path: Path) -> Path:
     path.write_text(f"v 0 0 0\nv 1 {BEYOND_FLOAT32!r} 0\nv 2 2 2\nl 1 2 3\n")
     return path
+
+
+def write_bvh_wide(path: Path, joints: int = 20_000, frames: int = 5_000) -> Path:
+    """A root with one channel and ``joints`` - 1 children without channels: a 600 KB file whose
+    forward kinematics would hold frames × joints poses (11 GB of float64)."""
+    lines = ["HIERARCHY", "ROOT r", "{", "OFFSET 0 0 0", "CHANNELS 1 Zrotation"]
+    for j in range(1, joints):
+        lines += [f"JOINT j{j}", "{", "OFFSET 0 1 0", "}"]
+    lines += ["}", "MOTION", f"Frames: {frames}", "Frame Time: 0.04"] + ["0"] * frames
+    path.write_text("\n".join(lines) + "\n")
+    return path

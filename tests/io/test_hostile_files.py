@@ -98,6 +98,13 @@ def test_bvh_frames_field(tmp_path, frames, words):
     assert_one_line_error(run_cli(tmp_path, "keys", path), "keys", path, words)
 
 
+def test_bvh_joints_without_channels_times_frames(tmp_path):
+    """Found while fixing the class above: channel-less joints cost no bytes per frame, but
+    forward kinematics holds every joint in every frame (a 600 KB file asked for 11 GB)."""
+    path = hostile.write_bvh_wide(tmp_path / "wide.bvh")
+    assert_one_line_error(run_cli(tmp_path, "keys", path), "keys", path, "5000 frames of 20000 joints")
+
+
 def test_bvh_nested_1200_deep_reads_and_keys(tmp_path):
     """A valid chain deeper than Python's recursion limit is read (and keyed), not refused."""
     path = hostile.write_bvh_deep(tmp_path / "deep.bvh", 1200)

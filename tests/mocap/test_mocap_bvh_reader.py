@@ -218,3 +218,16 @@ def test_writer_keeps_children_before_end_sites_in_file_order(tmp_path):
     (tmp_path / "tree.bvh").write_text(text)
     write_bvh(tmp_path / "out.bvh", read_bvh(tmp_path / "tree.bvh"))
     assert (tmp_path / "out.bvh").read_text() == text
+
+
+def test_frames_times_joints_is_bounded_by_the_file(tmp_path):
+    """Joints without channels take no bytes per frame, yet every frame poses them all."""
+    lines = ["HIERARCHY", "ROOT r", "{", "OFFSET 0 0 0", "CHANNELS 1 Zrotation"]
+    lines += [s for j in range(1, 3000) for s in (f"JOINT j{j}", "{", "OFFSET 0 1 0", "}")]
+    head = "\n".join([*lines, "}", "MOTION"])
+    p = tmp_path / "wide.bvh"
+    p.write_text(head + "\nFrames: 600\nFrame Time: 0.04\n" + "0\n" * 600)  # 1.8 M poses, 70 KB
+    with pytest.raises(FormatError, match="600 frames of 3000 joints"):
+        read_bvh(p)
+    p.write_text(head + "\nFrames: 300\nFrame Time: 0.04\n" + "0\n" * 300)  # 0.9 M: under the floor
+    assert read_bvh(p).joint_positions().shape == (300, 3000, 3)
