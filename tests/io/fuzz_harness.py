@@ -496,15 +496,20 @@ def run(name: str, count: int, seed: int, only: int | None = None) -> dict:
                 counts["refused"] += 1
             else:
                 failures.append({"index": index, "ops": ops, "error": result})
-    usage = resource.getrusage(resource.RUSAGE_SELF)
     return {
         "reader": name,
         "mutants": count if only is None else 1,
         **counts,
         "failures": failures,
         "cap_mb": cap // 2**20,
-        "max_rss_mb": usage.ru_maxrss // 1024,
+        "max_rss_mb": peak_rss_mb(),
     }
+
+
+def peak_rss_mb() -> int:
+    """This process's peak resident memory (VmHWM: ``ru_maxrss`` would include a forking parent's)."""
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) for line in f if line.startswith("VmHWM:")) // 1024
 
 
 def main(argv: list[str] | None = None) -> int:
