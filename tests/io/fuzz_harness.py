@@ -14,8 +14,9 @@ Mutations, 1 to 3 per mutant, each from its own ``default_rng([seed, index])``: 
 overwrites, truncations (and cut-out spans), huge or edge header counts (binary words, or
 numeric tokens in text), duplicated chunks and token swaps (two words of text, two 4-byte
 words of binary). Zip formats (.npz, projects) are also mutated member by member and zipped
-again with valid checksums, so mutations reach the readers' own checks rather than zip's CRC;
-members are duplicated, dropped and swapped there too.
+again with valid checksums, so mutations reach the readers' own checks rather than zip's CRC:
+a ``.npy`` member's header tokens (shapes, dtypes) or its data (counts, coordinates); members
+are duplicated, dropped and swapped there too.
 """
 
 from __future__ import annotations
@@ -137,6 +138,27 @@ def mutate_bytes(rng: np.random.Generator, data: bytes, text: bool) -> tuple[byt
     return bytes(out), names
 
 
+def _mutate_member(rng: np.random.Generator, content: bytes) -> tuple[bytes, list[str]]:
+    """A ``.npy`` member: its header as text (shape and dtype tokens: huge counts, swaps) or its
+    data as bytes (counts and coordinates); anything else (the manifest) as text."""
+    if content.startswith(b"\x93NUMPY") and len(content) >= 10:
+        size = 2 if content[6] == 1 else 4
+        end = 8 + size + int.from_bytes(content[8 : 8 + size], "little")
+        head, data = content[:end], content[end:]
+        r = rng.random()
+        if r < 0.3:
+            head = bytearray(head)
+            return bytes(head) + data, [_huge(rng, head, True)]
+        if r < 0.4:
+            head = bytearray(head)
+            return bytes(head) + data, [_swap(rng, head, True)]
+        if r < 0.5:
+            return mutate_bytes(rng, content, text=True)
+        new, ops = mutate_bytes(rng, data, text=False)
+        return head + new, ops
+    return mutate_bytes(rng, content, text=True)
+
+
 def mutate_zip(rng: np.random.Generator, data: bytes) -> tuple[bytes, list[str]]:
     """Mutate inside the members (the .npy headers as text, so shapes get huge) and zip again."""
     with zipfile.ZipFile(io.BytesIO(data)) as zf:
@@ -157,8 +179,7 @@ def mutate_zip(rng: np.random.Generator, data: bytes) -> tuple[bytes, list[str]]
             members[k], members[j] = (name, kind, members[j][2]), (members[j][0], members[j][1], content)
             names.append(f"swap {name} {members[k][0]}")
         else:
-            header_text = rng.random() < 0.6  # the .npy header: shape, dtype, order
-            new, ops = mutate_bytes(rng, content, text=header_text)
+            new, ops = _mutate_member(rng, content)
             members[k] = (name, kind, new)
             names.append(f"{name}: {'+'.join(ops)}")
     buf = io.BytesIO()
@@ -427,6 +448,27 @@ def mutant(reader: Reader, seeds: list[bytes], seed: int, index: int) -> tuple[b
     return mutate_bytes(rng, base, reader.text)
 
 
+MUTATION_CLASSES = ("bit flip", "overwrite", "truncation", "huge count", "duplicated chunk", "token swap")
+_CLASS_OF = {
+    "flip": "bit flip",
+    "overwrite": "overwrite",
+    "truncate": "truncation",
+    "cut": "truncation",
+    "drop": "truncation",
+    "huge": "huge count",
+    "duplicate": "duplicated chunk",
+    "swap": "token swap",
+}
+
+
+def mutation_classes(ops: list[str]) -> set[str]:
+    """The classes of a mutant's operations ("points.npy: flip+huge-32", "swap a b", "cut" …)."""
+    words = [w for op in ops if ": " in op for w in op.split(": ")[-1].split("+")]
+    words += [op.split(" ")[0] for op in ops if ": " not in op]
+    heads = [w.split("-")[0] for w in words]
+    return {_CLASS_OF[h] for h in heads if h in _CLASS_OF}
+
+
 def _chain(e: BaseException) -> list[BaseException]:
     seen: list[BaseException] = []
     while e is not None and e not in seen:
@@ -484,10 +526,13 @@ def run(name: str, count: int, seed: int, only: int | None = None) -> dict:
         # on stderr beside its one line.
         warnings.simplefilter("error")
         counts = {"read": 0, "refused": 0}
+        classes = dict.fromkeys(MUTATION_CLASSES, 0)
         failures = []
         path = work / f"case.{reader.ext}"
         for index in range(count) if only is None else [only]:
             data, ops = mutant(reader, seeds, seed, index)
+            for c in mutation_classes(ops):
+                classes[c] += 1
             path.write_bytes(data)
             result = outcome(reader, path)
             if result is None:
@@ -500,6 +545,7 @@ def run(name: str, count: int, seed: int, only: int | None = None) -> dict:
         "reader": name,
         "mutants": count if only is None else 1,
         **counts,
+        "classes": classes,
         "failures": failures,
         "cap_mb": cap // 2**20,
         "max_rss_mb": peak_rss_mb(),

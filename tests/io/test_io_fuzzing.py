@@ -184,4 +184,5 @@ def test_every_mutant_is_read_finite_or_refused_in_one_line(fuzz_reports, reader
     assert report["failures"] == [], "\n".join(json.dumps(f) for f in report["failures"][:10])
     assert report["read"] + report["refused"] == MUTANTS[reader]
     assert report["refused"] > 0 and report["read"] > 0  # the mutants reach both outcomes
+    assert min(report["classes"].values()) >= 50, report["classes"]  # every mutation class, often
     assert report["max_rss_mb"] < report["cap_mb"] < 4096
