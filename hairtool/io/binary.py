@@ -84,8 +84,9 @@ def float32_finite(path: str | os.PathLike[str], values: np.ndarray, what: str) 
 def require_strand_counts(
     path: str | os.PathLike[str], counts: np.ndarray, points: int | None = None
 ) -> int:
-    """Every strand needs a root and a tip, and at most ``points`` (the points the file holds, else
-    :data:`~hairtool.groom.MAX_STRAND_VERTICES`); returns the total, exact.
+    """Every strand needs a root and a tip, and at most ``points`` (the points the file's header
+    gives, else :data:`~hairtool.groom.MAX_STRAND_VERTICES`); returns the total, exact, which
+    must equal ``points`` when given.
 
     Bounding each count first keeps the int64 sum from wrapping around: counts of 2^62 whose sum
     wraps to the number of points in the file would otherwise pass the size checks.
@@ -103,12 +104,13 @@ def require_strand_counts(
     long = np.flatnonzero(counts > limit)
     if long.size:
         s = int(long[0])
-        where = f"the file holds {points}" if points is not None and points < MAX_STRAND_VERTICES else (
-            f"hairtool reads at most {MAX_STRAND_VERTICES} per strand"
+        if limit < MAX_STRAND_VERTICES:
+            raise FormatError(path, f"strand {s} claims {int(counts[s])} points; the file holds {points}")
+        raise FormatError(
+            path, f"strand {s} claims {int(counts[s])} points; hairtool reads at most {limit} per strand"
         )
-        raise FormatError(path, f"strand {s} claims {int(counts[s])} points; {where}")
     # Each count <= 2^31 - 1 and fewer than 2^32 strands: the int64 sum cannot wrap.
     total = int(counts.sum(dtype=np.int64))
     if points is not None and total != points:
-        raise FormatError(path, f"the strands add up to {total} points but the file holds {points}")
+        raise FormatError(path, f"the strands add up to {total} points but the header says {points}")
     return total

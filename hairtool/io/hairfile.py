@@ -144,9 +144,7 @@ def read(path: Path) -> Groom:
                 f"but the header says {v_count}",
             )
         counts = np.full(s_count, h.default_segments + 1, dtype=np.int64)
-    total = require_strand_counts(path, counts)
-    if total != v_count:
-        raise FormatError(path, f"the strands add up to {total} points but the header says {v_count}")
+    require_strand_counts(path, counts, v_count)
 
     points = array_at(path, data, offset, "<f4", 3 * v_count, "points").reshape(v_count, 3)
     offset += 12 * v_count
