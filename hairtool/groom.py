@@ -22,6 +22,11 @@ F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
 
+#: The most vertices one strand may have. Bounding every count (with fewer than 2^32 strands)
+#: keeps their int64 sum from wrapping around: counts of 2^62 could otherwise add up to the
+#: number of points and pass for a valid groom.
+MAX_STRAND_VERTICES = 2**31 - 1
+
 
 def _frozen(a: np.ndarray) -> np.ndarray:
     a.flags.writeable = False
@@ -37,13 +42,20 @@ class Topology:
             raise GroomError(f"strand counts must be a 1-D array, got shape {c.shape}")
         if c.size == 0:
             raise GroomError("a groom needs at least one strand")
-        if not np.issubdtype(c.dtype, np.integer):
-            if not np.all(np.isfinite(c)) or not np.all(c == np.round(c)):
-                raise GroomError("strand counts must be whole numbers")
-        c = c.astype(np.int64)
+        if c.dtype.kind not in "iuf":
+            raise GroomError(f"strand counts must be whole numbers, not {c.dtype}")
+        if c.dtype.kind == "f" and (not np.all(np.isfinite(c)) or not np.all(c == np.round(c))):
+            raise GroomError("strand counts must be whole numbers")
+        if c.size >= 2**32:
+            raise GroomError(f"a groom holds at most 2^32 - 1 strands, got {c.size}")
+        # Range checks in the given dtype, before the cast: a uint64 or a float of 2^64 would wrap.
         if c.min() < 2:
             bad = int(np.argmin(c))
             raise GroomError(f"strand {bad} has {int(c[bad])} vertices; every strand needs at least 2")
+        if c.max() > MAX_STRAND_VERTICES:
+            bad = int(np.argmax(c))
+            raise GroomError(f"strand {bad} has {int(c[bad])} vertices; the most is {MAX_STRAND_VERTICES}")
+        c = c.astype(np.int64)
         self.counts: I64 = _frozen(c)
 
     @property
@@ -105,16 +117,26 @@ def _check_points(points: ArrayLike, vertex_count: int, what: str) -> F32:
         raise GroomError(f"{what} must have shape (V, 3), got {p.shape}")
     if p.shape[0] != vertex_count:
         raise GroomError(f"{what} has {p.shape[0]} vertices but the strand counts add up to {vertex_count}")
-    if not np.all(np.isfinite(p)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(p), axis=1))[0])
-        raise GroomError(f"{what} has a non-finite coordinate at vertex {bad}")
-    return np.array(p, dtype=np.float32, copy=True)
+    out = _float32(p, what)
+    if not np.all(np.isfinite(out)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(out), axis=1))[0])
+        raise GroomError(f"{what} has a non-finite or beyond-float32 coordinate at vertex {bad}")
+    return out
+
+
+def _float32(values: np.ndarray, what: str) -> F32:
+    """A float32 copy; checked for finiteness by the caller *after* the cast, since a float64
+    beyond ±3.4e38 is finite but becomes inf."""
+    if values.dtype.kind not in "fiub":
+        raise GroomError(f"{what} must hold numbers, not {values.dtype}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.array(values, dtype=np.float32, copy=True)
 
 
 def _check_attribute(values: ArrayLike | None, vertex_count: int, width: int, name: str) -> F32 | None:
     if values is None:
         return None
-    a = np.array(values, dtype=np.float32, copy=True)
+    a = _float32(np.asarray(values), name)
     shape = (vertex_count,) if width == 1 else (vertex_count, width)
     if a.shape != shape:
         raise GroomError(f"{name} must have shape {shape}, got {a.shape}")
@@ -341,13 +363,14 @@ class Animation(_Attributes):
             raise GroomError(
                 f"animation frames have {f.shape[1]} vertices but the strand counts add up to {v}"
             )
-        if not np.all(np.isfinite(f)):
-            bad = int(np.flatnonzero(~np.all(np.isfinite(f), axis=(1, 2)))[0])
-            raise GroomError(f"animation frame {bad} has a non-finite coordinate")
+        frames32 = _float32(f, "animation frames")
+        if not np.all(np.isfinite(frames32)):
+            bad = int(np.flatnonzero(~np.all(np.isfinite(frames32), axis=(1, 2)))[0])
+            raise GroomError(f"animation frame {bad} has a non-finite or beyond-float32 coordinate")
         fps = float(fps)
         if not np.isfinite(fps) or fps <= 0:
             raise GroomError(f"frame rate must be a positive number, got {fps}")
-        self.frames: F32 = _frozen(np.array(f, dtype=np.float32, copy=True))
+        self.frames: F32 = _frozen(frames32)
         self.fps = fps
         self._set_attributes(thickness, transparency, colors, v)
         self._set_metadata(metadata, self.topology.strand_count)

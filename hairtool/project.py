@@ -36,7 +36,8 @@ from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterErr
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
-from hairtool.io.binary import require_finite, require_strand_counts
+from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
+from hairtool.io.npz import read_npy_header
 
 FORMAT = "hairtool project"
 FORMAT_VERSION = 1
@@ -259,15 +260,7 @@ class _Reader:
             raise FormatError(self.path, f"missing member {name!r}")
         info = self.infos[name]
         with self.zf.open(info) as f:
-            version = np.lib.format.read_magic(f)
-            if version == (1, 0):
-                shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
-            elif version in ((2, 0), (3, 0)):
-                shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
-            else:
-                raise FormatError(self.path, f"member {name!r} has .npy version {version}")
-            if dtype.hasobject:
-                raise FormatError(self.path, f"member {name!r} holds Python objects")
+            shape, fortran, dtype = read_npy_header(self.path, f, name)
             nbytes = math.prod(shape) * dtype.itemsize
             if f.tell() + nbytes != info.file_size:
                 raise FormatError(self.path, f"member {name!r}: shape {shape} does not match its stored size")
@@ -290,9 +283,9 @@ def _section(path: Path, manifest: dict, name: str, kind: type) -> Any:
 
 
 def _read_groom(r: _Reader, prefix: str, info: dict, frames_fps: float | None = None) -> Groom | Animation:
-    counts = r.array(f"{prefix}/counts.npy", 1, "iu").astype(np.int64)
-    require_strand_counts(r.path, counts)
-    v = int(counts.sum())
+    raw_counts = r.array(f"{prefix}/counts.npy", 1, "iu")
+    v = require_strand_counts(r.path, raw_counts)  # bounded before the cast and the sum
+    counts = raw_counts.astype(np.int64)
     attrs: dict[str, np.ndarray] = {}
     names = info.get("attributes", [])
     if not isinstance(names, list) or not set(names) <= set(_ATTRIBUTES):
@@ -302,19 +295,16 @@ def _read_groom(r: _Reader, prefix: str, info: dict, frames_fps: float | None = 
         want = (v, 3) if name == "colors" else (v,)
         if a.shape != want:
             raise FormatError(r.path, f"{prefix} {name} has shape {a.shape}, expected {want}")
-        require_finite(r.path, a, f"{prefix} {name}")
-        attrs[name] = a
+        attrs[name] = float32_finite(r.path, a, f"{prefix} {name}")
     if frames_fps is None:
         points = r.array(f"{prefix}/points.npy", 2, "f")
         if points.shape != (v, 3):
             raise FormatError(r.path, f"{prefix} points have shape {points.shape}, expected {(v, 3)}")
-        require_finite(r.path, points, f"{prefix} points")
-        return Groom(points, counts, **attrs)
+        return Groom(float32_finite(r.path, points, f"{prefix} points"), counts, **attrs)
     frames = r.array(f"{prefix}/frames.npy", 3, "f")
     if frames.shape[0] < 1 or frames.shape[1:] != (v, 3):
         raise FormatError(r.path, f"animation frames have shape {frames.shape}, expected (F≥1, {v}, 3)")
-    require_finite(r.path, frames.reshape(-1, 3), "animation frames")
-    return Animation(frames, counts, frames_fps, **attrs)
+    return Animation(float32_finite(r.path, frames, "animation frames"), counts, frames_fps, **attrs)
 
 
 def _read_params(r: _Reader, raw: dict) -> FrozenParams:
@@ -355,8 +345,7 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple[AlignSampl
         pts = r.array("strokes/aligned.npy", 2, "f")
         if pts.shape != rest.points.shape:
             raise FormatError(r.path, f"aligned points have shape {pts.shape}, expected {rest.points.shape}")
-        require_finite(r.path, pts, "aligned points")
-        aligned = rest.with_points(pts)
+        aligned = rest.with_points(float32_finite(r.path, pts, "aligned points"))
     return strokes, aligned
 
 

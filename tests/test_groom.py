@@ -154,3 +154,27 @@ def test_comb_grid_is_straight():
     d = g.segment_vectors
     np.testing.assert_allclose(d[:, [0, 2]], 0)
     assert np.all(d[:, 1] < 0)
+
+
+def test_counts_whose_int64_sum_wraps_around_are_refused():
+    """Counts of 2^62 add up, modulo 2^64, to the 10 points given: refused before they are summed."""
+    counts = np.array([2**62, 2**62, 2**62, 2**62, 10], dtype=np.int64)
+    assert counts.sum() == 10
+    with pytest.raises(GroomError, match="strand 0 has 4611686018427387904 vertices"):
+        Groom(np.zeros((10, 3)), counts)
+    with pytest.raises(GroomError, match="vertices"):
+        Groom(np.zeros((10, 3)), np.array([2**64 - 1, 11], dtype=np.uint64))
+    with pytest.raises(GroomError, match="whole numbers"):
+        Groom(np.zeros((10, 3)), np.array([10**30, 10], dtype=object))
+
+
+def test_float64_beyond_float32_is_cast_then_checked():
+    p = np.zeros((5, 3))
+    p[3, 1] = 1e39  # finite as float64, inf as float32
+    with pytest.raises(GroomError, match="vertex 3"):
+        Groom(p, [2, 3])
+    with pytest.raises(GroomError, match="frame 1"):
+        Animation(np.stack([np.zeros((5, 3)), p]), [2, 3])
+    with pytest.raises(GroomError, match="thickness"):
+        Groom(np.zeros((5, 3)), [2, 3], thickness=[1, 1, 1e39, 1, 1])
+    assert Groom(np.full((5, 3), 3.4e38), [2, 3]).points.max() == np.float32(3.4e38)

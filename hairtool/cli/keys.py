@@ -71,8 +71,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _load(args: argparse.Namespace):
     """``(kind, data, fps)``: kind "raw" (X), "animation" (Animation) or "bvh" (Motion)."""
-    import numpy as np
-
     from hairtool.errors import FormatError, GroomError
     from hairtool.groom import Animation
 
@@ -86,14 +84,10 @@ def _load(args: argparse.Namespace):
         motion = read_bvh(path)
         return "bvh", motion, motion.fps
     if suffix == ".npz":
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                names = set(z.files)
-                x = z["X"] if "X" in names and "kind" not in names else None
-        except (OSError, ValueError) as e:
-            raise FormatError(path, f"cannot read: {e}") from None
-        if x is not None:
-            return "raw", x, 1.0
+        from hairtool.io.npz import holds_feature_array, read_feature_array
+
+        if holds_feature_array(path):
+            return "raw", read_feature_array(path), 1.0
     from hairtool.io import read
 
     obj = read(path)

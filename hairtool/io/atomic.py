@@ -3,13 +3,25 @@
 The renamed file gets the permissions a plain ``open(path, "w")`` would give it: the mode of the
 file it replaces, or 0o666 less the process umask for a new file (a ``mkstemp`` file is 0o600,
 which would leave the user's groom unreadable to the rest of the studio).
+
+A writer killed outright (``kill -9``, a crash, a power cut) cannot remove its temporary file.
+Temporaries are therefore named ``.<name>.<host>-<pid>.<random>.tmp<suffix>``: ``host`` is a
+short tag of this machine and process namespace, ``pid`` the writer's process id. Every write
+to a path first removes that path's temporaries whose writer is gone: made under this host tag
+by a process id that no longer runs. A temporary of a live writer is never touched; a dead
+writer's whose id has been reused by another live process waits for a later write; one made
+on another machine sharing the folder is left alone, since its process id means nothing here.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
+import hashlib
 import os
+import re
 import secrets
+import socket
 import stat
 from collections.abc import Iterator
 from pathlib import Path
@@ -17,6 +29,71 @@ from pathlib import Path
 _CREATE_FLAGS = (
     os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOFOLLOW", 0)
 )
+
+
+@functools.cache
+def host_tag() -> str:
+    """Six hex digits naming this machine and its process-id namespace (process ids mean
+    something only within one namespace: a container sharing the folder has its own)."""
+    try:
+        namespace = os.readlink("/proc/self/ns/pid")
+    except OSError:
+        namespace = ""
+    return hashlib.sha1(f"{socket.gethostname()}|{namespace}".encode()).hexdigest()[:6]
+
+
+def temp_name(target: Path, pid: int, token: str) -> str:
+    """``.<name>.<host>-<pid>.<token>.tmp<suffix>``: hidden, beside the target, same suffix."""
+    return f".{target.name}.{host_tag()}-{pid}.{token}.tmp{target.suffix}"
+
+
+def _temp_pattern(target: Path) -> re.Pattern[str]:
+    """Our temporaries of ``target``, and files a library made from their names: usd-core saves
+    through its own ``<name without suffix>.XXXXXX`` beside the path it is given."""
+    name = re.escape(target.name)
+    return re.compile(rf"\.{name}\.{host_tag()}-(\d{{1,10}})\.[0-9a-f]{{8}}\.tmp(?:\.[^/]*)?")
+
+
+def process_alive(pid: int) -> bool:
+    """Whether process ``pid`` may still be writing; True whenever it cannot be ruled out."""
+    if pid == os.getpid():
+        return True
+    if os.name != "posix" or not 0 < pid < 2**31:
+        return True  # on Windows os.kill would terminate it; beyond pid_t it is no process id
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True  # it exists but belongs to someone else
+    try:  # a killed process not yet reaped by its parent is a zombie: it writes no more
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            state = f.read().rsplit(b")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return True
+    return state not in (b"Z", b"X")
+
+
+def remove_stale_temps(target: Path) -> list[Path]:
+    """Remove the temporaries of ``target`` left by writers of this host that no longer run."""
+    folder = target.parent if str(target.parent) else Path(".")
+    pattern = _temp_pattern(target)
+    prefix = f".{target.name}."
+    removed = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for entry in entries:
+        if not entry.name.startswith(prefix):
+            continue
+        m = pattern.fullmatch(entry.name)
+        if m is None or process_alive(int(m.group(1))):
+            continue
+        with contextlib.suppress(OSError):
+            os.unlink(entry.path)
+            removed.append(Path(entry.path))
+    return removed
 
 
 def _create_temp(target: Path) -> tuple[Path, int]:
@@ -28,7 +105,7 @@ def _create_temp(target: Path) -> tuple[Path, int]:
     """
     folder = target.parent if str(target.parent) else Path(".")
     for _ in range(100):
-        tmp = folder / f".{target.name}.{secrets.token_hex(4)}.tmp{target.suffix}"
+        tmp = folder / temp_name(target, os.getpid(), secrets.token_hex(4))
         try:
             fd = os.open(tmp, _CREATE_FLAGS, 0o666)
         except FileExistsError:
@@ -56,9 +133,11 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
 
     For writers that need a file name (usd-core, imageio). On any exception the temporary file
     is removed and the previous ``path``, if any, is untouched. The result keeps the mode of the
-    file it replaces; a new file gets 0o666 less the umask.
+    file it replaces; a new file gets 0o666 less the umask. Temporaries of ``path`` left by
+    killed writers are removed first (see the module docstring).
     """
     target = Path(path)
+    remove_stale_temps(target)
     tmp_path, new_file_mode = _create_temp(target)
     try:
         yield tmp_path

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from hairtool.errors import FormatError
+from hairtool.groom import MAX_STRAND_VERTICES
 
 
 def require_size(path: str | os.PathLike[str], data: bytes, min_size: int, what: str) -> None:
@@ -64,11 +65,52 @@ def require_finite(path: str | os.PathLike[str], values: np.ndarray, what: str) 
         raise FormatError(path, f"{what} has a non-finite value at index {int(flat[0])}")
 
 
-def require_strand_counts(path: str | os.PathLike[str], counts: np.ndarray) -> None:
-    """Every strand needs a root and a tip."""
+def float32_finite(path: str | os.PathLike[str], values: np.ndarray, what: str) -> np.ndarray:
+    """``values`` as float32, checked *after* the cast: a float64 of 1e39 is finite, its float32 is not."""
+    if values.dtype.kind not in "fiu":
+        raise FormatError(path, f"{what} must hold numbers, not {values.dtype}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = values.astype(np.float32, copy=False)
+    if not np.all(np.isfinite(out)):
+        big = np.isfinite(values) if values.dtype.kind == "f" else np.ones(values.shape, bool)
+        bad = ~np.isfinite(out)
+        index = int(np.flatnonzero(bad.reshape(len(out), -1).any(axis=1))[0])
+        if np.any(big & bad):
+            raise FormatError(path, f"{what} has a value at index {index} beyond float32's range (±3.4e38)")
+        raise FormatError(path, f"{what} has a non-finite value at index {index}")
+    return out
+
+
+def require_strand_counts(
+    path: str | os.PathLike[str], counts: np.ndarray, points: int | None = None
+) -> int:
+    """Every strand needs a root and a tip, and at most ``points`` (the points the file's header
+    gives, else :data:`~hairtool.groom.MAX_STRAND_VERTICES`); returns the total, exact, which
+    must equal ``points`` when given.
+
+    Bounding each count first keeps the int64 sum from wrapping around: counts of 2^62 whose sum
+    wraps to the number of points in the file would otherwise pass the size checks.
+    """
+    counts = np.asarray(counts)
     if counts.size == 0:
         raise FormatError(path, "the file holds no strands")
+    if counts.size >= 2**32:
+        raise FormatError(path, f"{counts.size} strands; hairtool reads at most 2^32 - 1")
     short = np.flatnonzero(counts < 2)
     if short.size:
         s = int(short[0])
         raise FormatError(path, f"strand {s} has {int(counts[s])} points; every strand needs at least 2")
+    limit = MAX_STRAND_VERTICES if points is None else min(int(points), MAX_STRAND_VERTICES)
+    long = np.flatnonzero(counts > limit)
+    if long.size:
+        s = int(long[0])
+        if limit < MAX_STRAND_VERTICES:
+            raise FormatError(path, f"strand {s} claims {int(counts[s])} points; the file holds {points}")
+        raise FormatError(
+            path, f"strand {s} claims {int(counts[s])} points; hairtool reads at most {limit} per strand"
+        )
+    # Each count <= 2^31 - 1 and fewer than 2^32 strands: the int64 sum cannot wrap.
+    total = int(counts.sum(dtype=np.int64))
+    if points is not None and total != points:
+        raise FormatError(path, f"the strands add up to {total} points but the header says {points}")
+    return total

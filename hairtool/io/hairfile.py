@@ -135,11 +135,16 @@ def read(path: Path) -> Groom:
     else:
         if h.default_segments < 1:
             raise FormatError(path, f"default_segments is {h.default_segments}; strands need at least 1")
+        # The header alone fixes every count: check the total (Python ints) before allocating S counts.
+        total = s_count * (h.default_segments + 1)
+        if total != v_count:
+            raise FormatError(
+                path,
+                f"{s_count} strands of {h.default_segments + 1} points add up to {total} points "
+                f"but the header says {v_count}",
+            )
         counts = np.full(s_count, h.default_segments + 1, dtype=np.int64)
-    require_strand_counts(path, counts)
-    total = int(counts.sum())
-    if total != v_count:
-        raise FormatError(path, f"the strands add up to {total} points but the header says {v_count}")
+    require_strand_counts(path, counts, v_count)
 
     points = array_at(path, data, offset, "<f4", 3 * v_count, "points").reshape(v_count, 3)
     offset += 12 * v_count

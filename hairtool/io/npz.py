@@ -10,6 +10,8 @@ caches written before it existed read as 0…F−1), and optional ``thickness`` 
 
 from __future__ import annotations
 
+import ast
+import os
 import struct
 import zipfile
 import zlib
@@ -20,7 +22,7 @@ import numpy as np
 from hairtool.errors import FormatError
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
-from hairtool.io.binary import require_finite, require_strand_counts
+from hairtool.io.binary import float32_finite, require_strand_counts
 from hairtool.metadata import Metadata
 
 FORMAT_VERSION = 1
@@ -28,6 +30,7 @@ ATTRIBUTES = ("thickness", "transparency", "colors")
 _KNOWN = {"format_version", "kind", "counts", "points", "frames", "fps", "time_codes", *ATTRIBUTES}
 # zlib's deflate never expands data more than about 1032:1; a member claiming more is corrupt.
 _MAX_DEFLATE_RATIO = 1100
+_MAX_NPY_HEADER = 10_000  # numpy's own limit on a header's length (max_header_size)
 
 _LOAD_ERRORS = (
     ValueError,
@@ -66,29 +69,64 @@ def _check_members(path: Path, zf: zipfile.ZipFile, file_size: int) -> None:
         name = info.filename
         if not name.endswith(".npy") or name[:-4] not in _KNOWN:
             raise FormatError(path, f"unexpected member {name!r}")
-        if info.compress_size > file_size:
-            raise FormatError(path, f"member {name!r} claims more bytes than the file has")
-        limit = (
-            info.compress_size
-            if info.compress_type == zipfile.ZIP_STORED
-            else (_MAX_DEFLATE_RATIO * info.compress_size + 1024)
-        )
-        if info.file_size > limit:
-            raise FormatError(path, f"member {name!r} claims an impossible size")
-        with zf.open(info) as f:
-            version = np.lib.format.read_magic(f)
-            if version == (1, 0):
-                shape, _fortran, dtype = np.lib.format.read_array_header_1_0(f)
-            elif version in ((2, 0), (3, 0)):
-                shape, _fortran, dtype = np.lib.format.read_array_header_2_0(f)
-            else:
-                raise FormatError(path, f"member {name!r} has .npy version {version}")
-            header_len = f.tell()
-        if dtype.hasobject:
-            raise FormatError(path, f"member {name!r} holds Python objects")
-        nbytes = int(np.prod(shape, dtype=object)) * dtype.itemsize
-        if header_len + nbytes != info.file_size:
-            raise FormatError(path, f"member {name!r}: shape {shape} does not match its stored size")
+        _member_header(path, zf, info, file_size)
+
+
+def _member_header(
+    path: Path, zf: zipfile.ZipFile, info: zipfile.ZipInfo, file_size: int
+) -> tuple[tuple[int, ...], np.dtype]:
+    """The shape and dtype a ``.npy`` member claims, checked against the bytes stored for it."""
+    name = info.filename
+    if info.compress_size > file_size:
+        raise FormatError(path, f"member {name!r} claims more bytes than the file has")
+    limit = (
+        info.compress_size
+        if info.compress_type == zipfile.ZIP_STORED
+        else (_MAX_DEFLATE_RATIO * info.compress_size + 1024)
+    )
+    if info.file_size > limit:
+        raise FormatError(path, f"member {name!r} claims an impossible size")
+    with zf.open(info) as f:
+        shape, _fortran, dtype = read_npy_header(path, f, name)
+        header_len = f.tell()
+    nbytes = int(np.prod(shape, dtype=object)) * dtype.itemsize
+    if header_len + nbytes != info.file_size:
+        raise FormatError(path, f"member {name!r}: shape {shape} does not match its stored size")
+    return shape, dtype
+
+
+def read_npy_header(path: str | os.PathLike[str], f, name: str) -> tuple[tuple[int, ...], bool, np.dtype]:
+    """``(shape, fortran_order, dtype)`` of the ``.npy`` member ``name`` open in ``f``, which is left
+    at the first data byte; any corrupt header, or one holding Python objects, is a FormatError.
+
+    The header's text is parsed here first: numpy falls back to a filter for Python 2 headers
+    when its own parse fails, and that filter warns and lets ``tokenize.TokenError`` escape.
+    """
+    start = f.tell()
+    magic = f.read(8)
+    if len(magic) < 8 or magic[:6] != b"\x93NUMPY":
+        raise FormatError(path, f"member {name!r} is not a .npy array")
+    version = (magic[6], magic[7])
+    if version not in ((1, 0), (2, 0), (3, 0)):
+        raise FormatError(path, f"member {name!r} has .npy version {version}")
+    size_bytes = f.read(2 if version == (1, 0) else 4)
+    header_len = int.from_bytes(size_bytes, "little")
+    if len(size_bytes) < (2 if version == (1, 0) else 4) or header_len > _MAX_NPY_HEADER:
+        raise FormatError(path, f"member {name!r} has a corrupt .npy header")
+    try:
+        header = f.read(header_len).decode("utf-8" if version == (3, 0) else "latin-1")
+        ast.literal_eval(header)
+    except (SyntaxError, ValueError, UnicodeDecodeError, MemoryError, RecursionError):
+        raise FormatError(path, f"member {name!r} has a corrupt .npy header") from None
+    f.seek(start)
+    read_magic = np.lib.format.read_magic(f)
+    if read_magic == (1, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
+    else:
+        shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
+    if dtype.hasobject:
+        raise FormatError(path, f"member {name!r} holds Python objects")
+    return shape, fortran, dtype
 
 
 def _member(path: Path, z, name: str) -> np.ndarray:
@@ -122,16 +160,29 @@ def _time_codes(path: Path, z, n_frames: int) -> Metadata | None:
     return Metadata(time_codes=tuple(t.tolist()))
 
 
+def _load_zip(path: Path, fh, single_npy: str):
+    """numpy's lazy view of the zip archive open in ``fh``; anything else is refused before
+    numpy reads it (a lone ``.npy`` would be read whole, whatever size its header claims)."""
+    magic = fh.read(4)
+    fh.seek(0)
+    if magic.startswith(b"\x93NUM"):
+        raise FormatError(path, single_npy)
+    if magic not in (b"PK\x03\x04", b"PK\x05\x06"):
+        raise FormatError(path, "not an .npz file (not a zip archive)")
+    return np.load(fh, allow_pickle=False)
+
+
 def read(path: Path) -> Groom | Animation:
     size = path.stat().st_size
     if size == 0:
         raise FormatError(path, "the file is empty")
     try:
-        with np.load(path, allow_pickle=False) as z:
-            if not isinstance(z, np.lib.npyio.NpzFile):
-                raise FormatError(path, "a single .npy array, not a hairtool .npz cache")
-            _check_members(path, z.zip, size)
-            return _build(path, z)
+        # numpy leaves a file it opened itself open when the zip is corrupt: open it here.
+        with open(path, "rb") as fh:
+            z = _load_zip(path, fh, "a single .npy array, not a hairtool .npz cache")
+            with z:
+                _check_members(path, z.zip, size)
+                return _build(path, z)
     except FormatError:
         raise
     except _LOAD_ERRORS as e:
@@ -143,9 +194,9 @@ def _build(path: Path, z) -> Groom | Animation:
     if version != FORMAT_VERSION:
         raise FormatError(path, f"cache format version {version}; this hairtool reads {FORMAT_VERSION}")
     kind = _scalar(path, z, "kind", "U")
-    counts = _array(path, z, "counts", 1, "iu").astype(np.int64)
-    require_strand_counts(path, counts)
-    v_count = int(counts.sum())
+    raw_counts = _array(path, z, "counts", 1, "iu")
+    v_count = require_strand_counts(path, raw_counts)  # bounded before the cast and the sum
+    counts = raw_counts.astype(np.int64)
     attrs: dict[str, np.ndarray] = {}
     for name in ATTRIBUTES:
         if name in z.files:
@@ -153,21 +204,94 @@ def _build(path: Path, z) -> Groom | Animation:
             want = (v_count, 3) if name == "colors" else (v_count,)
             if a.shape != want:
                 raise FormatError(path, f"{name!r} has shape {a.shape}, expected {want}")
-            require_finite(path, a, name)
-            attrs[name] = a
+            attrs[name] = float32_finite(path, a, name)
     if kind == "groom":
         points = _array(path, z, "points", 2, "f")
         if points.shape != (v_count, 3):
             raise FormatError(path, f"'points' has shape {points.shape}, expected {(v_count, 3)}")
-        require_finite(path, points, "points")
-        return Groom(points, counts, **attrs)
+        return Groom(float32_finite(path, points, "points"), counts, **attrs)
     if kind == "animation":
         frames = _array(path, z, "frames", 3, "f")
         if frames.shape[0] < 1 or frames.shape[1:] != (v_count, 3):
             raise FormatError(path, f"'frames' has shape {frames.shape}, expected (F>=1, {v_count}, 3)")
-        require_finite(path, frames.reshape(-1, 3), "frames")
+        frames = float32_finite(path, frames, "frames")
         fps = float(_scalar(path, z, "fps", "fiu"))
         if not (np.isfinite(fps) and fps > 0):
             raise FormatError(path, f"fps is {fps}; expected a positive number")
         return Animation(frames, counts, fps, **attrs, metadata=_time_codes(path, z, frames.shape[0]))
     raise FormatError(path, f"kind is {kind!r}; expected 'groom' or 'animation'")
+
+
+# -- raw feature arrays (``hairtool keys IN.npz`` with an array X) ----------------------------
+FEATURE_MEMBER = "X"
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+def _zip_names(path: Path) -> list[str]:
+    try:
+        with zipfile.ZipFile(path) as zf:
+            return zf.namelist()
+    except _LOAD_ERRORS as e:
+        raise FormatError(path, f"not a readable .npz file ({type(e).__name__}: {e})") from None
+
+
+def holds_feature_array(path: str | os.PathLike[str]) -> bool:
+    """Whether an ``.npz`` holds a raw feature array ``X`` rather than a hairtool cache (False for
+    anything that is not a zip archive: :func:`read` says what is wrong with it)."""
+    p = Path(path)
+    try:
+        if not zipfile.is_zipfile(p):
+            return False
+    except OSError as e:
+        raise FormatError(p, f"cannot read: {e}") from None
+    names = _zip_names(p)
+    return f"{FEATURE_MEMBER}.npy" in names and "kind.npy" not in names
+
+
+def read_feature_array(path: str | os.PathLike[str]) -> np.ndarray:
+    """The array ``X`` of an ``.npz`` as ``(frames, dims)`` float64, every frame a feature vector.
+
+    Checked like a cache: the size its header claims against the bytes stored (before numpy
+    allocates), a numeric dtype, the cast to float64 *then* finiteness and float32's range, at
+    least 2 frames and 1 dimension. A 1-D ``X`` is one value per frame (one column). Other
+    members are ignored.
+    """
+    p = Path(path)
+    size = p.stat().st_size
+    if size == 0:
+        raise FormatError(p, "the file is empty")
+    member = f"{FEATURE_MEMBER}.npy"
+    try:
+        with open(p, "rb") as fh:
+            z = _load_zip(p, fh, "a single .npy array; features are read from an .npz holding X")
+            with z:
+                if member not in z.zip.namelist():
+                    raise FormatError(p, f"no array {FEATURE_MEMBER!r} in the file")
+                shape, dtype = _member_header(p, z.zip, z.zip.getinfo(member), size)
+                if dtype.kind not in "fiu":
+                    raise FormatError(p, f"{FEATURE_MEMBER!r} must hold numbers, not {dtype}")
+                if len(shape) not in (1, 2):
+                    raise FormatError(p, f"{FEATURE_MEMBER!r} has shape {shape}; expected (frames, dims)")
+                x = z[FEATURE_MEMBER]
+    except FormatError:
+        raise
+    except _LOAD_ERRORS as e:
+        raise FormatError(p, f"not a readable .npz file ({type(e).__name__}: {e})") from None
+    if x.ndim == 1:
+        x = x[:, None]
+    if x.shape[0] < 2:
+        raise FormatError(p, f"{FEATURE_MEMBER!r} has {x.shape[0]} frame(s); keyframes need at least 2")
+    if x.shape[1] < 1:
+        raise FormatError(p, f"{FEATURE_MEMBER!r} has no dimensions; expected (frames, dims >= 1)")
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = np.ascontiguousarray(x, dtype=np.float64)  # cast, then check: a longdouble may overflow
+    finite = np.isfinite(out).all(axis=1)
+    if not finite.all():
+        raise FormatError(p, f"{FEATURE_MEMBER!r} has a non-finite value in frame {int(np.argmin(finite))}")
+    # As for every coordinate hairtool reads: beyond float32's range is corruption (and the key
+    # solver's squared differences would overflow float64 from about 1.3e154 on).
+    small = (np.abs(out) <= _FLOAT32_MAX).all(axis=1)
+    if not small.all():
+        frame = int(np.argmin(small))
+        raise FormatError(p, f"{FEATURE_MEMBER!r} has a value beyond ±3.4e38 in frame {frame}")
+    return out

@@ -20,7 +20,7 @@ import numpy as np
 from hairtool.errors import FormatError
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
-from hairtool.io.binary import require_finite, require_strand_counts
+from hairtool.io.binary import float32_finite, require_strand_counts
 
 
 @dataclass(frozen=True)
@@ -97,7 +97,7 @@ def _floats(path: Path, lines: list[str], key: str) -> np.ndarray:
             a = np.array([[float(t) for t in r[1:4]] for r in rows], dtype=np.float64)
     except ValueError:
         raise FormatError(path, f"a '{key}' record has a coordinate that is not a number") from None
-    require_finite(path, a, f"'{key}' coordinates")
+    float32_finite(path, a, f"'{key}' coordinates")  # grooms and meshes are float32: cast, then check
     return a
 
 

@@ -38,6 +38,9 @@ FORMAT_VERSION = 1
 JSON_SUFFIXES = (".json",)
 CSV_SUFFIXES = (".csv",)
 USD_SUFFIXES = (".usd", ".usda", ".usdc")
+#: Records nest a few levels (keys, params, uniform); a deeper one read back would make writing
+#: it again (``_plain``, ``json.dump``) recurse past Python's limit.
+MAX_NESTING = 32
 # Results that are large or only useful on screen; the record keeps everything else.
 _NOT_RECORDED = ("keys", "frames", "fps", "curve", "time_codes")
 
@@ -46,6 +49,8 @@ def _check_keys(keys: ArrayLike, n_frames: int) -> NDArray[np.int64]:
     k = np.asarray(keys)
     if k.ndim != 1 or k.size == 0:
         raise ParameterError("keys", k.tolist() if k.size < 8 else f"{k.size} values", "a 1-D list of frames")
+    if k.dtype.kind not in "iuf":  # e.g. Python ints beyond int64 make an object array
+        raise ParameterError("keys", k.tolist()[:8], f"whole frame numbers in [0, {n_frames})")
     if not np.issubdtype(k.dtype, np.integer):
         if not np.all(np.isfinite(k)) or np.any(k != np.round(k)):
             raise ParameterError("keys", k.tolist()[:8], "whole frame numbers")
@@ -116,6 +121,17 @@ def keys_record(
     }
 
 
+def _nesting(value: Any) -> int:
+    """How deeply lists and objects nest in a JSON value (counted without recursion)."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        v, depth = stack.pop()
+        if isinstance(v, dict | list):
+            deepest = max(deepest, depth)
+            stack.extend((c, depth + 1) for c in (v.values() if isinstance(v, dict) else v))
+    return deepest
+
+
 def record_keys(record: Mapping[str, Any]) -> NDArray[np.int64]:
     """The key frame numbers of a record, as int64."""
     return np.array([k["frame"] for k in record["keys"]], dtype=np.int64)
@@ -148,8 +164,14 @@ def read_keys_json(path: str | os.PathLike[str]) -> dict:
         record = json.loads(text)
     except json.JSONDecodeError as e:
         raise FormatError(path, f"not JSON: {e}") from None
+    except RecursionError:
+        raise FormatError(path, "not a keys record: JSON nested too deeply") from None
+    except ValueError:  # Python refuses integers of more than 4,300 digits
+        raise FormatError(path, "not a keys record: it holds a number thousands of digits long") from None
     if not isinstance(record, dict):
         raise FormatError(path, "a keys record is a JSON object")
+    if _nesting(record) > MAX_NESTING:
+        raise FormatError(path, f"not a keys record: its JSON nests deeper than {MAX_NESTING} levels")
     if record.get("format", FORMAT) != FORMAT:
         raise FormatError(path, f"format is {record.get('format')!r}, not {FORMAT!r}")
     version = record.get("version", FORMAT_VERSION)

@@ -31,6 +31,11 @@ F64 = NDArray[np.float64]
 CHANNEL_NAMES = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
 _MAX_JOINTS = 100_000
 _MAX_VALUES = 500_000_000  # frames × channels: refuse absurd headers before allocating
+_MIN_POSES = 1_000_000  # frames × joints any file may have; beyond, at most one per byte of the file
+_MIN_FRAME_TIME = 1e-6  # seconds; shorter would make the frame rate overflow (1 / 5e-324 is inf)
+#: Offsets and channel values beyond float32's range are corruption: the key solver squares
+#: differences of positions, which would overflow float64 from about 1.3e154 on.
+MAX_VALUE = float(np.finfo(np.float32).max)
 
 
 @dataclass
@@ -217,11 +222,16 @@ class _Tokens:
         except ValueError:
             raise FormatError(self.path, f"{what} is not a number: '{w[:40]}'") from None
         if not math.isfinite(v):
-            raise FormatError(self.path, f"{what} is not finite: '{w}'")
+            raise FormatError(self.path, f"{what} is not finite: '{w[:40]}'")
+        if abs(v) > MAX_VALUE:
+            raise FormatError(self.path, f"{what} is beyond ±{MAX_VALUE:.2g}: '{w[:40]}'")
         return v
 
 
 def _parse_hierarchy(tok: _Tokens, path: str):
+    """The joints in file order (parents before children), read with an explicit stack of open
+    joints rather than by recursion, so a chain of any depth reads (Python's recursion limit
+    stopped a chain 1,000 joints deep)."""
     names: list[str] = []
     parents: list[int] = []
     offsets: list[list[float]] = []
@@ -233,7 +243,8 @@ def _parse_hierarchy(tok: _Tokens, path: str):
         tok.expect("OFFSET")
         return [tok.number(f"OFFSET of {where}") for _ in range(3)]
 
-    def joint(parent: int) -> None:
+    def open_joint(parent: int) -> int:
+        """Read a joint's name, '{', OFFSET and CHANNELS; its children and '}' come after."""
         name = tok.next("a joint name")
         if name == "{":
             raise FormatError(path, "a joint has no name")
@@ -258,25 +269,38 @@ def _parse_hierarchy(tok: _Tokens, path: str):
                     raise FormatError(path, f"joint '{name}' lists channel '{c}' twice")
                 chans.append(c)
         channels.append(chans)
-        while True:
-            w = tok.next(f"'}}' closing joint '{name}'")
-            if w == "}":
-                return
-            if w == "JOINT":
-                joint(me)
-            elif w == "End":
-                tok.expect("Site")
-                tok.expect("{")
-                end_parents.append(me)
-                end_offsets.append(offset(f"the End Site of '{name}'"))
-                tok.expect("}")
-            else:
-                raise FormatError(path, f"unexpected '{w[:40]}' inside joint '{name}'")
+        return me
 
     tok.expect("HIERARCHY")
     tok.expect("ROOT")
-    joint(-1)
+    open_joints = [open_joint(-1)]
+    while open_joints:
+        me = open_joints[-1]
+        w = tok.next(f"'}}' closing joint '{names[me]}'")
+        if w == "}":
+            open_joints.pop()
+        elif w == "JOINT":
+            open_joints.append(open_joint(me))
+        elif w == "End":
+            tok.expect("Site")
+            tok.expect("{")
+            end_parents.append(me)
+            end_offsets.append(offset(f"the End Site of '{names[me]}'"))
+            tok.expect("}")
+        else:
+            raise FormatError(path, f"unexpected '{w[:40]}' inside joint '{names[me]}'")
     return names, parents, offsets, channels, end_parents, end_offsets
+
+
+def _frame_count(path: str, text: str) -> int:
+    """``Frames:`` as a whole number ≥ 1; NaN, infinities and fractions are refused before any cast."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise FormatError(path, f"Frames: '{text[:40]}' is not a number") from None
+    if not (math.isfinite(v) and v >= 1 and v == math.floor(v)):
+        raise FormatError(path, f"Frames: {text[:40]} is not a positive whole number")
+    return int(text) if text.isdigit() else int(v)  # digits: exact even beyond 2^53
 
 
 def read_bvh(path: str | os.PathLike[str]) -> Motion:
@@ -305,19 +329,34 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
     m = re.match(r"\s*Frames\s*:\s*(\S+)\s+Frame\s+Time\s*:\s*(\S+)", body)
     if not m:
         raise FormatError(p, "MOTION block lacks 'Frames:' and 'Frame Time:'")
+    n_frames = _frame_count(p, m.group(1))
     try:
-        n_frames = float(m.group(1))
         frame_time = float(m.group(2))
     except ValueError:
-        raise FormatError(p, "'Frames:' or 'Frame Time:' is not a number") from None
-    if n_frames != int(n_frames) or n_frames < 1:
-        raise FormatError(p, f"Frames: {m.group(1)} is not a positive whole number")
-    if not (math.isfinite(frame_time) and frame_time > 0):
-        raise FormatError(p, f"Frame Time: {m.group(2)} is not a positive number of seconds")
-    n_frames = int(n_frames)
+        raise FormatError(p, f"Frame Time: '{m.group(2)[:40]}' is not a number") from None
+    if not (math.isfinite(frame_time) and frame_time >= _MIN_FRAME_TIME):
+        raise FormatError(
+            p, f"Frame Time: {m.group(2)[:40]} is not a number of seconds ≥ {_MIN_FRAME_TIME:g}"
+        )
     width = sum(len(c) for c in channels)
     if n_frames * max(width, 1) > _MAX_VALUES:
         raise FormatError(p, f"{n_frames} frames × {width} channels is too large")
+    # Every value takes at least one character and a separator: bound the count by the file.
+    if n_frames * max(2 * width, 1) > len(body) - m.end():
+        raise FormatError(
+            p,
+            f"MOTION block is truncated: 'Frames:' says {n_frames} frames of {width} values, "
+            f"more than its {len(body) - m.end()} characters can hold",
+        )
+    # Forward kinematics holds every joint in every frame (112 bytes a pose): joints without
+    # channels cost no bytes in the file, so bound frames × joints by the file too.
+    poses = n_frames * (len(names) + len(end_parents))
+    if poses > max(len(raw), _MIN_POSES):
+        raise FormatError(
+            p,
+            f"{n_frames} frames of {len(names) + len(end_parents)} joints and End Sites is more "
+            f"than a file of {len(raw)} bytes can describe (joints without channels?)",
+        )
 
     lines = [ln for ln in body[m.end() :].splitlines() if ln.strip()]
     if len(lines) < n_frames:
@@ -336,6 +375,9 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
     if not np.all(np.isfinite(values)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(values), axis=1))[0])
         raise FormatError(p, f"frame {bad} has a non-finite value")
+    if np.any(np.abs(values) > MAX_VALUE):
+        bad = int(np.flatnonzero(np.any(np.abs(values) > MAX_VALUE, axis=1))[0])
+        raise FormatError(p, f"frame {bad} has a value beyond ±{MAX_VALUE:.2g}")
     return Motion(
         names,
         np.array(parents),
@@ -365,24 +407,31 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion) -> None:
     for e, j in enumerate(motion.end_parents):
         ends[j].append(e)
     out: list[str] = ["HIERARCHY"]
+    # Depth-first with an explicit stack (a chain may be deeper than Python's recursion limit):
+    # ("open", j) writes a joint's head and pushes its closing, its End Sites and its children.
+    stack: list[tuple[str, int]] = [("open", 0)]
+    depth = np.zeros(motion.n_joints, dtype=np.int64)
+    while stack:
+        step, j = stack.pop()
+        pad = "\t" * int(depth[j])
+        if step == "open":
+            out.append(f"{pad}{'ROOT' if j == 0 else 'JOINT'} {motion.joint_names[j]}")
+            out.append(f"{pad}{{")
+            out.append(f"{pad}\tOFFSET {' '.join(_fmt(v) for v in motion.offsets[j])}")
+            if motion.channels[j]:
+                out.append(f"{pad}\tCHANNELS {len(motion.channels[j])} {' '.join(motion.channels[j])}")
+            stack.append(("close", j))
+            for c in reversed(children[j]):
+                depth[c] = depth[j] + 1
+                stack.append(("open", c))
+        else:
+            for e in ends[j]:
+                out.append(f"{pad}\tEnd Site")
+                out.append(f"{pad}\t{{")
+                out.append(f"{pad}\t\tOFFSET {' '.join(_fmt(v) for v in motion.end_offsets[e])}")
+                out.append(f"{pad}\t}}")
+            out.append(f"{pad}}}")
 
-    def emit(j: int, depth: int) -> None:
-        pad = "\t" * depth
-        out.append(f"{pad}{'ROOT' if j == 0 else 'JOINT'} {motion.joint_names[j]}")
-        out.append(f"{pad}{{")
-        out.append(f"{pad}\tOFFSET {' '.join(_fmt(v) for v in motion.offsets[j])}")
-        if motion.channels[j]:
-            out.append(f"{pad}\tCHANNELS {len(motion.channels[j])} {' '.join(motion.channels[j])}")
-        for c in children[j]:
-            emit(c, depth + 1)
-        for e in ends[j]:
-            out.append(f"{pad}\tEnd Site")
-            out.append(f"{pad}\t{{")
-            out.append(f"{pad}\t\tOFFSET {' '.join(_fmt(v) for v in motion.end_offsets[e])}")
-            out.append(f"{pad}\t}}")
-        out.append(f"{pad}}}")
-
-    emit(0, 0)
     out += ["MOTION", f"Frames: {motion.n_frames}", f"Frame Time: {motion.frame_time:.7g}"]
     out += [" ".join(_fmt(v) for v in row) for row in motion.values]
     with atomic_open(path, "w", encoding="utf-8", newline="\n") as f:

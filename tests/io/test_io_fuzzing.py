@@ -1,11 +1,15 @@
 """Random bytes and mutated valid files at every reader: a valid groom/animation or FormatError, nothing else.
 
-Deterministic (derandomize=True); the example counts keep the whole module to a few seconds.
+Deterministic: hypothesis with derandomize=True for the in-process cases, fixed seeds for the
+capped children of ``fuzz_harness.py`` (issue 17's mutation classes, every reader).
 """
 
 from __future__ import annotations
 
+import json
 import struct
+import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -123,3 +127,62 @@ def test_mutated_valid_files(ext, data):
 @given(tail=st.binary(max_size=400), with_prefix=st.booleans())
 def test_random_bytes(ext, tail, with_prefix):
     _check(ext, (PREFIXES[ext] if with_prefix else b"") + tail)
+
+
+# -- every reader, every mutation class, under a memory cap ---------------------------------------
+# tests/io/fuzz_harness.py mutates real and hand-made seed files (bit flips, overwrites,
+# truncations, huge header counts, duplicated chunks, token swaps; zip members one by one with
+# valid checksums) and reads each mutant in a child process whose address space is capped at
+# its size after imports plus 1 GiB. The children run side by side; the counts keep the whole
+# set near 30 s of wall time on two cores. Rerun one reader by hand with
+# ``python tests/io/fuzz_harness.py READER --count N`` (``--only I`` for one mutant).
+HARNESS = Path(__file__).with_name("fuzz_harness.py")
+MUTANTS = {
+    "hair": 1200,
+    "tfx": 1200,
+    "npz": 1000,
+    "obj": 1000,
+    "mesh": 800,
+    "bvh": 700,
+    "project": 1500,
+    "keys": 1000,
+    "features": 1000,
+}
+
+
+@pytest.fixture(scope="module")
+def fuzz_reports() -> dict[str, dict]:
+    """Start one capped child per reader at once; their JSON reports by reader."""
+    children = {
+        name: subprocess.Popen(
+            [sys.executable, str(HARNESS), name, "--count", str(count), "--seed", "17"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+        )
+        for name, count in MUTANTS.items()
+    }
+    reports = {}
+    for name, child in children.items():
+        try:
+            out, err = child.communicate(timeout=240)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            out, err = child.communicate()
+            reports[name] = {"hang": True, "stderr": err.decode(errors="replace")[-2000:]}
+            continue
+        try:
+            reports[name] = json.loads(out.decode().strip().splitlines()[-1])
+        except (IndexError, ValueError):
+            reports[name] = {"crash": child.returncode, "stderr": err.decode(errors="replace")[-2000:]}
+    return reports
+
+
+@pytest.mark.parametrize("reader", sorted(MUTANTS))
+def test_every_mutant_is_read_finite_or_refused_in_one_line(fuzz_reports, reader):
+    report = fuzz_reports[reader]
+    assert "failures" in report, report  # no hang, no crash of the child
+    assert report["failures"] == [], "\n".join(json.dumps(f) for f in report["failures"][:10])
+    assert report["read"] + report["refused"] == MUTANTS[reader]
+    assert report["refused"] > 0 and report["read"] > 0  # the mutants reach both outcomes
+    assert min(report["classes"].values()) >= 50, report["classes"]  # every mutation class, often
+    assert report["max_rss_mb"] < report["cap_mb"] < 4096

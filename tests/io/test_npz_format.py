@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import io
+import os
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -123,3 +125,126 @@ def test_non_npz_bytes_raise_format_error(tmp_path, data):
     p.write_bytes(data)
     with pytest.raises(FormatError):
         read(p)
+
+
+# -- issue 17's hostile classes ------------------------------------------------------------------
+def _cache(tmp_path, **arrays):
+    p = tmp_path / "hostile.npz"
+    np.savez(p, format_version=np.array(1, dtype=np.int64), **arrays)
+    return p
+
+
+def test_counts_whose_sum_wraps_around_are_refused(tmp_path):
+    counts = np.array([2**62, 2**62, 2**62, 2**62, 10], dtype=np.int64)  # int64 sum: 10
+    p = _cache(tmp_path, kind=np.array("groom"), counts=counts, points=np.zeros((10, 3), np.float32))
+    with pytest.raises(FormatError, match="strand 0 claims 4611686018427387904 points"):
+        read(p)
+    huge = np.array([2**64 - 1, 12], dtype=np.uint64)  # checked as uint64: as int64 it would be −1
+    p = _cache(tmp_path, kind=np.array("groom"), counts=huge, points=np.zeros((11, 3), np.float32))
+    with pytest.raises(FormatError, match="strand 0"):
+        read(p)
+
+
+@pytest.mark.parametrize("member", ["points", "frames", "thickness", "colors"])
+def test_float64_beyond_float32_is_refused_after_the_cast(tmp_path, member):
+    counts = np.array([2, 3], dtype=np.int64)
+    arrays = {"counts": counts, "thickness": np.ones(5), "colors": np.ones((5, 3))}
+    if member == "frames":
+        arrays.update(kind=np.array("animation"), frames=np.zeros((2, 5, 3)), fps=np.array(24.0))
+    else:
+        arrays.update(kind=np.array("groom"), points=np.zeros((5, 3)))
+    arrays[member].reshape(-1)[-1] = 1e39
+    with pytest.raises(FormatError, match=f"{member} has a value at index \\d+ beyond float32"):
+        read(_cache(tmp_path, **arrays))
+
+
+def _features(tmp_path, name="x.npz", **arrays):
+    p = tmp_path / name
+    np.savez(p, **arrays)
+    return p
+
+
+def test_feature_array_reads_as_float64_frames(tmp_path):
+    x = np.arange(12, dtype=np.float32).reshape(6, 2)
+    p = _features(tmp_path, X=x, labels=np.arange(6))
+    assert npz.holds_feature_array(p)
+    out = npz.read_feature_array(p)
+    assert out.dtype == np.float64 and out.flags.c_contiguous
+    np.testing.assert_array_equal(out, x)
+    column = npz.read_feature_array(_features(tmp_path, "one.npz", X=np.arange(4)))
+    np.testing.assert_array_equal(column, [[0], [1], [2], [3]])
+    write(tmp_path / "cache.npz", Groom(np.zeros((2, 3)), [2]))
+    assert not npz.holds_feature_array(tmp_path / "cache.npz")
+    (tmp_path / "plain.npz").write_bytes(b"not a zip")
+    assert not npz.holds_feature_array(tmp_path / "plain.npz")
+
+
+@pytest.mark.parametrize(
+    ("arrays", "reason"),
+    [
+        ({"Y": np.zeros((3, 2))}, "no array 'X'"),
+        ({"X": np.zeros((1, 2))}, "1 frame"),
+        ({"X": np.zeros((3, 0))}, "no dimensions"),
+        ({"X": np.zeros((3, 2, 2))}, "shape"),
+        ({"X": np.array([["a", "b"], ["c", "d"]])}, "numbers"),
+        ({"X": np.array([[0.0, 1.0], [np.nan, 2.0]])}, "non-finite value in frame 1"),
+        ({"X": np.array([[0.0, 1.0], [1e200, 2.0]])}, "beyond"),
+        ({"X": np.array([[0.0], [1.0]], dtype=np.longdouble) * np.longdouble(1e308) * 1e10}, "non-finite"),
+    ],
+)
+def test_bad_feature_arrays_are_one_format_error(tmp_path, arrays, reason):
+    with pytest.raises(FormatError, match=reason) as e:
+        npz.read_feature_array(_features(tmp_path, **arrays))
+    assert e.value.path.endswith("x.npz")
+
+
+def test_feature_array_header_is_checked_before_numpy_allocates(tmp_path):
+    from .hostile import npy_header
+
+    p = tmp_path / "x.npz"
+    with zipfile.ZipFile(p, "w") as zf:  # a header claiming 10^12 values over 80 bytes of data
+        zf.writestr("X.npy", npy_header((10**6, 10**6)) + bytes(80))
+    with pytest.raises(FormatError, match="does not match its stored size"):
+        npz.read_feature_array(p)
+
+
+def _npz_with_member(path, name: str, member: bytes):
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr(name, member)
+    return path
+
+
+def test_corrupt_npy_header_is_a_format_error_not_a_token_error(tmp_path):
+    """numpy's fallback parse of a header with an unbalanced bracket let tokenize.TokenError escape."""
+    header = b"{'descr': '<f8', 'fortran_order': False, 'shape': (3, \x0f}"
+    member = b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header + bytes(24)
+    p = _npz_with_member(tmp_path / "x.npz", "X.npy", member)
+    with pytest.raises(FormatError, match=r"corrupt \.npy header"):
+        npz.read_feature_array(p)
+    p = _npz_with_member(tmp_path / "g.npz", "points.npy", member)
+    with pytest.raises(FormatError, match=r"corrupt \.npy header"):
+        read(p)
+
+
+def test_a_lone_npy_is_refused_before_numpy_reads_it(tmp_path):
+    from .hostile import npy_header
+
+    p = tmp_path / "single.npz"  # a .npy under an .npz name, claiming 10^12 values
+    p.write_bytes(npy_header((10**6, 10**6)) + bytes(80))
+    with pytest.raises(FormatError, match=r"a single \.npy array"):
+        read(p)
+    with pytest.raises(FormatError, match=r"a single \.npy array"):
+        npz.read_feature_array(p)
+    assert not npz.holds_feature_array(p)
+
+
+@pytest.mark.skipif(not Path("/proc/self/fd").is_dir(), reason="counts open files in /proc")
+def test_a_corrupt_zip_leaves_no_file_open(tmp_path):
+    """np.load given a path kept its file open when the zip was corrupt (held by the traceback)."""
+    p = tmp_path / "broken.npz"
+    p.write_bytes(b"PK\x03\x04" + bytes(60))
+    for reader in (read, npz.read_feature_array):
+        before = len(os.listdir("/proc/self/fd"))
+        with pytest.raises(FormatError) as e:
+            reader(p)
+        assert len(os.listdir("/proc/self/fd")) == before, e.value

@@ -195,3 +195,40 @@ def test_truncated_and_flipped_files_are_format_errors(tmp_path, edited):
         except FormatError as e:
             assert "broken.hairproj" in str(e)
     assert loaded < 30
+
+
+# -- issue 17's hostile classes ------------------------------------------------------------------
+@pytest.mark.parametrize("member", ["groom/points.npy", "groom/thickness.npy", "animation/frames.npy"])
+def test_float64_beyond_float32_is_refused_after_the_cast(tmp_path, member):
+    from .hostile import write_project_beyond_float32
+
+    p = write_project_beyond_float32(tmp_path / "big.hairproj", member)
+    with pytest.raises(FormatError, match="beyond float32") as e:
+        project.load(p)
+    assert e.value.path == str(p)
+
+
+def test_counts_whose_sum_wraps_around_are_refused(tmp_path):
+    from .hostile import write_project_wrapping_counts
+
+    p = write_project_wrapping_counts(tmp_path / "wrap.hairproj")
+    with pytest.raises(FormatError, match="strand 0 claims 4611686018427387904 points"):
+        project.load(p)
+
+
+def test_corrupt_npy_header_in_a_member_is_a_format_error(tmp_path):
+    """Found by fuzzing: a header with an unbalanced bracket let tokenize.TokenError escape."""
+    from hairtool.groom import Groom
+
+    p = tmp_path / "bad.hairproj"
+    project.save(p, project.Project(rest=Groom(np.zeros((4, 3)), [2, 2])))
+    header = b"{'descr': '<f4', 'fortran_order': False, 'shape': (4, \x0f}"
+    member = b"\x93NUMPY\x01\x00" + len(header).to_bytes(2, "little") + header + bytes(48)
+    with zipfile.ZipFile(p) as zf:
+        members = {i.filename: zf.read(i) for i in zf.infolist()}
+    members["groom/points.npy"] = member
+    with zipfile.ZipFile(p, "w") as zf:
+        for name, data in members.items():
+            zf.writestr(name, data)
+    with pytest.raises(FormatError, match=r"'groom/points\.npy' has a corrupt \.npy header"):
+        project.load(p)

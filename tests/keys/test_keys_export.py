@@ -119,3 +119,38 @@ def test_bad_exports_are_refused(tmp_path, solved):
     with pytest.raises(ParameterError, match="keys"):
         keys_record({"frames": 5, "fps": 24.0, "keys": [0, 9]})
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+        ('{"frames": 5, "fps": 24, "keys": [], "x": ' + "[" * 100_000 + "]" * 100_000 + "}", "nested"),
+        ('{"frames": ' + "9" * 5000 + ', "fps": 24, "keys": []}', "digits long"),
+        ('{"frames": 10, "fps": 24, "keys": [{"frame": ' + "9" * 30 + "}]}", "whole frame numbers"),
+        ('{"frames": 10, "fps": 1e400, "keys": [{"frame": 1}]}', "fps"),
+    ],
+)
+def test_hostile_json_is_one_error_naming_the_file(tmp_path, text, needle):
+    """Deep nesting, integers past Python's digit limit or past int64: no RecursionError,
+    ValueError or TypeError escapes (issue 17)."""
+    path = tmp_path / "hostile.json"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(FormatError, match=needle) as e:
+        read_keys_json(path)
+    assert e.value.path == str(path)
+
+
+def test_a_record_read_back_can_always_be_written_again(tmp_path):
+    """A record nested 900 levels parses, but writing it again would recurse past Python's limit:
+    the reader refuses anything deeper than MAX_NESTING."""
+    from hairtool.keys.export import MAX_NESTING, write_keys_json
+
+    base = '{"frames": 5, "fps": 24, "keys": [{"frame": 1}], "x": '
+    path = tmp_path / "deep.json"
+    path.write_text(base + "[" * 900 + "]" * 900 + "}", encoding="utf-8")
+    with pytest.raises(FormatError, match="nests deeper"):
+        read_keys_json(path)
+    path.write_text(base + "[" * (MAX_NESTING - 1) + "]" * (MAX_NESTING - 1) + "}", encoding="utf-8")
+    write_keys_json(tmp_path / "again.json", read_keys_json(path))
+    assert read_keys_json(tmp_path / "again.json")["x"] == read_keys_json(path)["x"]

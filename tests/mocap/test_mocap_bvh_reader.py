@@ -147,3 +147,87 @@ def test_motion_checks_its_skeleton():
         Motion(["a", "b"], [-1, 0], np.zeros((2, 3)), chans, np.zeros((1, 3)), 0.1)
     with pytest.raises(ParameterError, match="frame_time"):
         Motion(["a", "b"], [-1, 0], np.zeros((2, 3)), chans, np.zeros((1, 2)), 0.0)
+
+
+@pytest.mark.parametrize("frames", ["nan", "NaN", "1e400", "inf", "-inf", "0", "2.5", "0x10"])
+def test_frames_field_that_is_no_count_is_one_format_error(tmp_path, frames):
+    p = tmp_path / "frames.bvh"
+    p.write_text(CHAIN.replace("Frames: 3", f"Frames: {frames}"))
+    with pytest.raises(FormatError, match="Frames") as e:
+        read_bvh(p)
+    assert e.value.path == str(p)
+
+
+def test_frames_field_with_more_frames_than_the_file_can_hold(tmp_path):
+    """Checked against the file's size, not only against a fixed cap, before anything is allocated."""
+    p = tmp_path / "claim.bvh"
+    p.write_text(CHAIN.replace("Frames: 3", "Frames: 50000000"))  # 450 M values: under the cap
+    with pytest.raises(FormatError, match="truncated: 'Frames:' says 50000000 frames"):
+        read_bvh(p)
+    p.write_text(CHAIN.replace("Frames: 3", "Frames: 3.0"))  # a whole number written as a float
+    assert read_bvh(p).n_frames == 3
+
+
+@pytest.mark.parametrize(
+    ("edit", "reason"),
+    [
+        (lambda t: t.replace("Frame Time: 0.04", "Frame Time: 5e-324"), "Frame Time"),
+        (lambda t: t.replace("Frame Time: 0.04", "Frame Time: nan"), "Frame Time"),
+        (lambda t: t.replace("OFFSET 0 2 0", "OFFSET 0 1e300 0"), "beyond"),
+        (lambda t: t.replace("1 2 3 90 0 0 0 0 0", "1 2e39 3 90 0 0 0 0 0"), "beyond"),
+    ],
+)
+def test_values_that_would_overflow_later_are_refused(tmp_path, edit, reason):
+    p = tmp_path / "big.bvh"
+    p.write_text(edit(CHAIN))
+    with pytest.raises(FormatError, match=reason):
+        read_bvh(p)
+
+
+@pytest.mark.parametrize("depth", [1200, 5000])
+def test_deep_chains_read_and_write_without_recursion(tmp_path, depth):
+    """Joints nested deeper than Python's recursion limit (1,000): read, FK and written back."""
+    lines = ["HIERARCHY"]
+    for j in range(depth):
+        lines += [f"{'ROOT' if j == 0 else 'JOINT'} j{j}", "{", "OFFSET 0 1 0", "CHANNELS 1 Zrotation"]
+    lines += ["End Site", "{", "OFFSET 0 1 0", "}", *["}"] * depth, "MOTION", "Frames: 3", "Frame Time: 0.04"]
+    lines += [" ".join(str((f * 7 + j) % 30) for j in range(depth)) for f in range(3)]
+    p = tmp_path / "deep.bvh"
+    p.write_text("\n".join(lines) + "\n")
+    m = read_bvh(p)
+    assert m.n_joints == depth and len(m.end_parents) == 1
+    np.testing.assert_array_equal(m.parents, np.arange(-1, depth - 1))
+    np.testing.assert_array_equal(m.depths(), np.arange(depth))
+    assert np.all(np.isfinite(m.joint_positions(end_sites=True)))
+    write_bvh(tmp_path / "copy.bvh", m)
+    back = read_bvh(tmp_path / "copy.bvh")
+    np.testing.assert_array_equal(back.parents, m.parents)
+    np.testing.assert_array_equal(back.values, m.values)
+    assert back.joint_names == m.joint_names
+
+
+def test_writer_keeps_children_before_end_sites_in_file_order(tmp_path):
+    """The iterative writer emits the same text as the hierarchy it read (a branching skeleton)."""
+    text = (
+        "HIERARCHY\nROOT a\n{\n\tOFFSET 0 0 0\n\tCHANNELS 1 Zrotation\n"
+        "\tJOINT b\n\t{\n\t\tOFFSET 1 0 0\n\t\tEnd Site\n\t\t{\n\t\t\tOFFSET 1 0 0\n\t\t}\n\t}\n"
+        "\tJOINT c\n\t{\n\t\tOFFSET 0 1 0\n\t\tJOINT d\n\t\t{\n\t\t\tOFFSET 0 1 0\n\t\t}\n\t}\n"
+        "\tEnd Site\n\t{\n\t\tOFFSET 0 0 1\n\t}\n}\n"
+        "MOTION\nFrames: 2\nFrame Time: 0.04\n0\n45\n"
+    )
+    (tmp_path / "tree.bvh").write_text(text)
+    write_bvh(tmp_path / "out.bvh", read_bvh(tmp_path / "tree.bvh"))
+    assert (tmp_path / "out.bvh").read_text() == text
+
+
+def test_frames_times_joints_is_bounded_by_the_file(tmp_path):
+    """Joints without channels take no bytes per frame, yet every frame poses them all."""
+    lines = ["HIERARCHY", "ROOT r", "{", "OFFSET 0 0 0", "CHANNELS 1 Zrotation"]
+    lines += [s for j in range(1, 3000) for s in (f"JOINT j{j}", "{", "OFFSET 0 1 0", "}")]
+    head = "\n".join([*lines, "}", "MOTION"])
+    p = tmp_path / "wide.bvh"
+    p.write_text(head + "\nFrames: 600\nFrame Time: 0.04\n" + "0\n" * 600)  # 1.8 M poses, 70 KB
+    with pytest.raises(FormatError, match="600 frames of 3000 joints"):
+        read_bvh(p)
+    p.write_text(head + "\nFrames: 300\nFrame Time: 0.04\n" + "0\n" * 300)  # 0.9 M: under the floor
+    assert read_bvh(p).joint_positions().shape == (300, 3000, 3)

@@ -1,0 +1,161 @@
+"""Hand-made hostile files, one per class of issue 17 (section 2), shared by the regression tests.
+
+Each builder writes one small file that once escaped the readers' checks: a traceback, a wrong
+result or an unbounded allocation.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import struct
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+BEYOND_FLOAT32 = 1e39  # finite in float64, inf once cast to float32
+
+
+def bvh_chain(depth: int, frames: int = 2, frames_field: str | None = None) -> str:
+    """A chain of ``depth`` joints, each one level below the last, with one rotation channel each."""
+    lines = ["HIERARCHY"]
+    for j in range(depth):
+        lines += [f"{'ROOT' if j == 0 else 'JOINT'} j{j}", "{", "OFFSET 0 1 0", "CHANNELS 1 Zrotation"]
+    lines += ["End Site", "{", "OFFSET 0 1 0", "}"]
+    lines += ["}"] * depth
+    lines += ["MOTION", f"Frames: {frames if frames_field is None else frames_field}", "Frame Time: 0.04"]
+    lines += [" ".join(str((f * 7 + j) % 30) for j in range(depth)) for f in range(frames)]
+    return "\n".join(lines) + "\n"
+
+
+def write_bvh_frames(path: Path, frames_field: str) -> Path:
+    """A two-joint BVH with two frame lines whose ``Frames:`` reads ``frames_field``."""
+    path.write_text(bvh_chain(2, 2, frames_field))
+    return path
+
+
+def write_bvh_deep(path: Path, depth: int = 1200) -> Path:
+    path.write_text(bvh_chain(depth, frames=3))
+    return path
+
+
+def npz_bytes(**arrays: np.ndarray) -> bytes:
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
+
+
+def write_npz_beyond_float32(path: Path, member: str = "points") -> Path:
+    """A hairtool cache whose float64 ``member`` holds 1e39: finite, but inf as float32."""
+    counts = np.array([2, 3], dtype=np.int64)
+    points = np.linspace(0.0, 1.0, 15).reshape(5, 3)
+    thickness = np.full(5, 0.1)
+    if member == "points":
+        points[3, 1] = BEYOND_FLOAT32
+    else:
+        thickness[2] = BEYOND_FLOAT32
+    path.write_bytes(
+        npz_bytes(
+            format_version=np.array(1, dtype=np.int64),
+            kind=np.array("groom"),
+            counts=counts,
+            points=points,
+            thickness=thickness,
+        )
+    )
+    return path
+
+
+def wrapping_counts(points: int) -> np.ndarray:
+    """int64 strand counts, each at least 2, whose int64 sum wraps around to ``points``."""
+    return np.array([2**62, 2**62, 2**62, 2**62, points], dtype=np.int64)
+
+
+def write_npz_wrapping_counts(path: Path) -> Path:
+    points = np.arange(30, dtype=np.float32).reshape(10, 3)
+    path.write_bytes(
+        npz_bytes(
+            format_version=np.array(1, dtype=np.int64),
+            kind=np.array("groom"),
+            counts=wrapping_counts(10),
+            points=points,
+        )
+    )
+    return path
+
+
+def write_hair_claiming_strands(path: Path, strands: int = 2**31) -> Path:
+    """A ``.hair`` file without a segments array whose header claims ``strands`` strands of 2 points."""
+    points = np.arange(12, dtype="<f4")
+    head = struct.pack("<4sIIII", b"HAIR", strands, 4, 2, 1)  # arrays = points only, 1 segment each
+    head += struct.pack("<5f", 1.0, 0.0, 1.0, 1.0, 1.0) + b"\0" * 88
+    path.write_bytes(head + points.tobytes())
+    return path
+
+
+def npy_header(shape: tuple[int, ...], dtype: str = "<f8") -> bytes:
+    """A version 1.0 ``.npy`` header claiming ``shape``."""
+    text = f"{{'descr': '{dtype}', 'fortran_order': False, 'shape': {shape!r}, }}"
+    text += " " * (-(len(text) + 11) % 64) + "\n"
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(text)) + text.encode("latin-1")
+
+
+def write_npz_huge_feature_header(path: Path, values: int = 10**12) -> Path:
+    """An ``.npz`` with a raw array ``X`` whose header claims ``values`` float64s (the data is 80 bytes)."""
+    member = npy_header((values // 1000, 1000)) + np.zeros(10).tobytes()
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as zf:
+        zf.writestr("X.npy", member)
+    return path
+
+
+def write_project_beyond_float32(path: Path, member: str = "groom/points.npy") -> Path:
+    """A valid project (groom with thickness, an animation), re-written with ``member`` as float64
+    holding 1e39."""
+    from hairtool.groom import Animation, Groom
+    from hairtool.project import MANIFEST, Project, manifest_and_arrays
+
+    g = Groom(np.linspace(0.0, 1.0, 15).reshape(5, 3), [2, 3], thickness=np.full(5, 0.1))
+    anim = Animation(np.stack([g.points, g.points + 1]), g.topology, 24.0)
+    manifest, arrays = manifest_and_arrays(Project(rest=g, animation=anim))
+    bad = arrays[member].astype(np.float64)
+    bad.reshape(-1)[1] = BEYOND_FLOAT32
+    arrays[member] = bad
+    _write_project(path, manifest, arrays, MANIFEST)
+    return path
+
+
+def write_project_wrapping_counts(path: Path) -> Path:
+    from hairtool.groom import Groom
+    from hairtool.project import MANIFEST, Project, manifest_and_arrays
+
+    g = Groom(np.linspace(0.0, 1.0, 30).reshape(10, 3), [4, 6])
+    manifest, arrays = manifest_and_arrays(Project(rest=g))
+    arrays["groom/counts.npy"] = wrapping_counts(10)
+    _write_project(path, manifest, arrays, MANIFEST)
+    return path
+
+
+def _write_project(path: Path, manifest: dict, arrays: dict[str, np.ndarray], manifest_name: str) -> None:
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as zf:
+        zf.writestr(manifest_name, json.dumps(manifest))
+        for name, a in arrays.items():
+            buf = io.BytesIO()
+            np.lib.format.write_array(buf, a, allow_pickle=False)
+            zf.writestr(name, buf.getvalue())
+
+
+def write_obj_beyond_float32(path: Path) -> Path:
+    path.write_text(f"v 0 0 0\nv 1 {BEYOND_FLOAT32!r} 0\nv 2 2 2\nl 1 2 3\n")
+    return path
+
+
+def write_bvh_wide(path: Path, joints: int = 20_000, frames: int = 5_000) -> Path:
+    """A root with one channel and ``joints`` - 1 children without channels: a 600 KB file whose
+    forward kinematics would hold frames × joints poses (11 GB of float64)."""
+    lines = ["HIERARCHY", "ROOT r", "{", "OFFSET 0 0 0", "CHANNELS 1 Zrotation"]
+    for j in range(1, joints):
+        lines += [f"JOINT j{j}", "{", "OFFSET 0 1 0", "}"]
+    lines += ["}", "MOTION", f"Frames: {frames}", "Frame Time: 0.04"] + ["0"] * frames
+    path.write_text("\n".join(lines) + "\n")
+    return path
