@@ -147,6 +147,7 @@ MUTANTS = {
     "project": 1500,
     "keys": 1000,
     "features": 1000,
+    "usda": 600,  # usd-core parses slowly; its binary crates have tests/io/test_usd_fuzzing.py
 }
 
 
