@@ -3,12 +3,18 @@
 The renamed file gets the permissions a plain ``open(path, "w")`` would give it: the mode of the
 file it replaces, or 0o666 less the process umask for a new file (a ``mkstemp`` file is 0o600,
 which would leave the user's groom unreadable to the rest of the studio).
+
+Two helpers serve ``hairtool batch``, which runs any command and must learn what it wrote:
+:func:`recording_writes` collects the paths renamed into place, whatever the writer, and
+:func:`stale_temporaries` finds the temporary files a killed process left behind.
 """
 
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
+import re
 import secrets
 import stat
 from collections.abc import Iterator
@@ -41,6 +47,42 @@ def _create_temp(target: Path) -> tuple[Path, int]:
     raise FileExistsError(f"no free temporary name beside {target}")
 
 
+def _temp_name_pattern(target: Path) -> re.Pattern[str]:
+    """The names :func:`_create_temp` gives temporary files for ``target``."""
+    return re.compile(rf"\.{re.escape(target.name)}\.[0-9a-f]{{8}}\.tmp{re.escape(target.suffix)}")
+
+
+def stale_temporaries(path: str | os.PathLike[str]) -> list[Path]:
+    """Temporary files beside ``path`` from writes that never finished (a killed process cannot
+    remove its own); only call this when no other writer of ``path`` is running."""
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    pattern = _temp_name_pattern(target)
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    return sorted(folder / n for n in names if pattern.fullmatch(n))
+
+
+#: Lists that :func:`recording_writes` blocks in this context (thread or task) are filling.
+_recorders: contextvars.ContextVar[tuple[list[Path], ...]] = contextvars.ContextVar(
+    "hairtool_atomic_recorders", default=()
+)
+
+
+@contextlib.contextmanager
+def recording_writes() -> Iterator[list[Path]]:
+    """Collect the absolute path of every file an atomic write renames into place inside the block
+    (in this thread or task), in order; a path written twice appears twice."""
+    written: list[Path] = []
+    token = _recorders.set((*_recorders.get(), written))
+    try:
+        yield written
+    finally:
+        _recorders.reset(token)
+
+
 def _final_mode(target: Path, new_file_mode: int) -> int:
     """The mode of the file being replaced (permission bits only), else that of a new file."""
     try:
@@ -69,6 +111,8 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
         with contextlib.suppress(OSError):
             tmp_path.unlink()
         raise
+    for written in _recorders.get():
+        written.append(target.absolute())
 
 
 @contextlib.contextmanager
