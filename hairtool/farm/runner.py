@@ -59,8 +59,8 @@ def _call(argv: list[str]) -> tuple[int, str, str]:
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         try:
             rc = main(argv)
-        except SystemExit as e:  # argparse: a bad option, with its message on stderr
-            rc = e.code if isinstance(e.code, int) else 2
+        except SystemExit as e:  # argparse: a bad option (its message on stderr), or --help
+            rc = 0 if e.code is None else e.code if isinstance(e.code, int) else 1
         except Exception as e:  # a bug, not bad input: still one line in the report
             print(f"hairtool {argv[0]}: internal error: {type(e).__name__}: {e}", file=err)
             rc = 1
