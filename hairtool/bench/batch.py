@@ -10,7 +10,8 @@ BLAS thread, which a loaded machine needs); ``speedup``, their ratio; ``overhead
 worker time per job not spent inside a job, (workers × wall − Σ job seconds) / jobs, which
 also counts a worker idling at the end of the batch. Serial and batch passes alternate, so a
 busy moment of a shared machine falls on both, and both run warm (kernels compiled and
-loaded before timing).
+loaded before timing); ``load_1m`` is the machine's load average when the row was taken (a
+shared machine's other work leaves fewer cores to the workers than it has).
 
 Data: ``synthetic``, shots simulated from the scalp sample; ``mocap``, the BVH captures in
 ``shared/data/motion`` (short jobs, where the overhead shows).
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import statistics
 import tempfile
 import time
@@ -170,6 +172,7 @@ def run(args: argparse.Namespace) -> list[dict]:
                         "speedup": ratio(serial_s, timed["wall_s"]),
                         "overhead_ms": 1e3 * (workers * timed["wall_s"] - timed["busy_s"]) / len(jobs),
                         "start_s": timed["start_s"],
+                        "load_1m": round(os.getloadavg()[0], 2),
                     }
                 )
     return rows

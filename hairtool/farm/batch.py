@@ -3,8 +3,8 @@ one task each, and record every job that finishes.
 
 A job that fails is a row with its one-line error, and the batch goes on. A worker killed
 while it runs a job makes Dask's scheduler run the task again on another worker (the job is
-whole, its outputs atomic, so nothing is half-written); after
-:data:`~hairtool.farm.cluster.ALLOWED_FAILURES` deaths the job is reported failed. Every job
+whole, its outputs atomic, so nothing is half-written); when the scheduler gives up (after
+:data:`~hairtool.farm.cluster.ALLOWED_FAILURES` deaths on a local cluster) it is reported failed. Every job
 that finishes is written into its manifest at once, so a batch stopped half-way resumes.
 """
 
@@ -88,12 +88,14 @@ def _collect(future, job: Job, manifests: Manifests, warnings: list[str]) -> dic
 
     try:
         result = future.result()
-    except KilledWorker as e:
-        from hairtool.farm.cluster import ALLOWED_FAILURES
-
-        last = getattr(getattr(e, "last_worker", None), "address", "a worker")
-        reason = f"its worker died {ALLOWED_FAILURES} times (the last, {last}); Dask gave up on it"
-        return row(job, "failed", None, reason)
+    except KilledWorker as e:  # the scheduler's allowed-failures ran out
+        last = getattr(e.last_worker, "address", "unknown")
+        deaths = (
+            f"{e.allowed_failures + 1} times" if isinstance(e.allowed_failures, int) else "again and again"
+        )
+        return row(
+            job, "failed", None, f"the worker running it died {deaths} (the last: {last}); Dask gave up"
+        )
     except CancelledError:
         return row(job, "failed", None, "cancelled: the scheduler lost the job (restarted or shut down?)")
     except Exception as e:  # the task could not run at all (say, hairtool missing on a worker)

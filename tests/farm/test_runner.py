@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 import os
 
+import pytest
+
 from hairtool.cli import main
 from hairtool.farm.jobs import Job
 from hairtool.farm.manifest import file_sha256
@@ -119,3 +121,26 @@ def test_atomic_writes_are_recorded_only_when_they_finish(tmp_path):
     with atomic_open(tmp_path / "d.txt", "w") as f:
         f.write("d")
     assert outer == [tmp_path / "a.txt", tmp_path / "b.txt"]  # the block has ended
+
+
+def test_a_job_whose_workers_kept_dying_or_that_could_not_run_is_a_failed_row():
+    distributed = pytest.importorskip("distributed")
+    from hairtool.farm.batch import _collect
+    from hairtool.farm.manifest import Manifests
+
+    class Finished:
+        def __init__(self, error: BaseException) -> None:
+            self.error = error
+
+        def result(self):
+            raise self.error
+
+    job = Job(2, "keys", ("shots/a.npz",), "/nowhere")
+    worker = type("WorkerState", (), {"address": "tcp://127.0.0.1:4567"})()
+    killed = _collect(Finished(distributed.KilledWorker("k", worker, 2)), job, Manifests(), [])
+    assert killed["status"] == "failed" and killed["index"] == 2
+    assert (
+        killed["error"] == "the worker running it died 3 times (the last: tcp://127.0.0.1:4567); Dask gave up"
+    )
+    missing = _collect(Finished(ModuleNotFoundError("No module named 'hairtool'")), job, Manifests(), [])
+    assert missing["error"] == "ModuleNotFoundError: No module named 'hairtool'"
