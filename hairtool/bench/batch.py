@@ -8,10 +8,12 @@ another in one process with numba threads on every core (``serial_threads``), a 
 process of its own so that both sides run in the environment Dask gives its workers (one
 BLAS thread, which a loaded machine needs); ``speedup``, their ratio; ``overhead_ms``, the
 worker time per job not spent inside a job, (workers × wall − Σ job seconds) / jobs, which
-also counts a worker idling at the end of the batch. Serial and batch passes alternate, so a
-busy moment of a shared machine falls on both, and both run warm (kernels compiled and
-loaded before timing); ``load_1m`` is the machine's load average when the row was taken (a
-shared machine's other work leaves fewer cores to the workers than it has).
+also counts a worker idling at the end of the batch; ``split_s`` and ``split_speedup``, the
+same jobs dealt out to the workers in equal shares, one task per worker run one after
+another: the speed-up the machine's free cores allow at that moment, the batch's ceiling.
+Serial, split and batch passes alternate, so a busy moment of a shared machine falls on all,
+and all run warm (kernels compiled and loaded before timing). ``load_1m`` is the machine's
+load average when the row was taken (another's work leaves the workers fewer cores).
 
 Data: ``synthetic``, shots simulated from the scalp sample; ``mocap``, the BVH captures in
 ``shared/data/motion`` (short jobs, where the overhead shows).
@@ -104,9 +106,23 @@ def _batch_pass(client, jobs, threads) -> tuple[float, float]:
     return result.seconds, sum(r["seconds"] for r in result.rows)
 
 
+def _split_pass(client, jobs, threads) -> float:
+    """Seconds for every worker to run its share of ``jobs`` one after another, all at once: the
+    parallel time the machine allows now, without a task per job."""
+    workers = sorted(client.nthreads())
+    t0 = time.perf_counter()
+    futures = [
+        client.submit(serial_pass, jobs[i :: len(workers)], threads, workers=[w], pure=False)
+        for i, w in enumerate(workers)
+    ]
+    client.gather(futures)
+    return time.perf_counter() - t0
+
+
 def _measure(jobs, worker_counts: list[int], repeat: int) -> tuple[float, dict[int, dict]]:
-    """Serial and batch passes taken in turn, so a busy moment of the machine falls on both;
-    the median serial time and, per worker count, the median batch pass and the start-up."""
+    """Serial, split and batch passes taken in turn, so a busy moment of the machine falls on
+    all; the median serial time and, per worker count, the median batch pass, the median split
+    pass and the start-up."""
     from hairtool.farm.batch import default_threads
     from hairtool.farm.cluster import cores, open_client
     from hairtool.farm.runner import run_job
@@ -122,15 +138,21 @@ def _measure(jobs, worker_counts: list[int], repeat: int) -> tuple[float, dict[i
             start[w] = time.perf_counter() - t0
             threads = default_threads(None, w)
             clients[w].run(lambda threads=threads: [run_job(j, threads) for j in warm])
-        serial, runs = [], {w: [] for w in worker_counts}
+        serial, runs, split = [], {w: [] for w in worker_counts}, {w: [] for w in worker_counts}
         for _ in range(repeat):
             serial.append(alone.submit(serial_pass, jobs, cores(), pure=False).result())
             for w, client in clients.items():
                 runs[w].append(_batch_pass(client, jobs, default_threads(None, w)))
+                split[w].append(_split_pass(client, jobs, default_threads(None, w)))
     timed = {}
     for w, r in runs.items():
         wall_s, busy_s = sorted(r)[len(r) // 2]  # the median pass (the upper one of two)
-        timed[w] = {"start_s": start[w], "wall_s": wall_s, "busy_s": busy_s}
+        timed[w] = {
+            "start_s": start[w],
+            "wall_s": wall_s,
+            "busy_s": busy_s,
+            "split_s": statistics.median(split[w]),
+        }
     return statistics.median(serial), timed
 
 
@@ -170,6 +192,8 @@ def run(args: argparse.Namespace) -> list[dict]:
                         "serial_s": serial_s,
                         "serial_threads": serial_threads,
                         "speedup": ratio(serial_s, timed["wall_s"]),
+                        "split_s": timed["split_s"],
+                        "split_speedup": ratio(serial_s, timed["split_s"]),
                         "overhead_ms": 1e3 * (workers * timed["wall_s"] - timed["busy_s"]) / len(jobs),
                         "start_s": timed["start_s"],
                         "load_1m": round(os.getloadavg()[0], 2),
