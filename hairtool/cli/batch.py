@@ -30,7 +30,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--scheduler", metavar="ADDRESS", help="a running Dask scheduler, tcp://HOST:8786 (default: local)"
     )
-    parser.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    parser.add_argument(
+        "--workers", type=int, metavar="N", help="local worker processes (default: one per core)"
+    )
     parser.add_argument(
         "--job-threads",
         type=int,
