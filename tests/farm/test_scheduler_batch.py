@@ -124,7 +124,9 @@ def _kill_a_worker_running_a_job(client, pids: dict[str, int], thread: threading
     raise AssertionError("no worker was seen running a job")
 
 
-def test_a_batch_on_a_running_scheduler_survives_a_killed_worker_and_resumes(project, dask_pair, capsys):
+def test_a_batch_on_a_running_scheduler_survives_a_killed_worker_and_resumes(
+    project, dask_pair, capsys, grooms_dir
+):
     address, client, pids = dask_pair
     jobs = project / "jobs.json"
     entries = [
@@ -137,6 +139,7 @@ def test_a_batch_on_a_running_scheduler_survives_a_killed_worker_and_resumes(pro
             "args": ["{path}", "--keys", "4", "--out", "out/{stem}.json"],
         }
     )
+    entries.append({"command": "freeze", "args": [str(grooms_dir / "ponytail_tail.tfx"), "out/tail.usda"]})
     jobs.write_text(json.dumps({"jobs": entries}))
     report = project / "report.json"
 
@@ -154,14 +157,18 @@ def test_a_batch_on_a_running_scheduler_survives_a_killed_worker_and_resumes(pro
     assert not thread.is_alive(), "the batch did not finish"
     assert status == [0]
     summary = json.loads(capsys.readouterr().out)
-    assert summary["done"] == 6 and summary["failed"] == 0 and summary["scheduler"] == address
+    assert summary["done"] == 7 and summary["failed"] == 0 and summary["scheduler"] == address
 
     rows = json.loads(report.read_text())["jobs"]
-    assert [r["status"] for r in rows] == ["done"] * 6
+    assert [r["status"] for r in rows] == ["done"] * 7
     killed_pid = f":{pids[killed_worker]}"
     assert not any(r["worker"].endswith(killed_pid) for r in rows)  # what it ran was run again elsewhere
     assert rows[killed_job]["status"] == "done"
-    assert [r["key_count"] for r in rows[3:]] == [4, 4, 4]
+    assert [r["key_count"] for r in rows[3:6]] == [4, 4, 4]
+    assert (
+        read(project / "out" / "tail.usda").strand_count
+        == read(grooms_dir / "ponytail_tail.tfx").strand_count
+    )
 
     assert main(["simulate", SIMULATE[0], str(project / "by_hand.npz"), *SIMULATE[1:]]) == 0
     expected = read(project / "by_hand.npz").frames
@@ -175,4 +182,4 @@ def test_a_batch_on_a_running_scheduler_survives_a_killed_worker_and_resumes(pro
     capsys.readouterr()
     assert main(["batch", str(jobs), "--scheduler", address, "--json"]) == 0
     again = json.loads(capsys.readouterr().out)
-    assert again["skipped"] == 6 and again["done"] == 0
+    assert again["skipped"] == 7 and again["done"] == 0
