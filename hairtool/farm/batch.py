@@ -75,6 +75,21 @@ def _finished(job: Job, result: dict) -> dict:
     )
 
 
+def shared_outputs(rows: list[dict]) -> list[str]:
+    """One line per file that two jobs of the batch wrote (say, a glob template without
+    ``{stem}``): only the job that finished last left its output there."""
+    writer: dict[str, int] = {}
+    lines = []
+    for r in rows:
+        if r["status"] != "done":
+            continue
+        for path in r.get("outputs", ()):
+            if path in writer:
+                lines.append(f"job {writer[path] + 1} and job {r['index'] + 1} both wrote {path}")
+            writer.setdefault(path, r["index"])
+    return lines
+
+
 def default_threads(scheduler: str | None, workers: int) -> int | None:
     """Numba threads per job: the local cores shared among the local workers; a remote
     worker's own setting (``NUMBA_NUM_THREADS``) on a scheduler."""
@@ -182,6 +197,7 @@ def run_batch(
         progress.finish()
     result.rows = [rows[job.index] for job in jobs if job.index in rows]
     result.seconds = time.perf_counter() - t0
+    result.warnings += shared_outputs(result.rows)
     for w in result.warnings:
         print(f"hairtool batch: warning: {w}", file=sys.stderr)
     return result

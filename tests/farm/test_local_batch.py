@@ -152,3 +152,17 @@ def test_bad_options_are_one_line(project, capsys, args, message):
     assert main(["batch", str(jobs), *args]) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and "\n" not in err
+
+
+def test_two_jobs_writing_one_file_are_warned_about(project, capsys):
+    jobs = project / "jobs.json"
+    template = {
+        "glob": "shots/*.npz",
+        "command": "keys",
+        "args": ["{path}", "--keys", "3", "--out", "out/k.json"],
+    }
+    jobs.write_text(json.dumps({"jobs": [template]}))
+    assert main(["batch", str(jobs), "--workers", "1"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2  # three jobs, one file
+    assert all(ln.startswith("hairtool batch: warning: job ") and ln.endswith("k.json") for ln in err)
