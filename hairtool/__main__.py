@@ -1,3 +1,4 @@
 from hairtool.cli import entry
 
-entry()
+if __name__ == "__main__":  # not when multiprocessing re-imports it in a worker process
+    entry()

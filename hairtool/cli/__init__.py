@@ -8,10 +8,12 @@ Heavy imports belong inside ``run`` so that ``hairtool --help`` stays fast.
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib
 import pkgutil
 import sys
 from collections.abc import Sequence
+from importlib.metadata import entry_points
 
 from hairtool import __version__
 from hairtool.errors import HairtoolError
@@ -20,9 +22,32 @@ EXIT_OK = 0
 EXIT_BAD_INPUT = 2
 
 
+#: Entry-point group through which packages above the command line add commands: the farm's
+#: ``hairtool batch`` runs commands, so the command line cannot import it (no import circle).
+PLUGIN_GROUP = "hairtool.commands"
+
+
+def command_modules(package: str = __name__, group: str = PLUGIN_GROUP) -> dict[str, str]:
+    """Command name → module: each public module of ``package``, then the ``group`` entry points."""
+    here = importlib.import_module(package)
+    names = [m.name for m in pkgutil.iter_modules(here.__path__) if not m.name.startswith("_")]
+    found = {name: f"{package}.{name}" for name in names}
+    for ep in entry_points(group=group):
+        found.setdefault(ep.name, ep.value)
+    return dict(sorted(found.items()))
+
+
 def command_names() -> list[str]:
-    here = importlib.import_module(__name__)
-    return sorted(m.name for m in pkgutil.iter_modules(here.__path__) if not m.name.startswith("_"))
+    return list(command_modules())
+
+
+@functools.cache
+def command_parser(command: str) -> argparse.ArgumentParser:
+    """The argument parser of one ``hairtool`` command, as ``hairtool COMMAND`` builds it."""
+    module = importlib.import_module(command_modules()[command])
+    parser = argparse.ArgumentParser(prog=f"hairtool {command}", description=module.__doc__)
+    module.add_arguments(parser)
+    return parser
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -32,8 +57,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"hairtool {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in command_names():
-        module = importlib.import_module(f"{__name__}.{name}")
+    for name, path in command_modules().items():
+        module = importlib.import_module(path)
         p = sub.add_parser(name, help=module.HELP, description=module.__doc__)
         module.add_arguments(p)
         p.set_defaults(_run=module.run)

@@ -5,21 +5,18 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
-import pkgutil
+
+from hairtool.cli import command_modules
 
 HELP = "run a benchmark (freeze, keys, …) and print its numbers"
-
-
-def _benchmarks() -> list[str]:
-    import hairtool.bench as pkg
-
-    return sorted(m.name for m in pkgutil.iter_modules(pkg.__path__) if not m.name.startswith("_"))
+#: Entry-point group through which packages above the command line add benchmarks (the farm's).
+PLUGIN_GROUP = "hairtool.benchmarks"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     sub = parser.add_subparsers(dest="benchmark", metavar="BENCHMARK", required=True)
-    for name in _benchmarks():
-        module = importlib.import_module(f"hairtool.bench.{name}")
+    for name, path in command_modules("hairtool.bench", PLUGIN_GROUP).items():
+        module = importlib.import_module(path)
         p = sub.add_parser(name, help=module.HELP, description=module.__doc__)
         p.add_argument("--json", action="store_true", help="print a JSON list of rows")
         module.add_arguments(p)

@@ -11,11 +11,17 @@ to a path first removes that path's temporaries whose writer is gone: made under
 by a process id that no longer runs. A temporary of a live writer is never touched; a dead
 writer's whose id has been reused by another live process waits for a later write; one made
 on another machine sharing the folder is left alone, since its process id means nothing here.
+
+Two helpers serve ``hairtool batch``, which runs any command and must learn what it wrote:
+:func:`recording_writes` collects the paths renamed into place, whatever the writer, and
+:func:`stale_temporaries` lists every temporary of a path, from any machine, for a batch that
+knows no other writer of that path runs (a farm worker killed mid-job on another host).
 """
 
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import functools
 import hashlib
 import os
@@ -52,6 +58,38 @@ def _temp_pattern(target: Path) -> re.Pattern[str]:
     through its own ``<name without suffix>.XXXXXX`` beside the path it is given."""
     name = re.escape(target.name)
     return re.compile(rf"\.{name}\.{host_tag()}-(\d{{1,10}})\.[0-9a-f]{{8}}\.tmp(?:\.[^/]*)?")
+
+
+def stale_temporaries(path: str | os.PathLike[str]) -> list[Path]:
+    """Every temporary of ``path`` from any machine (``.<name>.<host>-<pid>.<random>.tmp…``);
+    only call this when no other writer of ``path`` is running."""
+    target = Path(path)
+    folder = target.parent if str(target.parent) else Path(".")
+    name = re.escape(target.name)
+    pattern = re.compile(rf"\.{name}\.[0-9a-f]{{6}}-\d{{1,10}}\.[0-9a-f]{{8}}\.tmp(?:\.[^/]*)?")
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    return sorted(folder / n for n in names if pattern.fullmatch(n))
+
+
+#: Lists that :func:`recording_writes` blocks in this context (thread or task) are filling.
+_recorders: contextvars.ContextVar[tuple[list[Path], ...]] = contextvars.ContextVar(
+    "hairtool_atomic_recorders", default=()
+)
+
+
+@contextlib.contextmanager
+def recording_writes() -> Iterator[list[Path]]:
+    """Collect the absolute path of every file an atomic write renames into place inside the block
+    (in this thread or task), in order; a path written twice appears twice."""
+    written: list[Path] = []
+    token = _recorders.set((*_recorders.get(), written))
+    try:
+        yield written
+    finally:
+        _recorders.reset(token)
 
 
 def process_alive(pid: int) -> bool:
@@ -148,6 +186,8 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
         with contextlib.suppress(OSError):
             tmp_path.unlink()
         raise
+    for written in _recorders.get():
+        written.append(target.absolute())
 
 
 @contextlib.contextmanager

@@ -1,0 +1,85 @@
+"""Where a batch's jobs run: a Dask cluster of local processes, or a running Dask scheduler.
+
+Dask is imported here only, when a batch runs, so the library and the other commands work
+without it; a missing Dask is one line saying how to install it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+from collections.abc import Iterator
+from types import ModuleType
+
+from hairtool.errors import HairtoolError, ParameterError
+
+INSTALL_HINT = "pip install 'hairtool[farm]' (or pip install 'dask[distributed]')"
+#: Seconds to wait for a scheduler to answer before giving up.
+CONNECT_TIMEOUT_S = 20.0
+#: A job whose worker died this many times is reported failed (Dask's allowed-failures + 1).
+ALLOWED_FAILURES = 3
+
+
+def require_dask() -> ModuleType:
+    """``distributed``, or a :class:`HairtoolError` naming the missing extra."""
+    try:
+        import distributed
+    except ImportError:
+        raise HairtoolError(
+            f"hairtool batch runs jobs on Dask, which is not installed; {INSTALL_HINT}"
+        ) from None
+    return distributed
+
+
+def cores() -> int:
+    """Cores this process may run on."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def local_workers(requested: int | None) -> int:
+    """Worker processes of a local cluster: ``requested``, or one per core."""
+    if requested is None:
+        return cores()
+    if requested < 1:
+        raise ParameterError("workers", requested, "a whole number ≥ 1")
+    return requested
+
+
+@contextlib.contextmanager
+def open_client(scheduler: str | None = None, workers: int | None = None) -> Iterator[object]:
+    """A ``distributed.Client``: connected to ``scheduler`` (``tcp://HOST:PORT``), or to a local
+    cluster of ``workers`` processes with one thread each, started here and closed on exit."""
+    distributed = require_dask()
+    import dask
+
+    if scheduler is not None:
+        if "://" not in scheduler and ":" not in scheduler:
+            raise ParameterError("scheduler", scheduler, "a Dask scheduler address such as tcp://HOST:8786")
+        try:
+            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT_S)
+        except (OSError, TimeoutError, ValueError) as e:
+            raise HairtoolError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    n = local_workers(workers)
+    with dask.config.set({"distributed.scheduler.allowed-failures": ALLOWED_FAILURES - 1}):
+        cluster = distributed.LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address="127.0.0.1:0",  # its status pages: loopback, any free port
+            silence_logs=logging.ERROR,
+        )
+    try:
+        client = distributed.Client(cluster)
+        try:
+            yield client
+        finally:
+            client.close()
+    finally:
+        cluster.close()

@@ -1,0 +1,190 @@
+"""The jobs file of ``hairtool batch``: a list of CLI commands, written out or made from a glob.
+
+``{"jobs": [{"command": "keys", "args": ["shot01.usdc", "--out", "shot01.keys.json"]},
+{"glob": "shots/*.usdc", "command": "keys", "args": ["{path}", "--out", "{dir}/{stem}.keys.json"]}]}``
+in JSON, or the same tables in TOML (``[[jobs]]``); a file holding one glob entry at the top
+level is read as a list of one. Any command of ``hairtool`` but ``batch`` and ``bench`` is a
+job, so a command added later needs nothing here. Relative paths are relative to the jobs
+file's folder: the job runs there (:mod:`hairtool.farm.runner`).
+
+Every mistake is a :class:`~hairtool.errors.FormatError` naming the file and the entry.
+"""
+
+from __future__ import annotations
+
+import glob
+import hashlib
+import json
+import os
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from hairtool.errors import FormatError
+
+#: Commands a job may not run: a batch inside a worker would start a cluster of its own, and a
+#: benchmark's numbers mean nothing on a shared worker.
+NOT_JOBS = ("batch", "bench")
+ENTRY_KEYS = ("command", "args", "glob")
+#: Placeholders of a glob entry's args, for a match ``shots/a.usdc``.
+PLACEHOLDERS = {
+    "path": "the match, shots/a.usdc",
+    "dir": "its folder, shots",
+    "name": "its file name, a.usdc",
+    "stem": "its name without the extension, a",
+    "suffix": "its extension, .usdc",
+}
+_TEMPLATE = re.compile(r"\{\{|\}\}|\{([^{}]*)\}")
+
+
+@dataclass(frozen=True)
+class Job:
+    """One command line to run; ``args`` as given (paths relative to ``base``)."""
+
+    index: int
+    command: str
+    args: tuple[str, ...]
+    base: str  # absolute folder of the jobs file: the job's working folder
+
+    @property
+    def argv(self) -> list[str]:
+        return [self.command, *self.args]
+
+    @property
+    def input(self) -> str | None:
+        """The first argument that is not an option (every command takes its input first)."""
+        return next((a for a in self.args if not a.startswith("-")), None)
+
+    @property
+    def key(self) -> str:
+        """Names the job in manifests: its command, arguments and working folder."""
+        text = json.dumps([self.command, list(self.args), self.base], separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+    def describe(self) -> str:
+        return f"job {self.index + 1} ({self.command} {self.input or ''}".rstrip() + ")"
+
+
+def job_commands() -> list[str]:
+    """The commands a job may run: every ``hairtool`` command but :data:`NOT_JOBS`."""
+    from hairtool.cli import command_names
+
+    return [c for c in command_names() if c not in NOT_JOBS]
+
+
+def _parse(path: Path) -> object:
+    suffix = path.suffix.lower()
+    if suffix not in (".json", ".toml"):
+        raise FormatError(path, "a jobs file is .json or .toml")
+    try:
+        data = path.read_bytes()
+    except OSError as e:
+        raise FormatError(path, f"cannot read: {e.strerror or e}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise FormatError(path, "not UTF-8 text") from None
+    try:
+        return json.loads(text) if suffix == ".json" else tomllib.loads(text)
+    except json.JSONDecodeError as e:
+        raise FormatError(path, f"not valid JSON: {e.msg} (line {e.lineno}, column {e.colno})") from None
+    except tomllib.TOMLDecodeError as e:
+        raise FormatError(path, f"not valid TOML: {e}") from None
+
+
+def _args(path: Path, where: str, value: object) -> list[str]:
+    if value is None:
+        return []
+    if not isinstance(value, list):
+        raise FormatError(path, f"{where}: args must be a list of strings, as on the command line")
+    out = []
+    for i, a in enumerate(value):
+        if isinstance(a, bool) or not isinstance(a, (str, int, float)):
+            raise FormatError(path, f"{where}: args[{i}] must be a string or a number, not {a!r}")
+        out.append(a if isinstance(a, str) else str(a))
+    return out
+
+
+def _fill(path: Path, where: str, arg: str, values: dict[str, str]) -> str:
+    """``arg`` with ``{name}`` placeholders replaced; ``{{`` and ``}}`` are literal braces."""
+
+    def replace(m: re.Match[str]) -> str:
+        if m.group(0) in ("{{", "}}"):
+            return m.group(0)[0]
+        name = m.group(1)
+        if name not in values:
+            valid = ", ".join("{" + p + "}" for p in PLACEHOLDERS)
+            raise FormatError(path, f"{where}: unknown placeholder {{{name}}} in {arg!r} (valid: {valid})")
+        return values[name]
+
+    return _TEMPLATE.sub(replace, arg)
+
+
+def _expand_glob(path: Path, where: str, pattern: object, args: list[str], base: str) -> list[list[str]]:
+    if not isinstance(pattern, str) or not pattern:
+        raise FormatError(path, f"{where}: glob must be a non-empty string such as shots/*.usdc")
+    matches = sorted(
+        m for m in glob.glob(pattern, root_dir=base, recursive=True) if os.path.isfile(os.path.join(base, m))
+    )
+    if not matches:
+        raise FormatError(path, f"{where}: glob {pattern!r} matches no file in {base}")
+    filled = []
+    for m in matches:
+        p = Path(m)
+        values = {
+            "path": m,
+            "dir": str(p.parent),
+            "name": p.name,
+            "stem": p.stem,
+            "suffix": p.suffix,
+        }
+        filled.append([_fill(path, where, a, values) for a in args])
+    return filled
+
+
+def _entries(path: Path, data: object) -> list[object]:
+    if not isinstance(data, dict):
+        raise FormatError(path, 'expected an object with a "jobs" list')
+    if "jobs" in data:
+        extra = sorted(set(data) - {"jobs"})
+        if extra:
+            raise FormatError(path, f"unknown top-level key {extra[0]!r} (expected only jobs)")
+        jobs = data["jobs"]
+        if not isinstance(jobs, list):
+            raise FormatError(path, '"jobs" must be a list of {"command", "args"} or {"glob", ...} entries')
+        return jobs
+    if "command" in data:
+        return [data]
+    raise FormatError(path, 'expected a "jobs" list (or one {"glob", "command", "args"} entry)')
+
+
+def load_jobs(path: str | os.PathLike[str]) -> list[Job]:
+    """The jobs of a ``.json`` or ``.toml`` jobs file, globs expanded, in file order."""
+    path = Path(path)
+    base = str(path.absolute().parent)
+    commands = job_commands()
+    jobs: list[Job] = []
+    seen: dict[str, str] = {}
+    for i, entry in enumerate(_entries(path, _parse(path))):
+        where = f"jobs[{i}]"
+        if not isinstance(entry, dict):
+            raise FormatError(path, f"{where}: expected an object with command and args")
+        unknown = sorted(set(entry) - set(ENTRY_KEYS))
+        if unknown:
+            raise FormatError(path, f"{where}: unknown key {unknown[0]!r} (expected {', '.join(ENTRY_KEYS)})")
+        command = entry.get("command")
+        if command not in commands:
+            shown = "missing" if command is None else repr(command)
+            raise FormatError(path, f"{where}: command {shown} is not one of {', '.join(commands)}")
+        args = _args(path, where, entry.get("args"))
+        lists = _expand_glob(path, where, entry["glob"], args, base) if "glob" in entry else [args]
+        for a in lists:
+            job = Job(len(jobs), command, tuple(a), base)
+            if job.key in seen:
+                raise FormatError(path, f"{where}: repeats {seen[job.key]} ({command} {' '.join(a)})")
+            seen[job.key] = where
+            jobs.append(job)
+    if not jobs:
+        raise FormatError(path, "no jobs")
+    return jobs

@@ -1,0 +1,153 @@
+"""The manifest beside a batch's outputs: which jobs are done, from which inputs, with which options.
+
+Each folder that received outputs holds one ``hairtool-batch.json``; its entry for a job (by
+:attr:`~hairtool.farm.jobs.Job.key`, which covers the command, its arguments and the working
+folder) lists every input with its sha256, size and modification time, and every output with
+its size and modification time. A job is done, and skipped, when a manifest beside one of the
+paths its arguments name has its entry, every output is still the file the job wrote, and
+every input has the same content: the same size and time (not read again), or else the same
+sha256 (a file touched or copied back). A file rewritten in place that keeps both its size and
+its time to the nanosecond is not noticed; ``--force`` reruns everything.
+
+Only the batch's client writes manifests, atomically, after re-reading the file, so entries
+another batch wrote in the meantime are kept.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+from pathlib import Path
+
+from hairtool import __version__
+from hairtool.errors import FormatError
+from hairtool.farm.jobs import Job
+from hairtool.io.atomic import atomic_open
+
+MANIFEST_NAME = "hairtool-batch.json"
+FORMAT = "hairtool batch manifest"
+VERSION = 1
+
+
+def file_state(path: str | os.PathLike[str]) -> dict:
+    """``{"bytes", "mtime_ns"}`` of a file (what an output is checked against)."""
+    st = os.stat(path)
+    return {"bytes": st.st_size, "mtime_ns": st.st_mtime_ns}
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
+
+
+def input_state(path: str | os.PathLike[str]) -> dict:
+    """``{"sha256", "bytes", "mtime_ns"}`` of an input file."""
+    state = file_state(path)
+    return {"sha256": file_sha256(path), **state}
+
+
+def named_paths(args: list[str] | tuple[str, ...], base: str | os.PathLike[str]) -> list[Path]:
+    """Every argument that could be a path (and the value of ``--option=value``), under ``base``."""
+    out = []
+    for a in args:
+        if a.startswith("-"):
+            if "=" not in a:
+                continue
+            a = a.split("=", 1)[1]
+        if a:
+            out.append(Path(base, a))
+    return out
+
+
+class Manifests:
+    """The manifests a batch reads and writes, each loaded once."""
+
+    def __init__(self) -> None:
+        self._entries: dict[Path, dict] = {}
+        self._hashes: dict[tuple[str, int, int], str] = {}
+
+    @staticmethod
+    def _read(folder: Path) -> dict:
+        """The entries of ``folder``'s manifest; none when it is missing or unreadable (it is
+        only a record of work done: the jobs then run again and a new one is written)."""
+        try:
+            with open(folder / MANIFEST_NAME, encoding="utf-8") as f:
+                data = json.load(f)
+        except (OSError, ValueError):
+            return {}
+        if not isinstance(data, dict) or data.get("format") != FORMAT or data.get("version") != VERSION:
+            return {}
+        jobs = data.get("jobs")
+        return jobs if isinstance(jobs, dict) else {}
+
+    def _folder(self, folder: Path) -> dict:
+        if folder not in self._entries:
+            self._entries[folder] = self._read(folder)
+        return self._entries[folder]
+
+    def _same_input(self, path: str, recorded: dict) -> bool:
+        try:
+            now = file_state(path)
+        except OSError:
+            return False
+        if now["bytes"] != recorded.get("bytes"):
+            return False
+        if now["mtime_ns"] == recorded.get("mtime_ns"):
+            return True
+        cache_key = (path, now["bytes"], now["mtime_ns"])
+        if cache_key not in self._hashes:
+            self._hashes[cache_key] = file_sha256(path)
+        return self._hashes[cache_key] == recorded.get("sha256")
+
+    def is_current(self, entry: dict) -> bool:
+        """Every output still as written and every input unchanged."""
+        outputs, inputs = entry.get("outputs"), entry.get("inputs")
+        if not isinstance(outputs, dict) or not outputs or not isinstance(inputs, dict):
+            return False
+        for path, recorded in outputs.items():
+            try:
+                if file_state(path) != {k: recorded.get(k) for k in ("bytes", "mtime_ns")}:
+                    return False
+            except OSError:
+                return False
+        return all(self._same_input(path, recorded) for path, recorded in inputs.items())
+
+    def find_done(self, job: Job) -> dict | None:
+        """The manifest entry that shows ``job`` done and its outputs current, else None."""
+        folders = dict.fromkeys(p.parent.absolute() for p in named_paths(job.args, job.base))
+        for folder in folders:
+            entry = self._folder(folder).get(job.key)
+            if isinstance(entry, dict) and self.is_current(entry):
+                return entry
+        return None
+
+    def record(self, job: Job, result: dict) -> Path | None:
+        """Write ``job``'s entry (from a ``done`` :func:`~hairtool.farm.runner.run_job` result) into
+        the manifest beside its first output; None when the job wrote nothing."""
+        if not result.get("outputs"):
+            return None
+        folder = Path(next(iter(result["outputs"]))).parent
+        entry = {
+            "command": job.command,
+            "args": list(job.args),
+            "base": job.base,
+            "inputs": result["inputs"],
+            "outputs": result["outputs"],
+            "seconds": result["seconds"],
+            "fields": result.get("fields", {}),
+            "finished": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+            "hairtool": __version__,
+        }
+        entries = self._read(folder)  # keep what another batch wrote since this one read the file
+        entries[job.key] = entry
+        path = folder / MANIFEST_NAME
+        try:
+            with atomic_open(path, "w", encoding="utf-8") as f:
+                json.dump({"format": FORMAT, "version": VERSION, "jobs": entries}, f, indent=1)
+                f.write("\n")
+        except OSError as e:
+            raise FormatError(path, f"cannot write the batch manifest: {e.strerror or e}") from None
+        self._entries[folder] = entries
+        return path

@@ -1,0 +1,90 @@
+"""The manifest beside the outputs: a job is done while its outputs are as written and its inputs
+have the same content; anything else runs it again."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+
+from hairtool.farm.jobs import Job
+from hairtool.farm.manifest import MANIFEST_NAME, Manifests
+from hairtool.farm.runner import run_job
+
+
+def done(project, job: Job) -> Manifests:
+    result = run_job(job)
+    assert result["status"] == "done", result["error"]
+    manifests = Manifests()
+    assert manifests.record(job, result) == project / "out" / MANIFEST_NAME
+    return manifests
+
+
+def keys_job(project, name: str = "a", index: int = 0) -> Job:
+    return Job(index, "keys", (f"shots/{name}.npz", "--keys", "4", "--out", f"out/{name}.json"), str(project))
+
+
+def test_a_recorded_job_is_done_for_a_new_reader_and_names_its_files(project):
+    job = keys_job(project)
+    done(project, job)
+    entry = Manifests().find_done(job)
+    assert entry is not None
+    assert list(entry["inputs"]) == [str(project / "shots" / "a.npz")]
+    assert list(entry["outputs"]) == [str(project / "out" / "a.json")]
+    assert entry["fields"]["key_count"] == 4
+    other_options = Job(0, "keys", ("shots/a.npz", "--keys", "5", "--out", "out/a.json"), str(project))
+    assert Manifests().find_done(other_options) is None
+
+
+def test_a_changed_or_missing_output_runs_the_job_again(project):
+    job = keys_job(project)
+    done(project, job)
+    out = project / "out" / "a.json"
+    out.write_text(out.read_text() + " ")
+    assert Manifests().find_done(job) is None
+    done(project, job)
+    out.unlink()
+    assert Manifests().find_done(job) is None
+
+
+def test_inputs_are_compared_by_content(project):
+    job = keys_job(project)
+    done(project, job)
+    a = project / "shots" / "a.npz"
+    os.utime(a, ns=(1_000_000_000, 1_000_000_000))  # touched, same bytes: still done
+    assert Manifests().find_done(job) is not None
+    shutil.copyfile(project / "shots" / "b.npz", a)  # another shot under the same name
+    assert Manifests().find_done(job) is None
+    data = bytearray(a.read_bytes())
+    done(project, job)
+    data[-100] ^= 1  # same size, one bit changed, new time
+    a.write_bytes(bytes(data))
+    assert Manifests().find_done(job) is None
+
+
+def test_jobs_of_one_folder_share_its_manifest_and_a_second_writer_keeps_the_first(project):
+    first, second = keys_job(project, "a"), keys_job(project, "b", 1)
+    writer_1, writer_2 = Manifests(), Manifests()
+    assert writer_1.find_done(first) is None and writer_2.find_done(second) is None  # both read it empty
+    writer_1.record(first, run_job(first))
+    writer_2.record(second, run_job(second))
+    data = json.loads((project / "out" / MANIFEST_NAME).read_text())
+    assert len(data["jobs"]) == 2
+    assert Manifests().find_done(first) and Manifests().find_done(second)
+
+
+def test_a_damaged_manifest_only_means_the_jobs_run_again(project):
+    job = keys_job(project)
+    done(project, job)
+    (project / "out" / MANIFEST_NAME).write_text('{"format": "hairtool batch manifest", "jobs": [')
+    assert Manifests().find_done(job) is None
+    done(project, job)
+    assert Manifests().find_done(job) is not None
+
+
+def test_a_job_that_wrote_nothing_is_not_recorded(project):
+    job = Job(0, "info", ("shots/a.npz",), str(project))
+    result = run_job(job)
+    assert result["status"] == "done" and result["outputs"] == {}
+    assert Manifests().record(job, result) is None
+    assert Manifests().find_done(job) is None
