@@ -22,6 +22,18 @@ F64 = NDArray[np.float64]
 #: linear (seed 000), Hermite with data tangents (seed 003), Hermite with fitted tangents
 INTERPOLATIONS = ("linear", "hermite", "hermite-fit")
 OBJECTIVES = ("total", "worst")
+#: A segment table of n frames holds n² float64 (and the DP a copy): beyond 4 GiB, refuse.
+MAX_TABLE_BYTES = 4 * 1024**3
+
+
+def check_frame_count(n: int) -> int:
+    """``n`` when its n × n table fits :data:`MAX_TABLE_BYTES`, else one clear error (a hostile
+    616-byte file can hold 50,000 frames of zeros, whose table alone is 18.6 GiB)."""
+    most = int((MAX_TABLE_BYTES / 8) ** 0.5)
+    if n > most:
+        gib = 8.0 * n * n / 1024**3
+        raise ParameterError("frames", n, f"at most {most} frames at once (a table of {gib:.1f} GiB)")
+    return n
 
 
 def total_table(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear", use_numba: bool = True) -> F64:
@@ -50,6 +62,7 @@ def cost_table(
         raise ParameterError("objective", objective, " or ".join(OBJECTIVES))
     if not np.isfinite(curvature) or curvature < 0:
         raise ParameterError("curvature", curvature, "a finite weight >= 0")
+    check_frame_count(np.shape(x)[0])
     if interp == "hermite-fit":
         if objective != "total":
             raise ParameterError("objective", objective, "total with hermite-fit (least-squares handles)")

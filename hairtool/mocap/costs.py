@@ -15,6 +15,7 @@ from numba import njit, prange
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
+from hairtool.keys.costs import check_frame_count
 from hairtool.mocap import quaternion as quat
 from hairtool.mocap.bvh import Motion, read_bvh
 
@@ -126,7 +127,7 @@ def rotation_cost_table(
     """
     if interp != "slerp":
         raise ParameterError("interp", interp, "'slerp'")
-    n = motion.n_frames
+    n = check_frame_count(motion.n_frames)
     if max_span is None:
         max_span = n
     if int(max_span) != max_span or max_span < 1:
