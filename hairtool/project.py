@@ -33,6 +33,7 @@ import numpy as np
 
 import hairtool
 from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterError
+from hairtool.frozen.brushes import BRUSHES, LUT_SIZE, BrushSample, check_sample
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
@@ -40,7 +41,8 @@ from hairtool.io.binary import float32_finite, require_finite, require_strand_co
 from hairtool.io.npz import read_npy_header
 
 FORMAT = "hairtool project"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: stroke logs with brushes beside align (version 1 files still read)
+READABLE_VERSIONS = (1, 2)
 SUFFIX = ".hairproj"
 MANIFEST = "manifest.json"
 MAX_MANIFEST_BYTES = 64 * 1024**2
@@ -78,7 +80,7 @@ class Project:
 
     rest: Groom
     params: FrozenParams = field(default_factory=FrozenParams)
-    strokes: tuple[AlignSample, ...] = ()
+    strokes: tuple[AlignSample | BrushSample, ...] = ()
     aligned: Groom | None = None
     brush: dict = field(default_factory=dict)
     display: dict = field(default_factory=dict)
@@ -160,13 +162,10 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
         "groom": {"source": project.groom_source, **_groom_arrays("groom", project.rest, arrays)},
         "params": _params_json(project.params, arrays),
     }
-    modes = sorted({s.mode for s in project.strokes})
-    n = len(project.strokes)
-    arrays["strokes/cursor.npy"] = np.array([s.cursor for s in project.strokes], np.float64).reshape(n, 3)
-    arrays["strokes/radius.npy"] = np.array([s.radius for s in project.strokes], np.float64)
-    arrays["strokes/intensity.npy"] = np.array([s.intensity for s in project.strokes], np.float64)
-    arrays["strokes/mode.npy"] = np.array([modes.index(s.mode) for s in project.strokes], np.int64)
-    manifest["strokes"] = {"count": n, "modes": modes, "aligned": project.aligned is not None}
+    manifest["strokes"] = _write_strokes(project.strokes, arrays)
+    manifest["strokes"]["aligned"] = project.aligned is not None
+    if "brushes" not in manifest["strokes"]:
+        manifest["version"] = 1  # align strokes only: readable by the hairtool before brushes
     if project.aligned is not None:
         if project.aligned.topology != project.rest.topology:
             raise GroomError("the aligned state must have the rest groom's strands")
@@ -242,9 +241,9 @@ class _Reader:
         if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
             raise FormatError(self.path, "not a hairtool project (manifest has no project format)")
         version = manifest.get("version")
-        if version != FORMAT_VERSION:
+        if version not in READABLE_VERSIONS:
             raise FormatError(
-                self.path, f"project format version {version!r}; this hairtool reads version {FORMAT_VERSION}"
+                self.path, f"project format version {version!r}; this hairtool reads versions 1 and 2"
             )
         listed = manifest.get("arrays")
         if not isinstance(listed, list) or not all(isinstance(n, str) for n in listed):
@@ -321,7 +320,42 @@ def _read_params(r: _Reader, raw: dict) -> FrozenParams:
         raise FormatError(r.path, f"engine parameters: {e}") from None
 
 
-def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple[AlignSample, ...], Groom | None]:
+def _write_strokes(log, arrays: dict) -> dict:
+    """The stroke log as columns: every sample's cursor, radius and intensity (a brush's
+    strength); align samples their mode; brush samples (version 2) their brush, direction and
+    falloff (one table of distinct falloff curves)."""
+    n = len(log)
+    aligns = [s for s in log if isinstance(s, AlignSample)]
+    modes = sorted({s.mode for s in aligns})
+    arrays["strokes/cursor.npy"] = np.array([s.cursor for s in log], np.float64).reshape(n, 3)
+    arrays["strokes/radius.npy"] = np.array([s.radius for s in log], np.float64)
+    arrays["strokes/intensity.npy"] = np.array(
+        [s.intensity if isinstance(s, AlignSample) else s.strength for s in log], np.float64
+    )
+    arrays["strokes/mode.npy"] = np.array(
+        [modes.index(s.mode) if isinstance(s, AlignSample) else -1 for s in log], np.int64
+    )
+    info: dict = {"count": n, "modes": modes}
+    if len(aligns) < n:
+        luts: list[tuple] = []
+        for s in log:
+            if isinstance(s, BrushSample) and s.lut not in luts:
+                luts.append(s.lut)
+        arrays["strokes/brush.npy"] = np.array(
+            [-1 if isinstance(s, AlignSample) else BRUSHES.index(s.brush) for s in log], np.int64
+        )
+        arrays["strokes/direction.npy"] = np.array(
+            [(0.0, 0.0, 0.0) if isinstance(s, AlignSample) else s.direction for s in log], np.float64
+        ).reshape(n, 3)
+        arrays["strokes/falloff.npy"] = np.array(
+            [-1 if isinstance(s, AlignSample) else luts.index(s.lut) for s in log], np.int64
+        )
+        arrays["strokes/falloffs.npy"] = np.array(luts, np.float64).reshape(len(luts), LUT_SIZE)
+        info["brushes"] = list(BRUSHES)
+    return info
+
+
+def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | None]:
     n, modes = info.get("count"), info.get("modes")
     if not isinstance(n, int) or n < 0 or not isinstance(modes, list):
         raise FormatError(r.path, "manifest.json: bad 'strokes' section")
@@ -331,15 +365,42 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple[AlignSampl
     mode = r.array("strokes/mode.npy", 1, "iu")
     if cursor.shape != (n, 3) or radius.shape != (n,) or intensity.shape != (n,) or mode.shape != (n,):
         raise FormatError(r.path, f"the stroke arrays do not all hold {n} strokes")
-    if n and (mode.min() < 0 or mode.max() >= len(modes)):
-        raise FormatError(r.path, "a stroke names an unknown align mode")
     for name, a in (("stroke cursor", cursor), ("stroke radius", radius), ("stroke intensity", intensity)):
         require_finite(r.path, a, name)
-    columns = (cursor.tolist(), radius.tolist(), intensity.tolist(), mode.tolist())
-    strokes = tuple(
-        AlignSample((float(c[0]), float(c[1]), float(c[2])), float(rad), float(i), str(modes[m]))
-        for c, rad, i, m in zip(*columns, strict=True)
-    )
+    brush = np.full(n, -1, np.int64)
+    if "brushes" in info:
+        names = info["brushes"]
+        brush = r.array("strokes/brush.npy", 1, "iu")
+        direction = r.array("strokes/direction.npy", 2, "f")
+        which = r.array("strokes/falloff.npy", 1, "iu")
+        luts = r.array("strokes/falloffs.npy", 2, "f")
+        if not isinstance(names, list) or any(b not in BRUSHES for b in names):
+            raise FormatError(r.path, "manifest.json: the strokes name an unknown brush")
+        shapes = (brush.shape, direction.shape, which.shape, luts.shape[1:])
+        if shapes != ((n,), (n, 3), (n,), (LUT_SIZE,)):
+            raise FormatError(r.path, f"the brush arrays do not all hold {n} strokes")
+        require_finite(r.path, direction, "stroke direction")
+        require_finite(r.path, luts, "falloff curves")
+        is_brush = brush >= 0
+        if np.any(brush >= len(names)) or np.any(is_brush & ((which < 0) | (which >= len(luts)))):
+            raise FormatError(r.path, "a stroke names an unknown brush or falloff")
+    if n and np.any((brush < 0) & ((mode < 0) | (mode >= len(modes)))):
+        raise FormatError(r.path, "a stroke names an unknown align mode")
+    strokes = []
+    for k in range(n):
+        c = (float(cursor[k, 0]), float(cursor[k, 1]), float(cursor[k, 2]))
+        if brush[k] < 0:
+            strokes.append(AlignSample(c, float(radius[k]), float(intensity[k]), str(modes[mode[k]])))
+            continue
+        sample = BrushSample(
+            names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
+            float(intensity[k]), tuple(luts[which[k]].tolist()),
+        )
+        try:
+            strokes.append(check_sample(sample))
+        except HairtoolError as e:
+            raise FormatError(r.path, f"stroke {k}: {e}") from None
+    strokes = tuple(strokes)
     aligned = None
     if info.get("aligned"):
         pts = r.array("strokes/aligned.npy", 2, "f")

@@ -54,6 +54,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="per-strand stiffness spread in [0, 4]: ×2^±spread",
     )
     f.add_argument("--no-freeze", action="store_true", help="skip FreezeDeform")
+    parser.add_argument(
+        "--strokes",
+        metavar="STROKES.json",
+        help="replay a stroke log (align, comb, smooth, length, puff, mask; the studio exports one) "
+        "after the --align cursors",
+    )
     a = parser.add_argument_group("UserAlign")
     a.add_argument(
         "--align", type=_point, action="append", default=[], metavar="X,Y,Z", help="cursor (repeatable)"
@@ -112,6 +118,11 @@ def run(args: argparse.Namespace) -> int:
     render = _guides.wanted(args)
     if render:
         _guides.check(args)
+    strokes = None
+    if args.strokes is not None:
+        from hairtool.frozen.strokes import read_strokes
+
+        strokes = read_strokes(args.strokes)  # a bad log is refused before any work
     groom = io.read_groom(args.input)
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
     if render:
@@ -122,6 +133,9 @@ def run(args: argparse.Namespace) -> int:
     timings = [pipe.timings]
     for cursor in args.align:
         pipe.align(cursor, radius, args.intensity, args.align_mode)
+        timings.append(pipe.timings)
+    for stroke in strokes or ():
+        pipe.apply_samples(stroke.pipeline_samples(float(pipe.scalp_centre[0])))
         timings.append(pipe.timings)
     report = {}
     if render:

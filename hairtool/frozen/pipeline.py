@@ -4,15 +4,17 @@ Built for dragging in the studio:
 
 - FreezeDeform always starts from the rest groom with noise hashed from (seed, strand, vertex),
   and is cached until a freeze parameter changes; it never feeds on its own output.
-- Alignment persists: each align sample (one mouse move) is applied to the cached aligned state
-  and appended to a log. When the frozen groom changes (new k_s, k_b, seed …) the log is
-  replayed on it, so strokes survive parameter changes.
+- Strokes persist: each brush sample (one mouse move of align, comb, smooth, length, puff or
+  mask, :mod:`hairtool.frozen.brushes`) is applied to the cached stroked state and appended to a
+  log. When the frozen groom changes (new k_s, k_b, seed …) the log is replayed on it, so
+  strokes survive parameter changes. Masked strands are locked for every brush.
 - Clumping is recomputed from the aligned state at every update and never accumulates.
 """
 
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field, fields, replace
 from typing import NamedTuple
 
@@ -21,12 +23,13 @@ from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
 from hairtool.frozen.align import align, check_align_params
+from hairtool.frozen.brushes import BrushSample, apply_brush, check_sample, paint_mask, scalp_centre
 from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
 from hairtool.frozen.clump_region import clump_points_interactive
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.noise import check_seed, draw_seed
 from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
-from hairtool.groom import Groom
+from hairtool.groom import Groom, vertex_ids_of
 
 
 @dataclass(frozen=True, eq=False)
@@ -103,14 +106,19 @@ class AlignSample(NamedTuple):
     mode: str
 
 
+Sample = AlignSample | BrushSample
+
+
 @dataclass(frozen=True)
 class FrozenSnapshot:
-    """Undo/redo state: the stroke log and the aligned points it produced (shared, read-only)."""
+    """Undo/redo state: the stroke log and the stroked points it produced (shared, read-only),
+    and the mask it painted (None: replay the log to find it)."""
 
-    log: tuple[AlignSample, ...]
+    log: tuple[Sample, ...]
     aligned: Groom
     freeze_key: tuple
     draw: int
+    locked: np.ndarray | None = None
 
 
 class FrozenPipeline:
@@ -122,7 +130,9 @@ class FrozenPipeline:
         strand_multipliers(rest.strand_count, self._params.strand_variation)  # shape check
         self._auto_h: float | None = None
         self._auto_step: tuple[tuple, float] | None = None  # (frozen groom's key, its auto step)
-        self._log: list[AlignSample] = []
+        self._log: list[Sample] = []
+        self._locked = np.zeros(rest.strand_count, dtype=bool)
+        self._scalp_centre: np.ndarray | None = None
         self._draw = 0
         self._workspace = ClumpWorkspace()
         self._timings = {"freeze": 0.0, "align": 0.0, "clump": 0.0, "total": 0.0}
@@ -157,8 +167,21 @@ class FrozenPipeline:
         return self._aligned
 
     @property
-    def strokes(self) -> tuple[AlignSample, ...]:
+    def strokes(self) -> tuple[Sample, ...]:
         return tuple(self._log)
+
+    @property
+    def locked(self) -> np.ndarray:
+        """``(S,)`` the strands the mask brush has locked (a copy)."""
+        return self._locked.copy()
+
+    @property
+    def scalp_centre(self) -> np.ndarray:
+        """Centre of the sphere fitted to the rest roots: puff's outward normal, and the default
+        X-symmetry plane (x = its x)."""
+        if self._scalp_centre is None:
+            self._scalp_centre = scalp_centre(self._rest)
+        return self._scalp_centre
 
     @property
     def timings(self) -> dict[str, float]:
@@ -228,10 +251,20 @@ class FrozenPipeline:
         """One align sample (one mouse move); it persists. Returns the updated result."""
         c = check_align_params(cursor, radius, intensity, mode)
         sample = AlignSample((float(c[0]), float(c[1]), float(c[2])), float(radius), float(intensity), mode)
+        return self.apply_samples([sample])
+
+    def brush(self, sample: BrushSample) -> Groom:
+        """One sample of a comb, smooth, length, puff or mask brush; it persists."""
+        return self.apply_samples([check_sample(sample)])
+
+    def apply_samples(self, samples: Sequence[Sample]) -> Groom:
+        """Samples of any brush (a stroke's, mirrored ones included), applied in order, then one
+        clumping: what a replayed stroke log does."""
         self._timings = dict.fromkeys(self._timings, 0.0)
         t0 = time.perf_counter()
-        self._aligned = align(self._aligned, c, radius, intensity, mode)
-        self._log.append(sample)
+        for sample in samples:
+            self._aligned = self._apply(self._aligned, sample)
+            self._log.append(sample)
         self._timings["align"] = (time.perf_counter() - t0) * 1e3
         self._reclump()
         return self._result
@@ -249,6 +282,7 @@ class FrozenPipeline:
     def reset_strokes(self) -> Groom:
         """Forget every stroke: back to the frozen groom (clumped)."""
         self._log = []
+        self._locked = np.zeros(self._rest.strand_count, dtype=bool)
         self._aligned = self._frozen
         self._timings = dict.fromkeys(self._timings, 0.0)
         self._reclump()
@@ -256,14 +290,22 @@ class FrozenPipeline:
 
     def snapshot(self) -> FrozenSnapshot:
         """Cheap state for undo/redo (no copies: grooms are immutable)."""
-        return FrozenSnapshot(tuple(self._log), self._aligned, self._freeze_key or (), self._draw)
+        return FrozenSnapshot(
+            tuple(self._log), self._aligned, self._freeze_key or (), self._draw, self._locked.copy()
+        )
 
     def restore(self, snapshot: FrozenSnapshot) -> Groom:
         """Back to a snapshot's strokes; replayed on the current frozen groom if it has changed."""
         self._log = list(snapshot.log)
         self._timings = dict.fromkeys(self._timings, 0.0)
-        if snapshot.freeze_key == self._freeze_key and snapshot.draw == self._draw:
+        if (
+            snapshot.freeze_key == self._freeze_key
+            and snapshot.draw == self._draw
+            and (snapshot.locked is not None or not any(isinstance(s, BrushSample) for s in snapshot.log))
+        ):
             self._aligned = snapshot.aligned
+            n = self._rest.strand_count
+            self._locked = np.zeros(n, bool) if snapshot.locked is None else snapshot.locked.copy()
         else:
             self._replay()
         self._reclump()
@@ -295,10 +337,25 @@ class FrozenPipeline:
         self._replay()
         self._timings["align"] = (time.perf_counter() - t1) * 1e3
 
+    def _apply(self, g: Groom, sample: Sample) -> Groom:
+        if isinstance(sample, AlignSample):
+            out = align(g, sample.cursor, sample.radius, sample.intensity, sample.mode)
+            if self._locked.any():  # masked strands are locked for the align brush too
+                keep = vertex_ids_of(g.topology, np.flatnonzero(self._locked))
+                pts = out.points.copy()
+                pts[keep] = g.points[keep]
+                out = g.with_points(pts)
+            return out
+        if sample.brush == "mask":
+            self._locked = paint_mask(g, sample, self._locked)
+            return g
+        return apply_brush(g, sample, self._locked, self.scalp_centre)
+
     def _replay(self) -> None:
         g = self._frozen
+        self._locked = np.zeros(self._rest.strand_count, dtype=bool)
         for s in self._log:
-            g = align(g, s.cursor, s.radius, s.intensity, s.mode)
+            g = self._apply(g, s)
         self._aligned = g
 
     def _reclump(self) -> None:

@@ -1,0 +1,336 @@
+"""Grooming brushes beside the paper's align: comb, smooth, length, puff and mask.
+
+Each brush sample acts on the vertices within its radius of the cursor, weighted by a falloff
+curve of the distance (smooth, linear, constant, or the artist's own curve), times its strength.
+Masked strands are locked for every brush. A sample may be mirrored across the plane x = m
+(X symmetry): the mirrored cursor and direction act as a second sample of the same stroke.
+
+- comb: the vertices move along the drag direction, more toward the tip (weight × arc-length
+  fraction), then every segment gets its length back root to tip: tips follow the drag, lengths
+  stay.
+- smooth: each inner vertex moves half way (at full weight) toward the mean of its neighbours (a
+  Laplacian step of 1/2, from the positions before the sample: larger steps flip zigzags instead
+  of flattening them), lengths restored: curvature falls, roots stay.
+- length: a strand's segments scale by 1 + strength·w, w the largest weight over its vertices:
+  strength > 0 grows, < 0 shrinks (cuts), as a fraction of the length, directions kept.
+- puff: a strand turns rigidly about its root so that its root direction moves toward the scalp
+  normal (outward from the sphere fitted to the roots) by strength·w at the root: tips lift
+  away from the scalp, lengths kept.
+- mask: strength > 0 locks the strands a sample touches, < 0 frees them.
+
+Every kernel has a numpy twin (``*_reference``) computing the same definition.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit, prange
+from numpy.typing import ArrayLike, NDArray
+
+from hairtool.errors import ParameterError
+from hairtool.groom import Groom
+
+F64 = NDArray[np.float64]
+
+BRUSHES = ("align", "comb", "smooth", "length", "puff", "mask")
+FALLOFFS = ("smooth", "linear", "constant")
+LUT_SIZE = 257  # samples of a falloff curve over [0, 1]: interpolated linearly between
+EPS = 1e-12
+
+
+def falloff_lut(falloff: str | Sequence[Sequence[float]]) -> F64:
+    """``(LUT_SIZE,)`` weights over t = distance / radius in [0, 1]: a preset name, or curve
+    points ``[[t, w], ...]`` (t increasing from 0 to 1, w in [0, 1]) joined by straight lines."""
+    t = np.linspace(0.0, 1.0, LUT_SIZE)
+    if isinstance(falloff, str):
+        if falloff == "smooth":
+            return 1.0 - t * t * (3.0 - 2.0 * t)  # smoothstep, 1 at the centre, 0 at the rim
+        if falloff == "linear":
+            return 1.0 - t
+        if falloff == "constant":
+            return np.ones_like(t)
+        raise ParameterError("falloff", falloff, f"one of {', '.join(FALLOFFS)} or a list of [t, w] points")
+    pts = np.asarray(falloff, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 2:
+        raise ParameterError("falloff", "curve", "at least two [t, w] points")
+    if not np.all(np.isfinite(pts)) or np.any(np.diff(pts[:, 0]) <= 0):
+        raise ParameterError("falloff", "curve", "finite points with t strictly increasing")
+    if pts[0, 0] != 0.0 or pts[-1, 0] != 1.0 or np.any((pts[:, 1] < 0) | (pts[:, 1] > 1)):
+        raise ParameterError("falloff", "curve", "t from 0 to 1 and weights in [0, 1]")
+    return np.interp(t, pts[:, 0], pts[:, 1])
+
+
+@dataclass(frozen=True)
+class BrushSample:
+    """One mouse move of one brush (groom units); ``lut`` from :func:`falloff_lut`."""
+
+    brush: str
+    cursor: tuple[float, float, float]
+    direction: tuple[float, float, float]
+    radius: float
+    strength: float
+    lut: tuple[float, ...]
+
+    def mirrored(self, plane_x: float) -> BrushSample:
+        c, d = self.cursor, self.direction
+        cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
+        return BrushSample(self.brush, cursor, direction, self.radius, self.strength, self.lut)
+
+
+def check_sample(sample: BrushSample) -> BrushSample:
+    if sample.brush not in BRUSHES or sample.brush == "align":
+        raise ParameterError("brush", sample.brush, "one of " + ", ".join(KINDS) + ", mask")
+    for name in ("cursor", "direction"):
+        v = np.asarray(getattr(sample, name), dtype=np.float64)
+        if v.shape != (3,) or not np.all(np.isfinite(v)):
+            raise ParameterError(name, getattr(sample, name), "three finite numbers")
+    if not np.isfinite(sample.radius) or sample.radius <= 0:
+        raise ParameterError("radius", sample.radius, "a positive finite distance")
+    low = -1.0 if sample.brush in ("length", "mask") else 0.0
+    if not np.isfinite(sample.strength) or not low <= sample.strength <= 1.0:
+        raise ParameterError("strength", sample.strength, f"a number in [{low:g}, 1]")
+    if len(sample.lut) != LUT_SIZE:
+        raise ParameterError("falloff", f"{len(sample.lut)} samples", f"{LUT_SIZE}")
+    return sample
+
+
+# -- shared pieces -----------------------------------------------------------------------------
+@njit(cache=True, nogil=True, inline="always")
+def _weight(px, py, pz, c, radius, lut):  # pragma: no cover - compiled
+    dx, dy, dz = px - c[0], py - c[1], pz - c[2]
+    t = np.sqrt(dx * dx + dy * dy + dz * dz) / radius
+    if t >= 1.0:
+        return 0.0
+    f = t * (lut.size - 1)
+    k = min(int(f), lut.size - 2)
+    a = f - k
+    return lut[k] * (1.0 - a) + lut[k + 1] * a
+
+
+def _weights_reference(p: F64, c: F64, radius: float, lut: F64) -> F64:
+    t = np.linalg.norm(p - c, axis=1) / radius
+    f = np.clip(t, 0.0, 1.0) * (lut.size - 1)
+    k = np.minimum(f.astype(np.int64), lut.size - 2)
+    a = f - k
+    return np.where(t < 1.0, lut[k] * (1.0 - a) + lut[k + 1] * a, 0.0)
+
+
+@njit(cache=True, nogil=True)
+def _restore_lengths(q, p, o, n):  # pragma: no cover - compiled
+    """q[o+1 .. o+n−1] pulled back, root to tip, to the segment lengths of p: each vertex at its
+    original distance from the (already restored) one before, in the direction q gives it (the
+    original direction where q collapses onto it)."""
+    for i in range(o + 1, o + n):
+        lx, ly, lz = p[i, 0] - p[i - 1, 0], p[i, 1] - p[i - 1, 1], p[i, 2] - p[i - 1, 2]
+        length = np.sqrt(lx * lx + ly * ly + lz * lz)
+        dx, dy, dz = q[i, 0] - q[i - 1, 0], q[i, 1] - q[i - 1, 1], q[i, 2] - q[i - 1, 2]
+        d = np.sqrt(dx * dx + dy * dy + dz * dz)
+        if d < EPS:
+            dx, dy, dz, d = lx, ly, lz, length
+        s = length / d if d >= EPS else 0.0
+        q[i, 0] = q[i - 1, 0] + dx * s
+        q[i, 1] = q[i - 1, 1] + dy * s
+        q[i, 2] = q[i - 1, 2] + dz * s
+
+
+def _restore_lengths_reference(q: F64, p: F64) -> F64:
+    out = q.copy()
+    for i in range(1, len(p)):
+        seg = p[i] - p[i - 1]
+        d = out[i] - out[i - 1]
+        if np.linalg.norm(d) < EPS:
+            d = seg
+        norm = np.linalg.norm(d)
+        out[i] = out[i - 1] + d * (np.linalg.norm(seg) / norm if norm >= EPS else 0.0)
+    return out
+
+
+# -- kernels -----------------------------------------------------------------------------------
+@njit(cache=True, nogil=True, parallel=True)
+def _brush_kernel(  # pragma: no cover - compiled
+    p, offsets, locked, kind, c, direction, radius, strength, lut, centre, out
+):
+    """kind: 0 comb, 1 smooth, 2 length, 3 puff; ``p`` and ``out`` float64 (V, 3)."""
+    for s in prange(offsets.size - 1):
+        o, e = offsets[s], offsets[s + 1]
+        n = e - o
+        for i in range(o, e):
+            out[i, 0], out[i, 1], out[i, 2] = p[i, 0], p[i, 1], p[i, 2]
+        if locked[s] or n < 2:
+            continue
+        if kind == 0 or kind == 1:
+            total = 0.0
+            for i in range(o + 1, e):
+                total += _dist(p, i, i - 1)
+            run = 0.0
+            moved = False
+            for i in range(o + 1, e):
+                run += _dist(p, i, i - 1)
+                w = _weight(p[i, 0], p[i, 1], p[i, 2], c, radius, lut) * strength
+                if w == 0.0:
+                    continue
+                moved = True
+                if kind == 0:
+                    u = run / total if total > EPS else 0.0
+                    for a in range(3):
+                        out[i, a] = p[i, a] + w * u * direction[a]
+                elif i < e - 1:
+                    for a in range(3):
+                        out[i, a] = p[i, a] + 0.5 * w * (0.5 * (p[i - 1, a] + p[i + 1, a]) - p[i, a])
+            if moved:
+                _restore_lengths(out, p, o, n)
+        elif kind == 2:
+            w = 0.0
+            for i in range(o, e):
+                w = max(w, _weight(p[i, 0], p[i, 1], p[i, 2], c, radius, lut))
+            factor = max(1.0 + strength * w, 0.0)
+            if w > 0.0:
+                for i in range(o + 1, e):
+                    for a in range(3):
+                        out[i, a] = out[i - 1, a] + factor * (p[i, a] - p[i - 1, a])
+        else:
+            w = _weight(p[o, 0], p[o, 1], p[o, 2], c, radius, lut) * strength
+            if w > 0.0:
+                _puff_strand(p, o, e, w, centre, out)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _dist(p, i, j):  # pragma: no cover - compiled
+    return np.sqrt((p[i, 0] - p[j, 0]) ** 2 + (p[i, 1] - p[j, 1]) ** 2 + (p[i, 2] - p[j, 2]) ** 2)
+
+
+@njit(cache=True, nogil=True)
+def _puff_strand(p, o, e, w, centre, out):  # pragma: no cover - compiled
+    """Turn the strand rigidly about its root: its first segment toward the outward normal by
+    the fraction w of the angle between them (Rodrigues' rotation)."""
+    nx, ny, nz = p[o, 0] - centre[0], p[o, 1] - centre[1], p[o, 2] - centre[2]
+    nn = np.sqrt(nx * nx + ny * ny + nz * nz)
+    tx, ty, tz = p[o + 1, 0] - p[o, 0], p[o + 1, 1] - p[o, 1], p[o + 1, 2] - p[o, 2]
+    tn = np.sqrt(tx * tx + ty * ty + tz * tz)
+    if nn < EPS or tn < EPS:
+        return
+    nx, ny, nz, tx, ty, tz = nx / nn, ny / nn, nz / nn, tx / tn, ty / tn, tz / tn
+    ax, ay, az = ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx
+    sin_a = np.sqrt(ax * ax + ay * ay + az * az)
+    cos_a = tx * nx + ty * ny + tz * nz
+    if sin_a < 1e-9:
+        return  # already along the normal (or exactly against it: no unique way to turn)
+    ax, ay, az = ax / sin_a, ay / sin_a, az / sin_a
+    angle = w * np.arctan2(sin_a, cos_a)
+    cs, sn = np.cos(angle), np.sin(angle)
+    for i in range(o + 1, e):
+        vx, vy, vz = p[i, 0] - p[o, 0], p[i, 1] - p[o, 1], p[i, 2] - p[o, 2]
+        dot = ax * vx + ay * vy + az * vz
+        cx, cy, cz = ay * vz - az * vy, az * vx - ax * vz, ax * vy - ay * vx
+        out[i, 0] = p[o, 0] + vx * cs + cx * sn + ax * dot * (1.0 - cs)
+        out[i, 1] = p[o, 1] + vy * cs + cy * sn + ay * dot * (1.0 - cs)
+        out[i, 2] = p[o, 2] + vz * cs + cz * sn + az * dot * (1.0 - cs)
+
+
+KINDS = {"comb": 0, "smooth": 1, "length": 2, "puff": 3}
+
+
+def scalp_centre(groom: Groom) -> F64:
+    """Centre of the sphere fitted to the roots (least squares, |x|² = 2c·x + k): the scalp's
+    outward normal at a root points away from it; the roots' centroid when they are coplanar."""
+    r = groom.roots.astype(np.float64)
+    a = np.column_stack([2.0 * r, np.ones(len(r))])
+    b = np.einsum("ij,ij->i", r, r)
+    sol, *_ = np.linalg.lstsq(a, b, rcond=None)
+    centre = sol[:3]
+    if len(r) < 4 or not np.all(np.isfinite(centre)) or np.linalg.matrix_rank(a) < 4:
+        centre = r.mean(axis=0) - np.array([0.0, 1.0, 0.0]) * float(np.ptp(r[:, 1]) + 1.0)
+    return centre
+
+
+def apply_brush(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike) -> Groom:
+    """One comb, smooth, length or puff sample (numba); ``locked``: ``(S,)`` masked strands."""
+    check_sample(sample)
+    out = np.empty((groom.vertex_count, 3))
+    _brush_kernel(
+        groom.points.astype(np.float64),
+        groom.offsets,
+        np.asarray(locked, dtype=np.bool_),
+        KINDS[sample.brush],
+        np.asarray(sample.cursor, np.float64),
+        np.asarray(sample.direction, np.float64),
+        float(sample.radius),
+        float(sample.strength),
+        np.asarray(sample.lut, np.float64),
+        np.asarray(centre, np.float64),
+        out,
+    )
+    return groom.with_points(out.astype(np.float32))
+
+
+def apply_brush_reference(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike) -> Groom:
+    """Numpy twin of :func:`apply_brush`, strand by strand from the definitions above."""
+    check_sample(sample)
+    p_all = groom.points.astype(np.float64)
+    out = p_all.copy()
+    c, d = np.asarray(sample.cursor, np.float64), np.asarray(sample.direction, np.float64)
+    lut = np.asarray(sample.lut, np.float64)
+    locked = np.asarray(locked, dtype=bool)
+    for s, (o, e) in enumerate(zip(groom.offsets[:-1], groom.offsets[1:], strict=True)):
+        p = p_all[o:e]
+        if locked[s] or len(p) < 2:
+            continue
+        w = _weights_reference(p, c, sample.radius, lut)
+        if sample.brush in ("comb", "smooth"):
+            q = p.copy()
+            wm = w * sample.strength
+            if not np.any(wm[1:] != 0):
+                continue
+            if sample.brush == "comb":
+                seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
+                u = np.concatenate([[0.0], np.cumsum(seg)]) / max(seg.sum(), EPS)
+                u = np.where(seg.sum() > EPS, u, 0.0)
+                q[1:] = p[1:] + (wm * u)[1:, None] * d
+            else:
+                q[1:-1] = p[1:-1] + 0.5 * wm[1:-1, None] * (0.5 * (p[:-2] + p[2:]) - p[1:-1])
+            out[o:e] = _restore_lengths_reference(q, p)
+        elif sample.brush == "length":
+            if w.max() > 0:
+                factor = max(1.0 + sample.strength * w.max(), 0.0)
+                for i in range(1, len(p)):
+                    out[o + i] = out[o + i - 1] + factor * (p[i] - p[i - 1])
+        else:
+            wr = w[0] * sample.strength
+            if wr > 0:
+                out[o:e] = _puff_reference(p, wr, np.asarray(centre, np.float64))
+    return groom.with_points(out.astype(np.float32))
+
+
+def _puff_reference(p: F64, w: float, centre: F64) -> F64:
+    n, t = p[0] - centre, p[1] - p[0]
+    if np.linalg.norm(n) < EPS or np.linalg.norm(t) < EPS:
+        return p
+    n, t = n / np.linalg.norm(n), t / np.linalg.norm(t)
+    axis = np.cross(t, n)
+    sin_a = np.linalg.norm(axis)
+    if sin_a < 1e-9:
+        return p
+    axis /= sin_a
+    angle = w * np.arctan2(sin_a, float(t @ n))
+    v = p - p[0]
+    rotated = (
+        v * np.cos(angle)
+        + np.cross(axis, v) * np.sin(angle)
+        + axis * (v @ axis)[:, None] * (1.0 - np.cos(angle))
+    )
+    return p[0] + rotated
+
+
+def paint_mask(groom: Groom, sample: BrushSample, locked: ArrayLike) -> np.ndarray:
+    """``(S,)`` the mask after one mask sample: strands with a vertex inside the brush are locked
+    (strength > 0) or freed (strength < 0)."""
+    check_sample(sample)
+    locked = np.array(locked, dtype=bool)
+    c, lut = np.asarray(sample.cursor, np.float64), np.asarray(sample.lut, np.float64)
+    w = _weights_reference(groom.points.astype(np.float64), c, sample.radius, lut)
+    touched = np.maximum.reduceat(w, groom.offsets[:-1]) > 0
+    locked[touched] = sample.strength > 0
+    return locked

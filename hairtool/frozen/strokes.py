@@ -1,0 +1,231 @@
+"""Stroke logs as files: an artist's strokes, replayed by a pipeline on a new version of a groom.
+
+A stroke log is a JSON list of strokes, in groom units::
+
+    [{"brush": "comb", "falloff": "smooth", "symmetry": "x", "mirror_x": 0.0,
+      "params": {}, "samples": [{"cursor": [x, y, z], "direction": [dx, dy, dz],
+                                 "radius": r, "strength": s}, ...]}, ...]
+
+- ``brush``: ``align`` (the paper's UserAlign; ``params.mode`` "paper" or "preserve-length",
+  ``strength`` its intensity, no direction needed), ``comb``, ``smooth``, ``length`` (a signed
+  strength: > 0 grows, < 0 shrinks, as a fraction of the strand's length at the brush centre),
+  ``puff`` or ``mask`` (> 0 locks the strands touched, < 0 frees them). ``clump`` is reserved.
+- ``falloff``: ``smooth``, ``linear``, ``constant``, or a curve ``[[t, w], ...]`` over t =
+  distance / radius from 0 to 1 (align keeps the paper's own weighting and ignores it).
+- ``symmetry``: ``"x"`` mirrors every sample across the plane x = ``mirror_x`` (default: the
+  centre of the sphere fitted to the roots), into the same stroke; null for none.
+
+Fields a reader does not know are ignored and missing optional ones take their defaults, so
+logs written by older and newer versions stay readable.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from hairtool.errors import FormatError, ParameterError
+from hairtool.frozen.align import MODES
+from hairtool.frozen.brushes import BRUSHES, BrushSample, check_sample, falloff_lut
+from hairtool.frozen.pipeline import AlignSample
+from hairtool.io.atomic import atomic_open
+
+MAX_LOG_BYTES = 256 * 1024**2
+
+
+@dataclass(frozen=True)
+class StrokeSample:
+    cursor: tuple[float, float, float]
+    radius: float
+    strength: float
+    direction: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Stroke:
+    """One press-drag-release of one brush."""
+
+    brush: str
+    samples: tuple[StrokeSample, ...]
+    falloff: str | tuple[tuple[float, float], ...] = "smooth"
+    symmetry: str | None = None
+    mirror_x: float | None = None
+    params: dict = field(default_factory=dict)
+
+    def validate(self) -> Stroke:
+        if self.brush not in BRUSHES:
+            raise ParameterError("brush", self.brush, " ".join(BRUSHES))
+        if self.symmetry not in (None, "x"):
+            raise ParameterError("symmetry", self.symmetry, '"x" or null')
+        if self.mirror_x is not None and not math.isfinite(self.mirror_x):
+            raise ParameterError("mirror_x", self.mirror_x, "a finite x")
+        falloff_lut(self.falloff)
+        if self.brush == "align" and self.params.get("mode", "paper") not in MODES:
+            raise ParameterError("mode", self.params.get("mode"), " or ".join(MODES))
+        return self
+
+    def pipeline_samples(self, default_mirror_x: float) -> list[AlignSample | BrushSample]:
+        """The samples a pipeline applies, mirrored ones right after their originals."""
+        self.validate()
+        out: list[AlignSample | BrushSample] = []
+        mirror = self.mirror_x if self.mirror_x is not None else default_mirror_x
+        lut = tuple(falloff_lut(self.falloff).tolist())
+        for s in self.samples:
+            if self.brush == "align":
+                mode = self.params.get("mode", "paper")
+                first = AlignSample(s.cursor, s.radius, s.strength, mode)
+                out.append(first)
+                if self.symmetry == "x":
+                    out.append(first._replace(cursor=(2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])))
+                continue
+            sample = check_sample(BrushSample(self.brush, s.cursor, s.direction, s.radius, s.strength, lut))
+            out.append(sample)
+            if self.symmetry == "x":
+                out.append(sample.mirrored(mirror))
+        return out
+
+    def to_dict(self) -> dict:
+        falloff = self.falloff if isinstance(self.falloff, str) else [list(p) for p in self.falloff]
+        return {
+            "brush": self.brush,
+            "falloff": falloff,
+            "symmetry": self.symmetry,
+            "mirror_x": self.mirror_x,
+            "params": dict(self.params),
+            "samples": [
+                {
+                    "cursor": list(s.cursor),
+                    "direction": list(s.direction),
+                    "radius": s.radius,
+                    "strength": s.strength,
+                }
+                for s in self.samples
+            ],
+        }
+
+
+def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
+    """A pipeline's log as strokes that replay to the same bytes: runs of samples of one brush
+    and falloff become one stroke, mirrored samples stay explicit (no symmetry flag)."""
+    runs: list[tuple[tuple, Stroke]] = []
+    for s in log:
+        if isinstance(s, AlignSample):
+            key: tuple = ("align", s.mode)
+            sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity)
+            start = Stroke("align", (sample,), params={"mode": s.mode})
+        else:
+            key = (s.brush, s.lut)
+            sample = StrokeSample(tuple(s.cursor), s.radius, s.strength, tuple(s.direction))
+            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut))
+        if runs and runs[-1][0] == key:
+            last = runs[-1][1]
+            runs[-1] = (key, Stroke(last.brush, (*last.samples, sample), last.falloff, params=last.params))
+        else:
+            runs.append((key, start))
+    return [stroke for _, stroke in runs]
+
+
+def _falloff_of(lut: Sequence[float]) -> str | tuple[tuple[float, float], ...]:
+    """A preset's name when the table is one, else the table as curve points."""
+    for name in ("smooth", "linear", "constant"):
+        if tuple(falloff_lut(name).tolist()) == tuple(lut):
+            return name
+    t = np.linspace(0.0, 1.0, len(lut))
+    return tuple((float(a), float(b)) for a, b in zip(t, lut, strict=True))
+
+
+def _vector(where: str, value: Any, default: tuple | None = None) -> tuple[float, float, float]:
+    if value is None and default is not None:
+        return default
+    if not isinstance(value, list) or len(value) != 3:
+        raise ParameterError(where, value, "three numbers [x, y, z]")
+    v = tuple(_number(where, c) for c in value)
+    return v  # type: ignore[return-value]
+
+
+def _number(where: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ParameterError(where, value, "a finite number")
+    return float(value)
+
+
+def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
+    """A :class:`Stroke` from its JSON form; ParameterError naming the field on anything wrong."""
+    if not isinstance(d, dict):
+        raise ParameterError(where, type(d).__name__, "an object with brush and samples")
+    raw_samples = d.get("samples")
+    if not isinstance(raw_samples, list):
+        raise ParameterError(f"{where}.samples", raw_samples, "a list of samples")
+    samples = []
+    for i, s in enumerate(raw_samples):
+        at = f"{where}.samples[{i}]"
+        if not isinstance(s, dict):
+            raise ParameterError(at, type(s).__name__, "an object with cursor, radius and strength")
+        samples.append(
+            StrokeSample(
+                _vector(f"{at}.cursor", s.get("cursor")),
+                _number(f"{at}.radius", s.get("radius")),
+                _number(f"{at}.strength", s.get("strength")),
+                _vector(f"{at}.direction", s.get("direction"), (0.0, 0.0, 0.0)),
+            )
+        )
+    falloff = d.get("falloff", "smooth")
+    if isinstance(falloff, list):
+        falloff = tuple(
+            tuple(_number(f"{where}.falloff", v) for v in p) if isinstance(p, list) else p for p in falloff
+        )
+    params = d.get("params") or {}
+    if not isinstance(params, dict):
+        raise ParameterError(f"{where}.params", params, "an object")
+    mirror = d.get("mirror_x")
+    stroke = Stroke(
+        brush=d.get("brush"),
+        samples=tuple(samples),
+        falloff=falloff,
+        symmetry=d.get("symmetry"),
+        mirror_x=None if mirror is None else _number(f"{where}.mirror_x", mirror),
+        params=params,
+    )
+    try:
+        stroke.pipeline_samples(0.0)  # every sample checked (radius, strength range) as it will run
+        return stroke
+    except ParameterError as e:
+        raise ParameterError(f"{where}.{e.name}", e.value, str(e).split("expected ", 1)[-1]) from None
+
+
+def read_strokes(path: str | os.PathLike[str]) -> list[Stroke]:
+    """A stroke log file; :class:`FormatError` naming the file and the bad entry."""
+    p = Path(path)
+    try:
+        if p.stat().st_size > MAX_LOG_BYTES:
+            raise FormatError(p, f"larger than {MAX_LOG_BYTES >> 20} MB: not a stroke log")
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except FormatError:
+        raise
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as e:
+        raise FormatError(p, f"not a readable stroke log ({type(e).__name__}: {e})") from None
+    if isinstance(data, dict) and isinstance(data.get("strokes"), list):
+        data = data["strokes"]
+    if not isinstance(data, list):
+        raise FormatError(p, "a stroke log is a JSON list of strokes")
+    try:
+        return [stroke_from_dict(s, f"strokes[{i}]") for i, s in enumerate(data)]
+    except ParameterError as e:
+        raise FormatError(p, str(e)) from None
+
+
+def write_strokes(path: str | os.PathLike[str], strokes: Sequence[Stroke]) -> None:
+    """Write a stroke log (atomically)."""
+    try:
+        with atomic_open(path, "w", encoding="utf-8") as f:
+            json.dump([s.to_dict() for s in strokes], f, indent=1, allow_nan=False)
+            f.write("\n")
+    except (OSError, ValueError) as e:
+        raise FormatError(path, f"cannot write the strokes: {e}") from None
