@@ -355,6 +355,7 @@ class MainWindow(QMainWindow):
         It opens untitled, so Save asks where to write instead of touching the shipped file.
         """
         from app import resources
+        from hairtool.guides.binding import bind_scalp
         from hairtool.io.obj import read_mesh
 
         try:
@@ -365,6 +366,11 @@ class MainWindow(QMainWindow):
             return False
         self.set_groom(groom)
         self.scene.set_mesh(mesh)
+        # Sintel's hair as guides with interpolated render hair, shaded as hair.
+        self.scene.set_binding(
+            bind_scalp(groom, mesh, resources.SINTEL_CHILDREN, seed=resources.SINTEL_CHILD_SEED)
+        )
+        self.scene.set_colour_mode("hair")
         self.viewport.frame_all()
         return True
 
