@@ -96,7 +96,12 @@ def shade(
 
 
 def shade_reference(
-    points: NDArray, offsets: NDArray, base: NDArray, light: NDArray, eye: NDArray, look: HairLook = DEFAULT_LOOK
+    points: NDArray,
+    offsets: NDArray,
+    base: NDArray,
+    light: NDArray,
+    eye: NDArray,
+    look: HairLook = DEFAULT_LOOK,
 ) -> NDArray[np.float32]:
     """Numpy twin of :func:`shade`: tangents by whole-array differences within each strand."""
     p = np.asarray(points, np.float64)
@@ -111,5 +116,8 @@ def shade_reference(
     th = t @ _half(light, eye)
     diffuse = np.sqrt(np.maximum(1.0 - tl * tl, 0.0))
     spec = np.maximum(1.0 - th * th, 0.0) ** (0.5 * look.exponent)
-    c = np.asarray(base, np.float64) * (look.ambient + look.diffuse * diffuse)[:, None] + look.specular * spec[:, None]
+    c = (
+        np.asarray(base, np.float64) * (look.ambient + look.diffuse * diffuse)[:, None]
+        + look.specular * spec[:, None]
+    )
     return np.clip(c, 0.0, 1.0).astype(np.float32)

@@ -457,7 +457,9 @@ class StrandRenderer:
             return
         base = self._base_colors if self.use_vertex_colors else self._ramp_vertex_colors()
         light, eye = light_and_eye(right, up, forward)
-        self._gpu.write_colors(shade(self._main.points, self.topology.offsets, base, light, eye, self.hair_look))
+        self._gpu.write_colors(
+            shade(self._main.points, self.topology.offsets, base, light, eye, self.hair_look)
+        )
         self._shade_key = key
 
     def _draw(self, method: str, points: PointSet, ghost: bool) -> None:

@@ -36,7 +36,7 @@ def vertex_colors(scene: Scene) -> np.ndarray | None:
         ids = np.asarray(scene.pipeline.clump_ids())
         if scene.has_children:  # each child in its nearest guide's clump
             b = scene.drawn_binding()
-            ids = np.concatenate([ids[b.guide_ids[:, 0]], ids[: guides]])
+            ids = np.concatenate([ids[b.guide_ids[:, 0]], ids[:guides]])
         colors = strand_to_vertex_colors(categorical_colors(ids), top)
     elif mode == "displacement":
         d = scene.displacement()

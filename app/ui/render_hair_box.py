@@ -38,7 +38,9 @@ class RenderHairBox(QGroupBox):
     def refresh(self) -> None:
         s = self.scene
         b = s.binding
-        self.children_label.setText("none" if b is None else f"{b.child_count:,} from {s.rest.strand_count:,} guides")
+        self.children_label.setText(
+            "none" if b is None else f"{b.child_count:,} from {s.rest.strand_count:,} guides"
+        )
         for w in (self.show_guides, self.drag_percent, self.release_percent):
             w.setEnabled(b is not None)
         with signals_blocked(self.show_guides, self.drag_percent, self.release_percent):
