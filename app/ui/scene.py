@@ -260,6 +260,16 @@ class Scene(QObject):
         """Every child at the guides' current shapes (full density), or None without children."""
         return None if self.binding is None else self.binding.build(self.result)
 
+    def export_groom(self) -> Groom:
+        """What a save or export writes: the edited groom, or with children the render hair
+        (tapered widths) and the guides as a second prim of purpose "guide"."""
+        hair = self.render_hair()
+        if hair is None:
+            return self.result
+        from hairtool.guides.files import with_guides
+
+        return with_guides(hair, self.result, self.rest.metadata)
+
     # -- engine parameters ---------------------------------------------------------------
     @property
     def params(self) -> FrozenParams:

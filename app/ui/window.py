@@ -418,7 +418,7 @@ class MainWindow(QMainWindow):
 
     def _write_groom(self, path: str | os.PathLike[str], *, adopt: bool) -> bool:
         try:
-            io.write(path, self.scene.result)
+            io.write(path, self.scene.export_groom())
         except HairtoolError as e:
             self.show_error("Cannot write file", str(e))
             return False
