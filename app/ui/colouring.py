@@ -29,7 +29,8 @@ def vertex_colors(scene: Scene) -> np.ndarray | None:
     if mode in ("root-to-tip", "hair"):
         if not guides:
             return None
-        colors = sample_linear(ramp_texture(scene.ramp, RAMP_TEXELS), top.vertex_param)  # as the renderer
+        colors = scene.cached(("ramp", scene.ramp), lambda: _guides_over_ramp(scene, top, guides))
+        return colors
     elif mode == "strand":
         colors = strand_to_vertex_colors(per_strand_random_colors(top.strand_count, STRAND_COLOUR_SEED), top)
     elif mode == "clump":
@@ -49,4 +50,11 @@ def vertex_colors(scene: Scene) -> np.ndarray | None:
     if guides:
         colors = np.array(colors, np.float32)
         colors[top.offsets[top.strand_count - guides] :] = GUIDE_RGB
+    return colors
+
+
+def _guides_over_ramp(scene: Scene, top, guides: int) -> np.ndarray:
+    """The ramp over t, sampled as the renderer samples it, with the guides in their colour."""
+    colors = sample_linear(ramp_texture(scene.ramp, RAMP_TEXELS), top.vertex_param)
+    colors[top.offsets[top.strand_count - guides] :] = GUIDE_RGB
     return colors

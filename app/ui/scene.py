@@ -54,6 +54,7 @@ class Scene(QObject):
         self.release_percent = RELEASE_PERCENT
         self.dragging = False
         self._subsets: dict[float, ChildBinding] = {}
+        self._cache: dict = {}  # per drawn density: its topology and colours (see cached)
         self._child_out: np.ndarray | None = None
         self._rest_drawn: np.ndarray | None = None
         self.last_children_ms = 0.0
@@ -79,6 +80,7 @@ class Scene(QObject):
         self.radius = 0.25 * extent if extent > 0 else 1.0
         self.binding = None
         self._subsets = {}
+        self._cache = {}
         self._rebuild_drawn()
 
     def load(self, groom: Groom, path: str | Path | None = None, params: FrozenParams | None = None) -> None:
@@ -143,6 +145,7 @@ class Scene(QObject):
             )
         self.binding = binding
         self._subsets = {}
+        self._cache = {}
         self._child_out = None
         self._rebuild_drawn()
         self.drawn_changed.emit()
@@ -201,6 +204,14 @@ class Scene(QObject):
             sub = self._subsets[p] = b.subset(ids)
         return sub
 
+    def cached(self, key: tuple, make):
+        """``make()`` once per drawn density and ``key`` (e.g. the ramp colours of 3 million
+        vertices), forgotten when the groom or its children change."""
+        full = (self.display_percent, self.show_guides, *key)
+        if full not in self._cache:
+            self._cache[full] = make()
+        return self._cache[full]
+
     def _children_points(self) -> np.ndarray:
         from hairtool.guides.children import build_points
 
@@ -223,8 +234,10 @@ class Scene(QObject):
         self._rest_drawn = None
         children = self._children_points()
         if self.show_guides:
-            counts = np.concatenate([b.counts, self.result.counts])
-            self.drawn_topology = Topology(counts)
+            key = (self.display_percent, "guides")
+            if key not in self._cache:  # one topology per density, so what hangs on it is kept
+                self._cache[key] = Topology(np.concatenate([b.counts, self.result.counts]))
+            self.drawn_topology = self._cache[key]
             self.drawn_points = np.concatenate([children, self.result.points])
             self.drawn_guides = self.result.strand_count
         else:
