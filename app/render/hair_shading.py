@@ -23,6 +23,7 @@ from numba import njit, prange
 from numpy.typing import NDArray
 
 LIGHT_IN_VIEW = (-0.35, 0.6, 0.72)  # toward the key light: (right, up, toward the viewer)
+HAIR_TAPER = 0.75  # shaded hair narrows to a quarter of its width at the tip (StrandRenderer.taper)
 
 
 @dataclass(frozen=True)

@@ -133,6 +133,8 @@ class StrandRenderer:
         # Hair shading (app.render.hair_shading): the base colours (vertex colours or the ramp)
         # lit from the strand direction per vertex, redone when points, colours or view change.
         self.hair_shading = False
+        self.taper = 0.0  # width at the tip = (1 − taper) × at the root (per segment, at its middle t)
+        self._taper_scale: tuple[float, NDArray[np.float64]] | None = None
         self.hair_look: HairLook = DEFAULT_LOOK
         self._base_colors: NDArray[np.float32] | None = None
         self._version = 0  # bumped by every change of points or base colours
@@ -402,6 +404,7 @@ class StrandRenderer:
             ("u_viewport", (float(size[0]), float(size[1]))),
             ("u_width", width),
             ("u_use_vertex_color", self.vertex_coloured),
+            ("u_taper", self._checked_taper()),
             ("u_ramp", 0),
             ("u_points", 1),
             ("u_colors", 2),
@@ -416,9 +419,32 @@ class StrandRenderer:
             self.raster = RasterLayer(self.ctx)
         points, colors, starts = self._main.cpu_points(), self.cpu_colors(), self._segment_starts
         mesh = self.mesh.vao is not None
+        scale = self.segment_width_scale() if width > 1.0 else None
         self.raster.render(
-            fbo, samples, points, starts, colors, mvp, size, width, background=background, read_depth=mesh
-        )
+            fbo, samples, points, starts, colors, mvp, size, width, background=background, read_depth=mesh,
+            scale=scale,
+        )  # fmt: skip
+
+    def _checked_taper(self) -> float:
+        t = float(self.taper)
+        if not 0.0 <= t < 1.0:
+            raise ParameterError(
+                "taper", self.taper, "a number in [0, 1): the share of the width lost at the tip"
+            )
+        return t
+
+    def segment_width_scale(self) -> NDArray[np.float64] | None:
+        """Per segment, its width factor 1 − taper·(t_a + t_b)/2 (as the shaders compute it from
+        the vertex parameter t in float32), or None without a taper."""
+        taper = self._checked_taper()
+        if taper == 0.0 or self._gpu is None:
+            return None
+        if self._taper_scale is None or self._taper_scale[0] != taper:
+            t, s = self._gpu.param, self._segment_starts
+            mid = (np.float32(0.5) * (t[s] + t[s + 1])).astype(np.float32)
+            scale = (np.float32(1.0) - np.float32(taper) * mid).astype(np.float64)
+            self._taper_scale = (taper, np.clip(scale, 0.0, 1.0))
+        return self._taper_scale[1]
 
     def cpu_colors(self) -> NDArray[np.float32]:
         """``(V, 3)`` the colour of every vertex as the GL draws give it: the vertex colours, or
@@ -504,6 +530,7 @@ class StrandRenderer:
         self.bounds = None
         self.use_vertex_colors = False
         self._segment_starts = self._ramp_colors = self._base_colors = None
+        self._taper_scale = None
         self._shade_key = None
 
     def release(self) -> None:

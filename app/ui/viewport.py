@@ -25,6 +25,7 @@ from PySide6.QtGui import QMouseEvent, QWheelEvent
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 
 from app.render.camera import Camera
+from app.render.hair_shading import HAIR_TAPER
 from app.render.strands import StrandRenderer
 from app.ui.colouring import vertex_colors
 from app.ui.scene import Scene
@@ -191,6 +192,7 @@ class Viewport(QOpenGLWidget):
             r.set_ramp(s.ramp)
             r.line_width = s.line_width
             r.set_hair_shading(s.colour_mode == "hair")
+            r.taper = HAIR_TAPER if s.colour_mode == "hair" else 0.0  # hair narrows root to tip
         if "colors" in dirty:
             own = shown and self.frame_colors is not None and not children
             r.set_vertex_colors(self.frame_colors if own else vertex_colors(s))

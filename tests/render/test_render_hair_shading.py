@@ -10,6 +10,7 @@ from app.render.camera import Camera
 from app.render.hair_shading import HairLook, light_and_eye, shade, shade_reference
 from app.render.ramps import ramp_colors
 from hairtool import samples
+from hairtool.errors import ParameterError
 
 SIZE = (200, 150)
 
@@ -59,8 +60,11 @@ def test_the_light_turns_with_the_camera():
     assert np.abs(after - before).max() > 0.1
 
 
-@pytest.mark.parametrize("width", [1.0, 2.0])
-def test_shaded_gl_and_cpu_pictures_agree(renderer, gl_ctx, width):
+@pytest.mark.parametrize(
+    ("width", "taper", "wide"),
+    [(1.0, 0.0, "geometry"), (2.0, 0.0, "geometry"), (3.0, 0.75, "geometry"), (3.0, 0.75, "quads")],
+)
+def test_shaded_gl_and_cpu_pictures_agree(renderer, gl_ctx, width, taper, wide):
     """Both draws interpolate the same per-vertex shade, so the pictures agree to within the
     rasterizers' own difference (stated: the pixels either draw lie within one pixel of the
     other's, and 98 % of those both draw are within 3 levels of 255 of each other)."""
@@ -68,6 +72,7 @@ def test_shaded_gl_and_cpu_pictures_agree(renderer, gl_ctx, width):
     renderer.set_groom(g)
     renderer.background = (0.0, 0.0, 0.0, 1.0)
     renderer.line_width = width
+    renderer.taper, renderer.wide_lines = taper, wide
     renderer.set_hair_shading(True)
     pictures = {}
     for raster in ("gl", "cpu"):
@@ -96,3 +101,30 @@ def test_shaded_gl_and_cpu_pictures_agree(renderer, gl_ctx, width):
     finally:
         fbo.release()
     assert np.abs(flat.astype(int) - cpu).max(axis=2)[lit].mean() > 10
+
+
+def test_a_tapered_width_narrows_strands_to_the_tip_and_the_kernel_equals_its_reference(renderer, gl_ctx):
+    from app.render.soft_raster import rasterize, rasterize_reference
+
+    g, _base, cam, _l, _e = _inputs(seed=2)
+    renderer.set_groom(g)
+    renderer.taper = 0.75
+    scale = renderer.segment_width_scale()
+    starts = g.topology.segment_end - 1
+    t = g.topology.vertex_param
+    np.testing.assert_allclose(scale, 1.0 - 0.75 * 0.5 * (t[starts] + t[starts + 1]), atol=1e-6)
+    mvp = (cam.view_matrix() @ cam.projection_matrix(SIZE[0] / SIZE[1])).astype(np.float32)
+    colors = np.ones((g.vertex_count, 3), np.float32)
+    got = rasterize(g.points, starts, colors, mvp, SIZE, 6.0, scale=scale)
+    want = rasterize_reference(g.points, starts, colors, mvp, SIZE, 6.0, scale=scale)
+    np.testing.assert_array_equal(got[0], want[0])
+    np.testing.assert_array_equal(got[1], want[1])
+    full = rasterize(g.points, starts, colors, mvp, SIZE, 6.0)[0][..., 0] > 0
+    assert (got[0][..., 0] > 0).sum() < 0.8 * full.sum()  # narrower overall
+    # the tip end of a strand covers fewer pixels than its root end
+    root = rasterize(g.points, starts[::11], colors, mvp, SIZE, 6.0, scale=scale[::11])[0][..., 0] > 0
+    tip = rasterize(g.points, starts[10::11], colors, mvp, SIZE, 6.0, scale=scale[10::11])[0][..., 0] > 0
+    assert tip.sum() < root.sum()
+    renderer.taper = 1.0
+    with pytest.raises(ParameterError, match="taper"):
+        renderer.segment_width_scale()
