@@ -71,6 +71,7 @@ class MainWindow(QMainWindow):
         self.viewport.frame_drawn.connect(self._update_frame_time)
         self.dock.param_edited.connect(self._on_param_edited)
         self.scene.groom_loaded.connect(self._update_counts)
+        self.scene.drawn_changed.connect(self._update_counts)
         self.scene.path_changed.connect(self._update_title)
         self.undo_stack.cleanChanged.connect(self._update_title)
         self._update_counts()
@@ -297,8 +298,11 @@ class MainWindow(QMainWindow):
         bar.addPermanentWidget(self.job_status)
 
     def _update_counts(self) -> None:
-        g = self.scene.result
-        self.counts_label.setText(f"{g.strand_count:,} strands · {g.vertex_count:,} vertices")
+        g, b = self.scene.result, self.scene.binding
+        text = f"{g.strand_count:,} strands · {g.vertex_count:,} vertices"
+        if b is not None:
+            text = f"{g.strand_count:,} guides · {b.child_count:,} children · {b.vertex_count:,} vertices"
+        self.counts_label.setText(text)
 
     def _update_frame_time(self) -> None:
         v, s = self.viewport, self.scene

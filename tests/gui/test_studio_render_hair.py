@@ -38,6 +38,7 @@ def test_children_follow_a_drag_at_the_drag_percentage_and_come_back_in_full_on_
     b = s.binding
     ui.grab(v)
     assert v.renderer.topology.strand_count == 2000 + 60  # children, then the guides
+    assert "60 guides · 2,000 children" in w.counts_label.text()
     s.set_radius(0.35 * float(np.max(s.rest.bounds[1] - s.rest.bounds[0])))
     before = s.result
     rest_children = b.build(before).points
