@@ -26,6 +26,7 @@ DEFAULT_METERS_PER_UNIT = 0.01
 #: ``"linear"`` or the cubic basis of USD's BasisCurves.
 BASES = ("linear", "bezier", "bspline", "catmullRom")
 WRAPS = ("nonperiodic", "periodic", "pinned")
+PURPOSES = ("default", "render", "proxy", "guide")  # UsdGeom's purpose tokens
 
 
 def _positive(name: str, value: float | None) -> float | None:
@@ -56,6 +57,7 @@ class CurvesPrim:
     strands: int
     basis: str = "linear"
     wrap: str = "nonperiodic"
+    purpose: str = "default"  # USD's purpose: "guide" marks guide curves beside the render hair
 
     def __post_init__(self) -> None:
         if not isinstance(self.path, str) or not self.path.startswith("/") or len(self.path) < 2:
@@ -66,6 +68,8 @@ class CurvesPrim:
             raise ParameterError("basis", self.basis, f"one of {', '.join(BASES)}")
         if self.wrap not in WRAPS:
             raise ParameterError("wrap", self.wrap, f"one of {', '.join(WRAPS)}")
+        if self.purpose not in PURPOSES:
+            raise ParameterError("purpose", self.purpose, f"one of {', '.join(PURPOSES)}")
 
     @property
     def description(self) -> str:

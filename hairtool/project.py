@@ -3,9 +3,11 @@
 The file (``.hairproj``) is a zip archive: ``manifest.json`` (format, version, engine
 parameters, brush, display, key and other settings, and the list of array members) and one
 ``.npy`` member per array (rest groom, stroke log, the aligned state of the stroke snapshot,
-the animation's frames). A zip keeps the manifest readable with any tool, the arrays exact
-(float32/float64 bit for bit), lets a reader check every member's size and checksum before
-it trusts it, and loads with ``allow_pickle=False``.
+the animation's frames, and for render hair the child definition: roots, guides and weights,
+length scales and offsets of :class:`~hairtool.guides.binding.ChildBinding`, never the
+children's points, since they are rebuilt from the guides). A zip keeps the manifest readable
+with any tool, the arrays exact (float32/float64 bit for bit), lets a reader check every
+member's size and checksum before it trusts it, and loads with ``allow_pickle=False``.
 
 Saving writes a temporary file beside the target and renames it, so an interrupted save never
 harms the previous project. Loading checks everything and raises one
@@ -36,6 +38,7 @@ from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterErr
 from hairtool.frozen.brushes import BRUSHES, LUT_SIZE, BrushSample, check_sample
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.groom import Animation, Groom
+from hairtool.guides.binding import ChildBinding
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
 from hairtool.io.npz import read_npy_header
@@ -89,6 +92,7 @@ class Project:
     key_settings: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)
     groom_source: str | None = None
+    children: ChildBinding | None = None  # render hair interpolated from ``rest`` (the guides)
 
     @classmethod
     def from_pipeline(cls, pipeline: FrozenPipeline, **fields: Any) -> Project:
@@ -177,8 +181,40 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
         manifest["animation"] = None
     for name in ("brush", "display", "key_settings", "settings"):
         manifest[name] = _json_object(name, getattr(project, name))
+    manifest["children"] = _children_arrays(project, arrays)
     manifest["arrays"] = sorted(arrays)
     return manifest, arrays
+
+
+# The child definition's arrays: (name, per vertex or per child, trailing shape, kinds, required).
+_CHILD_ARRAYS = (
+    ("counts", "child", (), "iu", True),
+    ("roots", "child", (3,), "f", True),
+    ("guide_ids", "child", (-1,), "iu", True),
+    ("weights", "child", (-1,), "f", True),
+    ("scale", "child", (), "f", True),
+    ("local", "vertex", (3,), "f", False),
+    ("faces", "child", (), "iu", False),
+    ("exact_points", "vertex", (3,), "f", False),
+    ("exact_blend", "vertex", (3,), "f", False),
+)
+
+
+def _children_arrays(project: Project, arrays: dict[str, np.ndarray]) -> dict | None:
+    b = project.children
+    if b is None:
+        return None
+    if b.rest_guides.topology != project.rest.topology or not np.array_equal(
+        b.rest_guides.points, project.rest.points
+    ):
+        raise GroomError("the children must be bound to the project's rest groom (their guides)")
+    stored = []
+    for name, *_ in _CHILD_ARRAYS:
+        value = getattr(b, name)
+        if value is not None:
+            arrays[f"children/{name}.npy"] = np.ascontiguousarray(value)
+            stored.append(name)
+    return {"count": b.child_count, "arrays": stored}
 
 
 def save(path: str | os.PathLike[str], project: Project, *, compress: bool = False) -> None:
@@ -410,6 +446,52 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
     return strokes, aligned
 
 
+def _read_children(r: _Reader, info: Any, rest: Groom) -> ChildBinding | None:
+    """The child definition, every array checked against the others and the guides."""
+    if info is None:
+        return None
+    stored = info.get("arrays") if isinstance(info, dict) else None
+    if not isinstance(stored, list) or not set(stored) <= {a[0] for a in _CHILD_ARRAYS}:
+        raise FormatError(r.path, "manifest.json: bad 'children' section")
+    raw_counts = r.array("children/counts.npy", 1, "iu")
+    v = require_strand_counts(r.path, raw_counts)
+    n = len(raw_counts)
+    values: dict[str, np.ndarray | None] = {"counts": raw_counts.astype(np.int64)}
+    k = None
+    for name, per, tail, kinds, required in _CHILD_ARRAYS[1:]:
+        if name not in stored:
+            if required:
+                raise FormatError(r.path, f"missing member 'children/{name}.npy'")
+            values[name] = None
+            continue
+        a = r.array(f"children/{name}.npy", 1 + len(tail), kinds)
+        if tail == (-1,):
+            k = a.shape[1] if k is None else k
+            tail = (k,)
+        want = ((n if per == "child" else v), *tail)
+        if a.shape != want or (tail and tail[0] == 0):
+            raise FormatError(r.path, f"children {name} has shape {a.shape}, expected {want}")
+        if kinds == "f":
+            require_finite(r.path, a, f"children {name}")
+        values[name] = a
+    ids = values["guide_ids"]
+    if ids.size and (ids.min() < 0 or ids.max() >= rest.strand_count):
+        raise FormatError(r.path, f"a child names a guide outside [0, {rest.strand_count})")
+    faces = values["faces"]
+    return ChildBinding(
+        rest,
+        values["counts"],
+        values["roots"].astype(np.float64),
+        ids.astype(np.int64),
+        values["weights"].astype(np.float64),
+        values["scale"].astype(np.float64),
+        None if values["local"] is None else values["local"].astype(np.float32),
+        None if faces is None else faces.astype(np.int64),
+        None if values["exact_points"] is None else values["exact_points"].astype(np.float32),
+        None if values["exact_blend"] is None else values["exact_blend"].astype(np.float64),
+    )
+
+
 def _build(r: _Reader) -> Project:
     manifest = r.manifest()
     path = r.path
@@ -443,6 +525,7 @@ def _build(r: _Reader) -> Project:
         key_settings=_section(path, manifest, "key_settings", dict),
         settings=_section(path, manifest, "settings", dict),
         groom_source=source if isinstance(source, str) else None,
+        children=_read_children(r, manifest.get("children"), rest),
     )
 
 

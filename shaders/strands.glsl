@@ -17,9 +17,11 @@ in float in_t;
 in vec3 in_color;
 
 out vec3 v_color;
+out float v_t;
 
 void main() {
     gl_Position = u_mvp * vec4(in_position, 1.0);
+    v_t = in_t;
     vec3 rgb = u_use_vertex_color ? in_color : texture(u_ramp, vec2(clamp(in_t, 0.0, 1.0), 0.5)).rgb;
     v_color = u_use_flat_color ? u_flat_color.rgb : rgb;
 }
@@ -31,8 +33,10 @@ layout(triangle_strip, max_vertices = 4) out;
 
 uniform vec2 u_viewport;        // framebuffer size in pixels
 uniform float u_width;          // line width in pixels
+uniform float u_taper;          // width × (1 − u_taper · t) at the segment's middle t
 
 in vec3 v_color[];
+in float v_t[];
 out vec3 g_color;
 
 const float W_MIN = 1e-5;
@@ -51,7 +55,7 @@ void main() {
     vec2 d = pb - pa;
     float len = length(d);
     vec2 dir = len > 1e-6 ? d / len : vec2(1.0, 0.0);
-    float h = 0.5 * u_width;
+    float h = 0.5 * u_width * (1.0 - u_taper * (0.5 * (v_t[0] + v_t[1])));
     // Half a width past each end, so consecutive segments overlap at the joints.
     vec2 along = dir * h * 2.0 / u_viewport;
     vec2 side = vec2(-dir.y, dir.x) * h * 2.0 / u_viewport;

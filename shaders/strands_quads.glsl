@@ -11,6 +11,7 @@
 uniform mat4 u_mvp;             // pyrr row-major view @ proj, written as is
 uniform vec2 u_viewport;        // framebuffer size in pixels
 uniform float u_width;          // line width in pixels
+uniform float u_taper;          // width × (1 − u_taper · t) at the segment's middle t
 uniform bool u_use_vertex_color;
 uniform bool u_use_flat_color;  // ghost: every vertex u_flat_color
 uniform vec4 u_flat_color;     // its alpha is the fragments' alpha
@@ -51,7 +52,7 @@ void main() {
     vec2 d = sb - sa;
     float len = length(d);
     vec2 dir = len > 1e-6 ? d / len : vec2(1.0, 0.0);
-    float h = 0.5 * u_width;
+    float h = 0.5 * u_width * (1.0 - u_taper * (0.5 * (pa.w + pb.w)));
     vec2 along = dir * h * 2.0 / u_viewport;
     vec2 side = vec2(-dir.y, dir.x) * h * 2.0 / u_viewport;
     // Corners in the geometry shader's order: a + side, a − side, b + side, b − side.

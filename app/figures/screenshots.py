@@ -3,7 +3,8 @@
 ``python -m app.figures.screenshots OUTDIR`` (needs a display: Xvfb works) writes
 
 - ``screenshot-studio.png``: Sintel's hair on her head, dragged into a frozen, clumped shape
-  with the align brush (three strokes), coloured root to tip;
+  with the align brush (three strokes): the 228 guides (orange) with their 30,000 interpolated
+  render strands following, shaded as hair;
 - ``screenshot-timeline.png``: an anime cycle on that groom in the timeline — the DP keys against
   uniform keys of the same count, the error and speed curves, the error-versus-key-count plot —
   with the anime wave dock beside it and the viewport in ghost mode at a frame between keys.

@@ -69,20 +69,22 @@ class RasterLayer:
         *,
         background: tuple[float, float, float, float] | None = None,
         read_depth: bool = False,
+        scale: ArrayLike | None = None,
     ) -> None:
         """Draw the strands into ``fbo`` (bound, viewport ``size``, with ``samples`` per pixel).
 
         Single-sampled, ``background`` (RGBA in [0, 1]) fills every pixel no strand covers, for
         a frame GL drew nothing into; without it what GL drew is read back, its depth too with
         ``read_depth`` (the head mesh). Multisampled, strands go over what is there.
+        ``scale``: per segment, its width factor (a tapering width; None: none).
         """
         self._resize(size)
         if samples > 0:
-            self._composite(points, starts, colors, mvp, size, width)
+            self._composite(points, starts, colors, mvp, size, width, scale)
             return
         if background is not None:
             clear = tuple(int(np.floor(c * 255.0 + 0.5)) for c in background)  # as GL stores it
-            rgba, _ = self.raster.draw(points, starts, colors, mvp, size, width, clear=clear)
+            rgba, _ = self.raster.draw(points, starts, colors, mvp, size, width, clear=clear, scale=scale)
             self._upload(rgba, self.raster.changed)
         else:
             rgba, depth = self.raster.images(size)
@@ -92,7 +94,7 @@ class RasterLayer:
             else:
                 depth.fill(1.0)
             fbo.read_into(rgba, viewport=viewport, components=4)
-            self.raster.draw(points, starts, colors, mvp, size, width, clear=None)
+            self.raster.draw(points, starts, colors, mvp, size, width, clear=None, scale=scale)
             self._upload(rgba, self.raster.changed)
         self.ctx.copy_framebuffer(fbo, self._source)
         fbo.use()
@@ -109,9 +111,9 @@ class RasterLayer:
             )
         self._texture_is_image = True
 
-    def _composite(self, points, starts, colors, mvp, size, width) -> None:
+    def _composite(self, points, starts, colors, mvp, size, width, scale) -> None:
         self._texture_is_image = False
-        rgba, depth = self.raster.draw(points, starts, colors, mvp, size, width)
+        rgba, depth = self.raster.draw(points, starts, colors, mvp, size, width, scale=scale)
         self.color_texture.write(rgba)
         self.depth_texture.write(depth)
         self.color_texture.use(location=COLOR_UNIT)

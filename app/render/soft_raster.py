@@ -18,6 +18,8 @@ The definition, shared by the kernels and :func:`rasterize_reference` (float64 t
   gives each column the centres between its sides, bottom in and top out (the same
   computation on the transposed image). t runs from 0 to 1 over the quad's length (clamped),
   as the shader's corner colours do.
+- a width that tapers: each segment's quad ``width`` × its own scale (the caller's per-segment
+  ``scale``, e.g. 1 − taper·(t_a + t_b)/2 as the shaders compute it from the vertex parameter);
 - colour and depth linear in t; fragments with depth outside [0, 1] dropped; depth test LESS in
   float32, segments in index order (ties keep the first drawn); colour rounded, alpha 255.
 
@@ -43,7 +45,7 @@ W_MIN = 1e-5  # as the geometry shader: an end nearer the eye plane than this is
 DIR_EPS = 1e-6  # as the geometry shader: shorter segments are drawn in direction (1, 0)
 AXIS_EPS = 1e-12  # a quad side this close to horizontal bounds rows, not columns
 OPAQUE = 0xFF000000
-_SEG = 12  # per segment: window x, y, depth of both ends, then both ends' RGB × 255
+_SEG = 13  # per segment: window x, y, depth of both ends, both ends' RGB × 255, its width scale
 TILE_SHIFT = 5  # tiles of 2**5 = 32 pixels a side are redrawn when a frame differs little from the last
 TILE = 1 << TILE_SHIFT
 REDRAW_ALL = 1.0  # a full draw when the changed tiles list more (segment, tile) pairs than this × segments
@@ -255,7 +257,7 @@ def _quad(seg, i, half, r0, r1, c0, c1, rgba, depth, w):
 @njit(cache=True, nogil=True, inline="always")
 def _segment(seg, i, half, r0, r1, c0, c1, rgba, depth, w):
     if half > 0.0:
-        _quad(seg, i, half, r0, r1, c0, c1, rgba, depth, w)
+        _quad(seg, i, half * seg[i, 12], r0, r1, c0, c1, rgba, depth, w)
     else:
         _line(seg, i, r0, r1, c0, c1, rgba, depth, w)
 
@@ -444,6 +446,7 @@ class StrandRaster:
         self._last_starts = np.zeros(0, np.int64)
         self._last_points = np.zeros((0, 3), np.float32)
         self._last_colors = np.zeros((0, 3), np.float32)
+        self._last_scale = np.float64(1.0)
         self._flags = np.zeros(0, np.bool_)
         self._which = np.zeros(0, np.bool_)
         self._all = np.zeros(0, np.bool_)  # an empty mask: every segment
@@ -478,13 +481,16 @@ class StrandRaster:
         size: tuple[int, int],
         width: float,
         clear: tuple[int, int, int, int] | None = (0, 0, 0, 0),
+        scale: ArrayLike | None = None,
     ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
         """Segments ``starts[i] → starts[i] + 1`` of ``points`` ``(V, 3)``, coloured by per-vertex
         RGB ``colors`` in [0, 1], seen through ``mvp``, into ``size = (W, H)`` images; ``width``
         in pixels (≤ 1: 1-px lines). The images are first cleared to the RGBA bytes ``clear`` and
         depth 1.0, or with ``clear=None`` drawn over as they are (see :meth:`images`).
+        ``scale``: per segment, a factor in [0, 1] of its quad's width (None: 1, no taper).
         Returns :meth:`images`; the next draw overwrites them."""
         p, s, c, m, w, h, width = _check(points, starts, colors, mvp, size, width)
+        sc = _check_scale(scale, s.size)
         rgba, depth = self._images((w, h))
         half = 0.0 if width <= 1.0 else 0.5 * width
         fill = np.array(clear if clear is not None else (0, 0, 0, 0), np.uint8).view(np.uint32)[0]
@@ -496,10 +502,11 @@ class StrandRaster:
             and self._last_points.shape == p.shape
             and np.array_equal(self._last_mvp, m)
             and np.array_equal(self._last_starts, s)
+            and np.array_equal(self._last_scale, sc)
         )
         self._last = None
         if not (same and self._redraw_changed(p, s, c, m, half, fill, depth)):
-            self._draw_all(p, s, c, m, half, clear is not None, fill, depth)
+            self._draw_all(p, s, c, m, half, clear is not None, fill, depth, sc)
         if clear is not None:
             self._last = key
         return rgba, depth
@@ -510,11 +517,13 @@ class StrandRaster:
         h, w = self.depth.shape
         _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, self._seg, self._box, which)
 
-    def _draw_all(self, p, s, c, m, half, clear, fill, depth) -> None:
+    def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
         h, w = depth.shape
         n = s.size
         if self._seg.shape[0] != n:
             self._seg, self._box = np.empty((n, _SEG)), np.empty((4, n), np.int32)
+        self._seg[:, 12] = scale
+        self._last_scale = scale.copy() if scale.ndim else scale
         self._setup(p, s, c, m, half, self._all)
         # One band per thread: more, smaller bands cut more segments in two, which cost more
         # than the better balance gained.
@@ -583,9 +592,20 @@ def rasterize(
     mvp: ArrayLike,
     size: tuple[int, int],
     width: float,
+    scale: ArrayLike | None = None,
 ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
     """:meth:`StrandRaster.draw` into fresh images."""
-    return StrandRaster().draw(points, starts, colors, mvp, size, width)
+    return StrandRaster().draw(points, starts, colors, mvp, size, width, scale=scale)
+
+
+def _check_scale(scale: ArrayLike | None, n: int) -> NDArray[np.float64]:
+    """Per-segment width factors as float64 (a 0-d 1.0 for None)."""
+    if scale is None:
+        return np.float64(1.0)
+    sc = np.asarray(scale, np.float64)
+    if sc.shape != (n,) or not np.all((sc >= 0.0) & (sc <= 1.0)):
+        raise ParameterError("scale", f"shape {sc.shape}", f"({n},) width factors in [0, 1], one per segment")
+    return sc
 
 
 def rasterize_reference(
@@ -595,10 +615,12 @@ def rasterize_reference(
     mvp: ArrayLike,
     size: tuple[int, int],
     width: float,
+    scale: ArrayLike | None = None,
 ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
     """The definition in the module doc in numpy, one segment at a time over the whole image
     (small inputs): the oracle the kernels are tested against."""
     p, s, c, m, w, h, width = _check(points, starts, colors, mvp, size, width)
+    sc = np.broadcast_to(_check_scale(scale, s.size), s.shape)
     half = 0.0 if width <= 1.0 else 0.5 * width
     p = p.astype(np.float64)
     clip = p[:, :1] * m[0] + p[:, 1:2] * m[1] + p[:, 2:3] * m[2] + m[3]
@@ -606,7 +628,7 @@ def rasterize_reference(
     rgba = np.zeros((h, w, 4), np.uint8)
     depth = np.ones((h, w), np.float32)
     scale = np.array([0.5 * w, 0.5 * h, 0.5])
-    for a in s:
+    for a, f_width in zip(s, sc, strict=True):
         ea, eb, ca, cb = clip[a], clip[a + 1], rgb[a], rgb[a + 1]
         if ea[3] < W_MIN and eb[3] < W_MIN:
             continue
@@ -618,7 +640,9 @@ def rasterize_reference(
             eb, cb = eb + f * (ea - eb), cb + f * (ca - cb)
         pa = (ea[:3] * (1.0 / ea[3]) + 1.0) * scale
         pb = (eb[:3] * (1.0 / eb[3]) + 1.0) * scale
-        rows, cols, t = _quad_fragments(pa, pb, half, w, h) if half else _line_fragments(pa, pb, w, h)
+        rows, cols, t = (
+            _quad_fragments(pa, pb, half * f_width, w, h) if half else _line_fragments(pa, pb, w, h)
+        )
         z = pa[2] + t * (pb[2] - pa[2])
         keep = (z >= 0.0) & (z <= 1.0)
         rows, cols, t, z32 = rows[keep], cols[keep], t[keep], z[keep].astype(np.float32)

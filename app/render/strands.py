@@ -45,6 +45,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from app.render.camera import Camera
+from app.render.hair_shading import DEFAULT_LOOK, HairLook, light_and_eye, shade
 from app.render.mesh_layer import MeshLayer
 from app.render.overlay import CircleOverlay
 from app.render.ramps import DEFAULT_RAMP, ramp_stops, ramp_texture, sample_linear
@@ -129,6 +130,15 @@ class StrandRenderer:
         self.ghost_rgba: tuple[float, float, float, float] = DEFAULT_GHOST_RGBA
         self._segment_starts: NDArray[np.int64] | None = None
         self._ramp_colors: NDArray[np.float32] | None = None  # the ramp at every vertex, for "cpu"
+        # Hair shading (app.render.hair_shading): the base colours (vertex colours or the ramp)
+        # lit from the strand direction per vertex, redone when points, colours or view change.
+        self.hair_shading = False
+        self.taper = 0.0  # width at the tip = (1 − taper) × at the root (per segment, at its middle t)
+        self._taper_scale: tuple[float, NDArray[np.float64]] | None = None
+        self.hair_look: HairLook = DEFAULT_LOOK
+        self._base_colors: NDArray[np.float32] | None = None
+        self._version = 0  # bumped by every change of points or base colours
+        self._shade_key: tuple | None = None
 
     # -- what is drawn and how -------------------------------------------------------
     def line_method(self) -> str:
@@ -215,6 +225,7 @@ class StrandRenderer:
         self._gpu = StrandGPU(self.ctx, top)
         self._main = PointSet(self._gpu, np.ascontiguousarray(groom.points, np.float32))
         self._segment_starts = np.ascontiguousarray(top.segment_end - 1)
+        self._version += 1
         self.bounds = groom.bounds
         self.set_vertex_colors(groom.colors)
         if ghost is not None:
@@ -232,6 +243,7 @@ class StrandRenderer:
             raise GroomError("points have a non-finite coordinate")
         self._main.write(p)
         self.bounds = box(p)
+        self._version += 1
 
     def set_ghost_points(
         self, points: ArrayLike | None, rgba: tuple[float, float, float, float] = DEFAULT_GHOST_RGBA
@@ -286,6 +298,8 @@ class StrandRenderer:
         """``(V, 3)`` RGB in [0, 1] per vertex, or None to colour by the ramp along t."""
         if colors is None:
             self.use_vertex_colors = False
+            self._base_colors = None
+            self._shade_key = None
             return
         if self.topology is None or self._gpu is None:
             raise GroomError("set_vertex_colors needs a groom: call set_groom first")
@@ -295,8 +309,11 @@ class StrandRenderer:
             raise ParameterError("colors", c.shape, f"shape ({v}, 3) (one RGB per vertex)")
         if not np.all(np.isfinite(c)):
             raise ParameterError("colors", "non-finite", "finite RGB values in [0, 1]")
-        self._gpu.write_colors(np.clip(c, 0.0, 1.0))
+        self._base_colors = np.clip(c, 0.0, 1.0)
+        self._gpu.write_colors(self._base_colors)
         self.use_vertex_colors = True
+        self._version += 1
+        self._shade_key = None
 
     def set_ramp(self, name: str) -> None:
         """Colour ramp used while no vertex colours are set (see :data:`app.render.ramps.RAMPS`)."""
@@ -305,6 +322,7 @@ class StrandRenderer:
             self.ramp_texture.write(ramp_texture(name, RAMP_TEXELS).tobytes())
             self.ramp = name
             self._ramp_colors = None
+            self._shade_key = None
 
     def set_mesh(self, mesh: Any | None) -> None:
         """A head mesh (``vertices``, ``faces``, optional ``normals``) drawn shaded; None removes it."""
@@ -362,6 +380,7 @@ class StrandRenderer:
         view = camera.view_matrix()
         mvp = (view @ camera.projection_matrix(w / h)).astype(np.float32)
         self.mesh.render(mvp, view)
+        self._shade(camera)
         if self._main is not None:
             gl_method = self.gl_line_method()
             if method != "cpu" or self._ghost is not None:
@@ -384,14 +403,15 @@ class StrandRenderer:
         for name, value in (
             ("u_viewport", (float(size[0]), float(size[1]))),
             ("u_width", width),
-            ("u_use_vertex_color", self.use_vertex_colors),
+            ("u_use_vertex_color", self.vertex_coloured),
+            ("u_taper", self._checked_taper()),
             ("u_ramp", 0),
             ("u_points", 1),
             ("u_colors", 2),
         ):
             if name in prog:
                 prog[name].value = value
-        if method == "quads" and self.use_vertex_colors:
+        if method == "quads" and self.vertex_coloured:
             self._gpu.color_texture().use(location=2)
 
     def _render_cpu(self, fbo, samples: int, mvp, size: tuple[int, int], width: float, background) -> None:
@@ -399,18 +419,74 @@ class StrandRenderer:
             self.raster = RasterLayer(self.ctx)
         points, colors, starts = self._main.cpu_points(), self.cpu_colors(), self._segment_starts
         mesh = self.mesh.vao is not None
+        scale = self.segment_width_scale() if width > 1.0 else None
         self.raster.render(
-            fbo, samples, points, starts, colors, mvp, size, width, background=background, read_depth=mesh
-        )
+            fbo, samples, points, starts, colors, mvp, size, width, background=background, read_depth=mesh,
+            scale=scale,
+        )  # fmt: skip
+
+    def _checked_taper(self) -> float:
+        t = float(self.taper)
+        if not 0.0 <= t < 1.0:
+            raise ParameterError(
+                "taper", self.taper, "a number in [0, 1): the share of the width lost at the tip"
+            )
+        return t
+
+    def segment_width_scale(self) -> NDArray[np.float64] | None:
+        """Per segment, its width factor 1 − taper·(t_a + t_b)/2 (as the shaders compute it from
+        the vertex parameter t in float32), or None without a taper."""
+        taper = self._checked_taper()
+        if taper == 0.0 or self._gpu is None:
+            return None
+        if self._taper_scale is None or self._taper_scale[0] != taper:
+            t, s = self._gpu.param, self._segment_starts
+            mid = (np.float32(0.5) * (t[s] + t[s + 1])).astype(np.float32)
+            scale = (np.float32(1.0) - np.float32(taper) * mid).astype(np.float64)
+            self._taper_scale = (taper, np.clip(scale, 0.0, 1.0))
+        return self._taper_scale[1]
 
     def cpu_colors(self) -> NDArray[np.float32]:
         """``(V, 3)`` the colour of every vertex as the GL draws give it: the vertex colours, or
         the ramp texture sampled at t (LINEAR, clamped), as the shaders do."""
-        if self.use_vertex_colors:
+        if self.vertex_coloured:
             return self._gpu.colors
+        return self._ramp_vertex_colors()
+
+    def _ramp_vertex_colors(self) -> NDArray[np.float32]:
         if self._ramp_colors is None:
             self._ramp_colors = sample_linear(ramp_texture(self.ramp, RAMP_TEXELS), self._gpu.param)
         return self._ramp_colors
+
+    @property
+    def vertex_coloured(self) -> bool:
+        """Whether the strands take the per-vertex colour buffer (vertex colours, or the shade)."""
+        return self.use_vertex_colors or (self.hair_shading and self._shade_key is not None)
+
+    def set_hair_shading(self, on: bool, look: HairLook | None = None) -> None:
+        """Shade the strands as hair (Kajiya-Kay from the strand tangent, the light tied to the
+        camera) over their colours: the vertex colours, or the ramp from root to tip."""
+        look = self.hair_look if look is None else look
+        if bool(on) != self.hair_shading or look != self.hair_look:
+            self.hair_shading, self.hair_look = bool(on), look
+            self._shade_key = None
+            if not on and self._gpu is not None and self._base_colors is not None:
+                self._gpu.write_colors(self._base_colors)
+
+    def _shade(self, camera: Camera) -> None:
+        """Write the shaded colours into the colour buffer when points, colours or view changed."""
+        if not self.hair_shading or self._main is None:
+            return
+        right, up, forward = camera.basis()
+        key = (self._version, id(self._gpu), tuple(right), tuple(up), self.hair_look)
+        if key == self._shade_key:
+            return
+        base = self._base_colors if self.use_vertex_colors else self._ramp_vertex_colors()
+        light, eye = light_and_eye(right, up, forward)
+        self._gpu.write_colors(
+            shade(self._main.points, self.topology.offsets, base, light, eye, self.hair_look)
+        )
+        self._shade_key = key
 
     def _draw(self, method: str, points: PointSet, ghost: bool) -> None:
         if method == "quads":
@@ -453,7 +529,9 @@ class StrandRenderer:
         self.topology = None
         self.bounds = None
         self.use_vertex_colors = False
-        self._segment_starts = self._ramp_colors = None
+        self._segment_starts = self._ramp_colors = self._base_colors = None
+        self._taper_scale = None
+        self._shade_key = None
 
     def release(self) -> None:
         """Free every GL object this renderer made (call with its context current)."""

@@ -1,4 +1,5 @@
-"""Per-vertex colours for the "Colour by" modes other than the root-to-tip ramp."""
+"""Per-vertex colours for the "Colour by" modes, of the strands the viewport draws: the groom,
+or its interpolated children followed by the guides (drawn in one colour of their own)."""
 
 from __future__ import annotations
 
@@ -8,28 +9,52 @@ from app.render.ramps import (
     categorical_colors,
     per_strand_random_colors,
     ramp_colors,
+    ramp_texture,
+    sample_linear,
     strand_to_vertex_colors,
 )
+from app.render.strands import RAMP_TEXELS
 from app.ui.scene import Scene
 
 STRAND_COLOUR_SEED = 7  # fixed, so a groom keeps its per-strand colours between runs
+GUIDE_RGB = (1.0, 0.62, 0.12)  # guides over render hair: one warm orange whatever the mode
 
 
 def vertex_colors(scene: Scene) -> np.ndarray | None:
-    """``(V, 3)`` float32 colours, or None where the renderer's ramp over t does the colouring."""
+    """``(V, 3)`` float32 colours of the drawn strands, or None where the renderer's ramp over t
+    does the colouring (shaded hair too: the renderer lights the ramp or these colours)."""
     mode = scene.colour_mode
-    top = scene.result.topology
-    if mode == "root-to-tip":
-        return None
-    if mode == "strand":
-        return strand_to_vertex_colors(per_strand_random_colors(top.strand_count, STRAND_COLOUR_SEED), top)
-    if mode == "clump":
+    top = scene.drawn_topology
+    guides = scene.drawn_guides if scene.has_children else 0
+    if mode in ("root-to-tip", "hair"):
+        if not guides:
+            return None
+        colors = scene.cached(("ramp", scene.ramp), lambda: _guides_over_ramp(scene, top, guides))
+        return colors
+    elif mode == "strand":
+        colors = strand_to_vertex_colors(per_strand_random_colors(top.strand_count, STRAND_COLOUR_SEED), top)
+    elif mode == "clump":
         ids = np.asarray(scene.pipeline.clump_ids())
-        return strand_to_vertex_colors(categorical_colors(ids), top)
-    if mode == "displacement":
+        if scene.has_children:  # each child in its nearest guide's clump
+            b = scene.drawn_binding()
+            ids = np.concatenate([ids[b.guide_ids[:, 0]], ids[:guides]])
+        colors = strand_to_vertex_colors(categorical_colors(ids), top)
+    elif mode == "displacement":
         d = scene.displacement()
         # Heat over [0, median strand length]: a fixed scale per groom, so colours do not
         # flicker while dragging as a per-frame maximum would.
         scale = float(np.median(scene.rest.strand_lengths))
-        return ramp_colors(d / max(scale, 1e-9), "heat")
-    raise ValueError(f"unknown colour mode {mode!r}")
+        colors = ramp_colors(d / max(scale, 1e-9), "heat")
+    else:
+        raise ValueError(f"unknown colour mode {mode!r}")
+    if guides:
+        colors = np.array(colors, np.float32)
+        colors[top.offsets[top.strand_count - guides] :] = GUIDE_RGB
+    return colors
+
+
+def _guides_over_ramp(scene: Scene, top, guides: int) -> np.ndarray:
+    """The ramp over t, sampled as the renderer samples it, with the guides in their colour."""
+    colors = sample_linear(ramp_texture(scene.ramp, RAMP_TEXELS), top.vertex_param)
+    colors[top.offsets[top.strand_count - guides] :] = GUIDE_RGB
+    return colors

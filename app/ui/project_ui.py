@@ -48,9 +48,7 @@ class ProjectController(QObject):
     saved = Signal(str)
     opened = Signal(str)
 
-    def __init__(
-        self, window: StudioHost, sources: AnimationSources, autosave_ms: int = AUTOSAVE_MS
-    ) -> None:
+    def __init__(self, window: StudioHost, sources: AnimationSources, autosave_ms: int = AUTOSAVE_MS) -> None:
         super().__init__(window)
         self.window, self.sources = window, sources
         self.path: Path | None = None
@@ -114,12 +112,16 @@ class ProjectController(QObject):
                 "ramp": scene.ramp,
                 "line_width": scene.line_width,
                 "ortho": bool(w.viewport.camera.ortho),
+                "show_guides": scene.show_guides,
+                "drag_percent": scene.drag_percent,
+                "release_percent": scene.release_percent,
             },
             animation=model.animation,
             animation_source=model.source,
             key_settings=dataclasses.asdict(model.settings),
             settings=settings,
             groom_source=source,
+            children=scene.binding,
         )
 
     def apply(self, project: pf.Project, path: str | os.PathLike[str] | None) -> None:
@@ -132,6 +134,7 @@ class ProjectController(QObject):
         w.undo_stack.clear()
         scene.load(project.rest, path, params=project.params)
         scene.restore(project.stroke_snapshot(scene.pipeline))
+        scene.set_binding(project.children)
         _apply_each(
             w,
             (
@@ -142,6 +145,11 @@ class ProjectController(QObject):
                 lambda: scene.set_ramp(str(project.display["ramp"])),
                 lambda: scene.set_line_width(float(project.display["line_width"])),
                 lambda: w.viewport.set_ortho(bool(project.display["ortho"])),
+                lambda: scene.set_show_guides(bool(project.display.get("show_guides", True))),
+                lambda: scene.set_display_percent(
+                    float(project.display.get("drag_percent", scene.drag_percent)),
+                    float(project.display.get("release_percent", scene.release_percent)),
+                ),
             ),
         )
         if project.animation is not None:

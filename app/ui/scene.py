@@ -16,7 +16,8 @@ from PySide6.QtCore import QObject, Signal
 from app.render.ramps import DEFAULT_RAMP
 from hairtool.errors import ParameterError
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
-from hairtool.groom import Groom
+from hairtool.groom import Groom, Topology
+from hairtool.guides.binding import ChildBinding
 
 ALIGN_MODES = ("paper", "preserve-length")
 COLOUR_MODES = {
@@ -24,7 +25,10 @@ COLOUR_MODES = {
     "strand": "Per-strand random",
     "clump": "Clump membership",
     "displacement": "Displacement from rest",
+    "hair": "Shaded hair",
 }
+DRAG_PERCENT = 10.0  # children drawn while a brush drags (XGen's preview density)
+RELEASE_PERCENT = 100.0  # … and once the mouse is released
 
 
 class Scene(QObject):
@@ -37,10 +41,23 @@ class Scene(QObject):
     display_changed = Signal()  # colour mode, ramp or line width
     mesh_changed = Signal()
     path_changed = Signal()
+    drawn_changed = Signal()  # the drawn strands' topology changed (children density, guides shown)
 
     def __init__(self, groom: Groom, params: FrozenParams | None = None, parent: QObject | None = None):
         super().__init__(parent)
-        self._params = params if params is not None else FrozenParams()
+        # The studio keeps strand lengths after clumping (FrozenParams' own default is the
+        # paper's printed ClumpWithGaps, which stretches them).
+        self._params = params if params is not None else FrozenParams(keep_lengths=True)
+        self.binding: ChildBinding | None = None  # render hair interpolated from the groom (the guides)
+        self.show_guides = True
+        self.drag_percent = DRAG_PERCENT
+        self.release_percent = RELEASE_PERCENT
+        self.dragging = False
+        self._subsets: dict[float, ChildBinding] = {}
+        self._cache: dict = {}  # per drawn density: its topology and colours (see cached)
+        self._child_out: np.ndarray | None = None
+        self._rest_drawn: np.ndarray | None = None
+        self.last_children_ms = 0.0
         self.colour_mode = "root-to-tip"
         self.ramp = DEFAULT_RAMP
         self.line_width = 2.0
@@ -61,6 +78,10 @@ class Scene(QObject):
         self.centre = ((lo.astype(np.float64) + hi) * 0.5).astype(np.float32)
         extent = float(np.max(hi - lo))
         self.radius = 0.25 * extent if extent > 0 else 1.0
+        self.binding = None
+        self._subsets = {}
+        self._cache = {}
+        self._rebuild_drawn()
 
     def load(self, groom: Groom, path: str | Path | None = None, params: FrozenParams | None = None) -> None:
         """Replace the groom being edited (strokes are dropped; the parameters stay unless
@@ -96,6 +117,7 @@ class Scene(QObject):
         self.result = self.pipeline.align(
             np.asarray(cursor, dtype=np.float64), self.radius, self.intensity, self.align_mode
         )
+        self._children_moved()
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
         self.points_changed.emit()
         return self.result
@@ -107,8 +129,159 @@ class Scene(QObject):
     def restore(self, snap: object) -> None:
         t0 = time.perf_counter()
         self.result = self.pipeline.restore(snap)
+        self._children_moved()
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
         self.points_changed.emit()
+
+    # -- render hair ---------------------------------------------------------------------
+    def set_binding(self, binding: ChildBinding | None) -> None:
+        """Render hair interpolated from the groom, which becomes its guides (None: no children).
+        The engine and the brushes keep running on the guides; the children follow."""
+        if binding is not None and binding.rest_guides.topology != self.rest.topology:
+            raise ParameterError(
+                "binding",
+                f"children bound to {binding.rest_guides.strand_count} guides",
+                f"children bound to this groom's {self.rest.strand_count} strands",
+            )
+        self.binding = binding
+        self._subsets = {}
+        self._cache = {}
+        self._child_out = None
+        self._rebuild_drawn()
+        self.drawn_changed.emit()
+
+    @property
+    def has_children(self) -> bool:
+        return self.binding is not None
+
+    def set_show_guides(self, on: bool) -> None:
+        if bool(on) != self.show_guides:
+            self.show_guides = bool(on)
+            self._rebuild_drawn()
+            self.drawn_changed.emit()
+
+    def set_display_percent(self, drag: float | None = None, release: float | None = None) -> None:
+        """The share of the children drawn while dragging and after release, in percent (0, 100]."""
+        for name, value in (("drag display percentage", drag), ("release display percentage", release)):
+            if value is not None and (not np.isfinite(value) or not 0.0 < value <= 100.0):
+                raise ParameterError(name, value, "a percentage in (0, 100]")
+        changed = False
+        if drag is not None and float(drag) != self.drag_percent:
+            self.drag_percent, changed = float(drag), changed or self.dragging
+        if release is not None and float(release) != self.release_percent:
+            self.release_percent, changed = float(release), changed or not self.dragging
+        if changed:
+            self._rebuild_drawn()
+            self.drawn_changed.emit()
+
+    def set_dragging(self, on: bool) -> None:
+        """A brush stroke begins (children at the drag percentage) or ends (release density)."""
+        if bool(on) == self.dragging:
+            return
+        self.dragging = bool(on)
+        if self.binding is not None and self.drag_percent != self.release_percent:
+            self._rebuild_drawn()
+            self.drawn_changed.emit()
+
+    @property
+    def display_percent(self) -> float:
+        return self.drag_percent if self.dragging else self.release_percent
+
+    def drawn_binding(self) -> ChildBinding | None:
+        """The children drawn now: p % of them (the drag or the release percentage), evenly
+        spaced over the binding's order (its scattering is random, so they cover the scalp)."""
+        b = self.binding
+        if b is None:
+            return None
+        p = self.display_percent
+        if p >= 100.0:
+            return b
+        sub = self._subsets.get(p)
+        if sub is None:
+            n = b.child_count
+            m = max(1, round(n * p / 100.0))
+            ids = (np.arange(m, dtype=np.int64) * n) // m
+            sub = self._subsets[p] = b.subset(ids)
+        return sub
+
+    def cached(self, key: tuple, make):
+        """``make()`` once per drawn density and ``key`` (e.g. the ramp colours of 3 million
+        vertices), forgotten when the groom or its children change."""
+        full = (self.display_percent, self.show_guides, *key)
+        if full not in self._cache:
+            self._cache[full] = make()
+        return self._cache[full]
+
+    def _children_points(self) -> np.ndarray:
+        from hairtool.guides.children import build_points
+
+        b = self.drawn_binding()
+        t0 = time.perf_counter()
+        self._child_out = build_points(b, self.result, out=self._child_out)
+        self.last_children_ms = (time.perf_counter() - t0) * 1e3
+        return self._child_out
+
+    def _rebuild_drawn(self) -> None:
+        """What the viewport draws: the groom itself, or the children (then the guides, if
+        shown, as the last strands)."""
+        b = self.drawn_binding()
+        if b is None:
+            self.drawn_topology = self.result.topology
+            self.drawn_points = self.result.points
+            self.drawn_guides = self.result.strand_count
+            return
+        self._child_out = None
+        self._rest_drawn = None
+        children = self._children_points()
+        if self.show_guides:
+            key = (self.display_percent, "guides")
+            if key not in self._cache:  # one topology per density, so what hangs on it is kept
+                self._cache[key] = Topology(np.concatenate([b.counts, self.result.counts]))
+            self.drawn_topology = self._cache[key]
+            self.drawn_points = np.concatenate([children, self.result.points])
+            self.drawn_guides = self.result.strand_count
+        else:
+            self.drawn_topology = b.topology
+            self.drawn_points = children
+            self.drawn_guides = 0
+
+    def _children_moved(self) -> None:
+        if self.binding is None:
+            self.drawn_points = self.result.points
+            return
+        children = self._children_points()
+        if self.show_guides:
+            self.drawn_points = np.concatenate([children, self.result.points])
+        else:
+            self.drawn_points = children
+
+    def drawn_for(self, guide_points: np.ndarray) -> np.ndarray:
+        """The drawn strands' points for the guides at ``guide_points`` (an animation frame)."""
+        g = Groom(guide_points, self.result.topology)
+        from hairtool.guides.children import build_points
+
+        children = build_points(self.drawn_binding(), g)
+        return np.concatenate([children, g.points]) if self.drawn_guides else children
+
+    def drawn_groom(self) -> Groom:
+        """The drawn strands as a groom (children first, then the guides if shown)."""
+        if self.binding is None:
+            return self.result
+        return Groom(self.drawn_points, self.drawn_topology)
+
+    def render_hair(self) -> Groom | None:
+        """Every child at the guides' current shapes (full density), or None without children."""
+        return None if self.binding is None else self.binding.build(self.result)
+
+    def export_groom(self) -> Groom:
+        """What a save or export writes: the edited groom, or with children the render hair
+        (tapered widths) and the guides as a second prim of purpose "guide"."""
+        hair = self.render_hair()
+        if hair is None:
+            return self.result
+        from hairtool.guides.files import with_guides
+
+        return with_guides(hair, self.result, self.rest.metadata)
 
     # -- engine parameters ---------------------------------------------------------------
     @property
@@ -120,6 +293,7 @@ class Scene(QObject):
             return
         t0 = time.perf_counter()
         self.result = self.pipeline.set_params(params)
+        self._children_moved()
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
         self._params = params
         self.params_changed.emit(params)
@@ -176,6 +350,12 @@ class Scene(QObject):
         self.mesh_changed.emit()
 
     def displacement(self) -> np.ndarray:
-        """``(V,)`` float64 distance of each vertex from its rest position (scene units)."""
+        """``(V,)`` float64 distance of each drawn vertex from its rest position (scene units)."""
+        if self.binding is not None:
+            if self._rest_drawn is None or len(self._rest_drawn) != len(self.drawn_points):
+                rest = self.drawn_binding().build().points
+                self._rest_drawn = np.concatenate([rest, self.rest.points]) if self.drawn_guides else rest
+            d = self.drawn_points.astype(np.float64) - self._rest_drawn
+            return np.sqrt(np.einsum("ij,ij->i", d, d))
         d = self.result.points.astype(np.float64) - self.rest.points
         return np.sqrt(np.einsum("ij,ij->i", d, d))

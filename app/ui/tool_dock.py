@@ -25,6 +25,7 @@ from PySide6.QtWidgets import (
 
 from app.render.ramps import RAMPS
 from app.ui.qt_utils import signals_blocked
+from app.ui.render_hair_box import RenderHairBox
 from app.ui.scene import ALIGN_MODES, COLOUR_MODES, Scene
 from app.ui.widgets import SliderSpin
 from hairtool.frozen.pipeline import FrozenParams
@@ -86,6 +87,7 @@ class ToolDock(QDockWidget):
         layout.addWidget(self._brush_box())
         layout.addWidget(self._engine_box())
         layout.addWidget(self._display_box())
+        layout.addWidget(RenderHairBox(scene))
         layout.addStretch(1)
         self.setWidget(body)
         scene.params_changed.connect(lambda _p: self.refresh_params())

@@ -25,6 +25,7 @@ from PySide6.QtGui import QMouseEvent, QWheelEvent
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 
 from app.render.camera import Camera
+from app.render.hair_shading import HAIR_TAPER
 from app.render.strands import StrandRenderer
 from app.ui.colouring import vertex_colors
 from app.ui.scene import Scene
@@ -88,6 +89,7 @@ class Viewport(QOpenGLWidget):
         scene.params_changed.connect(lambda _p: self._mark("colors"))
         scene.display_changed.connect(lambda: self._mark("display", "colors"))
         scene.mesh_changed.connect(lambda: self._mark("mesh"))
+        scene.drawn_changed.connect(lambda: self._mark("groom", "colors"))
         scene.tool_changed.connect(self.update)
 
     # -- scene → view ----------------------------------------------------------------------
@@ -175,22 +177,29 @@ class Viewport(QOpenGLWidget):
     def _upload(self) -> None:
         r, s, dirty = self.renderer, self.scene, self._dirty
         shown = self.frame_points is not None and len(self.frame_points) == s.result.vertex_count
+        children = s.has_children  # frames and ghosts are of the guides: their children are drawn
         if "groom" in dirty:
-            r.set_groom(s.result)
+            r.set_groom(s.drawn_groom())
             dirty.discard("points")
             dirty.update(("ghost", "points") if shown or self.ghost_points is not None else ())
         if "points" in dirty:
-            r.update_points(self.frame_points if shown else s.result.points)
+            if shown:
+                r.update_points(s.drawn_for(self.frame_points) if children else self.frame_points)
+            else:
+                r.update_points(s.drawn_points)
             self.shown_frame = self._pending_frame if shown else None
         if "display" in dirty:
             r.set_ramp(s.ramp)
             r.line_width = s.line_width
+            r.set_hair_shading(s.colour_mode == "hair")
+            r.taper = HAIR_TAPER if s.colour_mode == "hair" else 0.0  # hair narrows root to tip
         if "colors" in dirty:
-            own = shown and self.frame_colors is not None
+            own = shown and self.frame_colors is not None and not children
             r.set_vertex_colors(self.frame_colors if own else vertex_colors(s))
         if "ghost" in dirty:
             if shown and self.ghost_points is not None:
-                r.set_ghost_points(self.ghost_points, GHOST_RGBA)
+                ghost = s.drawn_for(self.ghost_points) if children else self.ghost_points
+                r.set_ghost_points(ghost, GHOST_RGBA)
             else:
                 r.set_ghost_points(None)
         if "mesh" in dirty:
@@ -299,6 +308,7 @@ class Viewport(QOpenGLWidget):
         if self._drag == "align":
             self._stroke_before = self.scene.snapshot()
             self.stroke_started.emit()
+            self.scene.set_dragging(True)  # children at the drag display percentage
             self._align_at(event.position())
         event.accept()
 
@@ -338,6 +348,7 @@ class Viewport(QOpenGLWidget):
             target.end()
         elif drag == "align" and self._stroke_before is not None:
             before, self._stroke_before = self._stroke_before, None
+            self.scene.set_dragging(False)  # full density again
             self.stroke_finished.emit(before, self.scene.snapshot())
         self.update()
 

@@ -71,6 +71,7 @@ class MainWindow(QMainWindow):
         self.viewport.frame_drawn.connect(self._update_frame_time)
         self.dock.param_edited.connect(self._on_param_edited)
         self.scene.groom_loaded.connect(self._update_counts)
+        self.scene.drawn_changed.connect(self._update_counts)
         self.scene.path_changed.connect(self._update_title)
         self.undo_stack.cleanChanged.connect(self._update_title)
         self._update_counts()
@@ -297,8 +298,11 @@ class MainWindow(QMainWindow):
         bar.addPermanentWidget(self.job_status)
 
     def _update_counts(self) -> None:
-        g = self.scene.result
-        self.counts_label.setText(f"{g.strand_count:,} strands · {g.vertex_count:,} vertices")
+        g, b = self.scene.result, self.scene.binding
+        text = f"{g.strand_count:,} strands · {g.vertex_count:,} vertices"
+        if b is not None:
+            text = f"{g.strand_count:,} guides · {b.child_count:,} children · {b.vertex_count:,} vertices"
+        self.counts_label.setText(text)
 
     def _update_frame_time(self) -> None:
         v, s = self.viewport, self.scene
@@ -355,6 +359,7 @@ class MainWindow(QMainWindow):
         It opens untitled, so Save asks where to write instead of touching the shipped file.
         """
         from app import resources
+        from hairtool.guides.binding import bind_scalp
         from hairtool.io.obj import read_mesh
 
         try:
@@ -365,6 +370,11 @@ class MainWindow(QMainWindow):
             return False
         self.set_groom(groom)
         self.scene.set_mesh(mesh)
+        # Sintel's hair as guides with interpolated render hair, shaded as hair.
+        self.scene.set_binding(
+            bind_scalp(groom, mesh, resources.SINTEL_CHILDREN, seed=resources.SINTEL_CHILD_SEED)
+        )
+        self.scene.set_colour_mode("hair")
         self.viewport.frame_all()
         return True
 
@@ -412,7 +422,7 @@ class MainWindow(QMainWindow):
 
     def _write_groom(self, path: str | os.PathLike[str], *, adopt: bool) -> bool:
         try:
-            io.write(path, self.scene.result)
+            io.write(path, self.scene.export_groom())
         except HairtoolError as e:
             self.show_error("Cannot write file", str(e))
             return False

@@ -39,7 +39,14 @@ def _usd_summary(obj) -> dict:
     if m.start_time_code is not None:
         out["time_code_range"] = [m.start_time_code, m.end_time_code]
     out["curves"] = [
-        {"path": c.path, "strands": c.strands, "basis": c.basis, "wrap": c.wrap, "drawn": c.description}
+        {
+            "path": c.path,
+            "strands": c.strands,
+            "basis": c.basis,
+            "wrap": c.wrap,
+            "purpose": c.purpose,
+            "drawn": c.description,
+        }
         for c in m.curves
     ]
     return out
@@ -99,7 +106,8 @@ def _bvh_text(s: dict) -> str:
 def _usd_text(u: dict) -> list[str]:
     lines = [f"space       {u['up_axis']}-up, {u['meters_per_unit']:g} m per unit"]
     for c in u["curves"]:
-        lines.append(f"curves      {c['path']}: {c['strands']} strands, {c['drawn']}")
+        purpose = "" if c["purpose"] == "default" else f", purpose {c['purpose']}"
+        lines.append(f"curves      {c['path']}: {c['strands']} strands, {c['drawn']}{purpose}")
     return lines
 
 

@@ -13,7 +13,8 @@ test cases):
 - the stage's ``upAxis``, ``metersPerUnit``, ``timeCodesPerSecond`` and start/end time codes
   are kept as authored (nothing is rotated or scaled); the time code rate is the frame rate;
 - curves of any basis (linear, cubic bezier / bspline / catmullRom): the control points are the
-  strand's points, the basis is remembered;
+  strand's points, the basis is remembered, and so is each prim's ``purpose`` (render hair
+  beside its guide curves, purpose ``guide``: :mod:`hairtool.guides.files`);
 - ``widths`` of every interpolation (see :mod:`hairtool.io.usd_basis`), colour from
   ``displayColor`` or Blender's ``primvars:color`` (color3f or color4f; its alpha is opacity),
   opacity from ``displayOpacity``.
@@ -47,7 +48,7 @@ from hairtool.groom import Animation, Groom
 from hairtool.io import usd_basis, usdc_check
 from hairtool.io.atomic import atomic_path
 from hairtool.io.binary import require_finite, require_strand_counts
-from hairtool.metadata import CurvesPrim, Metadata
+from hairtool.metadata import PURPOSES, CurvesPrim, Metadata
 
 PRIM_PATH = "/Groom/Strands"
 
@@ -149,6 +150,8 @@ def _write_prim(stage, prim: CurvesPrim, obj: Groom | Animation, strands: slice,
     if wrap != "nonperiodic":
         curves.CreateWrapAttr(wrap)
     curves.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(counts.astype(np.int32)))
+    if prim.purpose != "default":
+        curves.CreatePurposeAttr(prim.purpose)
     half_width = _write_attributes(curves, obj, vs, obj.metadata.color_primvar)
     points_attr = curves.CreatePointsAttr()
     extent_attr = curves.CreateExtentAttr()
@@ -411,6 +414,7 @@ class _Curves:
         if not usd_basis.fits(self.counts, basis, _wrap_for(basis, wrap)):
             basis = "linear"  # a cubic basis these counts cannot draw: the points as a polyline
         self.basis, self.wrap = basis, _wrap_for(basis, wrap)
+        self.purpose = _token(path, self.curves.GetPurposeAttr(), PURPOSES, "purpose")
         self.times = {float(t) for t in self.points.GetTimeSamples()}
 
     def _check_length(self, value) -> None:
@@ -424,7 +428,7 @@ class _Curves:
             )
 
     def info(self) -> CurvesPrim:
-        return CurvesPrim(self.name, int(self.counts.size), self.basis, self.wrap)
+        return CurvesPrim(self.name, int(self.counts.size), self.basis, self.wrap, self.purpose)
 
     def at(self, time, xforms) -> np.ndarray:
         from pxr import Gf

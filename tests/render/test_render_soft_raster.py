@@ -104,7 +104,7 @@ def test_any_split_into_bands_gives_the_same_bytes(width):
     mvp = np.ascontiguousarray(_perspective(), np.float64)
     ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, width)
     e, h = len(starts), SIZE[1]
-    seg, box = np.zeros((e, 12)), np.zeros((4, e), np.int32)
+    seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
     soft_raster._setup_kernel(
         points, starts, colors, mvp, SIZE[0], h, 0.75 * width + 1.0, seg, box, np.zeros(0, bool)
     )
@@ -134,7 +134,7 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
                 soft_raster._cover_steps,
             )
         )
-        seg, box = np.zeros((e, 12)), np.zeros((4, e), np.int32)
+        seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
         setup(points, starts, colors, mvp, w, h, 4.0, seg, box, np.zeros(0, bool))
         bounds = soft_raster.band_bounds(box[0], box[1], h, 3)
         images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)] * 3
