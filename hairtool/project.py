@@ -44,7 +44,7 @@ from hairtool.io.binary import float32_finite, require_finite, require_strand_co
 from hairtool.io.npz import read_npy_header
 
 FORMAT = "hairtool project"
-FORMAT_VERSION = 2  # 2: stroke logs with brushes beside align (version 1 files still read)
+FORMAT_VERSION = 2  # 2: brush strokes or render hair (children); version 1 files still read
 READABLE_VERSIONS = (1, 2)
 SUFFIX = ".hairproj"
 MANIFEST = "manifest.json"
@@ -182,6 +182,8 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
     for name in ("brush", "display", "key_settings", "settings"):
         manifest[name] = _json_object(name, getattr(project, name))
     manifest["children"] = _children_arrays(project, arrays)
+    if manifest["children"] is not None:
+        manifest["version"] = FORMAT_VERSION  # render hair an older hairtool would drop unseen
     manifest["arrays"] = sorted(arrays)
     return manifest, arrays
 
