@@ -10,7 +10,9 @@ that finishes is written into its manifest at once, so a batch stopped half-way 
 
 from __future__ import annotations
 
+import contextlib
 import secrets
+import stat
 import sys
 import time
 from collections.abc import Sequence
@@ -18,7 +20,7 @@ from dataclasses import dataclass, field
 
 from hairtool.errors import HairtoolError
 from hairtool.farm.jobs import Job
-from hairtool.farm.manifest import Manifests
+from hairtool.farm.manifest import Manifests, named_paths
 from hairtool.farm.progress import Progress
 
 
@@ -98,7 +100,9 @@ def default_threads(scheduler: str | None, workers: int) -> int | None:
     return None if scheduler is not None else max(1, cores() // workers)
 
 
-def _collect(future, job: Job, manifests: Manifests, warnings: list[str]) -> dict:
+def _outcome(future, job: Job) -> tuple[dict, dict | None]:
+    """The report row of a finished task and, when the job is done, its
+    :func:`~hairtool.farm.runner.run_job` result (for the manifest)."""
     from distributed import CancelledError, KilledWorker
 
     try:
@@ -110,41 +114,83 @@ def _collect(future, job: Job, manifests: Manifests, warnings: list[str]) -> dic
         )
         return row(
             job, "failed", None, f"the worker running it died {deaths} (the last: {last}); Dask gave up"
-        )
+        ), None
     except CancelledError:
-        return row(job, "failed", None, "cancelled: the scheduler lost the job (restarted or shut down?)")
+        lost = "cancelled: the scheduler lost the job (restarted or shut down?)"
+        return row(job, "failed", None, lost), None
     except Exception as e:  # the task could not run at all (say, hairtool missing on a worker)
-        return row(job, "failed", None, f"{type(e).__name__}: {e}".splitlines()[0])
-    if result["status"] == "done":
-        try:
-            manifests.record(job, result)
-        except HairtoolError as e:
-            warnings.append(str(e))
-    return _finished(job, result)
+        return row(job, "failed", None, f"{type(e).__name__}: {e}".splitlines()[0]), None
+    return _finished(job, result), result if result["status"] == "done" else None
+
+
+def _record(manifests: Manifests, done: list[tuple[Job, dict]], warnings: list[str]) -> None:
+    try:
+        manifests.record_many(done)
+    except HairtoolError as e:
+        warnings.append(str(e))
+
+
+def _collect(future, job: Job, manifests: Manifests, warnings: list[str]) -> dict:
+    """The report row of one finished task, its job recorded in the manifest when done."""
+    r, result = _outcome(future, job)
+    if result is not None:
+        _record(manifests, [(job, result)], warnings)
+    return r
+
+
+def input_bytes(job: Job) -> int:
+    """Bytes of the existing files the job's arguments name: how long it will run, roughly."""
+    total = 0
+    for p in named_paths(job.args, job.base):
+        with contextlib.suppress(OSError):
+            st = p.stat()
+            if stat.S_ISREG(st.st_mode):
+                total += st.st_size
+    return total
 
 
 def _run_on_dask(client, todo: list[Job], threads, manifests, rows, progress, warnings) -> None:
+    """One task per job, the largest inputs first: a batch ends when its last job does, and a long
+    job started last would leave the other workers idle while it runs (the short ones fill in at the
+    end instead). Results are taken as they arrive; those that arrive together go into their
+    manifest in one write."""
     from distributed import as_completed
 
     from hairtool.farm.runner import run_job
 
     batch_id = secrets.token_hex(4)
+    sizes = {job.index: input_bytes(job) for job in todo}
+    order = sorted(todo, key=lambda job: -sizes[job.index])  # stable: equal sizes keep file order
     futures = {
-        client.submit(run_job, job, threads, key=f"hairtool-batch-{batch_id}-{job.index}", pure=False): job
-        for job in todo
+        client.submit(
+            run_job,
+            job,
+            threads,
+            key=f"hairtool-batch-{batch_id}-{job.index}",
+            pure=False,
+            priority=len(order) - rank,
+        ): job
+        for rank, job in enumerate(order)
     }
     slots = max(1, sum(client.nthreads().values()))
     left = len(futures)
     progress.update(running=min(left, slots))
     try:
-        for future in as_completed(futures):
-            job = futures[future]
-            r = _collect(future, job, manifests, warnings)
-            rows[job.index] = r
-            future.release()
-            left -= 1
-            ok = r["status"] == "done"
-            progress.update(done=int(ok), failed=int(not ok), running=min(left, slots))
+        for finished in as_completed(futures).batches():
+            done = []
+            for future in finished:
+                job = futures[future]
+                r, result = _outcome(future, job)
+                rows[job.index] = r
+                if result is not None:
+                    done.append((job, result))
+                future.release()
+            if done:
+                _record(manifests, done, warnings)
+            for future in finished:
+                left -= 1
+                ok = rows[futures[future].index]["status"] == "done"
+                progress.update(done=int(ok), failed=int(not ok), running=min(left, slots))
     except BaseException:
         client.cancel(list(futures))
         raise

@@ -9,8 +9,10 @@ every input has the same content: the same size and time (not read again), or el
 sha256 (a file touched or copied back). A file rewritten in place that keeps both its size and
 its time to the nanosecond is not noticed; ``--force`` reruns everything.
 
-Only the batch's client writes manifests, atomically, after re-reading the file, so entries
-another batch wrote in the meantime are kept.
+Only the batch's client writes manifests, atomically, one write for the jobs that finished
+together; it re-reads the file first unless the file is still the one it wrote itself (same
+inode, size and time to the nanosecond), so entries another batch wrote in the meantime are
+kept without parsing the whole manifest again after every job.
 """
 
 from __future__ import annotations
@@ -67,6 +69,8 @@ class Manifests:
     def __init__(self) -> None:
         self._entries: dict[Path, dict] = {}
         self._hashes: dict[tuple[str, int, int], str] = {}
+        self._written: dict[Path, dict] = {}  # per folder: the entries this object last wrote
+        self._identity: dict[Path, tuple | None] = {}  # and the file it wrote them to
 
     @staticmethod
     def _read(folder: Path) -> dict:
@@ -126,10 +130,21 @@ class Manifests:
     def record(self, job: Job, result: dict) -> Path | None:
         """Write ``job``'s entry (from a ``done`` :func:`~hairtool.farm.runner.run_job` result) into
         the manifest beside its first output; None when the job wrote nothing."""
-        if not result.get("outputs"):
-            return None
-        folder = Path(next(iter(result["outputs"]))).parent
-        entry = {
+        paths = self.record_many([(job, result)])
+        return paths[0] if paths else None
+
+    def record_many(self, done: list[tuple[Job, dict]]) -> list[Path]:
+        """:meth:`record` for several jobs, one write per manifest; the manifests written."""
+        by_folder: dict[Path, dict[str, dict]] = {}
+        for job, result in done:
+            if result.get("outputs"):
+                folder = Path(next(iter(result["outputs"]))).parent
+                by_folder.setdefault(folder, {})[job.key] = self._entry(job, result)
+        return [self._write(folder, new) for folder, new in by_folder.items()]
+
+    @staticmethod
+    def _entry(job: Job, result: dict) -> dict:
+        return {
             "command": job.command,
             "args": list(job.args),
             "base": job.base,
@@ -140,14 +155,30 @@ class Manifests:
             "finished": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
             "hairtool": __version__,
         }
-        entries = self._read(folder)  # keep what another batch wrote since this one read the file
-        entries[job.key] = entry
+
+    def _write(self, folder: Path, new: dict[str, dict]) -> Path:
         path = folder / MANIFEST_NAME
+        # Keep what another batch wrote since this one last read or wrote the file: read it again
+        # unless it is still the very file written here (an atomic write by anyone makes a new
+        # file, so the same inode, size and time mean nobody else has written).
+        entries = self._written.get(folder)
+        if entries is None or _identity(path) != self._identity.get(folder):
+            entries = self._read(folder)
+        entries = {**entries, **new}
         try:
             with atomic_open(path, "w", encoding="utf-8") as f:
                 json.dump({"format": FORMAT, "version": VERSION, "jobs": entries}, f, indent=1)
                 f.write("\n")
         except OSError as e:
             raise FormatError(path, f"cannot write the batch manifest: {e.strerror or e}") from None
-        self._entries[folder] = entries
+        self._entries[folder] = self._written[folder] = entries
+        self._identity[folder] = _identity(path)
         return path
+
+
+def _identity(path: Path) -> tuple[int, int, int, int] | None:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns

@@ -8,7 +8,7 @@ cost comes from the Gram matrix in O(1): O(n³) in all, independent of the featu
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import get_num_threads, njit, prange
 from numpy.typing import NDArray
 
 from hairtool.keys.gram import check_gram, frame_errors_reference
@@ -18,9 +18,10 @@ F64 = NDArray[np.float64]
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _worst_kernel(g, curv, lam, hermite):  # pragma: no cover - compiled
-    # Row i costs ~(n − i)²/2, so each parallel step takes a row from each end (i and n − 1 − i):
-    # the threads get equal work, and each row is one thread's, whatever the thread count.
+def _worst_kernel(g, curv, lam, hermite, n_hands):  # pragma: no cover - compiled
+    # Row i costs ~(n − i)²/2: rows are dealt like cards (i ≡ c mod n_hands), one hand per thread,
+    # so the threads get equal work to within a row, and each row is one thread's, whatever the
+    # thread count.
     n = g.shape[0]
     out = np.zeros((n, n))
     base = np.empty(n)
@@ -28,11 +29,9 @@ def _worst_kernel(g, curv, lam, hermite):  # pragma: no cover - compiled
     for k in range(n):
         diag[k] = g[k, k]
         base[k] = g[k, k] + lam * curv[k]
-    for step in prange(n // 2):
-        _worst_row(g, base, diag, hermite, step, out[step])
-        _worst_row(g, base, diag, hermite, n - 1 - step, out[n - 1 - step])
-    if n % 2 == 1:
-        _worst_row(g, base, diag, hermite, n // 2, out[n // 2])
+    for c in prange(n_hands):
+        for i in range(c, n, n_hands):
+            _worst_row(g, base, diag, hermite, i, out[i])
     return out
 
 
@@ -57,11 +56,7 @@ def _worst_row(g, base, diag, hermite, i, w):  # pragma: no cover - compiled
             gk = g[k]
             a, gik = base[k], gi[k]
             di = float(k - i)
-            for j in range(k + 1, n):
-                s = di * inv[j]
-                r = 1.0 - s
-                quad = r * r * gii + 2.0 * r * s * gi[j] + s * s * diag[j]
-                w[j] = max(w[j], a - 2.0 * (r * gik + s * gk[j]) + quad)
+            _linear_span(w, gi, gk, diag, inv, a, gii, gik, di, k + 1, n)
         return
     # Hermite: per j, the ten ⟨u_a, u_b⟩ of hermite_quad_terms; the end tangent's stencil is
     # (j − 1, j + 1, 1/2) but at the last frame, which gets its own pass so the loop stays plain
@@ -75,13 +70,59 @@ def _worst_row(g, base, diag, hermite, i, w):  # pragma: no cover - compiled
         gk = g[k]
         a, gki, gkt = base[k], gk[i], gk[hi] - gk[li]
         di = float(k - i)
-        for j in range(k + 1, n - 1):
-            e = _hermite_cost(a, gki, gkt, gk[j], gk[j + 1] - gk[j - 1], di, inv[j], j - i, wi, 0.5, u, j)
-            w[j] = max(w[j], e)
+        _hermite_span(w, gk, inv, u, a, gki, gkt, di, i, wi, k + 1, n - 1)
         lj, hj, wj = stencil_at(n - 1, n)
         last = n - 1
         e = _hermite_cost(a, gki, gkt, gk[last], gk[hj] - gk[lj], di, inv[last], last - i, wi, wj, u, last)
         w[last] = max(w[last], e)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _linear_span(w, gi, gk, diag, inv, a, gii, gik, di, lo, hi):  # pragma: no cover - compiled
+    """w[j] = max(w[j], e_k of the linear segment (i, j)) for lo ≤ j < hi, on views from ``lo``."""
+    ww, g_i, g_k, dg, iv = w[lo:hi], gi[lo:hi], gk[lo:hi], diag[lo:hi], inv[lo:hi]
+    for t in range(hi - lo):
+        s = di * iv[t]
+        r = 1.0 - s
+        quad = r * r * gii + 2.0 * r * s * g_i[t] + s * s * dg[t]
+        ww[t] = max(ww[t], a - 2.0 * (r * gik + s * g_k[t]) + quad)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _hermite_span(w, gk, inv, u, a, gki, gkt, di, i, wi, lo, hi):  # pragma: no cover - compiled
+    """w[j] = max(w[j], e_k of the segment (i, j)) for lo ≤ j < hi (interior ends: stencil 1/2).
+
+    The same sum as :func:`_hermite_cost`, on views that start at ``lo``: plain non-negative
+    indices into 1-D arrays, which the compiler turns into SIMD lanes (indexing the 2-D ``u``
+    and ``gk[j ± 1]`` directly kept the loop scalar)."""
+    m = hi - lo
+    if m <= 0:
+        return
+    ww, g0, gp, gm, iv = w[lo:hi], gk[lo:hi], gk[lo + 1 : hi + 1], gk[lo - 1 : hi - 1], inv[lo:hi]
+    u0, u1, u2, u3, u4 = u[0, lo:hi], u[1, lo:hi], u[2, lo:hi], u[3, lo:hi], u[4, lo:hi]
+    u5, u6, u7, u8, u9 = u[5, lo:hi], u[6, lo:hi], u[7, lo:hi], u[8, lo:hi], u[9, lo:hi]
+    first = float(lo - i)
+    for t in range(m):
+        el = first + t
+        s = di * iv[t]
+        s2 = s * s
+        s3 = s2 * s
+        p0 = 1.0 - 3.0 * s2 + 2.0 * s3
+        p1 = s - 2.0 * s2 + s3
+        p2 = 3.0 * s2 - 2.0 * s3
+        p3 = s3 - s2
+        ti = el * wi * p1
+        tj = el * 0.5 * p3
+        cross = p0 * gki + ti * gkt + p2 * g0[t] + tj * (gp[t] - gm[t])
+        quad = (
+            p0 * p0 * u0[t]
+            + p1 * p1 * u2[t]
+            + p2 * p2 * u7[t]
+            + p3 * p3 * u9[t]
+            + 2.0 * (p0 * p1 * u1[t] + p0 * p2 * u3[t] + p0 * p3 * u4[t])
+            + 2.0 * (p1 * p2 * u5[t] + p1 * p3 * u6[t] + p2 * p3 * u8[t])
+        )
+        ww[t] = max(ww[t], a - 2.0 * cross + quad)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -126,4 +167,5 @@ def worst_table(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear", use
     g, curv = check_gram(g, curv, lam)
     if not use_numba:
         return worst_table_reference(g, curv, lam, interp)
-    return _worst_kernel(g, curv, float(lam), interp == "hermite")
+    n_hands = max(1, min(g.shape[0], get_num_threads()))
+    return _worst_kernel(g, curv, float(lam), interp == "hermite", n_hands)

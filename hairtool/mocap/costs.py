@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 
 import numpy as np
-from numba import njit, prange
+from numba import get_num_threads, njit, prange
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
@@ -133,7 +133,8 @@ def rotation_cost_table(
     if int(max_span) != max_span or max_span < 1:
         raise ParameterError("max_span", max_span, "a whole number of frames ≥ 1")
     q, p, w, wt = _cost_inputs(motion, weights, translation_weight)
-    cost = _cost_table_kernel(np.ascontiguousarray(q.transpose(1, 0, 2)), p, w, wt, int(min(max_span, n)))
+    q = np.ascontiguousarray(q.transpose(1, 0, 2))
+    cost = _cost_table_kernel(q, p, w, wt, int(min(max_span, n)), max(1, min(n, get_num_threads())))
     return cost + cost.T
 
 
@@ -160,11 +161,12 @@ def rotation_cost_table_reference(
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _acos_unit(x):
-    """arccos on [0, 1] to 2.2e-8 rad (Abramowitz & Stegun 4.4.46), four times faster than libm.
+def _acos_poly(x):
+    """P(x) with arccos(x) = sqrt(1 − x)·P(x) on [0, 1] to 2.2e-8 rad (Abramowitz & Stegun 4.4.46).
 
     The error is below the rounding of mocap files (1e-4 degrees = 1.7e-6 rad) and shrinks to 0
-    at x = 1, where the small angles of good interpolations live.
+    at x = 1, where the small angles of good interpolations live. The cost wants arccos², which
+    is (1 − x)·P(x)²: no square root, no libm call, so the loop that uses it vectorises.
     """
     p = -0.0012624911
     p = p * x + 0.0066700901
@@ -174,23 +176,80 @@ def _acos_unit(x):
     p = p * x + 0.0889789874
     p = p * x - 0.2145988016
     p = p * x + 1.5707963050
-    return np.sqrt(1.0 - x) * p
+    return p
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _cost_table_kernel(q, p, w, wt, max_span):
+def _cost_table_kernel(q, p, w, wt, max_span, n_hands):
     """Upper triangle of the cost table from q ``(J, F, 4)``; pairs farther apart than ``max_span`` get
     +inf. Each row i is computed by one thread, so the result does not depend on the thread count."""
     n = q.shape[1]
     cost = np.zeros((n, n))
-    # Row i costs ~(n − i)²: deal rows to chunks like cards (i ≡ c mod n_chunks) to balance threads.
-    n_chunks = min(n, 256)
-    for c in prange(n_chunks):
-        for i in range(c, n, n_chunks):
-            _cost_row(q, p, w, wt, i, min(n, i + max_span + 1), cost[i])
-            for j in range(i + max_span + 1, n):
+    # Row i costs ~(n − i)²: deal rows like cards (i ≡ c mod n_hands), one hand per thread, so
+    # every thread gets the same work to within one row.
+    for c in prange(n_hands):
+        for i in range(c, n, n_hands):
+            j_end = min(n, i + max_span + 1)
+            _cost_row(q, p, w, wt, i, j_end, cost[i])
+            for j in range(j_end, n):
                 cost[i, j] = np.inf
     return cost
+
+
+#: Segment ends l = j − i handled together: their running state (nine arrays) stays in the L1 cache.
+_BLOCK = 512
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _cos_sin_small(d):
+    """cos d and sin d for 0 ≤ d ≤ π/4 by their Taylor series to d¹⁸ (terms below 2e-18): a
+    polynomial, so the loop that uses it vectorises, and as exact as libm there."""
+    d2 = d * d
+    c = 1.0 / 6402373705728000.0  # 1/18!
+    c = c * d2 - 1.0 / 20922789888000.0
+    c = c * d2 + 1.0 / 87178291200.0
+    c = c * d2 - 1.0 / 479001600.0
+    c = c * d2 + 1.0 / 3628800.0
+    c = c * d2 - 1.0 / 40320.0
+    c = c * d2 + 1.0 / 720.0
+    c = c * d2 - 1.0 / 24.0
+    c = c * d2 + 0.5
+    s = 1.0 / 355687428096000.0  # 1/17!
+    s = s * d2 - 1.0 / 1307674368000.0
+    s = s * d2 + 1.0 / 6227020800.0
+    s = s * d2 - 1.0 / 39916800.0
+    s = s * d2 + 1.0 / 362880.0
+    s = s * d2 - 1.0 / 5040.0
+    s = s * d2 + 1.0 / 120.0
+    s = s * d2 - 1.0 / 6.0
+    return 1.0 - c * d2, d + d * (s * d2)
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _skip_frame(ca, sa, cd, sd, e0, e1, e2, e3, acc, dk, qk0, qk1, qk2, qk3, lo, hi):
+    """Frame k's term in every segment end l in [lo, hi) at once, and each end's (cos, sin) one
+    step on. The views start at 0 so the compiler sees plain non-negative indices and vectorises."""
+    ca, sa, cd, sd = ca[lo:hi], sa[lo:hi], cd[lo:hi], sd[lo:hi]
+    e0, e1, e2, e3, acc = e0[lo:hi], e1[lo:hi], e2[lo:hi], e3[lo:hi], acc[lo:hi]
+    for l in range(hi - lo):
+        c0, s0, c1, s1 = ca[l], sa[l], cd[l], sd[l]
+        x = min(1.0, abs(c0 * dk + s0 * (qk0 * e0[l] + qk1 * e1[l] + qk2 * e2[l] + qk3 * e3[l])))
+        a = _acos_poly(x)
+        acc[l] += (1.0 - x) * (a * a)
+        ca[l] = c0 * c1 - s0 * s1
+        sa[l] = s0 * c1 + c0 * s1
+
+
+@njit(cache=True, nogil=True, fastmath=True, inline="always")
+def _skip_frame_translation(tr, inv_l, d0, d1, d2, r, pk0, pk1, pk2, lo, hi):
+    """Frame k's squared distance to the root's lerp in every segment end l in [lo, hi)."""
+    tr, inv_l, d0, d1, d2 = tr[lo:hi], inv_l[lo:hi], d0[lo:hi], d1[lo:hi], d2[lo:hi]
+    for l in range(hi - lo):
+        t = r * inv_l[l]
+        r0 = pk0 - t * d0[l]
+        r1 = pk1 - t * d1[l]
+        r2 = pk2 - t * d2[l]
+        tr[l] += r0 * r0 + r1 * r1 + r2 * r2
 
 
 @njit(cache=True, nogil=True, fastmath=True)
@@ -198,70 +257,76 @@ def _cost_row(q, p, w, wt, i, j_end, out):
     """out[j] = cost[i, j] for i + 1 < j < j_end.
 
     Per (i, j, joint b) the slerp arc is s(t) = cos(tΩ) q_i + sin(tΩ) e with e the unit vector of
-    ±q_j − cos Ω q_i, so q_k·s needs q_k·q_i (once per row) and q_k·e. cos and sin of (k − i)·δ,
-    δ = Ω/(j − i), advance by rotation recurrences; two interleaved chains (odd and even k − i,
-    step 2δ) keep the floating-point pipeline busy.
+    ±q_j − cos Ω q_i, so q_k·s needs q_k·q_i and q_k·e. The loops run k outer and l = j − i
+    inner: every segment that skips frame k takes its term at once, each end l with its own
+    cos and sin of (k − i)·δ_l (δ_l = Ω_l/l ≤ π/4) advanced by a rotation step. The inner loop
+    has no dependence between iterations and no branch, so it runs in SIMD lanes; arccos² is
+    (1 − x)·P(x)² from the polynomial, without its square root.
     """
     n_b = q.shape[0]
-    dot_i = np.empty((n_b, j_end))
+    m = j_end - i  # local index l = j − i
+    acc = np.zeros(m)
+    ca = np.zeros(m)
+    sa = np.zeros(m)
+    cd = np.ones(m)
+    sd = np.zeros(m)
+    e0 = np.zeros(m)
+    e1 = np.zeros(m)
+    e2 = np.zeros(m)
+    e3 = np.zeros(m)
+    dl = np.zeros(m)
+    total = np.zeros(m)
     for b in range(n_b):
-        for k in range(i, j_end):
-            dot_i[b, k] = (
-                q[b, k, 0] * q[b, i, 0]
-                + q[b, k, 1] * q[b, i, 1]
-                + q[b, k, 2] * q[b, i, 2]
-                + q[b, k, 3] * q[b, i, 3]
-            )
-    for j in range(i + 2, j_end):
-        total = 0.0
-        span = j - i
-        for b in range(n_b):
-            c = dot_i[b, j]
+        qi0, qi1, qi2, qi3 = q[b, i, 0], q[b, i, 1], q[b, i, 2], q[b, i, 3]
+        for l in range(2, m):
+            j = i + l
+            c = q[b, j, 0] * qi0 + q[b, j, 1] * qi1 + q[b, j, 2] * qi2 + q[b, j, 3] * qi3
             sign = 1.0
             if c < 0.0:
                 sign = -1.0
                 c = -c
             c = min(c, 1.0)
             sin_om = np.sqrt(max(0.0, 1.0 - c * c))
-            e0 = e1 = e2 = e3 = 0.0
-            cd, sd = 1.0, 0.0
+            e0[l] = e1[l] = e2[l] = e3[l] = 0.0
+            dl[l] = 0.0
             if sin_om >= 1e-12:  # else q_j ≈ ±q_i: the arc is the point q_i
                 inv = 1.0 / sin_om
-                e0 = (sign * q[b, j, 0] - c * q[b, i, 0]) * inv
-                e1 = (sign * q[b, j, 1] - c * q[b, i, 1]) * inv
-                e2 = (sign * q[b, j, 2] - c * q[b, i, 2]) * inv
-                e3 = (sign * q[b, j, 3] - c * q[b, i, 3]) * inv
-                delta = np.arccos(c) / span
-                cd, sd = np.cos(delta), np.sin(delta)
-            c2 = cd * cd - sd * sd  # cos 2δ, sin 2δ
-            s2 = 2.0 * sd * cd
-            ca, sa = cd, sd  # odd chain: k − i = 1, 3, …
-            cb, sb = c2, s2  # even chain: k − i = 2, 4, …
-            acc_a = 0.0
-            acc_b = 0.0
-            k = i + 1
-            while k + 1 < j:
-                da = q[b, k, 0] * e0 + q[b, k, 1] * e1 + q[b, k, 2] * e2 + q[b, k, 3] * e3
-                db = q[b, k + 1, 0] * e0 + q[b, k + 1, 1] * e1 + q[b, k + 1, 2] * e2 + q[b, k + 1, 3] * e3
-                xa = _acos_unit(min(1.0, abs(ca * dot_i[b, k] + sa * da)))
-                xb = _acos_unit(min(1.0, abs(cb * dot_i[b, k + 1] + sb * db)))
-                acc_a += xa * xa
-                acc_b += xb * xb
-                ca, sa = ca * c2 - sa * s2, sa * c2 + ca * s2
-                cb, sb = cb * c2 - sb * s2, sb * c2 + cb * s2
-                k += 2
-            if k < j:
-                da = q[b, k, 0] * e0 + q[b, k, 1] * e1 + q[b, k, 2] * e2 + q[b, k, 3] * e3
-                xa = _acos_unit(min(1.0, abs(ca * dot_i[b, k] + sa * da)))
-                acc_a += xa * xa
-            total += w[b] * (acc_a + acc_b)
-        tr = 0.0
-        for k in range(i + 1, j):
-            t = (k - i) / span
-            for a in range(3):
-                r = p[k, a] - (p[i, a] + t * (p[j, a] - p[i, a]))
-                tr += r * r
-        out[j] = total + wt * tr
+                e0[l] = (sign * q[b, j, 0] - c * qi0) * inv
+                e1[l] = (sign * q[b, j, 1] - c * qi1) * inv
+                e2[l] = (sign * q[b, j, 2] - c * qi2) * inv
+                e3[l] = (sign * q[b, j, 3] - c * qi3) * inv
+                dl[l] = np.arccos(c) / l
+        for l in range(2, m):
+            cd[l], sd[l] = _cos_sin_small(dl[l])
+            ca[l], sa[l] = cd[l], sd[l]  # k − i = 1
+            acc[l] = 0.0
+        for l0 in range(2, m, _BLOCK):
+            l1 = min(m, l0 + _BLOCK)
+            for r in range(1, l1 - 1):  # frame k = i + r, skipped by every segment with l > r
+                k = i + r
+                qk0, qk1, qk2, qk3 = q[b, k, 0], q[b, k, 1], q[b, k, 2], q[b, k, 3]
+                dk = qk0 * qi0 + qk1 * qi1 + qk2 * qi2 + qk3 * qi3
+                _skip_frame(ca, sa, cd, sd, e0, e1, e2, e3, acc, dk, qk0, qk1, qk2, qk3, max(r + 1, l0), l1)
+        wb = w[b]
+        for l in range(2, m):
+            total[l] += wb * acc[l]
+    # The root translation against its lerp, k outer and j inner the same way.
+    tr = np.zeros(m)
+    inv_l = np.zeros(m)
+    d0 = np.zeros(m)
+    d1 = np.zeros(m)
+    d2 = np.zeros(m)
+    for l in range(2, m):
+        inv_l[l] = 1.0 / l
+        d0[l] = p[i + l, 0] - p[i, 0]
+        d1[l] = p[i + l, 1] - p[i, 1]
+        d2[l] = p[i + l, 2] - p[i, 2]
+    for r in range(1, m - 1):
+        k = i + r
+        pk0, pk1, pk2 = p[k, 0] - p[i, 0], p[k, 1] - p[i, 1], p[k, 2] - p[i, 2]
+        _skip_frame_translation(tr, inv_l, d0, d1, d2, float(r), pk0, pk1, pk2, r + 1, m)
+    for l in range(2, m):
+        out[i + l] = total[l] + wt * tr[l]
 
 
 # ---------------------------------------------------------------------------------------

@@ -73,6 +73,34 @@ def test_jobs_of_one_folder_share_its_manifest_and_a_second_writer_keeps_the_fir
     assert Manifests().find_done(first) and Manifests().find_done(second)
 
 
+def test_a_writer_that_wrote_before_reads_the_file_again_when_another_wrote_since(project):
+    a, b, c = keys_job(project, "a"), keys_job(project, "b", 1), keys_job(project, "c", 2)
+    writer_1, writer_2 = Manifests(), Manifests()
+    writer_1.record(a, run_job(a))
+    writer_2.record(b, run_job(b))  # after writer_1's write: writer_1's own copy is out of date
+    writer_1.record(c, run_job(c))
+    data = json.loads((project / "out" / MANIFEST_NAME).read_text())
+    assert len(data["jobs"]) == 3
+    assert all(Manifests().find_done(job) for job in (a, b, c))
+
+
+def test_jobs_that_finish_together_share_one_write(project, monkeypatch):
+    import hairtool.farm.manifest as manifest
+
+    jobs = [keys_job(project, name, i) for i, name in enumerate("abc")]
+    results = [run_job(job) for job in jobs]
+    opened, real = [], manifest.atomic_open
+
+    def counted(path, *args, **kwargs):
+        opened.append(path)
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(manifest, "atomic_open", counted)
+    assert Manifests().record_many(list(zip(jobs, results, strict=True))) == [project / "out" / MANIFEST_NAME]
+    assert len(opened) == 1
+    assert all(Manifests().find_done(job) for job in jobs)
+
+
 def test_a_damaged_manifest_only_means_the_jobs_run_again(project):
     job = keys_job(project)
     done(project, job)

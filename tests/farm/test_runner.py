@@ -144,3 +144,14 @@ def test_a_job_whose_workers_kept_dying_or_that_could_not_run_is_a_failed_row():
     )
     missing = _collect(Finished(ModuleNotFoundError("No module named 'hairtool'")), job, Manifests(), [])
     assert missing["error"] == "ModuleNotFoundError: No module named 'hairtool'"
+
+
+def test_input_bytes_weighs_a_job_by_the_files_it_names(project):
+    from hairtool.farm.batch import input_bytes
+
+    shot = project / "shots" / "a.npz"
+    job = Job(0, "keys", ("shots/a.npz", "--keys", "4", "--out", "out/missing.json"), str(project))
+    assert input_bytes(job) == shot.stat().st_size  # the output does not exist yet; options are no files
+    both = Job(1, "keys", ("shots/a.npz", "--export=shots/b.npz"), str(project))
+    assert input_bytes(both) == shot.stat().st_size + (project / "shots" / "b.npz").stat().st_size
+    assert input_bytes(Job(2, "keys", ("nothing.npz",), str(project))) == 0

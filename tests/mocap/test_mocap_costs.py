@@ -155,3 +155,20 @@ def test_bad_arguments(walk):
         rotation_cost_table(walk, interp="squad")
     with pytest.raises(ParameterError, match="max_span"):
         rotation_cost_table(walk, max_span=0)
+
+
+def test_long_segments_across_the_kernel_blocks_match_the_seed_formula():
+    # Ends 512 frames and more from the start fall in the kernel's second block of segment ends,
+    # and the cos/sin recurrence runs over hundreds of steps: both must stay exact to the twin.
+    m = random_motion(frames=560, seed=4)
+    w = joint_weights(m)
+    q = quat.align_hemisphere(m.local_rotations(), axis=0)
+    p = m.root_translation() / skeleton_size(m)
+    table = rotation_cost_table(m)
+    for i, j in [(0, 559), (0, 513), (1, 514), (3, 300), (40, 555)]:
+        t = (np.arange(i + 1, j) - i) / (j - i)
+        s = quat.slerp(q[i][None], q[j][None], t[:, None])
+        d = quat.distance(q[i + 1 : j], s)
+        lin = p[i] + t[:, None] * (p[j] - p[i])
+        total = np.sum(w * d * d) + w[0] * np.sum((p[i + 1 : j] - lin) ** 2)
+        assert table[i, j] == pytest.approx(total, rel=1e-7)
