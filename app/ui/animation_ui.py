@@ -23,6 +23,10 @@ from hairtool.frozen.align import align
 from hairtool.groom import Groom
 from hairtool.keys.session import key_edit_block
 
+KEY_EDIT_MISSED = (
+    "The brush touched no strand of this key pose: start the drag on the hair, or make it bigger ( ] )"
+)
+
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
 
@@ -114,6 +118,7 @@ class KeyEditBrush:
             return
         m.set_preview(frame, None)
         if np.array_equal(groom.points, m.animation.frames[frame]):
+            self.c.window.statusBar().showMessage(KEY_EDIT_MISSED, 6000)
             return
         try:
             start, block = key_edit_block(
@@ -184,9 +189,8 @@ class AnimationController(QObject):
             self.window.undo_stack.clear()
             self.scene.load(anim.rest, self.scene.path)
         self.viewport.brush_target = self.brush if anim is not None and self.recorder is None else None
-        self.viewport.extra_bounds = None if anim is None else anim.bounds
         if anim is not None:
-            self.viewport.frame_all()  # the whole motion in view
+            self.viewport.frame_all()  # the groom, not the empty space its whole motion spans
         self.refresh_display()
         self._update_fps_label()
 

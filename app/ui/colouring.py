@@ -7,9 +7,9 @@ import numpy as np
 from app.render.ramps import (
     categorical_colors,
     per_strand_random_colors,
-    ramp_colors,
     strand_to_vertex_colors,
 )
+from app.ui.legend import magnitude_colors
 from app.ui.scene import Scene
 
 STRAND_COLOUR_SEED = 7  # fixed, so a groom keeps its per-strand colours between runs
@@ -27,9 +27,11 @@ def vertex_colors(scene: Scene) -> np.ndarray | None:
         ids = np.asarray(scene.pipeline.clump_ids())
         return strand_to_vertex_colors(categorical_colors(ids), top)
     if mode == "displacement":
-        d = scene.displacement()
-        # Heat over [0, median strand length]: a fixed scale per groom, so colours do not
-        # flicker while dragging as a per-frame maximum would.
-        scale = float(np.median(scene.rest.strand_lengths))
-        return ramp_colors(d / max(scale, 1e-9), "heat")
+        return magnitude_colors(scene.displacement() / displacement_scale(scene))
     raise ValueError(f"unknown colour mode {mode!r}")
+
+
+def displacement_scale(scene: Scene) -> float:
+    """The displacement that shows at the ramp's top: the median strand length of the rest groom,
+    a fixed scale per groom, so colours do not flicker while dragging as a per-frame maximum would."""
+    return max(float(np.median(scene.rest.strand_lengths)), 1e-9)

@@ -30,7 +30,9 @@ from app.ui.colouring import vertex_colors
 from app.ui.scene import Scene
 
 BRUSH_STEP = 1.1  # radius factor per wheel notch or [ / ] press
-GHOST_RGBA = (0.55, 0.75, 1.0, 0.35)  # the reconstruction under the original: flat, translucent
+# The reconstruction behind the original: one flat cyan no ramp uses, opaque enough to read on the
+# dark background wherever it parts from the original (where they agree, the original covers it).
+GHOST_RGBA = (0.2, 0.9, 1.0, 0.75)
 
 
 class BrushTarget(Protocol):
@@ -78,7 +80,6 @@ class Viewport(QOpenGLWidget):
         self.shown_frame: int | None = None  # the frame number uploaded at the last paint
         self._pending_frame: int | None = None
         self.brush_target: BrushTarget | None = None
-        self.extra_bounds: tuple[np.ndarray, np.ndarray] | None = None  # e.g. a whole animation's box
         self._drag_target: BrushTarget | None = None  # the target that took the current drag
         self.setMouseTracking(True)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
@@ -147,8 +148,6 @@ class Viewport(QOpenGLWidget):
     def frame_all(self) -> None:
         """Fit the groom (and the head mesh) in view; planar grooms get the 2-D orthographic camera."""
         lo, hi = self.scene.result.bounds
-        if self.extra_bounds is not None:
-            lo, hi = np.minimum(lo, self.extra_bounds[0]), np.maximum(hi, self.extra_bounds[1])
         if self.scene.mesh is not None:
             v = np.asarray(self.scene.mesh.vertices, dtype=np.float32)
             if v.size:

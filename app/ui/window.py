@@ -9,17 +9,20 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from PySide6.QtCore import QSettings, Qt
+import numpy as np
+from PySide6.QtCore import QSettings, QSize, Qt
 from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QKeySequence, QUndoStack
-from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QWidget
+from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox, QWidget
 
 from app.ui import export
 from app.ui.animation_io import open_filters, read_any, save_filters
 from app.ui.animation_model import AnimationModel
 from app.ui.animation_ui import AnimationController
+from app.ui.colouring import displacement_scale
 from app.ui.commands import ParamCommand, StrokeCommand
 from app.ui.dialogs import StillOptions, ask_still_options
 from app.ui.jobs import JobRunner, JobStatus
+from app.ui.legend import RampLegend, unit_name
 from app.ui.qt_utils import add_action
 from app.ui.scene import COLOUR_MODES, Scene
 from app.ui.simulate_dialog import ask_simulate_options
@@ -32,7 +35,14 @@ from hairtool.groom import Animation, Groom
 from hairtool.simulate.options import SimulateOptions
 
 MAX_RECENT = 10
+FIRST_SIZE = (1280, 800)  # the window's first-start size, shrunk to fit smaller screens
+MISSED_STRANDS = "The brush touched no strand: start the drag on the hair, or make the brush bigger ( ] )"
 SETTINGS_ORG, SETTINGS_APP = "hairtool", "Hairtool Studio"
+
+
+def fitting_size(available: QSize) -> tuple[int, int]:
+    """The first-start window size: :data:`FIRST_SIZE`, or the screen's free area when smaller."""
+    return min(FIRST_SIZE[0], available.width()), min(FIRST_SIZE[1], available.height())
 
 
 class MainWindow(QMainWindow):
@@ -51,6 +61,8 @@ class MainWindow(QMainWindow):
         self.setObjectName("HairtoolStudio")
         self.settings = settings if settings is not None else QSettings(SETTINGS_ORG, SETTINGS_APP)
         self.undo_stack = QUndoStack(self)
+        self._shown_once = False
+        self._stroke_points: np.ndarray | None = None
         # long work (key solves, simulation, video export): window.jobs.run(title, fn, on_done)
         self.jobs = JobRunner(lambda title, message: self.show_error(title, message), self)
         start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
@@ -64,13 +76,28 @@ class MainWindow(QMainWindow):
         self._build_animation_ui()
         self._build_part2_menus()
         self.setAcceptDrops(True)
-        self.resize(1280, 800)
+        self.setDockOptions(
+            QMainWindow.DockOption.AnimatedDocks
+            | QMainWindow.DockOption.AllowTabbedDocks
+            | QMainWindow.DockOption.AllowNestedDocks
+        )
+        self.resize(*fitting_size(self.screen().availableGeometry().size()))
+        self._default_layout = (self.saveState(), self.size())
 
+        self.viewport.stroke_started.connect(self._on_stroke_started)
         self.viewport.stroke_finished.connect(self._on_stroke_finished)
         self.viewport.cursor_moved.connect(self._on_cursor_moved)
         self.viewport.frame_drawn.connect(self._update_frame_time)
         self.dock.param_edited.connect(self._on_param_edited)
         self.scene.groom_loaded.connect(self._update_counts)
+        self.scene.groom_loaded.connect(self._update_legend)
+        self.scene.display_changed.connect(self._update_legend)
+        for signal in (
+            self.animation.animation_changed,
+            self.animation.view_mode_changed,
+            self.animation.analysis_changed,
+        ):
+            signal.connect(self._update_legend)
         self.scene.path_changed.connect(self._update_title)
         self.undo_stack.cleanChanged.connect(self._update_title)
         self._update_counts()
@@ -121,6 +148,26 @@ class MainWindow(QMainWindow):
         state = self.settings.value("window_state")
         if state is not None:
             self.restoreState(state)
+
+    def reset_layout(self) -> None:
+        """Docks back where a first start puts them (tools and anime wave tabbed on the right,
+        the timeline below), none floating, and the window at its first-start size."""
+        state, size = self._default_layout
+        for dock in self.findChildren(QDockWidget):
+            dock.setFloating(False)
+            dock.show()
+        self.restoreState(state)
+        self.dock.raise_()
+        if not self.isMaximized() and not self.isFullScreen():
+            self.resize(size)
+        self.timeline.fit_height()
+        self.statusBar().showMessage("layout reset", 3000)
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        if not self._shown_once:  # docks can only be sized once they are laid out
+            self._shown_once = True
+            self.timeline.fit_height()
 
     def save_layout(self) -> None:
         self.settings.setValue("geometry", self.saveGeometry())
@@ -184,6 +231,7 @@ class MainWindow(QMainWindow):
             self.colour_actions[key] = a
         colour.aboutToShow.connect(lambda: self.colour_actions[self.scene.colour_mode].setChecked(True))
         view.addSeparator()
+        add_action(self, view, "&Reset layout", self.reset_layout)
         view.addAction(self.dock.toggleViewAction())
 
         brush = bar.addMenu("&Brush")
@@ -295,6 +343,27 @@ class MainWindow(QMainWindow):
         bar.addPermanentWidget(self.cursor_label)
         self.job_status = JobStatus(self.jobs)
         bar.addPermanentWidget(self.job_status)
+        self.legend = RampLegend()
+        bar.addPermanentWidget(self.legend)
+
+    def _update_legend(self, *_: object) -> None:
+        """The distance ramp's legend, in the groom's units, while distances colour the strands."""
+        unit = unit_name(self.scene.rest.metadata.meters_per_unit)
+        m = self.animation
+        if m.animation is not None and m.view_mode == "error" and m.error_scale > 0:
+            self.legend.show_scale(
+                "Key error", m.error_scale, unit,
+                "distance of each vertex from its reconstruction from the DP keys; "
+                "the top of the ramp is the keys' worst vertex over the whole animation",
+            )  # fmt: skip
+        elif m.animation is None and self.scene.colour_mode == "displacement":
+            self.legend.show_scale(
+                "Moved", displacement_scale(self.scene), unit,
+                "distance of each vertex from its rest position; the top of the ramp is the "
+                "median strand length (grey: not moved)",
+            )  # fmt: skip
+        else:
+            self.legend.hide()
 
     def _update_counts(self) -> None:
         g = self.scene.result
@@ -320,8 +389,14 @@ class MainWindow(QMainWindow):
         self.setWindowTitle(f"{name}{dirty} — Hairtool Studio")
 
     # -- editing -------------------------------------------------------------------------------
+    def _on_stroke_started(self) -> None:
+        self._stroke_points = self.scene.result.points.copy()
+
     def _on_stroke_finished(self, before: object, after: object) -> None:
         self.undo_stack.push(StrokeCommand(self.scene, before, after))
+        start, self._stroke_points = self._stroke_points, None
+        if start is not None and np.array_equal(start, self.scene.result.points):
+            self.statusBar().showMessage(MISSED_STRANDS, 6000)
 
     def _on_param_edited(self, name: str, value: object, drag: object) -> None:
         before = self.scene.params
