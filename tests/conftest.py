@@ -18,13 +18,14 @@ _xvfb: subprocess.Popen | None = None
 
 
 def _start_xvfb() -> None:
-    """Start ``Xvfb -displayfd`` and export DISPLAY, so plain ``pytest`` runs the GUI tests."""
+    """Start ``Xvfb -displayfd`` and export DISPLAY, so plain ``pytest`` runs the GUI tests, on a
+    1366×768 screen: the laptop size the studio must fit."""
     global _xvfb
     if os.environ.get("DISPLAY") or shutil.which("Xvfb") is None:
         return
     read_fd, write_fd = os.pipe()
     _xvfb = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
+        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1366x768x24", "-nolisten", "tcp"],
         pass_fds=(write_fd,),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,

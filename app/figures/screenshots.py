@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-WINDOW_SIZE = (1600, 1000)
+WINDOW_SIZE = (1366, 768)  # a laptop screen: the studio must fit one
 
 
 def stroke(window, start: Sequence[float], end: Sequence[float], steps: int = 24) -> None:
@@ -65,7 +65,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from app.surface import configure_gl
 
     configure_gl()
-    from PySide6.QtCore import QSettings, Qt
+    from PySide6.QtCore import QSettings
     from PySide6.QtWidgets import QApplication
 
     from app.ui.window import MainWindow
@@ -94,7 +94,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         window.sources.dock.raise_()
         window.sources.apply_anime()
         model = window.animation
-        window.resizeDocks([window.timeline], [360], Qt.Orientation.Vertical)
         settle(app)
         model.set_key_count(max(3, model.n_frames // 3))
         keys = model.dp_keys
