@@ -16,6 +16,7 @@ from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QUndoCommand
 from PySide6.QtWidgets import QLabel, QStyle, QWidget
 
 from app.ui.animation_model import VIEW_MODES, AnimationModel
+from app.ui.engine_start import WAIT_MESSAGE
 from app.ui.qt_utils import add_action
 from app.ui.recording import Recorder
 from hairtool.errors import HairtoolError
@@ -91,6 +92,9 @@ class KeyEditBrush:
 
     def begin(self, cursor: np.ndarray) -> bool:
         m = self.c.model
+        if not self.c.window.scene.engine_ready:  # the align kernel may still be compiling
+            self.c.window.statusBar().showMessage(WAIT_MESSAGE, 4000)
+            return False
         if m.animation is None or not m.is_key():
             self.c.window.statusBar().showMessage(
                 "Key edits happen at a DP key frame: jump to one with ↑ / ↓", 4000

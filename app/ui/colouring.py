@@ -24,6 +24,8 @@ def vertex_colors(scene: Scene) -> np.ndarray | None:
     if mode == "strand":
         return strand_to_vertex_colors(per_strand_random_colors(top.strand_count, STRAND_COLOUR_SEED), top)
     if mode == "clump":
+        if scene.pipeline is None:  # no clumps before the engine starts: all strands grey
+            return strand_to_vertex_colors(categorical_colors(np.full(top.strand_count, -1)), top)
         ids = np.asarray(scene.pipeline.clump_ids())
         return strand_to_vertex_colors(categorical_colors(ids), top)
     if mode == "displacement":

@@ -265,7 +265,7 @@ class ToolDock(QDockWidget):
                         w.value.setEnabled(value is not None)
                         if value is not None:
                             w.value.set_value(float(value))
-                        else:  # "Auto": show the value the engine uses (unticking starts there)
+                        elif self.scene.pipeline is not None:  # "Auto": the engine's value
                             w.value.set_value(float(getattr(self.scene.pipeline, spec.name)))
 
     def refresh_display(self) -> None:

@@ -25,7 +25,7 @@ from PySide6.QtGui import QMouseEvent, QWheelEvent
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 
 from app.render.camera import Camera
-from app.render.strands import StrandRenderer
+from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.colouring import vertex_colors
 from app.ui.scene import Scene
 
@@ -53,6 +53,7 @@ class Viewport(QOpenGLWidget):
     stroke_started = Signal()  # a left-drag on the scene's groom begins (before its first align)
     cursor_moved = Signal(object)  # (3,) float array on the interaction plane, or None
     frame_drawn = Signal()
+    engine_wait = Signal()  # a stroke began before the engine is ready: nothing was done
 
     def __init__(self, scene: Scene, parent=None) -> None:
         super().__init__(parent)
@@ -90,6 +91,7 @@ class Viewport(QOpenGLWidget):
         scene.display_changed.connect(lambda: self._mark("display", "colors"))
         scene.mesh_changed.connect(lambda: self._mark("mesh"))
         scene.tool_changed.connect(self.update)
+        scene.engine_started.connect(self._on_engine_started)
 
     # -- scene → view ----------------------------------------------------------------------
     def _mark(self, *what: str) -> None:
@@ -169,7 +171,14 @@ class Viewport(QOpenGLWidget):
     def initializeGL(self) -> None:
         self.ctx = moderngl.create_context()
         self.renderer = StrandRenderer(self.ctx)
+        if not self.scene.engine_ready:  # the CPU rasterizer's kernels are still compiling
+            self.renderer.strand_raster = "gl"
         self._dirty = {"groom", "colors", "display", "mesh"}
+
+    def _on_engine_started(self) -> None:
+        if self.renderer is not None:
+            self.renderer.strand_raster = default_strand_raster()
+        self._mark("groom", "colors", "display")
 
     def _upload(self) -> None:
         r, s, dirty = self.renderer, self.scene, self._dirty
@@ -295,7 +304,10 @@ class Viewport(QOpenGLWidget):
                 self._drag, self._drag_target = None, None
             event.accept()
             return
-        if self._drag == "align":
+        if self._drag == "align" and not self.scene.engine_ready:
+            self._drag = None
+            self.engine_wait.emit()
+        elif self._drag == "align":
             self._stroke_before = self.scene.snapshot()
             self.stroke_started.emit()
             self._align_at(event.position())

@@ -21,6 +21,7 @@ from app.ui.animation_ui import AnimationController
 from app.ui.colouring import displacement_scale
 from app.ui.commands import ParamCommand, StrokeCommand
 from app.ui.dialogs import StillOptions, ask_still_options
+from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import JobRunner, JobStatus
 from app.ui.legend import RampLegend, unit_name
 from app.ui.qt_utils import add_action
@@ -56,7 +57,10 @@ class MainWindow(QMainWindow):
         settings: QSettings | None = None,
         groom: Groom | None = None,
         parent: QWidget | None = None,
+        engine_ready: bool = True,
     ) -> None:
+        """``engine_ready=False``: the kernels are not cached yet, so the window shows without the
+        engine; :meth:`start_warmup` compiles them in the background and then starts it."""
         super().__init__(parent)
         self.setObjectName("HairtoolStudio")
         self.settings = settings if settings is not None else QSettings(SETTINGS_ORG, SETTINGS_APP)
@@ -66,7 +70,8 @@ class MainWindow(QMainWindow):
         # long work (key solves, simulation, video export): window.jobs.run(title, fn, on_done)
         self.jobs = JobRunner(lambda title, message: self.show_error(title, message), self)
         start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
-        self.scene = Scene(start, parent=self)
+        self.scene = Scene(start, parent=self, engine_ready=engine_ready)
+        self.engine_start: EngineStart | None = None
         self.viewport = Viewport(self.scene, self)
         self.setCentralWidget(self.viewport)
         self.dock = ToolDock(self.scene, self)
@@ -87,6 +92,7 @@ class MainWindow(QMainWindow):
         self.viewport.stroke_started.connect(self._on_stroke_started)
         self.viewport.stroke_finished.connect(self._on_stroke_finished)
         self.viewport.cursor_moved.connect(self._on_cursor_moved)
+        self.viewport.engine_wait.connect(lambda: self.statusBar().showMessage(WAIT_MESSAGE, 4000))
         self.viewport.frame_drawn.connect(self._update_frame_time)
         self.dock.param_edited.connect(self._on_param_edited)
         self.scene.groom_loaded.connect(self._update_counts)
@@ -149,6 +155,13 @@ class MainWindow(QMainWindow):
         if state is not None:
             self.restoreState(state)
 
+    def start_warmup(self) -> None:
+        """Compile the kernels in another process, progress in the status bar, then start the
+        engine (a first start: see :mod:`app.ui.engine_start`)."""
+        if self.engine_start is None and not self.scene.engine_ready:
+            self.engine_start = EngineStart(self.scene, self.statusBar(), self)
+            self.engine_start.start()
+
     def reset_layout(self) -> None:
         """Docks back where a first start puts them (tools and anime wave tabbed on the right,
         the timeline below), none floating, and the window at its first-start size."""
@@ -179,6 +192,8 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self.jobs.shutdown()
+        if self.engine_start is not None:
+            self.engine_start.stop()
         self.project.shutdown()
         self.save_layout()
         self.viewport.release_gl()
