@@ -49,6 +49,7 @@ def settle(app, rounds: int = 30) -> None:
 
 
 def save(window, path: Path) -> None:
+    window.statusBar().clearMessage()  # a stroke's passing remark is no part of the picture
     if not window.grab().save(str(path)):
         raise OSError(f"could not write {path}")
     print(f"wrote {path}")
