@@ -16,9 +16,8 @@ def missing_studio_packages() -> list[str]:
 
 
 def show_splash(app):
-    """A splash screen until the window is up: on a fresh install numba compiles the engine's
-    and the rasterizer's kernels first (about half a minute on two cores, then cached), and a
-    window that takes that long to appear with no sign of life looks hung."""
+    """A splash screen for the second or two until the window is up (on a first start the
+    kernels compile after it appears, in the background: see :mod:`app.ui.engine_start`)."""
     from PySide6.QtCore import Qt
     from PySide6.QtGui import QColor, QPixmap
     from PySide6.QtWidgets import QSplashScreen
@@ -27,8 +26,7 @@ def show_splash(app):
     pixmap.fill(QColor(41, 43, 48))
     splash = QSplashScreen(pixmap)
     splash.showMessage(
-        "Hairtool Studio\n\nPreparing the engine…\n"
-        "(the first start compiles its kernels: about half a minute)",
+        "Hairtool Studio\n\nStarting…",
         Qt.AlignmentFlag.AlignCenter,
         QColor(225, 228, 232),
     )
@@ -79,17 +77,21 @@ def main(argv: list[str] | None = None) -> int:
     configure_gl()
     from PySide6.QtWidgets import QApplication
 
+    from app.ui.kernel_warmup import kernels_cached
     from app.ui.window import MainWindow
 
     app = QApplication(sys.argv[:1])
     app.setOrganizationName("hairtool")
     app.setApplicationName("Hairtool Studio")
     splash = show_splash(app)
-    window = MainWindow(args.file)
+    cached = kernels_cached()
+    window = MainWindow(args.file, engine_ready=cached)
     if args.file is None:
         window.open_bundled_sample()
     window.show()
     splash.finish(window)
+    if not cached:
+        window.start_warmup()
     return app.exec()
 
 

@@ -18,13 +18,14 @@ _xvfb: subprocess.Popen | None = None
 
 
 def _start_xvfb() -> None:
-    """Start ``Xvfb -displayfd`` and export DISPLAY, so plain ``pytest`` runs the GUI tests."""
+    """Start ``Xvfb -displayfd`` and export DISPLAY, so plain ``pytest`` runs the GUI tests, on a
+    1366×768 screen: the laptop size the studio must fit."""
     global _xvfb
     if os.environ.get("DISPLAY") or shutil.which("Xvfb") is None:
         return
     read_fd, write_fd = os.pipe()
     _xvfb = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
+        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1366x768x24", "-nolisten", "tcp"],
         pass_fds=(write_fd,),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
@@ -37,8 +38,38 @@ def _start_xvfb() -> None:
     os.environ["DISPLAY"] = f":{number}"
 
 
+def missing_system_packages() -> str | None:
+    """``.ci/check-packages``'s one line naming the Debian packages the GUI tests lack, or None."""
+    script = ROOT / ".ci" / "check-packages"
+    if not script.is_file() or shutil.which("bash") is None:
+        return None
+    done = subprocess.run(["bash", str(script), "test"], capture_output=True, text=True, check=False)
+    if done.returncode != 1:
+        return None
+    return done.stdout.strip() or None
+
+
 def pytest_configure(config: pytest.Config) -> None:
-    _start_xvfb()
+    config.missing_system_packages = missing_system_packages()
+    if config.missing_system_packages is None:
+        _start_xvfb()
+
+
+def pytest_report_header(config: pytest.Config) -> str | None:
+    return config.missing_system_packages
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Without Qt's system libraries the GUI and render tests are skipped with the one line
+    that names the packages (Qt would otherwise abort the whole run at the first window)."""
+    reason = config.missing_system_packages
+    if reason is None:
+        return
+    needs_gui = (ROOT / "tests" / "gui", ROOT / "tests" / "render")
+    skip = pytest.mark.skip(reason=reason)
+    for item in items:
+        if item.get_closest_marker("gui") or any(d in Path(str(item.path)).parents for d in needs_gui):
+            item.add_marker(skip)
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:

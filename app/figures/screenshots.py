@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-WINDOW_SIZE = (1600, 1000)
+WINDOW_SIZE = (1366, 768)  # a laptop screen: the studio must fit one
 
 
 def stroke(window, start: Sequence[float], end: Sequence[float], steps: int = 24) -> None:
@@ -50,6 +50,7 @@ def settle(app, rounds: int = 30) -> None:
 
 
 def save(window, path: Path) -> None:
+    window.statusBar().clearMessage()  # a stroke's passing remark is no part of the picture
     if not window.grab().save(str(path)):
         raise OSError(f"could not write {path}")
     print(f"wrote {path}")
@@ -66,7 +67,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from app.surface import configure_gl
 
     configure_gl()
-    from PySide6.QtCore import QSettings, Qt
+    from PySide6.QtCore import QSettings
     from PySide6.QtWidgets import QApplication
 
     from app.ui.window import MainWindow
@@ -95,7 +96,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         window.sources.dock.raise_()
         window.sources.apply_anime()
         model = window.animation
-        window.resizeDocks([window.timeline], [360], Qt.Orientation.Vertical)
         settle(app)
         model.set_key_count(max(3, model.n_frames // 3))
         keys = model.dp_keys

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from PySide6.QtCore import QObject, Qt, QTimer, Signal
 
-from app.render.ramps import ramp_colors
 from app.ui.jobs import Job, JobRunner
+from app.ui.legend import magnitude_colors
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Animation
 from hairtool.keys import session as ks
@@ -28,7 +28,7 @@ from hairtool.keys.reconstruct import KeyPoses, interpolate_at
 VIEW_MODES = {
     "original": "Original",
     "reconstruction": "Reconstruction from keys",
-    "ghost": "Both (reconstruction as ghost)",
+    "ghost": "Both (reconstruction in cyan behind)",
     "error": "Colour by key error",
 }
 INLINE_VALUES = 3_000_000  # animations up to this many coordinates are solved on the GUI thread
@@ -566,4 +566,4 @@ class AnimationModel(QObject):
             return Display(f, original, ghost=rebuilt)
         d = np.sqrt(np.einsum("vi,vi->v", original - rebuilt, original - rebuilt))
         scale = self.error_scale or max(float(d.max()), 1e-12)
-        return Display(f, original, colors=ramp_colors(d / scale, "heat"))
+        return Display(f, original, colors=magnitude_colors(d / scale))

@@ -16,12 +16,17 @@ from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QUndoCommand
 from PySide6.QtWidgets import QLabel, QStyle, QWidget
 
 from app.ui.animation_model import VIEW_MODES, AnimationModel
+from app.ui.engine_start import WAIT_MESSAGE
 from app.ui.qt_utils import add_action
 from app.ui.recording import Recorder
 from hairtool.errors import HairtoolError
 from hairtool.frozen.align import align
 from hairtool.groom import Groom
 from hairtool.keys.session import key_edit_block
+
+KEY_EDIT_MISSED = (
+    "The brush touched no strand of this key pose: start the drag on the hair, or make it bigger ( ] )"
+)
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
@@ -87,6 +92,9 @@ class KeyEditBrush:
 
     def begin(self, cursor: np.ndarray) -> bool:
         m = self.c.model
+        if not self.c.window.scene.engine_ready:  # the align kernel may still be compiling
+            self.c.window.statusBar().showMessage(WAIT_MESSAGE, 4000)
+            return False
         if m.animation is None or not m.is_key():
             self.c.window.statusBar().showMessage(
                 "Key edits happen at a DP key frame: jump to one with ↑ / ↓", 4000
@@ -114,6 +122,7 @@ class KeyEditBrush:
             return
         m.set_preview(frame, None)
         if np.array_equal(groom.points, m.animation.frames[frame]):
+            self.c.window.statusBar().showMessage(KEY_EDIT_MISSED, 6000)
             return
         try:
             start, block = key_edit_block(
@@ -184,9 +193,8 @@ class AnimationController(QObject):
             self.window.undo_stack.clear()
             self.scene.load(anim.rest, self.scene.path)
         self.viewport.brush_target = self.brush if anim is not None and self.recorder is None else None
-        self.viewport.extra_bounds = None if anim is None else anim.bounds
         if anim is not None:
-            self.viewport.frame_all()  # the whole motion in view
+            self.viewport.frame_all()  # the groom, not the empty space its whole motion spans
         self.refresh_display()
         self._update_fps_label()
 

@@ -191,7 +191,8 @@ class AnimeDock(QDockWidget):
 
     # -- widgets ---------------------------------------------------------------------------
     def _wave_box(self) -> QGroupBox:
-        box = QGroupBox("Wave f(x, t), eq. (1)")
+        box = QGroupBox("Swing")
+        box.setToolTip("the wave f(x, t) of Furukawa & Nakata, eq. (1), drawn for every picture above")
         form = QFormLayout(box)
         self.a = SliderSpin(-3.0, 3.0, 3)
         self.k = SliderSpin(0.05, 10.0, 3, log=True)
@@ -199,11 +200,11 @@ class AnimeDock(QDockWidget):
         self.p = SliderSpin(0.0, 4.0, 3)
         self.period = SliderSpin(0.02, 5.0, 3, log=True)
         rows = (
-            (self.a, "Amplitude a", "how far the hair line swings (negative flips it)"),
-            (self.k, "Wave length k", "spatial period: smaller k puts more ripples on a bunch"),
-            (self.s, "Gravity s", "weight of the hair: sag a/s², swing a/s"),
-            (self.p, "Profile p", "root-to-tip growth of the swing: 0 even, 2 whips the tip"),
-            (self.period, "Period T (s)", "seconds per cycle"),
+            (self.a, "Swing size", "a, eq. (1): how far the hair line swings (negative flips it)"),
+            (self.k, "Wave length", "k, eq. (1): spatial period; smaller puts more ripples on a bunch"),
+            (self.s, "Weight", "s, eq. (1): gravity on the hair: sag a/s², swing a/s"),
+            (self.p, "Whip toward the tip", "p, eq. (1): swing growth root to tip; 0 even, 2 whips"),
+            (self.period, "Cycle length (s)", "T, eq. (1): seconds per cycle"),
         )
         for widget, label, tip in rows:
             widget.setToolTip(tip)

@@ -8,12 +8,12 @@ import numpy as np
 from app.render.ramps import (
     categorical_colors,
     per_strand_random_colors,
-    ramp_colors,
     ramp_texture,
     sample_linear,
     strand_to_vertex_colors,
 )
 from app.render.strands import RAMP_TEXELS
+from app.ui.legend import magnitude_colors
 from app.ui.scene import Scene
 
 STRAND_COLOUR_SEED = 7  # fixed, so a groom keeps its per-strand colours between runs
@@ -34,23 +34,28 @@ def vertex_colors(scene: Scene) -> np.ndarray | None:
     elif mode == "strand":
         colors = strand_to_vertex_colors(per_strand_random_colors(top.strand_count, STRAND_COLOUR_SEED), top)
     elif mode == "clump":
-        ids = np.asarray(scene.pipeline.clump_ids())
-        if scene.has_children:  # each child in its nearest guide's clump
-            b = scene.drawn_binding()
-            ids = np.concatenate([ids[b.guide_ids[:, 0]], ids[:guides]])
+        if scene.pipeline is None:  # no clumps before the engine starts: all strands grey
+            ids = np.full(top.strand_count, -1)
+        else:
+            ids = np.asarray(scene.pipeline.clump_ids())
+            if scene.has_children:  # each child in its nearest guide's clump
+                b = scene.drawn_binding()
+                ids = np.concatenate([ids[b.guide_ids[:, 0]], ids[:guides]])
         colors = strand_to_vertex_colors(categorical_colors(ids), top)
     elif mode == "displacement":
-        d = scene.displacement()
-        # Heat over [0, median strand length]: a fixed scale per groom, so colours do not
-        # flicker while dragging as a per-frame maximum would.
-        scale = float(np.median(scene.rest.strand_lengths))
-        colors = ramp_colors(d / max(scale, 1e-9), "heat")
+        colors = magnitude_colors(scene.displacement() / displacement_scale(scene))
     else:
         raise ValueError(f"unknown colour mode {mode!r}")
     if guides:
         colors = np.array(colors, np.float32)
         colors[top.offsets[top.strand_count - guides] :] = GUIDE_RGB
     return colors
+
+
+def displacement_scale(scene: Scene) -> float:
+    """The displacement that shows at the ramp's top: the median strand length of the rest groom,
+    a fixed scale per groom, so colours do not flicker while dragging as a per-frame maximum would."""
+    return max(float(np.median(scene.rest.strand_lengths)), 1e-9)
 
 
 def _guides_over_ramp(scene: Scene, top, guides: int) -> np.ndarray:

@@ -99,6 +99,7 @@ class ProjectController(QObject):
         """The window's state as a project (cheap: arrays are shared, not copied)."""
         w = self.window
         scene, model = w.scene, w.animation
+        scene.start_engine()  # a first start's engine may still be on its way: wait for it here
         source = None if scene.path is None or scene.path.suffix == pf.SUFFIX else str(scene.path)
         settings: dict = {
             "timeline": {"frame": model.frame, "view_mode": model.view_mode, "loop": model.loop},
@@ -252,8 +253,8 @@ class ProjectController(QObject):
     def autosave(self, wait: bool = False) -> bool:
         """Write the recovery file if anything changed since the last autosave (in a thread;
         ``wait`` blocks until it is written). Returns whether a write started."""
-        if self._changes == self._autosaved_at or self._offer_pending:
-            return False  # nothing new, or an unanswered recovery offer must not be overwritten
+        if self._changes == self._autosaved_at or self._offer_pending or not self.window.scene.engine_ready:
+            return False  # nothing new, an unanswered recovery offer, or the engine not started
         if self._autosave_thread is not None and self._autosave_thread.is_alive():
             return False  # the previous one is still writing; the next tick catches up
         project, path, changes = self.current_project(), self.recovery_path, self._changes

@@ -2,6 +2,10 @@
 
 The scene knows nothing of widgets. Setters emit a signal only when the value really changes, so
 a widget that writes a value and listens for it cannot loop; the viewport and the dock listen.
+
+On a first start the engine's kernels compile in another process (:mod:`app.ui.engine_start`):
+until :meth:`Scene.start_engine`, a scene made with ``engine_ready=False`` shows its groom as it
+is, keeps parameter edits for later, and has no pipeline (``pipeline`` None, no strokes).
 """
 
 from __future__ import annotations
@@ -42,9 +46,19 @@ class Scene(QObject):
     mesh_changed = Signal()
     path_changed = Signal()
     drawn_changed = Signal()  # the drawn strands' topology changed (children density, guides shown)
+    engine_starting = Signal()  # the pipeline is about to be built (may compile: show a wait)
+    engine_started = Signal()
 
-    def __init__(self, groom: Groom, params: FrozenParams | None = None, parent: QObject | None = None):
+    def __init__(
+        self,
+        groom: Groom,
+        params: FrozenParams | None = None,
+        parent: QObject | None = None,
+        *,
+        engine_ready: bool = True,
+    ):
         super().__init__(parent)
+        self.engine_ready = engine_ready
         # The studio keeps strand lengths after clumping (FrozenParams' own default is the
         # paper's printed ClumpWithGaps, which stretches them).
         self._params = params if params is not None else FrozenParams(keep_lengths=True)
@@ -71,9 +85,13 @@ class Scene(QObject):
 
     # -- strands -----------------------------------------------------------------------
     def _set_groom(self, groom: Groom) -> None:
+        if self.engine_ready:
+            self.pipeline: FrozenPipeline | None = FrozenPipeline(groom, self._params)
+            self.result: Groom = self.pipeline.result
+        else:
+            self._params.validate()
+            self.pipeline, self.result = None, groom
         self.rest = groom
-        self.pipeline = FrozenPipeline(groom, self._params)
-        self.result: Groom = self.pipeline.result
         lo, hi = groom.bounds
         self.centre = ((lo.astype(np.float64) + hi) * 0.5).astype(np.float32)
         extent = float(np.max(hi - lo))
@@ -107,12 +125,29 @@ class Scene(QObject):
             self.path = p
             self.path_changed.emit()
 
+    def start_engine(self) -> None:
+        """Build the pipeline of a scene made with ``engine_ready=False`` (nothing when ready):
+        the groom takes the frozen look with the parameters edited meanwhile."""
+        if self.engine_ready:
+            return
+        self.engine_starting.emit()
+        t0 = time.perf_counter()
+        self.pipeline = FrozenPipeline(self.rest, self._params)
+        self.result = self.pipeline.result
+        self._children_moved()  # the render hair follows the frozen guides
+        self.engine_ready = True
+        self.last_update_ms = (time.perf_counter() - t0) * 1e3
+        self.params_changed.emit(self._params)
+        self.points_changed.emit()
+        self.engine_started.emit()
+
     @property
     def is_planar(self) -> bool:
         return self.rest.is_planar
 
     def align(self, cursor: np.ndarray) -> Groom:
         """One mouse move of the align tool: align → freeze → clump, timed in ms."""
+        self.start_engine()
         t0 = time.perf_counter()
         self.result = self.pipeline.align(
             np.asarray(cursor, dtype=np.float64), self.radius, self.intensity, self.align_mode
@@ -123,10 +158,12 @@ class Scene(QObject):
         return self.result
 
     def snapshot(self) -> object:
-        """The pipeline's stroke state (for one undo step)."""
+        """The pipeline's stroke state (for one undo step); strokes need the engine running."""
+        self.start_engine()
         return self.pipeline.snapshot()
 
     def restore(self, snap: object) -> None:
+        self.start_engine()
         t0 = time.perf_counter()
         self.result = self.pipeline.restore(snap)
         self._children_moved()
@@ -290,6 +327,10 @@ class Scene(QObject):
 
     def set_params(self, params: FrozenParams) -> None:
         if params == self._params:
+            return
+        if not self.engine_ready:  # kept for the engine when it starts
+            self._params = params.validate()
+            self.params_changed.emit(params)
             return
         t0 = time.perf_counter()
         self.result = self.pipeline.set_params(params)

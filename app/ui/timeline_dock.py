@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
     QFormLayout,
     QHBoxLayout,
     QLabel,
+    QMainWindow,
     QSlider,
     QSpinBox,
     QSplitter,
@@ -30,13 +31,16 @@ from PySide6.QtWidgets import (
 from app.ui.animation_model import VIEW_MODES, AnimationModel
 from app.ui.qt_utils import signals_blocked
 from app.ui.timeline_plots import KeyCountPlot, TimelineView
-from app.ui.widgets import SliderSpin
+from app.ui.widgets import SliderSpin, scrolling
 from hairtool.errors import HairtoolError
 from hairtool.keys.session import KEY_MODES
 
 #: The key modes as the timeline names them.
 MODE_LABELS = {"count": "Key count", "tau": "Price per key (tau)", "budget": "Error budget"}
 TAU_RANGE = (1e-5, 1.0)  # a key's price as a share of the two-key error
+
+UNFOLDED_HEIGHT = 300  # px the timeline takes when an animation opens (the artist may drag it)
+FOLDED_MARGIN = 6  # px beside the transport bar when folded
 
 TRANSPORT = (
     "first",
@@ -267,7 +271,9 @@ class TimelineDock(QDockWidget):
         side_layout.addWidget(self.controls)
         side_layout.addWidget(self.plot, 1)
         split.addWidget(self.view)
-        split.addWidget(side)
+        split.addWidget(scrolling(side))  # a short screen scrolls the key controls
+        split.setChildrenCollapsible(False)
+        self.split = split
         split.setStretchFactor(0, 3)
         split.setStretchFactor(1, 1)
         outer.addWidget(split, 1)
@@ -297,4 +303,31 @@ class TimelineDock(QDockWidget):
         if m.n_frames:
             self.info.setText(f"/ {m.last_frame} · {m.frame / m.fps:.2f} s · {m.source}")
         else:
-            self.info.setText("no animation")
+            self.info.setText("no animation: open one, Apply to groom (Anime wave) or Animation → Simulate…")
+        self.set_folded(m.n_frames == 0)
+
+    @property
+    def folded(self) -> bool:
+        """True while only the transport bar shows (no animation to draw a timeline for)."""
+        return self.split.isHidden()
+
+    def set_folded(self, folded: bool) -> None:
+        """Fold the dock to its transport bar, or unfold it to the timeline and key controls,
+        handing the height to or taking it from the viewport."""
+        if folded == self.folded:
+            return
+        self.split.setHidden(folded)
+        self.fit_height()
+
+    def fit_height(self) -> None:
+        """Give the docked timeline the height its state wants: the transport bar when folded,
+        :data:`UNFOLDED_HEIGHT` otherwise (the window calls this after restoring a layout)."""
+        window = self.parentWidget()
+        if not isinstance(window, QMainWindow) or self.isFloating() or not self.isVisible():
+            return
+        vertical = (Qt.DockWidgetArea.TopDockWidgetArea, Qt.DockWidgetArea.BottomDockWidgetArea)
+        if window.dockWidgetArea(self) not in vertical:
+            return
+        minimum = self.widget().minimumSizeHint().height()
+        height = minimum + FOLDED_MARGIN if self.folded else max(UNFOLDED_HEIGHT, minimum)
+        window.resizeDocks([self], [height], Qt.Orientation.Vertical)

@@ -27,7 +27,7 @@ from app.render.ramps import RAMPS
 from app.ui.qt_utils import signals_blocked
 from app.ui.render_hair_box import RenderHairBox
 from app.ui.scene import ALIGN_MODES, COLOUR_MODES, Scene
-from app.ui.widgets import SliderSpin
+from app.ui.widgets import SliderSpin, scrolling
 from hairtool.frozen.pipeline import FrozenParams
 
 
@@ -41,29 +41,57 @@ class ParamSpec:
     lo: float = 0.0
     hi: float = 1.0
     log: bool = False
-    choices: tuple[str, ...] = ()
+    choices: tuple[tuple[str, str], ...] = ()  # (value, label)
     tip: str = ""
     relative: bool = False  # lo and hi are fractions of the groom's extent (distances)
 
 
-GAP_MODES = ("printed", "text", "off")
+#: How ClumpWithGaps keeps gaps, in the artist's words (the paper's eqs. 17–19 in the tooltip).
+GAP_MODES = (("printed", "Sharp edges (as printed)"), ("text", "Soft edges (as described)"), ("off", "Off"))
 ENGINE_PARAMS: tuple[ParamSpec, ...] = (
-    ParamSpec("freeze", "Freeze", "bool", tip="run FreezeDeform (stretch and bend noise)"),
-    ParamSpec("stretch_stiffness", "Stretch k_s", "float", 1.0, 100.0, log=True, tip="eq. 3: ±1/k_s length"),
-    ParamSpec("bend_stiffness", "Bend k_b", "float", 0.1, 100.0, log=True, tip="eq. 4: θ = θ_max/k_b·ξ"),
-    ParamSpec("max_bend_angle", "θ_max (°)", "angle", 0.0, 180.0, tip="eq. 4; degrees here, radians inside"),
+    ParamSpec("freeze", "Stylised noise", "bool", tip="FreezeDeform, eqs. 2–7: random stretch, bend"),
     ParamSpec(
-        "strand_variation", "Strand variation", "float", 0.0, 4.0, tip="stiffness ×2^(±spread) per strand"
+        "stretch_stiffness", "Stiffness (stretch)", "float", 1.0, 100.0, log=True,
+        tip="k_s, eq. 3: each segment's length varies by up to ±1/k_s; higher keeps lengths closer",
     ),
-    ParamSpec("seed", "Seed", "int", 0, 2**31 - 1, tip="η, ξ, ζ are hashed from (seed, strand, vertex)"),
     ParamSpec(
-        "redraw_noise", "Redraw noise", "bool", tip="new η, ξ every update (flickers, as in the paper)"
+        "bend_stiffness", "Stiffness (bend)", "float", 0.1, 100.0, log=True,
+        tip="k_b, eq. 4: bend angle θ = θ_max / k_b · ξ; higher bends less",
     ),
-    ParamSpec("clump", "Clump", "bool", tip="run ClumpWithGaps"),
-    ParamSpec("clump_radius", "Clump radius h", "optional", 1e-3, 0.5, log=True, relative=True, tip="eq. 14"),
-    ParamSpec("clump_iterations", "Iterations k", "int", 0, 100, tip="eq. 16"),
-    ParamSpec("clump_step", "Step Δt²/m", "optional", 1e-4, 0.5, log=True, relative=True, tip="eq. 16"),
-    ParamSpec("gap_mode", "Gaps", "choice", choices=GAP_MODES, tip="eqs. 17–19: printed formula, text, off"),
+    ParamSpec(
+        "max_bend_angle", "Max bend angle (°)", "angle", 0.0, 180.0,
+        tip="θ_max, eq. 4: the largest bend of one segment (degrees here, radians inside)",
+    ),
+    ParamSpec(
+        "strand_variation", "Stiffness variation", "float", 0.0, 4.0,
+        tip="each strand's stiffnesses k_s, k_b multiplied by 2^(±spread): some strands wilder than others",
+    ),
+    ParamSpec(
+        "seed", "Random seed", "int", 0, 2**31 - 1,
+        tip="the noise η, ξ, ζ is hashed from (seed, strand, vertex): the same seed, the same look",
+    ),
+    ParamSpec(
+        "redraw_noise", "New noise every update", "bool",
+        tip="draw η, ξ afresh at every update (flickers while dragging, as in the paper)",
+    ),
+    ParamSpec("clump", "Clumps", "bool", tip="ClumpWithGaps, eqs. 14–19: strands pulled into clumps"),
+    ParamSpec(
+        "clump_radius", "Clump size", "optional", 1e-3, 0.5, log=True, relative=True,
+        tip="h, eq. 14: how far apart strands may be and still clump together (groom units)",
+    ),
+    ParamSpec(
+        "clump_iterations", "Clump passes", "int", 0, 100,
+        tip="k, eq. 16: how many times strands are pulled toward their clump",
+    ),
+    ParamSpec(
+        "clump_step", "Clump strength", "optional", 1e-4, 0.5, log=True, relative=True,
+        tip="Δt²/m, eq. 16: how far each pass pulls a strand toward its clump (groom units)",
+    ),
+    ParamSpec(
+        "gap_mode", "Keep gaps between clumps", "choice", choices=GAP_MODES,
+        tip="eqs. 17–19, δ = clamp((r1 − r0)/h, 0, 1): λ = (1 − δ)ζ + δ as printed (sharp edges), "
+        "λ = (1 − δ)ζ with |r1 − r0| as the text says (soft edges), or no gaps",
+    ),
     ParamSpec(
         "keep_lengths",
         "Keep lengths",
@@ -89,7 +117,7 @@ class ToolDock(QDockWidget):
         layout.addWidget(self._display_box())
         layout.addWidget(RenderHairBox(scene))
         layout.addStretch(1)
-        self.setWidget(body)
+        self.setWidget(scrolling(body))
         scene.params_changed.connect(lambda _p: self.refresh_params())
         scene.tool_changed.connect(self.refresh_brush)
         scene.display_changed.connect(self.refresh_display)
@@ -102,14 +130,20 @@ class ToolDock(QDockWidget):
         form = QFormLayout(box)
         self.radius = SliderSpin(0.001, 10.0, decimals=4, log=True)
         self.radius.edited.connect(lambda v, _d: self.scene.set_radius(v))
+        self.radius.setToolTip("r, eqs. 8–9: strands within this distance of the cursor follow it ([ / ])")
         self.intensity = SliderSpin(0.0, 1.0, decimals=2)
         self.intensity.edited.connect(lambda v, _d: self.scene.set_intensity(v))
+        self.intensity.setToolTip("x, eq. 13: how far the strands turn toward the drag (0 none, 1 fully)")
         self.mode = QComboBox()
-        for mode, label in zip(ALIGN_MODES, ("Paper (eq. 13)", "Length-preserving"), strict=True):
+        for mode, label in zip(ALIGN_MODES, ("Follow the cursor", "Keep strand lengths"), strict=True):
             self.mode.addItem(label, mode)
+        self.mode.setToolTip(
+            "Follow the cursor: UserAlign as printed (eq. 13), strands may stretch; "
+            "Keep strand lengths: the same turn with every segment's length kept"
+        )
         self.mode.currentIndexChanged.connect(lambda i: self.scene.set_align_mode(self.mode.itemData(i)))
-        form.addRow("Radius r", self.radius)
-        form.addRow("Intensity x", self.intensity)
+        form.addRow("Brush size", self.radius)
+        form.addRow("Strength", self.intensity)
         form.addRow("Mode", self.mode)
         return box
 
@@ -145,8 +179,9 @@ class ToolDock(QDockWidget):
             return w
         if spec.kind == "choice":
             w = QComboBox()
-            w.addItems(list(spec.choices))
-            w.currentTextChanged.connect(lambda v: self.param_edited.emit(name, v, None))
+            for value, label in spec.choices:
+                w.addItem(label, value)
+            w.currentIndexChanged.connect(lambda i: self.param_edited.emit(name, w.itemData(i), None))
             return w
         if spec.kind == "optional":  # a value or None ("Auto")
             w = QWidget()
@@ -223,7 +258,7 @@ class ToolDock(QDockWidget):
                 elif spec.kind == "bool":
                     w.setChecked(bool(value))
                 elif spec.kind == "choice":
-                    w.setCurrentText(str(value))
+                    w.setCurrentIndex(w.findData(str(value)))
                 elif spec.kind == "optional":
                     with signals_blocked(w.auto, w.value):
                         if spec.relative:
@@ -232,7 +267,7 @@ class ToolDock(QDockWidget):
                         w.value.setEnabled(value is not None)
                         if value is not None:
                             w.value.set_value(float(value))
-                        else:  # "Auto": show the value the engine uses (unticking starts there)
+                        elif self.scene.pipeline is not None:  # "Auto": the engine's value
                             w.value.set_value(float(getattr(self.scene.pipeline, spec.name)))
 
     def refresh_display(self) -> None:

@@ -26,12 +26,14 @@ from PySide6.QtOpenGLWidgets import QOpenGLWidget
 
 from app.render.camera import Camera
 from app.render.hair_shading import HAIR_TAPER
-from app.render.strands import StrandRenderer
+from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.colouring import vertex_colors
 from app.ui.scene import Scene
 
 BRUSH_STEP = 1.1  # radius factor per wheel notch or [ / ] press
-GHOST_RGBA = (0.55, 0.75, 1.0, 0.35)  # the reconstruction under the original: flat, translucent
+# The reconstruction behind the original: one flat cyan no ramp uses, opaque enough to read on the
+# dark background wherever it parts from the original (where they agree, the original covers it).
+GHOST_RGBA = (0.2, 0.9, 1.0, 0.75)
 
 
 class BrushTarget(Protocol):
@@ -52,6 +54,7 @@ class Viewport(QOpenGLWidget):
     stroke_started = Signal()  # a left-drag on the scene's groom begins (before its first align)
     cursor_moved = Signal(object)  # (3,) float array on the interaction plane, or None
     frame_drawn = Signal()
+    engine_wait = Signal()  # a stroke began before the engine is ready: nothing was done
 
     def __init__(self, scene: Scene, parent=None) -> None:
         super().__init__(parent)
@@ -79,7 +82,6 @@ class Viewport(QOpenGLWidget):
         self.shown_frame: int | None = None  # the frame number uploaded at the last paint
         self._pending_frame: int | None = None
         self.brush_target: BrushTarget | None = None
-        self.extra_bounds: tuple[np.ndarray, np.ndarray] | None = None  # e.g. a whole animation's box
         self._drag_target: BrushTarget | None = None  # the target that took the current drag
         self.setMouseTracking(True)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
@@ -91,6 +93,7 @@ class Viewport(QOpenGLWidget):
         scene.mesh_changed.connect(lambda: self._mark("mesh"))
         scene.drawn_changed.connect(lambda: self._mark("groom", "colors"))
         scene.tool_changed.connect(self.update)
+        scene.engine_started.connect(self._on_engine_started)
 
     # -- scene → view ----------------------------------------------------------------------
     def _mark(self, *what: str) -> None:
@@ -149,8 +152,6 @@ class Viewport(QOpenGLWidget):
     def frame_all(self) -> None:
         """Fit the groom (and the head mesh) in view; planar grooms get the 2-D orthographic camera."""
         lo, hi = self.scene.result.bounds
-        if self.extra_bounds is not None:
-            lo, hi = np.minimum(lo, self.extra_bounds[0]), np.maximum(hi, self.extra_bounds[1])
         if self.scene.mesh is not None:
             v = np.asarray(self.scene.mesh.vertices, dtype=np.float32)
             if v.size:
@@ -172,7 +173,14 @@ class Viewport(QOpenGLWidget):
     def initializeGL(self) -> None:
         self.ctx = moderngl.create_context()
         self.renderer = StrandRenderer(self.ctx)
+        if not self.scene.engine_ready:  # the CPU rasterizer's kernels are still compiling
+            self.renderer.strand_raster = "gl"
         self._dirty = {"groom", "colors", "display", "mesh"}
+
+    def _on_engine_started(self) -> None:
+        if self.renderer is not None:
+            self.renderer.strand_raster = default_strand_raster()
+        self._mark("groom", "colors", "display")
 
     def _upload(self) -> None:
         r, s, dirty = self.renderer, self.scene, self._dirty
@@ -305,7 +313,10 @@ class Viewport(QOpenGLWidget):
                 self._drag, self._drag_target = None, None
             event.accept()
             return
-        if self._drag == "align":
+        if self._drag == "align" and not self.scene.engine_ready:
+            self._drag = None
+            self.engine_wait.emit()
+        elif self._drag == "align":
             self._stroke_before = self.scene.snapshot()
             self.stroke_started.emit()
             self.scene.set_dragging(True)  # children at the drag display percentage

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from PySide6.QtCore import Qt, Signal
-from PySide6.QtWidgets import QDoubleSpinBox, QHBoxLayout, QSlider, QWidget
+from PySide6.QtWidgets import QDoubleSpinBox, QFrame, QHBoxLayout, QScrollArea, QSlider, QWidget
 
 from app.ui.qt_utils import signals_blocked
 
@@ -97,3 +97,15 @@ class SliderSpin(QWidget):
         with signals_blocked(self.slider):
             self.slider.setValue(self._to_pos(value))
         self.edited.emit(float(value), None)
+
+
+def scrolling(body: QWidget) -> QScrollArea:
+    """``body`` in a frameless vertical scroll area: a dock on a short screen scrolls its controls
+    instead of making the window taller than the screen."""
+    area = QScrollArea()
+    area.setWidget(body)
+    area.setWidgetResizable(True)
+    area.setFrameShape(QFrame.Shape.NoFrame)
+    area.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+    area.setMinimumWidth(body.minimumSizeHint().width() + area.verticalScrollBar().sizeHint().width())
+    return area

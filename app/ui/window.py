@@ -9,17 +9,21 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from PySide6.QtCore import QSettings, Qt
+import numpy as np
+from PySide6.QtCore import QSettings, QSize, Qt
 from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QKeySequence, QUndoStack
-from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QWidget
+from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox, QWidget
 
 from app.ui import export
 from app.ui.animation_io import open_filters, read_any, save_filters
 from app.ui.animation_model import AnimationModel
 from app.ui.animation_ui import AnimationController
+from app.ui.colouring import displacement_scale
 from app.ui.commands import ParamCommand, StrokeCommand
 from app.ui.dialogs import StillOptions, ask_still_options
+from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import JobRunner, JobStatus
+from app.ui.legend import RampLegend, unit_name
 from app.ui.qt_utils import add_action
 from app.ui.scene import COLOUR_MODES, Scene
 from app.ui.simulate_dialog import ask_simulate_options
@@ -32,7 +36,14 @@ from hairtool.groom import Animation, Groom
 from hairtool.simulate.options import SimulateOptions
 
 MAX_RECENT = 10
+FIRST_SIZE = (1280, 800)  # the window's first-start size, shrunk to fit smaller screens
+MISSED_STRANDS = "The brush touched no strand: start the drag on the hair, or make the brush bigger ( ] )"
 SETTINGS_ORG, SETTINGS_APP = "hairtool", "Hairtool Studio"
+
+
+def fitting_size(available: QSize) -> tuple[int, int]:
+    """The first-start window size: :data:`FIRST_SIZE`, or the screen's free area when smaller."""
+    return min(FIRST_SIZE[0], available.width()), min(FIRST_SIZE[1], available.height())
 
 
 class MainWindow(QMainWindow):
@@ -46,15 +57,21 @@ class MainWindow(QMainWindow):
         settings: QSettings | None = None,
         groom: Groom | None = None,
         parent: QWidget | None = None,
+        engine_ready: bool = True,
     ) -> None:
+        """``engine_ready=False``: the kernels are not cached yet, so the window shows without the
+        engine; :meth:`start_warmup` compiles them in the background and then starts it."""
         super().__init__(parent)
         self.setObjectName("HairtoolStudio")
         self.settings = settings if settings is not None else QSettings(SETTINGS_ORG, SETTINGS_APP)
         self.undo_stack = QUndoStack(self)
+        self._shown_once = False
+        self._stroke_points: np.ndarray | None = None
         # long work (key solves, simulation, video export): window.jobs.run(title, fn, on_done)
         self.jobs = JobRunner(lambda title, message: self.show_error(title, message), self)
         start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
-        self.scene = Scene(start, parent=self)
+        self.scene = Scene(start, parent=self, engine_ready=engine_ready)
+        self.engine_start: EngineStart | None = None
         self.viewport = Viewport(self.scene, self)
         self.setCentralWidget(self.viewport)
         self.dock = ToolDock(self.scene, self)
@@ -64,14 +81,30 @@ class MainWindow(QMainWindow):
         self._build_animation_ui()
         self._build_part2_menus()
         self.setAcceptDrops(True)
-        self.resize(1280, 800)
+        self.setDockOptions(
+            QMainWindow.DockOption.AnimatedDocks
+            | QMainWindow.DockOption.AllowTabbedDocks
+            | QMainWindow.DockOption.AllowNestedDocks
+        )
+        self.resize(*fitting_size(self.screen().availableGeometry().size()))
+        self._default_layout = (self.saveState(), self.size())
 
+        self.viewport.stroke_started.connect(self._on_stroke_started)
         self.viewport.stroke_finished.connect(self._on_stroke_finished)
         self.viewport.cursor_moved.connect(self._on_cursor_moved)
+        self.viewport.engine_wait.connect(lambda: self.statusBar().showMessage(WAIT_MESSAGE, 4000))
         self.viewport.frame_drawn.connect(self._update_frame_time)
         self.dock.param_edited.connect(self._on_param_edited)
         self.scene.groom_loaded.connect(self._update_counts)
         self.scene.drawn_changed.connect(self._update_counts)
+        self.scene.groom_loaded.connect(self._update_legend)
+        self.scene.display_changed.connect(self._update_legend)
+        for signal in (
+            self.animation.animation_changed,
+            self.animation.view_mode_changed,
+            self.animation.analysis_changed,
+        ):
+            signal.connect(self._update_legend)
         self.scene.path_changed.connect(self._update_title)
         self.undo_stack.cleanChanged.connect(self._update_title)
         self._update_counts()
@@ -123,6 +156,33 @@ class MainWindow(QMainWindow):
         if state is not None:
             self.restoreState(state)
 
+    def start_warmup(self) -> None:
+        """Compile the kernels in another process, progress in the status bar, then start the
+        engine (a first start: see :mod:`app.ui.engine_start`)."""
+        if self.engine_start is None and not self.scene.engine_ready:
+            self.engine_start = EngineStart(self.scene, self.statusBar(), self)
+            self.engine_start.start()
+
+    def reset_layout(self) -> None:
+        """Docks back where a first start puts them (tools and anime wave tabbed on the right,
+        the timeline below), none floating, and the window at its first-start size."""
+        state, size = self._default_layout
+        for dock in self.findChildren(QDockWidget):
+            dock.setFloating(False)
+            dock.show()
+        self.restoreState(state)
+        self.dock.raise_()
+        if not self.isMaximized() and not self.isFullScreen():
+            self.resize(size)
+        self.timeline.fit_height()
+        self.statusBar().showMessage("layout reset", 3000)
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        if not self._shown_once:  # docks can only be sized once they are laid out
+            self._shown_once = True
+            self.timeline.fit_height()
+
     def save_layout(self) -> None:
         self.settings.setValue("geometry", self.saveGeometry())
         self.settings.setValue("window_state", self.saveState())
@@ -133,6 +193,8 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self.jobs.shutdown()
+        if self.engine_start is not None:
+            self.engine_start.stop()
         self.project.shutdown()
         self.save_layout()
         self.viewport.release_gl()
@@ -185,6 +247,7 @@ class MainWindow(QMainWindow):
             self.colour_actions[key] = a
         colour.aboutToShow.connect(lambda: self.colour_actions[self.scene.colour_mode].setChecked(True))
         view.addSeparator()
+        add_action(self, view, "&Reset layout", self.reset_layout)
         view.addAction(self.dock.toggleViewAction())
 
         brush = bar.addMenu("&Brush")
@@ -296,6 +359,27 @@ class MainWindow(QMainWindow):
         bar.addPermanentWidget(self.cursor_label)
         self.job_status = JobStatus(self.jobs)
         bar.addPermanentWidget(self.job_status)
+        self.legend = RampLegend()
+        bar.addPermanentWidget(self.legend)
+
+    def _update_legend(self, *_: object) -> None:
+        """The distance ramp's legend, in the groom's units, while distances colour the strands."""
+        unit = unit_name(self.scene.rest.metadata.meters_per_unit)
+        m = self.animation
+        if m.animation is not None and m.view_mode == "error" and m.error_scale > 0:
+            self.legend.show_scale(
+                "Key error", m.error_scale, unit,
+                "distance of each vertex from its reconstruction from the DP keys; "
+                "the top of the ramp is the keys' worst vertex over the whole animation",
+            )  # fmt: skip
+        elif m.animation is None and self.scene.colour_mode == "displacement":
+            self.legend.show_scale(
+                "Moved", displacement_scale(self.scene), unit,
+                "distance of each vertex from its rest position; the top of the ramp is the "
+                "median strand length (grey: not moved)",
+            )  # fmt: skip
+        else:
+            self.legend.hide()
 
     def _update_counts(self) -> None:
         g, b = self.scene.result, self.scene.binding
@@ -324,8 +408,14 @@ class MainWindow(QMainWindow):
         self.setWindowTitle(f"{name}{dirty} — Hairtool Studio")
 
     # -- editing -------------------------------------------------------------------------------
+    def _on_stroke_started(self) -> None:
+        self._stroke_points = self.scene.result.points.copy()
+
     def _on_stroke_finished(self, before: object, after: object) -> None:
         self.undo_stack.push(StrokeCommand(self.scene, before, after))
+        start, self._stroke_points = self._stroke_points, None
+        if start is not None and np.array_equal(start, self.scene.result.points):
+            self.statusBar().showMessage(MISSED_STRANDS, 6000)
 
     def _on_param_edited(self, name: str, value: object, drag: object) -> None:
         before = self.scene.params

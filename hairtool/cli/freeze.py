@@ -42,41 +42,72 @@ def _radius(text: str) -> float | None:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", metavar="IN", help="groom to read (.tfx, .hair, .usd*, .npz, .obj)")
     parser.add_argument("output", metavar="OUT", help="groom to write (.hair, .usd*, .npz, .obj)")
-    f = parser.add_argument_group("FreezeDeform")
-    f.add_argument("--stretch-stiffness", type=float, default=7.0, help="k_s ≥ 1: lengths vary by ±1/k_s")
-    f.add_argument("--bend-stiffness", type=float, default=7.0, help="k_b > 0: bends up to angle/k_b")
-    f.add_argument("--max-bend-angle", type=float, default=30.0, help="theta_max in degrees, [0, 180]")
-    f.add_argument("--seed", type=int, default=0, help="noise seed (same seed, same bytes)")
+    f = parser.add_argument_group("stylised noise (FreezeDeform, eqs. 2–7)")
+    f.add_argument(
+        "--stretch-stiffness",
+        type=float,
+        default=7.0,
+        help="stiffness (stretch) k_s ≥ 1: lengths vary by ±1/k_s",
+    )
+    f.add_argument(
+        "--bend-stiffness", type=float, default=7.0, help="stiffness (bend) k_b > 0: bends up to θ_max/k_b"
+    )
+    f.add_argument(
+        "--max-bend-angle", type=float, default=30.0, help="max bend angle θ_max in degrees, [0, 180]"
+    )
+    f.add_argument("--seed", type=int, default=0, help="random seed of the noise (same seed, same bytes)")
     f.add_argument(
         "--strand-variation",
         type=float,
         default=0.0,
-        help="per-strand stiffness spread in [0, 4]: ×2^±spread",
+        help="stiffness variation between strands in [0, 4]: ×2^±spread",
     )
-    f.add_argument("--no-freeze", action="store_true", help="skip FreezeDeform")
+    f.add_argument("--no-freeze", action="store_true", help="no stylised noise")
     parser.add_argument(
         "--strokes",
         metavar="STROKES.json",
         help="replay a stroke log (align, comb, smooth, length, puff, mask; the studio exports one) "
         "after the --align cursors",
     )
-    a = parser.add_argument_group("UserAlign")
+    a = parser.add_argument_group("align brush (UserAlign, eqs. 8–13)")
     a.add_argument(
-        "--align", type=_point, action="append", default=[], metavar="X,Y,Z", help="cursor (repeatable)"
+        "--align",
+        type=_point,
+        action="append",
+        default=[],
+        metavar="X,Y,Z",
+        help="brush position (repeatable: a drag)",
     )
     a.add_argument(
-        "--radius", type=float, default=None, help="tips within this of the cursor turn (default: groom size)"
+        "--radius", type=float, default=None, help="brush size r: tips this close turn (default: groom size)"
     )
-    a.add_argument("--intensity", type=float, default=0.8, help="x in [0, 1]: 1 turns strands like rods")
-    a.add_argument("--align-mode", choices=["paper", "preserve-length"], default="paper")
-    c = parser.add_argument_group("ClumpWithGaps")
-    c.add_argument("--clump-radius", type=_radius, default=None, help="h, or 'auto' (2× median root spacing)")
-    c.add_argument("--clump-iterations", type=int, default=3, help="k in [0, 100]")
+    a.add_argument(
+        "--intensity", type=float, default=0.8, help="strength x in [0, 1]: 1 turns strands like rods"
+    )
+    a.add_argument(
+        "--align-mode",
+        choices=["paper", "preserve-length"],
+        default="paper",
+        help="follow the cursor as printed (eq. 13; strands may stretch), or keep strand lengths",
+    )
+    c = parser.add_argument_group("clumps (ClumpWithGaps, eqs. 14–19)")
     c.add_argument(
-        "--clump-step", type=float, default=None, help="Δt²/m (default: 0.2·h over the mean kernel weight)"
+        "--clump-radius", type=_radius, default=None, help="clump size h, or 'auto' (2× median root spacing)"
     )
-    c.add_argument("--gap-mode", choices=["printed", "text", "off"], default="printed")
-    c.add_argument("--no-clump", action="store_true", help="skip ClumpWithGaps")
+    c.add_argument("--clump-iterations", type=int, default=3, help="clump passes k in [0, 100]")
+    c.add_argument(
+        "--clump-step",
+        type=float,
+        default=None,
+        help="clump strength Δt²/m (default: 0.2·h over the mean kernel weight)",
+    )
+    c.add_argument(
+        "--gap-mode",
+        choices=["printed", "text", "off"],
+        default="printed",
+        help="keep gaps between clumps: sharp edges (eqs. 17–19 as printed), soft (as described), or none",
+    )
+    c.add_argument("--no-clump", action="store_true", help="no clumps")
     c.add_argument(
         "--keep-lengths",
         action="store_true",

@@ -3,8 +3,8 @@
 IN is an animation file (.usd/.usda/.usdc/.npz cache), a .bvh, or an .npz holding an array
 ``X`` of shape (frames, dims) used as raw features. At most one mode: --keys K, --penalty TAU
 (a price per key, as a share of the error of keying only the first and last frame, so it means
-the same on any animation), --penalty-abs TAU (seed 003's absolute price, in squared feature
-units), --budget E (total error) or --max-error E (worst frame). Without one, the key count is
+the same on any animation), --penalty-abs TAU (an absolute price, Fei et al.'s τ, in squared
+feature units), --budget E (total error) or --max-error E (worst frame). Without one, the key count is
 the knee of the error-vs-count curve: the count past which each key buys less than its share.
 """
 
@@ -27,7 +27,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--penalty", type=float, metavar="TAU", help="price per key, a share of the two-key error (0.01: 1%%)"
     )
     mode.add_argument(
-        "--penalty-abs", type=float, metavar="TAU", help="price per key in squared feature units (seed 003)"
+        "--penalty-abs",
+        type=float,
+        metavar="TAU",
+        help="price per key in squared feature units (Fei et al.'s τ)",
     )
     mode.add_argument("--budget", type=float, metavar="E", help="fewest keys with total error <= E")
     mode.add_argument("--max-error", type=float, metavar="E", help="fewest keys with worst frame <= E")
@@ -36,7 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--interp",
         choices=("linear", "hermite", "hermite-fit"),
         default="linear",
-        help="linear, Hermite with data tangents (seed 003), or Hermite with tangents fitted per segment",
+        help="straight lines, smooth curves with tangents from the frames around each key, or smooth curves "
+        "with each segment's handles fitted (cubic Hermite)",
     )
     parser.add_argument("--curvature", type=float, default=0.0, metavar="LAMBDA", help="curvature weight")
     parser.add_argument(
@@ -46,7 +50,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     steer = parser.add_argument_group("frames the animator steers (0-based; lists and ranges, e.g. 10,30-34)")
     steer.add_argument("--pin", metavar="FRAMES", help="frames that must be keys")
     steer.add_argument("--exclude", metavar="FRAMES", help="frames that must not be keys")
-    feat = parser.add_argument_group("hair features (seed 000)")
+    feat = parser.add_argument_group("what counts as a change of the hair (Kim 2026's features)")
     feat.add_argument("--samples", type=int, default=16, metavar="M", help="points per strand (arc length)")
     feat.add_argument("--no-resample", action="store_true", help="use the original vertices")
     feat.add_argument("--tip-weight", type=float, default=2.0, metavar="W")
@@ -59,7 +63,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--bvh-features",
         choices=("positions", "rotations", "quaternion"),
         default="positions",
-        help="BVH: joint positions, quaternion features, or seed 003's quaternion-distance table",
+        help="BVH: joint positions, joint rotations (quaternions), or the rotation distance between frames",
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     parser.add_argument("--out", type=Path, metavar="KEYS.json", help="write keys, times and parameters")

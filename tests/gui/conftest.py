@@ -21,7 +21,8 @@ def settings_path(tmp_path):
 
 @pytest.fixture
 def make_window(qapp, qtbot, settings_path):
-    """``make_window(path=None, groom=None)`` → a shown MainWindow whose dialogs never block.
+    """``make_window(path=None, groom=None, size, engine_ready=True)`` → a shown MainWindow whose
+    dialogs never block.
 
     Errors that would pop up a dialog are collected in ``window.errors`` instead. The settings
     (and the autosave recovery file beside them) live in the test's ``tmp_path``.
@@ -30,9 +31,9 @@ def make_window(qapp, qtbot, settings_path):
 
     made = []
 
-    def make(path=None, *, groom=None, size=(900, 600)):
+    def make(path=None, *, groom=None, size=(900, 600), engine_ready=True):
         settings = QSettings(settings_path, QSettings.Format.IniFormat)
-        window = MainWindow(None, settings=settings, groom=groom)
+        window = MainWindow(None, settings=settings, groom=groom, engine_ready=engine_ready)
         window.errors = []
         window.show_error = lambda title, message: window.errors.append((title, message))
         # questions never block: close without saving, decline a recovery file (tests that

@@ -68,7 +68,7 @@ def test_every_engine_parameter_has_a_control(make_window):
     clump = w.dock.params["clump"]
     clump.setChecked(not clump.isChecked())
     gap = w.dock.params["gap_mode"]
-    gap.setCurrentText("off")
+    gap.setCurrentIndex(gap.findData("off"))
     assert w.scene.params.gap_mode == "off"
     assert w.undo_stack.count() == 3
 

@@ -1,0 +1,145 @@
+"""Compiling the studio's numba kernels in a separate process, so a first start shows the window
+at once (no Qt here: :mod:`app.ui.engine_start` runs this and shows its progress).
+
+``python -m app.ui.kernel_warmup`` runs the engine and the strand rasterizer once on a small
+groom, in the order the studio needs them, which compiles every kernel they call into numba's
+on-disk cache; each finished step prints ``step I N LABEL``. The studio then loads the kernels
+from the cache (a fraction of a second) instead of compiling them on its GUI thread (half a
+minute on two cores, with the window frozen). A second process, not a thread: numba compiles
+holding the GIL, so a compiling thread would stall the window as surely as compiling in it.
+
+:func:`kernels_cached` tells a start whether that is needed: the warm-up records the kernels it
+compiled, and they are cached when numba's index for each still matches its source.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import pkgutil
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+#: Packages and modules whose kernels the warm-up's steps compile (searched for numba dispatchers).
+KERNEL_PACKAGES = ("hairtool.frozen",)
+KERNEL_MODULES = ("hairtool.bounds", "app.render.soft_raster")
+
+
+def record_path() -> Path:
+    """Where the warm-up records the kernels it compiled (the user's cache folder)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "hairtool" / "studio-kernels.json"
+
+
+def _dispatchers() -> dict[str, object]:
+    """``module:function`` → numba dispatcher, for every cached kernel of :data:`KERNEL_PACKAGES`'
+    modules and of :data:`KERNEL_MODULES`."""
+    from numba.core.dispatcher import Dispatcher
+
+    names = list(KERNEL_MODULES)
+    for package in KERNEL_PACKAGES:
+        path = importlib.import_module(package).__path__
+        names += [f"{package}.{m.name}" for m in pkgutil.iter_modules(path)]
+    found = {}
+    for name in names:
+        try:
+            module = importlib.import_module(name)
+        except ImportError:  # a module the engine no longer has
+            continue
+        for attr, value in vars(module).items():
+            if isinstance(value, Dispatcher) and getattr(value, "_cache", None) is not None:
+                found[f"{name}:{attr}"] = value
+    return found
+
+
+def _has_cache(dispatcher: object) -> bool:
+    """True when numba's on-disk index for ``dispatcher`` exists and matches its source."""
+    try:
+        return bool(dispatcher._cache._cache_file._load_index())  # {} when missing or stale
+    except Exception:  # numba's cache internals moved: count it as not cached
+        return False
+
+
+def kernels_cached() -> bool:
+    """True when every kernel the last warm-up compiled is still in numba's cache; False on a
+    first start, after the caches were cleared, or after a kernel's source changed."""
+    try:
+        names = json.loads(record_path().read_text())["kernels"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+    found = _dispatchers()
+    return bool(names) and all(n in found and _has_cache(found[n]) for n in names)
+
+
+def _engine_step() -> None:
+    from hairtool import samples
+    from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+
+    groom = samples.scalp(strands=60, vertices=12)
+    pipe = FrozenPipeline(groom, FrozenParams())
+    lo, hi = groom.bounds
+    centre = (lo.astype(np.float64) + hi) * 0.5
+    extent = float(np.max(hi - lo))
+    for i in range(3):  # a short drag: the first sample and the incremental ones after it
+        pipe.align(centre + np.array([0.05 * i * extent, 0.0, 0.0]), 0.3 * extent, 0.8, "paper")
+
+
+def _more_engine_step() -> None:
+    from dataclasses import replace
+
+    from hairtool import samples
+    from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+
+    groom = samples.portrait(strands=30, vertices=10)
+    params = replace(FrozenParams(), keep_lengths=True, gap_mode="text", strand_variation=0.5)
+    pipe = FrozenPipeline(groom, params)
+    lo, hi = groom.bounds
+    pipe.align((lo.astype(np.float64) + hi) * 0.5, float(np.max(hi - lo)), 0.5, "preserve-length")
+
+
+def _raster_step() -> None:
+    from app.render.soft_raster import StrandRaster
+
+    rng = np.random.default_rng(0)
+    points = rng.uniform(-0.5, 0.5, (40, 3)).astype(np.float32)
+    starts = np.arange(0, 39, dtype=np.int64)
+    colors = rng.uniform(0.0, 1.0, (40, 3)).astype(np.float32)
+    mvp = np.eye(4)
+    for width in (2.0, 1.0):
+        raster = StrandRaster()
+        raster.draw(points, starts, colors, mvp, (64, 48), width)
+        moved = points.copy()
+        moved[3] += 0.01
+        raster.draw(moved, starts, colors, mvp, (64, 48), width)  # the tiles-only redraw
+
+
+#: (label, step) in the order the studio needs them: the engine for the first groom, the
+#: rasterizer for the first paint (the studio starts its engine after these two:
+#: :data:`app.ui.engine_start.STARTUP_STEPS`), then what other brush modes and settings reach.
+STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
+    ("hair engine", _engine_step),
+    ("strand drawing", _raster_step),
+    ("brush modes and settings", _more_engine_step),
+)
+
+
+def main() -> int:
+    for i, (label, step) in enumerate(STEPS):
+        step()
+        print(f"step {i + 1} {len(STEPS)} {label}", flush=True)
+    compiled = sorted(n for n, d in _dispatchers().items() if d.signatures)
+    path = record_path()
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps({"kernels": compiled}, indent=1))
+    except OSError:  # a read-only home: the next start warms up again, no worse than now
+        pass
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,97 @@
+"""A first start: the window shows before the kernels are compiled, says so when a stroke comes
+too early, keeps parameter edits for the engine, and starts it when the warm-up reports."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QProcess
+
+from app.ui import kernel_warmup
+from app.ui.engine_start import WAIT_MESSAGE
+from hairtool import samples
+
+pytestmark = pytest.mark.gui
+
+
+def test_before_the_engine_the_groom_shows_as_it_is_and_strokes_wait(ui, make_window):
+    groom = samples.scalp(strands=60, vertices=8)
+    w = make_window(groom=groom, engine_ready=False)
+    s, v = w.scene, w.viewport
+    assert not s.engine_ready and s.pipeline is None and s.result is groom
+    assert v.renderer.strand_raster == "gl"  # the CPU rasterizer's kernels may be compiling
+    assert ui.hair_mask(ui.grab(v)).sum() > 0  # drawn all the same
+    centre = v.project(s.centre[None])[0]
+    ui.drag(v, centre, centre + np.array([40.0, 10.0]))
+    assert w.statusBar().currentMessage() == WAIT_MESSAGE
+    assert w.undo_stack.count() == 0 and s.pipeline is None
+    w.dock.params["stretch_stiffness"].spin.setValue(20.0)  # kept for the engine
+    assert s.params.stretch_stiffness == 20.0 and w.undo_stack.count() == 1
+    s.set_colour_mode("clump")  # no clumps yet: grey, no error
+    assert not w.errors
+
+    s.start_engine()
+    assert s.engine_ready and s.pipeline is not None and s.pipeline.params.stretch_stiffness == 20.0
+    assert not np.array_equal(s.result.points, groom.points)  # the frozen look, at last
+    from app.render.strands import default_strand_raster
+
+    assert v.renderer.strand_raster == default_strand_raster()
+    ui.drag(v, centre, centre + np.array([40.0, 10.0]))
+    assert w.undo_stack.count() == 2
+
+
+def test_the_warm_up_reports_progress_and_starts_the_engine(make_window, qtbot, monkeypatch):
+    from app.ui.engine_start import EngineStart
+
+    steps = "import time\nfor i in (1, 2, 3):\n    print(f'step {i} 3 part', flush=True)\n    time.sleep(0.3)"
+    monkeypatch.setattr(
+        EngineStart, "start", lambda self: self.process.start(sys.executable, ["-c", steps])
+    )
+    w = make_window(groom=samples.comb(strands=10, vertices=6), engine_ready=False)
+    w.start_warmup()
+    es = w.engine_start
+    qtbot.waitUntil(lambda: es.step >= 1, timeout=10_000)
+    qtbot.waitUntil(lambda: w.scene.engine_ready, timeout=10_000)  # after step 2 of 3
+    assert es.step >= 2
+    qtbot.waitUntil(lambda: not es.running and es.label is None, timeout=10_000)
+    assert w.scene.pipeline is not None
+
+
+def test_a_failed_warm_up_still_starts_the_engine(make_window, qtbot, monkeypatch):
+    from app.ui.engine_start import EngineStart
+
+    monkeypatch.setattr(
+        EngineStart, "start", lambda self: self.process.start(sys.executable, ["-c", "raise SystemExit(3)"])
+    )
+    w = make_window(groom=samples.comb(strands=10, vertices=6), engine_ready=False)
+    w.start_warmup()
+    qtbot.waitUntil(lambda: w.scene.engine_ready, timeout=10_000)
+    assert w.engine_start.process.state() == QProcess.ProcessState.NotRunning
+
+
+def test_kernels_cached_reads_the_warm_up_record(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert not kernel_warmup.kernels_cached()  # no record: a first start
+    assert samples.comb(strands=4, vertices=3).bounds is not None  # compiles or loads bounds' kernel
+    record = kernel_warmup.record_path()
+    record.parent.mkdir(parents=True)
+    record.write_text(json.dumps({"kernels": ["hairtool.bounds:_box"]}))
+    assert kernel_warmup.kernels_cached()
+    record.write_text(json.dumps({"kernels": ["hairtool.bounds:_box", "hairtool.frozen.nothing:_here"]}))
+    assert not kernel_warmup.kernels_cached()
+    record.write_text("not json")
+    assert not kernel_warmup.kernels_cached()
+
+
+def test_the_warm_up_runs_its_steps_and_records_the_kernels(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert kernel_warmup.main() == 0
+    lines = capsys.readouterr().out.splitlines()
+    n = len(kernel_warmup.STEPS)
+    assert lines == [f"step {i + 1} {n} {label}" for i, (label, _) in enumerate(kernel_warmup.STEPS)]
+    names = json.loads(kernel_warmup.record_path().read_text())["kernels"]
+    assert "app.render.soft_raster:draw_bands" in names and "hairtool.frozen.clump:_clump_run" in names
+    assert kernel_warmup.kernels_cached()
