@@ -51,6 +51,9 @@ def missing_system_packages() -> str | None:
 
 def pytest_configure(config: pytest.Config) -> None:
     config.missing_system_packages = missing_system_packages()
+    if config.missing_system_packages is not None and os.environ.get("CI"):
+        # CI runs the GUI and render tests for real: a missing package fails the run, loudly
+        raise pytest.UsageError(f"CI needs the GUI's system packages: {config.missing_system_packages}")
     if config.missing_system_packages is None:
         _start_xvfb()
 
@@ -60,8 +63,9 @@ def pytest_report_header(config: pytest.Config) -> str | None:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Without Qt's system libraries the GUI and render tests are skipped with the one line
-    that names the packages (Qt would otherwise abort the whole run at the first window)."""
+    """Without Qt's system libraries (on a developer's machine: CI refuses to start) the GUI and
+    render tests are skipped with the one line that names the packages (Qt would otherwise abort
+    the whole run at the first window)."""
     reason = config.missing_system_packages
     if reason is None:
         return
