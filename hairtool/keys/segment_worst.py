@@ -66,14 +66,18 @@ def _worst_row(g, base, diag, hermite, i, w):  # pragma: no cover - compiled
         for m in range(10):
             u[m, j] = t[m]
     li, hi, wi = stencil_at(i, n)
-    for k in range(i + 1, n - 1):
+    last = n - 1
+    lj, hj, wj = stencil_at(last, n)
+    for k in range(i + 1, last):
         gk = g[k]
         a, gki, gkt = base[k], gk[i], gk[hi] - gk[li]
         di = float(k - i)
-        _hermite_span(w, gk, inv, u, a, gki, gkt, di, i, wi, k + 1, n - 1)
-        lj, hj, wj = stencil_at(n - 1, n)
-        last = n - 1
-        e = _hermite_cost(a, gki, gkt, gk[last], gk[hj] - gk[lj], di, inv[last], last - i, wi, wj, u, last)
+        _hermite_span(w, gk, inv, u, a, gki, gkt, di, i, wi, k + 1, last)
+        e = _hermite_frame_cost(
+            a, gki, gkt, gk[last], gk[hj] - gk[lj], di * inv[last], float(last - i), wi, wj,
+            u[0, last], u[1, last], u[2, last], u[3, last], u[4, last],
+            u[5, last], u[6, last], u[7, last], u[8, last], u[9, last],
+        )  # fmt: skip
         w[last] = max(w[last], e)
 
 
@@ -92,7 +96,7 @@ def _linear_span(w, gi, gk, diag, inv, a, gii, gik, di, lo, hi):  # pragma: no c
 def _hermite_span(w, gk, inv, u, a, gki, gkt, di, i, wi, lo, hi):  # pragma: no cover - compiled
     """w[j] = max(w[j], e_k of the segment (i, j)) for lo ≤ j < hi (interior ends: stencil 1/2).
 
-    The same sum as :func:`_hermite_cost`, on views that start at ``lo``: plain non-negative
+    :func:`_hermite_frame_cost` over views that start at ``lo``: plain non-negative
     indices into 1-D arrays, which the compiler turns into SIMD lanes (indexing the 2-D ``u``
     and ``gk[j ± 1]`` directly kept the loop scalar)."""
     m = hi - lo
@@ -103,34 +107,21 @@ def _hermite_span(w, gk, inv, u, a, gki, gkt, di, i, wi, lo, hi):  # pragma: no 
     u5, u6, u7, u8, u9 = u[5, lo:hi], u[6, lo:hi], u[7, lo:hi], u[8, lo:hi], u[9, lo:hi]
     first = float(lo - i)
     for t in range(m):
-        el = first + t
-        s = di * iv[t]
-        s2 = s * s
-        s3 = s2 * s
-        p0 = 1.0 - 3.0 * s2 + 2.0 * s3
-        p1 = s - 2.0 * s2 + s3
-        p2 = 3.0 * s2 - 2.0 * s3
-        p3 = s3 - s2
-        ti = el * wi * p1
-        tj = el * 0.5 * p3
-        cross = p0 * gki + ti * gkt + p2 * g0[t] + tj * (gp[t] - gm[t])
-        quad = (
-            p0 * p0 * u0[t]
-            + p1 * p1 * u2[t]
-            + p2 * p2 * u7[t]
-            + p3 * p3 * u9[t]
-            + 2.0 * (p0 * p1 * u1[t] + p0 * p2 * u3[t] + p0 * p3 * u4[t])
-            + 2.0 * (p1 * p2 * u5[t] + p1 * p3 * u6[t] + p2 * p3 * u8[t])
-        )
-        ww[t] = max(ww[t], a - 2.0 * cross + quad)
+        e = _hermite_frame_cost(
+            a, gki, gkt, g0[t], gp[t] - gm[t], di * iv[t], first + t, wi, 0.5,
+            u0[t], u1[t], u2[t], u3[t], u4[t], u5[t], u6[t], u7[t], u8[t], u9[t],
+        )  # fmt: skip
+        ww[t] = max(ww[t], e)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _hermite_cost(a, gki, gkt, gkj, gkt_j, di, inv, span, wi, wj, u, j):  # pragma: no cover
-    """e_k of the Hermite segment (i, j) from G's row k (gki = G[k, i], gkt = G[k, hi] − G[k, li],
-    the same at j) and the ten ⟨u_a, u_b⟩ at column j."""
-    el = float(span)
-    s = di * inv
+def _hermite_frame_cost(  # pragma: no cover - compiled
+    a, gki, gkt, gkj, gkt_j, s, el, wi, wj, u0, u1, u2, u3, u4, u5, u6, u7, u8, u9
+):
+    """e_k of the Hermite segment (i, j) at s = (k − i)/L, L = ``el``, from G's row k (gki =
+    G[k, i], gkt = G[k, hi] − G[k, li], the same at j) and the ten ⟨u_a, u_b⟩ of the segment
+    (u00, u01, u11, u02, u03, u12, u13, u22, u23, u33, with L·m scaled in). Scalars only, so the
+    loop that calls it over views stays vectorised."""
     s2 = s * s
     s3 = s2 * s
     p0 = 1.0 - 3.0 * s2 + 2.0 * s3
@@ -140,14 +131,13 @@ def _hermite_cost(a, gki, gkt, gkj, gkt_j, di, inv, span, wi, wj, u, j):  # prag
     ti = el * wi * p1
     tj = el * wj * p3
     cross = p0 * gki + ti * gkt + p2 * gkj + tj * gkt_j
-    # u = (u00, u01, u11, u02, u03, u12, u13, u22, u23, u33) with L·m scaled in
     quad = (
-        p0 * p0 * u[0, j]
-        + p1 * p1 * u[2, j]
-        + p2 * p2 * u[7, j]
-        + p3 * p3 * u[9, j]
-        + 2.0 * (p0 * p1 * u[1, j] + p0 * p2 * u[3, j] + p0 * p3 * u[4, j])
-        + 2.0 * (p1 * p2 * u[5, j] + p1 * p3 * u[6, j] + p2 * p3 * u[8, j])
+        p0 * p0 * u0
+        + p1 * p1 * u2
+        + p2 * p2 * u7
+        + p3 * p3 * u9
+        + 2.0 * (p0 * p1 * u1 + p0 * p2 * u3 + p0 * p3 * u4)
+        + 2.0 * (p1 * p2 * u5 + p1 * p3 * u6 + p2 * p3 * u8)
     )
     return a - 2.0 * cross + quad
 
