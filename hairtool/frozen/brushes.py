@@ -121,8 +121,10 @@ def _weights_reference(p: F64, c: F64, radius: float, lut: F64) -> F64:
 @njit(cache=True, nogil=True)
 def _restore_lengths(q, p, o, n):  # pragma: no cover - compiled
     """q[o+1 .. o+n−1] pulled back, root to tip, to the segment lengths of p: each vertex at its
-    original distance from the (already restored) one before, in the direction q gives it (the
-    original direction where q collapses onto it)."""
+    original distance from the (already restored) one before, in the direction toward where the
+    brush put it (the original direction where q collapses onto it). Follow-the-leader, so the
+    vertices past a moved one follow it: not :func:`hairtool.frozen.lengths.restore_lengths`,
+    which keeps each clumped segment's own direction and would pull a combed tip back."""
     for i in range(o + 1, o + n):
         lx, ly, lz = p[i, 0] - p[i - 1, 0], p[i, 1] - p[i - 1, 1], p[i, 2] - p[i - 1, 2]
         length = np.sqrt(lx * lx + ly * ly + lz * lz)
@@ -163,12 +165,14 @@ def _brush_kernel(  # pragma: no cover - compiled
             continue
         if kind == 0 or kind == 1:
             total = 0.0
-            for i in range(o + 1, e):
-                total += _dist(p, i, i - 1)
+            if kind == 0:  # only comb weighs by the arc-length fraction
+                for i in range(o + 1, e):
+                    total += _dist(p, i, i - 1)
             run = 0.0
             moved = False
             for i in range(o + 1, e):
-                run += _dist(p, i, i - 1)
+                if kind == 0:
+                    run += _dist(p, i, i - 1)
                 w = _weight(p[i, 0], p[i, 1], p[i, 2], c, radius, lut) * strength
                 if w == 0.0:
                     continue

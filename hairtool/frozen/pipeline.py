@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
 from hairtool.frozen.align import align, check_align_params
-from hairtool.frozen.brushes import BrushSample, apply_brush, check_sample, paint_mask, scalp_centre
+from hairtool.frozen.brushes import BrushSample, apply_brush, paint_mask, scalp_centre
 from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
 from hairtool.frozen.clump_region import clump_points_interactive
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
@@ -254,17 +254,24 @@ class FrozenPipeline:
         return self.apply_samples([sample])
 
     def brush(self, sample: BrushSample) -> Groom:
-        """One sample of a comb, smooth, length, puff or mask brush; it persists."""
-        return self.apply_samples([check_sample(sample)])
+        """One sample of a comb, smooth, length, puff or mask brush; it persists (checked where
+        it is applied: a refused sample leaves no trace in the log)."""
+        return self.apply_samples([sample])
 
     def apply_samples(self, samples: Sequence[Sample]) -> Groom:
         """Samples of any brush (a stroke's, mirrored ones included), applied in order, then one
         clumping: what a replayed stroke log does."""
         self._timings = dict.fromkeys(self._timings, 0.0)
         t0 = time.perf_counter()
-        for sample in samples:
-            self._aligned = self._apply(self._aligned, sample)
-            self._log.append(sample)
+        before = (self._aligned, self._locked, len(self._log))
+        try:
+            for sample in samples:
+                self._aligned = self._apply(self._aligned, sample)
+                self._log.append(sample)
+        except BaseException:  # a refused sample: none of these samples happened
+            self._aligned, self._locked = before[0], before[1]
+            del self._log[before[2] :]
+            raise
         self._timings["align"] = (time.perf_counter() - t0) * 1e3
         self._reclump()
         return self._result

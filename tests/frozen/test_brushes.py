@@ -198,3 +198,18 @@ def test_bad_samples_are_one_clear_error(groom):
         falloff_lut([[0, 1], [0.4, 2], [1, 0]])
     with pytest.raises(ParameterError, match="falloff"):
         falloff_lut("bumpy")
+
+
+def test_a_refused_sample_leaves_the_pipeline_as_it_was(groom):
+    c, r = centre_and_radius(groom)
+    pipe = FrozenPipeline(groom, FrozenParams(clump=False))
+    pipe.brush(sample("comb", c, r, 0.5, (0.1, 0, 0)))
+    log, points, locked = pipe.strokes, pipe.result.points.copy(), pipe.locked
+    with pytest.raises(ParameterError, match="strength"):
+        bad = sample("comb", c, r, 7.0)
+        pipe.apply_samples([sample("mask", c, r, 1.0), sample("smooth", c, r, 0.5), bad])
+    assert pipe.strokes == log
+    np.testing.assert_array_equal(pipe.result.points, points)
+    np.testing.assert_array_equal(pipe.locked, locked)
+    pipe.update()
+    np.testing.assert_array_equal(pipe.result.points, points)
