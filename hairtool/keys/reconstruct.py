@@ -17,6 +17,7 @@ from hairtool.errors import ParameterError
 from hairtool.groom import Animation
 from hairtool.keys.costs import INTERPOLATIONS
 from hairtool.keys.dp import uniform_keys
+from hairtool.keys.gram import tangent_stencil
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -79,9 +80,7 @@ def key_poses(frames: ArrayLike, keys: ArrayLike, interp: str = "linear") -> Key
         return _fitted_key_poses(f, k)
     tangents = None
     if interp == "hermite":
-        lo = np.clip(k - 1, 0, f.shape[0] - 1)
-        hi = np.clip(k + 1, 0, f.shape[0] - 1)
-        w = np.where((k == 0) | (k == f.shape[0] - 1), 1.0, 0.5)
+        lo, hi, w = (a[k] for a in tangent_stencil(f.shape[0]))
         tangents = (f[hi].astype(np.float64) - f[lo]) * w.reshape((-1,) + (1,) * (f.ndim - 1))
     return KeyPoses(k, f[k].astype(np.float64), tangents, int(f.shape[0]), interp)
 
@@ -231,14 +230,13 @@ def motion_speed(
     if n < 2:
         return out
     chunk = max(1, _CHUNK_VALUES // max(f.shape[1] * f.shape[2], 1))
+    lo, hi, w = tangent_stencil(n)  # the central difference, one-sided at the ends
     for f0 in range(0, n, chunk):
         if cancelled is not None and cancelled():
             return None
         t = np.arange(f0, min(n, f0 + chunk))
-        lo, hi = np.clip(t - 1, 0, n - 1), np.clip(t + 1, 0, n - 1)
-        d = f[hi].astype(np.float64) - f[lo]
-        w = np.where((t == 0) | (t == n - 1), 1.0, 0.5)
-        out[t] = np.sqrt(np.einsum("fvi,fvi->fv", d, d)).mean(axis=1) * w
+        d = f[hi[t]].astype(np.float64) - f[lo[t]]
+        out[t] = np.sqrt(np.einsum("fvi,fvi->fv", d, d)).mean(axis=1) * w[t]
     return out * fps
 
 

@@ -27,7 +27,7 @@ from numba import njit, prange
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
-from hairtool.keys.gram import HERMITE_BASIS
+from hairtool.keys.gram import HERMITE_BASIS, tangent_stencil
 from hairtool.keys.segment_hermite import hermite_quad_weights
 
 F64 = NDArray[np.float64]
@@ -175,9 +175,8 @@ def fit_segment(x: ArrayLike, i: int, j: int) -> tuple[F64, F64, F64]:
     closest to the data tangents; none: the data tangents."""
     x = np.asarray(x, dtype=np.float64)
     n, el = x.shape[0], j - i
-    lo, hi = np.clip([i - 1, j - 1], 0, n - 1), np.clip([i + 1, j + 1], 0, n - 1)
-    w = np.where(np.array([i, j]) % (n - 1) == 0, 1.0, 0.5)
-    a_data, b_data = (el * w[:, None] * (x[hi] - x[lo]))  # seed 003's, scaled by L
+    lo, hi, w = (a[[i, j]] for a in tangent_stencil(n))
+    a_data, b_data = el * w[:, None] * (x[hi] - x[lo])  # seed 003's, scaled by L
     k = np.arange(i + 1, j)
     s = (k - i) / el
     basis = HERMITE_BASIS @ np.stack([np.ones_like(s), s, s**2, s**3])  # h00, h10, h01, h11
