@@ -1,9 +1,11 @@
-"""The GL viewport: moderngl inside a QOpenGLWidget, camera navigation and the align brush.
+"""The GL viewport: moderngl inside a QOpenGLWidget, camera navigation and the brushes.
 
 Navigation follows Blender/Maya: middle-drag or Alt+left-drag orbits (pans in 2-D), Shift with
-either pans, the wheel zooms, Ctrl+wheel resizes the brush. A plain left-drag is the align tool:
-the cursor is unprojected onto the plane through the groom's centre facing the camera, and
-every move runs the frozen-hair pipeline. The view is told what changed by the scene's signals
+either pans, the wheel zooms, Ctrl+wheel resizes the brush. A plain left-drag is the current
+brush (Ctrl+left-drag inverts it, as in Blender: shrink for grow, erase for paint): the cursor is
+unprojected onto the plane through the groom's centre facing the camera, the mouse's motion
+between two moves on that plane is the brush's direction (comb), the camera's ray through the
+cursor its view (front faces only), and every move runs the frozen-hair pipeline. The view is told what changed by the scene's signals
 and uploads it at the next paint (positions only while dragging).
 
 With an animation loaded the window shows one of its frames instead of the scene's groom
@@ -73,6 +75,9 @@ class Viewport(QOpenGLWidget):
         self._drag_button = Qt.MouseButton.NoButton
         self._last_pos = QPointF()
         self._stroke_before: object | None = None
+        self._stroke_cursor: np.ndarray | None = None  # the last move's cursor (for the direction)
+        self._stroke_invert = False  # Ctrl held at the press
+        self.stroke_touched = False  # the brush reached a strand during the current / last stroke
         self._hover: QPointF | None = None
         self._auto_frame = True  # follow the widget's size with frame-all until the user navigates
         # an animation frame shown instead of the scene's groom (see show_frame)
@@ -93,6 +98,7 @@ class Viewport(QOpenGLWidget):
         scene.mesh_changed.connect(lambda: self._mark("mesh"))
         scene.drawn_changed.connect(lambda: self._mark("groom", "colors"))
         scene.tool_changed.connect(self.update)
+        scene.mask_changed.connect(lambda: self._mark("colors"))
         scene.engine_started.connect(self._on_engine_started)
 
     # -- scene → view ----------------------------------------------------------------------
@@ -318,9 +324,12 @@ class Viewport(QOpenGLWidget):
             self.engine_wait.emit()
         elif self._drag == "align":
             self._stroke_before = self.scene.snapshot()
+            self._stroke_cursor = None
+            self._stroke_invert = bool(event.modifiers() & Qt.KeyboardModifier.ControlModifier)
+            self.stroke_touched = False
             self.stroke_started.emit()
             self.scene.set_dragging(True)  # children at the drag display percentage
-            self._align_at(event.position())
+            self._brush_at(event.position())
         event.accept()
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
@@ -331,7 +340,7 @@ class Viewport(QOpenGLWidget):
         if self._drag == "align" and self._drag_target is not None:
             self._drag_target.move(self._cursor_at(pos))
         elif self._drag == "align":
-            self._align_at(pos)
+            self._brush_at(pos)
         elif self._drag == "orbit":
             self._auto_frame = False
             self.camera.orbit(dx, dy)
@@ -347,8 +356,17 @@ class Viewport(QOpenGLWidget):
         self.cursor_moved.emit(cursor)
         return cursor
 
-    def _align_at(self, pos: QPointF) -> None:
-        self.scene.align(self._cursor_at(pos))
+    def view_at(self, pos: QPointF) -> np.ndarray:
+        """The camera's viewing direction through ``pos`` (from the eye into the scene)."""
+        return self.camera.ray(pos.x(), pos.y(), self.width(), self.height())[1]
+
+    def _brush_at(self, pos: QPointF) -> None:
+        cursor = self._cursor_at(pos)
+        last, self._stroke_cursor = self._stroke_cursor, cursor
+        direction = np.zeros(3) if last is None else cursor - last
+        view = self.view_at(pos)
+        touched = self.scene.brush_move(cursor, direction, view, self._stroke_invert, not self.stroke_touched)
+        self.stroke_touched = self.stroke_touched or touched
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         if self._drag is None or event.button() != self._drag_button:
