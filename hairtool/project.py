@@ -35,7 +35,7 @@ import numpy as np
 
 import hairtool
 from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterError
-from hairtool.frozen.brushes import BRUSHES, LUT_SIZE, BrushSample, check_sample
+from hairtool.frozen.brushes import BRUSHES, LUT_SIZE, BrushSample, check_sample, check_view
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.groom import Animation, Groom
 from hairtool.guides.binding import ChildBinding
@@ -390,6 +390,12 @@ def _write_strokes(log, arrays: dict) -> dict:
         )
         arrays["strokes/falloffs.npy"] = np.array(luts, np.float64).reshape(len(luts), LUT_SIZE)
         info["brushes"] = list(BRUSHES)
+    if any(s.view is not None for s in log):  # front-facing samples: their cameras' directions
+        arrays["strokes/view.npy"] = np.array(
+            [(0.0, 0.0, 0.0) if s.view is None else s.view for s in log], np.float64
+        ).reshape(n, 3)
+        arrays["strokes/has_view.npy"] = np.array([s.view is not None for s in log], np.int64)
+        info["views"] = True
     return info
 
 
@@ -422,17 +428,29 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
         is_brush = brush >= 0
         if np.any(brush >= len(names)) or np.any(is_brush & ((which < 0) | (which >= len(luts)))):
             raise FormatError(r.path, "a stroke names an unknown brush or falloff")
+    views: list = [None] * n
+    if info.get("views"):
+        view = r.array("strokes/view.npy", 2, "f")
+        has_view = r.array("strokes/has_view.npy", 1, "iu")
+        if view.shape != (n, 3) or has_view.shape != (n,):
+            raise FormatError(r.path, f"the stroke view arrays do not all hold {n} strokes")
+        require_finite(r.path, view, "stroke view")
+        views = [tuple(float(x) for x in view[k]) if has_view[k] else None for k in range(n)]
     if n and np.any((brush < 0) & ((mode < 0) | (mode >= len(modes)))):
         raise FormatError(r.path, "a stroke names an unknown align mode")
     strokes = []
     for k in range(n):
         c = (float(cursor[k, 0]), float(cursor[k, 1]), float(cursor[k, 2]))
         if brush[k] < 0:
-            strokes.append(AlignSample(c, float(radius[k]), float(intensity[k]), str(modes[mode[k]])))
+            try:
+                v = check_view(views[k])
+            except HairtoolError as e:
+                raise FormatError(r.path, f"stroke {k}: {e}") from None
+            strokes.append(AlignSample(c, float(radius[k]), float(intensity[k]), str(modes[mode[k]]), v))
             continue
         sample = BrushSample(
             names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
-            float(intensity[k]), tuple(luts[which[k]].tolist()),
+            float(intensity[k]), tuple(luts[which[k]].tolist()), views[k],
         )
         try:
             strokes.append(check_sample(sample))

@@ -66,7 +66,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--strokes",
         metavar="STROKES.json",
-        help="replay a stroke log (align, comb, smooth, length, puff, mask; the studio exports one) "
+        help="replay a stroke log (align, comb, smooth, length, puff, clump, mask; the studio exports one) "
         "after the --align cursors",
     )
     a = parser.add_argument_group("align brush (UserAlign, eqs. 8–13)")

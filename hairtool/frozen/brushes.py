@@ -1,4 +1,4 @@
-"""Grooming brushes beside the paper's align: comb, smooth, length, puff and mask.
+"""Grooming brushes beside the paper's align: comb, smooth, length, puff, clump and mask.
 
 Each brush sample acts on the vertices within its radius of the cursor, weighted by a falloff
 curve of the distance (smooth, linear, constant, or the artist's own curve), times its strength.
@@ -17,6 +17,14 @@ Masked strands are locked for every brush. A sample may be mirrored across the p
   normal (outward from the sphere fitted to the roots) by strength·w at the root: tips lift
   away from the scalp, lengths kept.
 - mask: strength > 0 locks the strands a sample touches, < 0 frees them.
+- clump: paints each strand's clump strength s in [0, 1], which ClumpWithGaps scales its
+  adhesion step by: s moves toward 1 (strength > 0) or 0 (< 0) by |strength|·w, w the largest
+  weight over the strand's vertices.
+
+Front-facing only: a sample with a ``view`` (the camera's viewing direction, from the eye into
+the scene) leaves the strands whose root normal n has n·view > 0 (facing away from the camera)
+as if they were locked (:func:`root_normals`, :func:`facing_away`); the pipeline adds them to
+the mask for that sample, for every brush and align.
 
 Every kernel has a numpy twin (``*_reference``) computing the same definition.
 """
@@ -35,7 +43,7 @@ from hairtool.groom import Groom
 
 F64 = NDArray[np.float64]
 
-BRUSHES = ("align", "comb", "smooth", "length", "puff", "mask")
+BRUSHES = ("align", "comb", "smooth", "length", "puff", "mask", "clump")
 FALLOFFS = ("smooth", "linear", "constant")
 LUT_SIZE = 257  # samples of a falloff curve over [0, 1]: interpolated linearly between
 EPS = 1e-12
@@ -65,7 +73,9 @@ def falloff_lut(falloff: str | Sequence[Sequence[float]]) -> F64:
 
 @dataclass(frozen=True)
 class BrushSample:
-    """One mouse move of one brush (groom units); ``lut`` from :func:`falloff_lut`."""
+    """One mouse move of one brush (groom units); ``lut`` from :func:`falloff_lut`; ``view`` the
+    camera's viewing direction (from the eye into the scene): with it only the strands facing
+    the camera are touched; None: every strand."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -73,23 +83,42 @@ class BrushSample:
     radius: float
     strength: float
     lut: tuple[float, ...]
+    view: tuple[float, float, float] | None = None
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
-        return BrushSample(self.brush, cursor, direction, self.radius, self.strength, self.lut)
+        return BrushSample(
+            self.brush, cursor, direction, self.radius, self.strength, self.lut, mirrored_view(self.view)
+        )
+
+
+def mirrored_view(view: tuple[float, float, float] | None) -> tuple[float, float, float] | None:
+    """A viewing direction mirrored across a plane x = const (None stays None)."""
+    return None if view is None else (-view[0], view[1], view[2])
+
+
+def check_view(view: object) -> tuple[float, float, float] | None:
+    """None, or three finite numbers not all zero (ParameterError naming ``view``)."""
+    if view is None:
+        return None
+    v = np.asarray(view, dtype=np.float64) if isinstance(view, tuple | list | np.ndarray) else np.zeros(0)
+    if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.any(v != 0):
+        raise ParameterError("view", view, "null or three finite numbers, not all zero")
+    return (float(v[0]), float(v[1]), float(v[2]))
 
 
 def check_sample(sample: BrushSample) -> BrushSample:
     if sample.brush not in BRUSHES or sample.brush == "align":
-        raise ParameterError("brush", sample.brush, "one of " + ", ".join(KINDS) + ", mask")
+        raise ParameterError("brush", sample.brush, "one of " + ", ".join(KINDS) + ", mask, clump")
     for name in ("cursor", "direction"):
         v = np.asarray(getattr(sample, name), dtype=np.float64)
         if v.shape != (3,) or not np.all(np.isfinite(v)):
             raise ParameterError(name, getattr(sample, name), "three finite numbers")
     if not np.isfinite(sample.radius) or sample.radius <= 0:
         raise ParameterError("radius", sample.radius, "a positive finite distance")
-    low = -1.0 if sample.brush in ("length", "mask") else 0.0
+    check_view(sample.view)
+    low = -1.0 if sample.brush in ("length", "mask", "clump") else 0.0
     if not np.isfinite(sample.strength) or not low <= sample.strength <= 1.0:
         raise ParameterError("strength", sample.strength, f"a number in [{low:g}, 1]")
     if len(sample.lut) != LUT_SIZE:
@@ -237,22 +266,93 @@ def _puff_strand(p, o, e, w, centre, out):  # pragma: no cover - compiled
 KINDS = {"comb": 0, "smooth": 1, "length": 2, "puff": 3}
 
 
-def scalp_centre(groom: Groom) -> F64:
-    """Centre of the sphere fitted to the roots (least squares, |x|² = 2c·x + k): the scalp's
-    outward normal at a root points away from it; the roots' centroid when they are coplanar."""
+def _sphere_centre(groom: Groom) -> F64 | None:
+    """Centre of the sphere fitted to the roots (least squares, |x|² = 2c·x + k), or None where
+    the roots do not determine one (fewer than 4, coplanar, or a sphere far larger than them)."""
     r = groom.roots.astype(np.float64)
+    if len(r) < 4:
+        return None
     a = np.column_stack([2.0 * r, np.ones(len(r))])
     b = np.einsum("ij,ij->i", r, r)
     sol, *_ = np.linalg.lstsq(a, b, rcond=None)
     centre = sol[:3]
-    if len(r) < 4 or not np.all(np.isfinite(centre)) or np.linalg.matrix_rank(a) < 4:
+    if not np.all(np.isfinite(centre)) or np.linalg.matrix_rank(a) < 4:
+        return None
+    return centre
+
+
+def scalp_centre(groom: Groom) -> F64:
+    """Centre of the sphere fitted to the roots (least squares, |x|² = 2c·x + k): the scalp's
+    outward normal at a root points away from it; where the roots are coplanar (or fewer than
+    4), a point below their centroid."""
+    centre = _sphere_centre(groom)
+    if centre is None:
+        r = groom.roots.astype(np.float64)
         centre = r.mean(axis=0) - np.array([0.0, 1.0, 0.0]) * float(np.ptp(r[:, 1]) + 1.0)
     return centre
+
+
+PLANAR_RATIO = 100.0  # a fitted sphere this many times wider than the roots' extent: a flat scalp
+
+
+def root_normals(groom: Groom) -> F64:
+    """``(S, 3)`` unit outward scalp normal at each root, for front-facing brushes.
+
+    On a head (the roots fit a sphere, as puff uses): away from the sphere's centre. A headless
+    groom whose roots lie in a plane (or on a sphere over PLANAR_RATIO times wider than they
+    are: numerically a plane) has one normal, the plane's, on the side its strands grow to (the
+    mean root-to-tip direction): seen from that side every strand faces the camera, from
+    behind none does. Roots on a line or a point (no plane): zero normals, so no strand ever
+    faces away and front-facing changes nothing."""
+    r = groom.roots.astype(np.float64)
+    s = len(r)
+    centre = _sphere_centre(groom)
+    extent = float(np.ptp(r, axis=0).max()) if s else 0.0
+    if centre is not None and np.linalg.norm(r - centre, axis=1).max() <= PLANAR_RATIO * extent:
+        n = r - centre
+        norm = np.linalg.norm(n, axis=1, keepdims=True)
+        return np.divide(n, norm, out=np.zeros_like(n), where=norm > EPS)
+    out = np.zeros((s, 3))
+    if s < 3:
+        return out
+    _, sv, vt = np.linalg.svd(r - r.mean(axis=0), full_matrices=False)
+    if sv[1] <= 1e-9 * max(sv[0], EPS):
+        return out  # the roots lie on a line: no plane
+    normal = vt[2]
+    tips = groom.points[groom.topology.tip_indices].astype(np.float64)
+    if float(np.mean(tips - r, axis=0) @ normal) < 0:
+        normal = -normal
+    out[:] = normal
+    return out
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _facing_away_kernel(normals, view, out):  # pragma: no cover - compiled
+    for s in prange(normals.shape[0]):
+        out[s] = normals[s, 0] * view[0] + normals[s, 1] * view[1] + normals[s, 2] * view[2] > 0.0
+
+
+def facing_away(normals: ArrayLike, view: ArrayLike) -> np.ndarray:
+    """``(S,)`` the strands whose root normal faces away from a camera looking along ``view``
+    (n·view > 0): a front-facing brush leaves them as if locked."""
+    n = np.ascontiguousarray(normals, dtype=np.float64)
+    out = np.empty(len(n), dtype=np.bool_)
+    _facing_away_kernel(n, np.asarray(view, np.float64), out)
+    return out
+
+
+def facing_away_reference(normals: ArrayLike, view: ArrayLike) -> np.ndarray:
+    """Numpy twin of :func:`facing_away`."""
+    n = np.asarray(normals, np.float64)
+    v = np.asarray(view, np.float64)
+    return n[:, 0] * v[0] + n[:, 1] * v[1] + n[:, 2] * v[2] > 0.0
 
 
 def apply_brush(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike) -> Groom:
     """One comb, smooth, length or puff sample (numba); ``locked``: ``(S,)`` masked strands."""
     check_sample(sample)
+    if sample.brush not in KINDS:
+        raise ParameterError("brush", sample.brush, "one of " + ", ".join(KINDS))
     out = np.empty((groom.vertex_count, 3))
     _brush_kernel(
         groom.points.astype(np.float64),
@@ -328,13 +428,63 @@ def _puff_reference(p: F64, w: float, centre: F64) -> F64:
     return p[0] + rotated
 
 
-def paint_mask(groom: Groom, sample: BrushSample, locked: ArrayLike) -> np.ndarray:
+def paint_mask(
+    groom: Groom, sample: BrushSample, locked: ArrayLike, skip: ArrayLike | None = None
+) -> np.ndarray:
     """``(S,)`` the mask after one mask sample: strands with a vertex inside the brush are locked
-    (strength > 0) or freed (strength < 0)."""
+    (strength > 0) or freed (strength < 0); the strands ``skip`` (facing away) are left as they are."""
     check_sample(sample)
     locked = np.array(locked, dtype=bool)
     c, lut = np.asarray(sample.cursor, np.float64), np.asarray(sample.lut, np.float64)
     w = _weights_reference(groom.points.astype(np.float64), c, sample.radius, lut)
     touched = np.maximum.reduceat(w, groom.offsets[:-1]) > 0
+    if skip is not None:
+        touched &= ~np.asarray(skip, dtype=bool)
     locked[touched] = sample.strength > 0
     return locked
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _paint_clump_kernel(p, offsets, locked, c, radius, strength, lut, s_in, s_out):  # pragma: no cover
+    target = 1.0 if strength > 0.0 else 0.0
+    amount = abs(strength)
+    for s in prange(offsets.size - 1):
+        s_out[s] = s_in[s]
+        if locked[s]:
+            continue
+        w = 0.0
+        for i in range(offsets[s], offsets[s + 1]):
+            w = max(w, _weight(p[i, 0], p[i, 1], p[i, 2], c, radius, lut))
+        if w > 0.0:
+            s_out[s] = s_in[s] + amount * w * (target - s_in[s])
+
+
+def paint_clump(groom: Groom, sample: BrushSample, strength: ArrayLike, locked: ArrayLike) -> np.ndarray:
+    """``(S,)`` float64 clump strengths after one clump sample: each unlocked strand's s moves
+    toward 1 (sample strength > 0) or 0 (< 0) by |strength|·w, w its largest vertex weight, so
+    it stays in [0, 1] (numba)."""
+    check_sample(sample)
+    if sample.brush != "clump":
+        raise ParameterError("brush", sample.brush, "clump")
+    s_in = np.ascontiguousarray(strength, dtype=np.float64)
+    out = np.empty_like(s_in)
+    _paint_clump_kernel(
+        groom.points.astype(np.float64), groom.offsets, np.asarray(locked, np.bool_),
+        np.asarray(sample.cursor, np.float64), float(sample.radius), float(sample.strength),
+        np.asarray(sample.lut, np.float64), s_in, out,
+    )  # fmt: skip
+    return out
+
+
+def paint_clump_reference(
+    groom: Groom, sample: BrushSample, strength: ArrayLike, locked: ArrayLike
+) -> np.ndarray:
+    """Numpy twin of :func:`paint_clump`."""
+    check_sample(sample)
+    s_in = np.asarray(strength, dtype=np.float64)
+    c, lut = np.asarray(sample.cursor, np.float64), np.asarray(sample.lut, np.float64)
+    w = np.maximum.reduceat(_weights_reference(groom.points.astype(np.float64), c, sample.radius, lut),
+                            groom.offsets[:-1])
+    w = np.where(np.asarray(locked, bool), 0.0, w)
+    target = 1.0 if sample.strength > 0 else 0.0
+    return np.where(w > 0, s_in + abs(sample.strength) * w * (target - s_in), s_in)

@@ -4,10 +4,13 @@ Built for dragging in the studio:
 
 - FreezeDeform always starts from the rest groom with noise hashed from (seed, strand, vertex),
   and is cached until a freeze parameter changes; it never feeds on its own output.
-- Strokes persist: each brush sample (one mouse move of align, comb, smooth, length, puff or
-  mask, :mod:`hairtool.frozen.brushes`) is applied to the cached stroked state and appended to a
-  log. When the frozen groom changes (new k_s, k_b, seed …) the log is replayed on it, so
-  strokes survive parameter changes. Masked strands are locked for every brush.
+- Strokes persist: each brush sample (one mouse move of align, comb, smooth, length, puff,
+  clump or mask, :mod:`hairtool.frozen.brushes`) is applied to the cached stroked state and
+  appended to a log. When the frozen groom changes (new k_s, k_b, seed …) the log is replayed on
+  it, so strokes survive parameter changes. Masked strands are locked for every brush; a sample
+  with a ``view`` also locks, for itself only, the strands facing away from that camera.
+- The clump brush paints a per-strand clump strength (1 everywhere until painted), kept with the
+  mask in the state and the snapshots, which ClumpWithGaps scales each strand's step by.
 - Clumping is recomputed from the aligned state at every update and never accumulates.
 """
 
@@ -23,7 +26,16 @@ from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
 from hairtool.frozen.align import align, check_align_params
-from hairtool.frozen.brushes import BrushSample, apply_brush, paint_mask, scalp_centre
+from hairtool.frozen.brushes import (
+    BrushSample,
+    apply_brush,
+    check_view,
+    facing_away,
+    paint_clump,
+    paint_mask,
+    root_normals,
+    scalp_centre,
+)
 from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
 from hairtool.frozen.clump_region import clump_points_interactive
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
@@ -100,10 +112,14 @@ which stretches segments). ``redraw_noise``: new
 
 
 class AlignSample(NamedTuple):
+    """One align sample; ``view`` as :class:`~hairtool.frozen.brushes.BrushSample`'s (None: every
+    strand, as before the field existed)."""
+
     cursor: tuple[float, float, float]
     radius: float
     intensity: float
     mode: str
+    view: tuple[float, float, float] | None = None
 
 
 Sample = AlignSample | BrushSample
@@ -112,13 +128,14 @@ Sample = AlignSample | BrushSample
 @dataclass(frozen=True)
 class FrozenSnapshot:
     """Undo/redo state: the stroke log and the stroked points it produced (shared, read-only),
-    and the mask it painted (None: replay the log to find it)."""
+    the mask and the clump strengths it painted (None: replay the log to find them)."""
 
     log: tuple[Sample, ...]
     aligned: Groom
     freeze_key: tuple
     draw: int
     locked: np.ndarray | None = None
+    clump_strength: np.ndarray | None = None
 
 
 class FrozenPipeline:
@@ -132,7 +149,9 @@ class FrozenPipeline:
         self._auto_step: tuple[tuple, float] | None = None  # (frozen groom's key, its auto step)
         self._log: list[Sample] = []
         self._locked = np.zeros(rest.strand_count, dtype=bool)
+        self._clump_strength = np.ones(rest.strand_count)
         self._scalp_centre: np.ndarray | None = None
+        self._root_normals: np.ndarray | None = None
         self._draw = 0
         self._workspace = ClumpWorkspace()
         self._timings = {"freeze": 0.0, "align": 0.0, "clump": 0.0, "total": 0.0}
@@ -174,6 +193,19 @@ class FrozenPipeline:
     def locked(self) -> np.ndarray:
         """``(S,)`` the strands the mask brush has locked (a copy)."""
         return self._locked.copy()
+
+    @property
+    def clump_strength(self) -> np.ndarray:
+        """``(S,)`` the clump strength the clump brush has painted, in [0, 1] (a copy)."""
+        return self._clump_strength.copy()
+
+    @property
+    def root_normals(self) -> np.ndarray:
+        """``(S, 3)`` outward scalp normals at the rest roots, for front-facing samples
+        (:func:`~hairtool.frozen.brushes.root_normals`)."""
+        if self._root_normals is None:
+            self._root_normals = root_normals(self._rest)
+        return self._root_normals
 
     @property
     def scalp_centre(self) -> np.ndarray:
@@ -254,8 +286,8 @@ class FrozenPipeline:
         return self.apply_samples([sample])
 
     def brush(self, sample: BrushSample) -> Groom:
-        """One sample of a comb, smooth, length, puff or mask brush; it persists (checked where
-        it is applied: a refused sample leaves no trace in the log)."""
+        """One sample of a comb, smooth, length, puff, clump or mask brush; it persists (checked
+        where it is applied: a refused sample leaves no trace in the log)."""
         return self.apply_samples([sample])
 
     def apply_samples(self, samples: Sequence[Sample]) -> Groom:
@@ -263,14 +295,14 @@ class FrozenPipeline:
         clumping: what a replayed stroke log does."""
         self._timings = dict.fromkeys(self._timings, 0.0)
         t0 = time.perf_counter()
-        before = (self._aligned, self._locked, len(self._log))
+        before = (self._aligned, self._locked, self._clump_strength, len(self._log))
         try:
             for sample in samples:
                 self._aligned = self._apply(self._aligned, sample)
                 self._log.append(sample)
         except BaseException:  # a refused sample: none of these samples happened
-            self._aligned, self._locked = before[0], before[1]
-            del self._log[before[2] :]
+            self._aligned, self._locked, self._clump_strength = before[:3]
+            del self._log[before[3] :]
             raise
         self._timings["align"] = (time.perf_counter() - t0) * 1e3
         self._reclump()
@@ -290,6 +322,7 @@ class FrozenPipeline:
         """Forget every stroke: back to the frozen groom (clumped)."""
         self._log = []
         self._locked = np.zeros(self._rest.strand_count, dtype=bool)
+        self._clump_strength = np.ones(self._rest.strand_count)
         self._aligned = self._frozen
         self._timings = dict.fromkeys(self._timings, 0.0)
         self._reclump()
@@ -298,7 +331,8 @@ class FrozenPipeline:
     def snapshot(self) -> FrozenSnapshot:
         """Cheap state for undo/redo (no copies: grooms are immutable)."""
         return FrozenSnapshot(
-            tuple(self._log), self._aligned, self._freeze_key or (), self._draw, self._locked.copy()
+            tuple(self._log), self._aligned, self._freeze_key or (), self._draw, self._locked.copy(),
+            self._clump_strength.copy(),
         )
 
     def restore(self, snapshot: FrozenSnapshot) -> Groom:
@@ -308,11 +342,16 @@ class FrozenPipeline:
         if (
             snapshot.freeze_key == self._freeze_key
             and snapshot.draw == self._draw
-            and (snapshot.locked is not None or not any(isinstance(s, BrushSample) for s in snapshot.log))
+            and (
+                (snapshot.locked is not None and snapshot.clump_strength is not None)
+                or not any(isinstance(s, BrushSample) for s in snapshot.log)
+            )
         ):
             self._aligned = snapshot.aligned
             n = self._rest.strand_count
             self._locked = np.zeros(n, bool) if snapshot.locked is None else snapshot.locked.copy()
+            cs = snapshot.clump_strength
+            self._clump_strength = np.ones(n) if cs is None else cs.astype(np.float64)
         else:
             self._replay()
         self._reclump()
@@ -344,23 +383,35 @@ class FrozenPipeline:
         self._replay()
         self._timings["align"] = (time.perf_counter() - t1) * 1e3
 
+    def _away(self, view: tuple[float, float, float] | None) -> np.ndarray | None:
+        """The strands facing away from a sample's camera (None: no view, none)."""
+        if check_view(view) is None:
+            return None
+        return facing_away(self.root_normals, view)
+
     def _apply(self, g: Groom, sample: Sample) -> Groom:
+        away = self._away(sample.view)
+        if isinstance(sample, BrushSample) and sample.brush == "mask":
+            self._locked = paint_mask(g, sample, self._locked, away)
+            return g
+        locked = self._locked if away is None else self._locked | away  # this sample's lock
         if isinstance(sample, AlignSample):
             out = align(g, sample.cursor, sample.radius, sample.intensity, sample.mode)
-            if self._locked.any():  # masked strands are locked for the align brush too
-                keep = vertex_ids_of(g.topology, np.flatnonzero(self._locked))
+            if locked.any():  # masked strands are locked for the align brush too
+                keep = vertex_ids_of(g.topology, np.flatnonzero(locked))
                 pts = out.points.copy()
                 pts[keep] = g.points[keep]
                 out = g.with_points(pts)
             return out
-        if sample.brush == "mask":
-            self._locked = paint_mask(g, sample, self._locked)
+        if sample.brush == "clump":
+            self._clump_strength = paint_clump(g, sample, self._clump_strength, locked)
             return g
-        return apply_brush(g, sample, self._locked, self.scalp_centre)
+        return apply_brush(g, sample, locked, self.scalp_centre)
 
     def _replay(self) -> None:
         g = self._frozen
         self._locked = np.zeros(self._rest.strand_count, dtype=bool)
+        self._clump_strength = np.ones(self._rest.strand_count)
         for s in self._log:
             g = self._apply(g, s)
         self._aligned = g

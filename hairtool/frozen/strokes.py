@@ -4,12 +4,15 @@ A stroke log is a JSON list of strokes, in groom units::
 
     [{"brush": "comb", "falloff": "smooth", "symmetry": "x", "mirror_x": 0.0,
       "params": {}, "samples": [{"cursor": [x, y, z], "direction": [dx, dy, dz],
-                                 "radius": r, "strength": s}, ...]}, ...]
+                                 "radius": r, "strength": s, "view": [vx, vy, vz]}, ...]}, ...]
 
 - ``brush``: ``align`` (the paper's UserAlign; ``params.mode`` "paper" or "preserve-length",
   ``strength`` its intensity, no direction needed), ``comb``, ``smooth``, ``length`` (a signed
   strength: > 0 grows, < 0 shrinks, as a fraction of the strand's length at the brush centre),
-  ``puff`` or ``mask`` (> 0 locks the strands touched, < 0 frees them). ``clump`` is reserved.
+  ``puff``, ``mask`` (> 0 locks the strands touched, < 0 frees them) or ``clump`` (> 0 paints
+  clumping on, < 0 off: each strand's clump strength moves toward 1 or 0).
+- ``view`` (per sample, optional): the camera's viewing direction, from the eye into the scene;
+  only the strands facing that camera are touched. null or missing (older logs): every strand.
 - ``falloff``: ``smooth``, ``linear``, ``constant``, or a curve ``[[t, w], ...]`` over t =
   distance / radius from 0 to 1 (align keeps the paper's own weighting and ignores it).
 - ``symmetry``: ``"x"`` mirrors every sample across the plane x = ``mirror_x`` (default: the
@@ -33,7 +36,7 @@ import numpy as np
 
 from hairtool.errors import FormatError, ParameterError
 from hairtool.frozen.align import MODES
-from hairtool.frozen.brushes import BRUSHES, BrushSample, check_sample, falloff_lut
+from hairtool.frozen.brushes import BRUSHES, BrushSample, check_sample, check_view, falloff_lut, mirrored_view
 from hairtool.frozen.pipeline import AlignSample
 from hairtool.io.atomic import atomic_open
 
@@ -46,6 +49,7 @@ class StrokeSample:
     radius: float
     strength: float
     direction: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    view: tuple[float, float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -80,12 +84,14 @@ class Stroke:
         for s in self.samples:
             if self.brush == "align":
                 mode = self.params.get("mode", "paper")
-                first = AlignSample(s.cursor, s.radius, s.strength, mode)
+                first = AlignSample(s.cursor, s.radius, s.strength, mode, check_view(s.view))
                 out.append(first)
                 if self.symmetry == "x":
-                    out.append(first._replace(cursor=(2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])))
+                    cursor = (2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])
+                    out.append(first._replace(cursor=cursor, view=mirrored_view(s.view)))
                 continue
-            sample = check_sample(BrushSample(self.brush, s.cursor, s.direction, s.radius, s.strength, lut))
+            sample = BrushSample(self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view)
+            sample = check_sample(sample)
             out.append(sample)
             if self.symmetry == "x":
                 out.append(sample.mirrored(mirror))
@@ -105,6 +111,7 @@ class Stroke:
                     "direction": list(s.direction),
                     "radius": s.radius,
                     "strength": s.strength,
+                    "view": None if s.view is None else list(s.view),
                 }
                 for s in self.samples
             ],
@@ -118,11 +125,11 @@ def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
     for s in log:
         if isinstance(s, AlignSample):
             key: tuple = ("align", s.mode)
-            sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity)
+            sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view))
             start = Stroke("align", (sample,), params={"mode": s.mode})
         else:
             key = (s.brush, s.lut)
-            sample = StrokeSample(tuple(s.cursor), s.radius, s.strength, tuple(s.direction))
+            sample = StrokeSample(tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view))
             start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut))
         if runs and runs[-1][0] == key:
             last = runs[-1][1]
@@ -130,6 +137,10 @@ def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
         else:
             runs.append((key, start))
     return [stroke for _, stroke in runs]
+
+
+def _view_of(view: Sequence[float] | None) -> tuple[float, float, float] | None:
+    return None if view is None else (float(view[0]), float(view[1]), float(view[2]))
 
 
 def _falloff_of(lut: Sequence[float]) -> str | tuple[tuple[float, float], ...]:
@@ -174,6 +185,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
                 _number(f"{at}.radius", s.get("radius")),
                 _number(f"{at}.strength", s.get("strength")),
                 _vector(f"{at}.direction", s.get("direction"), (0.0, 0.0, 0.0)),
+                None if s.get("view") is None else _vector(f"{at}.view", s.get("view")),
             )
         )
     falloff = d.get("falloff", "smooth")

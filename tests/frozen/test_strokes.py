@@ -13,7 +13,7 @@ from hairtool import io, samples
 from hairtool.cli import main
 from hairtool.errors import FormatError
 from hairtool.frozen.brushes import BrushSample, falloff_lut
-from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline
 from hairtool.frozen.strokes import Stroke, StrokeSample, read_strokes, strokes_from_log, write_strokes
 
 
@@ -107,3 +107,76 @@ def test_brush_strokes_survive_a_project_round_trip(tmp_path):
 def test_stroke_sample_type():
     s = Stroke("length", (StrokeSample((0.0, 0.0, 0.0), 1.0, -0.5),))
     assert s.pipeline_samples(0.0)[0].strength == -0.5
+
+
+def painted_session(groom):
+    """Front-facing samples (a camera on +z) and clump strokes painting clumping off and on."""
+    pipe = FrozenPipeline(groom, FrozenParams(seed=6))
+    tips = groom.points[groom.topology.tip_indices].astype(np.float64)
+    c, r = tips[len(tips) // 2], 0.5 * float(np.ptp(groom.points, axis=0).max())
+    smooth, linear = tuple(falloff_lut("smooth").tolist()), tuple(falloff_lut("linear").tolist())
+    view = (0.0, -0.2, -1.0)
+    pipe.align(c + np.array([0.2, 0.3, 0.0]), r, 0.7)
+    pipe.apply_samples([AlignSample(tuple(c), r, 0.5, "paper", view)])
+    pipe.brush(BrushSample("comb", tuple(c), (0.05, 0.02, 0.0), r, 0.9, smooth, view))
+    pipe.brush(BrushSample("clump", tuple(c), (0, 0, 0), r, -0.8, linear, view))
+    pipe.brush(BrushSample("clump", tuple(tips[5]), (0, 0, 0), 0.5 * r, 0.6, smooth))
+    return pipe
+
+
+def test_views_and_clump_strokes_round_trip_through_json_and_the_cli(tmp_path):
+    groom = samples.scalp(150, 12, seed=2)
+    io.write(tmp_path / "groom.npz", groom)
+    pipe = painted_session(groom)
+    strength = pipe.clump_strength
+    assert strength.min() < 0.9 and np.all((strength >= 0) & (strength <= 1))
+    strokes = strokes_from_log(pipe.strokes)
+    assert [s.brush for s in strokes] == ["align", "comb", "clump", "clump"]
+    assert strokes[0].samples[0].view is None and strokes[0].samples[1].view == (0.0, -0.2, -1.0)
+    write_strokes(tmp_path / "strokes.json", strokes)
+    raw = json.loads((tmp_path / "strokes.json").read_text())
+    assert raw[2]["samples"][0]["view"] == [0.0, -0.2, -1.0] and raw[3]["samples"][0]["view"] is None
+    back = read_strokes(tmp_path / "strokes.json")
+    assert back == strokes
+    replay = FrozenPipeline(groom, FrozenParams(seed=6))
+    for s in back:
+        replay.apply_samples(s.pipeline_samples(float(replay.scalp_centre[0])))
+    assert replay.strokes == pipe.strokes
+    np.testing.assert_array_equal(replay.clump_strength, strength)
+    out = tmp_path / "replayed.npz"
+    argv = ["freeze", str(tmp_path / "groom.npz"), str(out), "--seed", "6"]
+    assert main([*argv, "--strokes", str(tmp_path / "strokes.json")]) == 0
+    np.testing.assert_array_equal(io.read(out).points, pipe.result.points)
+
+
+def test_an_older_log_without_views_reads_as_none(tmp_path):
+    comb = {"cursor": [0.1, 0.2, 0.3], "direction": [0.1, 0, 0], "radius": 1.0, "strength": 0.4}
+    log = [
+        {"brush": "comb", "falloff": "linear", "symmetry": "x", "mirror_x": 0.5, "samples": [comb]},
+        {"brush": "align", "samples": [{"cursor": [0, 1, 0], "radius": 1.0, "strength": 0.3, "view": None}]},
+    ]
+    (tmp_path / "old.json").write_text(json.dumps(log))
+    comb, align = read_strokes(tmp_path / "old.json")
+    first, mirrored = comb.pipeline_samples(0.0)
+    assert first.view is None and mirrored.view is None and align.pipeline_samples(0.0)[0].view is None
+
+
+def test_a_symmetric_stroke_mirrors_its_view():
+    s = Stroke("puff", (StrokeSample((0.3, 0.0, 0.0), 1.0, 0.5, view=(0.6, 0.0, -0.8)),), symmetry="x")
+    first, mirrored = s.pipeline_samples(1.0)
+    assert first.view == (0.6, 0.0, -0.8) and mirrored.view == (-0.6, 0.0, -0.8)
+    a = Stroke("align", (StrokeSample((0.3, 0.0, 0.0), 1.0, 0.5, view=(0.6, 0.0, -0.8)),), symmetry="x")
+    assert a.pipeline_samples(1.0)[1].view == (-0.6, 0.0, -0.8)
+
+
+def test_views_and_clump_strokes_survive_a_project_round_trip(tmp_path):
+    from hairtool import project as pf
+
+    groom = samples.scalp(60, 10, seed=1)
+    pipe = painted_session(groom)
+    pf.save(tmp_path / "p.hairproj", pf.Project.from_pipeline(pipe))
+    back = pf.load(tmp_path / "p.hairproj")
+    assert back.strokes == pipe.strokes
+    again = back.pipeline()
+    np.testing.assert_array_equal(again.result.points, pipe.result.points)
+    np.testing.assert_array_equal(again.clump_strength, pipe.clump_strength)
