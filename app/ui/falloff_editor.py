@@ -148,7 +148,7 @@ class FalloffEditor(QWidget):
             p.drawLine(self._to_px(f, 0.0), self._to_px(f, 1.0))
             p.drawLine(self._to_px(0.0, f), self._to_px(1.0, f))
         p.drawRect(r)
-        lut = falloff_lut(self._falloff if isinstance(self._falloff, str) else self._falloff)
+        lut = falloff_lut(self._falloff)
         t = np.linspace(0.0, 1.0, len(lut))
         path = QPainterPath(self._to_px(0.0, float(lut[0])))
         for a, b in zip(t[1:], lut[1:], strict=True):

@@ -63,5 +63,5 @@ class StrokeFiles:
             return False
         w.undo_stack.push(StrokeCommand(scene, before, scene.snapshot(), "Replayed"))
         w.remember_dir(path)
-        w.statusBar().showMessage(f"replayed {len(strokes)} strokes ({len(samples)} samples) from {path}", 5000)
+        w.statusBar().showMessage(f"replayed {len(strokes)} strokes ({len(samples)} moves) from {path}", 5000)
         return True

@@ -170,7 +170,9 @@ class ToolDock(QDockWidget):
         self.mirror_x = QDoubleSpinBox()
         self.mirror_x.setDecimals(4)
         self.mirror_x.setKeyboardTracking(False)
-        self.mirror_x.setToolTip("x of the mirror plane (default: the centre of the sphere fitted to the roots)")
+        self.mirror_x.setToolTip(
+            "x of the mirror plane (default: through the centre of the sphere fitted to the roots)"
+        )
         self.mirror_x.valueChanged.connect(lambda v: self.scene.set_mirror_x(float(v)))
         self.mirror_centre = QPushButton("Centre")
         self.mirror_centre.setToolTip("the mirror plane back through the head's centre")
@@ -305,7 +307,8 @@ class ToolDock(QDockWidget):
             self._brush_form.setRowVisible(self.mode, s.brush == "align")
             self._brush_form.setRowVisible(self.sign, labels is not None)
             custom = not isinstance(tool.falloff, str)
-            self.falloff.setCurrentIndex(self.falloff.count() - 1 if custom else self.falloff.findData(tool.falloff))
+            preset = self.falloff.count() - 1 if custom else self.falloff.findData(tool.falloff)
+            self.falloff.setCurrentIndex(preset)
             self.curve.set_falloff(tool.falloff)
             for w in (self.falloff, self.curve):  # align weighs by the paper's own rule
                 w.setEnabled(s.brush != "align")
