@@ -378,3 +378,29 @@ def test_each_brush_remembers_its_size_and_strength_and_keys_pick_brushes(make_w
     assert not w.dock.curve.isEnabled()  # align weighs by the paper's rule, not the curve
     w.dock.brush.setCurrentIndex(w.dock.brush.findData("length"))
     assert s.brush == "length" and w.dock.sign.currentText() == "Grow"
+
+
+def test_a_project_keeps_the_brush_settings_and_the_mask(ui, make_window, tmp_path):
+    w = plain(make_window)
+    s, v = w.scene, w.viewport
+    s.set_brush("comb")
+    s.set_radius(0.4)
+    s.set_brush("mask")
+    s.set_falloff([[0.0, 1.0], [0.5, 0.25], [1.0, 0.0]])
+    s.set_symmetry(True)
+    s.set_mirror_x(0.125)
+    s.set_front_only(False)
+    s.set_subtract("length", True)
+    pos = v.project(s.result.tips[front_strand(w)])[0]
+    click(ui, v, pos)
+    locked = s.locked.copy()
+    assert locked.any()
+    assert w.project.save_to(tmp_path / "brushes.hairproj")
+    w2 = make_window()
+    assert w2.project.open_project(w.project.path)
+    t = w2.scene.tool
+    assert (t.brush, t.symmetry, t.mirror_x, t.front_only) == ("mask", True, 0.125, False)
+    assert t.falloff == ((0.0, 1.0), (0.5, 0.25), (1.0, 0.0)) and t.subtract["length"]
+    assert t.radius["comb"] == pytest.approx(0.4)
+    np.testing.assert_array_equal(w2.scene.locked, locked)
+    assert w2.dock.mirror_x.value() == pytest.approx(0.125) and not w2.errors
