@@ -226,7 +226,23 @@ class Viewport(QOpenGLWidget):
             r.set_mesh(s.mesh)
         dirty.clear()
 
+    def mirror_outline(self, w: float, h: float) -> np.ndarray | None:
+        """``(4, 2)`` pixels (of a ``w`` × ``h`` view) of the X-symmetry plane's rectangle across
+        the groom's box, or None (symmetry off, or a corner behind the camera)."""
+        s = self.scene
+        if not s.tool.symmetry:
+            return None
+        lo, hi = s.result.bounds
+        pad = 0.05 * float(np.max(hi - lo))
+        y0, y1, z0, z1 = lo[1] - pad, hi[1] + pad, lo[2] - pad, hi[2] + pad
+        x = s.mirror_plane_x()
+        corners = np.array([[x, y0, z0], [x, y1, z0], [x, y1, z1], [x, y0, z1]], np.float64)
+        if not self.camera.ortho and np.any(self.camera.depth(corners) <= 1e-6):
+            return None
+        return self.camera.project(corners, w, h)
+
     def _overlay(self, w: int, h: int) -> None:
+        self.renderer.set_overlay_outline(self.mirror_outline(w, h), (w, h))
         if self._hover is None or self._drag not in (None, "align"):
             self.renderer.set_overlay_circle(None, 0.0, (w, h))
             return

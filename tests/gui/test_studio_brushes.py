@@ -404,3 +404,49 @@ def test_a_project_keeps_the_brush_settings_and_the_mask(ui, make_window, tmp_pa
     assert t.radius["comb"] == pytest.approx(0.4)
     np.testing.assert_array_equal(w2.scene.locked, locked)
     assert w2.dock.mirror_x.value() == pytest.approx(0.125) and not w2.errors
+
+
+def test_the_brush_controls_fit_a_laptop_screen(make_window):
+    from PySide6.QtWidgets import QApplication, QScrollArea
+
+    w = make_window(size=(1366, 768 - 32))
+    QApplication.processEvents()
+    assert w.minimumSizeHint().height() <= 768 - 32
+    bar = w.brush_bar
+    assert bar.isVisible() and bar.geometry().right() <= w.width()
+    for name, action in w.brush_actions.items():
+        button = bar.widgetForAction(action)
+        assert button is not None and button.isVisible(), name  # not folded into the overflow menu
+        assert bar.geometry().contains(button.geometry().translated(bar.pos())), name
+    w.dock.raise_()
+    QApplication.processEvents()
+    for control in (w.dock.brush, w.dock.curve, w.dock.falloff, w.dock.mirror_x, w.dock.front_only):
+        area = control.parentWidget()
+        while not isinstance(area, QScrollArea):
+            area = area.parentWidget()
+        area.ensureWidgetVisible(control)
+        QApplication.processEvents()
+        assert not control.visibleRegion().isEmpty(), control
+
+
+def test_the_symmetry_plane_is_drawn_where_the_artist_puts_it(ui, make_window):
+    w = make_window(groom=samples.scalp(strands=60, vertices=8))
+    v, s = w.viewport, w.scene
+
+    def violet(image):
+        im = image.astype(int)
+        return (im[..., 0] > 150) & (im[..., 2] > 190) & (im[..., 1] < 150)
+
+    ui.leave(v)
+    assert violet(ui.grab(v)).sum() == 0
+    s.set_symmetry(True)
+    s.set_mirror_x(0.0)
+    image = ui.grab(v)
+    assert violet(image).sum() > 100
+    px = v.mirror_outline(v.width(), v.height())
+    s.set_mirror_x(1.5)  # moved: the outline follows
+    moved = v.mirror_outline(v.width(), v.height())
+    assert np.all(moved[:, 0] > px[:, 0])
+    assert w.dock.mirror_x.value() == pytest.approx(1.5)
+    w.dock.mirror_centre.click()
+    assert s.tool.mirror_x is None and w.dock.mirror_x.value() == pytest.approx(s.pipeline.scalp_centre[0], abs=1e-4)
