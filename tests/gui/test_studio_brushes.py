@@ -449,4 +449,5 @@ def test_the_symmetry_plane_is_drawn_where_the_artist_puts_it(ui, make_window):
     assert np.all(moved[:, 0] > px[:, 0])
     assert w.dock.mirror_x.value() == pytest.approx(1.5)
     w.dock.mirror_centre.click()
-    assert s.tool.mirror_x is None and w.dock.mirror_x.value() == pytest.approx(s.pipeline.scalp_centre[0], abs=1e-4)
+    assert s.tool.mirror_x is None
+    assert w.dock.mirror_x.value() == pytest.approx(s.pipeline.scalp_centre[0], abs=1e-4)
