@@ -23,12 +23,20 @@ While a brush drags, :mod:`hairtool.frozen.clump_region` redoes a run only near 
 
 ``keep_lengths``: after the k iterations every segment is set back to its length before
 clumping, root to tip, direction kept (:mod:`hairtool.frozen.lengths`); off by default, as printed.
+
+Clump strength (the clump brush): a per-strand s in [0, 1] scales the step (16) of each of the
+strand's vertices, Δp = s·(Δt²/m)·f, before the gap correction, which then judges each pair by
+the steps its two vertices will really take (r1 from s_p·Δp_p and s_q·Δq_q). It scales how far
+a strand goes, not how hard it pulls: a strand painted to 0 stays exactly where it is and still
+draws its neighbours, so clumps form around it; the paper's adhesion weight g (14) and the
+automatic step (from Σg) stay as printed. All ones (the default) gives the printed bytes.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
+from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
 from hairtool.frozen.lengths import restore_lengths, restore_lengths_reference
@@ -61,6 +69,38 @@ def check_clump_params(radius: float, iterations: int, step: float | None, gap_m
         raise ParameterError("clump_step", step, "a non-negative finite number (Δt²/m)")
     if gap_mode not in GAP_MODES:
         raise ParameterError("gap_mode", gap_mode, " or ".join(GAP_MODES))
+
+
+def vertex_strength(groom: Groom, strength: ArrayLike | None) -> np.ndarray:
+    """``(V,)`` float64 clump strength of each vertex (its strand's), from ``(S,)`` values in
+    [0, 1] (None: all ones); ParameterError naming ``clump_strength`` otherwise."""
+    if strength is None:
+        return np.ones(groom.vertex_count)
+    s = np.asarray(strength, dtype=np.float64)
+    if s.shape != (groom.strand_count,) or not np.all((s >= 0.0) & (s <= 1.0)):
+        raise ParameterError("clump_strength", f"shape {s.shape}", f"{groom.strand_count} numbers in [0, 1]")
+    return s[groom.topology.strand_index]
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def keep_still(points, sv, out):
+    """The vertices at clump strength 0 back to ``points`` in ``out`` after the length pass
+    (which recomputes every segment and may round the last bit of an unmoved one)."""
+    for i in prange(sv.size):
+        if sv[i] == 0.0:
+            for a in range(3):
+                out[i, a] = points[i, a]
+
+
+def keep_still_reference(points: np.ndarray, sv: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """Numpy twin of :func:`keep_still`."""
+    return np.where((sv == 0.0)[:, None], points, out).astype(out.dtype)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _gather_strength(sv, order, S):
+    for k in prange(order.size):
+        S[k] = sv[order[k]]
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -170,19 +210,37 @@ def gap_lambda(ex, ey, ez, gx, gy, gz, step, zeta, h, gap):
     return (1.0 - delta) * zeta
 
 
+@njit(cache=True, nogil=True, inline="always")
+def moved_vertex(P, f, S, step, i, j, zeta, h, gap, Pout, o):
+    """Vertex i's next iterate into ``Pout[o]``: (16) scaled by its clump strength S[i], with
+    the gap correction (17)–(19) against its nearest neighbour j (−1: none) by the scaled steps
+    of both (S all ones: the printed arithmetic, bit for bit). S[i] = 0: not moved at all."""
+    si = S[i]
+    if si == 0.0:
+        for a in range(3):
+            Pout[o, a] = P[i, a]
+        return
+    lam = 1.0
+    if gap != 2 and j >= 0:
+        sj = S[j]
+        lam = gap_lambda(
+            P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2],
+            sj * f[j, 0] - si * f[i, 0], sj * f[j, 1] - si * f[i, 1], sj * f[j, 2] - si * f[i, 2],
+            step, zeta, h, gap,
+        )  # fmt: skip
+    lam *= si
+    for a in range(3):
+        Pout[o, a] = P[i, a] + lam * (step * f[i, a])  # (16), (19)
+
+
 @njit(cache=True, nogil=True, parallel=True)
-def _gap_kernel(P, f, step, best, heads, h, gap, it, Pout):
+def _gap_kernel(P, f, S, step, best, heads, h, gap, it, Pout):
     for i in prange(P.shape[0]):
-        lam = 1.0
         j = best[i]
+        zeta = 0.0
         if gap != 2 and j >= 0:
             zeta = hash_tail_u01_nb(heads[i], it)  # = hash_u01(seed, original index, it, CH_CLUMP)
-            lam = gap_lambda(
-                P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2],
-                f[j, 0] - f[i, 0], f[j, 1] - f[i, 1], f[j, 2] - f[i, 2], step, zeta, h, gap,
-            )  # fmt: skip
-        for a in range(3):
-            Pout[i, a] = P[i, a] + lam * (step * f[i, a])  # (16), (19)
+        moved_vertex(P, f, S, step, i, j, zeta, h, gap, Pout, i)
 
 
 @njit(cache=True, nogil=True)
@@ -232,17 +290,18 @@ def step_from_stats(h, w_sum, w_count):
 
 
 @njit(cache=True, nogil=True)
-def _clump_run(points, order, lists, sroot, h, iterations, step, gap, seed, bufs, out, record):
+def _clump_run(points, strength, order, lists, sroot, h, iterations, step, gap, seed, bufs, out, record):
     """The k Jacobi iterations on the cell-sorted list, one call (no Python between kernels).
     ``step`` < 0: automatic. Writes the result to ``out`` (original order, float32); returns
     (mean neighbours within h per moving vertex, the step used). ``record`` = (iterates (k, V, 3),
     forces (k, V, 3), counts, Σg), in original order, for :mod:`hairtool.frozen.clump_region`; empty
     arrays: not recorded."""
-    P, Pn, f, best, count, weight, heads = bufs
+    P, Pn, f, best, count, weight, heads, S = bufs
     aflat, aoff, acnt, bflat, bstart = lists
     rec_p, rec_f, rec_count, rec_weight = record
     keep = rec_p.shape[0] > 0
     _gather_points(points, order, P)
+    _gather_strength(strength, order, S)
     if gap != 2:
         _hash_heads(order, seed, heads)
     mean_nb = 0.0
@@ -260,7 +319,7 @@ def _clump_run(points, order, lists, sroot, h, iterations, step, gap, seed, bufs
             _scatter(order, f, rec_f[it])
             if it == 0:
                 _scatter_stats(order, count, weight, rec_count, rec_weight)
-        _gap_kernel(P, f, k_step, best, heads, h, gap, it, Pn)
+        _gap_kernel(P, f, S, k_step, best, heads, h, gap, it, Pn)
         P, Pn = Pn, P
     _scatter(order, P, out)
     return mean_nb, k_step
@@ -283,6 +342,7 @@ class ClumpRecord:
         self.forces = np.empty((iterations, vertices, 3))
         self.count = np.empty(vertices, np.int64)
         self.weight = np.empty(vertices)
+        self.strength = np.empty(vertices)  # each vertex's clump strength in the run
         self.step = 0.0
         self.mean_neighbours = 0.0
         self.lists = np.empty((vertices, 16), np.int32)  # each vertex's list, original indices
@@ -354,7 +414,8 @@ class ClumpWorkspace:
         return self._built is not None and _same_points(points, self._built[2])
 
     def buffers(self, v: int) -> tuple:
-        """Iterates, f, nearest neighbour, counts, Σg and hash heads for V vertices, reused."""
+        """Iterates, f, nearest neighbour, counts, Σg, hash heads and clump strengths for V
+        vertices, reused."""
         b = self._buffers
         if not b or len(b[0]) != v:
             self._buffers = (
@@ -365,6 +426,7 @@ class ClumpWorkspace:
                 np.empty(v, np.int64),
                 np.empty(v),
                 np.empty(v, np.uint64),
+                np.empty(v),
             )
         return self._buffers
 
@@ -378,10 +440,12 @@ def clump_points(
     seed: int = 0,
     workspace: ClumpWorkspace | None = None,
     keep_lengths: bool = False,
+    strength: ArrayLike | None = None,
 ) -> np.ndarray:
     """:func:`clump` returning float32 ``(V, 3)`` points instead of a groom."""
     check_clump_params(radius, iterations, step, gap_mode)
     seed = check_seed(seed)
+    sv = vertex_strength(groom, strength)
     ws = workspace or ClumpWorkspace()
     h = float(radius)
     ws.step = 0.0
@@ -399,7 +463,7 @@ def clump_points(
     if ws.record and v * k <= RECORD_LIMIT:
         rec = last if last is not None and last.fits(v, k) else ClumpRecord(v, k)
     ws.mean_neighbours, ws.step = _clump_run(
-        groom.points, nl.order, lists, nl.skip, h, k, -1.0 if step is None else float(step),
+        groom.points, sv, nl.order, lists, nl.skip, h, k, -1.0 if step is None else float(step),
         _GAP_CODE[gap_mode], seed_u64(seed), ws.buffers(v), out,
         _NO_RECORD if rec is None else (rec.iterates, rec.forces, rec.count, rec.weight),
     )  # fmt: skip
@@ -409,12 +473,14 @@ def clump_points(
         rec.lists_ready = False  # filled from the workspace's list when an update first needs them
         rec.key = record_key(groom, h, k, step, gap_mode, seed)
         rec.points[:] = groom.points
+        rec.strength[:] = sv
         rec.result[:] = out
         rec.step, rec.mean_neighbours = ws.step, ws.mean_neighbours
         rec.valid = True
         ws.recorded = rec
     if keep_lengths:  # after the record: it holds the iterations' result, as region updates redo it
         out = restore_lengths(groom.points, out, groom.topology)
+        keep_still(groom.points, sv, out)
     return out
 
 
@@ -434,6 +500,7 @@ def clump(
     seed: int = 0,
     workspace: ClumpWorkspace | None = None,
     keep_lengths: bool = False,
+    strength: ArrayLike | None = None,
 ) -> Groom:
     """ClumpWithGaps: vertices pulled toward nearby vertices of other strands; roots stay.
 
@@ -441,8 +508,9 @@ def clump(
     ``gap_mode`` "printed" | "text" | "off", ``seed`` for ζ. Pass a ``workspace`` to reuse
     buffers across updates and read ``mean_neighbours`` afterwards. ``keep_lengths``: segments
     back to their lengths before clumping afterwards (off: as printed, for the paper's figures).
+    ``strength``: ``(S,)`` clump strength of each strand in [0, 1] (None: all 1, as printed).
     """
-    pts = clump_points(groom, radius, iterations, step, gap_mode, seed, workspace, keep_lengths)
+    pts = clump_points(groom, radius, iterations, step, gap_mode, seed, workspace, keep_lengths, strength)
     return groom.with_points(pts)
 
 
@@ -454,10 +522,12 @@ def clump_reference(
     gap_mode: str = "printed",
     seed: int = 0,
     keep_lengths: bool = False,
+    strength: ArrayLike | None = None,
 ) -> Groom:
     """Plain numpy twin of :func:`clump`: candidate pairs from the start, filtered each iteration."""
     check_clump_params(radius, iterations, step, gap_mode)
     seed = check_seed(seed)
+    sv = vertex_strength(groom, strength)
     h = float(radius)
     top = groom.topology
     strand = top.strand_index
@@ -482,7 +552,7 @@ def clump_reference(
         if it == 0:
             wsum = np.bincount(i, weights=g, minlength=v)
             k_step = auto_step(h, wsum, np.bincount(i, minlength=v)) if step is None else float(step)
-        dp = k_step * f  # (16)
+        dp = sv[:, None] * (k_step * f)  # (16), scaled by the clump strength
         lam = np.ones(v)
         if gap_mode != "off" and len(i):
             first = np.lexsort((j, r, i))  # per vertex: nearest, then lowest index
@@ -501,4 +571,5 @@ def clump_reference(
         P = P + lam[:, None] * dp  # (19)
     if keep_lengths and iterations > 0:
         P = restore_lengths_reference(groom.points, P.astype(np.float32), top)
+        P = keep_still_reference(groom.points, sv, P)
     return groom.with_points(P)

@@ -12,7 +12,10 @@ last run and of this one, ends exactly where the last run left it. :func:`clump_
 keeps a :class:`~hairtool.frozen.clump.ClumpRecord` of each run (its input, output, each iteration's
 points and forces, every vertex's list), makes new lists for the changed vertices and those
 whose lists held or now hold one, and redoes the vertices within 2k steps, reading the record
-for their neighbours outside. The bytes are those of a full run (the tests hold it to that);
+for their neighbours outside. A strand whose clump strength changed (the clump brush) moves
+differently from the first step on while its points and lists stay: its vertices join the
+changed ones as the region's seeds, without new lists. The bytes are those of a full run (the
+tests hold it to that);
 where the automatic step comes out different, too many vertices changed, or the parameters
 did, it runs in full.
 """
@@ -28,10 +31,12 @@ from hairtool.frozen.clump import (
     ClumpWorkspace,
     _first_stats,
     clump_points,
-    gap_lambda,
+    keep_still,
+    moved_vertex,
     record_key,
     step_from_stats,
     vertex_force,
+    vertex_strength,
 )
 from hairtool.frozen.lengths import restore_lengths
 from hairtool.frozen.noise import CH_CLUMP, check_seed, hash_head_nb, hash_tail_u01_nb, seed_u64
@@ -128,21 +133,16 @@ def _region_force(P, flat, cap, list_count, region, roots, h, stats, F, best, co
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _region_gap(P, F, step, best, region, h, gap, it, seed, out):
+def _region_gap(P, F, S, step, best, region, h, gap, it, seed, out):
     """:func:`hairtool.frozen.clump._gap_kernel` for the vertices ``region``, into ``out`` (the next
-    iterate, or the float32 result after the last iteration)."""
+    iterate, or the float32 result after the last iteration); ``S`` clump strengths, original order."""
     for n in prange(region.size):
         i = region[n]
-        lam = 1.0
         j = best[n]
+        zeta = 0.0
         if gap != 2 and j >= 0:
             zeta = hash_tail_u01_nb(hash_head_nb(seed, i, CH_CLUMP), it)
-            lam = gap_lambda(
-                P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2],
-                F[j, 0] - F[i, 0], F[j, 1] - F[i, 1], F[j, 2] - F[i, 2], step, zeta, h, gap,
-            )  # fmt: skip
-        for a in range(3):
-            out[i, a] = P[i, a] + lam * (step * F[i, a])
+        moved_vertex(P, F, S, step, i, j, zeta, h, gap, out, i)
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -195,7 +195,14 @@ class RegionScratch:
 
 
 def _update_region(
-    groom: Groom, h: float, iterations: int, step: float | None, gap_mode: str, seed: int, ws: ClumpWorkspace
+    groom: Groom,
+    h: float,
+    iterations: int,
+    step: float | None,
+    gap_mode: str,
+    seed: int,
+    ws: ClumpWorkspace,
+    sv: np.ndarray,
 ) -> np.ndarray | None:
     """The result redone near the changed vertices, or None where only a full run will do (the
     record is then marked not valid, as this may have begun to rewrite it)."""
@@ -208,15 +215,17 @@ def _update_region(
     points = groom.points
     _changed(points, rec.points, sc.flags)
     changed = np.flatnonzero(sc.flags)
-    if changed.size == 0:
+    restrength = np.flatnonzero(sv != rec.strength)  # moved or not, they step differently
+    seeds = np.union1d(changed, restrength) if restrength.size else changed
+    if seeds.size == 0:
         ws.step, ws.mean_neighbours = rec.step, rec.mean_neighbours
         sc.fraction = 0.0
         sc.region = changed
         return rec.result.copy()
-    if changed.size > MAX_CHANGED * v or not rec.dense:
-        sc.skipping = changed.size > MAX_CHANGED * v  # (a record would not serve the next move either)
+    if seeds.size > MAX_CHANGED * v or not rec.dense:
+        sc.skipping = seeds.size > MAX_CHANGED * v  # (a record would not serve the next move either)
         return None
-    if changed.size >= 0.5 * sc.too_many:  # about as many as made the last try too large:
+    if seeds.size >= 0.5 * sc.too_many:  # about as many as made the last try too large:
         sc.too_many *= 1.25  # try again in a few moves
         sc.skipping = True  # and meanwhile, run in full without recording
         return None
@@ -239,7 +248,7 @@ def _update_region(
     nbr_c, cnt_c = _lists(nl, pos_c, sc)
     sc.relist[:] = False
     if _relist(changed, nbr_c, cnt_c, rec.lists, rec.list_count, sc.relist) > MAX_REGION * v:
-        sc.too_many = changed.size
+        sc.too_many = seeds.size
         return None  # the region holds these and more
     sc.relist[changed] = False
     pos_r = np.flatnonzero(sc.relist[nl.order])
@@ -250,13 +259,13 @@ def _update_region(
     sc.new_row[ids_r] = np.arange(ids_c.size, ids_c.size + ids_r.size)
     sc.mask[:] = False
     n = _within_steps(
-        iterations * (1 if gap_mode == "off" else 2), changed, rec.lists, rec.list_count, sc.new_row,
+        iterations * (1 if gap_mode == "off" else 2), seeds, rec.lists, rec.list_count, sc.new_row,
         nbr_c, cnt_c, nbr_r, cnt_r, int(MAX_REGION * v), sc.mask, sc.queue,
     )  # fmt: skip
     sc.new_row[ids_c] = -1
     sc.new_row[ids_r] = -1
     if n > MAX_REGION * v:
-        sc.too_many = changed.size
+        sc.too_many = seeds.size
         return None
     rec.valid = False  # rewritten from here on
     longest = max(int(cnt_c.max(initial=0)), int(cnt_r.max(initial=0)))
@@ -288,9 +297,10 @@ def _update_region(
                     return None  # the record's forces and counts are rewritten: dropped
             mean_nb = int(rec.count.sum()) / max(v - top.strand_count, 1)  # pairs per moving vertex
         out = rec.iterates[it + 1] if it + 1 < iterations else rec.result
-        _region_gap(p, f, k_step, best, region, h, gap, it, seed64, out)
+        _region_gap(p, f, sv, k_step, best, region, h, gap, it, seed64, out)
     sc.too_many = np.inf
     rec.points[:] = points
+    rec.strength[:] = sv
     rec.mean_neighbours = mean_nb
     rec.valid = True
     ws.step, ws.mean_neighbours = k_step, mean_nb
@@ -318,23 +328,25 @@ def clump_points_interactive(
     seed: int = 0,
     workspace: ClumpWorkspace | None = None,
     keep_lengths: bool = False,
+    strength: np.ndarray | None = None,
 ) -> np.ndarray:
     """:func:`~hairtool.frozen.clump.clump_points`, the same bytes, for a workspace that sees one
-    edit after another: redone only near what changed since its last run when it can. With
-    ``keep_lengths`` the length pass follows the iterations' result in either path (the record
-    keeps the result before it)."""
+    edit after another: redone only near what changed (points or clump ``strength``) since its
+    last run when it can. With ``keep_lengths`` the length pass follows the iterations' result
+    in either path (the record keeps the result before it)."""
     ws = workspace or ClumpWorkspace()
     if ws.region is None:
         ws.region = RegionScratch()
     ws.region.skipping = False
     out = None
+    sv = vertex_strength(groom, strength)
     if iterations > 0 and groom.strand_count >= 2:
         seed = check_seed(seed)
-        out = _update_region(groom, float(radius), int(iterations), step, gap_mode, seed, ws)
+        out = _update_region(groom, float(radius), int(iterations), step, gap_mode, seed, ws, sv)
     if out is None:
         ws.region.fraction = 1.0
         ws.record = not ws.region.skipping
-        out = clump_points(groom, radius, iterations, step, gap_mode, seed, ws)
+        out = clump_points(groom, radius, iterations, step, gap_mode, seed, ws, False, strength)
     sc = ws.region
     if not (keep_lengths and iterations > 0 and groom.strand_count >= 2):
         sc.kept = None
@@ -345,4 +357,5 @@ def clump_points_interactive(
         restore_lengths(groom.points, out, top, np.unique(top.strand_index[sc.region]), sc.kept)
     else:
         sc.kept = restore_lengths(groom.points, out, top)
+    keep_still(groom.points, sv, sc.kept)
     return sc.kept.copy()

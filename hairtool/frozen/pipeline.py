@@ -429,6 +429,7 @@ class FrozenPipeline:
                 draw_seed(p.seed, self._draw),
                 self._workspace,
                 bool(p.keep_lengths),
+                self._clump_strength,
             )
             self._result = self._rest.with_points(pts)
         else:
