@@ -451,3 +451,41 @@ def test_the_symmetry_plane_is_drawn_where_the_artist_puts_it(ui, make_window):
     w.dock.mirror_centre.click()
     assert s.tool.mirror_x is None
     assert w.dock.mirror_x.value() == pytest.approx(s.pipeline.scalp_centre[0], abs=1e-4)
+
+
+def test_with_render_hair_brushes_act_on_the_guides_and_masked_guides_children_show_it(ui, make_window):
+    from app.ui.colouring import MASK_KEEP, MASK_RGB, vertex_colors
+    from hairtool.guides.binding import bind_roots
+
+    w = plain(make_window, groom=samples.scalp(strands=60, vertices=12, seed=4))
+    s, v = w.scene, w.viewport
+    s.set_binding(bind_roots(s.rest, count=600, seed=2))
+    s.set_colour_mode("hair")
+    s.set_brush("mask")
+    s.set_falloff("constant")
+    pos = v.project(s.result.tips[front_strand(w)])[0]
+    click(ui, v, pos)
+    locked = s.locked
+    assert locked.any() and not locked.all()
+    colours = vertex_colors(s)
+    s.locked = np.zeros_like(locked)  # the same picture without the mask
+    plain_colours = vertex_colors(s)
+    s.locked = locked
+    top, b = s.drawn_topology, s.drawn_binding()
+    child_masked = np.repeat(locked[b.guide_ids[:, 0]], b.counts)
+    n = len(child_masked)
+    masked = np.concatenate([child_masked, np.repeat(locked, s.result.topology.counts)])
+    assert child_masked.any() and not child_masked.all()
+    dimmed = MASK_KEEP * plain_colours[masked] + (1 - MASK_KEEP) * MASK_RGB
+    np.testing.assert_allclose(colours[masked], dimmed)
+    np.testing.assert_array_equal(colours[~masked], plain_colours[~masked])
+    assert top.vertex_count == n + s.result.vertex_count
+    before = s.result
+    w.brush_actions["comb"].trigger()
+    s.set_radius(5.0)
+    s.set_front_only(False)
+    ui.drag(v, pos, pos + np.array([50.0, 0.0]))
+    shape = (before.strand_count, -1, 3)
+    after, old = s.result.points.reshape(shape), before.points.reshape(shape)
+    np.testing.assert_array_equal(after[locked], old[locked])
+    np.testing.assert_array_equal(s.drawn_points[:n], s.binding.build(s.result).points)
