@@ -105,6 +105,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         settle(app)
         save(window, args.outdir / "screenshot-studio.png")
 
+        scene.set_symmetry(False)  # the timeline's picture is about the animation
         window.timeline.show()
         window.sources.dock.raise_()
         window.sources.apply_anime()
