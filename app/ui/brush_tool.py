@@ -40,6 +40,7 @@ TIPS = {
 }
 #: Brushes with a signed strength: (label of > 0, label of < 0).
 SIGNED = {"length": ("Grow", "Shrink"), "clump": ("Paint", "Erase"), "mask": ("Paint", "Erase")}
+SIGN_LABELS = {"length": "Grow or shrink", "clump": "Paint or erase", "mask": "Paint or erase"}
 DEFAULT_STRENGTH = {
     "align": 0.8,
     "comb": 0.5,

@@ -27,7 +27,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.render.ramps import RAMPS
-from app.ui.brush_tool import FALLOFF_LABELS, LABELS, SHORTCUTS, SIGNED, TIPS, brushes
+from app.ui.brush_tool import FALLOFF_LABELS, LABELS, SHORTCUTS, SIGN_LABELS, SIGNED, TIPS, brushes
 from app.ui.falloff_editor import FalloffEditor
 from app.ui.qt_utils import signals_blocked
 from app.ui.render_hair_box import RenderHairBox
@@ -304,6 +304,7 @@ class ToolDock(QDockWidget):
                 for i, label in enumerate(labels):
                     self.sign.setItemText(i, label)
                 self.sign.setCurrentIndex(1 if tool.subtract[s.brush] else 0)
+                self._brush_form.labelForField(self.sign).setText(SIGN_LABELS[s.brush])
             self._brush_form.setRowVisible(self.mode, s.brush == "align")
             self._brush_form.setRowVisible(self.sign, labels is not None)
             custom = not isinstance(tool.falloff, str)

@@ -48,6 +48,7 @@ from hairtool.simulate.options import SimulateOptions
 MAX_RECENT = 10
 FIRST_SIZE = (1280, 800)  # the window's first-start size, shrunk to fit smaller screens
 MISSED_STRANDS = "The brush touched no strand: start the drag on the hair, or make the brush bigger ( ] )"
+CLUMP_FULL = "These strands already clump fully: Ctrl+drag (or Erase) loosens them, painting brings them back"
 SETTINGS_ORG, SETTINGS_APP = "hairtool", "Hairtool Studio"
 
 
@@ -77,6 +78,7 @@ class MainWindow(QMainWindow):
         self.undo_stack = QUndoStack(self)
         self._shown_once = False
         self._stroke_points: np.ndarray | None = None
+        self._stroke_clump: np.ndarray | None = None  # clump strengths when a clump stroke began
         # long work (key solves, simulation, video export): window.jobs.run(title, fn, on_done)
         self.jobs = JobRunner(lambda title, message: self.show_error(title, message), self)
         start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
@@ -458,6 +460,7 @@ class MainWindow(QMainWindow):
     # -- editing -------------------------------------------------------------------------------
     def _on_stroke_started(self) -> None:
         self._stroke_points = self.scene.result.points.copy()
+        self._stroke_clump = self.scene.pipeline.clump_strength if self.scene.brush == "clump" else None
 
     def _on_stroke_finished(self, before: object, after: object) -> None:
         self.undo_stack.push(StrokeCommand(self.scene, before, after, LABELS.get(self.scene.brush)))
@@ -465,6 +468,10 @@ class MainWindow(QMainWindow):
         moved = start is None or not np.array_equal(start, self.scene.result.points)
         if not moved and not self.viewport.stroke_touched:
             self.statusBar().showMessage(MISSED_STRANDS, 6000)
+        elif self._stroke_clump is not None and not moved:
+            if np.array_equal(self._stroke_clump, self.scene.pipeline.clump_strength):
+                self.statusBar().showMessage(CLUMP_FULL, 6000)
+        self._stroke_clump = None
 
     def _on_param_edited(self, name: str, value: object, drag: object) -> None:
         before = self.scene.params

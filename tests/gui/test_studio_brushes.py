@@ -173,6 +173,7 @@ def _ramp(scene):
 
 
 def test_clump_brush_paints_each_strands_clump_strength(ui, make_window):
+    from app.ui.window import CLUMP_FULL
     w = plain(make_window, clump=True)
     s, v = w.scene, w.viewport
     s.set_brush("clump")
@@ -180,6 +181,9 @@ def test_clump_brush_paints_each_strands_clump_strength(ui, make_window):
     s.set_intensity(1.0)
     before = s.result
     pos = v.project(before.tips[front_strand(w)])[0]
+    click(ui, v, pos)  # paint where every strand clumps fully already: nothing to do, and it says so
+    assert w.statusBar().currentMessage() == CLUMP_FULL
+    assert w.dock.sign.currentText() == "Paint"
     click(ui, v, pos, CTRL)  # erase: those strands no longer clump
     strength = s.pipeline.clump_strength
     off = strength < 1.0
@@ -191,6 +195,7 @@ def test_clump_brush_paints_each_strands_clump_strength(ui, make_window):
     np.testing.assert_array_equal(s.result.points, before.points)
     w.undo_stack.undo()
     np.testing.assert_array_equal(s.pipeline.clump_strength, strength)
+    assert w.undo_stack.count() == 3
 
 
 def mirrored_scalp() -> tuple[Groom, np.ndarray]:
