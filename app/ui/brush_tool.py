@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hairtool.errors import ParameterError
-from hairtool.frozen.brushes import BRUSHES, FALLOFFS, BrushSample, falloff_lut
+from hairtool.frozen.brushes import BRUSHES, BrushSample, falloff_lut, mirrored_view
 from hairtool.frozen.pipeline import AlignSample
 
 #: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
@@ -119,21 +119,16 @@ class BrushTool:
         "front faces only"."""
         c = tuple(float(x) for x in cursor)
         d = tuple(float(x) for x in direction)
-        view_arg = {} if view is None or not self.front_only else {"view": tuple(float(x) for x in view)}
+        v = None if view is None or not self.front_only else tuple(float(x) for x in view)
         r, name = self.radius[self.brush], self.brush
         if name == "align":
-            first = AlignSample(c, r, self.strength["align"], self.align_mode, **view_arg)
-            out = [first]
-            if self.symmetry:
-                mirrored = {"cursor": (2.0 * plane_x - c[0], c[1], c[2])}
-                if view_arg:
-                    v = view_arg["view"]
-                    mirrored["view"] = (-v[0], v[1], v[2])
-                out.append(first._replace(**mirrored))
-            return out
+            first = AlignSample(c, r, self.strength["align"], self.align_mode, v)
+            if not self.symmetry:
+                return [first]
+            return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
         if name == "comb" and math.hypot(*d) == 0.0:
             return []
-        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), **view_arg)
+        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v)
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
     def touches(self, points: np.ndarray, cursor: Sequence[float], plane_x: float) -> bool:
@@ -145,5 +140,3 @@ class BrushTool:
         p = np.asarray(points, np.float64)
         return any(bool(np.any(np.einsum("ij,ij->i", p - c, p - c) <= r * r)) for c in centres)
 
-
-__all__ = ["FALLOFFS", "BrushTool", "brushes", "check_falloff"]

@@ -20,6 +20,7 @@ from PySide6.QtCore import QObject, Signal
 from app.render.ramps import DEFAULT_RAMP
 from app.ui.brush_tool import SIGNED, BrushTool, check_falloff
 from hairtool.errors import ParameterError
+from hairtool.frozen.brushes import scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.groom import Groom, Topology
 from hairtool.guides.binding import ChildBinding
@@ -166,8 +167,6 @@ class Scene(QObject):
             return self.tool.mirror_x
         if self.pipeline is not None:
             return float(self.pipeline.scalp_centre[0])
-        from hairtool.frozen.brushes import scalp_centre
-
         return float(scalp_centre(self.rest)[0])
 
     def brush_move(

@@ -494,3 +494,28 @@ def test_with_render_hair_brushes_act_on_the_guides_and_masked_guides_children_s
     after, old = s.result.points.reshape(shape), before.points.reshape(shape)
     np.testing.assert_array_equal(after[locked], old[locked])
     np.testing.assert_array_equal(s.drawn_points[:n], s.binding.build(s.result).points)
+
+
+def test_one_move_gives_its_sample_and_the_mirrored_one_for_every_brush():
+    from app.ui.brush_tool import BrushTool, brushes
+    from hairtool.frozen.brushes import BRUSHES
+    from hairtool.frozen.pipeline import AlignSample
+
+    assert sorted(brushes()) == sorted(BRUSHES)  # the toolbar lists the engine's brushes
+    tool = BrushTool(symmetry=True)
+    tool.reset_radius(0.5)
+    for name in brushes():
+        tool.set_brush(name)
+        first, second = tool.samples((1.0, 2.0, 3.0), (0.1, 0.0, 0.0), (0.0, 0.0, -1.0), 0.25, invert=True)
+        assert second.cursor == (-0.5, 2.0, 3.0) and first.view == (0.0, 0.0, -1.0)
+        assert second.view == (-0.0, 0.0, -1.0) and first.radius == second.radius == 0.5
+        if isinstance(first, AlignSample):
+            assert first.intensity == 0.8 and first.mode == "paper"
+        else:
+            assert first.brush == name and second.direction == (-0.1, 0.0, 0.0)
+            sign = -1.0 if name in ("length", "mask", "clump") else 1.0  # Ctrl inverts the signed ones
+            assert first.strength == sign * tool.strength[name]
+    tool.set_brush("comb")
+    assert tool.samples((0, 0, 0), (0, 0, 0), None, 0.0) == []  # a comb standing still does nothing
+    tool.front_only = False
+    assert tool.samples((0, 0, 0), (1, 0, 0), (0, 0, 1), 0.0)[0].view is None
