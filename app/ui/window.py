@@ -296,6 +296,8 @@ class MainWindow(QMainWindow):
             self.brush_bar.addAction(a)
             self.brush_actions[name] = a
         self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.brush_bar)
+        view = next(a.menu() for a in self.menuBar().actions() if a.text() == "&View")
+        view.addAction(self.brush_bar.toggleViewAction())
 
     def _sync_brush_actions(self) -> None:
         tool = self.scene.tool
