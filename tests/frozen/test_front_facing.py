@@ -88,6 +88,9 @@ def test_align_and_the_mask_are_front_facing_too(head):
     p = pipe_of(head)
     p.brush(sample(head, "mask", 1.0, VIEW))
     np.testing.assert_array_equal(p.locked, ~away)  # the far side is not painted
+    p = pipe_of(head)
+    p.brush(sample(head, "clump", -1.0, VIEW))
+    np.testing.assert_array_equal(p.clump_strength, np.where(away, 1.0, 0.0))
 
 
 def test_without_a_view_nothing_changes(head):
@@ -153,3 +156,10 @@ def test_clump_painting_equals_its_twin_and_stays_in_range(head, strength):
     assert np.all(np.sign(a - start)[changed] == np.sign(strength))
     if abs(strength) == 1.0:  # full strength at the brush centre: all the way
         assert np.isclose(a[changed], 1.0 if strength > 0 else 0.0).any()
+
+
+def test_roots_on_a_line_never_face_away():
+    line = Groom.from_strands([np.linspace([x, 0.0, 0.0], [x, -1.0, 0.0], 6) for x in np.linspace(0, 1, 8)])
+    np.testing.assert_array_equal(root_normals(line), 0.0)
+    for view in [(0.0, 1.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0)]:
+        assert not facing_away(root_normals(line), view).any()
