@@ -163,3 +163,24 @@ def test_roots_on_a_line_never_face_away():
     np.testing.assert_array_equal(root_normals(line), 0.0)
     for view in [(0.0, 1.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0)]:
         assert not facing_away(root_normals(line), view).any()
+
+
+def test_a_session_without_views_gives_the_bytes_of_before_the_view():
+    """sha256 (first 16 hex digits) of this session's result, taken before samples had a view
+    and ClumpWithGaps a clump strength."""
+    import hashlib
+
+    groom = samples.scalp(150, 12, seed=2)
+    pipe = FrozenPipeline(groom, FrozenParams(seed=4, keep_lengths=True))
+    tips = groom.points[groom.topology.tip_indices].astype(np.float64)
+    c, r = tips[len(tips) // 2], 0.5 * float(np.ptp(groom.points, axis=0).max())
+    lut = {name: tuple(falloff_lut(name).tolist()) for name in ("smooth", "linear", "constant")}
+    curve = tuple(falloff_lut([[0, 1], [0.3, 0.9], [1, 0]]).tolist())
+    pipe.align(c + np.array([0.2, 0.3, 0.0]), r, 0.7)
+    for k in range(3):
+        pipe.brush(BrushSample("comb", tuple(c + k * 0.05), (0.05, 0.02, 0.0), r, 0.9, curve))
+    pipe.brush(BrushSample("mask", tuple(tips[3]), (0, 0, 0), 0.3 * r, 1.0, lut["constant"]))
+    pipe.brush(BrushSample("smooth", tuple(c), (0, 0, 0), r, 0.6, lut["linear"]))
+    pipe.brush(BrushSample("length", tuple(c), (0, 0, 0), r, -0.2, lut["smooth"]))
+    pipe.brush(BrushSample("puff", tuple(c), (0, 0, 0), r, 0.5, lut["smooth"]))
+    assert hashlib.sha256(pipe.result.points.tobytes()).hexdigest()[:16] == "d0490470c2fa36d9"
