@@ -86,6 +86,9 @@ def test_align_and_the_mask_are_front_facing_too(head):
     assert not strand_moved(head, out)[away].any()
     assert strand_moved(head, out)[~away].sum() > 10
     p = pipe_of(head)
+    by_method = p.align(c + np.array([0.0, -0.5, 0.0]), r, 0.8, view=VIEW)
+    np.testing.assert_array_equal(by_method.points, out.points)
+    p = pipe_of(head)
     p.brush(sample(head, "mask", 1.0, VIEW))
     np.testing.assert_array_equal(p.locked, ~away)  # the far side is not painted
     p = pipe_of(head)
@@ -135,6 +138,9 @@ def test_a_bad_view_is_refused(head):
     for bad in [(0.0, 0.0, 0.0), (np.nan, 1.0, 0.0), (1.0, 2.0)]:
         with pytest.raises(ParameterError, match="view"):
             p.brush(sample(head, "comb", 0.5, bad))
+    for bad in ["up", (1.0, "a", 0.0), [[1.0, 0.0, 0.0]]]:
+        with pytest.raises(ParameterError, match="view"):
+            p.align((0.0, 0.0, 0.0), 1.0, 0.5, view=bad)
     assert p.strokes == ()
 
 
