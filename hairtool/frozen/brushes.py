@@ -102,7 +102,10 @@ def check_view(view: object) -> tuple[float, float, float] | None:
     """None, or three finite numbers not all zero (ParameterError naming ``view``)."""
     if view is None:
         return None
-    v = np.asarray(view, dtype=np.float64) if isinstance(view, tuple | list | np.ndarray) else np.zeros(0)
+    try:
+        v = np.asarray(view, dtype=np.float64) if not isinstance(view, str | bytes) else np.zeros(0)
+    except (TypeError, ValueError):
+        v = np.zeros(0)
     if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.any(v != 0):
         raise ParameterError("view", view, "null or three finite numbers, not all zero")
     return (float(v[0]), float(v[1]), float(v[2]))

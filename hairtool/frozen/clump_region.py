@@ -235,25 +235,31 @@ def _update_region(
         while ws.neighbours.padded_lists(rec.lists, rec.list_count) > rec.lists.shape[1]:
             rec.lists = np.empty((v, 2 * rec.lists.shape[1]), np.int32)
         rec.lists_ready = True
-    radius = h * (1.0 + MARGIN)
     top = groom.topology
     roots = ws.roots_mask(top)
-    ws.invalidate()  # the sort below replaces the kept list's order
     nl = ws.neighbours
-    if not nl.sort(points, top.strand_index, roots, radius) or (tuple(nl.lo), tuple(nl.dims)) != rec.frame:
-        return None  # another grid: every list may come in another order
-    # New lists: the changed vertices', then those of the vertices their lists held or hold.
-    pos_c = np.flatnonzero(sc.flags[nl.order])
-    ids_c = nl.order[pos_c]
-    nbr_c, cnt_c = _lists(nl, pos_c, sc)
-    sc.relist[:] = False
-    if _relist(changed, nbr_c, cnt_c, rec.lists, rec.list_count, sc.relist) > MAX_REGION * v:
-        sc.too_many = seeds.size
-        return None  # the region holds these and more
-    sc.relist[changed] = False
-    pos_r = np.flatnonzero(sc.relist[nl.order])
-    ids_r = nl.order[pos_r]
-    nbr_r, cnt_r = _lists(nl, pos_r, sc)
+    if changed.size:
+        ws.invalidate()  # the sort below replaces the kept list's order
+        radius = h * (1.0 + MARGIN)
+        sorted_ = nl.sort(points, top.strand_index, roots, radius)
+        if not sorted_ or (tuple(nl.lo), tuple(nl.dims)) != rec.frame:
+            return None  # another grid: every list may come in another order
+        # New lists: the changed vertices', then those of the vertices their lists held or hold.
+        pos_c = np.flatnonzero(sc.flags[nl.order])
+        ids_c = nl.order[pos_c]
+        nbr_c, cnt_c = _lists(nl, pos_c, sc)
+        sc.relist[:] = False
+        if _relist(changed, nbr_c, cnt_c, rec.lists, rec.list_count, sc.relist) > MAX_REGION * v:
+            sc.too_many = seeds.size
+            return None  # the region holds these and more
+        sc.relist[changed] = False
+        pos_r = np.flatnonzero(sc.relist[nl.order])
+        ids_r = nl.order[pos_r]
+        nbr_r, cnt_r = _lists(nl, pos_r, sc)
+    else:  # strengths alone: the points, hence the lists and the step, are the last run's
+        ids_c = ids_r = np.zeros(0, np.int64)
+        nbr_c = nbr_r = np.zeros((0, sc.capacity), np.int32)
+        cnt_c = cnt_r = np.zeros(0, np.int64)
     # The region: within 2k steps of a changed vertex (k without gaps), along both runs' lists.
     sc.new_row[ids_c] = np.arange(ids_c.size)
     sc.new_row[ids_r] = np.arange(ids_c.size, ids_c.size + ids_r.size)
@@ -288,7 +294,9 @@ def _update_region(
             rec.weight, sc.ident,
         )  # fmt: skip
         if it == 0:
-            if step is None:  # Σg as a full run sums it, in its (sorted) order: the same bits
+            if step is None and changed.size == 0:
+                k_step = rec.step  # Σg depends on the points alone: the recorded run's step
+            elif step is None:  # Σg as a full run sums it, in its (sorted) order: the same bits
                 sorted_count, sorted_weight = np.empty(v, np.int64), np.empty(v)
                 _sorted_stats(nl.order, rec.count, rec.weight, sorted_count, sorted_weight)
                 _, _, w_sum, w_count = _first_stats(sorted_count, sorted_weight, nl.skip)

@@ -279,10 +279,20 @@ class FrozenPipeline:
         self._reclump()
         return self._result
 
-    def align(self, cursor: ArrayLike, radius: float, intensity: float = 0.8, mode: str = "paper") -> Groom:
-        """One align sample (one mouse move); it persists. Returns the updated result."""
+    def align(
+        self,
+        cursor: ArrayLike,
+        radius: float,
+        intensity: float = 0.8,
+        mode: str = "paper",
+        view: ArrayLike | None = None,
+    ) -> Groom:
+        """One align sample (one mouse move); it persists. Returns the updated result. ``view``:
+        the camera's viewing direction, for front-facing strands only (None: every strand)."""
         c = check_align_params(cursor, radius, intensity, mode)
-        sample = AlignSample((float(c[0]), float(c[1]), float(c[2])), float(radius), float(intensity), mode)
+        v = check_view(view)
+        cursor3 = (float(c[0]), float(c[1]), float(c[2]))
+        sample = AlignSample(cursor3, float(radius), float(intensity), mode, v)
         return self.apply_samples([sample])
 
     def brush(self, sample: BrushSample) -> Groom:

@@ -86,8 +86,14 @@ def test_align_and_the_mask_are_front_facing_too(head):
     assert not strand_moved(head, out)[away].any()
     assert strand_moved(head, out)[~away].sum() > 10
     p = pipe_of(head)
+    by_method = p.align(c + np.array([0.0, -0.5, 0.0]), r, 0.8, view=VIEW)
+    np.testing.assert_array_equal(by_method.points, out.points)
+    p = pipe_of(head)
     p.brush(sample(head, "mask", 1.0, VIEW))
     np.testing.assert_array_equal(p.locked, ~away)  # the far side is not painted
+    p = pipe_of(head)
+    p.brush(sample(head, "clump", -1.0, VIEW))
+    np.testing.assert_array_equal(p.clump_strength, np.where(away, 1.0, 0.0))
 
 
 def test_without_a_view_nothing_changes(head):
@@ -132,6 +138,9 @@ def test_a_bad_view_is_refused(head):
     for bad in [(0.0, 0.0, 0.0), (np.nan, 1.0, 0.0), (1.0, 2.0)]:
         with pytest.raises(ParameterError, match="view"):
             p.brush(sample(head, "comb", 0.5, bad))
+    for bad in ["up", (1.0, "a", 0.0), [[1.0, 0.0, 0.0]]]:
+        with pytest.raises(ParameterError, match="view"):
+            p.align((0.0, 0.0, 0.0), 1.0, 0.5, view=bad)
     assert p.strokes == ()
 
 
@@ -153,3 +162,31 @@ def test_clump_painting_equals_its_twin_and_stays_in_range(head, strength):
     assert np.all(np.sign(a - start)[changed] == np.sign(strength))
     if abs(strength) == 1.0:  # full strength at the brush centre: all the way
         assert np.isclose(a[changed], 1.0 if strength > 0 else 0.0).any()
+
+
+def test_roots_on_a_line_never_face_away():
+    line = Groom.from_strands([np.linspace([x, 0.0, 0.0], [x, -1.0, 0.0], 6) for x in np.linspace(0, 1, 8)])
+    np.testing.assert_array_equal(root_normals(line), 0.0)
+    for view in [(0.0, 1.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, 1.0)]:
+        assert not facing_away(root_normals(line), view).any()
+
+
+def test_a_session_without_views_gives_the_bytes_of_before_the_view():
+    """sha256 (first 16 hex digits) of this session's result, taken before samples had a view
+    and ClumpWithGaps a clump strength."""
+    import hashlib
+
+    groom = samples.scalp(150, 12, seed=2)
+    pipe = FrozenPipeline(groom, FrozenParams(seed=4, keep_lengths=True))
+    tips = groom.points[groom.topology.tip_indices].astype(np.float64)
+    c, r = tips[len(tips) // 2], 0.5 * float(np.ptp(groom.points, axis=0).max())
+    lut = {name: tuple(falloff_lut(name).tolist()) for name in ("smooth", "linear", "constant")}
+    curve = tuple(falloff_lut([[0, 1], [0.3, 0.9], [1, 0]]).tolist())
+    pipe.align(c + np.array([0.2, 0.3, 0.0]), r, 0.7)
+    for k in range(3):
+        pipe.brush(BrushSample("comb", tuple(c + k * 0.05), (0.05, 0.02, 0.0), r, 0.9, curve))
+    pipe.brush(BrushSample("mask", tuple(tips[3]), (0, 0, 0), 0.3 * r, 1.0, lut["constant"]))
+    pipe.brush(BrushSample("smooth", tuple(c), (0, 0, 0), r, 0.6, lut["linear"]))
+    pipe.brush(BrushSample("length", tuple(c), (0, 0, 0), r, -0.2, lut["smooth"]))
+    pipe.brush(BrushSample("puff", tuple(c), (0, 0, 0), r, 0.5, lut["smooth"]))
+    assert hashlib.sha256(pipe.result.points.tobytes()).hexdigest()[:16] == "d0490470c2fa36d9"
