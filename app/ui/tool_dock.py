@@ -306,6 +306,7 @@ class ToolDock(QDockWidget):
                 self.sign.setCurrentIndex(1 if tool.subtract[s.brush] else 0)
                 self._brush_form.labelForField(self.sign).setText(SIGN_LABELS[s.brush])
             self._brush_form.setRowVisible(self.mode, s.brush == "align")
+            self._brush_form.setRowVisible(self.intensity, s.brush != "mask")  # a mask is on or off
             self._brush_form.setRowVisible(self.sign, labels is not None)
             custom = not isinstance(tool.falloff, str)
             preset = self.falloff.count() - 1 if custom else self.falloff.findData(tool.falloff)

@@ -381,6 +381,9 @@ def test_each_brush_remembers_its_size_and_strength_and_keys_pick_brushes(make_w
         action.trigger()
         assert s.brush == brush and w.dock.brush.currentData() == brush
     assert not w.dock.curve.isEnabled()  # align weighs by the paper's rule, not the curve
+    assert w.dock.mode.isVisibleTo(w.dock) and w.dock.intensity.isVisibleTo(w.dock)
+    s.set_brush("mask")
+    assert not w.dock.mode.isVisibleTo(w.dock) and not w.dock.intensity.isVisibleTo(w.dock)
     w.dock.brush.setCurrentIndex(w.dock.brush.findData("length"))
     assert s.brush == "length" and w.dock.sign.currentText() == "Grow"
 
