@@ -13,6 +13,7 @@ frame after the release (``release_ms``, target under 250 ms); ``children_ms`` i
 the drawn children on each move. The viewport draws without
 MSAA unless HAIRTOOL_MSAA is set (the ``msaa`` column says which ran); the ``lines`` column says
 how strands were drawn (a GL line method, or rasterized on the CPU: ``--strand-raster``).
+``--brush`` drags another brush than align (``--symmetry``: mirrored, two samples per move).
 """
 
 from __future__ import annotations
@@ -59,6 +60,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=["auto", "gl", "cpu"],
         help="draw strands with GL or rasterize them on the CPU (default: HAIRTOOL_STRAND_RASTER, else auto)",
     )
+    parser.add_argument(
+        "--brush",
+        default="align",
+        choices=["align", "comb", "smooth", "length", "puff", "clump", "mask"],
+        help="the brush dragged (default align)",
+    )
+    parser.add_argument("--symmetry", action="store_true", help="X symmetry on: each move and its mirror")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON")
 
 
@@ -136,6 +144,8 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
         _bind_children(window, args)
     if args.no_clump:
         window.scene.set_params(window.scene.params.replace(clump=False))
+    window.scene.set_brush(getattr(args, "brush", "align"))
+    window.scene.set_symmetry(bool(getattr(args, "symmetry", False)))
     if args.line_width is not None:
         window.scene.set_line_width(args.line_width)
     window.resize(*args.size)
@@ -172,12 +182,14 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     release_ms = (time.perf_counter() - t0) * 1e3
     clump = window.scene.params.clump
     lines = _line_method(v.renderer)
+    brush = window.scene.brush + (" x2" if window.scene.tool.symmetry else "")
     window.ask_save_changes = lambda: "discard"  # the benchmark's strokes are not work to keep
     window.close()
     window.deleteLater()
     app.processEvents()
     row = {
         "groom": name,
+        "brush": brush,
         "strands": groom.strand_count,
         "vertices": groom.vertex_count,
         "moves": len(totals),

@@ -2,9 +2,10 @@
 
 ``python -m app.figures.screenshots OUTDIR`` (needs a display: Xvfb works) writes
 
-- ``screenshot-studio.png``: Sintel's hair on her head, dragged into a frozen, clumped shape
-  with the align brush (three strokes): the 228 guides (orange) with their 30,000 interpolated
-  render strands following, shaded as hair;
+- ``screenshot-studio.png``: Sintel's hair on her head, frozen and clumped, groomed with the
+  brushes as an artist would: the fringe combed aside with X symmetry (the mirror plane drawn),
+  the ends smoothed and puffed, one align stroke: the 228 guides (orange) with their 30,000
+  interpolated render strands following, shaded as hair;
 - ``screenshot-timeline.png``: an anime cycle on that groom in the timeline — the DP keys against
   uniform keys of the same count, the error and speed curves, the error-versus-key-count plot —
   with the anime wave dock beside it and the viewport in ghost mode at a frame between keys.
@@ -84,14 +85,27 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 1
         window.timeline.hide()
         settle(app)
-        # Comb the fringe across the brow, then sweep the ends on both sides out a little.
-        stroke(window, (0.44, 0.30), (0.62, 0.36))
+        # Comb the fringe aside with X symmetry, smooth and puff the ends, then sweep one side
+        # out with the paper's align brush; the comb stays selected, its mirror plane drawn.
+        scene = window.scene
+        scene.set_symmetry(True)
+        window.brush_actions["comb"].trigger()
+        scene.set_intensity(1.0)
+        stroke(window, (0.47, 0.30), (0.56, 0.40))
+        window.brush_actions["smooth"].trigger()
+        stroke(window, (0.40, 0.62), (0.44, 0.66))
+        window.brush_actions["puff"].trigger()
+        stroke(window, (0.60, 0.58), (0.61, 0.58), steps=4)
+        window.brush_actions["align"].trigger()
+        scene.set_symmetry(False)
         stroke(window, (0.62, 0.62), (0.70, 0.56))
-        stroke(window, (0.38, 0.62), (0.32, 0.58))
+        window.brush_actions["comb"].trigger()
+        scene.set_symmetry(True)
         window.viewport.leaveEvent(None)
         settle(app)
         save(window, args.outdir / "screenshot-studio.png")
 
+        scene.set_symmetry(False)  # the timeline's picture is about the animation
         window.timeline.show()
         window.sources.dock.raise_()
         window.sources.apply_anime()

@@ -205,6 +205,7 @@ def _render_in(
             renderer.set_vertex_colors(colors)
         renderer.set_mesh(mesh)
         renderer.set_overlay_circle(None)
+        renderer.set_overlay_outline(None)
         renderer.line_width = float(line_width)
         renderer.background = (0.0, 0.0, 0.0, 0.0) if transparent else bg
         if camera is None:

@@ -1,4 +1,5 @@
-"""Screen-space overlays over the 3-D scene: the brush circle (program ``shaders/overlay.glsl``)."""
+"""Screen-space overlays over the 3-D scene: the brush circle and the outline of the symmetry
+plane (program ``shaders/overlay.glsl``)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ from hairtool.errors import ParameterError
 CIRCLE_SEGMENTS = 96
 RING_WIDTH_PX = 1.5
 CIRCLE_COLOR = (1.0, 0.55, 0.1, 0.95)
+OUTLINE_COLOR = (0.8, 0.45, 1.0, 0.7)  # the X-symmetry plane: a violet no ramp or guide uses
+MAX_OUTLINE = 16  # corners of an outline
 
 
 def ring_strip(center: tuple[float, float], radius: float, width: float, segments: int) -> np.ndarray:
@@ -68,6 +71,63 @@ class CircleOverlay:
             moderngl.ONE_MINUS_SRC_ALPHA,
         )
         self.vao.render(moderngl.TRIANGLE_STRIP)
+        self.ctx.disable(moderngl.BLEND)
+
+    def release(self) -> None:
+        self.vao.release()
+        self.vbo.release()
+        self.program.release()
+
+
+def outline_triangles(corners: np.ndarray, width: float) -> np.ndarray:
+    """``(6·n, 2)`` float32 TRIANGLES vertices of the closed polygon through ``corners`` ``(n, 2)``
+    drawn ``width`` pixels wide (one quad per edge)."""
+    a = np.asarray(corners, np.float64)
+    b = np.roll(a, -1, axis=0)
+    d = b - a
+    n = np.column_stack([-d[:, 1], d[:, 0]])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-9)
+    n *= width / 2.0
+    quads = np.stack([a - n, a + n, b + n, a - n, b + n, b - n], axis=1)
+    return quads.reshape(-1, 2).astype(np.float32)
+
+
+class OutlineOverlay:
+    """A closed polygon outline in pixels (the symmetry plane's edges), hidden until set."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self.program = load_program(ctx, "overlay")
+        self.vbo = ctx.buffer(reserve=6 * MAX_OUTLINE * 2 * 4, dynamic=True)
+        self.vao = ctx.vertex_array(self.program, [(self.vbo, "2f", "in_px")])
+        self.color = OUTLINE_COLOR
+        self.count = 0
+        self.viewport_size = (1.0, 1.0)
+
+    def set(self, corners_px: np.ndarray | None, viewport_size: tuple[float, float] = (1, 1)) -> None:
+        """``(n, 2)`` corners (n ≤ :data:`MAX_OUTLINE`, finite) or None to hide."""
+        if corners_px is None or len(corners_px) < 2 or not np.all(np.isfinite(corners_px)):
+            self.count = 0
+            return
+        tris = outline_triangles(np.asarray(corners_px)[:MAX_OUTLINE], RING_WIDTH_PX)
+        self.vbo.write(tris.tobytes())
+        self.count = len(tris)
+        self.viewport_size = (float(viewport_size[0]), float(viewport_size[1]))
+
+    def render(self) -> None:
+        if not self.count:
+            return
+        self.program["u_viewport_size"].value = self.viewport_size
+        self.program["u_color"].value = self.color
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        self.ctx.enable(moderngl.BLEND)
+        self.ctx.blend_func = (
+            moderngl.SRC_ALPHA,
+            moderngl.ONE_MINUS_SRC_ALPHA,
+            moderngl.ONE,
+            moderngl.ONE_MINUS_SRC_ALPHA,
+        )
+        self.vao.render(moderngl.TRIANGLES, vertices=self.count)
         self.ctx.disable(moderngl.BLEND)
 
     def release(self) -> None:

@@ -47,7 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from app.render.camera import Camera
 from app.render.hair_shading import DEFAULT_LOOK, HairLook, light_and_eye, shade
 from app.render.mesh_layer import MeshLayer
-from app.render.overlay import CircleOverlay
+from app.render.overlay import CircleOverlay, OutlineOverlay
 from app.render.ramps import DEFAULT_RAMP, ramp_stops, ramp_texture, sample_linear
 from app.render.raster_layer import RasterLayer
 from app.render.shaders import load_program
@@ -120,6 +120,7 @@ class StrandRenderer:
         self.ramp_texture.write(ramp_texture(self.ramp, RAMP_TEXELS).tobytes())
         self.mesh = MeshLayer(ctx)
         self.overlay = CircleOverlay(ctx)
+        self.outline = OutlineOverlay(ctx)
         self.topology: Topology | None = None
         self.bounds: tuple[NDArray[np.float32], NDArray[np.float32]] | None = None
         self._gpu: StrandGPU | None = None
@@ -337,6 +338,10 @@ class StrandRenderer:
         """Brush circle in widget pixels (y down) of a viewport ``viewport_size``; None hides it."""
         self.overlay.set(center_px, radius_px, viewport_size)
 
+    def set_overlay_outline(self, corners_px, viewport_size: tuple[float, float] = (1, 1)) -> None:
+        """A closed outline through ``(n, 2)`` widget pixels (the symmetry plane); None hides it."""
+        self.outline.set(corners_px, viewport_size)
+
     def scene_bounds(self) -> tuple[NDArray[np.float32], NDArray[np.float32]] | None:
         """Box around the groom and the mesh, for :meth:`Camera.frame`."""
         boxes = [b for b in (self.bounds, self.mesh.bounds) if b is not None]
@@ -393,6 +398,7 @@ class StrandRenderer:
             else:
                 self.programs[method]["u_use_flat_color"].value = False
                 self._draw(method, self._main, ghost=False)
+        self.outline.render()
         self.overlay.render()
         ctx.disable(moderngl.DEPTH_TEST)
 
@@ -538,6 +544,7 @@ class StrandRenderer:
         self._free_groom()
         self.mesh.release()
         self.overlay.release()
+        self.outline.release()
         if self.raster is not None:
             self.raster.release()
             self.raster = None

@@ -1,5 +1,7 @@
 """Per-vertex colours for the "Colour by" modes, of the strands the viewport draws: the groom,
-or its interpolated children followed by the guides (drawn in one colour of their own)."""
+or its interpolated children followed by the guides (drawn in one colour of their own). Strands
+the mask brush locked are drawn darkened toward a slate blue in every mode, so the artist sees
+the mask (a child by its nearest guide)."""
 
 from __future__ import annotations
 
@@ -18,11 +20,30 @@ from app.ui.scene import Scene
 
 STRAND_COLOUR_SEED = 7  # fixed, so a groom keeps its per-strand colours between runs
 GUIDE_RGB = (1.0, 0.62, 0.12)  # guides over render hair: one warm orange whatever the mode
+MASK_RGB = np.array([0.24, 0.28, 0.5], np.float32)  # masked strands: toward this slate blue …
+MASK_KEEP = 0.3  # … keeping this share of their own colour
 
 
 def vertex_colors(scene: Scene) -> np.ndarray | None:
     """``(V, 3)`` float32 colours of the drawn strands, or None where the renderer's ramp over t
     does the colouring (shaded hair too: the renderer lights the ramp or these colours)."""
+    colors = _mode_colors(scene)
+    locked = scene.locked
+    if locked.size != scene.result.strand_count or not locked.any():
+        return colors
+    top = scene.drawn_topology
+    if colors is None:
+        colors = sample_linear(ramp_texture(scene.ramp, RAMP_TEXELS), top.vertex_param)
+    if scene.has_children:
+        guides = locked if scene.drawn_guides else np.zeros(0, bool)
+        locked = np.concatenate([locked[scene.drawn_binding().guide_ids[:, 0]], guides])
+    masked = np.repeat(locked, top.counts)
+    colors = np.array(colors, np.float32)
+    colors[masked] = MASK_KEEP * colors[masked] + (1.0 - MASK_KEEP) * MASK_RGB
+    return colors
+
+
+def _mode_colors(scene: Scene) -> np.ndarray | None:
     mode = scene.colour_mode
     top = scene.drawn_topology
     guides = scene.drawn_guides if scene.has_children else 0

@@ -1,4 +1,4 @@
-"""Undo steps: one per align stroke, one per (merged) parameter edit."""
+"""Undo steps: one per brush stroke (or replayed stroke log), one per (merged) parameter edit."""
 
 from __future__ import annotations
 
@@ -14,8 +14,8 @@ _PARAM_IDS: dict[str, int] = {}
 class StrokeCommand(QUndoCommand):
     """A whole left-drag, already applied while dragging: pushing it does not apply it again."""
 
-    def __init__(self, scene: Scene, before: object, after: object) -> None:
-        super().__init__("Align strands")
+    def __init__(self, scene: Scene, before: object, after: object, brush: str | None = "Align") -> None:
+        super().__init__(f"{brush or 'Brush'} stroke")
         self._scene = scene
         self._before = before
         self._after = after

@@ -107,7 +107,7 @@ class ProjectController(QObject):
         settings.update(self.sources.to_settings())
         return pf.Project.from_pipeline(
             scene.pipeline,
-            brush={"radius": scene.radius, "intensity": scene.intensity, "align_mode": scene.align_mode},
+            brush=_brush_settings(scene.tool),
             display={
                 "colour_mode": scene.colour_mode,
                 "ramp": scene.ramp,
@@ -142,6 +142,7 @@ class ProjectController(QObject):
                 lambda: scene.set_radius(float(project.brush["radius"])),
                 lambda: scene.set_intensity(float(project.brush["intensity"])),
                 lambda: scene.set_align_mode(str(project.brush["align_mode"])),
+                *_brush_setters(scene, project.brush),
                 lambda: scene.set_colour_mode(str(project.display["colour_mode"])),
                 lambda: scene.set_ramp(str(project.display["ramp"])),
                 lambda: scene.set_line_width(float(project.display["line_width"])),
@@ -298,6 +299,47 @@ class ProjectController(QObject):
         self._changed()
         self.window.statusBar().showMessage("restored the autosaved session; save it as a project", 8000)
         return True
+
+
+def _brush_settings(tool) -> dict:
+    """The brush as a project keeps it: the current brush's radius, strength and mode (what
+    older projects hold), and every brush's own, the falloff, symmetry and front faces only."""
+    falloff = tool.falloff if isinstance(tool.falloff, str) else [list(p) for p in tool.falloff]
+    return {
+        "radius": tool.radius[tool.brush],
+        "intensity": tool.strength[tool.brush],
+        "align_mode": tool.align_mode,
+        "brush": tool.brush,
+        "radii": dict(tool.radius),
+        "strengths": dict(tool.strength),
+        "subtract": dict(tool.subtract),
+        "falloff": falloff,
+        "symmetry": tool.symmetry,
+        "mirror_x": tool.mirror_x,
+        "front_only": tool.front_only,
+    }
+
+
+def _brush_setters(scene, brush: dict) -> tuple:
+    """Setters for :func:`_brush_settings`' fields beyond the first three (each may be missing)."""
+
+    def per_brush() -> None:
+        current = brush["brush"]
+        for name in brush["radii"]:
+            if name in scene.tool.radius:
+                scene.set_brush(name)
+                scene.set_radius(float(brush["radii"][name]))
+                scene.set_intensity(float(brush["strengths"][name]))
+        scene.set_brush(str(current))
+
+    return (
+        per_brush,
+        lambda: [scene.set_subtract(k, bool(v)) for k, v in brush["subtract"].items()],
+        lambda: scene.set_falloff(brush["falloff"]),
+        lambda: scene.set_symmetry(bool(brush["symmetry"])),
+        lambda: scene.set_mirror_x(None if brush["mirror_x"] is None else float(brush["mirror_x"])),
+        lambda: scene.set_front_only(bool(brush["front_only"])),
+    )
 
 
 def _key_settings(d: dict) -> dict:

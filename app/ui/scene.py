@@ -18,7 +18,9 @@ import numpy as np
 from PySide6.QtCore import QObject, Signal
 
 from app.render.ramps import DEFAULT_RAMP
+from app.ui.brush_tool import SIGNED, BrushTool, check_falloff
 from hairtool.errors import ParameterError
+from hairtool.frozen.brushes import scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.groom import Groom, Topology
 from hairtool.guides.binding import ChildBinding
@@ -41,7 +43,8 @@ class Scene(QObject):
     groom_loaded = Signal()  # new strands: topology may have changed, re-upload everything
     points_changed = Signal()  # same strands at new positions: re-upload positions only
     params_changed = Signal(object)  # FrozenParams
-    tool_changed = Signal()  # brush radius, intensity or align mode
+    tool_changed = Signal()  # the brush, its radius, strength, falloff, symmetry …
+    mask_changed = Signal()  # the strands the mask brush locked changed (their colour shows it)
     display_changed = Signal()  # colour mode, ramp or line width
     mesh_changed = Signal()
     path_changed = Signal()
@@ -77,9 +80,8 @@ class Scene(QObject):
         self.line_width = 2.0
         self.mesh = None
         self.path: Path | None = None
-        self.radius = 1.0
-        self.intensity = 0.8
-        self.align_mode = "paper"
+        self.tool = BrushTool()
+        self.locked = np.zeros(0, dtype=bool)  # the masked strands (a copy of the pipeline's)
         self.last_update_ms = 0.0
         self._set_groom(groom)
 
@@ -95,7 +97,9 @@ class Scene(QObject):
         lo, hi = groom.bounds
         self.centre = ((lo.astype(np.float64) + hi) * 0.5).astype(np.float32)
         extent = float(np.max(hi - lo))
-        self.radius = 0.25 * extent if extent > 0 else 1.0
+        self.tool.reset_radius(0.25 * extent if extent > 0 else 1.0)
+        self.tool.mirror_x = None  # the new groom's own centre
+        self.locked = np.zeros(groom.strand_count, dtype=bool)
         self.binding = None
         self._subsets = {}
         self._cache = {}
@@ -157,6 +161,54 @@ class Scene(QObject):
         self.points_changed.emit()
         return self.result
 
+    def mirror_plane_x(self) -> float:
+        """x of the X-symmetry plane: the artist's, or the centre of the sphere fitted to the roots."""
+        if self.tool.mirror_x is not None:
+            return self.tool.mirror_x
+        if self.pipeline is not None:
+            return float(self.pipeline.scalp_centre[0])
+        return float(scalp_centre(self.rest)[0])
+
+    def brush_move(
+        self,
+        cursor: np.ndarray,
+        direction: np.ndarray = (0.0, 0.0, 0.0),
+        view: np.ndarray | None = None,
+        invert: bool = False,
+        check_touch: bool = True,
+    ) -> bool:
+        """One mouse move of the current brush (its mirror too with symmetry on), applied through
+        the pipeline in one call; ``direction`` the mouse's motion in the world, ``view`` the
+        camera's direction at the cursor, ``invert`` Ctrl held. Returns whether the brush
+        reached a strand (its circle held a vertex; False unchecked with ``check_touch`` off)."""
+        self.start_engine()
+        t0 = time.perf_counter()
+        plane = self.mirror_plane_x()
+        samples = self.tool.samples(cursor, direction, view, plane, invert)
+        if samples:
+            self.result = self.pipeline.apply_samples(samples)
+            self._children_moved()
+            self._sync_mask()
+        self.last_update_ms = (time.perf_counter() - t0) * 1e3
+        self.points_changed.emit()
+        return check_touch and self.tool.touches(self.pipeline.aligned.points, cursor, plane)
+
+    def apply_samples(self, samples: list) -> None:
+        """Samples of any brush (a replayed stroke log) in one pipeline call."""
+        self.start_engine()
+        t0 = time.perf_counter()
+        self.result = self.pipeline.apply_samples(samples)
+        self._children_moved()
+        self._sync_mask()
+        self.last_update_ms = (time.perf_counter() - t0) * 1e3
+        self.points_changed.emit()
+
+    def _sync_mask(self) -> None:
+        locked = self.pipeline.locked
+        if not np.array_equal(locked, self.locked):
+            self.locked = locked
+            self.mask_changed.emit()
+
     def snapshot(self) -> object:
         """The pipeline's stroke state (for one undo step); strokes need the engine running."""
         self.start_engine()
@@ -167,6 +219,7 @@ class Scene(QObject):
         t0 = time.perf_counter()
         self.result = self.pipeline.restore(snap)
         self._children_moved()
+        self._sync_mask()
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
         self.points_changed.emit()
 
@@ -345,25 +398,82 @@ class Scene(QObject):
         return dataclasses.replace(self._params, **{name: value}).validate()
 
     # -- brush ---------------------------------------------------------------------------
+    @property
+    def brush(self) -> str:
+        return self.tool.brush
+
+    @property
+    def radius(self) -> float:
+        """The current brush's radius (groom units); each brush keeps its own."""
+        return self.tool.radius[self.tool.brush]
+
+    @property
+    def intensity(self) -> float:
+        """The current brush's strength in [0, 1] (its sign: :attr:`BrushTool.subtract`)."""
+        return self.tool.strength[self.tool.brush]
+
+    @property
+    def align_mode(self) -> str:
+        return self.tool.align_mode
+
+    def set_brush(self, name: str) -> None:
+        if name != self.tool.brush:
+            self.tool.set_brush(name)
+            self.tool_changed.emit()
+
     def set_radius(self, radius: float) -> None:
         if not np.isfinite(radius) or radius <= 0:
             raise ParameterError("radius", radius, "a positive number")
         if radius != self.radius:
-            self.radius = float(radius)
+            self.tool.radius[self.tool.brush] = float(radius)
             self.tool_changed.emit()
 
     def set_intensity(self, intensity: float) -> None:
         if not np.isfinite(intensity) or not 0.0 <= intensity <= 1.0:
-            raise ParameterError("intensity", intensity, "a number in [0, 1]")
+            raise ParameterError("strength", intensity, "a number in [0, 1]")
         if intensity != self.intensity:
-            self.intensity = float(intensity)
+            self.tool.strength[self.tool.brush] = float(intensity)
             self.tool_changed.emit()
 
     def set_align_mode(self, mode: str) -> None:
         if mode not in ALIGN_MODES:
             raise ParameterError("mode", mode, f"one of {', '.join(ALIGN_MODES)}")
-        if mode != self.align_mode:
-            self.align_mode = mode
+        if mode != self.tool.align_mode:
+            self.tool.align_mode = mode
+            self.tool_changed.emit()
+
+    def set_subtract(self, brush: str, on: bool) -> None:
+        """Shrink instead of grow (length), erase instead of paint (mask, clump)."""
+        if brush not in SIGNED:
+            raise ParameterError("brush", brush, "one of " + ", ".join(SIGNED))
+        if bool(on) != self.tool.subtract[brush]:
+            self.tool.subtract[brush] = bool(on)
+            self.tool_changed.emit()
+
+    def set_falloff(self, falloff) -> None:
+        """A preset name ("smooth", "linear", "constant") or curve points [[t, w], ...]."""
+        f = check_falloff(falloff)
+        if f != self.tool.falloff:
+            self.tool.falloff = f
+            self.tool_changed.emit()
+
+    def set_symmetry(self, on: bool) -> None:
+        if bool(on) != self.tool.symmetry:
+            self.tool.symmetry = bool(on)
+            self.tool_changed.emit()
+
+    def set_mirror_x(self, x: float | None) -> None:
+        """The X-symmetry plane x = ``x`` (None: through the scalp's centre)."""
+        if x is not None and not np.isfinite(x):
+            raise ParameterError("mirror plane", x, "a finite x")
+        x = None if x is None else float(x)
+        if x != self.tool.mirror_x:
+            self.tool.mirror_x = x
+            self.tool_changed.emit()
+
+    def set_front_only(self, on: bool) -> None:
+        if bool(on) != self.tool.front_only:
+            self.tool.front_only = bool(on)
             self.tool_changed.emit()
 
     # -- display -------------------------------------------------------------------------

@@ -1,4 +1,5 @@
-"""The tool dock: the align brush, every frozen-hair engine parameter, and the display settings.
+"""The tool dock: the brush (size, strength, falloff curve, symmetry, front faces only), every
+frozen-hair engine parameter, and the display settings.
 
 Widgets write to the scene through the window (engine parameters become undo steps) and are
 refreshed from the scene's signals with their own signals blocked, so nothing echoes.
@@ -10,20 +11,24 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from PySide6.QtCore import Signal
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
     QDockWidget,
+    QDoubleSpinBox,
     QFormLayout,
     QGroupBox,
     QHBoxLayout,
+    QPushButton,
     QSpinBox,
     QVBoxLayout,
     QWidget,
 )
 
 from app.render.ramps import RAMPS
+from app.ui.brush_tool import FALLOFF_LABELS, LABELS, SHORTCUTS, SIGN_LABELS, SIGNED, TIPS, brushes
+from app.ui.falloff_editor import FalloffEditor
 from app.ui.qt_utils import signals_blocked
 from app.ui.render_hair_box import RenderHairBox
 from app.ui.scene import ALIGN_MODES, COLOUR_MODES, Scene
@@ -126,14 +131,19 @@ class ToolDock(QDockWidget):
 
     # -- building --------------------------------------------------------------------------
     def _brush_box(self) -> QGroupBox:
-        box = QGroupBox("Align brush")
-        form = QFormLayout(box)
+        box = QGroupBox("Brush")
+        form = self._brush_form = QFormLayout(box)
+        self.brush = QComboBox()
+        for name in brushes():
+            self.brush.addItem(f"{LABELS.get(name, name)}  ({SHORTCUTS.get(name, '')})", name)
+            self.brush.setItemData(self.brush.count() - 1, TIPS.get(name, ""), Qt.ItemDataRole.ToolTipRole)
+        self.brush.currentIndexChanged.connect(lambda i: self.scene.set_brush(self.brush.itemData(i)))
         self.radius = SliderSpin(0.001, 10.0, decimals=4, log=True)
         self.radius.edited.connect(lambda v, _d: self.scene.set_radius(v))
-        self.radius.setToolTip("r, eqs. 8–9: strands within this distance of the cursor follow it ([ / ])")
+        self.radius.setToolTip("strands within this distance of the cursor are brushed ([ / ], Ctrl+wheel); "
+                               "r, eqs. 8–9 for align")  # fmt: skip
         self.intensity = SliderSpin(0.0, 1.0, decimals=2)
         self.intensity.edited.connect(lambda v, _d: self.scene.set_intensity(v))
-        self.intensity.setToolTip("x, eq. 13: how far the strands turn toward the drag (0 none, 1 fully)")
         self.mode = QComboBox()
         for mode, label in zip(ALIGN_MODES, ("Follow the cursor", "Keep strand lengths"), strict=True):
             self.mode.addItem(label, mode)
@@ -142,10 +152,56 @@ class ToolDock(QDockWidget):
             "Keep strand lengths: the same turn with every segment's length kept"
         )
         self.mode.currentIndexChanged.connect(lambda i: self.scene.set_align_mode(self.mode.itemData(i)))
+        self.sign = QComboBox()
+        self.sign.addItems(["", ""])
+        self.sign.setToolTip("Ctrl while dragging does the other (as in Blender)")
+        self.sign.currentIndexChanged.connect(lambda i: self.scene.set_subtract(self.scene.brush, i == 1))
+        self.falloff = QComboBox()
+        for key, label in FALLOFF_LABELS.items():
+            self.falloff.addItem(label, key)
+        self.falloff.addItem("Custom curve", None)
+        self.falloff.setToolTip("how the strength fades from the brush's centre to its rim")
+        self.falloff.currentIndexChanged.connect(self._on_falloff_preset)
+        self.curve = FalloffEditor()
+        self.curve.curve_edited.connect(self.scene.set_falloff)
+        self.symmetry = QCheckBox("X mirror")
+        self.symmetry.setToolTip("every stroke is mirrored across the plane x = … (Shift+X)")
+        self.symmetry.toggled.connect(self.scene.set_symmetry)
+        self.mirror_x = QDoubleSpinBox()
+        self.mirror_x.setDecimals(4)
+        self.mirror_x.setKeyboardTracking(False)
+        self.mirror_x.setToolTip(
+            "x of the mirror plane (default: through the centre of the sphere fitted to the roots)"
+        )
+        self.mirror_x.valueChanged.connect(lambda v: self.scene.set_mirror_x(float(v)))
+        self.mirror_centre = QPushButton("Centre")
+        self.mirror_centre.setToolTip("the mirror plane back through the head's centre")
+        self.mirror_centre.clicked.connect(lambda: self.scene.set_mirror_x(None))
+        mirror_row = QWidget()
+        row = QHBoxLayout(mirror_row)
+        row.setContentsMargins(0, 0, 0, 0)
+        row.addWidget(self.symmetry)
+        row.addWidget(self.mirror_x, 1)
+        row.addWidget(self.mirror_centre)
+        self.front_only = QCheckBox("Front faces only")
+        self.front_only.setToolTip(
+            "brush only the strands whose roots face the camera (the hair behind the head is left alone)"
+        )
+        self.front_only.toggled.connect(self.scene.set_front_only)
+        form.addRow("Brush", self.brush)
         form.addRow("Brush size", self.radius)
         form.addRow("Strength", self.intensity)
         form.addRow("Mode", self.mode)
+        form.addRow("Direction", self.sign)
+        form.addRow("Falloff", self.falloff)
+        form.addRow(self.curve)
+        form.addRow("Symmetry", mirror_row)
+        form.addRow(self.front_only)
         return box
+
+    def _on_falloff_preset(self, i: int) -> None:
+        key = self.falloff.itemData(i)
+        self.scene.set_falloff(key if key is not None else self.curve.points())
 
     def _engine_box(self) -> QGroupBox:
         box = QGroupBox("Frozen hair")
@@ -228,13 +284,41 @@ class ToolDock(QDockWidget):
 
     def refresh_brush(self) -> None:
         s = self.scene
+        tool = s.tool
         lo, hi = s.rest.bounds
         extent = max(float((hi - lo).max()), 1e-3)
-        with signals_blocked(self.radius, self.intensity, self.mode):
+        widgets = (self.brush, self.radius, self.intensity, self.mode, self.sign, self.falloff, self.curve)
+        with signals_blocked(*widgets, self.symmetry, self.mirror_x, self.front_only):
+            self.brush.setCurrentIndex(self.brush.findData(s.brush))
             self.radius.set_range(extent * 1e-3, extent * 2.0)
             self.radius.set_value(s.radius)
             self.intensity.set_value(s.intensity)
+            self.intensity.setToolTip(
+                "x, eq. 13: how far the strands turn toward the drag (0 none, 1 fully)"
+                if s.brush == "align"
+                else "how strongly each mouse move acts at the brush's centre (0 none, 1 fully)"
+            )
             self.mode.setCurrentIndex(self.mode.findData(s.align_mode))
+            labels = SIGNED.get(s.brush)
+            if labels is not None:
+                for i, label in enumerate(labels):
+                    self.sign.setItemText(i, label)
+                self.sign.setCurrentIndex(1 if tool.subtract[s.brush] else 0)
+                self._brush_form.labelForField(self.sign).setText(SIGN_LABELS[s.brush])
+            self._brush_form.setRowVisible(self.mode, s.brush == "align")
+            self._brush_form.setRowVisible(self.intensity, s.brush != "mask")  # a mask is on or off
+            self._brush_form.setRowVisible(self.sign, labels is not None)
+            custom = not isinstance(tool.falloff, str)
+            preset = self.falloff.count() - 1 if custom else self.falloff.findData(tool.falloff)
+            self.falloff.setCurrentIndex(preset)
+            self.curve.set_falloff(tool.falloff)
+            for w in (self.falloff, self.curve):  # align weighs by the paper's own rule
+                w.setEnabled(s.brush != "align")
+            self.symmetry.setChecked(tool.symmetry)
+            self.mirror_x.setRange(float(lo[0]) - extent, float(hi[0]) + extent)
+            self.mirror_x.setSingleStep(extent / 100.0)
+            self.mirror_x.setValue(s.mirror_plane_x())
+            self.front_only.setChecked(tool.front_only)
 
     def refresh_params(self) -> None:
         p: FrozenParams = self.scene.params

@@ -1,10 +1,16 @@
-"""The GL viewport: moderngl inside a QOpenGLWidget, camera navigation and the align brush.
+"""The GL viewport: moderngl inside a QOpenGLWidget, camera navigation and the brushes.
 
 Navigation follows Blender/Maya: middle-drag or Alt+left-drag orbits (pans in 2-D), Shift with
-either pans, the wheel zooms, Ctrl+wheel resizes the brush. A plain left-drag is the align tool:
-the cursor is unprojected onto the plane through the groom's centre facing the camera, and
-every move runs the frozen-hair pipeline. The view is told what changed by the scene's signals
-and uploads it at the next paint (positions only while dragging).
+either pans, the wheel zooms, Ctrl+wheel resizes the brush. A plain left-drag is the current
+brush (Ctrl+left-drag inverts it, as in Blender: shrink for grow, erase for paint): the cursor is
+unprojected onto a plane facing the camera, through the hair under the mouse at the press (the
+vertex nearest to it on screen within the brush circle, of a front-facing strand with "front
+faces only"; the groom's centre when the circle holds none), so that a brush reaches the hair the
+artist sees in a 3-D view, not the middle of the head; the mouse's motion
+between two moves on that plane is the brush's direction (comb), the camera's ray through the
+cursor its view (front faces only), and every move runs the frozen-hair pipeline. The view is
+told what changed by the scene's signals and uploads it at the next paint (positions only while
+dragging).
 
 With an animation loaded the window shows one of its frames instead of the scene's groom
 (:meth:`Viewport.show_frame`: positions, optional per-vertex colours and a ghost, all for the
@@ -29,6 +35,7 @@ from app.render.hair_shading import HAIR_TAPER
 from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.colouring import vertex_colors
 from app.ui.scene import Scene
+from hairtool.frozen.brushes import facing_away
 
 BRUSH_STEP = 1.1  # radius factor per wheel notch or [ / ] press
 # The reconstruction behind the original: one flat cyan no ramp uses, opaque enough to read on the
@@ -73,6 +80,10 @@ class Viewport(QOpenGLWidget):
         self._drag_button = Qt.MouseButton.NoButton
         self._last_pos = QPointF()
         self._stroke_before: object | None = None
+        self._stroke_cursor: np.ndarray | None = None  # the last move's cursor (for the direction)
+        self._stroke_depth: np.ndarray | None = None  # the stroke's cursor plane passes through it
+        self._stroke_invert = False  # Ctrl held at the press
+        self.stroke_touched = False  # the brush reached a strand during the current / last stroke
         self._hover: QPointF | None = None
         self._auto_frame = True  # follow the widget's size with frame-all until the user navigates
         # an animation frame shown instead of the scene's groom (see show_frame)
@@ -93,6 +104,7 @@ class Viewport(QOpenGLWidget):
         scene.mesh_changed.connect(lambda: self._mark("mesh"))
         scene.drawn_changed.connect(lambda: self._mark("groom", "colors"))
         scene.tool_changed.connect(self.update)
+        scene.mask_changed.connect(lambda: self._mark("colors"))
         scene.engine_started.connect(self._on_engine_started)
 
     # -- scene → view ----------------------------------------------------------------------
@@ -214,12 +226,29 @@ class Viewport(QOpenGLWidget):
             r.set_mesh(s.mesh)
         dirty.clear()
 
+    def mirror_outline(self, w: float, h: float) -> np.ndarray | None:
+        """``(4, 2)`` pixels (of a ``w`` × ``h`` view) of the X-symmetry plane's rectangle across
+        the groom's box, or None (symmetry off, or a corner behind the camera)."""
+        s = self.scene
+        if not s.tool.symmetry:
+            return None
+        lo, hi = s.result.bounds
+        pad = 0.05 * float(np.max(hi - lo))
+        y0, y1, z0, z1 = lo[1] - pad, hi[1] + pad, lo[2] - pad, hi[2] + pad
+        x = s.mirror_plane_x()
+        corners = np.array([[x, y0, z0], [x, y1, z0], [x, y1, z1], [x, y0, z1]], np.float64)
+        if not self.camera.ortho and np.any(self.camera.depth(corners) <= 1e-6):
+            return None
+        return self.camera.project(corners, w, h)
+
     def _overlay(self, w: int, h: int) -> None:
+        self.renderer.set_overlay_outline(self.mirror_outline(w, h), (w, h))
         if self._hover is None or self._drag not in (None, "align"):
             self.renderer.set_overlay_circle(None, 0.0, (w, h))
             return
         dpr = self.devicePixelRatioF()
-        radius_px = self.scene.radius * self.camera.pixels_per_unit_at(self.scene.centre, h)
+        depth = self.scene.centre if self._stroke_depth is None or self._drag is None else self._stroke_depth
+        radius_px = self.scene.radius * self.camera.pixels_per_unit_at(depth, h)
         centre = (self._hover.x() * dpr, self._hover.y() * dpr)
         self.renderer.set_overlay_circle(centre, radius_px, (w, h))
 
@@ -277,11 +306,12 @@ class Viewport(QOpenGLWidget):
             self.doneCurrent()
 
     # -- picking -------------------------------------------------------------------------------
-    def cursor_on_plane(self, pos: QPointF) -> np.ndarray:
-        """The 3-D point under ``pos`` (widget pixels) on the plane through the groom's centre."""
+    def cursor_on_plane(self, pos: QPointF, through: np.ndarray | None = None) -> np.ndarray:
+        """The 3-D point under ``pos`` (widget pixels) on the plane facing the camera through
+        ``through`` (default: the groom's centre)."""
+        q = self.scene.centre if through is None else through
         return np.asarray(
-            self.camera.unproject_to_plane(pos.x(), pos.y(), self.width(), self.height(), self.scene.centre),
-            dtype=np.float64,
+            self.camera.unproject_to_plane(pos.x(), pos.y(), self.width(), self.height(), q), dtype=np.float64
         )
 
     def project(self, points: np.ndarray) -> np.ndarray:
@@ -318,9 +348,13 @@ class Viewport(QOpenGLWidget):
             self.engine_wait.emit()
         elif self._drag == "align":
             self._stroke_before = self.scene.snapshot()
+            self._stroke_cursor = None
+            self._stroke_depth = self.hair_under(event.position())
+            self._stroke_invert = bool(event.modifiers() & Qt.KeyboardModifier.ControlModifier)
+            self.stroke_touched = False
             self.stroke_started.emit()
             self.scene.set_dragging(True)  # children at the drag display percentage
-            self._align_at(event.position())
+            self._brush_at(event.position())
         event.accept()
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
@@ -331,7 +365,7 @@ class Viewport(QOpenGLWidget):
         if self._drag == "align" and self._drag_target is not None:
             self._drag_target.move(self._cursor_at(pos))
         elif self._drag == "align":
-            self._align_at(pos)
+            self._brush_at(pos)
         elif self._drag == "orbit":
             self._auto_frame = False
             self.camera.orbit(dx, dy)
@@ -342,13 +376,37 @@ class Viewport(QOpenGLWidget):
             self.cursor_moved.emit(self.cursor_on_plane(pos))
         self.update()
 
-    def _cursor_at(self, pos: QPointF) -> np.ndarray:
-        cursor = self.cursor_on_plane(pos)
+    def _cursor_at(self, pos: QPointF, through: np.ndarray | None = None) -> np.ndarray:
+        cursor = self.cursor_on_plane(pos, through)
         self.cursor_moved.emit(cursor)
         return cursor
 
-    def _align_at(self, pos: QPointF) -> None:
-        self.scene.align(self._cursor_at(pos))
+    def view_at(self, pos: QPointF) -> np.ndarray:
+        """The camera's viewing direction through ``pos`` (from the eye into the scene)."""
+        return self.camera.ray(pos.x(), pos.y(), self.width(), self.height())[1]
+
+    def hair_under(self, pos: QPointF) -> np.ndarray:
+        """The point a stroke starting at ``pos`` keeps its cursor level with (module docstring)."""
+        s = self.scene
+        pts = s.result.points
+        xy = self.project(pts)
+        d2 = np.einsum("ij,ij->i", xy - (pos.x(), pos.y()), xy - (pos.x(), pos.y()))
+        r_px = s.radius * self.camera.pixels_per_unit_at(s.centre, self.height())
+        near = d2 <= r_px * r_px
+        if s.tool.front_only and s.pipeline is not None:
+            away = facing_away(s.pipeline.root_normals, self.view_at(pos))
+            near &= ~np.repeat(away, s.result.topology.counts)
+        if not near.any():
+            return np.asarray(s.centre, np.float64)
+        return pts[int(np.argmin(np.where(near, d2, np.inf)))].astype(np.float64)
+
+    def _brush_at(self, pos: QPointF) -> None:
+        cursor = self._cursor_at(pos, self._stroke_depth)
+        last, self._stroke_cursor = self._stroke_cursor, cursor
+        direction = np.zeros(3) if last is None else cursor - last
+        view = self.view_at(pos)
+        touched = self.scene.brush_move(cursor, direction, view, self._stroke_invert, not self.stroke_touched)
+        self.stroke_touched = self.stroke_touched or touched
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         if self._drag is None or event.button() != self._drag_button:

@@ -12,12 +12,21 @@ from pathlib import Path
 import numpy as np
 from PySide6.QtCore import QSettings, QSize, Qt
 from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QKeySequence, QUndoStack
-from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox, QWidget
+from PySide6.QtWidgets import (
+    QDockWidget,
+    QFileDialog,
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QToolBar,
+    QWidget,
+)
 
 from app.ui import export
 from app.ui.animation_io import open_filters, read_any, save_filters
 from app.ui.animation_model import AnimationModel
 from app.ui.animation_ui import AnimationController
+from app.ui.brush_tool import LABELS, SHORTCUTS, TIPS, brushes
 from app.ui.colouring import displacement_scale
 from app.ui.commands import ParamCommand, StrokeCommand
 from app.ui.dialogs import StillOptions, ask_still_options
@@ -27,6 +36,7 @@ from app.ui.legend import RampLegend, unit_name
 from app.ui.qt_utils import add_action
 from app.ui.scene import COLOUR_MODES, Scene
 from app.ui.simulate_dialog import ask_simulate_options
+from app.ui.stroke_files import StrokeFiles
 from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
 from app.ui.viewport import BRUSH_STEP, Viewport
@@ -38,6 +48,7 @@ from hairtool.simulate.options import SimulateOptions
 MAX_RECENT = 10
 FIRST_SIZE = (1280, 800)  # the window's first-start size, shrunk to fit smaller screens
 MISSED_STRANDS = "The brush touched no strand: start the drag on the hair, or make the brush bigger ( ] )"
+CLUMP_FULL = "These strands already clump fully: Ctrl+drag (or Erase) loosens them, painting brings them back"
 SETTINGS_ORG, SETTINGS_APP = "hairtool", "Hairtool Studio"
 
 
@@ -67,6 +78,7 @@ class MainWindow(QMainWindow):
         self.undo_stack = QUndoStack(self)
         self._shown_once = False
         self._stroke_points: np.ndarray | None = None
+        self._stroke_clump: np.ndarray | None = None  # clump strengths when a clump stroke began
         # long work (key solves, simulation, video export): window.jobs.run(title, fn, on_done)
         self.jobs = JobRunner(lambda title, message: self.show_error(title, message), self)
         start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
@@ -220,6 +232,10 @@ class MainWindow(QMainWindow):
         add_action(self, file, "&Export still…", self.export_still_dialog, "Ctrl+E")
         add_action(self, file, "Export &groom…", self.export_groom_dialog, "Ctrl+Shift+E")
         file.addSeparator()
+        self.stroke_files = StrokeFiles(self)
+        add_action(self, file, "Export S&trokes…", lambda: self.stroke_files.export_dialog())
+        add_action(self, file, "Import / &Replay Strokes…", lambda: self.stroke_files.replay_dialog())
+        file.addSeparator()
         add_action(self, file, "Load head &mesh…", self.load_mesh_dialog)
         add_action(self, file, "&Clear head mesh", lambda: self.scene.set_mesh(None))
         file.addSeparator()
@@ -251,8 +267,44 @@ class MainWindow(QMainWindow):
         view.addAction(self.dock.toggleViewAction())
 
         brush = bar.addMenu("&Brush")
+        self._build_brush_actions(brush)
+        brush.addSeparator()
         add_action(self, brush, "&Smaller", lambda: self.viewport.scale_brush(1.0 / BRUSH_STEP), "[")
         add_action(self, brush, "&Bigger", lambda: self.viewport.scale_brush(BRUSH_STEP), "]")
+        brush.addSeparator()
+        self.symmetry_action = add_action(
+            self, brush, "&X mirror", lambda on: self.scene.set_symmetry(on), "Shift+X", checkable=True
+        )
+        self.front_only_action = add_action(
+            self, brush, "&Front faces only", lambda on: self.scene.set_front_only(on), checkable=True
+        )
+        self.scene.tool_changed.connect(self._sync_brush_actions)
+        self._sync_brush_actions()
+
+    def _build_brush_actions(self, menu) -> None:
+        """One checkable action per brush, in the Brush menu and a toolbar, with its key."""
+        self.brush_bar = QToolBar("Brushes", self)
+        self.brush_bar.setObjectName("BrushToolBar")
+        group = QActionGroup(self)
+        self.brush_actions: dict[str, QAction] = {}
+        for name in brushes():
+            label = LABELS.get(name, name)
+            a = add_action(self, menu, label, lambda _=False, b=name: self.scene.set_brush(b),
+                           SHORTCUTS.get(name), checkable=True)  # fmt: skip
+            a.setToolTip(f"{label} ({SHORTCUTS.get(name, '')}): {TIPS.get(name, '')}")
+            group.addAction(a)
+            self.brush_bar.addAction(a)
+            self.brush_actions[name] = a
+        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.brush_bar)
+        view = next(a.menu() for a in self.menuBar().actions() if a.text() == "&View")
+        view.addAction(self.brush_bar.toggleViewAction())
+
+    def _sync_brush_actions(self) -> None:
+        tool = self.scene.tool
+        self.brush_actions[tool.brush].setChecked(True)
+        for action, on in ((self.symmetry_action, tool.symmetry), (self.front_only_action, tool.front_only)):
+            if action.isChecked() != on:
+                action.setChecked(on)
 
     # -- animation (timeline, playback, keys, recording) ---------------------------------------
     def _build_animation_ui(self) -> None:
@@ -410,12 +462,18 @@ class MainWindow(QMainWindow):
     # -- editing -------------------------------------------------------------------------------
     def _on_stroke_started(self) -> None:
         self._stroke_points = self.scene.result.points.copy()
+        self._stroke_clump = self.scene.pipeline.clump_strength if self.scene.brush == "clump" else None
 
     def _on_stroke_finished(self, before: object, after: object) -> None:
-        self.undo_stack.push(StrokeCommand(self.scene, before, after))
+        self.undo_stack.push(StrokeCommand(self.scene, before, after, LABELS.get(self.scene.brush)))
         start, self._stroke_points = self._stroke_points, None
-        if start is not None and np.array_equal(start, self.scene.result.points):
+        moved = start is None or not np.array_equal(start, self.scene.result.points)
+        if not moved and not self.viewport.stroke_touched:
             self.statusBar().showMessage(MISSED_STRANDS, 6000)
+        elif self._stroke_clump is not None and not moved:
+            if np.array_equal(self._stroke_clump, self.scene.pipeline.clump_strength):
+                self.statusBar().showMessage(CLUMP_FULL, 6000)
+        self._stroke_clump = None
 
     def _on_param_edited(self, name: str, value: object, drag: object) -> None:
         before = self.scene.params

@@ -1,0 +1,142 @@
+"""The brush an artist grooms with, as settings: which brush, its size and strength (each brush
+remembers its own), grow or shrink, paint or erase, the falloff curve, X symmetry and "front faces
+only"; and the pipeline samples that one mouse move of it gives.
+
+Plain Python (no Qt): the scene holds one and the tool dock edits it through the scene.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hairtool.errors import ParameterError
+from hairtool.frozen.brushes import BRUSHES, BrushSample, falloff_lut, mirrored_view
+from hairtool.frozen.pipeline import AlignSample
+
+#: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
+#: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump; the others by their initial).
+LABELS = {
+    "align": "Align",
+    "comb": "Comb",
+    "smooth": "Smooth",
+    "length": "Length",
+    "puff": "Puff",
+    "clump": "Clump",
+    "mask": "Mask",
+}
+SHORTCUTS = {"align": "A", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M"}
+TIPS = {
+    "align": "Strands turn toward the cursor's path (UserAlign, Kim 2026 eqs. 8–13)",
+    "comb": "Tips follow the drag, strand lengths kept",
+    "smooth": "Takes out kinks and curls; roots stay put (a Laplacian step, lengths kept)",
+    "length": "Grows or shrinks the strands under the brush (Ctrl: the other way)",
+    "puff": "Lifts strands away from the scalp near the root (turns them toward the scalp normal)",
+    "clump": "Paints how strongly strands clump (ClumpWithGaps' per-strand strength; Ctrl erases)",
+    "mask": "Paints a mask: masked strands are locked for every brush (Ctrl erases)",
+}
+#: Brushes with a signed strength: (label of > 0, label of < 0).
+SIGNED = {"length": ("Grow", "Shrink"), "clump": ("Paint", "Erase"), "mask": ("Paint", "Erase")}
+SIGN_LABELS = {"length": "Grow or shrink", "clump": "Paint or erase", "mask": "Paint or erase"}
+DEFAULT_STRENGTH = {
+    "align": 0.8,
+    "comb": 0.5,
+    "smooth": 0.5,
+    "length": 0.05,
+    "puff": 0.2,
+    "clump": 0.5,
+    "mask": 1.0,
+}
+FALLOFF_LABELS = {"smooth": "Smooth", "linear": "Linear", "constant": "Constant"}
+
+Falloff = str | tuple[tuple[float, float], ...]
+
+
+def brushes() -> tuple[str, ...]:
+    """The brushes the engine has, in the toolbar's order."""
+    return tuple(b for b in LABELS if b in BRUSHES) + tuple(b for b in BRUSHES if b not in LABELS)
+
+
+def check_falloff(falloff: str | Sequence[Sequence[float]]) -> Falloff:
+    """A preset name, or curve points as a tuple of (t, w) pairs; ParameterError otherwise."""
+    falloff_lut(falloff)  # the engine's own check
+    if isinstance(falloff, str):
+        return falloff
+    return tuple((float(t), float(w)) for t, w in falloff)
+
+
+@dataclass
+class BrushTool:
+    """See the module docstring. ``mirror_x`` None: the plane through the scalp's centre."""
+
+    brush: str = "align"
+    radius: dict[str, float] = field(default_factory=dict)
+    strength: dict[str, float] = field(default_factory=lambda: dict(DEFAULT_STRENGTH))
+    subtract: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(SIGNED, False))
+    falloff: Falloff = "smooth"
+    symmetry: bool = False
+    mirror_x: float | None = None
+    front_only: bool = True
+    align_mode: str = "paper"
+    _lut: tuple[Falloff, tuple[float, ...]] | None = field(default=None, repr=False)
+
+    def reset_radius(self, radius: float) -> None:
+        """Every brush at one size (a new groom)."""
+        self.radius = dict.fromkeys(brushes(), float(radius))
+
+    def set_brush(self, name: str) -> None:
+        if name not in brushes():
+            raise ParameterError("brush", name, "one of " + ", ".join(brushes()))
+        self.brush = name
+
+    def lut(self) -> tuple[float, ...]:
+        """The falloff as the engine's table (cached: a table per mouse move would cost)."""
+        if self._lut is None or self._lut[0] != self.falloff:
+            self._lut = (self.falloff, tuple(falloff_lut(self.falloff).tolist()))
+        return self._lut[1]
+
+    def signed_strength(self, invert: bool = False) -> float:
+        """The current brush's strength, negative for shrink / erase (``invert``: Ctrl held)."""
+        s = self.strength[self.brush]
+        if self.brush in SIGNED and self.subtract.get(self.brush, False) != bool(invert):
+            return -s
+        return s
+
+    def samples(
+        self,
+        cursor: Sequence[float],
+        direction: Sequence[float],
+        view: Sequence[float] | None,
+        plane_x: float,
+        invert: bool = False,
+    ) -> list[AlignSample | BrushSample]:
+        """The samples of one mouse move at ``cursor`` (groom units), mirrored one right after it
+        with symmetry on. ``direction``: the mouse's motion in the world (comb needs one: none
+        while it stands still). ``view``: the camera's direction, given to the engine with
+        "front faces only"."""
+        c = tuple(float(x) for x in cursor)
+        d = tuple(float(x) for x in direction)
+        v = None if view is None or not self.front_only else tuple(float(x) for x in view)
+        r, name = self.radius[self.brush], self.brush
+        if name == "align":
+            first = AlignSample(c, r, self.strength["align"], self.align_mode, v)
+            if not self.symmetry:
+                return [first]
+            return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
+        if name == "comb" and math.hypot(*d) == 0.0:
+            return []
+        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v)
+        return [first, first.mirrored(plane_x)] if self.symmetry else [first]
+
+    def touches(self, points: np.ndarray, cursor: Sequence[float], plane_x: float) -> bool:
+        """Whether a move at ``cursor`` (and its mirror) reaches any of ``points`` ``(V, 3)``."""
+        r = self.radius[self.brush]
+        centres = [np.asarray(cursor, np.float64)]
+        if self.symmetry:
+            centres.append(np.array([2.0 * plane_x - centres[0][0], centres[0][1], centres[0][2]]))
+        p = np.asarray(points, np.float64)
+        return any(bool(np.any(np.einsum("ij,ij->i", p - c, p - c) <= r * r)) for c in centres)
+
