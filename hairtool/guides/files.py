@@ -1,7 +1,8 @@
 """Render hair and its guides as one groom of two curves prims, so one USD file holds both:
 ``/Groom/Hair`` (the render strands, with widths) and ``/Groom/Guides`` marked with USD's
 purpose ``guide``, which DCCs show as guides and do not render (Blender imports render and
-default purposes as hair). :func:`split_guides` takes such a groom apart again.
+default purposes as hair). :func:`split_guides` takes such a groom apart again;
+:class:`AnimationWithGuides` is the same for an animation, its frames made one at a time.
 """
 
 from __future__ import annotations
@@ -9,7 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from hairtool.errors import ParameterError
-from hairtool.groom import Groom
+from hairtool.groom import Animation, Groom, Topology, vertex_ids_of
+from hairtool.guides.animate import RenderHairAnimation
 from hairtool.metadata import CurvesPrim, Metadata
 
 HAIR_PRIM = "/Groom/Hair"
@@ -19,8 +21,9 @@ TIP_WIDTH = 0.002  # … narrowing linearly to the tip
 GUIDE_WIDTH = 0.01
 
 
-def tapered_widths(groom: Groom, root: float = ROOT_WIDTH, tip: float = TIP_WIDTH) -> np.ndarray:
-    """``(V,)`` float32 widths from ``root`` at the root to ``tip`` at the tip, linear in t."""
+def tapered_widths(groom: Groom | Topology, root: float = ROOT_WIDTH, tip: float = TIP_WIDTH) -> np.ndarray:
+    """``(V,)`` float32 widths from ``root`` at the root to ``tip`` at the tip, linear in t
+    (of a groom's strands or of a topology's)."""
     for name, value in (("root width", root), ("tip width", tip)):
         if not np.isfinite(value) or value < 0:
             raise ParameterError(name, value, "a width ≥ 0 in scene units")
@@ -54,15 +57,77 @@ def with_guides(hair: Groom, guides: Groom, metadata: Metadata | None = None) ->
     )
 
 
-def split_guides(groom: Groom) -> tuple[Groom, Groom | None]:
+def split_guides(groom: Groom | Animation) -> tuple[Groom | Animation, Groom | Animation | None]:
     """``(hair, guides)``: the strands of prims with purpose ``guide`` apart from the rest
-    (``guides`` None when no prim is marked so)."""
+    (``guides`` None when no prim is marked so); an animation splits into two animations."""
     prims = groom.metadata.for_strands(groom.strand_count).curves
     marks = [np.full(c.strands, c.purpose == "guide") for c in prims]
     if not marks or not any(c.purpose == "guide" for c in prims):
         return groom, None
     is_guide = np.concatenate(marks)
     keep_meta = groom.metadata.with_(curves=())
+    if isinstance(groom, Animation):
+        top = groom.topology
+
+        def part(ids: np.ndarray) -> Animation:
+            vids = vertex_ids_of(top, ids)
+            pick = {k: (None if v is None else v[vids]) for k, v in groom.attributes.items()}
+            return Animation(groom.frames[:, vids], top.counts[ids], groom.fps, **pick, metadata=keep_meta)
+
+        return part(np.flatnonzero(~is_guide)), part(np.flatnonzero(is_guide))
     hair = groom.subset(np.flatnonzero(~is_guide)).with_metadata(keep_meta)
     guides = groom.subset(np.flatnonzero(is_guide)).with_metadata(keep_meta)
     return hair, guides
+
+
+class AnimationWithGuides:
+    """Render hair following an animation of its guides, and those guides, as one animation of
+    two prims (``/Groom/Hair`` then ``/Groom/Guides``, purpose ``guide``) whose frames are made
+    one at a time: what :func:`hairtool.io.usd.write` takes as a frame stream. Widths as in
+    :func:`with_guides`; the time codes, up axis and unit of ``metadata`` (default: the guides
+    animation's)."""
+
+    transparency = None
+    colors = None
+
+    def __init__(self, hair: RenderHairAnimation, metadata: Metadata | None = None) -> None:
+        self.hair, guides = hair, hair.guides
+        self.guides = guides
+        self.topology = Topology(np.concatenate([hair.counts, guides.counts]))
+        guide_widths = (
+            guides.thickness if guides.thickness is not None else np.full(guides.vertex_count, GUIDE_WIDTH)
+        )
+        self.thickness = np.concatenate([tapered_widths(hair.topology), guide_widths.astype(np.float32)])
+        base = guides.metadata if metadata is None else metadata
+        self.metadata = base.with_(
+            time_codes=guides.metadata.time_codes,
+            curves=(
+                CurvesPrim(HAIR_PRIM, hair.strand_count),
+                CurvesPrim(GUIDES_PRIM, guides.strand_count, purpose="guide"),
+            ),
+        )
+        self.fps = guides.fps
+
+    @property
+    def counts(self) -> np.ndarray:
+        return self.topology.counts
+
+    @property
+    def strand_count(self) -> int:
+        return self.topology.strand_count
+
+    @property
+    def vertex_count(self) -> int:
+        return self.topology.vertex_count
+
+    @property
+    def n_frames(self) -> int:
+        return self.guides.n_frames
+
+    @property
+    def time_codes(self) -> np.ndarray:
+        return self.guides.time_codes
+
+    def frame_points(self, f: int) -> np.ndarray:
+        """``(V, 3)`` float32: the children at frame ``f``, then the guides."""
+        return np.concatenate([self.hair.frame_points(f), self.guides.frames[f]])
