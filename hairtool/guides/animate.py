@@ -87,13 +87,22 @@ class RenderHairAnimation:
         """Frame ``f`` of the guides as a groom."""
         return Groom(self.guides.frames[f], self.guides.topology)
 
-    def frame_points(self, f: int) -> np.ndarray:
-        """``(V, 3)`` float32 points of the children at frame ``f`` (a new array)."""
+    def frame_points(self, f: int, out: np.ndarray | None = None) -> np.ndarray:
+        """``(V, 3)`` float32 points of the children at frame ``f``: a new array, or written
+        into ``out`` (a C-contiguous float32 ``(V, 3)``, e.g. rows of a larger frame)."""
+        if out is not None and (out.shape != (self.vertex_count, 3) or out.dtype != np.float32):
+            raise ParameterError("out", f"{out.dtype} {out.shape}", f"float32 ({self.vertex_count}, 3)")
+        if out is not None and not out.flags.c_contiguous:
+            raise ParameterError("out", "a strided array", "a C-contiguous array")
         g = self.guides_frame(f)
         c = self.render.clump
         if c is None or c.iterations == 0:
-            return build_points(self.binding, g)
-        return np.array(self.render.update(g).points)
+            return build_points(self.binding, g, out=out)
+        points = self.render.update(g).points
+        if out is None:
+            return np.array(points)
+        out[:] = points
+        return out
 
     def frame(self, f: int) -> Groom:
         return Groom(self.frame_points(f), self.topology)

@@ -130,4 +130,8 @@ class AnimationWithGuides:
 
     def frame_points(self, f: int) -> np.ndarray:
         """``(V, 3)`` float32: the children at frame ``f``, then the guides."""
-        return np.concatenate([self.hair.frame_points(f), self.guides.frames[f]])
+        out = np.empty((self.vertex_count, 3), np.float32)
+        n = self.hair.vertex_count
+        self.hair.frame_points(f, out[:n])  # the children straight into their rows
+        out[n:] = self.guides.frames[f]
+        return out

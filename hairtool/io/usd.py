@@ -46,6 +46,7 @@ from typing import Protocol
 
 import numpy as np
 
+from hairtool.bounds import box
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom, Topology
 from hairtool.io import usd_basis, usdc_check
@@ -107,10 +108,12 @@ def _wrap_for(basis: str, wrap: str) -> str:
 
 
 def _extent(points: np.ndarray, half_width: float):
+    """The box of the points grown by the half width (NaN where a point is not finite)."""
     from pxr import Vt
 
-    lo = points.min(axis=0).astype(np.float64) - half_width
-    hi = points.max(axis=0).astype(np.float64) + half_width
+    lo, hi = box(points)
+    lo = lo.astype(np.float64) - half_width
+    hi = hi.astype(np.float64) + half_width
     return Vt.Vec3fArray.FromNumpy(np.stack([lo, hi]).astype(np.float32))
 
 
@@ -201,8 +204,8 @@ def _frame_points(obj: Curves, f: int) -> np.ndarray:
     if isinstance(obj, Animation):
         return obj.frames[f]
     p = np.asarray(obj.frame_points(f))
-    if p.shape != (obj.vertex_count, 3) or not np.all(np.isfinite(p)):
-        raise ParameterError("frame", f, f"({obj.vertex_count}, 3) finite points")
+    if p.shape != (obj.vertex_count, 3):
+        raise ParameterError("frame", f, f"({obj.vertex_count}, 3) points")
     return p
 
 
@@ -222,8 +225,11 @@ def _write_samples(stage, obj: Curves, prims: list, times, progress: FrameProgre
         frame = _frame_points(obj, f)
         for points_attr, extent_attr, vs, half_width in prims:
             pts = np.ascontiguousarray(frame[vs], dtype=np.float32)
+            extent = _extent(pts, half_width)
+            if not np.all(np.isfinite(np.asarray(extent))):  # a stream's frames are not checked yet
+                raise ParameterError("frame", f, "finite points")
             points_attr.Set(Vt.Vec3fArray.FromNumpy(pts), code)
-            extent_attr.Set(_extent(pts, half_width), code)
+            extent_attr.Set(extent, code)
         del frame
         pending += obj.vertex_count * 12
         if crate and pending >= FLUSH_BYTES and f + 1 < len(times):

@@ -109,3 +109,23 @@ def test_a_write_stopped_between_frames_leaves_no_file(shot, tmp_path):
     with pytest.raises(Cancelled):
         usd.write(target, AnimationWithGuides(RenderHairAnimation(binding, anim)), progress=stop)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_stream_frame_that_is_not_finite_is_refused_and_out_must_fit(shot, tmp_path):
+    binding, anim = shot
+    hair = RenderHairAnimation(binding, anim)
+
+    class Broken(AnimationWithGuides):
+        def frame_points(self, f):
+            p = super().frame_points(f)
+            p[5, 1] = np.nan if f == 2 else p[5, 1]
+            return p
+
+    with pytest.raises(ParameterError, match="finite"):
+        usd.write(tmp_path / "nan.usdc", Broken(hair))
+    assert list(tmp_path.iterdir()) == []
+    rows = np.empty((binding.vertex_count + 10, 3), np.float32)
+    assert hair.frame_points(3, rows[:-10]) is not None
+    assert rows[:-10].tobytes() == hair.frame_points(3).tobytes()
+    with pytest.raises(ParameterError, match="out"):
+        hair.frame_points(0, rows)
