@@ -82,10 +82,9 @@ def wanted(args: argparse.Namespace) -> bool:
 
 
 def guides_path(args: argparse.Namespace) -> Path:
-    if args.guides_out:
-        return Path(args.guides_out)
-    out = Path(args.output)
-    return out.with_name(f"{out.stem}.guides{out.suffix}")
+    from hairtool.guides.files import guides_path_for
+
+    return Path(args.guides_out) if args.guides_out else guides_path_for(args.output)
 
 
 def check(args: argparse.Namespace, *, animated: bool = False) -> None:
@@ -197,32 +196,19 @@ def write(args: argparse.Namespace, hair: Groom, guides: Groom) -> dict:
 
 
 def write_animation(args: argparse.Namespace, binding: ChildBinding, guides: Animation) -> dict:
-    """Write the render-hair animation of an animation of the guides (a simulation, a cycle).
-
-    USD: one file, the children and the guides (purpose ``guide``) time-sampled frame by frame,
-    never the whole shot in memory (a ``.usdc`` is saved as it grows). Other formats cannot mark
-    guides: OUT gets the render hair (``.npz`` every frame, built whole in memory; ``.hair`` and
-    ``.obj`` frame 0) and the guides animation goes to ``--guides-out`` (default
-    OUT.guides.EXT). From a dense groom the guides go there in every format."""
-    from hairtool import io
+    """Write the render-hair animation of an animation of the guides (a simulation, a cycle):
+    :func:`hairtool.guides.files.write_animation` (USD: children + guide prim, streamed; other
+    formats: the guides animation in ``--guides-out``, also written from a dense groom)."""
     from hairtool.guides.animate import RenderHairAnimation
-    from hairtool.guides.files import AnimationWithGuides
-    from hairtool.io import usd
+    from hairtool.guides.files import write_animation
 
     hair = RenderHairAnimation(binding, guides, render(args, binding).clump)
     t0 = time.perf_counter()
-    if is_usd(args.output):
-        usd.write(Path(args.output), AnimationWithGuides(hair))
-    else:
-        io.write(args.output, hair.animation())
-    report = {
-        "output": str(args.output),
+    side = guides_path(args) if args.from_dense or not is_usd(args.output) else None
+    report = write_animation(args.output, hair, guides_path=side)
+    return report | {
         "guides": guides.strand_count,
         "children": binding.child_count,
         "child_vertices": binding.vertex_count,
         "render_seconds": round(time.perf_counter() - t0, 4),
     }
-    if args.from_dense or not is_usd(args.output):
-        io.write(guides_path(args), guides)
-        report["guides_output"] = str(guides_path(args))
-    return report

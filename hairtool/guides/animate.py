@@ -13,7 +13,7 @@ need the whole array. :func:`render_frames_reference` is the numpy twin.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
@@ -114,12 +114,15 @@ class RenderHairAnimation:
     def __len__(self) -> int:
         return self.n_frames
 
-    def animation(self) -> Animation:
+    def animation(self, progress: Callable[[int, int], object] | None = None) -> Animation:
         """Every frame in one Animation (F × V × 12 bytes, and a copy while it is checked: for
-        formats that take the whole array; USD takes the frames one by one)."""
+        formats that take the whole array; USD takes the frames one by one). ``progress(done,
+        total)`` after each frame; an exception it raises stops the build."""
         frames = np.empty((self.n_frames, self.vertex_count, 3), np.float32)
         for f in range(self.n_frames):
-            frames[f] = self.frame_points(f)
+            self.frame_points(f, frames[f])
+            if progress is not None:
+                progress(f + 1, self.n_frames)
         return Animation(frames, self.topology, self.fps, metadata=self.metadata)
 
 

@@ -7,6 +7,10 @@ default purposes as hair). :func:`split_guides` takes such a groom apart again;
 
 from __future__ import annotations
 
+import os
+from collections.abc import Callable
+from pathlib import Path
+
 import numpy as np
 
 from hairtool.errors import ParameterError
@@ -135,3 +139,45 @@ class AnimationWithGuides:
         self.hair.frame_points(f, out[:n])  # the children straight into their rows
         out[n:] = self.guides.frames[f]
         return out
+
+
+def guides_path_for(path: str | os.PathLike[str]) -> Path:
+    """Where the guides go beside render hair in a format that cannot mark them:
+    ``shot.npz`` → ``shot.guides.npz``."""
+    p = Path(path)
+    return p.with_name(f"{p.stem}.guides{p.suffix}")
+
+
+def write_animation(
+    path: str | os.PathLike[str],
+    hair: RenderHairAnimation,
+    *,
+    guides_path: str | os.PathLike[str] | None = None,
+    progress: Callable[[int, int], object] | None = None,
+) -> dict[str, str]:
+    """Write render hair following an animation of its guides, and the guides.
+
+    USD: one file, the children and the guides (purpose ``guide``) time-sampled frame by frame,
+    never the whole shot in memory (a ``.usdc`` is saved as it grows); the guides also go to
+    ``guides_path`` if given. Other formats cannot mark guides: ``path`` gets the render hair
+    (``.npz`` every frame, built whole in memory; ``.hair`` and ``.obj`` frame 0) and the guides
+    animation goes to ``guides_path`` (default :func:`guides_path_for`). ``progress(done,
+    total)`` after each frame; an exception it raises (Cancelled) stops the write, no file
+    left. Returns the paths written (``output``, ``guides_output``)."""
+    from hairtool import io
+    from hairtool.io import usd
+
+    usd_out = io.format_for(path, writing=True).module == "usd"
+    if not usd_out and guides_path is None:
+        guides_path = guides_path_for(path)
+    if guides_path is not None:
+        io.format_for(guides_path, writing=True)  # refused before the long part
+    if usd_out:
+        usd.write(Path(path), AnimationWithGuides(hair), progress=progress)
+    else:
+        io.write(path, hair.animation(progress))
+    report = {"output": str(path)}
+    if guides_path is not None:
+        io.write(guides_path, hair.guides)
+        report["guides_output"] = str(guides_path)
+    return report
