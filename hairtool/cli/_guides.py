@@ -7,8 +7,8 @@ chosen as guides and every strand is bound to them (along the surface of ``--sca
 given). The engine, simulation or cycle runs on the guides and OUT receives the render
 strands; in USD the guides go in the same file as a second prim of purpose ``guide``. The
 guides also go to ``--guides-out`` (default: OUT with ``.guides`` before its extension,
-``hair.usda`` → ``hair.guides.usda``) from a dense groom, and for an animation written to a
-format that cannot mark guides."""
+``hair.usda`` → ``hair.guides.usda``) when it is given, from a dense groom, and for an
+animation written to a format that cannot mark guides."""
 
 from __future__ import annotations
 
@@ -71,7 +71,10 @@ def add_arguments(
             "--guides", type=int, default=None, metavar="G", help="guides to pick with --from-dense"
         )
     g.add_argument(
-        "--guides-out", default=None, metavar="PATH", help="where the guides go (default OUT.guides.EXT)"
+        "--guides-out",
+        default=None,
+        metavar="PATH",
+        help="write the guides here too (default OUT.guides.EXT, where they go apart)",
     )
     return g
 
@@ -105,7 +108,7 @@ def check(args: argparse.Namespace, *, animated: bool = False) -> None:
     elif args.count is None:
         raise ParameterError("count", None, "a number of children (or --from-dense --guides G)")
     io.format_for(args.output, writing=True)
-    if args.from_dense or (animated and not is_usd(args.output)):
+    if args.from_dense or args.guides_out or (animated and not is_usd(args.output)):
         io.format_for(guides_path(args), writing=True)
 
 
@@ -182,14 +185,14 @@ def is_usd(path: str | Path) -> bool:
 
 def write(args: argparse.Namespace, hair: Groom, guides: Groom) -> dict:
     """Write the render strands: to USD with the guides as a second prim of purpose ``guide``
-    (:mod:`hairtool.guides.files`), elsewhere alone; from a dense groom the guides also go to
-    ``--guides-out``. The report's paths."""
+    (:mod:`hairtool.guides.files`), elsewhere alone; the guides also go to ``--guides-out``
+    when it is given and from a dense groom. The report's paths."""
     from hairtool import io
     from hairtool.guides.files import with_guides
 
     io.write(args.output, with_guides(hair, guides) if is_usd(args.output) else hair)
     report = {"output": str(args.output)}
-    if args.from_dense:
+    if args.from_dense or args.guides_out:
         io.write(guides_path(args), guides)
         report["guides_output"] = str(guides_path(args))
     return report
@@ -198,13 +201,14 @@ def write(args: argparse.Namespace, hair: Groom, guides: Groom) -> dict:
 def write_animation(args: argparse.Namespace, binding: ChildBinding, guides: Animation) -> dict:
     """Write the render-hair animation of an animation of the guides (a simulation, a cycle):
     :func:`hairtool.guides.files.write_animation` (USD: children + guide prim, streamed; other
-    formats: the guides animation in ``--guides-out``, also written from a dense groom)."""
+    formats: the guides animation in ``--guides-out``, also written from a dense groom or when
+    given)."""
     from hairtool.guides.animate import RenderHairAnimation
     from hairtool.guides.files import write_animation
 
     hair = RenderHairAnimation(binding, guides, render(args, binding).clump)
     t0 = time.perf_counter()
-    side = guides_path(args) if args.from_dense or not is_usd(args.output) else None
+    side = guides_path(args) if args.from_dense or args.guides_out or not is_usd(args.output) else None
     report = write_animation(args.output, hair, guides_path=side)
     return report | {
         "guides": guides.strand_count,

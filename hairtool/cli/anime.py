@@ -57,7 +57,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     b.add_argument("--sway", help="x,y,z direction positive wave y bends toward (default up, 0,1,0)")
     b.add_argument("--phase-spread", type=float, default=0.25, help="random phase per bunch, in cycles [0,1]")
     b.add_argument("--amplitude-spread", type=float, default=0.1, help="random amplitude scale 1±this [0,1]")
-    b.add_argument("--seed", type=int, default=0, help="seed of the per-bunch draws (default 0)")
+    b.add_argument(
+        "--seed", type=int, default=0, help="seed of the per-bunch draws and of the children (default 0)"
+    )
     o = parser.add_argument_group("output")
     o.add_argument("--compare", metavar="REF", help="report angular and position errors against REF")
     o.add_argument("--export-sheet", metavar="CSV", help="write the exposure sheet: frame, picture, time")

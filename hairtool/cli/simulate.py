@@ -51,7 +51,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     f.add_argument("--gusts", type=int, default=0, help="number of seeded wind gusts (default 0)")
     f.add_argument("--gust-strength", type=float, default=300.0, help="gust peak, units/s² (default 300)")
     f.add_argument("--gust-duration", type=float, default=0.25, help="seconds per gust (default 0.25)")
-    f.add_argument("--seed", type=int, default=0, help="seed of the gusts (default 0)")
+    f.add_argument("--seed", type=int, default=0, help="seed of the gusts and of the children (default 0)")
     h = parser.add_argument_group("head")
     h.add_argument("--no-collide", action="store_true", help="let strands pass through the head sphere")
     h.add_argument("--head-center", metavar="X,Y,Z", help="head sphere centre (default 0,0,0)")

@@ -70,3 +70,12 @@ def test_from_dense_and_bad_render_options(tmp_path, capsys):
         err = capsys.readouterr().err.strip()
         assert "\n" not in err and name in err
         assert not bad.exists()
+
+
+def test_guides_out_also_writes_the_guides_beside_a_usd_file(guides_file, tmp_path, capsys):
+    out, side = tmp_path / "shot.usda", tmp_path / "side.npz"
+    argv = ["simulate", str(guides_file), str(out), "--frames", "3", "--count", "50"]
+    assert main([*argv, "--guides-out", str(side), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["guides_output"] == str(side)
+    _, guides = split_guides(io.read(out))
+    assert io.read(side).frames.tobytes() == guides.frames.tobytes()
