@@ -38,8 +38,9 @@ from app.ui.colouring import vertex_colors
 from app.ui.jobs import Job
 from hairtool import io
 from hairtool.errors import Cancelled, FormatError, HairtoolError, ParameterError
-from hairtool.groom import Animation
+from hairtool.groom import Animation, Groom
 from hairtool.guides.animate import RenderHairAnimation
+from hairtool.guides.children import build_points
 from hairtool.guides.files import write_animation
 from hairtool.io.atomic import atomic_path
 from hairtool.keys.export import export_keys as write_keys
@@ -253,7 +254,7 @@ class RenderHairDialog(QDialog):
         self.render_hair.setToolTip(
             "USD: the render strands and the guides (a second prim of purpose 'guide', which DCCs "
             "do not render) in one file; .npz: the render strands, the guides beside in NAME.guides.npz. "
-            "Off: the guides alone, as the engine animates them. Videos draw the guides either way."
+            "Videos draw the children as the view does. Off: the guides alone, as the engine animates them."
         )
         layout.addWidget(self.render_hair)
         layout.addWidget(QLabel("Then choose the file (USD, .npz, MP4, GIF, PNG sequence)."))
@@ -267,7 +268,8 @@ class RenderHairDialog(QDialog):
 
 class FrameRenderer:
     """Draws an animation's frames as the viewport shows the groom: camera, ramp, colours,
-    line width and head mesh fixed when the export starts."""
+    line width and head mesh fixed when the export starts; ``frame_groom(f)``: what to draw
+    of frame f (default the animation's frame: render hair draws the children of its guides)."""
 
     def __init__(
         self,
@@ -279,8 +281,10 @@ class FrameRenderer:
         colors: NDArray | None = None,
         line_width: float = 2.0,
         mesh: object | None = None,
+        frame_groom: Callable[[int], Groom] | None = None,
     ) -> None:
         self.animation, self.size = animation, even_size(size)
+        self.frame_groom = animation.frame if frame_groom is None else frame_groom
         self.camera = Camera(
             camera.target,
             camera.distance,
@@ -297,7 +301,7 @@ class FrameRenderer:
     def render(self, frame: int, ctx: object | None = None) -> NDArray[np.uint8]:
         """``(H, W, 4)`` uint8 of one frame (``ctx``: a current moderngl context; None: headless)."""
         return render_image(
-            self.animation.frame(frame),
+            self.frame_groom(frame),
             size=self.size,
             camera=self.camera,
             ramp=self.ramp,
@@ -441,10 +445,26 @@ class AnimationExporter(QObject):
         self._done(path)
         return True
 
-    def renderer(self, animation: Animation, size: tuple[int, int] | None = None) -> FrameRenderer:
+    def renderer(
+        self, animation: Animation, size: tuple[int, int] | None = None, *, render_hair: bool = False
+    ) -> FrameRenderer:
+        """Frames drawn as the viewport draws them; ``render_hair``: the children drawn now (the
+        release share of them) following each frame's guides, the guides over them if shown."""
         w, scene = self.window, self.window.scene
-        colors = None
-        if animation.vertex_count == scene.result.vertex_count and scene.colour_mode in ("strand", "clump"):
+        colors, frame_groom = None, None
+        binding = self.render_hair_binding(animation) if render_hair else None
+        if binding is not None:
+            drawn, topology, guides_shown = scene.drawn_binding(), scene.drawn_topology, scene.drawn_guides
+
+            def frame_groom(f: int) -> Groom:
+                guides = Groom(animation.frames[f], animation.topology)
+                children = build_points(drawn, guides)
+                points = np.concatenate([children, guides.points]) if guides_shown else children
+                return Groom(points, topology)
+
+            if scene.colour_mode != "displacement":  # the others hang on the strands, not the pose
+                colors = vertex_colors(scene)
+        elif animation.vertex_count == scene.result.vertex_count and scene.colour_mode in ("strand", "clump"):
             colors = vertex_colors(scene)  # per-strand colours stay valid on every frame
         return FrameRenderer(
             animation,
@@ -454,6 +474,7 @@ class AnimationExporter(QObject):
             colors=colors,
             line_width=scene.line_width,
             mesh=scene.mesh,
+            frame_groom=frame_groom,
         )
 
     def export_animation(
@@ -486,7 +507,7 @@ class AnimationExporter(QObject):
                 raise FormatError(
                     path, "animations are written as .usda/.usdc/.usd, .npz, .mp4, .gif or .png"
                 )
-            renderer = self.renderer(anim, size)
+            renderer = self.renderer(anim, size, render_hair=binding is not None and render_hair is not False)
         except HairtoolError as e:
             w.show_error("Cannot export animation", str(e))
             return False

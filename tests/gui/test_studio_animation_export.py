@@ -191,3 +191,22 @@ def test_an_animation_of_other_strands_has_no_render_hair(render_hair_window, ou
     assert io.read(out / "o.usda").strand_count == 7
     assert w.exporter.export_animation(out / "x.usda", render_hair=True) is False
     assert "guides" in w.errors[-1][1] and not (out / "x.usda").exists()
+
+
+def test_a_video_of_render_hair_draws_the_children(render_hair_window, out):
+    w = render_hair_window
+    anim = w.animation.animation
+    hair = w.exporter.renderer(anim, (96, 64), render_hair=True)
+    guides = w.exporter.renderer(anim, (96, 64), render_hair=False)
+    drawn = hair.frame_groom(6)
+    assert drawn.strand_count == w.scene.drawn_topology.strand_count
+    assert drawn.points[: w.scene.binding.vertex_count].tobytes() == (
+        w.scene.binding.build(anim.frame(6)).points.tobytes()
+    )
+    assert guides.frame_groom(6).strand_count == 20
+    _wait(w, w.exporter.export_animation(out / "hair.gif", size=(96, 64)))
+    _wait(w, w.exporter.export_animation(out / "guides.gif", size=(96, 64), render_hair=False))
+    frames = {n: np.asarray(imageio.mimread(out / f"{n}.gif")[0])[..., :3] for n in ("hair", "guides")}
+    background = frames["guides"][0, 0]
+    covered = {n: int(np.any(f != background, axis=2).sum()) for n, f in frames.items()}
+    assert covered["hair"] > covered["guides"]  # 300 children fill more pixels than 20 guides
