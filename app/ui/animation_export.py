@@ -6,6 +6,11 @@ on request (:class:`GuiFrameSource`), so the window keeps drawing and Cancel wor
 frames. Every file is written beside its target and renamed at the end: a cancelled or failed
 export leaves no partial file (a PNG sequence appears all at once, from a temporary folder).
 
+With render hair (a groom with children) an animation of the guides is written as render hair
+by default: every child following the guides frame by frame, in USD with the guides as a second
+prim of purpose "guide" (frames streamed to the file), in ``.npz`` with the guides beside
+(``shot.guides.npz``); the Export Animation dialog asks first (:class:`RenderHairDialog`).
+
 API for the window: :class:`AnimationExporter` (``export_animation(path)``,
 ``export_keys(path)``, the two ``*_dialog`` methods); the functions below work without Qt
 widgets and are what the tests drive.
@@ -25,6 +30,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 from PySide6.QtCore import QObject, Qt, QThread, Signal, Slot
+from PySide6.QtWidgets import QCheckBox, QDialog, QDialogButtonBox, QLabel, QVBoxLayout, QWidget
 
 from app.render.camera import Camera
 from app.render.offscreen import render_image
@@ -32,13 +38,17 @@ from app.ui.colouring import vertex_colors
 from app.ui.jobs import Job
 from hairtool import io
 from hairtool.errors import Cancelled, FormatError, HairtoolError, ParameterError
-from hairtool.groom import Animation
+from hairtool.groom import Animation, Groom
+from hairtool.guides.animate import RenderHairAnimation
+from hairtool.guides.children import build_points
+from hairtool.guides.files import write_animation
 from hairtool.io.atomic import atomic_path
 from hairtool.keys.export import export_keys as write_keys
 from hairtool.keys.export import keys_record
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
+    from hairtool.guides.binding import ChildBinding
 
 DATA_SUFFIXES = (".usd", ".usda", ".usdc", ".npz")
 VIDEO_SUFFIXES = (".mp4", ".gif")
@@ -208,9 +218,58 @@ def write_animation_data(path: str | os.PathLike[str], animation: Animation) -> 
     io.write(path, animation)
 
 
+def write_render_hair_data(
+    path: str | os.PathLike[str],
+    animation: Animation,
+    binding: ChildBinding,
+    *,
+    progress: Progress = _ignore,
+    cancelled: CancelCheck = _never,
+) -> dict[str, str]:
+    """The render hair of ``binding`` following ``animation`` (of its guides), with the guides:
+    USD one file (guide prim), ``.npz`` the guides beside (:func:`hairtool.guides.files.write_animation`).
+    :class:`Cancelled` between frames leaves no file."""
+    if Path(path).suffix.lower() not in DATA_SUFFIXES:
+        raise FormatError(path, f"animations are written as {', '.join(DATA_SUFFIXES)}")
+    hair = RenderHairAnimation(binding, animation)
+
+    def step(done: int, total: int) -> None:
+        if cancelled():
+            raise Cancelled
+        progress(done / total, f"frame {done}/{total}")
+
+    return write_animation(path, hair, progress=step)
+
+
+class RenderHairDialog(QDialog):
+    """Export Animation's first question when the groom has children: write the render hair
+    (on by default) or the guides alone."""
+
+    def __init__(self, children: int, guides: int, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setWindowTitle("Export animation")
+        layout = QVBoxLayout(self)
+        self.render_hair = QCheckBox(f"Render hair: {children:,} strands following the {guides:,} guides")
+        self.render_hair.setChecked(True)
+        self.render_hair.setToolTip(
+            "USD: the render strands and the guides (a second prim of purpose 'guide', which DCCs "
+            "do not render) in one file; .npz: the render strands, the guides beside in NAME.guides.npz. "
+            "Videos draw the children as the view does. Off: the guides alone, as the engine animates them."
+        )
+        layout.addWidget(self.render_hair)
+        layout.addWidget(QLabel("Then choose the file (USD, .npz, MP4, GIF, PNG sequence)."))
+        buttons = QDialogButtonBox(
+            QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel
+        )
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        layout.addWidget(buttons)
+
+
 class FrameRenderer:
     """Draws an animation's frames as the viewport shows the groom: camera, ramp, colours,
-    line width and head mesh fixed when the export starts."""
+    line width and head mesh fixed when the export starts; ``frame_groom(f)``: what to draw
+    of frame f (default the animation's frame: render hair draws the children of its guides)."""
 
     def __init__(
         self,
@@ -222,8 +281,10 @@ class FrameRenderer:
         colors: NDArray | None = None,
         line_width: float = 2.0,
         mesh: object | None = None,
+        frame_groom: Callable[[int], Groom] | None = None,
     ) -> None:
         self.animation, self.size = animation, even_size(size)
+        self.frame_groom = animation.frame if frame_groom is None else frame_groom
         self.camera = Camera(
             camera.target,
             camera.distance,
@@ -240,7 +301,7 @@ class FrameRenderer:
     def render(self, frame: int, ctx: object | None = None) -> NDArray[np.uint8]:
         """``(H, W, 4)`` uint8 of one frame (``ctx``: a current moderngl context; None: headless)."""
         return render_image(
-            self.animation.frame(frame),
+            self.frame_groom(frame),
             size=self.size,
             camera=self.camera,
             ramp=self.ramp,
@@ -336,12 +397,35 @@ class AnimationExporter(QObject):
         self.window = window
         self.job: Job | None = None
 
+    def render_hair_binding(self, animation: Animation | None = None) -> ChildBinding | None:
+        """The children an animation can be written as: the groom's, when the animation is of
+        its guides (simulations, cycles and recordings are; an opened file may not be)."""
+        anim = self.window.animation.animation if animation is None else animation
+        binding = self.window.scene.binding
+        if anim is None or binding is None or anim.topology != binding.rest_guides.topology:
+            return None
+        return binding
+
+    def ask_render_hair(self, binding: ChildBinding) -> bool | None:
+        """The dialog's answer: render hair (True), the guides alone (False), or None (cancel)."""
+        dialog = RenderHairDialog(binding.child_count, binding.rest_guides.strand_count, self.window)
+        if dialog.exec() != QDialog.DialogCode.Accepted:
+            return None
+        return dialog.render_hair.isChecked()
+
     def export_animation_dialog(self) -> bool:
         if self.window.animation.animation is None:
             self.window.show_error("Cannot export animation", "No animation: make or open one first")
             return False
+        binding = self.render_hair_binding()
+        render_hair = False
+        if binding is not None:
+            answer = self.ask_render_hair(binding)
+            if answer is None:
+                return False
+            render_hair = answer
         path = self.window.ask_save_path("Export animation", ANIMATION_FILTERS, "animation.mp4")
-        return bool(path) and self.export_animation(path) is not False
+        return bool(path) and self.export_animation(path, render_hair=render_hair) is not False
 
     def export_keys_dialog(self) -> bool:
         path = self.window.ask_save_path("Export keys", KEY_FILTERS, "keys.json")
@@ -361,10 +445,26 @@ class AnimationExporter(QObject):
         self._done(path)
         return True
 
-    def renderer(self, animation: Animation, size: tuple[int, int] | None = None) -> FrameRenderer:
+    def renderer(
+        self, animation: Animation, size: tuple[int, int] | None = None, *, render_hair: bool = False
+    ) -> FrameRenderer:
+        """Frames drawn as the viewport draws them; ``render_hair``: the children drawn now (the
+        release share of them) following each frame's guides, the guides over them if shown."""
         w, scene = self.window, self.window.scene
-        colors = None
-        if animation.vertex_count == scene.result.vertex_count and scene.colour_mode in ("strand", "clump"):
+        colors, frame_groom = None, None
+        binding = self.render_hair_binding(animation) if render_hair else None
+        if binding is not None:
+            drawn, topology, guides_shown = scene.drawn_binding(), scene.drawn_topology, scene.drawn_guides
+
+            def frame_groom(f: int) -> Groom:
+                guides = Groom(animation.frames[f], animation.topology)
+                children = build_points(drawn, guides)
+                points = np.concatenate([children, guides.points]) if guides_shown else children
+                return Groom(points, topology)
+
+            if scene.colour_mode != "displacement":  # the others hang on the strands, not the pose
+                colors = vertex_colors(scene)
+        elif animation.vertex_count == scene.result.vertex_count and scene.colour_mode in ("strand", "clump"):
             colors = vertex_colors(scene)  # per-strand colours stay valid on every frame
         return FrameRenderer(
             animation,
@@ -374,19 +474,31 @@ class AnimationExporter(QObject):
             colors=colors,
             line_width=scene.line_width,
             mesh=scene.mesh,
+            frame_groom=frame_groom,
         )
 
     def export_animation(
-        self, path: str | os.PathLike[str], size: tuple[int, int] | None = None
+        self,
+        path: str | os.PathLike[str],
+        size: tuple[int, int] | None = None,
+        *,
+        render_hair: bool | None = None,
     ) -> bool | Job:
-        """Data formats are written at once (True/False); video and PNG sequences start a job
-        in ``window.jobs`` and return it (False when refused before starting)."""
+        """Data formats are written at once (True/False), or as render hair in a job;
+        video and PNG sequences start a job in ``window.jobs`` and return it (False when
+        refused before starting). ``render_hair``: write the children following the guides
+        (default: whenever the animation is of the guides of a groom with children)."""
         w = self.window
         anim = w.animation.animation
         suffix = Path(path).suffix.lower()
         try:
             if anim is None:
                 raise HairtoolError("no animation: make or open one first")
+            binding = self.render_hair_binding(anim)
+            if render_hair and binding is None:
+                raise HairtoolError("no render hair for this animation: it is not of the groom's guides")
+            if suffix in DATA_SUFFIXES and binding is not None and render_hair is not False:
+                return self._export_render_hair(path, anim, binding)
             if suffix in DATA_SUFFIXES:
                 write_animation_data(path, anim)
                 self._done(path)
@@ -395,7 +507,7 @@ class AnimationExporter(QObject):
                 raise FormatError(
                     path, "animations are written as .usda/.usdc/.usd, .npz, .mp4, .gif or .png"
                 )
-            renderer = self.renderer(anim, size)
+            renderer = self.renderer(anim, size, render_hair=binding is not None and render_hair is not False)
         except HairtoolError as e:
             w.show_error("Cannot export animation", str(e))
             return False
@@ -416,6 +528,21 @@ class AnimationExporter(QObject):
             return str(path)
 
         self.job = w.jobs.run(f"Exporting {Path(path).name}", work, on_done=lambda p: self._done(p))
+        return self.job
+
+    def _export_render_hair(
+        self, path: str | os.PathLike[str], anim: Animation, binding: ChildBinding
+    ) -> Job:
+        """Every child on every frame is a long write (30,000 children × 32 vertices are 11.5 MB a
+        frame): a job with progress and Cancel."""
+
+        def work(progress: Progress, cancelled: CancelCheck) -> str:
+            write_render_hair_data(path, anim, binding, progress=progress, cancelled=cancelled)
+            return str(path)
+
+        self.job = self.window.jobs.run(
+            f"Exporting render hair to {Path(path).name}", work, on_done=lambda p: self._done(p)
+        )
         return self.job
 
     def _done(self, path: str | os.PathLike[str]) -> None:

@@ -1,13 +1,14 @@
-"""Render-hair options shared by ``hairtool interpolate`` and ``hairtool freeze`` (not a
-subcommand: the leading underscore keeps it out of the command list).
+"""Render-hair options shared by ``hairtool interpolate``, ``freeze``, ``simulate`` and
+``anime`` (not a subcommand: the leading underscore keeps it out of the command list).
 
 Children come from guides and a scalp mesh (``--scalp``), from guides alone (roots around the
 guide roots), or ``--from-dense``: the input is a dense groom, ``--guides G`` strands of it are
 chosen as guides and every strand is bound to them (along the surface of ``--scalp`` if
-given). Both the render strands and the guides are
-written: the render strands to OUT, the guides to ``--guides-out`` (default: OUT with
-``.guides`` before its extension, ``hair.usda`` → ``hair.guides.usda``).
-"""
+given). The engine, simulation or cycle runs on the guides and OUT receives the render
+strands; in USD the guides go in the same file as a second prim of purpose ``guide``. The
+guides also go to ``--guides-out`` (default: OUT with ``.guides`` before its extension,
+``hair.usda`` → ``hair.guides.usda``) when it is given, from a dense groom, and for an
+animation written to a format that cannot mark guides."""
 
 from __future__ import annotations
 
@@ -19,12 +20,16 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     import numpy as np
 
-    from hairtool.groom import Groom
+    from hairtool.groom import Animation, Groom
     from hairtool.guides.binding import ChildBinding
     from hairtool.guides.render import RenderHair
 
 
-def add_arguments(parser: argparse.ArgumentParser, *, seed: bool = True) -> argparse._ArgumentGroup:
+def add_arguments(
+    parser: argparse.ArgumentParser, *, seed: bool = True, guides: bool = True
+) -> argparse._ArgumentGroup:
+    """The render-hair options; ``seed``/``guides`` False where the command has its own
+    ``--seed`` (used for the children too) or ``--guides`` (anime: it also takes G there)."""
     g = parser.add_argument_group("render hair (children interpolated from guides)")
     g.add_argument("--count", type=int, default=None, help="children to grow from the guides")
     g.add_argument("--scalp", metavar="MESH.obj", default=None, help="scalp mesh the children grow on")
@@ -61,9 +66,15 @@ def add_arguments(parser: argparse.ArgumentParser, *, seed: bool = True) -> argp
     g.add_argument(
         "--from-dense", action="store_true", help="the input is a dense groom: pick --guides G of it"
     )
-    g.add_argument("--guides", type=int, default=None, metavar="G", help="guides to pick with --from-dense")
+    if guides:
+        g.add_argument(
+            "--guides", type=int, default=None, metavar="G", help="guides to pick with --from-dense"
+        )
     g.add_argument(
-        "--guides-out", default=None, metavar="PATH", help="where the guides go (default OUT.guides.EXT)"
+        "--guides-out",
+        default=None,
+        metavar="PATH",
+        help="write the guides here too (default OUT.guides.EXT, where they go apart)",
     )
     return g
 
@@ -74,14 +85,14 @@ def wanted(args: argparse.Namespace) -> bool:
 
 
 def guides_path(args: argparse.Namespace) -> Path:
-    if args.guides_out:
-        return Path(args.guides_out)
-    out = Path(args.output)
-    return out.with_name(f"{out.stem}.guides{out.suffix}")
+    from hairtool.guides.files import guides_path_for
+
+    return Path(args.guides_out) if args.guides_out else guides_path_for(args.output)
 
 
-def check(args: argparse.Namespace) -> None:
-    """Refuse contradictory options and unwritable outputs before any work."""
+def check(args: argparse.Namespace, *, animated: bool = False) -> None:
+    """Refuse contradictory options and unwritable outputs before any work (``animated``: the
+    output is an animation, whose guides go beside it in formats other than USD)."""
     from hairtool import io
     from hairtool.errors import ParameterError
 
@@ -97,7 +108,7 @@ def check(args: argparse.Namespace) -> None:
     elif args.count is None:
         raise ParameterError("count", None, "a number of children (or --from-dense --guides G)")
     io.format_for(args.output, writing=True)
-    if args.from_dense:
+    if args.from_dense or args.guides_out or (animated and not is_usd(args.output)):
         io.format_for(guides_path(args), writing=True)
 
 
@@ -166,13 +177,42 @@ def render(args: argparse.Namespace, binding: ChildBinding) -> RenderHair:
     return RenderHair(binding, ChildClump(seed=args.seed) if args.clump_children else None)
 
 
-def write(args: argparse.Namespace, hair: Groom, guides: Groom) -> dict:
-    """Write the render strands (and, from a dense groom, the guides); the report's paths."""
+def is_usd(path: str | Path) -> bool:
     from hairtool import io
 
-    io.write(args.output, hair)
+    return io.format_for(path, writing=True).module == "usd"
+
+
+def write(args: argparse.Namespace, hair: Groom, guides: Groom) -> dict:
+    """Write the render strands: to USD with the guides as a second prim of purpose ``guide``
+    (:mod:`hairtool.guides.files`), elsewhere alone; the guides also go to ``--guides-out``
+    when it is given and from a dense groom. The report's paths."""
+    from hairtool import io
+    from hairtool.guides.files import with_guides
+
+    io.write(args.output, with_guides(hair, guides) if is_usd(args.output) else hair)
     report = {"output": str(args.output)}
-    if args.from_dense:
+    if args.from_dense or args.guides_out:
         io.write(guides_path(args), guides)
         report["guides_output"] = str(guides_path(args))
     return report
+
+
+def write_animation(args: argparse.Namespace, binding: ChildBinding, guides: Animation) -> dict:
+    """Write the render-hair animation of an animation of the guides (a simulation, a cycle):
+    :func:`hairtool.guides.files.write_animation` (USD: children + guide prim, streamed; other
+    formats: the guides animation in ``--guides-out``, also written from a dense groom or when
+    given)."""
+    from hairtool.guides.animate import RenderHairAnimation
+    from hairtool.guides.files import write_animation
+
+    hair = RenderHairAnimation(binding, guides, render(args, binding).clump)
+    t0 = time.perf_counter()
+    side = guides_path(args) if args.from_dense or args.guides_out or not is_usd(args.output) else None
+    report = write_animation(args.output, hair, guides_path=side)
+    return report | {
+        "guides": guides.strand_count,
+        "children": binding.child_count,
+        "child_vertices": binding.vertex_count,
+        "render_seconds": round(time.perf_counter() - t0, 4),
+    }

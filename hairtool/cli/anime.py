@@ -10,6 +10,12 @@ as the sheet says; OUT receives the animation (formats without time samples keep
 IN is a groom or animation file (its first frame is the rest pose) or a built-in sample:
 sample:NAME[:STRANDS[:VERTICES]] with NAME one of portrait (2-D), scalp (3-D), comb, e.g.
 sample:portrait or sample:scalp:500:24.
+
+Render hair: with --count N (children grown from IN as guides, on --scalp if given) or
+--from-dense --guides G (G guides picked from a dense IN: --guides is then a number, and every
+guide is a chain of its own), the guides wave and OUT receives the children following them
+frame by frame; in USD with the guides as a second prim of purpose "guide", elsewhere with the
+guides animation in --guides-out (default OUT.guides.EXT).
 """
 
 from __future__ import annotations
@@ -17,6 +23,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from hairtool.cli import _guides
 from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
 from hairtool.errors import ParameterError
 from hairtool.io.specs import load_groom
@@ -42,15 +49,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     w.add_argument("--gravity", type=float, default=1.2, help="weight s ≠ 0: sag a/s² (default 1.2)")
     w.add_argument("--profile", type=float, default=1.0, help="whip toward the tip p ≥ 0 (default 1)")
     b = parser.add_argument_group("bunches")
-    b.add_argument("--guides", help="chain strand ids, e.g. 0,5,10-13; other strands follow the nearest")
+    b.add_argument(
+        "--guides",
+        help="chain strand ids, e.g. 0,5,10-13; other strands follow the nearest "
+        "(with --from-dense: the number G of guides to pick)",
+    )
     b.add_argument("--sway", help="x,y,z direction positive wave y bends toward (default up, 0,1,0)")
     b.add_argument("--phase-spread", type=float, default=0.25, help="random phase per bunch, in cycles [0,1]")
     b.add_argument("--amplitude-spread", type=float, default=0.1, help="random amplitude scale 1±this [0,1]")
-    b.add_argument("--seed", type=int, default=0, help="seed of the per-bunch draws (default 0)")
+    b.add_argument(
+        "--seed", type=int, default=0, help="seed of the per-bunch draws and of the children (default 0)"
+    )
     o = parser.add_argument_group("output")
     o.add_argument("--compare", metavar="REF", help="report angular and position errors against REF")
     o.add_argument("--export-sheet", metavar="CSV", help="write the exposure sheet: frame, picture, time")
     o.add_argument("--json", action="store_true", help="print a JSON object")
+    _guides.add_arguments(parser, seed=False, guides=False)
 
 
 def parse_ids(text: str) -> list[int]:
@@ -65,6 +79,16 @@ def parse_ids(text: str) -> list[int]:
     if not ids:
         raise ParameterError("guides", text, "strand ids like 0,5,10-13")
     return ids
+
+
+def _dense_guides(text: str | None) -> int | None:
+    """``--guides`` with ``--from-dense``: a whole number of guides to pick."""
+    if text is None:
+        return None
+    try:
+        return int(text)
+    except ValueError:
+        raise ParameterError("guides", text, "a whole number of guides to pick with --from-dense") from None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -87,18 +111,30 @@ def run(args: argparse.Namespace) -> int:
         "profile": params.profile,
         "period": params.period,
     }
+    render = _guides.wanted(args)
+    chains = args.guides
+    if args.from_dense:
+        args.guides, chains = _dense_guides(args.guides), None
     if args.input is None:
         for flag in ("output", "compare"):
             if getattr(args, flag) is not None:
                 raise ParameterError(flag, getattr(args, flag), "an IN groom to make the cycle from")
+        if render:
+            raise ParameterError("count", args.count, "an IN groom and an OUT file for render hair")
     else:
         from hairtool.io import format_for
 
         if args.output is not None:
             out_fmt = format_for(args.output, writing=True)  # refuse a bad extension before posing
+        if render:
+            if args.output is None:
+                raise ParameterError("count", args.count, "an OUT file to write the render hair to")
+            _guides.check(args, animated=True)
         groom = load_groom(args.input)
+        if render:
+            groom, binding, bind_ms = _guides.bind(args, groom)  # the guides wave
         variation = {
-            "guides": None if args.guides is None else parse_ids(args.guides),
+            "guides": None if chains is None else parse_ids(chains),
             "sway": None if args.sway is None else parse_vector("sway", args.sway),
             "amplitude_spread": args.amplitude_spread,
             "phase_spread": args.phase_spread,
@@ -114,7 +150,10 @@ def run(args: argparse.Namespace) -> int:
                 "reference": args.compare,
                 **compare_cycle(anim, read(args.compare)).to_dict(),
             }
-        if args.output is not None:
+        if args.output is not None and render:
+            report.update(_guides.write_animation(args, binding, anim), bind_ms=round(bind_ms, 2))
+            report["output_frames"] = anim.n_frames if out_fmt.animated else 1
+        elif args.output is not None:
             from hairtool.io import write
 
             write(args.output, anim)
@@ -146,8 +185,12 @@ def _text(r: dict) -> str:
             f"vs {c['reference']}: angular error {c['angular_error_deg']:.3f} deg, "
             f"position error {c['position_error_pct']:.3f} % over {c['frames_compared']} frame(s)"
         )
+    if "children" in r:
+        lines.append(f"render hair: {r['children']} children following {r['guides']} guides")
     if "output" in r:
         lines.append(f"wrote {r['output']} ({r['output_frames']} frame(s))")
+    if "guides_output" in r:
+        lines.append(f"wrote the guides to {r['guides_output']}")
     if "sheet" in r:
         lines.append(f"wrote exposure sheet {r['sheet']}")
     return "\n".join(lines)

@@ -9,6 +9,12 @@ sample:NAME[:STRANDS[:VERTICES]] with NAME portrait, scalp or comb, e.g. sample:
 Units: the samples' head has radius 1 at the origin (≈ 10 cm); accelerations in units/s².
 For a real groom, --fit-head fits the head sphere to its roots and reads the accelerations
 in head radii/s², so the defaults move any groom as they move the samples.
+
+Render hair: with --count N (children grown from IN as guides, on --scalp if given) or
+--from-dense --guides G (guides picked from a dense IN), the guides are simulated and OUT
+receives the children following them frame by frame (see ``hairtool interpolate``); in USD
+with the guides as a second prim of purpose "guide", elsewhere with the guides animation in
+--guides-out (default OUT.guides.EXT).
 """
 
 from __future__ import annotations
@@ -17,6 +23,7 @@ import argparse
 import json
 import time
 
+from hairtool.cli import _guides
 from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
 from hairtool.io.specs import load_groom
 
@@ -44,7 +51,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     f.add_argument("--gusts", type=int, default=0, help="number of seeded wind gusts (default 0)")
     f.add_argument("--gust-strength", type=float, default=300.0, help="gust peak, units/s² (default 300)")
     f.add_argument("--gust-duration", type=float, default=0.25, help="seconds per gust (default 0.25)")
-    f.add_argument("--seed", type=int, default=0, help="seed of the gusts (default 0)")
+    f.add_argument("--seed", type=int, default=0, help="seed of the gusts and of the children (default 0)")
     h = parser.add_argument_group("head")
     h.add_argument("--no-collide", action="store_true", help="let strands pass through the head sphere")
     h.add_argument("--head-center", metavar="X,Y,Z", help="head sphere centre (default 0,0,0)")
@@ -55,6 +62,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="fit the head sphere to the roots, and read gravity, wind and gusts in head radii/s², "
         "so a groom of any scale moves as the samples do (instead of --head-center/--head-radius)",
     )
+    _guides.add_arguments(parser, seed=False)
     parser.add_argument("--json", action="store_true", help="print a JSON object")
 
 
@@ -67,9 +75,14 @@ def run(args: argparse.Namespace) -> int:
     from hairtool.simulate.head_motion import fit_head, parse_motion
 
     fmt = format_for(args.output, writing=True)  # refuse a bad extension before simulating
+    render = _guides.wanted(args)
+    if render:
+        _guides.check(args, animated=True)
     motion = parse_motion(args.motion)
     wind = parse_vector("wind", args.wind) if args.wind is not None else (0.0, 0.0, 0.0)
     groom = load_groom(args.input)
+    if render:
+        groom, binding, bind_ms = _guides.bind(args, groom)  # the guides are simulated
     if args.fit_head:
         if args.head_center is not None or args.head_radius is not None:
             raise ParameterError("fit-head", "with --head-center/--head-radius", "one or the other")
@@ -103,8 +116,13 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
     )
     seconds = time.perf_counter() - t0
-    write(args.output, anim)
+    extra = {}
+    if render:
+        extra = _guides.write_animation(args, binding, anim) | {"bind_ms": round(bind_ms, 2)}
+    else:
+        write(args.output, anim)
     report = {
+        **extra,
         "output": args.output,
         "animated": fmt.animated,
         "frames": anim.n_frames,
@@ -123,8 +141,13 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(report, indent=1))
     else:
         kept = "" if fmt.animated else " (this format keeps frame 0 only)"
+        what = f"{anim.strand_count} strands"
+        if render:
+            what = f"{binding.child_count} render strands following {anim.strand_count} guides"
+            if "guides_output" in extra:
+                what += f" (guides in {extra['guides_output']})"
         print(
             f"wrote {args.output}{kept}: {anim.n_frames} frames at {anim.fps:g} fps, "
-            f"{anim.strand_count} strands; simulated in {seconds:.2f} s"
+            f"{what}; simulated in {seconds:.2f} s"
         )
     return 0

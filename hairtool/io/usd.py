@@ -27,7 +27,9 @@ their parents as plain Xforms, world points; ``upAxis`` and ``metersPerUnit`` al
 defaults: Y-up, 0.01 m per unit); an animation's points as time samples at its time codes with
 ``timeCodesPerSecond`` = ``framesPerSecond`` = fps. Widths are vertex ``widths`` (a diameter,
 like HAIR's thickness), colours a vertex ``displayColor`` (or ``primvars:color`` color4f when
-they came from one), transparency ``displayOpacity`` = 1 − transparency.
+they came from one), transparency ``displayOpacity`` = 1 − transparency. Frames made on demand
+(:class:`FrameStream`: render hair following its guides) are written one at a time, and a
+crate file is saved as it grows, so a shot larger than memory can be written.
 
 ``pxr`` is imported inside the functions: usd-core takes a second or more to import.
 """
@@ -38,29 +40,60 @@ import contextlib
 import os
 import re
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
+from hairtool.bounds import box
 from hairtool.errors import FormatError, HairtoolError, ParameterError
-from hairtool.groom import Animation, Groom
+from hairtool.groom import Animation, Groom, Topology
 from hairtool.io import usd_basis, usdc_check
 from hairtool.io.atomic import atomic_path
 from hairtool.io.binary import require_finite, require_strand_counts
 from hairtool.metadata import PURPOSES, CurvesPrim, Metadata
 
 PRIM_PATH = "/Groom/Strands"
+FLUSH_BYTES = 32 << 20  # unsaved time samples a crate layer may hold before it is saved
+
+
+class FrameStream(Protocol):
+    """An animation whose frames are made one at a time (never held together): what an
+    :class:`~hairtool.groom.Animation` offers, with ``frame_points(f)`` for ``frames[f]``."""
+
+    topology: Topology
+    metadata: Metadata
+    thickness: np.ndarray | None
+    transparency: np.ndarray | None
+    colors: np.ndarray | None
+    fps: float
+
+    @property
+    def counts(self) -> np.ndarray: ...
+    @property
+    def strand_count(self) -> int: ...
+    @property
+    def vertex_count(self) -> int: ...
+    @property
+    def n_frames(self) -> int: ...
+    @property
+    def time_codes(self) -> np.ndarray: ...
+    def frame_points(self, f: int) -> np.ndarray: ...
+
+
+Curves = Groom | Animation | FrameStream
+FrameProgress = Callable[[int, int], object]
 
 
 # -- writing -------------------------------------------------------------------------------
-def _time_codes(obj: Groom | Animation, time_codes: Sequence[float] | None) -> np.ndarray | None:
+def _time_codes(obj: Curves, time_codes: Sequence[float] | None) -> np.ndarray | None:
     if isinstance(obj, Groom):
         if time_codes is not None:
             raise ParameterError("time_codes", time_codes, "None for a static groom")
         return None
     if time_codes is None:
-        return obj.time_codes
+        return np.asarray(obj.time_codes, dtype=np.float64)
     t = np.asarray(time_codes, dtype=np.float64).reshape(-1)
     if t.size != obj.n_frames:
         raise ParameterError("time_codes", f"{t.size} values", f"one per frame ({obj.n_frames})")
@@ -75,14 +108,16 @@ def _wrap_for(basis: str, wrap: str) -> str:
 
 
 def _extent(points: np.ndarray, half_width: float):
+    """The box of the points grown by the half width (NaN where a point is not finite)."""
     from pxr import Vt
 
-    lo = points.min(axis=0).astype(np.float64) - half_width
-    hi = points.max(axis=0).astype(np.float64) + half_width
+    lo, hi = box(points)
+    lo = lo.astype(np.float64) - half_width
+    hi = hi.astype(np.float64) + half_width
     return Vt.Vec3fArray.FromNumpy(np.stack([lo, hi]).astype(np.float32))
 
 
-def _prims(obj: Groom | Animation) -> tuple[CurvesPrim, ...]:
+def _prims(obj: Curves) -> tuple[CurvesPrim, ...]:
     from pxr import Sdf
 
     prims = obj.metadata.for_strands(obj.strand_count).curves
@@ -105,7 +140,7 @@ def _define_parents(stage, paths: Sequence[str]) -> None:
     stage.SetDefaultPrim(stage.GetPrimAtPath(first_root))
 
 
-def _write_attributes(curves, obj: Groom | Animation, vs: slice, color_primvar: str) -> float:
+def _write_attributes(curves, obj: Curves, vs: slice, color_primvar: str) -> float:
     """Widths, colour and opacity of one prim's vertices; returns the half width for its extent."""
     from pxr import Sdf, UsdGeom, Vt
 
@@ -133,8 +168,10 @@ def _write_attributes(curves, obj: Groom | Animation, vs: slice, color_primvar: 
     return half_width
 
 
-def _write_prim(stage, prim: CurvesPrim, obj: Groom | Animation, strands: slice, times) -> None:
-    from pxr import Usd, UsdGeom, Vt
+def _write_prim(stage, prim: CurvesPrim, obj: Curves, strands: slice, times):
+    """One prim's topology, basis and attributes; its points and extent now for a groom, or the
+    attributes and vertex range for :func:`_write_samples` to fill frame by frame."""
+    from pxr import UsdGeom, Vt
 
     counts = obj.counts[strands]
     off = obj.topology.offsets
@@ -159,15 +196,50 @@ def _write_prim(stage, prim: CurvesPrim, obj: Groom | Animation, strands: slice,
         pts = np.ascontiguousarray(obj.points[vs])
         points_attr.Set(Vt.Vec3fArray.FromNumpy(pts))
         extent_attr.Set(_extent(pts, half_width))
-        return
+        return None
+    return points_attr, extent_attr, vs, half_width
+
+
+def _frame_points(obj: Curves, f: int) -> np.ndarray:
+    if isinstance(obj, Animation):
+        return obj.frames[f]
+    p = np.asarray(obj.frame_points(f))
+    if p.shape != (obj.vertex_count, 3):
+        raise ParameterError("frame", f, f"({obj.vertex_count}, 3) points")
+    return p
+
+
+def _write_samples(stage, obj: Curves, prims: list, times, progress: FrameProgress | None) -> None:
+    """Every frame's points and extents, frame after frame (the frames of a stream are made one
+    at a time). A crate (``.usdc``) layer is saved whenever FLUSH_BYTES of samples are pending:
+    usd-core appends them to the file and lets them go from memory, so a long shot of render
+    hair needs a few frames of memory, not the whole shot (a text layer keeps every sample until
+    the end)."""
+    from pxr import Usd, Vt
+
+    layer = stage.GetRootLayer()
+    crate = layer.GetFileFormat().formatId == "usdc"
+    pending = 0
     for f, t in enumerate(times):
         code = Usd.TimeCode(float(t))
-        pts = np.ascontiguousarray(obj.frames[f, vs])
-        points_attr.Set(Vt.Vec3fArray.FromNumpy(pts), code)
-        extent_attr.Set(_extent(pts, half_width), code)
+        frame = _frame_points(obj, f)
+        for points_attr, extent_attr, vs, half_width in prims:
+            pts = np.ascontiguousarray(frame[vs], dtype=np.float32)
+            extent = _extent(pts, half_width)
+            if not np.all(np.isfinite(np.asarray(extent))):  # a stream's frames are not checked yet
+                raise ParameterError("frame", f, "finite points")
+            points_attr.Set(Vt.Vec3fArray.FromNumpy(pts), code)
+            extent_attr.Set(extent, code)
+        del frame
+        pending += obj.vertex_count * 12
+        if crate and pending >= FLUSH_BYTES and f + 1 < len(times):
+            layer.Save()
+            pending = 0
+        if progress is not None:
+            progress(f + 1, len(times))
 
 
-def _write_stage_metadata(stage, obj: Groom | Animation, times) -> None:
+def _write_stage_metadata(stage, obj: Curves, times) -> None:
     from pxr import UsdGeom
 
     meta = obj.metadata
@@ -186,12 +258,22 @@ def _write_stage_metadata(stage, obj: Groom | Animation, times) -> None:
         stage.SetEndTimeCode(end)
 
 
-def write(path: Path, obj: Groom | Animation, *, time_codes: Sequence[float] | None = None) -> None:
+def write(
+    path: Path,
+    obj: Curves,
+    *,
+    time_codes: Sequence[float] | None = None,
+    progress: FrameProgress | None = None,
+) -> None:
     """Write a groom, or an animation as time-sampled points.
 
-    ``time_codes``: for an animation, the time code of each frame (F strictly increasing
-    numbers; default: the animation's own, :attr:`Animation.time_codes`) — a keys-only export
-    writes just its key poses at their time codes, and USD readers interpolate linearly between.
+    ``obj``: a Groom, an Animation, or frames made on demand (:class:`FrameStream`, e.g. render
+    hair following an animation of its guides), written one frame at a time. ``time_codes``:
+    for an animation, the time code of each frame (F strictly increasing numbers; default: the
+    animation's own, :attr:`Animation.time_codes`) — a keys-only export writes just its key
+    poses at their time codes, and USD readers interpolate linearly between. ``progress(done,
+    total)`` after every frame; an exception it raises (e.g. Cancelled) stops the write and
+    leaves no file.
     """
     times = _time_codes(obj, time_codes)
     prims = _prims(obj)
@@ -203,10 +285,12 @@ def write(path: Path, obj: Groom | Animation, *, time_codes: Sequence[float] | N
             raise FormatError(path, "usd-core could not create the stage")
         _write_stage_metadata(stage, obj, times)
         _define_parents(stage, [c.path for c in prims])
-        first = 0
+        first, sampled = 0, []
         for prim in prims:
-            _write_prim(stage, prim, obj, slice(first, first + prim.strands), times)
+            sampled.append(_write_prim(stage, prim, obj, slice(first, first + prim.strands), times))
             first += prim.strands
+        if times is not None:
+            _write_samples(stage, obj, sampled, times, progress)
         stage.GetRootLayer().Save()
         del stage
 

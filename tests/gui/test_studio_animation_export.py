@@ -132,3 +132,81 @@ def test_write_video_cancelled_mid_way_and_bad_frames(tmp_path):
     with pytest.raises(FormatError, match="avi"):
         write_video(tmp_path / "v.avi", frames, 8, 12.0)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.fixture
+def render_hair_window(make_window):
+    """A groom with 300 children and an animation of its guides."""
+    from hairtool.guides.binding import bind_roots
+
+    guides = samples.scalp(20, 6, seed=4)
+    w = make_window(groom=guides, size=(640, 420))
+    w.scene.set_binding(bind_roots(guides, count=300, seed=1))
+    w.animation.load_animation(sway_animation(guides, FRAMES, flick_frame=6), "sway")
+    w.jobs.wait()
+    return w
+
+
+def test_animation_export_writes_render_hair_when_the_groom_has_children(render_hair_window, out):
+    from hairtool.guides.files import split_guides
+
+    w = render_hair_window
+    anim, binding = w.animation.animation, w.scene.binding
+    assert w.exporter.render_hair_binding() is binding
+    _wait(w, w.exporter.export_animation(out / "hair.usdc"))  # render hair by default: a job
+    children, guides = split_guides(io.read(out / "hair.usdc"))
+    assert (children.strand_count, guides.strand_count, children.n_frames) == (300, 20, FRAMES)
+    assert guides.frames.tobytes() == anim.frames.tobytes()
+    assert children.frames[6].tobytes() == binding.build(anim.frame(6)).points.tobytes()
+    _wait(w, w.exporter.export_animation(out / "hair.npz"))
+    assert io.read(out / "hair.npz").strand_count == 300
+    assert io.read(out / "hair.guides.npz").frames.tobytes() == anim.frames.tobytes()
+    assert w.exporter.export_animation(out / "g.usda", render_hair=False) is True  # the guides alone
+    assert io.read(out / "g.usda").frames.tobytes() == anim.frames.tobytes()
+    assert w.errors == []
+
+
+def test_the_export_dialog_asks_for_render_hair_first(render_hair_window, out, monkeypatch):
+    from app.ui.animation_export import RenderHairDialog
+
+    w = render_hair_window
+    dialog = RenderHairDialog(300, 20, w)
+    assert dialog.render_hair.isChecked() and "300" in dialog.render_hair.text()
+    dialog.deleteLater()
+    monkeypatch.setattr(w, "ask_save_path", lambda *a, **k: str(out / "guides.npz"))
+    monkeypatch.setattr(w.exporter, "ask_render_hair", lambda binding: False)
+    assert w.exporter.export_animation_dialog()
+    assert io.read(out / "guides.npz").strand_count == 20 and not (out / "guides.guides.npz").exists()
+    monkeypatch.setattr(w.exporter, "ask_render_hair", lambda binding: None)  # cancelled: no file asked
+    monkeypatch.setattr(w, "ask_save_path", lambda *a, **k: pytest.fail("asked for a file"))
+    assert not w.exporter.export_animation_dialog()
+
+
+def test_an_animation_of_other_strands_has_no_render_hair(render_hair_window, out):
+    w = render_hair_window
+    w.animation.load_animation(sway_animation(samples.scalp(7, 5, seed=1), FRAMES), "other")
+    w.jobs.wait()
+    assert w.exporter.render_hair_binding() is None
+    assert w.exporter.export_animation(out / "o.usda") is True  # written as it is
+    assert io.read(out / "o.usda").strand_count == 7
+    assert w.exporter.export_animation(out / "x.usda", render_hair=True) is False
+    assert "guides" in w.errors[-1][1] and not (out / "x.usda").exists()
+
+
+def test_a_video_of_render_hair_draws_the_children(render_hair_window, out):
+    w = render_hair_window
+    anim = w.animation.animation
+    hair = w.exporter.renderer(anim, (96, 64), render_hair=True)
+    guides = w.exporter.renderer(anim, (96, 64), render_hair=False)
+    drawn = hair.frame_groom(6)
+    assert drawn.strand_count == w.scene.drawn_topology.strand_count
+    assert drawn.points[: w.scene.binding.vertex_count].tobytes() == (
+        w.scene.binding.build(anim.frame(6)).points.tobytes()
+    )
+    assert guides.frame_groom(6).strand_count == 20
+    _wait(w, w.exporter.export_animation(out / "hair.gif", size=(96, 64)))
+    _wait(w, w.exporter.export_animation(out / "guides.gif", size=(96, 64), render_hair=False))
+    frames = {n: np.asarray(imageio.mimread(out / f"{n}.gif")[0])[..., :3] for n in ("hair", "guides")}
+    background = frames["guides"][0, 0]
+    covered = {n: int(np.any(f != background, axis=2).sum()) for n, f in frames.items()}
+    assert covered["hair"] > covered["guides"]  # 300 children fill more pixels than 20 guides

@@ -10,6 +10,7 @@ import pytest
 
 from hairtool import io, samples
 from hairtool.cli import main
+from hairtool.guides.files import split_guides
 
 RESOURCES = Path(__file__).resolve().parents[2] / "resources"
 GUIDES = str(RESOURCES / "sintel_hair.tfx")
@@ -37,9 +38,12 @@ def test_from_dense_writes_render_strands_and_guides(tmp_path, grooms_dir):
         == 0
     )
     dense = io.read_groom(src)
-    assert io.read_groom(out).points.tobytes() == dense.points.tobytes()
+    hair, guide_prim = split_guides(io.read_groom(out))  # USD: the guides are a prim of the file too
+    assert hair.points.tobytes() == dense.points.tobytes()
     guides = io.read_groom(tmp_path / "hair.guides.usda")
     assert guides.strand_count == 30
+    assert guide_prim.points.tobytes() == guides.points.tobytes()
+    assert hair.thickness is not None  # render strands have widths
     chosen = tmp_path / "chosen.npz"
     assert (
         main(
