@@ -433,9 +433,15 @@ class StrandRaster:
     (where they were and where they are), when those are few: the bytes are those of a full
     draw (the tests hold it to that). :attr:`changed` says which rows and columns the last draw
     may have changed, for an upload of just those.
+
+    The per-segment and per-vertex arrays are views into memory kept at the largest size drawn
+    so far: the studio alternates between a share of its render hair (while dragging) and all of
+    it (on release), and allocating 300 MB of segment table anew each time cost more than the
+    kernels filling it (the pages are faulted in on first write).
     """
 
     def __init__(self) -> None:
+        self._stores: dict[str, np.ndarray] = {}
         self._rgba32 = np.zeros((0, 0), np.uint32)  # the kernels write whole pixels
         self.rgba = self._rgba32.view(np.uint8).reshape(0, 0, 4)
         self.depth = np.zeros((0, 0), np.float32)
@@ -456,6 +462,15 @@ class StrandRaster:
         self.incremental = True  # redraw only what changed when it can (False: always all)
         self.changed: tuple[int, int, int, int] | None = None  # (row0, row1, col0, col1) or None
         self.tiles_redrawn = 0  # in the last draw; −1: all of the image
+
+    def _view(self, name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
+        """A C-contiguous ``shape`` array of ``dtype`` in the memory kept as ``name`` (grown when
+        too small; its content is whatever was there)."""
+        size = int(np.prod(shape))
+        store = self._stores.get(name)
+        if store is None or store.size < size or store.dtype != dtype:
+            store = self._stores[name] = np.empty(size, dtype)
+        return store[:size].reshape(shape)
 
     def images(self, size: tuple[int, int]) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
         """The ``(H, W, 4)`` colour and ``(H, W)`` depth images, resized to ``size = (W, H)``,
@@ -520,26 +535,28 @@ class StrandRaster:
     def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
         h, w = depth.shape
         n = s.size
-        if self._seg.shape[0] != n:
-            self._seg, self._box = np.empty((n, _SEG)), np.empty((4, n), np.int32)
+        self._seg, self._box = self._view("seg", (n, _SEG), np.float64), self._view("box", (4, n), np.int32)
         self._seg[:, 12] = scale
-        self._last_scale = scale.copy() if scale.ndim else scale
+        self._last_scale = self._kept("scale", scale) if scale.ndim else scale
         self._setup(p, s, c, m, half, self._all)
         # One band per thread: more, smaller bands cut more segments in two, which cost more
         # than the better balance gained.
         bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads())
         draw_bands(self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth)
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1
-        self._last_mvp, self._last_starts = m.copy(), s.copy()
-        self._last_points, self._last_colors = p.copy(), c.copy()
+        self._last_mvp, self._last_starts = m.copy(), self._kept("starts", s)
+        self._last_points, self._last_colors = self._kept("points", p), self._kept("colors", c)
+
+    def _kept(self, name: str, a: np.ndarray) -> np.ndarray:
+        """A copy of ``a`` in the memory kept as ``name``."""
+        out = self._view(name, a.shape, a.dtype.type)
+        out[...] = a
+        return out
 
     def _redraw_changed(self, p, s, c, m, half, fill, depth) -> bool:
         """Redraw the tiles the changed segments touch; False when a full draw is cheaper."""
         n, v = s.size, p.shape[0]
-        if self._flags.size != v:
-            self._flags = np.empty(v, np.bool_)
-        if self._which.size != n:
-            self._which = np.empty(n, np.bool_)
+        self._flags, self._which = self._view("flags", (v,), np.bool_), self._view("which", (n,), np.bool_)
         _changed_vertices(p, c, self._last_points, self._last_colors, self._flags)
         if _changed_ends(s, self._flags, self._which) == 0:
             self.changed, self.tiles_redrawn = None, 0
