@@ -45,6 +45,7 @@ W_MIN = 1e-5  # as the geometry shader: an end nearer the eye plane than this is
 DIR_EPS = 1e-6  # as the geometry shader: shorter segments are drawn in direction (1, 0)
 AXIS_EPS = 1e-12  # a quad side this close to horizontal bounds rows, not columns
 OPAQUE = 0xFF000000
+_NO_SCALE = np.zeros(0)  # the setup's scale when there is none (widths × 1)
 _SEG = 13  # per segment: window x, y, depth of both ends, both ends' RGB × 255, its width scale
 TILE_SHIFT = 5  # tiles of 2**5 = 32 pixels a side are redrawn when a frame differs little from the last
 TILE = 1 << TILE_SHIFT
@@ -69,15 +70,16 @@ def _unit(c):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _setup_kernel(points, starts, colors, m, w, h, margin, seg, box, which):
-    """Window coordinates and colours of every segment's ends (or of those flagged in
-    ``which``, when it is not empty), and the rows ``box[0, i] … box[1, i]`` and columns
-    ``box[2, i] … box[3, i]`` it may touch (rows ``0 … −1``: none, e.g. wholly behind the
-    eye or off the image)."""
+def _setup_kernel(points, starts, colors, m, w, h, margin, scale, seg, box, which):
+    """Window coordinates and colours of every segment's ends and its width ``scale`` (none
+    given: 1) (or of those flagged in ``which``, when it is not empty), and the rows
+    ``box[0, i] … box[1, i]`` and columns ``box[2, i] … box[3, i]`` it may touch (rows
+    ``0 … −1``: none, e.g. wholly behind the eye or off the image)."""
     for i in prange(starts.size):
         if which.size and not which[i]:
             continue
         box[0, i], box[1, i], box[2, i], box[3, i] = 0, -1, 0, -1
+        seg[i, 12] = scale[i] if scale.size else 1.0
         a = starts[i]
         ax, ay, az, aw = _project(points, a, m)
         bx, by, bz, bw = _project(points, a + 1, m)
@@ -442,6 +444,7 @@ class StrandRaster:
 
     def __init__(self) -> None:
         self._stores: dict[str, np.ndarray] = {}
+        self._sources: dict[str, np.ndarray] = {}  # read-only arrays kept as they were given
         self._rgba32 = np.zeros((0, 0), np.uint32)  # the kernels write whole pixels
         self.rgba = self._rgba32.view(np.uint8).reshape(0, 0, 4)
         self.depth = np.zeros((0, 0), np.float32)
@@ -505,7 +508,7 @@ class StrandRaster:
         ``scale``: per segment, a factor in [0, 1] of its quad's width (None: 1, no taper).
         Returns :meth:`images`; the next draw overwrites them."""
         p, s, c, m, w, h, width = _check(points, starts, colors, mvp, size, width)
-        sc = _check_scale(scale, s.size)
+        sc = scale if self._same("scale", scale) else _check_scale(scale, s.size)
         rgba, depth = self._images((w, h))
         half = 0.0 if width <= 1.0 else 0.5 * width
         fill = np.array(clear if clear is not None else (0, 0, 0, 0), np.uint8).view(np.uint32)[0]
@@ -516,8 +519,8 @@ class StrandRaster:
             and self._last == key
             and self._last_points.shape == p.shape
             and np.array_equal(self._last_mvp, m)
-            and np.array_equal(self._last_starts, s)
-            and np.array_equal(self._last_scale, sc)
+            and (self._same("starts", s) or np.array_equal(self._last_starts, s))
+            and (self._same("scale", sc) or np.array_equal(self._last_scale, sc))
         )
         self._last = None
         if not (same and self._redraw_changed(p, s, c, m, half, fill, depth)):
@@ -530,28 +533,39 @@ class StrandRaster:
         """The segments' window coordinates, colours and boxes (those flagged in ``which``, or all
         for an empty mask), the boxes widened for quads of half-width ``half``."""
         h, w = self.depth.shape
-        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, self._seg, self._box, which)
+        sc = self._last_scale if self._last_scale.ndim else _NO_SCALE
+        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, sc, self._seg, self._box, which)
 
     def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
         h, w = depth.shape
         n = s.size
         self._seg, self._box = self._view("seg", (n, _SEG), np.float64), self._view("box", (4, n), np.int32)
-        self._seg[:, 12] = scale
-        self._last_scale = self._kept("scale", scale) if scale.ndim else scale
+        self._last_scale = self._kept("scale", scale, fixed=True) if scale.ndim else scale
         self._setup(p, s, c, m, half, self._all)
         # One band per thread: more, smaller bands cut more segments in two, which cost more
         # than the better balance gained.
         bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads())
         draw_bands(self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth)
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1
-        self._last_mvp, self._last_starts = m.copy(), self._kept("starts", s)
+        self._last_mvp, self._last_starts = m.copy(), self._kept("starts", s, fixed=True)
         self._last_points, self._last_colors = self._kept("points", p), self._kept("colors", c)
 
-    def _kept(self, name: str, a: np.ndarray) -> np.ndarray:
-        """A copy of ``a`` in the memory kept as ``name``."""
+    def _kept(self, name: str, a: np.ndarray, fixed: bool = False) -> np.ndarray:
+        """``a`` as it is now: a copy in the memory kept as ``name``, or with ``fixed`` ``a``
+        itself when it is a read-only array (not a view of changing data: the renderer's segment
+        starts and widths, fixed per topology; comparing and copying those 3 million numbers
+        each frame cost more than drawing a drag's changes)."""
+        if fixed and not a.flags.writeable and a.base is None:
+            self._sources[name] = a
+            return a
+        self._sources.pop(name, None)
         out = self._view(name, a.shape, a.dtype.type)
         out[...] = a
         return out
+
+    def _same(self, name: str, a: object) -> bool:
+        """Whether ``a`` is the read-only array last kept as ``name`` (so equal to it)."""
+        return isinstance(a, np.ndarray) and not a.flags.writeable and self._sources.get(name) is a
 
     def _redraw_changed(self, p, s, c, m, half, fill, depth) -> bool:
         """Redraw the tiles the changed segments touch; False when a full draw is cheaper."""

@@ -51,6 +51,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from app.render.camera import Camera
+from app.render.color_clamp import clamp_colors
 from app.render.hair_shading import DEFAULT_LOOK, HairLook, light_and_eye, shade
 from app.render.mesh_layer import MeshLayer
 from app.render.overlay import CircleOverlay
@@ -262,6 +263,7 @@ class StrandRenderer:
             self._gpu = StrandGPU(self.ctx, topology)
             self._main = PointSet(self._gpu, p)
             self._segment_starts = np.ascontiguousarray(topology.segment_end - 1)
+            self._segment_starts.flags.writeable = False  # fixed: the raster need not compare it
         else:
             self._gpu, self._main, self._segment_starts = kept.gpu, kept.main, kept.segment_starts
             self._vaos.update(kept.vaos)
@@ -384,12 +386,14 @@ class StrandRenderer:
         v = self.topology.vertex_count
         if c.shape != (v, 3):
             raise ParameterError("colors", c.shape, f"shape ({v}, 3) (one RGB per vertex)")
-        if not np.all(np.isfinite(c)):
-            raise ParameterError("colors", "non-finite", "finite RGB values in [0, 1]")
         if self._base_store is None or self._base_store.shape != c.shape:
             self._base_store = np.empty_like(c)
-        self._base_colors = np.clip(c, 0.0, 1.0, out=self._base_store)
-        self._gpu.write_colors(self._base_colors)
+        if not clamp_colors(c, self._base_store):
+            self._base_colors, self.use_vertex_colors = None, False
+            raise ParameterError("colors", "non-finite", "finite RGB values in [0, 1]")
+        self._base_colors = self._base_store
+        if not self.hair_shading:  # shaded, the colour buffer gets the shade of these instead
+            self._gpu.write_colors(self._base_colors)
         self.use_vertex_colors = True
         self._version += 1
         self._shade_key = None
@@ -522,7 +526,9 @@ class StrandRenderer:
             t, s = self._gpu.param, self._segment_starts
             mid = (np.float32(0.5) * (t[s] + t[s + 1])).astype(np.float32)
             scale = (np.float32(1.0) - np.float32(taper) * mid).astype(np.float64)
-            self._taper_scale = (taper, np.clip(scale, 0.0, 1.0))
+            scale = np.clip(scale, 0.0, 1.0)
+            scale.flags.writeable = False  # fixed per taper: the raster need not compare it
+            self._taper_scale = (taper, scale)
         return self._taper_scale[1]
 
     def cpu_colors(self) -> NDArray[np.float32]:
