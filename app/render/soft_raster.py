@@ -50,6 +50,9 @@ _SEG = 13  # per segment: window x, y, depth of both ends, both ends' RGB × 255
 TILE_SHIFT = 5  # tiles of 2**5 = 32 pixels a side are redrawn when a frame differs little from the last
 TILE = 1 << TILE_SHIFT
 REDRAW_ALL = 1.0  # a full draw when the changed tiles list more (segment, tile) pairs than this × segments
+MOSTLY_CHANGED = 0.25  # … or at once when more than this share of the segments changed; and the
+# frame after such a one is drawn in full without looking for changes (render hair following
+# a brush: nearly every child moves, and the search cost a third of the full draw)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -463,6 +466,7 @@ class StrandRaster:
         self._entries = np.zeros(0, np.int64)
         self._near = np.zeros(0, np.int64)
         self.incremental = True  # redraw only what changed when it can (False: always all)
+        self._mostly_changed = False  # the last frame changed too much to redraw in part
         self.changed: tuple[int, int, int, int] | None = None  # (row0, row1, col0, col1) or None
         self.tiles_redrawn = 0  # in the last draw; −1: all of the image
 
@@ -523,6 +527,8 @@ class StrandRaster:
             and (self._same("scale", sc) or np.array_equal(self._last_scale, sc))
         )
         self._last = None
+        if same and self._mostly_changed:  # the last frame changed nearly all: so will this one
+            same = self._mostly_changed = False
         if not (same and self._redraw_changed(p, s, c, m, half, fill, depth)):
             self._draw_all(p, s, c, m, half, clear is not None, fill, depth, sc)
         if clear is not None:
@@ -572,9 +578,13 @@ class StrandRaster:
         n, v = s.size, p.shape[0]
         self._flags, self._which = self._view("flags", (v,), np.bool_), self._view("which", (n,), np.bool_)
         _changed_vertices(p, c, self._last_points, self._last_colors, self._flags)
-        if _changed_ends(s, self._flags, self._which) == 0:
+        changed = _changed_ends(s, self._flags, self._which)
+        if changed == 0:
             self.changed, self.tiles_redrawn = None, 0
             return True
+        if changed > MOSTLY_CHANGED * n:
+            self._mostly_changed = True
+            return False
         h, w = depth.shape
         dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
         _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # where they were,
