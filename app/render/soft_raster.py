@@ -50,9 +50,11 @@ _SEG = 13  # per segment: window x, y, depth of both ends, both ends' RGB × 255
 TILE_SHIFT = 5  # tiles of 2**5 = 32 pixels a side are redrawn when a frame differs little from the last
 TILE = 1 << TILE_SHIFT
 REDRAW_ALL = 1.0  # a full draw when the changed tiles list more (segment, tile) pairs than this × segments
-MOSTLY_CHANGED = 0.25  # … or at once when more than this share of the segments changed; and the
-# frame after such a one is drawn in full without looking for changes (render hair following
-# a brush: nearly every child moves, and the search cost a third of the full draw)
+MOSTLY_CHANGED = 0.25  # … or at once when more than this share of the segments changed; then the
+# next 1, 3, 7 (at most MAX_UNSEARCHED) frames are drawn in full without looking for changes
+# (render hair following a brush: nearly every child moves, and the search cost a third of
+# the full draw)
+MAX_UNSEARCHED = 7
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -466,7 +468,8 @@ class StrandRaster:
         self._entries = np.zeros(0, np.int64)
         self._near = np.zeros(0, np.int64)
         self.incremental = True  # redraw only what changed when it can (False: always all)
-        self._mostly_changed = False  # the last frame changed too much to redraw in part
+        self._unsearched = 0  # frames to draw in full without looking for changes (see MOSTLY_CHANGED)
+        self._next_unsearched = 0
         self.changed: tuple[int, int, int, int] | None = None  # (row0, row1, col0, col1) or None
         self.tiles_redrawn = 0  # in the last draw; −1: all of the image
 
@@ -527,8 +530,8 @@ class StrandRaster:
             and (self._same("scale", sc) or np.array_equal(self._last_scale, sc))
         )
         self._last = None
-        if same and self._mostly_changed:  # the last frame changed nearly all: so will this one
-            same = self._mostly_changed = False
+        if same and self._unsearched > 0:  # the last frames changed nearly all: so will this one
+            same, self._unsearched = False, self._unsearched - 1
         if not (same and self._redraw_changed(p, s, c, m, half, fill, depth)):
             self._draw_all(p, s, c, m, half, clear is not None, fill, depth, sc)
         if clear is not None:
@@ -579,11 +582,13 @@ class StrandRaster:
         self._flags, self._which = self._view("flags", (v,), np.bool_), self._view("which", (n,), np.bool_)
         _changed_vertices(p, c, self._last_points, self._last_colors, self._flags)
         changed = _changed_ends(s, self._flags, self._which)
+        mostly = changed > MOSTLY_CHANGED * n
+        self._next_unsearched = min(2 * self._next_unsearched + 1, MAX_UNSEARCHED) if mostly else 0
+        self._unsearched = self._next_unsearched
         if changed == 0:
             self.changed, self.tiles_redrawn = None, 0
             return True
-        if changed > MOSTLY_CHANGED * n:
-            self._mostly_changed = True
+        if mostly:
             return False
         h, w = depth.shape
         dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
