@@ -51,10 +51,11 @@ TILE_SHIFT = 5  # tiles of 2**5 = 32 pixels a side are redrawn when a frame diff
 TILE = 1 << TILE_SHIFT
 REDRAW_ALL = 1.0  # a full draw when the changed tiles list more (segment, tile) pairs than this × segments
 MOSTLY_CHANGED = 0.25  # … or at once when more than this share of the segments changed; then the
-# next 1, 3, 7 (at most MAX_UNSEARCHED) frames are drawn in full without looking for changes
-# (render hair following a brush: nearly every child moves, and the search cost a third of
-# the full draw)
-MAX_UNSEARCHED = 7
+# next 1, then 3 (MAX_UNSEARCHED) frames are drawn in full without looking for changes (render
+# hair following a brush: nearly every child moves, and the search cost a third of the full
+# draw); kept short, since a frame that changed nothing (the brush circle moving after a
+# stroke) is then drawn in full too
+MAX_UNSEARCHED = 3
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -530,7 +531,9 @@ class StrandRaster:
             and (self._same("scale", sc) or np.array_equal(self._last_scale, sc))
         )
         self._last = None
-        if same and self._unsearched > 0:  # the last frames changed nearly all: so will this one
+        if not same:  # other strands, view or size: whatever changed before tells nothing now
+            self._unsearched = self._next_unsearched = 0
+        elif self._unsearched > 0:  # the last frames changed nearly all: so will this one
             same, self._unsearched = False, self._unsearched - 1
         if not (same and self._redraw_changed(p, s, c, m, half, fill, depth)):
             self._draw_all(p, s, c, m, half, clear is not None, fill, depth, sc)
