@@ -51,7 +51,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from app.render.camera import Camera
-from app.render.color_clamp import clamp_colors
 from app.render.hair_shading import DEFAULT_LOOK, HairLook, light_and_eye, shade
 from app.render.mesh_layer import MeshLayer
 from app.render.overlay import CircleOverlay
@@ -386,12 +385,11 @@ class StrandRenderer:
         v = self.topology.vertex_count
         if c.shape != (v, 3):
             raise ParameterError("colors", c.shape, f"shape ({v}, 3) (one RGB per vertex)")
+        if not np.all(np.isfinite(c)):
+            raise ParameterError("colors", "non-finite", "finite RGB values in [0, 1]")
         if self._base_store is None or self._base_store.shape != c.shape:
             self._base_store = np.empty_like(c)
-        if not clamp_colors(c, self._base_store):
-            self._base_colors, self.use_vertex_colors = None, False
-            raise ParameterError("colors", "non-finite", "finite RGB values in [0, 1]")
-        self._base_colors = self._base_store
+        self._base_colors = np.clip(c, 0.0, 1.0, out=self._base_store)
         if not self.hair_shading:  # shaded, the colour buffer gets the shade of these instead
             self._gpu.write_colors(self._base_colors)
         self.use_vertex_colors = True

@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from app.render.camera import Camera
-from app.render.color_clamp import clamp_colors, clamp_colors_reference
 from app.render.hair_shading import HAIR_TAPER
 from app.render.soft_raster import StrandRaster, rasterize
 from app.render.strands import StrandRenderer
@@ -69,17 +68,6 @@ def test_bad_points_and_colours_are_refused_with_one_clear_error(renderer):
     colours[3, 2] = np.nan
     with pytest.raises(ParameterError, match="colors"):
         renderer.set_vertex_colors(colours)
-
-
-def test_the_colour_clamp_equals_its_numpy_twin():
-    rng = np.random.default_rng(4)
-    c = rng.normal(0.5, 0.7, (10_001, 3)).astype(np.float32)
-    got, want = np.empty_like(c), np.empty_like(c)
-    assert clamp_colors(c, got) and clamp_colors_reference(c, want)
-    np.testing.assert_array_equal(got, want)
-    for bad in (np.nan, np.inf, -np.inf):
-        c[5000, 1] = bad
-        assert not clamp_colors(c, got) and not clamp_colors_reference(c, want)
 
 
 def test_a_raster_drawing_large_small_large_draws_the_bytes_of_fresh_ones():
