@@ -420,7 +420,15 @@ def _balanced_jobs(work: NDArray[np.int64], n: int) -> tuple[NDArray[np.int64], 
     return tiles[order], np.searchsorted(job[order], np.arange(n + 1)).astype(np.int64)
 
 
-def _check(points, starts, colors, mvp, size, width):
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view: the kernels always see read-only inputs (a type of their own in numba),
+    however the caller made them, so one compilation (the studio's warm-up) serves every caller."""
+    view = a.view()
+    view.flags.writeable = False
+    return view
+
+
+def _check(points, starts, colors, mvp, size, width, check_starts=True):
     p = np.ascontiguousarray(points, np.float32)
     s = np.ascontiguousarray(starts, np.int64)
     c = np.ascontiguousarray(colors, np.float32)
@@ -430,7 +438,7 @@ def _check(points, starts, colors, mvp, size, width):
         raise ParameterError("points, colors", f"{p.shape}, {c.shape}", "(V, 3) and (V, 3)")
     if m.shape != (4, 4):
         raise ParameterError("mvp", m.shape, "a (4, 4) matrix")
-    if s.size and (s.min() < 0 or s.max() + 1 >= len(p)):
+    if check_starts and s.size and (s.min() < 0 or s.max() + 1 >= len(p)):
         raise ParameterError("starts", f"[{s.min()}, {s.max()}]", f"segment starts in [0, {len(p) - 1})")
     if w < 1 or h < 1:
         raise ParameterError("size", size, "(W, H) of at least one pixel")
@@ -521,7 +529,8 @@ class StrandRaster:
         depth 1.0, or with ``clear=None`` drawn over as they are (see :meth:`images`).
         ``scale``: per segment, a factor in [0, 1] of its quad's width (None: 1, no taper).
         Returns :meth:`images`; the next draw overwrites them."""
-        p, s, c, m, w, h, width = _check(points, starts, colors, mvp, size, width)
+        fixed = self._same("starts", starts) and self._last_points.shape == np.shape(points)
+        p, s, c, m, w, h, width = _check(points, starts, colors, mvp, size, width, check_starts=not fixed)
         sc = scale if self._same("scale", scale) else _check_scale(scale, s.size)
         rgba, depth = self._images((w, h))
         half = 0.0 if width <= 1.0 else 0.5 * width
@@ -533,7 +542,7 @@ class StrandRaster:
             and self._last == key
             and self._last_points.shape == p.shape
             and np.array_equal(self._last_mvp, m)
-            and (self._same("starts", s) or np.array_equal(self._last_starts, s))
+            and (fixed or np.array_equal(self._last_starts, s))
             and (self._same("scale", sc) or np.array_equal(self._last_scale, sc))
         )
         self._last = None
@@ -552,6 +561,7 @@ class StrandRaster:
         for an empty mask), the boxes widened for quads of half-width ``half``."""
         h, w = self.depth.shape
         sc = self._last_scale if self._last_scale.ndim else _NO_SCALE
+        p, s, c, m, sc = (_read_only(a) for a in (p, s, c, m, sc))
         _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, sc, self._seg, self._box, which)
 
     def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
@@ -592,8 +602,8 @@ class StrandRaster:
         """Redraw the tiles the changed segments touch; False when a full draw is cheaper."""
         n, v = s.size, p.shape[0]
         self._flags, self._which = self._view("flags", (v,), np.bool_), self._view("which", (n,), np.bool_)
-        _changed_vertices(p, c, self._last_points, self._last_colors, self._flags)
-        changed = _changed_ends(s, self._flags, self._which)
+        _changed_vertices(_read_only(p), _read_only(c), self._last_points, self._last_colors, self._flags)
+        changed = _changed_ends(_read_only(s), self._flags, self._which)
         mostly = changed > MOSTLY_CHANGED * n
         self._next_unsearched = min(2 * self._next_unsearched + 1, MAX_UNSEARCHED) if mostly else 0
         self._unsearched = self._next_unsearched
@@ -633,6 +643,9 @@ class StrandRaster:
             depth,
         )
         rows, cols = np.flatnonzero(dirty.any(axis=1)), np.flatnonzero(dirty.any(axis=0))
+        if rows.size == 0:  # the changed segments are off the image, before and after
+            self.changed, self.tiles_redrawn = None, 0
+            return True
         self.changed = (
             int(rows[0]) * TILE,
             min(int(rows[-1] + 1) * TILE, h),

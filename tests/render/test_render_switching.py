@@ -102,3 +102,35 @@ def test_a_raster_drawing_large_small_large_draws_the_bytes_of_fresh_ones():
             rgba, rasterize(points, starts, colours, mvp, SIZE, 2.0, scale=scale)[0]
         )
     assert redrawn[0] == -1 and redrawn[1] > 0
+
+
+def test_the_studio_warm_up_compiles_the_raster_kernels_its_draws_use():
+    # The renderer hands read-only arrays (its points, fixed starts and widths); the warm-up
+    # draws writable ones. The kernels see read-only views either way, so the first paint in
+    # the studio compiles nothing the warm-up process did not.
+    from app.render import soft_raster
+    from app.ui.kernel_warmup import _raster_step
+
+    _raster_step()
+    kernels = (soft_raster._setup_kernel, soft_raster._changed_vertices, soft_raster._changed_ends)
+    before = [set(k.signatures) for k in kernels]
+    g = samples.scalp(strands=30, vertices=6, seed=1)
+    points = g.points.copy()
+    view = points.view()
+    view.flags.writeable = False
+    starts = np.ascontiguousarray(g.topology.segment_end - 1)
+    starts.flags.writeable = False
+    scale = np.linspace(1.0, 0.5, starts.size)
+    scale.flags.writeable = False
+    colours = np.full((g.vertex_count, 3), 0.5, np.float32)
+    cam = Camera.for_groom(g, aspect=64 / 48)
+    on_screen = (cam.view_matrix() @ cam.projection_matrix(64 / 48)).astype(np.float64)
+    for mvp in (on_screen, np.eye(4)):  # the scalp's strands lie off the image of an identity mvp
+        raster = StrandRaster()
+        for _ in range(3):
+            rgba, _ = raster.draw(view, starts, colours, mvp, (64, 48), 2.0, scale=scale)
+            np.testing.assert_array_equal(
+                rgba, rasterize(view, starts, colours, mvp, (64, 48), 2.0, scale=scale)[0]
+            )
+            points[3] += np.float32(0.01)
+    assert [set(k.signatures) for k in kernels] == before
