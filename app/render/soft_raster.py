@@ -45,10 +45,17 @@ W_MIN = 1e-5  # as the geometry shader: an end nearer the eye plane than this is
 DIR_EPS = 1e-6  # as the geometry shader: shorter segments are drawn in direction (1, 0)
 AXIS_EPS = 1e-12  # a quad side this close to horizontal bounds rows, not columns
 OPAQUE = 0xFF000000
+_NO_SCALE = np.zeros(0)  # the setup's scale when there is none (widths × 1)
 _SEG = 13  # per segment: window x, y, depth of both ends, both ends' RGB × 255, its width scale
 TILE_SHIFT = 5  # tiles of 2**5 = 32 pixels a side are redrawn when a frame differs little from the last
 TILE = 1 << TILE_SHIFT
 REDRAW_ALL = 1.0  # a full draw when the changed tiles list more (segment, tile) pairs than this × segments
+MOSTLY_CHANGED = 0.25  # … or at once when more than this share of the segments changed; then the
+# next 1, then 3 (MAX_UNSEARCHED) frames are drawn in full without looking for changes (render
+# hair following a brush: nearly every child moves, and the search cost a third of the full
+# draw); kept short, since a frame that changed nothing (the brush circle moving after a
+# stroke) is then drawn in full too
+MAX_UNSEARCHED = 3
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -69,15 +76,16 @@ def _unit(c):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _setup_kernel(points, starts, colors, m, w, h, margin, seg, box, which):
-    """Window coordinates and colours of every segment's ends (or of those flagged in
-    ``which``, when it is not empty), and the rows ``box[0, i] … box[1, i]`` and columns
-    ``box[2, i] … box[3, i]`` it may touch (rows ``0 … −1``: none, e.g. wholly behind the
-    eye or off the image)."""
+def _setup_kernel(points, starts, colors, m, w, h, margin, scale, seg, box, which):
+    """Window coordinates and colours of every segment's ends and its width ``scale`` (none
+    given: 1) (or of those flagged in ``which``, when it is not empty), and the rows
+    ``box[0, i] … box[1, i]`` and columns ``box[2, i] … box[3, i]`` it may touch (rows
+    ``0 … −1``: none, e.g. wholly behind the eye or off the image)."""
     for i in prange(starts.size):
         if which.size and not which[i]:
             continue
         box[0, i], box[1, i], box[2, i], box[3, i] = 0, -1, 0, -1
+        seg[i, 12] = scale[i] if scale.size else 1.0
         a = starts[i]
         ax, ay, az, aw = _project(points, a, m)
         bx, by, bz, bw = _project(points, a + 1, m)
@@ -108,19 +116,25 @@ def _setup_kernel(points, starts, colors, m, w, h, margin, seg, box, which):
 
 
 @njit(cache=True, nogil=True)
-def _cover_steps(lo, hi, h):
-    """+1 where each segment's rows ``lo … hi`` start, −1 after they end (0 … −1: none, cancels)."""
-    steps = np.zeros(h + 1, np.int64)
+def _cover_steps(lo, hi, h, weight):
+    """+w where each segment's rows ``lo … hi`` start, −w after they end (0 … −1: none, cancels);
+    w its ``weight`` (none given: 1)."""
+    steps = np.zeros(h + 1)
     for i in range(lo.size):
-        steps[lo[i]] += 1
-        steps[hi[i] + 1] -= 1
+        wi = weight[i] if weight.size else 1.0
+        steps[lo[i]] += wi
+        steps[hi[i] + 1] -= wi
     return steps
 
 
-def band_bounds(lo: NDArray[np.int32], hi: NDArray[np.int32], h: int, n: int) -> NDArray[np.int64]:
-    """``n + 1`` row boundaries: n bands of about equal work, counted as one per row plus one per
-    (segment, row) pair, from each segment's rows ``lo … hi``."""
-    work = np.cumsum(np.cumsum(_cover_steps(lo, hi, h))[:h] + 1)
+def band_bounds(
+    lo: NDArray[np.int32], hi: NDArray[np.int32], h: int, n: int, weight: NDArray[np.float64] | None = None
+) -> NDArray[np.int64]:
+    """``n + 1`` row boundaries: n bands of about equal work, counted as one per row plus, per
+    (segment, row) pair, the segment's ``weight`` (default 1), from each segment's rows
+    ``lo … hi``."""
+    w = np.zeros(0) if weight is None else np.ascontiguousarray(weight, np.float64)
+    work = np.cumsum(np.cumsum(_cover_steps(lo, hi, h, w))[:h] + 1.0)
     bounds = np.searchsorted(work * n, work[-1] * np.arange(1, n), side="left") + 1
     return np.concatenate([[0], np.minimum(bounds, h), [h]]).astype(np.int64)
 
@@ -406,7 +420,15 @@ def _balanced_jobs(work: NDArray[np.int64], n: int) -> tuple[NDArray[np.int64], 
     return tiles[order], np.searchsorted(job[order], np.arange(n + 1)).astype(np.int64)
 
 
-def _check(points, starts, colors, mvp, size, width):
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view: the kernels always see read-only inputs (a type of their own in numba),
+    however the caller made them, so one compilation (the studio's warm-up) serves every caller."""
+    view = a.view()
+    view.flags.writeable = False
+    return view
+
+
+def _check(points, starts, colors, mvp, size, width, check_starts=True):
     p = np.ascontiguousarray(points, np.float32)
     s = np.ascontiguousarray(starts, np.int64)
     c = np.ascontiguousarray(colors, np.float32)
@@ -416,7 +438,7 @@ def _check(points, starts, colors, mvp, size, width):
         raise ParameterError("points, colors", f"{p.shape}, {c.shape}", "(V, 3) and (V, 3)")
     if m.shape != (4, 4):
         raise ParameterError("mvp", m.shape, "a (4, 4) matrix")
-    if s.size and (s.min() < 0 or s.max() + 1 >= len(p)):
+    if check_starts and s.size and (s.min() < 0 or s.max() + 1 >= len(p)):
         raise ParameterError("starts", f"[{s.min()}, {s.max()}]", f"segment starts in [0, {len(p) - 1})")
     if w < 1 or h < 1:
         raise ParameterError("size", size, "(W, H) of at least one pixel")
@@ -433,9 +455,16 @@ class StrandRaster:
     (where they were and where they are), when those are few: the bytes are those of a full
     draw (the tests hold it to that). :attr:`changed` says which rows and columns the last draw
     may have changed, for an upload of just those.
+
+    The per-segment and per-vertex arrays are views into memory kept at the largest size drawn
+    so far: the studio alternates between a share of its render hair (while dragging) and all of
+    it (on release), and allocating 300 MB of segment table anew each time cost more than the
+    kernels filling it (the pages are faulted in on first write).
     """
 
     def __init__(self) -> None:
+        self._stores: dict[str, np.ndarray] = {}
+        self._sources: dict[str, np.ndarray] = {}  # read-only arrays kept as they were given
         self._rgba32 = np.zeros((0, 0), np.uint32)  # the kernels write whole pixels
         self.rgba = self._rgba32.view(np.uint8).reshape(0, 0, 4)
         self.depth = np.zeros((0, 0), np.float32)
@@ -454,8 +483,19 @@ class StrandRaster:
         self._entries = np.zeros(0, np.int64)
         self._near = np.zeros(0, np.int64)
         self.incremental = True  # redraw only what changed when it can (False: always all)
+        self._unsearched = 0  # frames to draw in full without looking for changes (see MOSTLY_CHANGED)
+        self._next_unsearched = 0
         self.changed: tuple[int, int, int, int] | None = None  # (row0, row1, col0, col1) or None
         self.tiles_redrawn = 0  # in the last draw; −1: all of the image
+
+    def _view(self, name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
+        """A C-contiguous ``shape`` array of ``dtype`` in the memory kept as ``name`` (grown when
+        too small; its content is whatever was there)."""
+        size = int(np.prod(shape))
+        store = self._stores.get(name)
+        if store is None or store.size < size or store.dtype != dtype:
+            store = self._stores[name] = np.empty(size, dtype)
+        return store[:size].reshape(shape)
 
     def images(self, size: tuple[int, int]) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
         """The ``(H, W, 4)`` colour and ``(H, W)`` depth images, resized to ``size = (W, H)``,
@@ -489,8 +529,9 @@ class StrandRaster:
         depth 1.0, or with ``clear=None`` drawn over as they are (see :meth:`images`).
         ``scale``: per segment, a factor in [0, 1] of its quad's width (None: 1, no taper).
         Returns :meth:`images`; the next draw overwrites them."""
-        p, s, c, m, w, h, width = _check(points, starts, colors, mvp, size, width)
-        sc = _check_scale(scale, s.size)
+        fixed = self._same("starts", starts) and self._last_points.shape == np.shape(points)
+        p, s, c, m, w, h, width = _check(points, starts, colors, mvp, size, width, check_starts=not fixed)
+        sc = scale if self._same("scale", scale) else _check_scale(scale, s.size)
         rgba, depth = self._images((w, h))
         half = 0.0 if width <= 1.0 else 0.5 * width
         fill = np.array(clear if clear is not None else (0, 0, 0, 0), np.uint8).view(np.uint32)[0]
@@ -501,10 +542,14 @@ class StrandRaster:
             and self._last == key
             and self._last_points.shape == p.shape
             and np.array_equal(self._last_mvp, m)
-            and np.array_equal(self._last_starts, s)
-            and np.array_equal(self._last_scale, sc)
+            and (fixed or np.array_equal(self._last_starts, s))
+            and (self._same("scale", sc) or np.array_equal(self._last_scale, sc))
         )
         self._last = None
+        if not same:  # other strands, view or size: whatever changed before tells nothing now
+            self._unsearched = self._next_unsearched = 0
+        elif self._unsearched > 0:  # the last frames changed nearly all: so will this one
+            same, self._unsearched = False, self._unsearched - 1
         if not (same and self._redraw_changed(p, s, c, m, half, fill, depth)):
             self._draw_all(p, s, c, m, half, clear is not None, fill, depth, sc)
         if clear is not None:
@@ -515,35 +560,58 @@ class StrandRaster:
         """The segments' window coordinates, colours and boxes (those flagged in ``which``, or all
         for an empty mask), the boxes widened for quads of half-width ``half``."""
         h, w = self.depth.shape
-        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, self._seg, self._box, which)
+        sc = self._last_scale if self._last_scale.ndim else _NO_SCALE
+        p, s, c, m, sc = (_read_only(a) for a in (p, s, c, m, sc))
+        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, sc, self._seg, self._box, which)
 
     def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
         h, w = depth.shape
         n = s.size
-        if self._seg.shape[0] != n:
-            self._seg, self._box = np.empty((n, _SEG)), np.empty((4, n), np.int32)
-        self._seg[:, 12] = scale
-        self._last_scale = scale.copy() if scale.ndim else scale
+        self._seg, self._box = self._view("seg", (n, _SEG), np.float64), self._view("box", (4, n), np.int32)
+        self._last_scale = self._kept("scale", scale, fixed=True) if scale.ndim else scale
         self._setup(p, s, c, m, half, self._all)
         # One band per thread: more, smaller bands cut more segments in two, which cost more
-        # than the better balance gained.
-        bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads())
+        # than the better balance gained. A quad's row costs about 1 + its width in pixels
+        # (measured on the bench's tapered render hair: rows-only counts left one thread
+        # a third more work than the other).
+        weight = 1.0 + 2.0 * half * self._seg[:, 12] if half > 0.0 else None
+        bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads(), weight)
         draw_bands(self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth)
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1
-        self._last_mvp, self._last_starts = m.copy(), s.copy()
-        self._last_points, self._last_colors = p.copy(), c.copy()
+        self._last_mvp, self._last_starts = m.copy(), self._kept("starts", s, fixed=True)
+        self._last_points, self._last_colors = self._kept("points", p), self._kept("colors", c)
+
+    def _kept(self, name: str, a: np.ndarray, fixed: bool = False) -> np.ndarray:
+        """``a`` as it is now: a copy in the memory kept as ``name``, or with ``fixed`` ``a``
+        itself when it is a read-only array (not a view of changing data: the renderer's segment
+        starts and widths, fixed per topology; comparing and copying those 3 million numbers
+        each frame cost more than drawing a drag's changes)."""
+        if fixed and not a.flags.writeable and a.base is None:
+            self._sources[name] = a
+            return a
+        self._sources.pop(name, None)
+        out = self._view(name, a.shape, a.dtype.type)
+        out[...] = a
+        return out
+
+    def _same(self, name: str, a: object) -> bool:
+        """Whether ``a`` is the read-only array last kept as ``name`` (so equal to it)."""
+        return isinstance(a, np.ndarray) and not a.flags.writeable and self._sources.get(name) is a
 
     def _redraw_changed(self, p, s, c, m, half, fill, depth) -> bool:
         """Redraw the tiles the changed segments touch; False when a full draw is cheaper."""
         n, v = s.size, p.shape[0]
-        if self._flags.size != v:
-            self._flags = np.empty(v, np.bool_)
-        if self._which.size != n:
-            self._which = np.empty(n, np.bool_)
-        _changed_vertices(p, c, self._last_points, self._last_colors, self._flags)
-        if _changed_ends(s, self._flags, self._which) == 0:
+        self._flags, self._which = self._view("flags", (v,), np.bool_), self._view("which", (n,), np.bool_)
+        _changed_vertices(_read_only(p), _read_only(c), self._last_points, self._last_colors, self._flags)
+        changed = _changed_ends(_read_only(s), self._flags, self._which)
+        mostly = changed > MOSTLY_CHANGED * n
+        self._next_unsearched = min(2 * self._next_unsearched + 1, MAX_UNSEARCHED) if mostly else 0
+        self._unsearched = self._next_unsearched
+        if changed == 0:
             self.changed, self.tiles_redrawn = None, 0
             return True
+        if mostly:
+            return False
         h, w = depth.shape
         dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
         _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # where they were,
@@ -575,6 +643,9 @@ class StrandRaster:
             depth,
         )
         rows, cols = np.flatnonzero(dirty.any(axis=1)), np.flatnonzero(dirty.any(axis=0))
+        if rows.size == 0:  # the changed segments are off the image, before and after
+            self.changed, self.tiles_redrawn = None, 0
+            return True
         self.changed = (
             int(rows[0]) * TILE,
             min(int(rows[-1] + 1) * TILE, h),

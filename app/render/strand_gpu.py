@@ -70,13 +70,28 @@ class StrandGPU:
         self.topology = topology
         v = topology.vertex_count
         self.param = np.ascontiguousarray(topology.vertex_param, np.float32)
-        self.param_buffer = ctx.buffer(self.param)
-        self.color_buffer = ctx.buffer(reserve=v * 12, dynamic=True)
+        self._param_buffer: moderngl.Buffer | None = None
+        self._color_buffer: moderngl.Buffer | None = None
         self._colors = np.zeros((v, 3), np.float32)
         self._color_texture: moderngl.Texture | None = None
         self._color_texture_stale = False
         self._color_buffer_stale = False
         self._index: dict[str, moderngl.Buffer] = {}
+
+    # GL buffers are made when a GL draw first reads them: a groom only rasterized on the CPU
+    # (the studio on llvmpipe) uploads no t and reserves no colour buffer.
+    @property
+    def param_buffer(self) -> moderngl.Buffer:
+        if self._param_buffer is None:
+            self._param_buffer = self.ctx.buffer(self.param)
+        return self._param_buffer
+
+    @property
+    def color_buffer(self) -> moderngl.Buffer:
+        if self._color_buffer is None:
+            self._color_buffer = self.ctx.buffer(reserve=self.topology.vertex_count * 12, dynamic=True)
+            self._color_buffer_stale = True
+        return self._color_buffer
 
     def index_buffer(self, kind: str) -> moderngl.Buffer:
         """``"strip"`` (LINE_STRIP with restarts), ``"lines"`` or ``"quads"``, made on first use."""
@@ -95,12 +110,18 @@ class StrandGPU:
         """New vertex colours, uploaded when a GL draw reads them (a CPU draw reads
         :attr:`colors`, so colour modes that change every frame upload nothing there)."""
         self._colors[:] = colors
+        self.colors_written()
+
+    def colors_written(self) -> None:
+        """:attr:`colors` were written in place (e.g. shaded straight into them): upload them
+        before the next GL draw that reads them."""
         self._color_buffer_stale = self._color_texture_stale = True
 
     def sync_color_buffer(self) -> None:
         """Bring the colour vertex buffer up to date before a draw that reads it."""
+        buffer = self.color_buffer  # made, and marked stale, on first use
         if self._color_buffer_stale:
-            self.color_buffer.write(self._colors)
+            buffer.write(self._colors)
             self._color_buffer_stale = False
 
     def color_texture(self) -> moderngl.Texture:
@@ -113,34 +134,45 @@ class StrandGPU:
         return self._color_texture
 
     def release(self) -> None:
-        for obj in (self.param_buffer, self.color_buffer, self._color_texture, *self._index.values()):
+        for obj in (self._param_buffer, self._color_buffer, self._color_texture, *self._index.values()):
             if obj is not None:
                 obj.release()
         self._index.clear()
-        self._color_texture = None
+        self._param_buffer = self._color_buffer = self._color_texture = None
 
 
 class PointSet:
-    """One set of positions (the groom, or the ghost) in the forms the draws read."""
+    """One set of positions (the groom, or the ghost) in the forms the draws read: a contiguous
+    ``(V, 3)`` float32 copy on the CPU (what the CPU rasterizer reads without copying it again),
+    and the vertex buffer and texture, each made and uploaded when a draw first reads it."""
 
     def __init__(self, gpu: StrandGPU, points: NDArray[np.float32]) -> None:
         self.gpu = gpu
-        v = gpu.topology.vertex_count
-        self.buffer = gpu.ctx.buffer(points, dynamic=True)
-        self._texels = np.zeros((_rows(v) * TEXTURE_WIDTH, 4), np.float32)
-        self._texels[:v, 3] = gpu.param
-        self._texels[:v, :3] = points
+        self._points = np.array(points, np.float32, order="C")
+        self._buffer: moderngl.Buffer | None = None
+        self._texels: NDArray[np.float32] | None = None  # the texture's RGBA: xyz and t
         self._texture: moderngl.Texture | None = None
-        self._stale = {"buffer": False, "texture": True}
+        self._stale = {"buffer": True, "texture": True}
         self.last_used = "buffer"  # the form the last draw read ("buffer", "texture", "cpu")
 
     @property
+    def buffer(self) -> moderngl.Buffer:
+        """The vertex buffer object (made on first use; :meth:`vertex_buffer` brings it up to date)."""
+        if self._buffer is None:
+            self._buffer = self.gpu.ctx.buffer(reserve=max(self._points.nbytes, 4), dynamic=True)
+            self._stale["buffer"] = True
+        return self._buffer
+
+    @property
     def points(self) -> NDArray[np.float32]:
-        return self._texels[: self.gpu.topology.vertex_count, :3]
+        """The positions (a read-only view)."""
+        view = self._points.view()
+        view.flags.writeable = False
+        return view
 
     def write(self, points: NDArray[np.float32]) -> None:
         """New positions (same topology): upload the form in use now, the other when needed."""
-        self._texels[: len(points), :3] = points
+        self._points[:] = points
         self._stale = {"buffer": True, "texture": True}
         if self.last_used == "buffer":
             self.vertex_buffer()
@@ -157,26 +189,34 @@ class PointSet:
         upload to it at once)."""
         if draw:
             self.last_used = "buffer"
+        buffer = self.buffer
         if self._stale["buffer"]:
-            self.buffer.write(np.ascontiguousarray(self.points))
+            buffer.write(self._points)
             self._stale["buffer"] = False
-        return self.buffer
+        return buffer
 
     def texture(self) -> moderngl.Texture:
         self.last_used = "texture"
+        v = self.gpu.topology.vertex_count
         if self._texture is None:
-            self._texture = _texture(self.gpu.ctx, self.gpu.topology.vertex_count, 4)
+            self._texture = _texture(self.gpu.ctx, v, 4)
+            self._texels = np.zeros((_rows(v) * TEXTURE_WIDTH, 4), np.float32)
+            self._texels[:v, 3] = self.gpu.param
             self._stale["texture"] = True
         if self._stale["texture"]:
+            self._texels[:v, :3] = self._points
             _write_texture(self._texture, self._texels)
             self._stale["texture"] = False
         return self._texture
 
     def release(self) -> None:
-        self.buffer.release()
+        if self._buffer is not None:
+            self._buffer.release()
+            self._buffer = None
         if self._texture is not None:
             self._texture.release()
             self._texture = None
+            self._texels = None
 
 
 def _texture(ctx: moderngl.Context, v: int, components: int) -> moderngl.Texture:

@@ -33,11 +33,17 @@ On llvmpipe a draw costs about 0.2 µs per primitive (line or triangle) whatever
 plus the pixels it covers: fewer primitives, not a cheaper shader, is what makes it faster.
 An optional ghost (:meth:`StrandRenderer.set_ghost_points`) draws the same strands at other
 positions first, in one flat translucent colour (always with a GL method).
+
+The studio switches between two sets of strands on every stroke (a share of the render hair
+while dragging, all of it on release): the renderer keeps the buffers of the strands it drew
+last (:data:`KEEP_TOPOLOGIES`), so switching back to them rewrites positions into buffers that
+exist rather than allocating and uploading everything again.
 """
 
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from typing import Any
 
 import moderngl
@@ -75,6 +81,7 @@ DEFAULT_GHOST_RGBA = (0.55, 0.75, 1.0, 0.35)
 RASTER_ENV = "HAIRTOOL_STRAND_RASTER"
 STRAND_RASTERS = ("auto", "gl", "cpu")
 SOFTWARE_GL = ("llvmpipe", "softpipe", "swrast")
+KEEP_TOPOLOGIES = 1  # sets of strands kept besides the current one (the studio's drag / release pair)
 
 
 def is_software_gl(ctx: moderngl.Context) -> bool:
@@ -98,6 +105,26 @@ def strip_indices_reference(topology: Topology) -> NDArray[np.uint32]:
         parts.append(np.arange(topology.offsets[s], topology.offsets[s + 1]))
         parts.append([RESTART_INDEX])
     return np.concatenate(parts).astype(np.uint32)
+
+
+@dataclass
+class _Kept:
+    """What the renderer made for one topology, kept for when it comes back."""
+
+    gpu: StrandGPU
+    main: PointSet
+    vaos: dict
+    segment_starts: NDArray[np.int64]
+    ramp: str  # the ramp ramp_colors were sampled from
+    ramp_colors: NDArray[np.float32] | None
+    taper_scale: tuple[float, NDArray[np.float64]] | None
+    base_store: NDArray[np.float32] | None
+
+    def release(self) -> None:
+        for vao in self.vaos.values():
+            vao.release()
+        self.main.release()
+        self.gpu.release()
 
 
 class StrandRenderer:
@@ -138,6 +165,8 @@ class StrandRenderer:
         self._taper_scale: tuple[float, NDArray[np.float64]] | None = None
         self.hair_look: HairLook = DEFAULT_LOOK
         self._base_colors: NDArray[np.float32] | None = None
+        self._base_store: NDArray[np.float32] | None = None  # memory for _base_colors, per topology
+        self._kept: list[_Kept] = []  # the last topologies drawn before this one (KEEP_TOPOLOGIES)
         self._version = 0  # bumped by every change of points or base colours
         self._shade_key: tuple | None = None
 
@@ -219,31 +248,80 @@ class StrandRenderer:
     def set_groom(self, groom: Groom) -> None:
         """Upload a groom: positions, t = i/(N_s−1) (and the groom's colours); index buffers
         follow when a line method first needs them. A ghost of the same topology is kept."""
-        top = groom.topology
-        ghost = self._ghost_points_if_same(top)
-        self._free_groom()
-        self.topology = top
-        self._gpu = StrandGPU(self.ctx, top)
-        self._main = PointSet(self._gpu, np.ascontiguousarray(groom.points, np.float32))
-        self._segment_starts = np.ascontiguousarray(top.segment_end - 1)
+        self.set_strands(groom.points, groom.topology, groom.colors)
+
+    def set_strands(self, points: ArrayLike, topology: Topology, colors: ArrayLike | None = None) -> None:
+        """:meth:`set_groom` from ``(V, 3)`` points and their topology (no groom made to pass
+        them: the studio's render hair has millions of points). Strands of a topology drawn
+        recently reuse what was made for it (buffers, t, colours' memory)."""
+        p, bounds = self._checked_points(points, topology.vertex_count, "points")
+        ghost = self._ghost_points_if_same(topology)
+        kept = self._take_kept(topology)
+        self._park_groom()
+        self.topology = topology
+        if kept is None:
+            self._gpu = StrandGPU(self.ctx, topology)
+            self._main = PointSet(self._gpu, p)
+            self._segment_starts = np.ascontiguousarray(topology.segment_end - 1)
+            self._segment_starts.flags.writeable = False  # fixed: the raster need not compare it
+        else:
+            self._gpu, self._main, self._segment_starts = kept.gpu, kept.main, kept.segment_starts
+            self._vaos.update(kept.vaos)
+            self._ramp_colors = kept.ramp_colors if kept.ramp == self.ramp else None
+            self._taper_scale, self._base_store = kept.taper_scale, kept.base_store
+            self._main.write(p)
         self._version += 1
-        self.bounds = groom.bounds
-        self.set_vertex_colors(groom.colors)
+        self.bounds = bounds
+        self.set_vertex_colors(colors)
         if ghost is not None:
             self.set_ghost_points(ghost, self.ghost_rgba)
+
+    @staticmethod
+    def _checked_points(points: ArrayLike, v: int, what: str) -> tuple[NDArray[np.float32], tuple]:
+        """The points as contiguous float32, and their box (which also finds a non-finite one:
+        a NaN or an inf anywhere shows in it, at no extra pass over millions of points)."""
+        p = np.ascontiguousarray(points, dtype=np.float32)
+        if p.shape != (v, 3):
+            raise GroomError(f"{what} must have shape ({v}, 3) like the groom, got {p.shape}")
+        if v == 0:
+            return p, (np.zeros(3, np.float32), np.zeros(3, np.float32))
+        bounds = box(p)
+        if not (np.all(np.isfinite(bounds[0])) and np.all(np.isfinite(bounds[1]))):
+            raise GroomError(f"{what} have a non-finite coordinate")
+        return p, bounds
+
+    def _take_kept(self, topology: Topology) -> _Kept | None:
+        for i, kept in enumerate(self._kept):
+            if kept.gpu.topology is topology or kept.gpu.topology == topology:
+                return self._kept.pop(i)
+        return None
+
+    def _park_groom(self) -> None:
+        """Keep the current groom's GPU objects for when its topology comes back (the ghost
+        goes); free the oldest kept beyond :data:`KEEP_TOPOLOGIES`."""
+        if self._gpu is None or self._main is None:
+            self._free_groom()
+            return
+        self._free_ghost()
+        self._kept.insert(
+            0,
+            _Kept(
+                self._gpu, self._main, dict(self._vaos), self._segment_starts, self.ramp,
+                self._ramp_colors, self._taper_scale, self._base_store,
+            ),
+        )  # fmt: skip
+        self._vaos.clear()
+        self._main = self._gpu = None
+        self._free_groom()
+        while len(self._kept) > KEEP_TOPOLOGIES:
+            self._kept.pop().release()
 
     def update_points(self, points: ArrayLike) -> None:
         """Rewrite only the positions (same strands), e.g. every mouse move of a brush stroke."""
         if self.topology is None or self._main is None:
             raise GroomError("update_points needs a groom: call set_groom first")
-        p = np.ascontiguousarray(points, dtype=np.float32)
-        v = self.topology.vertex_count
-        if p.shape != (v, 3):
-            raise GroomError(f"points must have shape ({v}, 3) like the groom, got {p.shape}")
-        if not np.all(np.isfinite(p)):
-            raise GroomError("points have a non-finite coordinate")
+        p, self.bounds = self._checked_points(points, self.topology.vertex_count, "points")
         self._main.write(p)
-        self.bounds = box(p)
         self._version += 1
 
     def set_ghost_points(
@@ -310,8 +388,11 @@ class StrandRenderer:
             raise ParameterError("colors", c.shape, f"shape ({v}, 3) (one RGB per vertex)")
         if not np.all(np.isfinite(c)):
             raise ParameterError("colors", "non-finite", "finite RGB values in [0, 1]")
-        self._base_colors = np.clip(c, 0.0, 1.0)
-        self._gpu.write_colors(self._base_colors)
+        if self._base_store is None or self._base_store.shape != c.shape:
+            self._base_store = np.empty_like(c)
+        self._base_colors = np.clip(c, 0.0, 1.0, out=self._base_store)
+        if not self.hair_shading:  # shaded, the colour buffer gets the shade of these instead
+            self._gpu.write_colors(self._base_colors)
         self.use_vertex_colors = True
         self._version += 1
         self._shade_key = None
@@ -449,7 +530,9 @@ class StrandRenderer:
             t, s = self._gpu.param, self._segment_starts
             mid = (np.float32(0.5) * (t[s] + t[s + 1])).astype(np.float32)
             scale = (np.float32(1.0) - np.float32(taper) * mid).astype(np.float64)
-            self._taper_scale = (taper, np.clip(scale, 0.0, 1.0))
+            scale = np.clip(scale, 0.0, 1.0)
+            scale.flags.writeable = False  # fixed per taper: the raster need not compare it
+            self._taper_scale = (taper, scale)
         return self._taper_scale[1]
 
     def cpu_colors(self) -> NDArray[np.float32]:
@@ -489,9 +572,9 @@ class StrandRenderer:
             return
         base = self._base_colors if self.use_vertex_colors else self._ramp_vertex_colors()
         light, eye = light_and_eye(right, up, forward)
-        self._gpu.write_colors(
-            shade(self._main.points, self.topology.offsets, base, light, eye, self.hair_look)
-        )
+        gpu = self._gpu
+        shade(self._main.points, self.topology.offsets, base, light, eye, self.hair_look, out=gpu.colors)
+        gpu.colors_written()  # shaded in place: no (V, 3) array made and copied per frame
         self._shade_key = key
 
     def _draw(self, method: str, points: PointSet, ghost: bool) -> None:
@@ -535,13 +618,15 @@ class StrandRenderer:
         self.topology = None
         self.bounds = None
         self.use_vertex_colors = False
-        self._segment_starts = self._ramp_colors = self._base_colors = None
+        self._segment_starts = self._ramp_colors = self._base_colors = self._base_store = None
         self._taper_scale = None
         self._shade_key = None
 
     def release(self) -> None:
         """Free every GL object this renderer made (call with its context current)."""
         self._free_groom()
+        while self._kept:
+            self._kept.pop().release()
         self.mesh.release()
         self.overlay.release()
         self.outline.release()

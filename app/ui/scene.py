@@ -72,7 +72,6 @@ class Scene(QObject):
         self.dragging = False
         self._subsets: dict[float, ChildBinding] = {}
         self._cache: dict = {}  # per drawn density: its topology and colours (see cached)
-        self._child_out: np.ndarray | None = None
         self._rest_drawn: np.ndarray | None = None
         self.last_children_ms = 0.0
         self.colour_mode = "root-to-tip"
@@ -236,7 +235,6 @@ class Scene(QObject):
         self.binding = binding
         self._subsets = {}
         self._cache = {}
-        self._child_out = None
         self._rebuild_drawn()
         self.drawn_changed.emit()
 
@@ -302,14 +300,21 @@ class Scene(QObject):
             self._cache[full] = make()
         return self._cache[full]
 
-    def _children_points(self) -> np.ndarray:
+    def _build_drawn(self) -> None:
+        """The drawn children rebuilt from the guides' current shapes into ``drawn_points``
+        (the guides after them when shown): one array per density, written in place on every
+        move, so neither a drag nor a release allocates (or concatenates) millions of points."""
         from hairtool.guides.children import build_points
 
         b = self.drawn_binding()
+        guides = self.result.vertex_count if self.show_guides else 0
+        drawn = self.cached(("points",), lambda: np.empty((b.vertex_count + guides, 3), np.float32))
         t0 = time.perf_counter()
-        self._child_out = build_points(b, self.result, out=self._child_out)
+        build_points(b, self.result, out=drawn[: b.vertex_count])
         self.last_children_ms = (time.perf_counter() - t0) * 1e3
-        return self._child_out
+        if guides:
+            drawn[b.vertex_count :] = self.result.points
+        self.drawn_points = drawn
 
     def _rebuild_drawn(self) -> None:
         """What the viewport draws: the groom itself, or the children (then the guides, if
@@ -320,30 +325,23 @@ class Scene(QObject):
             self.drawn_points = self.result.points
             self.drawn_guides = self.result.strand_count
             return
-        self._child_out = None
         self._rest_drawn = None
-        children = self._children_points()
+        self._build_drawn()
         if self.show_guides:
             key = (self.display_percent, "guides")
             if key not in self._cache:  # one topology per density, so what hangs on it is kept
                 self._cache[key] = Topology(np.concatenate([b.counts, self.result.counts]))
             self.drawn_topology = self._cache[key]
-            self.drawn_points = np.concatenate([children, self.result.points])
             self.drawn_guides = self.result.strand_count
         else:
             self.drawn_topology = b.topology
-            self.drawn_points = children
             self.drawn_guides = 0
 
     def _children_moved(self) -> None:
         if self.binding is None:
             self.drawn_points = self.result.points
             return
-        children = self._children_points()
-        if self.show_guides:
-            self.drawn_points = np.concatenate([children, self.result.points])
-        else:
-            self.drawn_points = children
+        self._build_drawn()
 
     def drawn_for(self, guide_points: np.ndarray) -> np.ndarray:
         """The drawn strands' points for the guides at ``guide_points`` (an animation frame)."""

@@ -198,8 +198,8 @@ class Viewport(QOpenGLWidget):
         r, s, dirty = self.renderer, self.scene, self._dirty
         shown = self.frame_points is not None and len(self.frame_points) == s.result.vertex_count
         children = s.has_children  # frames and ghosts are of the guides: their children are drawn
-        if "groom" in dirty:
-            r.set_groom(s.drawn_groom())
+        if "groom" in dirty:  # render hair: its points as they are, no groom made of millions of them
+            r.set_strands(s.drawn_points, s.drawn_topology) if children else r.set_groom(s.drawn_groom())
             dirty.discard("points")
             dirty.update(("ghost", "points") if shown or self.ghost_points is not None else ())
         if "points" in dirty:

@@ -128,3 +128,17 @@ def test_a_tapered_width_narrows_strands_to_the_tip_and_the_kernel_equals_its_re
     renderer.taper = 1.0
     with pytest.raises(ParameterError, match="taper"):
         renderer.segment_width_scale()
+
+
+def test_the_shade_is_the_same_bytes_at_one_thread_and_at_all():
+    import numba
+
+    g, base, _cam, light, eye = _inputs()
+    threads = numba.get_num_threads()
+    every = shade(g.points, g.topology.offsets, base, light, eye)
+    numba.set_num_threads(1)
+    try:
+        one = shade(g.points, g.topology.offsets, base, light, eye)
+    finally:
+        numba.set_num_threads(threads)
+    np.testing.assert_array_equal(one, every)

@@ -106,7 +106,7 @@ def test_any_split_into_bands_gives_the_same_bytes(width):
     e, h = len(starts), SIZE[1]
     seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
     soft_raster._setup_kernel(
-        points, starts, colors, mvp, SIZE[0], h, 0.75 * width + 1.0, seg, box, np.zeros(0, bool)
+        points, starts, colors, mvp, SIZE[0], h, 0.75 * width + 1.0, np.zeros(0), seg, box, np.zeros(0, bool)
     )
     splits = [soft_raster.band_bounds(box[0], box[1], h, n) for n in (1, 4, 13)]
     splits += [np.arange(h + 1), np.array([0, 1, 2, 30, h])]  # one row each; uneven
@@ -135,7 +135,7 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
             )
         )
         seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
-        setup(points, starts, colors, mvp, w, h, 4.0, seg, box, np.zeros(0, bool))
+        setup(points, starts, colors, mvp, w, h, 4.0, np.zeros(0), seg, box, np.zeros(0, bool))
         bounds = soft_raster.band_bounds(box[0], box[1], h, 3)
         images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)] * 3
         images = [a.copy() for a in images]
@@ -149,7 +149,7 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
         soft_raster._bin_segments(box, dirty, 4, counts, entries, near)
         jobs, job_start = soft_raster._balanced_jobs(np.diff(counts) + 1, 3)
         tiles(seg, jobs, job_start, counts, entries, 4, 1.5, np.uint32(7), *images[4:])
-        out.append((seg, box, cover(box[0], box[1], h), *images))
+        out.append((seg, box, cover(box[0], box[1], h, np.linspace(1.0, 3.0, e)), *images))
     for compiled, python in zip(*out, strict=True):
         np.testing.assert_array_equal(compiled, python)
     np.testing.assert_array_equal(out[0][-2], out[0][-4])  # the tiles drew what the bands drew
@@ -165,6 +165,12 @@ def test_band_bounds_split_the_work_evenly():
     per_band = [work[a:b].sum() for a, b in itertools.pairwise(bounds)]
     assert max(per_band) - min(per_band) <= work.max()
     assert soft_raster.band_bounds(lo, hi, 100, 1).tolist() == [0, 100]
+    # weighted: segment 0 (all rows) counts 5 per row, the three on rows 10-19 count 2 each
+    weight = np.array([5.0, 2.0, 2.0, 2.0, 7.0, 7.0])
+    bounds = soft_raster.band_bounds(lo, hi, 100, 4, weight)
+    work = np.ones(100) + 5.0 + ((np.arange(100) >= 10) & (np.arange(100) < 20)) * 6.0
+    per_band = [work[a:b].sum() for a, b in itertools.pairwise(bounds)]
+    assert max(per_band) - min(per_band) <= work.max()
 
 
 def test_clear_none_draws_over_the_images_and_a_clear_colour_fills_them():
