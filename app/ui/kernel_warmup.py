@@ -25,8 +25,14 @@ from pathlib import Path
 import numpy as np
 
 #: Packages and modules whose kernels the warm-up's steps compile (searched for numba dispatchers).
-KERNEL_PACKAGES = ("hairtool.frozen",)
-KERNEL_MODULES = ("hairtool.bounds", "app.render.soft_raster")
+KERNEL_PACKAGES = (
+    "hairtool.frozen",
+    "hairtool.guides",
+    "hairtool.keys",
+    "hairtool.anime",
+    "hairtool.simulate",
+)
+KERNEL_MODULES = ("hairtool.bounds", "app.render.soft_raster", "app.render.hair_shading")
 
 
 def record_path() -> Path:
@@ -117,13 +123,65 @@ def _raster_step() -> None:
         raster.draw(moved, starts, colors, mvp, (64, 48), width)  # the tiles-only redraw
 
 
+def _brushes_step() -> None:
+    from hairtool import samples
+    from hairtool.frozen.brushes import BRUSHES, BrushSample, falloff_lut
+    from hairtool.frozen.pipeline import FrozenPipeline
+
+    groom = samples.scalp(strands=40, vertices=8)
+    pipe = FrozenPipeline(groom)
+    lo, hi = groom.bounds
+    centre = tuple(float(v) for v in (lo.astype(np.float64) + hi) * 0.5)
+    lut = tuple(falloff_lut("smooth").tolist())
+    for brush in BRUSHES[1:]:  # align has its own step
+        strength = -0.5 if brush == "length" else 0.5
+        pipe.brush(BrushSample(brush, centre, (1.0, 0.0, 0.0), float(np.max(hi - lo)), strength, lut))
+
+
+def _render_hair_step() -> None:
+    from app.render.hair_shading import light_and_eye, shade
+    from hairtool import samples
+    from hairtool.guides.binding import bind_roots
+    from hairtool.guides.render import RenderHair
+
+    guides = samples.scalp(strands=12, vertices=8)
+    roots = guides.points[guides.topology.offsets[:-1]].astype(np.float64)
+    rng = np.random.default_rng(0)
+    roots = roots[rng.integers(0, len(roots), 60)] + rng.normal(0.0, 1e-3, (60, 3))
+    children = RenderHair(bind_roots(guides, roots, k=3, seed=0)).update(guides)
+    light, eye = light_and_eye(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, -1.0]))
+    base = np.ones((len(children.points), 3), np.float32)
+    shade(children.points, children.topology.offsets, base, light, eye)
+
+
+def _animation_step() -> None:
+    from hairtool import samples
+    from hairtool.anime.settings import AnimeSettings, cycle_for_groom
+    from hairtool.keys import session as ks
+    from hairtool.simulate.options import SimulateOptions, run_simulation
+
+    groom = samples.scalp(strands=20, vertices=8)
+    anim = run_simulation(groom, SimulateOptions(frames=12, substeps=2), lambda *a: None, lambda: False)
+    cycle_for_groom(groom, AnimeSettings())
+    solves = (("total", "linear"), ("total", "hermite"), ("total", "hermite-fit"), ("worst", "linear"))
+    for objective, interp in solves:
+        session = ks.solve(anim, ks.KeySettings(objective=objective, interp=interp))
+        keys = session.keys_for_count(4)
+        ks.analyse(anim, keys, interp)
+
+
 #: (label, step) in the order the studio needs them: the engine for the first groom, the
 #: rasterizer for the first paint (the studio starts its engine after these two:
-#: :data:`app.ui.engine_start.STARTUP_STEPS`), then what other brush modes and settings reach.
+#: :data:`app.ui.engine_start.STARTUP_STEPS`), then what other brush modes and settings reach, the
+#: other brushes, render hair, and what opening an animation needs (simulation, anime waves, keys):
+#: without these, the first use of each compiled it inside the studio, on a job or the GUI thread.
 STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
     ("hair engine", _engine_step),
     ("strand drawing", _raster_step),
     ("brush modes and settings", _more_engine_step),
+    ("grooming brushes", _brushes_step),
+    ("render hair", _render_hair_step),
+    ("animation and keys", _animation_step),
 )
 
 

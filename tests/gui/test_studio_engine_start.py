@@ -94,4 +94,15 @@ def test_the_warm_up_runs_its_steps_and_records_the_kernels(tmp_path, monkeypatc
     assert lines == [f"step {i + 1} {n} {label}" for i, (label, _) in enumerate(kernel_warmup.STEPS)]
     names = json.loads(kernel_warmup.record_path().read_text())["kernels"]
     assert "app.render.soft_raster:draw_bands" in names and "hairtool.frozen.clump:_clump_run" in names
+    # what an artist reaches after the first groom: other brushes, render hair, keys, waves, sims
+    for kernel in (
+        "hairtool.frozen.brushes:_brush_kernel",
+        "hairtool.guides.children:_children_kernel",
+        "app.render.hair_shading:_shade_kernel",
+        "hairtool.keys.dp:_layers_kernel",
+        "hairtool.keys.segment_fit:_fit_kernel",
+        "hairtool.anime.pose:_pose_kernel",
+        "hairtool.simulate.dynamics:_frame_kernel",
+    ):
+        assert kernel in names
     assert kernel_warmup.kernels_cached()
