@@ -5,7 +5,9 @@ Feature arrays are random walks, except D = 96,000 which is a swaying hair anima
 strands resampled to 16 points (the features step is timed there). After the rows of the chosen
 interpolation come, for the sizes up to 3,000 dimensions, the other objectives and
 interpolations: the worst-frame objective, fitted Hermite handles, and the total objective with
-ten pinned and ten excluded frames (``constrained``), each a table plus the all-K DP.
+ten pinned and ten excluded frames (``constrained``), each a table plus the all-K DP; and seed
+003's quaternion-distance table (objective ``quaternion``, interp ``slerp``, dims = joints) of a
+real capture of that many frames, the 1,064-frame PyMO walk (23 joints) played forward and back.
 """
 
 from __future__ import annotations
@@ -117,7 +119,39 @@ def run(args: argparse.Namespace) -> list[dict]:
     for n, d in sizes:
         if d <= 3000:
             rows += _other_modes(n, d, min(args.max_keys, n))
+    for n in sorted({n for n, d in sizes if d <= 3000}):
+        rows.append(_quaternion_row(n, min(args.max_keys, n)))
     return rows
+
+
+QUATERNION_CAPTURE = "pymo_walk.bvh"
+
+
+def _quaternion_row(n: int, kmax: int) -> dict:
+    """Seed 003's quaternion-distance table of an n-frame capture, plus the all-K DP on it."""
+    from hairtool.bench import MOTION_DIR, threads
+    from hairtool.keys.dp import solve_layers
+    from hairtool.mocap.bvh import read_bvh
+    from hairtool.mocap.costs import rotation_cost_table
+
+    motion = read_bvh(MOTION_DIR / QUATERNION_CAPTURE)
+    v = motion.values
+    laps = [v if lap % 2 == 0 else v[::-1] for lap in range(n // len(v) + 1)]
+    motion = motion.with_values(np.concatenate(laps)[:n])
+    rotation_cost_table(motion.with_values(motion.values[: min(n, 12)]))  # compile outside the timing
+    table, table_s = _time(lambda: rotation_cost_table(motion))
+    _, dp_s = _time(lambda: solve_layers(table, kmax))
+    return {
+        "frames": n,
+        "dims": motion.n_joints,
+        "objective": "quaternion",
+        "interp": "slerp",
+        "constrained": False,
+        "table_s": table_s,
+        "dp_s": dp_s,
+        "select_s": table_s + dp_s,
+        "threads": threads(),
+    }
 
 
 def _other_modes(n: int, d: int, kmax: int) -> list[dict]:

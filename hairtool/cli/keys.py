@@ -67,7 +67,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     parser.add_argument("--out", type=Path, metavar="KEYS.json", help="write keys, times and parameters")
-    parser.add_argument("--export", type=Path, metavar="OUT.usd", help="write the key poses as time samples")
+    parser.add_argument(
+        "--export",
+        type=Path,
+        metavar="OUT",
+        help="write the keys by suffix: .usd/.usda/.usdc key poses as time samples (animations), .json "
+        "record, .csv sheet (one row per frame; with --interp hermite or hermite-fit, per channel the "
+        "key values and tangents)",
+    )
     parser.add_argument(
         "--bake", action="store_true", help="with --export: every frame of the key curve, not just the keys"
     )
@@ -216,43 +223,65 @@ def _report(args: argparse.Namespace, kind: str, data, n: int, fps: float, sel, 
 
 
 def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict) -> int:
-    """Exports, the handles of fitted tangents, and the printed line (or JSON)."""
-    import numpy as np
-
+    """The Hermite curves' values and tangents, exports, and the printed line (or JSON)."""
     from hairtool.errors import ParameterError
+    from hairtool.keys.export import CSV_SUFFIXES, JSON_SUFFIXES
 
+    if args.interp != "linear" and kind in ("raw", "bvh"):
+        result["tangents"] = _curves(kind, data, sel.keys, args.interp)
+    time_codes = data.time_codes if kind == "animation" else None
     if args.export is not None:
-        if kind != "animation":
-            raise ParameterError("export", str(args.export), "an animation input (hair strands)")
+        suffix = args.export.suffix.lower()
+        if (args.bake or suffix not in JSON_SUFFIXES + CSV_SUFFIXES) and kind != "animation":
+            raise ParameterError("export", str(args.export), "a .json or .csv file, or an animation input")
         if args.bake:
             from hairtool.io import write
             from hairtool.keys.reconstruct import reconstruct
 
             write(args.export, reconstruct(data, sel.keys, args.interp))
+        elif suffix in JSON_SUFFIXES + CSV_SUFFIXES:
+            from hairtool.keys.export import export_keys, keys_record
+
+            export_keys(args.export, keys_record(result, args.input, time_codes=time_codes))
         else:
             from hairtool.keys.export import write_key_poses
 
             write_key_poses(args.export, data, sel.keys)
     elif args.bake:
         raise ParameterError("bake", True, "an --export path to write the key curve to")
-    if args.interp == "hermite-fit" and kind in ("raw", "bvh"):
-        from hairtool.keys.reconstruct import key_poses
-
-        values = data if kind == "raw" else data.values  # BVH: the file's channels, as a DCC keys them
-        kp = key_poses(np.asarray(values, dtype=np.float64), sel.keys, "hermite-fit")
-        result["tangents"] = {
-            "space": "X columns" if kind == "raw" else "BVH channels",
-            "unit": "per frame",
-            "out": kp.tangents.tolist(),
-            "in": kp.tangents_in.tolist(),
-        }
     line = (
         f"{sel.n_keys} keys of {n} frames, {sel.objective} error {sel.cost:.6g} "
         f"(uniform {sel.uniform_cost:.6g}): {' '.join(map(str, sel.keys.tolist()))}"
     )
     if "note" in result:
         line += f"\n{result['note']}"
-    return _emit(args, result, line, data.time_codes if kind == "animation" else None)
+    return _emit(args, result, line, time_codes)
+
+
+def _curves(kind: str, data, keys, interp: str) -> dict:
+    """Per channel the values at the keys and the Hermite tangents leaving ("out") and arriving
+    at ("in") each key, per frame: fitted handles for hermite-fit, seed 003's data tangents
+    (in = out) for hermite. A BVH's curves are its file channels, as a DCC keys them."""
+    import numpy as np
+
+    from hairtool.keys.reconstruct import key_poses
+
+    if kind == "raw":
+        values = np.asarray(data, dtype=np.float64)
+        names = [f"x{c}" for c in range(values.shape[1])]
+    else:
+        values = np.asarray(data.values, dtype=np.float64)
+        names = [f"{j}.{c}" for j, chans in zip(data.joint_names, data.channels, strict=True) for c in chans]
+    kp = key_poses(values, keys, interp)
+    arriving = kp.tangents if kp.tangents_in is None else kp.tangents_in
+    return {
+        "space": "X columns" if kind == "raw" else "BVH channels",
+        "unit": "per frame",
+        "channels": names,
+        "values": kp.poses.tolist(),
+        "out": kp.tangents.tolist(),
+        "in": arriving.tolist(),
+    }
 
 
 def _emit(args: argparse.Namespace, result: dict, line: str, time_codes=None) -> int:

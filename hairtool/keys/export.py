@@ -4,7 +4,11 @@
   parameters and costs, for pipelines and for reopening a solve.
 - CSV (``write_key_sheet``): one row per frame, like an animator's exposure sheet: whether the
   frame is a key, which keys it lies between and its interpolation weight, so a reader can
-  rebuild every in-between without hairtool.
+  rebuild every in-between without hairtool. A record with Hermite curves (``record["tangents"]``,
+  written by ``hairtool keys --interp hermite|hermite-fit`` for a BVH or a feature array) adds
+  three columns per channel, filled on key rows: ``NAME`` (the value at the key), ``NAME:in``
+  and ``NAME:out`` (the tangents arriving at and leaving the key, per frame): see
+  :func:`sheet_rows` for the curve they give.
 - USD (``write_key_poses``): only the key poses as time samples at their time codes; USD
   readers interpolate linearly between samples, so the file plays back as the linear
   reconstruction in any USD viewer.
@@ -38,6 +42,7 @@ FORMAT_VERSION = 1
 JSON_SUFFIXES = (".json",)
 CSV_SUFFIXES = (".csv",)
 USD_SUFFIXES = (".usd", ".usda", ".usdc")
+F64 = NDArray[np.float64]
 #: Records nest a few levels (keys, params, uniform); a deeper one read back would make writing
 #: it again (``_plain``, ``json.dump``) recurse past Python's limit.
 MAX_NESTING = 32
@@ -194,18 +199,55 @@ def read_keys_json(path: str | os.PathLike[str]) -> dict:
     return record
 
 
+def _check_curves(curves: Mapping[str, Any], n_keys: int) -> tuple[list[str], F64, F64, F64]:
+    """Channel names and the ``(K, C)`` values, leaving and arriving tangents of a record's curves."""
+    try:
+        names = [str(c) for c in curves["channels"]]
+        arrays = [np.asarray(curves[f], dtype=np.float64) for f in ("values", "out", "in")]
+    except (KeyError, TypeError, ValueError):
+        raise ParameterError(
+            "tangents", sorted(curves) if isinstance(curves, Mapping) else type(curves).__name__,
+            "channels, values, out and in of every key",
+        ) from None
+    shape = (n_keys, len(names))
+    if any(a.shape != shape or not np.all(np.isfinite(a)) for a in arrays):
+        raise ParameterError("tangents", [a.shape for a in arrays], f"finite values of shape {shape}")
+    return names, *arrays
+
+
 def sheet_rows(
-    n_frames: int, fps: float, keys: ArrayLike, uniform_keys: ArrayLike | None = None
+    n_frames: int,
+    fps: float,
+    keys: ArrayLike,
+    uniform_keys: ArrayLike | None = None,
+    curves: Mapping[str, Any] | None = None,
 ) -> list[list[Any]]:
     """Rows of the key sheet (header first): frame, time, key, key number, previous and next
-    key, interpolation weight s (frame = (1 − s)·previous + s·next), and the uniform key column
-    when ``uniform_keys`` is given."""
+    key, interpolation weight s (frame = (1 − s)·previous + s·next), the uniform key column
+    when ``uniform_keys`` is given, and with ``curves`` (``{"channels", "values", "out", "in"}``,
+    one row of C numbers per key) three columns per channel, filled on key rows: NAME, NAME:in,
+    NAME:out.
+
+    They give the Hermite curve without hairtool: between keys a < b (L = b − a frames) the
+    channel at a frame of weight s is h00·v_a + h10·L·out_a + h01·v_b + h11·L·in_b, with
+    h00 = 2s³ − 3s² + 1, h10 = s³ − 2s² + s, h01 = −2s³ + 3s², h11 = s³ − s². Tangents are per
+    frame; seed 003's data tangents have in = out, fitted handles may break at a key. Numbers
+    are written with all their digits (Python's repr), so they read back to the same float64.
+    """
     k = _check_keys(keys, n_frames)
     header = ["frame", "time", "key", "key_number", "previous_key", "next_key", "weight"]
     uni = None
     if uniform_keys is not None:
         uni = set(_check_keys(uniform_keys, n_frames).tolist())
         header.append("uniform_key")
+    per_key: list[list[str]] = []
+    if curves is not None:
+        names, values, out_t, in_t = _check_curves(curves, k.size)
+        for name in names:
+            header += [name, f"{name}:in", f"{name}:out"]
+        stacked = np.stack([values, in_t, out_t], axis=2).reshape(k.size, -1)
+        per_key = [[repr(float(v)) for v in row] for row in stacked]
+        blank = [""] * (3 * len(names))
     rows: list[list[Any]] = [header]
     frames = np.arange(n_frames)
     right = np.clip(np.searchsorted(k, frames, side="left"), 0, k.size - 1)
@@ -225,6 +267,8 @@ def sheet_rows(
         row.append(repr(round(weight, 9)))
         if uni is not None:
             row.append(int(f in uni))
+        if per_key:
+            row += per_key[j] if is_key else blank
         rows.append(row)
     return rows
 
@@ -232,7 +276,8 @@ def sheet_rows(
 def write_key_sheet(path: str | os.PathLike[str], record: Mapping[str, Any]) -> None:
     """Write the CSV key sheet of a record (one row per frame), atomically."""
     uniform = record.get("uniform", {}).get("keys") if isinstance(record.get("uniform"), dict) else None
-    rows = sheet_rows(int(record["frames"]), float(record["fps"]), record_keys(record), uniform)
+    curves = record.get("tangents")
+    rows = sheet_rows(int(record["frames"]), float(record["fps"]), record_keys(record), uniform, curves)
     try:
         with atomic_open(path, "w", newline="", encoding="utf-8") as f:
             csv.writer(f).writerows(rows)

@@ -21,8 +21,10 @@ def test_quick_bench_rows(capsys):
             ("worst", "hermite", False),
             ("total", "hermite-fit", False),
             ("total", "linear", True),
+            ("quaternion", "slerp", False),
         )
     }
+    assert all(r["dims"] == 23 for r in rows if r["objective"] == "quaternion")
     assert all(r["select_s"] > 0 for r in rows)
     for r in main_rows:
         for key in ("select_s", "gram_s", "table_s", "dp_s", "direct_s", "features_s"):

@@ -154,3 +154,87 @@ def test_a_record_read_back_can_always_be_written_again(tmp_path):
     path.write_text(base + "[" * (MAX_NESTING - 1) + "]" * (MAX_NESTING - 1) + "}", encoding="utf-8")
     write_keys_json(tmp_path / "again.json", read_keys_json(path))
     assert read_keys_json(tmp_path / "again.json")["x"] == read_keys_json(path)["x"]
+
+
+def _curve_from_sheet(path):
+    """Every frame of every channel rebuilt from the CSV alone, by the formula sheet_rows documents."""
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    names = [c for c in rows[0] if f"{c}:in" in rows[0]]
+    keyed = {int(r["frame"]): r for r in rows if r["key"] == "1"}
+
+    def at(frame, name, what=""):
+        return float(keyed[frame][name + what])
+
+    out = np.empty((len(rows), len(names)))
+    for r in rows:
+        f, a, b = int(r["frame"]), int(r["previous_key"]), int(r["next_key"])
+        for c, name in enumerate(names):
+            if a == b:
+                out[f, c] = at(a, name)
+                continue
+            s, el = (f - a) / (b - a), b - a
+            h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+            h01, h11 = -2 * s**3 + 3 * s**2, s**3 - s**2
+            start = h00 * at(a, name) + h10 * el * at(a, name, ":out")
+            out[f, c] = start + h01 * at(b, name) + h11 * el * at(b, name, ":in")
+    return names, keyed, out
+
+
+@pytest.mark.parametrize("interp", ["hermite", "hermite-fit"])
+def test_csv_sheet_carries_the_tangents_and_rebuilds_the_json_curve(tmp_path, capsys, interp, motion_dir):
+    from hairtool.cli import main
+    from hairtool.keys.reconstruct import interpolate_keys, key_poses
+    from hairtool.mocap.bvh import read_bvh
+
+    bvh = motion_dir / "freebvh.bvh"
+    sheet, record = tmp_path / "k.csv", tmp_path / "k.json"
+    argv = ["keys", str(bvh), "--keys", "7", "--interp", interp, "--export", str(sheet), "--out", str(record)]
+    assert main(argv) == 0
+    capsys.readouterr()
+    back = read_keys_json(record)
+    keys = record_keys(back)
+    names, keyed, curve = _curve_from_sheet(sheet)
+    motion = read_bvh(bvh)
+    assert names == back["tangents"]["channels"] and len(names) == motion.values.shape[1]
+    assert names[0] == "mixamorig:Hips.Xposition"
+    for a, key in enumerate(keys.tolist()):  # the CSV holds the JSON's numbers to the bit
+        for what, field in (("", "values"), (":in", "in"), (":out", "out")):
+            got = [float(keyed[key][n + what]) for n in names]
+            assert got == back["tangents"][field][a]
+    kp = key_poses(motion.values, keys, interp)
+    np.testing.assert_allclose(curve, interpolate_keys(kp), rtol=1e-12, atol=1e-9)
+    if interp == "hermite":  # seed 003's data tangents: one per key
+        assert back["tangents"]["in"] == back["tangents"]["out"]
+
+
+def test_feature_arrays_export_json_and_csv_but_not_key_poses(tmp_path, capsys):
+    from hairtool.cli import main
+
+    x = np.cumsum(np.random.default_rng(4).normal(size=(40, 3)), axis=0)
+    np.savez(tmp_path / "x.npz", X=x)
+    base = ["keys", str(tmp_path / "x.npz"), "--keys", "5", "--interp", "hermite-fit", "--export"]
+    assert main([*base, str(tmp_path / "k.csv")]) == 0
+    assert main([*base, str(tmp_path / "k.json")]) == 0
+    capsys.readouterr()
+    names, _, curve = _curve_from_sheet(tmp_path / "k.csv")
+    assert names == ["x0", "x1", "x2"]
+    keys = record_keys(read_keys_json(tmp_path / "k.json"))
+    from hairtool.keys.reconstruct import interpolate_keys, key_poses
+
+    rebuilt = interpolate_keys(key_poses(x, keys, "hermite-fit"))
+    np.testing.assert_allclose(curve, rebuilt, rtol=1e-12, atol=1e-12)
+    assert main([*base, str(tmp_path / "k.usda")]) == 2
+    assert "export" in capsys.readouterr().err
+
+
+def test_sheet_refuses_curves_that_do_not_match_the_keys():
+    curves = {"channels": ["a"], "values": [[0.0], [1.0]], "out": [[0.0], [1.0]], "in": [[0.0]]}
+    with pytest.raises(ParameterError, match="tangents"):
+        sheet_rows(5, 24.0, [0, 4], curves=curves)
+    with pytest.raises(ParameterError, match="tangents"):
+        sheet_rows(5, 24.0, [0, 4], curves={"channels": ["a"]})
+    good = {**curves, "in": [[0.5], [2.0]]}
+    rows = sheet_rows(5, 24.0, [0, 4], curves=good)
+    assert rows[0][-3:] == ["a", "a:in", "a:out"]
+    assert rows[1][-3:] == ["0.0", "0.5", "0.0"] and rows[2][-3:] == ["", "", ""]

@@ -39,11 +39,17 @@ def walk(motion_dir):
     return m.with_values(m.values[:50])
 
 
+# Float64 rounding: each term Dist² moves by ~2 ulp of q_k·slerp (about 4e-16) whatever the
+# order of operations, and the rotation steps add a few ulp per frame; the old arccos polynomial
+# (good to 2e-8 rad) was off by 3e-8 relative.
+EXACT = {"rtol": 1e-10, "atol": 1e-12}
+
+
 def test_kernel_matches_numpy_twin_on_random_motion():
     m = random_motion()
     fast = rotation_cost_table(m)
     slow = rotation_cost_table_reference(m)
-    np.testing.assert_allclose(fast, slow, rtol=1e-6, atol=1e-12)
+    np.testing.assert_allclose(fast, slow, **EXACT)
     assert fast.max() > 0.1
 
 
@@ -51,7 +57,28 @@ def test_kernel_matches_numpy_twin_on_a_real_capture(walk):
     w = np.random.default_rng(5).uniform(0.1, 1.0, walk.n_joints)
     fast = rotation_cost_table(walk, weights=w, translation_weight=0.3)
     slow = rotation_cost_table_reference(walk, weights=w, translation_weight=0.3)
-    np.testing.assert_allclose(fast, slow, rtol=1e-6, atol=1e-12)
+    np.testing.assert_allclose(fast, slow, **EXACT)
+
+
+@pytest.mark.parametrize("name", ["mocapbank_walk", "pymo_walk", "freebvh"])
+def test_kernel_matches_numpy_twin_on_every_capture(motion_dir, name):
+    m = read_bvh(motion_dir / f"{name}.bvh")
+    m = m.with_values(m.values[:70])
+    fast, slow = rotation_cost_table(m), rotation_cost_table_reference(m)
+    np.testing.assert_allclose(fast, slow, **EXACT)
+    iu = np.triu_indices(m.n_frames, 2)
+    assert np.max(np.abs(fast[iu] - slow[iu]) / slow[iu]) < 1e-7  # even the smallest entries
+
+
+def test_arccos_squared_polynomials_are_exact_to_rounding():
+    from hairtool.mocap.costs import _acos2_far, _acos2_mid, _acos2_near, acos2_reference
+
+    for poly, top in ((_acos2_near, 1 / 16), (_acos2_mid, 1 / 4), (_acos2_far, 1.0)):
+        u = np.concatenate([np.linspace(0.0, top, 4001), np.geomspace(1e-17, top, 400)])
+        got = np.array([poly(v) for v in u])
+        exact = acos2_reference(u)
+        assert got[0] == 0.0
+        assert np.max(np.abs(got[1:] - exact[1:]) / exact[1:]) < 4e-15
 
 
 def test_max_span_marks_far_pairs_infinite(walk):
@@ -59,7 +86,7 @@ def test_max_span_marks_far_pairs_infinite(walk):
     slow = rotation_cost_table_reference(walk, max_span=7)
     far = np.abs(np.subtract.outer(np.arange(50), np.arange(50))) > 7
     assert np.all(np.isinf(fast[far])) and np.all(np.isfinite(fast[~far]))
-    np.testing.assert_allclose(fast[~far], slow[~far], rtol=1e-6, atol=1e-12)
+    np.testing.assert_allclose(fast[~far], slow[~far], **EXACT)
     np.testing.assert_allclose(fast[~far], rotation_cost_table(walk)[~far], rtol=1e-12, atol=1e-15)
 
 
@@ -96,7 +123,7 @@ def test_cost_is_the_seed_formula_for_one_segment():
         s = quat.slerp(q[i], q[j], (k - i) / (j - i))
         total += np.sum(w * quat.distance(q[k], s) ** 2)
         total += w[0] * np.sum((p[k] - (p[i] + (k - i) / (j - i) * (p[j] - p[i]))) ** 2)
-    assert rotation_cost_table(m)[0, 5] == pytest.approx(total, rel=1e-6)
+    assert rotation_cost_table(m)[0, 5] == pytest.approx(total, rel=1e-12)
 
 
 def test_same_bits_for_any_thread_count(walk):
