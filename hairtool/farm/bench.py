@@ -4,15 +4,16 @@ One row per data set and worker count: ``jobs`` keys jobs (``--out`` and ``--exp
 studio would key a sequence); ``wall_s``, the batch's median wall time on a started cluster
 (skip checks, submission and manifests included; the cluster's start-up is ``start_s``,
 apart); ``serial_s``, the same jobs run by :func:`~hairtool.farm.runner.run_job` one after
-another in one process with numba threads on every core (``serial_threads``), a Dask worker
-process of its own so that both sides run in the environment Dask gives its workers (one
-BLAS thread, which a loaded machine needs); ``speedup``, their ratio; ``overhead_ms``, the
+another in one process with numba threads on every core (``serial_threads``), one of the
+row's own workers (the others idle), so that both sides run in the environment Dask gives its
+workers (one BLAS thread, which a loaded machine needs); ``speedup``, their ratio; ``overhead_ms``, the
 worker time per job not spent inside a job, (workers × wall − Σ job seconds) / jobs, which
 also counts a worker idling at the end of the batch; ``split_s`` and ``split_speedup``, the
 same jobs dealt out to the workers in equal shares, one task per worker run one after
 another: the speed-up the machine's free cores allow at that moment, the batch's ceiling.
 Serial, split and batch passes alternate, so a busy moment of a shared machine falls on all,
-and all run warm (kernels compiled and loaded before timing). ``load_1m`` is the machine's
+and all run warm (kernels compiled and loaded before timing); each worker count is timed on a
+cluster of its own, the only one open then. ``load_1m`` is the machine's
 load average when the row was taken (another's work leaves the workers fewer cores).
 
 Data: ``synthetic``, shots simulated from the scalp sample; ``mocap``, the BVH captures in
@@ -22,7 +23,6 @@ Data: ``synthetic``, shots simulated from the scalp sample; ``mocap``, the BVH c
 from __future__ import annotations
 
 import argparse
-import contextlib
 import os
 import statistics
 import tempfile
@@ -46,7 +46,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--workers", type=int, nargs="+", default=None, help="local worker counts to time (default 1 2)"
     )
     parser.add_argument("--data", nargs="+", choices=DATA, default=None, help="data sets (default both)")
-    add_common_arguments(parser, quick="small synthetic shots, 2 workers, one run", repeat=3)
+    add_common_arguments(parser, quick="small synthetic shots, 2 workers, one run", repeat=4)
 
 
 def _synthetic_inputs(folder: Path, quick: bool) -> list[Path]:
@@ -119,41 +119,48 @@ def _split_pass(client, jobs, threads) -> float:
     return time.perf_counter() - t0
 
 
-def _measure(jobs, worker_counts: list[int], repeat: int) -> tuple[float, dict[int, dict]]:
-    """Serial, split and batch passes taken in turn, so a busy moment of the machine falls on
-    all; the median serial time and, per worker count, the median batch pass, the median split
-    pass and the start-up."""
+def _measure(jobs, worker_counts: list[int], repeat: int) -> dict[int, dict]:
+    """Per worker count, on a cluster of its own that alone is open while it is timed: the
+    median serial pass (on one of its workers, numba threads on every core), the median batch
+    pass, the median split pass, and the start-up. Serial, batch and split passes are taken in
+    turn, so a busy moment of the machine falls on all three, and batch and split take turns
+    right after the serial pass: on this 2-core VM whichever parallel pass follows one core's
+    idling (the serial pass, or 3 s of rest) runs 10-25 % slower, a split as much as a batch,
+    and always putting the batch there had charged it to the batch. One cluster at a time: the idle
+    workers, nannies and scheduler of another cluster cost a 2-core machine a few per cent,
+    which a real batch does not pay."""
     from hairtool.farm.batch import default_threads
     from hairtool.farm.cluster import cores, open_client
     from hairtool.farm.runner import run_job
 
     warm = _warm_jobs(jobs)
-    with contextlib.ExitStack() as stack:
-        alone = stack.enter_context(open_client(None, 1))
-        alone.run(lambda: [run_job(j, cores()) for j in warm])
-        clients, start = {}, {}
-        for w in worker_counts:
-            t0 = time.perf_counter()
-            clients[w] = stack.enter_context(open_client(None, w))
-            start[w] = time.perf_counter() - t0
-            threads = default_threads(None, w)
-            clients[w].run(lambda threads=threads: [run_job(j, threads) for j in warm])
-        serial, runs, split = [], {w: [] for w in worker_counts}, {w: [] for w in worker_counts}
-        for _ in range(repeat):
-            serial.append(alone.submit(serial_pass, jobs, cores(), pure=False).result())
-            for w, client in clients.items():
-                runs[w].append(_batch_pass(client, jobs, default_threads(None, w)))
-                split[w].append(_split_pass(client, jobs, default_threads(None, w)))
     timed = {}
-    for w, r in runs.items():
-        wall_s, busy_s = sorted(r)[len(r) // 2]  # the median pass (the upper one of two)
+    for w in worker_counts:
+        t0 = time.perf_counter()
+        with open_client(None, w) as client:
+            start_s = time.perf_counter() - t0
+            threads = default_threads(None, w)
+            client.run(lambda: [run_job(j, cores()) for j in warm])  # kernels loaded at both counts
+            client.run(lambda threads=threads: [run_job(j, threads) for j in warm])
+            first = sorted(client.nthreads())[:1]
+            serial, runs, split = [], [], []
+            for i in range(repeat):
+                serial.append(client.submit(serial_pass, jobs, cores(), workers=first, pure=False).result())
+                if i % 2 == 0:
+                    runs.append(_batch_pass(client, jobs, threads))
+                    split.append(_split_pass(client, jobs, threads))
+                else:
+                    split.append(_split_pass(client, jobs, threads))
+                    runs.append(_batch_pass(client, jobs, threads))
+        wall_s, busy_s = sorted(runs)[len(runs) // 2]  # the median pass (the upper one of two)
         timed[w] = {
-            "start_s": start[w],
+            "start_s": start_s,
+            "serial_s": statistics.median(serial),
             "wall_s": wall_s,
             "busy_s": busy_s,
-            "split_s": statistics.median(split[w]),
+            "split_s": statistics.median(split),
         }
-    return statistics.median(serial), timed
+    return timed
 
 
 def run(args: argparse.Namespace) -> list[dict]:
@@ -180,9 +187,10 @@ def run(args: argparse.Namespace) -> list[dict]:
                 if not inputs:
                     raise ParameterError("data", name, f"BVH captures in {MOTION_DIR}")
             jobs = _jobs(inputs, args.jobs, folder, export)
-            serial_s, by_workers = _measure(jobs, worker_counts, repeat)
+            by_workers = _measure(jobs, worker_counts, repeat)
             serial_threads = cores()
             for workers, timed in by_workers.items():
+                serial_s = timed["serial_s"]
                 rows.append(
                     {
                         "data": name,
