@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import sys
 
-from PySide6.QtCore import QEventLoop, QObject, QProcess, Qt
+from PySide6.QtCore import QEventLoop, QObject, QProcess, Qt, Signal
 from PySide6.QtGui import QGuiApplication
 from PySide6.QtWidgets import QLabel, QProgressBar, QStatusBar
 
@@ -20,7 +20,13 @@ WAIT_MESSAGE = "The hair engine is still being prepared (first start): strokes w
 
 class EngineStart(QObject):
     """Runs the warm-up process and starts ``scene``'s engine when it is done (or failed: then
-    the engine compiles in the studio, with a wait cursor and a message)."""
+    the engine compiles in the studio, with a wait cursor and a message).
+
+    ``step_ready(label)`` says which warm-up step's kernels are cached now, ``ended()`` that the
+    warm-up is over (done or not), so what waits for a step can go ahead."""
+
+    step_ready = Signal(str)
+    ended = Signal()
 
     def __init__(self, scene: Scene, bar: QStatusBar, parent: QObject | None = None) -> None:
         super().__init__(parent)
@@ -70,9 +76,11 @@ class EngineStart(QObject):
                 self.label.setText(f"Preparing the hair engine (first start): {label} ready, {done}/{total}")
                 if done >= STARTUP_STEPS and not self.scene.engine_ready:
                     self.scene.start_engine()  # what a stroke and a paint need is cached now
+                self.step_ready.emit(label)
 
     def _on_finished(self, code: int, status: QProcess.ExitStatus) -> None:
         ok = status == QProcess.ExitStatus.NormalExit and code == 0
+        self.ended.emit()
         if self.scene.engine_ready:
             self._remove_progress()
             return

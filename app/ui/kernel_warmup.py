@@ -170,17 +170,21 @@ def _animation_step() -> None:
         ks.analyse(anim, keys, interp)
 
 
+#: The step after which the bundled sample's render hair can be bound and shaded without compiling.
+RENDER_HAIR_STEP = "render hair"
+
 #: (label, step) in the order the studio needs them: the engine for the first groom, the
 #: rasterizer for the first paint (the studio starts its engine after these two:
-#: :data:`app.ui.engine_start.STARTUP_STEPS`), then what other brush modes and settings reach, the
-#: other brushes, render hair, and what opening an animation needs (simulation, anime waves, keys):
+#: :data:`app.ui.engine_start.STARTUP_STEPS`), render hair (the bundled sample's children wait for
+#: it), then what other brush modes and settings reach, the other brushes, and what opening an
+#: animation needs (simulation, anime waves, keys):
 #: without these, the first use of each compiled it inside the studio, on a job or the GUI thread.
 STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
     ("hair engine", _engine_step),
     ("strand drawing", _raster_step),
+    (RENDER_HAIR_STEP, _render_hair_step),
     ("brush modes and settings", _more_engine_step),
     ("grooming brushes", _brushes_step),
-    ("render hair", _render_hair_step),
     ("animation and keys", _animation_step),
 )
 

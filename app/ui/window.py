@@ -7,6 +7,7 @@ them (monkeypatch) and never block.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +33,7 @@ from app.ui.commands import ParamCommand, StrokeCommand
 from app.ui.dialogs import StillOptions, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import JobRunner, JobStatus
+from app.ui.kernel_warmup import RENDER_HAIR_STEP
 from app.ui.legend import RampLegend, unit_name
 from app.ui.qt_utils import add_action
 from app.ui.scene import COLOUR_MODES, Scene
@@ -84,6 +86,8 @@ class MainWindow(QMainWindow):
         start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
         self.scene = Scene(start, parent=self, engine_ready=engine_ready)
         self.engine_start: EngineStart | None = None
+        # the bundled sample's render hair, on a first start bound once its kernels are cached
+        self._pending_render_hair: Callable[[], None] | None = None
         self.viewport = Viewport(self.scene, self)
         self.setCentralWidget(self.viewport)
         self.dock = ToolDock(self.scene, self)
@@ -173,7 +177,18 @@ class MainWindow(QMainWindow):
         engine (a first start: see :mod:`app.ui.engine_start`)."""
         if self.engine_start is None and not self.scene.engine_ready:
             self.engine_start = EngineStart(self.scene, self.statusBar(), self)
+            self.engine_start.step_ready.connect(self._on_warmup_step)
+            self.engine_start.ended.connect(self._bind_pending_render_hair)
             self.engine_start.start()
+
+    def _on_warmup_step(self, label: str) -> None:
+        if label == RENDER_HAIR_STEP:
+            self._bind_pending_render_hair()
+
+    def _bind_pending_render_hair(self) -> None:
+        pending, self._pending_render_hair = self._pending_render_hair, None
+        if pending is not None:
+            pending()
 
     def reset_layout(self) -> None:
         """Docks back where a first start puts them (tools and anime wave tabbed on the right,
@@ -492,6 +507,7 @@ class MainWindow(QMainWindow):
         animation on the timeline is closed)."""
         self.animation.clear()
         self.undo_stack.clear()
+        self._pending_render_hair = None  # the bundled sample's children, not this groom's
         self.scene.load(groom, path)
         self.undo_stack.setClean()
         self._update_title()
@@ -518,12 +534,19 @@ class MainWindow(QMainWindow):
             return False
         self.set_groom(groom)
         self.scene.set_mesh(mesh)
-        # Sintel's hair as guides with interpolated render hair, shaded as hair.
-        self.scene.set_binding(
-            bind_scalp(groom, mesh, resources.SINTEL_CHILDREN, seed=resources.SINTEL_CHILD_SEED)
-        )
-        self.scene.set_colour_mode("hair")
         self.viewport.frame_all()
+
+        def render_hair() -> None:  # Sintel's hair as guides with interpolated render hair, shaded
+            self.scene.set_binding(
+                bind_scalp(groom, mesh, resources.SINTEL_CHILDREN, seed=resources.SINTEL_CHILD_SEED)
+            )
+            self.scene.set_colour_mode("hair")
+
+        if self.scene.engine_ready:
+            render_hair()
+        else:  # a first start: binding and shading would compile here, with the window frozen
+            self._pending_render_hair = render_hair
+            self.statusBar().showMessage("Sintel's guides; her render hair follows once the engine is ready")
         return True
 
     def open_dialog(self) -> None:

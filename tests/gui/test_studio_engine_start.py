@@ -60,6 +60,40 @@ def test_the_warm_up_reports_progress_and_starts_the_engine(make_window, qtbot, 
     assert w.scene.pipeline is not None
 
 
+def _fake_warm_up(monkeypatch, labels: list[str], pause_s: float = 0.2) -> None:
+    """The warm-up replaced by a process that reports ``labels`` as its steps."""
+    from app.ui.engine_start import EngineStart
+
+    lines = [f"step {i + 1} {len(labels)} {label}" for i, label in enumerate(labels)]
+    script = f"import time\nfor line in {lines!r}:\n    print(line, flush=True)\n    time.sleep({pause_s})"
+    monkeypatch.setattr(EngineStart, "start", lambda self: self.process.start(sys.executable, ["-c", script]))
+
+
+def test_a_first_start_shows_sintels_guides_and_binds_her_render_hair_when_its_kernels_are_ready(
+    make_window, qtbot, monkeypatch
+):
+    _fake_warm_up(monkeypatch, ["hair engine", "strand drawing", kernel_warmup.RENDER_HAIR_STEP, "more"], 0.3)
+    w = make_window(engine_ready=False)
+    assert w.open_bundled_sample(), w.errors
+    s = w.scene
+    assert not s.has_children and s.colour_mode == "root-to-tip"  # nothing compiled on this thread
+    assert s.rest.strand_count == 228 and "render hair" in w.statusBar().currentMessage()
+    w.start_warmup()
+    qtbot.waitUntil(lambda: s.has_children, timeout=10_000)
+    assert w.engine_start.step >= 3 and s.colour_mode == "hair"
+    assert s.binding.child_count > 1000
+
+
+def test_a_groom_opened_before_the_render_hair_step_keeps_no_children(make_window, qtbot, monkeypatch):
+    _fake_warm_up(monkeypatch, ["hair engine", "strand drawing", kernel_warmup.RENDER_HAIR_STEP])
+    w = make_window(engine_ready=False)
+    assert w.open_bundled_sample(), w.errors
+    w.set_groom(samples.comb(strands=10, vertices=6))  # the artist's own groom, first
+    w.start_warmup()
+    qtbot.waitUntil(lambda: not w.engine_start.running, timeout=10_000)
+    assert not w.scene.has_children and w.scene.rest.strand_count == 10
+
+
 def test_a_failed_warm_up_still_starts_the_engine(make_window, qtbot, monkeypatch):
     from app.ui.engine_start import EngineStart
 
