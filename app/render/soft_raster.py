@@ -574,7 +574,11 @@ class StrandRaster:
         # than the better balance gained. A quad's row costs about 1 + its width in pixels
         # (measured on the bench's tapered render hair: rows-only counts left one thread
         # a third more work than the other).
-        weight = 1.0 + 2.0 * half * self._seg[:, 12] if half > 0.0 else None
+        weight = None
+        if half > 0.0:  # into kept memory: numpy's two 25 MB temporaries page-faulted 50 ms a release
+            weight = self._view("weight", (n,), np.float64)
+            np.multiply(self._seg[:, 12], 2.0 * half, out=weight)
+            weight += 1.0
         bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads(), weight)
         draw_bands(self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth)
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1
