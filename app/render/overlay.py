@@ -27,17 +27,44 @@ def ring_strip(center: tuple[float, float], radius: float, width: float, segment
     return np.stack([inner, outer], axis=1).reshape(-1, 2).astype(np.float32)
 
 
-class CircleOverlay:
+class _ScreenOverlay:
+    """Triangles in pixels over the scene, straight alpha, no depth test (program ``overlay``)."""
+
+    def __init__(self, ctx: moderngl.Context, reserve_vertices: int, color: tuple) -> None:
+        self.ctx = ctx
+        self.program = load_program(ctx, "overlay")
+        self.vbo = ctx.buffer(reserve=reserve_vertices * 2 * 4, dynamic=True)
+        self.vao = ctx.vertex_array(self.program, [(self.vbo, "2f", "in_px")])
+        self.color = color
+        self.viewport_size = (1.0, 1.0)
+
+    def _draw(self, mode: int, vertices: int = -1) -> None:
+        self.program["u_viewport_size"].value = self.viewport_size
+        self.program["u_color"].value = self.color
+        self.ctx.disable(moderngl.DEPTH_TEST)
+        self.ctx.enable(moderngl.BLEND)
+        # Straight alpha over the scene; alpha itself accumulates (transparent exports stay correct).
+        self.ctx.blend_func = (
+            moderngl.SRC_ALPHA,
+            moderngl.ONE_MINUS_SRC_ALPHA,
+            moderngl.ONE,
+            moderngl.ONE_MINUS_SRC_ALPHA,
+        )
+        self.vao.render(mode, vertices=vertices)
+        self.ctx.disable(moderngl.BLEND)
+
+    def release(self) -> None:
+        self.vao.release()
+        self.vbo.release()
+        self.program.release()
+
+
+class CircleOverlay(_ScreenOverlay):
     """A ring of ``radius_px`` at ``center_px`` (pixels of a viewport of ``viewport_size``, y down)."""
 
     def __init__(self, ctx: moderngl.Context) -> None:
-        self.ctx = ctx
-        self.program = load_program(ctx, "overlay")
-        self.vbo = ctx.buffer(reserve=2 * (CIRCLE_SEGMENTS + 1) * 2 * 4, dynamic=True)
-        self.vao = ctx.vertex_array(self.program, [(self.vbo, "2f", "in_px")])
-        self.color = CIRCLE_COLOR
+        super().__init__(ctx, 2 * (CIRCLE_SEGMENTS + 1), CIRCLE_COLOR)
         self.visible = False
-        self.viewport_size = (1.0, 1.0)
 
     def set(
         self, center_px: tuple[float, float] | None, radius_px: float, viewport_size: tuple[float, float]
@@ -57,26 +84,8 @@ class CircleOverlay:
         self.visible = True
 
     def render(self) -> None:
-        if not self.visible:
-            return
-        self.program["u_viewport_size"].value = self.viewport_size
-        self.program["u_color"].value = self.color
-        self.ctx.disable(moderngl.DEPTH_TEST)
-        self.ctx.enable(moderngl.BLEND)
-        # Straight alpha over the scene; alpha itself accumulates (transparent exports stay correct).
-        self.ctx.blend_func = (
-            moderngl.SRC_ALPHA,
-            moderngl.ONE_MINUS_SRC_ALPHA,
-            moderngl.ONE,
-            moderngl.ONE_MINUS_SRC_ALPHA,
-        )
-        self.vao.render(moderngl.TRIANGLE_STRIP)
-        self.ctx.disable(moderngl.BLEND)
-
-    def release(self) -> None:
-        self.vao.release()
-        self.vbo.release()
-        self.program.release()
+        if self.visible:
+            self._draw(moderngl.TRIANGLE_STRIP)
 
 
 def outline_triangles(corners: np.ndarray, width: float) -> np.ndarray:
@@ -92,17 +101,12 @@ def outline_triangles(corners: np.ndarray, width: float) -> np.ndarray:
     return quads.reshape(-1, 2).astype(np.float32)
 
 
-class OutlineOverlay:
+class OutlineOverlay(_ScreenOverlay):
     """A closed polygon outline in pixels (the symmetry plane's edges), hidden until set."""
 
     def __init__(self, ctx: moderngl.Context) -> None:
-        self.ctx = ctx
-        self.program = load_program(ctx, "overlay")
-        self.vbo = ctx.buffer(reserve=6 * MAX_OUTLINE * 2 * 4, dynamic=True)
-        self.vao = ctx.vertex_array(self.program, [(self.vbo, "2f", "in_px")])
-        self.color = OUTLINE_COLOR
+        super().__init__(ctx, 6 * MAX_OUTLINE, OUTLINE_COLOR)
         self.count = 0
-        self.viewport_size = (1.0, 1.0)
 
     def set(self, corners_px: np.ndarray | None, viewport_size: tuple[float, float] = (1, 1)) -> None:
         """``(n, 2)`` corners (n ≤ :data:`MAX_OUTLINE`, finite) or None to hide."""
@@ -115,22 +119,5 @@ class OutlineOverlay:
         self.viewport_size = (float(viewport_size[0]), float(viewport_size[1]))
 
     def render(self) -> None:
-        if not self.count:
-            return
-        self.program["u_viewport_size"].value = self.viewport_size
-        self.program["u_color"].value = self.color
-        self.ctx.disable(moderngl.DEPTH_TEST)
-        self.ctx.enable(moderngl.BLEND)
-        self.ctx.blend_func = (
-            moderngl.SRC_ALPHA,
-            moderngl.ONE_MINUS_SRC_ALPHA,
-            moderngl.ONE,
-            moderngl.ONE_MINUS_SRC_ALPHA,
-        )
-        self.vao.render(moderngl.TRIANGLES, vertices=self.count)
-        self.ctx.disable(moderngl.BLEND)
-
-    def release(self) -> None:
-        self.vao.release()
-        self.vbo.release()
-        self.program.release()
+        if self.count:
+            self._draw(moderngl.TRIANGLES, self.count)
