@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit, prange
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
@@ -174,6 +175,45 @@ def position_errors(original: Animation, rebuilt: Animation | ArrayLike) -> Posi
     )
 
 
+def _segment_weights(kp: KeyPoses, t: NDArray[np.int64]) -> tuple[NDArray[np.int64], F64]:
+    """Per frame of ``t``: the key a before it and the weights of p_a, out_a, p_b, in_b in its
+    curve value (linear: 1 − s and s, tangents weighted 0), computed as :func:`interpolate_at`
+    computes them, so the curve from them has its bytes."""
+    a = np.clip(np.searchsorted(kp.keys, t, side="right") - 1, 0, kp.keys.size - 2)
+    el = (kp.keys[a + 1] - kp.keys[a]).astype(np.float64)
+    s = (t - kp.keys[a]) / el
+    w = np.zeros((t.size, 4))
+    if kp.tangents is None:
+        w[:, 0], w[:, 2] = 1.0 - s, s
+    else:
+        w[:, 0] = 2 * s**3 - 3 * s**2 + 1
+        w[:, 1] = (s**3 - 2 * s**2 + s) * el
+        w[:, 2] = -2 * s**3 + 3 * s**2
+        w[:, 3] = (s**3 - s**2) * el
+    return a, w
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _curve_distances(frames, t0, a, w, poses, out_t, in_t, hermite, e):
+    """e[c, v] = |frames[t0 + c, v] − curve(t0 + c)[v]| in float64, the curve value
+    w0·p_a + w1·out_a + w2·p_b + w3·in_b summed in that order (linear: the first and third
+    terms only), one frame per task: the key curve is never stored."""
+    for c in prange(e.shape[0]):
+        f, k = t0 + c, a[c]
+        w0, w1, w2, w3 = w[c, 0], w[c, 1], w[c, 2], w[c, 3]
+        for v in range(e.shape[1]):
+            sq = 0.0
+            for i in range(3):
+                if hermite:
+                    x = w0 * poses[k, v, i] + w1 * out_t[k, v, i]
+                    x = x + w2 * poses[k + 1, v, i] + w3 * in_t[k + 1, v, i]
+                else:
+                    x = w0 * poses[k, v, i] + w2 * poses[k + 1, v, i]
+                d = np.float64(frames[f, v, i]) - x
+                sq += d * d
+            e[c, v] = np.sqrt(sq)
+
+
 def key_curve_errors(
     animation: Animation,
     kp: KeyPoses,
@@ -181,9 +221,28 @@ def key_curve_errors(
     cancelled: Callable[[], bool] | None = None,
     progress: Callable[[float], None] | None = None,
 ) -> PositionErrors | None:
-    """:func:`position_errors` against the key curve itself, rebuilt a chunk of frames at a time
-    in float64 (a 2,000 × 24 × 240 animation rebuilt whole is 138 MB in float32): what the CLI and
-    the studio's timeline both report. None as soon as ``cancelled()`` turns True."""
+    """:func:`position_errors` against the key curve itself, in float64, a chunk of frames at a
+    time, the curve never stored (a 2,000 × 24 × 240 animation rebuilt whole is 138 MB in
+    float32): what the CLI and the studio's timeline both report. None as soon as
+    ``cancelled()`` turns True. The distances come from one kernel (:func:`_curve_distances`),
+    the sums from numpy as :func:`key_curve_errors_reference` takes them; the two agree to
+    rounding (the kernel may fuse a multiply and an add)."""
+    return _curve_errors(animation, kp, cancelled, progress, reference=False)
+
+
+def key_curve_errors_reference(
+    animation: Animation,
+    kp: KeyPoses,
+    *,
+    cancelled: Callable[[], bool] | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> PositionErrors | None:
+    """The numpy twin of :func:`key_curve_errors`: each chunk of the curve rebuilt by
+    :func:`interpolate_at`, then its distances."""
+    return _curve_errors(animation, kp, cancelled, progress, reference=True)
+
+
+def _curve_errors(animation, kp, cancelled, progress, reference: bool) -> PositionErrors | None:
     f = animation.frames
     n, v = f.shape[0], f.shape[1]
     if kp.n_frames != n or kp.poses.shape[1:] != f.shape[1:]:
@@ -192,12 +251,22 @@ def key_curve_errors(
     mean, tip, worst = np.empty(n), np.empty(n), np.empty(n)
     v_sum, v_max = np.zeros(v), np.zeros(v)
     chunk = max(1, _CHUNK_VALUES // max(3 * v, 1))
+    poses = np.ascontiguousarray(kp.poses, np.float64)
+    hermite = kp.tangents is not None
+    out_t = np.ascontiguousarray(kp.tangents, np.float64) if hermite else np.zeros((0, 0, 0))
+    in_t = out_t if kp.tangents_in is None else np.ascontiguousarray(kp.tangents_in, np.float64)
+    buffer = np.empty((min(chunk, n), v))
     for f0 in range(0, n, chunk):
         if cancelled is not None and cancelled():
             return None
         t = np.arange(f0, min(n, f0 + chunk))
-        d = f[t].astype(np.float64) - interpolate_at(kp, t)
-        e = np.sqrt(np.einsum("fvi,fvi->fv", d, d))  # (chunk, V)
+        if reference:
+            d = f[t].astype(np.float64) - interpolate_at(kp, t)
+            e = np.sqrt(np.einsum("fvi,fvi->fv", d, d))  # (chunk, V)
+        else:
+            e = buffer[: t.size]
+            a, w = _segment_weights(kp, t)
+            _curve_distances(f, f0, a, w, poses, out_t, in_t, hermite, e)
         mean[t], tip[t], worst[t] = e.mean(axis=1), e[:, tips].mean(axis=1), e.max(axis=1)
         v_sum += e.sum(axis=0)
         np.maximum(v_max, e.max(axis=0), out=v_max)

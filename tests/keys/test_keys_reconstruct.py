@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import importlib
+
 import numpy as np
 import pytest
 
@@ -11,6 +13,8 @@ from hairtool.keys.reconstruct import (
     compare_with_uniform,
     interpolate_at,
     interpolate_keys,
+    key_curve_errors,
+    key_curve_errors_reference,
     key_distribution,
     key_poses,
     position_errors,
@@ -55,6 +59,20 @@ def test_key_curve_at_a_few_frames_is_those_rows_of_the_whole(anim, interp):
     assert interpolate_at(kp, [5], np.float32).dtype == np.float32
     with pytest.raises(ParameterError, match="frames"):
         interpolate_at(kp, [72])
+
+
+@pytest.mark.parametrize("interp", ["linear", "hermite", "hermite-fit"])
+def test_key_curve_errors_kernel_equals_its_numpy_twin_and_the_rebuilt_animation(anim, interp, monkeypatch):
+    rc = importlib.import_module("hairtool.keys.reconstruct")  # the package exports a function of that name
+    keys = np.array([0, 7, 19, 33, 50, 71])
+    kp = key_poses(anim.frames, keys, interp)
+    monkeypatch.setattr(rc, "_CHUNK_VALUES", 3 * anim.vertex_count * 5)  # 5 frames a chunk
+    got, ref = key_curve_errors(anim, kp), key_curve_errors_reference(anim, kp)
+    for name in ("per_frame_mean", "per_frame_max", "per_frame_tip", "per_vertex_mean", "per_vertex_max"):
+        np.testing.assert_allclose(getattr(got, name), getattr(ref, name), rtol=1e-13, atol=1e-15)
+    whole = position_errors(anim, interpolate_keys(kp))
+    np.testing.assert_allclose(got.per_frame_mean, whole.per_frame_mean, rtol=1e-12, atol=1e-15)
+    assert np.all(got.per_frame_max[keys] == 0.0) and got.per_frame_max.max() > 0
 
 
 def test_position_errors_in_scene_units(anim):
