@@ -122,19 +122,14 @@ def interpolate_at(kp: KeyPoses, frames: ArrayLike, dtype: type = np.float64) ->
         raise ParameterError("frames", f"{t.min()}..{t.max()}", f"frame numbers in [0, {kp.n_frames - 1}]")
     shape = kp.poses.shape[1:]
     flat_p = kp.poses.reshape(kp.keys.size, -1)
-    a = np.clip(np.searchsorted(kp.keys, t, side="right") - 1, 0, kp.keys.size - 2)
-    el = (kp.keys[a + 1] - kp.keys[a]).astype(np.float64)
-    s = ((t - kp.keys[a]) / el)[:, None]
+    a, w = _segment_weights(kp, t)
     if kp.tangents is None:
-        v = (1.0 - s) * flat_p[a] + s * flat_p[a + 1]
+        v = w[:, 0:1] * flat_p[a] + w[:, 2:3] * flat_p[a + 1]
     else:
         flat_m = kp.tangents.reshape(kp.keys.size, -1)
         flat_in = flat_m if kp.tangents_in is None else kp.tangents_in.reshape(kp.keys.size, -1)
-        h00 = 2 * s**3 - 3 * s**2 + 1
-        h10 = (s**3 - 2 * s**2 + s) * el[:, None]
-        h01 = -2 * s**3 + 3 * s**2
-        h11 = (s**3 - s**2) * el[:, None]
-        v = h00 * flat_p[a] + h10 * flat_m[a] + h01 * flat_p[a + 1] + h11 * flat_in[a + 1]
+        v = w[:, 0:1] * flat_p[a] + w[:, 1:2] * flat_m[a]
+        v = v + w[:, 2:3] * flat_p[a + 1] + w[:, 3:4] * flat_in[a + 1]
     return v.reshape(t.size, *shape).astype(dtype, copy=False)
 
 
@@ -177,8 +172,8 @@ def position_errors(original: Animation, rebuilt: Animation | ArrayLike) -> Posi
 
 def _segment_weights(kp: KeyPoses, t: NDArray[np.int64]) -> tuple[NDArray[np.int64], F64]:
     """Per frame of ``t``: the key a before it and the weights of p_a, out_a, p_b, in_b in its
-    curve value (linear: 1 − s and s, tangents weighted 0), computed as :func:`interpolate_at`
-    computes them, so the curve from them has its bytes."""
+    curve value (linear: 1 − s and s, tangents weighted 0; Hermite: the basis h00, h10·L, h01,
+    h11·L), shared by :func:`interpolate_at` and the error kernel."""
     a = np.clip(np.searchsorted(kp.keys, t, side="right") - 1, 0, kp.keys.size - 2)
     el = (kp.keys[a + 1] - kp.keys[a]).astype(np.float64)
     s = (t - kp.keys[a]) / el
