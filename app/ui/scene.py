@@ -181,15 +181,12 @@ class Scene(QObject):
         camera's direction at the cursor, ``invert`` Ctrl held. Returns whether the brush
         reached a strand (its circle held a vertex; False unchecked with ``check_touch`` off)."""
         self.start_engine()
-        t0 = time.perf_counter()
         plane = self.mirror_plane_x()
         samples = self.tool.samples(cursor, direction, view, plane, invert)
         if samples:
-            self.result = self.pipeline.apply_samples(samples)
-            self._children_moved()
-            self._sync_mask()
-        self.last_update_ms = (time.perf_counter() - t0) * 1e3
-        self.points_changed.emit()
+            self.apply_samples(samples)
+        else:  # a comb standing still: nothing to apply; the view still follows the cursor
+            self.points_changed.emit()
         return check_touch and self.tool.touches(self.pipeline.aligned.points, cursor, plane)
 
     def apply_samples(self, samples: list) -> None:
