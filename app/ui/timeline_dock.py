@@ -103,7 +103,9 @@ class KeyControls(QWidget):
         self.curvature.setDecimals(4)
         self.curvature.setRange(0.0, 1000.0)
         self.curvature.setStepType(QDoubleSpinBox.StepType.AdaptiveDecimalStepType)
-        self.curvature.setToolTip("λ of the curvature term: short, sharp deformations cost more to skip")
+        self.curvature.setToolTip(
+            "weight λ of the curvature term (seed 000): short, sharp deformations cost more to skip"
+        )
         self.view = QComboBox()
         self.view.setObjectName("ViewMode")
         for key, label in VIEW_MODES.items():
@@ -122,7 +124,7 @@ class KeyControls(QWidget):
         form.addRow("Interpolation", self.interp)
         form.addRow("Samples / strand", self.samples)
         form.addRow("Tip weight", self.tip_weight)
-        form.addRow("Curvature λ", self.curvature)
+        form.addRow("Curvature weight", self.curvature)
         form.addRow("View", self.view)
         self.summary = QLabel()
         self.summary.setWordWrap(True)
