@@ -12,6 +12,9 @@ import os
 
 import numpy as np
 from numba import get_num_threads, njit, prange
+from numba.core import types
+from numba.extending import intrinsic
+from numba.np.arrayobj import make_array, populate_array
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
@@ -151,14 +154,19 @@ def rotation_cost_table_reference(
     cost = np.zeros((n, n))
     for i in range(n):
         for j in range(i + 2, n):
-            t = (np.arange(i + 1, j) - i) / (j - i)
-            s = quat.slerp(q[i][None], q[j][None], t[:, None])  # (k, J, 4)
-            d = quat.distance(q[i + 1 : j], s)
-            lin = p[i] + t[:, None] * (p[j] - p[i])
-            cost[i, j] = np.sum(w[None, :] * d * d) + wt * np.sum((p[i + 1 : j] - lin) ** 2)
+            cost[i, j] = _pair_cost_reference(q, p, w, wt, i, j)
     if max_span is not None:
         cost[np.triu(np.ones((n, n), dtype=bool), k=int(max_span) + 1)] = np.inf
     return cost + cost.T
+
+
+def _pair_cost_reference(q: F64, p: F64, w: F64, wt: float, i: int, j: int) -> float:
+    """cost[i, j] of :func:`rotation_cost_table_reference` from :func:`_cost_inputs`' arrays."""
+    t = (np.arange(i + 1, j) - i) / (j - i)
+    s = quat.slerp(q[i][None], q[j][None], t[:, None])  # (k, J, 4)
+    d = quat.distance(q[i + 1 : j], s)
+    lin = p[i] + t[:, None] * (p[j] - p[i])
+    return float(np.sum(w[None, :] * d * d) + wt * np.sum((p[i + 1 : j] - lin) ** 2))
 
 
 #: The kernel's only fast-math flag: "contract" fuses a multiply and an add into one FMA (one
@@ -254,6 +262,36 @@ def _cost_table_kernel(q, p, w, wt, max_span, n_hands):
     return cost
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _aligned_rows(n_rows, length):
+    """``(n_rows, ≥ length)`` zeros whose rows start on 64-byte boundaries (one cache line, one
+    512-bit vector), so that vector loads along a row never straddle two lines."""
+    stride = (length + 7) // 8 * 8
+    buf = np.zeros(n_rows * stride + 8)
+    start = ((-buf.ctypes.data) % 64) // 8
+    return buf[start : start + n_rows * stride].reshape((n_rows, stride))
+
+
+@intrinsic
+def _borrowed(typingctx, arr):
+    """A view of ``arr`` that holds no reference to its buffer; the caller keeps the owner alive.
+
+    Every view numba makes of an array takes a reference to its buffer and drops it again, two
+    atomic operations; the cost table's per-pass views of its ends' arrays spent a third of its
+    time on them. Views of a borrowed array take none.
+    """
+    if not isinstance(arr, types.Array):
+        return None
+
+    def codegen(context, builder, sig, args):
+        owner = make_array(sig.args[0])(context, builder, args[0])
+        view = make_array(sig.return_type)(context, builder)
+        populate_array(view, owner.data, owner.shape, owner.strides, owner.itemsize, meminfo=None)
+        return view._getvalue()
+
+    return arr(arr), codegen
+
+
 #: Segment ends l = j − i handled together: their running state (nine arrays) stays in the L1 cache.
 _BLOCK = 512
 
@@ -285,15 +323,15 @@ def _cos_sin_small(d):
 
 @njit(cache=True, nogil=True, fastmath=_EXACT, inline="always")
 def _skip_frame(ca, sa, cd, sd, e0, e1, e2, e3, live, gap, dk, qk0, qk1, qk2, qk3, lo, hi):
-    """Frame k's gap u = 1 − |q_k · slerp| = 1 − cos Dist in every segment end l in [lo, hi) (0
-    where ``live`` is 0), and each end's (cos, sin) one step on. The views start at 0 so the
-    compiler sees plain non-negative indices and vectorises."""
+    """Frame k's gap u = 1 − |q_k · slerp| = 1 − cos Dist in every segment end l in [lo, hi)
+    (min(u, live): 0 where ``live`` is 0, u where it is 2), and each end's (cos, sin) one step on.
+    The views start at 0 so the compiler sees plain non-negative indices and vectorises."""
     ca, sa, cd, sd, live = ca[lo:hi], sa[lo:hi], cd[lo:hi], sd[lo:hi], live[lo:hi]
     e0, e1, e2, e3, gap = e0[lo:hi], e1[lo:hi], e2[lo:hi], e3[lo:hi], gap[lo:hi]
     for l in range(hi - lo):
         c0, s0, c1, s1 = ca[l], sa[l], cd[l], sd[l]
         x = abs(c0 * dk + s0 * (qk0 * e0[l] + qk1 * e1[l] + qk2 * e2[l] + qk3 * e3[l]))
-        gap[l] = live[l] * max(1.0 - x, 0.0)
+        gap[l] = min(max(1.0 - x, 0.0), live[l])
         ca[l] = c0 * c1 - s0 * s1
         sa[l] = s0 * c1 + c0 * s1
 
@@ -313,11 +351,11 @@ def _skip_two_frames(
         f0, f1, f2, f3 = e0[l], e1[l], e2[l], e3[l]
         on = live[l]
         x = abs(c0 * dk + s0 * (qk0 * f0 + qk1 * f1 + qk2 * f2 + qk3 * f3))
-        gap[l] = on * max(1.0 - x, 0.0)
+        gap[l] = min(max(1.0 - x, 0.0), on)
         c2 = c0 * c1 - s0 * s1
         s2 = s0 * c1 + c0 * s1
         x = abs(c2 * dn + s2 * (qn0 * f0 + qn1 * f1 + qn2 * f2 + qn3 * f3))
-        gap2[l] = (0.0 if l == dead else on) * max(1.0 - x, 0.0)
+        gap2[l] = min(max(1.0 - x, 0.0), 0.0 if l == dead else on)
         ca[l] = c2 * c1 - s2 * s1
         sa[l] = s2 * c1 + c2 * s1
 
@@ -395,24 +433,19 @@ def _cost_row(q, p, w, wt, i, j_end, out):
     n_b = q.shape[0]
     m = j_end - i  # local index l = j − i
     # Lanes padded to whole SIMD vectors: a loop starts and ends on a multiple of 8 from its
-    # block's start, and lanes that take no part (segments that end before frame k, padding)
-    # have weight 0 in ``live``, so no loop has a scalar remainder.
+    # block's start, a 64-byte boundary, and lanes that take no part (segments that end before
+    # frame k, padding, l < 2) have weight 0 in ``live``, so no loop has a scalar remainder. The
+    # ends' arrays are rows of one buffer, borrowed (no reference counting in the passes' views);
+    # ``total`` keeps the buffer alive to the end.
     mp = m + 8
-    acc = np.zeros(mp)
-    ca = np.zeros(mp)
-    sa = np.zeros(mp)
-    cd = np.ones(mp)
-    sd = np.zeros(mp)
-    e0 = np.zeros(mp)
-    e1 = np.zeros(mp)
-    e2 = np.zeros(mp)
-    e3 = np.zeros(mp)
-    dl = np.zeros(mp)
-    live = np.zeros(mp)
-    total = np.zeros(m)
-    gap = np.zeros(mp)
+    lanes = _aligned_rows(14, mp)
+    total = lanes[13]
+    acc, ca, sa = _borrowed(lanes[0]), _borrowed(lanes[1]), _borrowed(lanes[2])
+    cd, sd, live = _borrowed(lanes[3]), _borrowed(lanes[4]), _borrowed(lanes[5])
+    e0, e1, e2, e3 = _borrowed(lanes[6]), _borrowed(lanes[7]), _borrowed(lanes[8]), _borrowed(lanes[9])
+    dl, gap, gap2 = _borrowed(lanes[10]), _borrowed(lanes[11]), _borrowed(lanes[12])
+    cd[:] = 1.0
     bits = gap.view(np.int64)
-    gap2 = np.zeros(mp)
     bits2 = gap2.view(np.int64)
     for b in range(n_b):
         qi0, qi1, qi2, qi3 = q[b, i, 0], q[b, i, 1], q[b, i, 2], q[b, i, 3]
@@ -438,8 +471,8 @@ def _cost_row(q, p, w, wt, i, j_end, out):
             cd[l], sd[l] = _cos_sin_small(dl[l])
             ca[l], sa[l] = cd[l], sd[l]  # k − i = 1
             acc[l] = 0.0
-            live[l] = 1.0
-        for l0 in range(2, m, _BLOCK):
+            live[l] = 2.0  # above any gap: min(gap, live) keeps it
+        for l0 in range(0, m, _BLOCK):  # from lane 0, aligned; lanes 0 and 1 weigh 0
             l1 = min(m, l0 + _BLOCK)
             hi = l0 + (l1 - l0 + 7) // 8 * 8
             r = 1

@@ -70,6 +70,29 @@ def test_kernel_matches_numpy_twin_on_every_capture(motion_dir, name):
     assert np.max(np.abs(fast[iu] - slow[iu]) / slow[iu]) < 1e-7  # even the smallest entries
 
 
+def test_kernel_matches_numpy_twin_across_blocks_of_ends(motion_dir):
+    """Rows longer than a block of segment ends (512) run several blocks, each from an aligned lane."""
+    from hairtool.mocap.costs import _BLOCK, _cost_inputs, _pair_cost_reference
+
+    m = read_bvh(motion_dir / "pymo_walk.bvh")
+    n = 2 * _BLOCK + 30  # the walk has 1,064 frames
+    m = m.with_values(m.values[:n])
+    fast = rotation_cost_table(m)
+    q, p, w, wt = _cost_inputs(m, None, None)
+    pairs = [(0, _BLOCK - 1), (0, _BLOCK), (0, _BLOCK + 1), (0, n - 1), (1, n - 1), (5, 2 * _BLOCK + 3)]
+    for i, j in pairs + [(400, n - 2)]:
+        assert fast[i, j] == pytest.approx(_pair_cost_reference(q, p, w, wt, i, j), rel=1e-12)
+
+
+def test_aligned_rows_start_on_cache_lines():
+    from hairtool.mocap.costs import _aligned_rows
+
+    for length in (1, 9, 1307):
+        rows = _aligned_rows(5, length)
+        assert rows.shape[0] == 5 and rows.shape[1] >= length and not rows.any()
+        assert all(rows[c].ctypes.data % 64 == 0 for c in range(5))
+
+
 def test_arccos_squared_polynomials_are_exact_to_rounding():
     from hairtool.mocap.costs import _acos2_far, _acos2_mid, _acos2_near, acos2_reference
 
