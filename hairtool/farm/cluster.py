@@ -19,6 +19,15 @@ INSTALL_HINT = "pip install 'hairtool[farm]' (or pip install 'dask[distributed]'
 CONNECT_TIMEOUT_S = 20.0
 #: A job whose worker died this many times is reported failed (Dask's allowed-failures + 1).
 ALLOWED_FAILURES = 3
+#: Local workers' housekeeping, slowed: by default each samples its running task's stack every
+#: 10 ms (the statistical profiler) and wakes its event loop every 20 ms to time it, taking the
+#: GIL from the job each time; on a machine whose every core runs a job, that is the jobs' time.
+QUIET_WORKERS = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
 
 
 def require_dask() -> ModuleType:
@@ -66,7 +75,7 @@ def open_client(scheduler: str | None = None, workers: int | None = None) -> Ite
             client.close()
         return
     n = local_workers(workers)
-    with dask.config.set({"distributed.scheduler.allowed-failures": ALLOWED_FAILURES - 1}):
+    with dask.config.set({"distributed.scheduler.allowed-failures": ALLOWED_FAILURES - 1, **QUIET_WORKERS}):
         cluster = distributed.LocalCluster(
             n_workers=n,
             threads_per_worker=1,

@@ -166,3 +166,16 @@ def test_two_jobs_writing_one_file_are_warned_about(project, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2  # three jobs, one file
     assert all(ln.startswith("hairtool batch: warning: job ") and ln.endswith("k.json") for ln in err)
+
+
+def test_local_workers_keep_their_housekeeping_off_the_jobs():
+    """A local cluster's workers neither profile their task nor wake their loop every 20 ms: on a
+    machine whose every core runs a job, that would be taken from the jobs."""
+    import dask
+
+    from hairtool.farm.cluster import QUIET_WORKERS, open_client
+
+    with open_client(None, 1) as client:
+        seen = client.run(lambda: {k: dask.config.get(k) for k in QUIET_WORKERS})
+    assert list(seen.values()) == [QUIET_WORKERS]
+    assert QUIET_WORKERS["distributed.worker.profile.enabled"] is False
