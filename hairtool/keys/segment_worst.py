@@ -11,6 +11,7 @@ import numpy as np
 from numba import get_num_threads, njit, prange
 from numpy.typing import NDArray
 
+from hairtool.kernel_arrays import borrowed
 from hairtool.keys.gram import check_gram, frame_errors_reference
 from hairtool.keys.segment_hermite import hermite_quad_terms, stencil_at
 
@@ -29,24 +30,30 @@ def _worst_kernel(g, curv, lam, hermite, n_hands):  # pragma: no cover - compile
     for k in range(n):
         diag[k] = g[k, k]
         base[k] = g[k, k] + lam * curv[k]
+    # Per hand, the rows' scratch (1/(j − i), and the Hermite terms): arguments of the row, so
+    # alive while it borrows them.
+    inv = np.zeros((n_hands, n))
+    u = np.empty((n_hands, 10, n) if hermite else (n_hands, 10, 0))
     for c in prange(n_hands):
         for i in range(c, n, n_hands):
-            _worst_row(g, base, diag, hermite, i, out[i])
+            _worst_row(g, base, diag, hermite, i, out[i], inv[c], u[c])
     return out
 
 
 @njit(cache=True, nogil=True)
-def _worst_row(g, base, diag, hermite, i, w):  # pragma: no cover - compiled
+def _worst_row(g, base, diag, hermite, i, w, inv, u):  # pragma: no cover - compiled
     """w[j] = W[i, j] for every j > i + 1, skipped frame by skipped frame: for each k, the cost
     of frame k in every segment (i, j > k) at once, kept where it is the largest so far.
 
     The loop over j reads rows of G (symmetric: G[k, j] is row k), needs no reduction and runs
     the length of the row, so it vectorises; the maximum is exact in any order, so the table is
-    the numpy twin's whatever the loop order.
+    the numpy twin's whatever the loop order. Its per-frame views are of borrowed arrays: both
+    threads slicing G had fought over its reference count (:mod:`hairtool.kernel_arrays`).
     """
     n = g.shape[0]
+    g, base, diag, w = borrowed(g), borrowed(base), borrowed(diag), borrowed(w)
+    inv, u = borrowed(inv), borrowed(u)
     gi = g[i]
-    inv = np.zeros(n)
     for j in range(i + 2, n):
         inv[j] = 1.0 / (j - i)
         w[j] = -np.inf
@@ -60,7 +67,6 @@ def _worst_row(g, base, diag, hermite, i, w):  # pragma: no cover - compiled
         return
     # Hermite: per j, the ten ⟨u_a, u_b⟩ of hermite_quad_terms; the end tangent's stencil is
     # (j − 1, j + 1, 1/2) but at the last frame, which gets its own pass so the loop stays plain
-    u = np.empty((10, n))
     for j in range(i + 2, n):
         t = hermite_quad_terms(g, i, j, n)
         for m in range(10):

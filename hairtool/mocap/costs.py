@@ -12,12 +12,10 @@ import os
 
 import numpy as np
 from numba import get_num_threads, njit, prange
-from numba.core import types
-from numba.extending import intrinsic
-from numba.np.arrayobj import make_array, populate_array
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
+from hairtool.kernel_arrays import aligned_rows, borrowed
 from hairtool.keys.costs import check_frame_count
 from hairtool.mocap import quaternion as quat
 from hairtool.mocap.bvh import Motion, read_bvh
@@ -262,36 +260,6 @@ def _cost_table_kernel(q, p, w, wt, max_span, n_hands):
     return cost
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _aligned_rows(n_rows, length):
-    """``(n_rows, ≥ length)`` zeros whose rows start on 64-byte boundaries (one cache line, one
-    512-bit vector), so that vector loads along a row never straddle two lines."""
-    stride = (length + 7) // 8 * 8
-    buf = np.zeros(n_rows * stride + 8)
-    start = ((-buf.ctypes.data) % 64) // 8
-    return buf[start : start + n_rows * stride].reshape((n_rows, stride))
-
-
-@intrinsic
-def _borrowed(typingctx, arr):
-    """A view of ``arr`` that holds no reference to its buffer; the caller keeps the owner alive.
-
-    Every view numba makes of an array takes a reference to its buffer and drops it again, two
-    atomic operations; the cost table's per-pass views of its ends' arrays spent a third of its
-    time on them. Views of a borrowed array take none.
-    """
-    if not isinstance(arr, types.Array):
-        return None
-
-    def codegen(context, builder, sig, args):
-        owner = make_array(sig.args[0])(context, builder, args[0])
-        view = make_array(sig.return_type)(context, builder)
-        populate_array(view, owner.data, owner.shape, owner.strides, owner.itemsize, meminfo=None)
-        return view._getvalue()
-
-    return arr(arr), codegen
-
-
 #: Segment ends l = j − i handled together: their running state (nine arrays) stays in the L1 cache.
 _BLOCK = 512
 
@@ -438,12 +406,12 @@ def _cost_row(q, p, w, wt, i, j_end, out):
     # ends' arrays are rows of one buffer, borrowed (no reference counting in the passes' views);
     # ``total`` keeps the buffer alive to the end.
     mp = m + 8
-    lanes = _aligned_rows(14, mp)
+    lanes = aligned_rows(14, mp)
     total = lanes[13]
-    acc, ca, sa = _borrowed(lanes[0]), _borrowed(lanes[1]), _borrowed(lanes[2])
-    cd, sd, live = _borrowed(lanes[3]), _borrowed(lanes[4]), _borrowed(lanes[5])
-    e0, e1, e2, e3 = _borrowed(lanes[6]), _borrowed(lanes[7]), _borrowed(lanes[8]), _borrowed(lanes[9])
-    dl, gap, gap2 = _borrowed(lanes[10]), _borrowed(lanes[11]), _borrowed(lanes[12])
+    acc, ca, sa = borrowed(lanes[0]), borrowed(lanes[1]), borrowed(lanes[2])
+    cd, sd, live = borrowed(lanes[3]), borrowed(lanes[4]), borrowed(lanes[5])
+    e0, e1, e2, e3 = borrowed(lanes[6]), borrowed(lanes[7]), borrowed(lanes[8]), borrowed(lanes[9])
+    dl, gap, gap2 = borrowed(lanes[10]), borrowed(lanes[11]), borrowed(lanes[12])
     cd[:] = 1.0
     bits = gap.view(np.int64)
     bits2 = gap2.view(np.int64)

@@ -84,15 +84,6 @@ def test_kernel_matches_numpy_twin_across_blocks_of_ends(motion_dir):
         assert fast[i, j] == pytest.approx(_pair_cost_reference(q, p, w, wt, i, j), rel=1e-12)
 
 
-def test_aligned_rows_start_on_cache_lines():
-    from hairtool.mocap.costs import _aligned_rows
-
-    for length in (1, 9, 1307):
-        rows = _aligned_rows(5, length)
-        assert rows.shape[0] == 5 and rows.shape[1] >= length and not rows.any()
-        assert all(rows[c].ctypes.data % 64 == 0 for c in range(5))
-
-
 def test_arccos_squared_polynomials_are_exact_to_rounding():
     from hairtool.mocap.costs import _acos2_far, _acos2_mid, _acos2_near, acos2_reference
 
