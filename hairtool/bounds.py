@@ -16,22 +16,18 @@ from hairtool.errors import GroomError
 
 @njit(cache=True, nogil=True)
 def _box(p, lo, hi):
-    """Min and max per column; a NaN in a column makes both NaN (as numpy's min and max do)."""
-    nan = np.zeros(3, np.bool_)
-    for a in range(3):
-        lo[a] = np.inf
-        hi[a] = -np.inf
+    """Min and max per column; a NaN in a column makes both NaN (as numpy's min and max do). The
+    running extremes live in registers (in ``lo`` and ``hi`` they cost a store per point: 2.5x)."""
+    l0 = l1 = l2 = np.inf
+    h0 = h1 = h2 = -np.inf
+    n0 = n1 = n2 = False
     for i in range(p.shape[0]):
-        for a in range(3):
-            x = p[i, a]
-            if x < lo[a]:
-                lo[a] = x
-            if x > hi[a]:
-                hi[a] = x
-            nan[a] |= x != x
-    for a in range(3):
-        if nan[a]:
-            lo[a] = hi[a] = np.nan
+        x, y, z = p[i, 0], p[i, 1], p[i, 2]
+        l0, h0, n0 = (x if x < l0 else l0), (x if x > h0 else h0), n0 | (x != x)
+        l1, h1, n1 = (y if y < l1 else l1), (y if y > h1 else h1), n1 | (y != y)
+        l2, h2, n2 = (z if z < l2 else l2), (z if z > h2 else h2), n2 | (z != z)
+    lo[0], lo[1], lo[2] = (np.nan if n0 else l0), (np.nan if n1 else l1), (np.nan if n2 else l2)
+    hi[0], hi[1], hi[2] = (np.nan if n0 else h0), (np.nan if n1 else h1), (np.nan if n2 else h2)
 
 
 def box(points: ArrayLike) -> tuple[NDArray, NDArray]:

@@ -87,10 +87,10 @@ def _frames_py(points, rest_tangent, n, out):
                     tx, ty, tz = ux, uy, uz
             d = nx * tx + ny * ty + nz * tz  # keep n ⟂ t and unit against drift
             nx, ny, nz, _ = _unit(nx - d * tx, ny - d * ty, nz - d * tz)
-            o = out[a + i]
-            o[0], o[1], o[2] = tx, ty, tz
-            o[3], o[4], o[5] = nx, ny, nz
-            o[6], o[7], o[8] = ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx
+            v = a + i  # (indexed in place: a row view per vertex costs two atomic counts)
+            out[v, 0], out[v, 1], out[v, 2] = tx, ty, tz
+            out[v, 3], out[v, 4], out[v, 5] = nx, ny, nz
+            out[v, 6], out[v, 7], out[v, 8] = ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx
 
 
 _frames_serial = njit(cache=True, nogil=True)(_frames_py)
