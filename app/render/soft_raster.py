@@ -76,16 +76,20 @@ def _unit(c):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _setup_kernel(points, starts, colors, m, w, h, margin, scale, seg, box, which):
+def _setup_kernel(points, starts, colors, m, w, h, margin, scale, seg, box, which, width, weight):
     """Window coordinates and colours of every segment's ends and its width ``scale`` (none
     given: 1) (or of those flagged in ``which``, when it is not empty), and the rows
     ``box[0, i] … box[1, i]`` and columns ``box[2, i] … box[3, i]`` it may touch (rows
-    ``0 … −1``: none, e.g. wholly behind the eye or off the image)."""
+    ``0 … −1``: none, e.g. wholly behind the eye or off the image); with a ``weight`` array, the
+    segment's work per row for :func:`band_bounds`, 1 + its quad's ``width`` × scale (as a
+    numpy pass over the table's strided column it had cost 10 ms a full-density frame)."""
     for i in prange(starts.size):
         if which.size and not which[i]:
             continue
         box[0, i], box[1, i], box[2, i], box[3, i] = 0, -1, 0, -1
         seg[i, 12] = scale[i] if scale.size else 1.0
+        if weight.size:
+            weight[i] = 1.0 + width * seg[i, 12]
         a = starts[i]
         ax, ay, az, aw = _project(points, a, m)
         bx, by, bz, bw = _project(points, a + 1, m)
@@ -470,6 +474,7 @@ class StrandRaster:
         self.depth = np.zeros((0, 0), np.float32)
         self._seg = np.zeros((0, _SEG))
         self._box = np.zeros((4, 0), np.int32)
+        self._weight = _NO_SCALE  # per segment, its work per row (quads only; see _draw_all)
         self._last: tuple | None = None  # (half, fill, size) of the images' last draw with a clear
         self._last_mvp = np.zeros((4, 4))
         self._last_starts = np.zeros(0, np.int64)
@@ -562,23 +567,21 @@ class StrandRaster:
         h, w = self.depth.shape
         sc = self._last_scale if self._last_scale.ndim else _NO_SCALE
         p, s, c, m, sc = (_read_only(a) for a in (p, s, c, m, sc))
-        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, sc, self._seg, self._box, which)
+        weight = self._weight if which.size == 0 else _NO_SCALE
+        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, sc, self._seg, self._box, which, 2.0 * half, weight)
 
     def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
         h, w = depth.shape
         n = s.size
         self._seg, self._box = self._view("seg", (n, _SEG), np.float64), self._view("box", (4, n), np.int32)
         self._last_scale = self._kept("scale", scale, fixed=True) if scale.ndim else scale
-        self._setup(p, s, c, m, half, self._all)
         # One band per thread: more, smaller bands cut more segments in two, which cost more
         # than the better balance gained. A quad's row costs about 1 + its width in pixels
         # (measured on the bench's tapered render hair: rows-only counts left one thread
-        # a third more work than the other).
-        weight = None
-        if half > 0.0:  # into kept memory: numpy's two 25 MB temporaries page-faulted 50 ms a release
-            weight = self._view("weight", (n,), np.float64)
-            np.multiply(self._seg[:, 12], 2.0 * half, out=weight)
-            weight += 1.0
+        # a third more work than the other); the set-up writes that weight, into kept memory.
+        self._weight = self._view("weight", (n,), np.float64) if half > 0.0 else _NO_SCALE
+        self._setup(p, s, c, m, half, self._all)
+        weight = self._weight if half > 0.0 else None
         bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads(), weight)
         draw_bands(self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth)
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1

@@ -106,7 +106,8 @@ def test_any_split_into_bands_gives_the_same_bytes(width):
     e, h = len(starts), SIZE[1]
     seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
     soft_raster._setup_kernel(
-        points, starts, colors, mvp, SIZE[0], h, 0.75 * width + 1.0, np.zeros(0), seg, box, np.zeros(0, bool)
+        points, starts, colors, mvp, SIZE[0], h, 0.75 * width + 1.0, np.zeros(0), seg, box, np.zeros(0, bool),
+        width, np.zeros(0),
     )
     splits = [soft_raster.band_bounds(box[0], box[1], h, n) for n in (1, 4, 13)]
     splits += [np.arange(h + 1), np.array([0, 1, 2, 30, h])]  # one row each; uneven
@@ -135,8 +136,10 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
             )
         )
         seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
-        setup(points, starts, colors, mvp, w, h, 4.0, np.zeros(0), seg, box, np.zeros(0, bool))
-        bounds = soft_raster.band_bounds(box[0], box[1], h, 3)
+        weight = np.zeros(e)
+        setup(points, starts, colors, mvp, w, h, 4.0, np.zeros(0), seg, box, np.zeros(0, bool), 3.0, weight)
+        np.testing.assert_array_equal(weight, 1.0 + 3.0 * seg[:, 12])
+        bounds = soft_raster.band_bounds(box[0], box[1], h, 3, weight)
         images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)] * 3
         images = [a.copy() for a in images]
         bands(seg, box, bounds, 0.0, True, np.uint32(7), *images[:2])
