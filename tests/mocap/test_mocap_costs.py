@@ -80,7 +80,7 @@ def test_kernel_matches_numpy_twin_across_blocks_of_ends(motion_dir):
     fast = rotation_cost_table(m)
     q, p, w, wt = _cost_inputs(m, None, None)
     pairs = [(0, _BLOCK - 1), (0, _BLOCK), (0, _BLOCK + 1), (0, n - 1), (1, n - 1), (5, 2 * _BLOCK + 3)]
-    for i, j in pairs + [(400, n - 2)]:
+    for i, j in [*pairs, (400, n - 2)]:
         assert fast[i, j] == pytest.approx(_pair_cost_reference(q, p, w, wt, i, j), rel=1e-12)
 
 
