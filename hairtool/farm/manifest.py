@@ -167,13 +167,27 @@ class Manifests:
         entries = {**entries, **new}
         try:
             with atomic_open(path, "w", encoding="utf-8") as f:
-                json.dump({"format": FORMAT, "version": VERSION, "jobs": entries}, f, indent=1)
-                f.write("\n")
+                f.write(manifest_text(entries))
         except OSError as e:
             raise FormatError(path, f"cannot write the batch manifest: {e.strerror or e}") from None
         self._entries[folder] = self._written[folder] = entries
         self._identity[folder] = _identity(path)
         return path
+
+
+def manifest_text(entries: dict[str, dict]) -> str:
+    """The manifest file's JSON: one job per line, each compact.
+
+    The client rewrites the manifest after every job that finishes, so its writing grows with the
+    square of the batch. ``json.dump`` with an indent encodes in Python; compact ``json.dumps``
+    per entry encodes in C (16 keys jobs: 0.1 s of the client's CPU a batch, taken from the
+    workers on a machine whose every core runs one, against about 0.01 s)."""
+    def compact(value) -> str:
+        return json.dumps(value, ensure_ascii=False, separators=(",", ":"))
+
+    head = json.dumps({"format": FORMAT, "version": VERSION}, ensure_ascii=False)[:-1]
+    jobs = ",\n".join(f"{compact(key)}: {compact(entry)}" for key, entry in entries.items())
+    return f'{head}, "jobs": {{\n{jobs}\n}}}}\n'
 
 
 def _identity(path: Path) -> tuple[int, int, int, int] | None:

@@ -116,3 +116,15 @@ def test_a_job_that_wrote_nothing_is_not_recorded(project):
     assert result["status"] == "done" and result["outputs"] == {}
     assert Manifests().record(job, result) is None
     assert Manifests().find_done(job) is None
+
+
+def test_the_manifest_text_is_the_entries_one_job_a_line():
+    import json
+
+    from hairtool.farm.manifest import FORMAT, VERSION, manifest_text
+
+    entries = {"keys a": {"inputs": {"shots/ä.npz": {"bytes": 3}}, "outputs": {}}, 'odd "key"': {}}
+    text = manifest_text(entries)
+    assert json.loads(text) == {"format": FORMAT, "version": VERSION, "jobs": entries}
+    assert text.count("\n") == len(entries) + 2 and "ä" in text
+    assert json.loads(manifest_text({}))["jobs"] == {}
