@@ -8,11 +8,13 @@ interpolations: the worst-frame objective, fitted Hermite handles, and the total
 ten pinned and ten excluded frames (``constrained``), each a table plus the all-K DP; and seed
 003's quaternion-distance table (objective ``quaternion``, interp ``slerp``, dims = joints) of a
 real capture of that many frames, the 1,064-frame PyMO walk (23 joints) played forward and back.
+Tables and DPs are the median of ``--repeat`` runs (features and the direct table: one).
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import time
 
 import numpy as np
@@ -28,11 +30,13 @@ HAIR_SAMPLES = 16
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--quick", action="store_true", help="tiny sizes (for tests)")
+    from hairtool.bench import add_common_arguments
+
     parser.add_argument("--sizes", help="comma-separated FRAMESxDIMS, e.g. 300x69,1300x69")
     parser.add_argument("--max-keys", type=int, default=100, help="DP for every K up to this")
     parser.add_argument("--interp", choices=("linear", "hermite"), default="linear")
     parser.add_argument("--no-direct", action="store_true", help="skip the direct O(n^3 D) table")
+    add_common_arguments(parser, quick="tiny sizes (for tests)", repeat=3)
 
 
 def _parse_sizes(text: str) -> list[tuple[int, int]]:
@@ -63,17 +67,24 @@ def _features(n: int, d: int) -> tuple[np.ndarray, float | None]:
     return np.cumsum(rng.normal(size=(n, d)), axis=0), None
 
 
-def _time(fn):
-    t0 = time.perf_counter()
-    out = fn()
-    return out, time.perf_counter() - t0
+def _time(fn, repeat: int = 1):
+    """``fn()`` and the median of ``repeat`` timings of it (the first run of a table also pays
+    for faulting in its fresh memory, which a single timing charged to whichever row came first)."""
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return out, statistics.median(times)
 
 
 def run(args: argparse.Namespace) -> list[dict]:
+    from hairtool.bench import setup
     from hairtool.keys.costs import cost_table
     from hairtool.keys.dp import solve_layers
     from hairtool.keys.segment_direct import direct_cost_table
 
+    repeat = setup(args)
     sizes = QUICK if args.quick else (_parse_sizes(args.sizes) if args.sizes else SIZES)
     # compile (or load) the kernels outside the timings
     warm = np.cumsum(np.random.default_rng(0).normal(size=(8, 2)), axis=0)
@@ -86,10 +97,10 @@ def run(args: argparse.Namespace) -> list[dict]:
     rows = []
     for n, d in sizes:
         x, features_s = _features(n, d)
-        _, gram_s = _time(lambda x=x: x @ x.T)
-        table, table_s = _time(lambda x=x: cost_table(x, args.interp))
+        _, gram_s = _time(lambda x=x: x @ x.T, repeat)
+        table, table_s = _time(lambda x=x: cost_table(x, args.interp), repeat)
         kmax = min(args.max_keys, n)
-        _, dp_s = _time(lambda t=table, k=kmax: solve_layers(t, k))
+        _, dp_s = _time(lambda t=table, k=kmax: solve_layers(t, k), repeat)
         select_s = table_s + dp_s
         direct_s, agree = None, None
         if not args.no_direct:
@@ -118,16 +129,16 @@ def run(args: argparse.Namespace) -> list[dict]:
         )
     for n, d in sizes:
         if d <= 3000:
-            rows += _other_modes(n, d, min(args.max_keys, n))
+            rows += _other_modes(n, d, min(args.max_keys, n), repeat)
     for n in sorted({n for n, d in sizes if d <= 3000}):
-        rows.append(_quaternion_row(n, min(args.max_keys, n)))
+        rows.append(_quaternion_row(n, min(args.max_keys, n), repeat))
     return rows
 
 
 QUATERNION_CAPTURE = "pymo_walk.bvh"
 
 
-def _quaternion_row(n: int, kmax: int) -> dict:
+def _quaternion_row(n: int, kmax: int, repeat: int = 1) -> dict:
     """Seed 003's quaternion-distance table of an n-frame capture, plus the all-K DP on it."""
     from hairtool.bench import MOTION_DIR, threads
     from hairtool.keys.dp import solve_layers
@@ -139,8 +150,8 @@ def _quaternion_row(n: int, kmax: int) -> dict:
     laps = [v if lap % 2 == 0 else v[::-1] for lap in range(n // len(v) + 1)]
     motion = motion.with_values(np.concatenate(laps)[:n])
     rotation_cost_table(motion.with_values(motion.values[: min(n, 12)]))  # compile outside the timing
-    table, table_s = _time(lambda: rotation_cost_table(motion))
-    _, dp_s = _time(lambda: solve_layers(table, kmax))
+    table, table_s = _time(lambda: rotation_cost_table(motion), repeat)
+    _, dp_s = _time(lambda: solve_layers(table, kmax), repeat)
     return {
         "frames": n,
         "dims": motion.n_joints,
@@ -154,7 +165,7 @@ def _quaternion_row(n: int, kmax: int) -> dict:
     }
 
 
-def _other_modes(n: int, d: int, kmax: int) -> list[dict]:
+def _other_modes(n: int, d: int, kmax: int, repeat: int = 1) -> list[dict]:
     """Table + all-K DP for the worst-frame objective, fitted handles, and pins/exclusions."""
     from hairtool.keys.constraints import KeyConstraints
     from hairtool.keys.costs import cost_table
@@ -172,9 +183,9 @@ def _other_modes(n: int, d: int, kmax: int) -> list[dict]:
     ):
         warm = x[: min(n, 12)]
         solve_layers(cost_table(warm, interp, 0.0, objective), 3, objective)
-        table, table_s = _time(lambda i=interp, o=objective: cost_table(x, i, 0.0, o))
+        table, table_s = _time(lambda i=interp, o=objective: cost_table(x, i, 0.0, o), repeat)
         c = cons if constrained else None
-        _, dp_s = _time(lambda t=table, o=objective, c=c: solve_layers(t, kmax, o, constraints=c))
+        _, dp_s = _time(lambda t=table, o=objective, c=c: solve_layers(t, kmax, o, constraints=c), repeat)
         out.append(
             {
                 "frames": n,
