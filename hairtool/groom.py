@@ -145,7 +145,26 @@ def _check_attribute(values: ArrayLike | None, vertex_count: int, width: int, na
     return _frozen(a)
 
 
-class _Attributes:
+class StrandSizes:
+    """``counts``, ``strand_count`` and ``vertex_count`` of anything with a ``topology``: grooms,
+    animations and the frame streams the writers take."""
+
+    topology: Topology
+
+    @property
+    def counts(self) -> I64:
+        return self.topology.counts
+
+    @property
+    def strand_count(self) -> int:
+        return self.topology.strand_count
+
+    @property
+    def vertex_count(self) -> int:
+        return self.topology.vertex_count
+
+
+class _Attributes(StrandSizes):
     """Optional per-vertex thickness, transparency and colour, shared by Groom and Animation."""
 
     thickness: F32 | None
@@ -225,20 +244,8 @@ class Groom(_Attributes):
 
     # -- sizes -------------------------------------------------------------------------
     @property
-    def counts(self) -> I64:
-        return self.topology.counts
-
-    @property
     def offsets(self) -> I64:
         return self.topology.offsets
-
-    @property
-    def strand_count(self) -> int:
-        return self.topology.strand_count
-
-    @property
-    def vertex_count(self) -> int:
-        return self.topology.vertex_count
 
     def __len__(self) -> int:
         return self.strand_count
@@ -413,20 +420,8 @@ class Animation(_Attributes):
         return Animation(self.frames, self.topology, self.fps, **self.attributes, metadata=metadata)
 
     @property
-    def counts(self) -> I64:
-        return self.topology.counts
-
-    @property
     def n_frames(self) -> int:
         return int(self.frames.shape[0])
-
-    @property
-    def strand_count(self) -> int:
-        return self.topology.strand_count
-
-    @property
-    def vertex_count(self) -> int:
-        return self.topology.vertex_count
 
     @property
     def duration(self) -> float:

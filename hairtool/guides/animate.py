@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from hairtool.errors import ParameterError
-from hairtool.groom import Animation, Groom, Topology
+from hairtool.groom import Animation, Groom, StrandSizes, Topology
 from hairtool.guides.binding import ChildBinding
 from hairtool.guides.children import build_points, build_points_reference
 from hairtool.guides.render import ChildClump, RenderHair
@@ -36,7 +36,7 @@ def _check(binding: ChildBinding, guides: Animation) -> None:
         )
 
 
-class RenderHairAnimation:
+class RenderHairAnimation(StrandSizes):
     """The render strands of ``binding`` at every frame of ``guides`` (an Animation of the
     guides), made on demand; ``clump``: ClumpWithGaps among the children on every frame."""
 
@@ -49,18 +49,6 @@ class RenderHairAnimation:
     @property
     def topology(self) -> Topology:
         return self.binding.topology
-
-    @property
-    def counts(self) -> np.ndarray:
-        return self.binding.counts
-
-    @property
-    def strand_count(self) -> int:
-        return self.binding.child_count
-
-    @property
-    def vertex_count(self) -> int:
-        return self.binding.vertex_count
 
     @property
     def n_frames(self) -> int:

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from hairtool.errors import ParameterError
-from hairtool.groom import Animation, Groom, Topology, vertex_ids_of
+from hairtool.groom import Animation, Groom, StrandSizes, Topology, vertex_ids_of
 from hairtool.guides.animate import RenderHairAnimation
 from hairtool.metadata import CurvesPrim, Metadata
 
@@ -84,7 +84,7 @@ def split_guides(groom: Groom | Animation) -> tuple[Groom | Animation, Groom | A
     return hair, guides
 
 
-class AnimationWithGuides:
+class AnimationWithGuides(StrandSizes):
     """Render hair following an animation of its guides, and those guides, as one animation of
     two prims (``/Groom/Hair`` then ``/Groom/Guides``, purpose ``guide``) whose frames are made
     one at a time: what :func:`hairtool.io.usd.write` takes as a frame stream. Widths as in
@@ -111,18 +111,6 @@ class AnimationWithGuides:
             ),
         )
         self.fps = guides.fps
-
-    @property
-    def counts(self) -> np.ndarray:
-        return self.topology.counts
-
-    @property
-    def strand_count(self) -> int:
-        return self.topology.strand_count
-
-    @property
-    def vertex_count(self) -> int:
-        return self.topology.vertex_count
 
     @property
     def n_frames(self) -> int:
