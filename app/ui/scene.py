@@ -191,9 +191,14 @@ class Scene(QObject):
 
     def apply_samples(self, samples: list) -> None:
         """Samples of any brush (a replayed stroke log) in one pipeline call."""
+        self._stroke_step(lambda: self.pipeline.apply_samples(samples))
+
+    def _stroke_step(self, step) -> None:
+        """``step()`` (a pipeline call that changes strokes, so maybe the mask) on the running
+        engine, timed; the render hair, the mask and the views follow."""
         self.start_engine()
         t0 = time.perf_counter()
-        self.result = self.pipeline.apply_samples(samples)
+        self.result = step()
         self._children_moved()
         self._sync_mask()
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
@@ -211,13 +216,7 @@ class Scene(QObject):
         return self.pipeline.snapshot()
 
     def restore(self, snap: object) -> None:
-        self.start_engine()
-        t0 = time.perf_counter()
-        self.result = self.pipeline.restore(snap)
-        self._children_moved()
-        self._sync_mask()
-        self.last_update_ms = (time.perf_counter() - t0) * 1e3
-        self.points_changed.emit()
+        self._stroke_step(lambda: self.pipeline.restore(snap))
 
     # -- render hair ---------------------------------------------------------------------
     def set_binding(self, binding: ChildBinding | None) -> None:
