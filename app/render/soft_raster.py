@@ -474,7 +474,6 @@ class StrandRaster:
         self.depth = np.zeros((0, 0), np.float32)
         self._seg = np.zeros((0, _SEG))
         self._box = np.zeros((4, 0), np.int32)
-        self._weight = _NO_SCALE  # per segment, its work per row (quads only; see _draw_all)
         self._last: tuple | None = None  # (half, fill, size) of the images' last draw with a clear
         self._last_mvp = np.zeros((4, 4))
         self._last_starts = np.zeros(0, np.int64)
@@ -561,13 +560,13 @@ class StrandRaster:
             self._last = key
         return rgba, depth
 
-    def _setup(self, p, s, c, m, half, which) -> None:
+    def _setup(self, p, s, c, m, half, which, weight=_NO_SCALE) -> None:
         """The segments' window coordinates, colours and boxes (those flagged in ``which``, or all
-        for an empty mask), the boxes widened for quads of half-width ``half``."""
+        for an empty mask), the boxes widened for quads of half-width ``half``; into a non-empty
+        ``weight``, each segment's work per row."""
         h, w = self.depth.shape
         sc = self._last_scale if self._last_scale.ndim else _NO_SCALE
         p, s, c, m, sc = (_read_only(a) for a in (p, s, c, m, sc))
-        weight = self._weight if which.size == 0 else _NO_SCALE
         _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, sc, self._seg, self._box, which, 2.0 * half, weight)
 
     def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
@@ -579,9 +578,8 @@ class StrandRaster:
         # than the better balance gained. A quad's row costs about 1 + its width in pixels
         # (measured on the bench's tapered render hair: rows-only counts left one thread
         # a third more work than the other); the set-up writes that weight, into kept memory.
-        self._weight = self._view("weight", (n,), np.float64) if half > 0.0 else _NO_SCALE
-        self._setup(p, s, c, m, half, self._all)
-        weight = self._weight if half > 0.0 else None
+        weight = self._view("weight", (n,), np.float64) if half > 0.0 else None
+        self._setup(p, s, c, m, half, self._all, _NO_SCALE if weight is None else weight)
         bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads(), weight)
         draw_bands(self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth)
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1
