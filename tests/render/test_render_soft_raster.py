@@ -106,17 +106,78 @@ def test_any_split_into_bands_gives_the_same_bytes(width):
     e, h = len(starts), SIZE[1]
     seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
     soft_raster._setup_kernel(
-        points, starts, colors, mvp, SIZE[0], h, 0.75 * width + 1.0, np.zeros(0), seg, box, np.zeros(0, bool),
-        width, np.zeros(0),
+        points,
+        starts,
+        colors,
+        mvp,
+        SIZE[0],
+        h,
+        0.75 * width + 1.0,
+        np.zeros(0),
+        seg,
+        box,
+        np.zeros(0, bool),
+        width,
+        np.zeros(0),
     )
     splits = [soft_raster.band_bounds(box[0], box[1], h, n) for n in (1, 4, 13)]
     splits += [np.arange(h + 1), np.array([0, 1, 2, 30, h])]  # one row each; uneven
     for bounds in splits:
         rgba, depth = np.zeros(SIZE[::-1], np.uint32), np.ones(SIZE[::-1], np.float32)
         half = 0.0 if width <= 1.0 else width / 2
-        soft_raster.draw_bands(seg, box, bounds, half, True, np.uint32(0), rgba, depth)
+        soft_raster.draw_bands(seg, box, bounds, half, True, np.uint32(0), rgba, depth, 2)
         np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
         np.testing.assert_array_equal(depth, ref_depth)
+
+
+@pytest.mark.parametrize("width", [1.0, 2.5])
+def test_hidden_segments_are_skipped_without_changing_a_byte(width):
+    # A dense groom drawn twice over in other colours (every copy ties with the first, and the
+    # depth test keeps the first), its cells' farthest depths brought up to date after every
+    # drawn segment, every 50 and never: the skipped segments change nothing.
+    from hairtool import samples
+
+    g = samples.scalp(strands=400, vertices=12, seed=5)
+    size = (80, 60)
+    cam = Camera.for_groom(g, aspect=size[0] / size[1])
+    mvp = np.ascontiguousarray(cam.view_matrix() @ cam.projection_matrix(size[0] / size[1]), np.float64)
+    rng = np.random.default_rng(1)
+    points = np.concatenate([g.points] * 3).astype(np.float32)
+    colors = rng.random((len(points), 3)).astype(np.float32)
+    one = g.topology.segment_end - 1
+    starts = np.concatenate([one + c * g.vertex_count for c in range(3)]).astype(np.int64)
+    ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, size, width)
+    e, (w, h) = len(starts), size
+    seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)
+    soft_raster._setup_kernel(
+        points,
+        starts,
+        colors,
+        mvp,
+        w,
+        h,
+        0.75 * width + 1.0,
+        np.zeros(0),
+        seg,
+        box,
+        np.zeros(0, bool),
+        width,
+        np.zeros(0),
+    )
+    half = 0.0 if width <= 1.0 else width / 2
+    hidden = {}
+    for refresh in (1, 50, 10**9):
+        for bounds in (np.array([0, h]), soft_raster.band_bounds(box[0], box[1], h, 3)):
+            rgba, depth = np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)
+            hidden[refresh] = soft_raster.draw_bands(
+                seg, box, bounds, half, True, np.uint32(0), rgba, depth, refresh
+            )
+            np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
+            np.testing.assert_array_equal(depth, ref_depth)
+    assert hidden[10**9] == 0  # never brought up to date: the cleared depth hides nothing
+    assert hidden[1] >= hidden[50] > 0
+    if width > 1.0:  # quads cover the scalp: most copies are skipped (1-px lines leave gaps)
+        assert hidden[1] > len(one) // 2
 
 
 def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
@@ -142,8 +203,8 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
         bounds = soft_raster.band_bounds(box[0], box[1], h, 3, weight)
         images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)] * 3
         images = [a.copy() for a in images]
-        bands(seg, box, bounds, 0.0, True, np.uint32(7), *images[:2])
-        bands(seg, box, bounds, 1.5, True, np.uint32(7), *images[2:4])
+        bands(seg, box, bounds, 0.0, True, np.uint32(7), *images[:2], 3)
+        bands(seg, box, bounds, 1.5, True, np.uint32(7), *images[2:4], 3)
         dirty = np.ones(((h + 15) // 16, (w + 15) // 16), bool)
         counts = np.zeros(dirty.size + 1, np.int64)
         near = np.zeros(e, np.int64)
