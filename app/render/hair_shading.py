@@ -47,47 +47,83 @@ def light_and_eye(right: NDArray, up: NDArray, forward: NDArray) -> tuple[NDArra
     return light / np.linalg.norm(light), -f / np.linalg.norm(f)
 
 
+_SQUARINGS = 6  # whole exponents p/2 below 2**6 (the default look's 24) by a fixed run of squarings
+
+
 @njit(cache=True, nogil=True, inline="always")
-def _power(x, e, whole):
-    """x**e for x in [0, 1]; by squarings when e is a whole number ``whole`` ≥ 0 (the default
-    highlight's 24: a pow() call per vertex was half the shading's time), else pow()."""
-    if whole < 0:
+def _power(x, e, bits, whole):
+    """x**e for x in [0, 1]: with ``whole`` from ``bits``, e's binary digits as 0.0 or 1.0, by a
+    fixed run of squarings, which vectorises (pow() did not, and was half the shading's time)."""
+    if not whole:
         return x**e
-    r = 1.0
-    while whole > 0:
-        if whole & 1:
-            r *= x
-        x *= x
-        whole >>= 1
-    return r
+    r = 1.0 + bits[0] * (x - 1.0)
+    x *= x
+    r *= 1.0 + bits[1] * (x - 1.0)
+    x *= x
+    r *= 1.0 + bits[2] * (x - 1.0)
+    x *= x
+    r *= 1.0 + bits[3] * (x - 1.0)
+    x *= x
+    r *= 1.0 + bits[4] * (x - 1.0)
+    x *= x
+    return r * (1.0 + bits[5] * (x - 1.0))
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _vertex(pf, bf, of, v, lo, hi, light, half, ambient, kd, ks, e, bits, whole):
+    """Vertex v's shade, its tangent from the points lo and hi (flat arrays; unsigned indices, so
+    numba adds no wrap-around for negative ones, which had kept the loop from vectorising)."""
+    one, two = np.uint64(1), np.uint64(2)
+    u, a, b = np.uint64(3) * v, np.uint64(3) * lo, np.uint64(3) * hi
+    tx = np.float64(pf[b]) - np.float64(pf[a])
+    ty = np.float64(pf[b + one]) - np.float64(pf[a + one])
+    tz = np.float64(pf[b + two]) - np.float64(pf[a + two])
+    n = np.sqrt(tx * tx + ty * ty + tz * tz)
+    inv = 1.0 / n if n > 0.0 else 0.0
+    tx, ty, tz = tx * inv, ty * inv, tz * inv
+    tl = tx * light[0] + ty * light[1] + tz * light[2]
+    th = tx * half[0] + ty * half[1] + tz * half[2]
+    k = ambient + kd * np.sqrt(max(1.0 - tl * tl, 0.0))
+    s = ks * _power(max(1.0 - th * th, 0.0), e, bits, whole)
+    of[u] = min(max(np.float64(bf[u]) * k + s, 0.0), 1.0)
+    of[u + one] = min(max(np.float64(bf[u + one]) * k + s, 0.0), 1.0)
+    of[u + two] = min(max(np.float64(bf[u + two]) * k + s, 0.0), 1.0)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _strand(pf, bf, of, a, b, light, half, ambient, kd, ks, e, bits, whole):
+    """The vertices a … b − 1 of one strand: central differences inside, one-sided at the ends."""
+    one = np.uint64(1)
+    if b == a:
+        return
+    for v in range(a + one, b - one):
+        _vertex(pf, bf, of, v, v - one, v + one, light, half, ambient, kd, ks, e, bits, whole)
+    _vertex(pf, bf, of, a, a, min(a + one, b - one), light, half, ambient, kd, ks, e, bits, whole)
+    if b - a >= 2:
+        _vertex(pf, bf, of, b - one, b - one - one, b - one, light, half, ambient, kd, ks, e, bits, whole)
 
 
 # fastmath (1.4x here): a strand's vertices are shaded by one thread in one loop, so each
 # vertex gets the same instructions whatever the thread count (the bytes stay deterministic);
-# the tests hold the kernel to its numpy twin.
+# the tests hold the kernels to their numpy twin. Two kernels, so that the common one's loop has
+# no pow() call in it (a branch between the two, even on an argument, kept it scalar).
 @njit(cache=True, nogil=True, parallel=True, fastmath=True)
-def _shade_kernel(points, offsets, base, light, half, ambient, kd, ks, exponent, out):
-    e = 0.5 * exponent
-    whole = int(e) if e == np.floor(e) and 0.0 <= e <= 1024.0 else -1
+def _shade_kernel(points, offsets, base, light, half, ambient, kd, ks, bits, out):
+    """Shades for a whole exponent e < 2**_SQUARINGS given by its binary digits ``bits``."""
+    pf, bf, of = points.reshape(-1), base.reshape(-1), out.reshape(-1)
     for s in prange(offsets.size - 1):
-        a, b = offsets[s], offsets[s + 1]
-        for v in range(a, b):
-            lo = v - 1 if v > a else v
-            hi = v + 1 if v < b - 1 else v
-            tx = np.float64(points[hi, 0]) - np.float64(points[lo, 0])
-            ty = np.float64(points[hi, 1]) - np.float64(points[lo, 1])
-            tz = np.float64(points[hi, 2]) - np.float64(points[lo, 2])
-            n = np.sqrt(tx * tx + ty * ty + tz * tz)
-            if n > 0.0:
-                inv = 1.0 / n
-                tx, ty, tz = tx * inv, ty * inv, tz * inv
-            tl = tx * light[0] + ty * light[1] + tz * light[2]
-            th = tx * half[0] + ty * half[1] + tz * half[2]
-            diffuse = np.sqrt(max(1.0 - tl * tl, 0.0))
-            spec = _power(max(1.0 - th * th, 0.0), e, whole)
-            k = ambient + kd * diffuse
-            for c in range(3):
-                out[v, c] = min(max(np.float64(base[v, c]) * k + ks * spec, 0.0), 1.0)
+        a, b = np.uint64(offsets[s]), np.uint64(offsets[s + 1])
+        _strand(pf, bf, of, a, b, light, half, ambient, kd, ks, 0.0, bits, True)
+
+
+@njit(cache=True, nogil=True, parallel=True, fastmath=True)
+def _shade_kernel_pow(points, offsets, base, light, half, ambient, kd, ks, e, out):
+    """Shades for any exponent e, by pow()."""
+    pf, bf, of = points.reshape(-1), base.reshape(-1), out.reshape(-1)
+    no_bits = np.zeros(0)
+    for s in prange(offsets.size - 1):
+        a, b = np.uint64(offsets[s]), np.uint64(offsets[s + 1])
+        _strand(pf, bf, of, a, b, light, half, ambient, kd, ks, e, no_bits, False)
 
 
 def _half(light: NDArray, eye: NDArray) -> NDArray[np.float64]:
@@ -109,11 +145,16 @@ def shade(
     S + 1 strand starts) with per-vertex ``base`` colours, unit ``light`` and ``eye`` directions."""
     if out is None or out.shape != (len(points), 3):
         out = np.empty((len(points), 3), np.float32)
-    _shade_kernel(
-        points, np.ascontiguousarray(offsets, np.int64), base,
-        np.asarray(light, np.float64), _half(light, eye), float(look.ambient), float(look.diffuse),
-        float(look.specular), float(look.exponent), out,
-    )  # fmt: skip
+    points, base = np.ascontiguousarray(points), np.ascontiguousarray(base)
+    offsets = np.ascontiguousarray(offsets, np.int64)
+    light, half = np.asarray(light, np.float64), _half(light, eye)
+    terms = (float(look.ambient), float(look.diffuse), float(look.specular))
+    e = 0.5 * float(look.exponent)
+    if e == np.floor(e) and 0.0 <= e < 2.0**_SQUARINGS:
+        bits = np.array([float((int(e) >> k) & 1) for k in range(_SQUARINGS)])
+        _shade_kernel(points, offsets, base, light, half, *terms, bits, out)
+    else:
+        _shade_kernel_pow(points, offsets, base, light, half, *terms, e, out)
     return out
 
 

@@ -41,6 +41,19 @@ def test_the_kernel_equals_its_numpy_twin():
         assert got.dtype == np.float32 and got.min() >= 0.0 and got.max() <= 1.0
 
 
+@pytest.mark.parametrize("exponent", [48.0, 126.0, 128.0, 7.0])  # squarings, and pow() above or between
+def test_short_and_empty_strands_shade_as_the_numpy_twin(exponent):
+    rng = np.random.default_rng(2)
+    offsets = np.array([0, 1, 1, 3, 6, 6, 10])  # one vertex, none, two, three, none, four
+    pts = rng.normal(size=(10, 3)).astype(np.float32)
+    pts[7] = pts[6]  # a zero-length segment: a one-sided tangent of zero
+    base = rng.random((10, 3)).astype(np.float32)
+    light, eye = light_and_eye(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, -1.0]))
+    look = HairLook(exponent=exponent)
+    got = shade(pts, offsets, base, light, eye, look)
+    np.testing.assert_allclose(got, shade_reference(pts, offsets, base, light, eye, look), rtol=0, atol=1e-6)
+
+
 def test_diffuse_follows_the_angle_to_the_light_and_the_highlight_the_half_vector():
     # two one-segment strands: one across the light (lit fully), one along it (ambient only)
     light, eye = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0])
