@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 from numba import njit, prange
 
-from hairtool.guides.frames import TINY, frames, frames_reference, resampled, root_tangents
+from hairtool.guides.frames import TINY, guide_tables, guide_tables_reference, resampled, root_tangents
 
 if TYPE_CHECKING:
     from hairtool.groom import Groom
@@ -58,25 +58,25 @@ class GuideTables:
     ``base[n] + j·n + i`` (for the kernel); the rest root tangents come from the binding."""
 
     def __init__(self, guides: Groom, binding: ChildBinding, reference: bool = False) -> None:
-        segs, lens, frms = [], [], []
+        counts = list(binding.vertex_counts)
         self.base: dict[int, int] = {}
         rows = 0
-        for n in binding.vertex_counts:
-            p = resampled(guides, n)
-            s = np.zeros_like(p)
-            s3 = s.reshape(-1, n, 3)
-            s3[:, 1:] = np.diff(p.reshape(-1, n, 3), axis=1)
-            tangent = binding.rest_tangents(n)
-            frms.append((frames_reference if reference else frames)(p, tangent, n))
-            segs.append(s)
-            lens.append(np.sqrt(s[:, 0] * s[:, 0] + s[:, 1] * s[:, 1] + s[:, 2] * s[:, 2]))
+        for n in counts:
             self.base[n] = rows
-            rows += len(p)
-        self.seg = np.concatenate(segs)
-        self.counts = np.array(binding.vertex_counts, np.int64)
-        self.bases = np.array([self.base[n] for n in binding.vertex_counts], np.int64)
-        self.seglen = np.concatenate(lens)
-        self.frames = np.concatenate(frms)
+            rows += guides.strand_count * n
+        self.counts = np.array(counts, np.int64)
+        self.bases = np.array([self.base[n] for n in counts], np.int64)
+        self.seg, self.seglen, self.frames = np.empty((rows, 3)), np.empty(rows), np.empty((rows, 9))
+        for n in counts:
+            span = slice(self.base[n], self.base[n] + guides.strand_count * n)
+            if reference:
+                self.seg[span], self.seglen[span], self.frames[span] = guide_tables_reference(
+                    guides, n, binding.rest_tangents(n)
+                )
+            else:
+                guide_tables(
+                    guides, n, binding.rest_tangents(n), (self.seg, self.seglen, self.frames), self.base[n]
+                )
 
     def child_base(self, binding: ChildBinding) -> np.ndarray:
         """``(N,)`` the first table row of each child's vertex count."""

@@ -7,7 +7,7 @@ segment, n from the world axis least along t) turned by the smallest rotation ta
 root tangent to the current one; along the guide each frame is the previous one turned by the
 smallest rotation from the previous segment's tangent to this one (parallel transport, the
 rotation-minimising frame of Wang et al. 2008 for a polyline). A zero-length segment keeps the
-previous frame. The numba kernel :func:`frames` has the numpy twin :func:`frames_reference`.
+previous frame. The numba kernel :func:`guide_tables` has the numpy twin :func:`guide_tables_reference`.
 """
 
 from __future__ import annotations
@@ -62,40 +62,100 @@ def _root_normal(tx, ty, tz):
     return nx, ny, nz
 
 
-def _frames_py(points, rest_tangent, n, out):
-    """``points`` (G·n, 3) float64, guide after guide; ``rest_tangent`` (G, 3) unit rest root
-    tangents; ``out`` (G·n, 9) rows t, n, b."""
-    for g in prange(points.shape[0] // n):
-        a = g * n
-        rx, ry, rz = rest_tangent[g, 0], rest_tangent[g, 1], rest_tangent[g, 2]
-        nx, ny, nz = _root_normal(rx, ry, rz)
-        tx, ty, tz, ok = _unit(
-            points[a + 1, 0] - points[a, 0], points[a + 1, 1] - points[a, 1], points[a + 1, 2] - points[a, 2]
-        )
-        if not ok:
-            tx, ty, tz = rx, ry, rz
-        nx, ny, nz = _turn(nx, ny, nz, rx, ry, rz, tx, ty, tz)  # rest root frame → current
-        for i in range(n):
-            if i >= 2:
-                ux, uy, uz, ok = _unit(
-                    points[a + i, 0] - points[a + i - 1, 0],
-                    points[a + i, 1] - points[a + i - 1, 1],
-                    points[a + i, 2] - points[a + i - 1, 2],
-                )
-                if ok:
-                    nx, ny, nz = _turn(nx, ny, nz, tx, ty, tz, ux, uy, uz)
-                    tx, ty, tz = ux, uy, uz
-            d = nx * tx + ny * ty + nz * tz  # keep n ⟂ t and unit against drift
-            nx, ny, nz, _ = _unit(nx - d * tx, ny - d * ty, nz - d * tz)
-            v = a + i  # (indexed in place: a row view per vertex costs two atomic counts)
-            out[v, 0], out[v, 1], out[v, 2] = tx, ty, tz
-            out[v, 3], out[v, 4], out[v, 5] = nx, ny, nz
-            out[v, 6], out[v, 7], out[v, 8] = ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx
+@njit(cache=True, nogil=True, inline="always")
+def _guide_rows(points, offsets, counts, n, rest_tangent, row0, seg, seglen, out, g):
+    """Guide g's rows ``row0 + g·n …`` of the tables: its ``points`` (float32; strand ``offsets``
+    and ``counts``) resampled to n vertices as :func:`resampled` does, each row's segment from
+    the previous point (0 at the root) and its length, and the frames (t, n, b) of
+    :func:`frames_reference`, whose tangents are these very differences."""
+    a = row0 + g * n
+    m, o = counts[g], offsets[g]
+    ratio = (m - 1) / (n - 1)
+    px, py, pz = 0.0, 0.0, 0.0
+    for i in range(n):
+        if m == n:
+            qx, qy, qz = (
+                np.float64(points[o + i, 0]),
+                np.float64(points[o + i, 1]),
+                np.float64(points[o + i, 2]),
+            )
+        else:
+            u = i * ratio
+            j = o + min(int(np.floor(u)), m - 2)
+            f = u - (j - o)
+            ax, ay, az = np.float64(points[j, 0]), np.float64(points[j, 1]), np.float64(points[j, 2])
+            bx, by, bz = (
+                np.float64(points[j + 1, 0]),
+                np.float64(points[j + 1, 1]),
+                np.float64(points[j + 1, 2]),
+            )
+            qx, qy, qz = ax + f * (bx - ax), ay + f * (by - ay), az + f * (bz - az)
+        sx, sy, sz = qx - px, qy - py, qz - pz
+        if i == 0:
+            sx, sy, sz = 0.0, 0.0, 0.0
+        seg[a + i, 0], seg[a + i, 1], seg[a + i, 2] = sx, sy, sz
+        seglen[a + i] = np.sqrt(sx * sx + sy * sy + sz * sz)
+        px, py, pz = qx, qy, qz
+    rx, ry, rz = rest_tangent[g, 0], rest_tangent[g, 1], rest_tangent[g, 2]
+    nx, ny, nz = _root_normal(rx, ry, rz)
+    tx, ty, tz, ok = _unit(seg[a + 1, 0], seg[a + 1, 1], seg[a + 1, 2])
+    if not ok:
+        tx, ty, tz = rx, ry, rz
+    nx, ny, nz = _turn(nx, ny, nz, rx, ry, rz, tx, ty, tz)  # rest root frame → current
+    for i in range(n):
+        if i >= 2:
+            ux, uy, uz, ok = _unit(seg[a + i, 0], seg[a + i, 1], seg[a + i, 2])
+            if ok:
+                nx, ny, nz = _turn(nx, ny, nz, tx, ty, tz, ux, uy, uz)
+                tx, ty, tz = ux, uy, uz
+        d = nx * tx + ny * ty + nz * tz  # keep n ⟂ t and unit against drift
+        nx, ny, nz, _ = _unit(nx - d * tx, ny - d * ty, nz - d * tz)
+        v = a + i  # (indexed in place: a row view per vertex costs two atomic counts)
+        out[v, 0], out[v, 1], out[v, 2] = tx, ty, tz
+        out[v, 3], out[v, 4], out[v, 5] = nx, ny, nz
+        out[v, 6], out[v, 7], out[v, 8] = ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx
 
 
-_frames_serial = njit(cache=True, nogil=True)(_frames_py)
-_frames_parallel = njit(cache=True, nogil=True, parallel=True)(_frames_py)
-PARALLEL_FRAMES = 100_000  # frames above which threads pay (below, waking them costs more)
+@njit(cache=True, nogil=True, parallel=True)
+def _tables_kernel(points, offsets, counts, n, rest_tangent, row0, seg, seglen, out):
+    """:func:`_guide_rows` of every guide, a guide per thread (threads pay from 10 guides on)."""
+    for g in prange(counts.size):
+        _guide_rows(points, offsets, counts, n, rest_tangent, row0, seg, seglen, out, g)
+
+
+def guide_tables(
+    guides: Groom,
+    n: int,
+    rest_tangent: np.ndarray,
+    out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    row0: int = 0,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(seg (G·n, 3), seglen (G·n,), frames (G·n, 9))`` float64 of the guides at n ≥ 2
+    vertices (``rest_tangent`` (G, 3): their rest root tangents), into rows ``row0 …`` of
+    ``out`` when given. The numpy twin is :func:`guide_tables_reference`."""
+    rows = guides.strand_count * n
+    seg, seglen, frm = out if out is not None else (np.empty((rows, 3)), np.empty(rows), np.empty((rows, 9)))
+    _tables_kernel(
+        np.ascontiguousarray(guides.points, np.float32), guides.offsets[:-1].astype(np.int64),
+        guides.counts.astype(np.int64), int(n), np.ascontiguousarray(rest_tangent, np.float64), int(row0),
+        seg, seglen, frm,
+    )  # fmt: skip
+    return seg, seglen, frm
+
+
+def guide_tables_reference(
+    guides: Groom, n: int, rest_tangent: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Numpy twin of :func:`guide_tables`: :func:`resampled`, whole-array differences and
+    :func:`frames_reference`."""
+    p = resampled(guides, n)
+    s = np.zeros_like(p)
+    s.reshape(-1, n, 3)[:, 1:] = np.diff(p.reshape(-1, n, 3), axis=1)
+    return (
+        s,
+        np.sqrt(s[:, 0] * s[:, 0] + s[:, 1] * s[:, 1] + s[:, 2] * s[:, 2]),
+        frames_reference(p, rest_tangent, n),
+    )
 
 
 def root_tangents(points: np.ndarray, n: int) -> np.ndarray:
@@ -108,14 +168,6 @@ def root_tangents(points: np.ndarray, n: int) -> np.ndarray:
     out = np.zeros_like(t)
     out[:, 0] = 1.0
     out[ok] = t[ok] / d[ok, None]
-    return out
-
-
-def frames(points: np.ndarray, rest_tangent: np.ndarray, n: int) -> np.ndarray:
-    """``(G·n, 9)`` float64 frames (t, n, b) of guides of n vertices (``points`` (G·n, 3))."""
-    out = np.empty((points.shape[0], 9))
-    kernel = _frames_parallel if points.shape[0] > PARALLEL_FRAMES else _frames_serial
-    kernel(np.ascontiguousarray(points, np.float64), np.ascontiguousarray(rest_tangent), n, out)
     return out
 
 

@@ -4,9 +4,10 @@ sampling, surface distances."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from hairtool import samples
-from hairtool.guides.frames import frames, frames_reference, resampled, root_tangents
+from hairtool.guides.frames import guide_tables, guide_tables_reference, resampled, root_tangents
 from hairtool.guides.nearest import (
     euclidean_nearest,
     euclidean_nearest_reference,
@@ -43,16 +44,27 @@ def sphere(rings: int = 10, segments: int = 16, radius: float = 1.0, jitter: flo
     return Mesh(v.astype(np.float32), faces, np.zeros_like(v, dtype=np.float32))
 
 
-def test_frames_match_their_twin_and_are_orthonormal():
+@pytest.mark.parametrize("n", [9, 5, 14])  # the guides' own count, fewer, more
+def test_guide_tables_match_their_twin_and_frames_are_orthonormal(n):
     g = samples.scalp(40, 9, seed=4)
-    p = resampled(g, 9)
+    p = np.array(g.points)
     p[3 * 9 + 4] = p[3 * 9 + 3]  # a zero-length segment
     p[5 * 9 + 5] = p[5 * 9 + 3]  # a hairpin: the segment turns back on itself
-    t = root_tangents(resampled(g, 9), 9)
-    got = frames(p, t, 9)
-    np.testing.assert_allclose(got, frames_reference(p, t, 9), atol=1e-12)
-    f = got.reshape(-1, 3, 3)
+    g = g.with_points(p)
+    t = root_tangents(resampled(g, n), n)
+    got = guide_tables(g, n, t)
+    want = guide_tables_reference(g, n, t)
+    np.testing.assert_array_equal(got[0], want[0])  # the same resampling and differences
+    np.testing.assert_array_equal(got[1], want[1])
+    np.testing.assert_allclose(got[2], want[2], atol=1e-12)
+    f = got[2].reshape(-1, 3, 3)
     np.testing.assert_allclose(f @ f.transpose(0, 2, 1), np.broadcast_to(np.eye(3), f.shape), atol=1e-9)
+    # into given tables at a row offset, as the children's tables for several counts are
+    out = (np.zeros((len(p) * 3, 3)), np.zeros(len(p) * 3), np.zeros((len(p) * 3, 9)))
+    rows = g.strand_count * n
+    guide_tables(g, n, t, out, row0=7)
+    for a, b in zip(out, got, strict=True):
+        np.testing.assert_array_equal(a[7 : 7 + rows], b)
 
 
 def test_resampling_keeps_a_guide_of_the_same_count_and_interpolates_others():
