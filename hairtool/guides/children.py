@@ -91,11 +91,12 @@ def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm,
     exact = exact_x.shape[0] > 0
     offsets = local.shape[0] > 0
     for c in prange(roots.shape[0]):
-        a = coff[c]
-        n = coff[c + 1] - a
-        tb = tbase[c]
+        # Unsigned rows: numba then adds no wrap-around test for negative indices (8 % here).
+        a = np.uint64(coff[c])
+        n = np.uint64(coff[c + 1]) - a
+        tb = np.uint64(tbase[c])
         qx, qy, qz = float(roots[c, 0]), float(roots[c, 1]), float(roots[c, 2])
-        near = tb + gid[c, 0] * n
+        near = tb + np.uint64(gid[c, 0]) * n
         sc = scale[c]
         for i in range(n):
             if i > 0:
@@ -104,7 +105,7 @@ def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm,
                 dz = 0.0
                 length = 0.0
                 for m in range(k):
-                    t = tb + gid[c, m] * n + i
+                    t = tb + np.uint64(gid[c, m]) * n + i
                     wm = w[c, m]
                     dx += wm * seg[t, 0]
                     dy += wm * seg[t, 1]
@@ -122,19 +123,20 @@ def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm,
                     qy += frm[near + i, 1] * length
                     qz += frm[near + i, 2] * length
             yx, yy, yz = qx, qy, qz
+            v = a + i
             if offsets:
                 r = near + i
-                o0, o1, o2 = float(local[a + i, 0]), float(local[a + i, 1]), float(local[a + i, 2])
+                o0, o1, o2 = float(local[v, 0]), float(local[v, 1]), float(local[v, 2])
                 yx += o0 * frm[r, 0] + o1 * frm[r, 3] + o2 * frm[r, 6]
                 yy += o0 * frm[r, 1] + o1 * frm[r, 4] + o2 * frm[r, 7]
                 yz += o0 * frm[r, 2] + o1 * frm[r, 5] + o2 * frm[r, 8]
             if exact:
-                yx = exact_x[a + i, 0] + (yx - exact_y[a + i, 0])
-                yy = exact_x[a + i, 1] + (yy - exact_y[a + i, 1])
-                yz = exact_x[a + i, 2] + (yz - exact_y[a + i, 2])
-            out[a + i, 0] = yx
-            out[a + i, 1] = yy
-            out[a + i, 2] = yz
+                yx = exact_x[v, 0] + (yx - exact_y[v, 0])
+                yy = exact_x[v, 1] + (yy - exact_y[v, 1])
+                yz = exact_x[v, 2] + (yz - exact_y[v, 2])
+            out[v, 0] = yx
+            out[v, 1] = yy
+            out[v, 2] = yz
 
 
 _NONE32 = np.zeros((0, 3), np.float32)  # no offsets / not exact
