@@ -659,7 +659,10 @@ class StrandRaster:
         )
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1
         self._last_mvp, self._last_starts = m.copy(), self._kept("starts", s, fixed=True)
-        self._last_points, self._last_colors = self._kept("points", p), self._kept("colors", c)
+        if self._unsearched == 0:  # the next draw may look for changes against what this one drew
+            self._last_points, self._last_colors = self._kept("points", p), self._kept("colors", c)
+        # (else it draws in full too, and so on up to one that keeps them: copying a drag frame's
+        # 350,000 points and colours had cost 0.8 ms a frame)
 
     def _kept(self, name: str, a: np.ndarray, fixed: bool = False) -> np.ndarray:
         """``a`` as it is now: a copy in the memory kept as ``name``, or with ``fixed`` ``a``

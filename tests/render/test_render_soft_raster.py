@@ -371,6 +371,30 @@ def test_redrawing_the_changed_tiles_gives_the_bytes_of_a_full_draw(width, n_thr
     assert partial >= 6  # most of these frames were redrawn in part
 
 
+def test_frames_that_change_nearly_all_then_little_give_the_bytes_of_a_full_draw():
+    # Render hair following a brush: most strands move for a few frames (drawn in full, the
+    # next ones without looking for changes, and without keeping what they drew), then few, some
+    # of them back where they were two frames before: each frame as a fresh draw gives it.
+    size = (160, 120)
+    g, starts, colors, mvp = _scalp_scene(size)
+    rng = np.random.default_rng(8)
+    raster = StrandRaster()
+    rest = g.points.copy()
+    shifts = [rng.normal(scale=0.02, size=rest.shape).astype(np.float32) for _ in range(3)]
+    kinds = []
+    for step in range(16):
+        points = rest + shifts[step % 3] if step < 9 else rest.copy()
+        if step >= 9:  # a few tips move, and back
+            tip = g.offsets[5 + step % 2]
+            points[tip - 2 : tip] += np.float32(0.03 if step % 2 else -0.03)
+        rgba, depth = raster.draw(points, starts, colors, mvp, size, 2.5)
+        want = StrandRaster().draw(points, starts, colors, mvp, size, 2.5)
+        np.testing.assert_array_equal(rgba, want[0])
+        np.testing.assert_array_equal(depth, want[1])
+        kinds.append(raster.tiles_redrawn)
+    assert kinds[1:9].count(-1) == 8 and any(k > 0 for k in kinds[10:])  # in full, then in part
+
+
 def test_what_makes_a_full_draw_and_what_draws_nothing():
     size = (160, 120)
     g, starts, colors, mvp = _scalp_scene(size)
