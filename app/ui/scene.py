@@ -300,13 +300,19 @@ class Scene(QObject):
         """The drawn children rebuilt from the guides' current shapes into ``drawn_points``
         (the guides after them when shown): one array per density, written in place on every
         move, so neither a drag nor a release allocates (or concatenates) millions of points."""
-        from hairtool.guides.children import build_points
+        from hairtool.guides.children import build_points, moved_guides
 
         b = self.drawn_binding()
         guides = self.result.vertex_count if self.show_guides else 0
         drawn = self.cached(("points",), lambda: np.empty((b.vertex_count + guides, 3), np.float32))
+        # The guides the drawn children were built from: only the children of guides that moved
+        # since are built again (none before the first build: NaN matches nothing).
+        source = self.cached(
+            ("built from",), lambda: np.full((self.result.vertex_count, 3), np.nan, np.float32)
+        )
         t0 = time.perf_counter()
-        build_points(b, self.result, out=drawn[: b.vertex_count])
+        build_points(b, self.result, out=drawn[: b.vertex_count], moved=moved_guides(self.result, source))
+        source[...] = self.result.points
         self.last_children_ms = (time.perf_counter() - t0) * 1e3
         if guides:
             drawn[b.vertex_count :] = self.result.points

@@ -86,11 +86,14 @@ class GuideTables:
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm, exact_x, exact_y, out):
+def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm, exact_x, exact_y, only, out):
+    """Every child (or those flagged in ``only``, when it is not empty) into ``out``."""
     k = gid.shape[1]
     exact = exact_x.shape[0] > 0
     offsets = local.shape[0] > 0
     for c in prange(roots.shape[0]):
+        if only.size and not only[c]:
+            continue
         # Unsigned rows: numba then adds no wrap-around test for negative indices (8 % here).
         a = np.uint64(coff[c])
         n = np.uint64(coff[c + 1]) - a
@@ -141,6 +144,7 @@ def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm,
 
 _NONE32 = np.zeros((0, 3), np.float32)  # no offsets / not exact
 _NONE64 = np.zeros((0, 3))
+_ALL = np.zeros(0, np.bool_)  # no child flags: every child
 
 
 def build_points(
@@ -149,22 +153,43 @@ def build_points(
     dtype: type = np.float32,
     exact: bool = True,
     out: np.ndarray | None = None,
+    moved: np.ndarray | None = None,
 ) -> np.ndarray:
     """``(V, 3)`` child points from the guides' current shapes (``dtype`` float32, or float64
     for the rest blends the binding keeps); ``exact`` False: y without the dense groom's
-    x + (y − y⁰); ``out``: an array to write them into (reused between frames)."""
+    x + (y − y⁰); ``out``: an array to write them into (reused between frames). ``moved``:
+    per guide, whether it differs from the guides ``out`` holds the children of (see
+    :func:`moved_guides`): then only the children that follow a moved guide are built again,
+    the others keep their points in ``out`` (a brush moves a few guides per mouse move)."""
     binding.check_guides(guides)
+    fresh = out is None or out.shape != (binding.vertex_count, 3) or out.dtype != dtype
+    if fresh:
+        out = np.empty((binding.vertex_count, 3), dtype)
+    only = _ALL
+    if moved is not None and not fresh:
+        only = np.asarray(moved, np.bool_)[binding.guide_ids].any(axis=1)
+        if not only.any():
+            return out
     tables = GuideTables(guides, binding)
     tbase = tables.child_base(binding)
-    if out is None or out.shape != (binding.vertex_count, 3) or out.dtype != dtype:
-        out = np.empty((binding.vertex_count, 3), dtype)
     use_exact = exact and binding.exact_points is not None
     _children_kernel(
         binding.offsets, tbase, binding.roots, binding.guide_ids, binding.weights, binding.scale,
         _NONE32 if binding.local is None else binding.local, tables.seg, tables.seglen, tables.frames,
-        binding.exact_points if use_exact else _NONE32, binding.exact_blend if use_exact else _NONE64, out,
+        binding.exact_points if use_exact else _NONE32, binding.exact_blend if use_exact else _NONE64,
+        only, out,
     )  # fmt: skip
     return out
+
+
+def moved_guides(guides: Groom, last: np.ndarray) -> np.ndarray:
+    """``(G,)`` whether each guide has a point that differs, bit for bit, from ``last`` (the points
+    children were last built from; any other shape: every guide moved)."""
+    points = np.ascontiguousarray(guides.points, np.float32)
+    if np.shape(last) != points.shape or np.asarray(last).dtype != np.float32:
+        return np.ones(guides.strand_count, np.bool_)
+    differs = (points.view(np.uint32) != np.asarray(last).view(np.uint32)).any(axis=1)
+    return np.logical_or.reduceat(differs, guides.offsets[:-1])
 
 
 def build_points_reference(binding: ChildBinding, guides: Groom, chunk: int = 8192) -> np.ndarray:

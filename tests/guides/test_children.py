@@ -14,7 +14,7 @@ from hairtool import io, samples
 from hairtool.errors import HairtoolError, ParameterError
 from hairtool.groom import Groom
 from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp, choose_guides
-from hairtool.guides.children import build_points, build_points_reference
+from hairtool.guides.children import build_points, build_points_reference, moved_guides
 from hairtool.guides.render import ChildClump, RenderHair
 from hairtool.guides.surface import closest_points
 from hairtool.io.obj import Mesh, read_mesh
@@ -89,6 +89,40 @@ def test_moving_one_guide_moves_only_the_children_that_weight_it(sintel, grooms_
     changed = np.unique(db.topology.strand_index[np.any(out != dense.points, axis=1)])
     assert set(changed) <= set(np.flatnonzero(np.any(db.guide_ids == 3, axis=1)))
     assert len(changed) > 0
+
+
+def test_children_of_the_moved_guides_alone_built_again_give_the_bytes_of_a_full_build(sintel, grooms_dir):
+    # As the studio does per mouse move: into the last frame's points, the children of the guides
+    # that moved since (bit for bit); guides moved back count as moved too.
+    guides, head = sintel
+    dense = io.read_groom(grooms_dir / "ratboy_mohawk.tfx")
+    for g0, b in (
+        (guides, bind_scalp(guides, head, 1500, seed=5, frizz=0.05)),
+        bind_dense(dense, 60, seed=1),
+    ):
+        rng = np.random.default_rng(2)
+        out = build_points(b, g0)
+        last = np.array(g0.points)
+        pts = np.array(g0.points)
+        for step in range(5):
+            for s in rng.choice(g0.strand_count, size=3, replace=False):
+                a, e = g0.offsets[s], g0.offsets[s + 1]
+                pts[a + 1 : e] += rng.normal(scale=0.02, size=(e - a - 1, 3)).astype(np.float32)
+            if step == 3:
+                pts[:] = g0.points  # all back at rest
+            now = g0.with_points(pts)
+            moved = moved_guides(now, last)
+            assert 0 < moved.sum() < g0.strand_count
+            build_points(b, now, out=out, moved=moved)
+            np.testing.assert_array_equal(_bits(out), _bits(build_points(b, now)))
+            last = pts.copy()
+        assert not moved_guides(now, last).any()
+        assert moved_guides(now, last[:-1]).all()  # another shape: nothing is known
+    signed = np.array(g0.points)  # one coordinate of guide 2 negated (0 → −0: other bits)
+    signed[g0.offsets[2] + 1, 0] = -signed[g0.offsets[2] + 1, 0] if signed[g0.offsets[2] + 1, 0] else -0.0
+    assert moved_guides(g0.with_points(signed), np.array(g0.points)).tolist() == [
+        s == 2 for s in range(g0.strand_count)
+    ]
 
 
 def test_roots_lie_on_the_scalp_in_the_default_region(sintel):
