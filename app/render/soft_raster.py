@@ -83,10 +83,12 @@ def _unit(c):
 def _setup_kernel(points, starts, colors, m, w, h, margin, scale, seg, box, which, width, weight):
     """Window coordinates and colours of every segment's ends and its width ``scale`` (none
     given: 1) (or of those flagged in ``which``, when it is not empty), and the rows
-    ``box[0, i] … box[1, i]`` and columns ``box[2, i] … box[3, i]`` it may touch (rows
-    ``0 … −1``: none, e.g. wholly behind the eye or off the image); with a ``weight`` array, the
-    segment's work per row for :func:`band_bounds`, 1 + its quad's ``width`` × scale (as a
-    numpy pass over the table's strided column it had cost 10 ms a full-density frame)."""
+    ``box[0, i] … box[1, i]`` and columns ``box[2, i] … box[3, i]`` it may touch: its ends' box
+    widened by 1 + (``margin`` − 1) × its scale (a quad of half-width h reaches h√2 past its
+    ends, a pixel centre half a pixel more; rows ``0 … −1``: none, e.g. wholly behind the eye
+    or off the image); with a ``weight`` array, the segment's work per row for
+    :func:`band_bounds`, 1 + its quad's ``width`` × scale (as a numpy pass over the table's
+    strided column it had cost 10 ms a full-density frame)."""
     for i in prange(starts.size):
         if which.size and not which[i]:
             continue
@@ -117,8 +119,9 @@ def _setup_kernel(points, starts, colors, m, w, h, margin, scale, seg, box, whic
         seg[i, 3], seg[i, 4], seg[i, 5] = xb, yb, (bz * ib + 1.0) * 0.5
         seg[i, 6], seg[i, 7], seg[i, 8] = 255.0 * cr, 255.0 * cg, 255.0 * cb
         seg[i, 9], seg[i, 10], seg[i, 11] = 255.0 * dr, 255.0 * dg, 255.0 * db
-        x0, x1 = min(xa, xb) - margin, max(xa, xb) + margin
-        y0, y1 = min(ya, yb) - margin, max(ya, yb) + margin
+        reach = (margin - 1.0) * seg[i, 12] + 1.0  # a tapered quad reaches less far (fewer cells)
+        x0, x1 = min(xa, xb) - reach, max(xa, xb) + reach
+        y0, y1 = min(ya, yb) - reach, max(ya, yb) + reach
         if x1 >= 0.0 and x0 <= w and y1 >= 0.0 and y0 <= h:
             box[0, i], box[1, i] = int(max(y0, 0.0)), int(min(y1, h - 1.0))
             box[2, i], box[3, i] = int(max(x0, 0.0)), int(min(x1, w - 1.0))

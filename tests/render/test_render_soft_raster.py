@@ -180,6 +180,39 @@ def test_hidden_segments_are_skipped_without_changing_a_byte(width):
         assert hidden[1] > len(one) // 2
 
 
+@pytest.mark.parametrize("width", [2.5, 8.0])
+def test_tapered_quads_split_into_bands_give_the_bytes_of_the_numpy_definition(width):
+    # Each box is widened by its own quad's reach: narrow tips get narrow boxes, which must
+    # still hold every pixel the quad covers, whichever band or cell a pixel falls in.
+    points, starts, colors = _awkward_segments(4)
+    scale = np.random.default_rng(4).random(len(starts))
+    scale[::5] = 0.0  # tips tapered away entirely
+    mvp = np.ascontiguousarray(_perspective(), np.float64)
+    ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, width, scale=scale)
+    e, h = len(starts), SIZE[1]
+    seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)
+    soft_raster._setup_kernel(
+        points,
+        starts,
+        colors,
+        mvp,
+        SIZE[0],
+        h,
+        0.75 * width + 1.0,
+        scale,
+        seg,
+        box,
+        np.zeros(0, bool),
+        width,
+        np.zeros(0),
+    )
+    for bounds in (np.array([0, h]), np.arange(h + 1), np.array([0, 1, 2, 30, h])):
+        rgba, depth = np.zeros(SIZE[::-1], np.uint32), np.ones(SIZE[::-1], np.float32)
+        soft_raster.draw_bands(seg, box, bounds, width / 2, True, np.uint32(0), rgba, depth, 1)
+        np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
+        np.testing.assert_array_equal(depth, ref_depth)
+
+
 def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
     # What NUMBA_DISABLE_JIT=1 runs: the kernels' Python bodies (helpers still compiled).
     points, starts, colors = _awkward_segments(7)
