@@ -47,6 +47,7 @@ W_MIN = 1e-5  # as the geometry shader: an end nearer the eye plane than this is
 DIR_EPS = 1e-6  # as the geometry shader: shorter segments are drawn in direction (1, 0)
 AXIS_EPS = 1e-12  # a quad side this close to horizontal bounds rows, not columns
 OPAQUE = 0xFF000000
+SQRT2 = math.sqrt(2.0)
 _NO_SCALE = np.zeros(0)  # the setup's scale when there is none (widths × 1)
 _SEG = 13  # per segment: window x, y, depth of both ends, both ends' RGB × 255, its width scale
 TILE_SHIFT = 5  # tiles of 2**5 = 32 pixels a side are redrawn when a frame differs little from the last
@@ -80,15 +81,16 @@ def _unit(c):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _setup_kernel(points, starts, colors, m, w, h, margin, scale, seg, box, which, width, weight):
+def _setup_kernel(points, starts, colors, m, w, h, scale, seg, box, which, width, weight):
     """Window coordinates and colours of every segment's ends and its width ``scale`` (none
     given: 1) (or of those flagged in ``which``, when it is not empty), and the rows
     ``box[0, i] … box[1, i]`` and columns ``box[2, i] … box[3, i]`` it may touch: its ends' box
-    widened by 1 + (``margin`` − 1) × its scale (a quad of half-width h reaches h√2 past its
-    ends, a pixel centre half a pixel more; rows ``0 … −1``: none, e.g. wholly behind the eye
-    or off the image); with a ``weight`` array, the segment's work per row for
-    :func:`band_bounds`, 1 + its quad's ``width`` × scale (as a numpy pass over the table's
-    strided column it had cost 10 ms a full-density frame)."""
+    widened by its quad's reach, h√2 for half-width h = ``width``/2 × scale, plus a quarter
+    pixel for rounding (a pixel's centre lies within the quad, so the pixel within h√2 − ½;
+    1-px lines, ``width`` 0: one pixel) (rows ``0 … −1``: none, e.g. wholly behind the eye or
+    off the image); with a ``weight`` array, the segment's work per row for :func:`band_bounds`,
+    1 + its quad's ``width`` × scale (as a numpy pass over the table's strided column it had
+    cost 10 ms a full-density frame)."""
     for i in prange(starts.size):
         if which.size and not which[i]:
             continue
@@ -119,7 +121,7 @@ def _setup_kernel(points, starts, colors, m, w, h, margin, scale, seg, box, whic
         seg[i, 3], seg[i, 4], seg[i, 5] = xb, yb, (bz * ib + 1.0) * 0.5
         seg[i, 6], seg[i, 7], seg[i, 8] = 255.0 * cr, 255.0 * cg, 255.0 * cb
         seg[i, 9], seg[i, 10], seg[i, 11] = 255.0 * dr, 255.0 * dg, 255.0 * db
-        reach = (margin - 1.0) * seg[i, 12] + 1.0  # a tapered quad reaches less far (fewer cells)
+        reach = SQRT2 * 0.5 * width * seg[i, 12] + 0.25 if width > 0.0 else 1.0
         x0, x1 = min(xa, xb) - reach, max(xa, xb) + reach
         y0, y1 = min(ya, yb) - reach, max(ya, yb) + reach
         if x1 >= 0.0 and x0 <= w and y1 >= 0.0 and y0 <= h:
@@ -643,7 +645,7 @@ class StrandRaster:
         h, w = self.depth.shape
         sc = self._last_scale if self._last_scale.ndim else _NO_SCALE
         p, s, c, m, sc = (_read_only(a) for a in (p, s, c, m, sc))
-        _setup_kernel(p, s, c, m, w, h, 1.5 * half + 1.0, sc, self._seg, self._box, which, 2.0 * half, weight)
+        _setup_kernel(p, s, c, m, w, h, sc, self._seg, self._box, which, 2.0 * half, weight)
 
     def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
         h, w = depth.shape

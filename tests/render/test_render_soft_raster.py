@@ -112,7 +112,6 @@ def test_any_split_into_bands_gives_the_same_bytes(width):
         mvp,
         SIZE[0],
         h,
-        0.75 * width + 1.0,
         np.zeros(0),
         seg,
         box,
@@ -156,7 +155,6 @@ def test_hidden_segments_are_skipped_without_changing_a_byte(width):
         mvp,
         w,
         h,
-        0.75 * width + 1.0,
         np.zeros(0),
         seg,
         box,
@@ -198,7 +196,6 @@ def test_tapered_quads_split_into_bands_give_the_bytes_of_the_numpy_definition(w
         mvp,
         SIZE[0],
         h,
-        0.75 * width + 1.0,
         scale,
         seg,
         box,
@@ -211,6 +208,27 @@ def test_tapered_quads_split_into_bands_give_the_bytes_of_the_numpy_definition(w
         soft_raster.draw_bands(seg, box, bounds, width / 2, True, np.uint32(0), rgba, depth, 1)
         np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
         np.testing.assert_array_equal(depth, ref_depth)
+
+
+def test_a_box_holds_the_pixel_at_its_quads_farthest_corner():
+    # A 45° quad's corners stick out h√2 from its ends: here the lowest corner lies just below a
+    # pixel centre, so that pixel, alone in its one-row band, is drawn only if the box reaches
+    # within half a pixel of the corner (h√2 − ½ from the end: the least any box may reach).
+    size, h = (40, 30), 2.0
+    ax, ay = 12.5, 10.5 + h * np.sqrt(2.0) - 0.01
+    ndc = 2.0 * np.array([[ax, ay], [ax + 6.0, ay + 6.0]]) / np.array(size) - 1.0
+    points = np.column_stack([ndc, np.zeros(2)]).astype(np.float32)
+    colors = np.ones((2, 3), np.float32)
+    mvp, starts = np.eye(4), np.array([0], np.int64)
+    ref_rgba, _ = rasterize_reference(points, starts, colors, mvp, size, 2.0 * h)
+    assert ref_rgba[10, 12, 3] == 255 and not ref_rgba[:10, :, 3].any()  # the corner's pixel, lowest
+    seg, box = np.ones((1, soft_raster._SEG)), np.zeros((4, 1), np.int32)
+    soft_raster._setup_kernel(
+        points, starts, colors, mvp, *size, np.zeros(0), seg, box, np.zeros(0, bool), 2 * h, np.zeros(0)
+    )
+    rgba, depth = np.zeros(size[::-1], np.uint32), np.ones(size[::-1], np.float32)
+    soft_raster.draw_bands(seg, box, np.arange(size[1] + 1), h, True, np.uint32(0), rgba, depth, 1)
+    np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
 
 
 def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
@@ -231,7 +249,7 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
         )
         seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
         weight = np.zeros(e)
-        setup(points, starts, colors, mvp, w, h, 4.0, np.zeros(0), seg, box, np.zeros(0, bool), 3.0, weight)
+        setup(points, starts, colors, mvp, w, h, np.zeros(0), seg, box, np.zeros(0, bool), 3.0, weight)
         np.testing.assert_array_equal(weight, 1.0 + 3.0 * seg[:, 12])
         bounds = soft_raster.band_bounds(box[0], box[1], h, 3, weight)
         images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)] * 3
