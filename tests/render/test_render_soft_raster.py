@@ -106,18 +106,7 @@ def test_any_split_into_bands_gives_the_same_bytes(width):
     e, h = len(starts), SIZE[1]
     seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
     soft_raster._setup_kernel(
-        points,
-        starts,
-        colors,
-        mvp,
-        SIZE[0],
-        h,
-        np.zeros(0),
-        seg,
-        box,
-        np.zeros(0, bool),
-        width,
-        np.zeros(0),
+        points, starts, colors, mvp, SIZE[0], h, np.zeros(0), seg, box, np.zeros(0, bool), width, np.zeros(0)
     )
     splits = [soft_raster.band_bounds(box[0], box[1], h, n) for n in (1, 4, 13)]
     splits += [np.arange(h + 1), np.array([0, 1, 2, 30, h])]  # one row each; uneven
@@ -149,18 +138,7 @@ def test_hidden_segments_are_skipped_without_changing_a_byte(width):
     e, (w, h) = len(starts), size
     seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)
     soft_raster._setup_kernel(
-        points,
-        starts,
-        colors,
-        mvp,
-        w,
-        h,
-        np.zeros(0),
-        seg,
-        box,
-        np.zeros(0, bool),
-        width,
-        np.zeros(0),
+        points, starts, colors, mvp, w, h, np.zeros(0), seg, box, np.zeros(0, bool), width, np.zeros(0)
     )
     half = 0.0 if width <= 1.0 else width / 2
     hidden = {}
@@ -190,18 +168,7 @@ def test_tapered_quads_split_into_bands_give_the_bytes_of_the_numpy_definition(w
     e, h = len(starts), SIZE[1]
     seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)
     soft_raster._setup_kernel(
-        points,
-        starts,
-        colors,
-        mvp,
-        SIZE[0],
-        h,
-        scale,
-        seg,
-        box,
-        np.zeros(0, bool),
-        width,
-        np.zeros(0),
+        points, starts, colors, mvp, SIZE[0], h, scale, seg, box, np.zeros(0, bool), width, np.zeros(0)
     )
     for bounds in (np.array([0, h]), np.arange(h + 1), np.array([0, 1, 2, 30, h])):
         rgba, depth = np.zeros(SIZE[::-1], np.uint32), np.ones(SIZE[::-1], np.float32)
