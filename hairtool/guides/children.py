@@ -86,14 +86,21 @@ class GuideTables:
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm, exact_x, exact_y, only, out):
-    """Every child (or those flagged in ``only``, when it is not empty) into ``out``."""
+def _children_kernel(
+    coff, tbase, roots, gid, w, scale, local, seg, seglen, frm, exact_x, exact_y, moved, out
+):
+    """Every child into ``out``, or with per-guide ``moved`` flags only those that follow a
+    moved guide."""
     k = gid.shape[1]
     exact = exact_x.shape[0] > 0
     offsets = local.shape[0] > 0
     for c in prange(roots.shape[0]):
-        if only.size and not only[c]:
-            continue
+        if moved.size:
+            follows = False
+            for m in range(k):
+                follows |= moved[gid[c, m]]
+            if not follows:
+                continue
         # Unsigned rows: numba then adds no wrap-around test for negative indices (8 % here).
         a = np.uint64(coff[c])
         n = np.uint64(coff[c + 1]) - a
@@ -144,7 +151,7 @@ def _children_kernel(coff, tbase, roots, gid, w, scale, local, seg, seglen, frm,
 
 _NONE32 = np.zeros((0, 3), np.float32)  # no offsets / not exact
 _NONE64 = np.zeros((0, 3))
-_ALL = np.zeros(0, np.bool_)  # no child flags: every child
+_ALL = np.zeros(0, np.bool_)  # no guide flags: every child
 
 
 def build_points(
@@ -165,10 +172,10 @@ def build_points(
     fresh = out is None or out.shape != (binding.vertex_count, 3) or out.dtype != dtype
     if fresh:
         out = np.empty((binding.vertex_count, 3), dtype)
-    only = _ALL
+    flags = _ALL
     if moved is not None and not fresh:
-        only = np.asarray(moved, np.bool_)[binding.guide_ids].any(axis=1)
-        if not only.any():
+        flags = np.ascontiguousarray(moved, np.bool_)
+        if not flags.any():
             return out
     tables = GuideTables(guides, binding)
     tbase = tables.child_base(binding)
@@ -177,7 +184,7 @@ def build_points(
         binding.offsets, tbase, binding.roots, binding.guide_ids, binding.weights, binding.scale,
         _NONE32 if binding.local is None else binding.local, tables.seg, tables.seglen, tables.frames,
         binding.exact_points if use_exact else _NONE32, binding.exact_blend if use_exact else _NONE64,
-        only, out,
+        flags, out,
     )  # fmt: skip
     return out
 
@@ -186,9 +193,27 @@ def moved_guides(guides: Groom, last: np.ndarray) -> np.ndarray:
     """``(G,)`` whether each guide has a point that differs, bit for bit, from ``last`` (the points
     children were last built from; any other shape: every guide moved)."""
     points = np.ascontiguousarray(guides.points, np.float32)
-    if np.shape(last) != points.shape or np.asarray(last).dtype != np.float32:
+    last = np.asarray(last)
+    if last.shape != points.shape or last.dtype != np.float32:
         return np.ones(guides.strand_count, np.bool_)
-    differs = (points.view(np.uint32) != np.asarray(last).view(np.uint32)).any(axis=1)
+    out = np.empty(guides.strand_count, np.bool_)
+    _moved_kernel(points.view(np.uint32), np.ascontiguousarray(last).view(np.uint32), guides.offsets, out)
+    return out
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _moved_kernel(points, last, offsets, out):
+    for g in prange(out.size):
+        differs = False
+        for v in range(offsets[g], offsets[g + 1]):
+            for a in range(3):
+                differs |= points[v, a] != last[v, a]
+        out[g] = differs
+
+
+def moved_guides_reference(guides: Groom, last: np.ndarray) -> np.ndarray:
+    """Numpy twin of :func:`moved_guides` (for ``last`` of the guides' shape)."""
+    differs = (np.asarray(guides.points, np.float32).view(np.uint32) != last.view(np.uint32)).any(axis=1)
     return np.logical_or.reduceat(differs, guides.offsets[:-1])
 
 

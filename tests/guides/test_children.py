@@ -14,7 +14,12 @@ from hairtool import io, samples
 from hairtool.errors import HairtoolError, ParameterError
 from hairtool.groom import Groom
 from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp, choose_guides
-from hairtool.guides.children import build_points, build_points_reference, moved_guides
+from hairtool.guides.children import (
+    build_points,
+    build_points_reference,
+    moved_guides,
+    moved_guides_reference,
+)
 from hairtool.guides.render import ChildClump, RenderHair
 from hairtool.guides.surface import closest_points
 from hairtool.io.obj import Mesh, read_mesh
@@ -112,6 +117,7 @@ def test_children_of_the_moved_guides_alone_built_again_give_the_bytes_of_a_full
                 pts[:] = g0.points  # all back at rest
             now = g0.with_points(pts)
             moved = moved_guides(now, last)
+            np.testing.assert_array_equal(moved, moved_guides_reference(now, last))
             assert 0 < moved.sum() < g0.strand_count
             build_points(b, now, out=out, moved=moved)
             np.testing.assert_array_equal(_bits(out), _bits(build_points(b, now)))
