@@ -142,6 +142,7 @@ def _render_hair_step() -> None:
     from app.render.hair_shading import light_and_eye, shade
     from hairtool import samples
     from hairtool.guides.binding import bind_roots
+    from hairtool.guides.children import moved_guides
     from hairtool.guides.render import RenderHair
 
     guides = samples.scalp(strands=12, vertices=8)
@@ -149,6 +150,7 @@ def _render_hair_step() -> None:
     rng = np.random.default_rng(0)
     roots = roots[rng.integers(0, len(roots), 60)] + rng.normal(0.0, 1e-3, (60, 3))
     children = RenderHair(bind_roots(guides, roots, k=3, seed=0)).update(guides)
+    moved_guides(guides, np.array(guides.points))  # what a drag asks before building children again
     light, eye = light_and_eye(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, -1.0]))
     base = np.ones((len(children.points), 3), np.float32)
     shade(children.points, children.topology.offsets, base, light, eye)
