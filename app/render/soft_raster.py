@@ -568,7 +568,6 @@ class StrandRaster:
         self._next_unsearched = 0
         self.changed: tuple[int, int, int, int] | None = None  # (row0, row1, col0, col1) or None
         self.tiles_redrawn = 0  # in the last draw; −1: all of the image
-        self.hidden = 0  # (segment, band) pairs the last full draw skipped as hidden
 
     def _view(self, name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
         """A C-contiguous ``shape`` array of ``dtype`` in the memory kept as ``name`` (grown when
@@ -659,9 +658,7 @@ class StrandRaster:
         weight = self._view("weight", (n,), np.float64) if half > 0.0 else None
         self._setup(p, s, c, m, half, self._all, _NO_SCALE if weight is None else weight)
         bounds = band_bounds(self._box[0], self._box[1], h, numba.get_num_threads(), weight)
-        self.hidden = draw_bands(
-            self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth, REFRESH_EVERY
-        )
+        draw_bands(self._seg, self._box, bounds, half, clear, fill, self._rgba32, depth, REFRESH_EVERY)
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1
         self._last_mvp, self._last_starts = m.copy(), self._kept("starts", s, fixed=True)
         if self._unsearched == 0:  # the next draw may look for changes against what this one drew
