@@ -128,3 +128,20 @@ def test_the_manifest_text_is_the_entries_one_job_a_line():
     assert json.loads(text) == {"format": FORMAT, "version": VERSION, "jobs": entries}
     assert text.count("\n") == len(entries) + 2 and "ä" in text
     assert json.loads(manifest_text({}))["jobs"] == {}
+
+
+def test_a_rewrite_reuses_the_lines_of_unchanged_entries_and_encodes_replaced_ones():
+    import json
+
+    from hairtool.farm.manifest import manifest_text
+
+    kept, old = {"seconds": 1.0}, {"seconds": 2.0}
+    encoded: dict = {}
+    first = manifest_text({"a": kept, "b": old}, encoded)
+    assert encoded["a"][0] is kept and encoded["b"][0] is old
+    line_a = encoded["a"][1]
+    second = manifest_text({"a": kept, "b": {"seconds": 3.0}, "c": {}}, encoded)
+    assert encoded["a"][1] is line_a  # not encoded again
+    assert json.loads(second)["jobs"] == {"a": kept, "b": {"seconds": 3.0}, "c": {}}
+    assert json.loads(first)["jobs"] == {"a": kept, "b": old}
+    assert second == manifest_text({"a": kept, "b": {"seconds": 3.0}, "c": {}})
