@@ -84,6 +84,20 @@ def test_kernel_matches_numpy_twin_across_blocks_of_ends(motion_dir):
         assert fast[i, j] == pytest.approx(_pair_cost_reference(q, p, w, wt, i, j), rel=1e-12)
 
 
+def test_coordinates_across_a_quaternion_are_an_orthonormal_basis():
+    from hairtool.mocap.costs import _across
+
+    rng = np.random.default_rng(11)
+    q = rng.normal(size=(1, 6, 4))
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    qi = q[0, 0]
+    basis = np.array([_across(np.eye(4)[None], 0, k, *qi) for k in range(4)]).T  # rows: q_i, then across
+    np.testing.assert_allclose(basis @ basis.T, np.eye(4), atol=1e-15)
+    np.testing.assert_allclose(basis[0], qi, atol=1e-15)
+    for k in range(1, 6):  # the coordinates of q_k are its products with the basis
+        np.testing.assert_allclose(_across(q, 0, k, *qi), basis @ q[0, k], atol=1e-15)
+
+
 def test_arccos_squared_polynomials_are_exact_to_rounding():
     from hairtool.mocap.costs import _acos2_far, _acos2_mid, _acos2_near, acos2_reference
 
