@@ -683,19 +683,28 @@ class StrandRaster:
         """Whether ``a`` is the read-only array last kept as ``name`` (so equal to it)."""
         return isinstance(a, np.ndarray) and not a.flags.writeable and self._sources.get(name) is a
 
+    def _plan_searches(self, in_full: bool) -> None:
+        """After a search for changes: a frame drawn in full (nearly every segment changed, or the
+        changed ones touch tiles that hold nearly all the work) makes the next 1, then 3 frames
+        draw in full without searching; a frame drawn in part (or not at all) resets that. Render
+        hair following a brush moves a quarter of the segments, across nearly every tile: before
+        the second case backed off too, 8 of the bench's 51 drag frames paid ~4 ms for a search
+        that found a full draw."""
+        self._next_unsearched = min(2 * self._next_unsearched + 1, MAX_UNSEARCHED) if in_full else 0
+        self._unsearched = self._next_unsearched
+
     def _redraw_changed(self, p, s, c, m, half, fill, depth) -> bool:
         """Redraw the tiles the changed segments touch; False when a full draw is cheaper."""
         n, v = s.size, p.shape[0]
         self._flags, self._which = self._view("flags", (v,), np.bool_), self._view("which", (n,), np.bool_)
         _changed_vertices(_read_only(p), _read_only(c), self._last_points, self._last_colors, self._flags)
         changed = _changed_ends(_read_only(s), self._flags, self._which)
-        mostly = changed > MOSTLY_CHANGED * n
-        self._next_unsearched = min(2 * self._next_unsearched + 1, MAX_UNSEARCHED) if mostly else 0
-        self._unsearched = self._next_unsearched
         if changed == 0:
+            self._plan_searches(in_full=False)
             self.changed, self.tiles_redrawn = None, 0
             return True
-        if mostly:
+        if changed > MOSTLY_CHANGED * n:
+            self._plan_searches(in_full=True)
             return False
         h, w = depth.shape
         dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
@@ -708,7 +717,9 @@ class StrandRaster:
             self._near = np.empty(n, np.int64)
         total = _bin_segments(self._box, dirty, TILE_SHIFT, self._counts, self._entries, self._near)
         if total > REDRAW_ALL * n:  # measured: then a full draw is as fast
+            self._plan_searches(in_full=True)
             return False
+        self._plan_searches(in_full=False)
         if self._entries.size < total:
             self._entries = np.empty(int(total * 1.5) + 64, np.int64)
             _bin_segments(self._box, dirty, TILE_SHIFT, self._counts, self._entries, self._near)

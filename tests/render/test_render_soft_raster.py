@@ -413,6 +413,31 @@ def test_frames_that_change_nearly_all_then_little_give_the_bytes_of_a_full_draw
     assert kinds[1:9].count(-1) == 8 and any(k > 0 for k in kinds[10:])  # in full, then in part
 
 
+def test_frames_whose_changes_touch_every_tile_stop_searching_for_a_while(monkeypatch):
+    # Render hair following a brush: a sixth of the strands move each frame, spread over the
+    # whole image, so their tiles hold every segment and the frame is drawn in full; the next
+    # 1, then 3 frames are drawn in full without searching. Bytes as fresh draws throughout.
+    from app.render import soft_raster
+
+    searches = []
+    search = soft_raster._changed_vertices
+    monkeypatch.setattr(soft_raster, "_changed_vertices", lambda *a: searches.append(1) or search(*a))
+    size = (160, 120)
+    g, starts, colors, mvp = _scalp_scene(size)
+    rng = np.random.default_rng(3)
+    raster = StrandRaster()
+    points = g.points.copy()
+    for _ in range(9):
+        for s in rng.choice(g.strand_count, size=g.strand_count // 6, replace=False):
+            points[g.offsets[s] + 1 : g.offsets[s + 1]] += np.float32(0.002)
+        rgba, depth = raster.draw(points, starts, colors, mvp, size, 2.5)
+        want = StrandRaster().draw(points, starts, colors, mvp, size, 2.5)
+        np.testing.assert_array_equal(rgba, want[0])
+        np.testing.assert_array_equal(depth, want[1])
+        assert raster.tiles_redrawn == -1
+    assert len(searches) == 3  # on frames 2, 4 and 8 (the first has nothing to compare with)
+
+
 def test_what_makes_a_full_draw_and_what_draws_nothing():
     size = (160, 120)
     g, starts, colors, mvp = _scalp_scene(size)
