@@ -98,31 +98,38 @@ def test_thread_counts_give_the_same_bytes_on_a_dense_groom(threads):
         np.testing.assert_array_equal(images[0][0], ref[0])
 
 
+def _tables(e: int):
+    """Empty set-up outputs for e segments: the segment table (width scale 1), boxes, nearest depths."""
+    return np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32), np.zeros(e, np.float32)
+
+
 @pytest.mark.parametrize("width", [1.0, 2.5])
 def test_any_split_into_bands_gives_the_same_bytes(width):
     points, starts, colors = _awkward_segments(3)
     mvp = np.ascontiguousarray(_perspective(), np.float64)
     ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, width)
     e, h = len(starts), SIZE[1]
-    seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
+    seg, box, nearest = _tables(e)
     soft_raster._setup_kernel(
-        points, starts, colors, mvp, SIZE[0], h, np.zeros(0), seg, box, np.zeros(0, bool), width, np.zeros(0)
+        points, starts, colors, mvp, SIZE[0], h, np.zeros(0), seg, box, nearest,
+        np.zeros(0, bool), width, np.zeros(0)
     )
     splits = [soft_raster.band_bounds(box[0], box[1], h, n) for n in (1, 4, 13)]
     splits += [np.arange(h + 1), np.array([0, 1, 2, 30, h])]  # one row each; uneven
     for bounds in splits:
         rgba, depth = np.zeros(SIZE[::-1], np.uint32), np.ones(SIZE[::-1], np.float32)
         half = 0.0 if width <= 1.0 else width / 2
-        soft_raster.draw_bands(seg, box, bounds, half, True, np.uint32(0), rgba, depth, 2)
+        soft_raster.draw_bands(seg, box, nearest, bounds, half, True, np.uint32(0), rgba, depth, 2)
         np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
         np.testing.assert_array_equal(depth, ref_depth)
 
 
-@pytest.mark.parametrize("width", [1.0, 2.5])
+@pytest.mark.parametrize("width", [1.0, 2.5, 9.0])
 def test_hidden_segments_are_skipped_without_changing_a_byte(width):
     # A dense groom drawn twice over in other colours (every copy ties with the first, and the
     # depth test keeps the first), its cells' farthest depths brought up to date after every
-    # drawn segment, every 50 and never: the skipped segments change nothing.
+    # drawn segment, every 50 and never: the skipped segments change nothing. (Wide quads'
+    # boxes span more than 3 × 3 cells, the others' fewer: both ways of reading them.)
     from hairtool import samples
 
     g = samples.scalp(strands=400, vertices=12, seed=5)
@@ -136,9 +143,10 @@ def test_hidden_segments_are_skipped_without_changing_a_byte(width):
     starts = np.concatenate([one + c * g.vertex_count for c in range(3)]).astype(np.int64)
     ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, size, width)
     e, (w, h) = len(starts), size
-    seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)
+    seg, box, nearest = _tables(e)
     soft_raster._setup_kernel(
-        points, starts, colors, mvp, w, h, np.zeros(0), seg, box, np.zeros(0, bool), width, np.zeros(0)
+        points, starts, colors, mvp, w, h, np.zeros(0), seg, box, nearest,
+        np.zeros(0, bool), width, np.zeros(0)
     )
     half = 0.0 if width <= 1.0 else width / 2
     hidden = {}
@@ -146,7 +154,7 @@ def test_hidden_segments_are_skipped_without_changing_a_byte(width):
         for bounds in (np.array([0, h]), soft_raster.band_bounds(box[0], box[1], h, 3)):
             rgba, depth = np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)
             hidden[refresh] = soft_raster.draw_bands(
-                seg, box, bounds, half, True, np.uint32(0), rgba, depth, refresh
+                seg, box, nearest, bounds, half, True, np.uint32(0), rgba, depth, refresh
             )
             np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
             np.testing.assert_array_equal(depth, ref_depth)
@@ -166,15 +174,44 @@ def test_tapered_quads_split_into_bands_give_the_bytes_of_the_numpy_definition(w
     mvp = np.ascontiguousarray(_perspective(), np.float64)
     ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, width, scale=scale)
     e, h = len(starts), SIZE[1]
-    seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)
+    seg, box, nearest = _tables(e)
     soft_raster._setup_kernel(
-        points, starts, colors, mvp, SIZE[0], h, scale, seg, box, np.zeros(0, bool), width, np.zeros(0)
+        points, starts, colors, mvp, SIZE[0], h, scale, seg, box, nearest,
+        np.zeros(0, bool), width, np.zeros(0)
     )
     for bounds in (np.array([0, h]), np.arange(h + 1), np.array([0, 1, 2, 30, h])):
         rgba, depth = np.zeros(SIZE[::-1], np.uint32), np.ones(SIZE[::-1], np.float32)
-        soft_raster.draw_bands(seg, box, bounds, width / 2, True, np.uint32(0), rgba, depth, 1)
+        soft_raster.draw_bands(seg, box, nearest, bounds, width / 2, True, np.uint32(0), rgba, depth, 1)
         np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
         np.testing.assert_array_equal(depth, ref_depth)
+
+
+@pytest.mark.parametrize("transpose", [False, True])
+def test_a_hidden_test_reads_the_third_row_and_column_of_cells(transpose):
+    # A wall of near quads covers the cells of rows 0-27; a far segment behind it reaches down
+    # into the open cells of rows 28-31, the third cell row (or, transposed, column) its box
+    # touches: its pixels there show, so it must not be skipped on the first two.
+    size = (40, 40)
+    wall = [((-1.0, r + 0.5, 0.2), (41.0, r + 0.5, 0.2)) for r in range(28)]
+    ends = np.array([*wall, ((20.5, 21.7, 0.5), (20.5, 29.5, 0.5))])  # window x, y, depth
+    if transpose:
+        ends = ends[:, :, [1, 0, 2]]
+    ndc = 2.0 * ends / np.array([*size, 1.0]) - 1.0
+    points = ndc.reshape(-1, 3).astype(np.float32)
+    starts = np.arange(0, len(points), 2, dtype=np.int64)
+    colors = np.repeat(np.random.default_rng(2).random((len(starts), 3)), 2, axis=0).astype(np.float32)
+    ref_rgba, ref_depth = rasterize_reference(points, starts, colors, np.eye(4), size, 2.0)
+    back = np.isclose(ref_depth, 0.5).T if transpose else np.isclose(ref_depth, 0.5)
+    assert back[28:].any() and not back[:28].any()
+    seg, box, nearest = _tables(len(starts))
+    soft_raster._setup_kernel(
+        points, starts, colors, np.eye(4), *size, np.zeros(0), seg, box, nearest,
+        np.zeros(0, bool), 2.0, np.zeros(0)
+    )
+    rgba, depth = np.zeros(size[::-1], np.uint32), np.ones(size[::-1], np.float32)
+    soft_raster.draw_bands(seg, box, nearest, np.array([0, size[1]]), 1.0, True, np.uint32(0), rgba, depth, 1)
+    np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
+    np.testing.assert_array_equal(depth, ref_depth)
 
 
 def test_a_box_holds_the_pixel_at_its_quads_farthest_corner():
@@ -189,12 +226,13 @@ def test_a_box_holds_the_pixel_at_its_quads_farthest_corner():
     mvp, starts = np.eye(4), np.array([0], np.int64)
     ref_rgba, _ = rasterize_reference(points, starts, colors, mvp, size, 2.0 * h)
     assert ref_rgba[10, 12, 3] == 255 and not ref_rgba[:10, :, 3].any()  # the corner's pixel, lowest
-    seg, box = np.ones((1, soft_raster._SEG)), np.zeros((4, 1), np.int32)
+    seg, box, nearest = _tables(1)
     soft_raster._setup_kernel(
-        points, starts, colors, mvp, *size, np.zeros(0), seg, box, np.zeros(0, bool), 2 * h, np.zeros(0)
+        points, starts, colors, mvp, *size, np.zeros(0), seg, box, nearest,
+        np.zeros(0, bool), 2 * h, np.zeros(0)
     )
     rgba, depth = np.zeros(size[::-1], np.uint32), np.ones(size[::-1], np.float32)
-    soft_raster.draw_bands(seg, box, np.arange(size[1] + 1), h, True, np.uint32(0), rgba, depth, 1)
+    soft_raster.draw_bands(seg, box, nearest, np.arange(size[1] + 1), h, True, np.uint32(0), rgba, depth, 1)
     np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
 
 
@@ -214,15 +252,17 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
                 soft_raster._cover_steps,
             )
         )
-        seg, box = np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32)  # width scale 1
+        seg, box, nearest = _tables(e)
         weight = np.zeros(e)
-        setup(points, starts, colors, mvp, w, h, np.zeros(0), seg, box, np.zeros(0, bool), 3.0, weight)
+        setup(
+            points, starts, colors, mvp, w, h, np.zeros(0), seg, box, nearest, np.zeros(0, bool), 3.0, weight
+        )
         np.testing.assert_array_equal(weight, 1.0 + 3.0 * seg[:, 12])
         bounds = soft_raster.band_bounds(box[0], box[1], h, 3, weight)
         images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)] * 3
         images = [a.copy() for a in images]
-        bands(seg, box, bounds, 0.0, True, np.uint32(7), *images[:2], 3)
-        bands(seg, box, bounds, 1.5, True, np.uint32(7), *images[2:4], 3)
+        bands(seg, box, nearest, bounds, 0.0, True, np.uint32(7), *images[:2], 3)
+        bands(seg, box, nearest, bounds, 1.5, True, np.uint32(7), *images[2:4], 3)
         dirty = np.ones(((h + 15) // 16, (w + 15) // 16), bool)
         counts = np.zeros(dirty.size + 1, np.int64)
         near = np.zeros(e, np.int64)
