@@ -341,8 +341,8 @@ def draw_bands(seg, box, nearest, bounds, half, clear, background, rgba, depth, 
     draws it and changes nothing); on the studio's render hair it skips 55 % of a drag frame's
     segments, 77 % of a full-density one's (hair on the far side of the head, behind the hair in
     front). A box of at most 3 × 3 cells, most of them, is read as nine cells without a loop
-    (repeating a row or column where it has fewer): the nested loops' exits had mispredicted
-    on every segment (12-16 % of the draw)."""
+    (repeating a row or column where it has fewer), where nested loops' exits mispredicted on
+    every segment; that and ``nearest`` in an array of its own made the bands 12-16 % faster."""
     w = depth.shape[1]
     flat_rgba, flat_depth = rgba.reshape(-1), depth.reshape(-1)
     bits = depth.view(np.int32)
