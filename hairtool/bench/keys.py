@@ -4,8 +4,9 @@ O(n³D) table (where it finishes in a minute) and one float64 X @ X.T of the sam
 Feature arrays are random walks, except D = 96,000 which is a swaying hair animation of 2,000
 strands resampled to 16 points (the features step is timed there). After the rows of the chosen
 interpolation come, for the sizes up to 3,000 dimensions, the other objectives and
-interpolations: the worst-frame objective, fitted Hermite handles, and the total objective with
-ten pinned and ten excluded frames (``constrained``), each a table plus the all-K DP; and seed
+interpolations: the worst-frame objective, fitted Hermite handles, and the total and worst-frame
+objectives with ten pinned and ten excluded frames (``constrained``, with ``constraint_overhead``
+against the same table without them), each a table plus the all-K DP; and seed
 003's quaternion-distance table (objective ``quaternion``, interp ``slerp``, dims = joints) of a
 real capture of that many frames, the 1,064-frame PyMO walk (23 joints) played forward and back.
 Tables and DPs are the median of ``--repeat`` runs (features and the direct table: one).
@@ -166,7 +167,10 @@ def _quaternion_row(n: int, kmax: int, repeat: int = 1) -> dict:
 
 
 def _other_modes(n: int, d: int, kmax: int, repeat: int = 1) -> list[dict]:
-    """Table + all-K DP for the worst-frame objective, fitted handles, and pins/exclusions."""
+    """Table + all-K DP for the worst-frame objective, fitted handles, and pins/exclusions. A
+    constrained row times its DP against the unconstrained one on the same table, taking turns,
+    and reports what the constraints add to the selection (``constraint_overhead``): apart, the
+    two would differ as much by the machine's drift between them as by the constraints."""
     from hairtool.keys.constraints import KeyConstraints
     from hairtool.keys.costs import cost_table
     from hairtool.keys.dp import solve_layers
@@ -180,22 +184,36 @@ def _other_modes(n: int, d: int, kmax: int, repeat: int = 1) -> list[dict]:
         ("worst", "hermite", False),
         ("total", "hermite-fit", False),
         ("total", "linear", True),
+        ("worst", "linear", True),
     ):
         warm = x[: min(n, 12)]
         solve_layers(cost_table(warm, interp, 0.0, objective), 3, objective)
         table, table_s = _time(lambda i=interp, o=objective: cost_table(x, i, 0.0, o), repeat)
-        c = cons if constrained else None
-        _, dp_s = _time(lambda t=table, o=objective, c=c: solve_layers(t, kmax, o, constraints=c), repeat)
-        out.append(
-            {
-                "frames": n,
-                "dims": d,
-                "objective": objective,
-                "interp": interp,
-                "constrained": constrained,
-                "table_s": table_s,
-                "dp_s": dp_s,
-                "select_s": table_s + dp_s,
-            }
-        )
+        row = {"frames": n, "dims": d, "objective": objective, "interp": interp, "constrained": constrained}
+        if constrained:
+            dp_s, free_s = _time_turns(
+                [
+                    lambda t=table, o=objective: solve_layers(t, kmax, o, constraints=cons),
+                    lambda t=table, o=objective: solve_layers(t, kmax, o),
+                ],
+                max(repeat, 5),
+            )
+            row["dp_unconstrained_s"] = free_s
+            row["constraint_overhead"] = (table_s + dp_s) / (table_s + free_s) - 1.0
+        else:
+            _, dp_s = _time(lambda t=table, o=objective: solve_layers(t, kmax, o), repeat)
+        out.append({**row, "table_s": table_s, "dp_s": dp_s, "select_s": table_s + dp_s})
     return out
+
+
+def _time_turns(fns, repeat: int) -> list[float]:
+    """Median seconds of each of ``fns``, run in turn ``repeat`` times (the order alternating), so
+    that a slow moment of the machine falls on all of them."""
+    times: list[list[float]] = [[] for _ in fns]
+    for r in range(repeat):
+        order = range(len(fns)) if r % 2 == 0 else reversed(range(len(fns)))
+        for i in order:
+            t0 = time.perf_counter()
+            fns[i]()
+            times[i].append(time.perf_counter() - t0)
+    return [statistics.median(t) for t in times]

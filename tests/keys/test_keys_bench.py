@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from hairtool.cli import main
 
 
@@ -21,11 +23,19 @@ def test_quick_bench_rows(capsys):
             ("worst", "hermite", False),
             ("total", "hermite-fit", False),
             ("total", "linear", True),
+            ("worst", "linear", True),
             ("quaternion", "slerp", False),
         )
     }
     assert all(r["dims"] == 23 for r in rows if r["objective"] == "quaternion")
     assert all(r["select_s"] > 0 for r in rows)
+    for r in rows:  # the constrained rows say what the constraints add, against their own table
+        assert ("constraint_overhead" in r) == r["constrained"]
+        if r["constrained"]:
+            assert r["dp_unconstrained_s"] > 0
+            assert r["constraint_overhead"] == pytest.approx(
+                (r["table_s"] + r["dp_s"]) / (r["table_s"] + r["dp_unconstrained_s"]) - 1.0
+            )
     for r in main_rows:
         for key in ("select_s", "gram_s", "table_s", "dp_s", "direct_s", "features_s"):
             assert key in r
