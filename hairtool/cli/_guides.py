@@ -25,6 +25,18 @@ if TYPE_CHECKING:
     from hairtool.guides.render import RenderHair
 
 
+#: Defaults of the options that shape the children (None on the command line: given or not).
+K = 4
+LENGTH_VARIATION = 0.1
+FRIZZ = 0.01
+#: Options that mean something only with --count or --from-dense (destination, flag).
+_RENDER_ONLY = (
+    ("scalp", "--scalp"), ("guides_per_child", "--guides-per-child"), ("vertices", "--vertices"),
+    ("length_variation", "--length-variation"), ("frizz", "--frizz"), ("region", "--region"),
+    ("density", "--density"), ("clump_children", "--clump-children"), ("guides_out", "--guides-out"),
+)  # fmt: skip
+
+
 def add_arguments(
     parser: argparse.ArgumentParser, *, seed: bool = True, guides: bool = True
 ) -> argparse._ArgumentGroup:
@@ -34,7 +46,7 @@ def add_arguments(
     g.add_argument("--count", type=int, default=None, help="children to grow from the guides")
     g.add_argument("--scalp", metavar="MESH.obj", default=None, help="scalp mesh the children grow on")
     g.add_argument(
-        "--guides-per-child", type=int, default=4, metavar="K", help="k nearest guides (default 4)"
+        "--guides-per-child", type=int, default=None, metavar="K", help=f"k nearest guides (default {K})"
     )
     if seed:
         g.add_argument(
@@ -44,14 +56,14 @@ def add_arguments(
     g.add_argument(
         "--length-variation",
         type=float,
-        default=0.1,
-        help="child lengths ×[1−v, 1+v], v in [0, 0.9] (default 0.1)",
+        default=None,
+        help=f"child lengths ×[1−v, 1+v], v in [0, 0.9] (default {LENGTH_VARIATION})",
     )
     g.add_argument(
         "--frizz",
         type=float,
-        default=0.01,
-        help="curl radius at the tip / child length, [0, 0.5] (default 0.01)",
+        default=None,
+        help=f"curl radius at the tip / child length, [0, 0.5] (default {FRIZZ})",
     )
     g.add_argument(
         "--region",
@@ -84,18 +96,55 @@ def wanted(args: argparse.Namespace) -> bool:
     return args.count is not None or args.from_dense
 
 
+def input_groom(args: argparse.Namespace, groom: Groom) -> Groom:
+    """The strands the command works on, from an input that may hold render hair and its guides
+    (two prims, the guides of purpose ``guide``, as this tool writes them): the guides, to grow
+    children from (``--count``); the render hair, to pick new guides from (``--from-dense``).
+    Without either option the command works on one set of strands, and such a file is refused
+    rather than its guides merged into its hair."""
+    from hairtool.errors import HairtoolError
+    from hairtool.guides.files import split_guides
+
+    hair, guides = split_guides(groom)
+    if guides is None:
+        return groom
+    if args.from_dense:
+        return hair
+    if args.count is not None:
+        return guides
+    raise HairtoolError(
+        f"{args.input}: holds render hair ({hair.strand_count} strands) and its guides "
+        f"({guides.strand_count}, purpose 'guide'); give --count N to work on the guides and grow "
+        "N render strands from them, or --from-dense --guides G to work on the render hair through G guides"
+    )
+
+
 def guides_path(args: argparse.Namespace) -> Path:
     from hairtool.guides.files import guides_path_for
 
     return Path(args.guides_out) if args.guides_out else guides_path_for(args.output)
 
 
-def check(args: argparse.Namespace, *, animated: bool = False) -> None:
-    """Refuse contradictory options and unwritable outputs before any work (``animated``: the
-    output is an animation, whose guides go beside it in formats other than USD)."""
+def check(
+    args: argparse.Namespace, *, animated: bool = False, guides_option: bool = True, required: bool = False
+) -> None:
+    """Refuse contradictory options, options that would do nothing, and unwritable outputs,
+    before any work (``animated``: the output is an animation, whose guides go beside it in
+    formats other than USD; ``guides_option`` False where ``--guides`` is the command's own and
+    means something without ``--from-dense``; ``required``: the command makes render hair or
+    nothing)."""
     from hairtool import io
     from hairtool.errors import ParameterError
 
+    if required and not wanted(args):
+        raise ParameterError("count", None, "a number of children (or --from-dense --guides G)")
+    if not wanted(args):
+        options = _RENDER_ONLY + ((("guides", "--guides"),) if guides_option else ())
+        for dest, flag in options:
+            if getattr(args, dest) not in (None, False):
+                value = getattr(args, dest)
+                raise ParameterError(flag[2:], value, f"{flag} only with --count N or --from-dense")
+        return
     if args.from_dense:
         if args.guides is None:
             raise ParameterError("guides", None, "a number of guides to pick with --from-dense")
@@ -103,10 +152,17 @@ def check(args: argparse.Namespace, *, animated: bool = False) -> None:
             raise ParameterError("from-dense", "with --count", "either --from-dense or --count")
         if args.region is not None or args.density is not None:
             raise ParameterError("from-dense", "with --region/--density", "the dense strands' own roots")
-        if args.vertices is not None:
-            raise ParameterError("vertices", args.vertices, "none with --from-dense (strands keep theirs)")
-    elif args.count is None:
-        raise ParameterError("count", None, "a number of children (or --from-dense --guides G)")
+        for dest in ("vertices", "length_variation", "frizz"):
+            value = getattr(args, dest)
+            if value is not None:
+                expected = "none with --from-dense (strands keep theirs)"
+                raise ParameterError(dest.replace("_", "-"), value, expected)
+    elif guides_option and args.guides is not None:
+        raise ParameterError("guides", args.guides, "none without --from-dense (IN's strands are the guides)")
+    if args.density is not None and args.scalp is None:
+        raise ParameterError("density", args.density, "a --scalp mesh whose triangles or vertices it weights")
+    if args.region is not None and args.scalp is None:
+        raise ParameterError("region", args.region, "a --scalp mesh to select triangles of")
     io.format_for(args.output, writing=True)
     if args.from_dense or args.guides_out or (animated and not is_usd(args.output)):
         io.format_for(guides_path(args), writing=True)
@@ -135,7 +191,11 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
     from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp
 
     t0 = time.perf_counter()
-    k = args.guides_per_child
+    k = K if args.guides_per_child is None else args.guides_per_child
+    shape = {
+        "length_variation": LENGTH_VARIATION if args.length_variation is None else args.length_variation,
+        "frizz": FRIZZ if args.frizz is None else args.frizz,
+    }
     mesh = None
     if args.scalp is not None:
         from hairtool.io.obj import read_mesh
@@ -155,19 +215,12 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
         density = None if args.density is None else _numbers(args.density, "densities")
         guides = groom
         binding = bind_scalp(
-            groom, mesh, args.count, k=k, vertices=args.vertices, seed=args.seed,
-            length_variation=args.length_variation, frizz=args.frizz, region=region, density=density,
+            groom, mesh, args.count, k=k, vertices=args.vertices, seed=args.seed, region=region,
+            density=density, **shape,
         )  # fmt: skip
     else:
-        if args.region is not None or args.density is not None:
-            raise ParameterError(
-                "region", args.region or args.density, "a --scalp mesh to select triangles of"
-            )
         guides = groom
-        binding = bind_roots(
-            groom, count=args.count, k=k, vertices=args.vertices, seed=args.seed,
-            length_variation=args.length_variation, frizz=args.frizz,
-        )  # fmt: skip
+        binding = bind_roots(groom, count=args.count, k=k, vertices=args.vertices, seed=args.seed, **shape)
     return guides, binding, (time.perf_counter() - t0) * 1e3
 
 

@@ -121,16 +121,16 @@ def run(args: argparse.Namespace) -> int:
                 raise ParameterError(flag, getattr(args, flag), "an IN groom to make the cycle from")
         if render:
             raise ParameterError("count", args.count, "an IN groom and an OUT file for render hair")
+        _guides.check(args, guides_option=False)  # render-hair options without render hair: refused
     else:
         from hairtool.io import format_for
 
         if args.output is not None:
             out_fmt = format_for(args.output, writing=True)  # refuse a bad extension before posing
-        if render:
-            if args.output is None:
-                raise ParameterError("count", args.count, "an OUT file to write the render hair to")
-            _guides.check(args, animated=True)
-        groom = load_groom(args.input)
+        if render and args.output is None:
+            raise ParameterError("count", args.count, "an OUT file to write the render hair to")
+        _guides.check(args, animated=True, guides_option=False)
+        groom = _guides.input_groom(args, load_groom(args.input))
         if render:
             groom, binding, bind_ms = _guides.bind(args, groom)  # the guides wave
         variation = {

@@ -147,14 +147,13 @@ def run(args: argparse.Namespace) -> int:
         (0.0, 0.0, 0.0), 1.0 if args.radius is None else args.radius, args.intensity, args.align_mode
     )
     render = _guides.wanted(args)
-    if render:
-        _guides.check(args)
+    _guides.check(args)
     strokes = None
     if args.strokes is not None:
         from hairtool.frozen.strokes import read_strokes
 
         strokes = read_strokes(args.strokes)  # a bad log is refused before any work
-    groom = io.read_groom(args.input)
+    groom = _guides.input_groom(args, io.read_groom(args.input))
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
     if render:
         groom, binding, bind_ms = _guides.bind(args, groom)  # the pipeline runs on the guides

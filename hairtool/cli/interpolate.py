@@ -30,8 +30,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from hairtool.io.specs import load_groom
 
-    _guides.check(args)
-    groom = load_groom(args.input)
+    _guides.check(args, required=True)
+    groom = _guides.input_groom(args, load_groom(args.input))
     guides, binding, bind_ms = _guides.bind(args, groom)
     hair = _guides.render(args, binding)
     t0 = time.perf_counter()

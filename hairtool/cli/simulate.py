@@ -76,11 +76,10 @@ def run(args: argparse.Namespace) -> int:
 
     fmt = format_for(args.output, writing=True)  # refuse a bad extension before simulating
     render = _guides.wanted(args)
-    if render:
-        _guides.check(args, animated=True)
+    _guides.check(args, animated=True)
     motion = parse_motion(args.motion)
     wind = parse_vector("wind", args.wind) if args.wind is not None else (0.0, 0.0, 0.0)
-    groom = load_groom(args.input)
+    groom = _guides.input_groom(args, load_groom(args.input))
     if render:
         groom, binding, bind_ms = _guides.bind(args, groom)  # the guides are simulated
     if args.fit_head:

@@ -138,3 +138,53 @@ def test_sample_guides_without_a_mesh(tmp_path):
     )
     kids = io.read_groom(out)
     assert kids.strand_count == 500 and set(kids.counts) == {12}
+
+
+def test_a_file_of_render_hair_and_guides_is_read_as_such(tmp_path, capsys):
+    """This tool's own USD (the hair, then the guides as a prim of purpose guide): --count grows
+    children from its guides, --from-dense picks guides among its render hair, and a command on
+    one set of strands refuses it rather than merging the two."""
+    both = tmp_path / "both.usda"
+    assert main(["interpolate", GUIDES, str(both), "--count", "300", "--scalp", HEAD]) == 0
+    hair, guides = split_guides(io.read_groom(both))
+    assert (hair.strand_count, guides.strand_count) == (300, 228)
+    again = tmp_path / "again.usda"
+    assert main(["interpolate", str(both), str(again), "--count", "300", "--scalp", HEAD, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["guides"] == 228
+    assert split_guides(io.read_groom(again))[0].points.tobytes() == hair.points.tobytes()  # same guides
+    dense = tmp_path / "dense.usda"
+    assert main(["interpolate", str(both), str(dense), "--from-dense", "--guides", "20", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["children"] == 300
+    assert split_guides(io.read_groom(dense))[0].points.tobytes() == hair.points.tobytes()
+    frozen = tmp_path / "frozen.usda"
+    assert main(["freeze", str(both), str(frozen), "--count", "300", "--scalp", HEAD, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["guides"] == 228
+    for command in (["freeze"], ["simulate", "--frames", "3"]):
+        out = tmp_path / "one.usda"
+        assert main([command[0], str(both), str(out), *command[1:]]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "both.usda" in err and "--count" in err
+        assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("command", "extra", "name"),
+    [
+        ("interpolate", ["--count", "10", "--guides", "5"], "guides"),
+        ("interpolate", ["--count", "10", "--density", "d.txt"], "density"),
+        ("interpolate", ["--from-dense", "--guides", "5", "--frizz", "0.2"], "frizz"),
+        ("interpolate", ["--from-dense", "--guides", "5", "--length-variation", "0.2"], "length-variation"),
+        ("freeze", ["--guides", "5"], "guides"),
+        ("freeze", ["--scalp", HEAD], "scalp"),
+        ("freeze", ["--clump-children"], "clump-children"),
+        ("freeze", ["--frizz", "0.1"], "frizz"),
+        ("simulate", ["--frames", "3", "--guides-per-child", "3"], "guides-per-child"),
+        ("anime", ["--vertices", "8"], "vertices"),
+    ],
+)
+def test_options_that_would_do_nothing_are_refused(tmp_path, capsys, command, extra, name):
+    out = tmp_path / "x.npz"
+    assert main([command, GUIDES, str(out), *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.split("=")[0].endswith(name), err
+    assert not out.exists()
