@@ -4,10 +4,12 @@ The file (``.hairproj``) is a zip archive: ``manifest.json`` (format, version, e
 parameters, brush, display, key and other settings, and the list of array members) and one
 ``.npy`` member per array (rest groom, stroke log, the aligned state of the stroke snapshot,
 the animation's frames, and for render hair the child definition: roots, guides and weights,
-length scales and offsets of :class:`~hairtool.guides.binding.ChildBinding`, never the
-children's points, since they are rebuilt from the guides). A zip keeps the manifest readable
-with any tool, the arrays exact (float32/float64 bit for bit), lets a reader check every
-member's size and checksum before it trusts it, and loads with ``allow_pickle=False``.
+length scales and the frizz's recipe of :class:`~hairtool.guides.binding.ChildBinding`, never
+the children's points, since they are rebuilt from the guides; for a dense groom bound to
+guides, its points alone, the offsets that return it exactly being bound again on loading).
+A zip keeps the manifest readable with any tool, the arrays exact (float32/float64 bit for
+bit), lets a reader check every member's size and checksum before it trusts it, and loads
+with ``allow_pickle=False``.
 
 Saving writes a temporary file beside the target and renames it, so an interrupted save never
 harms the previous project. Loading checks everything and raises one
@@ -38,7 +40,7 @@ from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterErr
 from hairtool.frozen.brushes import BRUSHES, LUT_SIZE, BrushSample, check_sample, check_view
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.groom import Animation, Groom
-from hairtool.guides.binding import ChildBinding
+from hairtool.guides.binding import MAX_FRIZZ, ChildBinding, bind_exactly, curl
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
 from hairtool.io.npz import read_npy_header
@@ -199,6 +201,8 @@ _CHILD_ARRAYS = (
     ("faces", "child", (), "iu", False),
     ("exact_points", "vertex", (3,), "f", False),
     ("exact_blend", "vertex", (3,), "f", False),
+    ("frizz_phase", "child", (), "f", False),
+    ("frizz_turns", "child", (), "f", False),
 )
 
 
@@ -211,12 +215,20 @@ def _children_arrays(project: Project, arrays: dict[str, np.ndarray]) -> dict | 
     ):
         raise GroomError("the children must be bound to the project's rest groom (their guides)")
     stored = []
+    derived = ()  # arrays that follow from the others, made again on loading:
+    if b.exact_points is not None:
+        derived = ("local", "exact_blend")  # a dense groom's offsets, from its points
+    elif b.frizz_phase is not None:
+        derived = ("local",)  # the frizz, from a few numbers per child
     for name, *_ in _CHILD_ARRAYS:
         value = getattr(b, name)
-        if value is not None:
+        if value is not None and name not in derived:
             arrays[f"children/{name}.npy"] = np.ascontiguousarray(value)
             stored.append(name)
-    return {"count": b.child_count, "arrays": stored}
+    info: dict[str, Any] = {"count": b.child_count, "arrays": stored}
+    if b.frizz_phase is not None:
+        info["frizz"] = b.frizz
+    return info
 
 
 def save(path: str | os.PathLike[str], project: Project, *, compress: bool = False) -> None:
@@ -498,7 +510,7 @@ def _read_children(r: _Reader, info: Any, rest: Groom) -> ChildBinding | None:
     if ids.size and (ids.min() < 0 or ids.max() >= rest.strand_count):
         raise FormatError(r.path, f"a child names a guide outside [0, {rest.strand_count})")
     faces = values["faces"]
-    return ChildBinding(
+    b = ChildBinding(
         rest,
         values["counts"],
         values["roots"].astype(np.float64),
@@ -510,6 +522,26 @@ def _read_children(r: _Reader, info: Any, rest: Groom) -> ChildBinding | None:
         None if values["exact_points"] is None else values["exact_points"].astype(np.float32),
         None if values["exact_blend"] is None else values["exact_blend"].astype(np.float64),
     )
+    if b.exact_points is not None and (b.local is None or b.exact_blend is None):
+        bind_exactly(b, b.exact_points)  # a dense groom's points: its offsets follow from them
+    elif b.local is None and values["frizz_phase"] is not None:
+        _curl_again(r, info, b, values)
+    return b
+
+
+def _curl_again(r: _Reader, info: dict, b: ChildBinding, values: dict) -> None:
+    """The children's frizz offsets from its recipe (amplitude, and each child's phase and turns)."""
+    frizz = info.get("frizz")
+    if isinstance(frizz, bool) or not isinstance(frizz, (int, float)) or not 0 < frizz <= MAX_FRIZZ:
+        raise FormatError(r.path, f"manifest.json: children 'frizz' must be a number in (0, {MAX_FRIZZ}]")
+    if values["frizz_turns"] is None:
+        raise FormatError(r.path, "missing member 'children/frizz_turns.npy'")
+    if b.child_count and np.any(b.counts != b.counts[0]):
+        raise FormatError(r.path, "frizzed children must have one vertex count")
+    b.frizz = float(frizz)
+    b.frizz_phase = values["frizz_phase"].astype(np.float64)
+    b.frizz_turns = values["frizz_turns"].astype(np.float64)
+    curl(b)
 
 
 def _build(r: _Reader) -> Project:

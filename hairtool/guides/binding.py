@@ -59,6 +59,9 @@ class ChildBinding:
     faces: np.ndarray | None = None  # (N,) the scalp triangle of each root, when on a mesh
     exact_points: np.ndarray | None = None  # (V, 3) float32: a dense groom's points …
     exact_blend: np.ndarray | None = None  # … and its float64 blend at rest (see children)
+    frizz: float = 0.0  # the curl that made ``local``: its radius at the tip / child length …
+    frizz_phase: np.ndarray | None = None  # … (N,) each child's starting angle, radians …
+    frizz_turns: np.ndarray | None = None  # … (N,) and its turns root to tip
     _tangents: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -104,10 +107,13 @@ class ChildBinding:
         def pick(a: np.ndarray | None) -> np.ndarray | None:
             return None if a is None else a[vids]
 
+        def per_child(a: np.ndarray | None) -> np.ndarray | None:
+            return None if a is None else a[ids]
+
         out = ChildBinding(
             self.rest_guides, self.counts[ids], self.roots[ids], self.guide_ids[ids], self.weights[ids],
-            self.scale[ids], pick(self.local), None if self.faces is None else self.faces[ids],
-            pick(self.exact_points), pick(self.exact_blend),
+            self.scale[ids], pick(self.local), per_child(self.faces), pick(self.exact_points),
+            pick(self.exact_blend), self.frizz, per_child(self.frizz_phase), per_child(self.frizz_turns),
         )  # fmt: skip
         out._tangents = self._tangents
         return out
@@ -171,15 +177,27 @@ def _bind(
     counts = np.full(count, n, np.int64)
     b = ChildBinding(guides, counts, roots, ids, w, scale, None, faces)
     if frizz > 0:
-        q = _children.build_points(b, guides, np.float64).reshape(count, n, 3)
-        b.local = np.zeros((count * n, 3), np.float32)
-        length = np.linalg.norm(np.diff(q, axis=1), axis=2).sum(axis=1)
-        u = np.arange(n) / (n - 1)
-        a = (frizz * length)[:, None] * u[None, :]
-        ang = 2.0 * np.pi * turns[:, None] * u[None, :] + phase[:, None]
-        b.local[:, 1] = (a * np.cos(ang)).reshape(-1)
-        b.local[:, 2] = (a * np.sin(ang)).reshape(-1)
+        b.frizz, b.frizz_phase, b.frizz_turns = float(frizz), phase, turns
+        curl(b)
     return b
+
+
+def curl(b: ChildBinding) -> None:
+    """``b.local`` from its frizz: a helix across the nearest guide's frames whose radius grows
+    from 0 at the root to ``frizz`` × the child's rest length at the tip. A few numbers per child
+    make it, so a project stores those and curls the children again on loading."""
+    n = int(b.counts[0])
+    count = b.child_count
+    b.local = None
+    q = _children.build_points(b, b.rest_guides, np.float64).reshape(count, n, 3)
+    local = np.zeros((count * n, 3), np.float32)
+    length = np.linalg.norm(np.diff(q, axis=1), axis=2).sum(axis=1)
+    u = np.arange(n) / (n - 1)
+    a = (b.frizz * length)[:, None] * u[None, :]
+    ang = 2.0 * np.pi * b.frizz_turns[:, None] * u[None, :] + b.frizz_phase[:, None]
+    local[:, 1] = (a * np.cos(ang)).reshape(-1)
+    local[:, 2] = (a * np.sin(ang)).reshape(-1)
+    b.local = local
 
 
 def _nearest(guides: Groom, roots: np.ndarray, k: int, mesh: Mesh | None) -> tuple:
@@ -283,14 +301,25 @@ def bind_dense(
     ids_k, w = weights(*near, k)
     scale = np.ones(dense.strand_count)
     b = ChildBinding(guides, dense.counts.copy(), roots, ids_k, w, scale, None, faces)
+    bind_exactly(b, dense.points)
+    return guides, b
+
+
+def bind_exactly(b: ChildBinding, points: np.ndarray) -> None:
+    """Give ``b`` (one child per dense strand, no offsets yet) the dense strands' ``points``
+    exactly: each vertex's offset from the blend in its nearest guide's frames (``local``), the
+    float64 blend at rest those offsets give (``exact_blend``) and the points themselves. The
+    first two follow from the points and the rest guides, so a project stores the points alone
+    and binds them again on loading."""
+    guides = b.rest_guides
+    b.local = b.exact_points = b.exact_blend = None  # the plain blend first
     q = _children.build_points(b, guides, np.float64)
     tables = _children.GuideTables(guides, b)
-    near_row = tables.child_base(b) + ids_k[:, 0] * b.counts
-    rows = np.repeat(near_row, b.counts) + dense.topology.index_in_strand
+    near_row = tables.child_base(b) + b.guide_ids[:, 0] * b.counts
+    rows = np.repeat(near_row, b.counts) + b.topology.index_in_strand
     fr = tables.frames[rows]  # (V, 9): each vertex's frame on its nearest guide
-    r = dense.points.astype(np.float64) - q
+    r = points.astype(np.float64) - q
     local = np.column_stack([np.einsum("ij,ij->i", r, fr[:, 3 * a : 3 * a + 3]) for a in range(3)])
     b.local = local.astype(np.float32)  # the rest blend below uses these very offsets
     b.exact_blend = _children.build_points(b, guides, np.float64)
-    b.exact_points = dense.points
-    return guides, b
+    b.exact_points = points

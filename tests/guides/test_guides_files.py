@@ -95,10 +95,63 @@ def test_a_project_stores_the_child_definition_exactly(tmp_path, dense):
             np.testing.assert_array_equal(a, b)
             assert a.dtype == b.dtype, name
     np.testing.assert_array_equal(back.build().points, binding.build().points)
+    moved = guides.with_points(guides.points + guides.topology.vertex_param[:, None].astype(np.float32))
+    np.testing.assert_array_equal(back.build(moved).points, binding.build(moved).points)
     with zipfile.ZipFile(path) as zf:  # the definition, not the children's points
         names = zf.namelist()
     assert not any("children/points" in n for n in names)
+    # Per-vertex offsets are made again on loading: a dense groom's from its points (stored
+    # once), the frizz from its amplitude and each child's phase and turns.
+    assert "children/local.npy" not in names and "children/exact_blend.npy" not in names
+    assert ("children/frizz_phase.npy" in names) != dense
     assert project.load(path).rest.strand_count == guides.strand_count
+
+
+def _drop_turns(manifest: dict, arrays: dict) -> None:
+    manifest["children"]["arrays"].remove("frizz_turns")
+    del arrays["children/frizz_turns.npy"]
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (lambda m, a: m["children"].update(frizz=7.0), "frizz"),
+        (lambda m, a: m["children"].update(frizz="curly"), "frizz"),
+        (_drop_turns, "turns"),
+    ],
+)
+def test_a_bad_frizz_recipe_is_one_format_error(tmp_path, change, match):
+    guides = samples.scalp(20, 6, seed=1)
+    binding = bind_roots(guides, count=50, seed=5, frizz=0.1)
+    manifest, arrays = project.manifest_and_arrays(project.Project(rest=guides, children=binding))
+    change(manifest, arrays)
+    manifest["arrays"] = sorted(arrays)
+    path = tmp_path / "bad.hairproj"
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr("manifest.json", json.dumps(manifest))
+        for name, a in arrays.items():
+            with zf.open(name, "w") as f:
+                np.lib.format.write_array(f, np.ascontiguousarray(a), allow_pickle=False)
+    with pytest.raises(FormatError, match=match):
+        project.load(path)
+
+
+def test_a_dense_project_stored_in_full_by_an_earlier_hairtool_still_loads(tmp_path):
+    guides, binding = bind_dense(samples.scalp(200, 8, seed=1), 20, seed=2)
+    manifest, arrays = project.manifest_and_arrays(project.Project(rest=guides, children=binding))
+    arrays["children/local.npy"] = binding.local
+    arrays["children/exact_blend.npy"] = binding.exact_blend
+    manifest["children"]["arrays"] += ["local", "exact_blend"]
+    manifest["arrays"] = sorted(arrays)
+    path = tmp_path / "old.hairproj"
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr("manifest.json", json.dumps(manifest))
+        for name, a in arrays.items():
+            with zf.open(name, "w") as f:
+                np.lib.format.write_array(f, np.ascontiguousarray(a), allow_pickle=False)
+    back = project.load(path).children
+    np.testing.assert_array_equal(back.local, binding.local)
+    np.testing.assert_array_equal(back.exact_blend, binding.exact_blend)
 
 
 def test_a_project_without_children_has_none(tmp_path):
