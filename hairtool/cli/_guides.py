@@ -225,9 +225,21 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
 
 
 def render(args: argparse.Namespace, binding: ChildBinding) -> RenderHair:
+    """The children, clumped with ``--clump-children``: at their own automatic radius (they are
+    far denser than the guides), with the command's clump passes, gap mode and length rule
+    where it has them (``freeze``: ``--clump-iterations``, ``--gap-mode``, ``--keep-lengths``),
+    else three passes, printed gaps and lengths kept."""
     from hairtool.guides.render import ChildClump, RenderHair
 
-    return RenderHair(binding, ChildClump(seed=args.seed) if args.clump_children else None)
+    if not args.clump_children:
+        return RenderHair(binding, None)
+    clump = ChildClump(
+        iterations=getattr(args, "clump_iterations", 3),
+        gap_mode=getattr(args, "gap_mode", "printed"),
+        seed=args.seed,
+        keep_lengths=getattr(args, "keep_lengths", True),
+    )
+    return RenderHair(binding, clump)
 
 
 def is_usd(path: str | Path) -> bool:

@@ -277,3 +277,28 @@ def test_dense_grooms_and_given_roots_bind_along_the_surface(sintel):
     assert np.any(flat.guide_ids != db.guide_ids)  # across her head, some neighbours differ
     given = bind_roots(guides, dense.roots[:300], mesh=head, frizz=0.0)
     np.testing.assert_allclose(build_points(given, guides), build_points_reference(given, guides), atol=1e-5)
+
+
+def test_a_density_map_shares_the_roots_out_by_area_times_density(sintel):
+    """Per face and per vertex: no root where the density is 0, and a face set at 4× the density
+    of the rest receives 4× the roots per unit area (within sampling error)."""
+    from hairtool.guides.scatter import default_region, face_areas, scatter_on_mesh
+
+    guides, head = sintel
+    region = default_region(head, guides)
+    faces = np.flatnonzero(region)
+    half = np.zeros(len(head.faces), bool)
+    half[faces[: faces.size // 2]] = True
+    density = np.where(half, 4.0, 1.0)
+    density[faces[-20:]] = 0.0
+    n = 40_000
+    _, hit = scatter_on_mesh(head, n, seed=7, region=region, density=density)
+    assert not np.isin(hit, faces[-20:]).any()
+    area = face_areas(head) * region * (density > 0)
+    want = 4.0 * area[half].sum() / (4.0 * area[half].sum() + area[~half].sum())
+    got = np.isin(hit, np.flatnonzero(half)).mean()
+    assert abs(got - want) < 4.0 * np.sqrt(want * (1 - want) / n)  # four standard errors
+    per_vertex = np.zeros(len(head.vertices))
+    per_vertex[np.unique(head.faces[faces[:50]])] = 1.0  # only triangles with a dense corner
+    _, hit = scatter_on_mesh(head, 2_000, seed=7, region=region, density=per_vertex)
+    assert np.all(per_vertex[head.faces[hit]].max(axis=1) > 0)

@@ -188,3 +188,28 @@ def test_options_that_would_do_nothing_are_refused(tmp_path, capsys, command, ex
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.split("=")[0].endswith(name), err
     assert not out.exists()
+
+
+def test_freeze_from_dense_gives_the_groom_back_when_nothing_moves(tmp_path, grooms_dir):
+    src = grooms_dir / "ponytail_tail.tfx"
+    out = tmp_path / "back.npz"
+    args = ["freeze", str(src), str(out), "--from-dense", "--guides", "40", "--no-freeze", "--no-clump"]
+    assert main(args) == 0
+    assert io.read_groom(out).points.tobytes() == io.read_groom(src).points.tobytes()
+    assert io.read_groom(tmp_path / "back.guides.npz").strand_count == 40
+
+
+def test_clumped_children_follow_freezes_length_rule(tmp_path):
+    """--clump-children with freeze's --keep-lengths keeps every child's segment lengths; as
+    printed (without it) ClumpWithGaps stretches them, as it does the guides."""
+    base = ["--count", "800", "--scalp", HEAD, "--clump-children", "--no-freeze", "--no-clump"]
+    outs = {}
+    for keep in (False, True):
+        outs[keep] = tmp_path / f"keep{keep}.npz"
+        assert main(["freeze", GUIDES, str(outs[keep]), *base, *(["--keep-lengths"] if keep else [])]) == 0
+    plain = tmp_path / "plain.npz"
+    assert main(["interpolate", GUIDES, str(plain), "--count", "800", "--scalp", HEAD]) == 0
+    rest = io.read_groom(plain).segment_lengths
+    kept, printed = (io.read_groom(outs[k]).segment_lengths for k in (True, False))
+    np.testing.assert_allclose(kept, rest, rtol=1e-4)
+    assert np.abs(printed / rest - 1.0).max() > 0.05
