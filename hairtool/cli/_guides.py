@@ -92,31 +92,28 @@ def add_arguments(
 
 
 def wanted(args: argparse.Namespace) -> bool:
-    """Whether the options ask for render hair."""
-    return args.count is not None or args.from_dense
+    """Whether the options ask for render hair, or the input brought its own
+    (:func:`input_groom`)."""
+    return args.count is not None or args.from_dense or getattr(args, "bound_hair", None) is not None
 
 
 def input_groom(args: argparse.Namespace, groom: Groom) -> Groom:
     """The strands the command works on, from an input that may hold render hair and its guides
     (two prims, the guides of purpose ``guide``, as this tool writes them): the guides, to grow
-    children from (``--count``); the render hair, to pick new guides from (``--from-dense``).
-    Without either option the command works on one set of strands, and such a file is refused
-    rather than its guides merged into its hair."""
-    from hairtool.errors import HairtoolError
+    new children from (``--count``); the render hair, to pick new guides from
+    (``--from-dense``); otherwise the guides, with the render hair bound to them exactly
+    (``args.bound_hair``), so that it follows what the command does to them."""
     from hairtool.guides.files import split_guides
 
     hair, guides = split_guides(groom)
+    args.bound_hair = None
     if guides is None:
         return groom
     if args.from_dense:
         return hair
-    if args.count is not None:
-        return guides
-    raise HairtoolError(
-        f"{args.input}: holds render hair ({hair.strand_count} strands) and its guides "
-        f"({guides.strand_count}, purpose 'guide'); give --count N to work on the guides and grow "
-        "N render strands from them, or --from-dense --guides G to work on the render hair through G guides"
-    )
+    if args.count is None:
+        args.bound_hair = hair
+    return guides
 
 
 def guides_path(args: argparse.Namespace) -> Path:
@@ -188,7 +185,7 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
     import numpy as np
 
     from hairtool.errors import ParameterError
-    from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp
+    from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp, bind_to_guides
 
     t0 = time.perf_counter()
     k = K if args.guides_per_child is None else args.guides_per_child
@@ -201,7 +198,9 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
         from hairtool.io.obj import read_mesh
 
         mesh = read_mesh(args.scalp)
-    if args.from_dense:
+    if getattr(args, "bound_hair", None) is not None:
+        guides, binding = groom, bind_to_guides(args.bound_hair, groom, k=k, mesh=mesh)
+    elif args.from_dense:
         guides, binding = bind_dense(groom, args.guides, k=k, seed=args.seed, mesh=mesh)
     elif mesh is not None:
         region = None

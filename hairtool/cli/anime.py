@@ -131,6 +131,9 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError("count", args.count, "an OUT file to write the render hair to")
         _guides.check(args, animated=True, guides_option=False)
         groom = _guides.input_groom(args, load_groom(args.input))
+        if args.output is None:
+            args.bound_hair = None  # a preview of the guides' cycle: no render hair to write
+        render = _guides.wanted(args)  # the input may bring render hair of its own
         if render:
             groom, binding, bind_ms = _guides.bind(args, groom)  # the guides wave
         variation = {

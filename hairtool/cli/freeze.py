@@ -154,6 +154,7 @@ def run(args: argparse.Namespace) -> int:
 
         strokes = read_strokes(args.strokes)  # a bad log is refused before any work
     groom = _guides.input_groom(args, io.read_groom(args.input))
+    render = _guides.wanted(args)  # the input may bring render hair of its own
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
     if render:
         groom, binding, bind_ms = _guides.bind(args, groom)  # the pipeline runs on the guides

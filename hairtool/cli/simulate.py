@@ -80,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
     motion = parse_motion(args.motion)
     wind = parse_vector("wind", args.wind) if args.wind is not None else (0.0, 0.0, 0.0)
     groom = _guides.input_groom(args, load_groom(args.input))
+    render = _guides.wanted(args)  # the input may bring render hair of its own
     if render:
         groom, binding, bind_ms = _guides.bind(args, groom)  # the guides are simulated
     if args.fit_head:

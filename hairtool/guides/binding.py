@@ -293,16 +293,25 @@ def bind_dense(
     """A dense groom as G guides and every strand bound to them (guides by root distance, along
     the surface of ``mesh`` if given): ``(guides, binding)``; the binding built on the guides
     at rest gives back ``dense``'s points bit for bit."""
-    ids = choose_guides(dense, guide_count, seed)
-    guides = dense.subset(ids)
+    guides = dense.subset(choose_guides(dense, guide_count, seed))
+    return guides, bind_to_guides(dense, guides, k=k, mesh=mesh)
+
+
+def bind_to_guides(
+    hair: Groom, guides: Groom, *, k: int = DEFAULT_K, mesh: Mesh | None = None
+) -> ChildBinding:
+    """Every strand of ``hair`` bound to the given ``guides`` (its k nearest by root distance,
+    along the surface of ``mesh`` if given), storing its offset from their blend: render hair
+    read beside its guides (a USD file's guide prim) follows them, and comes back bit for bit
+    while they are untouched."""
     k = check_k(k, guides.strand_count)
-    roots = dense.roots.astype(np.float64)
+    roots = hair.roots.astype(np.float64)
     near, faces = _nearest(guides, roots, k, mesh)
     ids_k, w = weights(*near, k)
-    scale = np.ones(dense.strand_count)
-    b = ChildBinding(guides, dense.counts.copy(), roots, ids_k, w, scale, None, faces)
-    bind_exactly(b, dense.points)
-    return guides, b
+    scale = np.ones(hair.strand_count)
+    b = ChildBinding(guides, hair.counts.copy(), roots, ids_k, w, scale, None, faces)
+    bind_exactly(b, hair.points)
+    return b
 
 
 def bind_exactly(b: ChildBinding, points: np.ndarray) -> None:

@@ -13,7 +13,7 @@ import pytest
 from hairtool import io, samples
 from hairtool.errors import HairtoolError, ParameterError
 from hairtool.groom import Groom
-from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp, choose_guides
+from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp, bind_to_guides, choose_guides
 from hairtool.guides.children import (
     build_points,
     build_points_reference,
@@ -302,3 +302,22 @@ def test_a_density_map_shares_the_roots_out_by_area_times_density(sintel):
     per_vertex[np.unique(head.faces[faces[:50]])] = 1.0  # only triangles with a dense corner
     _, hit = scatter_on_mesh(head, 2_000, seed=7, region=region, density=per_vertex)
     assert np.all(per_vertex[head.faces[hit]].max(axis=1) > 0)
+
+
+def test_hair_bound_to_guides_of_its_own_comes_back_and_follows_them(sintel):
+    """Render hair read beside its guides (not strands of it): bound exactly, it builds back bit
+    for bit, and a moved guide moves only the strands that weight it."""
+    guides, head = sintel
+    hair = bind_scalp(guides, head, 2000, seed=3, frizz=0.05).build(guides)
+    b = bind_to_guides(hair, guides, k=3)
+    assert b.build(guides).points.tobytes() == hair.points.tobytes()
+    moved = guides.points.copy()
+    on = guides.topology.strand_index == 17
+    moved[on] += (0.5 * guides.topology.vertex_param[on, None]).astype(np.float32)  # its tip swung
+    after = b.build(guides.with_points(moved)).points
+    changed = np.unique(hair.topology.strand_index[np.any(after != hair.points, axis=1)])
+    weighting = np.flatnonzero(np.any((b.guide_ids == 17) & (b.weights > 0), axis=1))
+    assert weighting.size > 5
+    np.testing.assert_array_equal(changed, weighting)
+    with pytest.raises(ParameterError, match="guides_per_child"):
+        bind_to_guides(hair, guides, k=229)

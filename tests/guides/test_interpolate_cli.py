@@ -142,8 +142,9 @@ def test_sample_guides_without_a_mesh(tmp_path):
 
 def test_a_file_of_render_hair_and_guides_is_read_as_such(tmp_path, capsys):
     """This tool's own USD (the hair, then the guides as a prim of purpose guide): --count grows
-    children from its guides, --from-dense picks guides among its render hair, and a command on
-    one set of strands refuses it rather than merging the two."""
+    new children from its guides, --from-dense picks guides among its render hair, and without
+    either the command works on the guides with the render hair following them, never on the
+    two merged."""
     both = tmp_path / "both.usda"
     assert main(["interpolate", GUIDES, str(both), "--count", "300", "--scalp", HEAD]) == 0
     hair, guides = split_guides(io.read_groom(both))
@@ -159,12 +160,23 @@ def test_a_file_of_render_hair_and_guides_is_read_as_such(tmp_path, capsys):
     frozen = tmp_path / "frozen.usda"
     assert main(["freeze", str(both), str(frozen), "--count", "300", "--scalp", HEAD, "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["guides"] == 228
-    for command in (["freeze"], ["simulate", "--frames", "3"]):
-        out = tmp_path / "one.usda"
-        assert main([command[0], str(both), str(out), *command[1:]]) == 2
-        err = capsys.readouterr().err.strip()
-        assert len(err.splitlines()) == 1 and "both.usda" in err and "--count" in err
-        assert not out.exists()
+    # Otherwise the command works on the guides, the render hair bound to them exactly.
+    same = tmp_path / "same.usda"
+    assert main(["freeze", str(both), str(same), "--no-freeze", "--no-clump"]) == 0
+    back, back_guides = split_guides(io.read_groom(same))
+    assert back.points.tobytes() == hair.points.tobytes()
+    assert back_guides.points.tobytes() == guides.points.tobytes()
+    moved = tmp_path / "moved.usda"
+    assert main(["freeze", str(both), str(moved), "--no-clump", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["children"] == 300
+    hair2, guides2 = split_guides(io.read_groom(moved))
+    assert np.abs(guides2.points - guides.points).max() > 1e-3  # the guides froze …
+    assert np.abs(hair2.points - hair.points).max() > 1e-3  # … and the render hair followed
+    np.testing.assert_array_equal(hair2.roots, hair.roots)
+    anim = tmp_path / "sim.usda"
+    assert main(["simulate", str(both), str(anim), "--frames", "3"]) == 0
+    sim_hair, sim_guides = split_guides(io.read(anim))
+    assert (sim_hair.strand_count, sim_guides.strand_count) == (300, 228)
 
 
 @pytest.mark.parametrize(
