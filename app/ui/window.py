@@ -45,6 +45,7 @@ from app.ui.viewport import BRUSH_STEP, Viewport
 from hairtool import io, samples
 from hairtool.errors import HairtoolError
 from hairtool.groom import Animation, Groom
+from hairtool.guides.files import split_guides
 from hairtool.simulate.options import SimulateOptions
 
 MAX_RECENT = 10
@@ -542,12 +543,34 @@ class MainWindow(QMainWindow):
             )
             self.scene.set_colour_mode("hair")
 
-        if self.scene.engine_ready:
-            render_hair()
-        else:  # a first start: binding and shading would compile here, with the window frozen
-            self._pending_render_hair = render_hair
-            self.statusBar().showMessage("Sintel's guides; her render hair follows once the engine is ready")
+        waiting = "Sintel's guides; her render hair follows once the engine is ready"
+        self._with_render_hair(render_hair, waiting)
         return True
+
+    def _with_render_hair(self, bind: Callable[[], None], waiting: str) -> None:
+        """Give the scene its render hair now, or, on a first start, once the engine is ready:
+        binding and shading would compile here, with the window frozen."""
+        if self.scene.engine_ready:
+            bind()
+        else:
+            self._pending_render_hair = bind
+            self.statusBar().showMessage(waiting)
+
+    def _open_with_guides(self, hair: Groom, guides: Groom, path: str | os.PathLike[str]) -> None:
+        """A file of render hair and its guides (as the studio saves it): the brushes work on the
+        guides, and the render hair, bound to them exactly, follows (and is what Save writes)."""
+        from hairtool.guides.binding import bind_to_guides
+
+        self.set_groom(guides, path)
+
+        def render_hair() -> None:
+            self.scene.set_binding(bind_to_guides(hair, guides))
+            self.scene.set_colour_mode("hair")
+            self.statusBar().showMessage(
+                f"{hair.strand_count:,} render strands follow the {guides.strand_count:,} guides", 5000
+            )
+
+        self._with_render_hair(render_hair, "The guides; the render hair follows once the engine is ready")
 
     def open_dialog(self) -> None:
         path = self.ask_open_path()
@@ -567,7 +590,11 @@ class MainWindow(QMainWindow):
             if obj.n_frames > 1:
                 self.animation.load_animation(obj, str(path))
         else:
-            self.set_groom(obj, path)
+            hair, guides = split_guides(obj)
+            if guides is None:
+                self.set_groom(obj, path)
+            else:
+                self._open_with_guides(hair, guides, path)
         self._add_recent(path)
         return True
 
