@@ -1,4 +1,5 @@
-"""Undo steps: one per brush stroke (or replayed stroke log), one per (merged) parameter edit."""
+"""Undo steps: one per brush stroke (or replayed stroke log), one per (merged) parameter edit, one
+per render hair grown or removed."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ from PySide6.QtGui import QUndoCommand
 
 from app.ui.scene import Scene
 from hairtool.frozen.pipeline import FrozenParams
+from hairtool.guides.binding import ChildBinding
 
 _PARAM_ID_BASE = 1000
 _PARAM_IDS: dict[str, int] = {}
@@ -61,3 +63,21 @@ class ParamCommand(QUndoCommand):
 
     def undo(self) -> None:
         self._scene.set_params(self._before)
+
+
+class RenderHairCommand(QUndoCommand):
+    """Render hair grown on, or taken off, the groom's strands (which stay as they are)."""
+
+    def __init__(
+        self, scene: Scene, before: ChildBinding | None, after: ChildBinding | None, text: str
+    ) -> None:
+        super().__init__(text)
+        self._scene = scene
+        self._before = before
+        self._after = after
+
+    def redo(self) -> None:
+        self._scene.set_binding(self._after)
+
+    def undo(self) -> None:
+        self._scene.set_binding(self._before)

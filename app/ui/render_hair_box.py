@@ -1,6 +1,6 @@
 """The tool dock's "Render hair" group: guides shown or hidden, and how many of the children
 are drawn while a brush drags and once it is released (XGen's preview density, Houdini's
-display percentage). Enabled while the groom has children."""
+display percentage). Enabled while the groom has children (grown from the Groom menu)."""
 
 from __future__ import annotations
 
@@ -38,9 +38,8 @@ class RenderHairBox(QGroupBox):
     def refresh(self) -> None:
         s = self.scene
         b = s.binding
-        self.children_label.setText(
-            "none" if b is None else f"{b.child_count:,} from {s.rest.strand_count:,} guides"
-        )
+        grown = None if b is None else f"{b.child_count:,} from {s.rest.strand_count:,} guides"
+        self.children_label.setText(grown or "none: Groom ▸ Grow render hair…")
         for w in (self.show_guides, self.drag_percent, self.release_percent):
             w.setEnabled(b is not None)
         with signals_blocked(self.show_guides, self.drag_percent, self.release_percent):

@@ -29,13 +29,14 @@ from app.ui.animation_model import AnimationModel
 from app.ui.animation_ui import AnimationController
 from app.ui.brush_tool import LABELS, SHORTCUTS, TIPS, brushes
 from app.ui.colouring import displacement_scale
-from app.ui.commands import ParamCommand, StrokeCommand
+from app.ui.commands import ParamCommand, RenderHairCommand, StrokeCommand
 from app.ui.dialogs import StillOptions, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
-from app.ui.jobs import JobRunner, JobStatus
+from app.ui.jobs import Job, JobRunner, JobStatus
 from app.ui.kernel_warmup import RENDER_HAIR_STEP
 from app.ui.legend import RampLegend, unit_name
 from app.ui.qt_utils import add_action
+from app.ui.render_hair_dialog import DENSE, GrowOptions, ask_grow_options, grow
 from app.ui.scene import COLOUR_MODES, Scene
 from app.ui.simulate_dialog import ask_simulate_options
 from app.ui.stroke_files import StrokeFiles
@@ -89,6 +90,7 @@ class MainWindow(QMainWindow):
         self.engine_start: EngineStart | None = None
         # the bundled sample's render hair, on a first start bound once its kernels are cached
         self._pending_render_hair: Callable[[], None] | None = None
+        self.grow_options = GrowOptions()  # the Grow render hair… dialog's last choices
         self.viewport = Viewport(self.scene, self)
         self.setCentralWidget(self.viewport)
         self.dock = ToolDock(self.scene, self)
@@ -296,6 +298,13 @@ class MainWindow(QMainWindow):
         )
         self.scene.tool_changed.connect(self._sync_brush_actions)
         self._sync_brush_actions()
+
+        groom = bar.addMenu("&Groom")
+        add_action(self, groom, "&Grow render hair…", self.grow_render_hair_dialog, "Ctrl+G")
+        self.remove_hair_action = add_action(self, groom, "&Remove render hair", self.remove_render_hair)
+        self.scene.drawn_changed.connect(self._sync_groom_menu)
+        self.scene.groom_loaded.connect(self._sync_groom_menu)
+        self._sync_groom_menu()
 
     def _build_brush_actions(self, menu) -> None:
         """One checkable action per brush, in the Brush menu and a toolbar, with its key."""
@@ -571,6 +580,51 @@ class MainWindow(QMainWindow):
             )
 
         self._with_render_hair(render_hair, "The guides; the render hair follows once the engine is ready")
+
+    # -- render hair ------------------------------------------------------------------------
+    def _sync_groom_menu(self) -> None:
+        self.remove_hair_action.setEnabled(self.scene.binding is not None)
+
+    def ask_grow_options(self, options: GrowOptions) -> GrowOptions | None:
+        """The Grow render hair… dialog: GrowOptions or None (tests replace this)."""
+        return ask_grow_options(self, options, self.scene.rest, self.scene.mesh)
+
+    def grow_render_hair_dialog(self) -> Job | None:
+        options = self.ask_grow_options(self.grow_options)
+        return None if options is None else self.grow_render_hair(options)
+
+    def grow_render_hair(self, options: GrowOptions) -> Job:
+        """Bind in a worker thread, then show the render hair. Grown from the strands, it is one
+        undo step; picked guides replace the groom (the strands follow them), like opening a file."""
+        self.grow_options = options
+        dense = options.mode == DENSE
+        groom = self.scene.result if dense else self.scene.rest  # dense: the strands as edited
+        rest, mesh = self.scene.rest, self.scene.mesh
+
+        def work(progress, cancelled):
+            progress(None, "binding the render hair to its guides")
+            return grow(options, groom, mesh)
+
+        def done(result) -> None:
+            guides, binding = result
+            if self.scene.rest is not rest:
+                return  # another groom was opened meanwhile
+            if dense:
+                self.set_groom(guides)
+                self.scene.set_binding(binding)
+                n, g = binding.child_count, guides.strand_count
+                self.statusBar().showMessage(f"{n:,} strands follow {g:,} guides picked among them", 5000)
+            else:
+                step = RenderHairCommand(self.scene, self.scene.binding, binding, "Grow render hair")
+                self.undo_stack.push(step)
+            self.scene.set_colour_mode("hair")
+
+        return self.jobs.run("Growing render hair", work, done, group="render-hair")
+
+    def remove_render_hair(self) -> None:
+        if self.scene.binding is not None:
+            step = RenderHairCommand(self.scene, self.scene.binding, None, "Remove render hair")
+            self.undo_stack.push(step)
 
     def open_dialog(self) -> None:
         path = self.ask_open_path()

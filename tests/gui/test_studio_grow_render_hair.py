@@ -1,0 +1,89 @@
+"""Groom ▸ Grow render hair…: children grown from the strands on the head mesh (over the region
+the artist picks), or guides picked among a dense groom's strands; undoable where the groom
+stays, the dialog's choices kept."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from app.ui.render_hair_dialog import DENSE, NEAR_GUIDES, WHOLE_MESH, GrowDialog, GrowOptions, grow
+from hairtool import io, samples
+from hairtool.errors import ParameterError
+from hairtool.io.obj import read_mesh
+
+pytestmark = pytest.mark.gui
+
+RESOURCES = Path(__file__).resolve().parents[2] / "resources"
+
+
+@pytest.fixture(scope="module")
+def sintel():
+    return io.read_groom(RESOURCES / "sintel_hair.tfx"), read_mesh(RESOURCES / "sintel_head.obj")
+
+
+def test_grow_roots_the_children_where_the_artist_chose(sintel):
+    guides, head = sintel
+    name = sorted(head.groups)[0]
+    for region, allowed in (
+        (NEAR_GUIDES, None),
+        (WHOLE_MESH, np.arange(len(head.faces))),
+        (name, head.groups[name]),
+    ):
+        same, b = grow(GrowOptions(count=500, region=region, seed=3), guides, head)
+        assert same is guides and b.child_count == 500
+        if allowed is not None:
+            assert np.isin(b.faces, allowed).all()
+    with pytest.raises(ParameterError, match="region"):
+        grow(GrowOptions(count=10, region="no such set"), guides, head)
+
+
+def test_the_dialog_offers_the_meshs_face_sets_and_round_trips_its_options(qtbot, sintel):
+    guides, head = sintel
+    chosen = GrowOptions(count=1234, guides_per_child=3, seed=9, length_variation=0.2, frizz=0.05,
+                         region=sorted(head.groups)[-1])  # fmt: skip
+    dialog = GrowDialog(None, chosen, guides, head)
+    qtbot.addWidget(dialog)
+    regions = [dialog.region.itemData(i) for i in range(dialog.region.count())]
+    assert regions == [NEAR_GUIDES, WHOLE_MESH, *sorted(head.groups)]
+    assert dialog.options() == chosen
+    dialog.set_options(GrowOptions(mode=DENSE, guides=40))
+    assert dialog.options().mode == DENSE and dialog.options().guides == 40
+    assert dialog.guides.isVisibleTo(dialog) and not dialog.count.isVisibleTo(dialog)
+    no_mesh = GrowDialog(None, GrowOptions(), guides, None)
+    qtbot.addWidget(no_mesh)
+    assert not no_mesh.region.isEnabled()
+
+
+def test_growing_and_removing_render_hair_are_undo_steps(make_window):
+    w = make_window(groom=samples.scalp(strands=60, vertices=12, seed=4))
+    w.ask_grow_options = lambda options: GrowOptions(count=800, seed=5)
+    w.grow_render_hair_dialog()
+    assert w.jobs.wait()
+    b = w.scene.binding
+    assert b is not None and b.child_count == 800 and w.grow_options.count == 800
+    assert w.remove_hair_action.isEnabled()
+    w.remove_render_hair()
+    assert w.scene.binding is None and not w.remove_hair_action.isEnabled()
+    w.undo_stack.undo()
+    assert w.scene.binding is b
+    w.undo_stack.undo()
+    assert w.scene.binding is None
+    w.undo_stack.redo()
+    assert w.scene.binding is b
+    w.ask_grow_options = lambda options: None  # Cancel: nothing happens
+    assert w.grow_render_hair_dialog() is None and w.scene.binding is b
+
+
+def test_picking_guides_among_a_dense_groom_keeps_its_strands(make_window):
+    dense = samples.scalp(strands=400, vertices=8, seed=2)
+    w = make_window(groom=dense)
+    w.scene.set_params(w.scene.params.replace(freeze=False, clump=False))
+    w.grow_render_hair(GrowOptions(mode=DENSE, guides=30, seed=1))
+    assert w.jobs.wait()
+    s = w.scene
+    assert s.rest.strand_count == 30 and s.binding.child_count == 400
+    s.set_params(s.params.replace(freeze=False, clump=False))
+    np.testing.assert_array_equal(s.render_hair().points, dense.points)  # untouched: itself
