@@ -1,9 +1,11 @@
 """Convert between any readable and any writable format (chosen by the file extensions).
 
-An animation written to a format without time samples keeps its first frame only; a warning
-on stderr says how many frames were dropped. A USD output keeps the input's up axis, unit, time
-codes and curve prims; ``--up-axis`` and ``--meters-per-unit`` say what the points are in where
-the input cannot (HAIR, OBJ, TressFX) or is wrong — they relabel, they do not move the points.
+An animation written to a format without time samples keeps its first frame only; a warning on
+stderr says how many frames were dropped. Render hair and its guides (a prim of purpose ``guide``)
+stay apart in USD and ``.npz``; elsewhere a warning says the guides join the hair. A USD output
+keeps the input's up axis, unit, time codes and curve prims; ``--up-axis`` and
+``--meters-per-unit`` say what the points are in where the input cannot (HAIR, OBJ, TressFX) or
+is wrong — they relabel, they do not move the points.
 """
 
 from __future__ import annotations
@@ -67,6 +69,14 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"hairtool convert: warning: {out_fmt.name} holds one pose; keeping frame 0 "
             f"and dropping {obj.n_frames - 1} of {obj.n_frames} frames",
+            file=sys.stderr,
+        )
+    guides = [c for c in obj.metadata.for_strands(obj.strand_count).curves if c.purpose == "guide"]
+    if guides and out_fmt.module not in ("usd", "npz"):
+        held = sum(c.strands for c in guides)
+        print(
+            f"hairtool convert: warning: {out_fmt.name} cannot mark guides; the {held} guide strands "
+            f"({', '.join(c.path for c in guides)}) are written as hair with the others",
             file=sys.stderr,
         )
     if Path(args.input).suffix.lower() == ".hair" and Path(args.output).suffix.lower() == ".hair":

@@ -4,13 +4,16 @@ Members (every one a plain, non-object array, so the file loads with ``allow_pic
 ``format_version`` int64 scalar, ``kind`` ``"groom"`` or ``"animation"``, ``counts`` int64 (S,),
 ``points`` float32 (V, 3) for a groom or ``frames`` float32 (F, V, 3) for an animation, ``fps``
 float64 scalar and ``time_codes`` float64 (F,) (animations: the source's time code of each frame;
-caches written before it existed read as 0…F−1), and optional ``thickness`` (V,),
-``transparency`` (V,), ``colors`` (V, 3) float32.
+caches written before it existed read as 0…F−1), optional ``thickness`` (V,),
+``transparency`` (V,), ``colors`` (V, 3) float32, and ``curves``, a unicode scalar holding the
+source's curve prims as JSON (path, strands, basis, wrap, purpose of each, in strand order), so
+render hair and its guides (purpose ``guide``) stay apart through a cache.
 """
 
 from __future__ import annotations
 
 import ast
+import json
 import os
 import struct
 import zipfile
@@ -19,15 +22,16 @@ from pathlib import Path
 
 import numpy as np
 
-from hairtool.errors import FormatError
+from hairtool.errors import FormatError, ParameterError
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_strand_counts
-from hairtool.metadata import Metadata
+from hairtool.metadata import CurvesPrim, Metadata
 
 FORMAT_VERSION = 1
 ATTRIBUTES = ("thickness", "transparency", "colors")
-_KNOWN = {"format_version", "kind", "counts", "points", "frames", "fps", "time_codes", *ATTRIBUTES}
+_KNOWN = {"format_version", "kind", "counts", "points", "frames", "fps", "time_codes", "curves", *ATTRIBUTES}
+_PRIM_FIELDS = ("path", "strands", "basis", "wrap", "purpose")
 # zlib's deflate never expands data more than about 1032:1; a member claiming more is corrupt.
 _MAX_DEFLATE_RATIO = 1100
 _MAX_NPY_HEADER = 10_000  # numpy's own limit on a header's length (max_header_size)
@@ -59,6 +63,9 @@ def write(path: Path, obj: Groom | Animation) -> None:
     for name, a in obj.attributes.items():
         if a is not None:
             arrays[name] = a
+    prims = obj.metadata.for_strands(obj.strand_count).curves
+    if prims:
+        arrays["curves"] = np.array(json.dumps([{f: getattr(c, f) for f in _PRIM_FIELDS} for c in prims]))
     with atomic_open(path, "wb") as f:
         np.savez_compressed(f, **arrays)
 
@@ -151,13 +158,33 @@ def _array(path: Path, z, name: str, ndim: int, kind: str) -> np.ndarray:
     return a
 
 
-def _time_codes(path: Path, z, n_frames: int) -> Metadata | None:
+def _time_codes(path: Path, z, n_frames: int) -> tuple[float, ...] | None:
     if "time_codes" not in z.files:
         return None
     t = _array(path, z, "time_codes", 1, "fiu").astype(np.float64)
     if t.shape != (n_frames,) or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise FormatError(path, f"'time_codes' must be {n_frames} finite, strictly increasing numbers")
-    return Metadata(time_codes=tuple(t.tolist()))
+    return tuple(t.tolist())
+
+
+def _curves(path: Path, z, strand_count: int) -> tuple[CurvesPrim, ...]:
+    if "curves" not in z.files:
+        return ()
+    text = _scalar(path, z, "curves", "U")
+    try:
+        items = json.loads(text)
+        if not isinstance(items, list) or not items:
+            raise ValueError("not a list of prims")
+        prims = []
+        for item in items:
+            if not isinstance(item, dict) or set(item) != set(_PRIM_FIELDS):
+                raise ValueError(f"each prim has exactly {', '.join(_PRIM_FIELDS)}")
+            prims.append(CurvesPrim(**item))
+    except (ValueError, TypeError, ParameterError) as e:
+        raise FormatError(path, f"'curves' is not a list of curve prims: {e}") from None
+    if sum(c.strands for c in prims) != strand_count:
+        raise FormatError(path, f"'curves' hold {sum(c.strands for c in prims)} strands, not {strand_count}")
+    return tuple(prims)
 
 
 def _load_zip(path: Path, fh, single_npy: str):
@@ -209,7 +236,8 @@ def _build(path: Path, z) -> Groom | Animation:
         points = _array(path, z, "points", 2, "f")
         if points.shape != (v_count, 3):
             raise FormatError(path, f"'points' has shape {points.shape}, expected {(v_count, 3)}")
-        return Groom(float32_finite(path, points, "points"), counts, **attrs)
+        meta = Metadata(curves=_curves(path, z, counts.size))
+        return Groom(float32_finite(path, points, "points"), counts, **attrs, metadata=meta)
     if kind == "animation":
         frames = _array(path, z, "frames", 3, "f")
         if frames.shape[0] < 1 or frames.shape[1:] != (v_count, 3):
@@ -218,7 +246,11 @@ def _build(path: Path, z) -> Groom | Animation:
         fps = float(_scalar(path, z, "fps", "fiu"))
         if not (np.isfinite(fps) and fps > 0):
             raise FormatError(path, f"fps is {fps}; expected a positive number")
-        return Animation(frames, counts, fps, **attrs, metadata=_time_codes(path, z, frames.shape[0]))
+        time_codes = _time_codes(path, z, frames.shape[0])
+        meta = Metadata(curves=_curves(path, z, counts.size))
+        if time_codes is not None:
+            meta = meta.with_(time_codes=time_codes)
+        return Animation(frames, counts, fps, **attrs, metadata=meta)
     raise FormatError(path, f"kind is {kind!r}; expected 'groom' or 'animation'")
 
 

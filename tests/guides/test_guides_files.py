@@ -179,3 +179,19 @@ def test_children_bound_to_other_guides_are_refused():
     binding = bind_roots(samples.scalp(20, 6, seed=1), count=50, seed=5)
     with pytest.raises(GroomError, match="rest groom"):
         project.manifest_and_arrays(project.Project(rest=samples.scalp(20, 6, seed=2), children=binding))
+
+
+def test_convert_keeps_guides_apart_where_it_can_and_warns_elsewhere(tmp_path, hair_and_guides, capsys):
+    from hairtool.cli import main
+
+    hair, guides, _b = hair_and_guides
+    src = tmp_path / "both.usda"
+    io.write(src, with_guides(hair, guides))
+    for suffix, warned in ((".npz", False), (".usdc", False), (".hair", True), (".obj", True)):
+        out = tmp_path / f"out{suffix}"
+        assert main(["convert", str(src), str(out)]) == 0
+        err = capsys.readouterr().err
+        assert ("cannot mark guides" in err) == warned, suffix
+        if not warned:
+            back_hair, back_guides = split_guides(io.read(out))
+            assert (back_hair.strand_count, back_guides.strand_count) == (500, 40)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import json
 import os
 import zipfile
 from pathlib import Path
@@ -44,6 +45,11 @@ def _write_members(path, **arrays):
         np.savez(f, **arrays)
 
 
+def _prims(*prims: tuple[str, int, str]) -> str:
+    fixed = {"basis": "linear", "wrap": "nonperiodic"}
+    return json.dumps([{"path": p, "strands": n, **fixed, "purpose": u} for p, n, u in prims])
+
+
 def _valid(**changes):
     base = {
         "format_version": np.array(1),
@@ -78,6 +84,11 @@ def _valid(**changes):
             _valid(kind=np.array("animation"), frames=np.zeros((0, 5, 3), np.float32), fps=np.array(24.0)),
             "F>=1",
         ),
+        (_valid(curves=np.array("[{")), "'curves' is not"),
+        (_valid(curves=np.array('[{"path": "/A", "strands": 2}]')), "exactly"),
+        (_valid(curves=np.array(_prims(("/A", 1, "guide")))), "hold 1 strands, not 2"),
+        (_valid(curves=np.array(_prims(("/A", 1, "hat"), ("/B", 1, "default")))), "purpose"),
+        (_valid(curves=np.array(3)), "'curves' must be"),
     ],
 )
 def test_invalid_members_raise_format_error(tmp_path, members, reason):
@@ -248,3 +259,21 @@ def test_a_corrupt_zip_leaves_no_file_open(tmp_path):
         with pytest.raises(FormatError) as e:
             reader(p)
         assert len(os.listdir("/proc/self/fd")) == before, e.value
+
+
+def test_render_hair_and_its_guides_stay_apart_through_a_cache(tmp_path):
+    from hairtool import samples
+    from hairtool.guides.binding import bind_roots
+    from hairtool.guides.files import split_guides, with_guides
+
+    guides = samples.scalp(12, 6, seed=1)
+    both = with_guides(bind_roots(guides, count=40, seed=2).build(guides), guides)
+    p = tmp_path / "both.npz"
+    write(p, both)
+    back = read(p)
+    assert back.metadata.curves == both.metadata.curves
+    hair, g = split_guides(back)
+    assert (hair.strand_count, g.strand_count) == (40, 12)
+    anim = Animation(np.stack([both.points, both.points + 1]), both.counts, 24.0, metadata=both.metadata)
+    write(p, anim)
+    assert read(p).metadata.curves == both.metadata.curves
