@@ -114,6 +114,7 @@ class ProjectController(QObject):
                 "line_width": scene.line_width,
                 "ortho": bool(w.viewport.camera.ortho),
                 "show_guides": scene.show_guides,
+                "clump_children": scene.clump_children,
                 "drag_percent": scene.drag_percent,
                 "release_percent": scene.release_percent,
             },
@@ -148,6 +149,7 @@ class ProjectController(QObject):
                 lambda: scene.set_line_width(float(project.display["line_width"])),
                 lambda: w.viewport.set_ortho(bool(project.display["ortho"])),
                 lambda: scene.set_show_guides(bool(project.display.get("show_guides", True))),
+                lambda: scene.set_clump_children(bool(project.display.get("clump_children", False))),
                 lambda: scene.set_display_percent(
                     float(project.display.get("drag_percent", scene.drag_percent)),
                     float(project.display.get("release_percent", scene.release_percent)),

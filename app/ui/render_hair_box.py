@@ -21,6 +21,13 @@ class RenderHairBox(QGroupBox):
         self.show_guides = QCheckBox()
         self.show_guides.setToolTip("draw the guide curves (what the brushes move) over the render hair")
         self.show_guides.toggled.connect(scene.set_show_guides)
+        self.clump_children = QCheckBox()
+        self.clump_children.setToolTip(
+            "ClumpWithGaps among the render strands (the paper's adhesion, at render density), "
+            "with the engine's clump passes, gaps and Keep lengths; applied when the mouse is "
+            "released and in saved files, not while a brush drags"
+        )
+        self.clump_children.toggled.connect(scene.set_clump_children)
         self.drag_percent = SliderSpin(0.1, 100.0, decimals=1, log=True)
         self.drag_percent.setToolTip("share of the children drawn while a brush drags, in percent")
         self.drag_percent.edited.connect(lambda v, _d: scene.set_display_percent(drag=v))
@@ -29,6 +36,7 @@ class RenderHairBox(QGroupBox):
         self.release_percent.edited.connect(lambda v, _d: scene.set_display_percent(release=v))
         form.addRow("Children", self.children_label)
         form.addRow("Show guides", self.show_guides)
+        form.addRow("Clump children", self.clump_children)
         form.addRow("While dragging %", self.drag_percent)
         form.addRow("On release %", self.release_percent)
         scene.drawn_changed.connect(self.refresh)
@@ -40,9 +48,10 @@ class RenderHairBox(QGroupBox):
         b = s.binding
         grown = None if b is None else f"{b.child_count:,} from {s.rest.strand_count:,} guides"
         self.children_label.setText(grown or "none: Groom ▸ Grow render hair…")
-        for w in (self.show_guides, self.drag_percent, self.release_percent):
+        for w in (self.show_guides, self.clump_children, self.drag_percent, self.release_percent):
             w.setEnabled(b is not None)
-        with signals_blocked(self.show_guides, self.drag_percent, self.release_percent):
+        with signals_blocked(self.show_guides, self.clump_children, self.drag_percent, self.release_percent):
             self.show_guides.setChecked(s.show_guides)
+            self.clump_children.setChecked(s.clump_children)
             self.drag_percent.set_value(s.drag_percent)
             self.release_percent.set_value(s.release_percent)

@@ -67,6 +67,7 @@ class Scene(QObject):
         self._params = params if params is not None else FrozenParams(keep_lengths=True)
         self.binding: ChildBinding | None = None  # render hair interpolated from the groom (the guides)
         self.show_guides = True
+        self.clump_children = False  # ClumpWithGaps among the children once the mouse is released
         self.drag_percent = DRAG_PERCENT
         self.release_percent = RELEASE_PERCENT
         self.dragging = False
@@ -238,6 +239,23 @@ class Scene(QObject):
     def has_children(self) -> bool:
         return self.binding is not None
 
+    def set_clump_children(self, on: bool) -> None:
+        """ClumpWithGaps among the drawn children (at their own automatic radius, with the
+        engine's passes, gaps and length rule) whenever the mouse is up, and in what a save
+        writes. Off while a brush drags: the preview shows them unclumped, as XGen's does."""
+        if bool(on) != self.clump_children:
+            self.clump_children = bool(on)
+            self._cache.clear()
+            if self.binding is not None:
+                self._rebuild_drawn()
+                self.drawn_changed.emit()
+
+    def _child_clump(self):
+        from hairtool.guides.render import ChildClump
+
+        p = self._params
+        return ChildClump(iterations=p.clump_iterations, gap_mode=p.gap_mode, keep_lengths=p.keep_lengths)
+
     def set_show_guides(self, on: bool) -> None:
         if bool(on) != self.show_guides:
             self.show_guides = bool(on)
@@ -263,7 +281,7 @@ class Scene(QObject):
         if bool(on) == self.dragging:
             return
         self.dragging = bool(on)
-        if self.binding is not None and self.drag_percent != self.release_percent:
+        if self.binding is not None and (self.drag_percent != self.release_percent or self.clump_children):
             self._rebuild_drawn()
             self.drawn_changed.emit()
 
@@ -311,8 +329,16 @@ class Scene(QObject):
             ("built from",), lambda: np.full((self.result.vertex_count, 3), np.nan, np.float32)
         )
         t0 = time.perf_counter()
-        build_points(b, self.result, out=drawn[: b.vertex_count], moved=moved_guides(self.result, source))
-        source[...] = self.result.points
+        if self.clump_children and not self.dragging:
+            from hairtool.guides.render import RenderHair
+
+            clump = self._child_clump()  # (the engine's settings are part of the key)
+            clumper = self.cached(("clumped", clump), lambda: RenderHair(b, clump))
+            drawn[: b.vertex_count] = clumper.update(self.result).points
+            source[...] = np.nan  # built whole: the next unclumped build starts afresh
+        else:
+            build_points(b, self.result, out=drawn[: b.vertex_count], moved=moved_guides(self.result, source))
+            source[...] = self.result.points
         self.last_children_ms = (time.perf_counter() - t0) * 1e3
         if guides:
             drawn[b.vertex_count :] = self.result.points
@@ -360,8 +386,15 @@ class Scene(QObject):
         return Groom(self.drawn_points, self.drawn_topology)
 
     def render_hair(self) -> Groom | None:
-        """Every child at the guides' current shapes (full density), or None without children."""
-        return None if self.binding is None else self.binding.build(self.result)
+        """Every child at the guides' current shapes (full density; clumped when switched on),
+        or None without children."""
+        if self.binding is None:
+            return None
+        if self.clump_children:
+            from hairtool.guides.render import RenderHair
+
+            return RenderHair(self.binding, self._child_clump()).update(self.result)
+        return self.binding.build(self.result)
 
     def export_groom(self) -> Groom:
         """What a save or export writes: the edited groom, or with children the render hair

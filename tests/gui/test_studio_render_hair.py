@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from PySide6 import QtWidgets
 from PySide6.QtCore import Qt
 
 from app.ui.colouring import GUIDE_RGB, vertex_colors
@@ -166,3 +167,29 @@ def test_a_saved_file_of_render_hair_and_guides_opens_as_guides_the_hair_follows
     np.testing.assert_array_equal(io.read(again).points, io.read(path).points)
     s.set_params(s.params.replace(freeze=True))  # the engine moves the guides: the hair follows
     assert np.abs(s.render_hair().points - hair).max() > 1e-4
+
+
+def test_clumping_the_children_is_a_switch_applied_on_release_and_saved(make_window, tmp_path):
+    from hairtool.guides.render import ChildClump, RenderHair
+
+    w = _window(make_window, children=1500, percent=100.0)
+    s = w.scene
+    plain = s.drawn_points[: s.binding.vertex_count].copy()
+    box = w.findChild(QtWidgets.QGroupBox, "RenderHairBox")
+    box.clump_children.setChecked(True)  # the artist's switch
+    assert s.clump_children
+    p = s.params
+    clump = ChildClump(iterations=p.clump_iterations, gap_mode=p.gap_mode, keep_lengths=p.keep_lengths)
+    want = RenderHair(s.binding, clump)
+    clumped = want.update(s.result).points
+    assert np.abs(clumped - plain).max() > 1e-3
+    np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], clumped)
+    np.testing.assert_array_equal(s.render_hair().points, clumped)  # what a save writes
+    s.set_dragging(True)  # a brush drags: the preview is unclumped
+    np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], plain)
+    s.set_dragging(False)
+    np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], clumped)
+    path = tmp_path / "p.hairproj"
+    assert w.project.save_to(path)
+    w2 = _window(make_window, children=10)
+    assert w2.project.open_project(path) and w2.scene.clump_children
