@@ -5,7 +5,10 @@ IN is an animation file (.usd/.usda/.usdc/.npz cache), a .bvh, or an .npz holdin
 (a price per key, as a share of the error of keying only the first and last frame, so it means
 the same on any animation), --penalty-abs TAU (an absolute price, Fei et al.'s τ, in squared
 feature units), --budget E (total error) or --max-error E (worst frame). Without one, the key count is
-the knee of the error-vs-count curve: the count past which each key buys less than its share.
+the knee of the error-vs-count curve: the count past which each key buys less than its share. The
+knee is that of the animation without --pin/--exclude, and the count stays the same under them
+(raised only when the pins need more keys), so pinning a frame that is already a key changes
+nothing and moving a key (pin the new frame, exclude the old) keeps the count.
 """
 
 from __future__ import annotations
@@ -22,7 +25,14 @@ HELP = "find globally optimal keyframes (exact DP) and compare with uniform keys
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", metavar="IN", help="animation file, .bvh, or .npz with an array X")
     mode = parser.add_mutually_exclusive_group()
-    mode.add_argument("--keys", "-k", type=int, metavar="K", help="exactly K keys")
+    mode.add_argument(
+        "--keys",
+        "-k",
+        type=int,
+        metavar="K",
+        help="exactly K keys (default: the knee of the error-vs-count curve without --pin/--exclude, "
+        "kept under them)",
+    )
     mode.add_argument(
         "--penalty", type=float, metavar="TAU", help="price per key, a share of the two-key error (0.01: 1%%)"
     )
@@ -123,7 +133,7 @@ def _mode(args: argparse.Namespace, session) -> dict:
         return {"budget": args.budget}
     if args.max_error is not None:
         return {"max_error": args.max_error}
-    return {"keys": args.keys if args.keys is not None else session.knee}
+    return {"keys": args.keys if args.keys is not None else session.default_count()}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -199,9 +209,13 @@ def _report(args: argparse.Namespace, kind: str, data, n: int, fps: float, sel, 
     if args.penalty is not None:
         result["params"]["penalty_share"] = args.penalty  # of the two-key error
     modes = (args.keys, args.penalty, args.penalty_abs, args.budget, args.max_error)
-    if all(v is None for v in modes):
-        result["params"]["count_rule"] = "knee"
     note = session.explain(sel)
+    if all(v is None for v in modes):
+        result["params"].update(count_rule="knee", knee=session.knee)
+        if sel.n_keys != session.knee:
+            more = sel.n_keys > session.knee
+            why = "the fewest these pins allow" if more else "the most these exclusions allow"
+            note = f"{sel.n_keys} keys, not the knee's {session.knee}: {why}"
     if note:
         result["note"] = note
     if kind == "animation":

@@ -62,7 +62,8 @@ CancelCheck = Callable[[], bool]
 class KeySettings:
     """What a caller chose: the mode and its value, the objective, the interpolation, features.
 
-    ``count`` 0 means the knee of the error-vs-count curve (:func:`knee_count`); ``tau`` is the
+    ``count`` 0 means the knee of the unconstrained error-vs-count curve (:attr:`KeySession.knee`:
+    pins and exclusions steer which keys, not how many); ``tau`` is the
     price of a key as a share of the two-key error (:meth:`KeySession.keys_for_tau`), so it means
     the same on any animation; ``samples`` 0 keeps the original vertices instead of resampling M
     points per strand; ``tip_weight`` is seed 000's root-to-tip weight at the tip
@@ -152,6 +153,7 @@ class KeySession:
         self.table_key = table_key or (objective, interp, None, None, self.curvature)
         self.energy: F64 | None = None  # (kmax + 1, n)
         self.back: I64 | None = None  # (kmax + 1, n)
+        self._knee: int | None = None  # of the unconstrained curve: the table's, kept across constrain()
 
     @property
     def n_frames(self) -> int:
@@ -215,9 +217,25 @@ class KeySession:
 
     @property
     def knee(self) -> int:
-        """The default key count: :func:`knee_count` of the curve up to :data:`KNEE_KEYS` keys."""
-        curve = self.curve
-        return knee_count(curve[curve[:, 0] <= KNEE_KEYS])
+        """The default key count: :func:`knee_count` of the UNCONSTRAINED curve up to
+        :data:`KNEE_KEYS` keys. It is a property of the animation, held while the animator
+        steers (as a key reducer's count is): pinning a frame that is already a key changes
+        nothing, moving a key keeps the count; the knee of the constrained curve would move with
+        every pin."""
+        if self._knee is None:
+            top = min(self.kmax, KNEE_KEYS)
+            if not self.constraints and self.energy is not None:
+                energy = self.energy
+            else:  # one unconstrained solve of the layers the knee reads (energies only)
+                energy, _, _ = solve_layers(self.table, top, self.objective)
+            ks = np.arange(2, top + 1)
+            self._knee = knee_count(np.column_stack([ks, energy[ks, self.n_frames - 1]]))
+        return self._knee
+
+    def default_count(self) -> int:
+        """:attr:`knee`, raised or lowered into the counts the pins and exclusions allow."""
+        lo, hi = self.constraints.key_range(self.n_frames)
+        return min(max(self.knee, lo), hi)
 
     def keys_for_budget(self, budget: float) -> I64:
         """The fewest keys whose error (total, or worst frame) is within ``budget``."""
@@ -232,15 +250,23 @@ class KeySession:
         ).keys
 
     def keys_for(self, settings: KeySettings) -> I64:
-        """The DP keys the settings ask for (count, tau or budget, under their pins and exclusions)."""
-        self.constrain(settings.constraints)
-        if settings.mode == "tau":
-            return self.keys_for_tau(settings.tau)
-        if settings.mode == "budget":
-            return self.keys_for_budget(settings.budget)
-        lo, hi = self.key_range
-        count = settings.count or self.knee
-        return self.keys_for_count(min(max(count, lo), hi))
+        """The DP keys the settings ask for (count, tau or budget, under their pins and exclusions).
+
+        All or nothing: a ParameterError (a budget these pins and exclusions cannot meet) leaves
+        the session under its previous constraints, so a refused edit can be dropped whole."""
+        before = (self.constraints, self.energy, self.back)
+        try:
+            self.constrain(settings.constraints)
+            if settings.mode == "tau":
+                return self.keys_for_tau(settings.tau)
+            if settings.mode == "budget":
+                return self.keys_for_budget(settings.budget)
+            lo, hi = self.key_range
+            count = settings.count or self.default_count()
+            return self.keys_for_count(min(max(count, lo), hi))
+        except ParameterError:
+            self.constraints, self.energy, self.back = before
+            raise
 
     def explain(self, sel: Selection) -> str | None:
         """Why a tau, budget or bound gave one of the two extremes (a key on every frame, or no
@@ -363,6 +389,7 @@ def solve(
     if layers:
         progress(0.9, "dynamic programming")
         session.layers()
+        _ = session.knee  # the default count, here in the background (under pins, one more solve)
     progress(1.0, "")
     return session
 

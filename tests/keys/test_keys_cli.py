@@ -198,6 +198,21 @@ def test_the_default_count_is_the_knee(files, capsys):
     assert len(out["keys"]) == knee_count(np.array(out["curve"]))
 
 
+def test_the_default_count_is_the_unconstrained_knee_and_holds_under_pins(motion_dir, capsys):
+    walk = motion_dir / "mocapbank_walk.bvh"
+    free = run_json(capsys, walk)
+    keys = free["keys"]
+    assert free["params"]["knee"] == len(keys) > 4
+    pinned = run_json(capsys, walk, "--pin", f"{keys[3]},{keys[4]}")  # frames that are keys already
+    assert pinned["keys"] == keys and pinned["cost"] == free["cost"] and "note" not in pinned
+    old, new = keys[2], keys[2] + 5  # a move: pin the new frame, exclude the old one
+    moved = run_json(capsys, walk, "--pin", new, "--exclude", old)
+    assert len(moved["keys"]) == len(keys) and new in moved["keys"] and old not in moved["keys"]
+    many = run_json(capsys, walk, "--pin", ",".join(str(f) for f in range(10, 400, 40)))
+    assert len(many["keys"]) == 12
+    assert many["note"] == f"12 keys, not the knee's {len(keys)}: the fewest these pins allow"
+
+
 def test_a_progress_bar_on_a_terminal_only(files, capsys):
     import io as text_io
 

@@ -155,11 +155,34 @@ def test_constraints_steer_every_mode_of_a_session_and_match_the_engine(anim):
     budget = float(solved.curve[3, 1])
     got = solved.keys_for(base.replace(mode="budget", budget=budget))
     np.testing.assert_array_equal(got, select_keys(table, budget=budget, constraints=cons).keys)
-    # the default count is the knee of the constrained curve, never fewer keys than the pins need
-    assert solved.keys_for(base).size == solved.knee >= 4
+    # the default count is the knee of the unconstrained curve, never fewer keys than the pins need
+    assert solved.knee == ks.solve(anim, ks.KeySettings()).knee
+    assert solved.keys_for(base).size == max(solved.knee, 4)
     with pytest.raises(ParameterError, match="with these pins"):
         solved.keys_for_count(3)
     # new constraints reuse the table: no features, no cost table
     assert solved.keys_for(ks.KeySettings(count=5)).size == 5 and not solved.constraints
     assert solved.key_range == (2, 40) and not solved.constraints
     np.testing.assert_array_equal(solved.keys_for_count(5), select_keys(table, keys=5).keys)
+
+
+@pytest.mark.parametrize("objective", ["total", "worst"])
+def test_the_default_count_holds_while_the_animator_steers(anim, objective):
+    """The knee is the unconstrained curve's, as a key reducer's count: pinning keys or excluding
+    frames that are not keys changes nothing, moving a key keeps the count."""
+    settings = ks.KeySettings(objective=objective)
+    solved = ks.solve(anim, settings)
+    keys, knee = solved.keys_for(settings), solved.knee
+    assert keys.size == knee > 3
+    inner = keys[1:-1].tolist()
+    others = [f for f in range(1, 39) if f not in keys]
+    for pins, excludes in (([inner[0]], ()), (inner[:2], others[:3]), (inner, others[::2])):
+        got = solved.keys_for(settings.replace(pins=pins, excludes=excludes))
+        np.testing.assert_array_equal(got, keys)
+    for old in inner:
+        for new in others[::4]:
+            got = solved.keys_for(settings.replace(pins=(new,), excludes=(old,)))
+            assert got.size == knee and new in got and old not in got
+    assert solved.knee == knee
+    # a fresh session under pins (a reopened project) gives the same default count
+    assert ks.solve(anim, settings.replace(pins=(others[0],))).keys_for(settings).size == knee
