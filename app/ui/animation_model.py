@@ -19,7 +19,7 @@ from PySide6.QtCore import QObject, Qt, QTimer, Signal
 
 from app.ui.jobs import Job, JobRunner
 from app.ui.legend import magnitude_colors
-from hairtool.errors import GroomError, ParameterError
+from hairtool.errors import GroomError, HairtoolError, ParameterError
 from hairtool.groom import Animation
 from hairtool.keys import session as ks
 from hairtool.keys.dp import uniform_keys
@@ -290,28 +290,43 @@ class AnimationModel(QObject):
 
     # -- key settings ----------------------------------------------------------------------
     def set_settings(self, **changes: object) -> None:
-        """Change key settings (ParameterError for a bad value); keys follow at once where the
-        existing solve covers them, else a new solve starts."""
+        """Change key settings; keys follow at once where the existing solve covers them, else a
+        new solve starts. A ParameterError (a bad value, or pins and exclusions the mode cannot
+        meet, such as an error budget no key set reaches without an excluded frame) comes before
+        anything changes, so a refused edit leaves the keys, settings and curves as they were."""
         new = self.settings.replace(**changes)
         if new == self.settings:
             return
-        if self.n_frames >= 2:
-            new.constraints.check(self.n_frames)  # before anything changes
-        self.settings = new
-        self.settings_changed.emit(new)
         if self.n_frames < 2:
+            self.settings = new
+            self.settings_changed.emit(new)
             return
-        if self.key_solve is None or self.solve_stale or new.table_key != self.key_solve.table_key:
-            self.request_solve()
+        new.constraints.check(self.n_frames)
+        solve = self.key_solve
+        if solve is None or self.solve_stale or new.table_key != solve.table_key:
+            if self._inline():  # solved here: a refusal can still leave everything as it was
+                solve = ks.solve(self.animation, new)
+                keys = solve.keys_for(new)
+                self._commit_settings(new)
+                self._apply_solve(solve, keys)
+            else:
+                self._commit_settings(new)
+                self.request_solve()
             return
+        reshaped = new.constraints != solve.constraints
+        keys = solve.keys_for(new)  # all or nothing
+        self._commit_settings(new)
         if self._solve_job is not None:  # back to the solved table: the pending solve is moot
             job, self._solve_job = self._solve_job, None
             job.cancel()
             self._busy_update()
-        if new.constraints != self.key_solve.constraints:  # the same table, other layers
-            self.key_solve.constrain(new.constraints)
+        if reshaped:  # the same table, other layers
             self.curve_changed.emit()
-        self._choose_keys()
+        self._show_keys(keys)
+
+    def _commit_settings(self, new: ks.KeySettings) -> None:
+        self.settings = new
+        self.settings_changed.emit(new)
 
     def steered(
         self,
@@ -368,7 +383,8 @@ class AnimationModel(QObject):
         if anim is None or anim.n_frames < 2:
             return
         if self._inline():
-            self._apply_solve(anim, ks.solve(anim, settings))
+            solve = ks.solve(anim, settings)
+            self._apply_solve(solve, solve.keys_for(settings))
             return
 
         def work(progress, cancelled):
@@ -388,19 +404,26 @@ class AnimationModel(QObject):
     def _solve_landed(self, job: Job, anim: Animation, result: ks.KeySession | None) -> None:
         if job is not self._solve_job:
             return
+        if anim is not self.animation or result is None:
+            self._solve_job = None
+            self._busy_update()
+            return
+        try:
+            keys = result.keys_for(self.settings)
+        except HairtoolError as e:  # e.g. a budget these pins cannot meet: back, and say why
+            self._job_failed(job, e)
+            return
         self._solve_job = None
         self._busy_update()
-        if anim is self.animation and result is not None:
-            self._apply_solve(anim, result)
+        self._apply_solve(result, keys)
 
-    def _apply_solve(self, anim: Animation, result: ks.KeySession) -> None:
+    def _apply_solve(self, result: ks.KeySession, keys: np.ndarray) -> None:
         self.key_solve = result
         self.solve_stale = False
         self.curve_changed.emit()
-        self._choose_keys(force=True)
+        self._show_keys(keys, force=True)
 
-    def _choose_keys(self, force: bool = False) -> None:
-        keys = self.key_solve.keys_for(self.settings)
+    def _show_keys(self, keys: np.ndarray, force: bool = False) -> None:
         if not force and self.dp_keys is not None and np.array_equal(keys, self.dp_keys):
             if self.analysis is None and self._analysis_job is None:
                 self.request_analysis()
@@ -491,7 +514,10 @@ class AnimationModel(QObject):
         if c.settings != self.settings:
             self.settings = c.settings
             self.settings_changed.emit(c.settings)
-        if c.solve is not self.key_solve:
+        steered = c.solve is not None and c.solve.constraints != c.settings.constraints
+        if c.solve is not self.key_solve or steered:
+            if steered:  # a later edit re-solved the same table under other pins
+                c.solve.constrain(c.settings.constraints)
             self.key_solve = c.solve
             self.curve_changed.emit()
         if not np.array_equal(c.dp_keys, self.dp_keys):

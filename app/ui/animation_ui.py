@@ -62,23 +62,44 @@ class KeyEditCommand(QUndoCommand):
 
 
 class SteerKeysCommand(QUndoCommand):
-    """A dope-sheet edit: the pinned and excluded frames before and after it."""
+    """A dope-sheet edit: the pinned and excluded frames before and after it. Pushed once the
+    edit is applied (a refused one is never pushed), so the first redo does nothing."""
 
-    def __init__(self, model: AnimationModel, text: str, before: tuple, after: tuple) -> None:
+    def __init__(
+        self, model: AnimationModel, text: str, before: tuple, after: tuple, report: Callable[[str], None]
+    ) -> None:
         super().__init__(text)
-        self.model, self.generation = model, model.generation
+        self.model, self.generation, self.report = model, model.generation, report
         self.before, self.after = before, after
+        self._applied = True
 
     def _apply(self, constraints: tuple) -> None:
         if self.model.generation == self.generation:  # the pins of a replaced animation mean nothing
             pins, excludes = constraints
-            self.model.set_settings(pins=pins, excludes=excludes)
+            try:  # the mode may have changed since (a tighter budget): refused, nothing changes
+                self.model.set_settings(pins=pins, excludes=excludes)
+            except HairtoolError as e:
+                self.report(refusal(self.text(), self.model, e))
 
     def redo(self) -> None:
+        if self._applied:
+            self._applied = False
+            return
         self._apply(self.after)
 
     def undo(self) -> None:
         self._apply(self.before)
+
+
+def refusal(text: str, model: AnimationModel, error: HairtoolError) -> str:
+    """One line, in the timeline's words, on why a dope-sheet edit changed nothing."""
+    if getattr(error, "name", "") in ("budget", "max_error"):
+        worst = " of the worst frame" if model.settings.objective == "worst" else ""
+        return (
+            f"{text}: not possible, no keys stay within the error budget{worst} with that change "
+            "(raise the budget, or undo a pin or an exclusion)"
+        )
+    return f"{text}: {error}"
 
 
 class KeyEditBrush:
@@ -166,16 +187,20 @@ class AnimationController(QObject):
         """One undoable dope-sheet edit (see :meth:`AnimationModel.steered`); a refused one says
         why in the status bar and changes nothing."""
         m = self.model
+        before = (m.settings.pins, m.settings.excludes)
         try:
             after = m.steered(**edit)
+            if after == before:
+                return False
+            m.set_settings(pins=after[0], excludes=after[1])  # all or nothing
         except HairtoolError as e:
-            self.window.statusBar().showMessage(f"{text}: {e}", 6000)
+            self.show_status(refusal(text, m, e))
             return False
-        before = (m.settings.pins, m.settings.excludes)
-        if after == before:
-            return False
-        self.window.undo_stack.push(SteerKeysCommand(m, text, before, after))
+        self.window.undo_stack.push(SteerKeysCommand(m, text, before, after, self.show_status))
         return True
+
+    def show_status(self, message: str) -> None:
+        self.window.statusBar().showMessage(message, 6000)
 
     # -- model → viewport ------------------------------------------------------------------
     def refresh_display(self, *_: object) -> None:

@@ -88,6 +88,50 @@ def test_dragging_a_key_moves_it_and_the_rest_re_solve(ui, studio):
     assert m.settings.pins == () and m.settings.excludes == ()
 
 
+def test_the_default_count_is_held_while_steering(ui, make_window):
+    """At the knee (no count chosen): pinning a key changes no key, a move keeps the count."""
+    w = make_window(groom=samples.comb(strands=12, vertices=8), size=(1400, 900))
+    w.animation.load_animation(sway_animation(w.scene.result, N_FRAMES, 24.0, flick_frame=27), "sway")
+    m, view = w.animation, w.timeline.view
+    assert m.settings.count == 0
+    before = m.dp_keys.copy()
+    knee = m.key_solve.knee
+    assert before.size == knee > 4
+    for key in before[1:-1]:
+        click(ui, view, int(key))
+    assert m.settings.pins == tuple(before[1:-1].tolist())
+    np.testing.assert_array_equal(m.dp_keys, before)
+    while w.undo_stack.canUndo():
+        w.undo_stack.undo()
+    assert m.settings.pins == ()
+    np.testing.assert_array_equal(m.dp_keys, before)
+    key = int(before[2])
+    target = next(f for f in range(key + 2, N_FRAMES - 1) if f not in before)
+    click(ui, view, key, to=target)
+    assert m.dp_keys.size == knee and target in m.dp_keys and key not in m.dp_keys
+    np.testing.assert_array_equal(m.dp_keys, engine(w, knee))
+    assert m.settings.count == 0 and w.timeline.controls.count_spin.value() == knee
+
+
+def test_an_edit_the_error_budget_cannot_meet_is_refused_whole(ui, studio):
+    w, _ = studio
+    m, view = w.animation, w.timeline.view
+    m.set_settings(mode="budget", budget=1e-6)  # every frame a key
+    keys, settings, curve = m.dp_keys.copy(), m.settings, m.key_solve.curve.copy()
+    steps, seen = w.undo_stack.count(), ui.record(m.keys_changed)
+    m.set_frame(20)
+    view.setFocus()
+    QTest.keyClick(view, Qt.Key.Key_Delete)
+    assert m.settings == settings and w.undo_stack.count() == steps and not seen
+    np.testing.assert_array_equal(m.dp_keys, keys)
+    np.testing.assert_array_equal(m.key_solve.curve, curve)
+    message = w.statusBar().currentMessage()
+    assert message.startswith("Exclude frame 20: not possible") and "error budget" in message
+    assert "\n" not in message and "budget=" not in message and not w.errors
+    QTest.keyClick(view, Qt.Key.Key_Insert)  # what the budget allows still works
+    assert m.settings.pins == (20,) and w.undo_stack.undoText() == "Pin frame 20"
+
+
 def test_delete_excludes_and_insert_pins_the_current_frame(ui, studio):
     w, _ = studio
     m, view = w.animation, w.timeline.view
