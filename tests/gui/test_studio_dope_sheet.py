@@ -135,20 +135,29 @@ def test_an_edit_the_error_budget_cannot_meet_is_refused_whole(ui, studio):
 def test_delete_excludes_and_insert_pins_the_current_frame(ui, studio):
     w, _ = studio
     m, view = w.animation, w.timeline.view
+    start = m.dp_keys.copy()
     key = int(m.dp_keys[3])
     m.set_frame(key)
     view.setFocus()
     QTest.keyClick(view, Qt.Key.Key_Delete)
     assert m.settings.excludes == (key,) and key not in m.dp_keys
+    excluded = m.dp_keys.copy()
     free = next(f for f in range(1, N_FRAMES - 1) if f not in m.dp_keys and f != key)
     m.set_frame(free)
     QTest.keyClick(view, Qt.Key.Key_Insert)
     assert m.settings.pins == (free,) and free in m.dp_keys
     np.testing.assert_array_equal(m.dp_keys, engine(w, 6))
     assert KeyConstraints((free,), (key,)).allows(m.dp_keys)
+    both = m.dp_keys.copy()
     w.undo_stack.undo()
+    assert m.settings.pins == () and m.settings.excludes == (key,)
+    np.testing.assert_array_equal(m.dp_keys, excluded)
     w.undo_stack.undo()
     assert m.settings.pins == () and m.settings.excludes == ()
+    np.testing.assert_array_equal(m.dp_keys, start)
+    w.undo_stack.redo()
+    w.undo_stack.redo()
+    np.testing.assert_array_equal(m.dp_keys, both)
 
 
 def test_the_ends_cannot_be_excluded_and_the_refusal_is_shown(ui, studio):
