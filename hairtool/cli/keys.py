@@ -120,14 +120,22 @@ def _load(args: argparse.Namespace):
 
 
 def _mode(args: argparse.Namespace, session) -> dict:
-    """The one mode asked for, with a relative tau made absolute; without one, the knee."""
+    """The one mode asked for, with a relative tau made absolute; without one, the knee. Errors
+    quote the value as typed (the engine sees the absolute price)."""
+    from hairtool.errors import ParameterError
+
+    worst = "the total-error objective, not worst: a price per key adds up over the keys"
     if args.penalty is not None:
         if not args.penalty >= 0 or args.penalty == float("inf"):
-            from hairtool.errors import ParameterError
-
             raise ParameterError("penalty", args.penalty, "a finite share >= 0 of the two-key error")
-        return {"penalty": args.penalty * session.two_key_error}
+        price = args.penalty * session.two_key_error
+        if session.objective != "total":
+            shown = f"{worst} (a share of {args.penalty:g} of the two-key error; absolute: {price:.6g})"
+            raise ParameterError("penalty", args.penalty, shown)
+        return {"penalty": price}
     if args.penalty_abs is not None:
+        if session.objective != "total":
+            raise ParameterError("penalty-abs", args.penalty_abs, worst)
         return {"penalty": args.penalty_abs}
     if args.budget is not None:
         return {"budget": args.budget}

@@ -175,6 +175,15 @@ def test_penalty_is_a_share_of_the_two_key_error_and_the_absolute_form_is_seed_0
     assert run_json(capsys, d / "x1000.npz", "--penalty", 0.02)["keys"] == rel["keys"]
 
 
+@pytest.mark.parametrize("flag", ["--penalty", "--penalty-abs"])
+def test_a_price_per_key_with_the_worst_frame_objective_quotes_what_was_typed(files, capsys, flag):
+    d, _ = files
+    assert main(["keys", str(d / "x.npz"), flag, "0.5", "--objective", "worst"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{flag[2:]}=0.5 is invalid" in err and "not worst" in err
+    assert ("absolute" in err) == (flag == "--penalty")
+
+
 def test_the_extremes_are_explained(files, capsys):
     d, _ = files
     every = run_json(capsys, d / "x.npz", "--penalty-abs", 0)
