@@ -52,7 +52,8 @@ class KeyConstraints:
 
     def check(self, n_frames: int) -> KeyConstraints:
         """Frames inside the animation; the first and last frame are always keys, so they cannot
-        be excluded; at least one frame must be free to choose."""
+        be excluded; pins on every frame leave nothing to solve. Exclusions of every other frame
+        are fine: the ends alone (and the pins) are then the one answer, in every mode."""
         for name, frames in (("pin", self.pins), ("exclude", self.excludes)):
             if frames and frames[-1] >= n_frames:
                 raise ParameterError(name, list(frames), f"frames in [0, {n_frames - 1}]")
@@ -61,12 +62,9 @@ class KeyConstraints:
             raise ParameterError(
                 "exclude", ends, f"frames other than the first (0) and the last ({n_frames - 1}), always keys"
             )
-        inner = set(range(1, n_frames - 1))
-        if n_frames > 2 and inner <= set(self.pins) | set(self.excludes):
-            raise ParameterError(
-                "pin", f"{len(self.pins)} pins, {len(self.excludes)} exclusions",
-                "at least one frame left for the solve to choose",
-            )
+        if n_frames > 2 and set(range(1, n_frames - 1)) <= set(self.pins):
+            pins = f"{len(self.pins)} pins"
+            raise ParameterError("pin", pins, "at least one frame left for the solve to choose")
         return self
 
     def key_range(self, n_frames: int) -> tuple[int, int]:

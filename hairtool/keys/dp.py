@@ -262,7 +262,8 @@ def select_keys(
     if mode == "keys":
         if not np.isfinite(value) or int(value) != value or not lo_k <= value <= hi_k:
             why = "" if (lo_k, hi_k) == (2, n) else " with these pins and exclusions"
-            raise ParameterError("keys", value, f"a whole number in [{lo_k}, {hi_k}]{why}")
+            counts = f"{lo_k}, the only count" if lo_k == hi_k else f"a whole number in [{lo_k}, {hi_k}]"
+            raise ParameterError("keys", value, f"{counts}{why}")
     elif not np.isfinite(value) or value < 0:
         raise ParameterError(mode, value, "a finite number >= 0")
     if not np.isfinite(curve_keys) or int(curve_keys) != curve_keys or curve_keys < 0:

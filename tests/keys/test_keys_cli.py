@@ -162,6 +162,22 @@ def test_impossible_constraints_are_one_line(files, capsys, argv, words):
     assert err.count("\n") == 1 and words in err
 
 
+@pytest.mark.parametrize(
+    "mode", [[], ["--keys", "2"], ["--penalty", "0.01"], ["--budget", "1e9"], ["--max-error", "1e9"]]
+)
+def test_excluding_every_inner_frame_gives_the_two_ends(files, capsys, mode):
+    d, _ = files
+    out = run_json(capsys, d / "x.npz", "--exclude", "1-28", *mode)
+    assert out["keys"] == [0, 29] and out["params"]["excludes"] == list(range(1, 29))
+
+
+def test_a_count_the_exclusions_cannot_meet_names_keys(files, capsys):
+    d, _ = files
+    assert main(["keys", str(d / "x.npz"), "--exclude", "1-28", "--keys", "3"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "keys=3 is invalid: expected 2, the only count with these pins" in err
+
+
 def test_penalty_is_a_share_of_the_two_key_error_and_the_absolute_form_is_seed_003s(files, capsys):
     d, x = files
     two_key = run_json(capsys, d / "x.npz", "--keys", 2)["cost"]

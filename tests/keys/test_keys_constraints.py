@@ -156,6 +156,22 @@ def test_impossible_constraints_are_one_clear_error():
         select_keys(table, keys=4, constraints=KeyConstraints(pins=(12,)))
 
 
+@pytest.mark.parametrize("objective", ["total", "worst"])
+def test_excluding_every_inner_frame_leaves_the_two_ends_in_every_mode(objective):
+    table = random_table(12, 1, objective)
+    cons = KeyConstraints(pins=(), excludes=tuple(range(1, 11)))
+    assert cons.check(12).key_range(12) == (2, 2)
+    bound = float(table[0, 11])
+    modes = [{"keys": 2}, {"max_error": bound}]
+    modes += [{"penalty": 0.0}, {"budget": bound}] if objective == "total" else []
+    for mode in modes:
+        assert select_keys(table, objective=objective, constraints=cons, **mode).keys.tolist() == [0, 11]
+    with pytest.raises(ParameterError, match=r"keys=3 .*2, the only count with these pins"):
+        select_keys(table, keys=3, objective=objective, constraints=cons)
+    mixed = KeyConstraints(pins=(4,), excludes=(*range(1, 4), *range(5, 11)))  # no frame left free
+    assert select_keys(table, keys=3, objective=objective, constraints=mixed).keys.tolist() == [0, 4, 11]
+
+
 def test_frame_lists_parse_like_the_command_line():
     assert parse_frames("pin", "10,55") == (10, 55)
     assert parse_frames("exclude", "30-34, 40") == (30, 31, 32, 33, 34, 40)
