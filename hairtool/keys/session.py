@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation
+from hairtool.keys import notes
 from hairtool.keys.constraints import KeyConstraints
 from hairtool.keys.costs import INTERPOLATIONS, OBJECTIVES, cost_table
 from hairtool.keys.dp import (
@@ -269,33 +270,10 @@ class KeySession:
             raise
 
     def explain(self, sel: Selection) -> str | None:
-        """Why a tau, budget or bound gave one of the two extremes (a key on every frame, or no
-        keys but the ends and pins), in words a user can act on; None otherwise."""
-        if sel.mode == "keys":
-            return None
-        lo, hi = self.constraints.key_range(self.n_frames)
-        value = float(sel.params[sel.mode])
-        n = self.n_frames
-        skip = float(np.diagonal(self.table, 2).min()) if n >= 3 else 0.0
-        what = {
-            "penalty": "the price per key",
-            "budget": "the error budget",
-            "max_error": "the worst-frame bound",
-        }
-        if sel.n_keys == hi and hi > lo:
-            return (
-                f"a key on every frame: {what[sel.mode]} ({value:.6g}) is below what skipping any one frame "
-                f"costs (the least is {skip:.6g})"
-            )
-        if sel.n_keys == lo and hi > lo:
-            ends = "two keys" if lo == 2 else "only the first, last and pinned frames"
-            if sel.mode == "penalty":
-                return (
-                    f"{ends}: no key saves more than its price ({value:.6g}; keying the ends alone "
-                    f"costs {self.two_key_error:.6g})"
-                )
-            return f"{ends}: they already meet {what[sel.mode]} ({value:.6g}; their error is {sel.cost:.6g})"
-        return None
+        """Why a tau, budget or bound gave one of the two extremes (a key on every frame the
+        constraints allow, or no keys but the ends and pins), in words a user can act on; None
+        otherwise (:func:`hairtool.keys.notes.explain`)."""
+        return notes.explain(self.table, self.constraints, self.objective, sel)
 
     def select(
         self,
