@@ -271,9 +271,12 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
             write_key_poses(args.export, data, sel.keys)
     elif args.bake:
         raise ParameterError("bake", True, "an --export path to write the key curve to")
+    uniform = f"uniform {sel.uniform_cost:.6g}"
+    if "note" in result["uniform"]:  # pins or exclusions the uniform keys ignore
+        uniform += f"; {result['uniform']['note']}"
     line = (
         f"{sel.n_keys} keys of {n} frames, {sel.objective} error {sel.cost:.6g} "
-        f"(uniform {sel.uniform_cost:.6g}): {' '.join(map(str, sel.keys.tolist()))}"
+        f"({uniform}): {' '.join(map(str, sel.keys.tolist()))}"
     )
     if "note" in result:
         line += f"\n{result['note']}"

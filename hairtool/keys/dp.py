@@ -173,15 +173,32 @@ class Selection:
         return int(self.keys.size)
 
     def to_dict(self) -> dict:
+        pins, excludes = self.params.get("pins", ()), self.params.get("excludes", ())
         return {
             "keys": self.keys.tolist(),
             "cost": self.cost,
             "objective": self.objective,
             "mode": self.mode,
-            "uniform": {"keys": self.uniform_keys.tolist(), "cost": self.uniform_cost},
+            "uniform": {"keys": self.uniform_keys.tolist(), "cost": self.uniform_cost}
+            | uniform_constraints(pins, excludes),
             "curve": [[int(k), float(c)] for k, c in self.curve],
             "params": self.params,
         }
+
+
+def uniform_constraints(pins: ArrayLike, excludes: ArrayLike) -> dict:
+    """What the uniform baseline does not honour, for its record: ``{}`` without constraints,
+    else the counts it ignores and a note. The baseline stays the papers' (evenly spread keys),
+    so under pins a DP cost above it compares two different problems, not a worse solve."""
+    n_pins, n_excl = len(pins), len(excludes)
+    if not (n_pins or n_excl):
+        return {}
+    pins_s = f"{n_pins} pin{'' if n_pins == 1 else 's'}"
+    excl_s = f"{n_excl} exclusion{'' if n_excl == 1 else 's'}"
+    return {
+        "ignores": {"pins": n_pins, "excludes": n_excl},
+        "note": f"the DP keys honour {pins_s} and {excl_s}, the uniform keys do not",
+    }
 
 
 def check_table(table: ArrayLike) -> F64:

@@ -140,8 +140,17 @@ def test_pinned_and_excluded_frames_steer_every_mode(files, capsys, mode):
     keys = set(out["keys"])
     assert {7, 20} <= keys and not keys & {10, 11, 12, 13}
     assert out["params"]["pins"] == [7, 20] and out["params"]["excludes"] == [10, 11, 12, 13]
+    assert out["uniform"]["ignores"] == {"pins": 2, "excludes": 4}
+    assert out["uniform"]["note"] == "the DP keys honour 2 pins and 4 exclusions, the uniform keys do not"
     free = run_json(capsys, d / "x.npz", *mode)
-    assert "pins" not in free["params"]
+    assert "pins" not in free["params"] and set(free["uniform"]) == {"keys", "cost"}
+
+
+def test_the_printed_line_says_the_uniform_keys_ignore_the_pins(motion_dir, capsys):
+    assert main(["keys", str(motion_dir / "pymo_walk.bvh"), "--keys", "10", "--pin", "10,55"]) == 0
+    line = capsys.readouterr().out.strip()
+    assert "(uniform " in line
+    assert "; the DP keys honour 2 pins and 0 exclusions, the uniform keys do not)" in line
 
 
 @pytest.mark.parametrize(
