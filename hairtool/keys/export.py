@@ -3,12 +3,12 @@
 - JSON (``write_keys_json``/``read_keys_json``): frame numbers and times of the keys, the solve's
   parameters and costs, for pipelines and for reopening a solve.
 - CSV (``write_key_sheet``): one row per frame, like an animator's exposure sheet: whether the
-  frame is a key, which keys it lies between and its interpolation weight, so a reader can
-  rebuild every in-between without hairtool. A record with Hermite curves (``record["tangents"]``,
-  written by ``hairtool keys --interp hermite|hermite-fit`` for a BVH or a feature array) adds
-  three columns per channel, filled on key rows: ``NAME`` (the value at the key), ``NAME:in``
-  and ``NAME:out`` (the tangents arriving at and leaving the key, per frame): see
-  :func:`sheet_rows` for the curve they give.
+  frame is a key (and on key rows whether the animator pinned it), which keys it lies between
+  and its interpolation weight, so a reader can rebuild every in-between without hairtool. A
+  record with Hermite curves (``record["tangents"]``, written by ``hairtool keys --interp
+  hermite|hermite-fit`` for a BVH or a feature array) adds three columns per channel, filled on
+  key rows: ``NAME`` (the value at the key), ``NAME:in`` and ``NAME:out`` (the tangents arriving
+  at and leaving the key, per frame): see :func:`sheet_rows` for the curve they give.
 - USD (``write_key_poses``): only the key poses as time samples at their time codes; USD
   readers interpolate linearly between samples, so the file plays back as the linear
   reconstruction in any USD viewer.
@@ -221,12 +221,14 @@ def sheet_rows(
     keys: ArrayLike,
     uniform_keys: ArrayLike | None = None,
     curves: Mapping[str, Any] | None = None,
+    pins: Sequence[int] = (),
 ) -> list[list[Any]]:
     """Rows of the key sheet (header first): frame, time, key, key number, previous and next
-    key, interpolation weight s (frame = (1 − s)·previous + s·next), the uniform key column
-    when ``uniform_keys`` is given, and with ``curves`` (``{"channels", "values", "out", "in"}``,
-    one row of C numbers per key) three columns per channel, filled on key rows: NAME, NAME:in,
-    NAME:out.
+    key, interpolation weight s (frame = (1 − s)·previous + s·next), pinned (1 on the key rows
+    of ``pins``, the frames the animator pinned, 0 on other key rows, blank between keys), the
+    uniform key column when ``uniform_keys`` is given, and with ``curves`` (``{"channels",
+    "values", "out", "in"}``, one row of C numbers per key) three columns per channel, filled on
+    key rows: NAME, NAME:in, NAME:out.
 
     They give the Hermite curve without hairtool: between keys a < b (L = b − a frames) the
     channel at a frame of weight s is h00·v_a + h10·L·out_a + h01·v_b + h11·L·in_b, with
@@ -235,7 +237,8 @@ def sheet_rows(
     are written with all their digits (Python's repr), so they read back to the same float64.
     """
     k = _check_keys(keys, n_frames)
-    header = ["frame", "time", "key", "key_number", "previous_key", "next_key", "weight"]
+    header = ["frame", "time", "key", "key_number", "previous_key", "next_key", "weight", "pinned"]
+    pinned = {int(p) for p in pins}
     uni = None
     if uniform_keys is not None:
         uni = set(_check_keys(uniform_keys, n_frames).tolist())
@@ -264,7 +267,7 @@ def sheet_rows(
             prev, nxt = int(k[j - 1]), int(k[j])
             weight = (f - prev) / (nxt - prev)
         row = [f, repr(round(f / fps, 9)), int(is_key), j + 1 if is_key else "", prev, nxt]
-        row.append(repr(round(weight, 9)))
+        row += [repr(round(weight, 9)), int(f in pinned) if is_key else ""]
         if uni is not None:
             row.append(int(f in uni))
         if per_key:
@@ -273,11 +276,23 @@ def sheet_rows(
     return rows
 
 
+def _pins(record: Mapping[str, Any]) -> list[int]:
+    """The pinned frames a record's params list (the CLI's ``--pin``, the studio's dope sheet)."""
+    params = record.get("params")
+    pins = params.get("pins", []) if isinstance(params, Mapping) else []
+    if not isinstance(pins, (list, tuple)):
+        raise ParameterError("pins", type(pins).__name__, "a list of frame numbers")
+    if not all(isinstance(p, int) and not isinstance(p, bool) for p in pins):
+        raise ParameterError("pins", list(pins)[:8], "whole frame numbers")
+    return list(pins)
+
+
 def write_key_sheet(path: str | os.PathLike[str], record: Mapping[str, Any]) -> None:
     """Write the CSV key sheet of a record (one row per frame), atomically."""
     uniform = record.get("uniform", {}).get("keys") if isinstance(record.get("uniform"), dict) else None
     curves = record.get("tangents")
-    rows = sheet_rows(int(record["frames"]), float(record["fps"]), record_keys(record), uniform, curves)
+    keys = record_keys(record)
+    rows = sheet_rows(int(record["frames"]), float(record["fps"]), keys, uniform, curves, _pins(record))
     try:
         with atomic_open(path, "w", newline="", encoding="utf-8") as f:
             csv.writer(f).writerows(rows)

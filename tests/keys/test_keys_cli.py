@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import itertools
 import json
 
@@ -144,6 +145,16 @@ def test_pinned_and_excluded_frames_steer_every_mode(files, capsys, mode):
     assert out["uniform"]["note"] == "the DP keys honour 2 pins and 4 exclusions, the uniform keys do not"
     free = run_json(capsys, d / "x.npz", *mode)
     assert "pins" not in free["params"] and set(free["uniform"]) == {"keys", "cost"}
+
+
+def test_the_csv_sheet_marks_the_pinned_keys(files, tmp_path, capsys):
+    d, _ = files
+    out = tmp_path / "k.csv"
+    assert main(["keys", str(d / "x.npz"), "--keys", "6", "--pin", "7,20", "--export", str(out)]) == 0
+    with open(out, newline="", encoding="utf-8") as f:
+        keyed = {int(r["frame"]): r["pinned"] for r in csv.DictReader(f) if r["key"] == "1"}
+    assert len(keyed) == 6 and {f for f, pinned in keyed.items() if pinned == "1"} == {7, 20}
+    assert set(keyed.values()) == {"0", "1"}
 
 
 def test_the_printed_line_says_the_uniform_keys_ignore_the_pins(motion_dir, capsys):

@@ -78,6 +78,25 @@ def test_csv_sheet_has_one_row_per_frame_with_weights(tmp_path, solved):
     assert float(row["weight"]) == pytest.approx(1 / (b - a))
 
 
+def test_csv_sheet_marks_the_pinned_keys(tmp_path):
+    from hairtool.keys.constraints import KeyConstraints
+
+    x = np.cumsum(np.random.default_rng(2).normal(size=(30, 3)), axis=0)
+    sel = select_keys(cost_table(x, "linear"), keys=6, constraints=KeyConstraints((7, 20), (10, 11)))
+    record = keys_record({"frames": 30, "fps": 24.0, **sel.to_dict()})
+    export_keys(tmp_path / "k.csv", record)
+    with open(tmp_path / "k.csv", newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert {r["pinned"] for r in rows if r["key"] == "0"} == {""}
+    assert {int(r["frame"]): int(r["pinned"]) for r in rows if r["key"] == "1"} == {
+        k: int(k in (7, 20)) for k in sel.keys.tolist()
+    }
+    free = keys_record({"frames": 30, "fps": 24.0, **select_keys(cost_table(x, "linear"), keys=6).to_dict()})
+    assert [r[7] for r in sheet_rows(30, 24.0, record_keys(free))[1:] if r[2]] == [0] * 6
+    with pytest.raises(ParameterError, match="pins"):
+        export_keys(tmp_path / "bad.csv", {**record, "params": {"pins": ["7"]}})
+
+
 def test_sheet_rows_outside_the_keys_hold_the_nearest_key():
     rows = sheet_rows(6, 24.0, [1, 3])
     assert rows[1][4:7] == [1, 1, "0.0"] and rows[6][4:7] == [3, 3, "0.0"]
