@@ -360,7 +360,7 @@ def keys_result(model: object) -> dict:
     """The keys on the timeline as a ``hairtool keys`` result: frames, fps, DP keys and their
     cost, the uniform keys of the same count and theirs, the key settings and, when measured,
     the mean/tip/max position errors of both reconstructions."""
-    from hairtool.keys.dp import keys_cost
+    from hairtool.keys.dp import keys_cost, uniform_constraints
 
     anim, solve, keys = model.animation, model.key_solve, model.dp_keys
     if anim is None or keys is None or solve is None:
@@ -376,7 +376,8 @@ def keys_result(model: object) -> dict:
         "cost": keys_cost(solve.table, keys, objective),
         "objective": objective,
         "mode": model.settings.mode,
-        "uniform": {"keys": np.asarray(uni).tolist(), "cost": keys_cost(solve.table, uni, objective)},
+        "uniform": {"keys": np.asarray(uni).tolist(), "cost": keys_cost(solve.table, uni, objective)}
+        | uniform_constraints(model.settings.pins, model.settings.excludes),
         "params": dataclasses.asdict(model.settings),
     }
     if model.analysis is not None:

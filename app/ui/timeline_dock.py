@@ -212,6 +212,8 @@ class KeyControls(QWidget):
                 f" · mean error DP {a.dp.mean.mean():.4g} / uniform {a.uniform.mean.mean():.4g}"
                 f" · tip DP {a.dp.tip.mean():.4g} / uniform {a.uniform.tip.mean():.4g}"
             )
+        if m.settings.constraints:
+            text += " · the uniform keys ignore the pins and exclusions"
         if m.solve_stale:
             text += " · edited since the solve"
         if m.busy:

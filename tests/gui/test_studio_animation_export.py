@@ -105,6 +105,28 @@ def test_exported_keys_read_back_as_json_csv_and_usd(window, out):
     assert json.loads((out / "k.json").read_text())["input"] == "sway"
 
 
+def test_exported_keys_carry_the_pins_and_exclusions(window, out):
+    import csv
+
+    from hairtool.keys.export import read_keys_json
+
+    w = window
+    m = w.animation
+    pin = next(f for f in range(1, FRAMES - 1) if f not in m.dp_keys)
+    excluded = next(f for f in range(1, FRAMES - 1) if f != pin)
+    steer = w.animation_ui.steer_keys
+    assert steer("Pin", pin=pin) and steer("Exclude", exclude=excluded)
+    assert w.exporter.export_keys(out / "k.json") and w.exporter.export_keys(out / "k.csv"), w.errors
+    record = read_keys_json(out / "k.json")
+    assert record["params"]["pins"] == [pin] and record["params"]["excludes"] == [excluded]
+    assert record["uniform"]["ignores"] == {"pins": 1, "excludes": 1}
+    with open(out / "k.csv", newline="", encoding="utf-8") as f:
+        keyed = {int(r["frame"]): r["pinned"] for r in csv.DictReader(f) if r["key"] == "1"}
+    assert list(keyed) == m.dp_keys.tolist() and excluded not in keyed
+    assert {f for f, pinned in keyed.items() if pinned == "1"} == {pin}
+    assert "the uniform keys ignore the pins" in w.timeline.controls.summary.text()
+
+
 def test_keys_without_an_animation_are_one_clear_error(make_window, out):
     w = make_window()
     assert not w.exporter.export_keys(out / "k.json")
