@@ -88,37 +88,82 @@ def test_constrained_optimum_equals_brute_force(cons, objective, seed):
             assert sel.cost + tau * sel.keys.size == pytest.approx(want[2], rel=1e-12, abs=1e-12)
 
 
-def independent_dp(table: np.ndarray, cons: KeyConstraints, k: int, objective: str) -> float:
-    """E[K][j] over the allowed segments, written from the definition of the constraints."""
-    n = table.shape[0]
+def allowed_by_definition(cons: KeyConstraints):
     pins, excl = set(cons.pins), set(cons.excludes)
+    return lambda i, j: i not in excl and j not in excl and not any(i < p < j for p in pins)
 
-    def allowed(i: int, j: int) -> bool:
-        return i not in excl and j not in excl and not any(i < p < j for p in pins)
 
-    e = np.full((k + 1, n), np.inf)
+def independent_layers(table: np.ndarray, cons: KeyConstraints, kmax: int, objective: str) -> np.ndarray:
+    """E[K] for K = 0..kmax over the allowed segments, written from the definition of the
+    constraints (no masked table)."""
+    n = table.shape[0]
+    allowed = allowed_by_definition(cons)
+    e = np.full((kmax + 1, n), np.inf)
     e[1, 0] = 0.0
-    for kk in range(2, k + 1):
+    for kk in range(2, kmax + 1):
         for j in range(1, n):
             for i in range(j):
                 if allowed(i, j) and np.isfinite(e[kk - 1, i]):
                     v = max(e[kk - 1, i], table[i, j]) if objective == "worst" else e[kk - 1, i] + table[i, j]
                     e[kk, j] = min(e[kk, j], v)
-    return e[k, n - 1]
+    return e[:, n - 1]
+
+
+def independent_priced(table: np.ndarray, cons: KeyConstraints, tau: float) -> float:
+    """min over allowed key sets of Σ C + tau · K (seed 003), from the definition."""
+    n = table.shape[0]
+    allowed = allowed_by_definition(cons)
+    e = np.full(n, np.inf)
+    e[0] = tau
+    for j in range(1, n):
+        e[j] = min((e[i] + table[i, j] + tau for i in range(j) if allowed(i, j)), default=np.inf)
+    return float(e[n - 1])
+
+
+LONG = KeyConstraints(pins=(7, 20, 21, 40), excludes=(10, 11, 12, 33))
 
 
 @pytest.mark.parametrize("objective", ["total", "worst"])
 def test_constrained_optimum_equals_an_independent_dp_on_a_longer_animation(objective):
     n = 48
     table = random_table(n, 5, objective)
-    cons = KeyConstraints(pins=(7, 20, 21, 40), excludes=(10, 11, 12, 33))
+    cons = LONG
+    energy = independent_layers(table, cons, 15, objective)
     for k in (6, 9, 15):
         sel = select_keys(table, keys=k, objective=objective, constraints=cons)
         assert cons.allows(sel.keys)
-        assert sel.cost == pytest.approx(independent_dp(table, cons, k, objective), rel=1e-12)
+        assert sel.cost == pytest.approx(energy[k], rel=1e-12)
         assert sel.params["pins"] == [7, 20, 21, 40] and sel.params["excludes"] == [10, 11, 12, 33]
     free = select_keys(table, keys=9, objective=objective)
     assert select_keys(table, keys=9, objective=objective, constraints=cons).cost >= free.cost
+
+
+@pytest.mark.parametrize("objective", ["total", "worst"])
+def test_the_fewest_keys_within_a_bound_equal_an_independent_dp_on_a_longer_animation(objective):
+    """The budget (total) and the worst-frame bound: the first K whose independent optimum fits."""
+    n, cons = 48, LONG
+    table = random_table(n, 6, objective)
+    lo, hi = cons.key_range(n)
+    energy = independent_layers(table, cons, hi, objective)
+    mode = "budget" if objective == "total" else "max_error"
+    for bound in np.quantile(energy[lo : hi + 1], [0.05, 0.3, 0.7]):
+        want = lo + int(np.flatnonzero(energy[lo : hi + 1] <= bound)[0])
+        sel = select_keys(table, objective=objective, constraints=cons, **{mode: float(bound)})
+        assert cons.allows(sel.keys) and sel.n_keys == want
+        assert sel.cost == pytest.approx(energy[want], rel=1e-12) and sel.cost <= bound
+    with pytest.raises(ParameterError, match="pins and exclusions can meet"):
+        select_keys(table, objective=objective, constraints=cons, **{mode: float(energy[lo:].min()) * 0.5})
+
+
+def test_a_price_per_key_equals_an_independent_dp_on_a_longer_animation():
+    n, cons = 48, LONG
+    table = random_table(n, 7)
+    top = float(table[0, n - 1])
+    for tau in (0.0, 1e-3 * top, 0.02 * top, 0.3 * top):
+        sel = select_keys(table, penalty=tau, constraints=cons)
+        assert cons.allows(sel.keys)
+        priced = sel.cost + tau * sel.n_keys
+        assert priced == pytest.approx(independent_priced(table, cons, tau), rel=1e-12, abs=1e-12)
 
 
 def test_the_numpy_twins_agree_under_constraints():
