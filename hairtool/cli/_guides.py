@@ -17,6 +17,8 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from hairtool.guides.limits import DEFAULT_FRIZZ, DEFAULT_K, DEFAULT_LENGTH_VARIATION
+
 if TYPE_CHECKING:
     import numpy as np
 
@@ -25,10 +27,6 @@ if TYPE_CHECKING:
     from hairtool.guides.render import RenderHair
 
 
-#: Defaults of the options that shape the children (None on the command line: given or not).
-K = 4
-LENGTH_VARIATION = 0.1
-FRIZZ = 0.01
 #: Options that mean something only with --count or --from-dense (destination, flag).
 _RENDER_ONLY = (
     ("scalp", "--scalp"), ("guides_per_child", "--guides-per-child"), ("vertices", "--vertices"),
@@ -46,7 +44,7 @@ def add_arguments(
     g.add_argument("--count", type=int, default=None, help="children to grow from the guides")
     g.add_argument("--scalp", metavar="MESH.obj", default=None, help="scalp mesh the children grow on")
     g.add_argument(
-        "--guides-per-child", type=int, default=None, metavar="K", help=f"k nearest guides (default {K})"
+        "--guides-per-child", type=int, metavar="K", help=f"k nearest guides (default {DEFAULT_K})"
     )
     if seed:
         g.add_argument(
@@ -57,13 +55,13 @@ def add_arguments(
         "--length-variation",
         type=float,
         default=None,
-        help=f"child lengths ×[1−v, 1+v], v in [0, 0.9] (default {LENGTH_VARIATION})",
+        help=f"child lengths ×[1−v, 1+v], v in [0, 0.9] (default {DEFAULT_LENGTH_VARIATION})",
     )
     g.add_argument(
         "--frizz",
         type=float,
         default=None,
-        help=f"curl radius at the tip / child length, [0, 0.5] (default {FRIZZ})",
+        help=f"curl radius at the tip / child length, [0, 0.5] (default {DEFAULT_FRIZZ})",
     )
     g.add_argument(
         "--region",
@@ -188,11 +186,9 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
     from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp, bind_to_guides
 
     t0 = time.perf_counter()
-    k = K if args.guides_per_child is None else args.guides_per_child
-    shape = {
-        "length_variation": LENGTH_VARIATION if args.length_variation is None else args.length_variation,
-        "frizz": FRIZZ if args.frizz is None else args.frizz,
-    }
+    k = DEFAULT_K if args.guides_per_child is None else args.guides_per_child
+    lv = DEFAULT_LENGTH_VARIATION if args.length_variation is None else args.length_variation
+    shape = {"length_variation": lv, "frizz": DEFAULT_FRIZZ if args.frizz is None else args.frizz}
     mesh = None
     if args.scalp is not None:
         from hairtool.io.obj import read_mesh

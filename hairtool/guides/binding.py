@@ -25,6 +25,14 @@ from hairtool.errors import ParameterError
 from hairtool.frozen.noise import check_seed
 from hairtool.groom import Groom, Topology, vertex_ids_of
 from hairtool.guides import children as _children
+from hairtool.guides.limits import (  # re-exported: the binding's callers import them from here
+    DEFAULT_FRIZZ,
+    DEFAULT_K,
+    DEFAULT_LENGTH_VARIATION,
+    MAX_CHILDREN,
+    MAX_FRIZZ,
+    MAX_LENGTH_VARIATION,
+)
 from hairtool.guides.nearest import euclidean_nearest, farthest_point_sampling, weights
 from hairtool.guides.scatter import (
     CH_VARIATION,
@@ -36,13 +44,6 @@ from hairtool.guides.scatter import (
 )
 from hairtool.guides.surface import closest_points, surface_nearest
 from hairtool.io.obj import Mesh
-
-MAX_CHILDREN = 10_000_000
-MAX_LENGTH_VARIATION = 0.9
-MAX_FRIZZ = 0.5
-DEFAULT_K = 4
-DEFAULT_LENGTH_VARIATION = 0.1
-DEFAULT_FRIZZ = 0.01
 
 
 @dataclass(eq=False)
