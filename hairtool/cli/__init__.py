@@ -41,13 +41,30 @@ def command_names() -> list[str]:
     return list(command_modules())
 
 
+def _parser(command: str, cls: type[argparse.ArgumentParser], **kwargs) -> argparse.ArgumentParser:
+    module = importlib.import_module(command_modules()[command])
+    parser = cls(prog=f"hairtool {command}", description=module.__doc__, **kwargs)
+    module.add_arguments(parser)
+    return parser
+
+
 @functools.cache
 def command_parser(command: str) -> argparse.ArgumentParser:
     """The argument parser of one ``hairtool`` command, as ``hairtool COMMAND`` builds it."""
-    module = importlib.import_module(command_modules()[command])
-    parser = argparse.ArgumentParser(prog=f"hairtool {command}", description=module.__doc__)
-    module.add_arguments(parser)
-    return parser
+    return _parser(command, argparse.ArgumentParser)
+
+
+class _RaisingParser(argparse.ArgumentParser):
+    def error(self, message: str):  # argparse's own prints the usage and exits
+        raise ValueError(message)
+
+
+@functools.cache
+def quiet_parser(command: str) -> argparse.ArgumentParser:
+    """The parser of one command for reading a command line someone else will run (a batch's
+    jobs): without ``--help``, and raising ``ValueError`` on bad arguments instead of printing
+    the usage and exiting."""
+    return _parser(command, _RaisingParser, add_help=False)
 
 
 def build_parser() -> argparse.ArgumentParser:

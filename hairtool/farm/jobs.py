@@ -12,6 +12,9 @@ Every mistake is a :class:`~hairtool.errors.FormatError` naming the file and the
 
 from __future__ import annotations
 
+import argparse
+import contextlib
+import functools
 import glob
 import hashlib
 import json
@@ -51,10 +54,10 @@ class Job:
     def argv(self) -> list[str]:
         return [self.command, *self.args]
 
-    @property
+    @functools.cached_property
     def input(self) -> str | None:
-        """The first argument that is not an option (every command takes its input first)."""
-        return next((a for a in self.args if not a.startswith("-")), None)
+        """The input the command reads from ``args`` (:func:`job_input`)."""
+        return job_input(self.command, self.args)
 
     @property
     def key(self) -> str:
@@ -64,6 +67,32 @@ class Job:
 
     def describe(self) -> str:
         return f"job {self.index + 1} ({self.command} {self.input or ''}".rstrip() + ")"
+
+
+@functools.cache
+def _input_dest(command: str) -> str | None:
+    """The command's input positional: the one named ``input``, else its first (``info FILE``)."""
+    from hairtool.cli import quiet_parser
+
+    positionals = [a.dest for a in quiet_parser(command)._actions if not a.option_strings]
+    return "input" if "input" in positionals else next(iter(positionals), None)
+
+
+def job_input(command: str, args: tuple[str, ...] | list[str]) -> str | None:
+    """The value of the command's input positional as its own parser reads ``args`` (so
+    ``--keys 4 shot.usdc`` gives ``shot.usdc``, not ``4``); None when it takes none or was
+    given none. Arguments the command will refuse (the job then fails with argparse's message)
+    still show the input when the parser met it before the mistake."""
+    from hairtool.cli import quiet_parser
+
+    dest = _input_dest(command)
+    if dest is None:
+        return None
+    seen = argparse.Namespace()  # filled as the parser goes, kept when it stops at a mistake
+    with contextlib.suppress(ValueError):
+        quiet_parser(command).parse_known_args(list(args), seen)
+    value = getattr(seen, dest, None)
+    return None if value is None else str(value)
 
 
 def job_commands() -> list[str]:

@@ -30,6 +30,37 @@ def test_listed_jobs_keep_their_arguments_and_numbers_become_text(tmp_path):
     assert job.base == str(tmp_path) and job.input == "s.npz"
 
 
+@pytest.mark.parametrize(
+    ("command", "args", "expected"),
+    [
+        ("keys", ["--keys", "4", "shot.usdc", "--out", "x.json"], "shot.usdc"),
+        ("keys", ["-k", "4", "--pin", "0,3", "shot.usdc"], "shot.usdc"),
+        ("keys", ["--out=x.json", "--export", "k.usdc", "shot.npz"], "shot.npz"),
+        ("convert", ["--up-axis", "z", "in.hair", "out.usda"], "in.hair"),
+        ("freeze", ["--seed", "3", "--clump-radius", "auto", "g.tfx", "f.npz"], "g.tfx"),
+        ("anime", ["--period", "0.5", "sample:portrait", "a.npz"], "sample:portrait"),
+        ("anime", ["--period", "0.5"], None),  # the schedule only: no input
+        ("info", ["shot.npz"], "shot.npz"),
+        ("keys", ["shot.npz", "--keys", "2", "--penalty", "1"], "shot.npz"),  # refused, after the input
+        ("keys", ["--keys", "four", "shot.npz"], None),  # refused before the input
+        ("convert", ["in.hair"], "in.hair"),  # OUT missing: refused at the end
+        ("keys", ["shot.npz", "--help"], "shot.npz"),  # nothing printed, nothing exits
+    ],
+)
+def test_the_input_is_read_by_the_commands_own_parser(command, args, expected, capsys):
+    from hairtool.cli import quiet_parser
+
+    assert load_one(command, args).input == expected
+    assert capsys.readouterr() == ("", "")
+    assert quiet_parser(command) is quiet_parser(command)  # built once per command
+
+
+def load_one(command: str, args: list[str]):
+    from hairtool.farm.jobs import Job
+
+    return Job(0, command, tuple(args), "/")
+
+
 def test_a_glob_fills_the_template_for_each_match_in_order(project):
     path = write(
         project / "jobs.json",

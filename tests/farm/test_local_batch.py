@@ -102,7 +102,7 @@ def test_failed_jobs_are_reported_and_counted_in_the_exit_status(project, capsys
         json.dumps(
             {
                 "jobs": [
-                    {"command": "keys", "args": ["shots/a.npz", "--keys", "999"]},
+                    {"command": "keys", "args": ["--keys", "999", "shots/a.npz", "--out", "out/a.json"]},
                     {"command": "convert", "args": ["grooms/scalp.npz", "out/scalp.hair"]},
                     {"command": "convert", "args": ["shots/missing.npz", "out/missing.usda"]},
                     {"command": "keys", "args": ["shots/b.npz", "--kees", "3"]},
@@ -117,7 +117,12 @@ def test_failed_jobs_are_reported_and_counted_in_the_exit_status(project, capsys
     assert out.strip().startswith("4 jobs: 1 done, 0 skipped, 3 failed in ")
     lines = err.strip().splitlines()
     assert len(lines) == 3 and all(ln.startswith("hairtool batch: job ") for ln in lines)
+    assert lines[0].startswith("hairtool batch: job 1 (keys shots/a.npz) failed: ")  # options first
     rows = json.loads(report.read_text())["jobs"]
+    inputs = ["shots/a.npz", "grooms/scalp.npz", "shots/missing.npz", "shots/b.npz"]
+    assert [r["input"] for r in rows] == inputs
+    with open(project / "report.csv", newline="") as f:
+        assert next(csv.DictReader(f))["input"] == "shots/a.npz"
     assert [r["status"] for r in rows] == ["failed", "done", "failed", "failed"]
     assert rows[0]["error"] == "hairtool keys: error: keys=999 is invalid: expected a whole number in [2, 24]"
     assert "missing.npz" in rows[2]["error"]
