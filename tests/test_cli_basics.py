@@ -83,6 +83,21 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, argv, message):
     assert err.count("\n") == 1 and "Traceback" not in err
 
 
+def test_an_output_in_a_missing_folder_gets_the_folder(tmp_path, capsys):
+    """As a render ROP does: a shot's new output folder needs no mkdir first."""
+    write(tmp_path / "in.hair", scalp(10, 5))
+    out = tmp_path / "shot01" / "hair" / "out.usdc"
+    assert main(["convert", str(tmp_path / "in.hair"), str(out)]) == 0
+    assert read(out).strand_count == 10
+    assert [p.name for p in out.parent.iterdir()] == ["out.usdc"]
+    (tmp_path / "taken").write_text("a file, not a folder")
+    blocked = tmp_path / "taken" / "out.usdc"
+    assert main(["convert", str(tmp_path / "in.hair"), str(blocked)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"hairtool convert: error: {blocked}: cannot write: ") and err.count("\n") == 1
+    assert f"'{tmp_path / 'taken'}'" in err and ".tmp" not in err
+
+
 def test_bad_input_from_a_real_process_has_no_traceback(tmp_path):
     bad = tmp_path / "bad.tfx"
     bad.write_bytes(b"\0\0\x80\x40" + b"\xff" * 300)

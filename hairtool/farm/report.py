@@ -22,12 +22,11 @@ CSV_COLUMNS = ("index", "command", "input", "status", "seconds", "error", *KEYS_
 
 
 def check_report_path(path: str | os.PathLike[str]) -> Path:
-    """``path`` if it names a ``.json`` file in an existing folder (checked before a batch runs)."""
+    """``path`` if it names a ``.json`` file (checked before a batch runs); its folder, like any
+    output's, is made when the report is written."""
     p = Path(path)
     if p.suffix.lower() != ".json":
         raise ParameterError("report", str(path), "a .json file (the .csv is written beside it)")
-    if not p.absolute().parent.is_dir():
-        raise FormatError(p, "cannot write the report: no such folder")
     return p
 
 
@@ -48,15 +47,17 @@ def _cell(name: str, value: object) -> object:
 def write_report(path: str | os.PathLike[str], rows: list[dict], summary: dict) -> tuple[Path, Path]:
     """Write the JSON report at ``path`` and its CSV beside it; both paths."""
     p, c = Path(path), csv_path(path)
+    writing = p
     try:
         with atomic_open(p, "w", encoding="utf-8") as f:
             json.dump({"summary": summary, "jobs": rows}, f, indent=1)
             f.write("\n")
+        writing = c
         with atomic_open(c, "w", encoding="utf-8", newline="") as f:
             w = csv.writer(f)
             w.writerow(CSV_COLUMNS)
             for r in rows:
                 w.writerow([_cell(k, r.get(k)) for k in CSV_COLUMNS])
     except OSError as e:
-        raise FormatError(e.filename or p, f"cannot write the report: {e.strerror or e}") from None
+        raise FormatError(writing, f"cannot write the report: {e}") from None
     return p, c

@@ -12,6 +12,10 @@ by a process id that no longer runs. A temporary of a live writer is never touch
 writer's whose id has been reused by another live process waits for a later write; one made
 on another machine sharing the folder is left alone, since its process id means nothing here.
 
+The target's missing folders are created first, as a render ROP does (a batch template's
+``out/{stem}/keys.json`` needs no set-up). A folder that cannot be made or written to is an
+``OSError`` naming that folder, never the temporary file the user has not heard of.
+
 Two helpers serve ``hairtool batch``, which runs any command and must learn what it wrote:
 :func:`recording_writes` collects the paths renamed into place, whatever the writer, and
 :func:`stale_temporaries` lists every temporary of a path, from any machine, for a batch that
@@ -22,6 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import errno
 import functools
 import hashlib
 import os
@@ -134,6 +139,17 @@ def remove_stale_temps(target: Path) -> list[Path]:
     return removed
 
 
+def _make_folder(folder: Path) -> None:
+    """Create ``folder`` and its missing parents; an error names the folder that failed."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):  # a file where a folder should be: name it
+        blocker = next((p for p in (folder, *folder.parents) if p.exists() and not p.is_dir()), folder)
+        raise NotADirectoryError(errno.ENOTDIR, "a file is in the way of the folder", str(blocker)) from None
+    except OSError as e:
+        raise type(e)(e.errno, e.strerror, e.filename or str(folder)) from None
+
+
 def _create_temp(target: Path) -> tuple[Path, int]:
     """A new empty file beside ``target`` and the mode a new file gets here (umask applied).
 
@@ -148,6 +164,8 @@ def _create_temp(target: Path) -> tuple[Path, int]:
             fd = os.open(tmp, _CREATE_FLAGS, 0o666)
         except FileExistsError:
             continue
+        except OSError as e:  # the folder's fault (read-only, full, gone): name it, not ``tmp``
+            raise type(e)(e.errno, e.strerror, str(folder)) from None
         try:
             mode = stat.S_IMODE(os.fstat(fd).st_mode)
         finally:
@@ -171,10 +189,12 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
 
     For writers that need a file name (usd-core, imageio). On any exception the temporary file
     is removed and the previous ``path``, if any, is untouched. The result keeps the mode of the
-    file it replaces; a new file gets 0o666 less the umask. Temporaries of ``path`` left by
-    killed writers are removed first (see the module docstring).
+    file it replaces; a new file gets 0o666 less the umask. Missing folders of ``path`` are
+    created, and temporaries of ``path`` left by killed writers removed, first (see the module
+    docstring).
     """
     target = Path(path)
+    _make_folder(target.parent if str(target.parent) else Path("."))
     remove_stale_temps(target)
     tmp_path, new_file_mode = _create_temp(target)
     try:

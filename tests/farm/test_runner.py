@@ -78,6 +78,21 @@ def test_a_failing_job_gives_the_commands_one_line(project):
     assert not (project / "out" / "x.usda").exists()
 
 
+def test_a_job_makes_its_missing_output_folders_and_a_blocked_one_names_the_output(project):
+    keys = ("shots/a.npz", "--keys", "4", "--export")
+    made = run_job(Job(0, "keys", (*keys, "out/new/v1/a.csv"), str(project)))
+    assert made["status"] == "done", made["error"]
+    assert list(made["outputs"]) == [str(project / "out" / "new" / "v1" / "a.csv")]
+    (project / "out" / "taken").write_text("a file, not a folder")
+    blocked = run_job(Job(1, "keys", (*keys, "out/taken/a.csv"), str(project)))
+    assert blocked["status"] == "failed" and blocked["outputs"] == {}
+    assert blocked["error"] == (
+        "hairtool keys: error: out/taken/a.csv: cannot write: [Errno 20] a file is in the way of the folder: "
+        "'out/taken'"
+    )
+    assert not [p for p in project.rglob("*") if ".tmp" in p.name]
+
+
 def test_a_job_without_json_still_runs_and_commands_with_json_report_numbers(project):
     result = run_job(Job(0, "sample", ("comb", "out/comb.hair", "--strands", "9"), str(project)))
     assert result["status"] == "done" and result["fields"] == {}  # sample prints no JSON

@@ -54,9 +54,40 @@ def test_failed_write_leaves_no_file(tmp_path, monkeypatch, groom, ext):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_unwritable_folder_is_a_format_error(tmp_path, groom):
-    with pytest.raises(FormatError, match="cannot write"):
-        write(tmp_path / "missing" / "g.hair", groom)
+@pytest.mark.parametrize("ext", WRITABLE)
+def test_missing_folders_of_the_output_are_created(tmp_path, groom, ext):
+    target = tmp_path / "shot" / "v2" / f"g.{ext}"
+    write(target, groom)
+    assert read(target).strand_count == groom.strand_count
+    assert [p.name for p in target.parent.iterdir()] == [target.name]  # no temporaries
+
+
+@pytest.mark.parametrize("inside", ["", "sub"])
+def test_a_file_in_the_way_of_the_folder_is_one_line_naming_both(tmp_path, groom, inside):
+    (tmp_path / "taken").write_bytes(b"")
+    target = tmp_path / "taken" / inside / "g.hair"
+    with pytest.raises(FormatError) as e:
+        write(target, groom)
+    message = str(e.value)
+    assert str(target) in message and f"'{tmp_path / 'taken'}'" in message and "in the way" in message
+    assert ".tmp" not in message and "\n" not in message
+    assert [p.name for p in tmp_path.iterdir()] == ["taken"]
+
+
+def test_a_folder_refusing_new_files_is_named_not_the_temporary(tmp_path, groom, monkeypatch):
+    """Root ignores permission bits, so the refusal is simulated where the temporary is made."""
+    real_open = os.open
+
+    def refuse(path, *args, **kwargs):
+        if ".tmp" in os.fspath(path):
+            raise PermissionError(13, "Permission denied", os.fspath(path))
+        return real_open(path, *args, **kwargs)
+
+    monkeypatch.setattr(atomic.os, "open", refuse)
+    with pytest.raises(FormatError) as e:
+        write(tmp_path / "g.hair", groom)
+    assert str(e.value).endswith(f"cannot write: [Errno 13] Permission denied: '{tmp_path}'")
+    assert list(tmp_path.iterdir()) == []
 
 
 @contextlib.contextmanager
