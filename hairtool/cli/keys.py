@@ -88,6 +88,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--bake", action="store_true", help="with --export: every frame of the key curve, not just the keys"
     )
+    parser.add_argument(
+        "--storage",
+        action="store_true",
+        help="measure what keying saves: write the key poses in IN's format to a temporary file (deleted) "
+        "and report its bytes over IN's (animations; null for others)",
+    )
 
 
 def _load(args: argparse.Namespace):
@@ -183,6 +189,8 @@ def run(args: argparse.Namespace) -> int:
         tau = args.penalty if relative else args.penalty_abs
         channels = per_channel_keys(x, tau, interp=args.interp, curvature=args.curvature, relative=relative)
         result = {"frames": n, "fps": fps, **channels.to_dict()}
+        if args.storage:
+            result["storage"] = None  # no one set of key poses
         return _emit(args, result, f"{len(result['union'])} frames key at least one of {x.shape[1]} channels")
 
     objective = "worst" if args.max_error is not None else args.objective
@@ -252,6 +260,10 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
     if args.interp != "linear" and kind in ("raw", "bvh"):
         result["tangents"] = _curves(kind, data, sel.keys, args.interp)
     time_codes = data.time_codes if kind == "animation" else None
+    if args.storage:
+        from hairtool.keys.storage import storage
+
+        result["storage"] = storage(data, sel.keys, args.input) if kind == "animation" else None
     if args.export is not None:
         suffix = args.export.suffix.lower()
         if (args.bake or suffix not in JSON_SUFFIXES + CSV_SUFFIXES) and kind != "animation":
@@ -280,6 +292,12 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
     )
     if "note" in result:
         line += f"\n{result['note']}"
+    if result.get("storage"):
+        st = result["storage"]
+        line += (
+            f"\nkeys only: {st['keys_only_bytes']} bytes as {st['format']}, "
+            f"{st['ratio']:.1%} of the input's {st['input_bytes']}"
+        )
     return _emit(args, result, line, time_codes)
 
 

@@ -1,21 +1,23 @@
 """The numbers a report row carries beyond status and time, per command, read from what the
-command printed with ``--json`` (nothing is solved again).
+command printed with ``--json`` (nothing is solved again); :func:`report_options` are the
+options a job gets so that it prints them.
 
 ``keys``: ``key_count`` and ``frames``; ``total_error`` and ``uniform_total_error``, the
 solve's error E summed over frames for the DP keys and for uniform keys of the same count
 (``hairtool keys``' ``cost``, under ``--objective total``; None under ``worst``);
 ``worst_error`` and ``uniform_worst_error``, the largest point distance of either
 reconstruction over all frames, and ``mean_error``/``uniform_mean_error`` the mean one, in
-scene units (animations and BVH captures; None for raw features); ``storage_ratio``, the
-bytes of the ``--export`` keys-only file over the bytes of the full animation read (None
-without ``--export``). Every command: ``summary``, the plain numbers and strings of its
-``--json`` object.
+scene units (animations and BVH captures; None for raw features); ``storage_ratio``, on every
+keys job of an animation whatever its ``--export``: the bytes of a real file holding only the
+key poses, written in the input's own format (``.usdc`` for a ``.usdc``) to the system's temp
+dir and deleted (``hairtool keys --storage``, :mod:`hairtool.keys.storage`), over the bytes
+of the input (None for BVH captures, raw features and ``--per-channel``). Every command:
+``summary``, the plain numbers and strings of its ``--json`` object.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from pathlib import Path
 
 from hairtool.farm.jobs import Job
 
@@ -36,9 +38,19 @@ def _number(value: object) -> float | None:
     return float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
-def _keys(job: Job, summary: dict, inputs: dict, outputs: dict) -> dict:
+#: Options a command's job gets beyond ``--json``, for the report's numbers.
+_OPTIONS = {"keys": ("--storage",)}
+
+
+def report_options(command: str) -> list[str]:
+    """``--json`` where the command takes it, then what :data:`_OPTIONS` adds."""
     from hairtool.cli import command_parser
 
+    takes = command_parser(command)._option_string_actions
+    return [o for o in ("--json", *_OPTIONS.get(command, ())) if o in takes]
+
+
+def _keys(summary: dict) -> dict:
     keys = summary.get("keys", summary.get("union")) or []
     uniform = summary.get("uniform") if isinstance(summary.get("uniform"), dict) else {}
     errors = summary.get("position_errors") if isinstance(summary.get("position_errors"), dict) else {}
@@ -53,24 +65,18 @@ def _keys(job: Job, summary: dict, inputs: dict, outputs: dict) -> dict:
         e = errors.get(name) if isinstance(errors.get(name), dict) else {}
         fields[f"{prefix}worst_error"] = _number(e.get("max"))
         fields[f"{prefix}mean_error"] = _number(e.get("mean"))
-    args = command_parser("keys").parse_known_args(list(job.args))[0]
-    ratio = None
-    if args.export is not None:
-        exported = outputs.get(str(Path(job.base, args.export).resolve()))
-        read = inputs.get(str(Path(job.base, args.input).resolve()))
-        if exported and read and read["bytes"] > 0:
-            ratio = exported["bytes"] / read["bytes"]
-    fields["storage_ratio"] = ratio
+    storage = summary.get("storage") if isinstance(summary.get("storage"), dict) else {}
+    fields["storage_ratio"] = _number(storage.get("ratio"))
     return fields
 
 
-_BY_COMMAND: dict[str, Callable[[Job, dict, dict, dict], dict]] = {"keys": _keys}
+_BY_COMMAND: dict[str, Callable[[dict], dict]] = {"keys": _keys}
 
 
-def report_fields(job: Job, summary: dict | None, inputs: dict, outputs: dict) -> dict:
+def report_fields(job: Job, summary: dict | None) -> dict:
     """The command's numbers for the report (empty when it printed no JSON object)."""
     if not isinstance(summary, dict):
         return {}
     plain = {k: v for k, v in summary.items() if isinstance(v, (int, float, str)) and not isinstance(v, bool)}
     special = _BY_COMMAND.get(job.command)
-    return {**(special(job, summary, inputs, outputs) if special else {}), "summary": plain}
+    return {**(special(summary) if special else {}), "summary": plain}

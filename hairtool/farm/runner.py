@@ -2,8 +2,9 @@
 
 The job is the ``hairtool`` command line, run in-process through :func:`hairtool.cli.main`
 (no new interpreter, and numba's compiled kernels stay loaded from one job to the next), in
-the jobs file's folder, with its output captured. Commands that take ``--json`` get it, so the
-report can carry their numbers (:mod:`hairtool.farm.fields`). What the job wrote is learned
+the jobs file's folder, with its output captured. Commands that take ``--json`` get it (and
+``keys`` its ``--storage``: :func:`~hairtool.farm.fields.report_options`), so the report can
+carry their numbers (:mod:`hairtool.farm.fields`). What the job wrote is learned
 from the atomic writes themselves (:func:`hairtool.io.atomic.recording_writes`), and what it
 read from the arguments naming existing files; the client records both in the manifest.
 
@@ -22,16 +23,11 @@ import socket
 import threading
 import time
 
-from hairtool.cli import command_parser
-from hairtool.farm.fields import report_fields
+from hairtool.farm.fields import report_fields, report_options
 from hairtool.farm.jobs import Job
 from hairtool.farm.manifest import file_state, input_state, named_paths
 
 _LOCK = threading.Lock()
-
-
-def takes_json(command: str) -> bool:
-    return "--json" in command_parser(command)._option_string_actions
 
 
 def _error_line(rc: int, stderr: str) -> str:
@@ -76,9 +72,7 @@ def run_job(job: Job, threads: int | None = None) -> dict:
     """
     from hairtool.io.atomic import recording_writes, stale_temporaries
 
-    argv = job.argv
-    if "--json" not in job.args and takes_json(job.command):
-        argv.append("--json")
+    argv = job.argv + [o for o in report_options(job.command) if o not in job.args]
     with _LOCK:
         previous = os.getcwd()
         t0 = time.perf_counter()
@@ -113,7 +107,7 @@ def run_job(job: Job, threads: int | None = None) -> dict:
         "seconds": seconds,
         "inputs": inputs,
         "outputs": outputs,
-        "fields": report_fields(job, summary, inputs, outputs),
+        "fields": report_fields(job, summary),
         "stderr": stderr.strip()[-2000:],
         "worker": f"{socket.gethostname()}:{os.getpid()}",
     }

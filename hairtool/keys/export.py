@@ -47,7 +47,7 @@ F64 = NDArray[np.float64]
 #: it again (``_plain``, ``json.dump``) recurse past Python's limit.
 MAX_NESTING = 32
 # Results that are large or only useful on screen; the record keeps everything else.
-_NOT_RECORDED = ("keys", "frames", "fps", "curve", "time_codes")
+_NOT_RECORDED = ("keys", "frames", "fps", "curve", "time_codes", "storage")
 
 
 def _check_keys(keys: ArrayLike, n_frames: int) -> NDArray[np.int64]:
@@ -300,20 +300,23 @@ def write_key_sheet(path: str | os.PathLike[str], record: Mapping[str, Any]) -> 
         raise FormatError(path, f"cannot write: {e}") from None
 
 
+def key_poses_only(animation: Animation, keys: Sequence[int] | ArrayLike) -> Animation:
+    """The animation with only its key poses, each at its time code in the source; the poses
+    keep the animation's metadata (up axis, unit, curve prims), so they land where the source's
+    frames are."""
+    k = _check_keys(keys, animation.n_frames)
+    return animation.with_frames(animation.frames[k], time_codes=animation.time_codes[k])
+
+
 def write_key_poses(
     path: str | os.PathLike[str], animation: Animation, keys: Sequence[int] | ArrayLike
 ) -> None:
-    """Write USD with only the key poses, each at its time code in the source (atomically).
-
-    The poses keep the animation's metadata (up axis, unit, curve prims), so they land where
-    the source's frames are."""
+    """Write USD with only the key poses (:func:`key_poses_only`), atomically."""
     from hairtool.io import usd
 
-    k = _check_keys(keys, animation.n_frames)
+    poses = key_poses_only(animation, keys)
     if Path(path).suffix.lower() not in USD_SUFFIXES:
         raise FormatError(path, f"key poses are written as USD ({', '.join(USD_SUFFIXES)})")
-    codes = animation.time_codes[k]
-    poses = animation.with_frames(animation.frames[k], time_codes=codes)
     try:
         usd.write(Path(path), poses)
     except OSError as e:

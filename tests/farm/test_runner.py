@@ -12,6 +12,7 @@ from hairtool.cli import main
 from hairtool.farm.jobs import Job
 from hairtool.farm.manifest import file_sha256
 from hairtool.farm.runner import run_job
+from hairtool.io import read, write
 from hairtool.io.atomic import atomic_open, recording_writes, stale_temporaries
 from hairtool.keys.export import read_keys_json
 
@@ -47,8 +48,23 @@ def test_a_keys_job_matches_the_command_run_by_hand(project, capsys, monkeypatch
     assert fields["worst_error"] == by_hand["position_errors"]["keys"]["max"]
     assert fields["uniform_worst_error"] == by_hand["position_errors"]["uniform"]["max"]
     assert fields["uniform_total_error"] >= fields["total_error"]  # the DP keys are optimal
-    exported = os.path.getsize(project / "out" / "a.keys.usda")
-    assert fields["storage_ratio"] == exported / os.path.getsize(a)
+    # The key poses alone in the input's own format (.npz), not the --export .usda.
+    shot, k = read(a), by_hand["keys"]
+    write(project / "poses.npz", shot.with_frames(shot.frames[k], time_codes=shot.time_codes[k]))
+    assert fields["storage_ratio"] == os.path.getsize(project / "poses.npz") / os.path.getsize(a)
+    assert 0 < fields["storage_ratio"] < 1
+
+
+def test_every_keys_job_of_an_animation_has_a_storage_ratio_and_leaves_no_file(project, monkeypatch):
+    import tempfile
+
+    scratch = project / "scratch"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    result = run_job(Job(0, "keys", ("--keys", "4", "shots/b.npz"), str(project)))
+    assert result["status"] == "done" and result["outputs"] == {}
+    assert 0 < result["fields"]["storage_ratio"] < 1
+    assert list(scratch.iterdir()) == []
 
 
 def test_the_job_runs_in_the_jobs_folder_and_leaves_the_working_folder_as_it_was(

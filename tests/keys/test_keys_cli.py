@@ -278,6 +278,38 @@ def test_a_progress_bar_on_a_terminal_only(files, capsys):
     assert capsys.readouterr().err == ""  # piped stderr stays clean
 
 
+def test_storage_is_the_bytes_of_the_key_poses_in_the_inputs_own_format(files, tmp_path, capsys, monkeypatch):
+    """Measured on a real file in the system's temp dir, deleted after; the --out record is the
+    same with or without it."""
+    import tempfile
+
+    from hairtool.io import read
+
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    d, _ = files
+    write(tmp_path / "anim.usdc", read(d / "anim.npz"))
+    for src in (d / "anim.npz", tmp_path / "anim.usdc"):
+        out = run_json(capsys, src, "--keys", 5, "--storage", "--out", tmp_path / "with.json")
+        anim, k = read(src), out["keys"]
+        by_hand = tmp_path / f"by_hand{src.suffix}"
+        write(by_hand, anim.with_frames(anim.frames[k], time_codes=anim.time_codes[k]))
+        size, full = by_hand.stat().st_size, src.stat().st_size
+        assert out["storage"] == {
+            "format": src.suffix,
+            "keys_only_bytes": size,
+            "input_bytes": full,
+            "ratio": size / full,
+        }
+        assert 0 < out["storage"]["ratio"] < 1 and list(scratch.iterdir()) == []
+        run_json(capsys, src, "--keys", 5, "--out", tmp_path / "without.json")
+        assert (tmp_path / "with.json").read_text() == (tmp_path / "without.json").read_text()
+    assert main(["keys", str(src), "--keys", "5", "--storage"]) == 0
+    assert f"keys only: {size} bytes as .usdc, " in capsys.readouterr().out
+    assert run_json(capsys, d / "x.npz", "--keys", 5, "--storage")["storage"] is None  # raw features
+
+
 def test_the_keys_record_keeps_the_sources_time_codes(tmp_path):
     from hairtool.bench import SHARED_DATA
 
