@@ -30,6 +30,13 @@ QUIET_WORKERS = {
 }
 
 
+#: Distributed's own log lines on a local cluster that pass, in this process (its scheduler and
+#: nannies) and in the workers: CRITICAL only. A killed worker makes it log ERROR tracebacks (a
+#: result it held lost, its replacement's heartbeat to a cluster closing) that the batch recovers
+#: from; what does fail reaches the user as one line per job (:mod:`hairtool.farm.batch`).
+LOCAL_LOG_LEVEL = logging.CRITICAL
+
+
 def require_dask() -> ModuleType:
     """``distributed``, or a :class:`HairtoolError` naming the missing extra."""
     try:
@@ -82,7 +89,7 @@ def open_client(scheduler: str | None = None, workers: int | None = None) -> Ite
             processes=True,
             host="127.0.0.1",
             dashboard_address="127.0.0.1:0",  # its status pages: loopback, any free port
-            silence_logs=logging.ERROR,
+            silence_logs=LOCAL_LOG_LEVEL,
         )
     try:
         client = distributed.Client(cluster)

@@ -186,3 +186,36 @@ def test_local_workers_keep_their_housekeeping_off_the_jobs():
         seen = client.run(lambda: {k: dask.config.get(k) for k in QUIET_WORKERS})
     assert list(seen.values()) == [QUIET_WORKERS]
     assert QUIET_WORKERS["distributed.worker.profile.enabled"] is False
+
+
+def _log_as_distributed(level: int, message: str) -> None:
+    import logging
+
+    logging.getLogger("distributed.worker").log(level, message)
+
+
+def test_a_local_cluster_lets_only_critical_log_lines_of_distributed_through(capfd):
+    """A worker killed mid-batch makes distributed log ERROR tracebacks the batch recovers from (a
+    result lost with the worker, in the scheduler; its replacement's heartbeat to a cluster
+    closing, in a worker): neither reaches stderr, while a CRITICAL line still would."""
+    import io
+    import logging
+
+    from hairtool.farm.cluster import open_client
+
+    capfd.readouterr()
+    here = io.StringIO()  # this process's stderr, as distributed's own handler writes to it
+    handler = logging.StreamHandler(here)
+    handler.setLevel(logging.WARNING)
+    logging.getLogger("distributed").addHandler(handler)
+    try:
+        with open_client(None, 1) as client:
+            client.run(_log_as_distributed, logging.ERROR, "worker error line")
+            logging.getLogger("distributed.scheduler").error("scheduler error line")
+            client.run(_log_as_distributed, logging.CRITICAL, "worker critical line")
+            logging.getLogger("distributed.scheduler").critical("scheduler critical line")
+    finally:
+        logging.getLogger("distributed").removeHandler(handler)
+    err = capfd.readouterr().err  # the worker processes write to the file descriptor
+    assert "worker critical line" in err and "error line" not in err
+    assert here.getvalue() == "scheduler critical line\n"
