@@ -219,3 +219,20 @@ def test_a_local_cluster_lets_only_critical_log_lines_of_distributed_through(cap
     err = capfd.readouterr().err  # the worker processes write to the file descriptor
     assert "worker critical line" in err and "error line" not in err
     assert here.getvalue() == "scheduler critical line\n"
+
+
+def test_the_default_local_cluster_has_one_single_threaded_worker_per_core(project, capsys, monkeypatch):
+    from hairtool.farm import cluster
+
+    usable = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else range(os.cpu_count() or 1)
+    assert cluster.cores() == len(usable)
+    assert cluster.local_workers(None) == cluster.cores()
+    # A core count unlike this machine's, so what starts is ours and not Dask's own default.
+    n = 1 if cluster.cores() != 1 else 2
+    monkeypatch.setattr(cluster, "cores", lambda: n)
+    with cluster.open_client() as client:
+        assert list(client.nthreads().values()) == [1] * n
+    jobs = project / "jobs.json"
+    jobs.write_text(json.dumps({"jobs": [{"command": "convert", "args": ["grooms/scalp.npz", "out/s.obj"]}]}))
+    rc, summary = batch(capsys, str(jobs))
+    assert rc == 0 and summary["done"] == 1 and summary["workers"] == n
