@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import zipfile
@@ -55,6 +56,25 @@ def test_the_library_installs_without_the_studio(wheel):
     studio = {name(r) for r in requires if 'extra == "studio"' in r}
     assert base == {"numpy", "numba", "usd-core"}
     assert studio == STUDIO_ONLY
+
+
+def test_the_farm_extra_is_dask_distributed_and_the_test_command_installs_it(wheel):
+    """``pip install "hairtool[farm]"`` gives ``hairtool batch`` its Dask; the README's test command
+    (``./dev test``, which CI runs) installs that extra, so the batch tests run instead of skipping."""
+    (meta,) = [n for n in wheel.namelist() if n.endswith(".dist-info/METADATA")]
+    requires = Parser().parsestr(wheel.read(meta).decode()).get_all("Requires-Dist")
+    farm = {re.split(r"[<>=;\s]", r, maxsplit=1)[0] for r in requires if 'extra == "farm"' in r}
+    assert farm == {"dask[distributed]"}
+
+    readme = (ROOT / "README.md").read_text()
+    assert re.search(r"^\./dev test\b", readme, re.M), "the README's test command is ./dev test"
+    dev = (ROOT / "dev").read_text()
+    case = re.search(r"^\s*test\)\n(.*?);;", dev, re.M | re.S)
+    assert case, "./dev has a test) case"
+    setup = re.search(r"^\s*setup ([\w,]+)\s*$", case.group(1), re.M)
+    assert setup and {"test", "farm"} <= set(setup.group(1).split(","))
+    assert re.search(r'pip install [^\n]*-e "\.\[\$extras\]"', dev), "setup installs the extras it is given"
+    assert "./dev test" in (ROOT / ".ci" / "run").read_text()
 
 
 def test_shaders_are_package_data():
