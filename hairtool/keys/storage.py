@@ -1,8 +1,9 @@
 """What keying saves on disk: the bytes of the key poses alone, in the source's own format.
 
-A real file is written and measured, not estimated: the key poses (:func:`~hairtool.keys.
-export.key_poses_only`, what ``--export KEYS.usdc`` writes) go in the input's format into a
-fresh folder of the system's temp dir, which is deleted at once, so nothing is left behind.
+A real file is written and measured, not estimated: the key poses
+(:func:`~hairtool.keys.export.key_poses_only`, what ``--export KEYS.usdc`` writes) go in the
+input's format into a fresh folder of the system's temp dir, deleted at once, so nothing is
+left behind.
 Compression (``.npz``, ``.usdc``) makes the ratio differ from keys / frames.
 """
 
