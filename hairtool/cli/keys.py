@@ -151,14 +151,28 @@ def _mode(args: argparse.Namespace, session) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
-
-    from hairtool.errors import ParameterError
     from hairtool.keys.constraints import KeyConstraints
-    from hairtool.keys.features import FeatureOptions, frame_features, raw_features
-    from hairtool.keys.session import KNEE_KEYS, KeySettings, solve
 
     constraints = KeyConstraints.parse(args.pin, args.exclude)
+    bar = ProgressBar(enabled=None if not args.json else False)
+    try:
+        done = _keys(args, constraints, bar)
+    finally:
+        bar.close()  # before anything is printed
+    return done if isinstance(done, int) else _finish(args, *done)
+
+
+def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
+    """``run``'s work, moving the bar through reading and features, the cost table, the DP and
+    the errors, the table and the DP by their shares of the work: ``(kind, data, n, selection,
+    record)`` for :func:`_finish`, or the exit status of a per-channel run."""
+    from hairtool.errors import ParameterError
+    from hairtool.keys.features import FeatureOptions, frame_features, raw_features
+    from hairtool.keys.session import KNEE_KEYS, KeySettings, solve, work_estimate
+
+    bar(0.0, "reading")
     kind, data, fps = _load(args)
+    bar(0.05, "features")
     options = FeatureOptions(
         samples=None if args.no_resample else args.samples,
         center=not args.no_center,
@@ -191,6 +205,7 @@ def run(args: argparse.Namespace) -> int:
         result = {"frames": n, "fps": fps, **channels.to_dict()}
         if args.storage:
             result["storage"] = None  # no one set of key poses
+        bar.close()
         return _emit(args, result, f"{len(result['union'])} frames key at least one of {x.shape[1]} channels")
 
     objective = "worst" if args.max_error is not None else args.objective
@@ -200,21 +215,24 @@ def run(args: argparse.Namespace) -> int:
 
         if args.interp != "linear" or args.curvature or objective != "total":
             raise ParameterError("bvh-features", "quaternion", "the linear (slerp) total objective only")
+        bar(0.1, "cost table (quaternions)")
         table = rotation_cost_table(data)
     settings = KeySettings(objective=objective, interp=args.interp, curvature=args.curvature)
-    bar = ProgressBar(enabled=None if not args.json else False)
-    try:
-        bar(0.3, "cost table")
-        session = solve(x, settings, table=table, layers=False, constraints=constraints, kmax=KNEE_KEYS)
-        bar(0.7, "keys")
-        mode = _mode(args, session)
-        sel = session.select(curve_keys=args.curve_keys, **mode)
-        bar(0.85, "errors")
-        result = _report(args, kind, data, n, fps, sel, options, session)
-        bar(1.0, "done")
-    finally:
-        bar.close()
-    return _finish(args, kind, data, n, sel, result)
+    # The table then the DP share the bar up to the errors, in proportion to their work.
+    table_share, dp_share = work_estimate(x.shape, settings, max(args.curve_keys, args.keys or 0, KNEE_KEYS))
+    if table is not None:
+        table_share = 0.0  # already made
+    split = 0.1 + 0.75 * table_share / max(table_share + dp_share, 1.0)
+    bar(0.1, "cost table")
+    session = solve(x, settings, table=table, layers=False, constraints=constraints, kmax=KNEE_KEYS)
+    bar(split, "keys")
+    mode = _mode(args, session)
+    on_dp = lambda f: bar(split + (0.85 - split) * f, "keys")  # noqa: E731
+    sel = session.select(curve_keys=args.curve_keys, **mode, progress=on_dp)
+    bar(0.85, "errors")
+    result = _report(args, kind, data, n, fps, sel, options, session)
+    bar(1.0, "done")
+    return kind, data, n, sel, result
 
 
 def _report(args: argparse.Namespace, kind: str, data, n: int, fps: float, sel, options, session) -> dict:

@@ -14,6 +14,7 @@ Ties go to the smallest i, so the numba kernels and their numpy twins return the
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -39,6 +40,32 @@ _LAYER_BLOCK = 16
 # instead of once per layer (the table is larger than L2 from n ≈ 600). Serial: a parallel
 # loop over j must synchronise per layer and lost 3x on the shared 2 cores.
 @njit(cache=True, nogil=True, fastmath={"nnan", "nsz", "reassoc"})
+def _layer_block(ct, e, back, k0, k1, use_max):  # pragma: no cover - compiled
+    """Layers K = k0 … k1 − 1 of E and back (rows of ``e``, ``back``), layers below k0 done."""
+    n = ct.shape[0]
+    for j in range(k0 - 1, n):
+        row = ct[j]
+        for kk in range(k0, min(k1, j + 2)):  # layer kk reaches frame j when j >= kk − 1
+            prev = e[kk - 1]
+            best = np.inf
+            if use_max:
+                for i in range(kk - 2, j):
+                    best = min(best, max(prev[i], row[i]))
+                for i in range(kk - 2, j):
+                    if max(prev[i], row[i]) == best:
+                        back[kk, j] = i
+                        break
+            else:
+                for i in range(kk - 2, j):
+                    best = min(best, prev[i] + row[i])
+                for i in range(kk - 2, j):  # the first i that reaches the minimum
+                    if prev[i] + row[i] == best:
+                        back[kk, j] = i
+                        break
+            e[kk, j] = best
+
+
+@njit(cache=True, nogil=True)
 def _layers_kernel(ct, kmax, use_max, stop):  # pragma: no cover - compiled
     """E[K, j], back[K, j] for K = 1..kmax from the transposed table ct[j, i] = C[i, j].
 
@@ -50,29 +77,27 @@ def _layers_kernel(ct, kmax, use_max, stop):  # pragma: no cover - compiled
     e[1, 0] = 0.0
     for k0 in range(2, kmax + 1, _LAYER_BLOCK):
         k1 = min(kmax + 1, k0 + _LAYER_BLOCK)
-        for j in range(k0 - 1, n):
-            row = ct[j]
-            for kk in range(k0, min(k1, j + 2)):  # layer kk reaches frame j when j >= kk − 1
-                prev = e[kk - 1]
-                best = np.inf
-                if use_max:
-                    for i in range(kk - 2, j):
-                        best = min(best, max(prev[i], row[i]))
-                    for i in range(kk - 2, j):
-                        if max(prev[i], row[i]) == best:
-                            back[kk, j] = i
-                            break
-                else:
-                    for i in range(kk - 2, j):
-                        best = min(best, prev[i] + row[i])
-                    for i in range(kk - 2, j):  # the first i that reaches the minimum
-                        if prev[i] + row[i] == best:
-                            back[kk, j] = i
-                            break
-                e[kk, j] = best
+        _layer_block(ct, e, back, k0, k1, use_max)
         for kk in range(k0, k1):
             if e[kk, n - 1] <= stop:
                 return e, back, kk
+    return e, back, kmax
+
+
+def _layers_in_blocks(ct: F64, kmax: int, use_max: bool, stop: float, progress: Callable[[float], None]):
+    """:func:`_layers_kernel`, one block of layers per call, saying after each what share of
+    the DP is done (every layer costs about the same)."""
+    n = ct.shape[0]
+    e = np.full((kmax + 1, n), np.inf)
+    back = np.full((kmax + 1, n), -1, dtype=np.int64)
+    e[1, 0] = 0.0
+    for k0 in range(2, kmax + 1, _LAYER_BLOCK):
+        k1 = min(kmax + 1, k0 + _LAYER_BLOCK)
+        _layer_block(ct, e, back, k0, k1, use_max)
+        for kk in range(k0, k1):
+            if e[kk, n - 1] <= stop:
+                return e, back, kk
+        progress((k1 - 2) / max(kmax - 1, 1))
     return e, back, kmax
 
 
@@ -220,21 +245,26 @@ def solve_layers(
     stop: float = -np.inf,
     use_numba: bool = True,
     constraints: KeyConstraints | None = None,
+    progress: Callable[[float], None] | None = None,
 ):
     """Layered DP: ``(E (kmax+1, n), back, last K computed)``; E[K, n−1] is the curve (+inf for
-    a count no key set under the constraints reaches)."""
+    a count no key set under the constraints reaches). ``progress(share)`` after each block of
+    layers, for a long animation's progress bar."""
     c = check_table(table)
     if constraints:
         c = constraints.apply(c)
-    return _layers(c, kmax, objective, stop, use_numba)
+    return _layers(c, kmax, objective, stop, use_numba, progress)
 
 
-def _layers(c: F64, kmax: int, objective: str, stop: float, use_numba: bool):
+def _layers(c: F64, kmax: int, objective: str, stop: float, use_numba: bool, progress=None):
     kmax = int(min(kmax, c.shape[0]))
     use_max = objective == "worst"
-    if use_numba:
-        return _layers_kernel(np.ascontiguousarray(c.T), kmax, use_max, float(stop))
-    return layers_reference(c, kmax, use_max, float(stop))
+    if not use_numba:
+        return layers_reference(c, kmax, use_max, float(stop))
+    ct = np.ascontiguousarray(c.T)
+    if progress is None:
+        return _layers_kernel(ct, kmax, use_max, float(stop))
+    return _layers_in_blocks(ct, kmax, use_max, float(stop), progress)
 
 
 def select_keys(
@@ -248,6 +278,7 @@ def select_keys(
     curve_keys: int = DEFAULT_CURVE_KEYS,
     constraints: KeyConstraints | None = None,
     use_numba: bool = True,
+    progress: Callable[[float], None] | None = None,
 ) -> Selection:
     """Exact keys for one of: ``keys`` = K, ``penalty`` = tau per key, ``budget`` on the total
     error (fewest keys), ``max_error`` on the worst frame (fewest keys). ``max_error`` implies
@@ -255,7 +286,8 @@ def select_keys(
     ``cost_table(..., objective="worst")`` builds it); the others sum the table's entries.
     ``curve_keys``: the curve covers K = 2..min(n, curve_keys) (and at least the chosen K), the
     counts no key set under the constraints reaches left out. ``constraints``: pinned frames are
-    keys and excluded frames are not, in an exact optimum (:mod:`hairtool.keys.constraints`)."""
+    keys and excluded frames are not, in an exact optimum (:mod:`hairtool.keys.constraints`).
+    ``progress(share)`` after each block of the DP's layers."""
     c = check_table(table)
     n = c.shape[0]
     cons = (constraints or KeyConstraints()).check(n)
@@ -301,7 +333,7 @@ def select_keys(
             kmax = max(kmax, chosen.size)
     stop = value if mode in ("budget", "max_error") else -np.inf
     layers = n if mode in ("budget", "max_error") else kmax
-    e, back, last = _layers(dp_table, layers, objective, stop, use_numba)
+    e, back, last = _layers(dp_table, layers, objective, stop, use_numba, progress)
     if mode in ("budget", "max_error"):
         if e[last, n - 1] > value:  # only under constraints: unconstrained, n keys cost 0
             best = float(np.min(e[1:, n - 1]))

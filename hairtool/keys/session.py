@@ -174,11 +174,12 @@ class KeySession:
         lo, hi = self.constraints.key_range(self.n_frames)
         return lo, min(hi, self.kmax)
 
-    def layers(self) -> KeySession:
-        """Solve the DP for every K up to ``kmax`` (once; later calls return at once)."""
+    def layers(self, progress: Callable[[float], None] | None = None) -> KeySession:
+        """Solve the DP for every K up to ``kmax`` (once; later calls return at once);
+        ``progress(share)`` as it goes."""
         if self.energy is None:
             self.energy, self.back, _ = solve_layers(
-                self.table, self.kmax, self.objective, constraints=self.constraints
+                self.table, self.kmax, self.objective, constraints=self.constraints, progress=progress
             )
         return self
 
@@ -283,6 +284,7 @@ class KeySession:
         budget: float | None = None,
         max_error: float | None = None,
         curve_keys: int = DEFAULT_CURVE_KEYS,
+        progress: Callable[[float], None] | None = None,
     ) -> Selection:
         """Exactly one of ``keys``, ``penalty``, ``budget``, ``max_error`` (see
         :func:`hairtool.keys.dp.select_keys`), with uniform keys of the same count and the
@@ -296,6 +298,7 @@ class KeySession:
             objective=self.objective,
             curve_keys=curve_keys,
             constraints=self.constraints,
+            progress=progress,
         )
         sel.params.update(interp=self.interp, curvature=self.curvature)
         return sel
@@ -323,6 +326,24 @@ def knee_count(curve: ArrayLike) -> int:
     return int(k[best]) if gain[best] > 1e-9 else int(k[0])  # a straight line has no knee
 
 
+#: The progress bar's share for the features (resampling, root removal): quick next to the rest.
+FEATURES_SHARE = 0.1
+
+
+def work_estimate(shape: tuple[int, int], settings: KeySettings, kmax: int) -> tuple[float, float]:
+    """Rough operation counts of the cost table and the all-K DP for ``(n, D)`` features, so
+    that the progress bar moves in proportion to the time: the Gram product n²D/2 (the worst
+    frame: plus n³/6 segment scans; fitted handles: a running solve per segment, n²D), the DP
+    about K·n²/2."""
+    n, d = shape
+    table = n * n * d / 2.0
+    if settings.objective == "worst":
+        table += n**3 / 6.0
+    if settings.interp == "hermite-fit":
+        table += n * n * d
+    return table, min(kmax, n) * n * n / 2.0
+
+
 def solve(
     source: Animation | ArrayLike,
     settings: KeySettings,
@@ -345,12 +366,15 @@ def solve(
     settings.validate()
     progress = progress or (lambda *a, **k: None)
     cancelled = cancelled or (lambda: False)
+    dp_from = 0.0  # the share of the work done when the DP starts
     if table is None:
         progress(0.0, "features")
         x = frame_features(source, features or settings.feature_options())
         if cancelled():
             return None
-        progress(0.3, "cost table")
+        work = work_estimate(x.shape, settings, kmax if layers else 0)
+        dp_from = FEATURES_SHARE + (1.0 - FEATURES_SHARE) * work[0] / max(sum(work), 1.0)
+        progress(FEATURES_SHARE, "cost table")
         table = cost_table(x, settings.interp, settings.curvature, settings.objective)
         del x
         if cancelled():
@@ -365,8 +389,8 @@ def solve(
         constraints=constraints if constraints is not None else settings.constraints,
     )
     if layers:
-        progress(0.9, "dynamic programming")
-        session.layers()
+        progress(dp_from, "dynamic programming")
+        session.layers(lambda share: progress(dp_from + (1.0 - dp_from) * share, "dynamic programming"))
         _ = session.knee  # the default count, here in the background (under pins, one more solve)
     progress(1.0, "")
     return session

@@ -278,6 +278,30 @@ def test_a_progress_bar_on_a_terminal_only(files, capsys):
     assert capsys.readouterr().err == ""  # piped stderr stays clean
 
 
+def test_the_bar_moves_through_the_dp_and_is_gone_before_the_result(files, capsys, monkeypatch):
+    import hairtool.cli.keys as keys_cli
+    from hairtool.cli._progress import ProgressBar
+
+    seen = []
+
+    class Recording(ProgressBar):
+        def __init__(self, enabled=None, stream=None):
+            super().__init__(enabled=enabled is None, stream=stream)
+
+        def __call__(self, fraction=None, stage=""):
+            seen.append((fraction, stage))
+            super().__call__(fraction, stage)
+
+    monkeypatch.setattr(keys_cli, "ProgressBar", Recording)
+    d, _ = files
+    assert main(["keys", str(d / "anim.npz"), "--keys", "5", "--curve-keys", "60"]) == 0
+    fractions = [f for f, _ in seen]
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+    assert sum(stage == "keys" for _, stage in seen) >= 4  # the DP's blocks of layers
+    err = capsys.readouterr().err
+    assert err.endswith("\r") and "5 keys" not in err  # cleared; the result went to stdout
+
+
 def test_storage_is_the_bytes_of_the_key_poses_in_the_inputs_own_format(files, tmp_path, capsys, monkeypatch):
     """Measured on a real file in the system's temp dir, deleted after; the --out record is the
     same with or without it."""

@@ -196,3 +196,31 @@ def test_bounds_that_need_more_keys_than_one_layer_block(objective):
         twin = select_keys(table, objective=objective, use_numba=False, **mode)
         assert sel.n_keys == fewest and sel.keys.tolist() == twin.keys.tolist()
         assert sel.curve.shape[0] >= 99 - 10 and sel.cost <= bound
+
+
+def test_the_dp_in_blocks_reports_progress_and_gives_the_same_bits():
+    """A long animation's progress bar moves through the DP's blocks of layers; the numbers are
+    the single kernel's, stop included."""
+    from hairtool.keys.dp import solve_layers
+
+    table = cost_table(walk(90, 5, seed=4))
+    for objective, stop in (("total", -np.inf), ("worst", -np.inf), ("total", 1.0)):
+        shares = []
+        a = solve_layers(table, 60, objective, stop=stop)
+        b = solve_layers(table, 60, objective, stop=stop, progress=shares.append)
+        for u, v in zip(a, b, strict=True):
+            np.testing.assert_array_equal(u, v)
+        if stop == -np.inf:
+            assert len(shares) == 4 and shares == sorted(shares) and shares[-1] == 1.0
+
+
+def test_a_solve_reports_progress_in_proportion_to_the_work():
+    from hairtool.keys.session import KeySettings, solve
+
+    seen = []
+    session = solve(walk(300, 12), KeySettings(count=8), lambda f, stage="": seen.append((f, stage)))
+    fractions = [f for f, _ in seen]
+    assert fractions == sorted(fractions) and fractions[0] == 0.0 and fractions[-1] == 1.0
+    dp = [f for f, stage in seen if stage == "dynamic programming"]
+    assert len(dp) >= 7 and dp[0] < 0.9  # every block of layers, the DP being most of the work
+    assert session.keys_for_count(8).size == 8
