@@ -193,7 +193,7 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
 # The child definition's arrays: (name, per vertex or per child, trailing shape, kinds, required).
 _CHILD_ARRAYS = (
     ("counts", "child", (), "iu", True),
-    ("roots", "child", (3,), "f", True),
+    ("roots", "child", (3,), "f", False),  # (a dense groom's: its strands' first points)
     ("guide_ids", "child", (-1,), "iu", True),
     ("weights", "child", (-1,), "f", True),
     ("scale", "child", (), "f", True),
@@ -217,18 +217,26 @@ def _children_arrays(project: Project, arrays: dict[str, np.ndarray]) -> dict | 
     stored = []
     derived = ()  # arrays that follow from the others, made again on loading:
     if b.exact_points is not None:
-        derived = ("local", "exact_blend")  # a dense groom's offsets, from its points
+        derived = ("roots", "local", "exact_blend")  # a dense groom's, from its points
     elif b.frizz_phase is not None:
         derived = ("local",)  # the frizz, from a few numbers per child
     for name, *_ in _CHILD_ARRAYS:
         value = getattr(b, name)
         if value is not None and name not in derived:
+            if name in ("counts", "guide_ids", "faces"):
+                value = _narrow(value)
             arrays[f"children/{name}.npy"] = np.ascontiguousarray(value)
             stored.append(name)
     info: dict[str, Any] = {"count": b.child_count, "arrays": stored}
     if b.frizz_phase is not None:
         info["frizz"] = b.frizz
     return info
+
+
+def _narrow(a: np.ndarray) -> np.ndarray:
+    """Whole numbers ≥ 0 in the smallest unsigned type that holds them (read back as int64)."""
+    top = int(a.max(initial=0))
+    return a.astype(np.uint16 if top < 2**16 else np.uint32 if top < 2**32 else np.uint64)
 
 
 def save(path: str | os.PathLike[str], project: Project, *, compress: bool = False) -> None:
@@ -510,6 +518,11 @@ def _read_children(r: _Reader, info: Any, rest: Groom) -> ChildBinding | None:
     if ids.size and (ids.min() < 0 or ids.max() >= rest.strand_count):
         raise FormatError(r.path, f"a child names a guide outside [0, {rest.strand_count})")
     faces = values["faces"]
+    if values["roots"] is None:
+        if values["exact_points"] is None:
+            raise FormatError(r.path, "missing member 'children/roots.npy'")
+        starts = np.concatenate([[0], np.cumsum(values["counts"])[:-1]])
+        values["roots"] = values["exact_points"][starts]  # a dense groom's strands start at its roots
     b = ChildBinding(
         rest,
         values["counts"],

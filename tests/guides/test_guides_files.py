@@ -103,7 +103,9 @@ def test_a_project_stores_the_child_definition_exactly(tmp_path, dense):
     # Per-vertex offsets are made again on loading: a dense groom's from its points (stored
     # once), the frizz from its amplitude and each child's phase and turns.
     assert "children/local.npy" not in names and "children/exact_blend.npy" not in names
-    assert ("children/frizz_phase.npy" in names) != dense
+    assert ("children/frizz_phase.npy" in names) != dense and ("children/roots.npy" in names) != dense
+    with zipfile.ZipFile(path) as zf, zf.open("children/guide_ids.npy") as f:
+        assert np.lib.format.read_array(f).dtype == np.uint16  # indices in the smallest type
     assert project.load(path).rest.strand_count == guides.strand_count
 
 
@@ -112,12 +114,18 @@ def _drop_turns(manifest: dict, arrays: dict) -> None:
     del arrays["children/frizz_turns.npy"]
 
 
+def _drop_roots(manifest: dict, arrays: dict) -> None:  # only a dense groom's follow from its points
+    manifest["children"]["arrays"].remove("roots")
+    del arrays["children/roots.npy"]
+
+
 @pytest.mark.parametrize(
     ("change", "match"),
     [
         (lambda m, a: m["children"].update(frizz=7.0), "frizz"),
         (lambda m, a: m["children"].update(frizz="curly"), "frizz"),
         (_drop_turns, "turns"),
+        (_drop_roots, "roots"),
     ],
 )
 def test_a_bad_frizz_recipe_is_one_format_error(tmp_path, change, match):
