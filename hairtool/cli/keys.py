@@ -215,15 +215,16 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
 
         if args.interp != "linear" or args.curvature or objective != "total":
             raise ParameterError("bvh-features", "quaternion", "the linear (slerp) total objective only")
-        bar(0.1, "cost table (quaternions)")
-        table = rotation_cost_table(data)
+        bar(0.1, "cost table (quaternions)")  # the longest step: O(F³·J)
+        table = rotation_cost_table(data, progress=lambda f: bar(0.1 + 0.7 * f, "cost table (quaternions)"))
     settings = KeySettings(objective=objective, interp=args.interp, curvature=args.curvature)
     # The table then the DP share the bar up to the errors, in proportion to their work.
     table_share, dp_share = work_estimate(x.shape, settings, max(args.curve_keys, args.keys or 0, KNEE_KEYS))
+    start = 0.1 if table is None else 0.8  # a quaternion table is made already
     if table is not None:
-        table_share = 0.0  # already made
-    split = 0.1 + 0.75 * table_share / max(table_share + dp_share, 1.0)
-    bar(0.1, "cost table")
+        table_share = 0.0
+    split = start + (0.85 - start) * table_share / max(table_share + dp_share, 1.0)
+    bar(start, "cost table")
     session = solve(x, settings, table=table, layers=False, constraints=constraints, kmax=KNEE_KEYS)
     bar(split, "keys")
     mode = _mode(args, session)

@@ -9,6 +9,7 @@ error of interpolating the frames between keys i and j: :func:`rotation_cost_tab
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 
 import numpy as np
 from numba import get_num_threads, njit, prange
@@ -113,6 +114,7 @@ def rotation_cost_table(
     interp: str = "slerp",
     translation_weight: float | None = None,
     max_span: int | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> F64:
     """``(F, F)`` float64 cost of keying frames i and j and interpolating the frames between.
 
@@ -125,7 +127,9 @@ def rotation_cost_table(
     pairs by default: O(F³·J) work, a DP over keys at most ``max_span`` apart needs O(F·span²·J)).
     Only "slerp" interpolation is offered. The kernel equals its numpy twin
     :func:`rotation_cost_table_reference` to float64 rounding: its arccos² is one of three
-    polynomials exact to a few units in the last place (:func:`acos2_reference`).
+    polynomials exact to a few units in the last place (:func:`acos2_reference`). With
+    ``progress``, the table is made in :data:`PROGRESS_STEPS` row ranges of equal work, saying
+    after each what share is done (the same numbers).
     """
     if interp != "slerp":
         raise ParameterError("interp", interp, "'slerp'")
@@ -136,7 +140,15 @@ def rotation_cost_table(
         raise ParameterError("max_span", max_span, "a whole number of frames ≥ 1")
     q, p, w, wt = _cost_inputs(motion, weights, translation_weight)
     q = np.ascontiguousarray(q.transpose(1, 0, 2))
-    cost = _cost_table_kernel(q, p, w, wt, int(min(max_span, n)), max(1, min(n, get_num_threads())))
+    span, hands = int(min(max_span, n)), max(1, min(n, get_num_threads()))
+    cost = np.zeros((n, n))
+    if progress is None:
+        _cost_table_kernel(q, p, w, wt, span, hands, cost, 0, n)
+    else:
+        ranges = _row_ranges(n, span, PROGRESS_STEPS)
+        for step, (lo, hi) in enumerate(ranges):
+            _cost_table_kernel(q, p, w, wt, span, hands, cost, lo, hi)
+            progress((step + 1) / len(ranges))
     return cost + cost.T
 
 
@@ -244,20 +256,31 @@ def acos2_reference(u: ArrayLike) -> F64:
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _cost_table_kernel(q, p, w, wt, max_span, n_hands):
-    """Upper triangle of the cost table from q ``(J, F, 4)``; pairs farther apart than ``max_span`` get
-    +inf. Each row i is computed by one thread, so the result does not depend on the thread count."""
+def _cost_table_kernel(q, p, w, wt, max_span, n_hands, cost, row_lo, row_hi):
+    """Rows ``row_lo … row_hi − 1`` of the upper triangle of the cost table (into ``cost``, zeros)
+    from q ``(J, F, 4)``; pairs farther apart than ``max_span`` get +inf. Each row i is computed
+    by one thread, so the result depends neither on the thread count nor on the row ranges."""
     n = q.shape[1]
-    cost = np.zeros((n, n))
     # Row i costs ~(n − i)²: deal rows like cards (i ≡ c mod n_hands), one hand per thread, so
     # every thread gets the same work to within one row.
     for c in prange(n_hands):
-        for i in range(c, n, n_hands):
+        for i in range(row_lo + c, row_hi, n_hands):
             j_end = min(n, i + max_span + 1)
             _cost_row(q, p, w, wt, i, j_end, cost[i])
             for j in range(j_end, n):
                 cost[i, j] = np.inf
-    return cost
+
+
+#: Row ranges of about equal work a table is made in when a progress bar follows it.
+PROGRESS_STEPS = 20
+
+
+def _row_ranges(n: int, span: int, steps: int) -> list[tuple[int, int]]:
+    """``steps`` consecutive row ranges of about equal work (row i costs ~min(n − i, span)²)."""
+    work = np.cumsum(np.minimum(n - np.arange(n), span).astype(np.float64) ** 2)
+    cuts = np.searchsorted(work, work[-1] * np.arange(1, steps) / steps)
+    edges = np.unique(np.concatenate([[0], cuts, [n]]))
+    return list(zip(edges[:-1].tolist(), edges[1:].tolist(), strict=True))
 
 
 #: Segment ends l = j − i handled together: the eleven arrays a block's passes touch (acc, ca, sa,

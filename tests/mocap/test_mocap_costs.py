@@ -118,6 +118,16 @@ def test_max_span_marks_far_pairs_infinite(walk):
     np.testing.assert_allclose(fast[~far], rotation_cost_table(walk)[~far], rtol=1e-12, atol=1e-15)
 
 
+@pytest.mark.parametrize("max_span", [None, 9])
+def test_a_table_made_in_row_ranges_for_a_progress_bar_is_the_same(motion_dir, max_span):
+    m = read_bvh(motion_dir / "pymo_walk.bvh")
+    m = m.with_values(m.values[:300])
+    shares = []
+    made = rotation_cost_table(m, max_span=max_span, progress=shares.append)
+    assert made.tobytes() == rotation_cost_table(m, max_span=max_span).tobytes()
+    assert len(shares) >= 15 and shares == sorted(shares) and shares[-1] == 1.0
+
+
 def test_table_is_symmetric_with_free_neighbours(walk):
     c = rotation_cost_table(walk)
     np.testing.assert_array_equal(c, c.T)
