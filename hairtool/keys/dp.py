@@ -65,12 +65,13 @@ def _layer_block(ct, e, back, k0, k1, use_max):  # pragma: no cover - compiled
             e[kk, j] = best
 
 
-@njit(cache=True, nogil=True)
-def _layers_kernel(ct, kmax, use_max, stop):  # pragma: no cover - compiled
-    """E[K, j], back[K, j] for K = 1..kmax from the transposed table ct[j, i] = C[i, j].
-
-    Stops after the block holding the first K with E[K, n−1] <= stop; returns that K (or kmax).
-    """
+def _layers_in_blocks(
+    ct: F64, kmax: int, use_max: bool, stop: float, progress: Callable[[float], None] | None = None
+):
+    """E[K, j], back[K, j] for K = 1..kmax from the transposed table ct[j, i] = C[i, j], one
+    :func:`_layer_block` per call, saying after each what share of the DP is done (every layer
+    costs about the same). Stops after the block holding the first K with E[K, n−1] <= stop;
+    returns that K (or kmax) too."""
     n = ct.shape[0]
     e = np.full((kmax + 1, n), np.inf)
     back = np.full((kmax + 1, n), -1, dtype=np.int64)
@@ -81,23 +82,8 @@ def _layers_kernel(ct, kmax, use_max, stop):  # pragma: no cover - compiled
         for kk in range(k0, k1):
             if e[kk, n - 1] <= stop:
                 return e, back, kk
-    return e, back, kmax
-
-
-def _layers_in_blocks(ct: F64, kmax: int, use_max: bool, stop: float, progress: Callable[[float], None]):
-    """:func:`_layers_kernel`, one block of layers per call, saying after each what share of
-    the DP is done (every layer costs about the same)."""
-    n = ct.shape[0]
-    e = np.full((kmax + 1, n), np.inf)
-    back = np.full((kmax + 1, n), -1, dtype=np.int64)
-    e[1, 0] = 0.0
-    for k0 in range(2, kmax + 1, _LAYER_BLOCK):
-        k1 = min(kmax + 1, k0 + _LAYER_BLOCK)
-        _layer_block(ct, e, back, k0, k1, use_max)
-        for kk in range(k0, k1):
-            if e[kk, n - 1] <= stop:
-                return e, back, kk
-        progress((k1 - 2) / max(kmax - 1, 1))
+        if progress is not None:
+            progress((k1 - 2) / max(kmax - 1, 1))
     return e, back, kmax
 
 
@@ -261,10 +247,7 @@ def _layers(c: F64, kmax: int, objective: str, stop: float, use_numba: bool, pro
     use_max = objective == "worst"
     if not use_numba:
         return layers_reference(c, kmax, use_max, float(stop))
-    ct = np.ascontiguousarray(c.T)
-    if progress is None:
-        return _layers_kernel(ct, kmax, use_max, float(stop))
-    return _layers_in_blocks(ct, kmax, use_max, float(stop), progress)
+    return _layers_in_blocks(np.ascontiguousarray(c.T), kmax, use_max, float(stop), progress)
 
 
 def select_keys(

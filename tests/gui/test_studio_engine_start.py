@@ -134,7 +134,7 @@ def test_the_warm_up_runs_its_steps_and_records_the_kernels(tmp_path, monkeypatc
         "hairtool.guides.children:_children_kernel",
         "hairtool.guides.children:_moved_kernel",
         "app.render.hair_shading:_shade_kernel",
-        "hairtool.keys.dp:_layers_kernel",
+        "hairtool.keys.dp:_layer_block",
         "hairtool.keys.segment_fit:_fit_kernel",
         "hairtool.anime.pose:_pose_kernel",
         "hairtool.simulate.dynamics:_frame_kernel",

@@ -11,7 +11,7 @@ from hairtool.errors import ParameterError
 from hairtool.keys.channels import per_channel_keys
 from hairtool.keys.costs import cost_table
 from hairtool.keys.dp import (
-    _layers_kernel,
+    _layers_in_blocks,
     _penalty_kernel,
     brute_force_keys,
     keys_cost,
@@ -54,7 +54,7 @@ def test_kernels_and_numpy_twins_are_bit_identical():
         table = np.triu(rng.random((n, n)) ** 3, 1)
         table[0, n - 1] = table[0, n - 1]  # keep dtype float64
         for use_max in (False, True):
-            a = _layers_kernel(np.ascontiguousarray(table.T), n, use_max, -np.inf)
+            a = _layers_in_blocks(np.ascontiguousarray(table.T), n, use_max, -np.inf)
             b = layers_reference(table, n, use_max)
             for u, v in zip(a, b, strict=True):
                 np.testing.assert_array_equal(u, v)

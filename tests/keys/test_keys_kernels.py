@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from hairtool.keys.costs import cost_table
-from hairtool.keys.dp import _layers_kernel, _penalty_kernel
+from hairtool.keys.dp import _layer_block, _penalty_kernel
 from hairtool.keys.features import _resample_kernel
 from hairtool.keys.gram import centered_gram, frame_curvature
 from hairtool.keys.segment_hermite import _hermite_kernel, hermite_quad_weights
@@ -34,7 +34,12 @@ def test_python_bodies_match_the_compiled_kernels():
         np.testing.assert_allclose(slow, fast, rtol=1e-13, atol=1e-12)
     ct = np.ascontiguousarray(cost_table(x).T)
     for use_max in (False, True):
-        a, b = _layers_kernel.py_func(ct, 14, use_max, -np.inf), _layers_kernel(ct, 14, use_max, -np.inf)
+        a, b = [(np.full((15, 14), np.inf), np.full((15, 14), -1)) for _ in range(2)]
+        for e, _ in (a, b):
+            e[1, 0] = 0.0
+        for k0, k1 in ((2, 9), (9, 15)):  # the Python function and the compiled one, block by block
+            _layer_block.py_func(ct, *a, k0, k1, use_max)
+            _layer_block(ct, *b, k0, k1, use_max)
         np.testing.assert_array_equal(a[0], b[0])
         np.testing.assert_array_equal(a[1], b[1])
     np.testing.assert_array_equal(_penalty_kernel.py_func(ct, 1.0)[1], _penalty_kernel(ct, 1.0)[1])
