@@ -16,6 +16,15 @@ from hairtool.guides.files import GUIDES_PRIM, HAIR_PRIM, split_guides, tapered_
 from hairtool.metadata import CurvesPrim
 
 
+def _write_project(path, manifest: dict, arrays: dict) -> None:
+    """A project file written by hand, as a damaged or older one would be."""
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr("manifest.json", json.dumps(manifest))
+        for name, a in arrays.items():
+            with zf.open(name, "w") as f:
+                np.lib.format.write_array(f, np.ascontiguousarray(a), allow_pickle=False)
+
+
 @pytest.fixture(scope="module")
 def hair_and_guides():
     guides = samples.scalp(40, 10, seed=3)
@@ -135,11 +144,7 @@ def test_a_bad_frizz_recipe_is_one_format_error(tmp_path, change, match):
     change(manifest, arrays)
     manifest["arrays"] = sorted(arrays)
     path = tmp_path / "bad.hairproj"
-    with zipfile.ZipFile(path, "w") as zf:
-        zf.writestr("manifest.json", json.dumps(manifest))
-        for name, a in arrays.items():
-            with zf.open(name, "w") as f:
-                np.lib.format.write_array(f, np.ascontiguousarray(a), allow_pickle=False)
+    _write_project(path, manifest, arrays)
     with pytest.raises(FormatError, match=match):
         project.load(path)
 
@@ -152,11 +157,7 @@ def test_a_dense_project_stored_in_full_by_an_earlier_hairtool_still_loads(tmp_p
     manifest["children"]["arrays"] += ["local", "exact_blend"]
     manifest["arrays"] = sorted(arrays)
     path = tmp_path / "old.hairproj"
-    with zipfile.ZipFile(path, "w") as zf:
-        zf.writestr("manifest.json", json.dumps(manifest))
-        for name, a in arrays.items():
-            with zf.open(name, "w") as f:
-                np.lib.format.write_array(f, np.ascontiguousarray(a), allow_pickle=False)
+    _write_project(path, manifest, arrays)
     back = project.load(path).children
     np.testing.assert_array_equal(back.local, binding.local)
     np.testing.assert_array_equal(back.exact_blend, binding.exact_blend)
@@ -174,11 +175,7 @@ def test_children_naming_a_missing_guide_are_one_format_error(tmp_path):
     manifest, arrays = project.manifest_and_arrays(project.Project(rest=guides, children=binding))
     arrays["children/guide_ids.npy"] = arrays["children/guide_ids.npy"] + 20
     path = tmp_path / "bad.hairproj"
-    with zipfile.ZipFile(path, "w") as zf:
-        zf.writestr("manifest.json", json.dumps(manifest))
-        for name, a in arrays.items():
-            with zf.open(name, "w") as f:
-                np.lib.format.write_array(f, np.ascontiguousarray(a), allow_pickle=False)
+    _write_project(path, manifest, arrays)
     with pytest.raises(FormatError, match="guide outside"):
         project.load(path)
 
