@@ -26,18 +26,8 @@ from PySide6.QtWidgets import (
 )
 
 from hairtool.groom import Groom
-from hairtool.guides.binding import (
-    DEFAULT_FRIZZ,
-    DEFAULT_K,
-    DEFAULT_LENGTH_VARIATION,
-    MAX_CHILDREN,
-    MAX_FRIZZ,
-    MAX_LENGTH_VARIATION,
-    ChildBinding,
-    bind_dense,
-    bind_roots,
-    bind_scalp,
-)
+from hairtool.guides import limits
+from hairtool.guides.binding import ChildBinding, bind_dense, bind_roots, bind_scalp
 
 GROW, DENSE = "grow", "dense"
 NEAR_GUIDES = ""  # the region where hair grows: the faces near the guides' roots …
@@ -53,10 +43,10 @@ class GrowOptions:
 
     mode: str = GROW
     count: int = 20_000
-    guides_per_child: int = DEFAULT_K
+    guides_per_child: int = limits.DEFAULT_K
     seed: int = 0
-    length_variation: float = DEFAULT_LENGTH_VARIATION
-    frizz: float = DEFAULT_FRIZZ
+    length_variation: float = limits.DEFAULT_LENGTH_VARIATION
+    frizz: float = limits.DEFAULT_FRIZZ
     region: str = NEAR_GUIDES
     guides: int = 200
 
@@ -94,7 +84,7 @@ class GrowDialog(QDialog):
         )
         form.addRow("Render hair", self.mode)
         self.count = QSpinBox()
-        self.count.setRange(1, MAX_CHILDREN)
+        self.count.setRange(1, limits.MAX_CHILDREN)
         self.count.setGroupSeparatorShown(True)
         self.count.setToolTip("how many render strands to grow")
         form.addRow("Children", self.count)
@@ -107,12 +97,12 @@ class GrowDialog(QDialog):
         self.k.setToolTip("each render strand blends this many nearest guides (k)")
         form.addRow("Guides per strand", self.k)
         self.length = QDoubleSpinBox()
-        self.length.setRange(0.0, MAX_LENGTH_VARIATION)
+        self.length.setRange(0.0, limits.MAX_LENGTH_VARIATION)
         self.length.setSingleStep(0.05)
         self.length.setToolTip("children's lengths vary by up to this share of their guides'")
         form.addRow("Length variation", self.length)
         self.frizz = QDoubleSpinBox()
-        self.frizz.setRange(0.0, MAX_FRIZZ)
+        self.frizz.setRange(0.0, limits.MAX_FRIZZ)
         self.frizz.setDecimals(3)
         self.frizz.setSingleStep(0.005)
         self.frizz.setToolTip("curl radius at the tip, as a share of the child's length")
