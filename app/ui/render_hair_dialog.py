@@ -31,6 +31,7 @@ from hairtool.guides.binding import ChildBinding, bind_dense, bind_roots, bind_s
 
 GROW, DENSE = "grow", "dense"
 NEAR_GUIDES = ""  # the region where hair grows: the faces near the guides' roots …
+NEAR_MASKED = "@mask"  # … near the guides the mask brush painted …
 WHOLE_MESH = "*"  # … every face of the head mesh, or a face set's name
 
 
@@ -51,8 +52,11 @@ class GrowOptions:
     guides: int = 200
 
 
-def grow(options: GrowOptions, groom: Groom, mesh=None) -> tuple[Groom, ChildBinding]:
-    """``(guides, binding)`` for ``options`` on ``groom`` (and the head ``mesh``, if any)."""
+def grow(
+    options: GrowOptions, groom: Groom, mesh=None, painted: np.ndarray | None = None
+) -> tuple[Groom, ChildBinding]:
+    """``(guides, binding)`` for ``options`` on ``groom`` (and the head ``mesh``, if any;
+    ``painted``: the strands the mask brush painted, for :data:`NEAR_MASKED`)."""
     o = options
     k = o.guides_per_child
     if o.mode == DENSE:
@@ -62,13 +66,20 @@ def grow(options: GrowOptions, groom: Groom, mesh=None) -> tuple[Groom, ChildBin
         return groom, bind_roots(groom, count=o.count, **shape)
     if o.region == WHOLE_MESH:
         region = np.ones(len(mesh.faces), bool)
+    elif o.region == NEAR_MASKED:
+        from hairtool.guides.scatter import default_region
+
+        region = default_region(mesh, groom, near=painted if painted is not None else np.zeros(0, bool))
     else:
         region = o.region or None  # None: near the guides' roots
     return groom, bind_scalp(groom, mesh, o.count, region=region, **shape)
 
 
 class GrowDialog(QDialog):
-    def __init__(self, parent: QWidget | None, options: GrowOptions, groom: Groom, mesh=None) -> None:
+    def __init__(
+        self, parent: QWidget | None, options: GrowOptions, groom: Groom, mesh=None, painted: int = 0
+    ) -> None:
+        """``painted``: how many strands the mask brush painted (offered as a region if any)."""
         super().__init__(parent)
         self.setWindowTitle("Grow render hair")
         self._strands = groom.strand_count
@@ -113,10 +124,15 @@ class GrowDialog(QDialog):
             self.region.setEnabled(False)
         else:
             self.region.addItem("Near the guide roots", NEAR_GUIDES)
+            if painted:
+                self.region.addItem(f"Near the {painted:,} masked guides", NEAR_MASKED)
             self.region.addItem("The whole head mesh", WHOLE_MESH)
             for name in sorted(getattr(mesh, "groups", {})):
                 self.region.addItem(f"Face set: {name}", name)
-        self.region.setToolTip("where on the head the children take root")
+        self.region.setToolTip(
+            "where on the head the children take root; paint guides with the Mask brush to grow "
+            "hair only near them"
+        )
         form.addRow("Grows on", self.region)
         self.seed = QSpinBox()
         self.seed.setRange(0, 2**31 - 1)
@@ -171,7 +187,7 @@ class GrowDialog(QDialog):
 
 
 def ask_grow_options(
-    parent: QWidget | None, options: GrowOptions, groom: Groom, mesh=None
+    parent: QWidget | None, options: GrowOptions, groom: Groom, mesh=None, painted: int = 0
 ) -> GrowOptions | None:
-    dialog = GrowDialog(parent, options, groom, mesh)
+    dialog = GrowDialog(parent, options, groom, mesh, painted)
     return dialog.options() if dialog.exec() == QDialog.DialogCode.Accepted else None

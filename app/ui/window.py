@@ -587,7 +587,8 @@ class MainWindow(QMainWindow):
 
     def ask_grow_options(self, options: GrowOptions) -> GrowOptions | None:
         """The Grow render hair… dialog: GrowOptions or None (tests replace this)."""
-        return ask_grow_options(self, options, self.scene.rest, self.scene.mesh)
+        painted = int(self.scene.locked.sum())
+        return ask_grow_options(self, options, self.scene.rest, self.scene.mesh, painted)
 
     def grow_render_hair_dialog(self) -> Job | None:
         options = self.ask_grow_options(self.grow_options)
@@ -599,11 +600,11 @@ class MainWindow(QMainWindow):
         self.grow_options = options
         dense = options.mode == DENSE
         groom = self.scene.result if dense else self.scene.rest  # dense: the strands as edited
-        rest, mesh = self.scene.rest, self.scene.mesh
+        rest, mesh, painted = self.scene.rest, self.scene.mesh, self.scene.locked.copy()
 
         def work(progress, cancelled):
             progress(None, "binding the render hair to its guides")
-            return grow(options, groom, mesh)
+            return grow(options, groom, mesh, painted)
 
         def done(result) -> None:
             guides, binding = result

@@ -55,13 +55,22 @@ def face_areas(mesh: Mesh) -> np.ndarray:
     return 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
 
 
-def default_region(mesh: Mesh, guides: Groom, reach: float = DEFAULT_REACH) -> np.ndarray:
+def default_region(
+    mesh: Mesh, guides: Groom, reach: float = DEFAULT_REACH, near: np.ndarray | None = None
+) -> np.ndarray:
     """``(F,)`` bool: the faces whose three corners lie on average within ``reach`` guide
-    spacings of a guide root along the surface."""
+    spacings of a guide root along the surface (of the guides flagged in ``near`` only, e.g.
+    those the artist painted, when given)."""
     check_mesh(mesh)
     if not np.isfinite(reach) or reach <= 0:
         raise ParameterError("reach", reach, "a positive number of guide spacings")
-    d = nearest_guide_distance(mesh, guides.roots.astype(np.float64))
+    roots = guides.roots.astype(np.float64)
+    if near is not None:
+        near = np.asarray(near, bool)
+        if near.shape != (guides.strand_count,) or not near.any():
+            raise ParameterError("region", f"{int(near.sum())} guides", "at least one guide to grow near")
+        roots = roots[near]
+    d = nearest_guide_distance(mesh, roots)
     return d[mesh.faces].mean(axis=1) <= reach * guide_spacing(guides)
 
 

@@ -9,7 +9,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from app.ui.render_hair_dialog import DENSE, NEAR_GUIDES, WHOLE_MESH, GrowDialog, GrowOptions, grow
+from app.ui.render_hair_dialog import (
+    DENSE,
+    NEAR_GUIDES,
+    NEAR_MASKED,
+    WHOLE_MESH,
+    GrowDialog,
+    GrowOptions,
+    grow,
+)
 from hairtool import io, samples
 from hairtool.errors import ParameterError
 from hairtool.io.obj import read_mesh
@@ -40,6 +48,19 @@ def test_grow_roots_the_children_where_the_artist_chose(sintel):
         grow(GrowOptions(count=10, region="no such set"), guides, head)
 
 
+def test_children_grow_near_the_guides_the_mask_brush_painted(sintel):
+    from hairtool.guides.scatter import default_region
+
+    guides, head = sintel
+    painted = guides.roots[:, 0] > np.median(guides.roots[:, 0])  # one side of her head
+    _, b = grow(GrowOptions(count=800, region=NEAR_MASKED, seed=2), guides, head, painted)
+    near_painted = default_region(head, guides, near=painted)
+    assert near_painted.sum() < default_region(head, guides).sum()
+    assert np.all(near_painted[b.faces])
+    with pytest.raises(ParameterError, match="region"):  # nothing painted
+        grow(GrowOptions(count=10, region=NEAR_MASKED), guides, head, np.zeros(guides.strand_count, bool))
+
+
 def test_the_dialog_offers_the_meshs_face_sets_and_round_trips_its_options(qtbot, sintel):
     guides, head = sintel
     chosen = GrowOptions(count=1234, guides_per_child=3, seed=9, length_variation=0.2, frizz=0.05,
@@ -48,6 +69,9 @@ def test_the_dialog_offers_the_meshs_face_sets_and_round_trips_its_options(qtbot
     qtbot.addWidget(dialog)
     regions = [dialog.region.itemData(i) for i in range(dialog.region.count())]
     assert regions == [NEAR_GUIDES, WHOLE_MESH, *sorted(head.groups)]
+    painted = GrowDialog(None, chosen, guides, head, painted=12)  # guides painted: offered
+    qtbot.addWidget(painted)
+    assert painted.region.itemData(1) == NEAR_MASKED and "12 masked" in painted.region.itemText(1)
     assert dialog.options() == chosen
     dialog.set_options(GrowOptions(mode=DENSE, guides=40))
     assert dialog.options().mode == DENSE and dialog.options().guides == 40
