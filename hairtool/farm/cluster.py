@@ -83,14 +83,17 @@ def open_client(scheduler: str | None = None, workers: int | None = None) -> Ite
         return
     n = local_workers(workers)
     with dask.config.set({"distributed.scheduler.allowed-failures": ALLOWED_FAILURES - 1, **QUIET_WORKERS}):
-        cluster = distributed.LocalCluster(
-            n_workers=n,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            dashboard_address="127.0.0.1:0",  # its status pages: loopback, any free port
-            silence_logs=LOCAL_LOG_LEVEL,
-        )
+        try:
+            cluster = distributed.LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address="127.0.0.1:0",  # its status pages: loopback, any free port
+                silence_logs=LOCAL_LOG_LEVEL,
+            )
+        except (OSError, RuntimeError, TimeoutError, ValueError) as e:  # no ports, processes, memory
+            raise HairtoolError(f"cannot start a local Dask cluster of {n} workers: {e}") from None
     try:
         client = distributed.Client(cluster)
         try:

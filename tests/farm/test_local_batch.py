@@ -236,3 +236,18 @@ def test_the_default_local_cluster_has_one_single_threaded_worker_per_core(proje
     jobs.write_text(json.dumps({"jobs": [{"command": "convert", "args": ["grooms/scalp.npz", "out/s.obj"]}]}))
     rc, summary = batch(capsys, str(jobs))
     assert rc == 0 and summary["done"] == 1 and summary["workers"] == n
+
+
+def test_a_local_cluster_that_cannot_start_is_one_line(project, capsys, monkeypatch):
+    import distributed
+
+    def refuse(*args, **kwargs):
+        raise OSError("no free port on 127.0.0.1")
+
+    monkeypatch.setattr(distributed, "LocalCluster", refuse)
+    jobs = project / "jobs.json"
+    job = {"command": "convert", "args": ["grooms/scalp.npz", "out/s.usda"]}
+    jobs.write_text(json.dumps({"jobs": [job]}))
+    assert main(["batch", str(jobs), "--workers", "2"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "cannot start a local Dask cluster of 2 workers" in err
