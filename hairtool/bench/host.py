@@ -2,10 +2,10 @@
 
 The targets of the other benchmarks are absolute times on the project's 2-core reference VM,
 whose speed drifts by 10-40 % within an hour as its host's other tenants come and go. This
-benchmark times three small probes and divides each into the same probe's time on that VM at
-its usual speed (its fastest medians over a day, 2026-12-02): ``speed`` 1.0 is the reference
-machine as the targets assume it, 0.8 a moment when everything takes 25 % longer. Run it
-beside another benchmark to read that one's numbers.
+benchmark times three small probes and divides each into the same probe's time on that VM with
+no other tenant in its way (its fastest medians over a day, 2026-12-02): ``speed`` 1.0 is the
+reference machine at its best, 0.8 a moment when everything takes 25 % longer. Run it beside
+another benchmark to read that one's numbers.
 
 Probes: ``arithmetic``, multiply-adds on rows in L1 cache (the numba kernels' kind of work),
 on one thread and the same work on every thread; ``memory``, copying 64 MB four times (the
@@ -34,7 +34,7 @@ ARITHMETIC_SHAPE = (64, 512)
 ARITHMETIC_ROUNDS = 12_000
 MEMORY_BYTES = 64 << 20
 PYTHON_STEPS = 400_000
-#: Median milliseconds of each probe on the reference VM at its usual speed.
+#: Median milliseconds of each probe on the reference VM at its best (its fastest medians of a day).
 REFERENCE_MS = {
     "arithmetic, 1 thread": 14.0,
     "arithmetic, all threads": 7.5,
