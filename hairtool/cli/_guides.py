@@ -114,6 +114,21 @@ def input_groom(args: argparse.Namespace, groom: Groom) -> Groom:
     return guides
 
 
+def prepare(
+    args: argparse.Namespace, groom: Groom, *, keep_hair: bool = True
+) -> tuple[Groom, ChildBinding | None, float]:
+    """What a command works on, from its input: :func:`input_groom`, then :func:`bind` where
+    the options ask for render hair or the input brought its own (``keep_hair`` False: a run
+    that writes none, which works on the guides alone). ``(groom, binding or None, bind
+    milliseconds)``, the groom being the guides where there is a binding."""
+    groom = input_groom(args, groom)
+    if not keep_hair:
+        args.bound_hair = None
+    if not wanted(args):
+        return groom, None, 0.0
+    return bind(args, groom)
+
+
 def guides_path(args: argparse.Namespace) -> Path:
     from hairtool.guides.files import guides_path_for
 

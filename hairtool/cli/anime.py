@@ -130,12 +130,11 @@ def run(args: argparse.Namespace) -> int:
         if render and args.output is None:
             raise ParameterError("count", args.count, "an OUT file to write the render hair to")
         _guides.check(args, animated=True, guides_option=False)
-        groom = _guides.input_groom(args, load_groom(args.input))
-        if args.output is None:
-            args.bound_hair = None  # a preview of the guides' cycle: no render hair to write
-        render = _guides.wanted(args)  # the input may bring render hair of its own
-        if render:
-            groom, binding, bind_ms = _guides.bind(args, groom)  # the guides wave
+        # With render hair (asked for, or the input's own), the guides wave; a preview of the
+        # cycle without OUT writes none.
+        writes = args.output is not None
+        groom, binding, bind_ms = _guides.prepare(args, load_groom(args.input), keep_hair=writes)
+        render = binding is not None
         variation = {
             "guides": None if chains is None else parse_ids(chains),
             "sway": None if args.sway is None else parse_vector("sway", args.sway),

@@ -146,18 +146,15 @@ def run(args: argparse.Namespace) -> int:
     check_align_params(
         (0.0, 0.0, 0.0), 1.0 if args.radius is None else args.radius, args.intensity, args.align_mode
     )
-    render = _guides.wanted(args)
     _guides.check(args)
     strokes = None
     if args.strokes is not None:
         from hairtool.frozen.strokes import read_strokes
 
         strokes = read_strokes(args.strokes)  # a bad log is refused before any work
-    groom = _guides.input_groom(args, io.read_groom(args.input))
-    render = _guides.wanted(args)  # the input may bring render hair of its own
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
-    if render:
-        groom, binding, bind_ms = _guides.bind(args, groom)  # the pipeline runs on the guides
+    # With render hair (asked for, or the input's own), the pipeline runs on the guides.
+    groom, binding, bind_ms = _guides.prepare(args, io.read_groom(args.input))
     pipe = FrozenPipeline(groom, params)
     lo, hi = groom.bounds
     radius = float(np.linalg.norm(hi - lo)) if args.radius is None else args.radius
@@ -169,7 +166,7 @@ def run(args: argparse.Namespace) -> int:
         pipe.apply_samples(stroke.pipeline_samples(float(pipe.scalp_centre[0])))
         timings.append(pipe.timings)
     report = {}
-    if render:
+    if binding is not None:
         hair = _guides.render(args, binding).update(pipe.result)
         report = _guides.write(args, hair, pipe.result)
         report |= {"guides": groom.strand_count, "children": binding.child_count, "bind_ms": bind_ms}

@@ -31,8 +31,7 @@ def run(args: argparse.Namespace) -> int:
     from hairtool.io.specs import load_groom
 
     _guides.check(args, required=True)
-    groom = _guides.input_groom(args, load_groom(args.input))
-    guides, binding, bind_ms = _guides.bind(args, groom)
+    guides, binding, bind_ms = _guides.prepare(args, load_groom(args.input))
     hair = _guides.render(args, binding)
     t0 = time.perf_counter()
     out = hair.update(guides)

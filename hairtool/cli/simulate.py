@@ -75,14 +75,12 @@ def run(args: argparse.Namespace) -> int:
     from hairtool.simulate.head_motion import fit_head, parse_motion
 
     fmt = format_for(args.output, writing=True)  # refuse a bad extension before simulating
-    render = _guides.wanted(args)
     _guides.check(args, animated=True)
     motion = parse_motion(args.motion)
     wind = parse_vector("wind", args.wind) if args.wind is not None else (0.0, 0.0, 0.0)
-    groom = _guides.input_groom(args, load_groom(args.input))
-    render = _guides.wanted(args)  # the input may bring render hair of its own
-    if render:
-        groom, binding, bind_ms = _guides.bind(args, groom)  # the guides are simulated
+    # With render hair (asked for, or the input's own), the guides are simulated.
+    groom, binding, bind_ms = _guides.prepare(args, load_groom(args.input))
+    render = binding is not None
     if args.fit_head:
         if args.head_center is not None or args.head_radius is not None:
             raise ParameterError("fit-head", "with --head-center/--head-radius", "one or the other")
