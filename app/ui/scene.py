@@ -244,8 +244,7 @@ class Scene(QObject):
         engine's passes, gaps and length rule) whenever the mouse is up, and in what a save
         writes. Off while a brush drags: the preview shows them unclumped, as XGen's does."""
         if bool(on) != self.clump_children:
-            self.clump_children = bool(on)
-            self._cache.clear()
+            self.clump_children = bool(on)  # (the drawn points are rebuilt; colours stay cached)
             if self.binding is not None:
                 self._rebuild_drawn()
                 self.drawn_changed.emit()

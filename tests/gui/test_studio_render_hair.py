@@ -189,6 +189,9 @@ def test_clumping_the_children_is_a_switch_applied_on_release_and_saved(make_win
     np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], plain)
     s.set_dragging(False)
     np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], clumped)
+    box.clump_children.setChecked(False)  # switched off: the children as they were
+    np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], plain)
+    box.clump_children.setChecked(True)
     path = tmp_path / "p.hairproj"
     assert w.project.save_to(path)
     w2 = _window(make_window, children=10)
