@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-SHARED_DATA = ROOT.parent / "shared" / "data"
-GROOMS = SHARED_DATA / "grooms"
-MOTION = SHARED_DATA / "motion"
+TEST_DATA = ROOT / "tests" / "data"  # real grooms, captures and Blender exports, licences beside
+GROOMS = TEST_DATA / "grooms"
+MOTION = TEST_DATA / "motion"
 
 _xvfb: subprocess.Popen | None = None
 

@@ -88,9 +88,7 @@ def test_the_default_scene_ships_unchanged_with_its_credits():
     for name in (bundled.SINTEL_HAIR, bundled.SINTEL_HEAD):
         shipped = bundled.path(name)
         assert shipped.is_file(), f"{name} is not package data"
-        original = ROOT.parent / "shared" / "data" / "grooms" / name
-        if original.is_file():
-            assert shipped.read_bytes() == original.read_bytes()
+        assert shipped.read_bytes() == (ROOT / "tests" / "data" / "grooms" / name).read_bytes()
     credits = bundled.path("CREDITS-sintel.txt").read_text()
     assert "Blender Foundation" in credits and "CC BY 3.0" in credits
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import statistics
 import time
 from collections.abc import Callable, Iterator
@@ -18,10 +19,22 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from hairtool.groom import Groom
 
-#: The real grooms and captures beside the checkout (``../shared/data``).
-SHARED_DATA = Path(__file__).resolve().parents[2].parent / "shared" / "data"
-GROOMS_DIR = SHARED_DATA / "grooms"
-MOTION_DIR = SHARED_DATA / "motion"
+
+
+def _data_dir() -> Path:
+    """The real grooms and captures: ``$HAIRTOOL_BENCH_DATA`` when set (a studio's own grooms),
+    else the checkout's ``tests/data`` (they travel with the repository), else ``../shared/data``."""
+    chosen = os.environ.get("HAIRTOOL_BENCH_DATA")
+    if chosen:
+        return Path(chosen)
+    checkout = Path(__file__).resolve().parents[2]
+    bundled = checkout / "tests" / "data"
+    return bundled if bundled.is_dir() else checkout.parent / "shared" / "data"
+
+
+DATA_DIR = _data_dir()
+GROOMS_DIR = DATA_DIR / "grooms"
+MOTION_DIR = DATA_DIR / "motion"
 
 
 def median_ms(

@@ -24,7 +24,6 @@ HELP = "time FreezeDeform, UserAlign, ClumpWithGaps and the whole pipeline again
 
 PAPER_SIZES = ["100x20", "300x20", "500x20"]
 DEFAULT_SIZES = [*PAPER_SIZES, "5000x20", "50000x20", "real"]
-GROOMS = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "grooms"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -33,7 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         nargs="+",
         default=None,
         metavar="SIZE",
-        help="STRANDSxVERTICES (scalp samples), 'real' (every groom in shared/data/grooms) or a groom path",
+        help="STRANDSxVERTICES (scalp samples), 'real' (every groom in tests/data/grooms or $HAIRTOOL_BENCH_DATA) or a groom path",
     )
     parser.add_argument("--quick", action="store_true", help="100x20 and 500x20 only, fewer repeats")
     parser.add_argument("--repeat", type=int, default=15, help="timed runs per number (median)")
@@ -44,13 +43,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _grooms(sizes: list[str]):
+    from hairtool.bench import GROOMS_DIR
     from hairtool.errors import ParameterError
     from hairtool.io import read_groom
     from hairtool.samples import scalp
 
     for size in sizes:
         if size == "real":
-            for path in sorted(GROOMS.glob("*.tfx")):
+            for path in sorted(GROOMS_DIR.glob("*.tfx")):
                 yield path.stem, read_groom(path)
         elif "x" in size and all(p.isdigit() for p in size.split("x")):
             s, v = (int(p) for p in size.split("x"))

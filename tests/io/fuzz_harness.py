@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-SHARED = Path(__file__).resolve().parents[3] / "shared" / "data"
+TEST_DATA = Path(__file__).resolve().parents[1] / "data"
 
 EDGE_INTS = (0, 1, 2, 3, 0xFFFF, 0x10000, 2**28, 2**31 - 1, 2**31, 2**32 - 1, 2**62, 2**63 - 1, 2**64 - 1)
 EDGE_TOKENS = (
@@ -316,7 +316,7 @@ def _seed_tfx(work: Path) -> list[bytes]:
     v3 = struct.pack("<f3Ii", 3.0, 4, 3, 0, 0) + b"\0" * 124 + struct.pack("<I", 148)
     v3 += g.points.astype("<f4").tobytes()
     out = [v4, v3]
-    real = SHARED / "grooms" / "ponytail_tail.tfx"
+    real = TEST_DATA / "grooms" / "ponytail_tail.tfx"
     if real.is_file():
         out.append(real.read_bytes())
     return out
@@ -372,7 +372,7 @@ def _seed_bvh(work: Path) -> list[bytes]:
         "MOTION\nFrames: 3\nFrame Time: 0.04\n0 0 0 0 0 0 0 0 0\n1 2 3 90 0 0 0 0 0\n0 0 0 90 0 0 -90 0 0\n"
     )
     out = [chain.encode()]
-    real = SHARED / "motion" / "freebvh.bvh"
+    real = TEST_DATA / "motion" / "freebvh.bvh"
     if real.is_file():
         out.append(real.read_bytes())
     return out

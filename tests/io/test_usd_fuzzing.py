@@ -27,7 +27,7 @@ from hairtool.errors import FormatError
 from hairtool.groom import Animation, Groom
 from hairtool.io import read, write
 
-INTEROP = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "interop"
+INTEROP = Path(__file__).resolve().parents[1] / "data" / "interop"
 
 VALID_USDA = """#usda 1.0
 (

@@ -15,7 +15,7 @@ from hairtool.io import read, usd, write
 from hairtool.keys.export import keys_record, write_key_poses
 from hairtool.metadata import CurvesPrim, Metadata
 
-INTEROP = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "interop"
+INTEROP = Path(__file__).resolve().parents[1] / "data" / "interop"
 HAIR = "/root/Head/Hair/HairData"
 
 

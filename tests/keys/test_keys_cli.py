@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import itertools
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -335,9 +336,8 @@ def test_storage_is_the_bytes_of_the_key_poses_in_the_inputs_own_format(files, t
 
 
 def test_the_keys_record_keeps_the_sources_time_codes(tmp_path):
-    from hairtool.bench import SHARED_DATA
-
-    src = SHARED_DATA / "interop" / "b_gnanim.usdc"  # Blender's time codes 1…48
+    # Blender's time codes 1…48
+    src = Path(__file__).resolve().parents[1] / "data" / "interop" / "b_gnanim.usdc"
     assert main(["keys", str(src), "--keys", "5", "--out", str(tmp_path / "k.json")]) == 0
     record = json.loads((tmp_path / "k.json").read_text())
     codes = [k["time_code"] for k in record["keys"]]
