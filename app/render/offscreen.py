@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import threading
 import weakref
+from dataclasses import dataclass
 from typing import Any
 
 import moderngl
@@ -17,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from app.render.camera import Camera
+from app.render.drawn import Drawn
 from app.render.strands import DEFAULT_BACKGROUND, STRAND_RASTERS, StrandRenderer, default_strand_raster
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Groom
@@ -140,14 +142,68 @@ def render_image(
     """Draw a groom headless; ``(H, W, 4)`` uint8 RGBA, top row first.
 
     ``camera`` None frames groom and mesh (orthographic for planar grooms). ``colors``: ``(V, 3)``
-    per-vertex RGB, else the groom's own colours, else ``ramp`` along t. ``transparent`` gives
-    alpha 0 wherever nothing is drawn (straight, not premultiplied, alpha). ``strand_raster``:
-    ``"gl"``, ``"cpu"`` or ``"auto"`` (see :mod:`app.render.strands`; None: the environment's
-    default); strands rasterized on the CPU are not multisampled.
+    per-vertex RGB, else the groom's own colours, else ``ramp`` along t. The other arguments
+    are :func:`render_drawn`'s.
     """
-    w, h = _check_size(size)
     if not np.isfinite(line_width) or not 0 < line_width <= 256:
         raise ParameterError("line_width", line_width, "a width in (0, 256] pixels")
+    own = None if colors is None else np.asarray(colors)
+    drawn = Drawn.of_groom(groom, own, ramp=ramp, line_width=line_width)
+    if camera is None:
+        camera = _framing(drawn, mesh, size, bool(groom.is_planar))
+    return render_drawn(
+        drawn,
+        size=size,
+        camera=camera,
+        background=background,
+        transparent=transparent,
+        mesh=mesh,
+        ctx=ctx,
+        strand_raster=strand_raster,
+    )
+
+
+def _framing(drawn: Drawn, mesh: Any | None, size: tuple[int, int], planar: bool) -> Camera:
+    w, h = _check_size(size)
+    lo, hi = drawn.groom().bounds
+    if mesh is not None and len(mesh.vertices):
+        v = np.asarray(mesh.vertices, np.float32)
+        lo, hi = np.minimum(lo, v.min(axis=0)), np.maximum(hi, v.max(axis=0))
+    return Camera.for_bounds(lo, hi, ortho=planar, aspect=w / h)
+
+
+@dataclass(frozen=True)
+class Overlays:
+    """The working overlays a still or video may include: the brush circle (centre and radius in
+    pixels of the image) and the symmetry plane's outline (``(4, 2)`` pixels); None: not drawn."""
+
+    circle: tuple[tuple[float, float], float] | None = None
+    outline: NDArray | None = None
+
+
+def render_drawn(
+    drawn: Drawn,
+    *,
+    size: tuple[int, int],
+    camera: Camera,
+    background: tuple[float, float, float, float] = DEFAULT_BACKGROUND,
+    transparent: bool = False,
+    mesh: Any | None = None,
+    ctx: moderngl.Context | None = None,
+    strand_raster: str | None = None,
+    overlays: Overlays | None = None,
+) -> NDArray[np.uint8]:
+    """Draw what the studio draws (:class:`~app.render.drawn.Drawn`) headless; ``(H, W, 4)``
+    uint8 RGBA, top row first, no overlay unless ``overlays`` gives some.
+
+    ``transparent`` gives alpha 0 wherever nothing is drawn (straight, not premultiplied,
+    alpha). ``ctx``: a current context to draw in (None: the process's headless one).
+    ``strand_raster``: ``"gl"``, ``"cpu"`` or ``"auto"`` (see :mod:`app.render.strands`; None:
+    the environment's default); strands rasterized on the CPU are not multisampled.
+    """
+    w, h = _check_size(size)
+    if not np.isfinite(drawn.line_width) or not 0 < drawn.line_width <= 256:
+        raise ParameterError("line_width", drawn.line_width, "a width in (0, 256] pixels")
     bg = tuple(float(c) for c in background)
     if len(bg) == 3:
         bg = (*bg, 1.0)
@@ -157,62 +213,28 @@ def render_image(
         strand_raster = default_strand_raster()
     if strand_raster not in STRAND_RASTERS:
         raise ParameterError("strand_raster", strand_raster, " or ".join(STRAND_RASTERS))
-    own = ctx is not None
-    if own:
-        return _render_in(
-            ctx,
-            StrandRenderer(ctx),
-            True,
-            groom,
-            camera,
-            (w, h),
-            ramp,
-            colors,
-            line_width,
-            bg,
-            transparent,
-            mesh,
-            strand_raster,
-        )
+    drawn.colors  # noqa: B018 - made (and checked) before any GL object is
+    args = (drawn, camera, (w, h), bg, transparent, mesh, strand_raster, overlays or Overlays())
+    if ctx is not None:
+        return _render_in(ctx, StrandRenderer(ctx), True, *args)
     ctx = shared_context()
     with ctx:  # current for this draw only: Qt may own the current context in the studio
-        return _render_in(
-            ctx,
-            _shared_renderer(ctx),
-            False,
-            groom,
-            camera,
-            (w, h),
-            ramp,
-            colors,
-            line_width,
-            bg,
-            transparent,
-            mesh,
-            strand_raster,
-        )
+        return _render_in(ctx, _shared_renderer(ctx), False, *args)
 
 
-def _render_in(
-    ctx, renderer, own, groom, camera, size, ramp, colors, line_width, bg, transparent, mesh, raster
-):
-    w, h = size
+def _render_in(ctx, renderer, own, drawn, camera, size, bg, transparent, mesh, raster, overlays):
     try:
         renderer.strand_raster = raster
-        renderer.set_groom(groom)
-        renderer.set_ramp(ramp)
-        if colors is not None:
-            renderer.set_vertex_colors(colors)
+        renderer.show(drawn)
         renderer.set_mesh(mesh)
+        centre, radius = overlays.circle or (None, 0.0)
+        renderer.set_overlay_circle(centre, radius, size)
+        renderer.set_overlay_outline(overlays.outline, size)
+        renderer.background = (0.0, 0.0, 0.0, 0.0) if transparent else bg
+        image = read_rgba(ctx, renderer, camera, size)
+        renderer.set_mesh(None)
         renderer.set_overlay_circle(None)
         renderer.set_overlay_outline(None)
-        renderer.line_width = float(line_width)
-        renderer.background = (0.0, 0.0, 0.0, 0.0) if transparent else bg
-        if camera is None:
-            lo, hi = renderer.scene_bounds()
-            camera = Camera.for_bounds(lo, hi, ortho=bool(groom.is_planar), aspect=w / h)
-        image = read_rgba(ctx, renderer, camera, (w, h))
-        renderer.set_mesh(None)
     finally:
         if own:
             renderer.release()

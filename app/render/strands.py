@@ -51,6 +51,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from app.render.camera import Camera
+from app.render.drawn import Drawn
 from app.render.hair_shading import DEFAULT_LOOK, HairLook, light_and_eye, shade
 from app.render.mesh_layer import MeshLayer
 from app.render.overlay import CircleOverlay, OutlineOverlay
@@ -275,6 +276,19 @@ class StrandRenderer:
         self.set_vertex_colors(colors)
         if ghost is not None:
             self.set_ghost_points(ghost, self.ghost_rgba)
+
+    def show(self, drawn: Drawn) -> None:
+        """Upload everything of a :class:`~app.render.drawn.Drawn`: strands, look and colours."""
+        self.set_strands(drawn.points, drawn.topology)
+        self.set_look(drawn)
+        self.set_vertex_colors(drawn.colors)
+
+    def set_look(self, drawn: Drawn) -> None:
+        """The ramp, line width, taper and hair shading of ``drawn`` (no upload of points)."""
+        self.set_ramp(drawn.ramp)
+        self.line_width = float(drawn.line_width)
+        self.set_hair_shading(drawn.shaded)
+        self.taper = float(drawn.taper)
 
     @staticmethod
     def _checked_points(points: ArrayLike, v: int, what: str) -> tuple[NDArray[np.float32], tuple]:

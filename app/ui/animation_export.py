@@ -33,14 +33,14 @@ from PySide6.QtCore import QObject, Qt, QThread, Signal, Slot
 from PySide6.QtWidgets import QCheckBox, QDialog, QDialogButtonBox, QLabel, QVBoxLayout, QWidget
 
 from app.render.camera import Camera
-from app.render.offscreen import render_image
-from app.ui.colouring import vertex_colors
+from app.render.drawn import Drawn
+from app.render.offscreen import Overlays, render_drawn
+from app.ui.drawn import drawn
 from app.ui.jobs import Job
 from hairtool import io
 from hairtool.errors import Cancelled, FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom
 from hairtool.guides.animate import RenderHairAnimation
-from hairtool.guides.children import build_points
 from hairtool.guides.files import write_animation
 from hairtool.io.atomic import atomic_path
 from hairtool.keys.export import export_keys as write_keys
@@ -267,9 +267,10 @@ class RenderHairDialog(QDialog):
 
 
 class FrameRenderer:
-    """Draws an animation's frames as the viewport shows the groom: camera, ramp, colours,
-    line width and head mesh fixed when the export starts; ``frame_groom(f)``: what to draw
-    of frame f (default the animation's frame: render hair draws the children of its guides)."""
+    """Draws an animation's frames as the viewport draws the groom: camera, look and head mesh
+    fixed when the export starts; ``frame_drawn(f)``: the :class:`~app.render.drawn.Drawn` of
+    frame f (default the animation's frame in the ramp: render hair draws the children of its
+    guides); ``overlays``: the working overlays drawn over every frame (None: none)."""
 
     def __init__(
         self,
@@ -277,39 +278,27 @@ class FrameRenderer:
         camera: Camera,
         size: tuple[int, int],
         *,
-        ramp: str = "root-tip",
-        colors: NDArray | None = None,
-        line_width: float = 2.0,
         mesh: object | None = None,
-        frame_groom: Callable[[int], Groom] | None = None,
+        frame_drawn: Callable[[int], Drawn] | None = None,
+        overlays: Overlays | None = None,
     ) -> None:
         self.animation, self.size = animation, even_size(size)
-        self.frame_groom = animation.frame if frame_groom is None else frame_groom
-        self.camera = Camera(
-            camera.target,
-            camera.distance,
-            camera.yaw,
-            camera.pitch,
-            camera.fov_y,
-            camera.ortho,
-            camera.ortho_height,
-        )
+        self.frame_drawn = frame_drawn or (lambda f: Drawn.of_groom(animation.frame(f)))
+        self.camera = camera.copy()
         lo, hi = animation.bounds
         self.camera.set_scene(lo, hi)  # near and far planes enclose the whole motion
-        self.ramp, self.colors, self.line_width, self.mesh = ramp, colors, line_width, mesh
+        self.mesh, self.overlays = mesh, overlays
+
+    def frame_groom(self, frame: int) -> Groom:
+        """The strands drawn on ``frame``, as a groom."""
+        return self.frame_drawn(frame).groom()
 
     def render(self, frame: int, ctx: object | None = None) -> NDArray[np.uint8]:
         """``(H, W, 4)`` uint8 of one frame (``ctx``: a current moderngl context; None: headless)."""
-        return render_image(
-            self.frame_groom(frame),
-            size=self.size,
-            camera=self.camera,
-            ramp=self.ramp,
-            colors=self.colors,
-            line_width=self.line_width,
-            mesh=self.mesh,
-            ctx=ctx,
-        )
+        return render_drawn(
+            self.frame_drawn(frame), size=self.size, camera=self.camera, mesh=self.mesh, ctx=ctx,
+            overlays=self.overlays,
+        )  # fmt: skip
 
 
 class GuiFrameSource(QObject):
@@ -426,7 +415,15 @@ class AnimationExporter(QObject):
                 return False
             render_hair = answer
         path = self.window.ask_save_path("Export animation", ANIMATION_FILTERS, "animation.mp4")
-        return bool(path) and self.export_animation(path, render_hair=render_hair) is not False
+        if not path:
+            return False
+        size, overlays = None, False
+        if Path(path).suffix.lower() in VIDEO_SUFFIXES + SEQUENCE_SUFFIXES:  # pictures: their size
+            picture = self.window.ask_picture_options()
+            if picture is None:
+                return False
+            size, overlays = picture.size, picture.overlays
+        return self.export_animation(path, size, render_hair=render_hair, overlays=overlays) is not False
 
     def export_keys_dialog(self) -> bool:
         path = self.window.ask_save_path("Export keys", KEY_FILTERS, "keys.json")
@@ -447,35 +444,46 @@ class AnimationExporter(QObject):
         return True
 
     def renderer(
-        self, animation: Animation, size: tuple[int, int] | None = None, *, render_hair: bool = False
+        self,
+        animation: Animation,
+        size: tuple[int, int] | None = None,
+        *,
+        render_hair: bool = False,
+        overlays: bool = False,
     ) -> FrameRenderer:
         """Frames drawn as the viewport draws them; ``render_hair``: the children drawn now (the
-        release share of them) following each frame's guides, the guides over them if shown."""
+        release share of them) following each frame's guides, the guides over them if shown;
+        ``overlays``: the brush circle, mirror plane and mask tint as the view shows them."""
         w, scene = self.window, self.window.scene
-        colors, frame_groom = None, None
+        size = even_size(size or w.viewport_pixel_size())
         binding = self.render_hair_binding(animation) if render_hair else None
+        look = drawn(scene, mask=overlays)
         if binding is not None:
-            drawn, topology, guides_shown = scene.drawn_binding(), scene.drawn_topology, scene.drawn_guides
 
-            def frame_groom(f: int) -> Groom:
-                guides = Groom(animation.frames[f], animation.topology)
-                children = build_points(drawn, guides)
-                points = np.concatenate([children, guides.points]) if guides_shown else children
-                return Groom(points, topology)
+            def frame_drawn(f: int) -> Drawn:
+                d = drawn(scene, animation.frames[f], mask=overlays)
+                if scene.colour_mode == "displacement":  # the edit's distances, not the pose's
+                    return dataclasses.replace(d, make_colors=lambda: None)
+                return d
 
-            if scene.colour_mode != "displacement":  # the others hang on the strands, not the pose
-                colors = vertex_colors(scene)
-        elif animation.vertex_count == scene.result.vertex_count and scene.colour_mode in ("strand", "clump"):
-            colors = vertex_colors(scene)  # per-strand colours stay valid on every frame
+        else:  # the animation's own strands (the guides alone, or another groom's)
+            same = animation.topology == scene.result.topology and not scene.has_children
+            per_strand = same and scene.colour_mode in ("strand", "clump")
+            colors = look.colors if per_strand else None  # per-strand colours hold on every frame
+
+            def frame_drawn(f: int) -> Drawn:
+                return dataclasses.replace(
+                    look, points=animation.frames[f], topology=animation.topology, guides=0,
+                    make_colors=lambda: colors,
+                )  # fmt: skip
+
         return FrameRenderer(
             animation,
             w.viewport.camera,
-            size or w.viewport_pixel_size(),
-            ramp=scene.ramp,
-            colors=colors,
-            line_width=scene.line_width,
+            size,
             mesh=scene.mesh,
-            frame_groom=frame_groom,
+            frame_drawn=frame_drawn,
+            overlays=w.viewport.overlays(size) if overlays else None,
         )
 
     def export_animation(
@@ -484,11 +492,13 @@ class AnimationExporter(QObject):
         size: tuple[int, int] | None = None,
         *,
         render_hair: bool | None = None,
+        overlays: bool = False,
     ) -> bool | Job:
         """Data formats are written at once (True/False), or as render hair in a job;
         video and PNG sequences start a job in ``window.jobs`` and return it (False when
         refused before starting). ``render_hair``: write the children following the guides
-        (default: whenever the animation is of the guides of a groom with children)."""
+        (default: whenever the animation is of the guides of a groom with children). Pictures:
+        ``size`` (default the viewport's), ``overlays`` the working overlays drawn too."""
         w = self.window
         anim = w.animation.animation
         suffix = Path(path).suffix.lower()
@@ -508,7 +518,8 @@ class AnimationExporter(QObject):
                 raise FormatError(
                     path, "animations are written as .usda/.usdc/.usd, .npz, .mp4, .gif or .png"
                 )
-            renderer = self.renderer(anim, size, render_hair=binding is not None and render_hair is not False)
+            hair = binding is not None and render_hair is not False
+            renderer = self.renderer(anim, size, render_hair=hair, overlays=overlays)
         except HairtoolError as e:
             w.show_error("Cannot export animation", str(e))
             return False

@@ -24,12 +24,13 @@ MASK_RGB = np.array([0.24, 0.28, 0.5], np.float32)  # masked strands: toward thi
 MASK_KEEP = 0.3  # … keeping this share of their own colour
 
 
-def vertex_colors(scene: Scene) -> np.ndarray | None:
+def vertex_colors(scene: Scene, mask: bool = True) -> np.ndarray | None:
     """``(V, 3)`` float32 colours of the drawn strands, or None where the renderer's ramp over t
-    does the colouring (shaded hair too: the renderer lights the ramp or these colours)."""
+    does the colouring (shaded hair too: the renderer lights the ramp or these colours);
+    ``mask`` False leaves out the mask's tint (a still or video without the working overlays)."""
     colors = _mode_colors(scene)
     locked = scene.locked
-    if locked.size != scene.result.strand_count or not locked.any():
+    if not mask or locked.size != scene.result.strand_count or not locked.any():
         return colors
     top = scene.drawn_topology
     if colors is None:

@@ -1,4 +1,5 @@
-"""The export-still dialog: resolution, transparent background, then the file name."""
+"""The export dialogs' options: picture size (the viewport's, 1080p or custom), transparent
+background, working overlays, then the file name."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ from pathlib import Path
 
 from PySide6.QtWidgets import (
     QCheckBox,
+    QComboBox,
     QDialog,
     QDialogButtonBox,
     QFileDialog,
@@ -17,39 +19,112 @@ from PySide6.QtWidgets import (
 
 from app.render.offscreen import MAX_SIZE
 
+SIZE_1080P = (1920, 1080)
+OVERLAYS_TIP = (
+    "Draw the brush circle, the X-mirror plane and the mask's tint as the viewport shows them "
+    "(off: the picture shows the hair and the head alone)"
+)
+
 
 @dataclass(frozen=True)
 class StillOptions:
     path: str
     size: tuple[int, int]
     transparent: bool
+    overlays: bool = False
+
+
+@dataclass(frozen=True)
+class PictureOptions:
+    """A video's (or PNG sequence's) picture: its size and whether the overlays are drawn."""
+
+    size: tuple[int, int]
+    overlays: bool = False
+
+
+class SizeForm:
+    """Size rows for a form: a choice of the viewport's size, 1080p or custom (width × height)."""
+
+    def __init__(self, form: QFormLayout, viewport: tuple[int, int]) -> None:
+        self.viewport = viewport
+        self.choice = QComboBox()
+        self.choice.addItem(f"Viewport ({viewport[0]} × {viewport[1]})", "viewport")
+        self.choice.addItem(f"1080p ({SIZE_1080P[0]} × {SIZE_1080P[1]})", "1080p")
+        self.choice.addItem("Custom", "custom")
+        self.width_box, self.height_box = QSpinBox(), QSpinBox()
+        for box, value in ((self.width_box, viewport[0]), (self.height_box, viewport[1])):
+            box.setRange(1, MAX_SIZE)
+            box.setValue(value)
+            box.setSuffix(" px")
+        form.addRow("Size", self.choice)
+        form.addRow("Width", self.width_box)
+        form.addRow("Height", self.height_box)
+        self.choice.currentIndexChanged.connect(self._on_choice)
+        self._on_choice()
+
+    def set_choice(self, key: str) -> None:
+        self.choice.setCurrentIndex(self.choice.findData(key))
+
+    def _on_choice(self, *_: object) -> None:
+        key = self.choice.currentData()
+        custom = key == "custom"
+        if not custom:
+            w, h = self.viewport if key == "viewport" else SIZE_1080P
+            self.width_box.setValue(w)
+            self.height_box.setValue(h)
+        self.width_box.setEnabled(custom)
+        self.height_box.setEnabled(custom)
+
+    def size_px(self) -> tuple[int, int]:
+        return self.width_box.value(), self.height_box.value()
+
+
+def _overlays_box() -> QCheckBox:
+    box = QCheckBox("Include overlays (brush circle, mirror plane, mask tint)")
+    box.setToolTip(OVERLAYS_TIP)
+    return box
+
+
+def _buttons(dialog: QDialog, form: QFormLayout) -> None:
+    buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel)
+    buttons.accepted.connect(dialog.accept)
+    buttons.rejected.connect(dialog.reject)
+    form.addRow(buttons)
 
 
 class StillDialog(QDialog):
-    """Width and height (the viewport's by default) and the transparent-background option."""
+    """Size (the viewport's by default), transparent background and the overlays option."""
 
     def __init__(self, size: tuple[int, int], parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setWindowTitle("Export still")
         form = QFormLayout(self)
-        self.width_box, self.height_box = QSpinBox(), QSpinBox()
-        for box, value in ((self.width_box, size[0]), (self.height_box, size[1])):
-            box.setRange(1, MAX_SIZE)
-            box.setValue(value)
-            box.setSuffix(" px")
+        self.size_form = SizeForm(form, size)
+        self.width_box, self.height_box = self.size_form.width_box, self.size_form.height_box
         self.transparent = QCheckBox("Transparent background (PNG)")
-        form.addRow("Width", self.width_box)
-        form.addRow("Height", self.height_box)
+        self.overlays = _overlays_box()
         form.addRow(self.transparent)
-        buttons = QDialogButtonBox(
-            QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel
-        )
-        buttons.accepted.connect(self.accept)
-        buttons.rejected.connect(self.reject)
-        form.addRow(buttons)
+        form.addRow(self.overlays)
+        _buttons(self, form)
 
     def size_px(self) -> tuple[int, int]:
-        return self.width_box.value(), self.height_box.value()
+        return self.size_form.size_px()
+
+
+class PictureDialog(QDialog):
+    """A video's picture: size and overlays."""
+
+    def __init__(self, size: tuple[int, int], parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setWindowTitle("Export video")
+        form = QFormLayout(self)
+        self.size_form = SizeForm(form, size)
+        self.overlays = _overlays_box()
+        form.addRow(self.overlays)
+        _buttons(self, form)
+
+    def options(self) -> PictureOptions:
+        return PictureOptions(self.size_form.size_px(), self.overlays.isChecked())
 
 
 def ask_still_options(
@@ -63,4 +138,12 @@ def ask_still_options(
     path, _ = QFileDialog.getSaveFileName(parent, "Export still", str(Path(start_dir) / "still.png"), filters)
     if not path:
         return None
-    return StillOptions(path, dialog.size_px(), dialog.transparent.isChecked())
+    return StillOptions(path, dialog.size_px(), dialog.transparent.isChecked(), dialog.overlays.isChecked())
+
+
+def ask_picture_options(parent: QWidget, size: tuple[int, int]) -> PictureOptions | None:
+    """Modal: a video's size and overlays, or None when cancelled."""
+    dialog = PictureDialog(size, parent)
+    if dialog.exec() != QDialog.DialogCode.Accepted:
+        return None
+    return dialog.options()

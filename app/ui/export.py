@@ -1,19 +1,23 @@
-"""Stills of the current view: PNG from an offscreen render, SVG for 2-D grooms."""
+"""Stills of the current view: PNG from an offscreen render, SVG for 2-D grooms.
+
+Both draw the view's :class:`~app.render.drawn.Drawn` (the groom or its render hair at full
+density, with the colours that go with those very points), never the brush circle, the
+symmetry plane or the mask's tint unless ``overlays`` asks for them.
+"""
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 import moderngl
-import numpy as np
 
 from app.render.camera import Camera
-from app.render.offscreen import render_image, save_png
+from app.render.drawn import Drawn
+from app.render.offscreen import Overlays, render_drawn, save_png
 from app.render.strands import DEFAULT_BACKGROUND
 from app.render.svg import save_svg
-from app.ui.colouring import vertex_colors
-from app.ui.scene import Scene
 from hairtool.errors import FormatError
 
 STILL_FORMATS = (".png", ".svg")
@@ -21,47 +25,45 @@ STILL_FORMATS = (".png", ".svg")
 
 def export_still(
     path: str | os.PathLike[str],
-    scene: Scene,
+    drawn: Drawn,
     camera: Camera,
     size: tuple[int, int],
+    *,
     transparent: bool = False,
+    mesh: Any | None = None,
+    planar: bool = False,
     ctx: moderngl.Context | None = None,
-    points: np.ndarray | None = None,
-    point_colors: np.ndarray | None = None,
+    overlays: Overlays | None = None,
 ) -> None:
-    """Write what the viewport shows (without the brush circle) at ``size`` pixels.
+    """Write ``drawn`` as ``camera`` sees it at ``size`` pixels (PNG; SVG for ``planar`` grooms).
 
-    ``ctx``: the (current) context to draw in; None uses the headless one. ``points`` (and
-    ``point_colors``): an animation frame shown instead of the scene's groom, same strands.
+    ``ctx``: the (current) context to draw in; None uses the headless one. ``overlays``: the
+    brush circle and symmetry plane to draw over it (PNG only; None: none).
     """
     suffix = Path(path).suffix.lower()
-    colors = point_colors if point_colors is not None else vertex_colors(scene)
-    groom = scene.result if points is None else scene.result.with_points(points)
     if suffix == ".png":
-        image = render_image(
-            groom,
+        image = render_drawn(
+            drawn,
             size=size,
             camera=camera,
-            ramp=scene.ramp,
-            colors=colors,
-            line_width=scene.line_width,
             transparent=transparent,
-            mesh=scene.mesh,
+            mesh=mesh,
             ctx=ctx,
             strand_raster="gl",  # a still is made once: GL's multisampled, antialiased strands
+            overlays=overlays,
         )
         save_png(path, image)
     elif suffix == ".svg":
-        if not scene.is_planar:
+        if not planar:
             raise FormatError(path, "SVG export is for 2-D (planar) grooms; export a PNG instead")
         save_svg(
             path,
-            groom,
+            drawn.groom(),
             camera,
             size,
-            ramp=scene.ramp,
-            colors=colors,
-            line_width=scene.line_width,
+            ramp=drawn.ramp,
+            colors=drawn.colors,
+            line_width=drawn.line_width,
             background=None if transparent else DEFAULT_BACKGROUND,
         )
     else:

@@ -31,9 +31,10 @@ from PySide6.QtGui import QMouseEvent, QWheelEvent
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 
 from app.render.camera import Camera
-from app.render.hair_shading import HAIR_TAPER
+from app.render.drawn import Drawn
+from app.render.offscreen import Overlays
 from app.render.strands import StrandRenderer, default_strand_raster
-from app.ui.colouring import vertex_colors
+from app.ui.drawn import drawn
 from app.ui.scene import Scene
 from hairtool.frozen.brushes import facing_away
 
@@ -194,28 +195,28 @@ class Viewport(QOpenGLWidget):
             self.renderer.strand_raster = default_strand_raster()
         self._mark("groom", "colors", "display")
 
+    def drawn(self, mask: bool = True) -> Drawn:
+        """What this view draws now: the scene's groom, or the animation frame it shows (with the
+        render hair following it), as stills and videos draw it too (``mask``: the mask's tint)."""
+        return drawn(self.scene, self.frame_points, self.frame_colors, mask=mask)
+
     def _upload(self) -> None:
         r, s, dirty = self.renderer, self.scene, self._dirty
         shown = self.frame_points is not None and len(self.frame_points) == s.result.vertex_count
         children = s.has_children  # frames and ghosts are of the guides: their children are drawn
+        d = self.drawn() if dirty & {"groom", "points", "display", "colors"} else None
         if "groom" in dirty:  # render hair: its points as they are, no groom made of millions of them
-            r.set_strands(s.drawn_points, s.drawn_topology) if children else r.set_groom(s.drawn_groom())
+            r.set_strands(d.points, d.topology)
             dirty.discard("points")
-            dirty.update(("ghost", "points") if shown or self.ghost_points is not None else ())
+            dirty.update(("ghost",) if shown or self.ghost_points is not None else ())
         if "points" in dirty:
-            if shown:
-                r.update_points(s.drawn_for(self.frame_points) if children else self.frame_points)
-            else:
-                r.update_points(s.drawn_points)
+            r.update_points(d.points)
+        if "groom" in dirty or "points" in dirty:
             self.shown_frame = self._pending_frame if shown else None
         if "display" in dirty:
-            r.set_ramp(s.ramp)
-            r.line_width = s.line_width
-            r.set_hair_shading(s.colour_mode == "hair")
-            r.taper = HAIR_TAPER if s.colour_mode == "hair" else 0.0  # hair narrows root to tip
+            r.set_look(d)
         if "colors" in dirty:
-            own = shown and self.frame_colors is not None and not children
-            r.set_vertex_colors(self.frame_colors if own else vertex_colors(s))
+            r.set_vertex_colors(d.colors)
         if "ghost" in dirty:
             if shown and self.ghost_points is not None:
                 ghost = s.drawn_for(self.ghost_points) if children else self.ghost_points
@@ -240,6 +241,19 @@ class Viewport(QOpenGLWidget):
         if not self.camera.ortho and np.any(self.camera.depth(corners) <= 1e-6):
             return None
         return self.camera.project(corners, w, h)
+
+    def overlays(self, size: tuple[int, int]) -> Overlays:
+        """The working overlays shown now (brush circle, symmetry plane) for an image of ``size``
+        pixels of this view's camera (a still or video that includes them)."""
+        w, h = size
+        circle = None
+        if self._hover is not None and self._drag in (None, "align") and self.width() > 0:
+            depth = self._stroke_depth if self._stroke_depth is not None and self._drag else self.scene.centre
+            cursor = self.cursor_on_plane(self._hover, depth)
+            centre = self.camera.project(cursor, w, h)[0]
+            radius_px = self.scene.radius * self.camera.pixels_per_unit_at(depth, h)
+            circle = ((float(centre[0]), float(centre[1])), radius_px)
+        return Overlays(circle, self.mirror_outline(w, h))
 
     def _overlay(self, w: int, h: int) -> None:
         self.renderer.set_overlay_outline(self.mirror_outline(w, h), (w, h))

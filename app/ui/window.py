@@ -30,7 +30,7 @@ from app.ui.animation_ui import AnimationController
 from app.ui.brush_tool import LABELS, SHORTCUTS, TIPS, brushes
 from app.ui.colouring import displacement_scale
 from app.ui.commands import ParamCommand, RenderHairCommand, StrokeCommand
-from app.ui.dialogs import StillOptions, ask_still_options
+from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import Job, JobRunner, JobStatus
 from app.ui.kernel_warmup import RENDER_HAIR_STEP
@@ -147,6 +147,10 @@ class MainWindow(QMainWindow):
 
     def ask_still_options(self) -> StillOptions | None:
         return ask_still_options(self, self.viewport_pixel_size(), self.scene.is_planar, self.last_dir())
+
+    def ask_picture_options(self) -> PictureOptions | None:
+        """A video's size and overlays (Export animation… to MP4, GIF or PNG frames)."""
+        return ask_picture_options(self, self.viewport_pixel_size())
 
     # -- settings ----------------------------------------------------------------------------
     def last_dir(self) -> str:
@@ -710,24 +714,33 @@ class MainWindow(QMainWindow):
         return max(1, round(self.viewport.width() * dpr)), max(1, round(self.viewport.height() * dpr))
 
     def export_still_dialog(self) -> bool:
-        options = self.ask_still_options()
-        return options is not None and self.export_still(options.path, options.size, options.transparent)
+        o = self.ask_still_options()
+        return o is not None and self.export_still(o.path, o.size, o.transparent, overlays=o.overlays)
 
     def export_still(
-        self, path: str | os.PathLike[str], size: tuple[int, int] | None = None, transparent: bool = False
+        self,
+        path: str | os.PathLike[str],
+        size: tuple[int, int] | None = None,
+        transparent: bool = False,
+        *,
+        overlays: bool = False,
     ) -> bool:
-        """PNG (any groom) or SVG (2-D grooms) of the current view; ``size`` defaults to the viewport's."""
+        """PNG (any groom) or SVG (2-D grooms) of what the view draws (render hair at full
+        density, an animation frame when one is shown); ``size`` defaults to the viewport's;
+        ``overlays``: the brush circle, mirror plane and mask tint too."""
+        size = size or self.viewport_pixel_size()
         try:
             with self.viewport.current_context() as ctx:
                 export.export_still(
                     path,
-                    self.scene,
+                    self.viewport.drawn(mask=overlays),
                     self.viewport.camera,
-                    size or self.viewport_pixel_size(),
-                    transparent,
+                    size,
+                    transparent=transparent,
+                    mesh=self.scene.mesh,
+                    planar=self.scene.is_planar,
                     ctx=ctx,
-                    points=self.viewport.frame_points,  # an animation frame, when one is shown
-                    point_colors=self.viewport.frame_colors,
+                    overlays=self.viewport.overlays(size) if overlays else None,
                 )
         except HairtoolError as e:
             self.show_error("Cannot export still", str(e))
