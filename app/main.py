@@ -43,7 +43,7 @@ def parse_args(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
     parser.add_argument(
         "file",
         nargs="?",
-        help="a groom or animation to open (any readable format); default: Sintel's hair and head",
+        help="a groom, animation or project (.hairproj) to open; default: Sintel's hair and head",
     )
     parser.add_argument(
         "--bench",
@@ -51,6 +51,17 @@ def parse_args(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
         help="run the responsiveness benchmark (options as python -m app.bench)",
     )
     return parser.parse_known_args(argv)
+
+
+def open_window(file: str | None, *, engine_ready: bool = True, settings=None):
+    """The studio's window on ``file`` (a groom, animation or ``.hairproj`` project); with no
+    file, or one that cannot be opened (its error shown), on the bundled Sintel scene."""
+    from app.ui.window import MainWindow
+
+    window = MainWindow(None, engine_ready=engine_ready, settings=settings)
+    if file is None or not window.open_path(file):
+        window.open_bundled_sample()
+    return window
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -78,16 +89,13 @@ def main(argv: list[str] | None = None) -> int:
     from PySide6.QtWidgets import QApplication
 
     from app.ui.kernel_warmup import kernels_cached
-    from app.ui.window import MainWindow
 
     app = QApplication(sys.argv[:1])
     app.setOrganizationName("hairtool")
     app.setApplicationName("Hairtool Studio")
     splash = show_splash(app)
     cached = kernels_cached()
-    window = MainWindow(args.file, engine_ready=cached)
-    if args.file is None:
-        window.open_bundled_sample()
+    window = open_window(args.file, engine_ready=cached)
     window.show()
     splash.finish(window)
     if not cached:

@@ -44,6 +44,7 @@ from hairtool.guides.binding import MAX_FRIZZ, ChildBinding, bind_exactly, curl
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
 from hairtool.io.npz import read_npy_header
+from hairtool.io.obj import Mesh
 
 FORMAT = "hairtool project"
 FORMAT_VERSION = 2  # 2: brush strokes or render hair (children); version 1 files still read
@@ -95,6 +96,7 @@ class Project:
     settings: dict = field(default_factory=dict)
     groom_source: str | None = None
     children: ChildBinding | None = None  # render hair interpolated from ``rest`` (the guides)
+    mesh: Mesh | None = None  # the head or scalp the groom sits on (part of the groom's document)
 
     @classmethod
     def from_pipeline(cls, pipeline: FrozenPipeline, **fields: Any) -> Project:
@@ -165,7 +167,12 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
         "version": FORMAT_VERSION,
         "writer": f"hairtool {hairtool.__version__}",
         "saved": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-        "groom": {"source": project.groom_source, **_groom_arrays("groom", project.rest, arrays)},
+        "groom": {
+            "source": project.groom_source,
+            "up_axis": project.rest.metadata.up_axis,
+            "meters_per_unit": project.rest.metadata.meters_per_unit,
+            **_groom_arrays("groom", project.rest, arrays),
+        },
         "params": _params_json(project.params, arrays),
     }
     manifest["strokes"] = _write_strokes(project.strokes, arrays)
@@ -183,11 +190,25 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
         manifest["animation"] = None
     for name in ("brush", "display", "key_settings", "settings"):
         manifest[name] = _json_object(name, getattr(project, name))
+    manifest["mesh"] = _mesh_arrays(project.mesh, arrays)
     manifest["children"] = _children_arrays(project, arrays)
     if manifest["children"] is not None:
         manifest["version"] = FORMAT_VERSION  # render hair an older hairtool would drop unseen
     manifest["arrays"] = sorted(arrays)
     return manifest, arrays
+
+
+def _mesh_arrays(mesh: Mesh | None, arrays: dict[str, np.ndarray]) -> dict | None:
+    """The head mesh: vertices, triangles, normals and one array of triangles per face set."""
+    if mesh is None:
+        return None
+    arrays["mesh/vertices.npy"] = np.ascontiguousarray(mesh.vertices, np.float32)
+    arrays["mesh/faces.npy"] = np.ascontiguousarray(mesh.faces, np.int32)
+    arrays["mesh/normals.npy"] = np.ascontiguousarray(mesh.normals, np.float32)
+    names = list(mesh.groups)
+    for i, name in enumerate(names):
+        arrays[f"mesh/group_{i}.npy"] = np.asarray(mesh.groups[name], np.int64)
+    return {"groups": names}
 
 
 # The child definition's arrays: (name, per vertex or per child, trailing shape, kinds, required).
@@ -486,6 +507,30 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
     return strokes, aligned
 
 
+def _read_mesh(r: _Reader, info: Any) -> Mesh | None:
+    """The head mesh, its faces checked against its vertices."""
+    if info is None:
+        return None
+    names = info.get("groups") if isinstance(info, dict) else None
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        raise FormatError(r.path, "manifest.json: bad 'mesh' section")
+    vertices = float32_finite(r.path, r.array("mesh/vertices.npy", 2, "f"), "mesh vertices")
+    faces = r.array("mesh/faces.npy", 2, "iu")
+    normals = float32_finite(r.path, r.array("mesh/normals.npy", 2, "f"), "mesh normals")
+    n = len(vertices)
+    if vertices.shape[1:] != (3,) or normals.shape != vertices.shape or faces.shape[1:] != (3,):
+        raise FormatError(r.path, "the mesh arrays must be (n, 3) vertices and normals and (m, 3) faces")
+    if n > np.iinfo(np.int32).max or (faces.size and (faces.min() < 0 or faces.max() >= n)):
+        raise FormatError(r.path, f"a mesh face names a vertex outside [0, {n})")
+    groups = {}
+    for i, name in enumerate(names):
+        ids = r.array(f"mesh/group_{i}.npy", 1, "iu").astype(np.int64)
+        if ids.size and (ids.min() < 0 or ids.max() >= len(faces)):
+            raise FormatError(r.path, f"mesh face set {name!r} names a triangle outside [0, {len(faces)})")
+        groups[name] = ids
+    return Mesh(vertices, faces.astype(np.int32), normals, groups)
+
+
 def _read_children(r: _Reader, info: Any, rest: Groom) -> ChildBinding | None:
     """The child definition, every array checked against the others and the guides."""
     if info is None:
@@ -562,6 +607,11 @@ def _build(r: _Reader) -> Project:
     path = r.path
     groom_info = _section(path, manifest, "groom", dict)
     rest = _read_groom(r, "groom", groom_info)
+    try:
+        space = {k: groom_info[k] for k in ("up_axis", "meters_per_unit") if k in groom_info}
+        rest = rest.with_metadata(rest.metadata.with_(**space)) if space else rest
+    except HairtoolError as e:
+        raise FormatError(path, f"manifest.json: groom {e}") from None
     source = groom_info.get("source")
     params = _read_params(r, _section(path, manifest, "params", dict))
     sv = params.strand_variation
@@ -591,6 +641,7 @@ def _build(r: _Reader) -> Project:
         settings=_section(path, manifest, "settings", dict),
         groom_source=source if isinstance(source, str) else None,
         children=_read_children(r, manifest.get("children"), rest),
+        mesh=_read_mesh(r, manifest.get("mesh")),
     )
 
 

@@ -17,9 +17,12 @@ import numpy as np
 from hairtool import io
 from hairtool.errors import FormatError
 from hairtool.groom import Animation, Groom
+from hairtool.io.obj import Mesh
 from hairtool.mocap.bvh import Motion, read_bvh
+from hairtool.project import SUFFIX as PROJECT_SUFFIX  # opened by the window's project controller
 
 BVH_EXTENSIONS = (".bvh",)
+USD_EXTENSIONS = (".usda", ".usdc", ".usd")
 
 
 def skeleton_animation(motion: Motion) -> Animation:
@@ -33,15 +36,35 @@ def skeleton_animation(motion: Motion) -> Animation:
     return Animation(pos[:, ends], np.full(child.size, 2), motion.fps)
 
 
+def readable_extensions() -> list[str]:
+    """Every extension the studio opens: the groom formats, BVH and projects."""
+    return [e for f in io.FORMATS if f.readable for e in f.extensions] + [*BVH_EXTENSIONS, PROJECT_SUFFIX]
+
+
 def read_any(path: str | os.PathLike[str]) -> Groom | Animation:
     """A groom or an animation from any readable format, BVH included (as a skeleton)."""
-    if Path(path).suffix.lower() in BVH_EXTENSIONS:
+    suffix = Path(path).suffix.lower()
+    if suffix not in readable_extensions() or suffix == PROJECT_SUFFIX:
+        what = "projects are opened with Open Project" if suffix == PROJECT_SUFFIX else "supported"
+        every = ", ".join(readable_extensions())
+        raise FormatError(path, f"cannot read '{suffix or 'no extension'}' files; {what}: {every}")
+    if suffix in BVH_EXTENSIONS:
         motion = read_bvh(path)
         try:
             return skeleton_animation(motion)
         except FormatError as e:
             raise FormatError(path, e.reason) from None
     return io.read(path)
+
+
+def surface_of(path: str | os.PathLike[str]) -> Mesh | None:
+    """The head mesh a groom file carries (USD: its Mesh prims), or None (other formats have none:
+    a TressFX or HAIR groom's head comes as an OBJ beside it, through Load head mesh)."""
+    if Path(path).suffix.lower() not in USD_EXTENSIONS:
+        return None
+    from hairtool.io.usd_mesh import read_mesh
+
+    return read_mesh(path)
 
 
 def dialog_filters(formats: Sequence[tuple[str, Sequence[str]]]) -> str:
@@ -54,7 +77,8 @@ def dialog_filters(formats: Sequence[tuple[str, Sequence[str]]]) -> str:
 def open_filters() -> str:
     """Every readable groom/animation format and BVH."""
     formats = [(f.name, f.extensions) for f in io.FORMATS if f.readable]
-    return dialog_filters([*formats, ("BVH motion capture (skeleton)", BVH_EXTENSIONS)])
+    extra = [("BVH motion capture (skeleton)", BVH_EXTENSIONS), ("Hairtool project", (PROJECT_SUFFIX,))]
+    return dialog_filters([*formats, *extra])
 
 
 def save_filters() -> str:

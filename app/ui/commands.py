@@ -1,5 +1,5 @@
 """Undo steps: one per brush stroke (or replayed stroke log), one per (merged) parameter edit, one
-per render hair grown or removed."""
+per render hair grown or removed, one per head mesh loaded or removed."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from PySide6.QtGui import QUndoCommand
 from app.ui.scene import Scene
 from hairtool.frozen.pipeline import FrozenParams
 from hairtool.guides.binding import ChildBinding
+from hairtool.io.obj import Mesh
 
 _PARAM_ID_BASE = 1000
 _PARAM_IDS: dict[str, int] = {}
@@ -81,3 +82,17 @@ class RenderHairCommand(QUndoCommand):
 
     def undo(self) -> None:
         self._scene.set_binding(self._before)
+
+
+class MeshCommand(QUndoCommand):
+    """The groom's head mesh loaded, replaced or removed (the strands stay as they are)."""
+
+    def __init__(self, scene: Scene, before: Mesh | None, after: Mesh | None, text: str) -> None:
+        super().__init__(text)
+        self._scene, self._before, self._after = scene, before, after
+
+    def redo(self) -> None:
+        self._scene.set_mesh(self._after)
+
+    def undo(self) -> None:
+        self._scene.set_mesh(self._before)

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, QSettings, QStandardPaths, QTimer, Signal
 
+from app.render.camera import Camera
 from hairtool import project as pf
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.keys.session import KeySettings
@@ -59,6 +60,9 @@ class ProjectController(QObject):
         self.autosave_error: str | None = None
         self.recovery_path = recovery_folder(window.settings) / RECOVERY_NAME
         window.undo_stack.indexChanged.connect(self._changed)
+        # The project's path belongs to the document: another groom opened is not this project
+        # (opening a project sets it again, after the groom is loaded).
+        window.scene.groom_loaded.connect(self._forget_path)
         model = window.animation
         model.animation_changed.connect(self._on_animation_changed)
         model.frames_edited.connect(lambda *_: self._mark_animation())
@@ -71,6 +75,9 @@ class ProjectController(QObject):
         window.settings.sync()
         if self._offer_pending:
             QTimer.singleShot(0, self.offer_recovery)
+
+    def _forget_path(self) -> None:
+        self.path = None
 
     # -- changes ---------------------------------------------------------------------------
     def _changed(self, *_: object) -> None:
@@ -117,6 +124,7 @@ class ProjectController(QObject):
                 "clump_children": scene.clump_children,
                 "drag_percent": scene.drag_percent,
                 "release_percent": scene.release_percent,
+                "camera": w.viewport.camera.state(),
             },
             animation=model.animation,
             animation_source=model.source,
@@ -124,6 +132,7 @@ class ProjectController(QObject):
             settings=settings,
             groom_source=source,
             children=scene.binding,
+            mesh=scene.mesh,
         )
 
     def apply(self, project: pf.Project, path: str | os.PathLike[str] | None) -> None:
@@ -134,7 +143,7 @@ class ProjectController(QObject):
             w.jobs.cancel(job)
         model.clear()
         w.undo_stack.clear()
-        scene.load(project.rest, path, params=project.params)
+        scene.load(project.rest, path, params=project.params, mesh=project.mesh)
         scene.restore(project.stroke_snapshot(scene.pipeline))
         scene.set_binding(project.children)
         _apply_each(
@@ -169,6 +178,8 @@ class ProjectController(QObject):
                 ),
             )
         self.sources.apply_settings(project.settings)
+        if "camera" in project.display:  # after everything that frames the view again
+            _apply_each(w, (lambda: w.viewport.set_camera(Camera.from_state(project.display["camera"])),))
         self._mark_saved()
 
     # -- save and open ---------------------------------------------------------------------

@@ -24,6 +24,7 @@ from hairtool.frozen.brushes import scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.groom import Groom, Topology
 from hairtool.guides.binding import ChildBinding
+from hairtool.io.obj import Mesh
 
 ALIGN_MODES = ("paper", "preserve-length")
 COLOUR_MODES = {
@@ -78,7 +79,7 @@ class Scene(QObject):
         self.colour_mode = "root-to-tip"
         self.ramp = DEFAULT_RAMP
         self.line_width = 2.0
-        self.mesh = None
+        self.mesh: Mesh | None = None
         self.path: Path | None = None
         self.tool = BrushTool()
         self.locked = np.zeros(0, dtype=bool)  # the masked strands (a copy of the pipeline's)
@@ -105,9 +106,17 @@ class Scene(QObject):
         self._cache = {}
         self._rebuild_drawn()
 
-    def load(self, groom: Groom, path: str | Path | None = None, params: FrozenParams | None = None) -> None:
+    def load(
+        self,
+        groom: Groom,
+        path: str | Path | None = None,
+        params: FrozenParams | None = None,
+        mesh: Mesh | None = None,
+    ) -> None:
         """Replace the groom being edited (strokes are dropped; the parameters stay unless
-        ``params`` gives new ones, e.g. a project's, which may only fit the new strands)."""
+        ``params`` gives new ones, e.g. a project's, which may only fit the new strands). The
+        head mesh is the new groom's own, ``mesh`` (None: it has none): a surface belongs to its
+        groom, never to the window."""
         old_params = self._params
         if params is not None:
             self._params = params
@@ -117,7 +126,10 @@ class Scene(QObject):
             self._params = old_params
             raise
         self.path = None if path is None else Path(path)
+        old_mesh, self.mesh = self.mesh, mesh
         self.groom_loaded.emit()
+        if mesh is not old_mesh:
+            self.mesh_changed.emit()
         self.tool_changed.emit()
         self.path_changed.emit()
         if params is not None and params != old_params:
@@ -528,9 +540,11 @@ class Scene(QObject):
             self.line_width = float(width)
             self.display_changed.emit()
 
-    def set_mesh(self, mesh: object | None) -> None:
-        self.mesh = mesh
-        self.mesh_changed.emit()
+    def set_mesh(self, mesh: Mesh | None) -> None:
+        """The groom's head or scalp mesh (None: none); drawn under the hair, kept in projects."""
+        if mesh is not self.mesh:
+            self.mesh = mesh
+            self.mesh_changed.emit()
 
     def displacement(self) -> np.ndarray:
         """``(V,)`` float64 distance of each drawn vertex from its rest position (scene units)."""

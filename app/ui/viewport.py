@@ -173,6 +173,12 @@ class Viewport(QOpenGLWidget):
         self._auto_frame = True
         self.update()
 
+    def set_camera(self, camera: Camera) -> None:
+        """Look through ``camera`` (a project's saved view): kept as it is, not framed again."""
+        self.camera = camera
+        self._auto_frame = False
+        self.update()
+
     def set_ortho(self, on: bool) -> None:
         """2-D (orthographic, front view) or 3-D (perspective) view, framed again."""
         if self.camera.ortho != on:

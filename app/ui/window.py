@@ -24,12 +24,19 @@ from PySide6.QtWidgets import (
 )
 
 from app.ui import export
-from app.ui.animation_io import open_filters, read_any, save_filters
+from app.ui.animation_io import (
+    PROJECT_SUFFIX,
+    USD_EXTENSIONS,
+    open_filters,
+    read_any,
+    save_filters,
+    surface_of,
+)
 from app.ui.animation_model import AnimationModel
 from app.ui.animation_ui import AnimationController
 from app.ui.brush_tool import LABELS, SHORTCUTS, TIPS, brushes
 from app.ui.colouring import displacement_scale
-from app.ui.commands import ParamCommand, RenderHairCommand, StrokeCommand
+from app.ui.commands import MeshCommand, ParamCommand, RenderHairCommand, StrokeCommand
 from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import Job, JobRunner, JobStatus
@@ -44,9 +51,10 @@ from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
 from app.ui.viewport import BRUSH_STEP, Viewport
 from hairtool import io, samples
-from hairtool.errors import HairtoolError
+from hairtool.errors import FormatError, HairtoolError
 from hairtool.groom import Animation, Groom
 from hairtool.guides.files import split_guides
+from hairtool.io.obj import Mesh
 from hairtool.simulate.options import SimulateOptions
 
 MAX_RECENT = 10
@@ -258,9 +266,6 @@ class MainWindow(QMainWindow):
         add_action(self, file, "Export S&trokes…", lambda: self.stroke_files.export_dialog())
         add_action(self, file, "Import / &Replay Strokes…", lambda: self.stroke_files.replay_dialog())
         file.addSeparator()
-        add_action(self, file, "Load head &mesh…", self.load_mesh_dialog)
-        add_action(self, file, "&Clear head mesh", lambda: self.scene.set_mesh(None))
-        file.addSeparator()
         add_action(self, file, "&Quit", self.close, QKeySequence.StandardKey.Quit)
 
         edit = bar.addMenu("&Edit")
@@ -306,6 +311,11 @@ class MainWindow(QMainWindow):
         groom = bar.addMenu("&Groom")
         add_action(self, groom, "&Grow render hair…", self.grow_render_hair_dialog, "Ctrl+G")
         self.remove_hair_action = add_action(self, groom, "&Remove render hair", self.remove_render_hair)
+        groom.addSeparator()
+        add_action(self, groom, "Load head &mesh…", self.load_mesh_dialog)
+        self.remove_mesh_action = add_action(self, groom, "Remove &head mesh", self.remove_mesh)
+        self.remove_mesh_action.setToolTip("Take the head or scalp mesh off this groom (undoable)")
+        self.scene.mesh_changed.connect(self._sync_groom_menu)
         self.scene.drawn_changed.connect(self._sync_groom_menu)
         self.scene.groom_loaded.connect(self._sync_groom_menu)
         self._sync_groom_menu()
@@ -516,20 +526,21 @@ class MainWindow(QMainWindow):
             self.undo_stack.push(ParamCommand(self.scene, name, before, after, drag))
 
     # -- files ----------------------------------------------------------------------------------
-    def set_groom(self, groom: Groom, path: str | os.PathLike[str] | None = None) -> None:
-        """Show a new groom; its strokes start afresh, so the undo history is cleared (and an
-        animation on the timeline is closed)."""
+    def set_groom(
+        self, groom: Groom, path: str | os.PathLike[str] | None = None, mesh: Mesh | None = None
+    ) -> None:
+        """Show a new groom on its own head ``mesh`` (None: none); its strokes start afresh, so
+        the undo history is cleared (and an animation on the timeline is closed)."""
         self.animation.clear()
         self.undo_stack.clear()
         self._pending_render_hair = None  # the bundled sample's children, not this groom's
-        self.scene.load(groom, path)
+        self.scene.load(groom, path, mesh=mesh)
         self.undo_stack.setClean()
         self._update_title()
 
     def new_from_sample(self, kind: str) -> None:
         """A procedural sample groom, as a new untitled scene (no head mesh)."""
         self.set_groom(samples.sample(kind))
-        self.scene.set_mesh(None)
 
     def open_bundled_sample(self) -> bool:
         """The studio's default scene: Sintel's hair on her head, shipped in ``app.resources``.
@@ -546,8 +557,7 @@ class MainWindow(QMainWindow):
         except HairtoolError as e:  # a broken installation: say so, keep the scene
             self.show_error("Cannot open the bundled sample", str(e))
             return False
-        self.set_groom(groom)
-        self.scene.set_mesh(mesh)
+        self.set_groom(groom, mesh=mesh)
         self.viewport.frame_all()
 
         def render_hair() -> None:  # Sintel's hair as guides with interpolated render hair, shaded
@@ -569,12 +579,14 @@ class MainWindow(QMainWindow):
             self._pending_render_hair = bind
             self.statusBar().showMessage(waiting)
 
-    def _open_with_guides(self, hair: Groom, guides: Groom, path: str | os.PathLike[str]) -> None:
+    def _open_with_guides(
+        self, hair: Groom, guides: Groom, path: str | os.PathLike[str], mesh: Mesh | None = None
+    ) -> None:
         """A file of render hair and its guides (as the studio saves it): the brushes work on the
         guides, and the render hair, bound to them exactly, follows (and is what Save writes)."""
         from hairtool.guides.binding import bind_to_guides
 
-        self.set_groom(guides, path)
+        self.set_groom(guides, path, mesh)
 
         def render_hair() -> None:
             self.scene.set_binding(bind_to_guides(hair, guides))
@@ -588,6 +600,7 @@ class MainWindow(QMainWindow):
     # -- render hair ------------------------------------------------------------------------
     def _sync_groom_menu(self) -> None:
         self.remove_hair_action.setEnabled(self.scene.binding is not None)
+        self.remove_mesh_action.setEnabled(self.scene.mesh is not None)
 
     def ask_grow_options(self, options: GrowOptions) -> GrowOptions | None:
         """The Grow render hair… dialog: GrowOptions or None (tests replace this)."""
@@ -615,7 +628,7 @@ class MainWindow(QMainWindow):
             if self.scene.rest is not rest:
                 return  # another groom was opened meanwhile
             if dense:
-                self.set_groom(guides)
+                self.set_groom(guides, mesh=mesh)  # the same head under the picked guides
                 self.scene.set_binding(binding)
                 n, g = binding.child_count, guides.strand_count
                 self.statusBar().showMessage(f"{n:,} strands follow {g:,} guides picked among them", 5000)
@@ -637,23 +650,30 @@ class MainWindow(QMainWindow):
             self.open_path(path)
 
     def open_path(self, path: str | os.PathLike[str]) -> bool:
-        """Open any readable groom, or an animation (USD time samples, ``.npz``, BVH as a
-        skeleton) into the timeline on its first frame; on failure the scene is kept."""
+        """Open a project (``.hairproj``), any readable groom, or an animation (USD time samples,
+        ``.npz``, BVH as a skeleton) into the timeline on its first frame, on the file's own
+        head mesh (USD: its Mesh prims) or none; on failure the scene is kept."""
+        if Path(path).suffix.lower() == PROJECT_SUFFIX:
+            ok = self.project.open_project(path)
+            if ok:
+                self._add_recent(path)
+            return ok
         try:
             obj = read_any(path)
+            mesh = surface_of(path)
         except HairtoolError as e:
             self.show_error("Cannot open file", str(e))
             return False
         if isinstance(obj, Animation):
-            self.set_groom(obj.rest, path)
+            self.set_groom(obj.rest, path, mesh)
             if obj.n_frames > 1:
                 self.animation.load_animation(obj, str(path))
         else:
             hair, guides = split_guides(obj)
             if guides is None:
-                self.set_groom(obj, path)
+                self.set_groom(obj, path, mesh)
             else:
-                self._open_with_guides(hair, guides, path)
+                self._open_with_guides(hair, guides, path, mesh)
         self._add_recent(path)
         return True
 
@@ -680,6 +700,10 @@ class MainWindow(QMainWindow):
     def _write_groom(self, path: str | os.PathLike[str], *, adopt: bool) -> bool:
         try:
             io.write(path, self.scene.export_groom())
+            if self.scene.mesh is not None and Path(path).suffix.lower() in USD_EXTENSIONS:
+                from hairtool.io.usd_mesh import add_mesh
+
+                add_mesh(path, self.scene.mesh)  # the head goes with the groom (a Mesh prim beside)
         except HairtoolError as e:
             self.show_error("Cannot write file", str(e))
             return False
@@ -692,21 +716,29 @@ class MainWindow(QMainWindow):
         return True
 
     def load_mesh_dialog(self) -> None:
-        path = self.ask_open_path("Load head mesh", "Wavefront OBJ (*.obj)")
+        path = self.ask_open_path("Load head mesh", "Wavefront OBJ (*.obj);;USD meshes (*.usda *.usdc *.usd)")
         if path:
             self.load_mesh(path)
 
     def load_mesh(self, path: str | os.PathLike[str]) -> bool:
+        """Put this groom on the head mesh of an OBJ file (or a USD file's Mesh prims); undoable."""
         from hairtool.io.obj import read_mesh
 
         try:
-            mesh = read_mesh(path)
+            mesh = surface_of(path) if Path(path).suffix.lower() != ".obj" else read_mesh(path)
+            if mesh is None:
+                raise FormatError(path, "no mesh in this file")
         except HairtoolError as e:
             self.show_error("Cannot load head mesh", str(e))
             return False
         self.remember_dir(path)
-        self.scene.set_mesh(mesh)
+        self.undo_stack.push(MeshCommand(self.scene, self.scene.mesh, mesh, "Load head mesh"))
         return True
+
+    def remove_mesh(self) -> None:
+        """Take the head mesh off this groom (undoable)."""
+        if self.scene.mesh is not None:
+            self.undo_stack.push(MeshCommand(self.scene, self.scene.mesh, None, "Remove head mesh"))
 
     # -- stills ----------------------------------------------------------------------------------
     def viewport_pixel_size(self) -> tuple[int, int]:

@@ -232,3 +232,31 @@ def test_corrupt_npy_header_in_a_member_is_a_format_error(tmp_path):
             zf.writestr(name, data)
     with pytest.raises(FormatError, match=r"'groom/points\.npy' has a corrupt \.npy header"):
         project.load(p)
+
+
+def test_the_head_mesh_and_the_up_axis_are_part_of_the_project(tmp_path):
+    from hairtool.io.obj import Mesh
+
+    rest = samples.scalp(8, 4, seed=1)
+    rest = rest.with_metadata(rest.metadata.with_(up_axis="Z", meters_per_unit=1.0))
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], np.float32)
+    f = np.array([[0, 1, 2], [0, 2, 3]], np.int32)
+    mesh = Mesh(v, f, np.tile(np.float32([0, 0, 1]), (4, 1)), {"scalp": np.array([1])})
+    path = tmp_path / "head.hairproj"
+    project.save(path, project.Project(rest=rest, mesh=mesh))
+    back = project.load(path)
+    assert back.rest.metadata.up_axis == "Z" and back.rest.metadata.meters_per_unit == 1.0
+    assert back.mesh.vertices.tobytes() == v.tobytes() and back.mesh.faces.tolist() == f.tolist()
+    assert back.mesh.groups["scalp"].tolist() == [1]
+    assert project.load(_saved(tmp_path, project.Project(rest=samples.comb()))).mesh is None
+
+    bad = Mesh(v, np.array([[0, 1, 9]], np.int32), v, {})
+    project.save(path, project.Project(rest=rest, mesh=bad))
+    with pytest.raises(FormatError, match=r"head\.hairproj.*outside"):
+        project.load(path)
+
+
+def _saved(tmp_path, proj) -> object:
+    path = tmp_path / "plain.hairproj"
+    project.save(path, proj)
+    return path
