@@ -1,8 +1,11 @@
 """An orbit camera for the viewport and for exports: numpy and pyrr only, no GL, no Qt.
 
 Conventions: y is up; yaw = pitch = 0 looks along −z (the eye sits on +z of the target), which
-is also the fixed view of the orthographic 2-D mode. Matrices are pyrr's row-major ones: a row
-vector ``[x, y, z, 1] @ view @ proj`` gives clip coordinates, and the same arrays written to a
+is also the fixed view of the orthographic 2-D mode. A Z-up scene (``up_axis="Z"``, a USD stage's
+or the artist's choice) is seen through the same orbit turned by (x, y, z) ↦ (x, −z, y), the
+DCCs' convention (hairtool.metadata's frame): up is +z and the front view looks along +y.
+Matrices are pyrr's row-major ones: a row vector ``[x, y, z, 1] @ view @ proj`` gives clip
+coordinates, and the same arrays written to a
 GLSL ``mat4`` need no transpose. Pixel coordinates have their origin at the top-left corner with
 y down, like Qt's mouse events and image rows.
 """
@@ -21,6 +24,7 @@ from hairtool.errors import ParameterError
 ORBIT_RAD_PER_PX = 0.01
 ZOOM_PER_STEP = 1.15
 PITCH_LIMIT = math.radians(89.0)
+UP_AXES = ("Y", "Z")
 FRAME_MARGIN = 1.08  # frame-all leaves this much room around the box
 
 
@@ -55,8 +59,12 @@ class Camera:
         fov_y: float = 35.0,
         ortho: bool = False,
         ortho_height: float = 2.0,
+        up_axis: str = "Y",
     ) -> None:
         self.target = _vec3(target, "target")
+        self.up_axis = str(up_axis).upper()
+        if self.up_axis not in UP_AXES:
+            raise ParameterError("up axis", up_axis, "Y or Z")
         self.distance = _positive(distance, "distance")
         self.yaw = float(yaw)
         self.pitch = float(np.clip(pitch, -PITCH_LIMIT, PITCH_LIMIT))
@@ -71,9 +79,12 @@ class Camera:
 
     # -- placing ---------------------------------------------------------------------
     @classmethod
-    def for_bounds(cls, lo: ArrayLike, hi: ArrayLike, *, ortho: bool = False, aspect: float = 1.0) -> Camera:
-        """A camera framing the box: a front view in 2-D, a three-quarter view in 3-D."""
-        cam = cls(ortho=ortho) if ortho else cls(yaw=0.35, pitch=0.15)
+    def for_bounds(
+        cls, lo: ArrayLike, hi: ArrayLike, *, ortho: bool = False, aspect: float = 1.0, up_axis: str = "Y"
+    ) -> Camera:
+        """A camera framing the box: a front view in 2-D, a three-quarter view in 3-D, with
+        ``up_axis`` (Y or Z) up on screen."""
+        cam = cls(ortho=ortho, up_axis=up_axis) if ortho else cls(yaw=0.35, pitch=0.15, up_axis=up_axis)
         cam.frame(lo, hi, aspect=aspect)
         return cam
 
@@ -99,7 +110,7 @@ class Camera:
         if self.ortho:
             self.yaw = self.pitch = 0.0
             extent = hi_v - lo_v
-            height = max(extent[1], extent[0] / aspect, 1e-6)
+            height = max(extent[1 if self.up_axis == "Y" else 2], extent[0] / aspect, 1e-6)
             self.ortho_height = height * FRAME_MARGIN
             self.distance = 2.0 * r + 1.0
         else:
@@ -140,24 +151,28 @@ class Camera:
             self.distance = float(np.clip(self.distance / f, r * 1e-3, r * 1e4))
 
     # -- geometry --------------------------------------------------------------------
+    def _world(self, x: float, y: float, z: float) -> NDArray[np.float64]:
+        """A direction of the Y-up orbit frame in world axes (turned for a Z-up scene)."""
+        return np.array([x, y, z] if self.up_axis == "Y" else [x, -z, y])
+
     def forward(self) -> NDArray[np.float64]:
         """Unit view direction, from the eye toward the target."""
         cp = math.cos(self.pitch)
-        return -np.array([cp * math.sin(self.yaw), math.sin(self.pitch), cp * math.cos(self.yaw)])
+        return self._world(-cp * math.sin(self.yaw), -math.sin(self.pitch), -cp * math.cos(self.yaw))
 
     def eye(self) -> NDArray[np.float64]:
         return self.target - self.forward() * self.distance
 
     def basis(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """Unit ``(right, up, forward)`` of the view in world space: right = f × y, up = right × f,
+        """Unit ``(right, up, forward)`` of the view in world space: right = f × up, up = right × f,
         written out (np.cross costs ~10 µs a call, and a drag frame asks for the basis a dozen
         times)."""
-        f = self.forward()
-        fx, fy, fz = float(f[0]), float(f[1]), float(f[2])
+        cp = math.cos(self.pitch)
+        fx, fy, fz = -cp * math.sin(self.yaw), -math.sin(self.pitch), -cp * math.cos(self.yaw)
         n = math.hypot(fz, fx)
         rx, rz = -fz / n, fx / n
-        right = np.array([rx, 0.0, rz])
-        return right, np.array([-rz * fy, rz * fx - rx * fz, rx * fy]), f
+        w = self._world
+        return w(rx, 0.0, rz), w(-rz * fy, rz * fx - rx * fz, rx * fy), w(fx, fy, fz)
 
     def near_far(self) -> tuple[float, float]:
         """Clip planes that enclose the scene sphere (and the target) with some slack."""
@@ -249,6 +264,7 @@ class Camera:
             "ortho_height": self.ortho_height,
             "scene_center": [float(v) for v in self.scene_center],
             "scene_radius": self.scene_radius,
+            "up_axis": self.up_axis,
         }
 
     @classmethod
@@ -262,6 +278,7 @@ class Camera:
                 fov_y=state["fov_y"],
                 ortho=state["ortho"],
                 ortho_height=state["ortho_height"],
+                up_axis=state.get("up_axis", "Y"),
             )
         except (KeyError, TypeError) as e:
             raise ParameterError("camera state", state, f"a dict from Camera.state() ({e})") from None

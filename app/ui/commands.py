@@ -1,5 +1,5 @@
 """Undo steps: one per brush stroke (or replayed stroke log), one per (merged) parameter edit, one
-per render hair grown or removed, one per head mesh loaded or removed."""
+per render hair grown or removed, one per head mesh loaded or removed, one per up axis set."""
 
 from __future__ import annotations
 
@@ -96,3 +96,17 @@ class MeshCommand(QUndoCommand):
 
     def undo(self) -> None:
         self._scene.set_mesh(self._before)
+
+
+class UpAxisCommand(QUndoCommand):
+    """The groom's up axis set (View > Up axis): the points stay, the view and engines turn."""
+
+    def __init__(self, scene: Scene, before: str, after: str) -> None:
+        super().__init__(f"Up axis {after}")
+        self._scene, self._before, self._after = scene, before, after
+
+    def redo(self) -> None:
+        self._scene.set_up_axis(self._after)
+
+    def undo(self) -> None:
+        self._scene.set_up_axis(self._before)

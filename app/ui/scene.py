@@ -25,6 +25,7 @@ from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.groom import Groom, Topology
 from hairtool.guides.binding import ChildBinding
 from hairtool.io.obj import Mesh
+from hairtool.metadata import UP_AXES
 
 ALIGN_MODES = ("paper", "preserve-length")
 COLOUR_MODES = {
@@ -52,6 +53,7 @@ class Scene(QObject):
     drawn_changed = Signal()  # the drawn strands' topology changed (children density, guides shown)
     engine_starting = Signal()  # the pipeline is about to be built (may compile: show a wait)
     engine_started = Signal()
+    up_axis_changed = Signal()  # the document's up axis (Y or Z): the view turns, engines follow
 
     def __init__(
         self,
@@ -156,6 +158,33 @@ class Scene(QObject):
         self.params_changed.emit(self._params)
         self.points_changed.emit()
         self.engine_started.emit()
+
+    @property
+    def up_axis(self) -> str:
+        """The groom's up axis, "Y" or "Z": its file's (a USD stage's upAxis), or the artist's
+        choice for formats that have none. It lives in the groom's metadata, so the engines
+        (puff's head sphere, simulation, anime cycles) and every save read it from there."""
+        return self.rest.metadata.up_axis
+
+    def set_up_axis(self, axis: str) -> None:
+        """Say which axis is up (the points stay where they are: a relabelling, as a USD stage's
+        upAxis is). The pipeline is rebuilt on the relabelled groom, its strokes kept."""
+        axis = str(axis).upper()
+        if axis not in UP_AXES:
+            raise ParameterError("up axis", axis, "Y or Z")
+        if axis == self.up_axis:
+            return
+        rest = self.rest.with_metadata(self.rest.metadata.with_(up_axis=axis))
+        self.rest = rest
+        if self.pipeline is None:
+            self.result = rest
+        else:
+            snap = self.pipeline.snapshot()
+            self.pipeline = FrozenPipeline(rest, self._params)
+            self.result = self.pipeline.restore(snap)
+        self._children_moved()
+        self.up_axis_changed.emit()
+        self.points_changed.emit()
 
     @property
     def is_planar(self) -> bool:

@@ -107,6 +107,7 @@ class Viewport(QOpenGLWidget):
         scene.tool_changed.connect(self.update)
         scene.mask_changed.connect(lambda: self._mark("colors"))
         scene.engine_started.connect(self._on_engine_started)
+        scene.up_axis_changed.connect(self._on_up_axis_changed)
 
     # -- scene → view ----------------------------------------------------------------------
     def _mark(self, *what: str) -> None:
@@ -119,7 +120,16 @@ class Viewport(QOpenGLWidget):
     def _fresh_camera(self) -> Camera:
         """Front orthographic view for planar grooms (2-D), a three-quarter perspective otherwise."""
         lo, hi = self.scene.result.bounds
-        return Camera.for_bounds(lo, hi, ortho=self.scene.is_planar, aspect=self._aspect())
+        s = self.scene
+        return Camera.for_bounds(lo, hi, ortho=s.is_planar, aspect=self._aspect(), up_axis=s.up_axis)
+
+    def _on_up_axis_changed(self) -> None:
+        """The document's up axis changed: the same kind of view, with that axis up, framed."""
+        ortho = self.camera.ortho
+        self.camera = Camera.for_bounds(
+            *self.scene.result.bounds, ortho=ortho, aspect=self._aspect(), up_axis=self.scene.up_axis
+        )
+        self.frame_all()
 
     def _on_groom_loaded(self) -> None:
         self.camera = self._fresh_camera()
@@ -185,7 +195,8 @@ class Viewport(QOpenGLWidget):
             if on:
                 self.camera.ortho = True
             else:
-                self.camera = Camera.for_bounds(*self.scene.result.bounds, ortho=False, aspect=self._aspect())
+                lo, hi = self.scene.result.bounds
+                self.camera = Camera.for_bounds(lo, hi, aspect=self._aspect(), up_axis=self.scene.up_axis)
             self.frame_all()
 
     # -- GL ----------------------------------------------------------------------------------

@@ -36,7 +36,7 @@ from app.ui.animation_model import AnimationModel
 from app.ui.animation_ui import AnimationController
 from app.ui.brush_tool import LABELS, SHORTCUTS, TIPS, brushes
 from app.ui.colouring import displacement_scale
-from app.ui.commands import MeshCommand, ParamCommand, RenderHairCommand, StrokeCommand
+from app.ui.commands import MeshCommand, ParamCommand, RenderHairCommand, StrokeCommand, UpAxisCommand
 from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import Job, JobRunner, JobStatus
@@ -280,6 +280,22 @@ class MainWindow(QMainWindow):
         add_action(self, view, "&Frame all", self.viewport.frame_all, "F")  # Home: first frame
         self.ortho_action = add_action(self, view, "&2-D view", self.toggle_ortho, "5", checkable=True)
         view.aboutToShow.connect(self._sync_view_menu)
+        up = view.addMenu("&Up axis")
+        up.setToolTipsVisible(True)
+        up_group = QActionGroup(self)
+        self.up_axis_actions: dict[str, QAction] = {}
+        for axis in ("Y", "Z"):
+            a = add_action(self, up, f"{axis} up", lambda _=False, x=axis: self.set_up_axis(x))
+            a.setCheckable(True)
+            a.setToolTip(
+                f"This groom's {axis} axis points up (HAIR, TressFX and OBJ files do not say; a USD "
+                "stage does): the view turns, and puff, simulation and anime cycles pull along it"
+            )
+            up_group.addAction(a)
+            self.up_axis_actions[axis] = a
+        self.scene.up_axis_changed.connect(self._sync_view_menu)
+        self.scene.groom_loaded.connect(self._sync_view_menu)
+        self._sync_view_menu()
         colour = view.addMenu("&Colour by")
         group = QActionGroup(self)
         self.colour_actions: dict[str, QAction] = {}
@@ -432,6 +448,15 @@ class MainWindow(QMainWindow):
 
     def _sync_view_menu(self) -> None:
         self.ortho_action.setChecked(self.viewport.camera.ortho)
+        self.up_axis_actions[self.scene.up_axis].setChecked(True)
+
+    def set_up_axis(self, axis: str) -> None:
+        """View ▸ Up axis: which axis of this groom points up (one undo step; kept in projects
+        and written to USD as the stage's upAxis)."""
+        before = self.scene.up_axis
+        if axis != before:
+            self.undo_stack.push(UpAxisCommand(self.scene, before, axis))
+        self._sync_view_menu()
 
     def _fill_recent_menu(self) -> None:
         self.recent_menu.clear()

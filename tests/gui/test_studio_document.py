@@ -79,8 +79,12 @@ def test_a_project_restores_the_head_mesh_and_the_camera(make_window, grooms_dir
     assert w2.project.open_project(path), w2.errors
     assert w2.scene.mesh is not None
     assert w2.scene.mesh.vertices.tobytes() == w.scene.mesh.vertices.tobytes()
+    restored = w2.viewport.camera.state()
     for key, value in saved.items():
-        np.testing.assert_allclose(w2.viewport.camera.state()[key], value, err_msg=key)
+        if isinstance(value, (str, bool)):
+            assert restored[key] == value, key
+        else:
+            np.testing.assert_allclose(restored[key], value, err_msg=key)
     w2.resize(w2.width() + 40, w2.height())  # a resize does not frame the restored view again
     QApplication.processEvents()
     np.testing.assert_allclose(w2.viewport.camera.distance, saved["distance"])
@@ -136,3 +140,43 @@ def test_an_unknown_format_lists_every_format_the_studio_opens(make_window, tmp_
     message = w.errors[-1][1]
     for ext in (".bvh", ".hairproj", ".tfx", ".usda", ".hair", ".npz", ".obj"):
         assert ext in message, (ext, message)
+
+
+def _z_up(groom):
+    """The groom turned as a Z-up DCC holds it: (x, y, z) ↦ (x, −z, y)."""
+    p = groom.points
+    return groom.with_points(np.stack([p[:, 0], -p[:, 2], p[:, 1]], axis=1))
+
+
+def test_up_axis_switch_for_a_z_up_hair_file(make_window, tmp_path):
+    path = tmp_path / "z_up.hair"
+    io.write(path, _z_up(samples.scalp(40, 8, seed=6)))  # HAIR files say nothing of their up axis
+    w = make_window()
+    assert w.open_path(path), w.errors
+    s, v = w.scene, w.viewport
+    assert s.up_axis == "Y" and w.up_axis_actions["Y"].isChecked()
+
+    def crown_above_tips() -> float:
+        roots, tips = v.project(s.result.roots).mean(axis=0), v.project(s.result.tips).mean(axis=0)
+        return float(tips[1] - roots[1])  # pixels the tips hang below the crown
+
+    lying = crown_above_tips()
+    w.up_axis_actions["Z"].trigger()
+    assert s.up_axis == "Z" and w.up_axis_actions["Z"].isChecked()
+    assert v.camera.up_axis == "Z" and v.camera.basis()[1][2] > 0.9
+    assert crown_above_tips() > max(lying, 0.0) + 20  # she stands up
+    assert s.pipeline.rest.metadata.up_axis == s.result.metadata.up_axis == "Z"  # what the engines read
+    assert w.undo_stack.undoText() == "Up axis Z"
+
+    proj = tmp_path / "z.hairproj"
+    assert w.project.save_to(proj), w.errors
+    usd = tmp_path / "z.usda"
+    assert w.export_groom(usd), w.errors
+    assert io.read_groom(usd).metadata.up_axis == "Z"  # the stage's upAxis
+    w2 = make_window()
+    assert w2.project.open_project(proj), w2.errors
+    assert w2.scene.up_axis == "Z" and w2.viewport.camera.up_axis == "Z"
+    assert w2.open_path(usd) and w2.scene.up_axis == "Z" and w2.up_axis_actions["Z"].isChecked()
+
+    w.undo_stack.undo()
+    assert s.up_axis == "Y" and v.camera.up_axis == "Y"

@@ -136,3 +136,22 @@ def test_bad_parameters_name_themselves():
         Camera(target=(0, float("nan"), 0))
     with pytest.raises(ParameterError, match="aspect"):
         Camera().projection_matrix(0)
+
+
+@pytest.mark.parametrize("ortho", [False, True])
+def test_a_z_up_camera_is_the_y_up_one_turned_by_the_dccs_frame(ortho):
+    turn = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # (x, y, z) ↦ (x, −z, y)
+    lo, hi = np.array([-1.0, -2.0, -0.5]), np.array([1.0, 3.0, 0.5])
+    y_up = Camera.for_bounds(lo, hi, ortho=ortho, aspect=1.5)
+    z_lo, z_hi = np.minimum(turn @ lo, turn @ hi), np.maximum(turn @ lo, turn @ hi)
+    z_up = Camera.for_bounds(z_lo, z_hi, ortho=ortho, aspect=1.5, up_axis="Z")
+    for a, b in zip(y_up.basis(), z_up.basis(), strict=True):
+        np.testing.assert_allclose(turn @ a, b, atol=1e-12)
+    rng = np.random.default_rng(1)
+    p = rng.uniform(-1, 1, (20, 3))
+    np.testing.assert_allclose(y_up.project(p, 300, 200), z_up.project(p @ turn.T, 300, 200), atol=1e-6)
+    top = z_up.project([[0.0, 0.0, 2.0], [0.0, 0.0, -2.0]], 300, 200)
+    assert top[0, 1] < top[1, 1]  # +z is up on screen
+    assert Camera.from_state(z_up.state()).up_axis == "Z"
+    with pytest.raises(ParameterError, match="up axis"):
+        Camera(up_axis="X")
