@@ -468,8 +468,9 @@ class AnimationExporter(QObject):
 
         else:  # the animation's own strands (the guides alone, or another groom's)
             same = animation.topology == scene.result.topology and not scene.has_children
-            per_strand = same and scene.colour_mode in ("strand", "clump")
-            colors = look.colors if per_strand else None  # per-strand colours hold on every frame
+            # the view's colours hang on the strands (ramp, per strand, clumps, mask), not the pose,
+            # so they hold on every frame; the distances from rest are the edit's, not the frame's
+            colors = look.colors if same and scene.colour_mode != "displacement" else None
 
             def frame_drawn(f: int) -> Drawn:
                 return dataclasses.replace(

@@ -91,3 +91,59 @@ def test_a_drawn_value_refuses_colours_of_other_strands(sintel):
     bad = Drawn(d.points, d.topology, make_colors=lambda: wrong)
     with pytest.raises(ParameterError, match="colors"):
         bad.colors  # noqa: B018
+
+
+def test_the_mask_tint_is_in_stills_and_videos_only_with_overlays(ui, make_window, tmp_path, monkeypatch):
+    from app.ui.dialogs import PictureOptions
+    from hairtool import samples
+    from hairtool.simulate.sway import sway_animation
+
+    groom = samples.scalp(30, 8, seed=4)
+    w = make_window(groom=groom, size=(520, 380))
+    v = w.viewport
+    w.scene.set_brush("mask")
+    w.scene.set_radius(0.5)
+    tips = v.project(w.scene.result.tips)
+    ui.drag(v, tips[0], tips[0] + np.array([40.0, 10.0]), steps=4)
+    assert w.scene.locked.any()
+    ui.leave(v)
+    plain, tinted = tmp_path / "plain.png", tmp_path / "tinted.png"
+    assert w.export_still(plain) and w.export_still(tinted, overlays=True), w.errors
+    a, b = iio.imread(plain), iio.imread(tinted)
+    assert np.any(a != b, axis=2).sum() > 20  # the masked strands' slate blue, only when asked
+    size = w.viewport_pixel_size()
+    with v.current_context() as ctx:
+        untinted = render_drawn(v.drawn(mask=False), size=size, camera=v.camera, ctx=ctx, strand_raster="gl")
+    np.testing.assert_array_equal(a, untinted)
+
+    w.animation.load_animation(sway_animation(groom, 4), "sway")
+    w.jobs.wait()
+    asked = []
+    monkeypatch.setattr(w, "ask_save_path", lambda *a, **k: str(tmp_path / "plain.gif"))
+    monkeypatch.setattr(w, "ask_picture_options", lambda: asked.append(1) or PictureOptions((100, 80), False))
+    assert w.exporter.export_animation_dialog() and asked  # a video asks for its size first
+    assert w.jobs.wait(60)
+    job = w.exporter.export_animation(tmp_path / "tinted.gif", (100, 80), overlays=True)
+    assert job is not False and w.jobs.wait(60) and job.state == "done", w.errors
+    frames = {n: np.asarray(imageio.mimread(tmp_path / f"{n}.gif")[0])[..., :3] for n in ("plain", "tinted")}
+    assert frames["plain"].shape == (80, 100, 3)
+    assert np.any(frames["plain"] != frames["tinted"], axis=2).sum() > 5
+
+
+def test_the_size_choice_offers_the_viewport_1080p_and_a_custom_size(qtbot):
+    from app.ui.dialogs import PictureDialog, StillDialog
+
+    still = StillDialog((640, 360))
+    qtbot.addWidget(still)
+    assert still.size_px() == (640, 360) and not still.width_box.isEnabled()
+    assert not still.overlays.isChecked()  # overlays are left out unless ticked
+    still.size_form.set_choice("1080p")
+    assert still.size_px() == (1920, 1080)
+    still.size_form.set_choice("custom")
+    still.width_box.setValue(800)
+    assert still.width_box.isEnabled() and still.size_px() == (800, 1080)
+    video = PictureDialog((500, 300))
+    qtbot.addWidget(video)
+    video.size_form.set_choice("1080p")
+    video.overlays.setChecked(True)
+    assert video.options().size == (1920, 1080) and video.options().overlays
