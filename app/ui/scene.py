@@ -419,12 +419,6 @@ class Scene(QObject):
         children = build_points(self.drawn_binding(), g)
         return np.concatenate([children, g.points]) if self.drawn_guides else children
 
-    def drawn_groom(self) -> Groom:
-        """The drawn strands as a groom (children first, then the guides if shown)."""
-        if self.binding is None:
-            return self.result
-        return Groom(self.drawn_points, self.drawn_topology)
-
     def render_hair(self) -> Groom | None:
         """Every child at the guides' current shapes (full density; clumped when switched on),
         or None without children."""
