@@ -133,7 +133,7 @@ class Viewport(QOpenGLWidget):
 
     def _on_groom_loaded(self) -> None:
         self.camera = self._fresh_camera()
-        self._auto_frame = True
+        self.frame_all()  # the groom and its own head (set with it)
         self._mark("groom", "colors")
 
     def _on_points_changed(self) -> None:

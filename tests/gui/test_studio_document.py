@@ -39,6 +39,8 @@ def test_opening_another_groom_shows_its_own_head_or_none(make_window, grooms_di
     head = w.scene.mesh
     assert head is not None and len(head.vertices) == len(sintel_head.vertices)
     assert head is not sintel_head  # the file's own head, read from its Mesh prim
+    px = w.viewport.project(head.vertices)
+    assert px.min() >= 0 and np.all(px.max(axis=0) <= (w.viewport.width(), w.viewport.height()))  # in view
     w.new_from_sample("comb")
     assert w.scene.mesh is None
 
