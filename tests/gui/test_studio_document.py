@@ -150,7 +150,7 @@ def _z_up(groom):
     return groom.with_points(np.stack([p[:, 0], -p[:, 2], p[:, 1]], axis=1))
 
 
-def test_up_axis_switch_for_a_z_up_hair_file(make_window, tmp_path):
+def test_up_axis_switch_for_a_z_up_hair_file(ui, make_window, tmp_path):
     path = tmp_path / "z_up.hair"
     io.write(path, _z_up(samples.scalp(40, 8, seed=6)))  # HAIR files say nothing of their up axis
     w = make_window()
@@ -163,7 +163,12 @@ def test_up_axis_switch_for_a_z_up_hair_file(make_window, tmp_path):
         return float(tips[1] - roots[1])  # pixels the tips hang below the crown
 
     lying = crown_above_tips()
+    start = v.project(s.result.tips[5:6])[0]
+    ui.drag(v, start, start + np.array([30.0, 20.0]), steps=3)
+    strokes, shaped = s.pipeline.strokes, s.result.points.copy()
+    assert strokes
     w.up_axis_actions["Z"].trigger()
+    assert s.pipeline.strokes == strokes and s.result.points.tobytes() == shaped.tobytes()  # kept
     assert s.up_axis == "Z" and w.up_axis_actions["Z"].isChecked()
     assert v.camera.up_axis == "Z" and v.camera.basis()[1][2] > 0.9
     assert crown_above_tips() > max(lying, 0.0) + 20  # she stands up
