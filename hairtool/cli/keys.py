@@ -83,10 +83,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="OUT",
         help="write the keys by suffix: .usd/.usda/.usdc key poses as time samples (animations), .json "
         "record, .csv sheet (one row per frame; with --interp hermite or hermite-fit, per channel the "
-        "key values and tangents)",
+        "key values and tangents), .bvh (BVH input: the key curve at every frame, or with --edit the "
+        "edited capture)",
     )
     parser.add_argument(
         "--bake", action="store_true", help="with --export: every frame of the key curve, not just the keys"
+    )
+    parser.add_argument(
+        "--edit",
+        type=Path,
+        metavar="EDITS.json",
+        help="BVH: key poses moved by IK, a list of {frame (a key), joint, target [x, y, z], chain (how many "
+        "joints above it turn)}; with --export OUT.bvh writes the edited capture, the captured detail kept",
     )
     parser.add_argument(
         "--storage",
@@ -172,6 +180,7 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
 
     bar(0.0, "reading")
     kind, data, fps = _load(args)
+    args.edits = _read_edits(args, kind, data)
     bar(0.05, "features")
     options = FeatureOptions(
         samples=None if args.no_resample else args.samples,
@@ -199,6 +208,8 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
             raise ParameterError("per-channel", True, "a --penalty TAU (seed 003 prices keys per channel)")
         if constraints:
             raise ParameterError("pin", args.pin or args.exclude, "keys of the whole pose, not --per-channel")
+        if args.edits is not None:
+            raise ParameterError("edit", str(args.edit), "keys of the whole pose, not --per-channel")
         relative = args.penalty is not None
         tau = args.penalty if relative else args.penalty_abs
         channels = per_channel_keys(x, tau, interp=args.interp, curvature=args.curvature, relative=relative)
@@ -283,10 +294,15 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
         from hairtool.keys.storage import storage
 
         result["storage"] = storage(data, sel.keys, args.input) if kind == "animation" else None
-    if args.export is not None:
+    if args.export is not None and args.export.suffix.lower() == ".bvh":
+        _export_bvh(args, kind, data, sel.keys, result)
+    elif args.edits is not None:
+        raise ParameterError("edit", str(args.edit), "an --export OUT.bvh to write the edited capture to")
+    elif args.export is not None:
         suffix = args.export.suffix.lower()
         if (args.bake or suffix not in JSON_SUFFIXES + CSV_SUFFIXES) and kind != "animation":
-            raise ParameterError("export", str(args.export), "a .json or .csv file, or an animation input")
+            wanted = "a .json or .csv file, a .bvh for a BVH input, or an animation input"
+            raise ParameterError("export", str(args.export), wanted)
         if args.bake:
             from hairtool.io import write
             from hairtool.keys.reconstruct import reconstruct
@@ -311,6 +327,14 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
     )
     if "note" in result:
         line += f"\n{result['note']}"
+    for i, r in enumerate(result.get("edits", []), 1):
+        line += (
+            f"\nedit {i}: {r['edit']['joint']} at frame {r['edit']['frame']} within {r['miss']:.3g} of its "
+            f"target ({r['miss_share']:.2g} of the figure's height), turning {', '.join(r['turned'])} "
+            f"({r['method']}); frames {r['first']}-{r['last']} follow"
+        )
+        if r["miss_share"] > r["tolerance_share"]:
+            line += " (out of reach: as near as the chain allows)"
     if result.get("storage"):
         st = result["storage"]
         line += (
@@ -318,6 +342,46 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
             f"{st['ratio']:.1%} of the input's {st['input_bytes']}"
         )
     return _emit(args, result, line, time_codes)
+
+
+def _read_edits(args: argparse.Namespace, kind: str, data):
+    """The checked edits of ``--edit`` (before the keys are solved, so a bad file fails fast), or None."""
+    if args.edit is None:
+        return None
+    from hairtool.errors import ParameterError
+
+    if kind != "bvh":
+        raise ParameterError("edit", str(args.edit), "a .bvh input (edits move a skeleton's joints)")
+    from hairtool.mocap.pose_edit import read_edits
+
+    return read_edits(args.edit, data)
+
+
+def _export_bvh(args: argparse.Namespace, kind: str, data, keys, result: dict) -> None:
+    """``--export OUT.bvh``: the capture with ``--edit``'s key poses (residuals kept), or the key
+    curve itself (the reduced motion); the input's hierarchy, offsets, channels and frame time."""
+    from hairtool.errors import FormatError, ParameterError
+    from hairtool.mocap.bvh import write_bvh
+
+    if kind != "bvh":
+        raise ParameterError("export", str(args.export), "a .bvh input to write a .bvh")
+    if args.edits is None:
+        from hairtool.mocap.costs import reconstruct_motion
+
+        write_bvh(args.export, reconstruct_motion(data, keys, args.interp))
+        return
+    if args.bake:
+        why = "no --edit: --bake writes the key curve, --edit the edited capture"
+        raise ParameterError("bake", True, why)
+    from hairtool.mocap.pose_edit import PoseEditor
+
+    listed = " ".join(map(str, keys.tolist()))
+    for i, e in enumerate(args.edits, 1):
+        if e.frame not in keys:
+            raise FormatError(args.edit, f"edit {i}: frame {e.frame} is not a key; the keys are {listed}")
+    editor = PoseEditor(data, keys, args.interp)
+    result["edits"] = [r.to_dict() for r in editor.apply_all(args.edits)]
+    write_bvh(args.export, editor.motion())
 
 
 def _curves(kind: str, data, keys, interp: str) -> dict:

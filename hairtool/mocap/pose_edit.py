@@ -59,8 +59,8 @@ class PoseEdit:
 @dataclass
 class EditReport:
     """What one edit did: the joints it turned, the solver, how far the effector is from the
-    target (scene units and share of the figure's height) and the frames it changed
-    (``first``..``last``, the frames strictly between the neighbouring keys)."""
+    target (scene units and share of the figure's height; more than ``tolerance_share``: out of
+    reach) and the frames it changed (``first``..``last``, strictly between the neighbouring keys)."""
 
     edit: PoseEdit
     turned: list[str]
@@ -70,6 +70,7 @@ class EditReport:
     miss_share: float
     first: int
     last: int
+    tolerance_share: float = ik.TOLERANCE
 
     def to_dict(self) -> dict:
         d = asdict(self)
