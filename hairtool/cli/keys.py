@@ -71,9 +71,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     feat.add_argument("--no-relative", action="store_true", help="keep world positions, not root-relative")
     parser.add_argument(
         "--bvh-features",
-        choices=("positions", "rotations", "quaternion"),
+        choices=("positions", "rotations", "quaternion", "channels"),
         default="positions",
-        help="BVH: joint positions, joint rotations (quaternions), or the rotation distance between frames",
+        help="BVH: joint positions, joint rotations (quaternions), the rotation distance between frames, or "
+        "the file's own channels (angles unwrapped; with --per-channel each channel keyed on its own, "
+        "as a DCC keys them, and editable with --edit)",
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     parser.add_argument("--out", type=Path, metavar="KEYS.json", help="write keys, times and parameters")
@@ -191,7 +193,11 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
         tip_weight=args.tip_weight,
         exponent=args.weight_exponent,
     )
-    if kind == "bvh":
+    if kind == "bvh" and args.bvh_features == "channels":
+        from hairtool.mocap.channel_edit import channel_features
+
+        x = channel_features(data)
+    elif kind == "bvh":
         from hairtool.mocap.costs import motion_features
 
         x = motion_features(data, "positions" if args.bvh_features == "positions" else "rotations")
@@ -208,16 +214,26 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
             raise ParameterError("per-channel", True, "a --penalty TAU (seed 003 prices keys per channel)")
         if constraints:
             raise ParameterError("pin", args.pin or args.exclude, "keys of the whole pose, not --per-channel")
-        if args.edits is not None:
-            raise ParameterError("edit", str(args.edit), "keys of the whole pose, not --per-channel")
+        bvh_out = args.export is not None and args.export.suffix.lower() == ".bvh"
+        if (args.edits is not None or bvh_out) and args.bvh_features != "channels":
+            what = "edit" if args.edits is not None else "export"
+            shown = str(args.edit if args.edits is not None else args.export)
+            wanted = "--bvh-features channels with --per-channel (keys per BVH channel)"
+            raise ParameterError(what, shown, wanted)
         relative = args.penalty is not None
         tau = args.penalty if relative else args.penalty_abs
         channels = per_channel_keys(x, tau, interp=args.interp, curvature=args.curvature, relative=relative)
         result = {"frames": n, "fps": fps, **channels.to_dict()}
         if args.storage:
             result["storage"] = None  # no one set of key poses
+        if bvh_out:
+            _export_channels_bvh(args, data, channels.keys, result)
+        elif args.edits is not None:
+            raise ParameterError("edit", str(args.edit), "an --export OUT.bvh to write the edited capture to")
         bar.close()
-        return _emit(args, result, f"{len(result['union'])} frames key at least one of {x.shape[1]} channels")
+        line = f"{len(result['union'])} frames key at least one of {x.shape[1]} channels"
+        line += _edit_lines(result)
+        return _emit(args, result, line)
 
     objective = "worst" if args.max_error is not None else args.objective
     table = None
@@ -327,14 +343,7 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
     )
     if "note" in result:
         line += f"\n{result['note']}"
-    for i, r in enumerate(result.get("edits", []), 1):
-        line += (
-            f"\nedit {i}: {r['edit']['joint']} at frame {r['edit']['frame']} within {r['miss']:.3g} of its "
-            f"target ({r['miss_share']:.2g} of the figure's height), turning {', '.join(r['turned'])} "
-            f"({r['method']}); frames {r['first']}-{r['last']} follow"
-        )
-        if r["miss_share"] > r["tolerance_share"]:
-            line += " (out of reach: as near as the chain allows)"
+    line += _edit_lines(result)
     if result.get("storage"):
         st = result["storage"]
         line += (
@@ -380,6 +389,41 @@ def _export_bvh(args: argparse.Namespace, kind: str, data, keys, result: dict) -
         if e.frame not in keys:
             raise FormatError(args.edit, f"edit {i}: frame {e.frame} is not a key; the keys are {listed}")
     editor = PoseEditor(data, keys, args.interp)
+    result["edits"] = [r.to_dict() for r in editor.apply_all(args.edits)]
+    write_bvh(args.export, editor.motion())
+
+
+def _edit_lines(result: dict) -> str:
+    """One line per edit of ``result["edits"]``: where the joint got to, what turned, what followed."""
+    text = ""
+    for i, r in enumerate(result.get("edits", []), 1):
+        text += (
+            f"\nedit {i}: {r['edit']['joint']} at frame {r['edit']['frame']} within {r['miss']:.3g} of its "
+            f"target ({r['miss_share']:.2g} of the figure's height), turning {', '.join(r['turned'])} "
+            f"({r['method']}); frames {r['first']}-{r['last']} follow"
+        )
+        if r["miss_share"] > r["tolerance_share"]:
+            text += " (out of reach: as near as the chain allows)"
+    return text
+
+
+def _export_channels_bvh(args: argparse.Namespace, data, keys: list, result: dict) -> None:
+    """``--per-channel --bvh-features channels --export OUT.bvh``: each channel its own key curve,
+    or with ``--edit`` the capture with the edits' keys moved (residuals kept)."""
+    from hairtool.errors import FormatError
+    from hairtool.mocap.bvh import write_bvh
+    from hairtool.mocap.channel_edit import ChannelEditor, channel_key_curve
+
+    if args.edits is None:
+        write_bvh(args.export, channel_key_curve(data, keys, args.interp))
+        return
+    editor = ChannelEditor(data, keys, args.interp)
+    union = editor.union
+    for i, e in enumerate(args.edits, 1):
+        if e.frame not in union:
+            listed = " ".join(map(str, union.tolist()))
+            why = f"edit {i}: frame {e.frame} is not a key of any channel; the keys are {listed}"
+            raise FormatError(args.edit, why)
     result["edits"] = [r.to_dict() for r in editor.apply_all(args.edits)]
     write_bvh(args.export, editor.motion())
 

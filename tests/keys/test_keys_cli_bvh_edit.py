@@ -121,8 +121,40 @@ def test_bad_edits_exit_2_with_one_line(motion_dir, tmp_path, capsys):
     as_json = [src, "--keys", 6, "--edit", path, "--export", tmp_path / "k.json"]
     _refused(capsys, tmp_path, as_json, "--export OUT.bvh")
     _refused(capsys, tmp_path, [*base, path, "--bake"], "bake")
-    _refused(capsys, tmp_path, [src, "--penalty", 0.01, "--per-channel", "--edit", path], "not --per-channel")
+    per = [src, "--penalty", 0.01, "--per-channel"]
+    channels = "--bvh-features channels with --per-channel"
+    _refused(capsys, tmp_path, [*per, "--edit", path, "--export", out], channels)
+    _refused(capsys, tmp_path, [*per, "--export", out], channels)
+    _refused(capsys, tmp_path, [*per, "--bvh-features", "channels", "--edit", path], "an --export OUT.bvh")
     x = tmp_path / "x.npz"
     np.savez(x, X=np.cumsum(np.ones((20, 2)), axis=0))
     _refused(capsys, tmp_path, [x, "--keys", 4, "--edit", path, "--export", out], "a .bvh input")
     _refused(capsys, tmp_path, [x, "--keys", 4, "--export", out], "a .bvh input to write a .bvh")
+
+
+def test_per_channel_keys_of_the_bvh_channels_edit_the_same_way(motion_dir, tmp_path, capsys):
+    src = motion_dir / "freebvh.bvh"
+    m = read_bvh(src)
+    h = ik.figure_height(m)
+    per = [src, "--per-channel", "--penalty", 0.01, "--bvh-features", "channels", "--interp", "hermite"]
+    out = tmp_path / "same.bvh"
+    got = _keys(capsys, *per, "--edit", _write(tmp_path / "none.json", []), "--export", out)
+    assert len(got["channels"]) == m.n_channels and got["edits"] == []
+    assert np.array_equal(read_bvh(out).values, m.values)
+    f = 30
+    assert f in got["union"]
+    e = m.joint_names.index("mixamorig:RightHand")
+    target = m.joint_positions()[f, e] + [0.0, 0.06 * h, 0.03 * h]
+    edit = {"frame": f, "joint": "mixamorig:RightHand", "target": target.tolist(), "chain": 2}
+    got = _keys(capsys, *per, "--edit", _write(tmp_path / "e.json", [edit]), "--export", out)
+    assert got["edits"][0]["miss_share"] < 1e-4
+    edited = read_bvh(out)
+    assert np.linalg.norm(edited.joint_positions()[f, e] - target) < 1e-4 * h
+    assert np.array_equal(edited.offsets, m.offsets)
+    # Without --edit: every channel its own key curve.
+    reduced = tmp_path / "reduced.bvh"
+    _keys(capsys, *per, "--export", reduced)
+    from hairtool.mocap.channel_edit import channel_key_curve
+
+    want = channel_key_curve(m, got["channels"], "hermite").values
+    np.testing.assert_allclose(read_bvh(reduced).values, want, rtol=0, atol=5.1e-7)
