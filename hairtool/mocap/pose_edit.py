@@ -33,7 +33,7 @@ from hairtool.errors import FormatError, ParameterError
 from hairtool.keys.reconstruct import KeyPoses, check_keys, interpolate_at, key_poses
 from hairtool.mocap import ik
 from hairtool.mocap import quaternion as quat
-from hairtool.mocap.bvh import Motion
+from hairtool.mocap.bvh import MAX_VALUE, Motion
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -118,6 +118,8 @@ def parse_edits(data: object, motion: Motion, source: str = "edits") -> list[Pos
             raise FormatError(source, f"{where}: target {str(target)[:60]} is not [x, y, z] (3 numbers)")
         if not all(math.isfinite(v) for v in target):
             raise FormatError(source, f"{where}: target {target} is not finite")
+        if any(abs(v) > MAX_VALUE for v in target):
+            raise FormatError(source, f"{where}: target {target} is beyond ±{MAX_VALUE:.2g} (no capture is)")
         j = names[joint]
         if not _is_int(chain) or not 1 <= chain <= depths[j]:
             why = f"is not a whole number 1..{depths[j]} (the ancestors of '{joint}')"

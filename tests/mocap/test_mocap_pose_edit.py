@@ -213,3 +213,64 @@ def test_bad_edits_are_one_line_naming_the_edit(motion_dir, tmp_path):
         read_edits(path, m)
     path.write_text(json.dumps([ok]))
     assert read_edits(path, m) == [PoseEdit(0, "LeftWrist", (1.0, 2.0, 3.0), 2)]
+
+
+def _hinged_arm(n=40):
+    """A root, a ball shoulder, a hinge elbow (one Xrotation channel) and a hand joint without
+    channels, swinging over ``n`` frames."""
+    from hairtool.mocap.bvh import Motion
+
+    t = np.linspace(0.0, 2.0 * np.pi, n)
+    values = np.zeros((n, 10))
+    values[:, 1] = 10.0 + 0.5 * np.sin(t)  # root height
+    values[:, 3:6] = np.column_stack([20 * np.sin(t), 15 * np.cos(t), 5 * t])  # root ZXY
+    values[:, 6:9] = np.column_stack([30 * np.sin(2 * t), 10 + 5 * t, -20 * np.cos(t)])  # shoulder ZXY
+    values[:, 9] = 40 + 30 * np.sin(t)  # elbow hinge
+    return Motion(
+        ["root", "shoulder", "elbow", "hand"],
+        np.array([-1, 0, 1, 2]),
+        np.array([[0, 0, 0], [0, 5, 0], [0, 4, 0], [0, 3, 0]], dtype=float),
+        [
+            ["Xposition", "Yposition", "Zposition", "Zrotation", "Xrotation", "Yrotation"],
+            ["Zrotation", "Xrotation", "Yrotation"],
+            ["Xrotation"],
+            [],
+        ],
+        values,
+        1 / 30,
+    )
+
+
+@pytest.mark.parametrize("interp", ["linear", "hermite"])
+def test_a_hinge_joint_is_solved_on_its_one_angle_and_the_ends_of_the_capture_edit_too(interp):
+    m = _hinged_arm()
+    h = ik.figure_height(m)
+    keys = np.array([0, 10, 20, 30, 39])
+    p = m.joint_positions()
+    for f in (0, 20, 39):  # the first key, a middle one, the last
+        editor = PoseEditor(m, keys, interp)
+        # Where the hand is on another frame, relative to the shoulder: a pose the arm can take.
+        g = (f + 7) % m.n_frames
+        target = p[f, 1] + (p[g, 3] - p[g, 1]) * 0.98
+        report = editor.apply(PoseEdit(f, "hand", tuple(target), 2))
+        assert report.method == "damped least squares"  # no two-bone on a hinge
+        out = editor.motion()
+        assert np.linalg.norm(out.joint_positions()[f, 3] - target) < 1e-4 * h
+        first, last = editor.span(f)
+        a = int(np.searchsorted(keys, f))
+        assert first == (0 if f == 0 else keys[a - 1] + 1)
+        assert last == (m.n_frames - 1 if f == 39 else keys[a + 1] - 1)
+        outside = np.setdiff1d(np.arange(m.n_frames), np.arange(first, last + 1))
+        assert np.array_equal(out.values[outside], m.values[outside])
+        assert np.array_equal(out.values[:, :6], m.values[:, :6])  # the root's channels
+        moved = np.abs(out.values[:, 9] - m.values[:, 9])
+        assert moved[f] == moved.max() > 0  # the hinge angle moved most at the key
+        bones = np.linalg.norm(np.diff(out.joint_positions()[:, 1:], axis=1), axis=2)
+        np.testing.assert_allclose(bones, [[4.0, 3.0]] * m.n_frames, atol=1e-9)
+
+
+def test_targets_beyond_any_capture_are_refused(motion_dir):
+    m = read_bvh(motion_dir / "mocapbank_walk.bvh")
+    edit = {"frame": 0, "joint": "LeftWrist", "target": [0.0, 1e300, 0.0], "chain": 2}
+    with pytest.raises(FormatError, match="beyond"):
+        parse_edits([edit], m, "EDITS.json")
