@@ -15,8 +15,10 @@ neighbouring keys, so every other frame keeps the capture's values bit for bit, 
 every joint no edit turned. The Hermite tangents stay those of the captured samples (seed 003),
 so the change fades from the key to zero at its neighbours. Joints with one or two rotation
 channels are edited on their angles directly. New angles are written in the joint's channel
-order, each frame nearest the previous edited frame moved as the capture moves there
-(:func:`hairtool.mocap.ik.euler_nearest`): no 360° turns or Euler-family flips appear.
+order, each frame nearest the previous one moved as the capture moves there, so they stay
+continuous with the unchanged frames on both sides (no 360° turns, no jumps to the other Euler
+family); only where the edited turn winds through gimbal lock do the first and third angles
+jump together, once, at the frame nearest the lock (:meth:`PoseEditor._track`).
 """
 
 from __future__ import annotations
@@ -86,6 +88,13 @@ def _is_number(v: object) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
+def _finite(v: float) -> bool:
+    try:
+        return math.isfinite(v)
+    except OverflowError:  # a JSON integer of hundreds of digits
+        return False
+
+
 def parse_edits(data: object, motion: Motion, source: str = "edits") -> list[PoseEdit]:
     """Edits from JSON data (a list of objects, or ``{"edits": [...]}``), checked against the
     skeleton: known joint, three finite numbers, a chain of 1 up to the joint's ancestors with
@@ -116,7 +125,7 @@ def parse_edits(data: object, motion: Motion, source: str = "edits") -> list[Pos
             raise FormatError(source, f"{where}: joint {str(joint)[:60]!r} is not in the skeleton ({shown})")
         if not (isinstance(target, list) and len(target) == 3 and all(_is_number(v) for v in target)):
             raise FormatError(source, f"{where}: target {str(target)[:60]} is not [x, y, z] (3 numbers)")
-        if not all(math.isfinite(v) for v in target):
+        if not all(_finite(v) for v in target):
             raise FormatError(source, f"{where}: target {target} is not finite")
         if any(abs(v) > MAX_VALUE for v in target):
             raise FormatError(source, f"{where}: target {target} is beyond ±{MAX_VALUE:.2g} (no capture is)")
@@ -140,9 +149,11 @@ def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
     except OSError as e:
         raise FormatError(p, f"cannot read: {e.strerror or e}") from None
     try:
-        data = json.loads(raw.decode("utf-8"), parse_constant=lambda c: float(c))
+        data = json.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as e:
         raise FormatError(p, f"not valid JSON ({str(e)[:80]})") from None
+    except RecursionError:
+        raise FormatError(p, "not valid JSON (nested too deep)") from None
     return parse_edits(data, motion, p)
 
 

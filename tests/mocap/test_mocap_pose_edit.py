@@ -269,8 +269,20 @@ def test_a_hinge_joint_is_solved_on_its_one_angle_and_the_ends_of_the_capture_ed
         np.testing.assert_allclose(bones, [[4.0, 3.0]] * m.n_frames, atol=1e-9)
 
 
-def test_targets_beyond_any_capture_are_refused(motion_dir):
+def test_targets_beyond_any_capture_and_hostile_json_are_refused(motion_dir, tmp_path):
     m = read_bvh(motion_dir / "mocapbank_walk.bvh")
     edit = {"frame": 0, "joint": "LeftWrist", "target": [0.0, 1e300, 0.0], "chain": 2}
     with pytest.raises(FormatError, match="beyond"):
         parse_edits([edit], m, "EDITS.json")
+    path = tmp_path / "e.json"
+    path.write_text('[{"frame": 0, "joint": "LeftWrist", "target": [1%s, 0, 0], "chain": 2}]' % ("0" * 400))
+    with pytest.raises(FormatError, match="not finite"):
+        read_edits(path, m)
+    path.write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(FormatError, match="not valid JSON"):
+        read_edits(path, m)
+    path.write_bytes(b"\xff\xfe[")
+    with pytest.raises(FormatError, match="not valid JSON"):
+        read_edits(path, m)
+    with pytest.raises(FormatError, match="cannot read"):
+        read_edits(tmp_path, m)
