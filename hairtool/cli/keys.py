@@ -71,9 +71,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     feat.add_argument("--no-relative", action="store_true", help="keep world positions, not root-relative")
     parser.add_argument(
         "--bvh-features",
-        choices=("positions", "rotations", "quaternion"),
+        choices=("positions", "rotations", "quaternion", "channels"),
         default="positions",
-        help="BVH: joint positions, joint rotations (quaternions), or the rotation distance between frames",
+        help="BVH: joint positions, joint rotations (quaternions), the rotation distance between frames, or "
+        "the file's own channels (angles unwrapped; with --per-channel each channel keyed on its own, "
+        "as a DCC keys them, and editable with --edit)",
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     parser.add_argument("--out", type=Path, metavar="KEYS.json", help="write keys, times and parameters")
@@ -83,10 +85,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="OUT",
         help="write the keys by suffix: .usd/.usda/.usdc key poses as time samples (animations), .json "
         "record, .csv sheet (one row per frame; with --interp hermite or hermite-fit, per channel the "
-        "key values and tangents)",
+        "key values and tangents), .bvh (BVH input: the key curve at every frame, or with --edit the "
+        "edited capture)",
     )
     parser.add_argument(
         "--bake", action="store_true", help="with --export: every frame of the key curve, not just the keys"
+    )
+    parser.add_argument(
+        "--edit",
+        type=Path,
+        metavar="EDITS.json",
+        help="BVH: key poses moved by IK, a list of {frame (a key), joint, target [x, y, z], chain (how many "
+        "joints above it turn)}; with --export OUT.bvh writes the edited capture, the captured detail kept",
     )
     parser.add_argument(
         "--storage",
@@ -172,6 +182,7 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
 
     bar(0.0, "reading")
     kind, data, fps = _load(args)
+    args.edits = _read_edits(args, kind, data)
     bar(0.05, "features")
     options = FeatureOptions(
         samples=None if args.no_resample else args.samples,
@@ -182,7 +193,11 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
         tip_weight=args.tip_weight,
         exponent=args.weight_exponent,
     )
-    if kind == "bvh":
+    if kind == "bvh" and args.bvh_features == "channels":
+        from hairtool.mocap.channel_edit import channel_features
+
+        x = channel_features(data)
+    elif kind == "bvh":
         from hairtool.mocap.costs import motion_features
 
         x = motion_features(data, "positions" if args.bvh_features == "positions" else "rotations")
@@ -199,14 +214,26 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
             raise ParameterError("per-channel", True, "a --penalty TAU (seed 003 prices keys per channel)")
         if constraints:
             raise ParameterError("pin", args.pin or args.exclude, "keys of the whole pose, not --per-channel")
+        bvh_out = args.export is not None and args.export.suffix.lower() == ".bvh"
+        if (args.edits is not None or bvh_out) and args.bvh_features != "channels":
+            what = "edit" if args.edits is not None else "export"
+            shown = str(args.edit if args.edits is not None else args.export)
+            wanted = "--bvh-features channels with --per-channel (keys per BVH channel)"
+            raise ParameterError(what, shown, wanted)
         relative = args.penalty is not None
         tau = args.penalty if relative else args.penalty_abs
         channels = per_channel_keys(x, tau, interp=args.interp, curvature=args.curvature, relative=relative)
         result = {"frames": n, "fps": fps, **channels.to_dict()}
         if args.storage:
             result["storage"] = None  # no one set of key poses
+        if bvh_out:
+            _export_channels_bvh(args, data, channels.keys, result)
+        elif args.edits is not None:
+            raise ParameterError("edit", str(args.edit), "an --export OUT.bvh to write the edited capture to")
         bar.close()
-        return _emit(args, result, f"{len(result['union'])} frames key at least one of {x.shape[1]} channels")
+        line = f"{len(result['union'])} frames key at least one of {x.shape[1]} channels"
+        line += _edit_lines(result)
+        return _emit(args, result, line)
 
     objective = "worst" if args.max_error is not None else args.objective
     table = None
@@ -283,10 +310,15 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
         from hairtool.keys.storage import storage
 
         result["storage"] = storage(data, sel.keys, args.input) if kind == "animation" else None
-    if args.export is not None:
+    if args.export is not None and args.export.suffix.lower() == ".bvh":
+        _export_bvh(args, kind, data, sel.keys, result)
+    elif args.edits is not None:
+        raise ParameterError("edit", str(args.edit), "an --export OUT.bvh to write the edited capture to")
+    elif args.export is not None:
         suffix = args.export.suffix.lower()
         if (args.bake or suffix not in JSON_SUFFIXES + CSV_SUFFIXES) and kind != "animation":
-            raise ParameterError("export", str(args.export), "a .json or .csv file, or an animation input")
+            wanted = "a .json or .csv file, a .bvh for a BVH input, or an animation input"
+            raise ParameterError("export", str(args.export), wanted)
         if args.bake:
             from hairtool.io import write
             from hairtool.keys.reconstruct import reconstruct
@@ -311,6 +343,7 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
     )
     if "note" in result:
         line += f"\n{result['note']}"
+    line += _edit_lines(result)
     if result.get("storage"):
         st = result["storage"]
         line += (
@@ -318,6 +351,81 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
             f"{st['ratio']:.1%} of the input's {st['input_bytes']}"
         )
     return _emit(args, result, line, time_codes)
+
+
+def _read_edits(args: argparse.Namespace, kind: str, data):
+    """The checked edits of ``--edit`` (before the keys are solved, so a bad file fails fast), or None."""
+    if args.edit is None:
+        return None
+    from hairtool.errors import ParameterError
+
+    if kind != "bvh":
+        raise ParameterError("edit", str(args.edit), "a .bvh input (edits move a skeleton's joints)")
+    from hairtool.mocap.pose_edit import read_edits
+
+    return read_edits(args.edit, data)
+
+
+def _export_bvh(args: argparse.Namespace, kind: str, data, keys, result: dict) -> None:
+    """``--export OUT.bvh``: the capture with ``--edit``'s key poses (residuals kept), or the key
+    curve itself (the reduced motion); the input's hierarchy, offsets, channels and frame time."""
+    from hairtool.errors import FormatError, ParameterError
+    from hairtool.mocap.bvh import write_bvh
+
+    if kind != "bvh":
+        raise ParameterError("export", str(args.export), "a .bvh input to write a .bvh")
+    if args.edits is None:
+        from hairtool.mocap.costs import reconstruct_motion
+
+        write_bvh(args.export, reconstruct_motion(data, keys, args.interp))
+        return
+    if args.bake:
+        why = "no --edit: --bake writes the key curve, --edit the edited capture"
+        raise ParameterError("bake", True, why)
+    from hairtool.mocap.pose_edit import PoseEditor
+
+    listed = " ".join(map(str, keys.tolist()))
+    for i, e in enumerate(args.edits, 1):
+        if e.frame not in keys:
+            raise FormatError(args.edit, f"edit {i}: frame {e.frame} is not a key; the keys are {listed}")
+    editor = PoseEditor(data, keys, args.interp)
+    result["edits"] = [r.to_dict() for r in editor.apply_all(args.edits)]
+    write_bvh(args.export, editor.motion())
+
+
+def _edit_lines(result: dict) -> str:
+    """One line per edit of ``result["edits"]``: where the joint got to, what turned, what followed."""
+    text = ""
+    for i, r in enumerate(result.get("edits", []), 1):
+        text += (
+            f"\nedit {i}: {r['edit']['joint']} at frame {r['edit']['frame']} within {r['miss']:.3g} of its "
+            f"target ({r['miss_share']:.2g} of the figure's height), turning {', '.join(r['turned'])} "
+            f"({r['method']}); frames {r['first']}-{r['last']} follow"
+        )
+        if r["miss_share"] > r["tolerance_share"]:
+            text += " (out of reach: as near as the chain allows)"
+    return text
+
+
+def _export_channels_bvh(args: argparse.Namespace, data, keys: list, result: dict) -> None:
+    """``--per-channel --bvh-features channels --export OUT.bvh``: each channel its own key curve,
+    or with ``--edit`` the capture with the edits' keys moved (residuals kept)."""
+    from hairtool.errors import FormatError
+    from hairtool.mocap.bvh import write_bvh
+    from hairtool.mocap.channel_edit import ChannelEditor, channel_key_curve
+
+    if args.edits is None:
+        write_bvh(args.export, channel_key_curve(data, keys, args.interp))
+        return
+    editor = ChannelEditor(data, keys, args.interp)
+    union = editor.union
+    for i, e in enumerate(args.edits, 1):
+        if e.frame not in union:
+            listed = " ".join(map(str, union.tolist()))
+            why = f"edit {i}: frame {e.frame} is not a key of any channel; the keys are {listed}"
+            raise FormatError(args.edit, why)
+    result["edits"] = [r.to_dict() for r in editor.apply_all(args.edits)]
+    write_bvh(args.export, editor.motion())
 
 
 def _curves(kind: str, data, keys, interp: str) -> dict:

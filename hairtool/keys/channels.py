@@ -65,7 +65,8 @@ def per_channel_keys(
     keys, costs, prices = [], np.zeros(d), np.zeros(d)
     for c in range(d):
         table = cost_table(x[:, c : c + 1], interp, curvature)
-        prices[c] = float(tau[c]) * float(table[0, -1]) if relative else float(tau[c])
+        # A constant channel's two-key error is 0 up to rounding, which may leave it a hair below.
+        prices[c] = float(tau[c]) * max(float(table[0, -1]), 0.0) if relative else float(tau[c])
         sel = select_keys(table, penalty=prices[c], curve_keys=0)
         keys.append(sel.keys)
         costs[c] = sel.cost

@@ -184,6 +184,16 @@ def test_per_channel_keys_each_channel_on_its_own():
         per_channel_keys(x, -1.0)
 
 
+def test_a_constant_channel_takes_two_keys_at_a_relative_price():
+    """Its two-key error is 0 up to rounding, a hair below 0 for a constant -1.636 (a finger
+    channel of the bundled mixamo capture): a share of it is a price of 0, not a negative one."""
+    x = np.column_stack([np.full(69, -1.636), np.full(69, -23.5577), np.sin(np.arange(69) / 5.0)])
+    assert cost_table(x[:, 1:2], "hermite")[0, -1] < 0
+    res = per_channel_keys(x, 0.01, interp="hermite", relative=True)
+    assert res.keys[0].tolist() == [0, 68] and res.keys[1].tolist() == [0, 68]
+    assert np.all(res.penalties >= 0)
+
+
 @pytest.mark.parametrize("objective", ["total", "worst"])
 def test_bounds_that_need_more_keys_than_one_layer_block(objective):
     table = cost_table(walk(90, 3, seed=14), objective=objective)

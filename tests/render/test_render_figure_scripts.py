@@ -81,3 +81,23 @@ def test_frozen_figures_show_the_papers_comparisons(tmp_path):
     unclumped = iio.imread(tmp_path / "frozen_fig3b_aligned_and_frozen_no_clumping.png")
     clumped = iio.imread(tmp_path / "frozen_fig3d_clump_radius_0.12.png")
     assert _differing(unclumped, clumped) > 0.005
+
+
+def test_the_fig9_jump_figure_edits_one_key_of_the_walk(tmp_path, capsys):
+    from app.figures import mocap
+    from hairtool.mocap.bvh import read_bvh
+
+    mocap.make([str(tmp_path), "--size", "64"])
+    sheet = iio.imread(tmp_path / "mocap_fig9_jump.png")
+    panel = 64 + LABEL_HEIGHT
+    assert sheet.shape[0] == 2 * panel + 3 * GAP
+    top, bottom = sheet[GAP : GAP + 64], sheet[2 * GAP + panel : 2 * GAP + panel + 64]
+    red = lambda img: (img[..., 0] > 150) & (img[..., 1] < 100) & (img[..., 2] < 100)  # noqa: E731
+    assert not red(top).any() and red(bottom).sum() > 50  # the edited frames, in red, below
+    edited = read_bvh(tmp_path / "mocap_fig9_jump.bvh")
+    walk = read_bvh(mocap.CAPTURE)
+    changed = np.flatnonzero(np.any(np.abs(edited.values - walk.values) > 1e-6, axis=1))
+    assert 0 < changed.min() and changed.max() < walk.n_frames - 1  # one key's neighbourhood only
+    assert np.array_equal(edited.offsets, walk.offsets)
+    out = capsys.readouterr().out
+    assert out.count("of the figure's height from its target") == 4

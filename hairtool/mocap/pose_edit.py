@@ -1,0 +1,331 @@
+"""Key poses of a capture edited by inverse kinematics, the change carried to every frame while
+the captured detail stays (seed 003 §5, Fig. 9).
+
+Each joint's rotation is a key curve through its key poses (slerp for "linear", the cubic
+Hermite of seed 003 on hemisphere-aligned quaternion components for "hermite", fitted handles
+for "hermite-fit": the curves of :func:`hairtool.mocap.costs.reconstruct_motion`) plus the
+residual of every frame against it. An edit drags one joint at a key frame to a target; the IK
+(:mod:`hairtool.mocap.ik`) turns its nearest ancestors; the key curve is rebuilt with the new
+key pose and the residual added back:
+
+    q_f' = normalize(q_f + ĉ_new(f) − ĉ_old(f))     (= ĉ_new(f) + residual_f)
+
+which is exact where nothing moved: a key's curve changes only strictly between its
+neighbouring keys, so every other frame keeps the capture's values bit for bit, and so does
+every joint no edit turned. The Hermite tangents stay those of the captured samples (seed 003),
+so the change fades from the key to zero at its neighbours. Joints with one or two rotation
+channels are edited on their angles directly. New angles are written in the joint's channel
+order, each frame nearest the previous one moved as the capture moves there, so they stay
+continuous with the unchanged frames on both sides (no 360° turns, no jumps to the other Euler
+family); only where the edited turn winds through gimbal lock do the first and third angles
+jump together, once, at the frame nearest the lock (:meth:`PoseEditor._track`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from hairtool.errors import FormatError, ParameterError
+from hairtool.keys.reconstruct import KeyPoses, check_keys, interpolate_at, key_poses
+from hairtool.mocap import ik
+from hairtool.mocap import quaternion as quat
+from hairtool.mocap.bvh import MAX_VALUE, Motion
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+
+INTERPS = ("linear", "hermite", "hermite-fit")
+FIELDS = ("frame", "joint", "target", "chain")
+
+
+@dataclass(frozen=True)
+class PoseEdit:
+    """Move ``joint`` to the world point ``target`` at key ``frame`` by turning its ``chain``
+    nearest ancestors (2: upper and lower limb, solved analytically)."""
+
+    frame: int
+    joint: str
+    target: tuple[float, float, float]
+    chain: int
+
+    def to_dict(self) -> dict:
+        return {"frame": self.frame, "joint": self.joint, "target": list(self.target), "chain": self.chain}
+
+
+@dataclass
+class EditReport:
+    """What one edit did: the joints it turned, the solver, how far the effector is from the
+    target (scene units and share of the figure's height; more than ``tolerance_share``: out of
+    reach) and the frames it changed (``first``..``last``, strictly between the neighbouring keys)."""
+
+    edit: PoseEdit
+    turned: list[str]
+    method: str
+    iterations: int
+    miss: float
+    miss_share: float
+    first: int
+    last: int
+    tolerance_share: float = ik.TOLERANCE
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["edit"] = self.edit.to_dict()
+        return d
+
+
+def _is_int(v: object) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _is_number(v: object) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _finite(v: float) -> bool:
+    try:
+        return math.isfinite(v)
+    except OverflowError:  # a JSON integer of hundreds of digits
+        return False
+
+
+def parse_edits(data: object, motion: Motion, source: str = "edits") -> list[PoseEdit]:
+    """Edits from JSON data (a list of objects, or ``{"edits": [...]}``), checked against the
+    skeleton: known joint, three finite numbers, a chain of 1 up to the joint's ancestors with
+    rotation channels to turn. Key frames are checked by :meth:`PoseEditor.apply`. Any fault
+    raises :class:`FormatError` naming ``source`` and the edit (counted from 1)."""
+    if isinstance(data, dict) and set(data) == {"edits"}:
+        data = data["edits"]
+    if not isinstance(data, list):
+        raise FormatError(source, 'expected a list of edits {"frame", "joint", "target", "chain"}')
+    names = {n: j for j, n in enumerate(motion.joint_names)}
+    depths = motion.depths()
+    out = []
+    for i, e in enumerate(data, 1):
+        where = f"edit {i}"
+        if not isinstance(e, dict):
+            raise FormatError(source, f"{where} is not an object with the fields {', '.join(FIELDS)}")
+        missing = [k for k in FIELDS if k not in e]
+        extra = sorted(str(k)[:40] for k in e if k not in FIELDS)
+        if missing or extra:
+            what = f"lacks {', '.join(missing)}" if missing else f"has unknown fields {', '.join(extra)}"
+            raise FormatError(source, f"{where} {what} (fields: {', '.join(FIELDS)})")
+        frame, joint, target, chain = (e[k] for k in FIELDS)
+        if not _is_int(frame) or not 0 <= frame < motion.n_frames:
+            last = motion.n_frames - 1
+            raise FormatError(source, f"{where}: frame {frame!r} is not a frame number 0..{last}")
+        if not isinstance(joint, str) or joint not in names:
+            shown = ", ".join(motion.joint_names[:8]) + (", …" if motion.n_joints > 8 else "")
+            raise FormatError(source, f"{where}: joint {str(joint)[:60]!r} is not in the skeleton ({shown})")
+        if not (isinstance(target, list) and len(target) == 3 and all(_is_number(v) for v in target)):
+            raise FormatError(source, f"{where}: target {str(target)[:60]} is not [x, y, z] (3 numbers)")
+        if not all(_finite(v) for v in target):
+            raise FormatError(source, f"{where}: target {target} is not finite")
+        if any(abs(v) > MAX_VALUE for v in target):
+            raise FormatError(source, f"{where}: target {target} is beyond ±{MAX_VALUE:.2g} (no capture is)")
+        j = names[joint]
+        if not _is_int(chain) or not 1 <= chain <= depths[j]:
+            why = f"is not a whole number 1..{depths[j]} (the ancestors of '{joint}')"
+            raise FormatError(source, f"{where}: chain {chain!r} {why}")
+        turned = ik.ancestors(motion, j, chain)
+        if not any(ik.rotation_columns(motion, a)[0] for a in turned):
+            raise FormatError(source, f"{where}: the chain above '{joint}' has no rotation channels to turn")
+        out.append(PoseEdit(int(frame), joint, tuple(float(v) for v in target), int(chain)))
+    return out
+
+
+def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
+    """:func:`parse_edits` of a JSON file; unreadable or invalid JSON raises :class:`FormatError`."""
+    p = os.fspath(path)
+    try:
+        with open(p, "rb") as f:
+            raw = f.read()
+    except OSError as e:
+        raise FormatError(p, f"cannot read: {e.strerror or e}") from None
+    try:
+        data = json.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise FormatError(p, f"not valid JSON ({str(e)[:80]})") from None
+    except RecursionError:
+        raise FormatError(p, "not valid JSON (nested too deep)") from None
+    return parse_edits(data, motion, p)
+
+
+class PoseEditor:
+    """A capture, its keys, and its key poses as edited so far; the original is kept, so
+    edits undo (:meth:`undo`, :meth:`reset`) and compose (each solve starts from the edited pose)."""
+
+    def __init__(self, motion: Motion, keys: ArrayLike, interp: str = "linear") -> None:
+        if interp not in INTERPS:
+            raise ParameterError("interp", interp, " or ".join(INTERPS))
+        self.original = motion
+        self.interp = interp
+        self.keys: I64 = check_keys(keys, motion.n_frames)
+        self.height = ik.figure_height(motion)
+        self._q = quat.align_hemisphere(motion.local_rotations(), axis=0)
+        self._base_values = motion.values[self.keys].copy()
+        self._key_values = self._base_values.copy()
+        self._key_q = self._q[self.keys].copy()
+        self._history: list[tuple[EditReport, int, F64, F64]] = []
+        self._curves: dict[int, KeyPoses] = {}
+
+    # -- keys ------------------------------------------------------------------------------
+    def key_index(self, frame: int) -> int:
+        hit = np.flatnonzero(self.keys == frame)
+        if hit.size == 0:
+            raise ParameterError("frame", frame, f"a key frame: {' '.join(map(str, self.keys.tolist()))}")
+        return int(hit[0])
+
+    def key_pose(self, frame: int) -> F64:
+        """``(C,)`` channel values of the edited pose at a key frame."""
+        return self._key_values[self.key_index(frame)].copy()
+
+    def span(self, frame: int) -> tuple[int, int]:
+        """``(first, last)``: the frames an edit at this key changes (strictly between its neighbours)."""
+        a = self.key_index(frame)
+        first = int(self.keys[a - 1]) + 1 if a > 0 else 0
+        last = int(self.keys[a + 1]) - 1 if a < self.keys.size - 1 else self.original.n_frames - 1
+        return first, last
+
+    @property
+    def reports(self) -> list[EditReport]:
+        return [r for r, *_ in self._history]
+
+    # -- editing ---------------------------------------------------------------------------
+    def apply(self, edit: PoseEdit, method: str = "auto") -> EditReport:
+        """Solve one edit on the current pose at its key and keep the new key pose."""
+        m = self.original
+        if edit.joint not in m.joint_names:
+            raise ParameterError("joint", edit.joint, "a joint of the skeleton")
+        a = self.key_index(edit.frame)
+        e = m.joint_names.index(edit.joint)
+        values = self._key_values[a]
+        s = ik.solve(m, values, e, edit.chain, edit.target, ik.TOLERANCE * self.height, method)
+        turned = ik.ancestors(m, e, edit.chain)
+        saved = (a, self._key_values[a].copy(), self._key_q[a].copy())
+        self._key_values[a] = s.values
+        for j in turned:
+            cols, order = ik.rotation_columns(m, j)
+            if ik.is_ball_joint(m, j):
+                q = quat.from_euler(s.values[cols], order)
+                ref = self._q[self.keys[a], j]
+                self._key_q[a, j] = -q if np.dot(q, ref) < 0 else q
+        first, last = self.span(edit.frame)
+        names = [m.joint_names[j] for j in turned]
+        report = EditReport(edit, names, s.method, s.iterations, s.miss, s.miss / self.height, first, last)
+        self._history.append((report, *saved))
+        return report
+
+    def apply_all(self, edits: list[PoseEdit], method: str = "auto") -> list[EditReport]:
+        """Edits in order, each on the pose the ones before it left."""
+        return [self.apply(e, method) for e in edits]
+
+    def undo(self) -> PoseEdit | None:
+        """Take back the last edit (None when there is none)."""
+        if not self._history:
+            return None
+        report, a, values, q = self._history.pop()
+        self._key_values[a], self._key_q[a] = values, q
+        return report.edit
+
+    def reset(self) -> None:
+        while self._history:
+            self.undo()
+
+    # -- the edited capture ----------------------------------------------------------------
+    def _kp(self, j: int) -> KeyPoses:
+        """A ball joint's key curve on its captured quaternions (tangents kept through edits)."""
+        if j not in self._curves:
+            kind = "linear" if self.interp == "linear" else self.interp
+            self._curves[j] = key_poses(self._q[:, j], self.keys, kind)
+        return self._curves[j]
+
+    def _curve(self, j: int, poses: F64, frames: I64) -> F64:
+        """``(len(frames), 4)`` joint j's key curve through the key quaternions ``poses``."""
+        if self.interp == "linear":  # slerp, as reconstruct_motion rebuilds it
+            k = self.keys
+            a = np.clip(np.searchsorted(k, frames, side="right") - 1, 0, k.size - 2)
+            s = (frames - k[a]) / (k[a + 1] - k[a]).astype(np.float64)
+            return quat.slerp(poses[a], poses[a + 1], s)
+        kp = self._kp(j)
+        edited = KeyPoses(kp.keys, poses, kp.tangents, kp.n_frames, kp.interp, kp.tangents_in)
+        return interpolate_at(edited, frames)
+
+    def motion(self) -> Motion:
+        """The edited capture at every frame: the edited key curves plus the stored residuals."""
+        m = self.original
+        values = m.values.copy()
+        changed = np.any(self._key_values != self._base_values, axis=0)  # (C,) columns any edit moved
+        for j in range(m.n_joints):
+            cols, order = ik.rotation_columns(m, j)
+            if not cols or not np.any(changed[cols]):
+                continue
+            rows = np.flatnonzero(np.any(self._key_values[:, cols] != self._base_values[:, cols], axis=1))
+            frames = np.unique(np.concatenate([np.arange(*self._span_of(a)) for a in rows]))
+            ball = ik.is_ball_joint(m, j)
+            # The edit's spread on the angles themselves: the key's change of angles weighted by
+            # the curve's basis (the tangents are the same before and after, so they cancel).
+            if ball:
+                base = self._q[self.keys, j]
+                delta = self._curve(j, self._key_q[:, j], frames) - self._curve(j, base, frames)
+                q = quat.normalize(self._q[frames, j] + delta)
+                for run in np.split(np.arange(frames.size), np.flatnonzero(np.diff(frames) > 1) + 1):
+                    values[np.ix_(frames[run], cols)] = self._track(frames[run], cols, order, q[run])
+            else:
+                spread = self._spread(self._key_values[:, cols] - self._base_values[:, cols], frames)
+                values[np.ix_(frames, cols)] = m.values[np.ix_(frames, cols)] + spread
+        return m.with_values(values)
+
+    def _span_of(self, a: int) -> tuple[int, int]:
+        """``[start, stop)`` frames of key index ``a``'s span."""
+        first, last = self.span(int(self.keys[a]))
+        return first, last + 1
+
+    def _spread(self, change: F64, frames: I64) -> F64:
+        """``(len(frames), D)`` key changes ``(K, D)`` carried to the frames by the curve's basis
+        (the tangents are the same before and after an edit, so they cancel)."""
+        zero = None if self.interp == "linear" else np.zeros_like(change)
+        kind = "linear" if self.interp == "linear" else "hermite"
+        return interpolate_at(KeyPoses(self.keys, change, zero, self.original.n_frames, kind), frames)
+
+    def _track(self, run: I64, cols: list[int], order: str, q: F64) -> F64:
+        """Euler angles for the rotations ``q`` of a run of consecutive frames, continuous with the
+        unchanged frames on both sides.
+
+        Forward from the frame before the run, each frame is written nearest the previous one
+        moved as the capture moves there (so the capture's own wraps stay where they are);
+        backward the same from the frame after. The two agree unless the edited turn winds
+        around gimbal lock (the middle angle through ±90°), which no continuous set of angles
+        can undo by the run's end: then the run switches from the one to the other at the frame
+        nearest the lock, where the two triples describe nearly the same turn."""
+        orig = self.original.values[:, cols]
+        n = self.original.n_frames
+        first, last = int(run[0]), int(run[-1])
+
+        def follow(frames: list[int], step: int) -> F64:
+            out = np.empty((len(frames), len(cols)))
+            prev = None
+            anchor = frames[0] - step
+            if 0 <= anchor < n:
+                prev = orig[anchor]
+            for i, f in enumerate(frames):
+                ref = orig[f] if prev is None else prev + (orig[f] - orig[f - step])
+                out[i] = prev = ik.euler_nearest(q[f - first], order, ref)
+            return out
+
+        forward = follow(list(range(first, last + 1)), 1)
+        if last == n - 1:
+            return forward
+        backward = follow(list(range(last, first - 1, -1)), -1)[::-1]
+        if first == 0 or np.allclose(forward, backward, rtol=0, atol=1e-6):
+            return backward if first == 0 else forward
+        i, _, k = ("XYZ".index(c) for c in order)
+        lock = np.abs(quat.to_matrix(q)[:, i, k])  # |sin| of the middle angle
+        split = int(np.argmax(lock))
+        return np.concatenate([forward[:split], backward[split:]])
