@@ -9,6 +9,7 @@ reader turns MemoryError into "cannot read"), so the tests require the size chec
 
 from __future__ import annotations
 
+import json
 import os
 import resource
 import subprocess
@@ -165,3 +166,119 @@ def test_keys_feature_array_with_a_huge_header(tmp_path):
     run = run_cli(tmp_path, "keys", path)
     assert_one_line_error(run, "keys", path, "'X.npy'", "does not match its stored size")
     assert run.max_rss_mb < 500
+
+
+# -- issue 27: jobs files ------------------------------------------------------------------------
+@pytest.mark.parametrize("suffix", [".json", ".toml"])
+def test_jobs_file_nested_100000_deep(tmp_path, suffix):
+    path = hostile.write_jobs_nested(tmp_path / f"deep{suffix}", 100_000)
+    assert_one_line_error(run_cli(tmp_path, "batch", path), "batch", path, "levels deep", "at most 64")
+
+
+@pytest.mark.parametrize("suffix", [".json", ".toml"])
+def test_jobs_file_integer_of_5000_digits(tmp_path, suffix):
+    path = hostile.write_jobs_huge_int(tmp_path / f"int{suffix}", 5000)
+    assert_one_line_error(run_cli(tmp_path, "batch", path), "batch", path, "5000 digits")
+
+
+@pytest.mark.parametrize(
+    ("pattern", "words"),
+    [
+        ("shots/*.usdc" * 1000, "characters long"),
+        ("*/" * 1000 + "x", "characters long"),
+        ("a/" * 400 + "*.usdc", "path components"),
+        ("**/" * 4 + "*.usdc", "more than two **"),
+    ],
+    ids=["repeated-1000", "components-1000", "components-400", "double-star"],
+)
+def test_jobs_glob_pattern_bounded(tmp_path, pattern, words):
+    path = hostile.write_jobs_glob(tmp_path / "glob.json", pattern)
+    run = run_cli(tmp_path, "batch", path)
+    assert_one_line_error(run, "batch", path, words)
+    assert len(run.stderr_lines[0]) < 400  # the pattern is shown cut, not whole
+
+
+# -- issue 27: stroke logs -----------------------------------------------------------------------
+def _freeze_with_strokes(tmp_path: Path, log: Path) -> tuple[Run, Path]:
+    from hairtool.io import write
+
+    groom = tmp_path / "groom.npz"
+    write(groom, hostile_groom())
+    out = tmp_path / "frozen.npz"
+    return run_cli(tmp_path, "freeze", groom, out, "--strokes", log), out
+
+
+def hostile_groom():
+    from hairtool.groom import Groom
+
+    return Groom(np.random.default_rng(0).standard_normal((20, 3)), [5, 5, 5, 5])
+
+
+@pytest.mark.parametrize(
+    ("strokes", "words"),
+    [
+        ([hostile.stroke(radius=10**400)], "401 digits"),
+        ([hostile.stroke(falloff=[[0, 1], [0.5], [1, 0]])], "falloff[1]"),
+        ([hostile.stroke(falloff=[[0, 1], [0.5, [1, 2]], [1, 0]])], "falloff"),
+        ([hostile.stroke(falloff=[[i / 10**5, 0.5] for i in range(10**5 + 1)])], "at most 1028"),
+        ([hostile.stroke(falloff=[[0, 10**30], [1, 0]])], "weights in [0, 1]"),
+        ([hostile.stroke(falloff=[[0, "heavy"], [1, 0]])], "a finite number"),
+        ([hostile.stroke(radius="x" * 100_000)], "a str of 100000 characters"),
+    ],
+    ids=["radius-10^400", "ragged", "ragged-nested", "huge-falloff", "falloff-10^30", "falloff-text",
+         "radius-long-text"],
+)  # fmt: skip
+def test_stroke_log_refused_in_one_line_and_nothing_written(tmp_path, strokes, words):
+    log = hostile.write_strokes(tmp_path / "log.json", *strokes)
+    run, out = _freeze_with_strokes(tmp_path, log)
+    assert_one_line_error(run, "freeze", log, words)
+    assert len(run.stderr_lines[0]) < 400
+    assert not out.exists()
+
+
+def test_stroke_log_nested_100000_deep(tmp_path):
+    log = hostile.write_strokes_nested(tmp_path / "deep.json")
+    run, out = _freeze_with_strokes(tmp_path, log)
+    assert_one_line_error(run, "freeze", log, "levels deep")
+    assert not out.exists()
+
+
+# -- issue 27: project manifests (the studio reads them; no command does) -------------------------
+def _deep_settings(m: dict) -> str:
+    return json.dumps(m).replace('"settings": {}', '"settings": ' + '{"a": ' * 100_000 + "1" + "}" * 100_000)
+
+
+def _set(section: str, key: str, value: object):
+    def change(m: dict) -> None:
+        m[section][key] = value
+
+    return change
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        (_deep_settings, "100001 levels deep"),
+        (lambda m: json.dumps(m).replace('"fps": 24.0', '"fps": 1' + "0" * 400), "401 digits"),
+        (_set("animation", "fps", 10**30), None),  # a number, just a very fast one: it reads
+        (_set("params", "seed", [1, [2, 3]]), "engine parameter 'seed' is a JSON list"),
+        (_set("params", "strand_variation", [[0.1], [0.2, 0.3]]), "strand_variation must be a number"),
+        (_set("params", "strand_variation", "lots"), "strand_variation must be a number"),
+        (_set("strokes", "count", "2"), "bad 'strokes' section"),
+        (_set("groom", "attributes", {"thickness": 1}), "bad attribute list"),
+    ],
+    ids=["deep-settings", "fps-10^400", "fps-10^30", "seed-ragged", "variation-ragged", "variation-text",
+         "count-text", "attributes-object"],
+)  # fmt: skip
+def test_project_manifest_hostile_values(tmp_path, change, words):
+    from hairtool.errors import FormatError
+    from hairtool.project import load
+
+    path = hostile.write_project_manifest(tmp_path / "p.hairproj", change)
+    if words is None:
+        assert load(path).animation.fps == 1e30
+        return
+    with pytest.raises(FormatError) as e:
+        load(path)
+    assert str(e.value).startswith(f"{path}: ") and "\n" not in str(e.value), e.value
+    assert words in str(e.value), e.value

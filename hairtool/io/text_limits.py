@@ -1,0 +1,70 @@
+"""Limits on JSON and TOML documents, checked on their text before a parser sees it.
+
+Python's ``json`` and ``tomllib`` recurse once per level of nesting (a file nested 100,000
+deep ends in a RecursionError, or worse in a parser that catches it late) and turn every
+integer literal into an ``int`` (beyond 4,300 digits a ValueError; 10⁴⁰⁰ overflows ``float()``
+afterwards). :func:`check_text` measures the deepest nesting and the longest run of digits
+outside strings and comments, with regular expressions and numpy (no Python loop over the
+text), so jobs files, stroke logs and project manifests refuse such documents in one line
+naming the file, the line and the limit.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+
+import numpy as np
+
+from hairtool.errors import FormatError
+
+#: Deepest nesting of lists and objects a document may have (jobs files need 4, stroke logs 5).
+MAX_DEPTH = 64
+#: Longest run of digits outside strings: no count, index, coordinate or argument needs more
+#: (float64 keeps 17 significant digits; an int64 has 19).
+MAX_DIGITS = 40
+
+# JSON strings hold no raw control characters, so replacing each with "" keeps line numbers.
+_JSON_STRINGS = re.compile(r'"(?:[^"\\\x00-\x1f]|\\.)*"')
+# TOML: multi-line strings first (replaced keeping their newlines), then one-line strings and comments.
+_TOML_LONG = re.compile(r'"""(?:[^\\]|\\.)*?"""{0,2}|\'\'\'.*?\'\'\'\'{0,2}', re.S)
+_TOML_SHORT = re.compile(r'"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*')
+_NOT_BRACKET = re.compile(r"[^\[\]{}]+")
+_LONG_DIGITS = re.compile(rf"\d[\d_]{{{MAX_DIGITS},}}")
+
+
+def _structure(text: str, kind: str) -> str:
+    """``text`` with every string (and TOML comment) emptied, line breaks kept."""
+    if kind == "json":
+        return _JSON_STRINGS.sub('""', text)
+    text = _TOML_LONG.sub(lambda m: '""' + "\n" * m.group().count("\n"), text)
+    return _TOML_SHORT.sub('""', text)
+
+
+def nesting_depth(structure: str) -> int:
+    """The deepest nesting of ``[`` and ``{`` in text whose strings are emptied."""
+    brackets = _NOT_BRACKET.sub("", structure).encode("ascii")
+    if not brackets:
+        return 0
+    b = np.frombuffer(brackets, dtype=np.uint8)
+    steps = np.where((b == ord("[")) | (b == ord("{")), 1, -1).astype(np.int32)
+    return int(np.cumsum(steps).max())
+
+
+def check_text(
+    path: str | os.PathLike[str], text: str, kind: str, what: str, max_depth: int = MAX_DEPTH
+) -> None:
+    """Refuse a ``kind`` ("json" or "toml") document nested deeper than ``max_depth`` or holding
+    a number of more than :data:`MAX_DIGITS` digits (a :class:`FormatError` naming ``path``
+    and ``what`` the file is, such as "a jobs file")."""
+    structure = _structure(text, kind)
+    depth = nesting_depth(structure)
+    if depth > max_depth:
+        raise FormatError(path, f"nested {depth} levels deep; {what} nests at most {max_depth}")
+    m = _LONG_DIGITS.search(structure)
+    if m is not None:
+        line = structure.count("\n", 0, m.start()) + 1
+        digits = len(m.group()) - m.group().count("_")
+        raise FormatError(
+            path, f"line {line}: a number of {digits} digits; {what} holds none longer than {MAX_DIGITS}"
+        )
