@@ -217,3 +217,51 @@ def write_project_manifest(path: Path, change) -> Path:
             zf.writestr(name, buf.getvalue())
     return path
 
+
+
+# -- issue 27: USD files usd-core warns about, and one of 10^7 widths ---------------------------
+USDA_CURVES = """#usda 1.0
+(
+    upAxis = "Z"
+    metersPerUnit = 1
+)
+def Xform "Head"
+{
+    double3 xformOp:translate = (0, 0, 1)
+    float xformOp:rotateZ.timeSamples = {1: 0, 2: 30}
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateZ"]
+    def BasisCurves "Hair"
+    {
+        uniform token type = "linear"
+        int[] curveVertexCounts = [4, 3]
+        point3f[] points = [(0, 0, 0), (0, 0, 1), (0, 0, 2), (0, 0, 3), (1, 0, 0), (1, 0, 1), (1, 0, 2)]
+        float[] widths = [0.1, 0.2] (interpolation = "uniform")
+    }
+}
+"""
+
+
+def write_usda(path: Path, old: str = "", new: str = "") -> Path:
+    """:data:`USDA_CURVES` with ``old`` replaced by ``new`` (once)."""
+    assert old in USDA_CURVES
+    path.write_text(USDA_CURVES.replace(old, new, 1))
+    return path
+
+
+def write_usda_widths(path: Path, count: int = 10**7) -> Path:
+    """Two curves of seven points and ``count`` uniform widths: 20 MB of text for 10^7."""
+    widths = "[" + ",".join(["1"] * count) + "]"
+    return write_usda(path, "[0.1, 0.2]", widths)
+
+
+def write_usdc_bad_prim_name(path: Path) -> Path:
+    """A crate whose token for the prim name "Head" reads ";-) ", which usd-core warns about."""
+    from pxr import Sdf, Usd
+
+    layer = Sdf.Layer.CreateAnonymous(".usda")
+    layer.ImportFromString(USDA_CURVES)
+    Usd.Stage.Open(layer).Export(str(path))
+    data = path.read_bytes()
+    assert data.count(b"Head\0") == 1, "usd-core stored the tokens in a way this builder does not know"
+    path.write_bytes(data.replace(b"Head\0", b";-) \0"))
+    return path
