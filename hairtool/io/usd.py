@@ -659,13 +659,15 @@ def _pxr_conversion_noise_hidden():
 
     Reading a corrupt crate value, usd-core raises its error (which the reader turns into a
     FormatError) but first reports, through ``sys.excepthook``, a TypeError "No to_python
-    (by-value) converter found" for the value it could not convert. Only that report is hidden,
-    and only while the reader runs; anything else still reaches the previous hook.
+    (by-value) converter found" for the value it could not convert, and a UnicodeDecodeError for
+    a token whose bytes are not UTF-8 (the value then reads as None, which the reader refuses).
+    Only those reports are hidden, and only while the reader runs; anything else still reaches
+    the previous hook.
     """
     previous = sys.excepthook
 
     def hook(kind, value, tb):
-        if not (kind is TypeError and "to_python" in str(value)):
+        if not ((kind is TypeError and "to_python" in str(value)) or kind is UnicodeDecodeError):
             previous(kind, value, tb)
 
     sys.excepthook = hook
