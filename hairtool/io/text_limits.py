@@ -3,10 +3,11 @@
 Python's ``json`` and ``tomllib`` recurse once per level of nesting (a file nested 100,000
 deep ends in a RecursionError, or worse in a parser that catches it late) and turn every
 integer literal into an ``int`` (beyond 4,300 digits a ValueError; 10⁴⁰⁰ overflows ``float()``
-afterwards). :func:`check_text` measures the deepest nesting and the longest run of digits
-outside strings and comments, with regular expressions and numpy (no Python loop over the
-text), so jobs files, stroke logs and project manifests refuse such documents in one line
-naming the file, the line and the limit.
+afterwards), and ``tomllib`` spends time and memory quadratic in the parts of a dotted key (a
+100,000-part key ``a.a.a… = 1`` took 22 GB). :func:`check_text` measures the deepest nesting,
+the longest run of digits and the longest dotted key outside strings and comments, with
+regular expressions and numpy (no Python loop over the text), so jobs files, stroke logs and
+project manifests refuse such documents in one line naming the file, the line and the limit.
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ MAX_DEPTH = 64
 #: Longest run of digits outside strings: no count, index, coordinate or argument needs more
 #: (float64 keeps 17 significant digits; an int64 has 19).
 MAX_DIGITS = 40
+#: Most parts of a TOML dotted key or table name (``[a.b.c]``): a jobs file needs one.
+MAX_KEY_PARTS = 16
 
 # JSON strings hold no raw control characters, so replacing each with "" keeps line numbers.
 _JSON_STRINGS = re.compile(r'"(?:[^"\\\x00-\x1f]|\\.)*"')
@@ -31,6 +34,9 @@ _TOML_LONG = re.compile(r'"""(?:[^\\]|\\.)*?"""{0,2}|\'\'\'.*?\'\'\'\'{0,2}', re
 _TOML_SHORT = re.compile(r'"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*')
 _NOT_BRACKET = re.compile(r"[^\[\]{}]+")
 _LONG_DIGITS = re.compile(rf"\d[\d_]{{{MAX_DIGITS},}}")
+# A bare or (emptied) quoted key part, then more than MAX_KEY_PARTS - 1 dotted ones.
+_KEY_PART = r'(?:[\w-]+|"")'
+_LONG_KEY = re.compile(rf"{_KEY_PART}(?:[ \t]*\.[ \t]*{_KEY_PART}){{{MAX_KEY_PARTS},}}")
 
 
 def _structure(text: str, kind: str) -> str:
@@ -67,4 +73,11 @@ def check_text(
         digits = len(m.group()) - m.group().count("_")
         raise FormatError(
             path, f"line {line}: a number of {digits} digits; {what} holds none longer than {MAX_DIGITS}"
+        )
+    m = _LONG_KEY.search(structure) if kind == "toml" else None
+    if m is not None:
+        line = structure.count("\n", 0, m.start()) + 1
+        parts = m.group().count(".") + 1
+        raise FormatError(
+            path, f"line {line}: a dotted key of {parts} parts; {what} has none longer than {MAX_KEY_PARTS}"
         )

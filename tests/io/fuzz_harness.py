@@ -20,10 +20,10 @@ are duplicated, dropped and swapped there too.
 
 Documents (stroke logs, jobs files in JSON and TOML, a project's manifest) are also mutated by
 their structure, half of their mutants: a value is parsed out and replaced by itself nested
-65 to 100,000 levels deep, by an integer of 20 to 5,000 digits, by a value of another type, or
-a list is made ragged (an element dropped, added, turned into a scalar or a list) or 5,000
-long. Whatever a reader (or usd-core beneath it) prints on fd 2 is a failure too: the CLI's
-one line is the only line.
+65 to 100,000 levels deep (in lists, objects, or in TOML a dotted key), by an integer of 20 to
+5,000 digits, by a value of another type, or a list is made ragged (an element dropped, added,
+turned into a scalar or a list) or 5,000 long. Whatever a reader (or usd-core beneath it)
+prints on fd 2 is a failure too: the CLI's one line is the only line.
 """
 
 from __future__ import annotations
@@ -263,7 +263,10 @@ def _dump(tree, toml: bool) -> str:
 
 
 def _nested(rng, inner: str, depth: int, toml: bool) -> tuple[str, str]:
-    if rng.random() < 0.5:
+    r = rng.random()
+    if toml and r < 0.3:  # an inline table of one dotted key: tomllib nests a table per part
+        return "{" + ".".join(["a"] * depth) + " = " + inner + "}", f"nest-key-{depth}"
+    if r < 0.6:
         return "[" * depth + inner + "]" * depth, f"nest-list-{depth}"
     key = "a = " if toml else '"a": '
     return ("{" + key) * depth + inner + "}" * depth, f"nest-object-{depth}"

@@ -49,3 +49,18 @@ def test_limits_and_their_messages(tmp_path):
         check_text(p, f"[\n1,\n{ok}1]", "json", "a log")
     with pytest.raises(FormatError, match="line 2: a number of 50 digits"):
         check_text(p, "# 1\nx = 1_" + "0" * 49 + "\n", "toml", "a jobs file")
+
+
+def test_toml_dotted_keys(tmp_path):
+    """tomllib's time and memory grow with the square of a dotted key's parts (22 GB for 100,000)."""
+    p = tmp_path / "x.toml"
+    key = ".".join(["a"] * 16)
+    valid = f'[{key}]\n{key} = 1.5\nb = {{ {key} = "x.y.z" }}\nd = 1979-05-27T07:32:00.5\n'
+    tomllib.loads(valid)
+    check_text(p, valid, "toml", "jobs")
+    long = '"q".' + key
+    spaced = long.replace(".", " . ")
+    for text in (f"[{long}]\n", f"{long} = 1\n", f"x = {{ {long} = 1 }}\n", f"x = {{ {spaced} = 1 }}\n"):
+        with pytest.raises(FormatError, match="line 1: a dotted key of 17 parts; jobs has none longer"):
+            check_text(p, text, "toml", "jobs")
+    check_text(p, f"[{long}]", "json", "jobs")  # JSON has no dotted keys
