@@ -47,14 +47,20 @@ def _structure(text: str, kind: str) -> str:
     return _TOML_SHORT.sub('""', text)
 
 
+_CHUNK = 1 << 22  # brackets summed at a time: 16 MB of int32 steps, however large the file
+
+
 def nesting_depth(structure: str) -> int:
     """The deepest nesting of ``[`` and ``{`` in text whose strings are emptied."""
     brackets = _NOT_BRACKET.sub("", structure).encode("ascii")
-    if not brackets:
-        return 0
-    b = np.frombuffer(brackets, dtype=np.uint8)
-    steps = np.where((b == ord("[")) | (b == ord("{")), 1, -1).astype(np.int32)
-    return int(np.cumsum(steps).max())
+    depth = deepest = 0
+    for start in range(0, len(brackets), _CHUNK):
+        b = np.frombuffer(brackets, dtype=np.uint8, count=min(_CHUNK, len(brackets) - start), offset=start)
+        steps = ((b == ord("[")) | (b == ord("{"))).astype(np.int32) * 2 - 1
+        running = np.cumsum(steps)
+        deepest = max(deepest, depth + int(running.max()))
+        depth += int(running[-1])
+    return deepest
 
 
 def check_text(

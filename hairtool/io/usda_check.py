@@ -28,6 +28,9 @@ MAGIC = b"#usda"
 MIN_SCAN_BYTES = 1 << 20
 #: Arrays this short are never refused (what usd-core makes of them is small).
 FLOOR = 1 << 16
+#: More braces than this (no real stage has them; usd-core stops at a stray one) and the prims
+#: are not told apart: every curve array is counted against the file's largest points array.
+MAX_BRACES = 1 << 22
 #: The attributes of a curves prim the reader sizes from its points, by name.
 CURVE_ARRAYS = (
     "curveVertexCounts",
@@ -77,14 +80,16 @@ def _arrays(text: bytes, names: tuple[str, ...]) -> list[tuple[int, str, int]]:
     return out
 
 
-def _blocks(text: bytes) -> list[tuple[int, int, int]]:
-    """(definition, start, end) of the body of every prim that is BasisCurves or an untyped over."""
+def _blocks(text: bytes) -> list[tuple[int, int]]:
+    """(start, end) of the body of every prim that is BasisCurves or an untyped over."""
+    if text.count(b"{") + text.count(b"}") > MAX_BRACES:
+        return [(0, len(text))]  # one block: the whole file
     b = np.frombuffer(text, dtype=np.uint8)
     pos = np.flatnonzero((b == ord("{")) | (b == ord("}")))
     if not pos.size:
         return []
     opening = b[pos] == ord("{")
-    depth = np.cumsum(np.where(opening, 1, -1))
+    depth = np.cumsum(np.where(opening, 1, -1).astype(np.int32))
     out = []
     for m in _PRIM.finditer(text):
         if m.start() and (text[m.start() - 1 : m.start()].isalnum() or text[m.start() - 1] == ord("_")):
@@ -97,7 +102,7 @@ def _blocks(text: bytes) -> list[tuple[int, int, int]]:
             continue
         closing = np.flatnonzero(depth[i:] < depth[i])
         end = int(pos[i + closing[0]]) if closing.size else len(text)
-        out.append((m.start(), int(pos[i]), end))
+        out.append((int(pos[i]), end))
     return out
 
 
@@ -114,18 +119,18 @@ def check(path: Path) -> None:
     arrays = _arrays(text, ("points", *CURVE_ARRAYS))
     file_points = max((n for _, name, n in arrays if name == "points"), default=0)
     composed = any(word in text for word in _ARCS)
-    for defined, start, end in blocks:
-        inside = [(name, n) for at, name, n in arrays if start <= at < end]
-        points = max((n for name, n in inside if name == "points"), default=None)
+    for start, end in blocks:
+        inside = [(at, name, n) for at, name, n in arrays if start <= at < end]
+        points = max((n for _, name, n in inside if name == "points"), default=None)
         if points is None and composed:
             continue  # its points may come from another layer
         if points is None:
             points = file_points
-        for name, n in inside:
+        for at, name, n in inside:
             if name != "points" and n > max(points, FLOOR):
-                line = text.count(b"\n", 0, defined) + 1
+                line = text.count(b"\n", 0, at) + 1
                 raise FormatError(
                     path,
-                    f"the curves prim at line {line}: {name} holds {n} values for at most {points} "
-                    "points (refused before usd-core parses it)",
+                    f"line {line}: {name} holds {n} values for curves of at most {points} points "
+                    "(refused before usd-core parses it)",
                 )

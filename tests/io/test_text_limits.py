@@ -8,6 +8,7 @@ import tomllib
 import pytest
 
 from hairtool.errors import FormatError
+from hairtool.io import text_limits
 from hairtool.io.text_limits import MAX_DIGITS, check_text, nesting_depth
 from hairtool.io.text_limits import _structure as structure
 
@@ -16,7 +17,10 @@ from hairtool.io.text_limits import _structure as structure
     "value",
     [[], [[1]], {"a": [{"b": [[[]]]}]}, ["[[[", "{{", "]]"], {"k": '"[\\"[' * 3}, [1, [2, [3]], 4]],
 )
-def test_json_depth_is_the_parsers(value):
+@pytest.mark.parametrize("chunk", [1 << 22, 1, 3], ids=["whole", "chunks-of-1", "chunks-of-3"])
+def test_json_depth_is_the_parsers(monkeypatch, value, chunk):
+    monkeypatch.setattr(text_limits, "_CHUNK", chunk)  # the sum carried across chunks
+
     def depth(v):
         children = v.values() if isinstance(v, dict) else v if isinstance(v, list) else []
         return 1 + max(map(depth, children), default=0) if isinstance(v, dict | list) else 0

@@ -44,13 +44,13 @@ def test_real_and_written_files_pass(tmp_path, scan_everything):
 @pytest.mark.parametrize(
     ("old", "new", "words"),
     [
-        ("[0.1, 0.2]", "[" + "1, " * 8 + "1]", "widths holds 9 values for at most 7 points"),
+        ("[0.1, 0.2]", "[" + "1, " * 8 + "1]", "line 16: widths holds 9 values for curves of at most 7"),
         ("= [4, 3]", "= [" + "2," * 9 + "2]", "curveVertexCounts holds 10"),
         ("widths = [0.1, 0.2]", "widths.timeSamples = {1: [1, 1], 2: [" + "1," * 9 + "1]}", "widths hold"),
         ('float[] widths = [0.1, 0.2] (interpolation = "uniform")',
          "color3f[] primvars:displayColor = [" + "(1, 0, 0), " * 8 + "(1, 0, 0)]", "displayColor holds 9"),
         ("}\n}\n", '}\n}\nover "Head" {\n over "Hair" {\n  float[] widths = [' + "1," * 9 + "1]\n }\n}\n",
-         "widths holds 10 values for at most 7 points"),
+         "widths holds 10 values for curves of at most 7 points"),
     ],
     ids=["widths", "counts", "time-samples", "colour", "over"],
 )  # fmt: skip
@@ -58,6 +58,14 @@ def test_an_array_beyond_its_points(tmp_path, scan_everything, old, new, words):
     path = hostile.write_usda(tmp_path / "h.usda", old, new)
     with pytest.raises(FormatError, match=words):
         usda_check.check(path)
+
+
+def test_a_file_of_too_many_braces_is_one_block(tmp_path, scan_everything, monkeypatch):
+    monkeypatch.setattr(usda_check, "MAX_BRACES", 4)
+    wide = hostile.write_usda(tmp_path / "w.usda", "[0.1, 0.2]", "[" + "1," * 7 + "1]")
+    with pytest.raises(FormatError, match="line 16: widths holds 8 values for curves of at most 7 points"):
+        usda_check.check(wide)  # against the file's largest points array
+    usda_check.check(hostile.write_usda(tmp_path / "ok.usda"))
 
 
 def test_strings_comments_and_composed_points(tmp_path, scan_everything):
