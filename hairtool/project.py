@@ -41,10 +41,10 @@ from hairtool.frozen.brushes import BRUSHES, LUT_SIZE, BrushSample, check_sample
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.groom import Animation, Groom
 from hairtool.guides.binding import MAX_FRIZZ, ChildBinding, bind_exactly, curl
+from hairtool.io import text_limits
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
 from hairtool.io.npz import read_npy_header
-from hairtool.io.text_limits import check_text
 
 FORMAT = "hairtool project"
 FORMAT_VERSION = 2  # 2: brush strokes or render hair (children); version 1 files still read
@@ -294,7 +294,7 @@ class _Reader:
         if info.file_size > MAX_MANIFEST_BYTES:
             raise FormatError(self.path, "manifest.json is too large")
         text = self.zf.read(MANIFEST).decode("utf-8")
-        check_text(self.path, text, "json", "a project's manifest.json")  # before json recurses
+        text_limits.check_text(self.path, text, "json", "a project's manifest.json")  # before json recurses
         try:
             manifest = json.loads(text)
         except json.JSONDecodeError as e:
