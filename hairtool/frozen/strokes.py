@@ -177,7 +177,8 @@ def _number(where: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ParameterError(where, _short(value), "a finite number")
     if isinstance(value, int) and not -sys.float_info.max <= value <= sys.float_info.max:
-        raise ParameterError(where, f"an integer of {len(str(abs(value)))} digits", "a finite number")
+        digits = int(abs(value).bit_length() * math.log10(2)) + 1  # str() refuses over 4,300 digits
+        raise ParameterError(where, f"an integer of about {digits} digits", "a finite number")
     if not math.isfinite(value):
         raise ParameterError(where, value, "a finite number")
     return float(value)
