@@ -29,6 +29,7 @@ prints on fd 2 is a failure too: the CLI's one line is the only line.
 from __future__ import annotations
 
 import argparse
+import atexit
 import contextlib
 import io
 import json
@@ -720,6 +721,7 @@ class _Stderr:
 
     def __init__(self) -> None:
         self.file = tempfile.TemporaryFile()
+        atexit.register(self.file.close)  # closed before exit, where warnings are errors
 
     @contextlib.contextmanager
     def captured(self):
