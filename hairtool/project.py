@@ -41,6 +41,7 @@ from hairtool.frozen.brushes import BRUSHES, LUT_SIZE, BrushSample, check_sample
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.groom import Animation, Groom
 from hairtool.guides.binding import MAX_FRIZZ, ChildBinding, bind_exactly, curl
+from hairtool.io import text_limits
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
 from hairtool.io.npz import read_npy_header
@@ -313,8 +314,10 @@ class _Reader:
             raise FormatError(self.path, "not a hairtool project (no manifest.json)")
         if info.file_size > MAX_MANIFEST_BYTES:
             raise FormatError(self.path, "manifest.json is too large")
+        text = self.zf.read(MANIFEST).decode("utf-8")
+        text_limits.check_text(self.path, text, "json", "a project's manifest.json")  # before json recurses
         try:
-            manifest = json.loads(self.zf.read(MANIFEST).decode("utf-8"))
+            manifest = json.loads(text)
         except json.JSONDecodeError as e:
             raise FormatError(self.path, f"manifest.json is not JSON: {e}") from None
         if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
@@ -390,9 +393,14 @@ def _read_params(r: _Reader, raw: dict) -> FrozenParams:
     if unknown:
         raise FormatError(r.path, f"unknown engine parameter {sorted(unknown)[0]!r}")
     values = dict(raw)
+    for name, value in values.items():  # numbers, flags and names, as save() writes them
+        if not (value is None or isinstance(value, bool | int | float | str)) and name != "strand_variation":
+            raise FormatError(r.path, f"engine parameter {name!r} is a JSON {type(value).__name__}")
     sv = values.get("strand_variation")
     if isinstance(sv, dict):
         values["strand_variation"] = r.array(sv.get("array", ""), 1, "f").astype(np.float64)
+    elif isinstance(sv, bool) or not isinstance(sv, int | float | None):
+        raise FormatError(r.path, 'strand_variation must be a number or {"array": member}')
     try:
         return FrozenParams(**values).validate()
     except (HairtoolError, TypeError, ValueError) as e:

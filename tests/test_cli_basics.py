@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -142,3 +143,37 @@ def test_groom_input_spec(tmp_path):
     for bad in ("1,2", "a,b,c", "1,2,3,4", ""):
         with pytest.raises(ParameterError, match="three numbers"):
             parse_vector("wind", bad)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [["info", "{groom}"], ["info", "{groom}", "--json"], ["--help"], ["info", "--help"], ["--version"],
+     ["convert", "{groom}", "{out}"], ["info", "{missing}"]],
+    ids=["info", "info-json", "help", "info-help", "version", "convert", "bad-input"],
+)  # fmt: skip
+@pytest.mark.skipif(sys.platform == "win32", reason="SIGPIPE and /dev/null as on POSIX")
+def test_a_closed_pipe_exits_quietly(tmp_path, argv):
+    """``hairtool info F | head -1``: the reader leaves; no BrokenPipeError traceback, status 141
+    (as a shell reports for cat), and a file the command wrote is whole."""
+    groom = tmp_path / "g.npz"
+    write(groom, scalp(10, 5))
+    names = {"groom": groom, "out": tmp_path / "out.usda", "missing": tmp_path / "none.npz"}
+    raw, argv = argv, [a.format(**names) for a in argv]
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"}  # stdout buffered, as usual
+    r, w = os.pipe()
+    os.close(r)  # the reader has gone before the first write: every write to stdout fails
+    try:
+        for stderr in (subprocess.PIPE, w):  # stderr apart, and both into the closed pipe (2>&1)
+            p = subprocess.run(
+                [sys.executable, "-m", "hairtool", *argv], stdout=w, stderr=stderr, env=env, timeout=120
+            )
+            if "{missing}" in raw and stderr != w:  # nothing for stdout; the error line reaches stderr
+                assert p.returncode == 2 and len(p.stderr.splitlines()) == 1, p.stderr
+                continue
+            assert p.returncode == 141, p.stderr
+            assert stderr == w or p.stderr == b"", p.stderr.decode()
+    finally:
+        os.close(w)
+    if "convert" in argv:
+        assert read(names["out"]).strand_count == 10
+        assert sorted(f.name for f in tmp_path.iterdir()) == ["g.npz", "out.usda"]  # no temporary left

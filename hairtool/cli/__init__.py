@@ -10,7 +10,9 @@ from __future__ import annotations
 import argparse
 import functools
 import importlib
+import os
 import pkgutil
+import signal
 import sys
 from collections.abc import Sequence
 from importlib.metadata import entry_points
@@ -20,6 +22,10 @@ from hairtool.errors import HairtoolError
 
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2
+#: The reader of the output went away (``hairtool info F | head -1``): 128 + SIGPIPE, the status
+#: a shell reports for ``cat`` or ``grep`` stopped by a closed pipe, so ``set -o pipefail``
+#: scripts see a cut listing as they do theirs, and no caller takes it for complete output.
+EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
 
 
 #: Entry-point group through which packages above the command line add commands: the farm's
@@ -96,4 +102,26 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def entry() -> None:
-    sys.exit(main())
+    """The ``hairtool`` program: :func:`main`, its output flushed here, a closed pipe quiet.
+
+    Python ignores SIGPIPE and raises BrokenPipeError at the write instead: caught here (after
+    every ``with`` block of the command has removed its temporary files, which the signal's
+    default action would leave behind), stdout is pointed at /dev/null so that the flush at
+    exit cannot report the pipe again, and the status is :data:`EXIT_BROKEN_PIPE`.
+    """
+    try:
+        try:
+            status = main()
+        except SystemExit as e:  # argparse's --help, --version and usage errors
+            status = e.code
+        sys.stdout.flush()  # now, where a closed pipe can still be caught
+    except BrokenPipeError:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except BrokenPipeError:
+                devnull = os.open(os.devnull, os.O_WRONLY)
+                os.dup2(devnull, stream.fileno())
+                os.close(devnull)
+        status = EXIT_BROKEN_PIPE
+    sys.exit(status)

@@ -25,11 +25,18 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from hairtool.errors import FormatError
+from hairtool.io.text_limits import check_text
 
 #: Commands a job may not run: a batch inside a worker would start a cluster of its own, and a
 #: benchmark's numbers mean nothing on a shared worker.
 NOT_JOBS = ("batch", "bench")
 ENTRY_KEYS = ("command", "args", "glob")
+#: A jobs file larger than this is not one (100,000 jobs of 200 characters are 20 MB).
+MAX_JOBS_BYTES = 64 << 20
+#: A glob's length and its path components: more is a mistake, and Python's glob recurses once
+#: per component (a pattern of 1,000 components ends in a RecursionError).
+MAX_GLOB_CHARS = 1024
+MAX_GLOB_PARTS = 32
 #: Placeholders of a glob entry's args, for a match ``shots/a.usdc``.
 PLACEHOLDERS = {
     "path": "the match, shots/a.usdc",
@@ -107,6 +114,8 @@ def _parse(path: Path) -> object:
     if suffix not in (".json", ".toml"):
         raise FormatError(path, "a jobs file is .json or .toml")
     try:
+        if path.stat().st_size > MAX_JOBS_BYTES:
+            raise FormatError(path, f"larger than {MAX_JOBS_BYTES >> 20} MB: not a jobs file")
         data = path.read_bytes()
     except OSError as e:
         raise FormatError(path, f"cannot read: {e.strerror or e}") from None
@@ -114,12 +123,15 @@ def _parse(path: Path) -> object:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
         raise FormatError(path, "not UTF-8 text") from None
+    check_text(path, text, suffix[1:], "a jobs file")  # before the parsers recurse or convert
     try:
         return json.loads(text) if suffix == ".json" else tomllib.loads(text)
     except json.JSONDecodeError as e:
         raise FormatError(path, f"not valid JSON: {e.msg} (line {e.lineno}, column {e.colno})") from None
     except tomllib.TOMLDecodeError as e:
         raise FormatError(path, f"not valid TOML: {e}") from None
+    except (RecursionError, ValueError) as e:  # past the checks above only on a deep call stack
+        raise FormatError(path, f"not a readable jobs file ({type(e).__name__})") from None
 
 
 def _args(path: Path, where: str, value: object) -> list[str]:
@@ -150,14 +162,29 @@ def _fill(path: Path, where: str, arg: str, values: dict[str, str]) -> str:
     return _TEMPLATE.sub(replace, arg)
 
 
+def _shown(text: str, limit: int = 80) -> str:
+    """``text`` quoted for a message, its middle cut when it is long."""
+    return repr(text if len(text) <= limit else text[: limit // 2] + "…" + text[-limit // 4 :])
+
+
 def _expand_glob(path: Path, where: str, pattern: object, args: list[str], base: str) -> list[list[str]]:
     if not isinstance(pattern, str) or not pattern:
         raise FormatError(path, f"{where}: glob must be a non-empty string such as shots/*.usdc")
+    if len(pattern) > MAX_GLOB_CHARS:
+        long = f"{len(pattern)} characters long"
+        raise FormatError(path, f"{where}: glob {_shown(pattern)} is {long}; at most {MAX_GLOB_CHARS}")
+    parts = len(re.split(r"[/\\]+", pattern.strip("/\\")))
+    if parts > MAX_GLOB_PARTS:
+        raise FormatError(
+            path, f"{where}: glob {_shown(pattern)} has {parts} path components; at most {MAX_GLOB_PARTS}"
+        )
+    if pattern.count("**") > 2:  # each ** walks the whole tree again below the last
+        raise FormatError(path, f"{where}: glob {_shown(pattern)} has more than two **")
     matches = sorted(
         m for m in glob.glob(pattern, root_dir=base, recursive=True) if os.path.isfile(os.path.join(base, m))
     )
     if not matches:
-        raise FormatError(path, f"{where}: glob {pattern!r} matches no file in {base}")
+        raise FormatError(path, f"{where}: glob {_shown(pattern)} matches no file in {base}")
     filled = []
     for m in matches:
         p = Path(m)

@@ -80,7 +80,7 @@ class Manifests:
         try:
             with open(folder / MANIFEST_NAME, encoding="utf-8") as f:
                 data = json.load(f)
-        except (OSError, ValueError):
+        except (OSError, ValueError, RecursionError):  # RecursionError: JSON nested 100,000 deep
             return {}
         if not isinstance(data, dict) or data.get("format") != FORMAT or data.get("version") != VERSION:
             return {}

@@ -46,6 +46,7 @@ F64 = NDArray[np.float64]
 BRUSHES = ("align", "comb", "smooth", "length", "puff", "mask", "clump")
 FALLOFFS = ("smooth", "linear", "constant")
 LUT_SIZE = 257  # samples of a falloff curve over [0, 1]: interpolated linearly between
+MAX_FALLOFF_POINTS = 4 * LUT_SIZE  # a curve of more points than this says nothing more
 EPS = 1e-12
 
 
@@ -61,14 +62,36 @@ def falloff_lut(falloff: str | Sequence[Sequence[float]]) -> F64:
         if falloff == "constant":
             return np.ones_like(t)
         raise ParameterError("falloff", falloff, f"one of {', '.join(FALLOFFS)} or a list of [t, w] points")
-    pts = np.asarray(falloff, dtype=np.float64)
-    if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] < 2:
+    pts = _curve_points(falloff)
+    if pts.shape[0] < 2:
         raise ParameterError("falloff", "curve", "at least two [t, w] points")
     if not np.all(np.isfinite(pts)) or np.any(np.diff(pts[:, 0]) <= 0):
         raise ParameterError("falloff", "curve", "finite points with t strictly increasing")
     if pts[0, 0] != 0.0 or pts[-1, 0] != 1.0 or np.any((pts[:, 1] < 0) | (pts[:, 1] > 1)):
         raise ParameterError("falloff", "curve", "t from 0 to 1 and weights in [0, 1]")
     return np.interp(t, pts[:, 0], pts[:, 1])
+
+
+def _curve_points(falloff: object) -> F64:
+    """``(n, 2)`` float64 curve points, the shape and every value checked before numpy sees
+    them: a ragged curve, a huge one, a string or an integer beyond float64 is a ParameterError."""
+    if isinstance(falloff, np.ndarray):
+        if falloff.ndim != 2 or falloff.shape[1:] != (2,) or falloff.dtype.kind not in "fiu":
+            raise ParameterError("falloff", "curve", "a list of [t, w] points")
+        falloff = falloff.tolist()
+    if not isinstance(falloff, Sequence) or isinstance(falloff, str | bytes):
+        raise ParameterError("falloff", type(falloff).__name__, "a preset name or a list of [t, w] points")
+    if len(falloff) > MAX_FALLOFF_POINTS:
+        raise ParameterError("falloff", f"{len(falloff)} points", f"at most {MAX_FALLOFF_POINTS} points")
+    for p in falloff:
+        if isinstance(p, str | bytes) or not isinstance(p, Sequence | np.ndarray) or len(p) != 2:
+            raise ParameterError("falloff", "curve", "[t, w] points of two numbers each")
+        for v in p:
+            if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+                raise ParameterError("falloff", "curve", "[t, w] points of two numbers each")
+            if isinstance(v, int) and abs(v) > 1:  # t and w lie in [0, 1]: refused before float()
+                raise ParameterError("falloff", "curve", "t from 0 to 1 and weights in [0, 1]")
+    return np.array(falloff, dtype=np.float64).reshape(len(falloff), 2)
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,9 +37,18 @@ import numpy as np
 
 from hairtool.errors import FormatError, ParameterError
 from hairtool.frozen.align import MODES
-from hairtool.frozen.brushes import BRUSHES, BrushSample, check_sample, check_view, falloff_lut, mirrored_view
+from hairtool.frozen.brushes import (
+    BRUSHES,
+    MAX_FALLOFF_POINTS,
+    BrushSample,
+    check_sample,
+    check_view,
+    falloff_lut,
+    mirrored_view,
+)
 from hairtool.frozen.pipeline import AlignSample
 from hairtool.io.atomic import atomic_open
+from hairtool.io.text_limits import check_text
 
 MAX_LOG_BYTES = 256 * 1024**2
 
@@ -156,15 +166,30 @@ def _vector(where: str, value: Any, default: tuple | None = None) -> tuple[float
     if value is None and default is not None:
         return default
     if not isinstance(value, list) or len(value) != 3:
-        raise ParameterError(where, value, "three numbers [x, y, z]")
+        raise ParameterError(where, _short(value), "three numbers [x, y, z]")
     v = tuple(_number(where, c) for c in value)
     return v  # type: ignore[return-value]
 
 
 def _number(where: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+    """A finite float; an integer beyond float64's range is refused before ``float()`` (the
+    comparison of an int with a float is exact, so it cannot overflow)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ParameterError(where, _short(value), "a finite number")
+    if isinstance(value, int) and not -sys.float_info.max <= value <= sys.float_info.max:
+        digits = int(abs(value).bit_length() * math.log10(2)) + 1  # str() refuses over 4,300 digits
+        raise ParameterError(where, f"an integer of about {digits} digits", "a finite number")
+    if not math.isfinite(value):
         raise ParameterError(where, value, "a finite number")
     return float(value)
+
+
+def _short(value: Any) -> Any:
+    """``value`` for a message: a long list or text by its kind and length."""
+    if isinstance(value, list | dict | str) and len(repr(value)) > 80:
+        unit = "characters" if isinstance(value, str) else "items"
+        return f"a {type(value).__name__} of {len(value)} {unit}"
+    return value
 
 
 def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
@@ -173,7 +198,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
         raise ParameterError(where, type(d).__name__, "an object with brush and samples")
     raw_samples = d.get("samples")
     if not isinstance(raw_samples, list):
-        raise ParameterError(f"{where}.samples", raw_samples, "a list of samples")
+        raise ParameterError(f"{where}.samples", _short(raw_samples), "a list of samples")
     samples = []
     for i, s in enumerate(raw_samples):
         at = f"{where}.samples[{i}]"
@@ -190,12 +215,16 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
         )
     falloff = d.get("falloff", "smooth")
     if isinstance(falloff, list):
-        falloff = tuple(
-            tuple(_number(f"{where}.falloff", v) for v in p) if isinstance(p, list) else p for p in falloff
-        )
+        if len(falloff) > MAX_FALLOFF_POINTS:
+            many = f"{len(falloff)} points"
+            raise ParameterError(f"{where}.falloff", many, f"at most {MAX_FALLOFF_POINTS}")
+        for k, p in enumerate(falloff):
+            if not isinstance(p, list) or len(p) != 2:
+                raise ParameterError(f"{where}.falloff[{k}]", _short(p), "a point [t, w]")
+        falloff = tuple((_number(f"{where}.falloff", t), _number(f"{where}.falloff", w)) for t, w in falloff)
     params = d.get("params") or {}
     if not isinstance(params, dict):
-        raise ParameterError(f"{where}.params", params, "an object")
+        raise ParameterError(f"{where}.params", _short(params), "an object")
     mirror = d.get("mirror_x")
     stroke = Stroke(
         brush=d.get("brush"),
@@ -209,7 +238,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
         stroke.pipeline_samples(0.0)  # every sample checked (radius, strength range) as it will run
         return stroke
     except ParameterError as e:
-        raise ParameterError(f"{where}.{e.name}", e.value, str(e).split("expected ", 1)[-1]) from None
+        raise ParameterError(f"{where}.{e.name}", _short(e.value), str(e).split("expected ", 1)[-1]) from None
 
 
 def read_strokes(path: str | os.PathLike[str]) -> list[Stroke]:
@@ -218,7 +247,9 @@ def read_strokes(path: str | os.PathLike[str]) -> list[Stroke]:
     try:
         if p.stat().st_size > MAX_LOG_BYTES:
             raise FormatError(p, f"larger than {MAX_LOG_BYTES >> 20} MB: not a stroke log")
-        data = json.loads(p.read_text(encoding="utf-8"))
+        text = p.read_text(encoding="utf-8")
+        check_text(p, text, "json", "a stroke log")  # before the parser recurses or converts
+        data = json.loads(text)
     except FormatError:
         raise
     except (OSError, UnicodeDecodeError, ValueError, RecursionError) as e:

@@ -40,6 +40,7 @@ import contextlib
 import os
 import re
 import sys
+import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Protocol
@@ -49,7 +50,7 @@ import numpy as np
 from hairtool.bounds import box
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom, Topology
-from hairtool.io import usd_basis, usdc_check
+from hairtool.io import usd_basis, usda_check, usdc_check
 from hairtool.io.atomic import atomic_path
 from hairtool.io.binary import require_finite, require_strand_counts
 from hairtool.metadata import PURPOSES, CurvesPrim, Metadata
@@ -340,6 +341,7 @@ def _open_stage(path: Path):
     if path.stat().st_size == 0:
         raise FormatError(path, "the file is empty")
     usdc_check.check(path)  # before usd-core allocates from a crate's counts
+    usda_check.check(path)  # before usd-core's text parser holds every value of an array
     try:
         layer = Sdf.Layer.Find(str(path))
         # A layer still cached from an earlier open may be stale: the file can have been replaced.
@@ -533,12 +535,14 @@ class _Curves:
         need = usd_basis.expected_count(interpolation, self.counts, self.basis, self.wrap)
         if need is None:
             raise FormatError(self.path, f"{self.name}: {what} has unknown interpolation {interpolation!r}")
-        a = np.asarray(values if values is not None else [], dtype=np.float64)
-        if a.shape != (need, *width):
+        count = 0 if values is None else len(values)
+        if count == need:  # counted before a float64 copy is made of it
+            a = np.asarray(values if values is not None else [], dtype=np.float64)
+            count = a.shape[0] if a.ndim else 0
+        if count != need or a.shape != (need, *width):
             raise FormatError(
                 self.path,
-                f"{self.name}: {what} has {a.shape[0] if a.ndim else 0} values; "
-                f"{interpolation} interpolation needs {need}",
+                f"{self.name}: {what} has {count} values; {interpolation} interpolation needs {need}",
             )
         require_finite(self.path, a, f"{self.name} {what}")
         return usd_basis.per_vertex(a, interpolation, self.counts, self.basis, self.wrap)
@@ -655,13 +659,15 @@ def _pxr_conversion_noise_hidden():
 
     Reading a corrupt crate value, usd-core raises its error (which the reader turns into a
     FormatError) but first reports, through ``sys.excepthook``, a TypeError "No to_python
-    (by-value) converter found" for the value it could not convert. Only that report is hidden,
-    and only while the reader runs; anything else still reaches the previous hook.
+    (by-value) converter found" for the value it could not convert, and a UnicodeDecodeError for
+    a token whose bytes are not UTF-8 (the value then reads as None, which the reader refuses).
+    Only those reports are hidden, and only while the reader runs; anything else still reaches
+    the previous hook.
     """
     previous = sys.excepthook
 
     def hook(kind, value, tb):
-        if not (kind is TypeError and "to_python" in str(value)):
+        if not ((kind is TypeError and "to_python" in str(value)) or kind is UnicodeDecodeError):
             previous(kind, value, tb)
 
     sys.excepthook = hook
@@ -672,30 +678,87 @@ def _pxr_conversion_noise_hidden():
             sys.excepthook = previous
 
 
-def read(path: Path) -> Groom | Animation:
-    """Merge every BasisCurves prim; time-sampled points or transforms make an Animation."""
+def _commentary(diagnostic) -> str:
+    try:
+        return " ".join(str(diagnostic.commentary).split())
+    except UnicodeDecodeError:
+        return "a message quoting undecodable bytes of the file"
+
+
+@contextlib.contextmanager
+def _usd_diagnostics(notes: list[str]):
+    """usd-core's own warnings and status lines while it reads ("Invalid prim name", "Integer
+    literal … out of range"), kept off stderr and appended to ``notes``: through its
+    ``Tf.DiagnosticTrap`` (a TfDiagnosticMgr trap), or, in a usd-core without one, by pointing
+    fd 2 at a temporary file."""
     from pxr import Tf
 
+    if hasattr(Tf, "DiagnosticTrap"):
+        with Tf.DiagnosticTrap() as trap:
+            try:
+                yield
+            finally:
+                notes.extend(_commentary(d) for d in (*trap.GetWarnings(), *trap.GetStatuses()))
+                trap.Clear()  # what is left in a trap is printed when it closes
+        return
+    sys.stderr.flush()
+    with tempfile.TemporaryFile() as f:
+        saved = os.dup(2)
+        os.dup2(f.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            f.seek(0)
+            text = f.read().decode("utf-8", "replace")
+            lines = (line.split(" -- ", 1)[-1] for line in text.splitlines() if line.strip())
+            notes.extend(" ".join(line.split()) for line in lines)
+
+
+def _diagnosed(path: Path, work: Callable[[], object]):
+    """``work()`` reading ``path`` through usd-core, every failure one FormatError.
+
+    usd-core's diagnostics never reach stderr: when the file is refused, the first is folded
+    into the error's line (it often says what is wrong, and where); when it reads, they are
+    dropped: hairtool checks every value it uses itself, so what usd-core repaired on the way
+    (an integer literal out of range read as a double) is a value that passed those checks.
+    """
+    from pxr import Tf
+
+    notes: list[str] = []
     try:
-        with _pxr_conversion_noise_hidden():
-            return _read_stage(path, _open_stage(path))
-    except HairtoolError:
-        raise
-    except Tf.ErrorException as e:  # a crate's values are read lazily, inside Get()
-        raise FormatError(path, f"usd-core cannot read it: {_last_line(e)}") from None
-    except (ValueError, TypeError, OverflowError, MemoryError) as e:
-        raise FormatError(path, f"not readable as hair curves ({type(e).__name__}: {e})") from None
+        with _usd_diagnostics(notes), _pxr_conversion_noise_hidden():
+            try:
+                return work()
+            except HairtoolError:
+                raise
+            except Tf.ErrorException as e:  # a crate's values are read lazily, inside Get()
+                raise FormatError(path, f"usd-core cannot read it: {_last_line(e)}") from None
+            except (ValueError, TypeError, OverflowError, MemoryError) as e:
+                raise FormatError(path, f"not readable as hair curves ({type(e).__name__}: {e})") from None
+    except FormatError as e:
+        if not notes:
+            raise
+        more = f"; {len(notes) - 1} more" if len(notes) > 1 else ""
+        note = notes[0] if len(notes[0]) <= 200 else notes[0][:200] + "…"
+        raise FormatError(e.path, f"{e.reason} (usd-core warned: {note}{more})") from None
+
+
+def read(path: Path) -> Groom | Animation:
+    """Merge every BasisCurves prim; time-sampled points or transforms make an Animation."""
+    return _diagnosed(path, lambda: _read_stage(path, _open_stage(path)))
 
 
 def time_codes(path: str | os.PathLike[str]) -> list[float]:
     """The authored time codes of the file's hair: its points' and transforms' samples (empty when static)."""
-    from pxr import Tf, UsdGeom
+    from pxr import UsdGeom
 
     p = Path(path)
-    try:
-        with _pxr_conversion_noise_hidden():
-            stage = _open_stage(p)
-            prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.BasisCurves)]
-            return _sample_times([_Curves(p, q) for q in prims])
-    except Tf.ErrorException as e:
-        raise FormatError(p, f"usd-core cannot read it: {_last_line(e)}") from None
+
+    def work() -> list[float]:
+        stage = _open_stage(p)
+        prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.BasisCurves)]
+        return _sample_times([_Curves(p, q) for q in prims])
+
+    return _diagnosed(p, work)

@@ -103,11 +103,12 @@ def test_jobs_that_finish_together_share_one_write(project, monkeypatch):
 
 def test_a_damaged_manifest_only_means_the_jobs_run_again(project):
     job = keys_job(project)
-    done(project, job)
-    (project / "out" / MANIFEST_NAME).write_text('{"format": "hairtool batch manifest", "jobs": [')
-    assert Manifests().find_done(job) is None
-    done(project, job)
-    assert Manifests().find_done(job) is not None
+    for damaged in ('{"format": "hairtool batch manifest", "jobs": [', "[" * 100_000 + "]" * 100_000):
+        done(project, job)
+        (project / "out" / MANIFEST_NAME).write_text(damaged)
+        assert Manifests().find_done(job) is None
+        done(project, job)
+        assert Manifests().find_done(job) is not None
 
 
 def test_a_job_that_wrote_nothing_is_not_recorded(project):

@@ -11,10 +11,17 @@ import pytest
 
 from hairtool import io, samples
 from hairtool.cli import main
-from hairtool.errors import FormatError
+from hairtool.errors import FormatError, ParameterError
 from hairtool.frozen.brushes import BrushSample, falloff_lut
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline
-from hairtool.frozen.strokes import Stroke, StrokeSample, read_strokes, strokes_from_log, write_strokes
+from hairtool.frozen.strokes import (
+    Stroke,
+    StrokeSample,
+    read_strokes,
+    stroke_from_dict,
+    strokes_from_log,
+    write_strokes,
+)
 
 
 def studio_session(groom):
@@ -180,3 +187,13 @@ def test_views_and_clump_strokes_survive_a_project_round_trip(tmp_path):
     again = back.pipeline()
     np.testing.assert_array_equal(again.result.points, pipe.result.points)
     np.testing.assert_array_equal(again.clump_strength, pipe.clump_strength)
+
+
+@pytest.mark.parametrize("big", [10**400, -(10**5000)], ids=["10^400", "-10^5000"])
+def test_an_integer_beyond_float64_is_refused_before_float(big):
+    """Through the API too (a file's numbers are bounded earlier, by their digits)."""
+    stroke = {"brush": "comb", "samples": [{"cursor": [0, 0, 0], "radius": big, "strength": 0.5}]}
+    with pytest.raises(ParameterError, match=r"radius='an integer of about \d+ digits'"):
+        stroke_from_dict(stroke)
+    stroke["samples"][0]["radius"] = 10**300  # within float64: a radius, just a large one
+    assert stroke_from_dict(stroke).samples[0].radius == 1e300

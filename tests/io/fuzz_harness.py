@@ -17,19 +17,30 @@ words of binary). Zip formats (.npz, projects) are also mutated member by member
 again with valid checksums, so mutations reach the readers' own checks rather than zip's CRC:
 a ``.npy`` member's header tokens (shapes, dtypes) or its data (counts, coordinates); members
 are duplicated, dropped and swapped there too.
+
+Documents (stroke logs, jobs files in JSON and TOML, a project's manifest) are also mutated by
+their structure, half of their mutants: a value is parsed out and replaced by itself nested
+65 to 100,000 levels deep (in lists, objects, or in TOML a dotted key), by an integer of 20 to
+5,000 digits, by a value of another type, or a list is made ragged (an element dropped, added,
+turned into a scalar or a list) or 5,000 long. Whatever a reader (or usd-core beneath it)
+prints on fd 2 is a failure too: the CLI's one line is the only line.
 """
 
 from __future__ import annotations
 
 import argparse
+import atexit
+import contextlib
 import io
 import json
 import math
+import os
 import re
 import resource
 import struct
 import sys
 import tempfile
+import tomllib
 import traceback
 import warnings
 import zipfile
@@ -159,10 +170,24 @@ def _mutate_member(rng: np.random.Generator, content: bytes) -> tuple[bytes, lis
     return mutate_bytes(rng, content, text=True)
 
 
+def _members(data: bytes) -> list[tuple[str, int, bytes]]:
+    with zipfile.ZipFile(io.BytesIO(data)) as zf:
+        return [(i.filename, i.compress_type, zf.read(i)) for i in zf.infolist()]
+
+
+def _zip(members: list[tuple[str, int, bytes]]) -> bytes:
+    buf = io.BytesIO()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "Duplicate name" is the point
+        with zipfile.ZipFile(buf, "w") as zf:
+            for name, kind, content in members:
+                zf.writestr(zipfile.ZipInfo(name, (2020, 1, 1, 0, 0, 0)), content, compress_type=kind)
+    return buf.getvalue()
+
+
 def mutate_zip(rng: np.random.Generator, data: bytes) -> tuple[bytes, list[str]]:
     """Mutate inside the members (the .npy headers as text, so shapes get huge) and zip again."""
-    with zipfile.ZipFile(io.BytesIO(data)) as zf:
-        members = [(i.filename, i.compress_type, zf.read(i)) for i in zf.infolist()]
+    members = _members(data)
     names: list[str] = []
     for _ in range(int(rng.integers(1, 3))):
         k = int(rng.integers(0, len(members)))
@@ -182,13 +207,134 @@ def mutate_zip(rng: np.random.Generator, data: bytes) -> tuple[bytes, list[str]]
             new, ops = _mutate_member(rng, content)
             members[k] = (name, kind, new)
             names.append(f"{name}: {'+'.join(ops)}")
-    buf = io.BytesIO()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # "Duplicate name" is the point
-        with zipfile.ZipFile(buf, "w") as zf:
-            for name, kind, content in members:
-                zf.writestr(zipfile.ZipInfo(name, (2020, 1, 1, 0, 0, 0)), content, compress_type=kind)
-    return buf.getvalue(), names
+    return _zip(members), names
+
+
+# -- structure-aware mutations of documents ------------------------------------------------------
+STRUCTURE_CLASSES = ("deep nesting", "huge integer", "wrong type", "ragged array")
+NESTING = (65, 1000, 100_000)
+HUGE_INTEGERS = ("1" + "0" * 19, "18446744073709551616", "9" * 41, "1" + "0" * 400, "-" + "9" * 5000)
+OTHER_TYPES = ("text", True, None, {}, [], 3.5, -0.0, [1, "a"], {"x": {"y": []}}, float("inf"))
+
+
+def _nodes(tree) -> list[tuple[tuple, object]]:
+    """Every (path, value) of a parsed document, without recursion."""
+    out, stack = [], [((), tree)]
+    while stack:
+        path, v = stack.pop()
+        out.append((path, v))
+        if isinstance(v, dict):
+            stack.extend(((*path, k), c) for k, c in v.items())
+        elif isinstance(v, list):
+            stack.extend(((*path, i), c) for i, c in enumerate(v))
+    return out
+
+
+def _put(tree, path: tuple, value):
+    if not path:
+        return value
+    parent = tree
+    for k in path[:-1]:
+        parent = parent[k]
+    parent[path[-1]] = value
+    return tree
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if v is None:
+        return "1979-05-27T07:32:00Z"  # TOML has no null: a datetime, another wrong type
+    if isinstance(v, float):
+        return "nan" if v != v else "inf" if v == math.inf else "-inf" if v == -math.inf else repr(v)
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, str):
+        return json.dumps(v)  # a JSON string is a TOML basic string
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return "{" + ", ".join(f"{json.dumps(str(k))} = {_toml_value(x)}" for k, x in v.items()) + "}"
+
+
+def _dump(tree, toml: bool) -> str:
+    if not toml:
+        return json.dumps(tree)
+    table = tree if isinstance(tree, dict) else {"value": tree}
+    return "".join(f"{json.dumps(str(k))} = {_toml_value(v)}\n" for k, v in table.items())
+
+
+def _nested(rng, inner: str, depth: int, toml: bool) -> tuple[str, str]:
+    r = rng.random()
+    if toml and r < 0.3:  # an inline table of one dotted key: tomllib nests a table per part
+        return "{" + ".".join(["a"] * depth) + " = " + inner + "}", f"nest-key-{depth}"
+    if r < 0.6:
+        return "[" * depth + inner + "]" * depth, f"nest-list-{depth}"
+    key = "a = " if toml else '"a": '
+    return ("{" + key) * depth + inner + "}" * depth, f"nest-object-{depth}"
+
+
+def mutate_document(rng: np.random.Generator, data: bytes, toml: bool) -> tuple[bytes, list[str]]:
+    """1 or 2 structure mutations of a JSON or TOML document (module docstring)."""
+    tree = tomllib.loads(data.decode()) if toml else json.loads(data)
+    raw: dict[str, str] = {}  # placeholder string -> the text it stands for
+    ops = []
+    for k in range(int(rng.integers(1, 3))):
+        nodes = _nodes(tree)
+        kind = int(rng.integers(0, 4))
+        if kind == 0:  # deep nesting of a value
+            path, value = nodes[int(rng.integers(0, len(nodes)))]
+            hole = f"\x00hole{k}\x00"
+            depth = NESTING[int(rng.integers(0, len(NESTING)))]
+            raw[hole], op = _nested(rng, _dump(value, False) if not toml else _toml_value(value), depth, toml)
+            tree = _put(tree, path, hole)
+        elif kind == 1:  # an integer of many digits, where a number is if there is one
+            numbers = [n for n in nodes if isinstance(n[1], int | float) and not isinstance(n[1], bool)]
+            path, _ = (numbers or nodes)[int(rng.integers(0, len(numbers or nodes)))]
+            hole = f"\x00hole{k}\x00"
+            raw[hole] = HUGE_INTEGERS[int(rng.integers(0, len(HUGE_INTEGERS)))]
+            op = f"bigint-{len(raw[hole].lstrip('-'))}"
+            tree = _put(tree, path, hole)
+        elif kind == 2:  # a value of another type
+            path, _ = nodes[int(rng.integers(0, len(nodes)))]
+            other = OTHER_TYPES[int(rng.integers(0, len(OTHER_TYPES)))]
+            tree = _put(tree, path, json.loads(json.dumps(other)))
+            op = f"type-{type(other).__name__}"
+        else:  # a ragged (or a very long) list
+            lists = [n for n in nodes if isinstance(n[1], list) and n[1]]
+            if not lists:
+                ops.append("ragged-none")
+                continue
+            inner = [n for n in lists if any(isinstance(x, list) for x in n[1])]
+            path, value = (inner or lists)[int(rng.integers(0, len(inner or lists)))]
+            i = int(rng.integers(0, len(value)))
+            r = rng.random()
+            if isinstance(value[i], list) and r < 0.3 and value[i]:
+                value[i].pop()
+                op = "ragged-short"
+            elif isinstance(value[i], list) and r < 0.6:
+                value[i].append(value[i][-1] if value[i] else 0)
+                op = "ragged-long"
+            elif r < 0.8:
+                value[i] = [value[i]] if not isinstance(value[i], list) else 0.5
+                op = "ragged-mixed"
+            else:
+                value.extend([value[i]] * 5000)
+                op = "ragged-5000"
+        ops.append(op)
+    text = _dump(tree, toml)
+    for hole, replacement in raw.items():
+        text = text.replace(json.dumps(hole), replacement, 1)
+    return text.encode(), ops
+
+
+def mutate_manifest(rng: np.random.Generator, data: bytes) -> tuple[bytes, list[str]]:
+    """A project's manifest.json mutated by its structure, the archive zipped again."""
+    members = _members(data)
+    k = next(i for i, m in enumerate(members) if m[0] == "manifest.json")
+    name, kind, content = members[k]
+    new, ops = mutate_document(rng, content, toml=False)
+    members[k] = (name, kind, new)
+    return _zip(members), [f"{name}: {'+'.join(ops)}"]
 
 
 # -- the readers and what a good read looks like -------------------------------------------------
@@ -273,6 +419,34 @@ def _read_features(path: Path):
     return read_feature_array(path)
 
 
+def _read_strokes(path: Path):
+    from hairtool.frozen.strokes import read_strokes
+
+    return read_strokes(path)
+
+
+def _check_strokes(strokes) -> None:
+    from hairtool.frozen.strokes import Stroke
+
+    assert isinstance(strokes, list) and all(isinstance(s, Stroke) for s in strokes)
+    for s in strokes:
+        for sample in s.pipeline_samples(0.0):
+            _finite(np.array([*sample.cursor, sample.radius]))
+
+
+def _read_jobs(path: Path):
+    from hairtool.farm.jobs import load_jobs
+
+    return load_jobs(path)
+
+
+def _check_jobs(jobs) -> None:
+    from hairtool.farm.jobs import Job
+
+    assert jobs and all(isinstance(j, Job) for j in jobs)
+    assert all(isinstance(a, str) for j in jobs for a in j.argv)
+
+
 @dataclass(frozen=True)
 class Reader:
     ext: str
@@ -281,6 +455,7 @@ class Reader:
     check: Callable[[object], None]
     text: bool = False
     zipped: bool = False
+    structured: bool = False  # a JSON or TOML document (a zip's manifest.json): structure mutations too
 
 
 def _small_groom(seed: int = 7, uniform: bool = False):
@@ -425,6 +600,58 @@ def _seed_usda(work: Path) -> list[bytes]:
     return [(work / "a.usda").read_bytes(), (work / "g.usda").read_bytes()]
 
 
+def _seed_strokes(work: Path) -> list[bytes]:
+    from hairtool.frozen.strokes import Stroke, StrokeSample, write_strokes
+
+    a = StrokeSample((0.1, 1.0, 0.2), 0.8, 0.6, (0.05, 0.0, 0.0), (0.0, -0.3, -1.0))
+    b = StrokeSample((0.0, 0.5, 0.1), 0.4, -0.5)
+    strokes = [
+        Stroke("comb", (a, a), falloff=((0.0, 1.0), (0.4, 0.7), (1.0, 0.0)), symmetry="x", mirror_x=0.0),
+        Stroke("align", (a,), params={"mode": "preserve-length"}),
+        Stroke("length", (b,), falloff="linear"),
+        Stroke("mask", (b, a), falloff="constant"),
+    ]
+    write_strokes(work / "s.json", strokes)
+    wrapped = {"strokes": [strokes[0].to_dict()], "note": "fields a reader does not know"}
+    return [(work / "s.json").read_bytes(), json.dumps(wrapped).encode()]
+
+
+def _shots(work: Path) -> None:
+    (work / "shots").mkdir(exist_ok=True)
+    for name in ("a.npz", "b.npz"):
+        (work / "shots" / name).write_bytes(b"")  # a glob only asks that they are files
+
+
+JOBS = {
+    "jobs": [
+        {"command": "info", "args": ["shots/a.npz", "--json"]},
+        {"command": "keys", "args": ["shots/b.npz", "--keys", 4, "--out", "k.json"]},
+        {"glob": "shots/*.npz", "command": "convert", "args": ["{path}", "out/{stem}.usda"]},
+    ]
+}
+
+
+def _seed_jobs(work: Path) -> list[bytes]:
+    _shots(work)
+    single = {"glob": "shots/*.npz", "command": "info", "args": ["{path}"]}
+    return [json.dumps(JOBS, indent=1).encode(), json.dumps(single).encode()]
+
+
+def _seed_jobs_toml(work: Path) -> list[bytes]:
+    _shots(work)
+    tables = """# one job written out, one per matching file
+[[jobs]]
+command = "keys"
+args = ["shots/b.npz", "--keys", 4, "--out", "k.json"]
+
+[[jobs]]
+glob = 'shots/*.npz'
+command = "convert"
+args = ["{path}", "out/{stem}.usda"]
+"""
+    return [tables.encode(), _dump(JOBS, toml=True).encode()]
+
+
 READERS: dict[str, Reader] = {
     "hair": Reader("hair", _seed_hair, _read_any, _check_groom),
     "tfx": Reader("tfx", _seed_tfx, _read_any, _check_groom),
@@ -432,10 +659,13 @@ READERS: dict[str, Reader] = {
     "obj": Reader("obj", _seed_obj, _read_any, _check_groom, text=True),
     "mesh": Reader("obj", _seed_mesh, _read_mesh, _check_mesh, text=True),
     "bvh": Reader("bvh", _seed_bvh, _read_bvh, _check_motion, text=True),
-    "project": Reader("hairproj", _seed_project, _read_project, _check_project, zipped=True),
+    "project": Reader("hairproj", _seed_project, _read_project, _check_project, zipped=True, structured=True),
     "keys": Reader("json", _seed_keys, _read_keys, _check_keys, text=True),
     "features": Reader("npz", _seed_features, _read_features, _check_features, zipped=True),
     "usda": Reader("usda", _seed_usda, _read_any, _check_groom, text=True),
+    "strokes": Reader("json", _seed_strokes, _read_strokes, _check_strokes, text=True, structured=True),
+    "jobs": Reader("json", _seed_jobs, _read_jobs, _check_jobs, text=True, structured=True),
+    "jobs-toml": Reader("toml", _seed_jobs_toml, _read_jobs, _check_jobs, text=True, structured=True),
 }
 
 
@@ -443,6 +673,10 @@ READERS: dict[str, Reader] = {
 def mutant(reader: Reader, seeds: list[bytes], seed: int, index: int) -> tuple[bytes, list[str]]:
     rng = np.random.default_rng([seed, index])
     base = seeds[index % len(seeds)]
+    if reader.structured and rng.random() < 0.5:
+        if reader.zipped:
+            return mutate_manifest(rng, base)
+        return mutate_document(rng, base, toml=reader.ext == "toml")
     if reader.zipped and rng.random() < 0.6:
         return mutate_zip(rng, base)
     return mutate_bytes(rng, base, reader.text)
@@ -458,6 +692,10 @@ _CLASS_OF = {
     "huge": "huge count",
     "duplicate": "duplicated chunk",
     "swap": "token swap",
+    "nest": "deep nesting",
+    "bigint": "huge integer",
+    "type": "wrong type",
+    "ragged": "ragged array",
 }
 
 
@@ -477,8 +715,47 @@ def _chain(e: BaseException) -> list[BaseException]:
     return seen
 
 
+class _Stderr:
+    """fd 2 pointed at a temporary file around each read: a line usd-core (or anything beneath a
+    reader) prints there would stand beside the CLI's one line."""
+
+    def __init__(self) -> None:
+        self.file = tempfile.TemporaryFile()
+        atexit.register(self.file.close)  # closed before exit, where warnings are errors
+
+    @contextlib.contextmanager
+    def captured(self):
+        sys.stderr.flush()
+        self.file.seek(0)
+        self.file.truncate()
+        saved = os.dup(2)
+        os.dup2(self.file.fileno(), 2)
+        try:
+            yield
+        finally:
+            sys.stderr.flush()
+            os.dup2(saved, 2)
+            os.close(saved)
+
+    def text(self) -> str:
+        self.file.seek(0)
+        return self.file.read(400).decode("utf-8", "replace")
+
+
+_STDERR = _Stderr()
+
+
 def outcome(reader: Reader, path: Path) -> str | None:
     """None for a good read or a good refusal, else what went wrong (one line)."""
+    with _STDERR.captured():
+        result = _outcome(reader, path)
+    printed = _STDERR.text()
+    if printed and result in (None, "refused"):
+        return f"printed on stderr: {printed[:200]!r}"
+    return result
+
+
+def _outcome(reader: Reader, path: Path) -> str | None:
     from hairtool.errors import FormatError, HairtoolError
 
     try:
@@ -526,12 +803,12 @@ def run(name: str, count: int, seed: int, only: int | None = None) -> dict:
         # on stderr beside its one line.
         warnings.simplefilter("error")
         counts = {"read": 0, "refused": 0}
-        classes = dict.fromkeys(MUTATION_CLASSES, 0)
+        classes = dict.fromkeys(MUTATION_CLASSES + (STRUCTURE_CLASSES if reader.structured else ()), 0)
         failures = []
         path = work / f"case.{reader.ext}"
         for index in range(count) if only is None else [only]:
             data, ops = mutant(reader, seeds, seed, index)
-            for c in mutation_classes(ops):
+            for c in mutation_classes(ops) & set(classes):
                 classes[c] += 1
             path.write_bytes(data)
             result = outcome(reader, path)

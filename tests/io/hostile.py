@@ -159,3 +159,109 @@ def write_bvh_wide(path: Path, joints: int = 20_000, frames: int = 5_000) -> Pat
     lines += ["}", "MOTION", f"Frames: {frames}", "Frame Time: 0.04"] + ["0"] * frames
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+# -- issue 27: jobs files, stroke logs and project manifests ------------------------------------
+def write_jobs_nested(path: Path, depth: int = 100_000) -> Path:
+    """A jobs file whose "jobs" list is nested ``depth`` deep (JSON or TOML by the suffix)."""
+    nested = "[" * depth + "]" * depth
+    path.write_text('{"jobs": ' + nested + "}" if path.suffix == ".json" else f"jobs = {nested}\n")
+    return path
+
+
+def write_jobs_huge_int(path: Path, digits: int = 5000) -> Path:
+    """One job whose argument is an integer of ``digits`` digits (JSON or TOML by the suffix)."""
+    number = "9" * digits
+    if path.suffix == ".json":
+        path.write_text('{"jobs": [{"command": "info", "args": [' + number + "]}]}")
+    else:
+        path.write_text(f'[[jobs]]\ncommand = "info"\nargs = [{number}]\n')
+    return path
+
+
+def write_jobs_glob(path: Path, pattern: str) -> Path:
+    path.write_text(json.dumps({"jobs": [{"glob": pattern, "command": "info", "args": ["{path}"]}]}))
+    return path
+
+
+def stroke(radius: object = 0.5, falloff: object = "smooth") -> dict:
+    """One comb stroke of one sample, in a log's JSON form."""
+    sample = {"cursor": [0, 0, 0], "direction": [0.1, 0, 0], "radius": radius, "strength": 0.5}
+    return {"brush": "comb", "falloff": falloff, "samples": [sample]}
+
+
+def write_strokes(path: Path, *strokes: dict) -> Path:
+    path.write_text(json.dumps(list(strokes)))
+    return path
+
+
+def write_strokes_nested(path: Path, depth: int = 100_000) -> Path:
+    path.write_text("[" * depth + "]" * depth)
+    return path
+
+
+def write_project_manifest(path: Path, change) -> Path:
+    """A valid project whose manifest ``change(manifest)`` edits (its text, when it returns a str)."""
+    from hairtool.groom import Animation, Groom
+    from hairtool.project import MANIFEST, Project, manifest_and_arrays
+
+    g = Groom(np.linspace(0.0, 1.0, 30).reshape(10, 3), [4, 6])
+    anim = Animation(np.stack([g.points, g.points + 1]), g.topology, 24.0)
+    manifest, arrays = manifest_and_arrays(Project(rest=g, animation=anim))
+    text = change(manifest)
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_STORED) as zf:
+        zf.writestr(MANIFEST, text if isinstance(text, str) else json.dumps(manifest))
+        for name, a in arrays.items():
+            buf = io.BytesIO()
+            np.lib.format.write_array(buf, a, allow_pickle=False)
+            zf.writestr(name, buf.getvalue())
+    return path
+
+
+
+# -- issue 27: USD files usd-core warns about, and one of 10^7 widths ---------------------------
+USDA_CURVES = """#usda 1.0
+(
+    upAxis = "Z"
+    metersPerUnit = 1
+)
+def Xform "Head"
+{
+    double3 xformOp:translate = (0, 0, 1)
+    float xformOp:rotateZ.timeSamples = {1: 0, 2: 30}
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateZ"]
+    def BasisCurves "Hair"
+    {
+        uniform token type = "linear"
+        int[] curveVertexCounts = [4, 3]
+        point3f[] points = [(0, 0, 0), (0, 0, 1), (0, 0, 2), (0, 0, 3), (1, 0, 0), (1, 0, 1), (1, 0, 2)]
+        float[] widths = [0.1, 0.2] (interpolation = "uniform")
+    }
+}
+"""
+
+
+def write_usda(path: Path, old: str = "", new: str = "") -> Path:
+    """:data:`USDA_CURVES` with ``old`` replaced by ``new`` (once)."""
+    assert old in USDA_CURVES
+    path.write_text(USDA_CURVES.replace(old, new, 1))
+    return path
+
+
+def write_usda_widths(path: Path, count: int = 10**7) -> Path:
+    """Two curves of seven points and ``count`` uniform widths: 20 MB of text for 10^7."""
+    widths = "[" + ",".join(["1"] * count) + "]"
+    return write_usda(path, "[0.1, 0.2]", widths)
+
+
+def write_usdc_bad_prim_name(path: Path) -> Path:
+    """A crate whose token for the prim name "Head" reads ";-) ", which usd-core warns about."""
+    from pxr import Sdf, Usd
+
+    layer = Sdf.Layer.CreateAnonymous(".usda")
+    layer.ImportFromString(USDA_CURVES)
+    Usd.Stage.Open(layer).Export(str(path))
+    data = path.read_bytes()
+    assert data.count(b"Head\0") == 1, "usd-core stored the tokens in a way this builder does not know"
+    path.write_bytes(data.replace(b"Head\0", b";-) \0"))
+    return path

@@ -132,8 +132,10 @@ def test_random_bytes(ext, tail, with_prefix):
 # -- every reader, every mutation class, under a memory cap ---------------------------------------
 # tests/io/fuzz_harness.py mutates real and hand-made seed files (bit flips, overwrites,
 # truncations, huge header counts, duplicated chunks, token swaps; zip members one by one with
-# valid checksums) and reads each mutant in a child process whose address space is capped at
-# its size after imports plus 1 GiB. The children run side by side; the counts keep the whole
+# valid checksums; documents by their structure: deep nesting, huge integers, wrong types,
+# ragged lists) and reads each mutant in a child process whose address space is capped at its
+# size after imports plus 1 GiB, with fd 2 watched (nothing may print beside the CLI's line).
+# The children run side by side; the counts keep the whole
 # set near 30 s of wall time on two cores. Rerun one reader by hand with
 # ``python tests/io/fuzz_harness.py READER --count N`` (``--only I`` for one mutant).
 HARNESS = Path(__file__).with_name("fuzz_harness.py")
@@ -148,6 +150,9 @@ MUTANTS = {
     "keys": 1000,
     "features": 1000,
     "usda": 600,  # usd-core parses slowly; its binary crates have tests/io/test_usd_fuzzing.py
+    "strokes": 500,  # these three and project: half of the mutants by their JSON/TOML structure
+    "jobs": 500,
+    "jobs-toml": 500,
 }
 
 
