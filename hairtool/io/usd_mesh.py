@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from hairtool.errors import FormatError, HairtoolError
+from hairtool.errors import FormatError
 from hairtool.io import usd
 from hairtool.io.atomic import atomic_path
 from hairtool.io.obj import Mesh
@@ -80,23 +80,22 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 def read_mesh(path: str | os.PathLike[str]) -> Mesh | None:
     """The stage's Mesh prims merged into one triangle mesh, or None when it has none."""
-    from pxr import Tf, Usd, UsdGeom
+    from pxr import Usd, UsdGeom
 
     p = Path(path)
-    try:
-        with usd._pxr_conversion_noise_hidden():
-            stage = usd._open_stage(p)
-            prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.Mesh)]
-            if not prims:
-                return None
-            xforms = UsdGeom.XformCache(Usd.TimeCode.Default())
-            parts = [(str(q.GetPath()), *_prim_mesh(p, q, xforms)) for q in prims]
-    except HairtoolError:
-        raise
-    except Tf.ErrorException as e:
-        raise FormatError(p, f"usd-core cannot read its meshes: {usd._last_line(e)}") from None
-    except (ValueError, TypeError, OverflowError, MemoryError) as e:
-        raise FormatError(p, f"its meshes are not readable ({type(e).__name__}: {e})") from None
+
+    def work():
+        stage = usd._open_stage(p)
+        prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.Mesh)]
+        if not prims:
+            return None
+        xforms = UsdGeom.XformCache(Usd.TimeCode.Default())
+        return [(str(q.GetPath()), *_prim_mesh(p, q, xforms)) for q in prims]
+
+    # through the curves reader's guard: usd-core's warnings folded into one line, never stderr
+    parts = usd._diagnosed(p, work)
+    if parts is None:
+        return None
     vertices, faces, groups, base, tri = [], [], {}, 0, 0
     for name, v, sizes, idx in parts:
         f = fan_triangles(sizes, idx) + base
