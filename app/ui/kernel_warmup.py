@@ -135,7 +135,8 @@ def _brushes_step() -> None:
     lut = tuple(falloff_lut("smooth").tolist())
     for brush in BRUSHES[1:]:  # align has its own step
         strength = -0.5 if brush == "length" else 0.5
-        pipe.brush(BrushSample(brush, centre, (1.0, 0.0, 0.0), float(np.max(hi - lo)), strength, lut))
+        radius = float(np.max(hi - lo)) * (0.05 if brush == "delete" else 1.0)  # delete: not every strand
+        pipe.brush(BrushSample(brush, centre, (1.0, 0.0, 0.0), radius, strength, lut, start=True))
 
 
 def _render_hair_step() -> None:

@@ -66,8 +66,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--strokes",
         metavar="STROKES.json",
-        help="replay a stroke log (align, comb, smooth, length, puff, clump, mask; the studio exports one) "
-        "after the --align cursors",
+        help="replay a stroke log (align, comb, smooth, length, puff, clump, mask, delete, pinch, "
+        "snake_hook; the studio exports one) after the --align cursors",
     )
     a = parser.add_argument_group("align brush (UserAlign, eqs. 8–13)")
     a.add_argument(
@@ -166,6 +166,10 @@ def run(args: argparse.Namespace) -> int:
         pipe.apply_samples(stroke.pipeline_samples(float(pipe.scalp_centre[0])))
         timings.append(pipe.timings)
     report = {}
+    if binding is not None and pipe.result.strand_count != groom.strand_count:
+        raise ParameterError(
+            "strokes", "delete strokes with render hair", "no delete stroke where children follow the guides"
+        )
     if binding is not None:
         hair = _guides.render(args, binding).update(pipe.result)
         report = _guides.write(args, hair, pipe.result)

@@ -26,6 +26,8 @@ the scene) leaves the strands whose root normal n has n·view > 0 (facing away f
 as if they were locked (:func:`root_normals`, :func:`facing_away`); the pipeline adds them to
 the mask for that sample, for every brush and align.
 
+Delete, pinch and snake hook live in :mod:`hairtool.frozen.sculpt`.
+
 Every kernel has a numpy twin (``*_reference``) computing the same definition.
 """
 
@@ -43,7 +45,10 @@ from hairtool.groom import Groom
 
 F64 = NDArray[np.float64]
 
-BRUSHES = ("align", "comb", "smooth", "length", "puff", "mask", "clump")
+BRUSHES = ("align", "comb", "smooth", "length", "puff", "mask", "clump", "delete", "pinch", "snake_hook")
+#: The brushes of :mod:`hairtool.frozen.sculpt`; delete changes the groom's strands.
+SCULPT = ("delete", "pinch", "snake_hook")
+SIGNED = ("length", "mask", "clump", "pinch")  # strength in [-1, 1]; the others in [0, 1]
 FALLOFFS = ("smooth", "linear", "constant")
 LUT_SIZE = 257  # samples of a falloff curve over [0, 1]: interpolated linearly between
 EPS = 1e-12
@@ -75,7 +80,8 @@ def falloff_lut(falloff: str | Sequence[Sequence[float]]) -> F64:
 class BrushSample:
     """One mouse move of one brush (groom units); ``lut`` from :func:`falloff_lut`; ``view`` the
     camera's viewing direction (from the eye into the scene): with it only the strands facing
-    the camera are touched; None: every strand."""
+    the camera are touched; None: every strand. ``start``: the first sample of a stroke (a
+    snake hook hooks its strands there)."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -84,12 +90,14 @@ class BrushSample:
     strength: float
     lut: tuple[float, ...]
     view: tuple[float, float, float] | None = None
+    start: bool = False
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
         return BrushSample(
-            self.brush, cursor, direction, self.radius, self.strength, self.lut, mirrored_view(self.view)
+            self.brush, cursor, direction, self.radius, self.strength, self.lut, mirrored_view(self.view),
+            self.start,
         )
 
 
@@ -113,7 +121,7 @@ def check_view(view: object) -> tuple[float, float, float] | None:
 
 def check_sample(sample: BrushSample) -> BrushSample:
     if sample.brush not in BRUSHES or sample.brush == "align":
-        raise ParameterError("brush", sample.brush, "one of " + ", ".join(KINDS) + ", mask, clump")
+        raise ParameterError("brush", sample.brush, "one of " + ", ".join(BRUSHES[1:]))
     for name in ("cursor", "direction"):
         v = np.asarray(getattr(sample, name), dtype=np.float64)
         if v.shape != (3,) or not np.all(np.isfinite(v)):
@@ -121,7 +129,7 @@ def check_sample(sample: BrushSample) -> BrushSample:
     if not np.isfinite(sample.radius) or sample.radius <= 0:
         raise ParameterError("radius", sample.radius, "a positive finite distance")
     check_view(sample.view)
-    low = -1.0 if sample.brush in ("length", "mask", "clump") else 0.0
+    low = -1.0 if sample.brush in SIGNED else 0.0
     if not np.isfinite(sample.strength) or not low <= sample.strength <= 1.0:
         raise ParameterError("strength", sample.strength, f"a number in [{low:g}, 1]")
     if len(sample.lut) != LUT_SIZE:

@@ -12,6 +12,14 @@ Built for dragging in the studio:
 - The clump brush paints a per-strand clump strength (1 everywhere until painted), kept with the
   mask in the state and the snapshots, which ClumpWithGaps scales each strand's step by.
 - Clumping is recomputed from the aligned state at every update and never accumulates.
+- Delete (:mod:`hairtool.frozen.sculpt`) changes the strands: a stage like the others, applied
+  to the stroked state, which takes the kept strands with their mask and clump strength; the
+  pipeline records the rest strand each remaining strand comes from (:attr:`FrozenPipeline.origin`),
+  kept in the snapshots, so undo brings the deleted strands back bit for bit and a replay deletes
+  the same ones. The result has the stroked state's strands, not necessarily the rest groom's.
+- Snake hook hooks strands at a stroke's first sample (``start``) and drags them through the
+  stroke's later samples; the hooked weights are part of the state (one set per sample of a
+  stroke's start: its mirrored sample has its own, used in turn).
 """
 
 from __future__ import annotations
@@ -40,6 +48,7 @@ from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_poin
 from hairtool.frozen.clump_region import clump_points_interactive
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.noise import check_seed, draw_seed
+from hairtool.frozen.sculpt import hook_weights, pinch, snake_hook, strands_to_delete
 from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
 from hairtool.groom import Groom, vertex_ids_of
 
@@ -128,7 +137,8 @@ Sample = AlignSample | BrushSample
 @dataclass(frozen=True)
 class FrozenSnapshot:
     """Undo/redo state: the stroke log and the stroked points it produced (shared, read-only),
-    the mask and the clump strengths it painted (None: replay the log to find them)."""
+    the mask and the clump strengths it painted (None: replay the log to find them), the rest
+    strand of each stroked strand (None: every rest strand, in order) and a snake hook's state."""
 
     log: tuple[Sample, ...]
     aligned: Groom
@@ -136,6 +146,8 @@ class FrozenSnapshot:
     draw: int
     locked: np.ndarray | None = None
     clump_strength: np.ndarray | None = None
+    origin: np.ndarray | None = None
+    hooks: tuple[tuple, int, bool] = ((), 0, False)
 
 
 class FrozenPipeline:
@@ -150,6 +162,10 @@ class FrozenPipeline:
         self._log: list[Sample] = []
         self._locked = np.zeros(rest.strand_count, dtype=bool)
         self._clump_strength = np.ones(rest.strand_count)
+        self._origin = np.arange(rest.strand_count, dtype=np.int64)
+        self._hooks: list[tuple] = []  # a snake hook's (weights, tips, cursor) at each start sample
+        self._hook_next = 0  # the set the next sample of the stroke uses
+        self._hooking = False  # the last sample was a snake hook's start
         self._scalp_centre: np.ndarray | None = None
         self._root_normals: np.ndarray | None = None
         self._draw = 0
@@ -195,6 +211,12 @@ class FrozenPipeline:
         return self._locked.copy()
 
     @property
+    def origin(self) -> np.ndarray:
+        """``(S',)`` the rest strand each strand of the stroked state (and the result) comes from,
+        in order: the strands delete has removed are missing (a copy)."""
+        return self._origin.copy()
+
+    @property
     def clump_strength(self) -> np.ndarray:
         """``(S,)`` the clump strength the clump brush has painted, in [0, 1] (a copy)."""
         return self._clump_strength.copy()
@@ -202,7 +224,8 @@ class FrozenPipeline:
     @property
     def root_normals(self) -> np.ndarray:
         """``(S, 3)`` outward scalp normals at the rest roots, for front-facing samples
-        (:func:`~hairtool.frozen.brushes.root_normals`)."""
+        (:func:`~hairtool.frozen.brushes.root_normals`); index them by :attr:`origin` for the
+        strands of the result."""
         if self._root_normals is None:
             self._root_normals = root_normals(self._rest)
         return self._root_normals
@@ -305,14 +328,16 @@ class FrozenPipeline:
         clumping: what a replayed stroke log does."""
         self._timings = dict.fromkeys(self._timings, 0.0)
         t0 = time.perf_counter()
-        before = (self._aligned, self._locked, self._clump_strength, len(self._log))
+        before = (self._aligned, self._locked, self._clump_strength, self._origin, len(self._log))
+        hooks = self._hook_state()
         try:
             for sample in samples:
                 self._aligned = self._apply(self._aligned, sample)
                 self._log.append(sample)
         except BaseException:  # a refused sample: none of these samples happened
-            self._aligned, self._locked, self._clump_strength = before[:3]
-            del self._log[before[3] :]
+            self._aligned, self._locked, self._clump_strength, self._origin = before[:4]
+            self._set_hooks(hooks)
+            del self._log[before[4] :]
             raise
         self._timings["align"] = (time.perf_counter() - t0) * 1e3
         self._reclump()
@@ -331,8 +356,7 @@ class FrozenPipeline:
     def reset_strokes(self) -> Groom:
         """Forget every stroke: back to the frozen groom (clumped)."""
         self._log = []
-        self._locked = np.zeros(self._rest.strand_count, dtype=bool)
-        self._clump_strength = np.ones(self._rest.strand_count)
+        self._clear_state()
         self._aligned = self._frozen
         self._timings = dict.fromkeys(self._timings, 0.0)
         self._reclump()
@@ -342,7 +366,7 @@ class FrozenPipeline:
         """Cheap state for undo/redo (no copies: grooms are immutable)."""
         return FrozenSnapshot(
             tuple(self._log), self._aligned, self._freeze_key or (), self._draw, self._locked.copy(),
-            self._clump_strength.copy(),
+            self._clump_strength.copy(), self._origin.copy(), self._hook_state(),
         )
 
     def restore(self, snapshot: FrozenSnapshot) -> Groom:
@@ -358,10 +382,13 @@ class FrozenPipeline:
             )
         ):
             self._aligned = snapshot.aligned
-            n = self._rest.strand_count
+            n = snapshot.aligned.strand_count
             self._locked = np.zeros(n, bool) if snapshot.locked is None else snapshot.locked.copy()
             cs = snapshot.clump_strength
             self._clump_strength = np.ones(n) if cs is None else cs.astype(np.float64)
+            o = snapshot.origin
+            self._origin = np.arange(n, dtype=np.int64) if o is None else o.astype(np.int64)
+            self._set_hooks(snapshot.hooks)
         else:
             self._replay()
         self._reclump()
@@ -397,9 +424,50 @@ class FrozenPipeline:
         """The strands facing away from a sample's camera (None: no view, none)."""
         if check_view(view) is None:
             return None
-        return facing_away(self.root_normals, view)
+        return facing_away(self.root_normals[self._origin], view)
+
+    def _clear_state(self) -> None:
+        n = self._rest.strand_count
+        self._locked = np.zeros(n, dtype=bool)
+        self._clump_strength = np.ones(n)
+        self._origin = np.arange(n, dtype=np.int64)
+        self._set_hooks(((), 0, False))
+
+    def _hook_state(self) -> tuple[tuple, int, bool]:
+        return (tuple(self._hooks), self._hook_next, self._hooking)
+
+    def _set_hooks(self, state: tuple[tuple, int, bool]) -> None:
+        self._hooks, self._hook_next, self._hooking = list(state[0]), state[1], state[2]
+
+    def _snake(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
+        """A snake hook's sample: a start hooks strands (a run of starts, one set each: the
+        stroke's sample and its mirror); the later ones use the sets in turn."""
+        if sample.start or not self._hooks:
+            if not self._hooking:
+                self._hooks = []
+            hook = hook_weights(g, sample, locked)
+            self._hooks.append((hook, g.tips.astype(np.float64), np.asarray(sample.cursor, np.float64)))
+            self._hooking, self._hook_next = True, len(self._hooks) - 1
+        else:
+            self._hooking = False
+            self._hook_next = (self._hook_next + 1) % len(self._hooks)
+        hook, anchors, start = self._hooks[self._hook_next]
+        return snake_hook(g, hook, anchors, np.asarray(sample.cursor, np.float64) - start)
+
+    def _delete(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
+        gone = strands_to_delete(g, sample, locked)
+        if not gone.any():
+            return g
+        if gone.all():
+            raise ParameterError("delete", "every strand", "a stroke that leaves at least one strand")
+        keep = np.flatnonzero(~gone)
+        self._locked, self._clump_strength = self._locked[keep], self._clump_strength[keep]
+        self._origin = self._origin[keep]
+        return g.subset(keep)
 
     def _apply(self, g: Groom, sample: Sample) -> Groom:
+        if not (isinstance(sample, BrushSample) and sample.brush == "snake_hook"):
+            self._set_hooks(((), 0, False))  # another brush ends a snake hook's stroke
         away = self._away(sample.view)
         if isinstance(sample, BrushSample) and sample.brush == "mask":
             self._locked = paint_mask(g, sample, self._locked, away)
@@ -416,12 +484,17 @@ class FrozenPipeline:
         if sample.brush == "clump":
             self._clump_strength = paint_clump(g, sample, self._clump_strength, locked)
             return g
+        if sample.brush == "delete":
+            return self._delete(g, sample, locked)
+        if sample.brush == "pinch":
+            return pinch(g, sample, locked)
+        if sample.brush == "snake_hook":
+            return self._snake(g, sample, locked)
         return apply_brush(g, sample, locked, self.scalp_centre)
 
     def _replay(self) -> None:
         g = self._frozen
-        self._locked = np.zeros(self._rest.strand_count, dtype=bool)
-        self._clump_strength = np.ones(self._rest.strand_count)
+        self._clear_state()
         for s in self._log:
             g = self._apply(g, s)
         self._aligned = g
@@ -441,7 +514,7 @@ class FrozenPipeline:
                 bool(p.keep_lengths),
                 self._clump_strength,
             )
-            self._result = self._rest.with_points(pts)
+            self._result = self._aligned.with_points(pts)
         else:
             self._workspace.mean_neighbours = 0.0
             self._result = self._aligned

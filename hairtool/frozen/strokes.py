@@ -10,7 +10,14 @@ A stroke log is a JSON list of strokes, in groom units::
   ``strength`` its intensity, no direction needed), ``comb``, ``smooth``, ``length`` (a signed
   strength: > 0 grows, < 0 shrinks, as a fraction of the strand's length at the brush centre),
   ``puff``, ``mask`` (> 0 locks the strands touched, < 0 frees them) or ``clump`` (> 0 paints
-  clumping on, < 0 off: each strand's clump strength moves toward 1 or 0).
+  clumping on, < 0 off: each strand's clump strength moves toward 1 or 0), ``delete`` (removes
+  the strands whose root lies within the radius; strength > 0, falloff ignored), ``pinch`` (> 0
+  gathers toward the brush centre, < 0 spreads) or ``snake_hook`` (the strands whose tip lies
+  within the radius at the stroke's first sample follow the cursor; ``direction`` is the
+  cursor's motion since the sample before).
+- ``start`` (per sample, optional): true where a stroke begins (a snake hook hooks its strands
+  there); missing: true for a stroke's first sample only. Written for snake hooks, whose
+  mirrored first sample is a start too.
 - ``view`` (per sample, optional): the camera's viewing direction, from the eye into the scene;
   only the strands facing that camera are touched. null or missing (older logs): every strand.
 - ``falloff``: ``smooth``, ``linear``, ``constant``, or a curve ``[[t, w], ...]`` over t =
@@ -50,6 +57,7 @@ class StrokeSample:
     strength: float
     direction: tuple[float, float, float] = (0.0, 0.0, 0.0)
     view: tuple[float, float, float] | None = None
+    start: bool | None = None  # None: the stroke's first sample starts it
 
 
 @dataclass(frozen=True)
@@ -81,7 +89,7 @@ class Stroke:
         out: list[AlignSample | BrushSample] = []
         mirror = self.mirror_x if self.mirror_x is not None else default_mirror_x
         lut = tuple(falloff_lut(self.falloff).tolist())
-        for s in self.samples:
+        for i, s in enumerate(self.samples):
             if self.brush == "align":
                 mode = self.params.get("mode", "paper")
                 first = AlignSample(s.cursor, s.radius, s.strength, mode, check_view(s.view))
@@ -90,7 +98,9 @@ class Stroke:
                     cursor = (2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])
                     out.append(first._replace(cursor=cursor, view=mirrored_view(s.view)))
                 continue
-            sample = BrushSample(self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view)
+            start = (i == 0) if s.start is None else s.start
+            start = start and self.brush == "snake_hook"  # (the only brush a start changes)
+            sample = BrushSample(self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start)
             sample = check_sample(sample)
             out.append(sample)
             if self.symmetry == "x":
@@ -113,6 +123,7 @@ class Stroke:
                     "strength": s.strength,
                     "view": None if s.view is None else list(s.view),
                 }
+                | ({} if s.start is None else {"start": s.start})
                 for s in self.samples
             ],
         }
@@ -123,15 +134,22 @@ def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
     and falloff become one stroke, mirrored samples stay explicit (no symmetry flag)."""
     runs: list[tuple[tuple, Stroke]] = []
     for s in log:
+        split = False
         if isinstance(s, AlignSample):
             key: tuple = ("align", s.mode)
             sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view))
             start = Stroke("align", (sample,), params={"mode": s.mode})
         else:
             key = (s.brush, s.lut)
-            sample = StrokeSample(tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view))
+            hook = s.brush == "snake_hook"
+            sample = StrokeSample(
+                tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view),
+                bool(s.start) if hook else None,
+            )  # fmt: skip
             start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut))
-        if runs and runs[-1][0] == key:
+            # a snake hook's start (not its mirror's) begins a new stroke, with its own strands
+            split = hook and s.start and bool(runs) and not runs[-1][1].samples[-1].start
+        if runs and runs[-1][0] == key and not split:
             last = runs[-1][1]
             runs[-1] = (key, Stroke(last.brush, (*last.samples, sample), last.falloff, params=last.params))
         else:
@@ -167,6 +185,12 @@ def _number(where: str, value: Any) -> float:
     return float(value)
 
 
+def _flag(where: str, value: Any) -> bool | None:
+    if value is None or isinstance(value, bool):
+        return value
+    raise ParameterError(where, value, "true, false or null")
+
+
 def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
     """A :class:`Stroke` from its JSON form; ParameterError naming the field on anything wrong."""
     if not isinstance(d, dict):
@@ -186,6 +210,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
                 _number(f"{at}.strength", s.get("strength")),
                 _vector(f"{at}.direction", s.get("direction"), (0.0, 0.0, 0.0)),
                 None if s.get("view") is None else _vector(f"{at}.view", s.get("view")),
+                _flag(f"{at}.start", s.get("start")),
             )
         )
     falloff = d.get("falloff", "smooth")
