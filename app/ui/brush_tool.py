@@ -18,7 +18,8 @@ from hairtool.frozen.brushes import BRUSHES, BrushSample, falloff_lut, mirrored_
 from hairtool.frozen.pipeline import AlignSample
 
 #: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
-#: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump; the others by their initial).
+#: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump, K snake hook; X deletes as
+#: in Blender's editors; pinch, with P taken by clump, is Shift+P; the others by their initial).
 LABELS = {
     "align": "Align",
     "comb": "Comb",
@@ -27,8 +28,14 @@ LABELS = {
     "puff": "Puff",
     "clump": "Clump",
     "mask": "Mask",
+    "pinch": "Pinch",
+    "snake_hook": "Snake Hook",
+    "delete": "Delete",
 }
-SHORTCUTS = {"align": "A", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M"}
+SHORTCUTS = {
+    "align": "A", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M",
+    "pinch": "Shift+P", "snake_hook": "K", "delete": "X",
+}  # fmt: skip
 TIPS = {
     "align": "Strands turn toward the cursor's path (UserAlign, Kim 2026 eqs. 8–13)",
     "comb": "Tips follow the drag, strand lengths kept",
@@ -37,10 +44,20 @@ TIPS = {
     "puff": "Lifts strands away from the scalp near the root (turns them toward the scalp normal)",
     "clump": "Paints how strongly strands clump (ClumpWithGaps' per-strand strength; Ctrl erases)",
     "mask": "Paints a mask: masked strands are locked for every brush (Ctrl erases)",
+    "pinch": "Gathers strands toward the brush centre (Ctrl: spreads them); roots stay, lengths kept",
+    "snake_hook": "The strands whose tips are under the brush when you press follow the cursor, "
+    "roots fixed, lengths kept",
+    "delete": "Removes the strands whose roots are under the brush (undo brings them back)",
 }
 #: Brushes with a signed strength: (label of > 0, label of < 0).
-SIGNED = {"length": ("Grow", "Shrink"), "clump": ("Paint", "Erase"), "mask": ("Paint", "Erase")}
-SIGN_LABELS = {"length": "Grow or shrink", "clump": "Paint or erase", "mask": "Paint or erase"}
+SIGNED = {
+    "length": ("Grow", "Shrink"), "clump": ("Paint", "Erase"), "mask": ("Paint", "Erase"),
+    "pinch": ("Gather", "Spread"),
+}  # fmt: skip
+SIGN_LABELS = {
+    "length": "Grow or shrink", "clump": "Paint or erase", "mask": "Paint or erase",
+    "pinch": "Gather or spread",
+}  # fmt: skip
 DEFAULT_STRENGTH = {
     "align": 0.8,
     "comb": 0.5,
@@ -49,6 +66,9 @@ DEFAULT_STRENGTH = {
     "puff": 0.2,
     "clump": 0.5,
     "mask": 1.0,
+    "pinch": 0.1,
+    "snake_hook": 1.0,
+    "delete": 1.0,
 }
 FALLOFF_LABELS = {"smooth": "Smooth", "linear": "Linear", "constant": "Constant"}
 
@@ -112,11 +132,12 @@ class BrushTool:
         view: Sequence[float] | None,
         plane_x: float,
         invert: bool = False,
+        start: bool = False,
     ) -> list[AlignSample | BrushSample]:
         """The samples of one mouse move at ``cursor`` (groom units), mirrored one right after it
         with symmetry on. ``direction``: the mouse's motion in the world (comb needs one: none
         while it stands still). ``view``: the camera's direction, given to the engine with
-        "front faces only"."""
+        "front faces only". ``start``: the stroke's first move (a snake hook hooks there)."""
         c = tuple(float(x) for x in cursor)
         d = tuple(float(x) for x in direction)
         v = None if view is None or not self.front_only else tuple(float(x) for x in view)
@@ -128,7 +149,8 @@ class BrushTool:
             return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
         if name == "comb" and math.hypot(*d) == 0.0:
             return []
-        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v)
+        hook = start and name == "snake_hook"
+        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v, hook)
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
     def touches(self, points: np.ndarray, cursor: Sequence[float], plane_x: float) -> bool:

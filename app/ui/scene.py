@@ -18,11 +18,11 @@ import numpy as np
 from PySide6.QtCore import QObject, Signal
 
 from app.render.ramps import DEFAULT_RAMP
-from app.ui.brush_tool import SIGNED, BrushTool, check_falloff
-from hairtool.errors import ParameterError
-from hairtool.frozen.brushes import scalp_centre
+from app.ui.brush_tool import LABELS, SIGNED, BrushTool, check_falloff
+from hairtool.errors import HairtoolError, ParameterError
+from hairtool.frozen.brushes import CHANGE_STRANDS, scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
-from hairtool.groom import Groom, Topology
+from hairtool.groom import Groom, Topology, vertex_ids_of
 from hairtool.guides.binding import ChildBinding
 
 ALIGN_MODES = ("paper", "preserve-length")
@@ -51,6 +51,7 @@ class Scene(QObject):
     drawn_changed = Signal()  # the drawn strands' topology changed (children density, guides shown)
     engine_starting = Signal()  # the pipeline is about to be built (may compile: show a wait)
     engine_started = Signal()
+    refused = Signal(str)  # a stroke the brush cannot make, in words for the status bar
 
     def __init__(
         self,
@@ -83,6 +84,9 @@ class Scene(QObject):
         self.tool = BrushTool()
         self.locked = np.zeros(0, dtype=bool)  # the masked strands (a copy of the pipeline's)
         self.last_update_ms = 0.0
+        #: Callables naming what holds the strands as they are (e.g. an animation of them), or
+        #: None: brushes that add or remove strands are refused while one names something.
+        self.strand_holders: list = []
         self._set_groom(groom)
 
     # -- strands -----------------------------------------------------------------------
@@ -176,16 +180,23 @@ class Scene(QObject):
         view: np.ndarray | None = None,
         invert: bool = False,
         check_touch: bool = True,
+        start: bool = False,
     ) -> bool:
         """One mouse move of the current brush (its mirror too with symmetry on), applied through
         the pipeline in one call; ``direction`` the mouse's motion in the world, ``view`` the
         camera's direction at the cursor, ``invert`` Ctrl held. Returns whether the brush
-        reached a strand (its circle held a vertex; False unchecked with ``check_touch`` off)."""
+        reached a strand (its circle held a vertex; False unchecked with ``check_touch`` off).
+        ``start``: the stroke's first move. A move the engine refuses (a delete that would leave
+        no strand) changes nothing and says why (``refused``)."""
         self.start_engine()
         plane = self.mirror_plane_x()
-        samples = self.tool.samples(cursor, direction, view, plane, invert)
+        samples = self.tool.samples(cursor, direction, view, plane, invert, start)
         if samples:
-            self.apply_samples(samples)
+            try:
+                self.apply_samples(samples)
+            except HairtoolError as e:
+                self.refused.emit(f"{LABELS.get(self.tool.brush, self.tool.brush)}: {e}")
+                return False
         else:  # a comb standing still: nothing to apply; the view still follows the cursor
             self.points_changed.emit()
         return check_touch and self.tool.touches(self.pipeline.aligned.points, cursor, plane)
@@ -194,12 +205,30 @@ class Scene(QObject):
         """Samples of any brush (a replayed stroke log) in one pipeline call."""
         self._stroke_step(lambda: self.pipeline.apply_samples(samples))
 
+    def stroke_refusal(self) -> str | None:
+        """Why a stroke of the current brush cannot start now (None: it can): brushes that add
+        or remove strands wait while render hair or an animation holds the strands."""
+        if self.tool.brush not in CHANGE_STRANDS:
+            return None
+        reasons = ["the render hair follows these guides"] if self.binding is not None else []
+        reasons += [r for r in (h() for h in self.strand_holders) if r]
+        if not reasons:
+            return None
+        label = LABELS.get(self.tool.brush, self.tool.brush)
+        return f"{label} changes the strands, but {' and '.join(reasons)}: remove it first"
+
     def _stroke_step(self, step) -> None:
-        """``step()`` (a pipeline call that changes strokes, so maybe the mask) on the running
-        engine, timed; the render hair, the mask and the views follow."""
+        """``step()`` (a pipeline call that changes strokes, so maybe the mask or the strands)
+        on the running engine, timed; the render hair, the mask and the views follow."""
         self.start_engine()
         t0 = time.perf_counter()
+        topology = self.result.topology
         self.result = step()
+        if self.result.topology != topology:  # strands deleted, or brought back by an undo
+            self._cache = {}
+            self._rest_drawn = None
+            self._rebuild_drawn()
+            self.drawn_changed.emit()
         self._children_moved()
         self._sync_mask()
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
@@ -540,5 +569,8 @@ class Scene(QObject):
                 self._rest_drawn = np.concatenate([rest, self.rest.points]) if self.drawn_guides else rest
             d = self.drawn_points.astype(np.float64) - self._rest_drawn
             return np.sqrt(np.einsum("ij,ij->i", d, d))
-        d = self.result.points.astype(np.float64) - self.rest.points
+        rest = self.rest.points
+        if self.result.topology != self.rest.topology:  # after a delete: the kept strands' rest
+            rest = rest[vertex_ids_of(self.rest.topology, self.pipeline.origin)]
+        d = self.result.points.astype(np.float64) - rest
         return np.sqrt(np.einsum("ij,ij->i", d, d))

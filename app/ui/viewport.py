@@ -346,6 +346,9 @@ class Viewport(QOpenGLWidget):
         if self._drag == "align" and not self.scene.engine_ready:
             self._drag = None
             self.engine_wait.emit()
+        elif self._drag == "align" and (why := self.scene.stroke_refusal()) is not None:
+            self._drag = None
+            self.scene.refused.emit(why)
         elif self._drag == "align":
             self._stroke_before = self.scene.snapshot()
             self._stroke_cursor = None
@@ -394,7 +397,7 @@ class Viewport(QOpenGLWidget):
         r_px = s.radius * self.camera.pixels_per_unit_at(s.centre, self.height())
         near = d2 <= r_px * r_px
         if s.tool.front_only and s.pipeline is not None:
-            away = facing_away(s.pipeline.root_normals, self.view_at(pos))
+            away = facing_away(s.pipeline.strand_normals, self.view_at(pos))
             near &= ~np.repeat(away, s.result.topology.counts)
         if not near.any():
             return np.asarray(s.centre, np.float64)
@@ -405,7 +408,9 @@ class Viewport(QOpenGLWidget):
         last, self._stroke_cursor = self._stroke_cursor, cursor
         direction = np.zeros(3) if last is None else cursor - last
         view = self.view_at(pos)
-        touched = self.scene.brush_move(cursor, direction, view, self._stroke_invert, not self.stroke_touched)
+        touched = self.scene.brush_move(
+            cursor, direction, view, self._stroke_invert, not self.stroke_touched, start=last is None
+        )
         self.stroke_touched = self.stroke_touched or touched
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:

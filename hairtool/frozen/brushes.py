@@ -46,8 +46,9 @@ from hairtool.groom import Groom
 F64 = NDArray[np.float64]
 
 BRUSHES = ("align", "comb", "smooth", "length", "puff", "mask", "clump", "delete", "pinch", "snake_hook")
-#: The brushes of :mod:`hairtool.frozen.sculpt`; delete changes the groom's strands.
+#: The brushes of :mod:`hairtool.frozen.sculpt`, and those that add or remove strands.
 SCULPT = ("delete", "pinch", "snake_hook")
+CHANGE_STRANDS = ("delete",)
 SIGNED = ("length", "mask", "clump", "pinch")  # strength in [-1, 1]; the others in [0, 1]
 FALLOFFS = ("smooth", "linear", "constant")
 LUT_SIZE = 257  # samples of a falloff curve over [0, 1]: interpolated linearly between

@@ -231,6 +231,12 @@ class FrozenPipeline:
         return self._root_normals
 
     @property
+    def strand_normals(self) -> np.ndarray:
+        """``(S', 3)`` :attr:`root_normals` of the strands of the stroked state and the result."""
+        n = self.root_normals
+        return n if len(self._origin) == len(n) else n[self._origin]
+
+    @property
     def scalp_centre(self) -> np.ndarray:
         """Centre of the sphere fitted to the rest roots: puff's outward normal, and the default
         X-symmetry plane (x = its x)."""
@@ -424,7 +430,7 @@ class FrozenPipeline:
         """The strands facing away from a sample's camera (None: no view, none)."""
         if check_view(view) is None:
             return None
-        return facing_away(self.root_normals[self._origin], view)
+        return facing_away(self.strand_normals, view)
 
     def _clear_state(self) -> None:
         n = self._rest.strand_count

@@ -300,3 +300,14 @@ def test_a_bad_start_flag_is_named(tmp_path):
     (tmp_path / "s.json").write_text(json.dumps([{"brush": "snake_hook", "samples": [bad]}]))
     with pytest.raises(FormatError, match=r"strokes\[0\]\.samples\[0\]\.start"):
         read_strokes(tmp_path / "s.json")
+
+
+def test_a_delete_log_with_render_hair_is_refused_in_one_line(flat, tmp_path, capsys):
+    io.write(tmp_path / "groom.npz", flat)
+    log = [{"brush": "delete", "samples": [{"cursor": [0.1, 0, 0.1], "radius": 0.08, "strength": 1}]}]
+    (tmp_path / "s.json").write_text(json.dumps(log))
+    out = tmp_path / "out.npz"
+    args = ["freeze", str(tmp_path / "groom.npz"), str(out), "--count", "100"]
+    assert main([*args, "--strokes", str(tmp_path / "s.json")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "delete" in err and "\n" not in err and not out.exists()

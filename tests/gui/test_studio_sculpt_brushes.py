@@ -1,0 +1,131 @@
+"""Delete, pinch and snake hook through the studio: toolbar, Brush menu and tool dock entries with
+keys that clash with no other action; each drag is one undo step; delete removes the strands
+under the brush and undo brings them back bit for bit (the view redraws either way); snake hook
+drags the tips it hooked; the exported stroke log replays in the CLI to the studio's bytes; a
+delete that render hair or an animation depends on is refused with a message."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtGui import QAction
+
+from hairtool import samples
+from hairtool.frozen.brushes import facing_away
+
+pytestmark = pytest.mark.gui
+
+
+def plain(make_window, groom=None):
+    w = make_window(groom=groom if groom is not None else samples.scalp(strands=200, vertices=12))
+    w.scene.set_params(w.scene.params.replace(freeze=False, clump=False))
+    return w
+
+
+
+
+def front_strand(w) -> int:
+    from hairtool.frozen.brushes import root_normals
+
+    return int(np.argmin(root_normals(w.scene.rest) @ w.viewport.camera.forward()))
+
+
+def test_the_new_brushes_have_entries_and_keys_that_clash_with_nothing(make_window):
+    w = plain(make_window)
+    keys = {"delete": "X", "pinch": "Shift+P", "snake_hook": "K"}
+    combo = [w.dock.brush.itemData(i) for i in range(w.dock.brush.count())]
+    for name, key in keys.items():
+        a = w.brush_actions[name]
+        assert a.shortcut().toString() == key and a in w.brush_bar.actions() and name in combo
+        a.trigger()
+        assert w.scene.brush == name and w.dock.brush.currentData() == name
+    w.scene.set_brush("pinch")
+    assert w.dock.sign.isVisibleTo(w.dock) and w.dock.sign.currentText() == "Gather"
+    seen: dict[str, str] = {}
+    for a in w.findChildren(QAction):
+        for k in a.shortcuts():
+            text = k.toString()
+            assert text not in seen or seen[text] == a.text(), f"{text}: {seen.get(text)} and {a.text()}"
+            seen[text] = a.text()
+
+
+def test_delete_removes_the_strands_under_the_brush_and_undo_brings_them_back(ui, make_window):
+    w = plain(make_window)
+    s, v = w.scene, w.viewport
+    rest = s.result
+    w.brush_actions["delete"].trigger()
+    s.set_radius(0.25)
+    s_front = front_strand(w)
+    pos = v.project(rest.roots[s_front])[0]
+    ui.grab(v)
+    ui.drag(v, pos, pos + np.array([10.0, 0.0]), steps=2)
+    after = s.result
+    assert 0 < after.strand_count < rest.strand_count
+    gone = np.setdiff1d(np.arange(rest.strand_count), s.pipeline.origin)
+    assert s_front in gone
+    under = np.zeros(rest.strand_count, bool)  # roots under some move's brush, facing its camera
+    for x in s.pipeline.strokes:
+        near = np.linalg.norm(rest.roots - np.array(x.cursor), axis=1) / x.radius < 1.0
+        under |= near & ~facing_away(s.pipeline.root_normals, x.view)
+    np.testing.assert_array_equal(gone, np.flatnonzero(under))
+    np.testing.assert_array_equal(after.points, rest.subset(s.pipeline.origin).points)
+    assert f"{after.strand_count:,} strands" in w.counts_label.text()
+    assert ui.hair_mask(ui.grab(v)).any()  # drawn with the new strands
+    assert w.undo_stack.count() == 1 and w.undo_stack.undoText() == "Delete stroke"
+    w.undo_stack.undo()
+    assert s.result.topology == rest.topology
+    np.testing.assert_array_equal(s.result.points, rest.points)
+    assert f"{rest.strand_count:,} strands" in w.counts_label.text()
+    ui.grab(v)
+    w.undo_stack.redo()
+    np.testing.assert_array_equal(s.result.points, after.points)
+    s.set_colour_mode("displacement")  # colours over the kept strands
+    ui.grab(v)
+
+
+def test_pinch_and_snake_hook_strokes_replay_in_the_cli_to_the_studios_bytes(ui, make_window, tmp_path):
+    from hairtool import io
+    from hairtool.cli import main
+
+    rest = samples.scalp(strands=200, vertices=12)
+    w = make_window(groom=rest)  # noise, clumps and lengths kept: the studio's own parameters
+    s, v = w.scene, w.viewport
+    s.set_symmetry(True)
+    f = front_strand(w)
+    pos = v.project(s.result.tips[f])[0]
+    w.brush_actions["snake_hook"].trigger()
+    s.set_radius(0.1)
+    aligned = s.pipeline.aligned
+    ui.drag(v, pos, pos + np.array([30.0, -20.0]), steps=5)
+    hooked = s.pipeline.aligned
+    assert np.linalg.norm(hooked.tips[f] - aligned.tips[f]) > 0.05  # the hooked tip followed
+    np.testing.assert_array_equal(hooked.roots, aligned.roots)
+    np.testing.assert_allclose(hooked.strand_lengths, aligned.strand_lengths, rtol=1e-5)
+    w.brush_actions["pinch"].trigger()
+    ui.drag(v, pos, pos + np.array([5.0, 5.0]), steps=3)
+    w.brush_actions["delete"].trigger()
+    s.set_radius(0.2)
+    at = v.project(s.result.roots[f])[0]
+    ui.drag(v, at, at + np.array([3.0, 0.0]), steps=1)
+    assert s.result.strand_count < rest.strand_count
+    assert w.undo_stack.count() == 3
+    assert w.stroke_files.export(tmp_path / "strokes.json")
+    io.write(tmp_path / "rest.npz", rest)
+    args = ["freeze", str(tmp_path / "rest.npz"), str(tmp_path / "out.npz"), "--keep-lengths"]
+    assert main([*args, "--strokes", str(tmp_path / "strokes.json")]) == 0
+    np.testing.assert_array_equal(io.read_groom(tmp_path / "out.npz").points, s.result.points)
+
+
+def test_delete_waits_while_render_hair_follows_the_guides(ui, make_window):
+    from hairtool.guides.binding import bind_roots
+
+    w = plain(make_window, groom=samples.scalp(strands=60, vertices=12, seed=4))
+    s, v = w.scene, w.viewport
+    s.set_binding(bind_roots(s.rest, count=300, seed=2))
+    messages = ui.record(s.refused)
+    w.brush_actions["delete"].trigger()
+    pos = v.project(s.result.roots[front_strand(w)])[0]
+    ui.drag(v, pos, pos + np.array([5.0, 0.0]), steps=2)
+    assert s.result.strand_count == 60 and w.undo_stack.count() == 0
+    assert messages and "render hair" in messages[0][0]
+    assert "render hair" in w.statusBar().currentMessage()
