@@ -100,9 +100,9 @@ class Project:
     def from_pipeline(cls, pipeline: FrozenPipeline, **fields: Any) -> Project:
         """A project of the pipeline's rest groom, parameters and stroke snapshot."""
         snap = pipeline.snapshot()
-        return cls(
-            rest=pipeline.rest, params=pipeline.params, strokes=snap.log, aligned=snap.aligned, **fields
-        )
+        # After a delete the stroked state has fewer strands than the rest groom: replayed on load.
+        aligned = snap.aligned if snap.aligned.topology == pipeline.rest.topology else None
+        return cls(rest=pipeline.rest, params=pipeline.params, strokes=snap.log, aligned=aligned, **fields)
 
     def stroke_snapshot(self, pipeline: FrozenPipeline) -> FrozenSnapshot:
         """The stroke snapshot to ``restore`` on a pipeline built from this project's rest and params.
@@ -416,6 +416,10 @@ def _write_strokes(log, arrays: dict) -> dict:
         ).reshape(n, 3)
         arrays["strokes/has_view.npy"] = np.array([s.view is not None for s in log], np.int64)
         info["views"] = True
+    if any(isinstance(s, BrushSample) and s.start for s in log):  # where snake hooks hooked
+        starts = [isinstance(s, BrushSample) and s.start for s in log]
+        arrays["strokes/start.npy"] = np.array(starts, np.int64)
+        info["starts"] = True
     return info
 
 
@@ -456,6 +460,11 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
             raise FormatError(r.path, f"the stroke view arrays do not all hold {n} strokes")
         require_finite(r.path, view, "stroke view")
         views = [tuple(float(x) for x in view[k]) if has_view[k] else None for k in range(n)]
+    starts = np.zeros(n, np.int64)
+    if info.get("starts"):
+        starts = r.array("strokes/start.npy", 1, "iu")
+        if starts.shape != (n,):
+            raise FormatError(r.path, f"the stroke start flags do not hold {n} strokes")
     if n and np.any((brush < 0) & ((mode < 0) | (mode >= len(modes)))):
         raise FormatError(r.path, "a stroke names an unknown align mode")
     strokes = []
@@ -470,7 +479,7 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
             continue
         sample = BrushSample(
             names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
-            float(intensity[k]), tuple(luts[which[k]].tolist()), views[k],
+            float(intensity[k]), tuple(luts[which[k]].tolist()), views[k], bool(starts[k]),
         )
         try:
             strokes.append(check_sample(sample))

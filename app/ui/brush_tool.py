@@ -19,7 +19,8 @@ from hairtool.frozen.pipeline import AlignSample
 
 #: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
 #: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump, K snake hook; X deletes as
-#: in Blender's editors; pinch, with P taken by clump, is Shift+P; the others by their initial).
+#: in Blender's editors; pinch, with P taken by clump, is Shift+P; slide G as Blender's grab;
+#: the others by their initial).
 LABELS = {
     "align": "Align",
     "comb": "Comb",
@@ -31,10 +32,11 @@ LABELS = {
     "pinch": "Pinch",
     "snake_hook": "Snake Hook",
     "delete": "Delete",
+    "slide": "Slide",
 }
 SHORTCUTS = {
     "align": "A", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M",
-    "pinch": "Shift+P", "snake_hook": "K", "delete": "X",
+    "pinch": "Shift+P", "snake_hook": "K", "delete": "X", "slide": "G",
 }  # fmt: skip
 TIPS = {
     "align": "Strands turn toward the cursor's path (UserAlign, Kim 2026 eqs. 8–13)",
@@ -48,6 +50,8 @@ TIPS = {
     "snake_hook": "The strands whose tips are under the brush when you press follow the cursor, "
     "roots fixed, lengths kept",
     "delete": "Removes the strands whose roots are under the brush (undo brings them back)",
+    "slide": "Slides the roots under the brush along the head in the drag's direction; each strand "
+    "keeps its shape (needs the head mesh)",
 }
 #: Brushes with a signed strength: (label of > 0, label of < 0).
 SIGNED = {
@@ -69,6 +73,7 @@ DEFAULT_STRENGTH = {
     "pinch": 0.1,
     "snake_hook": 1.0,
     "delete": 1.0,
+    "slide": 1.0,
 }
 FALLOFF_LABELS = {"smooth": "Smooth", "linear": "Linear", "constant": "Constant"}
 
@@ -147,7 +152,7 @@ class BrushTool:
             if not self.symmetry:
                 return [first]
             return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
-        if name == "comb" and math.hypot(*d) == 0.0:
+        if name in ("comb", "slide") and math.hypot(*d) == 0.0:
             return []
         hook = start and name == "snake_hook"
         first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v, hook)

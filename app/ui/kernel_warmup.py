@@ -128,8 +128,12 @@ def _brushes_step() -> None:
     from hairtool.frozen.brushes import BRUSHES, BrushSample, falloff_lut
     from hairtool.frozen.pipeline import FrozenPipeline
 
+    class Flat:  # a surface for slide: the plane through each point, facing up
+        def project(self, points):
+            return np.asarray(points, np.float64), np.tile([0.0, 1.0, 0.0], (len(points), 1))
+
     groom = samples.scalp(strands=40, vertices=8)
-    pipe = FrozenPipeline(groom)
+    pipe = FrozenPipeline(groom, surface=Flat())
     lo, hi = groom.bounds
     centre = tuple(float(v) for v in (lo.astype(np.float64) + hi) * 0.5)
     lut = tuple(falloff_lut("smooth").tolist())

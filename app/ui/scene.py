@@ -20,7 +20,7 @@ from PySide6.QtCore import QObject, Signal
 from app.render.ramps import DEFAULT_RAMP
 from app.ui.brush_tool import LABELS, SIGNED, BrushTool, check_falloff
 from hairtool.errors import HairtoolError, ParameterError
-from hairtool.frozen.brushes import CHANGE_STRANDS, scalp_centre
+from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.groom import Groom, Topology, vertex_ids_of
 from hairtool.guides.binding import ChildBinding
@@ -92,7 +92,7 @@ class Scene(QObject):
     # -- strands -----------------------------------------------------------------------
     def _set_groom(self, groom: Groom) -> None:
         if self.engine_ready:
-            self.pipeline: FrozenPipeline | None = FrozenPipeline(groom, self._params)
+            self.pipeline: FrozenPipeline | None = FrozenPipeline(groom, self._params, self._surface())
             self.result: Groom = self.pipeline.result
         else:
             self._params.validate()
@@ -140,7 +140,7 @@ class Scene(QObject):
             return
         self.engine_starting.emit()
         t0 = time.perf_counter()
-        self.pipeline = FrozenPipeline(self.rest, self._params)
+        self.pipeline = FrozenPipeline(self.rest, self._params, self._surface())
         self.result = self.pipeline.result
         self._children_moved()  # the render hair follows the frozen guides
         self.engine_ready = True
@@ -206,15 +206,18 @@ class Scene(QObject):
         self._stroke_step(lambda: self.pipeline.apply_samples(samples))
 
     def stroke_refusal(self) -> str | None:
-        """Why a stroke of the current brush cannot start now (None: it can): brushes that add
-        or remove strands wait while render hair or an animation holds the strands."""
+        """Why a stroke of the current brush cannot start now (None: it can): slide needs the
+        head mesh; brushes that add or remove strands wait while render hair or an animation
+        holds the strands."""
+        label = LABELS.get(self.tool.brush, self.tool.brush)
+        if self.tool.brush in NEED_SURFACE and (self.pipeline is None or self.pipeline.surface is None):
+            return f"{label} slides roots along the head: load its mesh first (File → Load head mesh…)"
         if self.tool.brush not in CHANGE_STRANDS:
             return None
         reasons = ["the render hair follows these guides"] if self.binding is not None else []
         reasons += [r for r in (h() for h in self.strand_holders) if r]
         if not reasons:
             return None
-        label = LABELS.get(self.tool.brush, self.tool.brush)
         return f"{label} changes the strands, but {' and '.join(reasons)}: remove it first"
 
     def _stroke_step(self, step) -> None:
@@ -558,8 +561,30 @@ class Scene(QObject):
             self.display_changed.emit()
 
     def set_mesh(self, mesh: object | None) -> None:
+        """The head mesh: drawn, and the surface the slide brush slides roots on (strokes that
+        slid on the last one are replayed on it; without one they keep the last head's)."""
         self.mesh = mesh
+        if self.pipeline is not None:
+            surface = self._surface()
+            slid = any(getattr(x, "brush", None) in NEED_SURFACE for x in self.pipeline.strokes)
+            if surface is None and slid:
+                self.refused.emit("the slide strokes keep sliding on the head they were made on")
+            elif slid:  # replayed on the new head
+                self._stroke_step(lambda: self.pipeline.set_surface(surface))
+            else:
+                self.pipeline.set_surface(surface)
         self.mesh_changed.emit()
+
+    def _surface(self):
+        """The head mesh as the slide brush's surface (None without a usable one)."""
+        from hairtool.guides.surface import MeshSurface
+
+        if self.mesh is None:
+            return None
+        try:
+            return MeshSurface(self.mesh)
+        except HairtoolError:
+            return None
 
     def displacement(self) -> np.ndarray:
         """``(V,)`` float64 distance of each drawn vertex from its rest position (scene units)."""

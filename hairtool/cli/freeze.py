@@ -117,6 +117,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print timings and sizes as JSON")
 
 
+def _surface(args: argparse.Namespace, strokes):
+    """The head the slide strokes need (``--scalp``, also without ``--count``), or None; a log
+    with slide strokes and no ``--scalp`` is refused before any work."""
+    from hairtool.errors import ParameterError
+    from hairtool.frozen.brushes import NEED_SURFACE
+
+    needs = sorted({s.brush for s in strokes or () if s.brush in NEED_SURFACE})
+    if not needs:
+        return None
+    if args.scalp is None:
+        raise ParameterError("scalp", None, f"a head mesh (--scalp MESH.obj) for {', '.join(needs)} strokes")
+    from hairtool.guides.surface import MeshSurface
+    from hairtool.io.obj import read_mesh
+
+    surface = MeshSurface(read_mesh(args.scalp))
+    if not _guides.wanted(args):
+        args.scalp = None  # the surface's only: no children to grow on it
+    return surface
+
+
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -146,16 +166,17 @@ def run(args: argparse.Namespace) -> int:
     check_align_params(
         (0.0, 0.0, 0.0), 1.0 if args.radius is None else args.radius, args.intensity, args.align_mode
     )
-    _guides.check(args)
     strokes = None
     if args.strokes is not None:
         from hairtool.frozen.strokes import read_strokes
 
         strokes = read_strokes(args.strokes)  # a bad log is refused before any work
+    surface = _surface(args, strokes)
+    _guides.check(args)
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
     # With render hair (asked for, or the input's own), the pipeline runs on the guides.
     groom, binding, bind_ms = _guides.prepare(args, io.read_groom(args.input))
-    pipe = FrozenPipeline(groom, params)
+    pipe = FrozenPipeline(groom, params, surface)
     lo, hi = groom.bounds
     radius = float(np.linalg.norm(hi - lo)) if args.radius is None else args.radius
     timings = [pipe.timings]

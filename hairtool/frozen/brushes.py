@@ -26,7 +26,7 @@ the scene) leaves the strands whose root normal n has n·view > 0 (facing away f
 as if they were locked (:func:`root_normals`, :func:`facing_away`); the pipeline adds them to
 the mask for that sample, for every brush and align.
 
-Delete, pinch and snake hook live in :mod:`hairtool.frozen.sculpt`.
+Delete, pinch and snake hook live in :mod:`hairtool.frozen.sculpt`, slide in :mod:`hairtool.frozen.slide`.
 
 Every kernel has a numpy twin (``*_reference``) computing the same definition.
 """
@@ -45,10 +45,14 @@ from hairtool.groom import Groom
 
 F64 = NDArray[np.float64]
 
-BRUSHES = ("align", "comb", "smooth", "length", "puff", "mask", "clump", "delete", "pinch", "snake_hook")
-#: The brushes of :mod:`hairtool.frozen.sculpt`, and those that add or remove strands.
-SCULPT = ("delete", "pinch", "snake_hook")
+BRUSHES = (
+    "align", "comb", "smooth", "length", "puff", "mask", "clump", "delete", "pinch", "snake_hook", "slide",
+)  # fmt: skip
+#: The brushes of :mod:`hairtool.frozen.sculpt` and :mod:`hairtool.frozen.slide`, those that
+#: add or remove strands, and those that need the head's surface.
+SCULPT = ("delete", "pinch", "snake_hook", "slide")
 CHANGE_STRANDS = ("delete",)
+NEED_SURFACE = ("slide",)
 SIGNED = ("length", "mask", "clump", "pinch")  # strength in [-1, 1]; the others in [0, 1]
 FALLOFFS = ("smooth", "linear", "constant")
 LUT_SIZE = 257  # samples of a falloff curve over [0, 1]: interpolated linearly between

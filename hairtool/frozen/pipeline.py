@@ -49,6 +49,7 @@ from hairtool.frozen.clump_region import clump_points_interactive
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.noise import check_seed, draw_seed
 from hairtool.frozen.sculpt import hook_weights, pinch, snake_hook, strands_to_delete
+from hairtool.frozen.slide import Surface, slide
 from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
 from hairtool.groom import Groom, vertex_ids_of
 
@@ -153,8 +154,11 @@ class FrozenSnapshot:
 class FrozenPipeline:
     """FreezeDeform → UserAlign → ClumpWithGaps on a rest groom, for interactive use."""
 
-    def __init__(self, rest: Groom, params: FrozenParams | None = None) -> None:
+    def __init__(
+        self, rest: Groom, params: FrozenParams | None = None, surface: Surface | None = None
+    ) -> None:
         self._rest = rest
+        self._surface = surface  # the head the slide brush slides roots on
         self._params = (params or FrozenParams()).validate()
         strand_multipliers(rest.strand_count, self._params.strand_variation)  # shape check
         self._auto_h: float | None = None
@@ -296,7 +300,26 @@ class FrozenPipeline:
         """Mean number of other-strand vertices within h per moving vertex in the last clumping."""
         return self._workspace.mean_neighbours
 
+    @property
+    def surface(self) -> Surface | None:
+        """The head's surface (:class:`~hairtool.frozen.slide.Surface`) slide needs, or None."""
+        return self._surface
+
     # -- operations ----------------------------------------------------------------------
+    def set_surface(self, surface: Surface | None) -> Groom:
+        """A new head surface; strokes that slid roots on the old one are replayed on it (a log
+        with slide strokes refuses to go without one, and keeps the old surface then)."""
+        old, self._surface = self._surface, surface
+        if any(isinstance(s, BrushSample) and s.brush == "slide" for s in self._log):
+            try:
+                self._replay()
+            except BaseException:
+                self._surface = old
+                self._replay()
+                raise
+            self._reclump()
+        return self._result
+
     def set_params(self, params: FrozenParams) -> Groom:
         """New parameters; the frozen groom is re-derived only if a freeze parameter changed,
         and the strokes are replayed on it."""
@@ -376,7 +399,16 @@ class FrozenPipeline:
         )
 
     def restore(self, snapshot: FrozenSnapshot) -> Groom:
-        """Back to a snapshot's strokes; replayed on the current frozen groom if it has changed."""
+        """Back to a snapshot's strokes; replayed on the current frozen groom if it has changed
+        (a replay that fails, e.g. slide strokes without a surface, leaves the state as it was)."""
+        now = self.snapshot()
+        try:
+            return self._restore(snapshot)
+        except BaseException:
+            self._restore(now)
+            raise
+
+    def _restore(self, snapshot: FrozenSnapshot) -> Groom:
         self._log = list(snapshot.log)
         self._timings = dict.fromkeys(self._timings, 0.0)
         if (
@@ -496,6 +528,8 @@ class FrozenPipeline:
             return pinch(g, sample, locked)
         if sample.brush == "snake_hook":
             return self._snake(g, sample, locked)
+        if sample.brush == "slide":
+            return slide(g, sample, locked, self._surface)
         return apply_brush(g, sample, locked, self.scalp_centre)
 
     def _replay(self) -> None:

@@ -132,16 +132,23 @@ def _hook_weights_kernel(tips, c, radius, strength, lut, locked, out):  # pragma
         out[s] = 0.0 if locked[s] else _weight(tips[s, 0], tips[s, 1], tips[s, 2], c, radius, lut) * strength
 
 
+def end_weights(ends: ArrayLike, sample: BrushSample, locked: ArrayLike) -> F64:
+    """``(S,)`` strength × falloff weight of one point per strand (its tip, its root), 0 where
+    ``locked`` (numba)."""
+    ends = np.ascontiguousarray(ends, np.float64)
+    out = np.empty(len(ends))
+    _hook_weights_kernel(
+        ends, np.asarray(sample.cursor, np.float64), float(sample.radius), float(sample.strength),
+        np.asarray(sample.lut, np.float64), np.asarray(locked, np.bool_), out,
+    )  # fmt: skip
+    return out
+
+
 def hook_weights(groom: Groom, sample: BrushSample, locked: ArrayLike) -> F64:
     """``(S,)`` the weight h = strength·w(tip) with which a snake-hook stroke's first sample
     hooks each strand (0: not hooked; masked or facing-away strands are not) (numba)."""
     _check(sample, "snake_hook")
-    out = np.empty(groom.strand_count)
-    _hook_weights_kernel(
-        groom.tips.astype(np.float64), np.asarray(sample.cursor, np.float64), float(sample.radius),
-        float(sample.strength), np.asarray(sample.lut, np.float64), np.asarray(locked, np.bool_), out,
-    )  # fmt: skip
-    return out
+    return end_weights(groom.tips, sample, locked)
 
 
 def hook_weights_reference(groom: Groom, sample: BrushSample, locked: ArrayLike) -> F64:

@@ -17,6 +17,7 @@ import heapq
 import numpy as np
 from numba import njit, prange
 
+from hairtool.errors import ParameterError
 from hairtool.io.obj import Mesh
 
 
@@ -255,3 +256,43 @@ def nearest_guide_distance(mesh: Mesh, guide_roots: np.ndarray) -> np.ndarray:
     on_mesh, gface = closest_points(mesh, guide_roots)
     _, d = nearest_sources(mesh, on_mesh, gface, 1)
     return d[:, 0]
+
+
+class MeshSurface:
+    """A head mesh as the surface the frozen brushes slide roots on
+    (:class:`hairtool.frozen.slide.Surface`): the closest point of the mesh and the smooth normal
+    there (the vertex normals interpolated barycentrically, the face's own normal where they
+    cancel)."""
+
+    def __init__(self, mesh: Mesh) -> None:
+        if len(mesh.faces) == 0:
+            raise ParameterError("scalp", "a mesh without faces", "a mesh with at least one triangle")
+        if not np.all(np.isfinite(mesh.vertices)):
+            raise ParameterError("scalp", "a mesh with non-finite vertices", "finite vertex coordinates")
+        self.mesh = mesh
+        self._v = mesh.vertices.astype(np.float64)
+        self._n = mesh.normals.astype(np.float64)
+        self._f = mesh.faces.astype(np.int64)
+
+    def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(P, 3)`` float64 closest points on the mesh and ``(P, 3)`` unit normals there."""
+        q, face = closest_points(self.mesh, points)
+        tri = self._f[face]
+        a, b, c = self._v[tri[:, 0]], self._v[tri[:, 1]], self._v[tri[:, 2]]
+        e0, e1, e2 = b - a, c - a, q - a
+        d00, d01, d11 = (e0 * e0).sum(1), (e0 * e1).sum(1), (e1 * e1).sum(1)
+        d20, d21 = (e2 * e0).sum(1), (e2 * e1).sum(1)
+        den = d00 * d11 - d01 * d01
+        ok = np.abs(den) > 1e-300
+        den = np.where(ok, den, 1.0)
+        v = np.where(ok, (d11 * d20 - d01 * d21) / den, 1.0 / 3.0)
+        w = np.where(ok, (d00 * d21 - d01 * d20) / den, 1.0 / 3.0)
+        u = 1.0 - v - w
+        nv = self._n
+        n = u[:, None] * nv[tri[:, 0]] + v[:, None] * nv[tri[:, 1]] + w[:, None] * nv[tri[:, 2]]
+        length = np.linalg.norm(n, axis=1)
+        flat = length < 1e-9
+        if flat.any():  # opposite vertex normals (a fold): the face's own
+            n[flat] = np.cross(e0[flat], e1[flat])
+            length[flat] = np.linalg.norm(n[flat], axis=1)
+        return q, n / np.maximum(length, 1e-300)[:, None]

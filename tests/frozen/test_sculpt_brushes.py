@@ -311,3 +311,17 @@ def test_a_delete_log_with_render_hair_is_refused_in_one_line(flat, tmp_path, ca
     assert main([*args, "--strokes", str(tmp_path / "s.json")]) == 2
     err = capsys.readouterr().err.strip()
     assert "delete" in err and "\n" not in err and not out.exists()
+
+
+def test_a_project_keeps_deletes_and_snake_hooks_and_loads_to_the_same_bytes(flat, tmp_path):
+    from hairtool import project
+
+    pipe = FrozenPipeline(flat, FrozenParams(seed=1))
+    t0 = flat.tips.astype(np.float64)
+    drag(pipe, t0[14] + np.array([[0.0, 0, 0], [0.03, 0, 0]]), 0.04, symmetry_plane=0.1)
+    drag(pipe, t0[20] + np.array([[0.0, 0, 0], [0.0, 0, 0.03]]), 0.04)
+    pipe.brush(sample("delete", flat.roots[30], 0.06, 1.0))
+    project.save(tmp_path / "p.hairproj", project.Project.from_pipeline(pipe))
+    back = project.load(tmp_path / "p.hairproj")
+    assert back.strokes == pipe.strokes  # the start flags too
+    np.testing.assert_array_equal(back.pipeline().result.points, pipe.result.points)

@@ -6,6 +6,8 @@ delete that render hair or an animation depends on is refused with a message."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from PySide6.QtGui import QAction
@@ -32,7 +34,7 @@ def front_strand(w) -> int:
 
 def test_the_new_brushes_have_entries_and_keys_that_clash_with_nothing(make_window):
     w = plain(make_window)
-    keys = {"delete": "X", "pinch": "Shift+P", "snake_hook": "K"}
+    keys = {"delete": "X", "pinch": "Shift+P", "snake_hook": "K", "slide": "G"}
     combo = [w.dock.brush.itemData(i) for i in range(w.dock.brush.count())]
     for name, key in keys.items():
         a = w.brush_actions[name]
@@ -129,3 +131,38 @@ def test_delete_waits_while_render_hair_follows_the_guides(ui, make_window):
     assert s.result.strand_count == 60 and w.undo_stack.count() == 0
     assert messages and "render hair" in messages[0][0]
     assert "render hair" in w.statusBar().currentMessage()
+
+
+def test_slide_moves_roots_along_the_head_and_waits_for_a_head_mesh(ui, make_window, tmp_path):
+    from hairtool import io
+    from hairtool.cli import main
+    from hairtool.io.obj import read_mesh
+
+    data = Path(__file__).resolve().parents[1] / "data" / "grooms"
+    rest = io.read_groom(data / "sintel_hair.tfx")
+    w = plain(make_window, groom=rest)
+    s, v = w.scene, w.viewport
+    messages = ui.record(s.refused)
+    w.brush_actions["slide"].trigger()
+    assert w.brush_actions["slide"].shortcut().toString() == "G"
+    k = front_strand(w)
+    pos = v.project(rest.roots[k])[0]
+    ui.drag(v, pos, pos + np.array([25.0, 0.0]), steps=3)
+    assert w.undo_stack.count() == 0 and messages and "head mesh" in messages[-1][0]
+    s.set_mesh(read_mesh(data / "sintel_head.obj"))
+    s.set_radius(2.0)
+    ui.drag(v, pos, pos + np.array([25.0, 0.0]), steps=3)
+    out = s.result
+    moved = np.flatnonzero(np.any(out.roots != rest.roots, axis=1))
+    assert moved.size >= 1 and w.undo_stack.count() == 1 and w.undo_stack.undoText() == "Slide stroke"
+    on, _ = s.pipeline.surface.project(out.roots[moved].astype(np.float64))
+    np.testing.assert_allclose(out.roots[moved], on, atol=1e-4)
+    np.testing.assert_allclose(out.strand_lengths, rest.strand_lengths, rtol=1e-5)
+    assert w.stroke_files.export(tmp_path / "strokes.json")
+    io.write(tmp_path / "rest.npz", rest)
+    args = ["freeze", str(tmp_path / "rest.npz"), str(tmp_path / "out.npz"), "--no-freeze", "--no-clump"]
+    args += ["--scalp", str(data / "sintel_head.obj")]
+    assert main([*args, "--strokes", str(tmp_path / "strokes.json")]) == 0
+    np.testing.assert_array_equal(io.read_groom(tmp_path / "out.npz").points, out.points)
+    w.undo_stack.undo()
+    np.testing.assert_array_equal(s.result.points, rest.points)
