@@ -416,6 +416,9 @@ def _write_strokes(log, arrays: dict) -> dict:
         ).reshape(n, 3)
         arrays["strokes/has_view.npy"] = np.array([s.view is not None for s in log], np.int64)
         info["views"] = True
+    if not all(s.collide for s in log):  # strokes that may pass through the head
+        arrays["strokes/collide.npy"] = np.array([s.collide for s in log], np.int64)
+        info["collide"] = True
     if any(isinstance(s, BrushSample) and s.start for s in log):  # where snake hooks hooked
         starts = [isinstance(s, BrushSample) and s.start for s in log]
         arrays["strokes/start.npy"] = np.array(starts, np.int64)
@@ -465,6 +468,11 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
         starts = r.array("strokes/start.npy", 1, "iu")
         if starts.shape != (n,):
             raise FormatError(r.path, f"the stroke start flags do not hold {n} strokes")
+    collides = np.ones(n, np.int64)
+    if info.get("collide"):
+        collides = r.array("strokes/collide.npy", 1, "iu")
+        if collides.shape != (n,):
+            raise FormatError(r.path, f"the stroke collision flags do not hold {n} strokes")
     if n and np.any((brush < 0) & ((mode < 0) | (mode >= len(modes)))):
         raise FormatError(r.path, "a stroke names an unknown align mode")
     strokes = []
@@ -475,11 +483,13 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
                 v = check_view(views[k])
             except HairtoolError as e:
                 raise FormatError(r.path, f"stroke {k}: {e}") from None
-            strokes.append(AlignSample(c, float(radius[k]), float(intensity[k]), str(modes[mode[k]]), v))
+            mode_k = str(modes[mode[k]])
+            hit = bool(collides[k])
+            strokes.append(AlignSample(c, float(radius[k]), float(intensity[k]), mode_k, v, hit))
             continue
         sample = BrushSample(
             names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
-            float(intensity[k]), tuple(luts[which[k]].tolist()), views[k], bool(starts[k]),
+            float(intensity[k]), tuple(luts[which[k]].tolist()), views[k], bool(starts[k]), bool(collides[k]),
         )
         try:
             strokes.append(check_sample(sample))

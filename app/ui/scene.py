@@ -561,15 +561,16 @@ class Scene(QObject):
             self.display_changed.emit()
 
     def set_mesh(self, mesh: object | None) -> None:
-        """The head mesh: drawn, and the surface the slide brush slides roots on (strokes that
-        slid on the last one are replayed on it; without one they keep the last head's)."""
+        """The head mesh: drawn, the surface the slide brush slides roots on and the brushes
+        collide with (strokes are replayed on a new one; slide strokes keep the last head
+        when the mesh is cleared)."""
         self.mesh = mesh
         if self.pipeline is not None:
             surface = self._surface()
             slid = any(getattr(x, "brush", None) in NEED_SURFACE for x in self.pipeline.strokes)
             if surface is None and slid:
                 self.refused.emit("the slide strokes keep sliding on the head they were made on")
-            elif slid:  # replayed on the new head
+            elif self.pipeline.strokes:  # replayed on the new head (slides, collisions)
                 self._stroke_step(lambda: self.pipeline.set_surface(surface))
             else:
                 self.pipeline.set_surface(surface)

@@ -118,16 +118,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _surface(args: argparse.Namespace, strokes):
-    """The head the slide strokes need (``--scalp``, also without ``--count``), or None; a log
-    with slide strokes and no ``--scalp`` is refused before any work."""
+    """The head (``--scalp``, also without ``--count``) that strokes and align cursors collide
+    with and slide strokes slide on, or None; a log with slide strokes and no ``--scalp`` is
+    refused before any work."""
     from hairtool.errors import ParameterError
     from hairtool.frozen.brushes import NEED_SURFACE
 
     needs = sorted({s.brush for s in strokes or () if s.brush in NEED_SURFACE})
-    if not needs:
-        return None
-    if args.scalp is None:
+    if needs and args.scalp is None:
         raise ParameterError("scalp", None, f"a head mesh (--scalp MESH.obj) for {', '.join(needs)} strokes")
+    if args.scalp is None or not (strokes or args.align):
+        return None
     from hairtool.guides.surface import MeshSurface
     from hairtool.io.obj import read_mesh
 

@@ -52,6 +52,7 @@ BRUSHES = (
 #: add or remove strands, and those that need the head's surface.
 SCULPT = ("delete", "pinch", "snake_hook", "slide")
 CHANGE_STRANDS = ("delete",)
+MOVE_NONE = ("mask", "clump", "delete")  # brushes that move no vertex: nothing to collide
 NEED_SURFACE = ("slide",)
 SIGNED = ("length", "mask", "clump", "pinch")  # strength in [-1, 1]; the others in [0, 1]
 FALLOFFS = ("smooth", "linear", "constant")
@@ -86,7 +87,8 @@ class BrushSample:
     """One mouse move of one brush (groom units); ``lut`` from :func:`falloff_lut`; ``view`` the
     camera's viewing direction (from the eye into the scene): with it only the strands facing
     the camera are touched; None: every strand. ``start``: the first sample of a stroke (a
-    snake hook hooks its strands there)."""
+    snake hook hooks its strands there). ``collide``: with a head surface, no vertex the
+    sample moves ends inside it (:mod:`hairtool.frozen.collide`)."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -96,13 +98,14 @@ class BrushSample:
     lut: tuple[float, ...]
     view: tuple[float, float, float] | None = None
     start: bool = False
+    collide: bool = True
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
         return BrushSample(
             self.brush, cursor, direction, self.radius, self.strength, self.lut, mirrored_view(self.view),
-            self.start,
+            self.start, self.collide,
         )
 
 

@@ -17,6 +17,8 @@ Built for dragging in the studio:
   pipeline records the rest strand each remaining strand comes from (:attr:`FrozenPipeline.origin`),
   kept in the snapshots, so undo brings the deleted strands back bit for bit and a replay deletes
   the same ones. The result has the stroked state's strands, not necessarily the rest groom's.
+- With a head surface (:meth:`FrozenPipeline.set_surface`), a sample with ``collide`` (the
+  default) leaves no vertex it moved inside the head (:mod:`hairtool.frozen.collide`).
 - Snake hook hooks strands at a stroke's first sample (``start``) and drags them through the
   stroke's later samples; the hooked weights are part of the state (one set per sample of a
   stroke's start: its mirrored sample has its own, used in turn).
@@ -35,6 +37,7 @@ from numpy.typing import ArrayLike
 from hairtool.errors import ParameterError
 from hairtool.frozen.align import align, check_align_params
 from hairtool.frozen.brushes import (
+    MOVE_NONE,
     BrushSample,
     apply_brush,
     check_view,
@@ -46,6 +49,7 @@ from hairtool.frozen.brushes import (
 )
 from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
 from hairtool.frozen.clump_region import clump_points_interactive
+from hairtool.frozen.collide import MARGIN, collide
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.noise import check_seed, draw_seed
 from hairtool.frozen.sculpt import hook_weights, pinch, snake_hook, strands_to_delete
@@ -130,6 +134,7 @@ class AlignSample(NamedTuple):
     intensity: float
     mode: str
     view: tuple[float, float, float] | None = None
+    collide: bool = True  # as BrushSample's
 
 
 Sample = AlignSample | BrushSample
@@ -307,10 +312,11 @@ class FrozenPipeline:
 
     # -- operations ----------------------------------------------------------------------
     def set_surface(self, surface: Surface | None) -> Groom:
-        """A new head surface; strokes that slid roots on the old one are replayed on it (a log
-        with slide strokes refuses to go without one, and keeps the old surface then)."""
+        """A new head surface; strokes that slid roots on the old one or collided with it are
+        replayed on it (a log with slide strokes refuses to go without one, and keeps the old
+        surface then)."""
         old, self._surface = self._surface, surface
-        if any(isinstance(s, BrushSample) and s.brush == "slide" for s in self._log):
+        if self._log:
             try:
                 self._replay()
             except BaseException:
@@ -504,6 +510,16 @@ class FrozenPipeline:
         return g.subset(keep)
 
     def _apply(self, g: Groom, sample: Sample) -> Groom:
+        out = self._apply_one(g, sample)
+        moves = isinstance(sample, AlignSample) or sample.brush not in MOVE_NONE
+        surface = self._surface
+        if moves and sample.collide and surface is not None and hasattr(surface, "signed_distance"):
+            lo, hi = self._rest.bounds
+            margin = MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
+            out = collide(g, out, surface, margin)  # type: ignore[arg-type]
+        return out
+
+    def _apply_one(self, g: Groom, sample: Sample) -> Groom:
         if not (isinstance(sample, BrushSample) and sample.brush == "snake_hook"):
             self._set_hooks(((), 0, False))  # another brush ends a snake hook's stroke
         away = self._away(sample.view)

@@ -15,6 +15,8 @@ A stroke log is a JSON list of strokes, in groom units::
   gathers toward the brush centre, < 0 spreads) or ``snake_hook`` (the strands whose tip lies
   within the radius at the stroke's first sample follow the cursor; ``direction`` is the
   cursor's motion since the sample before).
+- ``collision`` (per stroke, optional, default true): with a head surface (``--scalp``), no
+  vertex the stroke moves ends inside it; false: strands may pass through the head.
 - ``start`` (per sample, optional): true where a stroke begins (a snake hook hooks its strands
   there); missing: true for a stroke's first sample only. Written for snake hooks, whose
   mirrored first sample is a start too.
@@ -35,7 +37,7 @@ import json
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -70,6 +72,7 @@ class Stroke:
     symmetry: str | None = None
     mirror_x: float | None = None
     params: dict = field(default_factory=dict)
+    collision: bool = True  # with a head surface, no vertex the stroke moves ends inside it
 
     def validate(self) -> Stroke:
         if self.brush not in BRUSHES:
@@ -92,7 +95,7 @@ class Stroke:
         for i, s in enumerate(self.samples):
             if self.brush == "align":
                 mode = self.params.get("mode", "paper")
-                first = AlignSample(s.cursor, s.radius, s.strength, mode, check_view(s.view))
+                first = AlignSample(s.cursor, s.radius, s.strength, mode, check_view(s.view), self.collision)
                 out.append(first)
                 if self.symmetry == "x":
                     cursor = (2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])
@@ -100,7 +103,9 @@ class Stroke:
                 continue
             start = (i == 0) if s.start is None else s.start
             start = start and self.brush == "snake_hook"  # (the only brush a start changes)
-            sample = BrushSample(self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start)
+            sample = BrushSample(
+                self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start, self.collision
+            )
             sample = check_sample(sample)
             out.append(sample)
             if self.symmetry == "x":
@@ -115,6 +120,7 @@ class Stroke:
             "symmetry": self.symmetry,
             "mirror_x": self.mirror_x,
             "params": dict(self.params),
+            **({} if self.collision else {"collision": False}),
             "samples": [
                 {
                     "cursor": list(s.cursor),
@@ -136,22 +142,23 @@ def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
     for s in log:
         split = False
         if isinstance(s, AlignSample):
-            key: tuple = ("align", s.mode)
+            key: tuple = ("align", s.mode, s.collide)
             sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view))
-            start = Stroke("align", (sample,), params={"mode": s.mode})
+            start = Stroke("align", (sample,), params={"mode": s.mode}, collision=s.collide)
         else:
-            key = (s.brush, s.lut)
+            key = (s.brush, s.lut, s.collide)
             hook = s.brush == "snake_hook"
             sample = StrokeSample(
                 tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view),
                 bool(s.start) if hook else None,
             )  # fmt: skip
-            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut))
+            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut), collision=s.collide)
             # a snake hook's start (not its mirror's) begins a new stroke, with its own strands
             split = hook and s.start and bool(runs) and not runs[-1][1].samples[-1].start
         if runs and runs[-1][0] == key and not split:
             last = runs[-1][1]
-            runs[-1] = (key, Stroke(last.brush, (*last.samples, sample), last.falloff, params=last.params))
+            more = Stroke(last.brush, (*last.samples, sample), last.falloff, params=last.params)
+            runs[-1] = (key, replace(more, collision=last.collision))
         else:
             runs.append((key, start))
     return [stroke for _, stroke in runs]
@@ -229,6 +236,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
         symmetry=d.get("symmetry"),
         mirror_x=None if mirror is None else _number(f"{where}.mirror_x", mirror),
         params=params,
+        collision=_flag(f"{where}.collision", d.get("collision")) is not False,
     )
     try:
         stroke.pipeline_samples(0.0)  # every sample checked (radius, strength range) as it will run
