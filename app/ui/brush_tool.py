@@ -105,6 +105,8 @@ class BrushTool:
     symmetry: bool = False
     mirror_x: float | None = None
     front_only: bool = True
+    #: per brush: with a head mesh, no vertex the brush moves ends inside it (on by default)
+    collide: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(brushes(), True))
     align_mode: str = "paper"
     _lut: tuple[Falloff, tuple[float, ...]] | None = field(default=None, repr=False)
 
@@ -147,15 +149,16 @@ class BrushTool:
         d = tuple(float(x) for x in direction)
         v = None if view is None or not self.front_only else tuple(float(x) for x in view)
         r, name = self.radius[self.brush], self.brush
+        hit = self.collide.get(name, True)
         if name == "align":
-            first = AlignSample(c, r, self.strength["align"], self.align_mode, v)
+            first = AlignSample(c, r, self.strength["align"], self.align_mode, v, hit)
             if not self.symmetry:
                 return [first]
             return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
         if name in ("comb", "slide") and math.hypot(*d) == 0.0:
             return []
         hook = start and name == "snake_hook"
-        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v, hook)
+        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v, hook, hit)
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
     def touches(self, points: np.ndarray, cursor: Sequence[float], plane_x: float) -> bool:

@@ -540,6 +540,12 @@ class Scene(QObject):
             self.tool.front_only = bool(on)
             self.tool_changed.emit()
 
+    def set_collide(self, on: bool) -> None:
+        """The current brush keeps strands out of the head mesh (each brush has its own)."""
+        if bool(on) != self.tool.collide.get(self.tool.brush, True):
+            self.tool.collide[self.tool.brush] = bool(on)
+            self.tool_changed.emit()
+
     # -- display -------------------------------------------------------------------------
     def set_colour_mode(self, mode: str) -> None:
         if mode not in COLOUR_MODES:

@@ -166,3 +166,33 @@ def test_slide_moves_roots_along_the_head_and_waits_for_a_head_mesh(ui, make_win
     np.testing.assert_array_equal(io.read_groom(tmp_path / "out.npz").points, out.points)
     w.undo_stack.undo()
     np.testing.assert_array_equal(s.result.points, rest.points)
+
+
+def test_brushes_keep_strands_out_of_the_head_unless_told_not_to(ui, make_window):
+    from hairtool import io
+    from hairtool.io.obj import read_mesh
+
+    data = Path(__file__).resolve().parents[1] / "data" / "grooms"
+    rest = io.read_groom(data / "sintel_hair.tfx")
+    w = plain(make_window, groom=rest)
+    s, v = w.scene, w.viewport
+    s.set_mesh(read_mesh(data / "sintel_head.obj"))
+    w.brush_actions["comb"].trigger()
+    assert w.dock.collide.isVisibleTo(w.dock) and w.dock.collide.isChecked()
+    s.set_radius(6.0)
+    s.set_intensity(1.0)
+    k = front_strand(w)
+    centre = v.project(s.pipeline.surface.mesh.vertices.mean(axis=0).astype(np.float64))[0]
+    pos = v.project(rest.points[rest.offsets[k] + 16])[0]
+    ui.drag(v, pos, pos + 0.6 * (centre - pos), steps=4)  # toward the middle of the head
+    moved = np.any(s.result.points != rest.points, axis=1) & (rest.topology.index_in_strand > 0)
+    assert moved.sum() > 20
+    sd, _, _ = s.pipeline.surface.signed_distance(s.result.points[moved].astype(np.float64))
+    assert np.all(sd >= 0)
+    assert all(x.collide for x in s.pipeline.strokes)
+    w.dock.collide.setChecked(False)  # this brush only
+    assert not s.tool.collide["comb"] and s.tool.collide["pinch"]
+    ui.drag(v, pos, pos + 0.6 * (centre - pos), steps=2)
+    assert not s.pipeline.strokes[-1].collide
+    s.set_brush("mask")
+    assert not w.dock.collide.isVisibleTo(w.dock)  # the mask moves nothing
