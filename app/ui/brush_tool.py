@@ -20,6 +20,7 @@ from hairtool.frozen.pipeline import AlignSample
 #: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
 #: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump, K snake hook; X deletes as
 #: in Blender's editors; pinch, with P taken by clump, is Shift+P; slide G as Blender's grab;
+#: add Shift+A as Blender's Add menu;
 #: the others by their initial).
 LABELS = {
     "align": "Align",
@@ -33,10 +34,12 @@ LABELS = {
     "snake_hook": "Snake Hook",
     "delete": "Delete",
     "slide": "Slide",
+    "add": "Add",
 }
 SHORTCUTS = {
     "align": "A", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M",
     "pinch": "Shift+P", "snake_hook": "K", "delete": "X", "slide": "G",
+    "add": "Shift+A",
 }  # fmt: skip
 TIPS = {
     "align": "Strands turn toward the cursor's path (UserAlign, Kim 2026 eqs. 8–13)",
@@ -52,6 +55,8 @@ TIPS = {
     "delete": "Removes the strands whose roots are under the brush (undo brings them back)",
     "slide": "Slides the roots under the brush along the head in the drag's direction; each strand "
     "keeps its shape (needs the head mesh)",
+    "add": "Plants new strands on the head under the brush, shaped like their neighbours "
+    "(needs the head mesh)",
 }
 #: Brushes with a signed strength: (label of > 0, label of < 0).
 SIGNED = {
@@ -74,6 +79,7 @@ DEFAULT_STRENGTH = {
     "snake_hook": 1.0,
     "delete": 1.0,
     "slide": 1.0,
+    "add": 1.0,
 }
 FALLOFF_LABELS = {"smooth": "Smooth", "linear": "Linear", "constant": "Constant"}
 
@@ -107,6 +113,7 @@ class BrushTool:
     front_only: bool = True
     #: per brush: with a head mesh, no vertex the brush moves ends inside it (on by default)
     collide: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(brushes(), True))
+    add_count: int = 2  # strands the add brush plants per mouse move
     align_mode: str = "paper"
     _lut: tuple[Falloff, tuple[float, ...]] | None = field(default=None, repr=False)
 
@@ -158,7 +165,8 @@ class BrushTool:
         if name in ("comb", "slide") and math.hypot(*d) == 0.0:
             return []
         hook = start and name == "snake_hook"
-        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v, hook, hit)
+        count = self.add_count if name == "add" else 1
+        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v, hook, hit, count)
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
     def touches(self, points: np.ndarray, cursor: Sequence[float], plane_x: float) -> bool:

@@ -211,7 +211,7 @@ class Scene(QObject):
         holds the strands."""
         label = LABELS.get(self.tool.brush, self.tool.brush)
         if self.tool.brush in NEED_SURFACE and (self.pipeline is None or self.pipeline.surface is None):
-            return f"{label} slides roots along the head: load its mesh first (File → Load head mesh…)"
+            return f"{label} works on the head's surface: load its mesh first (File → Load head mesh…)"
         if self.tool.brush not in CHANGE_STRANDS:
             return None
         reasons = ["the render hair follows these guides"] if self.binding is not None else []
@@ -540,6 +540,16 @@ class Scene(QObject):
             self.tool.front_only = bool(on)
             self.tool_changed.emit()
 
+    def set_add_count(self, count: int) -> None:
+        """Strands the add brush plants per mouse move."""
+        from hairtool.frozen.brushes import MAX_COUNT
+
+        if isinstance(count, bool) or int(count) != count or not 1 <= count <= MAX_COUNT:
+            raise ParameterError("strands per move", count, f"a whole number in [1, {MAX_COUNT}]")
+        if int(count) != self.tool.add_count:
+            self.tool.add_count = int(count)
+            self.tool_changed.emit()
+
     def set_collide(self, on: bool) -> None:
         """The current brush keeps strands out of the head mesh (each brush has its own)."""
         if bool(on) != self.tool.collide.get(self.tool.brush, True):
@@ -584,12 +594,12 @@ class Scene(QObject):
 
     def _surface(self):
         """The head mesh as the slide brush's surface (None without a usable one)."""
-        from hairtool.guides.surface import MeshSurface
+        from hairtool.guides.planting import HeadSurface
 
         if self.mesh is None:
             return None
         try:
-            return MeshSurface(self.mesh)
+            return HeadSurface(self.mesh)
         except HairtoolError:
             return None
 

@@ -195,11 +195,16 @@ class ToolDock(QDockWidget):
             "along the surface normal, lengths kept); each brush has its own"
         )
         self.collide.toggled.connect(self.scene.set_collide)
+        self.add_count = QSpinBox()
+        self.add_count.setRange(1, 1000)
+        self.add_count.setToolTip("how many strands the add brush plants at each mouse move")
+        self.add_count.valueChanged.connect(self.scene.set_add_count)
         form.addRow("Brush", self.brush)
         form.addRow("Brush size", self.radius)
         form.addRow("Strength", self.intensity)
         form.addRow("Mode", self.mode)
         form.addRow("Direction", self.sign)
+        form.addRow("Strands per move", self.add_count)
         form.addRow("Falloff", self.falloff)
         form.addRow(self.curve)
         form.addRow("Symmetry", mirror_row)
@@ -296,7 +301,8 @@ class ToolDock(QDockWidget):
         lo, hi = s.rest.bounds
         extent = max(float((hi - lo).max()), 1e-3)
         widgets = (self.brush, self.radius, self.intensity, self.mode, self.sign, self.falloff, self.curve)
-        with signals_blocked(*widgets, self.symmetry, self.mirror_x, self.front_only, self.collide):
+        more = (self.symmetry, self.mirror_x, self.front_only, self.collide, self.add_count)
+        with signals_blocked(*widgets, *more):
             self.brush.setCurrentIndex(self.brush.findData(s.brush))
             self.radius.set_range(extent * 1e-3, extent * 2.0)
             self.radius.set_value(s.radius)
@@ -329,6 +335,8 @@ class ToolDock(QDockWidget):
             self.front_only.setChecked(tool.front_only)
             self.collide.setChecked(tool.collide.get(s.brush, True))
             self._brush_form.setRowVisible(self.collide, s.brush not in MOVE_NONE)
+            self.add_count.setValue(tool.add_count)
+            self._brush_form.setRowVisible(self.add_count, s.brush == "add")
 
     def refresh_params(self) -> None:
         p: FrozenParams = self.scene.params

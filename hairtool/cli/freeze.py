@@ -67,7 +67,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--strokes",
         metavar="STROKES.json",
         help="replay a stroke log (align, comb, smooth, length, puff, clump, mask, delete, pinch, "
-        "snake_hook; the studio exports one) after the --align cursors",
+        "snake_hook, slide, add; the studio exports one) after the --align cursors",
     )
     a = parser.add_argument_group("align brush (UserAlign, eqs. 8–13)")
     a.add_argument(
@@ -129,10 +129,10 @@ def _surface(args: argparse.Namespace, strokes):
         raise ParameterError("scalp", None, f"a head mesh (--scalp MESH.obj) for {', '.join(needs)} strokes")
     if args.scalp is None or not (strokes or args.align):
         return None
-    from hairtool.guides.surface import MeshSurface
+    from hairtool.guides.planting import HeadSurface
     from hairtool.io.obj import read_mesh
 
-    surface = MeshSurface(read_mesh(args.scalp))
+    surface = HeadSurface(read_mesh(args.scalp))
     if not _guides.wanted(args):
         args.scalp = None  # the surface's only: no children to grow on it
     return surface
@@ -190,7 +190,7 @@ def run(args: argparse.Namespace) -> int:
     report = {}
     if binding is not None and pipe.result.strand_count != groom.strand_count:
         raise ParameterError(
-            "strokes", "delete strokes with render hair", "no delete stroke where children follow the guides"
+            "strokes", "add or delete strokes with render hair", "none where children follow the guides"
         )
     if binding is not None:
         hair = _guides.render(args, binding).update(pipe.result)

@@ -47,13 +47,15 @@ F64 = NDArray[np.float64]
 
 BRUSHES = (
     "align", "comb", "smooth", "length", "puff", "mask", "clump", "delete", "pinch", "snake_hook", "slide",
+    "add",
 )  # fmt: skip
 #: The brushes of :mod:`hairtool.frozen.sculpt` and :mod:`hairtool.frozen.slide`, those that
 #: add or remove strands, and those that need the head's surface.
-SCULPT = ("delete", "pinch", "snake_hook", "slide")
-CHANGE_STRANDS = ("delete",)
-MOVE_NONE = ("mask", "clump", "delete")  # brushes that move no vertex: nothing to collide
-NEED_SURFACE = ("slide",)
+SCULPT = ("delete", "pinch", "snake_hook", "slide", "add")
+CHANGE_STRANDS = ("delete", "add")
+MOVE_NONE = ("mask", "clump", "delete", "add")  # brushes that move no vertex: nothing to collide
+NEED_SURFACE = ("slide", "add")
+MAX_COUNT = 1000  # strands one add sample may plant
 SIGNED = ("length", "mask", "clump", "pinch")  # strength in [-1, 1]; the others in [0, 1]
 FALLOFFS = ("smooth", "linear", "constant")
 LUT_SIZE = 257  # samples of a falloff curve over [0, 1]: interpolated linearly between
@@ -88,7 +90,8 @@ class BrushSample:
     camera's viewing direction (from the eye into the scene): with it only the strands facing
     the camera are touched; None: every strand. ``start``: the first sample of a stroke (a
     snake hook hooks its strands there). ``collide``: with a head surface, no vertex the
-    sample moves ends inside it (:mod:`hairtool.frozen.collide`)."""
+    sample moves ends inside it (:mod:`hairtool.frozen.collide`). ``count`` and ``seed``: the
+    strands an add sample plants, and the seed of where."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -99,13 +102,15 @@ class BrushSample:
     view: tuple[float, float, float] | None = None
     start: bool = False
     collide: bool = True
+    count: int = 1
+    seed: int = 0
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
         return BrushSample(
             self.brush, cursor, direction, self.radius, self.strength, self.lut, mirrored_view(self.view),
-            self.start, self.collide,
+            self.start, self.collide, self.count, self.seed,
         )
 
 
@@ -140,6 +145,12 @@ def check_sample(sample: BrushSample) -> BrushSample:
     low = -1.0 if sample.brush in SIGNED else 0.0
     if not np.isfinite(sample.strength) or not low <= sample.strength <= 1.0:
         raise ParameterError("strength", sample.strength, f"a number in [{low:g}, 1]")
+    c = sample.count
+    if isinstance(c, bool) or not isinstance(c, int | np.integer) or not 1 <= c <= MAX_COUNT:
+        raise ParameterError("count", c, f"a whole number of strands in [1, {MAX_COUNT}]")
+    s = sample.seed
+    if isinstance(s, bool) or not isinstance(s, int | np.integer) or not 0 <= s < 2**32:
+        raise ParameterError("seed", s, "a whole number in [0, 2^32)")
     if len(sample.lut) != LUT_SIZE:
         raise ParameterError("falloff", f"{len(sample.lut)} samples", f"{LUT_SIZE}")
     return sample

@@ -125,6 +125,30 @@ which stretches segments). ``redraw_noise``: new
         return replace(self, **changes)
 
 
+def append_strands(g: Groom, new: Groom) -> Groom:
+    """``g`` with ``new``'s strands after its own; each per-vertex attribute of ``g`` taken for a
+    new strand from the strand whose root is nearest, by the vertex parameter."""
+    attrs = {}
+    if any(a is not None for a in g.attributes.values()):
+        near = np.argmin(((new.roots[:, None, :] - g.roots[None, :, :]) ** 2).sum(-1), axis=1)
+        for name, a in g.attributes.items():
+            if a is None:
+                attrs[name] = None
+                continue
+            rows = []
+            for s, t in zip(near, new.topology.offsets[:-1], strict=True):
+                o, e = g.offsets[s], g.offsets[s + 1]
+                tn = new.vertex_param[t : t + new.counts[len(rows)]]
+                src, ts = a[o:e], g.vertex_param[o:e]
+                if a.ndim == 1:
+                    rows.append(np.interp(tn, ts, src))
+                else:
+                    rows.append(np.column_stack([np.interp(tn, ts, src[:, c]) for c in range(a.shape[1])]))
+            attrs[name] = np.concatenate([a, *rows]).astype(np.float32)
+    points, counts = np.concatenate([g.points, new.points]), np.concatenate([g.counts, new.counts])
+    return Groom(points, counts, **attrs, metadata=g.metadata.with_(curves=()))
+
+
 class AlignSample(NamedTuple):
     """One align sample; ``view`` as :class:`~hairtool.frozen.brushes.BrushSample`'s (None: every
     strand, as before the field existed)."""
@@ -241,9 +265,16 @@ class FrozenPipeline:
 
     @property
     def strand_normals(self) -> np.ndarray:
-        """``(S', 3)`` :attr:`root_normals` of the strands of the stroked state and the result."""
+        """``(S', 3)`` :attr:`root_normals` of the strands of the stroked state and the result
+        (a planted strand's: the surface normal at its root)."""
         n = self.root_normals
-        return n if len(self._origin) == len(n) else n[self._origin]
+        if len(self._origin) == len(n) and self._origin.min(initial=0) >= 0:
+            return n  # (deletes keep the order, plants come last: this is every rest strand)
+        out = n[np.maximum(self._origin, 0)]
+        new = self._origin < 0
+        if new.any():
+            _, out[new] = self._surface.project(self._aligned.roots[new].astype(np.float64))  # type: ignore[union-attr]
+        return out
 
     @property
     def scalp_centre(self) -> np.ndarray:
@@ -498,6 +529,21 @@ class FrozenPipeline:
         hook, anchors, start = self._hooks[self._hook_next]
         return snake_hook(g, hook, anchors, np.asarray(sample.cursor, np.float64) - start)
 
+    def _add(self, g: Groom, sample: BrushSample) -> Groom:
+        """An add sample: the strands the surface plants appended, unmasked, clump strength 1."""
+        surface = self._surface
+        if surface is None or not hasattr(surface, "plant"):
+            raise ParameterError("scalp", None, "a head mesh for the add brush (--scalp MESH.obj)")
+        new = surface.plant(g, sample.cursor, sample.radius, sample.count, sample.seed, sample.view)
+        if new is None:
+            return g
+        out = append_strands(g, new)
+        m = new.strand_count
+        self._locked = np.concatenate([self._locked, np.zeros(m, bool)])
+        self._clump_strength = np.concatenate([self._clump_strength, np.ones(m)])
+        self._origin = np.concatenate([self._origin, np.full(m, -1, np.int64)])
+        return out
+
     def _delete(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
         gone = strands_to_delete(g, sample, locked)
         if not gone.any():
@@ -540,6 +586,8 @@ class FrozenPipeline:
             return g
         if sample.brush == "delete":
             return self._delete(g, sample, locked)
+        if sample.brush == "add":
+            return self._add(g, sample)
         if sample.brush == "pinch":
             return pinch(g, sample, locked)
         if sample.brush == "snake_hook":
@@ -549,11 +597,10 @@ class FrozenPipeline:
         return apply_brush(g, sample, locked, self.scalp_centre)
 
     def _replay(self) -> None:
-        g = self._frozen
+        self._aligned = self._frozen
         self._clear_state()
-        for s in self._log:
-            g = self._apply(g, s)
-        self._aligned = g
+        for s in self._log:  # (the stroked state so far: planted strands' normals come from it)
+            self._aligned = self._apply(self._aligned, s)
 
     def _reclump(self) -> None:
         p = self._params

@@ -14,7 +14,9 @@ A stroke log is a JSON list of strokes, in groom units::
   the strands whose root lies within the radius; strength > 0, falloff ignored), ``pinch`` (> 0
   gathers toward the brush centre, < 0 spreads) or ``snake_hook`` (the strands whose tip lies
   within the radius at the stroke's first sample follow the cursor; ``direction`` is the
-  cursor's motion since the sample before).
+  cursor's motion since the sample before), ``slide`` (roots slide along the head; needs one)
+  or ``add`` (plants ``params.count`` strands per sample, default 1, around the head's point
+  nearest the cursor, drawn from ``params.seed``, default 0, and the cursor; needs a head).
 - ``collision`` (per stroke, optional, default true): with a head surface (``--scalp``), no
   vertex the stroke moves ends inside it; false: strands may pass through the head.
 - ``start`` (per sample, optional): true where a stroke begins (a snake hook hooks its strands
@@ -103,8 +105,12 @@ class Stroke:
                 continue
             start = (i == 0) if s.start is None else s.start
             start = start and self.brush == "snake_hook"  # (the only brush a start changes)
+            count, seed = 1, 0
+            if self.brush == "add":  # (checked with the sample: whole numbers in range)
+                count, seed = self.params.get("count", 1), self.params.get("seed", 0)
             sample = BrushSample(
-                self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start, self.collision
+                self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start, self.collision,
+                count, seed,
             )
             sample = check_sample(sample)
             out.append(sample)
@@ -146,13 +152,14 @@ def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
             sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view))
             start = Stroke("align", (sample,), params={"mode": s.mode}, collision=s.collide)
         else:
-            key = (s.brush, s.lut, s.collide)
+            key = (s.brush, s.lut, s.collide, s.count, s.seed)
             hook = s.brush == "snake_hook"
             sample = StrokeSample(
                 tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view),
                 bool(s.start) if hook else None,
             )  # fmt: skip
-            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut), collision=s.collide)
+            params = {"count": s.count, "seed": s.seed} if s.brush == "add" else {}
+            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut), params=params, collision=s.collide)
             # a snake hook's start (not its mirror's) begins a new stroke, with its own strands
             split = hook and s.start and bool(runs) and not runs[-1][1].samples[-1].start
         if runs and runs[-1][0] == key and not split:

@@ -196,3 +196,30 @@ def test_brushes_keep_strands_out_of_the_head_unless_told_not_to(ui, make_window
     assert not s.pipeline.strokes[-1].collide
     s.set_brush("mask")
     assert not w.dock.collide.isVisibleTo(w.dock)  # the mask moves nothing
+
+
+def test_add_plants_strands_on_the_head_and_undo_takes_them_away(ui, make_window):
+    from hairtool import io
+    from hairtool.io.obj import read_mesh
+
+    data = Path(__file__).resolve().parents[1] / "data" / "grooms"
+    rest = io.read_groom(data / "sintel_hair.tfx")
+    w = plain(make_window, groom=rest)
+    s, v = w.scene, w.viewport
+    w.brush_actions["add"].trigger()
+    assert w.brush_actions["add"].shortcut().toString() == "Shift+A"
+    assert w.dock.add_count.isVisibleTo(w.dock)
+    pos = v.project(rest.roots[front_strand(w)])[0]
+    messages = ui.record(s.refused)
+    ui.drag(v, pos, pos + np.array([10.0, 0.0]), steps=2)
+    assert s.result.strand_count == rest.strand_count and "head" in messages[-1][0]
+    s.set_mesh(read_mesh(data / "sintel_head.obj"))
+    w.dock.add_count.setValue(3)
+    s.set_radius(1.5)
+    ui.drag(v, pos, pos + np.array([10.0, 0.0]), steps=2)  # press + 2 moves: 3 samples
+    assert s.result.strand_count == rest.strand_count + 9
+    assert f"{rest.strand_count + 9:,} strands" in w.counts_label.text()
+    ui.grab(v)
+    assert w.undo_stack.count() == 1 and w.undo_stack.undoText() == "Add stroke"
+    w.undo_stack.undo()
+    np.testing.assert_array_equal(s.result.points, rest.points)
