@@ -419,9 +419,10 @@ def _write_strokes(log, arrays: dict) -> dict:
     if not all(s.collide for s in log):  # strokes that may pass through the head
         arrays["strokes/collide.npy"] = np.array([s.collide for s in log], np.int64)
         info["collide"] = True
-    if any(isinstance(s, BrushSample) and s.brush == "add" for s in log):  # how many, which seed
+    if any(isinstance(s, BrushSample) and s.brush in ("add", "density") for s in log):  # what to plant
         arrays["strokes/count.npy"] = np.array([getattr(s, "count", 1) for s in log], np.int64)
         arrays["strokes/seed.npy"] = np.array([getattr(s, "seed", 0) for s in log], np.int64)
+        arrays["strokes/spacing.npy"] = np.array([getattr(s, "spacing", 0.0) for s in log], np.float64)
         info["plants"] = True
     if any(isinstance(s, BrushSample) and s.start for s in log):  # where snake hooks hooked
         starts = [isinstance(s, BrushSample) and s.start for s in log]
@@ -472,11 +473,13 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
         starts = r.array("strokes/start.npy", 1, "iu")
         if starts.shape != (n,):
             raise FormatError(r.path, f"the stroke start flags do not hold {n} strokes")
-    counts, seeds = np.ones(n, np.int64), np.zeros(n, np.int64)
+    counts, seeds, spacings = np.ones(n, np.int64), np.zeros(n, np.int64), np.zeros(n)
     if info.get("plants"):
         counts, seeds = r.array("strokes/count.npy", 1, "iu"), r.array("strokes/seed.npy", 1, "iu")
-        if counts.shape != (n,) or seeds.shape != (n,):
+        spacings = r.array("strokes/spacing.npy", 1, "f")
+        if counts.shape != (n,) or seeds.shape != (n,) or spacings.shape != (n,):
             raise FormatError(r.path, f"the add strokes' counts and seeds do not hold {n} strokes")
+        require_finite(r.path, spacings, "stroke spacing")
     collides = np.ones(n, np.int64)
     if info.get("collide"):
         collides = r.array("strokes/collide.npy", 1, "iu")
@@ -499,7 +502,7 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
         sample = BrushSample(
             names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
             float(intensity[k]), tuple(luts[which[k]].tolist()), views[k], bool(starts[k]), bool(collides[k]),
-            int(counts[k]), int(seeds[k]),
+            int(counts[k]), int(seeds[k]), float(spacings[k]),
         )
         try:
             strokes.append(check_sample(sample))

@@ -35,11 +35,12 @@ LABELS = {
     "delete": "Delete",
     "slide": "Slide",
     "add": "Add",
+    "density": "Density",
 }
 SHORTCUTS = {
     "align": "A", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M",
     "pinch": "Shift+P", "snake_hook": "K", "delete": "X", "slide": "G",
-    "add": "Shift+A",
+    "add": "Shift+A", "density": "D",
 }  # fmt: skip
 TIPS = {
     "align": "Strands turn toward the cursor's path (UserAlign, Kim 2026 eqs. 8–13)",
@@ -56,6 +57,8 @@ TIPS = {
     "slide": "Slides the roots under the brush along the head in the drag's direction; each strand "
     "keeps its shape (needs the head mesh)",
     "add": "Plants new strands on the head under the brush, shaped like their neighbours "
+    "(needs the head mesh)",
+    "density": "Removes or plants strands under the brush until the roots are the spacing apart "
     "(needs the head mesh)",
 }
 #: Brushes with a signed strength: (label of > 0, label of < 0).
@@ -80,6 +83,7 @@ DEFAULT_STRENGTH = {
     "delete": 1.0,
     "slide": 1.0,
     "add": 1.0,
+    "density": 1.0,
 }
 FALLOFF_LABELS = {"smooth": "Smooth", "linear": "Linear", "constant": "Constant"}
 
@@ -114,12 +118,14 @@ class BrushTool:
     #: per brush: with a head mesh, no vertex the brush moves ends inside it (on by default)
     collide: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(brushes(), True))
     add_count: int = 2  # strands the add brush plants per mouse move
+    spacing: float = 0.05  # between roots, the density brush's (groom units)
     align_mode: str = "paper"
     _lut: tuple[Falloff, tuple[float, ...]] | None = field(default=None, repr=False)
 
     def reset_radius(self, radius: float) -> None:
         """Every brush at one size (a new groom)."""
         self.radius = dict.fromkeys(brushes(), float(radius))
+        self.spacing = 0.2 * float(radius)
 
     def set_brush(self, name: str) -> None:
         if name not in brushes():
@@ -166,7 +172,9 @@ class BrushTool:
             return []
         hook = start and name == "snake_hook"
         count = self.add_count if name == "add" else 1
-        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v, hook, hit, count)
+        spacing = self.spacing if name == "density" else 0.0
+        strength = self.signed_strength(invert)
+        first = BrushSample(name, c, d, r, strength, self.lut(), v, hook, hit, count, 0, spacing)
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
     def touches(self, points: np.ndarray, cursor: Sequence[float], plane_x: float) -> bool:

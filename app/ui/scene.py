@@ -550,6 +550,14 @@ class Scene(QObject):
             self.tool.add_count = int(count)
             self.tool_changed.emit()
 
+    def set_spacing(self, spacing: float) -> None:
+        """The distance the density brush leaves between roots (groom units)."""
+        if not np.isfinite(spacing) or spacing <= 0:
+            raise ParameterError("spacing", spacing, "a positive distance between roots")
+        if float(spacing) != self.tool.spacing:
+            self.tool.spacing = float(spacing)
+            self.tool_changed.emit()
+
     def set_collide(self, on: bool) -> None:
         """The current brush keeps strands out of the head mesh (each brush has its own)."""
         if bool(on) != self.tool.collide.get(self.tool.brush, True):

@@ -199,12 +199,21 @@ class ToolDock(QDockWidget):
         self.add_count.setRange(1, 1000)
         self.add_count.setToolTip("how many strands the add brush plants at each mouse move")
         self.add_count.valueChanged.connect(self.scene.set_add_count)
+        self.spacing = QDoubleSpinBox()
+        self.spacing.setDecimals(4)
+        self.spacing.setKeyboardTracking(False)
+        self.spacing.setToolTip(
+            "the density brush leaves roots this far apart (groom units): no two closer, "
+            "no gap wider than twice it"
+        )
+        self.spacing.valueChanged.connect(lambda x: self.scene.set_spacing(float(x)))
         form.addRow("Brush", self.brush)
         form.addRow("Brush size", self.radius)
         form.addRow("Strength", self.intensity)
         form.addRow("Mode", self.mode)
         form.addRow("Direction", self.sign)
         form.addRow("Strands per move", self.add_count)
+        form.addRow("Spacing", self.spacing)
         form.addRow("Falloff", self.falloff)
         form.addRow(self.curve)
         form.addRow("Symmetry", mirror_row)
@@ -301,7 +310,7 @@ class ToolDock(QDockWidget):
         lo, hi = s.rest.bounds
         extent = max(float((hi - lo).max()), 1e-3)
         widgets = (self.brush, self.radius, self.intensity, self.mode, self.sign, self.falloff, self.curve)
-        more = (self.symmetry, self.mirror_x, self.front_only, self.collide, self.add_count)
+        more = (self.symmetry, self.mirror_x, self.front_only, self.collide, self.add_count, self.spacing)
         with signals_blocked(*widgets, *more):
             self.brush.setCurrentIndex(self.brush.findData(s.brush))
             self.radius.set_range(extent * 1e-3, extent * 2.0)
@@ -337,6 +346,10 @@ class ToolDock(QDockWidget):
             self._brush_form.setRowVisible(self.collide, s.brush not in MOVE_NONE)
             self.add_count.setValue(tool.add_count)
             self._brush_form.setRowVisible(self.add_count, s.brush == "add")
+            self.spacing.setRange(extent * 1e-4, extent)
+            self.spacing.setSingleStep(extent / 200.0)
+            self.spacing.setValue(tool.spacing)
+            self._brush_form.setRowVisible(self.spacing, s.brush == "density")
 
     def refresh_params(self) -> None:
         p: FrozenParams = self.scene.params

@@ -67,7 +67,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--strokes",
         metavar="STROKES.json",
         help="replay a stroke log (align, comb, smooth, length, puff, clump, mask, delete, pinch, "
-        "snake_hook, slide, add; the studio exports one) after the --align cursors",
+        "snake_hook, slide, add, density; the studio exports one) after the --align cursors",
     )
     a = parser.add_argument_group("align brush (UserAlign, eqs. 8–13)")
     a.add_argument(
@@ -188,10 +188,9 @@ def run(args: argparse.Namespace) -> int:
         pipe.apply_samples(stroke.pipeline_samples(float(pipe.scalp_centre[0])))
         timings.append(pipe.timings)
     report = {}
-    if binding is not None and pipe.result.strand_count != groom.strand_count:
-        raise ParameterError(
-            "strokes", "add or delete strokes with render hair", "none where children follow the guides"
-        )
+    if binding is not None and not np.array_equal(pipe.origin, np.arange(groom.strand_count)):
+        what = "add, delete or density strokes with render hair"
+        raise ParameterError("strokes", what, "none where children follow the guides")
     if binding is not None:
         hair = _guides.render(args, binding).update(pipe.result)
         report = _guides.write(args, hair, pipe.result)

@@ -47,14 +47,14 @@ F64 = NDArray[np.float64]
 
 BRUSHES = (
     "align", "comb", "smooth", "length", "puff", "mask", "clump", "delete", "pinch", "snake_hook", "slide",
-    "add",
+    "add", "density",
 )  # fmt: skip
 #: The brushes of :mod:`hairtool.frozen.sculpt` and :mod:`hairtool.frozen.slide`, those that
 #: add or remove strands, and those that need the head's surface.
-SCULPT = ("delete", "pinch", "snake_hook", "slide", "add")
-CHANGE_STRANDS = ("delete", "add")
-MOVE_NONE = ("mask", "clump", "delete", "add")  # brushes that move no vertex: nothing to collide
-NEED_SURFACE = ("slide", "add")
+SCULPT = ("delete", "pinch", "snake_hook", "slide", "add", "density")
+CHANGE_STRANDS = ("delete", "add", "density")
+MOVE_NONE = ("mask", "clump", "delete", "add", "density")  # they move no vertex: nothing to collide
+NEED_SURFACE = ("slide", "add", "density")
 MAX_COUNT = 1000  # strands one add sample may plant
 SIGNED = ("length", "mask", "clump", "pinch")  # strength in [-1, 1]; the others in [0, 1]
 FALLOFFS = ("smooth", "linear", "constant")
@@ -91,7 +91,8 @@ class BrushSample:
     the camera are touched; None: every strand. ``start``: the first sample of a stroke (a
     snake hook hooks its strands there). ``collide``: with a head surface, no vertex the
     sample moves ends inside it (:mod:`hairtool.frozen.collide`). ``count`` and ``seed``: the
-    strands an add sample plants, and the seed of where."""
+    strands an add sample plants, and the seed of where (density's too); ``spacing``: the
+    distance a density sample leaves between roots."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -104,13 +105,14 @@ class BrushSample:
     collide: bool = True
     count: int = 1
     seed: int = 0
+    spacing: float = 0.0
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
         return BrushSample(
             self.brush, cursor, direction, self.radius, self.strength, self.lut, mirrored_view(self.view),
-            self.start, self.collide, self.count, self.seed,
+            self.start, self.collide, self.count, self.seed, self.spacing,
         )
 
 
@@ -151,6 +153,8 @@ def check_sample(sample: BrushSample) -> BrushSample:
     s = sample.seed
     if isinstance(s, bool) or not isinstance(s, int | np.integer) or not 0 <= s < 2**32:
         raise ParameterError("seed", s, "a whole number in [0, 2^32)")
+    if sample.brush == "density" and not (np.isfinite(sample.spacing) and sample.spacing > 0):
+        raise ParameterError("spacing", sample.spacing, "a positive distance between roots (groom units)")
     if len(sample.lut) != LUT_SIZE:
         raise ParameterError("falloff", f"{len(sample.lut)} samples", f"{LUT_SIZE}")
     return sample

@@ -50,6 +50,7 @@ from hairtool.frozen.brushes import (
 from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
 from hairtool.frozen.clump_region import clump_points_interactive
 from hairtool.frozen.collide import MARGIN, collide
+from hairtool.frozen.density import accept, disc_candidates, thin
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.noise import check_seed, draw_seed
 from hairtool.frozen.sculpt import hook_weights, pinch, snake_hook, strands_to_delete
@@ -544,6 +545,50 @@ class FrozenPipeline:
         self._origin = np.concatenate([self._origin, np.full(m, -1, np.int64)])
         return out
 
+    def _density(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
+        """A density sample (:mod:`hairtool.frozen.density`): thinned, then planted."""
+        surface = self._surface
+        if surface is None or not hasattr(surface, "grow"):
+            raise ParameterError("scalp", None, "a head mesh for the density brush (--scalp MESH.obj)")
+        if sample.strength <= 0:
+            return g
+        q, n = surface.project(np.asarray(sample.cursor, np.float64).reshape(1, 3))
+        q, n = q[0], n[0]
+        if sample.view is not None and float(n @ np.asarray(sample.view, np.float64)) > 0:
+            return g
+        spacing, r = float(sample.spacing), float(sample.radius)
+        roots = g.roots.astype(np.float64)
+        dist = np.linalg.norm(roots - q, axis=1)
+        near = np.flatnonzero(dist < r + spacing)
+        keep = thin(roots[near], (dist[near] >= r) | locked[near], spacing)
+        gone = np.zeros(g.strand_count, bool)
+        gone[near[~keep]] = True
+        if gone.all():
+            raise ParameterError("density", "every strand", "a stroke that leaves at least one strand")
+        if gone.any():
+            kept = np.flatnonzero(~gone)
+            self._locked, self._clump_strength = self._locked[kept], self._clump_strength[kept]
+            self._origin = self._origin[kept]
+            g = g.subset(kept)
+        bits = np.asarray(sample.cursor, np.float64).view(np.uint32)
+        rng = np.random.default_rng([int(sample.seed), *(int(b) for b in bits), 0xDE5])
+        cands, cn = surface.project(disc_candidates(q, n, r, spacing, rng))
+        ok = np.linalg.norm(cands - q, axis=1) < r
+        if sample.view is not None:
+            ok &= cn @ np.asarray(sample.view, np.float64) <= 0
+        cands = cands[ok]
+        roots = g.roots.astype(np.float64)
+        around = roots[np.linalg.norm(roots - q, axis=1) < r + spacing]
+        new_roots = cands[accept(cands, around, spacing)]
+        if len(new_roots) == 0:
+            return g
+        new = surface.grow(g, new_roots)
+        m = new.strand_count
+        self._locked = np.concatenate([self._locked, np.zeros(m, bool)])
+        self._clump_strength = np.concatenate([self._clump_strength, np.ones(m)])
+        self._origin = np.concatenate([self._origin, np.full(m, -1, np.int64)])
+        return append_strands(g, new)
+
     def _delete(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
         gone = strands_to_delete(g, sample, locked)
         if not gone.any():
@@ -588,6 +633,8 @@ class FrozenPipeline:
             return self._delete(g, sample, locked)
         if sample.brush == "add":
             return self._add(g, sample)
+        if sample.brush == "density":
+            return self._density(g, sample, locked)
         if sample.brush == "pinch":
             return pinch(g, sample, locked)
         if sample.brush == "snake_hook":

@@ -16,7 +16,9 @@ A stroke log is a JSON list of strokes, in groom units::
   within the radius at the stroke's first sample follow the cursor; ``direction`` is the
   cursor's motion since the sample before), ``slide`` (roots slide along the head; needs one)
   or ``add`` (plants ``params.count`` strands per sample, default 1, around the head's point
-  nearest the cursor, drawn from ``params.seed``, default 0, and the cursor; needs a head).
+  nearest the cursor, drawn from ``params.seed``, default 0, and the cursor; needs a head) or
+  ``density`` (removes and plants strands under the brush until the roots are
+  ``params.spacing`` apart, in groom units; ``params.seed`` as add's; needs a head).
 - ``collision`` (per stroke, optional, default true): with a head surface (``--scalp``), no
   vertex the stroke moves ends inside it; false: strands may pass through the head.
 - ``start`` (per sample, optional): true where a stroke begins (a snake hook hooks its strands
@@ -105,12 +107,15 @@ class Stroke:
                 continue
             start = (i == 0) if s.start is None else s.start
             start = start and self.brush == "snake_hook"  # (the only brush a start changes)
-            count, seed = 1, 0
-            if self.brush == "add":  # (checked with the sample: whole numbers in range)
+            count, seed, spacing = 1, 0, 0.0
+            if self.brush in ("add", "density"):  # (checked with the sample)
                 count, seed = self.params.get("count", 1), self.params.get("seed", 0)
+            if self.brush == "density":
+                spacing = self.params.get("spacing")
+                spacing = _number("params.spacing", spacing) if spacing is not None else 0.0
             sample = BrushSample(
                 self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start, self.collision,
-                count, seed,
+                count, seed, spacing,
             )
             sample = check_sample(sample)
             out.append(sample)
@@ -152,13 +157,15 @@ def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
             sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view))
             start = Stroke("align", (sample,), params={"mode": s.mode}, collision=s.collide)
         else:
-            key = (s.brush, s.lut, s.collide, s.count, s.seed)
+            key = (s.brush, s.lut, s.collide, s.count, s.seed, s.spacing)
             hook = s.brush == "snake_hook"
             sample = StrokeSample(
                 tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view),
                 bool(s.start) if hook else None,
             )  # fmt: skip
             params = {"count": s.count, "seed": s.seed} if s.brush == "add" else {}
+            if s.brush == "density":
+                params = {"spacing": s.spacing, "seed": s.seed}
             start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut), params=params, collision=s.collide)
             # a snake hook's start (not its mirror's) begins a new stroke, with its own strands
             split = hook and s.start and bool(runs) and not runs[-1][1].samples[-1].start

@@ -60,6 +60,15 @@ class HeadSurface(MeshSurface):
         r = radius * np.sqrt(rng.random(int(count)))
         t = 2.0 * np.pi * rng.random(int(count))
         roots, _ = self.project(q[0] + r[:, None] * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v))
+        return self.grow(groom, roots)
+
+    def grow(self, groom: Groom, roots: np.ndarray) -> Groom:
+        """New strands at ``roots`` shaped like the groom's strands around them (render-hair
+        children of them with no random length variation or frizz), in the order of ``roots``."""
+        roots = np.asarray(roots, np.float64)
         k = min(DEFAULT_K, groom.strand_count)
-        binding = bind_roots(groom, roots, k=k, seed=int(seed) & 0x7FFFFFFF, length_variation=0.0, frizz=0.0)
-        return binding.build(groom)
+        binding = bind_roots(groom, roots, k=k, length_variation=0.0, frizz=0.0)
+        built = binding.build(groom)
+        # the binding orders children by their nearest strand: back to the order asked for
+        order = np.argsort(np.argmin(((binding.roots[:, None, :] - roots[None]) ** 2).sum(-1), axis=1))
+        return built.subset(order)

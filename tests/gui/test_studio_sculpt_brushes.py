@@ -1,8 +1,10 @@
-"""Delete, pinch and snake hook through the studio: toolbar, Brush menu and tool dock entries with
-keys that clash with no other action; each drag is one undo step; delete removes the strands
-under the brush and undo brings them back bit for bit (the view redraws either way); snake hook
-drags the tips it hooked; the exported stroke log replays in the CLI to the studio's bytes; a
-delete that render hair or an animation depends on is refused with a message."""
+"""Delete, pinch, snake hook, slide, add and density through the studio: toolbar, Brush menu
+and tool dock entries with keys that clash with no other action; each drag is one undo step;
+delete removes the strands under the brush and undo brings them back bit for bit (the view
+redraws either way); snake hook drags the tips it hooked; slide, add and density wait for a head
+mesh; the brushes keep strands out of the head unless told not to; exported stroke logs replay
+in the CLI to the studio's bytes; a delete that render hair depends on is refused with a
+message."""
 
 from __future__ import annotations
 
@@ -35,6 +37,7 @@ def front_strand(w) -> int:
 def test_the_new_brushes_have_entries_and_keys_that_clash_with_nothing(make_window):
     w = plain(make_window)
     keys = {"delete": "X", "pinch": "Shift+P", "snake_hook": "K", "slide": "G"}
+    keys |= {"add": "Shift+A", "density": "D"}
     combo = [w.dock.brush.itemData(i) for i in range(w.dock.brush.count())]
     for name, key in keys.items():
         a = w.brush_actions[name]
@@ -221,5 +224,28 @@ def test_add_plants_strands_on_the_head_and_undo_takes_them_away(ui, make_window
     assert f"{rest.strand_count + 9:,} strands" in w.counts_label.text()
     ui.grab(v)
     assert w.undo_stack.count() == 1 and w.undo_stack.undoText() == "Add stroke"
+    w.undo_stack.undo()
+    np.testing.assert_array_equal(s.result.points, rest.points)
+
+
+def test_density_thins_under_the_brush_to_the_spacing_in_one_undo_step(ui, make_window):
+    from hairtool import io
+    from hairtool.io.obj import read_mesh
+
+    data = Path(__file__).resolve().parents[1] / "data" / "grooms"
+    rest = io.read_groom(data / "sintel_hair.tfx")
+    w = plain(make_window, groom=rest)
+    s, v = w.scene, w.viewport
+    s.set_mesh(read_mesh(data / "sintel_head.obj"))
+    w.brush_actions["density"].trigger()
+    assert w.dock.spacing.isVisibleTo(w.dock) and not w.dock.add_count.isVisibleTo(w.dock)
+    w.dock.spacing.setValue(2.5)  # wider than Sintel's guides are apart: thinning
+    s.set_radius(4.0)
+    pos = v.project(rest.roots[front_strand(w)])[0]
+    ui.drag(v, pos, pos + np.array([5.0, 0.0]), steps=2)
+    assert s.result.strand_count < rest.strand_count
+    assert all(x.spacing == 2.5 for x in s.pipeline.strokes)
+    assert w.undo_stack.count() == 1
+    ui.grab(v)
     w.undo_stack.undo()
     np.testing.assert_array_equal(s.result.points, rest.points)
