@@ -138,11 +138,18 @@ def _brushes_step() -> None:
     centre = tuple(float(v) for v in (lo.astype(np.float64) + hi) * 0.5)
     lut = tuple(falloff_lut("smooth").tolist())
     for brush in BRUSHES[1:]:  # align has its own step
-        if brush == "add":  # no kernel of its own: render hair's binding (warmed with render hair)
+        if brush in ("add", "density"):  # they plant with render hair's binding (warmed there)
             continue
         strength = -0.5 if brush == "length" else 0.5
         radius = float(np.max(hi - lo)) * (0.05 if brush == "delete" else 1.0)  # delete: not every strand
         pipe.brush(BrushSample(brush, centre, (1.0, 0.0, 0.0), radius, strength, lut, start=True))
+
+
+    from hairtool.frozen.density import accept, thin
+
+    pts = groom.roots.astype(np.float64)
+    accept(pts[:8], pts[8:], 0.1)  # density's own kernels
+    thin(pts, np.zeros(len(pts), bool), 0.1)
 
 
 def _render_hair_step() -> None:
