@@ -200,6 +200,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         report |= {
             "strands": groom.strand_count,
+            "result_strands": pipe.result.strand_count,  # after add, delete and density strokes
             "vertices": groom.vertex_count,
             "clump_radius": pipe.clump_radius,
             "mean_neighbours": pipe.mean_neighbours,
