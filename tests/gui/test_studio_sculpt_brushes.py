@@ -249,3 +249,17 @@ def test_density_thins_under_the_brush_to_the_spacing_in_one_undo_step(ui, make_
     ui.grab(v)
     w.undo_stack.undo()
     np.testing.assert_array_equal(s.result.points, rest.points)
+
+
+def test_a_project_keeps_the_new_brush_settings(make_window, tmp_path):
+    w = plain(make_window, groom=samples.scalp(strands=50, vertices=8))
+    s = w.scene
+    s.set_add_count(5)
+    s.set_spacing(0.07)
+    s.set_brush("pinch")
+    s.set_collide(False)
+    assert w.project.save_to(tmp_path / "p.hairproj")
+    w2 = plain(make_window, groom=samples.scalp(strands=50, vertices=8))
+    assert w2.project.open_project(tmp_path / "p.hairproj")
+    t = w2.scene.tool
+    assert (t.add_count, t.spacing, t.collide["pinch"], t.collide["comb"]) == (5, 0.07, False, True)
