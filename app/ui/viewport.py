@@ -35,7 +35,7 @@ from app.render.hair_shading import HAIR_TAPER
 from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.colouring import vertex_colors
 from app.ui.scene import Scene
-from hairtool.frozen.brushes import facing_away
+from hairtool.frozen.brushes import NEED_SURFACE, facing_away
 
 BRUSH_STEP = 1.1  # radius factor per wheel notch or [ / ] press
 # The reconstruction behind the original: one flat cyan no ramp uses, opaque enough to read on the
@@ -389,8 +389,16 @@ class Viewport(QOpenGLWidget):
         return self.camera.ray(pos.x(), pos.y(), self.width(), self.height())[1]
 
     def hair_under(self, pos: QPointF) -> np.ndarray:
-        """The point a stroke starting at ``pos`` keeps its cursor level with (module docstring)."""
+        """The point a stroke starting at ``pos`` keeps its cursor level with (module docstring);
+        for the brushes that work on the head's surface (slide, add, density), the head mesh
+        under the mouse where it is there."""
         s = self.scene
+        surface = None if s.pipeline is None else s.pipeline.surface
+        if s.tool.brush in NEED_SURFACE and surface is not None and hasattr(surface, "ray_hit"):
+            eye, ray = self.camera.ray(pos.x(), pos.y(), self.width(), self.height())
+            hit = surface.ray_hit(eye, ray)
+            if hit is not None:
+                return hit
         pts = s.result.points
         xy = self.project(pts)
         d2 = np.einsum("ij,ij->i", xy - (pos.x(), pos.y()), xy - (pos.x(), pos.y()))

@@ -396,6 +396,28 @@ class MeshSurface:
         sd[near] = np.einsum("ij,ij->i", pts[near] - q[near], n[near])
         return sd, q, n
 
+    def ray_hit(self, origin, direction) -> np.ndarray | None:
+        """The first point where the ray from ``origin`` along ``direction`` meets the mesh
+        (Möller–Trumbore over every face, vectorised), or None: what a brush on the head
+        touches under the mouse."""
+        o, d = np.asarray(origin, np.float64), np.asarray(direction, np.float64)
+        tri = self._f
+        a, b, c = self._v[tri[:, 0]], self._v[tri[:, 1]], self._v[tri[:, 2]]
+        e1, e2 = b - a, c - a
+        p = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        t0 = o - a
+        u = np.einsum("ij,ij->i", t0, p) * inv
+        q = np.cross(t0, e1)
+        v = (q @ d) * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
+        if not hit.any():
+            return None
+        return o + float(t[hit].min()) * d
+
     def _normals(self, q: np.ndarray, face: np.ndarray) -> np.ndarray:
         tri = self._f[face]
         a, b, c = self._v[tri[:, 0]], self._v[tri[:, 1]], self._v[tri[:, 2]]

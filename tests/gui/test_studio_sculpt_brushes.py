@@ -219,8 +219,13 @@ def test_add_plants_strands_on_the_head_and_undo_takes_them_away(ui, make_window
     s.set_mesh(read_mesh(data / "sintel_head.obj"))
     w.dock.add_count.setValue(3)
     s.set_radius(1.5)
+    eye, ray = v.camera.ray(pos[0], pos[1], v.width(), v.height())
+    hit = s.pipeline.surface.ray_hit(eye, ray)  # the head under the mouse
+    assert hit is not None and np.allclose(s.pipeline.surface.project(hit[None])[0], hit, atol=1e-6)
     ui.drag(v, pos, pos + np.array([10.0, 0.0]), steps=2)  # press + 2 moves: 3 samples
     assert s.result.strand_count == rest.strand_count + 9
+    planted = s.result.roots[rest.strand_count :].astype(np.float64)
+    assert np.linalg.norm(planted - hit, axis=1).max() < 1.5 + 1.0  # under the brush, near the mouse
     assert f"{rest.strand_count + 9:,} strands" in w.counts_label.text()
     ui.grab(v)
     assert w.undo_stack.count() == 1 and w.undo_stack.undoText() == "Add stroke"
