@@ -45,13 +45,13 @@ class Scene(QObject):
     params_changed = Signal(object)  # FrozenParams
     tool_changed = Signal()  # the brush, its radius, strength, falloff, symmetry …
     mask_changed = Signal()  # the strands the mask brush locked changed (their colour shows it)
+    refused = Signal(str)  # a stroke the brush cannot make, in words for the status bar
     display_changed = Signal()  # colour mode, ramp or line width
     mesh_changed = Signal()
     path_changed = Signal()
     drawn_changed = Signal()  # the drawn strands' topology changed (children density, guides shown)
     engine_starting = Signal()  # the pipeline is about to be built (may compile: show a wait)
     engine_started = Signal()
-    refused = Signal(str)  # a stroke the brush cannot make, in words for the status bar
 
     def __init__(
         self,
@@ -87,6 +87,7 @@ class Scene(QObject):
         #: Callables naming what holds the strands as they are (e.g. an animation of them), or
         #: None: brushes that add or remove strands are refused while one names something.
         self.strand_holders: list = []
+        self.mesh_changed.connect(self._on_mesh_changed)
         self._set_groom(groom)
 
     # -- strands -----------------------------------------------------------------------
@@ -585,20 +586,23 @@ class Scene(QObject):
             self.display_changed.emit()
 
     def set_mesh(self, mesh: object | None) -> None:
-        """The head mesh: drawn, the surface the slide brush slides roots on and the brushes
-        collide with (strokes are replayed on a new one; slide strokes keep the last head
-        when the mesh is cleared)."""
         self.mesh = mesh
-        if self.pipeline is not None:
-            surface = self._surface()
-            slid = any(getattr(x, "brush", None) in NEED_SURFACE for x in self.pipeline.strokes)
-            if surface is None and slid:
-                self.refused.emit("the slide strokes keep sliding on the head they were made on")
-            elif self.pipeline.strokes:  # replayed on the new head (slides, collisions)
-                self._stroke_step(lambda: self.pipeline.set_surface(surface))
-            else:
-                self.pipeline.set_surface(surface)
         self.mesh_changed.emit()
+
+    def _on_mesh_changed(self) -> None:
+        """A new head mesh is also the surface the brushes slide on, plant on and collide with
+        (strokes are replayed on it; strokes that need a head keep the last one when the mesh is
+        cleared)."""
+        if self.pipeline is None or getattr(self.pipeline.surface, "mesh", None) is self.mesh:
+            return
+        surface = self._surface()
+        needs = any(getattr(x, "brush", None) in NEED_SURFACE for x in self.pipeline.strokes)
+        if surface is None and needs:
+            self.refused.emit("the strokes that need a head keep the one they were made on")
+        elif self.pipeline.strokes:  # replayed on the new head (slides, plants, collisions)
+            self._stroke_step(lambda: self.pipeline.set_surface(surface))
+        else:
+            self.pipeline.set_surface(surface)
 
     def _surface(self):
         """The head mesh as the slide brush's surface (None without a usable one)."""

@@ -182,6 +182,12 @@ def _view_of(view: Sequence[float] | None) -> tuple[float, float, float] | None:
     return None if view is None else (float(view[0]), float(view[1]), float(view[2]))
 
 
+def _flag(where: str, value: Any) -> bool | None:
+    if value is None or isinstance(value, bool):
+        return value
+    raise ParameterError(where, value, "true, false or null")
+
+
 def _falloff_of(lut: Sequence[float]) -> str | tuple[tuple[float, float], ...]:
     """A preset's name when the table is one, else the table as curve points."""
     for name in ("smooth", "linear", "constant"):
@@ -204,12 +210,6 @@ def _number(where: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
         raise ParameterError(where, value, "a finite number")
     return float(value)
-
-
-def _flag(where: str, value: Any) -> bool | None:
-    if value is None or isinstance(value, bool):
-        return value
-    raise ParameterError(where, value, "true, false or null")
 
 
 def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
