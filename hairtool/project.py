@@ -103,9 +103,9 @@ class Project:
     def from_pipeline(cls, pipeline: FrozenPipeline, **fields: Any) -> Project:
         """A project of the pipeline's rest groom, parameters and stroke snapshot."""
         snap = pipeline.snapshot()
-        return cls(
-            rest=pipeline.rest, params=pipeline.params, strokes=snap.log, aligned=snap.aligned, **fields
-        )
+        # After a delete the stroked state has fewer strands than the rest groom: replayed on load.
+        aligned = snap.aligned if snap.aligned.topology == pipeline.rest.topology else None
+        return cls(rest=pipeline.rest, params=pipeline.params, strokes=snap.log, aligned=aligned, **fields)
 
     def stroke_snapshot(self, pipeline: FrozenPipeline) -> FrozenSnapshot:
         """The stroke snapshot to ``restore`` on a pipeline built from this project's rest and params.
@@ -445,6 +445,18 @@ def _write_strokes(log, arrays: dict) -> dict:
         ).reshape(n, 3)
         arrays["strokes/has_view.npy"] = np.array([s.view is not None for s in log], np.int64)
         info["views"] = True
+    if not all(s.collide for s in log):  # strokes that may pass through the head
+        arrays["strokes/collide.npy"] = np.array([s.collide for s in log], np.int64)
+        info["collide"] = True
+    if any(isinstance(s, BrushSample) and s.brush in ("add", "density") for s in log):  # what to plant
+        arrays["strokes/count.npy"] = np.array([getattr(s, "count", 1) for s in log], np.int64)
+        arrays["strokes/seed.npy"] = np.array([getattr(s, "seed", 0) for s in log], np.int64)
+        arrays["strokes/spacing.npy"] = np.array([getattr(s, "spacing", 0.0) for s in log], np.float64)
+        info["plants"] = True
+    if any(isinstance(s, BrushSample) and s.start for s in log):  # where snake hooks hooked
+        starts = [isinstance(s, BrushSample) and s.start for s in log]
+        arrays["strokes/start.npy"] = np.array(starts, np.int64)
+        info["starts"] = True
     return info
 
 
@@ -485,6 +497,23 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
             raise FormatError(r.path, f"the stroke view arrays do not all hold {n} strokes")
         require_finite(r.path, view, "stroke view")
         views = [tuple(float(x) for x in view[k]) if has_view[k] else None for k in range(n)]
+    starts = np.zeros(n, np.int64)
+    if info.get("starts"):
+        starts = r.array("strokes/start.npy", 1, "iu")
+        if starts.shape != (n,):
+            raise FormatError(r.path, f"the stroke start flags do not hold {n} strokes")
+    counts, seeds, spacings = np.ones(n, np.int64), np.zeros(n, np.int64), np.zeros(n)
+    if info.get("plants"):
+        counts, seeds = r.array("strokes/count.npy", 1, "iu"), r.array("strokes/seed.npy", 1, "iu")
+        spacings = r.array("strokes/spacing.npy", 1, "f")
+        if counts.shape != (n,) or seeds.shape != (n,) or spacings.shape != (n,):
+            raise FormatError(r.path, f"the add strokes' counts and seeds do not hold {n} strokes")
+        require_finite(r.path, spacings, "stroke spacing")
+    collides = np.ones(n, np.int64)
+    if info.get("collide"):
+        collides = r.array("strokes/collide.npy", 1, "iu")
+        if collides.shape != (n,):
+            raise FormatError(r.path, f"the stroke collision flags do not hold {n} strokes")
     if n and np.any((brush < 0) & ((mode < 0) | (mode >= len(modes)))):
         raise FormatError(r.path, "a stroke names an unknown align mode")
     strokes = []
@@ -495,11 +524,14 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
                 v = check_view(views[k])
             except HairtoolError as e:
                 raise FormatError(r.path, f"stroke {k}: {e}") from None
-            strokes.append(AlignSample(c, float(radius[k]), float(intensity[k]), str(modes[mode[k]]), v))
+            mode_k = str(modes[mode[k]])
+            hit = bool(collides[k])
+            strokes.append(AlignSample(c, float(radius[k]), float(intensity[k]), mode_k, v, hit))
             continue
         sample = BrushSample(
             names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
-            float(intensity[k]), tuple(luts[which[k]].tolist()), views[k],
+            float(intensity[k]), tuple(luts[which[k]].tolist()), views[k], bool(starts[k]), bool(collides[k]),
+            int(counts[k]), int(seeds[k]), float(spacings[k]),
         )
         try:
             strokes.append(check_sample(sample))

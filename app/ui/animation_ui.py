@@ -165,6 +165,7 @@ class AnimationController(QObject):
         self.viewport, self.scene = window.viewport, window.scene
         self.clock: Callable[[], float] = time.perf_counter
         self.recorder: Recorder | None = None
+        self.scene.strand_holders.append(self._holds_strands)
         self.brush = KeyEditBrush(self)
         self._drawn: deque[tuple[float, int]] = deque(maxlen=240)
         self.fps_label = QLabel()
@@ -282,6 +283,14 @@ class AnimationController(QObject):
                 self.model.load_animation(anim, "recording")
         if "record" in self.actions:
             self.actions["record"].setChecked(self.recording)
+
+    def _holds_strands(self) -> str | None:
+        """What of the animation needs the groom's strands as they are (None: nothing)."""
+        if self.recorder is not None:
+            return "drags are being recorded"
+        if self.model.animation is not None:
+            return "the timeline holds an animation of these strands"
+        return None
 
     def _on_stroke_started(self) -> None:
         if self.recorder is not None:

@@ -18,7 +18,10 @@ from hairtool.frozen.brushes import BRUSHES, BrushSample, falloff_lut, mirrored_
 from hairtool.frozen.pipeline import AlignSample
 
 #: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
-#: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump; the others by their initial).
+#: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump, K snake hook; X deletes as
+#: in Blender's editors; pinch, with P taken by clump, is Shift+P; slide G as Blender's grab;
+#: add Shift+A as Blender's Add menu;
+#: the others by their initial).
 LABELS = {
     "align": "Align",
     "comb": "Comb",
@@ -27,8 +30,18 @@ LABELS = {
     "puff": "Puff",
     "clump": "Clump",
     "mask": "Mask",
+    "pinch": "Pinch",
+    "snake_hook": "Snake Hook",
+    "delete": "Delete",
+    "slide": "Slide",
+    "add": "Add",
+    "density": "Density",
 }
-SHORTCUTS = {"align": "A", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M"}
+SHORTCUTS = {
+    "align": "A", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M",
+    "pinch": "Shift+P", "snake_hook": "K", "delete": "X", "slide": "G",
+    "add": "Shift+A", "density": "D",
+}  # fmt: skip
 TIPS = {
     "align": "Strands turn toward the cursor's path (UserAlign, Kim 2026 eqs. 8–13)",
     "comb": "Tips follow the drag, strand lengths kept",
@@ -37,10 +50,26 @@ TIPS = {
     "puff": "Lifts strands away from the scalp near the root (turns them toward the scalp normal)",
     "clump": "Paints how strongly strands clump (ClumpWithGaps' per-strand strength; Ctrl erases)",
     "mask": "Paints a mask: masked strands are locked for every brush (Ctrl erases)",
+    "pinch": "Gathers strands toward the brush centre (Ctrl: spreads them); roots stay, lengths kept",
+    "snake_hook": "The strands whose tips are under the brush when you press follow the cursor, "
+    "roots fixed, lengths kept",
+    "delete": "Removes the strands whose roots are under the brush (undo brings them back)",
+    "slide": "Slides the roots under the brush along the head in the drag's direction; each strand "
+    "keeps its shape (needs the head mesh)",
+    "add": "Plants new strands on the head under the brush, shaped like their neighbours "
+    "(needs the head mesh)",
+    "density": "Removes or plants strands under the brush until the roots are the spacing apart "
+    "(needs the head mesh)",
 }
 #: Brushes with a signed strength: (label of > 0, label of < 0).
-SIGNED = {"length": ("Grow", "Shrink"), "clump": ("Paint", "Erase"), "mask": ("Paint", "Erase")}
-SIGN_LABELS = {"length": "Grow or shrink", "clump": "Paint or erase", "mask": "Paint or erase"}
+SIGNED = {
+    "length": ("Grow", "Shrink"), "clump": ("Paint", "Erase"), "mask": ("Paint", "Erase"),
+    "pinch": ("Gather", "Spread"),
+}  # fmt: skip
+SIGN_LABELS = {
+    "length": "Grow or shrink", "clump": "Paint or erase", "mask": "Paint or erase",
+    "pinch": "Gather or spread",
+}  # fmt: skip
 DEFAULT_STRENGTH = {
     "align": 0.8,
     "comb": 0.5,
@@ -49,6 +78,12 @@ DEFAULT_STRENGTH = {
     "puff": 0.2,
     "clump": 0.5,
     "mask": 1.0,
+    "pinch": 0.1,
+    "snake_hook": 1.0,
+    "delete": 1.0,
+    "slide": 1.0,
+    "add": 1.0,
+    "density": 1.0,
 }
 FALLOFF_LABELS = {"smooth": "Smooth", "linear": "Linear", "constant": "Constant"}
 
@@ -80,12 +115,17 @@ class BrushTool:
     symmetry: bool = False
     mirror_x: float | None = None
     front_only: bool = True
+    #: per brush: with a head mesh, no vertex the brush moves ends inside it (on by default)
+    collide: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(brushes(), True))
+    add_count: int = 2  # strands the add brush plants per mouse move
+    spacing: float = 0.05  # between roots, the density brush's (groom units)
     align_mode: str = "paper"
     _lut: tuple[Falloff, tuple[float, ...]] | None = field(default=None, repr=False)
 
     def reset_radius(self, radius: float) -> None:
         """Every brush at one size (a new groom)."""
         self.radius = dict.fromkeys(brushes(), float(radius))
+        self.spacing = 0.2 * float(radius)
 
     def set_brush(self, name: str) -> None:
         if name not in brushes():
@@ -112,23 +152,29 @@ class BrushTool:
         view: Sequence[float] | None,
         plane_x: float,
         invert: bool = False,
+        start: bool = False,
     ) -> list[AlignSample | BrushSample]:
         """The samples of one mouse move at ``cursor`` (groom units), mirrored one right after it
         with symmetry on. ``direction``: the mouse's motion in the world (comb needs one: none
         while it stands still). ``view``: the camera's direction, given to the engine with
-        "front faces only"."""
+        "front faces only". ``start``: the stroke's first move (a snake hook hooks there)."""
         c = tuple(float(x) for x in cursor)
         d = tuple(float(x) for x in direction)
         v = None if view is None or not self.front_only else tuple(float(x) for x in view)
         r, name = self.radius[self.brush], self.brush
+        hit = self.collide.get(name, True)
         if name == "align":
-            first = AlignSample(c, r, self.strength["align"], self.align_mode, v)
+            first = AlignSample(c, r, self.strength["align"], self.align_mode, v, hit)
             if not self.symmetry:
                 return [first]
             return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
-        if name == "comb" and math.hypot(*d) == 0.0:
+        if name in ("comb", "slide") and math.hypot(*d) == 0.0:
             return []
-        first = BrushSample(name, c, d, r, self.signed_strength(invert), self.lut(), v)
+        hook = start and name == "snake_hook"
+        count = self.add_count if name == "add" else 1
+        spacing = self.spacing if name == "density" else 0.0
+        strength = self.signed_strength(invert)
+        first = BrushSample(name, c, d, r, strength, self.lut(), v, hook, hit, count, 0, spacing)
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
     def touches(self, points: np.ndarray, cursor: Sequence[float], plane_x: float) -> bool:

@@ -128,14 +128,28 @@ def _brushes_step() -> None:
     from hairtool.frozen.brushes import BRUSHES, BrushSample, falloff_lut
     from hairtool.frozen.pipeline import FrozenPipeline
 
+    class Flat:  # a surface for slide: the plane through each point, facing up
+        def project(self, points):
+            return np.asarray(points, np.float64), np.tile([0.0, 1.0, 0.0], (len(points), 1))
+
     groom = samples.scalp(strands=40, vertices=8)
-    pipe = FrozenPipeline(groom)
+    pipe = FrozenPipeline(groom, surface=Flat())
     lo, hi = groom.bounds
     centre = tuple(float(v) for v in (lo.astype(np.float64) + hi) * 0.5)
     lut = tuple(falloff_lut("smooth").tolist())
     for brush in BRUSHES[1:]:  # align has its own step
+        if brush in ("add", "density"):  # they plant with render hair's binding (warmed there)
+            continue
         strength = -0.5 if brush == "length" else 0.5
-        pipe.brush(BrushSample(brush, centre, (1.0, 0.0, 0.0), float(np.max(hi - lo)), strength, lut))
+        radius = float(np.max(hi - lo)) * (0.05 if brush == "delete" else 1.0)  # delete: not every strand
+        pipe.brush(BrushSample(brush, centre, (1.0, 0.0, 0.0), radius, strength, lut, start=True))
+
+
+    from hairtool.frozen.density import accept, thin
+
+    pts = groom.roots.astype(np.float64)
+    accept(pts[:8], pts[8:], 0.1)  # density's own kernels
+    thin(pts, np.zeros(len(pts), bool), 0.1)
 
 
 def _render_hair_step() -> None:

@@ -316,7 +316,8 @@ class ProjectController(QObject):
 
 def _brush_settings(tool) -> dict:
     """The brush as a project keeps it: the current brush's radius, strength and mode (what
-    older projects hold), and every brush's own, the falloff, symmetry and front faces only."""
+    older projects hold), and every brush's own, the falloff, symmetry, front faces only and
+    each brush's collision with the head, add's strands per move and density's spacing."""
     falloff = tool.falloff if isinstance(tool.falloff, str) else [list(p) for p in tool.falloff]
     return {
         "radius": tool.radius[tool.brush],
@@ -330,11 +331,17 @@ def _brush_settings(tool) -> dict:
         "symmetry": tool.symmetry,
         "mirror_x": tool.mirror_x,
         "front_only": tool.front_only,
+        "collide": dict(tool.collide),
+        "add_count": tool.add_count,
+        "spacing": tool.spacing,
     }
 
 
 def _brush_setters(scene, brush: dict) -> tuple:
     """Setters for :func:`_brush_settings`' fields beyond the first three (each may be missing)."""
+    from app.ui.brush_tool import brushes
+
+    names = brushes()
 
     def per_brush() -> None:
         current = brush["brush"]
@@ -352,6 +359,9 @@ def _brush_setters(scene, brush: dict) -> tuple:
         lambda: scene.set_symmetry(bool(brush["symmetry"])),
         lambda: scene.set_mirror_x(None if brush["mirror_x"] is None else float(brush["mirror_x"])),
         lambda: scene.set_front_only(bool(brush["front_only"])),
+        lambda: scene.tool.collide.update({k: bool(v) for k, v in brush["collide"].items() if k in names}),
+        lambda: scene.set_add_count(int(brush["add_count"])),
+        lambda: scene.set_spacing(float(brush["spacing"])),
     )
 
 

@@ -18,11 +18,11 @@ import numpy as np
 from PySide6.QtCore import QObject, Signal
 
 from app.render.ramps import DEFAULT_RAMP
-from app.ui.brush_tool import SIGNED, BrushTool, check_falloff
-from hairtool.errors import ParameterError
-from hairtool.frozen.brushes import scalp_centre
+from app.ui.brush_tool import LABELS, SIGNED, BrushTool, check_falloff
+from hairtool.errors import HairtoolError, ParameterError
+from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
-from hairtool.groom import Groom, Topology
+from hairtool.groom import Groom, Topology, vertex_ids_of
 from hairtool.guides.binding import ChildBinding
 from hairtool.io.obj import Mesh
 from hairtool.metadata import UP_AXES
@@ -47,6 +47,7 @@ class Scene(QObject):
     params_changed = Signal(object)  # FrozenParams
     tool_changed = Signal()  # the brush, its radius, strength, falloff, symmetry …
     mask_changed = Signal()  # the strands the mask brush locked changed (their colour shows it)
+    refused = Signal(str)  # a stroke the brush cannot make, in words for the status bar
     display_changed = Signal()  # colour mode, ramp or line width
     mesh_changed = Signal()
     path_changed = Signal()
@@ -86,12 +87,16 @@ class Scene(QObject):
         self.tool = BrushTool()
         self.locked = np.zeros(0, dtype=bool)  # the masked strands (a copy of the pipeline's)
         self.last_update_ms = 0.0
+        #: Callables naming what holds the strands as they are (e.g. an animation of them), or
+        #: None: brushes that add or remove strands are refused while one names something.
+        self.strand_holders: list = []
+        self.mesh_changed.connect(self._on_mesh_changed)
         self._set_groom(groom)
 
     # -- strands -----------------------------------------------------------------------
     def _set_groom(self, groom: Groom) -> None:
         if self.engine_ready:
-            self.pipeline: FrozenPipeline | None = FrozenPipeline(groom, self._params)
+            self.pipeline: FrozenPipeline | None = FrozenPipeline(groom, self._params, self._surface())
             self.result: Groom = self.pipeline.result
         else:
             self._params.validate()
@@ -150,7 +155,7 @@ class Scene(QObject):
             return
         self.engine_starting.emit()
         t0 = time.perf_counter()
-        self.pipeline = FrozenPipeline(self.rest, self._params)
+        self.pipeline = FrozenPipeline(self.rest, self._params, self._surface())
         self.result = self.pipeline.result
         self._children_moved()  # the render hair follows the frozen guides
         self.engine_ready = True
@@ -217,16 +222,23 @@ class Scene(QObject):
         view: np.ndarray | None = None,
         invert: bool = False,
         check_touch: bool = True,
+        start: bool = False,
     ) -> bool:
         """One mouse move of the current brush (its mirror too with symmetry on), applied through
         the pipeline in one call; ``direction`` the mouse's motion in the world, ``view`` the
         camera's direction at the cursor, ``invert`` Ctrl held. Returns whether the brush
-        reached a strand (its circle held a vertex; False unchecked with ``check_touch`` off)."""
+        reached a strand (its circle held a vertex; False unchecked with ``check_touch`` off).
+        ``start``: the stroke's first move. A move the engine refuses (a delete that would leave
+        no strand) changes nothing and says why (``refused``)."""
         self.start_engine()
         plane = self.mirror_plane_x()
-        samples = self.tool.samples(cursor, direction, view, plane, invert)
+        samples = self.tool.samples(cursor, direction, view, plane, invert, start)
         if samples:
-            self.apply_samples(samples)
+            try:
+                self.apply_samples(samples)
+            except HairtoolError as e:
+                self.refused.emit(f"{LABELS.get(self.tool.brush, self.tool.brush)}: {e}")
+                return False
         else:  # a comb standing still: nothing to apply; the view still follows the cursor
             self.points_changed.emit()
         return check_touch and self.tool.touches(self.pipeline.aligned.points, cursor, plane)
@@ -235,12 +247,33 @@ class Scene(QObject):
         """Samples of any brush (a replayed stroke log) in one pipeline call."""
         self._stroke_step(lambda: self.pipeline.apply_samples(samples))
 
+    def stroke_refusal(self) -> str | None:
+        """Why a stroke of the current brush cannot start now (None: it can): slide needs the
+        head mesh; brushes that add or remove strands wait while render hair or an animation
+        holds the strands."""
+        label = LABELS.get(self.tool.brush, self.tool.brush)
+        if self.tool.brush in NEED_SURFACE and (self.pipeline is None or self.pipeline.surface is None):
+            return f"{label} works on the head's surface: load its mesh first (File → Load head mesh…)"
+        if self.tool.brush not in CHANGE_STRANDS:
+            return None
+        reasons = ["the render hair follows these guides"] if self.binding is not None else []
+        reasons += [r for r in (h() for h in self.strand_holders) if r]
+        if not reasons:
+            return None
+        return f"{label} changes the strands, but {' and '.join(reasons)}: remove it first"
+
     def _stroke_step(self, step) -> None:
-        """``step()`` (a pipeline call that changes strokes, so maybe the mask) on the running
-        engine, timed; the render hair, the mask and the views follow."""
+        """``step()`` (a pipeline call that changes strokes, so maybe the mask or the strands)
+        on the running engine, timed; the render hair, the mask and the views follow."""
         self.start_engine()
         t0 = time.perf_counter()
+        topology = self.result.topology
         self.result = step()
+        if self.result.topology != topology:  # strands deleted, or brought back by an undo
+            self._cache = {}
+            self._rest_drawn = None
+            self._rebuild_drawn()
+            self.drawn_changed.emit()
         self._children_moved()
         self._sync_mask()
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
@@ -543,6 +576,30 @@ class Scene(QObject):
             self.tool.front_only = bool(on)
             self.tool_changed.emit()
 
+    def set_add_count(self, count: int) -> None:
+        """Strands the add brush plants per mouse move."""
+        from hairtool.frozen.brushes import MAX_COUNT
+
+        if isinstance(count, bool) or int(count) != count or not 1 <= count <= MAX_COUNT:
+            raise ParameterError("strands per move", count, f"a whole number in [1, {MAX_COUNT}]")
+        if int(count) != self.tool.add_count:
+            self.tool.add_count = int(count)
+            self.tool_changed.emit()
+
+    def set_spacing(self, spacing: float) -> None:
+        """The distance the density brush leaves between roots (groom units)."""
+        if not np.isfinite(spacing) or spacing <= 0:
+            raise ParameterError("spacing", spacing, "a positive distance between roots")
+        if float(spacing) != self.tool.spacing:
+            self.tool.spacing = float(spacing)
+            self.tool_changed.emit()
+
+    def set_collide(self, on: bool) -> None:
+        """The current brush keeps strands out of the head mesh (each brush has its own)."""
+        if bool(on) != self.tool.collide.get(self.tool.brush, True):
+            self.tool.collide[self.tool.brush] = bool(on)
+            self.tool_changed.emit()
+
     # -- display -------------------------------------------------------------------------
     def set_colour_mode(self, mode: str) -> None:
         if mode not in COLOUR_MODES:
@@ -569,6 +626,32 @@ class Scene(QObject):
             self.mesh = mesh
             self.mesh_changed.emit()
 
+    def _on_mesh_changed(self) -> None:
+        """A new head mesh is also the surface the brushes slide on, plant on and collide with
+        (strokes are replayed on it; strokes that need a head keep the last one when the mesh is
+        cleared)."""
+        if self.pipeline is None or getattr(self.pipeline.surface, "mesh", None) is self.mesh:
+            return
+        surface = self._surface()
+        needs = any(getattr(x, "brush", None) in NEED_SURFACE for x in self.pipeline.strokes)
+        if surface is None and needs:
+            self.refused.emit("the strokes that need a head keep the one they were made on")
+        elif self.pipeline.strokes:  # replayed on the new head (slides, plants, collisions)
+            self._stroke_step(lambda: self.pipeline.set_surface(surface))
+        else:
+            self.pipeline.set_surface(surface)
+
+    def _surface(self):
+        """The head mesh as the slide brush's surface (None without a usable one)."""
+        from hairtool.guides.planting import HeadSurface
+
+        if self.mesh is None:
+            return None
+        try:
+            return HeadSurface(self.mesh)
+        except HairtoolError:
+            return None
+
     def displacement(self) -> np.ndarray:
         """``(V,)`` float64 distance of each drawn vertex from its rest position (scene units)."""
         if self.binding is not None:
@@ -577,5 +660,8 @@ class Scene(QObject):
                 self._rest_drawn = np.concatenate([rest, self.rest.points]) if self.drawn_guides else rest
             d = self.drawn_points.astype(np.float64) - self._rest_drawn
             return np.sqrt(np.einsum("ij,ij->i", d, d))
-        d = self.result.points.astype(np.float64) - self.rest.points
+        rest = self.rest.points
+        if self.result.topology != self.rest.topology:  # after a delete: the kept strands' rest
+            rest = rest[vertex_ids_of(self.rest.topology, self.pipeline.origin)]
+        d = self.result.points.astype(np.float64) - rest
         return np.sqrt(np.einsum("ij,ij->i", d, d))

@@ -33,6 +33,7 @@ from app.ui.qt_utils import signals_blocked
 from app.ui.render_hair_box import RenderHairBox
 from app.ui.scene import ALIGN_MODES, COLOUR_MODES, Scene
 from app.ui.widgets import SliderSpin, scrolling
+from hairtool.frozen.brushes import MOVE_NONE
 from hairtool.frozen.pipeline import FrozenParams
 
 
@@ -188,15 +189,36 @@ class ToolDock(QDockWidget):
             "brush only the strands whose roots face the camera (the hair behind the head is left alone)"
         )
         self.front_only.toggled.connect(self.scene.set_front_only)
+        self.collide = QCheckBox("Keep out of the head")
+        self.collide.setToolTip(
+            "with a head mesh loaded, no point of a brushed strand ends inside the head (pushed out "
+            "along the surface normal, lengths kept); each brush has its own"
+        )
+        self.collide.toggled.connect(self.scene.set_collide)
+        self.add_count = QSpinBox()
+        self.add_count.setRange(1, 1000)
+        self.add_count.setToolTip("how many strands the add brush plants at each mouse move")
+        self.add_count.valueChanged.connect(self.scene.set_add_count)
+        self.spacing = QDoubleSpinBox()
+        self.spacing.setDecimals(4)
+        self.spacing.setKeyboardTracking(False)
+        self.spacing.setToolTip(
+            "the density brush leaves roots this far apart (groom units): no two closer, "
+            "no gap wider than twice it"
+        )
+        self.spacing.valueChanged.connect(lambda x: self.scene.set_spacing(float(x)))
         form.addRow("Brush", self.brush)
         form.addRow("Brush size", self.radius)
         form.addRow("Strength", self.intensity)
         form.addRow("Mode", self.mode)
         form.addRow("Direction", self.sign)
+        form.addRow("Strands per move", self.add_count)
+        form.addRow("Spacing", self.spacing)
         form.addRow("Falloff", self.falloff)
         form.addRow(self.curve)
         form.addRow("Symmetry", mirror_row)
         form.addRow(self.front_only)
+        form.addRow(self.collide)
         return box
 
     def _on_falloff_preset(self, i: int) -> None:
@@ -288,7 +310,8 @@ class ToolDock(QDockWidget):
         lo, hi = s.rest.bounds
         extent = max(float((hi - lo).max()), 1e-3)
         widgets = (self.brush, self.radius, self.intensity, self.mode, self.sign, self.falloff, self.curve)
-        with signals_blocked(*widgets, self.symmetry, self.mirror_x, self.front_only):
+        more = (self.symmetry, self.mirror_x, self.front_only, self.collide, self.add_count, self.spacing)
+        with signals_blocked(*widgets, *more):
             self.brush.setCurrentIndex(self.brush.findData(s.brush))
             self.radius.set_range(extent * 1e-3, extent * 2.0)
             self.radius.set_value(s.radius)
@@ -319,6 +342,14 @@ class ToolDock(QDockWidget):
             self.mirror_x.setSingleStep(extent / 100.0)
             self.mirror_x.setValue(s.mirror_plane_x())
             self.front_only.setChecked(tool.front_only)
+            self.collide.setChecked(tool.collide.get(s.brush, True))
+            self._brush_form.setRowVisible(self.collide, s.brush not in MOVE_NONE)
+            self.add_count.setValue(tool.add_count)
+            self._brush_form.setRowVisible(self.add_count, s.brush == "add")
+            self.spacing.setRange(extent * 1e-4, extent)
+            self.spacing.setSingleStep(extent / 200.0)
+            self.spacing.setValue(tool.spacing)
+            self._brush_form.setRowVisible(self.spacing, s.brush == "density")
 
     def refresh_params(self) -> None:
         p: FrozenParams = self.scene.params

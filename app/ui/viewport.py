@@ -36,7 +36,7 @@ from app.render.offscreen import Overlays
 from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.drawn import drawn
 from app.ui.scene import Scene
-from hairtool.frozen.brushes import facing_away
+from hairtool.frozen.brushes import NEED_SURFACE, facing_away
 
 BRUSH_STEP = 1.1  # radius factor per wheel notch or [ / ] press
 # The reconstruction behind the original: one flat cyan no ramp uses, opaque enough to read on the
@@ -377,6 +377,9 @@ class Viewport(QOpenGLWidget):
         if self._drag == "align" and not self.scene.engine_ready:
             self._drag = None
             self.engine_wait.emit()
+        elif self._drag == "align" and (why := self.scene.stroke_refusal()) is not None:
+            self._drag = None
+            self.scene.refused.emit(why)
         elif self._drag == "align":
             self._stroke_before = self.scene.snapshot()
             self._stroke_cursor = None
@@ -417,15 +420,23 @@ class Viewport(QOpenGLWidget):
         return self.camera.ray(pos.x(), pos.y(), self.width(), self.height())[1]
 
     def hair_under(self, pos: QPointF) -> np.ndarray:
-        """The point a stroke starting at ``pos`` keeps its cursor level with (module docstring)."""
+        """The point a stroke starting at ``pos`` keeps its cursor level with (module docstring);
+        for the brushes that work on the head's surface (slide, add, density), the head mesh
+        under the mouse where it is there."""
         s = self.scene
+        surface = None if s.pipeline is None else s.pipeline.surface
+        if s.tool.brush in NEED_SURFACE and surface is not None and hasattr(surface, "ray_hit"):
+            eye, ray = self.camera.ray(pos.x(), pos.y(), self.width(), self.height())
+            hit = surface.ray_hit(eye, ray)
+            if hit is not None:
+                return hit
         pts = s.result.points
         xy = self.project(pts)
         d2 = np.einsum("ij,ij->i", xy - (pos.x(), pos.y()), xy - (pos.x(), pos.y()))
         r_px = s.radius * self.camera.pixels_per_unit_at(s.centre, self.height())
         near = d2 <= r_px * r_px
         if s.tool.front_only and s.pipeline is not None:
-            away = facing_away(s.pipeline.root_normals, self.view_at(pos))
+            away = facing_away(s.pipeline.strand_normals, self.view_at(pos))
             near &= ~np.repeat(away, s.result.topology.counts)
         if not near.any():
             return np.asarray(s.centre, np.float64)
@@ -436,7 +447,9 @@ class Viewport(QOpenGLWidget):
         last, self._stroke_cursor = self._stroke_cursor, cursor
         direction = np.zeros(3) if last is None else cursor - last
         view = self.view_at(pos)
-        touched = self.scene.brush_move(cursor, direction, view, self._stroke_invert, not self.stroke_touched)
+        touched = self.scene.brush_move(
+            cursor, direction, view, self._stroke_invert, not self.stroke_touched, start=last is None
+        )
         self.stroke_touched = self.stroke_touched or touched
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:

@@ -120,6 +120,7 @@ class MainWindow(QMainWindow):
         self.viewport.stroke_finished.connect(self._on_stroke_finished)
         self.viewport.cursor_moved.connect(self._on_cursor_moved)
         self.viewport.engine_wait.connect(lambda: self.statusBar().showMessage(WAIT_MESSAGE, 4000))
+        self.scene.refused.connect(lambda text: self.statusBar().showMessage(text, 6000))
         self.viewport.frame_drawn.connect(self._update_frame_time)
         self.dock.param_edited.connect(self._on_param_edited)
         self.scene.groom_loaded.connect(self._update_counts)

@@ -42,7 +42,10 @@ def add_arguments(
     ``--seed`` (used for the children too) or ``--guides`` (anime: it also takes G there)."""
     g = parser.add_argument_group("render hair (children interpolated from guides)")
     g.add_argument("--count", type=int, default=None, help="children to grow from the guides")
-    g.add_argument("--scalp", metavar="MESH.obj", default=None, help="scalp mesh the children grow on")
+    g.add_argument(
+        "--scalp", metavar="MESH.obj", default=None,
+        help="scalp mesh the children grow on (freeze: also the head strokes collide with and slide on)",
+    )  # fmt: skip
     g.add_argument(
         "--guides-per-child", type=int, metavar="K", help=f"k nearest guides (default {DEFAULT_K})"
     )

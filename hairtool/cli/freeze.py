@@ -66,8 +66,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--strokes",
         metavar="STROKES.json",
-        help="replay a stroke log (align, comb, smooth, length, puff, clump, mask; the studio exports one) "
-        "after the --align cursors",
+        help="replay a stroke log (align, comb, smooth, length, puff, clump, mask, delete, pinch, "
+        "snake_hook, slide, add, density; the studio exports one) after the --align cursors",
     )
     a = parser.add_argument_group("align brush (UserAlign, eqs. 8–13)")
     a.add_argument(
@@ -117,6 +117,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print timings and sizes as JSON")
 
 
+def _surface(args: argparse.Namespace, strokes):
+    """The head (``--scalp``, also without ``--count``) that strokes and align cursors collide
+    with and slide strokes slide on, or None; a log with slide strokes and no ``--scalp`` is
+    refused before any work."""
+    from hairtool.errors import ParameterError
+    from hairtool.frozen.brushes import NEED_SURFACE
+
+    needs = sorted({s.brush for s in strokes or () if s.brush in NEED_SURFACE})
+    if needs and args.scalp is None:
+        raise ParameterError("scalp", None, f"a head mesh (--scalp MESH.obj) for {', '.join(needs)} strokes")
+    if args.scalp is None or not (strokes or args.align):
+        return None
+    from hairtool.guides.planting import HeadSurface
+    from hairtool.io.obj import read_mesh
+
+    surface = HeadSurface(read_mesh(args.scalp))
+    if not _guides.wanted(args):
+        args.scalp = None  # the surface's only: no children to grow on it
+    return surface
+
+
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -146,16 +167,17 @@ def run(args: argparse.Namespace) -> int:
     check_align_params(
         (0.0, 0.0, 0.0), 1.0 if args.radius is None else args.radius, args.intensity, args.align_mode
     )
-    _guides.check(args)
     strokes = None
     if args.strokes is not None:
         from hairtool.frozen.strokes import read_strokes
 
         strokes = read_strokes(args.strokes)  # a bad log is refused before any work
+    surface = _surface(args, strokes)
+    _guides.check(args)
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
     # With render hair (asked for, or the input's own), the pipeline runs on the guides.
     groom, binding, bind_ms = _guides.prepare(args, io.read_groom(args.input))
-    pipe = FrozenPipeline(groom, params)
+    pipe = FrozenPipeline(groom, params, surface)
     lo, hi = groom.bounds
     radius = float(np.linalg.norm(hi - lo)) if args.radius is None else args.radius
     timings = [pipe.timings]
@@ -166,6 +188,9 @@ def run(args: argparse.Namespace) -> int:
         pipe.apply_samples(stroke.pipeline_samples(float(pipe.scalp_centre[0])))
         timings.append(pipe.timings)
     report = {}
+    if binding is not None and not np.array_equal(pipe.origin, np.arange(groom.strand_count)):
+        what = "add, delete or density strokes with render hair"
+        raise ParameterError("strokes", what, "none where children follow the guides")
     if binding is not None:
         hair = _guides.render(args, binding).update(pipe.result)
         report = _guides.write(args, hair, pipe.result)
@@ -175,6 +200,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         report |= {
             "strands": groom.strand_count,
+            "result_strands": pipe.result.strand_count,  # after add, delete and density strokes
             "vertices": groom.vertex_count,
             "clump_radius": pipe.clump_radius,
             "mean_neighbours": pipe.mean_neighbours,

@@ -26,6 +26,8 @@ the scene) leaves the strands whose root normal n has n·view > 0 (facing away f
 as if they were locked (:func:`root_normals`, :func:`facing_away`); the pipeline adds them to
 the mask for that sample, for every brush and align.
 
+Delete, pinch and snake hook live in :mod:`hairtool.frozen.sculpt`, slide in :mod:`hairtool.frozen.slide`.
+
 Every kernel has a numpy twin (``*_reference``) computing the same definition.
 """
 
@@ -43,7 +45,18 @@ from hairtool.groom import Groom
 
 F64 = NDArray[np.float64]
 
-BRUSHES = ("align", "comb", "smooth", "length", "puff", "mask", "clump")
+BRUSHES = (
+    "align", "comb", "smooth", "length", "puff", "mask", "clump", "delete", "pinch", "snake_hook", "slide",
+    "add", "density",
+)  # fmt: skip
+#: The brushes of :mod:`hairtool.frozen.sculpt` and :mod:`hairtool.frozen.slide`, those that
+#: add or remove strands, and those that need the head's surface.
+SCULPT = ("delete", "pinch", "snake_hook", "slide", "add", "density")
+CHANGE_STRANDS = ("delete", "add", "density")
+MOVE_NONE = ("mask", "clump", "delete", "add", "density")  # they move no vertex: nothing to collide
+NEED_SURFACE = ("slide", "add", "density")
+MAX_COUNT = 1000  # strands one add sample may plant
+SIGNED = ("length", "mask", "clump", "pinch")  # strength in [-1, 1]; the others in [0, 1]
 FALLOFFS = ("smooth", "linear", "constant")
 LUT_SIZE = 257  # samples of a falloff curve over [0, 1]: interpolated linearly between
 MAX_FALLOFF_POINTS = 4 * LUT_SIZE  # a curve of more points than this says nothing more
@@ -98,7 +111,11 @@ def _curve_points(falloff: object) -> F64:
 class BrushSample:
     """One mouse move of one brush (groom units); ``lut`` from :func:`falloff_lut`; ``view`` the
     camera's viewing direction (from the eye into the scene): with it only the strands facing
-    the camera are touched; None: every strand."""
+    the camera are touched; None: every strand. ``start``: the first sample of a stroke (a
+    snake hook hooks its strands there). ``collide``: with a head surface, no vertex the
+    sample moves ends inside it (:mod:`hairtool.frozen.collide`). ``count`` and ``seed``: the
+    strands an add sample plants, and the seed of where (density's too); ``spacing``: the
+    distance a density sample leaves between roots."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -107,12 +124,18 @@ class BrushSample:
     strength: float
     lut: tuple[float, ...]
     view: tuple[float, float, float] | None = None
+    start: bool = False
+    collide: bool = True
+    count: int = 1
+    seed: int = 0
+    spacing: float = 0.0
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
         return BrushSample(
-            self.brush, cursor, direction, self.radius, self.strength, self.lut, mirrored_view(self.view)
+            self.brush, cursor, direction, self.radius, self.strength, self.lut, mirrored_view(self.view),
+            self.start, self.collide, self.count, self.seed, self.spacing,
         )
 
 
@@ -136,7 +159,7 @@ def check_view(view: object) -> tuple[float, float, float] | None:
 
 def check_sample(sample: BrushSample) -> BrushSample:
     if sample.brush not in BRUSHES or sample.brush == "align":
-        raise ParameterError("brush", sample.brush, "one of " + ", ".join(KINDS) + ", mask, clump")
+        raise ParameterError("brush", sample.brush, "one of " + ", ".join(BRUSHES[1:]))
     for name in ("cursor", "direction"):
         v = np.asarray(getattr(sample, name), dtype=np.float64)
         if v.shape != (3,) or not np.all(np.isfinite(v)):
@@ -144,9 +167,17 @@ def check_sample(sample: BrushSample) -> BrushSample:
     if not np.isfinite(sample.radius) or sample.radius <= 0:
         raise ParameterError("radius", sample.radius, "a positive finite distance")
     check_view(sample.view)
-    low = -1.0 if sample.brush in ("length", "mask", "clump") else 0.0
+    low = -1.0 if sample.brush in SIGNED else 0.0
     if not np.isfinite(sample.strength) or not low <= sample.strength <= 1.0:
         raise ParameterError("strength", sample.strength, f"a number in [{low:g}, 1]")
+    c = sample.count
+    if isinstance(c, bool) or not isinstance(c, int | np.integer) or not 1 <= c <= MAX_COUNT:
+        raise ParameterError("count", c, f"a whole number of strands in [1, {MAX_COUNT}]")
+    s = sample.seed
+    if isinstance(s, bool) or not isinstance(s, int | np.integer) or not 0 <= s < 2**32:
+        raise ParameterError("seed", s, "a whole number in [0, 2^32)")
+    if sample.brush == "density" and not (np.isfinite(sample.spacing) and sample.spacing > 0):
+        raise ParameterError("spacing", sample.spacing, "a positive distance between roots (groom units)")
     if len(sample.lut) != LUT_SIZE:
         raise ParameterError("falloff", f"{len(sample.lut)} samples", f"{LUT_SIZE}")
     return sample

@@ -12,6 +12,16 @@ Built for dragging in the studio:
 - The clump brush paints a per-strand clump strength (1 everywhere until painted), kept with the
   mask in the state and the snapshots, which ClumpWithGaps scales each strand's step by.
 - Clumping is recomputed from the aligned state at every update and never accumulates.
+- Delete (:mod:`hairtool.frozen.sculpt`) changes the strands: a stage like the others, applied
+  to the stroked state, which takes the kept strands with their mask and clump strength; the
+  pipeline records the rest strand each remaining strand comes from (:attr:`FrozenPipeline.origin`),
+  kept in the snapshots, so undo brings the deleted strands back bit for bit and a replay deletes
+  the same ones. The result has the stroked state's strands, not necessarily the rest groom's.
+- With a head surface (:meth:`FrozenPipeline.set_surface`), a sample with ``collide`` (the
+  default) leaves no vertex it moved inside the head (:mod:`hairtool.frozen.collide`).
+- Snake hook hooks strands at a stroke's first sample (``start``) and drags them through the
+  stroke's later samples; the hooked weights are part of the state (one set per sample of a
+  stroke's start: its mirrored sample has its own, used in turn).
 """
 
 from __future__ import annotations
@@ -27,6 +37,7 @@ from numpy.typing import ArrayLike
 from hairtool.errors import ParameterError
 from hairtool.frozen.align import align, check_align_params
 from hairtool.frozen.brushes import (
+    MOVE_NONE,
     BrushSample,
     apply_brush,
     check_view,
@@ -38,8 +49,12 @@ from hairtool.frozen.brushes import (
 )
 from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
 from hairtool.frozen.clump_region import clump_points_interactive
+from hairtool.frozen.collide import MARGIN, collide
+from hairtool.frozen.density import accept, disc_candidates, thin
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.noise import check_seed, draw_seed
+from hairtool.frozen.sculpt import hook_weights, pinch, snake_hook, strands_to_delete
+from hairtool.frozen.slide import Surface, slide
 from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
 from hairtool.groom import Groom, vertex_ids_of
 
@@ -111,6 +126,30 @@ which stretches segments). ``redraw_noise``: new
         return replace(self, **changes)
 
 
+def append_strands(g: Groom, new: Groom) -> Groom:
+    """``g`` with ``new``'s strands after its own; each per-vertex attribute of ``g`` taken for a
+    new strand from the strand whose root is nearest, by the vertex parameter."""
+    attrs = {}
+    if any(a is not None for a in g.attributes.values()):
+        near = np.argmin(((new.roots[:, None, :] - g.roots[None, :, :]) ** 2).sum(-1), axis=1)
+        for name, a in g.attributes.items():
+            if a is None:
+                attrs[name] = None
+                continue
+            rows = []
+            for s, t in zip(near, new.topology.offsets[:-1], strict=True):
+                o, e = g.offsets[s], g.offsets[s + 1]
+                tn = new.vertex_param[t : t + new.counts[len(rows)]]
+                src, ts = a[o:e], g.vertex_param[o:e]
+                if a.ndim == 1:
+                    rows.append(np.interp(tn, ts, src))
+                else:
+                    rows.append(np.column_stack([np.interp(tn, ts, src[:, c]) for c in range(a.shape[1])]))
+            attrs[name] = np.concatenate([a, *rows]).astype(np.float32)
+    points, counts = np.concatenate([g.points, new.points]), np.concatenate([g.counts, new.counts])
+    return Groom(points, counts, **attrs, metadata=g.metadata.with_(curves=()))
+
+
 class AlignSample(NamedTuple):
     """One align sample; ``view`` as :class:`~hairtool.frozen.brushes.BrushSample`'s (None: every
     strand, as before the field existed)."""
@@ -120,6 +159,7 @@ class AlignSample(NamedTuple):
     intensity: float
     mode: str
     view: tuple[float, float, float] | None = None
+    collide: bool = True  # as BrushSample's
 
 
 Sample = AlignSample | BrushSample
@@ -128,7 +168,8 @@ Sample = AlignSample | BrushSample
 @dataclass(frozen=True)
 class FrozenSnapshot:
     """Undo/redo state: the stroke log and the stroked points it produced (shared, read-only),
-    the mask and the clump strengths it painted (None: replay the log to find them)."""
+    the mask and the clump strengths it painted (None: replay the log to find them), the rest
+    strand of each stroked strand (None: every rest strand, in order) and a snake hook's state."""
 
     log: tuple[Sample, ...]
     aligned: Groom
@@ -136,13 +177,18 @@ class FrozenSnapshot:
     draw: int
     locked: np.ndarray | None = None
     clump_strength: np.ndarray | None = None
+    origin: np.ndarray | None = None
+    hooks: tuple[tuple, int, bool] = ((), 0, False)
 
 
 class FrozenPipeline:
     """FreezeDeform → UserAlign → ClumpWithGaps on a rest groom, for interactive use."""
 
-    def __init__(self, rest: Groom, params: FrozenParams | None = None) -> None:
+    def __init__(
+        self, rest: Groom, params: FrozenParams | None = None, surface: Surface | None = None
+    ) -> None:
         self._rest = rest
+        self._surface = surface  # the head the slide brush slides roots on
         self._params = (params or FrozenParams()).validate()
         strand_multipliers(rest.strand_count, self._params.strand_variation)  # shape check
         self._auto_h: float | None = None
@@ -150,6 +196,10 @@ class FrozenPipeline:
         self._log: list[Sample] = []
         self._locked = np.zeros(rest.strand_count, dtype=bool)
         self._clump_strength = np.ones(rest.strand_count)
+        self._origin = np.arange(rest.strand_count, dtype=np.int64)
+        self._hooks: list[tuple] = []  # a snake hook's (weights, tips, cursor) at each start sample
+        self._hook_next = 0  # the set the next sample of the stroke uses
+        self._hooking = False  # the last sample was a snake hook's start
         self._scalp_centre: np.ndarray | None = None
         self._root_normals: np.ndarray | None = None
         self._draw = 0
@@ -195,6 +245,12 @@ class FrozenPipeline:
         return self._locked.copy()
 
     @property
+    def origin(self) -> np.ndarray:
+        """``(S',)`` the rest strand each strand of the stroked state (and the result) comes from,
+        in order: the strands delete has removed are missing (a copy)."""
+        return self._origin.copy()
+
+    @property
     def clump_strength(self) -> np.ndarray:
         """``(S,)`` the clump strength the clump brush has painted, in [0, 1] (a copy)."""
         return self._clump_strength.copy()
@@ -202,10 +258,24 @@ class FrozenPipeline:
     @property
     def root_normals(self) -> np.ndarray:
         """``(S, 3)`` outward scalp normals at the rest roots, for front-facing samples
-        (:func:`~hairtool.frozen.brushes.root_normals`)."""
+        (:func:`~hairtool.frozen.brushes.root_normals`); index them by :attr:`origin` for the
+        strands of the result."""
         if self._root_normals is None:
             self._root_normals = root_normals(self._rest)
         return self._root_normals
+
+    @property
+    def strand_normals(self) -> np.ndarray:
+        """``(S', 3)`` :attr:`root_normals` of the strands of the stroked state and the result
+        (a planted strand's: the surface normal at its root)."""
+        n = self.root_normals
+        if len(self._origin) == len(n) and self._origin.min(initial=0) >= 0:
+            return n  # (deletes keep the order, plants come last: this is every rest strand)
+        out = n[np.maximum(self._origin, 0)]
+        new = self._origin < 0
+        if new.any():
+            _, out[new] = self._surface.project(self._aligned.roots[new].astype(np.float64))  # type: ignore[union-attr]
+        return out
 
     @property
     def scalp_centre(self) -> np.ndarray:
@@ -267,7 +337,27 @@ class FrozenPipeline:
         """Mean number of other-strand vertices within h per moving vertex in the last clumping."""
         return self._workspace.mean_neighbours
 
+    @property
+    def surface(self) -> Surface | None:
+        """The head's surface (:class:`~hairtool.frozen.slide.Surface`) slide needs, or None."""
+        return self._surface
+
     # -- operations ----------------------------------------------------------------------
+    def set_surface(self, surface: Surface | None) -> Groom:
+        """A new head surface; strokes that slid roots on the old one or collided with it are
+        replayed on it (a log with slide strokes refuses to go without one, and keeps the old
+        surface then)."""
+        old, self._surface = self._surface, surface
+        if self._log:
+            try:
+                self._replay()
+            except BaseException:
+                self._surface = old
+                self._replay()
+                raise
+            self._reclump()
+        return self._result
+
     def set_params(self, params: FrozenParams) -> Groom:
         """New parameters; the frozen groom is re-derived only if a freeze parameter changed,
         and the strokes are replayed on it."""
@@ -305,14 +395,16 @@ class FrozenPipeline:
         clumping: what a replayed stroke log does."""
         self._timings = dict.fromkeys(self._timings, 0.0)
         t0 = time.perf_counter()
-        before = (self._aligned, self._locked, self._clump_strength, len(self._log))
+        before = (self._aligned, self._locked, self._clump_strength, self._origin, len(self._log))
+        hooks = self._hook_state()
         try:
             for sample in samples:
                 self._aligned = self._apply(self._aligned, sample)
                 self._log.append(sample)
         except BaseException:  # a refused sample: none of these samples happened
-            self._aligned, self._locked, self._clump_strength = before[:3]
-            del self._log[before[3] :]
+            self._aligned, self._locked, self._clump_strength, self._origin = before[:4]
+            self._set_hooks(hooks)
+            del self._log[before[4] :]
             raise
         self._timings["align"] = (time.perf_counter() - t0) * 1e3
         self._reclump()
@@ -331,8 +423,7 @@ class FrozenPipeline:
     def reset_strokes(self) -> Groom:
         """Forget every stroke: back to the frozen groom (clumped)."""
         self._log = []
-        self._locked = np.zeros(self._rest.strand_count, dtype=bool)
-        self._clump_strength = np.ones(self._rest.strand_count)
+        self._clear_state()
         self._aligned = self._frozen
         self._timings = dict.fromkeys(self._timings, 0.0)
         self._reclump()
@@ -342,11 +433,20 @@ class FrozenPipeline:
         """Cheap state for undo/redo (no copies: grooms are immutable)."""
         return FrozenSnapshot(
             tuple(self._log), self._aligned, self._freeze_key or (), self._draw, self._locked.copy(),
-            self._clump_strength.copy(),
+            self._clump_strength.copy(), self._origin.copy(), self._hook_state(),
         )
 
     def restore(self, snapshot: FrozenSnapshot) -> Groom:
-        """Back to a snapshot's strokes; replayed on the current frozen groom if it has changed."""
+        """Back to a snapshot's strokes; replayed on the current frozen groom if it has changed
+        (a replay that fails, e.g. slide strokes without a surface, leaves the state as it was)."""
+        now = self.snapshot()
+        try:
+            return self._restore(snapshot)
+        except BaseException:
+            self._restore(now)
+            raise
+
+    def _restore(self, snapshot: FrozenSnapshot) -> Groom:
         self._log = list(snapshot.log)
         self._timings = dict.fromkeys(self._timings, 0.0)
         if (
@@ -358,10 +458,13 @@ class FrozenPipeline:
             )
         ):
             self._aligned = snapshot.aligned
-            n = self._rest.strand_count
+            n = snapshot.aligned.strand_count
             self._locked = np.zeros(n, bool) if snapshot.locked is None else snapshot.locked.copy()
             cs = snapshot.clump_strength
             self._clump_strength = np.ones(n) if cs is None else cs.astype(np.float64)
+            o = snapshot.origin
+            self._origin = np.arange(n, dtype=np.int64) if o is None else o.astype(np.int64)
+            self._set_hooks(snapshot.hooks)
         else:
             self._replay()
         self._reclump()
@@ -397,9 +500,119 @@ class FrozenPipeline:
         """The strands facing away from a sample's camera (None: no view, none)."""
         if check_view(view) is None:
             return None
-        return facing_away(self.root_normals, view)
+        return facing_away(self.strand_normals, view)
+
+    def _clear_state(self) -> None:
+        n = self._rest.strand_count
+        self._locked = np.zeros(n, dtype=bool)
+        self._clump_strength = np.ones(n)
+        self._origin = np.arange(n, dtype=np.int64)
+        self._set_hooks(((), 0, False))
+
+    def _hook_state(self) -> tuple[tuple, int, bool]:
+        return (tuple(self._hooks), self._hook_next, self._hooking)
+
+    def _set_hooks(self, state: tuple[tuple, int, bool]) -> None:
+        self._hooks, self._hook_next, self._hooking = list(state[0]), state[1], state[2]
+
+    def _snake(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
+        """A snake hook's sample: a start hooks strands (a run of starts, one set each: the
+        stroke's sample and its mirror); the later ones use the sets in turn."""
+        if sample.start or not self._hooks:
+            if not self._hooking:
+                self._hooks = []
+            hook = hook_weights(g, sample, locked)
+            self._hooks.append((hook, g.tips.astype(np.float64), np.asarray(sample.cursor, np.float64)))
+            self._hooking, self._hook_next = True, len(self._hooks) - 1
+        else:
+            self._hooking = False
+            self._hook_next = (self._hook_next + 1) % len(self._hooks)
+        hook, anchors, start = self._hooks[self._hook_next]
+        return snake_hook(g, hook, anchors, np.asarray(sample.cursor, np.float64) - start)
+
+    def _add(self, g: Groom, sample: BrushSample) -> Groom:
+        """An add sample: the strands the surface plants appended, unmasked, clump strength 1."""
+        surface = self._surface
+        if surface is None or not hasattr(surface, "plant"):
+            raise ParameterError("scalp", None, "a head mesh for the add brush (--scalp MESH.obj)")
+        new = surface.plant(g, sample.cursor, sample.radius, sample.count, sample.seed, sample.view)
+        if new is None:
+            return g
+        out = append_strands(g, new)
+        m = new.strand_count
+        self._locked = np.concatenate([self._locked, np.zeros(m, bool)])
+        self._clump_strength = np.concatenate([self._clump_strength, np.ones(m)])
+        self._origin = np.concatenate([self._origin, np.full(m, -1, np.int64)])
+        return out
+
+    def _density(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
+        """A density sample (:mod:`hairtool.frozen.density`): thinned, then planted."""
+        surface = self._surface
+        if surface is None or not hasattr(surface, "grow"):
+            raise ParameterError("scalp", None, "a head mesh for the density brush (--scalp MESH.obj)")
+        if sample.strength <= 0:
+            return g
+        q, n = surface.project(np.asarray(sample.cursor, np.float64).reshape(1, 3))
+        q, n = q[0], n[0]
+        if sample.view is not None and float(n @ np.asarray(sample.view, np.float64)) > 0:
+            return g
+        spacing, r = float(sample.spacing), float(sample.radius)
+        roots = g.roots.astype(np.float64)
+        dist = np.linalg.norm(roots - q, axis=1)
+        near = np.flatnonzero(dist < r + spacing)
+        keep = thin(roots[near], (dist[near] >= r) | locked[near], spacing)
+        gone = np.zeros(g.strand_count, bool)
+        gone[near[~keep]] = True
+        if gone.all():
+            raise ParameterError("density", "every strand", "a stroke that leaves at least one strand")
+        if gone.any():
+            kept = np.flatnonzero(~gone)
+            self._locked, self._clump_strength = self._locked[kept], self._clump_strength[kept]
+            self._origin = self._origin[kept]
+            g = g.subset(kept)
+        bits = np.asarray(sample.cursor, np.float64).view(np.uint32)
+        rng = np.random.default_rng([int(sample.seed), *(int(b) for b in bits), 0xDE5])
+        cands, cn = surface.project(disc_candidates(q, n, r, spacing, rng))
+        ok = np.linalg.norm(cands - q, axis=1) < r
+        if sample.view is not None:
+            ok &= cn @ np.asarray(sample.view, np.float64) <= 0
+        cands = cands[ok]
+        roots = g.roots.astype(np.float64)
+        around = roots[np.linalg.norm(roots - q, axis=1) < r + spacing]
+        new_roots = cands[accept(cands, around, spacing)]
+        if len(new_roots) == 0:
+            return g
+        new = surface.grow(g, new_roots)
+        m = new.strand_count
+        self._locked = np.concatenate([self._locked, np.zeros(m, bool)])
+        self._clump_strength = np.concatenate([self._clump_strength, np.ones(m)])
+        self._origin = np.concatenate([self._origin, np.full(m, -1, np.int64)])
+        return append_strands(g, new)
+
+    def _delete(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
+        gone = strands_to_delete(g, sample, locked)
+        if not gone.any():
+            return g
+        if gone.all():
+            raise ParameterError("delete", "every strand", "a stroke that leaves at least one strand")
+        keep = np.flatnonzero(~gone)
+        self._locked, self._clump_strength = self._locked[keep], self._clump_strength[keep]
+        self._origin = self._origin[keep]
+        return g.subset(keep)
 
     def _apply(self, g: Groom, sample: Sample) -> Groom:
+        out = self._apply_one(g, sample)
+        moves = isinstance(sample, AlignSample) or sample.brush not in MOVE_NONE
+        surface = self._surface
+        if moves and sample.collide and surface is not None and hasattr(surface, "signed_distance"):
+            lo, hi = self._rest.bounds
+            margin = MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
+            out = collide(g, out, surface, margin)  # type: ignore[arg-type]
+        return out
+
+    def _apply_one(self, g: Groom, sample: Sample) -> Groom:
+        if not (isinstance(sample, BrushSample) and sample.brush == "snake_hook"):
+            self._set_hooks(((), 0, False))  # another brush ends a snake hook's stroke
         away = self._away(sample.view)
         if isinstance(sample, BrushSample) and sample.brush == "mask":
             self._locked = paint_mask(g, sample, self._locked, away)
@@ -416,15 +629,25 @@ class FrozenPipeline:
         if sample.brush == "clump":
             self._clump_strength = paint_clump(g, sample, self._clump_strength, locked)
             return g
+        if sample.brush == "delete":
+            return self._delete(g, sample, locked)
+        if sample.brush == "add":
+            return self._add(g, sample)
+        if sample.brush == "density":
+            return self._density(g, sample, locked)
+        if sample.brush == "pinch":
+            return pinch(g, sample, locked)
+        if sample.brush == "snake_hook":
+            return self._snake(g, sample, locked)
+        if sample.brush == "slide":
+            return slide(g, sample, locked, self._surface)
         return apply_brush(g, sample, locked, self.scalp_centre)
 
     def _replay(self) -> None:
-        g = self._frozen
-        self._locked = np.zeros(self._rest.strand_count, dtype=bool)
-        self._clump_strength = np.ones(self._rest.strand_count)
-        for s in self._log:
-            g = self._apply(g, s)
-        self._aligned = g
+        self._aligned = self._frozen
+        self._clear_state()
+        for s in self._log:  # (the stroked state so far: planted strands' normals come from it)
+            self._aligned = self._apply(self._aligned, s)
 
     def _reclump(self) -> None:
         p = self._params
@@ -441,7 +664,7 @@ class FrozenPipeline:
                 bool(p.keep_lengths),
                 self._clump_strength,
             )
-            self._result = self._rest.with_points(pts)
+            self._result = self._aligned.with_points(pts)
         else:
             self._workspace.mean_neighbours = 0.0
             self._result = self._aligned

@@ -10,7 +10,20 @@ A stroke log is a JSON list of strokes, in groom units::
   ``strength`` its intensity, no direction needed), ``comb``, ``smooth``, ``length`` (a signed
   strength: > 0 grows, < 0 shrinks, as a fraction of the strand's length at the brush centre),
   ``puff``, ``mask`` (> 0 locks the strands touched, < 0 frees them) or ``clump`` (> 0 paints
-  clumping on, < 0 off: each strand's clump strength moves toward 1 or 0).
+  clumping on, < 0 off: each strand's clump strength moves toward 1 or 0), ``delete`` (removes
+  the strands whose root lies within the radius; strength > 0, falloff ignored), ``pinch`` (> 0
+  gathers toward the brush centre, < 0 spreads) or ``snake_hook`` (the strands whose tip lies
+  within the radius at the stroke's first sample follow the cursor; ``direction`` is the
+  cursor's motion since the sample before), ``slide`` (roots slide along the head; needs one)
+  or ``add`` (plants ``params.count`` strands per sample, default 1, around the head's point
+  nearest the cursor, drawn from ``params.seed``, default 0, and the cursor; needs a head) or
+  ``density`` (removes and plants strands under the brush until the roots are
+  ``params.spacing`` apart, in groom units; ``params.seed`` as add's; needs a head).
+- ``collision`` (per stroke, optional, default true): with a head surface (``--scalp``), no
+  vertex the stroke moves ends inside it; false: strands may pass through the head.
+- ``start`` (per sample, optional): true where a stroke begins (a snake hook hooks its strands
+  there); missing: true for a stroke's first sample only. Written for snake hooks, whose
+  mirrored first sample is a start too.
 - ``view`` (per sample, optional): the camera's viewing direction, from the eye into the scene;
   only the strands facing that camera are touched. null or missing (older logs): every strand.
 - ``falloff``: ``smooth``, ``linear``, ``constant``, or a curve ``[[t, w], ...]`` over t =
@@ -29,7 +42,7 @@ import math
 import os
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -60,6 +73,7 @@ class StrokeSample:
     strength: float
     direction: tuple[float, float, float] = (0.0, 0.0, 0.0)
     view: tuple[float, float, float] | None = None
+    start: bool | None = None  # None: the stroke's first sample starts it
 
 
 @dataclass(frozen=True)
@@ -72,6 +86,7 @@ class Stroke:
     symmetry: str | None = None
     mirror_x: float | None = None
     params: dict = field(default_factory=dict)
+    collision: bool = True  # with a head surface, no vertex the stroke moves ends inside it
 
     def validate(self) -> Stroke:
         if self.brush not in BRUSHES:
@@ -91,16 +106,27 @@ class Stroke:
         out: list[AlignSample | BrushSample] = []
         mirror = self.mirror_x if self.mirror_x is not None else default_mirror_x
         lut = tuple(falloff_lut(self.falloff).tolist())
-        for s in self.samples:
+        for i, s in enumerate(self.samples):
             if self.brush == "align":
                 mode = self.params.get("mode", "paper")
-                first = AlignSample(s.cursor, s.radius, s.strength, mode, check_view(s.view))
+                first = AlignSample(s.cursor, s.radius, s.strength, mode, check_view(s.view), self.collision)
                 out.append(first)
                 if self.symmetry == "x":
                     cursor = (2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])
                     out.append(first._replace(cursor=cursor, view=mirrored_view(s.view)))
                 continue
-            sample = BrushSample(self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view)
+            start = (i == 0) if s.start is None else s.start
+            start = start and self.brush == "snake_hook"  # (the only brush a start changes)
+            count, seed, spacing = 1, 0, 0.0
+            if self.brush in ("add", "density"):  # (checked with the sample)
+                count, seed = self.params.get("count", 1), self.params.get("seed", 0)
+            if self.brush == "density":
+                spacing = self.params.get("spacing")
+                spacing = _number("params.spacing", spacing) if spacing is not None else 0.0
+            sample = BrushSample(
+                self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start, self.collision,
+                count, seed, spacing,
+            )
             sample = check_sample(sample)
             out.append(sample)
             if self.symmetry == "x":
@@ -115,6 +141,7 @@ class Stroke:
             "symmetry": self.symmetry,
             "mirror_x": self.mirror_x,
             "params": dict(self.params),
+            **({} if self.collision else {"collision": False}),
             "samples": [
                 {
                     "cursor": list(s.cursor),
@@ -123,6 +150,7 @@ class Stroke:
                     "strength": s.strength,
                     "view": None if s.view is None else list(s.view),
                 }
+                | ({} if s.start is None else {"start": s.start})
                 for s in self.samples
             ],
         }
@@ -133,17 +161,28 @@ def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
     and falloff become one stroke, mirrored samples stay explicit (no symmetry flag)."""
     runs: list[tuple[tuple, Stroke]] = []
     for s in log:
+        split = False
         if isinstance(s, AlignSample):
-            key: tuple = ("align", s.mode)
+            key: tuple = ("align", s.mode, s.collide)
             sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view))
-            start = Stroke("align", (sample,), params={"mode": s.mode})
+            start = Stroke("align", (sample,), params={"mode": s.mode}, collision=s.collide)
         else:
-            key = (s.brush, s.lut)
-            sample = StrokeSample(tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view))
-            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut))
-        if runs and runs[-1][0] == key:
+            key = (s.brush, s.lut, s.collide, s.count, s.seed, s.spacing)
+            hook = s.brush == "snake_hook"
+            sample = StrokeSample(
+                tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view),
+                bool(s.start) if hook else None,
+            )  # fmt: skip
+            params = {"count": s.count, "seed": s.seed} if s.brush == "add" else {}
+            if s.brush == "density":
+                params = {"spacing": s.spacing, "seed": s.seed}
+            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut), params=params, collision=s.collide)
+            # a snake hook's start (not its mirror's) begins a new stroke, with its own strands
+            split = hook and s.start and bool(runs) and not runs[-1][1].samples[-1].start
+        if runs and runs[-1][0] == key and not split:
             last = runs[-1][1]
-            runs[-1] = (key, Stroke(last.brush, (*last.samples, sample), last.falloff, params=last.params))
+            more = Stroke(last.brush, (*last.samples, sample), last.falloff, params=last.params)
+            runs[-1] = (key, replace(more, collision=last.collision))
         else:
             runs.append((key, start))
     return [stroke for _, stroke in runs]
@@ -151,6 +190,12 @@ def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
 
 def _view_of(view: Sequence[float] | None) -> tuple[float, float, float] | None:
     return None if view is None else (float(view[0]), float(view[1]), float(view[2]))
+
+
+def _flag(where: str, value: Any) -> bool | None:
+    if value is None or isinstance(value, bool):
+        return value
+    raise ParameterError(where, value, "true, false or null")
 
 
 def _falloff_of(lut: Sequence[float]) -> str | tuple[tuple[float, float], ...]:
@@ -211,6 +256,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
                 _number(f"{at}.strength", s.get("strength")),
                 _vector(f"{at}.direction", s.get("direction"), (0.0, 0.0, 0.0)),
                 None if s.get("view") is None else _vector(f"{at}.view", s.get("view")),
+                _flag(f"{at}.start", s.get("start")),
             )
         )
     falloff = d.get("falloff", "smooth")
@@ -233,6 +279,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
         symmetry=d.get("symmetry"),
         mirror_x=None if mirror is None else _number(f"{where}.mirror_x", mirror),
         params=params,
+        collision=_flag(f"{where}.collision", d.get("collision")) is not False,
     )
     try:
         stroke.pipeline_samples(0.0)  # every sample checked (radius, strength range) as it will run

@@ -17,6 +17,7 @@ import heapq
 import numpy as np
 from numba import njit, prange
 
+from hairtool.errors import ParameterError
 from hairtool.io.obj import Mesh
 
 
@@ -255,3 +256,185 @@ def nearest_guide_distance(mesh: Mesh, guide_roots: np.ndarray) -> np.ndarray:
     on_mesh, gface = closest_points(mesh, guide_roots)
     _, d = nearest_sources(mesh, on_mesh, gface, 1)
     return d[:, 0]
+
+
+GRID_CELLS = 48  # cells along the mesh's longest side in MeshSurface's grid of faces
+
+
+@njit(cache=True, nogil=True)
+def _bin_faces(vertices, faces, lo, cell, dims, start, items):  # pragma: no cover - compiled
+    """Faces into the grid cells their bounding boxes overlap: CSR ``start`` (cells + 1) and
+    ``items`` (None: counting pass, ``start`` gets the counts)."""
+    fill = start.copy()
+    for f in range(faces.shape[0]):
+        c0 = np.empty(3, np.int64)
+        c1 = np.empty(3, np.int64)
+        for a in range(3):
+            x0 = min(vertices[faces[f, 0], a], vertices[faces[f, 1], a], vertices[faces[f, 2], a])
+            x1 = max(vertices[faces[f, 0], a], vertices[faces[f, 1], a], vertices[faces[f, 2], a])
+            c0[a] = min(max(int(np.floor((x0 - lo[a]) / cell)), 0), dims[a] - 1)
+            c1[a] = min(max(int(np.floor((x1 - lo[a]) / cell)), 0), dims[a] - 1)
+        for i in range(c0[0], c1[0] + 1):
+            for j in range(c0[1], c1[1] + 1):
+                for k in range(c0[2], c1[2] + 1):
+                    c = (i * dims[1] + j) * dims[2] + k
+                    if items.size == 0:
+                        start[c + 1] += 1
+                    else:
+                        items[fill[c]] = f
+                        fill[c] += 1
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _grid_closest_kernel(  # pragma: no cover - compiled
+    points, vertices, faces, lo, cell, dims, start, items, out, face_of
+):
+    """:func:`closest_points` (same ties: the lower face) for points inside the grid's box,
+    visiting rings of cells outward until no unvisited cell can hold a closer face; face −1
+    for points outside the box."""
+    for k in prange(points.shape[0]):
+        px, py, pz = points[k, 0], points[k, 1], points[k, 2]
+        ci = np.empty(3, np.int64)
+        inside = True
+        for a in range(3):
+            f = (points[k, a] - lo[a]) / cell
+            if not (0.0 <= f < dims[a]):
+                inside = False
+            else:
+                ci[a] = int(f)
+        face_of[k] = -1
+        if not inside:
+            continue
+        best, bf = np.inf, -1
+        r = 0
+        while True:
+            for i in range(max(ci[0] - r, 0), min(ci[0] + r, dims[0] - 1) + 1):
+                for j in range(max(ci[1] - r, 0), min(ci[1] + r, dims[1] - 1) + 1):
+                    for kk in range(max(ci[2] - r, 0), min(ci[2] + r, dims[2] - 1) + 1):
+                        if max(abs(i - ci[0]), abs(j - ci[1]), abs(kk - ci[2])) != r:
+                            continue
+                        c = (i * dims[1] + j) * dims[2] + kk
+                        for t in range(start[c], start[c + 1]):
+                            f = items[t]
+                            a, b, e = faces[f, 0], faces[f, 1], faces[f, 2]
+                            va, vb, ve = vertices[a], vertices[b], vertices[e]
+                            qx, qy, qz = _closest_on_triangle(
+                                px, py, pz, va[0], va[1], va[2], vb[0], vb[1], vb[2], ve[0], ve[1], ve[2]
+                            )
+                            d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
+                            if d < best or (d == best and f < bf):
+                                best, bf = d, f
+                                out[k, 0], out[k, 1], out[k, 2] = qx, qy, qz
+            # the nearest an unvisited cell can be: across the visited block's unclipped sides
+            reach = np.inf
+            for a in range(3):
+                if ci[a] - r > 0:
+                    reach = min(reach, points[k, a] - (lo[a] + (ci[a] - r) * cell))
+                if ci[a] + r < dims[a] - 1:
+                    reach = min(reach, lo[a] + (ci[a] + r + 1) * cell - points[k, a])
+            if reach == np.inf or (bf >= 0 and best <= reach * reach):
+                break
+            r += 1
+        face_of[k] = bf
+
+
+class MeshSurface:
+    """A head mesh as the surface the frozen brushes slide roots on
+    (:class:`hairtool.frozen.slide.Surface`): the closest point of the mesh and the smooth normal
+    there (the vertex normals interpolated barycentrically, the face's own normal where they
+    cancel)."""
+
+    def __init__(self, mesh: Mesh) -> None:
+        if len(mesh.faces) == 0:
+            raise ParameterError("scalp", "a mesh without faces", "a mesh with at least one triangle")
+        if not np.all(np.isfinite(mesh.vertices)):
+            raise ParameterError("scalp", "a mesh with non-finite vertices", "finite vertex coordinates")
+        self.mesh = mesh
+        self._v = mesh.vertices.astype(np.float64)
+        self._n = mesh.normals.astype(np.float64)
+        self._f = mesh.faces.astype(np.int64)
+        lo, hi = self._v.min(axis=0), self._v.max(axis=0)
+        self.cell = max(float((hi - lo).max()) / GRID_CELLS, 1e-12)
+        self.lo = lo - self.cell  # one cell of margin around the mesh
+        self.dims = (np.floor((hi - self.lo) / self.cell).astype(np.int64) + 2).clip(1, None)
+        self._start = np.zeros(int(np.prod(self.dims)) + 1, np.int64)
+        _bin_faces(self._v, self._f, self.lo, self.cell, self.dims, self._start, np.zeros(0, np.int64))
+        np.cumsum(self._start, out=self._start)
+        self._items = np.empty(int(self._start[-1]), np.int64)
+        _bin_faces(self._v, self._f, self.lo, self.cell, self.dims, self._start, self._items)
+
+    def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`closest_points` through the grid of faces (the same bytes): ``(P, 3)`` points
+        and ``(P,)`` faces, face −1 (and NaN points) for points outside the mesh's box (plus a
+        cell), which lie outside the head."""
+        pts = np.ascontiguousarray(points, np.float64)
+        out = np.full_like(pts, np.nan)
+        face_of = np.empty(len(pts), np.int64)
+        _grid_closest_kernel(
+            pts, self._v, self._f, self.lo, self.cell, self.dims, self._start, self._items, out, face_of
+        )
+        return out, face_of
+
+    def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(P, 3)`` float64 closest points on the mesh and ``(P, 3)`` unit normals there."""
+        q, face = self.nearest(points)
+        far = face < 0
+        if far.any():
+            q[far], face[far] = closest_points(self.mesh, np.asarray(points, np.float64)[far])
+        return q, self._normals(q, face)
+
+    def signed_distance(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(P,)`` signed distance to the head (< 0 inside: behind the surface's normal at the
+        closest point), the closest points and the normals there; points outside the mesh's box
+        get +inf (and NaN points and normals)."""
+        pts = np.asarray(points, np.float64)
+        q, face = self.nearest(pts)
+        n = np.full_like(q, np.nan)
+        near = face >= 0
+        n[near] = self._normals(q[near], face[near])
+        sd = np.full(len(pts), np.inf)
+        sd[near] = np.einsum("ij,ij->i", pts[near] - q[near], n[near])
+        return sd, q, n
+
+    def ray_hit(self, origin, direction) -> np.ndarray | None:
+        """The first point where the ray from ``origin`` along ``direction`` meets the mesh
+        (Möller–Trumbore over every face, vectorised), or None: what a brush on the head
+        touches under the mouse."""
+        o, d = np.asarray(origin, np.float64), np.asarray(direction, np.float64)
+        tri = self._f
+        a, b, c = self._v[tri[:, 0]], self._v[tri[:, 1]], self._v[tri[:, 2]]
+        e1, e2 = b - a, c - a
+        p = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        t0 = o - a
+        u = np.einsum("ij,ij->i", t0, p) * inv
+        q = np.cross(t0, e1)
+        v = (q @ d) * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
+        if not hit.any():
+            return None
+        return o + float(t[hit].min()) * d
+
+    def _normals(self, q: np.ndarray, face: np.ndarray) -> np.ndarray:
+        tri = self._f[face]
+        a, b, c = self._v[tri[:, 0]], self._v[tri[:, 1]], self._v[tri[:, 2]]
+        e0, e1, e2 = b - a, c - a, q - a
+        d00, d01, d11 = (e0 * e0).sum(1), (e0 * e1).sum(1), (e1 * e1).sum(1)
+        d20, d21 = (e2 * e0).sum(1), (e2 * e1).sum(1)
+        den = d00 * d11 - d01 * d01
+        ok = np.abs(den) > 1e-300
+        den = np.where(ok, den, 1.0)
+        v = np.where(ok, (d11 * d20 - d01 * d21) / den, 1.0 / 3.0)
+        w = np.where(ok, (d00 * d21 - d01 * d20) / den, 1.0 / 3.0)
+        u = 1.0 - v - w
+        nv = self._n
+        n = u[:, None] * nv[tri[:, 0]] + v[:, None] * nv[tri[:, 1]] + w[:, None] * nv[tri[:, 2]]
+        length = np.linalg.norm(n, axis=1)
+        flat = length < 1e-9
+        if flat.any():  # opposite vertex normals (a fold): the face's own
+            n[flat] = np.cross(e0[flat], e1[flat])
+            length[flat] = np.linalg.norm(n[flat], axis=1)
+        return n / np.maximum(length, 1e-300)[:, None]

@@ -500,7 +500,7 @@ def test_with_render_hair_brushes_act_on_the_guides_and_masked_guides_children_s
 
 
 def test_one_move_gives_its_sample_and_the_mirrored_one_for_every_brush():
-    from app.ui.brush_tool import BrushTool, brushes
+    from app.ui.brush_tool import SIGNED, BrushTool, brushes
     from hairtool.frozen.brushes import BRUSHES
     from hairtool.frozen.pipeline import AlignSample
 
@@ -516,7 +516,7 @@ def test_one_move_gives_its_sample_and_the_mirrored_one_for_every_brush():
             assert first.intensity == 0.8 and first.mode == "paper"
         else:
             assert first.brush == name and second.direction == (-0.1, 0.0, 0.0)
-            sign = -1.0 if name in ("length", "mask", "clump") else 1.0  # Ctrl inverts the signed ones
+            sign = -1.0 if name in SIGNED else 1.0  # Ctrl inverts the signed ones
             assert first.strength == sign * tool.strength[name]
     tool.set_brush("comb")
     assert tool.samples((0, 0, 0), (0, 0, 0), None, 0.0) == []  # a comb standing still does nothing

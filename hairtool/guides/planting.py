@@ -1,0 +1,74 @@
+"""New strands on a head, shaped like the strands around them: what the add brush plants.
+
+:class:`HeadSurface` is a :class:`~hairtool.guides.surface.MeshSurface` that also plants: N roots
+scattered uniformly over the disc of the brush's radius in the surface's tangent plane at the
+surface point closest to the cursor, each moved to the surface; then each new strand is built as
+a render-hair child of the groom's strands (:func:`~hairtool.guides.binding.bind_roots`: its k
+nearest strands' shapes carried in their root frames, blended by inverse distance), with no
+random length variation or frizz, so its length is the neighbours' (interpolated as the shape
+is). The draws come from the seed and the cursor's bytes, so one sample always plants the same
+strands and a replay the same bytes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from hairtool.errors import ParameterError
+from hairtool.groom import Groom
+from hairtool.guides.binding import DEFAULT_K, bind_roots
+from hairtool.guides.surface import MeshSurface
+
+MAX_PLANT = 1000  # strands one sample may plant
+
+
+def _generator(seed: int, cursor) -> np.random.Generator:
+    bits = np.asarray(cursor, np.float64).view(np.uint32)
+    return np.random.default_rng([int(seed) & 0xFFFFFFFF, *(int(b) for b in bits), 0xADD])
+
+
+def _basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    a = np.eye(3)[int(np.argmin(np.abs(n)))]
+    u = np.cross(n, a)
+    u /= np.linalg.norm(u)
+    return u, np.cross(n, u)
+
+
+class HeadSurface(MeshSurface):
+    """A head mesh the brushes slide on, collide with and plant strands on."""
+
+    def plant(
+        self,
+        groom: Groom,
+        cursor,
+        radius: float,
+        count: int,
+        seed: int,
+        view=None,
+    ) -> Groom | None:
+        """``count`` new strands around the surface point closest to ``cursor`` (module
+        docstring), or None where the surface there faces away from a camera looking along
+        ``view``."""
+        if isinstance(count, bool) or int(count) != count or not 1 <= count <= MAX_PLANT:
+            raise ParameterError("count", count, f"a whole number of strands in [1, {MAX_PLANT}]")
+        c = np.asarray(cursor, np.float64).reshape(1, 3)
+        q, n = self.project(c)
+        if view is not None and float(n[0] @ np.asarray(view, np.float64)) > 0:
+            return None
+        u, v = _basis(n[0])
+        rng = _generator(seed, cursor)
+        r = radius * np.sqrt(rng.random(int(count)))
+        t = 2.0 * np.pi * rng.random(int(count))
+        roots, _ = self.project(q[0] + r[:, None] * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v))
+        return self.grow(groom, roots)
+
+    def grow(self, groom: Groom, roots: np.ndarray) -> Groom:
+        """New strands at ``roots`` shaped like the groom's strands around them (render-hair
+        children of them with no random length variation or frizz), in the order of ``roots``."""
+        roots = np.asarray(roots, np.float64)
+        k = min(DEFAULT_K, groom.strand_count)
+        binding = bind_roots(groom, roots, k=k, length_variation=0.0, frizz=0.0)
+        built = binding.build(groom)
+        # the binding orders children by their nearest strand: back to the order asked for
+        order = np.argsort(np.argmin(((binding.roots[:, None, :] - roots[None]) ** 2).sum(-1), axis=1))
+        return built.subset(order)
