@@ -236,10 +236,10 @@ class MainWindow(QMainWindow):
         file = bar.addMenu("&File")
         new = file.addMenu("&New from sample")
         sintel = self.open_bundled_sample
-        add_action(self, new, "Sintel (hair and head)", sintel, QKeySequence.StandardKey.New)
+        add_action(self, new, "Sintel (hair and head)", self._asking(sintel), QKeySequence.StandardKey.New)
         new.addSeparator()
         for kind in samples.SAMPLES:
-            add_action(self, new, kind.capitalize(), lambda _=False, k=kind: self.new_from_sample(k))
+            add_action(self, new, kind.capitalize(), self._asking(lambda k=kind: self.new_from_sample(k)))
         add_action(self, file, "&Open…", self.open_dialog, QKeySequence.StandardKey.Open)
         self.recent_menu = file.addMenu("Open &Recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
@@ -385,27 +385,44 @@ class MainWindow(QMainWindow):
         menus["&View"].addAction(self.sources.dock.toggleViewAction())
 
     def ask_save_changes(self) -> str:
-        """The answer to unsaved changes: "save", "discard" or "cancel" (tests replace this)."""
-        box = QMessageBox.question(
-            self,
+        """The one question before changed work is replaced (Open, Open Project, New, a drop,
+        Quit): "save", "discard" or "cancel" (tests replace this)."""
+        name = self.scene.path.name if self.scene.path is not None else "The untitled groom"
+        buttons = QMessageBox.StandardButton
+        box = QMessageBox(
+            QMessageBox.Icon.Question,
             "Unsaved changes",
-            "The project has unsaved changes. Save them first?",
-            QMessageBox.StandardButton.Save
-            | QMessageBox.StandardButton.Discard
-            | QMessageBox.StandardButton.Cancel,
+            f"{name} has changes that are not saved. Save them first?",
+            buttons.Save | buttons.Discard | buttons.Cancel,
+            self,
         )
-        return {QMessageBox.StandardButton.Save: "save", QMessageBox.StandardButton.Discard: "discard"}.get(
-            box, "cancel"
-        )
+        box.setInformativeText("Discard loses them; Cancel goes back to the work.")
+        box.setDefaultButton(buttons.Save)
+        box.setEscapeButton(buttons.Cancel)
+        answer = box.exec()
+        return {buttons.Save: "save", buttons.Discard: "discard"}.get(buttons(answer), "cancel")
 
     def ask_restore_recovery(self, path: str) -> bool:
-        """Restore the autosave a crashed session left? (tests replace this)"""
-        answer = QMessageBox.question(
-            self,
-            "Restore autosaved work",
-            f"Hairtool Studio did not close properly last time. Restore the autosaved session?\n{path}",
-        )
-        return answer == QMessageBox.StandardButton.Yes
+        """Restore the autosave a crashed session left (True), or discard it (tests replace this)."""
+        from app.ui.project_ui import recovery_question
+
+        buttons = QMessageBox.StandardButton
+        box = QMessageBox(QMessageBox.Icon.Question, "Restore autosaved work", recovery_question(path),
+                          buttons.NoButton, self)  # fmt: skip
+        restore = box.addButton("Restore", QMessageBox.ButtonRole.AcceptRole)
+        box.addButton(buttons.Discard)
+        box.setDefaultButton(restore)
+        box.exec()
+        return box.clickedButton() is restore
+
+    def _asking(self, action: Callable[[], object]) -> Callable[..., None]:
+        """A menu action that replaces the work: it runs once changed work was saved or discarded."""
+
+        def run(*_: object) -> None:
+            if self.project.confirm_discard():
+                action()
+
+        return run
 
     def ask_simulate_options(self, options: SimulateOptions) -> SimulateOptions | None:
         """The Simulate… dialog: SimulateOptions or None (tests replace this)."""
@@ -422,7 +439,7 @@ class MainWindow(QMainWindow):
     def _fill_recent_menu(self) -> None:
         self.recent_menu.clear()
         for path in self.recent_files():
-            self.recent_menu.addAction(path, lambda p=path: self.open_path(p))
+            self.recent_menu.addAction(path, self._asking(lambda p=path: self.open_path(p)))
         self.recent_menu.setEnabled(True)
 
     # -- status bar --------------------------------------------------------------------------
@@ -613,6 +630,7 @@ class MainWindow(QMainWindow):
             if dense:
                 self.set_groom(guides)
                 self.scene.set_binding(binding)
+                self.undo_stack.resetClean()  # new guides, not saved anywhere yet
                 n, g = binding.child_count, guides.strand_count
                 self.statusBar().showMessage(f"{n:,} strands follow {g:,} guides picked among them", 5000)
             else:
@@ -628,6 +646,9 @@ class MainWindow(QMainWindow):
             self.undo_stack.push(step)
 
     def open_dialog(self) -> None:
+        """File ▸ Open: asks about changed work first (Cancel opens nothing)."""
+        if not self.project.confirm_discard():
+            return
         path = self.ask_open_path()
         if path:
             self.open_path(path)
@@ -745,4 +766,5 @@ class MainWindow(QMainWindow):
         files = [u.toLocalFile() for u in event.mimeData().urls() if u.isLocalFile()]
         if files:
             event.acceptProposedAction()
-            self.open_path(files[0])
+            if self.project.confirm_discard():
+                self.open_path(files[0])
