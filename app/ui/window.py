@@ -43,6 +43,7 @@ from app.ui.stroke_files import StrokeFiles
 from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
 from app.ui.viewport import BRUSH_STEP, Viewport
+from app.ui.widgets import WheelGuard, keep_controls_put
 from hairtool import io, samples
 from hairtool.errors import HairtoolError
 from hairtool.groom import Animation, Groom
@@ -107,6 +108,9 @@ class MainWindow(QMainWindow):
         )
         self.resize(*fitting_size(self.screen().availableGeometry().size()))
         self._default_layout = (self.saveState(), self.size())
+        self._wheel_guard = WheelGuard(self)
+        for dock in self.findChildren(QDockWidget):  # a passing wheel scrolls the dock instead
+            keep_controls_put(dock, self._wheel_guard)
 
         self.viewport.stroke_started.connect(self._on_stroke_started)
         self.viewport.stroke_finished.connect(self._on_stroke_finished)
