@@ -22,7 +22,7 @@ from app.ui.legend import magnitude_colors
 from hairtool.errors import GroomError, HairtoolError, ParameterError
 from hairtool.groom import Animation
 from hairtool.keys import session as ks
-from hairtool.keys.dp import uniform_keys
+from hairtool.keys.dp import keys_cost, uniform_keys
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at
 
 VIEW_MODES = {
@@ -358,6 +358,17 @@ class AnimationModel(QObject):
         new = self.settings.replace(pins=tuple(pins), excludes=tuple(excl))
         new.constraints.check(max(self.n_frames, 2))
         return new.pins, new.excludes
+
+    def key_errors(self) -> tuple[float, float] | None:
+        """The objective the solve minimised, of the DP keys and of uniform keys of the same
+        count: E = Σ e_ij (total) or max e_ij (worst frame) over the key segments of the cost
+        table, in seed 000's feature space (:func:`hairtool.keys.dp.keys_cost`). Pins and
+        exclusions can only raise the DP keys' E. None before a solve."""
+        s = self.key_solve
+        if s is None or self.dp_keys is None or self.uniform_keys is None:
+            return None
+        dp, uniform = (keys_cost(s.table, k, s.objective) for k in (self.dp_keys, self.uniform_keys))
+        return dp, uniform
 
     def set_key_count(self, count: int) -> None:
         """Exactly ``count`` DP keys (switches to the key-count mode)."""
