@@ -31,6 +31,7 @@ VIEW_MODES = {
     "ghost": "Both (reconstruction in cyan behind)",
     "error": "Colour by key error",
 }
+DEFAULT_FPS = 24.0  # the playback (and recording) rate of a document without an animation
 INLINE_VALUES = 3_000_000  # animations up to this many coordinates are solved on the GUI thread
 
 
@@ -80,7 +81,7 @@ class AnimationModel(QObject):
         self.source = ""
         self.generation = 0  # counts loaded animations (undo steps of an older one do nothing)
         self.frame = 0
-        self.fps = 24.0
+        self.fps = DEFAULT_FPS
         self.playing = False
         self.loop = True
         self.settings = ks.KeySettings()
@@ -162,6 +163,18 @@ class AnimationModel(QObject):
         self._clear_keys()
         self._committed = None
         self._announce_new_animation()
+
+    def reset(self) -> None:
+        """A new document: no animation, and the frame rate and key settings back to their
+        defaults (a BVH's 120 fps or the last groom's error budget are not the next one's; an
+        animation or a project brings its own)."""
+        self.clear()
+        if self.settings != ks.KeySettings():
+            self.settings = ks.KeySettings()
+            self.settings_changed.emit(self.settings)
+        if self.fps != DEFAULT_FPS:
+            self.fps = DEFAULT_FPS
+            self.fps_changed.emit(self.fps)
 
     def _announce_new_animation(self) -> None:
         """Everything depends on the animation: tell every listener it was reset."""

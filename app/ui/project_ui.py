@@ -148,7 +148,7 @@ class ProjectController(QObject):
         scene, model = w.scene, w.animation
         for job in w.jobs.active("simulate"):  # its result belongs to the scene being replaced
             w.jobs.cancel(job)
-        model.clear()
+        model.reset()  # frame rate and key settings: the project's own, or the defaults
         w.undo_stack.clear()
         scene.load(project.rest, path, params=project.params)
         scene.restore(project.stroke_snapshot(scene.pipeline))

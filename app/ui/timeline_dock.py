@@ -143,7 +143,7 @@ class KeyControls(QWidget):
         self.summary.setToolTip(SUMMARY_TIP)
         form.addRow(self.summary)
 
-        self.mode.activated.connect(lambda _i: self._set(mode=self.mode.currentData()))
+        self.mode.activated.connect(lambda _i: self._set_mode(self.mode.currentData()))
         self.count_slider.valueChanged.connect(lambda v: self._set(mode="count", count=int(v)))
         self.count_spin.valueChanged.connect(lambda v: self._set(mode="count", count=int(v)))
         self.tau.edited.connect(lambda v, _d: self._set(mode="tau", tau=float(v)))
@@ -173,6 +173,21 @@ class KeyControls(QWidget):
             self.report("Invalid key setting", str(e))
             self.refresh()
 
+    def _set_mode(self, mode: str) -> None:
+        """Switching to the error budget starts from the current keys' error, so the keys stay."""
+        solved = self.model.key_errors()
+        if mode == "budget" and self.model.settings.mode != "budget" and solved is not None:
+            self._set(mode="budget", budget=solved[0])
+        else:
+            self._set(mode=mode)
+
+    def budget_shown(self) -> float:
+        """The budget field: the budget itself in budget mode; otherwise the current keys' solved
+        error (in the units of the current interpolation's table), which is the budget that
+        keeps them, so the field never shows a figure of another table or a clamped default."""
+        s, solved = self.model.settings, self.model.key_errors()
+        return s.budget if s.mode == "budget" or solved is None else solved[0]
+
     def _set_view(self, mode: str) -> None:
         self.model.set_view_mode(mode)
 
@@ -195,9 +210,10 @@ class KeyControls(QWidget):
                 positive = curve[curve > 0]
                 lo = max(float(positive.min()) * 0.1, 1e-9) if positive.size else 1e-6
                 hi = max(float(curve.max()) * 2.0, lo * 10.0)
-                self.budget.set_range(lo, hi)
+                shown = self.budget_shown()  # within the range: never clamped to another value
+                self.budget.set_range(min(lo, shown) if shown > 0 else lo, max(hi, shown))
             self.tau.set_value(s.tau)
-            self.budget.set_value(s.budget)
+            self.budget.set_value(self.budget_shown())
             self.objective.setCurrentIndex(self.objective.findData(s.objective))
             self.interp.setCurrentIndex(self.interp.findData(s.interp))
             self.samples.setValue(s.samples)

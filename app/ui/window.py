@@ -11,12 +11,11 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QSettings, QSize, Qt
+from PySide6.QtCore import QEvent, QSettings, QSize, Qt
 from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QKeySequence, QUndoStack
 from PySide6.QtWidgets import (
     QDockWidget,
     QFileDialog,
-    QLabel,
     QMainWindow,
     QMessageBox,
     QToolBar,
@@ -39,6 +38,7 @@ from app.ui.qt_utils import add_action
 from app.ui.render_hair_dialog import DENSE, GrowOptions, ask_grow_options, grow
 from app.ui.scene import COLOUR_MODES, Scene
 from app.ui.simulate_dialog import ask_simulate_options
+from app.ui.status_line import ElidedLabel, StatusLine
 from app.ui.stroke_files import StrokeFiles
 from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
@@ -79,6 +79,7 @@ class MainWindow(QMainWindow):
         engine; :meth:`start_warmup` compiles them in the background and then starts it."""
         super().__init__(parent)
         self.setObjectName("HairtoolStudio")
+        self.setStatusBar(StatusLine(self))  # first: messages are never painted over its widgets
         self.settings = settings if settings is not None else QSettings(SETTINGS_ORG, SETTINGS_APP)
         self.undo_stack = QUndoStack(self)
         self._shown_once = False
@@ -118,6 +119,7 @@ class MainWindow(QMainWindow):
         self.viewport.engine_wait.connect(lambda: self.statusBar().showMessage(WAIT_MESSAGE, 4000))
         self.viewport.frame_drawn.connect(self._update_frame_time)
         self.dock.param_edited.connect(self._on_param_edited)
+        self.scene.groom_loaded.connect(self._on_document_changed)
         self.scene.groom_loaded.connect(self._update_counts)
         self.scene.drawn_changed.connect(self._update_counts)
         self.scene.groom_loaded.connect(self._update_legend)
@@ -195,6 +197,7 @@ class MainWindow(QMainWindow):
     def _bind_pending_render_hair(self) -> None:
         pending, self._pending_render_hair = self._pending_render_hair, None
         if pending is not None:
+            self.statusBar().set_note("render hair", None)
             pending()
 
     def reset_layout(self) -> None:
@@ -448,12 +451,15 @@ class MainWindow(QMainWindow):
 
     # -- status bar --------------------------------------------------------------------------
     def _build_status_bar(self) -> None:
+        """Counts, then the message (:class:`StatusLine`), then the read-outs, the jobs' progress,
+        the legend and the playback rate; every text shortens itself before it would overlap."""
         bar = self.statusBar()
-        self.counts_label = QLabel()
-        self.frame_label = QLabel()
-        self.cursor_label = QLabel()
-        bar.addWidget(self.counts_label)
-        bar.addWidget(self.frame_label)
+        self.counts_label = ElidedLabel(min_width=60)
+        self.frame_label = ElidedLabel(min_width=40)
+        self.frame_label.setObjectName("FrameTime")
+        self.cursor_label = ElidedLabel(min_width=40)
+        bar.insertWidget(0, self.counts_label)
+        bar.addWidget(self.frame_label)  # beside the message: both shorten when space is short
         bar.addPermanentWidget(self.cursor_label)
         self.job_status = JobStatus(self.jobs)
         bar.addPermanentWidget(self.job_status)
@@ -486,13 +492,29 @@ class MainWindow(QMainWindow):
             text = f"{g.strand_count:,} guides · {b.child_count:,} children · {b.vertex_count:,} vertices"
         self.counts_label.setText(text)
 
+    def _on_document_changed(self) -> None:
+        """Another groom opened: the status line forgets the last one (its messages, its frame
+        times: the pipeline time of its last stroke is not this groom's)."""
+        self.statusBar().clear_document()
+        self.scene.last_update_ms = 0.0
+        self.frame_label.setText("")
+        self.cursor_label.setText("")
+
+    def event(self, event: QEvent) -> bool:
+        if event.type() == QEvent.Type.StatusTip:  # a menu entry's tip: through the status line
+            if event.tip():
+                self.statusBar().showMessage(event.tip(), 4000)
+            return True
+        return super().event(event)
+
     def _update_frame_time(self) -> None:
         v, s = self.viewport, self.scene
         total = s.last_update_ms + v.last_upload_ms + v.last_draw_ms
-        self.frame_label.setText(
-            f"update {total:.1f} ms (pipeline {s.last_update_ms:.1f}, upload {v.last_upload_ms:.1f}, "
-            f"draw {v.last_draw_ms:.1f})"
+        self.frame_label.detail = (
+            f"the last update: engine pipeline {s.last_update_ms:.1f} ms, upload to the GPU "
+            f"{v.last_upload_ms:.1f} ms, draw {v.last_draw_ms:.1f} ms"
         )
+        self.frame_label.setText(f"update {total:.1f} ms")
 
     def _on_cursor_moved(self, cursor) -> None:
         if cursor is None:
@@ -536,7 +558,7 @@ class MainWindow(QMainWindow):
     def set_groom(self, groom: Groom, path: str | os.PathLike[str] | None = None) -> None:
         """Show a new groom; its strokes start afresh, so the undo history is cleared (and an
         animation on the timeline is closed)."""
-        self.animation.clear()
+        self.animation.reset()  # the last document's frame rate and key settings are not this one's
         self.undo_stack.clear()
         self._pending_render_hair = None  # the bundled sample's children, not this groom's
         self.scene.load(groom, path)
@@ -584,7 +606,7 @@ class MainWindow(QMainWindow):
             bind()
         else:
             self._pending_render_hair = bind
-            self.statusBar().showMessage(waiting)
+            self.statusBar().set_note("render hair", waiting)
 
     def _open_with_guides(self, hair: Groom, guides: Groom, path: str | os.PathLike[str]) -> None:
         """A file of render hair and its guides (as the studio saves it): the brushes work on the
