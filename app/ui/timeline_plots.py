@@ -535,6 +535,16 @@ class KeyCountPlot(QWidget):
         y = r.bottom() - r.height() * (math.log10(max(v, 10**lo)) - lo) / (hi - lo)
         return QPointF(x, y)
 
+    def current_point(self) -> tuple[int, float] | None:
+        """The marked point: the current key count and its optimal error on the curve (the
+        curve starts at the fewest keys the pins allow, not always at 2)."""
+        s, keys = self.model.key_solve, self.model.dp_keys
+        if s is None or keys is None:
+            return None
+        curve = s.curve
+        row = np.flatnonzero(curve[:, 0] == keys.size)
+        return (int(keys.size), float(curve[row[0], 1])) if row.size else None
+
     def mousePressEvent(self, event: QMouseEvent) -> None:
         if event.button() == Qt.MouseButton.LeftButton and self.model.key_solve is not None:
             self.model.set_key_count(self.count_at(event.position().x()))
@@ -582,8 +592,9 @@ class KeyCountPlot(QWidget):
         p.setPen(QPen(DP_COLOUR, 1.6))
         p.drawPath(path)
         keys = self.model.dp_keys
-        if keys is not None and 2 <= keys.size <= s.kmax:
-            pt = self._point(keys.size, curve[keys.size - 2, 1], lo, hi)
+        current = self.current_point()
+        if current is not None:
+            pt = self._point(current[0], current[1], lo, hi)
             p.setPen(QPen(PLAYHEAD, 1.0))
             p.drawLine(QPointF(pt.x(), r.top()), QPointF(pt.x(), r.bottom()))
             p.setBrush(PLAYHEAD)

@@ -101,3 +101,11 @@ def test_the_key_error_shown_is_the_objective_solved_and_steering_only_raises_it
     assert "moved away" in view.tooltip_at(QPointF(view.frame_to_x(moved), y))
     assert "pinned" in view.tooltip_at(QPointF(view.frame_to_x(pinned), y))
     assert "never a key" in w.timeline.legend.text()
+
+
+def test_the_curve_marks_the_solved_error_of_the_current_count_under_pins(make_window):
+    w, m, _ = _open(make_window, WALK)
+    m.set_settings(pins=(40, 90, 150, 210, 300))  # at least 7 keys: the curve starts at 7
+    m.set_key_count(9)
+    assert m.key_solve.curve[0, 0] == 7
+    assert w.timeline.plot.current_point() == (9, m.key_errors()[0])
