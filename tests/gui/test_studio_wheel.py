@@ -7,7 +7,9 @@ import pytest
 from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtGui import QWheelEvent
 from PySide6.QtTest import QTest
-from PySide6.QtWidgets import QApplication, QScrollArea
+from PySide6.QtWidgets import QApplication, QDockWidget, QScrollArea
+
+from app.ui.widgets import WHEEL_CONTROLS
 
 pytestmark = pytest.mark.gui
 
@@ -43,5 +45,6 @@ def test_a_wheel_over_wave_length_scrolls_the_anime_dock_until_it_is_clicked(mak
     before = scroll.value()
     wheel(dock.k.spin, 1)
     assert dock.k.value() != length and scroll.value() == before  # focused: the wheel is its own
-    timeline_count = w.timeline.controls.count_slider
-    assert timeline_count.focusPolicy() == Qt.FocusPolicy.StrongFocus  # every dock is guarded
+    controls = [c for d in w.findChildren(QDockWidget) for t in WHEEL_CONTROLS for c in d.findChildren(t)]
+    assert len(controls) > 40  # the tool dock, the anime dock and the timeline's key controls
+    assert all(c.focusPolicy() == Qt.FocusPolicy.StrongFocus for c in controls)
