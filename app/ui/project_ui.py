@@ -249,13 +249,11 @@ class ProjectController(QObject):
         return answer == "discard"
 
     def save_changes(self) -> bool:
-        """The save the question's Save runs: the project when the work is one or holds an
-        animation made here (a groom file cannot keep it), else the groom file's own Save
-        (which asks for a name when it has none or is a read-only format)."""
+        """The save the question's Save runs: the project when the work is one, is untitled or
+        holds an animation (Save writes a static groom: an edited capture or a cycle made here
+        would be lost), else the groom file's own Save (Save As for a format it cannot write)."""
         w = self.window
-        model = w.animation
-        made_here = model.animation is not None and model.source in MADE_IN_STUDIO
-        if self.path is not None or made_here or w.scene.path is None:
+        if self.path is not None or w.animation.animation is not None or w.scene.path is None:
             return self.save_project()
         return w.save()
 

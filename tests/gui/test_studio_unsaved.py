@@ -80,6 +80,14 @@ def test_save_runs_the_normal_save_before_opening(ui, make_window, tmp_path):
     assert w.scene.path.name == "ponytail_tail.tfx" and w.errors == []
     np.testing.assert_allclose(io.read_groom(path).points, edited, atol=1e-6)
 
+    assert w.open_path("tests/data/motion/freebvh.bvh")  # a capture: its keys steered
+    key = int(w.animation.dp_keys[1])
+    assert w.animation_ui.steer_keys(f"Pin key {key}", pin=key) and not w.undo_stack.isClean()
+    project = tmp_path / "walk.hairproj"
+    w.ask_save_path = lambda title, filters, suggested="": str(project)
+    _drop(w, GROOM)  # Save keeps the animation: a project, not the static groom
+    assert project.is_file() and w.scene.path.name == "ponytail_tail.tfx" and w.errors == []
+
 
 def test_opening_a_file_asks_nothing_afterwards(ui, make_window):
     w = make_window(groom=samples.portrait(strands=12, vertices=6))
