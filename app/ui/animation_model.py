@@ -165,13 +165,17 @@ class AnimationModel(QObject):
         self._announce_new_animation()
 
     def reset(self) -> None:
-        """A new document: no animation, and the frame rate and key settings back to their
-        defaults (a BVH's 120 fps or the last groom's error budget are not the next one's; an
-        animation or a project brings its own)."""
+        """A new document: no animation, and the values that belong to a document back to their
+        defaults: the frame rate (a BVH's 120 fps is not the next groom's) and the key mode with
+        its error budget (a figure in the last animation's units). The method chosen stays
+        (interpolation, objective, features, the price per key, which is relative); an
+        animation or a project brings its own values."""
         self.clear()
-        if self.settings != ks.KeySettings():
-            self.settings = ks.KeySettings()
-            self.settings_changed.emit(self.settings)
+        d = ks.KeySettings()
+        new = self.settings.replace(mode=d.mode, count=0, budget=d.budget, pins=(), excludes=())
+        if new != self.settings:
+            self.settings = new
+            self.settings_changed.emit(new)
         if self.fps != DEFAULT_FPS:
             self.fps = DEFAULT_FPS
             self.fps_changed.emit(self.fps)

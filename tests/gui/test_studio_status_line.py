@@ -54,7 +54,7 @@ def test_opening_another_groom_clears_the_status_line(ui, make_window):
     assert "pipeline 633" not in w.frame_label.detail  # the last groom's stroke time is gone
 
 
-def test_new_from_sample_brings_its_own_frame_rate_and_key_settings(make_window):
+def test_new_from_sample_brings_its_own_frame_rate_and_error_budget(make_window):
     w = make_window()
     assert w.open_path(LONG)
     m = w.animation
@@ -62,7 +62,8 @@ def test_new_from_sample_brings_its_own_frame_rate_and_key_settings(make_window)
     assert m.fps == 120.0 and w.timeline.fps_spin.value() == 120.0
     w.new_from_sample("comb")
     assert m.animation is None and m.fps == 24.0 and w.timeline.fps_spin.value() == 24.0
-    assert m.settings.interp == "linear" and m.settings.mode == "count" and m.settings.budget == 1.0
+    assert m.settings.mode == "count" and m.settings.budget == 1.0  # the capture's numbers go
+    assert m.settings.interp == "hermite"  # the method chosen stays
     assert w.animation_ui.recorder is None
 
 
