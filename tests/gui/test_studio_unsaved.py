@@ -154,3 +154,16 @@ def test_after_a_crash_the_next_start_offers_the_autosave_with_its_time(
         w2.close()
         w2.deleteLater()
     assert not recovery.exists()  # a clean quit removes it
+
+
+def test_the_question_itself_names_the_work_and_maps_its_buttons(make_window, monkeypatch):
+    from app.ui.window import MainWindow
+
+    w = make_window()
+    assert w.open_path(GROOM)
+    shown, b = [], QMessageBox.StandardButton
+    for pressed, expected in ((b.Save, "save"), (b.Discard, "discard"), (b.Cancel, "cancel")):
+        answer = int(pressed.value)
+        monkeypatch.setattr(QMessageBox, "exec", lambda box, a=answer: shown.append(box.text()) or a)
+        assert MainWindow.ask_save_changes(w) == expected
+    assert all("ponytail_tail.tfx has changes that are not saved" in text for text in shown)
