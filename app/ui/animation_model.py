@@ -22,7 +22,7 @@ from app.ui.legend import magnitude_colors
 from hairtool.errors import GroomError, HairtoolError, ParameterError
 from hairtool.groom import Animation
 from hairtool.keys import session as ks
-from hairtool.keys.dp import uniform_keys
+from hairtool.keys.dp import keys_cost, uniform_keys
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at
 
 VIEW_MODES = {
@@ -31,6 +31,7 @@ VIEW_MODES = {
     "ghost": "Both (reconstruction in cyan behind)",
     "error": "Colour by key error",
 }
+DEFAULT_FPS = 24.0  # the playback (and recording) rate of a document without an animation
 INLINE_VALUES = 3_000_000  # animations up to this many coordinates are solved on the GUI thread
 
 
@@ -80,7 +81,7 @@ class AnimationModel(QObject):
         self.source = ""
         self.generation = 0  # counts loaded animations (undo steps of an older one do nothing)
         self.frame = 0
-        self.fps = 24.0
+        self.fps = DEFAULT_FPS
         self.playing = False
         self.loop = True
         self.settings = ks.KeySettings()
@@ -162,6 +163,22 @@ class AnimationModel(QObject):
         self._clear_keys()
         self._committed = None
         self._announce_new_animation()
+
+    def reset(self) -> None:
+        """A new document: no animation, and the values that belong to a document back to their
+        defaults: the frame rate (a BVH's 120 fps is not the next groom's) and the key mode with
+        its error budget (a figure in the last animation's units). The method chosen stays
+        (interpolation, objective, features, the price per key, which is relative); an
+        animation or a project brings its own values."""
+        self.clear()
+        d = ks.KeySettings()
+        new = self.settings.replace(mode=d.mode, count=0, budget=d.budget, pins=(), excludes=())
+        if new != self.settings:
+            self.settings = new
+            self.settings_changed.emit(new)
+        if self.fps != DEFAULT_FPS:
+            self.fps = DEFAULT_FPS
+            self.fps_changed.emit(self.fps)
 
     def _announce_new_animation(self) -> None:
         """Everything depends on the animation: tell every listener it was reset."""
@@ -358,6 +375,17 @@ class AnimationModel(QObject):
         new = self.settings.replace(pins=tuple(pins), excludes=tuple(excl))
         new.constraints.check(max(self.n_frames, 2))
         return new.pins, new.excludes
+
+    def key_errors(self) -> tuple[float, float] | None:
+        """The objective the solve minimised, of the DP keys and of uniform keys of the same
+        count: E = Σ e_ij (total) or max e_ij (worst frame) over the key segments of the cost
+        table, in seed 000's feature space (:func:`hairtool.keys.dp.keys_cost`). Pins and
+        exclusions can only raise the DP keys' E. None before a solve."""
+        s = self.key_solve
+        if s is None or self.dp_keys is None or self.uniform_keys is None:
+            return None
+        dp, uniform = (keys_cost(s.table, k, s.objective) for k in (self.dp_keys, self.uniform_keys))
+        return dp, uniform
 
     def set_key_count(self, count: int) -> None:
         """Exactly ``count`` DP keys (switches to the key-count mode)."""

@@ -10,9 +10,10 @@ import sys
 
 from PySide6.QtCore import QEventLoop, QObject, QProcess, Qt, Signal
 from PySide6.QtGui import QGuiApplication
-from PySide6.QtWidgets import QLabel, QProgressBar, QStatusBar
+from PySide6.QtWidgets import QProgressBar, QStatusBar
 
 from app.ui.scene import Scene
+from app.ui.status_line import ElidedLabel
 
 STARTUP_STEPS = 2  # the warm-up's steps the engine and the first paint need (the rest follow)
 WAIT_MESSAGE = "The hair engine is still being prepared (first start): strokes work in a moment"
@@ -31,11 +32,11 @@ class EngineStart(QObject):
     def __init__(self, scene: Scene, bar: QStatusBar, parent: QObject | None = None) -> None:
         super().__init__(parent)
         self.scene, self.bar = scene, bar
-        self.label = QLabel("Preparing the hair engine (first start)…")
+        self.label = ElidedLabel("Preparing the hair engine (first start)…", min_width=80)
         self.label.setObjectName("EngineLabel")
         self.progress = QProgressBar()
         self.progress.setObjectName("EngineProgress")
-        self.progress.setMaximumWidth(140)
+        self.progress.setFixedWidth(140)  # its own width: the percentage inside is never squeezed
         self.progress.setRange(0, 0)  # busy until the first step reports
         self.progress.setToolTip(
             "numba compiles the engine's kernels once, in the background; later starts load them"

@@ -33,8 +33,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from PySide6.QtCore import QElapsedTimer, QObject, QRunnable, Qt, QThreadPool, Signal, Slot
-from PySide6.QtWidgets import QApplication, QHBoxLayout, QLabel, QProgressBar, QToolButton, QWidget
+from PySide6.QtWidgets import QApplication, QHBoxLayout, QProgressBar, QToolButton, QWidget
 
+from app.ui.status_line import ElidedLabel
 from hairtool.errors import Cancelled, HairtoolError
 
 ProgressFn = Callable[..., None]
@@ -217,9 +218,9 @@ class JobStatus(QWidget):
         self.runner = runner
         layout = QHBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        self.label = QLabel()
+        self.label = ElidedLabel(min_width=60)
         self.bar = QProgressBar()
-        self.bar.setFixedWidth(140)
+        self.bar.setFixedWidth(140)  # its own width: the percentage inside is never squeezed
         self.bar.setMaximumHeight(16)
         self.bar.setRange(0, 1000)
         self.cancel_button = QToolButton()

@@ -1,10 +1,13 @@
 """Projects in the studio: Save Project / Open Project, the unsaved-changes question on close,
 autosave to a recovery file, and the offer to restore it after a crash.
 
-The file format is :mod:`hairtool.project`. Unsaved changes are the ones a user would lose:
-strokes and parameter edits (the undo stack is not clean), and an animation made or edited in
-the studio (anime cycle, simulation, recording, key edits) since the project was last saved or
-opened. The recovery file lives beside the settings file (an INI file, as in tests) or in
+The file format is :mod:`hairtool.project`. "Changed since the last save" has one meaning, the
+undo stack's clean state: strokes, parameter edits, key edits and dope-sheet steps are undo
+steps, and an animation made in the studio (anime cycle, simulation, recording) or restored
+from the recovery file leaves the clean state for good (``QUndoStack.resetClean``) until the
+next save. Saving, opening and New set it clean again.
+
+The recovery file lives beside the settings file (an INI file, as in tests) or in
 ``QStandardPaths.AppDataLocation``; it is written on a timer from a plain thread (the groom and
 animation are immutable arrays, so the GUI never waits for the disk) and removed on a clean
 close. Found at start-up with the last session not marked as closed cleanly, it is offered
@@ -16,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import threading
+from datetime import datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -43,6 +47,20 @@ def recovery_folder(settings: QSettings) -> Path:
     return Path(QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation))
 
 
+def recovery_question(path: str | os.PathLike[str], now: datetime | None = None) -> str:
+    """The recovery offer in words: when the work was autosaved (the file's time) and where."""
+    saved = datetime.fromtimestamp(Path(path).stat().st_mtime)
+    now = now or datetime.now()
+    if saved.date() == now.date():
+        when = f"today at {saved:%H:%M}"
+    else:
+        when = f"on {saved.day} {saved:%B %Y} at {saved:%H:%M}"
+    return (
+        f"Hairtool Studio did not close properly last time. Its work was autosaved {when}.\n"
+        f"Restore it? Discard deletes the autosave.\n\n{path}"
+    )
+
+
 class ProjectController(QObject):
     """Owned by the window (``window.project``); see the module docstring."""
 
@@ -53,7 +71,6 @@ class ProjectController(QObject):
         super().__init__(window)
         self.window, self.sources = window, sources
         self.path: Path | None = None
-        self._anim_dirty = False
         self._changes = 0  # counts edits; autosave writes when it moved since the last autosave
         self._autosaved_at = 0
         self._autosave_thread: threading.Thread | None = None
@@ -65,7 +82,6 @@ class ProjectController(QObject):
         window.scene.groom_loaded.connect(self._forget_path)
         model = window.animation
         model.animation_changed.connect(self._on_animation_changed)
-        model.frames_edited.connect(lambda *_: self._mark_animation())
         self.timer = QTimer(self)
         self.timer.setInterval(max(int(autosave_ms), 1000))
         self.timer.timeout.connect(self.autosave)
@@ -84,7 +100,8 @@ class ProjectController(QObject):
         self._changes += 1
 
     def _mark_animation(self) -> None:
-        self._anim_dirty = True
+        """Work no undo step holds (an animation made here): unsaved until the next save."""
+        self.window.undo_stack.resetClean()
         self._changed()
 
     def _on_animation_changed(self) -> None:
@@ -95,11 +112,10 @@ class ProjectController(QObject):
             self._changed()
 
     def has_unsaved_changes(self) -> bool:
-        return not self.window.undo_stack.isClean() or self._anim_dirty
+        return not self.window.undo_stack.isClean()
 
     def _mark_saved(self) -> None:
         self.window.undo_stack.setClean()
-        self._anim_dirty = False
 
     # -- building and applying -------------------------------------------------------------------
     def current_project(self) -> pf.Project:
@@ -141,7 +157,7 @@ class ProjectController(QObject):
         scene, model = w.scene, w.animation
         for job in w.jobs.active("simulate"):  # its result belongs to the scene being replaced
             w.jobs.cancel(job)
-        model.clear()
+        model.reset()  # frame rate and key settings: the project's own, or the defaults
         w.undo_stack.clear()
         scene.load(project.rest, path, params=project.params, mesh=project.mesh)
         scene.restore(project.stroke_snapshot(scene.pipeline))
@@ -233,13 +249,24 @@ class ProjectController(QObject):
 
     # -- closing -----------------------------------------------------------------------------
     def confirm_discard(self) -> bool:
-        """Ask about unsaved changes: True to go on (saved or discarded), False to stay."""
+        """Before work is replaced (Open, Open Project, New, a drop, Quit): ask Save / Discard /
+        Cancel when it changed since the last save. True to go on (saved or discarded), False to
+        stay (Cancel, or a save that was cancelled or failed)."""
         if not self.has_unsaved_changes():
             return True
         answer = self.window.ask_save_changes()
         if answer == "save":
-            return self.save_project()
+            return self.save_changes()
         return answer == "discard"
+
+    def save_changes(self) -> bool:
+        """The save the question's Save runs: the project when the work is one, is untitled or
+        holds an animation (Save writes a static groom: an edited capture or a cycle made here
+        would be lost), else the groom file's own Save (Save As for a format it cannot write)."""
+        w = self.window
+        if self.path is not None or w.animation.animation is not None or w.scene.path is None:
+            return self.save_project()
+        return w.save()
 
     def shutdown(self) -> None:
         """A clean close: no autosave any more, the recovery file removed, the exit marked clean."""
@@ -297,7 +324,7 @@ class ProjectController(QObject):
         path = self.recovery_path
         if not path.is_file():
             return False
-        if not self.window.ask_restore_recovery(str(path)):
+        if not self.window.ask_restore_recovery(str(path)):  # Discard
             path.unlink(missing_ok=True)
             return False
         try:
@@ -308,8 +335,7 @@ class ProjectController(QObject):
             return False
         self.apply(project, None)
         self.path = None
-        self._anim_dirty = True  # restored work is not saved anywhere yet
-        self._changed()
+        self._mark_animation()  # restored work is not saved anywhere yet
         self.window.statusBar().showMessage("restored the autosaved session; save it as a project", 8000)
         return True
 

@@ -30,7 +30,7 @@ from PySide6.QtWidgets import (
 
 from app.ui.animation_model import VIEW_MODES, AnimationModel
 from app.ui.qt_utils import signals_blocked
-from app.ui.timeline_plots import KeyCountPlot, TimelineView
+from app.ui.timeline_plots import KEY_LEGEND, KeyCountPlot, TimelineView
 from app.ui.widgets import SliderSpin, scrolling
 from hairtool.errors import HairtoolError
 from hairtool.keys.session import KEY_MODES
@@ -52,6 +52,17 @@ TRANSPORT = (
     "last",
     "loop",
     "record",
+)
+
+
+SUMMARY_TIP = (
+    "Solved key error: what the keys minimise, E = Σ e_ij over the key segments (the worst "
+    "frame: max e_ij), with e_ij = Σ_f ‖x_f − x̂_f‖² over the frames f between keys i and j, in "
+    "seed 000's feature space (M points per strand by arc length, mean root removed, relative to "
+    "each root, weighted root to tip; plus λ times the curvature term). Pins and moves can only "
+    "raise it. Mean and tip distance: |p − p̂| on the original vertices (tips alone), averaged "
+    "over vertices and frames, in scene units. The solve does not minimise them, so steering a "
+    "key may lower them while E rises."
 )
 
 
@@ -127,10 +138,12 @@ class KeyControls(QWidget):
         form.addRow("Curvature weight", self.curvature)
         form.addRow("View", self.view)
         self.summary = QLabel()
+        self.summary.setObjectName("KeySummary")
         self.summary.setWordWrap(True)
+        self.summary.setToolTip(SUMMARY_TIP)
         form.addRow(self.summary)
 
-        self.mode.activated.connect(lambda _i: self._set(mode=self.mode.currentData()))
+        self.mode.activated.connect(lambda _i: self._set_mode(self.mode.currentData()))
         self.count_slider.valueChanged.connect(lambda v: self._set(mode="count", count=int(v)))
         self.count_spin.valueChanged.connect(lambda v: self._set(mode="count", count=int(v)))
         self.tau.edited.connect(lambda v, _d: self._set(mode="tau", tau=float(v)))
@@ -160,6 +173,21 @@ class KeyControls(QWidget):
             self.report("Invalid key setting", str(e))
             self.refresh()
 
+    def _set_mode(self, mode: str) -> None:
+        """Switching to the error budget starts from the current keys' error, so the keys stay."""
+        solved = self.model.key_errors()
+        if mode == "budget" and self.model.settings.mode != "budget" and solved is not None:
+            self._set(mode="budget", budget=solved[0])
+        else:
+            self._set(mode=mode)
+
+    def budget_shown(self) -> float:
+        """The budget field: the budget itself in budget mode; otherwise the current keys' solved
+        error (in the units of the current interpolation's table), which is the budget that
+        keeps them, so the field never shows a figure of another table or a clamped default."""
+        s, solved = self.model.settings, self.model.key_errors()
+        return s.budget if s.mode == "budget" or solved is None else solved[0]
+
     def _set_view(self, mode: str) -> None:
         self.model.set_view_mode(mode)
 
@@ -182,9 +210,10 @@ class KeyControls(QWidget):
                 positive = curve[curve > 0]
                 lo = max(float(positive.min()) * 0.1, 1e-9) if positive.size else 1e-6
                 hi = max(float(curve.max()) * 2.0, lo * 10.0)
-                self.budget.set_range(lo, hi)
+                shown = self.budget_shown()  # within the range: never clamped to another value
+                self.budget.set_range(min(lo, shown) if shown > 0 else lo, max(hi, shown))
             self.tau.set_value(s.tau)
-            self.budget.set_value(s.budget)
+            self.budget.set_value(self.budget_shown())
             self.objective.setCurrentIndex(self.objective.findData(s.objective))
             self.interp.setCurrentIndex(self.interp.findData(s.interp))
             self.samples.setValue(s.samples)
@@ -206,10 +235,14 @@ class KeyControls(QWidget):
             self.summary.setText("solving keys…" if m.busy else "no keys")
             return
         text = f"{m.dp_keys.size} keys of {m.n_frames} frames"
+        solved = m.key_errors()
+        if solved is not None:
+            worst = "worst-frame " if m.key_solve.objective == "worst" else ""
+            text += f" · solved {worst}key error {solved[0]:.4g} (uniform keys {solved[1]:.4g})"
         a = m.analysis
         if a is not None:
             text += (
-                f" · mean error DP {a.dp.mean.mean():.4g} / uniform {a.uniform.mean.mean():.4g}"
+                f" · mean distance DP {a.dp.mean.mean():.4g} / uniform {a.uniform.mean.mean():.4g}"
                 f" · tip DP {a.dp.tip.mean():.4g} / uniform {a.uniform.tip.mean():.4g}"
             )
         if m.settings.constraints:
@@ -267,6 +300,16 @@ class TimelineDock(QDockWidget):
 
         split = QSplitter(Qt.Orientation.Horizontal)
         self.view = TimelineView(model, steer=steer)
+        self.legend = QLabel(KEY_LEGEND)  # what the dope sheet's marks mean, the red cross too
+        self.legend.setObjectName("KeyLegend")
+        self.legend.setWordWrap(True)
+        self.legend.setStyleSheet("color: #9aa0a8; font-size: 8pt")
+        sheet = QWidget()
+        sheet_layout = QVBoxLayout(sheet)
+        sheet_layout.setContentsMargins(0, 0, 0, 0)
+        sheet_layout.setSpacing(1)
+        sheet_layout.addWidget(self.view, 1)
+        sheet_layout.addWidget(self.legend)
         side = QWidget()
         side_layout = QVBoxLayout(side)
         side_layout.setContentsMargins(0, 0, 0, 0)
@@ -274,7 +317,7 @@ class TimelineDock(QDockWidget):
         self.plot = KeyCountPlot(model)
         side_layout.addWidget(self.controls)
         side_layout.addWidget(self.plot, 1)
-        split.addWidget(self.view)
+        split.addWidget(sheet)
         split.addWidget(scrolling(side))  # a short screen scrolls the key controls
         split.setChildrenCollapsible(False)
         self.split = split

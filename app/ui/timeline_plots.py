@@ -8,10 +8,12 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-from PySide6.QtCore import QPointF, QRect, QRectF, QSize, Qt
+from PySide6.QtCore import QEvent, QPointF, QRect, QRectF, QSize, Qt
 from PySide6.QtGui import (
     QColor,
     QFont,
+    QHelpEvent,
+    QKeyEvent,
     QMouseEvent,
     QPainter,
     QPainterPath,
@@ -20,8 +22,9 @@ from PySide6.QtGui import (
     QPixmap,
     QPolygonF,
     QResizeEvent,
+    QWheelEvent,
 )
-from PySide6.QtWidgets import QSizePolicy, QWidget
+from PySide6.QtWidgets import QApplication, QSizePolicy, QToolTip, QWidget
 
 from app.ui.animation_model import AnimationModel
 from hairtool.keys.dp import keys_cost, uniform_keys
@@ -38,6 +41,15 @@ PLAYHEAD = QColor(235, 64, 64)
 
 LEFT, RIGHT = 56, 12  # px margins; frames map linearly onto the width between them
 RULER_H, ROW_H = 22, 16
+ZOOM_STEP = 1.25  # one wheel notch with Ctrl: the frames shown shrink or grow by this factor
+MIN_SPAN = 8  # frames: the deepest zoom
+
+#: What the dope sheet's marks mean (the dock's legend and the view's tooltip say the same).
+KEY_LEGEND = (
+    "◆ DP key: click pins it, drag moves it · ○ pinned: always a key · "
+    "✕ never a key: a key was moved away from it (or Delete excluded it; Insert or undo frees it) · "
+    "□ uniform keys of the same count · Ctrl+wheel zoom, middle-drag pan, Home all frames"
+)
 
 
 def _nice_step(span: float, pixels: float, min_px: float = 50.0) -> int:
@@ -56,11 +68,14 @@ class TimelineView(QWidget):
     """Ruler, DP and uniform key rows, and the error and speed curves over frames.
 
     A left press or drag anywhere sets the frame (the viewport follows at once). The DP row is a
-    dope sheet when a ``steer`` callback is given: a click on a key pins or unpins it, dragging a
-    key moves it (the new frame pinned, the old one excluded; the other keys re-solve at once),
-    Delete excludes the current frame and Insert pins it. Everything but the playhead is drawn
-    once into a pixmap and reused until the keys, curves or size change, so a frame change
-    repaints in well under a millisecond.
+    dope sheet when a ``steer`` callback is given: a click on a key pins or unpins it (the mouse
+    may wander less than Qt's start-drag distance: at a thousand frames a pixel is more than a
+    frame), dragging a key moves it (the new frame pinned, the old one excluded, drawn as a
+    cross, so the solve cannot put the key straight back; the other keys re-solve at once),
+    Delete excludes the current frame and Insert pins it. Ctrl+wheel zooms about the cursor, a
+    middle drag (or the wheel, zoomed in) pans, Home shows every frame again. Everything but the
+    playhead is drawn once into a pixmap and reused until the keys, curves, view or size change,
+    so a frame change repaints in well under a millisecond.
     """
 
     def __init__(
@@ -73,6 +88,10 @@ class TimelineView(QWidget):
         self.model = model
         self.steer = steer
         self._grab: int | None = None  # the DP key pressed on, while the button is down
+        self._press_x = 0.0
+        self._dragging = False  # the grabbed key moved past the start-drag distance
+        self._view: tuple[float, float] | None = None  # first and last frame shown (None: all)
+        self._pan: tuple[float, tuple[float, float]] | None = None  # middle drag: start x, view
         self.setMinimumHeight(150)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
         self.setMouseTracking(False)
@@ -88,7 +107,9 @@ class TimelineView(QWidget):
             model.settings_changed,
         ):
             signal.connect(self.invalidate)
-        model.frame_changed.connect(self.update)
+        model.animation_changed.connect(self.show_all)
+        model.frame_changed.connect(self._follow_frame)
+        self.setToolTip(KEY_LEGEND)
 
     def invalidate(self, *_: object) -> None:
         self._cache = None
@@ -101,14 +122,67 @@ class TimelineView(QWidget):
     def sizeHint(self) -> QSize:
         return QSize(700, 190)
 
+    # -- the frames shown: zoom and pan ---------------------------------------------------------
+    @property
+    def view_range(self) -> tuple[float, float]:
+        """The first and last frame across the width (every frame unless zoomed in)."""
+        return self._view if self._view is not None else (0.0, float(max(self.model.n_frames - 1, 1)))
+
+    @property
+    def zoomed(self) -> bool:
+        return self._view is not None
+
+    def set_view(self, first: float, last: float) -> None:
+        """Show frames ``first .. last`` (kept inside the animation, at least :data:`MIN_SPAN`)."""
+        n = float(max(self.model.n_frames - 1, 1))
+        span = min(max(last - first, min(MIN_SPAN, n)), n)
+        first = min(max(first, 0.0), n - span)
+        view = None if span >= n else (first, first + span)
+        if view != self._view:
+            self._view = view
+            self.invalidate()
+
+    def show_all(self) -> None:
+        self.set_view(0.0, float(max(self.model.n_frames - 1, 1)))
+
+    def zoom(self, factor: float, about_x: float) -> None:
+        """Zoom by ``factor`` (> 1: fewer frames across) keeping the frame under ``about_x`` put."""
+        v0, v1 = self.view_range
+        at = self._x_to_f(about_x)
+        self.set_view(at - (at - v0) / factor, at + (v1 - at) / factor)
+
+    def pan(self, frames: float) -> None:
+        v0, v1 = self.view_range
+        self.set_view(v0 + frames, v1 + frames)
+
+    def _follow_frame(self, frame: int) -> None:
+        """Zoomed in, a frame outside the view (playback, the arrows) brings the view with it."""
+        v0, v1 = self.view_range
+        margin = 0.1 * (v1 - v0)  # the frame lands a tenth of the view inside the edge it crossed
+        if self.zoomed and frame < v0:
+            self.pan(frame - margin - v0)
+        elif self.zoomed and frame > v1:
+            self.pan(frame + margin - v1)
+        self.update()
+
     # -- geometry (tests use these to find pixels) --------------------------------------------
+    def _frames_per_px(self) -> float:
+        v0, v1 = self.view_range
+        return (v1 - v0) / max(self.width() - LEFT - RIGHT, 1)
+
     def frame_to_x(self, frame: float) -> float:
-        n = max(self.model.n_frames - 1, 1)
-        return LEFT + (self.width() - LEFT - RIGHT) * float(frame) / n
+        v0, _ = self.view_range
+        return LEFT + (float(frame) - v0) / self._frames_per_px()
+
+    def _x_to_f(self, x: float) -> float:
+        return self.view_range[0] + (x - LEFT) * self._frames_per_px()
 
     def x_to_frame(self, x: float) -> int:
-        n = max(self.model.n_frames - 1, 1)
-        return round((x - LEFT) / max(self.width() - LEFT - RIGHT, 1) * n)
+        return round(self._x_to_f(x))
+
+    def visible_frames(self) -> range:
+        v0, v1 = self.view_range
+        return range(max(math.floor(v0), 0), min(math.ceil(v1), self.model.n_frames - 1) + 1)
 
     def row_rect(self, row: str) -> QRect:
         """ "ruler", "dp", "uniform" or "curves": the band each is drawn in."""
@@ -136,33 +210,111 @@ class TimelineView(QWidget):
 
     # -- input ----------------------------------------------------------------------------------
     def mousePressEvent(self, event: QMouseEvent) -> None:
-        if event.button() == Qt.MouseButton.LeftButton:
+        if event.button() == Qt.MouseButton.MiddleButton:
+            self._pan = (event.position().x(), self.view_range)
+            event.accept()
+        elif event.button() == Qt.MouseButton.LeftButton:
             self.model.pause()
             self._grab = self.key_at(event.position()) if self.steer is not None else None
+            self._press_x, self._dragging = event.position().x(), False
             frame = self._grab if self._grab is not None else self.x_to_frame(event.position().x())
             self.model.set_frame(frame)
             event.accept()
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
-        if event.buttons() & Qt.MouseButton.LeftButton:
-            self.model.set_frame(min(max(self.x_to_frame(event.position().x()), 0), self.model.last_frame))
+        x = event.position().x()
+        if self._pan is not None and event.buttons() & Qt.MouseButton.MiddleButton:
+            start, (v0, v1) = self._pan
+            self.set_view(v0 - (x - start) * self._frames_per_px(), v1 - (x - start) * self._frames_per_px())
+            event.accept()
+        elif event.buttons() & Qt.MouseButton.LeftButton:
+            if self._grab is not None and not self._dragging:
+                if abs(x - self._press_x) < QApplication.startDragDistance():
+                    return  # a click wobbles: the key stays where it is
+                self._dragging = True
+            self.model.set_frame(min(max(self.x_to_frame(x), 0), self.model.last_frame))
             event.accept()
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        if event.button() == Qt.MouseButton.MiddleButton:
+            self._pan = None
+            return
         grabbed, self._grab = self._grab, None
         if event.button() != Qt.MouseButton.LeftButton or grabbed is None or self.steer is None:
             return
         target = min(max(self.x_to_frame(event.position().x()), 0), self.model.last_frame)
-        if target == grabbed:  # a click: pin or unpin
+        if not self._dragging:  # a click: pin or unpin
             if grabbed in self.model.settings.pins:
                 self.steer(f"Unpin key {grabbed}", unpin=grabbed)
             else:
                 self.steer(f"Pin key {grabbed}", pin=grabbed)
-        else:
+        elif target != grabbed:
             self.steer(f"Move key {grabbed} to {target}", move=(grabbed, target))
+        else:
+            self.model.set_frame(grabbed)  # dragged back where it was: nothing changes
         event.accept()
 
+    def wheelEvent(self, event: QWheelEvent) -> None:
+        notches = event.angleDelta().y() / 120.0
+        if not notches or self.model.n_frames < 2:
+            event.ignore()
+        elif event.modifiers() & Qt.KeyboardModifier.ControlModifier:
+            self.zoom(ZOOM_STEP**notches, event.position().x())
+            event.accept()
+        elif self.zoomed:  # zoomed in, the plain wheel walks along the frames
+            v0, v1 = self.view_range
+            self.pan(-notches * (v1 - v0) * 0.1)
+            event.accept()
+        else:
+            event.ignore()
+
+    def event(self, event: QEvent) -> bool:
+        if event.type() == QEvent.Type.ShortcutOverride and self._home_frames_all(event):
+            event.accept()  # Home here shows every frame, not the first frame's shortcut
+            return True
+        if event.type() == QEvent.Type.ToolTip and isinstance(event, QHelpEvent):
+            QToolTip.showText(event.globalPos(), self.tooltip_at(QPointF(event.pos())), self)
+            return True
+        return super().event(event)
+
+    def _home_frames_all(self, event: QEvent) -> bool:
+        return (
+            isinstance(event, QKeyEvent)
+            and event.key() == Qt.Key.Key_Home
+            and event.modifiers() == Qt.KeyboardModifier.NoModifier
+            and self.zoomed
+        )
+
+    def tooltip_at(self, pos: QPointF) -> str:
+        """What the mark under ``pos`` means (a key, a pin, an excluded frame), else the legend."""
+        m = self.model
+        if m.n_frames >= 2 and self.row_rect("dp").contains(pos.toPoint()):
+            frame = min(max(self.x_to_frame(pos.x()), 0), m.last_frame)
+            at = self._x_to_f(pos.x())
+            near = max(max(self._half(), 4.0) * self._frames_per_px(), 0.5)
+            excluded = sorted((abs(f - at), f) for f in m.settings.excludes if abs(f - at) <= near)
+            key = self.key_at(pos)
+            if excluded and (key is None or excluded[0][0] < abs(key - at)):
+                key = None  # the cross is nearer than the key beside it
+            excluded = [f for _, f in excluded]
+            if key is not None and key in m.settings.pins:
+                return f"Key {key}, pinned: a key whatever the solve. Click unpins it, drag moves it."
+            if key is not None:
+                return f"Key {key}, chosen by the solve. Click pins it, drag moves it."
+            if excluded:
+                return (
+                    f"Frame {excluded[0]} is never a key: a key was moved away from it (or Delete "
+                    "excluded it), so the solve cannot put it back there. Insert at that frame, or "
+                    "undo, frees it again."
+                )
+            return f"Frame {frame}. {KEY_LEGEND}"
+        return KEY_LEGEND
+
     def keyPressEvent(self, event) -> None:
+        if self._home_frames_all(event):
+            self.show_all()
+            event.accept()
+            return
         frame = self.model.frame
         if self.steer is not None and self.model.n_frames >= 2:
             if event.key() in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace):
@@ -201,6 +353,9 @@ class TimelineView(QWidget):
             p.drawText(self.rect(), Qt.AlignmentFlag.AlignCenter, "No animation: open one, or record a drag")
         else:
             p.setRenderHint(QPainter.RenderHint.Antialiasing, True)
+            self._paint_row_label(p, "dp", "DP")
+            self._paint_row_label(p, "uniform", "uniform")
+            p.setClipRect(QRectF(LEFT - 8, 0, self.width() - LEFT - RIGHT + 16, self.height()))
             self._paint_ruler(p)
             self._paint_keys(p, "dp", m.dp_keys, DP_COLOUR, filled=True)
             self._paint_constraints(p)
@@ -210,15 +365,15 @@ class TimelineView(QWidget):
         return pixmap
 
     def _paint_ruler(self, p: QPainter) -> None:
-        m = self.model
         r = self.row_rect("ruler")
+        v0, v1 = self.view_range
         span = self.width() - LEFT - RIGHT
-        step = _nice_step(m.n_frames - 1, span)
-        small = span / max(m.n_frames - 1, 1) >= 5
+        step = _nice_step(v1 - v0, span)
+        small = span / max(v1 - v0, 1) >= 5
         font = QFont(p.font())
         font.setPointSizeF(7.5)
         p.setFont(font)
-        for f in range(m.n_frames):
+        for f in self.visible_frames():
             x = self.frame_to_x(f)
             if f % step == 0:
                 p.setPen(TEXT)
@@ -232,7 +387,8 @@ class TimelineView(QWidget):
 
     def _half(self) -> float:
         """Half the size of a key's mark at the current zoom."""
-        return min(5.0, max(2.5, (self.width() - LEFT - RIGHT) / max(self.model.n_frames, 1) / 2.2))
+        v0, v1 = self.view_range
+        return min(5.0, max(2.5, (self.width() - LEFT - RIGHT) / max(v1 - v0 + 1, 1) / 2.2))
 
     def _paint_constraints(self, p: QPainter) -> None:
         """Pinned keys get a ring round their diamond; excluded frames a cross on the DP row."""
@@ -249,14 +405,13 @@ class TimelineView(QWidget):
             p.drawLine(QPointF(x - d, cy - d), QPointF(x + d, cy + d))
             p.drawLine(QPointF(x - d, cy + d), QPointF(x + d, cy - d))
 
-    def _paint_keys(self, p: QPainter, row: str, keys, colour: QColor, filled: bool) -> None:
+    def _paint_row_label(self, p: QPainter, row: str, text: str) -> None:
         r = self.row_rect(row)
         p.setPen(TEXT)
-        p.drawText(
-            QRect(2, r.top(), LEFT - 6, r.height()),
-            Qt.AlignmentFlag.AlignVCenter,
-            "DP" if filled else "uniform",
-        )
+        p.drawText(QRect(2, r.top(), LEFT - 6, r.height()), Qt.AlignmentFlag.AlignVCenter, text)
+
+    def _paint_keys(self, p: QPainter, row: str, keys, colour: QColor, filled: bool) -> None:
+        r = self.row_rect(row)
         if keys is None:
             return
         cy = r.center().y() + 0.5
@@ -286,9 +441,10 @@ class TimelineView(QWidget):
 
     def _curve_path(self, values: np.ndarray, top: float, height: float, scale: float) -> QPainterPath:
         path = QPainterPath()
-        for f, v in enumerate(values):
-            pt = QPointF(self.frame_to_x(f), top + height - height * float(v) / scale)
-            path.lineTo(pt) if f else path.moveTo(pt)
+        frames = self.visible_frames()
+        for i, f in enumerate(frames):
+            pt = QPointF(self.frame_to_x(f), top + height - height * float(values[f]) / scale)
+            path.lineTo(pt) if i else path.moveTo(pt)
         return path
 
     def _paint_curves(self, p: QPainter) -> None:
@@ -304,8 +460,9 @@ class TimelineView(QWidget):
             return
         if a.speed is not None and a.speed.max() > 0:
             area = self._curve_path(a.speed, top, height, float(a.speed.max()))
-            area.lineTo(self.frame_to_x(m.n_frames - 1), top + height)
-            area.lineTo(self.frame_to_x(0), top + height)
+            frames = self.visible_frames()
+            area.lineTo(self.frame_to_x(frames[-1]), top + height)
+            area.lineTo(self.frame_to_x(frames[0]), top + height)
             area.closeSubpath()
             p.fillPath(area, SPEED_COLOUR)
         scale = max(
@@ -318,7 +475,7 @@ class TimelineView(QWidget):
             p.drawPath(self._curve_path(err.tip, top, height, scale))
         p.setPen(TEXT)
         legend = (
-            f"error (max {scale:.3g}): — mean  - - tip   DP {a.dp.mean.mean():.3g}  "
+            f"distance on the vertices (max {scale:.3g}): — mean  - - tip   DP {a.dp.mean.mean():.3g}  "
             f"uniform {a.uniform.mean.mean():.3g} (mean)   ▒ speed"
         )
         p.drawText(QRect(LEFT, r.top(), self.width() - LEFT - RIGHT, 14), Qt.AlignmentFlag.AlignLeft, legend)
@@ -378,6 +535,16 @@ class KeyCountPlot(QWidget):
         y = r.bottom() - r.height() * (math.log10(max(v, 10**lo)) - lo) / (hi - lo)
         return QPointF(x, y)
 
+    def current_point(self) -> tuple[int, float] | None:
+        """The marked point: the current key count and its optimal error on the curve (the
+        curve starts at the fewest keys the pins allow, not always at 2)."""
+        s, keys = self.model.key_solve, self.model.dp_keys
+        if s is None or keys is None:
+            return None
+        curve = s.curve
+        row = np.flatnonzero(curve[:, 0] == keys.size)
+        return (int(keys.size), float(curve[row[0], 1])) if row.size else None
+
     def mousePressEvent(self, event: QMouseEvent) -> None:
         if event.button() == Qt.MouseButton.LeftButton and self.model.key_solve is not None:
             self.model.set_key_count(self.count_at(event.position().x()))
@@ -425,8 +592,9 @@ class KeyCountPlot(QWidget):
         p.setPen(QPen(DP_COLOUR, 1.6))
         p.drawPath(path)
         keys = self.model.dp_keys
-        if keys is not None and 2 <= keys.size <= s.kmax:
-            pt = self._point(keys.size, curve[keys.size - 2, 1], lo, hi)
+        current = self.current_point()
+        if current is not None:
+            pt = self._point(current[0], current[1], lo, hi)
             p.setPen(QPen(PLAYHEAD, 1.0))
             p.drawLine(QPointF(pt.x(), r.top()), QPointF(pt.x(), r.bottom()))
             p.setBrush(PLAYHEAD)

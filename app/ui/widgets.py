@@ -1,11 +1,26 @@
-"""A slider paired with a spin box, for parameters an artist drags and sometimes types."""
+"""A slider paired with a spin box, for parameters an artist drags and sometimes types; the
+docks' scroll areas; and the wheel guard that keeps the docks' controls put while they scroll."""
 
 from __future__ import annotations
 
 import math
 
-from PySide6.QtCore import Qt, Signal
-from PySide6.QtWidgets import QDoubleSpinBox, QFrame, QHBoxLayout, QScrollArea, QSlider, QWidget
+from PySide6.QtCore import QEvent, QObject, Qt, Signal
+from PySide6.QtGui import QWheelEvent
+from PySide6.QtWidgets import (
+    QAbstractScrollArea,
+    QAbstractSlider,
+    QAbstractSpinBox,
+    QApplication,
+    QComboBox,
+    QDoubleSpinBox,
+    QFrame,
+    QHBoxLayout,
+    QScrollArea,
+    QScrollBar,
+    QSlider,
+    QWidget,
+)
 
 from app.ui.qt_utils import signals_blocked
 
@@ -109,3 +124,42 @@ def scrolling(body: QWidget) -> QScrollArea:
     area.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
     area.setMinimumWidth(body.minimumSizeHint().width() + area.verticalScrollBar().sizeHint().width())
     return area
+
+
+#: Controls a passing wheel would change: they take the wheel only once they have the focus.
+WHEEL_CONTROLS = (QAbstractSlider, QAbstractSpinBox, QComboBox)
+
+
+class WheelGuard(QObject):
+    """Event filter: a wheel over an unfocused slider, spin box or combo box is not theirs, so
+    the scroll area round them scrolls instead (as in Blender and Maya); a click (or Tab) gives
+    the control the focus, and then the wheel changes its value."""
+
+    def eventFilter(self, obj: QObject, event: QEvent) -> bool:
+        if event.type() != QEvent.Type.Wheel or not isinstance(obj, QWidget) or obj.hasFocus():
+            return False
+        area = obj.parentWidget()
+        while area is not None and not isinstance(area, QAbstractScrollArea):
+            area = area.parentWidget()
+        if area is not None:
+            scroll_by_wheel(area.verticalScrollBar(), event)
+        return True  # never the control's
+
+
+def scroll_by_wheel(bar: QScrollBar, event: QWheelEvent) -> None:
+    """Scroll ``bar`` as a wheel over its area would: pixels from a touchpad, else the
+    platform's lines per notch."""
+    pixels = event.pixelDelta().y()
+    if pixels == 0:
+        notches = event.angleDelta().y() / 120.0
+        pixels = round(notches * QApplication.wheelScrollLines() * bar.singleStep())
+    bar.setValue(bar.value() - pixels)
+
+
+def keep_controls_put(root: QWidget, guard: WheelGuard) -> None:
+    """Guard every wheel control under ``root``: click or Tab focus only (StrongFocus, not the
+    wheel focus spin boxes have by default), and the wheel only with the focus."""
+    for w in root.findChildren(QWidget):
+        if isinstance(w, WHEEL_CONTROLS):
+            w.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+            w.installEventFilter(guard)

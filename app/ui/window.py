@@ -11,12 +11,11 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QSettings, QSize, Qt
+from PySide6.QtCore import QEvent, QSettings, QSize, Qt
 from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QKeySequence, QUndoStack
 from PySide6.QtWidgets import (
     QDockWidget,
     QFileDialog,
-    QLabel,
     QMainWindow,
     QMessageBox,
     QToolBar,
@@ -46,10 +45,12 @@ from app.ui.qt_utils import add_action
 from app.ui.render_hair_dialog import DENSE, GrowOptions, ask_grow_options, grow
 from app.ui.scene import COLOUR_MODES, Scene
 from app.ui.simulate_dialog import ask_simulate_options
+from app.ui.status_line import ElidedLabel, StatusLine
 from app.ui.stroke_files import StrokeFiles
 from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
 from app.ui.viewport import BRUSH_STEP, Viewport
+from app.ui.widgets import WheelGuard, keep_controls_put
 from hairtool import io, samples
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.groom import Animation, Groom
@@ -86,6 +87,7 @@ class MainWindow(QMainWindow):
         engine; :meth:`start_warmup` compiles them in the background and then starts it."""
         super().__init__(parent)
         self.setObjectName("HairtoolStudio")
+        self.setStatusBar(StatusLine(self))  # first: messages are never painted over its widgets
         self.settings = settings if settings is not None else QSettings(SETTINGS_ORG, SETTINGS_APP)
         self.undo_stack = QUndoStack(self)
         self._shown_once = False
@@ -115,6 +117,9 @@ class MainWindow(QMainWindow):
         )
         self.resize(*fitting_size(self.screen().availableGeometry().size()))
         self._default_layout = (self.saveState(), self.size())
+        self._wheel_guard = WheelGuard(self)
+        for dock in self.findChildren(QDockWidget):  # a passing wheel scrolls the dock instead
+            keep_controls_put(dock, self._wheel_guard)
 
         self.viewport.stroke_started.connect(self._on_stroke_started)
         self.viewport.stroke_finished.connect(self._on_stroke_finished)
@@ -123,6 +128,7 @@ class MainWindow(QMainWindow):
         self.scene.refused.connect(lambda text: self.statusBar().showMessage(text, 6000))
         self.viewport.frame_drawn.connect(self._update_frame_time)
         self.dock.param_edited.connect(self._on_param_edited)
+        self.scene.groom_loaded.connect(self._on_document_changed)
         self.scene.groom_loaded.connect(self._update_counts)
         self.scene.drawn_changed.connect(self._update_counts)
         self.scene.groom_loaded.connect(self._update_legend)
@@ -204,6 +210,7 @@ class MainWindow(QMainWindow):
     def _bind_pending_render_hair(self) -> None:
         pending, self._pending_render_hair = self._pending_render_hair, None
         if pending is not None:
+            self.statusBar().set_note("render hair", None)
             pending()
 
     def reset_layout(self) -> None:
@@ -249,10 +256,10 @@ class MainWindow(QMainWindow):
         file = bar.addMenu("&File")
         new = file.addMenu("&New from sample")
         sintel = self.open_bundled_sample
-        add_action(self, new, "Sintel (hair and head)", sintel, QKeySequence.StandardKey.New)
+        add_action(self, new, "Sintel (hair and head)", self._asking(sintel), QKeySequence.StandardKey.New)
         new.addSeparator()
         for kind in samples.SAMPLES:
-            add_action(self, new, kind.capitalize(), lambda _=False, k=kind: self.new_from_sample(k))
+            add_action(self, new, kind.capitalize(), self._asking(lambda k=kind: self.new_from_sample(k)))
         add_action(self, file, "&Open…", self.open_dialog, QKeySequence.StandardKey.Open)
         self.recent_menu = file.addMenu("Open &Recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
@@ -416,27 +423,44 @@ class MainWindow(QMainWindow):
         menus["&View"].addAction(self.sources.dock.toggleViewAction())
 
     def ask_save_changes(self) -> str:
-        """The answer to unsaved changes: "save", "discard" or "cancel" (tests replace this)."""
-        box = QMessageBox.question(
-            self,
+        """The one question before changed work is replaced (Open, Open Project, New, a drop,
+        Quit): "save", "discard" or "cancel" (tests replace this)."""
+        name = self.scene.path.name if self.scene.path is not None else "The untitled groom"
+        buttons = QMessageBox.StandardButton
+        box = QMessageBox(
+            QMessageBox.Icon.Question,
             "Unsaved changes",
-            "The project has unsaved changes. Save them first?",
-            QMessageBox.StandardButton.Save
-            | QMessageBox.StandardButton.Discard
-            | QMessageBox.StandardButton.Cancel,
+            f"{name} has changes that are not saved. Save them first?",
+            buttons.Save | buttons.Discard | buttons.Cancel,
+            self,
         )
-        return {QMessageBox.StandardButton.Save: "save", QMessageBox.StandardButton.Discard: "discard"}.get(
-            box, "cancel"
-        )
+        box.setInformativeText("Discard loses them; Cancel goes back to the work.")
+        box.setDefaultButton(buttons.Save)
+        box.setEscapeButton(buttons.Cancel)
+        answer = box.exec()
+        return {buttons.Save: "save", buttons.Discard: "discard"}.get(buttons(answer), "cancel")
 
     def ask_restore_recovery(self, path: str) -> bool:
-        """Restore the autosave a crashed session left? (tests replace this)"""
-        answer = QMessageBox.question(
-            self,
-            "Restore autosaved work",
-            f"Hairtool Studio did not close properly last time. Restore the autosaved session?\n{path}",
-        )
-        return answer == QMessageBox.StandardButton.Yes
+        """Restore the autosave a crashed session left (True), or discard it (tests replace this)."""
+        from app.ui.project_ui import recovery_question
+
+        buttons = QMessageBox.StandardButton
+        box = QMessageBox(QMessageBox.Icon.Question, "Restore autosaved work", recovery_question(path),
+                          buttons.NoButton, self)  # fmt: skip
+        restore = box.addButton("Restore", QMessageBox.ButtonRole.AcceptRole)
+        box.addButton(buttons.Discard)
+        box.setDefaultButton(restore)
+        box.exec()
+        return box.clickedButton() is restore
+
+    def _asking(self, action: Callable[[], object]) -> Callable[..., None]:
+        """A menu action that replaces the work: it runs once changed work was saved or discarded."""
+
+        def run(*_: object) -> None:
+            if self.project.confirm_discard():
+                action()
+
+        return run
 
     def ask_simulate_options(self, options: SimulateOptions) -> SimulateOptions | None:
         """The Simulate… dialog: SimulateOptions or None (tests replace this)."""
@@ -462,17 +486,20 @@ class MainWindow(QMainWindow):
     def _fill_recent_menu(self) -> None:
         self.recent_menu.clear()
         for path in self.recent_files():
-            self.recent_menu.addAction(path, lambda p=path: self.open_path(p))
+            self.recent_menu.addAction(path, self._asking(lambda p=path: self.open_path(p)))
         self.recent_menu.setEnabled(True)
 
     # -- status bar --------------------------------------------------------------------------
     def _build_status_bar(self) -> None:
+        """Counts, then the message (:class:`StatusLine`), then the read-outs, the jobs' progress,
+        the legend and the playback rate; every text shortens itself before it would overlap."""
         bar = self.statusBar()
-        self.counts_label = QLabel()
-        self.frame_label = QLabel()
-        self.cursor_label = QLabel()
-        bar.addWidget(self.counts_label)
-        bar.addWidget(self.frame_label)
+        self.counts_label = ElidedLabel(min_width=60)
+        self.frame_label = ElidedLabel(min_width=40)
+        self.frame_label.setObjectName("FrameTime")
+        self.cursor_label = ElidedLabel(min_width=40)
+        bar.insertWidget(0, self.counts_label)
+        bar.addWidget(self.frame_label)  # beside the message: both shorten when space is short
         bar.addPermanentWidget(self.cursor_label)
         self.job_status = JobStatus(self.jobs)
         bar.addPermanentWidget(self.job_status)
@@ -505,13 +532,29 @@ class MainWindow(QMainWindow):
             text = f"{g.strand_count:,} guides · {b.child_count:,} children · {b.vertex_count:,} vertices"
         self.counts_label.setText(text)
 
+    def _on_document_changed(self) -> None:
+        """Another groom opened: the status line forgets the last one (its messages, its frame
+        times: the pipeline time of its last stroke is not this groom's)."""
+        self.statusBar().clear_document()
+        self.scene.last_update_ms = 0.0
+        self.frame_label.setText("")
+        self.cursor_label.setText("")
+
+    def event(self, event: QEvent) -> bool:
+        if event.type() == QEvent.Type.StatusTip:  # a menu entry's tip: through the status line
+            if event.tip():
+                self.statusBar().showMessage(event.tip(), 4000)
+            return True
+        return super().event(event)
+
     def _update_frame_time(self) -> None:
         v, s = self.viewport, self.scene
         total = s.last_update_ms + v.last_upload_ms + v.last_draw_ms
-        self.frame_label.setText(
-            f"update {total:.1f} ms (pipeline {s.last_update_ms:.1f}, upload {v.last_upload_ms:.1f}, "
-            f"draw {v.last_draw_ms:.1f})"
+        self.frame_label.detail = (
+            f"the last update: engine pipeline {s.last_update_ms:.1f} ms, upload to the GPU "
+            f"{v.last_upload_ms:.1f} ms, draw {v.last_draw_ms:.1f} ms"
         )
+        self.frame_label.setText(f"update {total:.1f} ms")
 
     def _on_cursor_moved(self, cursor) -> None:
         if cursor is None:
@@ -557,7 +600,7 @@ class MainWindow(QMainWindow):
     ) -> None:
         """Show a new groom on its own head ``mesh`` (None: none); its strokes start afresh, so
         the undo history is cleared (and an animation on the timeline is closed)."""
-        self.animation.clear()
+        self.animation.reset()  # the last document's frame rate and key settings are not this one's
         self.undo_stack.clear()
         self._pending_render_hair = None  # the bundled sample's children, not this groom's
         self.scene.load(groom, path, mesh=mesh)
@@ -603,7 +646,7 @@ class MainWindow(QMainWindow):
             bind()
         else:
             self._pending_render_hair = bind
-            self.statusBar().showMessage(waiting)
+            self.statusBar().set_note("render hair", waiting)
 
     def _open_with_guides(
         self, hair: Groom, guides: Groom, path: str | os.PathLike[str], mesh: Mesh | None = None
@@ -656,6 +699,7 @@ class MainWindow(QMainWindow):
             if dense:
                 self.set_groom(guides, mesh=mesh)  # the same head under the picked guides
                 self.scene.set_binding(binding)
+                self.undo_stack.resetClean()  # new guides, not saved anywhere yet
                 n, g = binding.child_count, guides.strand_count
                 self.statusBar().showMessage(f"{n:,} strands follow {g:,} guides picked among them", 5000)
             else:
@@ -671,6 +715,9 @@ class MainWindow(QMainWindow):
             self.undo_stack.push(step)
 
     def open_dialog(self) -> None:
+        """File ▸ Open: asks about changed work first (Cancel opens nothing)."""
+        if not self.project.confirm_discard():
+            return
         path = self.ask_open_path()
         if path:
             self.open_path(path)
@@ -816,4 +863,5 @@ class MainWindow(QMainWindow):
         files = [u.toLocalFile() for u in event.mimeData().urls() if u.isLocalFile()]
         if files:
             event.acceptProposedAction()
-            self.open_path(files[0])
+            if self.project.confirm_discard():
+                self.open_path(files[0])
