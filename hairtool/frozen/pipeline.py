@@ -457,8 +457,11 @@ class FrozenPipeline:
                 or not any(isinstance(s, BrushSample) for s in snapshot.log)
             )
         ):
-            self._aligned = snapshot.aligned
-            n = snapshot.aligned.strand_count
+            aligned = snapshot.aligned
+            if aligned.metadata is not self._rest.metadata:  # a relabelled rest (its up axis): its record
+                aligned = aligned.with_metadata(self._rest.metadata)
+            self._aligned = aligned
+            n = aligned.strand_count
             self._locked = np.zeros(n, bool) if snapshot.locked is None else snapshot.locked.copy()
             cs = snapshot.clump_strength
             self._clump_strength = np.ones(n) if cs is None else cs.astype(np.float64)
