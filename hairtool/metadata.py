@@ -18,6 +18,8 @@ import itertools
 import math
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from hairtool.errors import ParameterError, finite_number
 
 UP_AXES = ("Y", "Z")
@@ -27,6 +29,10 @@ DEFAULT_METERS_PER_UNIT = 0.01
 BASES = ("linear", "bezier", "bspline", "catmullRom")
 WRAPS = ("nonperiodic", "periodic", "pinned")
 PURPOSES = ("default", "render", "proxy", "guide")  # UsdGeom's purpose tokens
+#: The per-vertex attributes a prim may lack when several prims are merged into one groom.
+ATTRIBUTES = ("thickness", "transparency", "colors")
+#: Hair width where a source gives none: 80 µm, a typical human hair, in metres.
+HAIR_WIDTH_M = 80e-6
 
 
 def _positive(name: str, value: float | None) -> float | None:
@@ -58,6 +64,9 @@ class CurvesPrim:
     basis: str = "linear"
     wrap: str = "nonperiodic"
     purpose: str = "default"  # USD's purpose: "guide" marks guide curves beside the render hair
+    #: Attributes (of ATTRIBUTES) this prim did not author: merged with prims that did, its
+    #: vertices hold defaults there, and a writer leaves them out of this prim again.
+    lacks: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.path, str) or not self.path.startswith("/") or len(self.path) < 2:
@@ -70,6 +79,10 @@ class CurvesPrim:
             raise ParameterError("wrap", self.wrap, f"one of {', '.join(WRAPS)}")
         if self.purpose not in PURPOSES:
             raise ParameterError("purpose", self.purpose, f"one of {', '.join(PURPOSES)}")
+        lacks = tuple(self.lacks) if isinstance(self.lacks, (list, tuple)) else None
+        if lacks is None or any(a not in ATTRIBUTES for a in lacks) or len(set(lacks)) != len(lacks):
+            raise ParameterError("lacks", self.lacks, f"distinct names from {', '.join(ATTRIBUTES)}")
+        object.__setattr__(self, "lacks", tuple(a for a in ATTRIBUTES if a in lacks))
 
     @property
     def description(self) -> str:
@@ -136,3 +149,83 @@ class Metadata:
         if self.curves and sum(c.strands for c in self.curves) != strand_count:
             return replace(self, curves=())
         return self
+
+    # -- the scene's frame --------------------------------------------------------------
+    @property
+    def up(self) -> np.ndarray:
+        """``(3,)`` the stage's up direction: +y or +z."""
+        return self.frame[:, 1].copy()
+
+    @property
+    def frame(self) -> np.ndarray:
+        """``(3, 3)`` rotation from hairtool's reference frame (x lateral, y up, z front, as the
+        samples are built) to the scene's axes: the identity for Y-up; for Z-up the DCCs'
+        convention (x, y, z) ↦ (x, −z, y), so up is +z and the front −y (Blender's front view).
+        Directions the engines define in the reference frame (gravity, a head turn's axis, a
+        gust's plane) are this matrix times their reference vector."""
+        if self.up_axis == "Y":
+            return np.eye(3)
+        return np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+
+    @property
+    def units_per_meter(self) -> float:
+        return 1.0 / self.meters_per_unit
+
+    def derived(self, *, time_codes=None, curves: tuple[CurvesPrim, ...] | None = None) -> Metadata:
+        """The record of something made from this source (a simulation, a cycle, a frozen
+        pose): the same space, unit, colour primvar and prims (``curves`` to replace them), and
+        the new frames' ``time_codes`` (None: a static groom). The source's authored time code
+        range and rate are dropped: the new stage declares its own."""
+        return replace(
+            self,
+            time_codes=None if time_codes is None else tuple(float(t) for t in time_codes),
+            time_codes_per_second=None,
+            start_time_code=None,
+            end_time_code=None,
+            curves=self.curves if curves is None else tuple(curves),
+        )
+
+    def first_time_code(self) -> float:
+        """Where frames made from this source start: its authored start time code, else 0."""
+        return 0.0 if self.start_time_code is None else float(self.start_time_code)
+
+
+def default_attribute(name: str, vertex_count: int, meters_per_unit: float) -> np.ndarray:
+    """Where a prim authored no ``name`` but others merged with it did: widths of 80 µm (in
+    scene units), no transparency, USD's fallback grey (``displayColor`` 0.5)."""
+    if name == "thickness":
+        return np.full(vertex_count, HAIR_WIDTH_M / meters_per_unit, np.float32)
+    if name == "transparency":
+        return np.zeros(vertex_count, np.float32)
+    if name == "colors":
+        return np.full((vertex_count, 3), 0.5, np.float32)
+    raise ParameterError("attribute", name, f"one of {', '.join(ATTRIBUTES)}")
+
+
+def join_attributes(
+    parts: list[dict[str, np.ndarray | None]], vertex_counts: list[int], meters_per_unit: float
+) -> tuple[dict[str, np.ndarray | None], list[tuple[str, ...]]]:
+    """Per-vertex attributes of several parts (prims) laid end to end: an attribute some part
+    has and another lacks is kept, the lacking part's vertices filled with
+    :func:`default_attribute`. Returns the joined arrays (None where no part has one) and, per
+    part, the attributes it lacked (for :attr:`CurvesPrim.lacks`)."""
+    out: dict[str, np.ndarray | None] = {}
+    lacks: list[list[str]] = [[] for _ in parts]
+    for name in ATTRIBUTES:
+        values = [a.get(name) for a in parts]
+        if all(v is None for v in values):
+            out[name] = None
+            continue
+        filled = []
+        for k, (v, n) in enumerate(zip(values, vertex_counts, strict=True)):
+            if v is None:
+                lacks[k].append(name)
+                v = default_attribute(name, n, meters_per_unit)
+            filled.append(np.asarray(v, np.float32))
+        out[name] = np.concatenate(filled)
+    return out, [tuple(x) for x in lacks]
+
+
+def to_reference(meta: Metadata, vectors: np.ndarray) -> np.ndarray:
+    """Scene-axis vectors ``(..., 3)`` in hairtool's reference frame (the inverse of ``frame``)."""
+    return np.asarray(vectors, dtype=np.float64) @ meta.frame

@@ -17,7 +17,9 @@ test cases):
   beside its guide curves, purpose ``guide``: :mod:`hairtool.guides.files`);
 - ``widths`` of every interpolation (see :mod:`hairtool.io.usd_basis`), colour from
   ``displayColor`` or Blender's ``primvars:color`` (color3f or color4f; its alpha is opacity),
-  opacity from ``displayOpacity``.
+  opacity from ``displayOpacity``. Merging prims keeps each one's: a prim without widths or
+  colour beside prims with them gets defaults (80 µm, grey) and its record lists what it
+  lacked (:attr:`~hairtool.metadata.CurvesPrim.lacks`), so the writer leaves them out again;
 
 Every value is type-checked before it is used and every lazy read of a crate file is guarded, so
 a hostile file ends in one :class:`~hairtool.errors.FormatError`.
@@ -52,7 +54,7 @@ from hairtool.groom import Animation, Groom, Topology
 from hairtool.io import usd_basis, usdc_check
 from hairtool.io.atomic import atomic_path
 from hairtool.io.binary import require_finite, require_strand_counts
-from hairtool.metadata import PURPOSES, CurvesPrim, Metadata
+from hairtool.metadata import PURPOSES, CurvesPrim, Metadata, join_attributes
 
 PRIM_PATH = "/Groom/Strands"
 FLUSH_BYTES = 32 << 20  # unsaved time samples a crate layer may hold before it is saved
@@ -140,19 +142,23 @@ def _define_parents(stage, paths: Sequence[str]) -> None:
     stage.SetDefaultPrim(stage.GetPrimAtPath(first_root))
 
 
-def _write_attributes(curves, obj: Curves, vs: slice, color_primvar: str) -> float:
-    """Widths, colour and opacity of one prim's vertices; returns the half width for its extent."""
+def _write_attributes(curves, obj: Curves, vs: slice, color_primvar: str, lacks: Sequence[str] = ()) -> float:
+    """Widths, colour and opacity of one prim's vertices (not those the prim ``lacks``: it was
+    merged with prims that had them); returns the half width for its extent."""
     from pxr import Sdf, UsdGeom, Vt
 
     half_width = 0.0
-    if obj.thickness is not None:
-        curves.CreateWidthsAttr(Vt.FloatArray.FromNumpy(np.ascontiguousarray(obj.thickness[vs])))
+    thickness = None if "thickness" in lacks else obj.thickness
+    colors = None if "colors" in lacks else obj.colors
+    transparency = None if "transparency" in lacks else obj.transparency
+    if thickness is not None:
+        curves.CreateWidthsAttr(Vt.FloatArray.FromNumpy(np.ascontiguousarray(thickness[vs])))
         curves.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
-        half_width = float(np.abs(obj.thickness[vs]).max()) / 2
-    opacity = None if obj.transparency is None else (1.0 - obj.transparency[vs]).astype(np.float32)
-    if obj.colors is not None and color_primvar == "color":
-        rgba = np.ones((obj.colors[vs].shape[0], 4), dtype=np.float32)
-        rgba[:, :3] = obj.colors[vs]
+        half_width = float(np.abs(thickness[vs]).max()) / 2
+    opacity = None if transparency is None else (1.0 - transparency[vs]).astype(np.float32)
+    if colors is not None and color_primvar == "color":
+        rgba = np.ones((colors[vs].shape[0], 4), dtype=np.float32)
+        rgba[:, :3] = colors[vs]
         if opacity is not None:
             rgba[:, 3] = opacity
             opacity = None
@@ -160,9 +166,9 @@ def _write_attributes(curves, obj: Curves, vs: slice, color_primvar: str) -> flo
             "color", Sdf.ValueTypeNames.Color4fArray, UsdGeom.Tokens.vertex
         )
         pv.Set(Vt.Vec4fArray.FromNumpy(rgba))
-    elif obj.colors is not None:
-        colors = Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(obj.colors[vs]))
-        curves.CreateDisplayColorPrimvar(UsdGeom.Tokens.vertex).Set(colors)
+    elif colors is not None:
+        values = Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(colors[vs]))
+        curves.CreateDisplayColorPrimvar(UsdGeom.Tokens.vertex).Set(values)
     if opacity is not None:
         curves.CreateDisplayOpacityPrimvar(UsdGeom.Tokens.vertex).Set(Vt.FloatArray.FromNumpy(opacity))
     return half_width
@@ -189,7 +195,7 @@ def _write_prim(stage, prim: CurvesPrim, obj: Curves, strands: slice, times):
     curves.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(counts.astype(np.int32)))
     if prim.purpose != "default":
         curves.CreatePurposeAttr(prim.purpose)
-    half_width = _write_attributes(curves, obj, vs, obj.metadata.color_primvar)
+    half_width = _write_attributes(curves, obj, vs, obj.metadata.color_primvar, prim.lacks)
     points_attr = curves.CreatePointsAttr()
     extent_attr = curves.CreateExtentAttr()
     if times is None:
@@ -511,8 +517,8 @@ class _Curves:
                 f"but points has {len(value)}",
             )
 
-    def info(self) -> CurvesPrim:
-        return CurvesPrim(self.name, int(self.counts.size), self.basis, self.wrap, self.purpose)
+    def info(self, lacks: Sequence[str] = ()) -> CurvesPrim:
+        return CurvesPrim(self.name, int(self.counts.size), self.basis, self.wrap, self.purpose, tuple(lacks))
 
     def at(self, time, xforms) -> np.ndarray:
         from pxr import Gf
@@ -575,16 +581,17 @@ class _Curves:
         return out, source
 
 
-def _merge_attributes(parts: list[_Curves]) -> tuple[dict[str, np.ndarray], str]:
-    """An attribute survives the merge only if every prim has it."""
+def _merge_attributes(
+    parts: list[_Curves], meters_per_unit: float
+) -> tuple[dict[str, np.ndarray | None], str, list[tuple[str, ...]]]:
+    """The prims' attributes end to end: one prim lacking widths or colour does not strip the
+    others; its vertices get defaults (80 µm, no transparency, grey) and its prim records what
+    it lacked, so writing it back authors them on the prims that had them only. Also the colour
+    primvar's name and each prim's lacks."""
     read = [c.attributes() for c in parts]
-    out = {}
-    for name in ("thickness", "transparency", "colors"):
-        values = [a[name] for a, _ in read]
-        if all(v is not None for v in values):
-            out[name] = np.concatenate(values)
+    attrs, lacks = join_attributes([a for a, _ in read], [c.vertex_count for c in parts], meters_per_unit)
     sources = {s for a, s in read if a["colors"] is not None}
-    return out, ("color" if sources == {"color"} else "displayColor")
+    return attrs, ("color" if sources == {"color"} else "displayColor"), lacks
 
 
 def _stage_metadata(path: Path, stage) -> dict:
@@ -628,10 +635,10 @@ def _read_stage(path: Path, stage) -> Groom | Animation:
         raise FormatError(path, "no BasisCurves prim on the stage")
     parts = [_Curves(path, p) for p in prims]
     counts = np.concatenate([c.counts for c in parts])
-    attrs, color_source = _merge_attributes(parts)
     stage_meta = _stage_metadata(path, stage)
+    attrs, color_source, lacks = _merge_attributes(parts, stage_meta["meters_per_unit"])
     fps = stage_meta.pop("fps")
-    curves = tuple(c.info() for c in parts)
+    curves = tuple(c.info(lack) for c, lack in zip(parts, lacks, strict=True))
     times = _sample_times(parts)
     if not times:
         once = set().union(*(c.transform_times for c in parts))  # a transform set at one time code
