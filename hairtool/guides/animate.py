@@ -136,4 +136,5 @@ def render_frames_reference(binding: ChildBinding, guides: Animation) -> np.ndar
     """``(F, V, 3)`` float32: :func:`~hairtool.guides.children.build_points_reference` on every
     frame of the guides (no clumping), the numpy twin of :class:`RenderHairAnimation`."""
     _check(binding, guides)
-    return np.stack([build_points_reference(binding, Groom(p, guides.topology)) for p in guides.frames])
+    poses = (Groom(p, guides.topology, metadata=guides.metadata) for p in guides.frames)
+    return np.stack([build_points_reference(binding, g) for g in poses])
