@@ -38,6 +38,7 @@ class ChildBinding(Protocol):
     @property
     def vertex_count(self) -> int: ...
 
+
 _CHUNK = 8192  # children blended at a time (bounds the (chunk, k, n, 3) temporary)
 
 

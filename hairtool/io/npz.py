@@ -163,6 +163,11 @@ def _scalar(path: Path, z, name: str, kind: str) -> object:
     a = _member(path, z, name)
     if a.shape != () or a.dtype.kind not in kind:
         raise FormatError(path, f"{name!r} must be a scalar of kind {kind!r}, got {a.dtype} {a.shape}")
+    if a.dtype.kind == "U" and a.dtype.itemsize:
+        # Code points past U+10FFFF (or surrogates) make a str that breaks whoever reads it.
+        codes = np.ascontiguousarray(a.astype(a.dtype.newbyteorder("="))).reshape(1).view(np.uint32)
+        if codes.max() > 0x10FFFF or np.any((codes >= 0xD800) & (codes <= 0xDFFF)):
+            raise FormatError(path, f"{name!r} holds characters that are not text")
     return a.item()
 
 
