@@ -314,3 +314,28 @@ def test_child_attribute_blend_matches_its_reference():
     np.testing.assert_allclose(blend(widths, b), blend_reference(widths, b), rtol=1e-6)
     np.testing.assert_allclose(blend(mixed.colors, b), blend_reference(mixed.colors, b), rtol=1e-6)
     assert b.build().colors is not None and b.build().thickness is None  # the guides had no widths
+
+
+def test_a_batch_of_commands_keeps_the_scene_as_the_commands_do(scenes, tmp_path, capsys):
+    pytest.importorskip("distributed", reason="the farm extra (dask[distributed]) is not installed")
+    import json
+    import shutil
+
+    shutil.copy(scenes["z"], tmp_path / "b.usda")
+    jobs = [
+        {
+            "command": "simulate",
+            "args": ["b.usda", "out/sim.usda", "--frames", "3", "--motion", "nod", "--fit-head"],
+        },
+        {"command": "anime", "args": ["b.usda", "out/cycle.npz", "--frames", "3"]},
+    ]
+    (tmp_path / "jobs.json").write_text(json.dumps({"jobs": jobs}))
+    assert main(["batch", str(tmp_path / "jobs.json"), "--workers", "1"]) == 0
+    for job in jobs:
+        by_hand = tmp_path / ("hand" + Path(job["args"][1]).suffix)
+        _run([job["command"], tmp_path / "b.usda", by_hand, *job["args"][2:]])
+        farmed, mine = io.read(tmp_path / job["args"][1]), io.read(by_hand)
+        np.testing.assert_array_equal(farmed.frames, mine.frames)
+        assert farmed.metadata == mine.metadata
+        assert (farmed.metadata.up_axis, farmed.metadata.meters_per_unit) == ("Z", 1.0)
+        assert [c.path for c in farmed.metadata.curves] == [HAIR]

@@ -26,19 +26,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--up-axis",
         type=str.upper,
         choices=("Y", "Z"),
-        help="the up axis the USD output declares (default: the input's; Y for formats without one)",
+        help="the up axis a USD or .npz output declares (default: the input's; Y for formats without one)",
     )
     parser.add_argument(
         "--meters-per-unit",
         type=float,
         metavar="M",
-        help="metres per unit the USD output declares (default: the input's; 0.01, centimetres, "
+        help="metres per unit a USD or .npz output declares (default: the input's; 0.01, centimetres, "
         "for formats without one)",
     )
 
 
 def _override(args: argparse.Namespace, obj):
-    """The groom with the up axis / unit the command line declares (USD outputs only)."""
+    """The groom with the up axis / unit the command line declares (USD and .npz outputs)."""
     from hairtool.errors import ParameterError
     from hairtool.io import format_for
 
@@ -49,9 +49,10 @@ def _override(args: argparse.Namespace, obj):
         changes["meters_per_unit"] = args.meters_per_unit
     if not changes:
         return obj
-    if format_for(args.output, writing=True).module != "usd":
+    if format_for(args.output, writing=True).module not in ("usd", "npz"):
         name = "up-axis" if "up_axis" in changes else "meters-per-unit"
-        raise ParameterError(name, next(iter(changes.values())), "a USD output (.usda, .usdc, .usd)")
+        expected = "a USD output or an .npz cache (.usda, .usdc, .usd, .npz)"
+        raise ParameterError(name, next(iter(changes.values())), expected)
     return obj.with_metadata(obj.metadata.with_(**changes))
 
 
