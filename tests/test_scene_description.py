@@ -339,3 +339,21 @@ def test_a_batch_of_commands_keeps_the_scene_as_the_commands_do(scenes, tmp_path
         assert farmed.metadata == mine.metadata
         assert (farmed.metadata.up_axis, farmed.metadata.meters_per_unit) == ("Z", 1.0)
         assert [c.path for c in farmed.metadata.curves] == [HAIR]
+
+
+def test_a_simulation_layered_over_its_groom_replaces_the_hair_and_keeps_the_head(scenes, tmp_path):
+    from pxr import Sdf, Usd, UsdGeom
+
+    _run(["simulate", scenes["z"], tmp_path / "sim.usda", "--frames", "4", "--motion", "nod", "--fit-head"])
+    shot = Sdf.Layer.CreateNew(str(tmp_path / "shot.usda"))
+    shot.subLayerPaths.append(str(tmp_path / "sim.usda"))  # stronger: the simulation
+    shot.subLayerPaths.append(str(scenes["z"]))  # weaker: the groom with its head
+    shot.Save()
+    stage = Usd.Stage.Open(str(tmp_path / "shot.usda"))
+    assert stage.GetPrimAtPath("/root/Head/Icosphere").IsA(UsdGeom.Mesh)
+    curves = [p.GetPath() for p in stage.Traverse() if p.IsA(UsdGeom.BasisCurves)]
+    assert [str(p) for p in curves] == [HAIR]
+    sim = io.read(tmp_path / "sim.usda")
+    points = UsdGeom.BasisCurves(stage.GetPrimAtPath(HAIR)).GetPointsAttr()
+    for f, t in enumerate(sim.time_codes):
+        np.testing.assert_array_equal(np.asarray(points.Get(Usd.TimeCode(t)), np.float32), sim.frames[f])
