@@ -226,6 +226,56 @@ def join_attributes(
     return out, [tuple(x) for x in lacks]
 
 
+_RECORD_NUMBERS = ("meters_per_unit", "time_codes_per_second", "start_time_code", "end_time_code")
+_RECORD_FIELDS = ("up_axis", *_RECORD_NUMBERS, "color_primvar", "time_codes", "curves")
+_PRIM_KEYS = ("path", "strands", "basis", "wrap", "purpose", "lacks")
+
+
+def to_record(meta: Metadata) -> dict:
+    """The record as plain JSON (a project file's ``scene``)."""
+    return {
+        "up_axis": meta.up_axis,
+        **{k: getattr(meta, k) for k in _RECORD_NUMBERS},
+        "color_primvar": meta.color_primvar,
+        "time_codes": None if meta.time_codes is None else list(meta.time_codes),
+        "curves": [
+            {k: (list(v) if isinstance(v := getattr(c, k), tuple) else v) for k in _PRIM_KEYS}
+            for c in meta.curves
+        ],
+    }
+
+
+def from_record(record: object) -> Metadata:
+    """The inverse of :func:`to_record`; anything else is a ParameterError naming the field."""
+    if not isinstance(record, dict) or set(record) != set(_RECORD_FIELDS):
+        raise ParameterError(
+            "scene", type(record).__name__, f"a record of exactly {', '.join(_RECORD_FIELDS)}"
+        )
+    for k in _RECORD_NUMBERS:
+        v = record[k]
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
+            raise ParameterError(k.replace("_", " "), v, "a number or null")
+    for k in ("up_axis", "color_primvar"):
+        if not isinstance(record[k], str):
+            raise ParameterError(k.replace("_", " "), record[k], "a string")
+    codes = record["time_codes"]
+    if codes is not None and (
+        not isinstance(codes, list)
+        or not all(isinstance(t, (int, float)) and not isinstance(t, bool) for t in codes)
+    ):
+        raise ParameterError("time codes", "…", "a list of numbers or null")
+    items = record["curves"]
+    if not isinstance(items, list):
+        raise ParameterError("curves", type(items).__name__, "a list of prims")
+    prims = []
+    for item in items:
+        if not isinstance(item, dict) or set(item) != set(_PRIM_KEYS) or not isinstance(item["lacks"], list):
+            raise ParameterError("curves", "a prim", f"a record of exactly {', '.join(_PRIM_KEYS)}")
+        prims.append(CurvesPrim(**{k: (tuple(v) if k == "lacks" else v) for k, v in item.items()}))
+    fields = {k: record[k] for k in ("up_axis", *_RECORD_NUMBERS, "color_primvar")}
+    return Metadata(**fields, time_codes=None if codes is None else tuple(codes), curves=tuple(prims))
+
+
 def to_reference(meta: Metadata, vectors: np.ndarray) -> np.ndarray:
     """Scene-axis vectors ``(..., 3)`` in hairtool's reference frame (the inverse of ``frame``)."""
     return np.asarray(vectors, dtype=np.float64) @ meta.frame

@@ -44,6 +44,7 @@ from hairtool.guides.binding import MAX_FRIZZ, ChildBinding, bind_exactly, curl
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
 from hairtool.io.npz import read_npy_header
+from hairtool.metadata import Metadata, from_record, to_record
 
 FORMAT = "hairtool project"
 FORMAT_VERSION = 2  # 2: brush strokes or render hair (children); version 1 files still read
@@ -148,7 +149,7 @@ def _groom_arrays(prefix: str, obj: Groom | Animation, arrays: dict[str, np.ndar
         if value is not None:
             arrays[f"{prefix}/{name}.npy"] = value
             attrs.append(name)
-    return {"attributes": attrs}
+    return {"attributes": attrs, "scene": to_record(obj.metadata)}
 
 
 def _json_object(name: str, value: Any) -> dict:
@@ -354,14 +355,38 @@ def _read_groom(r: _Reader, prefix: str, info: dict, frames_fps: float | None = 
             raise FormatError(r.path, f"{prefix} {name} has shape {a.shape}, expected {want}")
         attrs[name] = float32_finite(r.path, a, f"{prefix} {name}")
     if frames_fps is None:
+        meta = _read_scene(r, prefix, info, counts.size, None)
         points = r.array(f"{prefix}/points.npy", 2, "f")
         if points.shape != (v, 3):
             raise FormatError(r.path, f"{prefix} points have shape {points.shape}, expected {(v, 3)}")
-        return Groom(float32_finite(r.path, points, f"{prefix} points"), counts, **attrs)
+        return Groom(float32_finite(r.path, points, f"{prefix} points"), counts, **attrs, metadata=meta)
     frames = r.array(f"{prefix}/frames.npy", 3, "f")
     if frames.shape[0] < 1 or frames.shape[1:] != (v, 3):
         raise FormatError(r.path, f"animation frames have shape {frames.shape}, expected (F≥1, {v}, 3)")
-    return Animation(float32_finite(r.path, frames, "animation frames"), counts, frames_fps, **attrs)
+    meta = _read_scene(r, prefix, info, counts.size, frames.shape[0])
+    frames = float32_finite(r.path, frames, "animation frames")
+    return Animation(frames, counts, frames_fps, **attrs, metadata=meta)
+
+
+def _read_scene(r: _Reader, prefix: str, info: dict, strand_count: int, frames: int | None) -> Metadata:
+    """The groom's scene description (Y-up centimetres for a project saved before it was kept)."""
+    if "scene" not in info:
+        return Metadata()
+    try:
+        meta = from_record(info["scene"])
+    except (ParameterError, TypeError, ValueError, OverflowError) as e:
+        raise FormatError(r.path, f"manifest.json: {prefix} scene: {e}") from None
+    held = sum(c.strands for c in meta.curves)
+    if meta.curves and held != strand_count:
+        raise FormatError(
+            r.path, f"manifest.json: {prefix} scene prims hold {held} strands, not {strand_count}"
+        )
+    codes = meta.time_codes
+    if codes is not None and (frames is None or len(codes) != frames):
+        raise FormatError(
+            r.path, f"manifest.json: {prefix} scene has {len(codes)} time codes for {frames} frames"
+        )
+    return meta
 
 
 def _read_params(r: _Reader, raw: dict) -> FrozenParams:
@@ -469,8 +494,13 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
             strokes.append(AlignSample(c, float(radius[k]), float(intensity[k]), str(modes[mode[k]]), v))
             continue
         sample = BrushSample(
-            names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
-            float(intensity[k]), tuple(luts[which[k]].tolist()), views[k],
+            names[brush[k]],
+            c,
+            tuple(float(v) for v in direction[k]),
+            float(radius[k]),
+            float(intensity[k]),
+            tuple(luts[which[k]].tolist()),
+            views[k],
         )
         try:
             strokes.append(check_sample(sample))

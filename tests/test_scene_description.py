@@ -357,3 +357,32 @@ def test_a_simulation_layered_over_its_groom_replaces_the_hair_and_keeps_the_hea
     points = UsdGeom.BasisCurves(stage.GetPrimAtPath(HAIR)).GetPointsAttr()
     for f, t in enumerate(sim.time_codes):
         np.testing.assert_array_equal(np.asarray(points.Get(Usd.TimeCode(t)), np.float32), sim.frames[f])
+
+
+def test_a_project_keeps_the_scene_description(scenes, tmp_path):
+    from hairtool import project
+    from hairtool.errors import FormatError
+
+    rest = io.read(scenes["z"])
+    anim = rest.animate(np.stack([rest.points] * 3), 24.0)
+    proj = project.Project(rest=rest, animation=anim, animation_source="simulate")
+    project.save(tmp_path / "p.hairproj", proj)
+    back = project.load(tmp_path / "p.hairproj")
+    assert back.rest.metadata == rest.metadata and back.animation.metadata == anim.metadata
+    assert (back.rest.metadata.up_axis, back.rest.metadata.curves[0].path) == ("Z", HAIR)
+    # A hand-edited scene record is one line naming it.
+    manifest, arrays = project.manifest_and_arrays(proj)
+    manifest["groom"]["scene"]["meters_per_unit"] = "big"
+    import json
+    import zipfile
+
+    with zipfile.ZipFile(tmp_path / "bad.hairproj", "w") as zf:
+        zf.writestr("manifest.json", json.dumps(manifest))
+        for name, a in arrays.items():
+            import io as _io
+
+            buf = _io.BytesIO()
+            np.save(buf, a)
+            zf.writestr(name, buf.getvalue())
+    with pytest.raises(FormatError, match="groom scene"):
+        project.load(tmp_path / "bad.hairproj")
