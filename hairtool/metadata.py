@@ -109,6 +109,11 @@ class Metadata:
     time_codes: tuple[float, ...] | None = None
     curves: tuple[CurvesPrim, ...] = ()
     color_primvar: str = "displayColor"
+    #: ``(prim path, 16 numbers)``: the static local transforms (4×4, row vectors as USD's
+    #: ``p' = p·M``) of the curves prims and their ancestors that had one, so that a writer puts
+    #: them back and writes points in the prims' own space: the file then layers over its
+    #: source without moving the hair twice. Empty when the source had none or animated them.
+    xforms: tuple[tuple[str, tuple[float, ...]], ...] = ()
 
     def __post_init__(self) -> None:
         up = str(self.up_axis).upper()
@@ -139,6 +144,21 @@ class Metadata:
             raise ParameterError("prim paths", paths[:8], "one prim per path")
         if self.color_primvar not in ("displayColor", "color"):
             raise ParameterError("colour primvar", self.color_primvar, "displayColor or color")
+        xforms = []
+        for item in self.xforms:
+            try:
+                path, values = item
+                m = np.asarray(values, dtype=np.float64).reshape(4, 4)
+            except (TypeError, ValueError):
+                raise ParameterError("transform", "an entry", "(prim path, 16 numbers)") from None
+            if not isinstance(path, str) or not path.startswith("/"):
+                raise ParameterError("transform path", path, "an absolute prim path")
+            if not np.all(np.isfinite(m)) or abs(np.linalg.det(m[:3, :3])) < 1e-12 or np.any(m[:3, 3] != 0):
+                raise ParameterError("transform", path, "a finite, invertible affine 4×4 (row vectors)")
+            xforms.append((path, tuple(float(v) for v in m.reshape(-1))))
+        if len({p for p, _ in xforms}) != len(xforms):
+            raise ParameterError("transforms", [p for p, _ in xforms][:8], "one per prim")
+        object.__setattr__(self, "xforms", tuple(xforms))
 
     def with_(self, **changes) -> Metadata:
         """A copy with some fields changed (checked again)."""
@@ -170,6 +190,20 @@ class Metadata:
     @property
     def units_per_meter(self) -> float:
         return 1.0 / self.meters_per_unit
+
+    def world_matrix(self, path: str) -> np.ndarray | None:
+        """``(4, 4)`` local-to-world of the prim at ``path`` from :attr:`xforms` (its own and its
+        ancestors' transforms, row vectors), or None when none of them has one."""
+        table = dict(self.xforms)
+        parts = path.strip("/").split("/")
+        chain = ["/" + "/".join(parts[: k + 1]) for k in range(len(parts))][::-1]  # prim first
+        found = [np.asarray(table[p], np.float64).reshape(4, 4) for p in chain if p in table]
+        if not found:
+            return None
+        m = np.eye(4)
+        for local in found:
+            m = m @ local
+        return m
 
     def derived(self, *, time_codes=None, curves: tuple[CurvesPrim, ...] | None = None) -> Metadata:
         """The record of something made from this source (a simulation, a cycle, a frozen
@@ -227,7 +261,7 @@ def join_attributes(
 
 
 _RECORD_NUMBERS = ("meters_per_unit", "time_codes_per_second", "start_time_code", "end_time_code")
-_RECORD_FIELDS = ("up_axis", *_RECORD_NUMBERS, "color_primvar", "time_codes", "curves")
+_RECORD_FIELDS = ("up_axis", *_RECORD_NUMBERS, "color_primvar", "time_codes", "curves", "xforms")
 _PRIM_KEYS = ("path", "strands", "basis", "wrap", "purpose", "lacks")
 
 
@@ -242,6 +276,7 @@ def to_record(meta: Metadata) -> dict:
             {k: (list(v) if isinstance(v := getattr(c, k), tuple) else v) for k in _PRIM_KEYS}
             for c in meta.curves
         ],
+        "xforms": [[path, list(m)] for path, m in meta.xforms],
     }
 
 
@@ -273,7 +308,18 @@ def from_record(record: object) -> Metadata:
             raise ParameterError("curves", "a prim", f"a record of exactly {', '.join(_PRIM_KEYS)}")
         prims.append(CurvesPrim(**{k: (tuple(v) if k == "lacks" else v) for k, v in item.items()}))
     fields = {k: record[k] for k in ("up_axis", *_RECORD_NUMBERS, "color_primvar")}
-    return Metadata(**fields, time_codes=None if codes is None else tuple(codes), curves=tuple(prims))
+    xforms = record["xforms"]
+    if not isinstance(xforms, list) or not all(isinstance(x, list) and len(x) == 2 for x in xforms):
+        raise ParameterError("xforms", type(xforms).__name__, "a list of [prim path, 16 numbers]")
+    for _, m in xforms:
+        if not isinstance(m, list) or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in m
+        ):
+            raise ParameterError("xforms", "a matrix", "16 numbers")
+    codes_t = None if codes is None else tuple(codes)
+    return Metadata(
+        **fields, time_codes=codes_t, curves=tuple(prims), xforms=tuple((x[0], tuple(x[1])) for x in xforms)
+    )
 
 
 def to_reference(meta: Metadata, vectors: np.ndarray) -> np.ndarray:

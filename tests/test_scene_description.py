@@ -386,3 +386,35 @@ def test_a_project_keeps_the_scene_description(scenes, tmp_path):
             zf.writestr(name, buf.getvalue())
     with pytest.raises(FormatError, match="groom scene"):
         project.load(tmp_path / "bad.hairproj")
+
+
+def test_hair_under_transformed_parents_is_written_in_their_space_and_layers_over_its_source(tmp_path):
+    """b_xform.usdc: the hair sits under /root/Head and /root/Head/Hair with their own translate,
+    rotate and scale. The output puts those transforms back and writes the points in the prim's
+    space, so alone it stands where the source does, and sublayered over the source the hair is
+    moved once, not twice."""
+    from pxr import Sdf, Usd, UsdGeom
+
+    src = INTEROP / "b_xform.usdc"
+    _run(["simulate", src, tmp_path / "sim.usda", "--frames", "3", "--motion", "nod", "--fit-head"])
+    shot = Sdf.Layer.CreateNew(str(tmp_path / "shot.usda"))
+    shot.subLayerPaths.append(str(tmp_path / "sim.usda"))
+    shot.subLayerPaths.append(str(src))
+    shot.Save()
+    sim = io.read(tmp_path / "sim.usda")
+    source = Usd.Stage.Open(str(src))
+    np.testing.assert_allclose(sim.frames[0], io.read(src).points, atol=1e-6)  # where the groom stands
+    for stage_path in (tmp_path / "sim.usda", tmp_path / "shot.usda"):
+        stage = Usd.Stage.Open(str(stage_path))
+        for prim in ("/root/Head", "/root/Head/Hair"):
+            t = Usd.TimeCode.Default()
+            mine = UsdGeom.Xformable(stage.GetPrimAtPath(prim)).ComputeLocalToWorldTransform(t)
+            theirs = UsdGeom.Xformable(source.GetPrimAtPath(prim)).ComputeLocalToWorldTransform(t)
+            np.testing.assert_allclose(np.asarray(mine), np.asarray(theirs), atol=1e-12)
+        hair = UsdGeom.BasisCurves(stage.GetPrimAtPath(HAIR))
+        for f, t in enumerate(sim.time_codes):
+            m = np.asarray(hair.ComputeLocalToWorldTransform(Usd.TimeCode(t)))
+            local = np.asarray(hair.GetPointsAttr().Get(Usd.TimeCode(t)), np.float64)
+            np.testing.assert_allclose(local @ m[:3, :3] + m[3, :3], sim.frames[f], atol=1e-6)
+    _run(["convert", tmp_path / "sim.usda", tmp_path / "sim.npz"])
+    assert io.read(tmp_path / "sim.npz").metadata == sim.metadata and sim.metadata.xforms

@@ -10,7 +10,8 @@ source's curve prims as JSON (path, strands, basis, wrap, purpose and the attrib
 each, in strand order), so render hair and its guides (purpose ``guide``) stay apart through a
 cache, and ``metadata``, a unicode scalar of JSON with the rest of the scene description
 (``up_axis``, ``meters_per_unit``, ``time_codes_per_second``, ``start_time_code``,
-``end_time_code``, ``color_primvar``): USD → npz → USD gives back the same stage. Caches
+``end_time_code``, ``color_primvar``, and ``xforms``, the static transforms of the prims and
+their ancestors, when the source had any): USD → npz → USD gives back the same stage. Caches
 without it read as Y-up centimetres.
 """
 
@@ -82,7 +83,10 @@ def write(path: Path, obj: Groom | Animation) -> None:
             {f: (list(v) if isinstance(v := getattr(c, f), tuple) else v) for f in fields} for c in prims
         ]
         arrays["curves"] = np.array(json.dumps(items))
-    arrays["metadata"] = np.array(json.dumps({f: getattr(obj.metadata, f) for f in _SCENE_FIELDS}))
+    scene = {f: getattr(obj.metadata, f) for f in _SCENE_FIELDS}
+    if obj.metadata.xforms:
+        scene["xforms"] = [[path, list(m)] for path, m in obj.metadata.xforms]
+    arrays["metadata"] = np.array(json.dumps(scene))
     with atomic_open(path, "wb") as f:
         np.savez_compressed(f, **arrays)
 
@@ -236,8 +240,19 @@ def _scene(path: Path, z, strand_count: int) -> Metadata:
         return Metadata(curves=curves)
     record = _json(path, z, "metadata")
     try:
-        if not isinstance(record, dict) or set(record) != set(_SCENE_FIELDS):
-            raise ValueError(f"it has exactly {', '.join(_SCENE_FIELDS)}")
+        if not isinstance(record, dict) or not set(_SCENE_FIELDS) <= set(record) <= {
+            *_SCENE_FIELDS,
+            "xforms",
+        }:
+            raise ValueError(f"it has exactly {', '.join(_SCENE_FIELDS)} (and optionally xforms)")
+        record = dict(record)
+        xforms = record.pop("xforms", [])
+        if not isinstance(xforms, list) or not all(
+            isinstance(x, list) and len(x) == 2 and isinstance(x[1], list) and len(x[1]) == 16 for x in xforms
+        ):
+            raise ValueError("xforms is a list of [prim path, 16 numbers]")
+        if any(isinstance(v, bool) or not isinstance(v, (int, float)) for x in xforms for v in x[1]):
+            raise ValueError("a transform holds numbers")
         for key in ("meters_per_unit", "time_codes_per_second", "start_time_code", "end_time_code"):
             v = record[key]
             if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
@@ -245,7 +260,7 @@ def _scene(path: Path, z, strand_count: int) -> Metadata:
         for key in ("up_axis", "color_primvar"):
             if not isinstance(record[key], str):
                 raise ValueError(f"{key} is a string")
-        return Metadata(**record, curves=curves)
+        return Metadata(**record, curves=curves, xforms=tuple((x[0], tuple(x[1])) for x in xforms))
     except (ValueError, TypeError, OverflowError, ParameterError) as e:
         raise FormatError(path, f"'metadata' is not a scene description: {e}") from None
 

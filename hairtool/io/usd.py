@@ -128,14 +128,25 @@ def _prims(obj: Curves) -> tuple[CurvesPrim, ...]:
     return prims
 
 
-def _define_parents(stage, paths: Sequence[str]) -> None:
-    """Plain Xforms for every ancestor of the curves prims; the first root is the default prim."""
+def _set_transform(prim, meta: Metadata) -> None:
+    """The source's local transform of ``prim`` (one ``xformOp:transform``), if it had one."""
+    from pxr import Gf, UsdGeom
+
+    table = dict(meta.xforms)
+    m = table.get(str(prim.GetPath()))
+    if m is not None:
+        UsdGeom.Xformable(prim).AddTransformOp().Set(Gf.Matrix4d(*m))
+
+
+def _define_parents(stage, paths: Sequence[str], meta: Metadata) -> None:
+    """Xforms for every ancestor of the curves prims, with the source's transforms where it had
+    them (:attr:`~hairtool.metadata.Metadata.xforms`); the first root is the default prim."""
     from pxr import Sdf, UsdGeom
 
     for p in paths:
         for parent in Sdf.Path(p).GetParentPath().GetPrefixes():
             if not stage.GetPrimAtPath(parent):
-                UsdGeom.Xform.Define(stage, parent)
+                _set_transform(UsdGeom.Xform.Define(stage, parent).GetPrim(), meta)
     first_root = Sdf.Path(paths[0]).GetPrefixes()[0]
     if not stage.GetPrimAtPath(first_root):
         UsdGeom.Xform.Define(stage, first_root)
@@ -183,6 +194,8 @@ def _write_prim(stage, prim: CurvesPrim, obj: Curves, strands: slice, times):
     off = obj.topology.offsets
     vs = slice(int(off[strands.start]), int(off[strands.stop]))
     curves = UsdGeom.BasisCurves.Define(stage, prim.path)
+    _set_transform(curves.GetPrim(), obj.metadata)
+    to_local = _to_local(obj.metadata, prim.path)
     basis = prim.basis if usd_basis.fits(counts, prim.basis, prim.wrap) else "linear"
     if basis == "linear":
         curves.CreateTypeAttr(UsdGeom.Tokens.linear)
@@ -199,11 +212,22 @@ def _write_prim(stage, prim: CurvesPrim, obj: Curves, strands: slice, times):
     points_attr = curves.CreatePointsAttr()
     extent_attr = curves.CreateExtentAttr()
     if times is None:
-        pts = np.ascontiguousarray(obj.points[vs])
+        pts = to_local(obj.points[vs])
         points_attr.Set(Vt.Vec3fArray.FromNumpy(pts))
         extent_attr.Set(_extent(pts, half_width))
         return None
-    return points_attr, extent_attr, vs, half_width
+    return points_attr, extent_attr, vs, half_width, to_local
+
+
+def _to_local(meta: Metadata, path: str):
+    """World points → the prim's own space under the transforms the writer puts back
+    (the points as they are where there are none)."""
+    m = meta.world_matrix(path)
+    if m is None:
+        return lambda p: np.ascontiguousarray(p, dtype=np.float32)
+    inv = np.linalg.inv(m[:3, :3])
+    t = m[3, :3]
+    return lambda p: np.ascontiguousarray((np.asarray(p, np.float64) - t) @ inv, dtype=np.float32)
 
 
 def _frame_points(obj: Curves, f: int) -> np.ndarray:
@@ -229,8 +253,8 @@ def _write_samples(stage, obj: Curves, prims: list, times, progress: FrameProgre
     for f, t in enumerate(times):
         code = Usd.TimeCode(float(t))
         frame = _frame_points(obj, f)
-        for points_attr, extent_attr, vs, half_width in prims:
-            pts = np.ascontiguousarray(frame[vs], dtype=np.float32)
+        for points_attr, extent_attr, vs, half_width, to_local in prims:
+            pts = to_local(frame[vs])
             extent = _extent(pts, half_width)
             if not np.all(np.isfinite(np.asarray(extent))):  # a stream's frames are not checked yet
                 raise ParameterError("frame", f, "finite points")
@@ -290,7 +314,7 @@ def write(
         if stage is None:
             raise FormatError(path, "usd-core could not create the stage")
         _write_stage_metadata(stage, obj, times)
-        _define_parents(stage, [c.path for c in prims])
+        _define_parents(stage, [c.path for c in prims], obj.metadata)
         first, sampled = 0, []
         for prim in prims:
             sampled.append(_write_prim(stage, prim, obj, slice(first, first + prim.strands), times))
@@ -627,6 +651,27 @@ def _sample_times(parts: list[_Curves]) -> list[float]:
     return times if point_times or len(times) > 1 else []
 
 
+def _static_xforms(parts: list[_Curves]) -> tuple:
+    """The curves prims' and their ancestors' local transforms (non-identity ones), when none is
+    animated: :attr:`hairtool.metadata.Metadata.xforms`, so a writer can put them back."""
+    from pxr import Gf, Usd, UsdGeom
+
+    if any(c.transform_times for c in parts):
+        return ()
+    table: dict[str, tuple[float, ...]] = {}
+    for c in parts:
+        for p in _lineage(c.prim):
+            xf = UsdGeom.Xformable(p)
+            if not xf:
+                continue
+            if xf.GetResetXformStack():
+                return ()  # a prim that ignores its parents: not kept (the points stay world)
+            m = xf.GetLocalTransformation(Usd.TimeCode.Default())
+            if m != Gf.Matrix4d(1.0):
+                table[str(p.GetPath())] = tuple(float(v) for v in np.asarray(m, np.float64).reshape(-1))
+    return tuple(sorted(table.items()))
+
+
 def _read_stage(path: Path, stage) -> Groom | Animation:
     from pxr import Usd, UsdGeom
 
@@ -639,6 +684,10 @@ def _read_stage(path: Path, stage) -> Groom | Animation:
     attrs, color_source, lacks = _merge_attributes(parts, stage_meta["meters_per_unit"])
     fps = stage_meta.pop("fps")
     curves = tuple(c.info(lack) for c, lack in zip(parts, lacks, strict=True))
+    try:
+        stage_meta["xforms"] = Metadata(xforms=_static_xforms(parts)).xforms
+    except HairtoolError:
+        stage_meta["xforms"] = ()  # a transform these writers cannot put back (projective, singular)
     times = _sample_times(parts)
     if not times:
         once = set().union(*(c.transform_times for c in parts))  # a transform set at one time code
