@@ -149,7 +149,7 @@ class Metadata:
             try:
                 path, values = item
                 m = np.asarray(values, dtype=np.float64).reshape(4, 4)
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 raise ParameterError("transform", "an entry", "(prim path, 16 numbers)") from None
             if not isinstance(path, str) or not path.startswith("/"):
                 raise ParameterError("transform path", path, "an absolute prim path")

@@ -267,9 +267,22 @@ def test_npz_metadata_member_is_checked(tmp_path):
     assert io.read(tmp_path / "ok.npz").metadata == g.metadata
     with np.load(tmp_path / "ok.npz") as z:
         members = {k: z[k] for k in z.files}
+    import json
+
     from hairtool.errors import FormatError
 
-    for bad in ('{"up_axis": "X"}', "[" * 100_000, '{"up_axis": "Z", "meters_per_unit": ' + "9" * 5000 + "}"):
+    record = json.loads(str(members["metadata"]))
+    singular = json.dumps(record | {"xforms": [["/A", [0.0] * 16]]})
+    overflowing = (
+        json.dumps(record).replace('"xforms"', '"x"')[:-1] + ', "xforms": [["/A", [' + "9" * 400 + "]]]}"
+    )
+    for bad in (
+        '{"up_axis": "X"}',
+        "[" * 100_000,
+        '{"up_axis": "Z", "meters_per_unit": ' + "9" * 5000 + "}",
+        singular,
+        overflowing,
+    ):
         np.savez(tmp_path / "bad.npz", **(members | {"metadata": np.array(bad)}))
         with pytest.raises(FormatError, match="metadata"):
             io.read(tmp_path / "bad.npz")
