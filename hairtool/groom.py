@@ -275,6 +275,16 @@ class Groom(_Attributes):
         """The same groom with another source record (up axis, unit, prims)."""
         return Groom(self.points, self.topology, **self.attributes, metadata=metadata)
 
+    def animate(self, frames: ArrayLike, fps: float) -> Animation:
+        """An animation of these strands (a simulation, a cycle): their attributes and source
+        record by construction, frames at time codes from the source's start (0 by default),
+        so an engine that makes frames cannot drop the scene's space, unit or prims."""
+        n = int(np.shape(frames)[0]) if np.ndim(frames) == 3 else 0
+        first = self.metadata.first_time_code()
+        codes = None if first == 0.0 or n == 0 else first + np.arange(n, dtype=np.float64)
+        meta = self.metadata.derived(time_codes=codes)
+        return Animation(frames, self.topology, fps, **self.attributes, metadata=meta)
+
     def subset(self, strand_ids: ArrayLike) -> Groom:
         """A groom of the chosen strands, in the given order."""
         ids = np.asarray(strand_ids, dtype=np.int64).reshape(-1)

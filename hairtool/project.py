@@ -46,6 +46,7 @@ from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
 from hairtool.io.npz import read_npy_header
 from hairtool.io.obj import Mesh
+from hairtool.metadata import Metadata, from_record, to_record
 
 FORMAT = "hairtool project"
 FORMAT_VERSION = 2  # 2: brush strokes or render hair (children); version 1 files still read
@@ -151,7 +152,7 @@ def _groom_arrays(prefix: str, obj: Groom | Animation, arrays: dict[str, np.ndar
         if value is not None:
             arrays[f"{prefix}/{name}.npy"] = value
             attrs.append(name)
-    return {"attributes": attrs}
+    return {"attributes": attrs, "scene": to_record(obj.metadata)}
 
 
 def _json_object(name: str, value: Any) -> dict:
@@ -170,8 +171,6 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
         "saved": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
         "groom": {
             "source": project.groom_source,
-            "up_axis": project.rest.metadata.up_axis,
-            "meters_per_unit": project.rest.metadata.meters_per_unit,
             **_groom_arrays("groom", project.rest, arrays),
         },
         "params": _params_json(project.params, arrays),
@@ -378,14 +377,38 @@ def _read_groom(r: _Reader, prefix: str, info: dict, frames_fps: float | None = 
             raise FormatError(r.path, f"{prefix} {name} has shape {a.shape}, expected {want}")
         attrs[name] = float32_finite(r.path, a, f"{prefix} {name}")
     if frames_fps is None:
+        meta = _read_scene(r, prefix, info, counts.size, None)
         points = r.array(f"{prefix}/points.npy", 2, "f")
         if points.shape != (v, 3):
             raise FormatError(r.path, f"{prefix} points have shape {points.shape}, expected {(v, 3)}")
-        return Groom(float32_finite(r.path, points, f"{prefix} points"), counts, **attrs)
+        return Groom(float32_finite(r.path, points, f"{prefix} points"), counts, **attrs, metadata=meta)
     frames = r.array(f"{prefix}/frames.npy", 3, "f")
     if frames.shape[0] < 1 or frames.shape[1:] != (v, 3):
         raise FormatError(r.path, f"animation frames have shape {frames.shape}, expected (F≥1, {v}, 3)")
-    return Animation(float32_finite(r.path, frames, "animation frames"), counts, frames_fps, **attrs)
+    meta = _read_scene(r, prefix, info, counts.size, frames.shape[0])
+    frames = float32_finite(r.path, frames, "animation frames")
+    return Animation(frames, counts, frames_fps, **attrs, metadata=meta)
+
+
+def _read_scene(r: _Reader, prefix: str, info: dict, strand_count: int, frames: int | None) -> Metadata:
+    """The groom's scene description (Y-up centimetres for a project saved before it was kept)."""
+    if "scene" not in info:
+        return Metadata()
+    try:
+        meta = from_record(info["scene"])
+    except (ParameterError, TypeError, ValueError, OverflowError) as e:
+        raise FormatError(r.path, f"manifest.json: {prefix} scene: {e}") from None
+    held = sum(c.strands for c in meta.curves)
+    if meta.curves and held != strand_count:
+        raise FormatError(
+            r.path, f"manifest.json: {prefix} scene prims hold {held} strands, not {strand_count}"
+        )
+    codes = meta.time_codes
+    if codes is not None and (frames is None or len(codes) != frames):
+        raise FormatError(
+            r.path, f"manifest.json: {prefix} scene has {len(codes)} time codes for {frames} frames"
+        )
+    return meta
 
 
 def _read_params(r: _Reader, raw: dict) -> FrozenParams:
@@ -647,11 +670,6 @@ def _build(r: _Reader) -> Project:
     path = r.path
     groom_info = _section(path, manifest, "groom", dict)
     rest = _read_groom(r, "groom", groom_info)
-    try:
-        space = {k: groom_info[k] for k in ("up_axis", "meters_per_unit") if k in groom_info}
-        rest = rest.with_metadata(rest.metadata.with_(**space)) if space else rest
-    except HairtoolError as e:
-        raise FormatError(path, f"manifest.json: groom {e}") from None
     source = groom_info.get("source")
     params = _read_params(r, _section(path, manifest, "params", dict))
     sv = params.strand_variation

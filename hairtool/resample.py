@@ -37,6 +37,7 @@ def resample_points(groom: Groom, m: int) -> np.ndarray:
 
 
 def resample(groom: Groom, m: int) -> Groom:
-    """The groom with every strand resampled to ``m`` points by arc length (attributes dropped)."""
+    """The groom with every strand resampled to ``m`` points by arc length (attributes dropped,
+    the scene and prims kept)."""
     pts = resample_points(groom, m)
-    return Groom(pts.reshape(-1, 3), np.full(groom.strand_count, m))
+    return Groom(pts.reshape(-1, 3), np.full(groom.strand_count, m), metadata=groom.metadata)

@@ -15,9 +15,16 @@ def normalize(v: ArrayLike, eps: float = EPS) -> NDArray[np.float64]:
     return np.where(n > eps, a / np.maximum(n, eps), 0.0)
 
 
-def any_perpendicular(v: ArrayLike) -> NDArray[np.float64]:
-    """A unit vector perpendicular to each row of ``v`` (a fixed, deterministic choice)."""
+def any_perpendicular(v: ArrayLike, frame: ArrayLike | None = None) -> NDArray[np.float64]:
+    """A unit vector perpendicular to each row of ``v`` (a fixed, deterministic choice).
+
+    ``frame``: a 3×3 rotation whose columns are the axes to choose from (a scene's axes,
+    :attr:`hairtool.metadata.Metadata.frame`; default x, y, z), so that the same groom turned
+    into another frame gets the same vectors, turned."""
     a = np.asarray(v, dtype=np.float64)
+    if frame is not None:
+        f = np.asarray(frame, dtype=np.float64)
+        return any_perpendicular(a @ f) @ f.T
     # Cross with the coordinate axis least aligned with v: never near-parallel.
     helper = np.zeros_like(a)
     helper[np.arange(len(a)) if a.ndim == 2 else ..., np.argmin(np.abs(a), axis=-1)] = 1.0

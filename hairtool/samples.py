@@ -1,7 +1,9 @@
 """Procedural sample grooms, seeded and sized by parameters.
 
-Units: the head radius is 1. The up axis is +y and gravity pulls toward −y, as in TressFX
-and most DCC scenes; 2-D grooms lie in the z = 0 plane.
+Units: the head radius is 1, a head of 10 cm: the samples' record says 0.1 m per unit, so
+gravity in m/s² (:mod:`hairtool.simulate.dynamics`) and default hair widths in µm land at their
+real sizes. The up axis is +y and gravity pulls toward −y, as in TressFX and most DCC scenes;
+2-D grooms lie in the z = 0 plane.
 """
 
 from __future__ import annotations
@@ -12,8 +14,11 @@ import numpy as np
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Groom
+from hairtool.metadata import Metadata
 
 HEAD_RADIUS = 1.0
+#: The samples' space: Y-up, one unit a tenth of a metre (the head's radius, 10 cm).
+SAMPLE_METADATA = Metadata(up_axis="Y", meters_per_unit=0.1)
 
 
 def _check_size(strands: int, vertices: int) -> None:
@@ -80,7 +85,7 @@ def portrait(strands: int = 160, vertices: int = 20, seed: int = 0) -> Groom:
     lengths = 2.4 * HEAD_RADIUS * rng.uniform(0.85, 1.15, strands)
     pts = _grow(roots, _parted(normals), lengths, vertices, gravity=0.35)
     pts[..., 2] = 0.0
-    return Groom(pts.reshape(-1, 3), np.full(strands, vertices))
+    return Groom(pts.reshape(-1, 3), np.full(strands, vertices), metadata=SAMPLE_METADATA)
 
 
 def scalp(strands: int = 2000, vertices: int = 24, seed: int = 0) -> Groom:
@@ -97,7 +102,7 @@ def scalp(strands: int = 2000, vertices: int = 24, seed: int = 0) -> Groom:
     normals = _parted(normals)
     curl = np.column_stack([rng.uniform(0.02, 0.06, strands), rng.uniform(0, 2 * np.pi, strands)])
     pts = _grow(roots, normals, lengths, vertices, gravity=0.3, curl=curl)
-    return Groom(pts.reshape(-1, 3), np.full(strands, vertices))
+    return Groom(pts.reshape(-1, 3), np.full(strands, vertices), metadata=SAMPLE_METADATA)
 
 
 def comb(strands: int = 100, vertices: int = 20, seed: int = 0, spacing: float = 0.05) -> Groom:
@@ -118,7 +123,7 @@ def comb(strands: int = 100, vertices: int = 20, seed: int = 0, spacing: float =
     length = spacing * 10.0
     t = np.linspace(0.0, 1.0, vertices)
     pts = roots[:, None, :] + t[None, :, None] * np.array([0.0, -length, 0.0])
-    return Groom(pts.reshape(-1, 3), np.full(strands, vertices))
+    return Groom(pts.reshape(-1, 3), np.full(strands, vertices), metadata=SAMPLE_METADATA)
 
 
 SAMPLES: dict[str, Callable[..., Groom]] = {"portrait": portrait, "scalp": scalp, "comb": comb}

@@ -267,7 +267,8 @@ class AnimationController(QObject):
             return
         if on:
             self.model.pause()
-            self.recorder = Recorder(self.scene.result.topology, self.model.fps)
+            result = self.scene.result
+            self.recorder = Recorder(result.topology, self.model.fps, result.metadata)
             self.viewport.brush_target = None
             self.refresh_display()
             self.window.statusBar().showMessage("Recording: drag the hair; toggle Record again to stop")

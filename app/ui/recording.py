@@ -12,6 +12,7 @@ import numpy as np
 
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Animation, Topology
+from hairtool.metadata import Metadata
 
 _EPS = 1e-9  # seconds: a sample exactly on a frame time counts for that frame
 
@@ -19,10 +20,11 @@ _EPS = 1e-9  # seconds: a sample exactly on a frame time counts for that frame
 class Recorder:
     """Collects poses ``(V, 3)`` with wall-clock times (seconds) into frames at ``fps``."""
 
-    def __init__(self, topology: Topology, fps: float = 24.0) -> None:
+    def __init__(self, topology: Topology, fps: float = 24.0, metadata: Metadata | None = None) -> None:
         if not np.isfinite(fps) or fps <= 0:
             raise ParameterError("fps", fps, "a positive frame rate")
         self.topology = topology
+        self.metadata = Metadata() if metadata is None else metadata.derived()  # the groom's scene
         self.fps = float(fps)
         self.frames: list[np.ndarray] = []
         self._current: np.ndarray | None = None
@@ -66,4 +68,4 @@ class Recorder:
         """The recorded frames; GroomError when fewer than two were captured."""
         if len(self.frames) < 2:
             raise GroomError("nothing recorded: hold Record and drag the hair for a moment")
-        return Animation(np.stack(self.frames), self.topology, self.fps)
+        return Animation(np.stack(self.frames), self.topology, self.fps, metadata=self.metadata)

@@ -99,7 +99,7 @@ class SimulateDialog(QDialog):
 
         forces = QGroupBox("Forces")
         f = QFormLayout(forces)
-        self.gravity = _spin(-1e5, 1e5, 2, 10.0, " units/s²")
+        self.gravity = _spin(-1e4, 1e4, 2, 1.0, " m/s²")
         self.damping = _spin(0.0, 1e4, 3, 0.5, " /s")
         self.stiffness = _spin(0.0, 1.0, 3, 0.01)
         self.stiffness.setToolTip("pull toward the styled shape per frame (0: none, 1: rigid)")
@@ -125,7 +125,7 @@ class SimulateDialog(QDialog):
         self.head_radius = _spin(0.0, 1e4, 3, 0.1)
         self.fit_button = QPushButton("Fit to groom")
         self.fit_button.setToolTip(
-            "Fit the sphere to the groom's roots and scale gravity, wind and gusts with the head size"
+            "Fit the sphere to the groom's roots and scale wind and gusts with the head size"
         )
         self.fit_button.setEnabled(groom is not None)
         self.fit_button.clicked.connect(self.fit_to_groom)

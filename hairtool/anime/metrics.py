@@ -134,7 +134,7 @@ def _frames_as_chains(obj: Groom | Animation, m: int | None) -> F64:
     if m is None:
         n = int(obj.counts[0])
         return pts.astype(np.float64).reshape(pts.shape[0], obj.strand_count, n, 3)
-    return np.stack([resample_points(Groom(p, obj.topology), m) for p in pts])
+    return np.stack([resample_points(Groom(p, obj.topology, metadata=obj.metadata), m) for p in pts])
 
 
 def compare_cycle(generated: Animation | Groom, reference: Animation | Groom) -> ChainErrors:

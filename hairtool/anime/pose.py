@@ -24,8 +24,8 @@ from hairtool.rotation import any_perpendicular, normalize
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
 
-UP = np.array([0.0, 1.0, 0.0])  # gravity pulls toward −y (hairtool.samples)
-VIEW_HORIZONTAL = np.array([1.0, 0.0, 0.0])
+UP = np.array([0.0, 1.0, 0.0])  # the reference frame's up (hairtool.samples); a scene's: its frame
+VIEW_HORIZONTAL = np.array([1.0, 0.0, 0.0])  # lateral in Y-up and Z-up scenes alike
 _DEGENERATE = 1e-6  # |sin| between a chord and the sway below which the sway gives no axis
 
 
@@ -71,17 +71,21 @@ def check_sway(sway: ArrayLike | None) -> F64 | None:
     return w / np.linalg.norm(w)
 
 
-def bend_axes(chains: Groom, sway: ArrayLike | None = None, planar: bool | None = None) -> F64:
+def bend_axes(
+    chains: Groom, sway: ArrayLike | None = None, planar: bool | None = None, up: ArrayLike | None = None
+) -> F64:
     """``(S,)``×3 unit bend axes, one per chain, so that positive wave y bends toward ``sway``.
 
     The axis is chord × sway (chord = root → tip of the rest chain). ``sway`` defaults to up
-    (−gravity): the axis is then perpendicular to the strand and to gravity and the wave's
-    gravity term pulls chains down. 2-D grooms always bend about ±z and stay planar. Chords
-    parallel to the sway fall back to the view's horizontal (+x) as the sway, then to any
-    perpendicular. ``planar`` defaults to ``chains.is_planar``.
+    (−gravity: ``up``, default the chains' scene's up axis, +y or +z): the axis is then
+    perpendicular to the strand and to gravity and the wave's gravity term pulls chains down.
+    2-D grooms always bend about ±z and stay planar. Chords parallel to the sway fall back to
+    the view's horizontal (+x) as the sway, then to any perpendicular. ``planar`` defaults to
+    ``chains.is_planar``.
     """
     w = check_sway(sway)
-    w = UP if w is None else w
+    up_dir = chains.metadata.up if up is None else np.asarray(up, dtype=np.float64)
+    w = up_dir if w is None else w
     chord = (chains.tips - chains.roots).astype(np.float64)
     length = np.linalg.norm(chord, axis=1)
     if chains.is_planar if planar is None else planar:
@@ -94,9 +98,9 @@ def bend_axes(chains: Groom, sway: ArrayLike | None = None, planar: bool | None 
     axes = np.cross(chord, w)
     ok = np.linalg.norm(axes, axis=1) > _DEGENERATE * np.maximum(length, 1e-30)
     if not np.all(ok):
-        fallback = np.cross(chord[~ok], VIEW_HORIZONTAL if abs(w[0]) < 0.9 else UP)
+        fallback = np.cross(chord[~ok], VIEW_HORIZONTAL if abs(w[0]) < 0.9 else up_dir)
         bad = np.linalg.norm(fallback, axis=1) <= _DEGENERATE * np.maximum(length[~ok], 1e-30)
-        fallback[bad] = any_perpendicular(np.where(length[~ok][bad, None] > 0, chord[~ok][bad], UP))
+        fallback[bad] = any_perpendicular(np.where(length[~ok][bad, None] > 0, chord[~ok][bad], up_dir))
         axes[~ok] = fallback
     return normalize(axes)
 

@@ -77,4 +77,4 @@ def cycle_for_groom(groom: Groom, settings: AnimeSettings, strand_ids: ArrayLike
     part = cycle_animation(groom.subset(ids), settings.wave, **kwargs)
     frames = np.repeat(groom.points[None], part.n_frames, axis=0)
     frames[:, vertex_ids_of(groom.topology, ids)] = part.frames
-    return Animation(frames, groom.topology, part.fps, **groom.attributes)
+    return groom.animate(frames, part.fps)

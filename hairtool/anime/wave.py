@@ -223,7 +223,8 @@ def cycle_animation(
     ``bunches`` (from :func:`make_bunches`) or the keywords of :func:`make_bunches` (guides,
     sway, amplitude_scale, phase, amplitude_spread, phase_spread, seed) set the per-bunch
     variation; by default every strand is a bunch with a seeded phase and amplitude. The
-    groom's attributes (thickness, colours) are kept.
+    groom's attributes (thickness, colours) and source record (up axis, unit, prims) are kept,
+    and "up" is the scene's.
     """
     params = WaveParams() if params is None else params
     sched = schedule(params.period, fps, hold)
@@ -238,4 +239,4 @@ def cycle_animation(
         )
     b = make_bunches(groom, **variation) if bunches is None else bunches
     pictures = pose_pictures(groom, params, sched.picture_times, b).astype(np.float32)
-    return Animation(pictures[exposure], groom.topology, sched.fps, **groom.attributes)
+    return groom.animate(pictures[exposure], sched.fps)

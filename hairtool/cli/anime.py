@@ -54,7 +54,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="chain strand ids, e.g. 0,5,10-13; other strands follow the nearest "
         "(with --from-dense: the number G of guides to pick)",
     )
-    b.add_argument("--sway", help="x,y,z direction positive wave y bends toward (default up, 0,1,0)")
+    b.add_argument(
+        "--sway", help="x,y,z direction positive wave y bends toward (default the scene's up: 0,1,0 or 0,0,1)"
+    )
     b.add_argument("--phase-spread", type=float, default=0.25, help="random phase per bunch, in cycles [0,1]")
     b.add_argument("--amplitude-spread", type=float, default=0.1, help="random amplitude scale 1±this [0,1]")
     b.add_argument(

@@ -2,8 +2,10 @@
 
 An animation written to a format without time samples keeps its first frame only; a warning on
 stderr says how many frames were dropped. Render hair and its guides (a prim of purpose ``guide``)
-stay apart in USD and ``.npz``; elsewhere a warning says the guides join the hair. A USD output
-keeps the input's up axis, unit, time codes and curve prims; ``--up-axis`` and
+stay apart in USD and ``.npz``; elsewhere a warning says the guides join the hair. USD and
+``.npz`` outputs keep the input's scene description (up axis, unit, time codes, curve prims
+with their basis, purposes and colour primvar); HAIR and OBJ cannot, and one warning names what
+is dropped; ``--up-axis`` and
 ``--meters-per-unit`` say what the points are in where the input cannot (HAIR, OBJ, TressFX) or
 is wrong — they relabel, they do not move the points.
 """
@@ -24,19 +26,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--up-axis",
         type=str.upper,
         choices=("Y", "Z"),
-        help="the up axis the USD output declares (default: the input's; Y for formats without one)",
+        help="the up axis a USD or .npz output declares (default: the input's; Y for formats without one)",
     )
     parser.add_argument(
         "--meters-per-unit",
         type=float,
         metavar="M",
-        help="metres per unit the USD output declares (default: the input's; 0.01, centimetres, "
+        help="metres per unit a USD or .npz output declares (default: the input's; 0.01, centimetres, "
         "for formats without one)",
     )
 
 
 def _override(args: argparse.Namespace, obj):
-    """The groom with the up axis / unit the command line declares (USD outputs only)."""
+    """The groom with the up axis / unit the command line declares (USD and .npz outputs)."""
     from hairtool.errors import ParameterError
     from hairtool.io import format_for
 
@@ -47,10 +49,31 @@ def _override(args: argparse.Namespace, obj):
         changes["meters_per_unit"] = args.meters_per_unit
     if not changes:
         return obj
-    if format_for(args.output, writing=True).module != "usd":
+    if format_for(args.output, writing=True).module not in ("usd", "npz"):
         name = "up-axis" if "up_axis" in changes else "meters-per-unit"
-        raise ParameterError(name, next(iter(changes.values())), "a USD output (.usda, .usdc, .usd)")
+        expected = "a USD output or an .npz cache (.usda, .usdc, .usd, .npz)"
+        raise ParameterError(name, next(iter(changes.values())), expected)
     return obj.with_metadata(obj.metadata.with_(**changes))
+
+
+def _scene_lost(obj) -> list[str]:
+    """What of the scene description a format without one drops (empty when it held nothing
+    beyond the defaults these formats read back as)."""
+    from hairtool.io.usd import PRIM_PATH
+    from hairtool.metadata import DEFAULT_METERS_PER_UNIT, DEFAULT_UP_AXIS, CurvesPrim
+
+    m = obj.metadata
+    lost = []
+    if m.up_axis != DEFAULT_UP_AXIS:
+        lost.append(f"{m.up_axis}-up")
+    if m.meters_per_unit != DEFAULT_METERS_PER_UNIT:
+        lost.append(f"{m.meters_per_unit:g} m per unit")
+    prims = m.for_strands(obj.strand_count).curves
+    if prims == (CurvesPrim(PRIM_PATH, obj.strand_count),):
+        prims = ()  # hairtool's own default prim: nothing to lose
+    if prims:
+        lost.append("prims " + ", ".join(f"{c.path} ({c.description})" for c in prims))
+    return lost
 
 
 def run(args: argparse.Namespace) -> int:
@@ -77,6 +100,13 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"hairtool convert: warning: {out_fmt.name} cannot mark guides; the {held} guide strands "
             f"({', '.join(c.path for c in guides)}) are written as hair with the others",
+            file=sys.stderr,
+        )
+    lost = _scene_lost(obj) if out_fmt.module not in ("usd", "npz") else []
+    if lost:
+        print(
+            f"hairtool convert: warning: {out_fmt.name} cannot hold the scene description; dropping "
+            f"{'; '.join(lost)} (it reads back as Y-up, 0.01 m per unit, one linear prim)",
             file=sys.stderr,
         )
     if Path(args.input).suffix.lower() == ".hair" and Path(args.output).suffix.lower() == ".hair":

@@ -4,6 +4,11 @@ Align samples (--align, repeatable) are applied in order, like mouse moves in th
 With --count (children grown from the input as guides) or --from-dense --guides G (guides picked
 from the input), the pipeline runs on the guides and OUT receives the render strands
 interpolated from the frozen guides (see ``hairtool interpolate``).
+
+Freeze styles one pose. An animation IN is refused unless --frame F names the pose to style
+(0 = the first): freezing every frame would clump and align each pose on its own, so the locks
+would jump from frame to frame; style the rest pose, then simulate or cycle it. OUT is a static
+groom in IN's space, unit and prims (no frame range).
 """
 
 from __future__ import annotations
@@ -42,6 +47,13 @@ def _radius(text: str) -> float | None:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("input", metavar="IN", help="groom to read (.tfx, .hair, .usd*, .npz, .obj)")
     parser.add_argument("output", metavar="OUT", help="groom to write (.hair, .usd*, .npz, .obj)")
+    parser.add_argument(
+        "--frame",
+        type=int,
+        default=None,
+        metavar="F",
+        help="the pose of an animation IN to freeze (0 = first)",
+    )
     f = parser.add_argument_group("stylised noise (FreezeDeform, eqs. 2–7)")
     f.add_argument(
         "--stretch-stiffness",
@@ -137,6 +149,29 @@ def _surface(args: argparse.Namespace, strokes):
         args.scalp = None  # the surface's only: no children to grow on it
     return surface
 
+def _pose(args: argparse.Namespace):
+    """The groom to freeze: IN, or the ``--frame`` pose of an animation IN (which is refused
+    without it), as a static groom without the animation's frame range."""
+    from hairtool import io
+    from hairtool.errors import ParameterError
+    from hairtool.groom import Animation
+
+    obj = io.read(args.input)
+    frames = obj.n_frames if isinstance(obj, Animation) else 1
+    if args.frame is None and frames > 1:
+        raise ParameterError(
+            "frame",
+            None,
+            f"the pose to freeze: {args.input} is an animation of {frames} frames (--frame 0…{frames - 1})",
+        )
+    f = 0 if args.frame is None else args.frame
+    if not 0 <= f < frames:
+        raise ParameterError("frame", f, f"a frame of {args.input} in [0, {frames - 1}]")
+    if not isinstance(obj, Animation):
+        return obj
+    pose = obj.frame(f)
+    return pose.with_metadata(pose.metadata.derived())
+
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
@@ -176,7 +211,7 @@ def run(args: argparse.Namespace) -> int:
     _guides.check(args)
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
     # With render hair (asked for, or the input's own), the pipeline runs on the guides.
-    groom, binding, bind_ms = _guides.prepare(args, io.read_groom(args.input))
+    groom, binding, bind_ms = _guides.prepare(args, _pose(args))
     pipe = FrozenPipeline(groom, params, surface)
     lo, hi = groom.bounds
     radius = float(np.linalg.norm(hi - lo)) if args.radius is None else args.radius

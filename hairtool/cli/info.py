@@ -54,6 +54,8 @@ def _usd_summary(obj) -> dict:
 
 def summary(path: str) -> dict:
     """The facts ``hairtool info`` prints, as plain JSON-ready values."""
+    import numpy as np
+
     from hairtool.groom import Animation
     from hairtool.io import format_for, read
 
@@ -78,6 +80,13 @@ def summary(path: str) -> dict:
         "bounds": {"min": [float(x) for x in lo], "max": [float(x) for x in hi]},
         "attributes": [name for name, a in obj.attributes.items() if a is not None],
     }
+    prims = obj.metadata.for_strands(obj.strand_count).curves
+    guide_prims = [c for c in prims if c.purpose == "guide"]
+    if guide_prims:  # render hair and its guides, counted apart
+        guides = sum(c.strands for c in guide_prims)
+        is_guide = np.repeat([c.purpose == "guide" for c in prims], [c.strands for c in prims])
+        out["render_hair"] = {"strands": obj.strand_count - guides, "vertices": int(counts[~is_guide].sum())}
+        out["guides"] = {"strands": guides, "vertices": int(counts[is_guide].sum())}
     if isinstance(obj, Animation):
         out["frames"] = obj.n_frames
         out["fps"] = obj.fps
@@ -121,6 +130,14 @@ def _text(s: dict) -> str:
         f"format      {s['format']} ({s['kind']})",
         f"strands     {s['strands']}",
         f"vertices    {s['vertices']}  (per strand min {vps['min']}, mean {vps['mean']:g}, max {vps['max']})",
+        *(
+            [
+                f"render hair {s['render_hair']['strands']} strands, {s['render_hair']['vertices']} vertices",
+                f"guides      {s['guides']['strands']} strands, {s['guides']['vertices']} vertices",
+            ]
+            if "guides" in s
+            else []
+        ),
         f"bounds      min ({', '.join(f'{x:.6g}' for x in lo)})  max ({', '.join(f'{x:.6g}' for x in hi)})",
     ]
     if "frames" in s:

@@ -6,9 +6,13 @@ Motions (comma-separated, played in equal slots): still, turn, nod, shake, hop.
 
 IN is a groom or animation file (its first frame is the rest pose) or a built-in sample:
 sample:NAME[:STRANDS[:VERTICES]] with NAME portrait, scalp or comb, e.g. sample:scalp:500:24.
-Units: the samples' head has radius 1 at the origin (≈ 10 cm); accelerations in units/s².
-For a real groom, --fit-head fits the head sphere to its roots and reads the accelerations
-in head radii/s², so the defaults move any groom as they move the samples.
+Space: the groom's own (a USD stage's up axis and metersPerUnit; Y-up centimetres for
+formats that say nothing; the samples' head has radius 1 at the origin, 1 unit = 10 cm).
+Gravity is in m/s² along the stage's −up; turn and shake are about the up axis, nod about
+the lateral (x) axis; wind and gusts are in scene units/s². For a real groom, --fit-head fits
+the head sphere to its roots and reads wind and gusts in head radii/s², so the defaults move
+any groom as they move the samples. OUT keeps IN's up axis, unit, prim paths, basis, widths
+and colours: a simulation of /root/Head/Hair/HairData writes /root/Head/Hair/HairData.
 
 Render hair: with --count N (children grown from IN as guides, on --scalp if given) or
 --from-dense --guides G (guides picked from a dense IN), the guides are simulated and OUT
@@ -44,7 +48,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     m.add_argument("--fps", type=float, default=24.0, help="frames per second (default 24)")
     m.add_argument("--substeps", type=int, default=8, help="solver steps per frame (default 8)")
     f = parser.add_argument_group("forces")
-    f.add_argument("--gravity", type=float, default=GRAVITY, help=f"units/s² along −y (default {GRAVITY})")
+    f.add_argument(
+        "--gravity", type=float, default=GRAVITY, help=f"m/s² along the scene's −up (default {GRAVITY})"
+    )
     f.add_argument("--damping", type=float, default=2.0, help="velocity decay per second (default 2)")
     f.add_argument("--stiffness", type=float, default=0.05, help="pull toward the styled shape, 0..1/frame")
     f.add_argument("--wind", metavar="X,Y,Z", help="constant wind acceleration, units/s²")
@@ -59,7 +65,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     h.add_argument(
         "--fit-head",
         action="store_true",
-        help="fit the head sphere to the roots, and read gravity, wind and gusts in head radii/s², "
+        help="fit the head sphere to the roots, and read wind and gusts in head radii/s², "
         "so a groom of any scale moves as the samples do (instead of --head-center/--head-radius)",
     )
     _guides.add_arguments(parser, seed=False)
@@ -90,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
         centre = parse_vector("head-center", args.head_center or "0,0,0")
         radius = 1.0 if args.head_radius is None else args.head_radius
         scale = 1.0
-    forces = scaled_accelerations(scale, args.gravity, args.gust_strength, wind)
+    forces = scaled_accelerations(scale, args.gust_strength, wind)
     w = np.asarray(forces["wind"])
     strength = float(np.linalg.norm(w))
     wind_arg = None if args.wind is None else (w if strength > 0 else (0.0, 0.0, 1.0), strength)
@@ -101,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
         frames=args.frames,
         fps=args.fps,
         substeps=args.substeps,
-        gravity=forces["gravity"],
+        gravity=args.gravity,
         damping=args.damping,
         stiffness=args.stiffness,
         wind=wind_arg,

@@ -341,11 +341,12 @@ def _sphere_centre(groom: Groom) -> F64 | None:
 def scalp_centre(groom: Groom) -> F64:
     """Centre of the sphere fitted to the roots (least squares, |x|² = 2c·x + k): the scalp's
     outward normal at a root points away from it; where the roots are coplanar (or fewer than
-    4), a point below their centroid."""
+    4), a point below their centroid, along the scene's −up (its up axis, +y or +z)."""
     centre = _sphere_centre(groom)
     if centre is None:
         r = groom.roots.astype(np.float64)
-        centre = r.mean(axis=0) - np.array([0.0, 1.0, 0.0]) * float(np.ptp(r[:, 1]) + 1.0)
+        up = groom.metadata.up
+        centre = r.mean(axis=0) - up * float(np.ptp(r @ up) + 1.0)
     return centre
 
 

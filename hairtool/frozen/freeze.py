@@ -162,11 +162,21 @@ def freeze(
     ks, kb, seed = _effective(
         groom, stretch_stiffness, bend_stiffness, max_bend_angle, seed, strand_variation
     )
-    out = np.empty_like(groom.points)
-    _freeze_kernel(
-        groom.points, groom.offsets, ks, kb, float(max_bend_angle), seed_u64(seed), groom.is_planar, out
-    )
-    return groom.with_points(out)
+    points, back = _in_reference_axes(groom)
+    out = np.empty_like(points)
+    _freeze_kernel(points, groom.offsets, ks, kb, float(max_bend_angle), seed_u64(seed), groom.is_planar, out)
+    return groom.with_points(back(out))
+
+
+def _in_reference_axes(groom: Groom):
+    """The points in hairtool's reference axes (y up) and the map back: the fallback bend axis
+    is picked among the coordinate axes, so a Z-up groom is frozen as its Y-up twin is. The
+    axes differ by a signed permutation, so both maps are exact."""
+    frame = groom.metadata.frame
+    if groom.metadata.up_axis == "Y":
+        return groom.points, lambda p: p
+    ref = np.ascontiguousarray((groom.points.astype(np.float64) @ frame).astype(np.float32))
+    return ref, lambda p: (np.asarray(p, np.float64) @ frame.T).astype(np.float32)
 
 
 def freeze_reference(
@@ -182,7 +192,8 @@ def freeze_reference(
         groom, stretch_stiffness, bend_stiffness, max_bend_angle, seed, strand_variation
     )
     top = groom.topology
-    p = groom.points.astype(np.float64)
+    points, back = _in_reference_axes(groom)
+    p = points.astype(np.float64)
     end = top.segment_end
     s, i = top.strand_index[end], top.index_in_strand[end]
     d = p[end] - p[end - 1]  # (2)
@@ -208,4 +219,4 @@ def freeze_reference(
     for k in range(1, int(top.counts.max())):  # root outwards, all strands at once
         sel = i == k
         out[end[sel]] = out[end[sel] - 1] + step[sel]
-    return groom.with_points(out)
+    return groom.with_points(back(out))

@@ -64,7 +64,25 @@ class RenderHairAnimation(StrandSizes):
 
     @property
     def metadata(self) -> Metadata:
-        return self.guides.metadata.with_(curves=())
+        """The guides animation's scene and time codes, the children's prims (if bound with any)."""
+        return self.guides.metadata.with_(curves=self.binding.metadata.curves)
+
+    @property
+    def attributes(self) -> dict[str, np.ndarray | None]:
+        """The children's widths, colours and transparency (constant over the frames)."""
+        return self.binding.attributes
+
+    @property
+    def thickness(self) -> np.ndarray | None:
+        return self.binding.attributes["thickness"]
+
+    @property
+    def transparency(self) -> np.ndarray | None:
+        return self.binding.attributes["transparency"]
+
+    @property
+    def colors(self) -> np.ndarray | None:
+        return self.binding.attributes["colors"]
 
     @property
     def frame_bytes(self) -> int:
@@ -73,7 +91,7 @@ class RenderHairAnimation(StrandSizes):
 
     def guides_frame(self, f: int) -> Groom:
         """Frame ``f`` of the guides as a groom."""
-        return Groom(self.guides.frames[f], self.guides.topology)
+        return Groom(self.guides.frames[f], self.guides.topology, metadata=self.guides.metadata)
 
     def frame_points(self, f: int, out: np.ndarray | None = None) -> np.ndarray:
         """``(V, 3)`` float32 points of the children at frame ``f``: a new array, or written
@@ -93,7 +111,7 @@ class RenderHairAnimation(StrandSizes):
         return out
 
     def frame(self, f: int) -> Groom:
-        return Groom(self.frame_points(f), self.topology)
+        return Groom(self.frame_points(f), self.topology, **self.attributes, metadata=self.metadata)
 
     def __iter__(self) -> Iterator[np.ndarray]:
         for f in range(self.n_frames):
@@ -111,11 +129,12 @@ class RenderHairAnimation(StrandSizes):
             self.frame_points(f, frames[f])
             if progress is not None:
                 progress(f + 1, self.n_frames)
-        return Animation(frames, self.topology, self.fps, metadata=self.metadata)
+        return Animation(frames, self.topology, self.fps, **self.attributes, metadata=self.metadata)
 
 
 def render_frames_reference(binding: ChildBinding, guides: Animation) -> np.ndarray:
     """``(F, V, 3)`` float32: :func:`~hairtool.guides.children.build_points_reference` on every
     frame of the guides (no clumping), the numpy twin of :class:`RenderHairAnimation`."""
     _check(binding, guides)
-    return np.stack([build_points_reference(binding, Groom(p, guides.topology)) for p in guides.frames])
+    poses = (Groom(p, guides.topology, metadata=guides.metadata) for p in guides.frames)
+    return np.stack([build_points_reference(binding, g) for g in poses])

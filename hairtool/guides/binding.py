@@ -44,6 +44,7 @@ from hairtool.guides.scatter import (
 )
 from hairtool.guides.surface import closest_points, surface_nearest
 from hairtool.io.obj import Mesh
+from hairtool.metadata import Metadata
 
 
 @dataclass(eq=False)
@@ -63,7 +64,12 @@ class ChildBinding:
     frizz: float = 0.0  # the curl that made ``local``: its radius at the tip / child length …
     frizz_phase: np.ndarray | None = None  # … (N,) each child's starting angle, radians …
     frizz_turns: np.ndarray | None = None  # … (N,) and its turns root to tip
+    #: a dense groom's own per-vertex thickness / transparency / colours (None: the guides' blend)
+    exact_attributes: dict | None = None
+    #: the prims the bound hair came from (render hair read beside its guides), kept on write
+    hair_prims: tuple = ()
     _tangents: dict = field(default_factory=dict, repr=False)
+    _attributes: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         self.offsets = np.zeros(len(self.counts) + 1, np.int64)
@@ -117,12 +123,38 @@ class ChildBinding:
             pick(self.exact_blend), self.frizz, per_child(self.frizz_phase), per_child(self.frizz_turns),
         )  # fmt: skip
         out._tangents = self._tangents
+        if self.exact_attributes is not None:
+            out.exact_attributes = {k: pick(v) for k, v in self.exact_attributes.items()}
         return out
 
+    @property
+    def attributes(self) -> dict[str, np.ndarray | None]:
+        """The children's thickness, transparency and colours (:mod:`hairtool.guides.attributes`:
+        a dense strand's own, else the guides' blended root to tip; None where the guides have
+        none), computed once: they follow the rest guides, not their pose."""
+        if not self._attributes:
+            from hairtool.guides.attributes import child_attributes
+
+            self._attributes.update(child_attributes(self))
+        return dict(self._attributes)
+
+    @property
+    def metadata(self) -> Metadata:
+        """The children's record: the guides' space, unit and colour primvar; the bound hair's
+        prims where it came with its own."""
+        meta = self.rest_guides.metadata.with_(curves=())
+        prims = tuple(self.hair_prims)
+        if prims and sum(c.strands for c in prims) == self.child_count:
+            meta = meta.with_(curves=prims)
+        return meta
+
     def build(self, guides: Groom | None = None) -> Groom:
-        """The children from the guides' current shapes (the rest guides by default)."""
+        """The children from the guides' current shapes (the rest guides by default), with
+        their widths and colours (:attr:`attributes`) and the guides' scene (:attr:`metadata`)."""
         pose = self.rest_guides if guides is None else guides
-        return Groom(_children.build_points(self, pose), self.topology)
+        return Groom(
+            _children.build_points(self, pose), self.topology, **self.attributes, metadata=self.metadata
+        )
 
 
 def check_k(k: int, guide_count: int) -> int:
@@ -312,6 +344,10 @@ def bind_to_guides(
     scale = np.ones(hair.strand_count)
     b = ChildBinding(guides, hair.counts.copy(), roots, ids_k, w, scale, None, faces)
     bind_exactly(b, hair.points)
+    b.exact_attributes = hair.attributes
+    b.hair_prims = tuple(
+        c for c in hair.metadata.for_strands(hair.strand_count).curves if c.purpose != "guide"
+    )
     return b
 
 

@@ -44,6 +44,7 @@ class ChildBinding(Protocol):
     exact_blend: np.ndarray | None
     offsets: np.ndarray
     vertex_counts: list[int]
+    rest_guides: Groom
 
     @property
     def child_count(self) -> int: ...
@@ -69,14 +70,15 @@ class GuideTables:
         self.seg, self.seglen, self.frames = np.empty((rows, 3)), np.empty(rows), np.empty((rows, 9))
         for n in counts:
             span = slice(self.base[n], self.base[n] + guides.strand_count * n)
+            # Root normals in the rest guides' scene axes, whatever record the posed guides carry.
+            axes = binding.rest_guides.metadata.frame
             if reference:
                 self.seg[span], self.seglen[span], self.frames[span] = guide_tables_reference(
-                    guides, n, binding.rest_tangents(n)
+                    guides, n, binding.rest_tangents(n), axes
                 )
             else:
-                guide_tables(
-                    guides, n, binding.rest_tangents(n), (self.seg, self.seglen, self.frames), self.base[n]
-                )
+                out = (self.seg, self.seglen, self.frames)
+                guide_tables(guides, n, binding.rest_tangents(n), out, self.base[n], axes)
 
     def child_base(self, binding: ChildBinding) -> np.ndarray:
         """``(N,)`` the first table row of each child's vertex count."""

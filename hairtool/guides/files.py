@@ -1,14 +1,18 @@
-"""Render hair and its guides as one groom of two curves prims, so one USD file holds both:
-``/Groom/Hair`` (the render strands, with widths) and ``/Groom/Guides`` marked with USD's
-purpose ``guide``, which DCCs show as guides and do not render (Blender imports render and
-default purposes as hair). :func:`split_guides` takes such a groom apart again;
-:class:`AnimationWithGuides` is the same for an animation, its frames made one at a time.
+"""Render hair and its guides as one groom of two kinds of curves prims, so one USD file holds
+both: the render strands (with widths and colours) and the guides marked with USD's purpose
+``guide``, which DCCs show as guides and do not render (Blender imports render and default
+purposes as hair). The prims are the sources' own where they have them (a Blender groom's
+``/root/Head/Hair/HairData`` as guides, its children beside it at ``…/HairDataRender``),
+hairtool's ``/Groom/Hair`` and ``/Groom/Guides`` otherwise (:func:`render_prims`).
+:func:`split_guides` takes such a groom apart again; :class:`AnimationWithGuides` is the same
+for an animation, its frames made one at a time.
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -16,18 +20,28 @@ import numpy as np
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation, Groom, StrandSizes, Topology, vertex_ids_of
 from hairtool.guides.animate import RenderHairAnimation
-from hairtool.metadata import CurvesPrim, Metadata
+from hairtool.metadata import HAIR_WIDTH_M, CurvesPrim, Metadata, join_attributes
 
 HAIR_PRIM = "/Groom/Hair"
 GUIDES_PRIM = "/Groom/Guides"
-ROOT_WIDTH = 0.01  # render strand width at the root, in scene units (centimetres: 0.1 mm)
-TIP_WIDTH = 0.002  # … narrowing linearly to the tip
-GUIDE_WIDTH = 0.01
+ROOT_WIDTH_M = HAIR_WIDTH_M  # render strand width at the root where the guides have none: 80 µm …
+TIP_WIDTH_M = HAIR_WIDTH_M / 5  # … narrowing linearly to 16 µm at the tip
+GUIDE_WIDTH_M = HAIR_WIDTH_M
 
 
-def tapered_widths(groom: Groom | Topology, root: float = ROOT_WIDTH, tip: float = TIP_WIDTH) -> np.ndarray:
+def tapered_widths(
+    groom: Groom | Topology,
+    root: float | None = None,
+    tip: float | None = None,
+    meters_per_unit: float = 0.01,
+) -> np.ndarray:
     """``(V,)`` float32 widths from ``root`` at the root to ``tip`` at the tip, linear in t
-    (of a groom's strands or of a topology's)."""
+    (of a groom's strands or of a topology's), in scene units; by default 80 µm → 16 µm in a
+    scene of ``meters_per_unit`` (a groom's own unit when a groom is given)."""
+    if isinstance(groom, Groom):
+        meters_per_unit = groom.metadata.meters_per_unit
+    root = ROOT_WIDTH_M / meters_per_unit if root is None else root
+    tip = TIP_WIDTH_M / meters_per_unit if tip is None else tip
     for name, value in (("root width", root), ("tip width", tip)):
         if not np.isfinite(value) or value < 0:
             raise ParameterError(name, value, "a width ≥ 0 in scene units")
@@ -35,81 +49,117 @@ def tapered_widths(groom: Groom | Topology, root: float = ROOT_WIDTH, tip: float
     return (root + (tip - root) * t).astype(np.float32)
 
 
+def _fitting(meta: Metadata, strands: int, guide: bool) -> tuple[CurvesPrim, ...]:
+    prims = meta.for_strands(strands).curves
+    return tuple(c for c in prims if (c.purpose == "guide") == guide) if prims else ()
+
+
+def render_prims(hair: Metadata, hair_strands: int, guides: Metadata, guide_strands: int):
+    """``(hair prims, guide prims)`` of render hair written beside its guides.
+
+    Each side keeps the prims it came with (paths, basis, wrap; the guides' purpose set to
+    ``guide``), so a groom's guide prim ``/root/Head/Hair/HairData`` stays there. A side
+    without prims of its own is named after the other: children of the guides at P go to
+    ``P + "Render"`` (``/Groom/Hair`` beside hairtool's own ``/Groom/Guides``) and are drawn
+    with the guides' basis (their points are interpolated control points); guides picked from
+    dense hair at H go to ``H + "Guides"``; with neither, ``/Groom/Hair`` and ``/Groom/Guides``."""
+    own_hair = _fitting(hair, hair_strands, guide=False)
+    own_guides = tuple(replace(c, purpose="guide") for c in guides.for_strands(guide_strands).curves)
+    if not own_guides:
+        path = own_hair[0].path + "Guides" if len(own_hair) == 1 else GUIDES_PRIM
+        own_guides = (CurvesPrim(path, guide_strands, purpose="guide"),)
+    if not own_hair:
+        first = own_guides[0]
+        path = HAIR_PRIM if first.path == GUIDES_PRIM else first.path + "Render"
+        own_hair = (CurvesPrim(path, hair_strands, first.basis, first.wrap),)
+    if {c.path for c in own_hair} & {c.path for c in own_guides}:  # never two prims on one path
+        own_guides = tuple(replace(c, path=c.path + "Guides") for c in own_guides)
+    return own_hair, own_guides
+
+
+def _with_lacks(prims: tuple[CurvesPrim, ...], lacks: tuple[str, ...]) -> tuple[CurvesPrim, ...]:
+    return tuple(replace(c, lacks=tuple(sorted(set(c.lacks) | set(lacks)))) for c in prims)
+
+
+def joined_attributes(hair, hair_topology: Topology, guides, meta: Metadata, prims) -> tuple[dict, tuple]:
+    """The per-vertex attributes of the hair then the guides, widths defaulted where a side has
+    none (80 µm tapered to 16 µm for the hair, 80 µm for the guides, in ``meta``'s unit), a
+    colour or transparency only one side has filled on the other (its prims then say they lack
+    it, so it is not written there); and the prims with those marks."""
+    mpu = meta.meters_per_unit
+    h = dict(hair) if isinstance(hair, dict) else dict(hair.attributes)
+    g = dict(guides.attributes)
+    if h.get("thickness") is None:
+        h["thickness"] = tapered_widths(hair_topology, meters_per_unit=mpu)
+    if g.get("thickness") is None:
+        g["thickness"] = np.full(guides.vertex_count, GUIDE_WIDTH_M / mpu, np.float32)
+    attrs, lacks = join_attributes([h, g], [hair_topology.vertex_count, guides.vertex_count], mpu)
+    hair_prims, guide_prims = prims
+    return attrs, _with_lacks(hair_prims, lacks[0]) + _with_lacks(guide_prims, lacks[1])
+
+
 def with_guides(hair: Groom, guides: Groom, metadata: Metadata | None = None) -> Groom:
-    """One groom: the render strands (widths their own or tapered) then the guides (purpose
-    ``guide``), as two prims; ``metadata``'s space and time codes (default: the guides')."""
-    widths = hair.thickness if hair.thickness is not None else tapered_widths(hair)
-    guide_widths = (
-        guides.thickness if guides.thickness is not None else np.full(guides.vertex_count, GUIDE_WIDTH)
-    )
-    colors = None
-    if hair.colors is not None and guides.colors is not None:
-        colors = np.concatenate([hair.colors, guides.colors])
+    """One groom: the render strands then the guides (purpose ``guide``), each on its prims
+    (:func:`render_prims`), with their widths, colours and transparency
+    (:func:`joined_attributes`); ``metadata``'s space and time codes (default: the guides')."""
     base = guides.metadata if metadata is None else metadata
-    meta = base.with_(
-        curves=(
-            CurvesPrim(HAIR_PRIM, hair.strand_count),
-            CurvesPrim(GUIDES_PRIM, guides.strand_count, purpose="guide"),
-        )
-    )
+    prims = render_prims(hair.metadata, hair.strand_count, guides.metadata, guides.strand_count)
+    attrs, curves = joined_attributes(hair, hair.topology, guides, base, prims)
     return Groom(
         np.concatenate([hair.points, guides.points]),
         np.concatenate([hair.counts, guides.counts]),
-        thickness=np.concatenate([widths, guide_widths.astype(np.float32)]),
-        colors=colors,
-        metadata=meta,
+        **attrs,
+        metadata=base.with_(curves=curves),
     )
 
 
 def split_guides(groom: Groom | Animation) -> tuple[Groom | Animation, Groom | Animation | None]:
     """``(hair, guides)``: the strands of prims with purpose ``guide`` apart from the rest
-    (``guides`` None when no prim is marked so); an animation splits into two animations."""
+    (``guides`` None when no prim is marked so); an animation splits into two animations. Each
+    part keeps the scene and its own prims (paths, basis, wrap)."""
     prims = groom.metadata.for_strands(groom.strand_count).curves
     marks = [np.full(c.strands, c.purpose == "guide") for c in prims]
     if not marks or not any(c.purpose == "guide" for c in prims):
         return groom, None
     is_guide = np.concatenate(marks)
-    keep_meta = groom.metadata.with_(curves=())
+
+    def meta(guide: bool) -> Metadata:
+        return groom.metadata.with_(curves=tuple(c for c in prims if (c.purpose == "guide") == guide))
+
     if isinstance(groom, Animation):
         top = groom.topology
 
-        def part(ids: np.ndarray) -> Animation:
+        def part(ids: np.ndarray, guide: bool) -> Animation:
             vids = vertex_ids_of(top, ids)
             pick = {k: (None if v is None else v[vids]) for k, v in groom.attributes.items()}
-            return Animation(groom.frames[:, vids], top.counts[ids], groom.fps, **pick, metadata=keep_meta)
+            return Animation(groom.frames[:, vids], top.counts[ids], groom.fps, **pick, metadata=meta(guide))
 
-        return part(np.flatnonzero(~is_guide)), part(np.flatnonzero(is_guide))
-    hair = groom.subset(np.flatnonzero(~is_guide)).with_metadata(keep_meta)
-    guides = groom.subset(np.flatnonzero(is_guide)).with_metadata(keep_meta)
+        return part(np.flatnonzero(~is_guide), False), part(np.flatnonzero(is_guide), True)
+    hair = groom.subset(np.flatnonzero(~is_guide)).with_metadata(meta(False))
+    guides = groom.subset(np.flatnonzero(is_guide)).with_metadata(meta(True))
     return hair, guides
 
 
 class AnimationWithGuides(StrandSizes):
     """Render hair following an animation of its guides, and those guides, as one animation of
-    two prims (``/Groom/Hair`` then ``/Groom/Guides``, purpose ``guide``) whose frames are made
-    one at a time: what :func:`hairtool.io.usd.write` takes as a frame stream. Widths as in
-    :func:`with_guides`; the time codes, up axis and unit of ``metadata`` (default: the guides
-    animation's)."""
-
-    transparency = None
-    colors = None
+    their prims (:func:`render_prims`: the guides' own, purpose ``guide``) whose frames are made
+    one at a time: what :func:`hairtool.io.usd.write` takes as a frame stream. Widths, colours
+    and transparency as in :func:`with_guides`; the time codes, up axis and unit of ``metadata``
+    (default: the guides animation's)."""
 
     def __init__(self, hair: RenderHairAnimation, metadata: Metadata | None = None) -> None:
         self.hair, guides = hair, hair.guides
         self.guides = guides
         self.topology = Topology(np.concatenate([hair.counts, guides.counts]))
-        guide_widths = (
-            guides.thickness if guides.thickness is not None else np.full(guides.vertex_count, GUIDE_WIDTH)
-        )
-        self.thickness = np.concatenate([tapered_widths(hair.topology), guide_widths.astype(np.float32)])
         base = guides.metadata if metadata is None else metadata
-        self.metadata = base.with_(
-            time_codes=guides.metadata.time_codes,
-            curves=(
-                CurvesPrim(HAIR_PRIM, hair.strand_count),
-                CurvesPrim(GUIDES_PRIM, guides.strand_count, purpose="guide"),
-            ),
+        prims = render_prims(hair.metadata, hair.strand_count, guides.metadata, guides.strand_count)
+        attrs, curves = joined_attributes(hair.binding.attributes, hair.topology, guides, base, prims)
+        self.thickness, self.transparency, self.colors = (
+            attrs["thickness"],
+            attrs["transparency"],
+            attrs["colors"],
         )
+        self.metadata = base.with_(time_codes=guides.metadata.time_codes, curves=curves)
         self.fps = guides.fps
 
     @property

@@ -48,22 +48,21 @@ def _unit(x, y, z):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _root_normal(tx, ty, tz):
-    """n of a rest root frame: the world axis least along t, made perpendicular to t."""
-    ax, ay, az = abs(tx), abs(ty), abs(tz)
-    if ax <= ay and ax <= az:
-        ex, ey, ez = 1.0, 0.0, 0.0
-    elif ay <= az:
-        ex, ey, ez = 0.0, 1.0, 0.0
-    else:
-        ex, ey, ez = 0.0, 0.0, 1.0
+def _root_normal(tx, ty, tz, axes):
+    """n of a rest root frame: the scene axis (a column of ``axes``, the groom's frame) least
+    along t, made perpendicular to t; so the same groom in Y-up or Z-up gets the same frames."""
+    ax = abs(axes[0, 0] * tx + axes[1, 0] * ty + axes[2, 0] * tz)
+    ay = abs(axes[0, 1] * tx + axes[1, 1] * ty + axes[2, 1] * tz)
+    az = abs(axes[0, 2] * tx + axes[1, 2] * ty + axes[2, 2] * tz)
+    k = 0 if ax <= ay and ax <= az else (1 if ay <= az else 2)
+    ex, ey, ez = axes[0, k], axes[1, k], axes[2, k]
     d = ex * tx + ey * ty + ez * tz
     nx, ny, nz, _ = _unit(ex - d * tx, ey - d * ty, ez - d * tz)
     return nx, ny, nz
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _guide_rows(points, offsets, counts, n, rest_tangent, row0, seg, seglen, out, g):
+def _guide_rows(points, offsets, counts, n, rest_tangent, axes, row0, seg, seglen, out, g):
     """Guide g's rows ``row0 + g·n …`` of the tables: its ``points`` (float32; strand ``offsets``
     and ``counts``) resampled to n vertices as :func:`resampled` does, each row's segment from
     the previous point (0 at the root) and its length, and the frames (t, n, b) of
@@ -97,7 +96,7 @@ def _guide_rows(points, offsets, counts, n, rest_tangent, row0, seg, seglen, out
         seglen[a + i] = np.sqrt(sx * sx + sy * sy + sz * sz)
         px, py, pz = qx, qy, qz
     rx, ry, rz = rest_tangent[g, 0], rest_tangent[g, 1], rest_tangent[g, 2]
-    nx, ny, nz = _root_normal(rx, ry, rz)
+    nx, ny, nz = _root_normal(rx, ry, rz, axes)
     tx, ty, tz, ok = _unit(seg[a + 1, 0], seg[a + 1, 1], seg[a + 1, 2])
     if not ok:
         tx, ty, tz = rx, ry, rz
@@ -117,10 +116,10 @@ def _guide_rows(points, offsets, counts, n, rest_tangent, row0, seg, seglen, out
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _tables_kernel(points, offsets, counts, n, rest_tangent, row0, seg, seglen, out):
+def _tables_kernel(points, offsets, counts, n, rest_tangent, axes, row0, seg, seglen, out):
     """:func:`_guide_rows` of every guide, a guide per thread (threads pay from 10 guides on)."""
     for g in prange(counts.size):
-        _guide_rows(points, offsets, counts, n, rest_tangent, row0, seg, seglen, out, g)
+        _guide_rows(points, offsets, counts, n, rest_tangent, axes, row0, seg, seglen, out, g)
 
 
 def guide_tables(
@@ -129,22 +128,26 @@ def guide_tables(
     rest_tangent: np.ndarray,
     out: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
     row0: int = 0,
+    axes: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(seg (G·n, 3), seglen (G·n,), frames (G·n, 9))`` float64 of the guides at n ≥ 2
     vertices (``rest_tangent`` (G, 3): their rest root tangents), into rows ``row0 …`` of
-    ``out`` when given. The numpy twin is :func:`guide_tables_reference`."""
+    ``out`` when given; ``axes``: the scene's frame the root normals start from (default the
+    guides' own, :attr:`hairtool.metadata.Metadata.frame`). The numpy twin is
+    :func:`guide_tables_reference`."""
     rows = guides.strand_count * n
     seg, seglen, frm = out if out is not None else (np.empty((rows, 3)), np.empty(rows), np.empty((rows, 9)))
+    frame = guides.metadata.frame if axes is None else axes
     _tables_kernel(
         np.ascontiguousarray(guides.points, np.float32), guides.offsets[:-1].astype(np.int64),
-        guides.counts.astype(np.int64), int(n), np.ascontiguousarray(rest_tangent, np.float64), int(row0),
-        seg, seglen, frm,
+        guides.counts.astype(np.int64), int(n), np.ascontiguousarray(rest_tangent, np.float64),
+        np.ascontiguousarray(frame, np.float64), int(row0), seg, seglen, frm,
     )  # fmt: skip
     return seg, seglen, frm
 
 
 def guide_tables_reference(
-    guides: Groom, n: int, rest_tangent: np.ndarray
+    guides: Groom, n: int, rest_tangent: np.ndarray, axes: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Numpy twin of :func:`guide_tables`: :func:`resampled`, whole-array differences and
     :func:`frames_reference`."""
@@ -154,7 +157,7 @@ def guide_tables_reference(
     return (
         s,
         np.sqrt(s[:, 0] * s[:, 0] + s[:, 1] * s[:, 1] + s[:, 2] * s[:, 2]),
-        frames_reference(p, rest_tangent, n),
+        frames_reference(p, rest_tangent, n, guides.metadata.frame if axes is None else axes),
     )
 
 
@@ -179,13 +182,17 @@ def _turn_ref(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return v * c + np.cross(k, v) + k * float(k @ v) / (1.0 + c)
 
 
-def frames_reference(points: np.ndarray, rest_tangent: np.ndarray, n: int) -> np.ndarray:
-    """Numpy twin of :func:`frames`, one guide and one vertex at a time."""
+def frames_reference(
+    points: np.ndarray, rest_tangent: np.ndarray, n: int, axes: np.ndarray | None = None
+) -> np.ndarray:
+    """Numpy twin of :func:`frames`, one guide and one vertex at a time (``axes``: the scene's
+    frame, default x, y, z)."""
     p = np.asarray(points, np.float64).reshape(-1, n, 3)
     out = np.empty((p.shape[0], n, 9))
+    f = np.eye(3) if axes is None else np.asarray(axes, np.float64)
     for g in range(p.shape[0]):
         r = rest_tangent[g]
-        e = np.eye(3)[int(np.argmin(np.abs(r)))]
+        e = f[:, int(np.argmin(np.abs(r @ f)))]
         nrm = e - float(e @ r) * r
         nrm = nrm / np.linalg.norm(nrm)
         first = p[g, 1] - p[g, 0]

@@ -135,7 +135,9 @@ def scatter_on_mesh(
 
 def scatter_around(guides: Groom, count: int, seed: int) -> np.ndarray:
     """``(N, 3)`` float64 roots without a mesh: around random guide roots, in the disc of one
-    guide spacing across each root's tangent."""
+    guide spacing across each root's tangent. The disc's axes start from the scene's axis
+    least along the tangent (in the groom's frame, :attr:`hairtool.metadata.Metadata.frame`),
+    so the same groom in Y-up or Z-up gets the same roots."""
     rng = generator(seed, CH_SCATTER)
     g = rng.integers(0, guides.strand_count, count)
     radius = guide_spacing(guides) * np.sqrt(rng.random(count))
@@ -144,7 +146,8 @@ def scatter_around(guides: Groom, count: int, seed: int) -> np.ndarray:
     root = pts[guides.offsets[:-1]]
     t = pts[guides.offsets[:-1] + 1] - root
     t /= np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-30)
-    e = np.eye(3)[np.argmin(np.abs(t), axis=1)]
+    axes = guides.metadata.frame
+    e = axes.T[np.argmin(np.abs(t @ axes), axis=1)]  # a column of the frame: a scene axis
     n = e - np.einsum("ij,ij->i", e, t)[:, None] * t
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     b = np.cross(t, n)

@@ -5,9 +5,14 @@ Members (every one a plain, non-object array, so the file loads with ``allow_pic
 ``points`` float32 (V, 3) for a groom or ``frames`` float32 (F, V, 3) for an animation, ``fps``
 float64 scalar and ``time_codes`` float64 (F,) (animations: the source's time code of each frame;
 caches written before it existed read as 0…F−1), optional ``thickness`` (V,),
-``transparency`` (V,), ``colors`` (V, 3) float32, and ``curves``, a unicode scalar holding the
-source's curve prims as JSON (path, strands, basis, wrap, purpose of each, in strand order), so
-render hair and its guides (purpose ``guide``) stay apart through a cache.
+``transparency`` (V,), ``colors`` (V, 3) float32, ``curves``, a unicode scalar holding the
+source's curve prims as JSON (path, strands, basis, wrap, purpose and the attributes it lacks of
+each, in strand order), so render hair and its guides (purpose ``guide``) stay apart through a
+cache, and ``metadata``, a unicode scalar of JSON with the rest of the scene description
+(``up_axis``, ``meters_per_unit``, ``time_codes_per_second``, ``start_time_code``,
+``end_time_code``, ``color_primvar``, and ``xforms``, the static transforms of the prims and
+their ancestors, when the source had any): USD → npz → USD gives back the same stage. Caches
+without it read as Y-up centimetres.
 """
 
 from __future__ import annotations
@@ -30,8 +35,16 @@ from hairtool.metadata import CurvesPrim, Metadata
 
 FORMAT_VERSION = 1
 ATTRIBUTES = ("thickness", "transparency", "colors")
-_KNOWN = {"format_version", "kind", "counts", "points", "frames", "fps", "time_codes", "curves", *ATTRIBUTES}
-_PRIM_FIELDS = ("path", "strands", "basis", "wrap", "purpose")
+_KNOWN = {
+    "format_version", "kind", "counts", "points", "frames", "fps", "time_codes", "curves", "metadata",
+    *ATTRIBUTES,
+}  # fmt: skip
+_PRIM_FIELDS = ("path", "strands", "basis", "wrap", "purpose")  # each prim has these …
+_PRIM_OPTIONAL = ("lacks",)  # … and may have these
+_SCENE_FIELDS = (
+    "up_axis", "meters_per_unit", "time_codes_per_second", "start_time_code", "end_time_code", "color_primvar"
+)  # fmt: skip
+_MAX_JSON = 1 << 20  # characters of a JSON member: far more than any scene needs
 # zlib's deflate never expands data more than about 1032:1; a member claiming more is corrupt.
 _MAX_DEFLATE_RATIO = 1100
 _MAX_NPY_HEADER = 10_000  # numpy's own limit on a header's length (max_header_size)
@@ -65,7 +78,15 @@ def write(path: Path, obj: Groom | Animation) -> None:
             arrays[name] = a
     prims = obj.metadata.for_strands(obj.strand_count).curves
     if prims:
-        arrays["curves"] = np.array(json.dumps([{f: getattr(c, f) for f in _PRIM_FIELDS} for c in prims]))
+        fields = _PRIM_FIELDS + _PRIM_OPTIONAL
+        items = [
+            {f: (list(v) if isinstance(v := getattr(c, f), tuple) else v) for f in fields} for c in prims
+        ]
+        arrays["curves"] = np.array(json.dumps(items))
+    scene = {f: getattr(obj.metadata, f) for f in _SCENE_FIELDS}
+    if obj.metadata.xforms:
+        scene["xforms"] = [[path, list(m)] for path, m in obj.metadata.xforms]
+    arrays["metadata"] = np.array(json.dumps(scene))
     with atomic_open(path, "wb") as f:
         np.savez_compressed(f, **arrays)
 
@@ -146,6 +167,11 @@ def _scalar(path: Path, z, name: str, kind: str) -> object:
     a = _member(path, z, name)
     if a.shape != () or a.dtype.kind not in kind:
         raise FormatError(path, f"{name!r} must be a scalar of kind {kind!r}, got {a.dtype} {a.shape}")
+    if a.dtype.kind == "U" and a.dtype.itemsize:
+        # Code points past U+10FFFF (or surrogates) make a str that breaks whoever reads it.
+        codes = np.ascontiguousarray(a.astype(a.dtype.newbyteorder("="))).reshape(1).view(np.uint32)
+        if codes.max() > 0x10FFFF or np.any((codes >= 0xD800) & (codes <= 0xDFFF)):
+            raise FormatError(path, f"{name!r} holds characters that are not text")
     return a.item()
 
 
@@ -167,24 +193,76 @@ def _time_codes(path: Path, z, n_frames: int) -> tuple[float, ...] | None:
     return tuple(t.tolist())
 
 
+def _json(path: Path, z, name: str):
+    """A JSON member, bounded in size and nesting before it is parsed."""
+    text = _scalar(path, z, name, "U")
+    if len(text) > _MAX_JSON:
+        raise FormatError(path, f"{name!r} holds {len(text)} characters; at most {_MAX_JSON}")
+    depth = 0
+    for ch in text:  # a flat record: nothing nests deeper than a list in an object in a list
+        depth += ch in "[{"
+        depth -= ch in "]}"
+        if depth > 4:
+            raise FormatError(path, f"{name!r} nests deeper than a scene record does")
+    try:
+        return json.loads(text)
+    except (ValueError, RecursionError) as e:
+        raise FormatError(path, f"{name!r} is not JSON: {e}") from None
+
+
 def _curves(path: Path, z, strand_count: int) -> tuple[CurvesPrim, ...]:
     if "curves" not in z.files:
         return ()
-    text = _scalar(path, z, "curves", "U")
+    items = _json(path, z, "curves")
     try:
-        items = json.loads(text)
         if not isinstance(items, list) or not items:
             raise ValueError("not a list of prims")
         prims = []
         for item in items:
-            if not isinstance(item, dict) or set(item) != set(_PRIM_FIELDS):
-                raise ValueError(f"each prim has exactly {', '.join(_PRIM_FIELDS)}")
-            prims.append(CurvesPrim(**item))
+            if not isinstance(item, dict) or not set(_PRIM_FIELDS) <= set(item) <= set(
+                _PRIM_FIELDS + _PRIM_OPTIONAL
+            ):
+                raise ValueError(f"each prim has exactly {', '.join(_PRIM_FIELDS)} (and optionally lacks)")
+            if "lacks" in item and not isinstance(item["lacks"], list):
+                raise ValueError("lacks is a list of attribute names")
+            prims.append(CurvesPrim(**{k: (tuple(v) if k == "lacks" else v) for k, v in item.items()}))
     except (ValueError, TypeError, ParameterError) as e:
         raise FormatError(path, f"'curves' is not a list of curve prims: {e}") from None
     if sum(c.strands for c in prims) != strand_count:
         raise FormatError(path, f"'curves' hold {sum(c.strands for c in prims)} strands, not {strand_count}")
     return tuple(prims)
+
+
+def _scene(path: Path, z, strand_count: int) -> Metadata:
+    """The cache's scene description (defaults for a cache written before it was kept)."""
+    curves = _curves(path, z, strand_count)
+    if "metadata" not in z.files:
+        return Metadata(curves=curves)
+    record = _json(path, z, "metadata")
+    try:
+        if not isinstance(record, dict) or not set(_SCENE_FIELDS) <= set(record) <= {
+            *_SCENE_FIELDS,
+            "xforms",
+        }:
+            raise ValueError(f"it has exactly {', '.join(_SCENE_FIELDS)} (and optionally xforms)")
+        record = dict(record)
+        xforms = record.pop("xforms", [])
+        if not isinstance(xforms, list) or not all(
+            isinstance(x, list) and len(x) == 2 and isinstance(x[1], list) and len(x[1]) == 16 for x in xforms
+        ):
+            raise ValueError("xforms is a list of [prim path, 16 numbers]")
+        if any(isinstance(v, bool) or not isinstance(v, (int, float)) for x in xforms for v in x[1]):
+            raise ValueError("a transform holds numbers")
+        for key in ("meters_per_unit", "time_codes_per_second", "start_time_code", "end_time_code"):
+            v = record[key]
+            if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
+                raise ValueError(f"{key} is a number or null")
+        for key in ("up_axis", "color_primvar"):
+            if not isinstance(record[key], str):
+                raise ValueError(f"{key} is a string")
+        return Metadata(**record, curves=curves, xforms=tuple((x[0], tuple(x[1])) for x in xforms))
+    except (ValueError, TypeError, OverflowError, ParameterError) as e:
+        raise FormatError(path, f"'metadata' is not a scene description: {e}") from None
 
 
 def _load_zip(path: Path, fh, single_npy: str):
@@ -236,7 +314,7 @@ def _build(path: Path, z) -> Groom | Animation:
         points = _array(path, z, "points", 2, "f")
         if points.shape != (v_count, 3):
             raise FormatError(path, f"'points' has shape {points.shape}, expected {(v_count, 3)}")
-        meta = Metadata(curves=_curves(path, z, counts.size))
+        meta = _scene(path, z, counts.size)
         return Groom(float32_finite(path, points, "points"), counts, **attrs, metadata=meta)
     if kind == "animation":
         frames = _array(path, z, "frames", 3, "f")
@@ -247,7 +325,7 @@ def _build(path: Path, z) -> Groom | Animation:
         if not (np.isfinite(fps) and fps > 0):
             raise FormatError(path, f"fps is {fps}; expected a positive number")
         time_codes = _time_codes(path, z, frames.shape[0])
-        meta = Metadata(curves=_curves(path, z, counts.size))
+        meta = _scene(path, z, counts.size)
         if time_codes is not None:
             meta = meta.with_(time_codes=time_codes)
         return Animation(frames, counts, fps, **attrs, metadata=meta)

@@ -21,6 +21,7 @@ from hairtool.errors import FormatError
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_strand_counts
+from hairtool.metadata import Metadata
 
 
 @dataclass(frozen=True)
@@ -126,7 +127,7 @@ def read(path: Path) -> Groom:
     tokens = [t.split("/", 1)[0] for _, ts in rec.lines for t in ts]
     known = np.repeat(np.array([k for k, _ in rec.lines], dtype=np.int64), counts)
     idx = _indices(path, tokens, known, len(rec.vertices), "vertex")
-    return Groom(rec.vertices[idx].astype(np.float32), counts)
+    return Groom(rec.vertices[idx].astype(np.float32), counts, metadata=Metadata())  # no scene in OBJ
 
 
 def read_mesh(path: str | os.PathLike[str]) -> Mesh:

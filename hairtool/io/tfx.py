@@ -24,6 +24,7 @@ import numpy as np
 from hairtool.errors import FormatError
 from hairtool.groom import Groom
 from hairtool.io.binary import array_at, read_bytes, require_finite, require_size
+from hairtool.metadata import Metadata
 
 V4_HEADER_SIZE = 160
 V3_OFFSETS_AT = 144
@@ -92,7 +93,7 @@ def _read_v3(path: Path, data: bytes) -> Groom:
     v = strands * per_strand
     points = array_at(path, data, off_pos, "<f4", 3 * v, "vertex positions").reshape(v, 3)
     require_finite(path, points, "vertex positions")
-    return Groom(points, np.full(strands, per_strand, dtype=np.int64))
+    return Groom(points, np.full(strands, per_strand, dtype=np.int64), metadata=Metadata())  # Y-up cm
 
 
 def read(path: Path) -> Groom:

@@ -17,7 +17,9 @@ test cases):
   beside its guide curves, purpose ``guide``: :mod:`hairtool.guides.files`);
 - ``widths`` of every interpolation (see :mod:`hairtool.io.usd_basis`), colour from
   ``displayColor`` or Blender's ``primvars:color`` (color3f or color4f; its alpha is opacity),
-  opacity from ``displayOpacity``.
+  opacity from ``displayOpacity``. Merging prims keeps each one's: a prim without widths or
+  colour beside prims with them gets defaults (80 µm, grey) and its record lists what it
+  lacked (:attr:`~hairtool.metadata.CurvesPrim.lacks`), so the writer leaves them out again;
 
 Every value is type-checked before it is used and every lazy read of a crate file is guarded, so
 a hostile file ends in one :class:`~hairtool.errors.FormatError`.
@@ -53,7 +55,7 @@ from hairtool.groom import Animation, Groom, Topology
 from hairtool.io import usd_basis, usda_check, usdc_check
 from hairtool.io.atomic import atomic_path
 from hairtool.io.binary import require_finite, require_strand_counts
-from hairtool.metadata import PURPOSES, CurvesPrim, Metadata
+from hairtool.metadata import PURPOSES, CurvesPrim, Metadata, join_attributes
 
 PRIM_PATH = "/Groom/Strands"
 FLUSH_BYTES = 32 << 20  # unsaved time samples a crate layer may hold before it is saved
@@ -127,33 +129,48 @@ def _prims(obj: Curves) -> tuple[CurvesPrim, ...]:
     return prims
 
 
-def _define_parents(stage, paths: Sequence[str]) -> None:
-    """Plain Xforms for every ancestor of the curves prims; the first root is the default prim."""
+def _set_transform(prim, meta: Metadata) -> None:
+    """The source's local transform of ``prim`` (one ``xformOp:transform``), if it had one."""
+    from pxr import Gf, UsdGeom
+
+    table = dict(meta.xforms)
+    m = table.get(str(prim.GetPath()))
+    if m is not None:
+        UsdGeom.Xformable(prim).AddTransformOp().Set(Gf.Matrix4d(*m))
+
+
+def _define_parents(stage, paths: Sequence[str], meta: Metadata) -> None:
+    """Xforms for every ancestor of the curves prims, with the source's transforms where it had
+    them (:attr:`~hairtool.metadata.Metadata.xforms`); the first root is the default prim."""
     from pxr import Sdf, UsdGeom
 
     for p in paths:
         for parent in Sdf.Path(p).GetParentPath().GetPrefixes():
             if not stage.GetPrimAtPath(parent):
-                UsdGeom.Xform.Define(stage, parent)
+                _set_transform(UsdGeom.Xform.Define(stage, parent).GetPrim(), meta)
     first_root = Sdf.Path(paths[0]).GetPrefixes()[0]
     if not stage.GetPrimAtPath(first_root):
         UsdGeom.Xform.Define(stage, first_root)
     stage.SetDefaultPrim(stage.GetPrimAtPath(first_root))
 
 
-def _write_attributes(curves, obj: Curves, vs: slice, color_primvar: str) -> float:
-    """Widths, colour and opacity of one prim's vertices; returns the half width for its extent."""
+def _write_attributes(curves, obj: Curves, vs: slice, color_primvar: str, lacks: Sequence[str] = ()) -> float:
+    """Widths, colour and opacity of one prim's vertices (not those the prim ``lacks``: it was
+    merged with prims that had them); returns the half width for its extent."""
     from pxr import Sdf, UsdGeom, Vt
 
     half_width = 0.0
-    if obj.thickness is not None:
-        curves.CreateWidthsAttr(Vt.FloatArray.FromNumpy(np.ascontiguousarray(obj.thickness[vs])))
+    thickness = None if "thickness" in lacks else obj.thickness
+    colors = None if "colors" in lacks else obj.colors
+    transparency = None if "transparency" in lacks else obj.transparency
+    if thickness is not None:
+        curves.CreateWidthsAttr(Vt.FloatArray.FromNumpy(np.ascontiguousarray(thickness[vs])))
         curves.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
-        half_width = float(np.abs(obj.thickness[vs]).max()) / 2
-    opacity = None if obj.transparency is None else (1.0 - obj.transparency[vs]).astype(np.float32)
-    if obj.colors is not None and color_primvar == "color":
-        rgba = np.ones((obj.colors[vs].shape[0], 4), dtype=np.float32)
-        rgba[:, :3] = obj.colors[vs]
+        half_width = float(np.abs(thickness[vs]).max()) / 2
+    opacity = None if transparency is None else (1.0 - transparency[vs]).astype(np.float32)
+    if colors is not None and color_primvar == "color":
+        rgba = np.ones((colors[vs].shape[0], 4), dtype=np.float32)
+        rgba[:, :3] = colors[vs]
         if opacity is not None:
             rgba[:, 3] = opacity
             opacity = None
@@ -161,9 +178,9 @@ def _write_attributes(curves, obj: Curves, vs: slice, color_primvar: str) -> flo
             "color", Sdf.ValueTypeNames.Color4fArray, UsdGeom.Tokens.vertex
         )
         pv.Set(Vt.Vec4fArray.FromNumpy(rgba))
-    elif obj.colors is not None:
-        colors = Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(obj.colors[vs]))
-        curves.CreateDisplayColorPrimvar(UsdGeom.Tokens.vertex).Set(colors)
+    elif colors is not None:
+        values = Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(colors[vs]))
+        curves.CreateDisplayColorPrimvar(UsdGeom.Tokens.vertex).Set(values)
     if opacity is not None:
         curves.CreateDisplayOpacityPrimvar(UsdGeom.Tokens.vertex).Set(Vt.FloatArray.FromNumpy(opacity))
     return half_width
@@ -178,6 +195,8 @@ def _write_prim(stage, prim: CurvesPrim, obj: Curves, strands: slice, times):
     off = obj.topology.offsets
     vs = slice(int(off[strands.start]), int(off[strands.stop]))
     curves = UsdGeom.BasisCurves.Define(stage, prim.path)
+    _set_transform(curves.GetPrim(), obj.metadata)
+    to_local = _to_local(obj.metadata, prim.path)
     basis = prim.basis if usd_basis.fits(counts, prim.basis, prim.wrap) else "linear"
     if basis == "linear":
         curves.CreateTypeAttr(UsdGeom.Tokens.linear)
@@ -190,15 +209,26 @@ def _write_prim(stage, prim: CurvesPrim, obj: Curves, strands: slice, times):
     curves.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(counts.astype(np.int32)))
     if prim.purpose != "default":
         curves.CreatePurposeAttr(prim.purpose)
-    half_width = _write_attributes(curves, obj, vs, obj.metadata.color_primvar)
+    half_width = _write_attributes(curves, obj, vs, obj.metadata.color_primvar, prim.lacks)
     points_attr = curves.CreatePointsAttr()
     extent_attr = curves.CreateExtentAttr()
     if times is None:
-        pts = np.ascontiguousarray(obj.points[vs])
+        pts = to_local(obj.points[vs])
         points_attr.Set(Vt.Vec3fArray.FromNumpy(pts))
         extent_attr.Set(_extent(pts, half_width))
         return None
-    return points_attr, extent_attr, vs, half_width
+    return points_attr, extent_attr, vs, half_width, to_local
+
+
+def _to_local(meta: Metadata, path: str):
+    """World points → the prim's own space under the transforms the writer puts back
+    (the points as they are where there are none)."""
+    m = meta.world_matrix(path)
+    if m is None:
+        return lambda p: np.ascontiguousarray(p, dtype=np.float32)
+    inv = np.linalg.inv(m[:3, :3])
+    t = m[3, :3]
+    return lambda p: np.ascontiguousarray((np.asarray(p, np.float64) - t) @ inv, dtype=np.float32)
 
 
 def _frame_points(obj: Curves, f: int) -> np.ndarray:
@@ -224,8 +254,8 @@ def _write_samples(stage, obj: Curves, prims: list, times, progress: FrameProgre
     for f, t in enumerate(times):
         code = Usd.TimeCode(float(t))
         frame = _frame_points(obj, f)
-        for points_attr, extent_attr, vs, half_width in prims:
-            pts = np.ascontiguousarray(frame[vs], dtype=np.float32)
+        for points_attr, extent_attr, vs, half_width, to_local in prims:
+            pts = to_local(frame[vs])
             extent = _extent(pts, half_width)
             if not np.all(np.isfinite(np.asarray(extent))):  # a stream's frames are not checked yet
                 raise ParameterError("frame", f, "finite points")
@@ -285,7 +315,7 @@ def write(
         if stage is None:
             raise FormatError(path, "usd-core could not create the stage")
         _write_stage_metadata(stage, obj, times)
-        _define_parents(stage, [c.path for c in prims])
+        _define_parents(stage, [c.path for c in prims], obj.metadata)
         first, sampled = 0, []
         for prim in prims:
             sampled.append(_write_prim(stage, prim, obj, slice(first, first + prim.strands), times))
@@ -513,8 +543,8 @@ class _Curves:
                 f"but points has {len(value)}",
             )
 
-    def info(self) -> CurvesPrim:
-        return CurvesPrim(self.name, int(self.counts.size), self.basis, self.wrap, self.purpose)
+    def info(self, lacks: Sequence[str] = ()) -> CurvesPrim:
+        return CurvesPrim(self.name, int(self.counts.size), self.basis, self.wrap, self.purpose, tuple(lacks))
 
     def at(self, time, xforms) -> np.ndarray:
         from pxr import Gf
@@ -579,16 +609,17 @@ class _Curves:
         return out, source
 
 
-def _merge_attributes(parts: list[_Curves]) -> tuple[dict[str, np.ndarray], str]:
-    """An attribute survives the merge only if every prim has it."""
+def _merge_attributes(
+    parts: list[_Curves], meters_per_unit: float
+) -> tuple[dict[str, np.ndarray | None], str, list[tuple[str, ...]]]:
+    """The prims' attributes end to end: one prim lacking widths or colour does not strip the
+    others; its vertices get defaults (80 µm, no transparency, grey) and its prim records what
+    it lacked, so writing it back authors them on the prims that had them only. Also the colour
+    primvar's name and each prim's lacks."""
     read = [c.attributes() for c in parts]
-    out = {}
-    for name in ("thickness", "transparency", "colors"):
-        values = [a[name] for a, _ in read]
-        if all(v is not None for v in values):
-            out[name] = np.concatenate(values)
+    attrs, lacks = join_attributes([a for a, _ in read], [c.vertex_count for c in parts], meters_per_unit)
     sources = {s for a, s in read if a["colors"] is not None}
-    return out, ("color" if sources == {"color"} else "displayColor")
+    return attrs, ("color" if sources == {"color"} else "displayColor"), lacks
 
 
 def _stage_metadata(path: Path, stage) -> dict:
@@ -624,6 +655,27 @@ def _sample_times(parts: list[_Curves]) -> list[float]:
     return times if point_times or len(times) > 1 else []
 
 
+def _static_xforms(parts: list[_Curves]) -> tuple:
+    """The curves prims' and their ancestors' local transforms (non-identity ones), when none is
+    animated: :attr:`hairtool.metadata.Metadata.xforms`, so a writer can put them back."""
+    from pxr import Gf, Usd, UsdGeom
+
+    if any(c.transform_times for c in parts):
+        return ()
+    table: dict[str, tuple[float, ...]] = {}
+    for c in parts:
+        for p in _lineage(c.prim):
+            xf = UsdGeom.Xformable(p)
+            if not xf:
+                continue
+            if xf.GetResetXformStack():
+                return ()  # a prim that ignores its parents: not kept (the points stay world)
+            m = xf.GetLocalTransformation(Usd.TimeCode.Default())
+            if m != Gf.Matrix4d(1.0):
+                table[str(p.GetPath())] = tuple(float(v) for v in np.asarray(m, np.float64).reshape(-1))
+    return tuple(sorted(table.items()))
+
+
 def _read_stage(path: Path, stage) -> Groom | Animation:
     from pxr import Usd, UsdGeom
 
@@ -632,10 +684,14 @@ def _read_stage(path: Path, stage) -> Groom | Animation:
         raise FormatError(path, "no BasisCurves prim on the stage")
     parts = [_Curves(path, p) for p in prims]
     counts = np.concatenate([c.counts for c in parts])
-    attrs, color_source = _merge_attributes(parts)
     stage_meta = _stage_metadata(path, stage)
+    attrs, color_source, lacks = _merge_attributes(parts, stage_meta["meters_per_unit"])
     fps = stage_meta.pop("fps")
-    curves = tuple(c.info() for c in parts)
+    curves = tuple(c.info(lack) for c, lack in zip(parts, lacks, strict=True))
+    try:
+        stage_meta["xforms"] = Metadata(xforms=_static_xforms(parts)).xforms
+    except HairtoolError:
+        stage_meta["xforms"] = ()  # a transform these writers cannot put back (projective, singular)
     times = _sample_times(parts)
     if not times:
         once = set().union(*(c.transform_times for c in parts))  # a transform set at one time code

@@ -14,7 +14,12 @@ Gravity acts relative to the rest pose (a styled groom is in equilibrium at fram
 effective pull is g − R(t)·R(0)ᵀ·g, so tilting the head lets the hair fall while a still head
 leaves it exactly at rest.
 
-Units: scene units (head radius 1 ≈ 10 cm) and seconds; accelerations in units/s².
+Units and axes: the groom's own (its :class:`~hairtool.metadata.Metadata`). Gravity is given in
+m/s² and pulls along the stage's −up at g / metersPerUnit scene units/s², so a Z-up metre groom
+and the same groom in Y-up centimetres fall alike; wind and gusts are in scene units/s², gusts
+blow across the up axis, and the named head motions turn about the scene's up and lateral axes
+(:mod:`hairtool.simulate.head_motion`). The result carries the groom's record
+(:meth:`~hairtool.groom.Groom.animate`): written back, it lands on the prims it came from.
 Every strand is independent, so the numba kernel runs strands in parallel and its result does
 not depend on the thread count; :func:`simulate_reference` runs the same steps in numpy.
 """
@@ -34,8 +39,8 @@ from hairtool.simulate.head_motion import check_transform, head_motion
 
 F64 = NDArray[np.float64]
 
-#: 9.81 m/s² with a head radius of 10 cm.
-GRAVITY = 98.1
+#: Earth's gravity in m/s² (converted to scene units by the groom's metres per unit).
+GRAVITY = 9.81
 
 
 @dataclass(frozen=True)
@@ -54,9 +59,17 @@ class Gust:
 
 
 def gust_schedule(
-    count: int, clip_duration: float, strength: float, duration: float, seed: int
+    count: int,
+    clip_duration: float,
+    strength: float,
+    duration: float,
+    seed: int,
+    frame: ArrayLike | None = None,
 ) -> list[Gust]:
-    """``count`` seeded gusts with horizontal directions, starting after the first tenth of the clip."""
+    """``count`` seeded gusts with horizontal directions, starting after the first tenth of the clip.
+
+    ``frame``: the scene's axes (:attr:`hairtool.metadata.Metadata.frame`; default Y-up), so
+    "horizontal" is across the stage's up axis."""
     if int(count) != count or not 0 <= count <= 10_000:
         raise ParameterError("gusts", count, "a whole number in [0, 10000]")
     if not (np.isfinite(strength) and strength >= 0):
@@ -68,23 +81,23 @@ def gust_schedule(
     starts = np.sort(rng.uniform(0.1 * clip_duration, latest, int(count)))
     angles = rng.uniform(0.0, 2.0 * np.pi, int(count))
     scale = rng.uniform(0.75, 1.25, int(count))
+    axes = np.eye(3) if frame is None else np.asarray(frame, dtype=np.float64)
+    directions = np.column_stack([np.cos(angles), np.zeros(len(angles)), np.sin(angles)]) @ axes.T
     return [
-        Gust(float(s), float(duration), (float(np.cos(a)), 0.0, float(np.sin(a))), float(strength * k))
-        for s, a, k in zip(starts, angles, scale, strict=True)
+        Gust(float(s), float(duration), tuple(float(v) for v in d), float(strength * k))
+        for s, d, k in zip(starts, directions, scale, strict=True)
     ]
 
 
 # ---------------------------------------------------------------------------------------
 # Parameters
 # ---------------------------------------------------------------------------------------
-def scaled_accelerations(
-    factor: float, gravity: float, gust_strength: float, wind: ArrayLike = (0.0, 0.0, 0.0)
-) -> dict:
-    """Gravity, gust strength and the wind vector (units/s²) for a head ``factor`` times larger:
-    they scale with the head, so hair on the larger head moves as it did on the smaller one.
-    The keyword arguments of :func:`simulate` (the wind as a vector) that change with scale."""
+def scaled_accelerations(factor: float, gust_strength: float, wind: ArrayLike = (0.0, 0.0, 0.0)) -> dict:
+    """Gust strength and the wind vector (units/s²) for a head ``factor`` times larger: they
+    scale with the head, so hair on the larger head moves as it did on the smaller one (gravity
+    is physical, in m/s², and needs no scaling). The keyword arguments of :func:`simulate` (the
+    wind as a vector) that change with scale."""
     return {
-        "gravity": float(gravity) * factor,
         "gust_strength": float(gust_strength) * factor,
         "wind": tuple(float(v) * factor for v in np.asarray(wind, dtype=np.float64).reshape(3)),
     }
@@ -131,9 +144,9 @@ def _schedule(transform: Callable[[float], F64], frames: int, fps: float, subste
     return times, mats, m0
 
 
-def _accelerations(times: F64, rotations: F64, r0: F64, gravity: float, wind: F64, gusts: list[Gust]) -> F64:
-    """(K, 3) external acceleration per substep: relative gravity + wind + gusts."""
-    g = np.array([0.0, -gravity, 0.0])
+def _accelerations(times: F64, rotations: F64, r0: F64, g: F64, wind: F64, gusts: list[Gust]) -> F64:
+    """(K, 3) external acceleration per substep: relative gravity (``g``, a vector in units/s²)
+    + wind + gusts."""
     g_head = r0.T @ g
     acc = g[None, :] - rotations @ g_head + wind[None, :]
     for gust in gusts:
@@ -169,7 +182,8 @@ def simulate(
         on the head sphere (``head_center``, ``head_radius``; :func:`~hairtool.simulate.head_motion.fit_head`
         finds one for a real groom), or a callable t (s) → rigid 4×4 head transform (world from
         head; the groom is posed at t = 0).
-    substeps: solver steps per frame. gravity: units/s² along −y. damping: velocity decay per
+    substeps: solver steps per frame. gravity: m/s² along the stage's −up (the groom's up axis),
+        g / metersPerUnit in scene units/s². damping: velocity decay per
         second (v ← v·e^(−damping·Δt)). stiffness: fraction of each vertex's distance from its
         rest position in the head frame removed per frame. ftl_damping: s_damping of Müller et al. eq. 9.
     wind: (direction, strength in units/s²), constant. gusts: a count of seeded gusts
@@ -182,7 +196,7 @@ def simulate(
     frames = _whole("frames", frames, 1, 1_000_000)
     substeps = _whole("substeps", substeps, 1, 1000)
     fps = _number("fps", fps, 1e-3, 1e5, "a positive frame rate up to 100000")
-    gravity = _number("gravity", gravity, -1e6, 1e6, "a finite acceleration in units/s²")
+    gravity = _number("gravity", gravity, -1e4, 1e4, "an acceleration in m/s² within ±10000")
     damping = _number("damping", damping, 0.0, 1e4, "a decay rate in [0, 10000] per second")
     stiffness = _number("stiffness", stiffness, 0.0, 1.0, "a fraction in [0, 1]")
     ftl_damping = _number("ftl_damping", ftl_damping, 0.0, 1.0, "a number in [0, 1]")
@@ -209,7 +223,8 @@ def simulate(
             wind_acc = strength * d / n
     duration = (frames - 1) / fps
     if isinstance(gusts, (int, np.integer)) and not isinstance(gusts, bool):
-        gust_list = gust_schedule(int(gusts), max(duration, 1.0 / fps), gust_strength, gust_duration, seed)
+        clip = max(duration, 1.0 / fps)
+        gust_list = gust_schedule(int(gusts), clip, gust_strength, gust_duration, seed, groom.metadata.frame)
     else:
         gust_list = list(gusts)
         for g in gust_list:
@@ -224,7 +239,7 @@ def simulate(
         transform = motion
     else:
         scale = head_radius if head_radius > 0 else 1.0  # the named motions sized to the head
-        transform = head_motion(motion, max(duration, 1.0 / fps), centre_world, scale)
+        transform = head_motion(motion, max(duration, 1.0 / fps), centre_world, scale, groom.metadata.frame)
     times, mats, m0 = _schedule(transform, frames, fps, substeps)
 
     # Rest pose in the head frame.
@@ -245,7 +260,8 @@ def simulate(
     if frames > 1:
         rot = np.ascontiguousarray(mats[:, :3, :3])
         trans = np.ascontiguousarray(mats[:, :3, 3])
-        acc = _accelerations(times, rot, m0[:3, :3], gravity, wind_acc, gust_list)
+        g = -gravity * groom.metadata.units_per_meter * groom.metadata.up
+        acc = _accelerations(times, rot, m0[:3, :3], g, wind_acc, gust_list)
         dt = 1.0 / (fps * substeps)
         bend = 1.0 - (1.0 - stiffness) ** (1.0 / substeps)
         decay = float(np.exp(-damping * dt))
@@ -272,7 +288,7 @@ def simulate(
             out[f] = x
             if progress is not None:
                 progress(f + 1, frames)
-    return Animation(out, groom.topology, fps, **groom.attributes)
+    return groom.animate(out, fps)
 
 
 def simulate_reference(groom: Groom, **kwargs) -> Animation:

@@ -2,9 +2,12 @@
 
 Motions are written for the head of :mod:`hairtool.samples` (radius 1 at the origin, y up) and
 placed on any other head sphere by :func:`head_motion`'s ``centre`` and ``radius``, which
-:func:`fit_head` finds from a groom's roots. Each named motion starts and ends at the rest
-pose, so motions chain ("turn,nod") without jumps; all but "hop" also start and end at rest
-velocity. "hop" takes off and lands abruptly: a short event that good key frames must not miss.
+:func:`fit_head` finds from a groom's roots, and in any scene's axes by its ``frame``
+(:attr:`hairtool.metadata.Metadata.frame`): a turn or a shake is about the stage's up axis, a
+nod about its lateral (x) axis, a hop along up, whatever the up axis. Each named motion
+starts and ends at the rest pose, so motions chain ("turn,nod") without jumps; all but "hop"
+also start and end at rest velocity. "hop" takes off and lands abruptly: a short event that
+good key frames must not miss.
 """
 
 from __future__ import annotations
@@ -83,13 +86,19 @@ def parse_motion(spec: str | Sequence[str]) -> list[str]:
 
 
 def head_motion(
-    spec: str | Sequence[str], duration: float, centre: ArrayLike = (0.0, 0.0, 0.0), radius: float = 1.0
+    spec: str | Sequence[str],
+    duration: float,
+    centre: ArrayLike = (0.0, 0.0, 0.0),
+    radius: float = 1.0,
+    frame: ArrayLike | None = None,
 ) -> HeadMotion:
     """A callable t (seconds) → 4×4: the named motions play one after another, equal slots over
     ``duration``; times outside [0, duration] hold the rest pose.
 
     ``centre`` and ``radius`` place the unit head's motions on another head: the neck pivot
     sits at ``centre + radius·PIVOT`` and a hop rises 0.6·``radius``; angles stay the same.
+    ``frame``: the scene's axes as columns (lateral, up, front; default the identity, Y-up):
+    each motion M of the reference head becomes frame·M·frameᵀ.
     """
     names = parse_motion(spec)
     if not (np.isfinite(duration) and duration > 0):
@@ -99,6 +108,9 @@ def head_motion(
         raise ParameterError("head centre", centre, "three finite numbers")
     if not (np.isfinite(radius) and radius > 0):
         raise ParameterError("head radius", radius, "a positive finite number")
+    axes = np.eye(3) if frame is None else np.asarray(frame, dtype=np.float64)
+    if axes.shape != (3, 3) or not np.allclose(axes @ axes.T, np.eye(3)) or np.linalg.det(axes) < 0:
+        raise ParameterError("frame", "matrix", "a 3×3 rotation (the scene's axes)")
     slot = duration / len(names)
 
     def transform(t: float) -> F64:
@@ -106,9 +118,12 @@ def head_motion(
             return np.eye(4)
         k = min(int(t / slot), len(names) - 1)
         m = MOTIONS[names[k]]((t - k * slot) / slot)
-        # x ↦ c + radius·M((x − c)/radius): the same rotation, the translation rescaled.
-        out = m.copy()
-        out[:3, 3] = c - m[:3, :3] @ c + radius * m[:3, 3]
+        # In the scene's axes: F·M·Fᵀ. Then x ↦ c + radius·M((x − c)/radius): the same
+        # rotation, the translation rescaled.
+        r = axes @ m[:3, :3] @ axes.T
+        out = np.eye(4)
+        out[:3, :3] = r
+        out[:3, 3] = c - r @ c + radius * (axes @ m[:3, 3])
         return out
 
     return transform

@@ -23,7 +23,7 @@ class SimulateOptions:
     frames: int = 72
     fps: float = 24.0
     substeps: int = 8
-    gravity: float = GRAVITY
+    gravity: float = GRAVITY  # m/s² along the stage's −up
     damping: float = 2.0
     stiffness: float = 0.05
     wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # constant acceleration, units/s²
@@ -48,8 +48,9 @@ class SimulateOptions:
         return dataclasses.asdict(self)
 
     def fitted_to(self, groom: Groom) -> SimulateOptions:
-        """The head sphere fitted to ``groom``'s roots, with gravity, wind and gusts scaled by
-        the change of head radius, so the hair moves alike on a head of any size."""
+        """The head sphere fitted to ``groom``'s roots, with wind and gusts scaled by the change
+        of head radius, so the hair moves alike on a head of any size (gravity is in m/s² and
+        follows the groom's unit by itself)."""
         centre, radius = fit_head(groom.roots)
         radius = max(round(radius, 3), 0.001)  # what the dialog's fields hold
         scale = radius / self.head_radius if self.head_radius > 0 else radius
@@ -57,7 +58,7 @@ class SimulateOptions:
             self,
             head_center=tuple(round(float(v), 3) for v in centre),
             head_radius=radius,
-            **scaled_accelerations(scale, self.gravity, self.gust_strength, self.wind),
+            **scaled_accelerations(scale, self.gust_strength, self.wind),
         )
 
     @classmethod

@@ -23,7 +23,8 @@ def sway_animation(
 ) -> Animation:
     """Frames of ``groom`` under rigid head motion plus a root-to-tip sway.
 
-    The head turns about +y by ``turn``·sin (radians) and moves sideways; every strand bends
+    The head turns about the scene's up axis by ``turn``·sin (radians) and moves sideways (all
+    in the groom's axes, :attr:`hairtool.metadata.Metadata.frame`); every strand bends
     about its root by an angle growing as u² toward the tip (``sway`` radians at the tip,
     lagging behind the head), and at ``flick_frame`` a 3-frame flick of ``flick`` radians
     snaps the tips: the short, important deformation that uniform keys miss.
@@ -33,7 +34,8 @@ def sway_animation(
     n = int(n_frames)
     t = np.arange(n) / fps
     top = groom.topology
-    p0 = groom.points.astype(np.float64)
+    frame = groom.metadata.frame
+    p0 = groom.points.astype(np.float64) @ frame  # in the reference axes (y up), exactly
     roots = p0[top.root_indices][top.strand_index]
     rel = p0 - roots
     u = groom.arc_param[:, None]
@@ -50,5 +52,5 @@ def sway_animation(
         bent = np.column_stack([c * rel[:, 0] - s * rel[:, 1], s * rel[:, 0] + c * rel[:, 1], rel[:, 2]])
         head = axis_angle_matrix([0.0, 1.0, 0.0], turn * np.sin(phase))
         shift = np.array([0.3 * np.sin(0.5 * phase), 0.05 * np.sin(2 * phase), 0.0])
-        frames[f] = (roots + bent) @ head.T + shift
-    return Animation(frames, top, fps)
+        frames[f] = ((roots + bent) @ head.T + shift) @ frame.T
+    return groom.animate(frames, fps)
