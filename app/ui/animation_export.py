@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 from PySide6.QtCore import QObject, Qt, QThread, Signal, Slot
+from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QCheckBox, QDialog, QDialogButtonBox, QLabel, QVBoxLayout, QWidget
 
 from app.render.camera import Camera
@@ -37,6 +38,7 @@ from app.render.drawn import Drawn
 from app.render.offscreen import Overlays, render_drawn
 from app.ui.drawn import drawn
 from app.ui.jobs import Job
+from app.ui.qt_utils import set_available
 from hairtool import io
 from hairtool.errors import Cancelled, FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom
@@ -63,6 +65,11 @@ ANIMATION_FILTERS = ";;".join(
         "PNG sequence (*.png)",
     ]
 )
+NO_ANIMATION = "No animation to export: open one, record drags, simulate or apply the anime cycle"
+NO_KEYS = "No keys to export: open or make an animation first (the timeline solves its keys)"
+KEYS_SOLVING = "No keys to export yet: the timeline is still solving them"
+ANIMATION_TIP = "Write the animation: USD, a .npz cache, MP4, GIF or a PNG sequence"
+KEYS_TIP = "Write the timeline's DP keys: a JSON record, a CSV key sheet or USD key poses"
 KEY_FILTERS = "Keys record (*.json);;Key sheet (*.csv);;USD key poses (*.usda *.usdc *.usd)"
 MP4_QUALITY = 8  # imageio-ffmpeg's 0..10 scale: visually clean thin hair lines, small files
 
@@ -402,6 +409,23 @@ class AnimationExporter(QObject):
         if dialog.exec() != QDialog.DialogCode.Accepted:
             return None
         return dialog.render_hair.isChecked()
+
+    def bind_actions(self, animation_action: QAction, keys_action: QAction) -> None:
+        """File ▸ Export Animation… and Export Keys…, greyed out (their tooltips say why) while
+        there is no animation or no keys to write."""
+        self._actions = (animation_action, keys_action)
+        model = self.window.animation
+        for signal in (model.animation_changed, model.keys_changed):
+            signal.connect(self._sync_actions)
+        self._sync_actions()
+
+    def _sync_actions(self, *_: object) -> None:
+        model = self.window.animation
+        animation_action, keys_action = self._actions
+        has_animation = model.animation is not None
+        has_keys = has_animation and model.key_solve is not None and model.dp_keys is not None
+        set_available(animation_action, has_animation, NO_ANIMATION, ANIMATION_TIP)
+        set_available(keys_action, has_keys, NO_KEYS if not has_animation else KEYS_SOLVING, KEYS_TIP)
 
     def export_animation_dialog(self) -> bool:
         if self.window.animation.animation is None:

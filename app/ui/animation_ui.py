@@ -277,9 +277,10 @@ class AnimationController(QObject):
             self.window.statusBar().clearMessage()
             try:
                 anim = rec.animation()
-            except HairtoolError as e:
+            except HairtoolError as e:  # a status-bar line, not a dialog: nothing went wrong
                 self._on_animation_changed()
-                self.window.show_error("Nothing recorded", str(e))
+                message = str(e)
+                self.window.statusBar().showMessage(message[:1].upper() + message[1:], 6000)
             else:
                 self.model.load_animation(anim, "recording")
         if "record" in self.actions:

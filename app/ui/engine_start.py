@@ -52,16 +52,21 @@ class EngineStart(QObject):
         scene.engine_starting.connect(self._on_starting)
         scene.engine_started.connect(self._on_started)
         self._waiting_cursor = False
+        self._closing = False
 
     @property
     def running(self) -> bool:
         return self.process.state() != QProcess.ProcessState.NotRunning
 
     def start(self) -> None:
-        self.process.start(sys.executable, ["-m", "app.ui.kernel_warmup"])
+        # --with-parent: the warm-up ends when this process does (its stdin is our pipe)
+        self.process.start(sys.executable, ["-m", "app.ui.kernel_warmup", "--with-parent"])
 
-    def stop(self) -> None:
-        """End the warm-up (the window closes); the kernels compiled so far stay cached."""
+    def stop(self, closing: bool = True) -> None:
+        """End the warm-up; the kernels compiled so far stay cached. ``closing`` (the window
+        closes): nothing follows, the engine is not started here (it would compile every kernel
+        on the GUI thread of a window being closed) and ``ended`` is not emitted."""
+        self._closing = self._closing or closing
         if self.running:
             self.process.kill()
             self.process.waitForFinished(3000)
@@ -80,6 +85,8 @@ class EngineStart(QObject):
                 self.step_ready.emit(label)
 
     def _on_finished(self, code: int, status: QProcess.ExitStatus) -> None:
+        if self._closing:
+            return
         ok = status == QProcess.ExitStatus.NormalExit and code == 0
         self.ended.emit()
         if self.scene.engine_ready:
@@ -106,7 +113,7 @@ class EngineStart(QObject):
             self._waiting_cursor = False
         self.bar.showMessage("The hair engine is ready", 4000)
         if self.step < STARTUP_STEPS:  # started before the warm-up got there: it compiled here
-            self.stop()
+            self.stop(closing=False)
         if not self.running:
             self._remove_progress()
 

@@ -10,6 +10,12 @@ holding the GIL, so a compiling thread would stall the window as surely as compi
 
 :func:`kernels_cached` tells a start whether that is needed: the warm-up records the kernels it
 compiled, and they are cached when numba's index for each still matches its source.
+
+Started by the studio (``--with-parent``), the warm-up ends quietly as soon as the studio does,
+however it ends (Quit, a crash, a kill): its standard input is the studio's pipe, and a thread
+that waits on it ends the process at end-of-file. A closed output pipe or Ctrl+C in the terminal
+ends it quietly too, never with a traceback; what it compiled so far stays cached (numba writes
+each cache file whole, by renaming).
 """
 
 from __future__ import annotations
@@ -205,10 +211,43 @@ STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
 )
 
 
-def main() -> int:
-    for i, (label, step) in enumerate(STEPS):
-        step()
-        print(f"step {i + 1} {len(STEPS)} {label}", flush=True)
+def _end_with_parent() -> None:
+    """End the process when its standard input (the studio's pipe) reaches end-of-file."""
+    import threading
+
+    def wait() -> None:
+        try:
+            while sys.stdin.buffer.read(4096):
+                pass
+        except (OSError, ValueError):
+            pass
+        os._exit(0)  # the studio is gone: nobody reads the progress any more
+
+    threading.Thread(target=wait, name="warm-up-parent", daemon=True).start()
+
+
+def _quietly_gone() -> int:
+    """Standard output has no reader any more: stop without Python's flush error at exit."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except OSError:
+        pass
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if "--with-parent" in argv:
+        _end_with_parent()
+    try:
+        for i, (label, step) in enumerate(STEPS):
+            step()
+            print(f"step {i + 1} {len(STEPS)} {label}", flush=True)
+    except BrokenPipeError:
+        return _quietly_gone()
+    except KeyboardInterrupt:
+        return 130
     compiled = sorted(n for n, d in _dispatchers().items() if d.signatures)
     path = record_path()
     try:

@@ -50,6 +50,13 @@ def send_mouse(
     QApplication.sendEvent(widget, event)
 
 
+def set_available(action: QAction, available: bool, why_not: str, tip: str = "") -> None:
+    """Enable ``action`` where it can apply; greyed out, its tooltip says why (``why_not``), as
+    an action that cannot apply must not be an error after the click."""
+    action.setEnabled(available)
+    action.setToolTip(tip or action.text().replace("&", "") if available else why_not)
+
+
 def add_action(owner: QObject, menu, text: str, slot, shortcut=None, *, checkable: bool = False) -> QAction:
     """A menu entry calling ``slot``, with one shortcut or a list of them (owned by ``owner``)."""
     action = QAction(text, owner)

@@ -41,7 +41,7 @@ from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import Job, JobRunner, JobStatus
 from app.ui.kernel_warmup import RENDER_HAIR_STEP
 from app.ui.legend import RampLegend, unit_name
-from app.ui.qt_utils import add_action
+from app.ui.qt_utils import add_action, set_available
 from app.ui.render_hair_dialog import DENSE, GrowOptions, ask_grow_options, grow
 from app.ui.scene import COLOUR_MODES, Scene
 from app.ui.simulate_dialog import ask_simulate_options
@@ -333,6 +333,7 @@ class MainWindow(QMainWindow):
         self._sync_brush_actions()
 
         groom = bar.addMenu("&Groom")
+        groom.setToolTipsVisible(True)
         add_action(self, groom, "&Grow render hair…", self.grow_render_hair_dialog, "Ctrl+G")
         self.remove_hair_action = add_action(self, groom, "&Remove render hair", self.remove_render_hair)
         groom.addSeparator()
@@ -400,6 +401,7 @@ class MainWindow(QMainWindow):
         menus = {a.text(): a.menu() for a in self.menuBar().actions()}
         file = menus["&File"]
         quit_action = file.actions()[-1]
+        made: dict[str, QAction] = {}
         for text, slot, key in (
             ("Open &Project…", self.project.open_project_dialog, "Ctrl+Shift+O"),
             ("Save Pro&ject", self.project.save_project, "Ctrl+Alt+S"),
@@ -417,6 +419,9 @@ class MainWindow(QMainWindow):
                 action.setShortcut(QKeySequence(key))
             action.triggered.connect(lambda _=False, f=slot: f())
             file.insertAction(quit_action, action)
+            made[text] = action
+        self.exporter.bind_actions(made["Export &Animation…"], made["Export &Keys…"])
+        file.setToolTipsVisible(True)  # a greyed-out entry's tooltip says why
         animation = menus["&Animation"]
         animation.addSeparator()
         add_action(self, animation, "&Simulate…", self.sources.simulate_dialog, "Ctrl+Alt+M")
@@ -668,8 +673,9 @@ class MainWindow(QMainWindow):
 
     # -- render hair ------------------------------------------------------------------------
     def _sync_groom_menu(self) -> None:
-        self.remove_hair_action.setEnabled(self.scene.binding is not None)
-        self.remove_mesh_action.setEnabled(self.scene.mesh is not None)
+        why_not = "No render hair to remove: Groom ▸ Grow render hair… makes some"
+        set_available(self.remove_hair_action, self.scene.binding is not None, why_not)
+        set_available(self.remove_mesh_action, self.scene.mesh is not None, "No head mesh to remove")
 
     def ask_grow_options(self, options: GrowOptions) -> GrowOptions | None:
         """The Grow render hair… dialog: GrowOptions or None (tests replace this)."""

@@ -133,6 +133,24 @@ def test_keys_without_an_animation_are_one_clear_error(make_window, out):
     assert "no keys" in w.errors[-1][1] and not (out / "k.json").exists()
 
 
+def test_the_export_entries_are_greyed_out_saying_why_until_there_is_something_to_write(make_window):
+    from app.ui import animation_export as ae
+
+    w = make_window(groom=samples.scalp(20, 6, seed=4), size=(640, 420))
+    entries = {a.text(): a for a in w.menuBar().actions()[0].menu().actions()}
+    animation, keys = entries["Export &Animation…"], entries["Export &Keys…"]
+    assert not animation.isEnabled() and animation.toolTip() == ae.NO_ANIMATION
+    assert not keys.isEnabled() and keys.toolTip() == ae.NO_KEYS
+    w.animation.load_animation(sway_animation(w.scene.rest, FRAMES, flick_frame=6), "sway")
+    assert animation.isEnabled() and animation.toolTip() == ae.ANIMATION_TIP
+    w.jobs.wait()
+    assert keys.isEnabled() and keys.toolTip() == ae.KEYS_TIP
+    w.animation.clear()
+    assert not animation.isEnabled() and not keys.isEnabled() and keys.toolTip() == ae.NO_KEYS
+    remove = next(a for a in w.menuBar().actions() if a.text() == "&Groom").menu().actions()[1]
+    assert not remove.isEnabled() and "No render hair" in remove.toolTip()
+
+
 def test_write_video_cancelled_mid_way_and_bad_frames(tmp_path):
     from app.ui.animation_export import write_video
     from hairtool.errors import Cancelled, FormatError, ParameterError
