@@ -12,6 +12,7 @@ from PySide6.QtCore import QEventLoop, QObject, QProcess, Qt, Signal
 from PySide6.QtGui import QGuiApplication
 from PySide6.QtWidgets import QLabel, QProgressBar, QStatusBar
 
+from app.ui.kernel_warmup import STEPS
 from app.ui.scene import Scene
 
 STARTUP_STEPS = 2  # the warm-up's steps the engine and the first paint need (the rest follow)
@@ -36,7 +37,10 @@ class EngineStart(QObject):
         self.progress = QProgressBar()
         self.progress.setObjectName("EngineProgress")
         self.progress.setMaximumWidth(140)
-        self.progress.setRange(0, 0)  # busy until the first step reports
+        # a step count from the start, never the busy animation: with a GL viewport in the window
+        # every frame of it recomposes the whole window on the GL (llvmpipe: most of a core)
+        self.progress.setRange(0, len(STEPS))
+        self.progress.setValue(0)
         self.progress.setToolTip(
             "numba compiles the engine's kernels once, in the background; later starts load them"
         )
