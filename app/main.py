@@ -98,9 +98,33 @@ def main(argv: list[str] | None = None) -> int:
     window = open_window(args.file, engine_ready=cached)
     window.show()
     splash.finish(window)
+    trace_start(window)
     if not cached:
         window.start_warmup()
     return app.exec()
+
+
+def trace_start(window) -> None:
+    """The start's moments on standard error when HAIRTOOL_STARTUP_TRACE is set (see
+    :mod:`app.ui.startup_trace`; ``python -m app.bench --cold-start`` reads them)."""
+    from app.ui import startup_trace
+
+    if not startup_trace.enabled():
+        return
+    startup_trace.mark("window-shown")
+    scene, viewport = window.scene, window.viewport
+    if scene.engine_ready:
+        startup_trace.mark("engine-ready")
+    else:
+        scene.engine_started.connect(lambda: startup_trace.mark("engine-ready"))
+    shown = []
+
+    def on_frame() -> None:  # the first frame drawn with the render hair bound
+        if not shown and scene.binding is not None:
+            shown.append(True)
+            startup_trace.mark("render-hair")
+
+    viewport.frame_drawn.connect(on_frame)
 
 
 def entry() -> None:

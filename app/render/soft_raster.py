@@ -189,7 +189,7 @@ def _slab(u, v, a0, a1):
 # range test is skipped.
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _line(seg, i, r0, r1, c0, c1, rgba, depth, w):
     """Segment i's 1-px line, in rows [r0, r1) and columns [c0, c1)."""
     xa, ya, z0, xb, yb, z1 = seg[i, 0], seg[i, 1], seg[i, 2], seg[i, 3], seg[i, 4], seg[i, 5]
@@ -248,7 +248,7 @@ def _corner_rows(ya, yb, ux, uy, half):
     return min(ya - uy * half, yb + uy * half) - across, max(ya - uy * half, yb + uy * half) + across
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _quad(seg, i, half, r0, r1, c0, c1, rgba, depth, w):
     """Segment i's quad (the geometry shader's), in rows [r0, r1) and columns [c0, c1): by rows
     of pixels, or for a steep quad by columns (x and y swapped, the same arithmetic)."""
@@ -287,7 +287,7 @@ def _quad(seg, i, half, r0, r1, c0, c1, rgba, depth, w):
                     rgba[k] = _packed(t, e0, e1, e2, d0, d1, d2)
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _segment(seg, i, half, r0, r1, c0, c1, rgba, depth, w):
     if half > 0.0:
         _quad(seg, i, half * seg[i, 12], r0, r1, c0, c1, rgba, depth, w)

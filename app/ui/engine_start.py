@@ -12,6 +12,7 @@ from PySide6.QtCore import QEventLoop, QObject, QProcess, Qt, Signal
 from PySide6.QtGui import QGuiApplication
 from PySide6.QtWidgets import QProgressBar, QStatusBar
 
+from app.ui.kernel_warmup import STEPS
 from app.ui.scene import Scene
 from app.ui.status_line import ElidedLabel
 
@@ -37,7 +38,10 @@ class EngineStart(QObject):
         self.progress = QProgressBar()
         self.progress.setObjectName("EngineProgress")
         self.progress.setFixedWidth(140)  # its own width: the percentage inside is never squeezed
-        self.progress.setRange(0, 0)  # busy until the first step reports
+        # a step count from the start, never the busy animation: with a GL viewport in the window
+        # every frame of it recomposes the whole window on the GL (llvmpipe: most of a core)
+        self.progress.setRange(0, len(STEPS))
+        self.progress.setValue(0)
         self.progress.setToolTip(
             "numba compiles the engine's kernels once, in the background; later starts load them"
         )

@@ -30,6 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
+from app.ui import startup_trace
+
 #: Packages and modules whose kernels the warm-up's steps compile (searched for numba dispatchers).
 KERNEL_PACKAGES = (
     "hairtool.frozen",
@@ -87,7 +89,45 @@ def kernels_cached() -> bool:
     return bool(names) and all(n in found and _has_cache(found[n]) for n in names)
 
 
+#: The studio's engine parameters for a new scene (``app.ui.scene.Scene``'s default; that module
+#: is Qt): the first screen's kernels are compiled for exactly these.
+STUDIO_PARAMS = {"keep_lengths": True}
+
+
+def _sintel():
+    """The first screen's groom and head: the bundled Sintel (228 guides), read as the studio
+    reads her, so every kernel is compiled for the very types (float32 points) it will meet."""
+    from app import resources
+    from hairtool import io
+    from hairtool.io.obj import read_mesh
+
+    return io.read_groom(resources.path(resources.SINTEL_HAIR)), read_mesh(
+        resources.path(resources.SINTEL_HEAD)
+    )
+
+
 def _engine_step() -> None:
+    """Sintel's engine and a short align drag as the viewport makes it (front faces only)."""
+    from app.ui.brush_tool import BrushTool
+    from hairtool.frozen.brushes import scalp_centre
+    from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+
+    groom, _ = _sintel()
+    pipe = FrozenPipeline(groom, FrozenParams(**STUDIO_PARAMS))
+    lo, hi = groom.bounds
+    centre = (lo.astype(np.float64) + hi) * 0.5
+    extent = float(np.max(hi - lo))
+    tool = BrushTool()
+    tool.reset_radius(0.3 * extent)
+    plane = float(scalp_centre(groom)[0])
+    for i in range(3):  # the first sample and the incremental ones after it
+        cursor = centre + np.array([0.05 * i * extent, 0.0, 0.0])
+        pipe.apply_samples(tool.samples(cursor, (1.0, 0.0, 0.0), (0.0, 0.0, -1.0), plane))
+        tool.touches(pipe.aligned.points, cursor, plane)
+
+
+def _scalp_engine_step() -> None:
+    """The engine with the engine's own defaults (keep lengths off) on a procedural groom."""
     from hairtool import samples
     from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 
@@ -96,7 +136,7 @@ def _engine_step() -> None:
     lo, hi = groom.bounds
     centre = (lo.astype(np.float64) + hi) * 0.5
     extent = float(np.max(hi - lo))
-    for i in range(3):  # a short drag: the first sample and the incremental ones after it
+    for i in range(3):
         pipe.align(centre + np.array([0.05 * i * extent, 0.0, 0.0]), 0.3 * extent, 0.8, "paper")
 
 
@@ -159,6 +199,32 @@ def _brushes_step() -> None:
 
 
 def _render_hair_step() -> None:
+    """Sintel's render hair as the studio makes it (bound on her scalp, built in place from the
+    moved guides, shaded), with fewer children: the same kernels, the same types."""
+    from app import resources
+    from app.render.hair_shading import light_and_eye, shade
+    from hairtool.bounds import box
+    from hairtool.guides.binding import bind_scalp
+    from hairtool.guides.children import build_points, moved_guides
+
+    guides, mesh = _sintel()
+    binding = bind_scalp(guides, mesh, 300, seed=resources.SINTEL_CHILD_SEED)
+    drawn = np.empty((binding.vertex_count, 3), np.float32)
+    source = np.full((guides.vertex_count, 3), np.nan, np.float32)
+    build_points(binding, guides, out=drawn, moved=moved_guides(guides, source))
+    # as the renderer takes them: its box, and shading from its read-only points and topology
+    # (numba compiles read-only arrays apart from writable ones)
+    box(drawn)
+    points, offsets = drawn.copy(), binding.offsets.copy()
+    for a in (points, offsets):
+        a.setflags(write=False)
+    light, eye = light_and_eye(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, -1.0]))
+    base = np.ones((len(drawn), 3), np.float32)
+    shade(points, offsets, base, light, eye, out=np.empty((len(drawn), 3), np.float32))
+
+
+def _clumped_hair_step() -> None:
+    """Render hair bound to given roots, clumped (what Grow render hair… and clumped children reach)."""
     from app.render.hair_shading import light_and_eye, shade
     from hairtool import samples
     from hairtool.guides.binding import bind_roots
@@ -170,7 +236,7 @@ def _render_hair_step() -> None:
     rng = np.random.default_rng(0)
     roots = roots[rng.integers(0, len(roots), 60)] + rng.normal(0.0, 1e-3, (60, 3))
     children = RenderHair(bind_roots(guides, roots, k=3, seed=0)).update(guides)
-    moved_guides(guides, np.array(guides.points))  # what a drag asks before building children again
+    moved_guides(guides, np.array(guides.points))
     light, eye = light_and_eye(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, -1.0]))
     base = np.ones((len(children.points), 3), np.float32)
     shade(children.points, children.topology.offsets, base, light, eye)
@@ -195,20 +261,40 @@ def _animation_step() -> None:
 #: The step after which the bundled sample's render hair can be bound and shaded without compiling.
 RENDER_HAIR_STEP = "render hair"
 
+#: The steps after which the first screen (Sintel, her render hair shaded and drawn, an align
+#: drag) compiles nothing: tests/gui/test_studio_first_screen_kernels.py checks it.
+FIRST_SCREEN_STEPS = 3
+
 #: (label, step) in the order the studio needs them: the engine for the first groom, the
 #: rasterizer for the first paint (the studio starts its engine after these two:
 #: :data:`app.ui.engine_start.STARTUP_STEPS`), render hair (the bundled sample's children wait for
 #: it), then what other brush modes and settings reach, the other brushes, and what opening an
 #: animation needs (simulation, anime waves, keys):
 #: without these, the first use of each compiled it inside the studio, on a job or the GUI thread.
-STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
+_STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
     ("hair engine", _engine_step),
     ("strand drawing", _raster_step),
     (RENDER_HAIR_STEP, _render_hair_step),
     ("brush modes and settings", _more_engine_step),
+    ("engine defaults", _scalp_engine_step),
+    ("clumped render hair", _clumped_hair_step),
     ("grooming brushes", _brushes_step),
     ("animation and keys", _animation_step),
 )
+
+
+def _traced(i: int, label: str, step: Callable[[], None]) -> Callable[[], None]:
+    """``step``, then its moment for ``python -m app.bench --cold-start`` (HAIRTOOL_STARTUP_TRACE)."""
+
+    def run() -> None:
+        step()
+        startup_trace.mark("warmup-step", f"{i + 1}/{len(_STEPS)} {label}")
+
+    run.__name__ = run.__qualname__ = step.__name__
+    return run
+
+
+STEPS = tuple((label, _traced(i, label, step)) for i, (label, step) in enumerate(_STEPS))
 
 
 def _end_with_parent() -> None:

@@ -171,7 +171,7 @@ def _gather(order, points, strand, skip, sx, sy, sz, sstrand, sskip):
         sskip[k] = skip[i]
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _scan_row(
     sx, sy, sz, sstrand, j, end, px, py, pz, si, sweep, ylo, yhi, zlo, zhi, r2, jmin, grow, flat, pos, lim
 ):
@@ -262,7 +262,7 @@ def _forward_kernel(
         used[c] = pos - base[c]
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _row_run(start, sx, r, cy, cz, dy, dz, ny, nz, sweep):
     """Row (cy + dy, cz + dz)'s run in sorted order from where its window may start for a vertex
     whose sweep line is ``sweep`` (empty where the row lies outside the grid). Bisection: on x

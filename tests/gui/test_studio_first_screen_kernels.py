@@ -1,0 +1,97 @@
+"""The warm-up's first steps compile every kernel the first screen uses: after them, Sintel with
+her render hair, shaded, drawn and combed with the align brush loads every kernel from numba's
+cache and compiles none on the GUI thread (which would freeze the window on a first start)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+pytestmark = pytest.mark.gui
+
+#: ``startup``: run the warm-up's first-screen steps; ``screen``: the studio's first screen
+#: (window, engine, render hair, a frame, an align drag). Either prints the numba dispatchers'
+#: signatures in the process afterwards and the kernels it compiled (cache misses).
+SCRIPT = r"""
+import gc, json, sys
+from numba.core import event
+from numba.core.dispatcher import Dispatcher
+
+compiled = []
+class Compiles(event.Listener):
+    def on_start(self, e):
+        d = e.data["dispatcher"]
+        compiled.append(f"{d.py_func.__module__}:{d.py_func.__qualname__} {e.data['args']}")
+    def on_end(self, e):
+        pass
+event.register("numba:compile", Compiles())
+
+if sys.argv[1] == "startup":
+    from app.ui import kernel_warmup
+    for label, step in kernel_warmup.STEPS[: kernel_warmup.FIRST_SCREEN_STEPS]:
+        step()
+else:
+    import tempfile
+    import numpy as np
+    from app.surface import configure_gl
+    configure_gl()
+    from PySide6.QtCore import QSettings
+    from PySide6.QtWidgets import QApplication
+    from app.main import open_window
+    from app.ui.qt_utils import send_mouse
+    from PySide6.QtCore import Qt
+    app = QApplication([])
+    settings = QSettings(tempfile.mkdtemp() + "/studio.ini", QSettings.Format.IniFormat)
+    w = open_window(None, engine_ready=False, settings=settings)
+    w.ask_save_changes = lambda: "discard"
+    w.resize(640, 480)
+    w.show()
+    app.processEvents()
+    del compiled[:]  # what compiled before the window showed is not the first start's concern
+    w.scene.start_engine()  # what the warm-up's startup steps let the studio do
+    w._bind_pending_render_hair()  # and its render hair step
+    v = w.viewport
+    v.draw_now()
+    s = w.scene
+    assert s.binding is not None and s.engine_ready
+    centre = v.project(s.centre[None])[0]
+    left = Qt.MouseButton.LeftButton
+    send_mouse(v, "press", centre, left, left, None)
+    for f in np.linspace(0.0, 1.0, 6)[1:]:
+        send_mouse(v, "move", centre + f * np.array([40.0, 10.0]), None, left, None)
+        v.draw_now()
+    send_mouse(v, "release", centre + np.array([40.0, 10.0]), left, None, None)
+    v.draw_now()
+    assert w.undo_stack.count() == 1
+    w.close()
+
+sigs = sorted(
+    f"{d.py_func.__module__}:{d.py_func.__qualname__} {s}"
+    for d in gc.get_objects() if isinstance(d, Dispatcher) for s in d.signatures
+)
+print(json.dumps({"signatures": sigs, "compiled": compiled}))
+"""
+
+
+def _run(mode: str, env: dict) -> dict:
+    command = [sys.executable, "-c", SCRIPT, mode]
+    out = subprocess.run(command, env=env, capture_output=True, text=True, timeout=900, check=False)
+    assert out.returncode == 0, out.stderr[-3000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_the_first_screen_compiles_nothing_after_the_startup_steps():
+    """Both processes use the same cache (the worktree's, usually warm: then both load, and the
+    first screen's signatures must be among those the startup steps loaded or compiled; from
+    an empty cache the startup steps compile them and the first screen must compile nothing)."""
+    env = dict(os.environ)
+    startup = _run("startup", env)
+    screen = _run("screen", env)
+    missing = sorted(set(screen["signatures"]) - set(startup["signatures"]))
+    needed = "the first screen needs kernels the startup steps do not compile:\n"
+    assert not missing, needed + "\n".join(missing)
+    assert not screen["compiled"], "compiled on the GUI thread:\n" + "\n".join(screen["compiled"])
