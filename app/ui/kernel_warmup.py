@@ -107,13 +107,16 @@ def _sintel():
 
 
 def _engine_step() -> None:
-    """Sintel's engine and a short align drag as the viewport makes it (front faces only)."""
+    """Sintel's engine on her head and a short align drag as the viewport makes it (front faces
+    only, kept out of the head)."""
     from app.ui.brush_tool import BrushTool
     from hairtool.frozen.brushes import scalp_centre
     from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+    from hairtool.guides.planting import HeadSurface
 
-    groom, _ = _sintel()
-    pipe = FrozenPipeline(groom, FrozenParams(**STUDIO_PARAMS))
+    groom, head = _sintel()
+    # on her head, as the studio runs it: the strokes keep out of it (surface collision)
+    pipe = FrozenPipeline(groom, FrozenParams(**STUDIO_PARAMS), HeadSurface(head))
     lo, hi = groom.bounds
     centre = (lo.astype(np.float64) + hi) * 0.5
     extent = float(np.max(hi - lo))
