@@ -17,7 +17,6 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QWidget
 MAGNITUDE_STOPS = np.array(
     [[0.55, 0.59, 0.66], [1.0, 0.84, 0.0], [1.0, 0.45, 0.0], [0.85, 0.05, 0.05]], dtype=np.float64
 )
-UNIT_NAMES = {1.0: "m", 0.1: "dm", 0.01: "cm", 0.001: "mm"}
 
 
 def magnitude_colors(values: ArrayLike) -> NDArray[np.float32]:
@@ -27,13 +26,15 @@ def magnitude_colors(values: ArrayLike) -> NDArray[np.float32]:
     return np.column_stack([np.interp(v, x, MAGNITUDE_STOPS[:, c]) for c in range(3)]).astype(np.float32)
 
 
-def unit_name(meters_per_unit: float) -> str:
-    """"cm" for a groom in centimetres (USD's metersPerUnit 0.01), and so on; other scales as
-    "units (1 = … m)"."""
-    for scale, name in UNIT_NAMES.items():
-        if abs(meters_per_unit - scale) <= 1e-9 * scale:
-            return name
-    return f"units (1 = {meters_per_unit:g} m)"
+def readable_length(value: float, meters_per_unit: float) -> tuple[float, str]:
+    """``value`` groom units as an artist reads a length: ``(number, "mm" | "cm" | "m")``, the
+    unit chosen for the size (a 5 mm error, a 20 cm strand), whatever unit the scene is in."""
+    metres = float(value) * float(meters_per_unit)
+    if abs(metres) < 0.01:
+        return metres * 1e3, "mm"
+    if abs(metres) < 1.0:
+        return metres * 1e2, "cm"
+    return metres, "m"
 
 
 class RampBar(QWidget):

@@ -40,7 +40,7 @@ from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, as
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import Job, JobRunner, JobStatus
 from app.ui.kernel_warmup import RENDER_HAIR_STEP
-from app.ui.legend import RampLegend, unit_name
+from app.ui.legend import RampLegend, readable_length
 from app.ui.qt_utils import add_action, set_available
 from app.ui.render_hair_dialog import DENSE, GrowOptions, ask_grow_options, grow
 from app.ui.scene import COLOUR_MODES, Scene
@@ -513,17 +513,17 @@ class MainWindow(QMainWindow):
 
     def _update_legend(self, *_: object) -> None:
         """The distance ramp's legend, in the groom's units, while distances colour the strands."""
-        unit = unit_name(self.scene.rest.metadata.meters_per_unit)
+        mpu = self.scene.rest.metadata.meters_per_unit
         m = self.animation
         if m.animation is not None and m.view_mode == "error" and m.error_scale > 0:
             self.legend.show_scale(
-                "Key error", m.error_scale, unit,
+                "Key error", *readable_length(m.error_scale, mpu),
                 "distance of each vertex from its reconstruction from the DP keys; "
                 "the top of the ramp is the keys' worst vertex over the whole animation",
             )  # fmt: skip
         elif m.animation is None and self.scene.colour_mode == "displacement":
             self.legend.show_scale(
-                "Moved", displacement_scale(self.scene), unit,
+                "Moved", *readable_length(displacement_scale(self.scene), mpu),
                 "distance of each vertex from its rest position; the top of the ramp is the "
                 "median strand length (grey: not moved)",
             )  # fmt: skip
