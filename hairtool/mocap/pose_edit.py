@@ -42,6 +42,7 @@ I64 = NDArray[np.int64]
 
 INTERPS = ("linear", "hermite", "hermite-fit")
 FIELDS = ("frame", "joint", "target", "chain")
+CHANNEL_FIELDS = ("frame", "joint", "channel", "value")
 
 
 @dataclass(frozen=True)
@@ -58,13 +59,27 @@ class PoseEdit:
         return {"frame": self.frame, "joint": self.joint, "target": list(self.target), "chain": self.chain}
 
 
+@dataclass(frozen=True)
+class ChannelEdit:
+    """Set one rotation channel of the key pose at key ``frame`` to ``value`` (degrees): a key
+    dragged in value in a graph editor, carried to the frames around it like an IK edit."""
+
+    frame: int
+    joint: str
+    channel: str
+    value: float
+
+    def to_dict(self) -> dict:
+        return {"frame": self.frame, "joint": self.joint, "channel": self.channel, "value": self.value}
+
+
 @dataclass
 class EditReport:
     """What one edit did: the joints it turned, the solver, how far the effector is from the
     target (scene units and share of the figure's height; more than ``tolerance_share``: out of
     reach) and the frames it changed (``first``..``last``, strictly between the neighbouring keys)."""
 
-    edit: PoseEdit
+    edit: PoseEdit | ChannelEdit
     turned: list[str]
     method: str
     iterations: int
@@ -137,6 +152,46 @@ def parse_edits(data: object, motion: Motion, source: str = "edits") -> list[Pos
         if not any(ik.rotation_columns(motion, a)[0] for a in turned):
             raise FormatError(source, f"{where}: the chain above '{joint}' has no rotation channels to turn")
         out.append(PoseEdit(int(frame), joint, tuple(float(v) for v in target), int(chain)))
+    return out
+
+
+def parse_edit_list(data: object, motion: Motion, source: str = "edits") -> list[PoseEdit | ChannelEdit]:
+    """Pose edits (:func:`parse_edits`) and channel edits ``{"frame", "joint", "channel",
+    "value"}`` in one list, in order (what a studio project keeps); faults raise
+    :class:`FormatError` naming ``source`` and the edit (counted from 1)."""
+    if isinstance(data, dict) and set(data) == {"edits"}:
+        data = data["edits"]
+    if not isinstance(data, list):
+        raise FormatError(source, "expected a list of edits")
+    out: list[PoseEdit | ChannelEdit] = []
+    for i, e in enumerate(data, 1):
+        if not (isinstance(e, dict) and "channel" in e):
+            try:
+                out += parse_edits([e], motion, source)
+            except FormatError as err:
+                raise FormatError(source, err.reason.replace("edit 1", f"edit {i}", 1)) from None
+            continue
+        missing = [k for k in CHANNEL_FIELDS if k not in e]
+        extra = sorted(str(k)[:40] for k in e if k not in CHANNEL_FIELDS)
+        if missing or extra:
+            what = f"lacks {', '.join(missing)}" if missing else f"has unknown fields {', '.join(extra)}"
+            raise FormatError(source, f"edit {i} {what} (fields: {', '.join(CHANNEL_FIELDS)})")
+        frame, joint, channel, value = (e[k] for k in CHANNEL_FIELDS)
+        if not _is_int(frame) or not 0 <= frame < motion.n_frames:
+            raise FormatError(
+                source, f"edit {i}: frame {frame!r} is not a frame number 0..{motion.n_frames - 1}"
+            )
+        if not isinstance(joint, str) or joint not in motion.joint_names:
+            raise FormatError(source, f"edit {i}: joint {str(joint)[:60]!r} is not in the skeleton")
+        j = motion.joint_names.index(joint)
+        rotations = [c for c in motion.channels[j] if c.endswith("rotation")]
+        if channel not in rotations:
+            raise FormatError(
+                source, f"edit {i}: '{str(channel)[:40]}' is not a rotation channel of '{joint}'"
+            )
+        if not _is_number(value) or not _finite(value) or abs(value) > MAX_VALUE:
+            raise FormatError(source, f"edit {i}: value {str(value)[:40]} is not a finite angle")
+        out.append(ChannelEdit(int(frame), joint, channel, float(value)))
     return out
 
 
@@ -222,11 +277,40 @@ class PoseEditor:
         self._history.append((report, *saved))
         return report
 
-    def apply_all(self, edits: list[PoseEdit], method: str = "auto") -> list[EditReport]:
-        """Edits in order, each on the pose the ones before it left."""
-        return [self.apply(e, method) for e in edits]
+    def apply_channel(self, edit: ChannelEdit) -> EditReport:
+        """Set one rotation channel of a key pose (a key dragged in value): the key curve through
+        the new pose plus the residuals, as for an IK edit. A ball joint's key quaternion is made
+        from its three angles at the key, so the other two keep their values there."""
+        m = self.original
+        if edit.joint not in m.joint_names:
+            raise ParameterError("joint", edit.joint, "a joint of the skeleton")
+        j = m.joint_names.index(edit.joint)
+        cols, order = ik.rotation_columns(m, j)
+        names = [m.channels[j][c - int(m._starts[j])] for c in cols]
+        if edit.channel not in names:
+            raise ParameterError(
+                "channel", edit.channel, f"a rotation channel of '{edit.joint}': {', '.join(names)}"
+            )
+        if not (math.isfinite(edit.value) and abs(edit.value) <= MAX_VALUE):
+            raise ParameterError("value", edit.value, "a finite angle in degrees")
+        a = self.key_index(edit.frame)
+        saved = (a, self._key_values[a].copy(), self._key_q[a].copy())
+        self._key_values[a, cols[names.index(edit.channel)]] = float(edit.value)
+        if ik.is_ball_joint(m, j):
+            q = quat.from_euler(self._key_values[a, cols], order)
+            ref = self._q[self.keys[a], j]
+            self._key_q[a, j] = -q if np.dot(q, ref) < 0 else q
+        first, last = self.span(edit.frame)
+        report = EditReport(edit, [edit.joint], "channel", 0, 0.0, 0.0, first, last)
+        self._history.append((report, *saved))
+        return report
 
-    def undo(self) -> PoseEdit | None:
+    def apply_all(self, edits: list[PoseEdit | ChannelEdit], method: str = "auto") -> list[EditReport]:
+        """Edits in order, each on the pose the ones before it left (channel edits as
+        :meth:`apply_channel`)."""
+        return [self.apply_channel(e) if isinstance(e, ChannelEdit) else self.apply(e, method) for e in edits]
+
+    def undo(self) -> PoseEdit | ChannelEdit | None:
         """Take back the last edit (None when there is none)."""
         if not self._history:
             return None
@@ -281,6 +365,27 @@ class PoseEditor:
                 spread = self._spread(self._key_values[:, cols] - self._base_values[:, cols], frames)
                 values[np.ix_(frames, cols)] = m.values[np.ix_(frames, cols)] + spread
         return m.with_values(values)
+
+    def key_curve(self, joint: int, reference: F64 | None = None) -> F64:
+        """``(F, n)`` a joint's rotation channels on its edited key curve alone (no residuals):
+        the curve a graph editor draws through the keys. Angles are written nearest
+        ``reference`` (``(F, n)``, default the edited capture's), so the two overlay."""
+        m = self.original
+        cols, order = ik.rotation_columns(m, joint)
+        frames = np.arange(m.n_frames)
+        if reference is None:
+            reference = self.motion().values[:, cols]
+        if ik.is_ball_joint(m, joint):
+            q = self._curve(joint, self._key_q[:, joint], frames)
+            return np.array([ik.euler_nearest(q[f], order, reference[f]) for f in frames]).reshape(
+                -1, len(cols)
+            )
+        kind = "linear" if self.interp == "linear" else self.interp
+        kp = key_poses(m.values[:, cols], self.keys, kind)
+        edited = KeyPoses(
+            kp.keys, self._key_values[:, cols], kp.tangents, kp.n_frames, kp.interp, kp.tangents_in
+        )
+        return interpolate_at(edited, frames)
 
     def _span_of(self, a: int) -> tuple[int, int]:
         """``[start, stop)`` frames of key index ``a``'s span."""
