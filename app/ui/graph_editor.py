@@ -23,9 +23,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPainter, QPainterPath, QPen, QWheelEvent
-from PySide6.QtWidgets import QDockWidget, QLabel, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QDockWidget, QHBoxLayout, QLabel, QSpinBox, QVBoxLayout, QWidget
 
 from app.ui.capture_edit import CaptureEditor
+from app.ui.hair_channels import HairChannels
 from hairtool.mocap import ik
 from hairtool.mocap.pose_edit import ChannelEdit, TangentEdit
 
@@ -33,10 +34,14 @@ if TYPE_CHECKING:
     from app.ui.host import StudioHost
 
 AXIS_COLOURS = {"X": QColor(230, 80, 80), "Y": QColor(110, 200, 90), "Z": QColor(80, 140, 240)}
+HANDLES_FIXED = "Hair keys move in value here; their handles are the sampled tangents"
 PICK_PX = 8.0
 MARGIN = 24.0  # pixels around the plot
 ZOOM_STEP = 1.15  # per wheel notch
-EMPTY = "Select a joint of a capture (click its handle at a key frame) to see its channels"
+EMPTY = (
+    "Select a joint of a capture (click its dot at a key frame), or open a hair animation, "
+    "to see its channels"
+)
 
 
 @dataclass
@@ -54,6 +59,13 @@ class Curve:
     values: np.ndarray
     slope_in: np.ndarray | None
     slope_out: np.ndarray | None
+
+
+def hair_curves(hair: HairChannels) -> list[Curve]:
+    """The chosen strand vertex's x, y, z of a hair animation (none without one)."""
+    if not hair.active:
+        return []
+    return [Curve(n, AXIS_COLOURS[n.upper()], *rest) for n, *rest in hair.channels()]
 
 
 def capture_curves(capture: CaptureEditor) -> list[Curve]:
@@ -94,9 +106,9 @@ class GraphView(QWidget):
 
     view_changed = Signal()
 
-    def __init__(self, capture: CaptureEditor, parent: QWidget | None = None) -> None:
+    def __init__(self, capture: CaptureEditor, hair: HairChannels, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        self.capture = capture
+        self.capture, self.hair = capture, hair
         self.curves: list[Curve] = []
         self.x_range = (0.0, 1.0)
         self.y_range = (-1.0, 1.0)
@@ -108,9 +120,16 @@ class GraphView(QWidget):
         self.setMouseTracking(False)
 
     # -- data --------------------------------------------------------------------------------
+    @property
+    def on_hair(self) -> bool:
+        return not self.capture.attached and self.hair.active
+
     def refresh(self) -> None:
-        self.curves = capture_curves(self.capture)
-        what = (self.capture.generation, self.capture.joint)
+        self.curves = hair_curves(self.hair) if self.on_hair else capture_curves(self.capture)
+        if self.on_hair:
+            what = ("hair", self.capture.model.generation, self.hair.strand, self.hair.vertex)
+        else:
+            what = (self.capture.generation, self.capture.joint)
         if self.curves and what != self._framed_for:
             self._framed_for = what
             self.frame_all()
@@ -250,6 +269,8 @@ class GraphView(QWidget):
                     self.capture.model.set_frame(int(c.keys[k]))  # the key's pose in the viewport
                 if hit is not None:
                     self._drag = ("key", p, hit, float(c.values[k]))
+                elif self.on_hair:
+                    self.capture.window.statusBar().showMessage(HANDLES_FIXED, 4000)
                 else:
                     self._drag = ("handle", p, handle, 0.0)
         event.accept()
@@ -273,8 +294,18 @@ class GraphView(QWidget):
             _, start, (i, k), v0 = self._drag
             value = v0 + (self.from_px(p.x(), p.y())[1] - self.from_px(start.x(), start.y())[1])
             self.last_value = value
-            self.capture.preview(self._edit(i, k, value))
-            self._preview_curve(i, self._edit(i, k, value))
+            if self.on_hair:
+                c = self.curves[i]
+                result = self.hair.preview(i, int(c.keys[k]), value)
+                values = c.values.copy()
+                values[k] = value
+                self.curves[i] = Curve(
+                    c.name, c.colour, c.original, result, c.key_curve, c.keys, values, c.slope_in, c.slope_out
+                )
+                self.update()
+            else:
+                self.capture.preview(self._edit(i, k, value))
+                self._preview_curve(i, self._edit(i, k, value))
         elif kind == "handle":
             _, _, (i, k, side), _ = self._drag
             c = self.curves[i]
@@ -289,7 +320,11 @@ class GraphView(QWidget):
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         drag, self._drag = self._drag, None
-        if drag is not None and drag[0] == "key" and self.last_value is not None:
+        if drag is not None and drag[0] == "key" and self.last_value is not None and self.on_hair:
+            _, _, (i, k), _ = drag
+            self.hair.preview(None)
+            self.hair.commit(i, int(self.curves[i].keys[k]), self.last_value)
+        elif drag is not None and drag[0] == "key" and self.last_value is not None:
             _, _, (i, k), _ = drag
             self.capture.preview(None)
             edit = self._edit(i, k, self.last_value)
@@ -363,7 +398,7 @@ class GraphView(QWidget):
         (x0, x1), (y0, y1) = self.x_range, self.y_range
         for v in (y0, y1):
             _, py = self.to_px(0.0, v)
-            painter.drawText(QPointF(2.0, float(py) + 4), f"{v:.0f}°")
+            painter.drawText(QPointF(2.0, float(py) + 4), f"{v:.3g}" if self.on_hair else f"{v:.0f}°")
         for f in (x0, x1):
             px, _ = self.to_px(f, 0.0)
             painter.drawText(QPointF(float(px) - 8, r.bottom() + 14), f"{f:.0f}")
@@ -408,12 +443,28 @@ class GraphEditorDock(QDockWidget):
         self.setObjectName("GraphEditorDock")
         self.window = window
         capture: CaptureEditor = window.capture
-        self.view = GraphView(capture)
+        self.hair = HairChannels(window)
+        self.view = GraphView(capture, self.hair)
         self.title = QLabel("")
+        self.strand = QSpinBox()
+        self.strand.setRange(0, 0)
+        self.strand.setToolTip("The strand whose vertex is shown (a hair animation)")
+        self.vertex = QSpinBox()
+        self.vertex.setRange(-1, 0)
+        self.vertex.setValue(-1)
+        self.vertex.setSpecialValueText("tip")
+        self.vertex.setToolTip("The vertex along the strand, from the root (0); tip: the last one")
+        self.strand.valueChanged.connect(self._pick_vertex)
+        self.vertex.valueChanged.connect(self._pick_vertex)
+        top = QHBoxLayout()
+        top.addWidget(self.title, 1)
+        self.pickers = [QLabel("Strand"), self.strand, QLabel("Vertex"), self.vertex]
+        for widget in self.pickers:
+            top.addWidget(widget)
         body = QWidget()
         layout = QVBoxLayout(body)
         layout.setContentsMargins(2, 2, 2, 2)
-        layout.addWidget(self.title)
+        layout.addLayout(top)
         layout.addWidget(self.view, 1)
         self.setWidget(body)
         self.setToolTip(
@@ -423,12 +474,33 @@ class GraphEditorDock(QDockWidget):
         )
         window.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self)
         self.hide()  # View ▸ Graph editor: the timeline keeps its first-start height
-        for signal in (capture.changed, capture.selection_changed):
+        model = window.animation
+        for signal in (
+            capture.changed,
+            capture.selection_changed,
+            model.keys_changed,
+            model.animation_changed,
+        ):
             signal.connect(self.refresh)
-        window.animation.frame_changed.connect(lambda *_: self.view.update())
+        model.frames_edited.connect(self.refresh)
+        model.frame_changed.connect(lambda *_: self.view.update())
         self.refresh()
+
+    def _pick_vertex(self, *_: object) -> None:
+        self.hair.strand, self.hair.vertex = self.strand.value(), self.vertex.value()
+        self.view.refresh()
 
     def refresh(self, *_: object) -> None:
         c = self.window.capture
-        self.title.setText(f"{c.joint}: rotation channels (degrees)" if c.attached and c.joint else "")
+        on_hair = self.view.on_hair
+        for widget in self.pickers:
+            widget.setVisible(on_hair)
+        if on_hair:
+            topo = self.window.animation.animation.topology
+            self.strand.setMaximum(topo.strand_count - 1)
+            s = min(self.strand.value(), topo.strand_count - 1)
+            self.vertex.setMaximum(int(topo.offsets[s + 1] - topo.offsets[s]) - 1)
+            self.title.setText("strand vertex: x, y, z")
+        else:
+            self.title.setText(f"{c.joint}: rotation channels (degrees)" if c.attached and c.joint else "")
         self.view.refresh()

@@ -213,3 +213,38 @@ def test_the_graph_editor_drags_a_handle_like_the_library(ui, capture):
     np.testing.assert_array_equal(w.animation.animation.frames, skeleton_animation(lib.motion()).frames)
     w.undo_stack.undo()
     assert np.array_equal(c.motion().values, motion.values)
+
+
+def test_on_hair_the_graph_editor_moves_a_vertex_key_through_the_timelines_edit(ui, make_window):
+    from hairtool import samples
+    from hairtool.keys.edit import KeyEditor
+    from hairtool.simulate.sway import sway_animation
+
+    w = make_window(groom=samples.comb(strands=6, vertices=5))
+    anim = sway_animation(w.scene.result, 30, 24.0, flick_frame=20)
+    w.animation.load_animation(anim, "sway")
+    dock = w.graph_editor
+    dock.show()
+    view = dock.view
+    view.resize(600, 260)
+    dock.strand.setValue(2)
+    assert view.on_hair and [c.name for c in view.curves] == ["x", "y", "z"]
+    v = int(anim.topology.offsets[3]) - 1  # strand 2's tip
+    np.testing.assert_array_equal(view.curves[0].original, anim.frames[:, v, 0])
+    keys = w.animation.dp_keys
+    k = 1
+    key = int(keys[k])
+    p = np.array(view.key_point(0, k))
+    ui.drag(view, p, p + np.array([0, -40]))
+    assert w.undo_stack.count() == 1 and w.animation.frame == key
+    got = w.animation.animation.frames
+    value = float(got[key, v, 0])
+    assert value > float(anim.frames[key, v, 0])
+    pose = np.array(anim.frames[key], dtype=np.float64)
+    pose[v, 0] = value
+    editor = KeyEditor(anim.frames, keys, w.animation.dp_poses.interp)
+    editor.set_key_pose(key, pose)
+    np.testing.assert_allclose(got, editor.frames(np.float32), atol=1e-6)
+    np.testing.assert_array_equal(view.curves[0].original, anim.frames[:, v, 0])  # still the opened one
+    w.undo_stack.undo()
+    np.testing.assert_array_equal(w.animation.animation.frames, anim.frames)
