@@ -70,6 +70,7 @@ NO_KEYS = "No keys to export: open or make an animation first (the timeline solv
 KEYS_SOLVING = "No keys to export yet: the timeline is still solving them"
 ANIMATION_TIP = "Write the animation: USD, a .npz cache, MP4, GIF or a PNG sequence"
 KEYS_TIP = "Write the timeline's DP keys: a JSON record, a CSV key sheet or USD key poses"
+CAPTURE_FILTER = "BVH motion capture, edited (*.bvh)"
 KEY_FILTERS = "Keys record (*.json);;Key sheet (*.csv);;USD key poses (*.usda *.usdc *.usd)"
 MP4_QUALITY = 8  # imageio-ffmpeg's 0..10 scale: visually clean thin hair lines, small files
 
@@ -438,7 +439,12 @@ class AnimationExporter(QObject):
             if answer is None:
                 return False
             render_hair = answer
-        path = self.window.ask_save_path("Export animation", ANIMATION_FILTERS, "animation.mp4")
+        capture = getattr(self.window, "capture", None)
+        if capture is not None and capture.attached:  # a capture: its edited BVH first
+            filters, suggested = f"{CAPTURE_FILTER};;{ANIMATION_FILTERS}", "animation.bvh"
+        else:
+            filters, suggested = ANIMATION_FILTERS, "animation.mp4"
+        path = self.window.ask_save_path("Export animation", filters, suggested)
         if not path:
             return False
         size, overlays = None, False
@@ -527,6 +533,8 @@ class AnimationExporter(QObject):
         w = self.window
         anim = w.animation.animation
         suffix = Path(path).suffix.lower()
+        if suffix == ".bvh" and getattr(w, "capture", None) is not None:
+            return w.capture.export_bvh(path)  # the edited capture at every frame
         try:
             if anim is None:
                 raise HairtoolError("no animation: make or open one first")

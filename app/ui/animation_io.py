@@ -43,6 +43,11 @@ def readable_extensions() -> list[str]:
 
 def read_any(path: str | os.PathLike[str]) -> Groom | Animation:
     """A groom or an animation from any readable format, BVH included (as a skeleton)."""
+    return read_with_capture(path)[0]
+
+
+def read_with_capture(path: str | os.PathLike[str]) -> tuple[Groom | Animation, Motion | None]:
+    """:func:`read_any`, and for a BVH the capture itself (what the studio poses by IK)."""
     suffix = Path(path).suffix.lower()
     if suffix not in readable_extensions() or suffix == PROJECT_SUFFIX:
         what = "projects are opened with Open Project" if suffix == PROJECT_SUFFIX else "supported"
@@ -51,10 +56,10 @@ def read_any(path: str | os.PathLike[str]) -> Groom | Animation:
     if suffix in BVH_EXTENSIONS:
         motion = read_bvh(path)
         try:
-            return skeleton_animation(motion)
+            return skeleton_animation(motion), motion
         except FormatError as e:
             raise FormatError(path, e.reason) from None
-    return io.read(path)
+    return io.read(path), None
 
 
 def surface_of(path: str | os.PathLike[str]) -> Mesh | None:

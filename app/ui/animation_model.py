@@ -78,6 +78,9 @@ class AnimationModel(QObject):
         self.inline_values = INLINE_VALUES  # tests set 0 to send every solve through the runner
         self.clock: Callable[[], float] = time.perf_counter
         self.animation: Animation | None = None
+        # what the keys are solved on when not the animation itself: a capture's skeleton as
+        # captured, so its keys stay those of the capture while its key poses are edited
+        self.key_source: Animation | None = None
         self.source = ""
         self.generation = 0  # counts loaded animations (undo steps of an older one do nothing)
         self.frame = 0
@@ -111,6 +114,11 @@ class AnimationModel(QObject):
         return 0 if self.animation is None else self.animation.n_frames
 
     @property
+    def keyed(self) -> Animation | None:
+        """What keys are solved on: :attr:`key_source`, else the animation."""
+        return self.key_source if self.key_source is not None else self.animation
+
+    @property
     def last_frame(self) -> int:
         return max(self.n_frames - 1, 0)
 
@@ -137,6 +145,7 @@ class AnimationModel(QObject):
         self._cancel_jobs()
         self.generation += 1
         self.animation = animation
+        self.key_source = None
         self.source = str(source)
         self.frame = 0
         self._preview = None
@@ -160,6 +169,7 @@ class AnimationModel(QObject):
         self._cancel_jobs()
         self.generation += 1
         self.animation, self.source, self.frame, self._preview = None, "", 0, None
+        self.key_source = None
         self._clear_keys()
         self._committed = None
         self._announce_new_animation()
@@ -322,7 +332,7 @@ class AnimationModel(QObject):
         solve = self.key_solve
         if solve is None or self.solve_stale or new.table_key != solve.table_key:
             if self._inline():  # solved here: a refusal can still leave everything as it was
-                solve = ks.solve(self.animation, new)
+                solve = ks.solve(self.keyed, new)
                 keys = solve.keys_for(new)
                 self._commit_settings(new)
                 self._apply_solve(solve, keys)
@@ -407,7 +417,7 @@ class AnimationModel(QObject):
 
     def request_solve(self) -> None:
         """Solve keys for the current animation and settings (in the background when large)."""
-        anim, settings = self.animation, self.settings
+        anim, settings = self.keyed, self.settings
         if anim is None or anim.n_frames < 2:
             return
         if self._inline():
@@ -432,7 +442,7 @@ class AnimationModel(QObject):
     def _solve_landed(self, job: Job, anim: Animation, result: ks.KeySession | None) -> None:
         if job is not self._solve_job:
             return
-        if anim is not self.animation or result is None:
+        if anim is not self.keyed or result is None:
             self._solve_job = None
             self._busy_update()
             return

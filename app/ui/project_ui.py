@@ -128,6 +128,9 @@ class ProjectController(QObject):
             "timeline": {"frame": model.frame, "view_mode": model.view_mode, "loop": model.loop},
         }
         settings.update(self.sources.to_settings())
+        capture = getattr(w, "capture", None)
+        if capture is not None and capture.attached:  # the BVH and its pose edits
+            settings["capture"] = capture.to_settings()
         return pf.Project.from_pipeline(
             scene.pipeline,
             brush=_brush_settings(scene.tool),
@@ -194,6 +197,8 @@ class ProjectController(QObject):
                 ),
             )
         self.sources.apply_settings(project.settings)
+        if project.animation is not None and getattr(w, "capture", None) is not None:
+            w.capture.apply_settings(project.settings.get("capture"))
         if "camera" in project.display:  # after everything that frames the view again
             _apply_each(w, (lambda: w.viewport.set_camera(Camera.from_state(project.display["camera"])),))
         self._mark_saved()

@@ -45,7 +45,10 @@ GHOST_RGBA = (0.2, 0.9, 1.0, 0.75)
 
 
 class BrushTarget(Protocol):
-    """Takes over the align drag (e.g. editing an animation's key pose instead of the groom)."""
+    """Takes over the align drag (e.g. editing an animation's key pose instead of the groom).
+
+    A target may also pick in screen space: ``press(pos, modifiers) -> bool`` is asked first on
+    a left press (True takes the drag, Alt included), then ``drag(pos)`` on each move."""
 
     def begin(self, cursor: np.ndarray) -> bool:
         """A left press at ``cursor`` (on the interaction plane); False leaves the drag unused."""
@@ -365,6 +368,14 @@ class Viewport(QOpenGLWidget):
     def mousePressEvent(self, event: QMouseEvent) -> None:
         if self._drag is not None:
             return
+        target = self.brush_target
+        if event.button() == Qt.MouseButton.LeftButton and hasattr(target, "press"):
+            # a target that picks in screen space (a capture's joint handles) takes Alt there too
+            if target.press(event.position(), event.modifiers()):
+                self._drag, self._drag_button, self._drag_target = "align", event.button(), target
+                self._last_pos = event.position()
+                event.accept()
+                return
         self._drag = self._navigation(event)
         self._drag_button = event.button()
         self._last_pos = event.position()
@@ -396,7 +407,9 @@ class Viewport(QOpenGLWidget):
         self._hover = pos
         dx, dy = pos.x() - self._last_pos.x(), pos.y() - self._last_pos.y()
         self._last_pos = pos
-        if self._drag == "align" and self._drag_target is not None:
+        if self._drag == "align" and self._drag_target is not None and hasattr(self._drag_target, "drag"):
+            self._drag_target.drag(pos)
+        elif self._drag == "align" and self._drag_target is not None:
             self._drag_target.move(self._cursor_at(pos))
         elif self._drag == "align":
             self._brush_at(pos)

@@ -27,7 +27,7 @@ from app.ui.animation_io import (
     PROJECT_SUFFIX,
     USD_EXTENSIONS,
     open_filters,
-    read_any,
+    read_with_capture,
     save_filters,
     surface_of,
 )
@@ -393,9 +393,13 @@ class MainWindow(QMainWindow):
         simulation), ``self.exporter`` (animation and keys export) and their menu entries."""
         from app.ui.animation_export import AnimationExporter
         from app.ui.animation_sources import AnimationSources
+        from app.ui.capture_edit import CaptureEditor
+        from app.ui.graph_editor import GraphEditorDock
         from app.ui.project_ui import ProjectController
 
         self.sources = AnimationSources(self)
+        self.capture = CaptureEditor(self)
+        self.graph_editor = GraphEditorDock(self)
         self.exporter = AnimationExporter(self)
         self.project = ProjectController(self, self.sources)
         menus = {a.text(): a.menu() for a in self.menuBar().actions()}
@@ -426,6 +430,7 @@ class MainWindow(QMainWindow):
         animation.addSeparator()
         add_action(self, animation, "&Simulate…", self.sources.simulate_dialog, "Ctrl+Alt+M")
         menus["&View"].addAction(self.sources.dock.toggleViewAction())
+        menus["&View"].addAction(self.graph_editor.toggleViewAction())
 
     def ask_save_changes(self) -> str:
         """The one question before changed work is replaced (Open, Open Project, New, a drop,
@@ -738,7 +743,7 @@ class MainWindow(QMainWindow):
                 self._add_recent(path)
             return ok
         try:
-            obj = read_any(path)
+            obj, capture = read_with_capture(path)
             mesh = surface_of(path)
         except HairtoolError as e:
             self.show_error("Cannot open file", str(e))
@@ -747,6 +752,8 @@ class MainWindow(QMainWindow):
             self.set_groom(obj.rest, path, mesh)
             if obj.n_frames > 1:
                 self.animation.load_animation(obj, str(path))
+                if capture is not None:  # a BVH: its key poses are edited by IK
+                    self.capture.attach(capture, str(path))
         else:
             hair, guides = split_guides(obj)
             if guides is None:

@@ -42,6 +42,8 @@ I64 = NDArray[np.int64]
 
 INTERPS = ("linear", "hermite", "hermite-fit")
 FIELDS = ("frame", "joint", "target", "chain")
+CHANNEL_FIELDS = ("frame", "joint", "channel", "value")
+TANGENT_FIELDS = ("frame", "joint", "channel", "slope")
 
 
 @dataclass(frozen=True)
@@ -58,13 +60,45 @@ class PoseEdit:
         return {"frame": self.frame, "joint": self.joint, "target": list(self.target), "chain": self.chain}
 
 
+@dataclass(frozen=True)
+class ChannelEdit:
+    """Set one rotation channel of the key pose at key ``frame`` to ``value`` (degrees): a key
+    dragged in value in a graph editor, carried to the frames around it like an IK edit."""
+
+    frame: int
+    joint: str
+    channel: str
+    value: float
+
+    def to_dict(self) -> dict:
+        return {"frame": self.frame, "joint": self.joint, "channel": self.channel, "value": self.value}
+
+
+@dataclass(frozen=True)
+class TangentEdit:
+    """Set the slope (degrees per frame) that one rotation channel's key curve enters and leaves
+    the key at ``frame`` with: a Hermite handle dragged in a graph editor (both handles of the
+    key aligned on it), carried to the frames between the neighbouring keys like any edit."""
+
+    frame: int
+    joint: str
+    channel: str
+    slope: float
+
+    def to_dict(self) -> dict:
+        return {"frame": self.frame, "joint": self.joint, "channel": self.channel, "slope": self.slope}
+
+
+Edit = PoseEdit | ChannelEdit | TangentEdit
+
+
 @dataclass
 class EditReport:
     """What one edit did: the joints it turned, the solver, how far the effector is from the
     target (scene units and share of the figure's height; more than ``tolerance_share``: out of
     reach) and the frames it changed (``first``..``last``, strictly between the neighbouring keys)."""
 
-    edit: PoseEdit
+    edit: Edit
     turned: list[str]
     method: str
     iterations: int
@@ -140,6 +174,49 @@ def parse_edits(data: object, motion: Motion, source: str = "edits") -> list[Pos
     return out
 
 
+def parse_edit_list(data: object, motion: Motion, source: str = "edits") -> list[Edit]:
+    """Pose edits (:func:`parse_edits`), channel edits ``{"frame", "joint", "channel", "value"}``
+    and handle edits ``{"frame", "joint", "channel", "slope"}`` in one list, in order (what a
+    studio project keeps); faults raise :class:`FormatError` naming ``source`` and the edit
+    (counted from 1)."""
+    if isinstance(data, dict) and set(data) == {"edits"}:
+        data = data["edits"]
+    if not isinstance(data, list):
+        raise FormatError(source, "expected a list of edits")
+    out: list[Edit] = []
+    for i, e in enumerate(data, 1):
+        if not (isinstance(e, dict) and "channel" in e):
+            try:
+                out += parse_edits([e], motion, source)
+            except FormatError as err:
+                raise FormatError(source, err.reason.replace("edit 1", f"edit {i}", 1)) from None
+            continue
+        fields = TANGENT_FIELDS if "slope" in e else CHANNEL_FIELDS
+        missing = [k for k in fields if k not in e]
+        extra = sorted(str(k)[:40] for k in e if k not in fields)
+        if missing or extra:
+            what = f"lacks {', '.join(missing)}" if missing else f"has unknown fields {', '.join(extra)}"
+            raise FormatError(source, f"edit {i} {what} (fields: {', '.join(fields)})")
+        frame, joint, channel, value = (e[k] for k in fields)
+        if not _is_int(frame) or not 0 <= frame < motion.n_frames:
+            raise FormatError(
+                source, f"edit {i}: frame {frame!r} is not a frame number 0..{motion.n_frames - 1}"
+            )
+        if not isinstance(joint, str) or joint not in motion.joint_names:
+            raise FormatError(source, f"edit {i}: joint {str(joint)[:60]!r} is not in the skeleton")
+        j = motion.joint_names.index(joint)
+        rotations = [c for c in motion.channels[j] if c.endswith("rotation")]
+        if channel not in rotations:
+            raise FormatError(
+                source, f"edit {i}: '{str(channel)[:40]}' is not a rotation channel of '{joint}'"
+            )
+        if not _is_number(value) or not _finite(value) or abs(value) > MAX_VALUE:
+            raise FormatError(source, f"edit {i}: {fields[3]} {str(value)[:40]} is not a finite number")
+        kind = TangentEdit if fields is TANGENT_FIELDS else ChannelEdit
+        out.append(kind(int(frame), joint, channel, float(value)))
+    return out
+
+
 def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
     """:func:`parse_edits` of a JSON file; unreadable or invalid JSON raises :class:`FormatError`."""
     p = os.fspath(path)
@@ -172,8 +249,12 @@ class PoseEditor:
         self._base_values = motion.values[self.keys].copy()
         self._key_values = self._base_values.copy()
         self._key_q = self._q[self.keys].copy()
-        self._history: list[tuple[EditReport, int, F64, F64]] = []
+        # report, key index, its values and quaternions before, and for a handle edit the
+        # joint and its tangents before (None: the captured ones)
+        self._history: list[tuple[EditReport, int, F64, F64, tuple | None]] = []
         self._curves: dict[int, KeyPoses] = {}
+        self._angle_curves: dict[int, KeyPoses] = {}
+        self._tangents: dict[int, tuple[F64, F64]] = {}  # joint → edited (out, in) tangents (K, D)
 
     # -- keys ------------------------------------------------------------------------------
     def key_index(self, frame: int) -> int:
@@ -219,19 +300,148 @@ class PoseEditor:
         first, last = self.span(edit.frame)
         names = [m.joint_names[j] for j in turned]
         report = EditReport(edit, names, s.method, s.iterations, s.miss, s.miss / self.height, first, last)
-        self._history.append((report, *saved))
+        self._history.append((report, *saved, None))
         return report
 
-    def apply_all(self, edits: list[PoseEdit], method: str = "auto") -> list[EditReport]:
-        """Edits in order, each on the pose the ones before it left."""
-        return [self.apply(e, method) for e in edits]
+    def apply_channel(self, edit: ChannelEdit) -> EditReport:
+        """Set one rotation channel of a key pose (a key dragged in value): the key curve through
+        the new pose plus the residuals, as for an IK edit. A ball joint's key quaternion is made
+        from its three angles at the key, so the other two keep their values there."""
+        m = self.original
+        j, cols, order, i = self._channel(edit)
+        if not (math.isfinite(edit.value) and abs(edit.value) <= MAX_VALUE):
+            raise ParameterError("value", edit.value, "a finite angle in degrees")
+        a = self.key_index(edit.frame)
+        saved = (a, self._key_values[a].copy(), self._key_q[a].copy())
+        self._key_values[a, cols[i]] = float(edit.value)
+        if ik.is_ball_joint(m, j):
+            q = quat.from_euler(self._key_values[a, cols], order)
+            ref = self._q[self.keys[a], j]
+            self._key_q[a, j] = -q if np.dot(q, ref) < 0 else q
+        first, last = self.span(edit.frame)
+        report = EditReport(edit, [edit.joint], "channel", 0, 0.0, 0.0, first, last)
+        self._history.append((report, *saved, None))
+        return report
 
-    def undo(self) -> PoseEdit | None:
+    def _channel(self, edit: ChannelEdit | TangentEdit) -> tuple[int, list[int], str, int]:
+        """The joint, its rotation columns and order, and the edited channel's place among them."""
+        m = self.original
+        if edit.joint not in m.joint_names:
+            raise ParameterError("joint", edit.joint, "a joint of the skeleton")
+        j = m.joint_names.index(edit.joint)
+        cols, order = ik.rotation_columns(m, j)
+        names = [m.channels[j][c - int(m._starts[j])] for c in cols]
+        if edit.channel not in names:
+            raise ParameterError(
+                "channel", edit.channel, f"a rotation channel of '{edit.joint}': {', '.join(names)}"
+            )
+        return j, cols, order, names.index(edit.channel)
+
+    def apply_tangent(self, edit: TangentEdit) -> EditReport:
+        """Set one rotation channel's slope at a key (a Hermite handle dragged; both handles of
+        the key take it). A ball joint's curve is on quaternions: its tangent there moves along
+        the quaternion's derivative with respect to that angle, J_c = ∂q/∂θ_c, by what the slope
+        lacks (J⁺ t is the three angles' slope, so the other two keep theirs). Linear keys have
+        no handles (ParameterError)."""
+        if self.interp == "linear":
+            raise ParameterError(
+                "interp", self.interp, "hermite or hermite-fit (linear keys have no handles)"
+            )
+        m = self.original
+        j, cols, order, i = self._channel(edit)
+        if not (math.isfinite(edit.slope) and abs(edit.slope) <= MAX_VALUE):
+            raise ParameterError("slope", edit.slope, "a finite slope in degrees per frame")
+        a = self.key_index(edit.frame)
+        before = self._tangents.get(j)
+        out, inn = (t.copy() for t in self._current_tangents(j))
+        if ik.is_ball_joint(m, j):
+            jac = self._euler_jacobian(a, j, cols, order)
+            for t in (out, inn):
+                now = np.linalg.lstsq(jac, t[a], rcond=None)[0]
+                t[a] = t[a] + jac[:, i] * (float(edit.slope) - now[i])
+        else:
+            out[a, i] = inn[a, i] = float(edit.slope)
+        self._tangents[j] = (out, inn)
+        first, last = self.span(edit.frame)
+        report = EditReport(edit, [edit.joint], "handle", 0, 0.0, 0.0, first, last)
+        self._history.append((report, a, self._key_values[a].copy(), self._key_q[a].copy(), (j, before)))
+        return report
+
+    def key_slopes(self, joint: int) -> tuple[F64, F64] | None:
+        """``(in, out)``, each ``(K, n)``: the slopes (degrees per frame) a joint's key curve
+        enters and leaves each key with, its rotation channels in channel order; None for
+        linear keys (no handles)."""
+        if self.interp == "linear":
+            return None
+        m = self.original
+        cols, order = ik.rotation_columns(m, joint)
+        out, inn = self._current_tangents(joint)
+        if not ik.is_ball_joint(m, joint):
+            return inn.copy(), out.copy()
+        s_in, s_out = np.empty((self.keys.size, 3)), np.empty((self.keys.size, 3))
+        for a in range(self.keys.size):
+            jac = self._euler_jacobian(a, joint, cols, order)
+            s_in[a] = np.linalg.lstsq(jac, inn[a], rcond=None)[0]
+            s_out[a] = np.linalg.lstsq(jac, out[a], rcond=None)[0]
+        return s_in, s_out
+
+    def _euler_jacobian(self, a: int, j: int, cols: list[int], order: str) -> F64:
+        """``(4, 3)`` ∂q/∂θ (per degree) of a ball joint's key quaternion at key index a."""
+        e = self._key_values[a, cols]
+        sign = 1.0 if np.dot(quat.from_euler(e, order), self._key_q[a, j]) >= 0 else -1.0
+        h = 1e-3
+        steps = np.eye(3) * h
+        plus = quat.from_euler(e + steps, order)
+        minus = quat.from_euler(e - steps, order)
+        return sign * (plus - minus).T / (2 * h)
+
+    def _base_tangents(self, j: int) -> tuple[F64, F64]:
+        """A joint's captured key tangents ``(out, in)``: of its quaternions (ball joints) or its
+        angles (hinges)."""
+        if ik.is_ball_joint(self.original, j):
+            kp = self._kp(j)
+        else:
+            if j not in self._angle_curves:
+                cols, _ = ik.rotation_columns(self.original, j)
+                self._angle_curves[j] = key_poses(self.original.values[:, cols], self.keys, self.interp)
+            kp = self._angle_curves[j]
+        return kp.tangents, kp.tangents if kp.tangents_in is None else kp.tangents_in
+
+    def _current_tangents(self, j: int) -> tuple[F64, F64]:
+        return self._tangents[j] if j in self._tangents else self._base_tangents(j)
+
+    def _tangent_rows(self, j: int) -> I64:
+        """Key indices whose tangents a handle edit changed for joint j."""
+        if j not in self._tangents:
+            return np.zeros(0, dtype=np.int64)
+        (out, inn), (b_out, b_in) = self._tangents[j], self._base_tangents(j)
+        return np.flatnonzero(np.any(out != b_out, axis=1) | np.any(inn != b_in, axis=1))
+
+    def apply_all(self, edits: list[Edit], method: str = "auto") -> list[EditReport]:
+        """Edits in order, each on the pose the ones before it left (channel and handle edits as
+        :meth:`apply_channel` and :meth:`apply_tangent`)."""
+        out = []
+        for e in edits:
+            if isinstance(e, ChannelEdit):
+                out.append(self.apply_channel(e))
+            elif isinstance(e, TangentEdit):
+                out.append(self.apply_tangent(e))
+            else:
+                out.append(self.apply(e, method))
+        return out
+
+    def undo(self) -> Edit | None:
         """Take back the last edit (None when there is none)."""
         if not self._history:
             return None
-        report, a, values, q = self._history.pop()
+        report, a, values, q, tangents = self._history.pop()
         self._key_values[a], self._key_q[a] = values, q
+        if tangents is not None:
+            j, before = tangents
+            if before is None:
+                self._tangents.pop(j, None)
+            else:
+                self._tangents[j] = before
         return report.edit
 
     def reset(self) -> None:
@@ -246,15 +456,19 @@ class PoseEditor:
             self._curves[j] = key_poses(self._q[:, j], self.keys, kind)
         return self._curves[j]
 
-    def _curve(self, j: int, poses: F64, frames: I64) -> F64:
-        """``(len(frames), 4)`` joint j's key curve through the key quaternions ``poses``."""
+    def _curve(self, j: int, poses: F64, frames: I64, tangents: tuple[F64, F64] | None = None) -> F64:
+        """``(len(frames), 4)`` joint j's key curve through the key quaternions ``poses`` (with
+        the ``(out, in)`` tangents given, else the captured ones)."""
         if self.interp == "linear":  # slerp, as reconstruct_motion rebuilds it
             k = self.keys
             a = np.clip(np.searchsorted(k, frames, side="right") - 1, 0, k.size - 2)
             s = (frames - k[a]) / (k[a + 1] - k[a]).astype(np.float64)
             return quat.slerp(poses[a], poses[a + 1], s)
         kp = self._kp(j)
-        edited = KeyPoses(kp.keys, poses, kp.tangents, kp.n_frames, kp.interp, kp.tangents_in)
+        if tangents is not None:
+            edited = KeyPoses(kp.keys, poses, tangents[0], kp.n_frames, kp.interp, tangents[1])
+        else:
+            edited = KeyPoses(kp.keys, poses, kp.tangents, kp.n_frames, kp.interp, kp.tangents_in)
         return interpolate_at(edited, frames)
 
     def motion(self) -> Motion:
@@ -264,32 +478,64 @@ class PoseEditor:
         changed = np.any(self._key_values != self._base_values, axis=0)  # (C,) columns any edit moved
         for j in range(m.n_joints):
             cols, order = ik.rotation_columns(m, j)
-            if not cols or not np.any(changed[cols]):
+            handles = self._tangent_rows(j) if cols else np.zeros(0, dtype=np.int64)
+            if not cols or not (np.any(changed[cols]) or handles.size):
                 continue
             rows = np.flatnonzero(np.any(self._key_values[:, cols] != self._base_values[:, cols], axis=1))
+            rows = np.union1d(rows, handles)
+            tangents = self._tangents.get(j) if handles.size else None
             frames = np.unique(np.concatenate([np.arange(*self._span_of(a)) for a in rows]))
             ball = ik.is_ball_joint(m, j)
             # The edit's spread on the angles themselves: the key's change of angles weighted by
             # the curve's basis (the tangents are the same before and after, so they cancel).
             if ball:
                 base = self._q[self.keys, j]
-                delta = self._curve(j, self._key_q[:, j], frames) - self._curve(j, base, frames)
+                delta = self._curve(j, self._key_q[:, j], frames, tangents) - self._curve(j, base, frames)
                 q = quat.normalize(self._q[frames, j] + delta)
                 for run in np.split(np.arange(frames.size), np.flatnonzero(np.diff(frames) > 1) + 1):
                     values[np.ix_(frames[run], cols)] = self._track(frames[run], cols, order, q[run])
             else:
-                spread = self._spread(self._key_values[:, cols] - self._base_values[:, cols], frames)
+                change = self._key_values[:, cols] - self._base_values[:, cols]
+                if tangents is not None:
+                    (out, inn), (b_out, b_in) = tangents, self._base_tangents(j)
+                    spread = self._spread(change, frames, (out - b_out, inn - b_in))
+                else:
+                    spread = self._spread(change, frames)
                 values[np.ix_(frames, cols)] = m.values[np.ix_(frames, cols)] + spread
         return m.with_values(values)
+
+    def key_curve(self, joint: int, reference: F64 | None = None) -> F64:
+        """``(F, n)`` a joint's rotation channels on its edited key curve alone (no residuals):
+        the curve a graph editor draws through the keys. Angles are written nearest
+        ``reference`` (``(F, n)``, default the edited capture's), so the two overlay."""
+        m = self.original
+        cols, order = ik.rotation_columns(m, joint)
+        frames = np.arange(m.n_frames)
+        if reference is None:
+            reference = self.motion().values[:, cols]
+        if ik.is_ball_joint(m, joint):
+            q = self._curve(joint, self._key_q[:, joint], frames, self._tangents.get(joint))
+            return np.array([ik.euler_nearest(q[f], order, reference[f]) for f in frames]).reshape(
+                -1, len(cols)
+            )
+        kind = "linear" if self.interp == "linear" else self.interp
+        kp = key_poses(m.values[:, cols], self.keys, kind)
+        out, inn = self._tangents.get(joint, (kp.tangents, kp.tangents_in))
+        edited = KeyPoses(kp.keys, self._key_values[:, cols], out, kp.n_frames, kp.interp, inn)
+        return interpolate_at(edited, frames)
 
     def _span_of(self, a: int) -> tuple[int, int]:
         """``[start, stop)`` frames of key index ``a``'s span."""
         first, last = self.span(int(self.keys[a]))
         return first, last + 1
 
-    def _spread(self, change: F64, frames: I64) -> F64:
+    def _spread(self, change: F64, frames: I64, tangents: tuple[F64, F64] | None = None) -> F64:
         """``(len(frames), D)`` key changes ``(K, D)`` carried to the frames by the curve's basis
-        (the tangents are the same before and after an edit, so they cancel)."""
+        (the tangents are the same before and after an edit, so they cancel, unless a handle
+        edit changed them by ``tangents`` = (Δout, Δin))."""
+        if tangents is not None:
+            kp = KeyPoses(self.keys, change, tangents[0], self.original.n_frames, "hermite", tangents[1])
+            return interpolate_at(kp, frames)
         zero = None if self.interp == "linear" else np.zeros_like(change)
         kind = "linear" if self.interp == "linear" else "hermite"
         return interpolate_at(KeyPoses(self.keys, change, zero, self.original.n_frames, kind), frames)

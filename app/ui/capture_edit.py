@@ -1,0 +1,412 @@
+"""Posing a motion capture at its keys (seed 003 §5) in the studio.
+
+A BVH opened in the studio is drawn as a skeleton of bones (:mod:`app.ui.animation_io`); this
+module keeps the capture itself beside it. At a key frame its joints are handles
+(:mod:`app.ui.joint_handles`): dragging one moves that joint to the cursor by inverse
+kinematics on the chain above it (the tool dock's chain length, or Alt-drag for the whole limb
+up to the root's child), solved live through :class:`hairtool.mocap.pose_edit.PoseEditor`
+while the frames around the key follow as faint ghosts. A finished drag is one undo step; the
+timeline's skeleton is the edited capture (the key curves plus the captured residuals), so the
+key errors and the viewport follow. File ▸ Export Animation writes it as BVH, and a project
+keeps the capture and its list of edits (the ``hairtool keys --edit`` EDITS.json dicts, plus the
+graph editor's key and handle edits) and applies them again on open.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from PySide6.QtCore import QObject, QPointF, Qt, Signal
+from PySide6.QtGui import QUndoCommand
+from PySide6.QtWidgets import QFormLayout, QGroupBox, QLabel, QScrollArea, QSpinBox
+
+from app.ui.animation_io import skeleton_animation
+from hairtool.errors import FormatError, HairtoolError
+from hairtool.mocap.bvh import Motion, read_bvh, write_bvh
+from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, parse_edit_list
+
+if TYPE_CHECKING:
+    from app.ui.host import StudioHost
+
+PICK_PX = 12.0  # a press this near a handle (widget pixels) takes that joint
+GHOSTS = 6  # neighbouring frames drawn faintly while a key pose is dragged
+NOT_A_KEY = "Capture poses are edited at a key frame: jump to one with ↑ / ↓"
+NO_HANDLE = "Drag a joint's handle (the dots) to pose the capture; Alt-drag moves the whole limb"
+
+
+def motion_text(motion: Motion) -> str:
+    """The capture as BVH text (what a project keeps)."""
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "capture.bvh"
+        write_bvh(p, motion)
+        return p.read_text(encoding="utf-8")
+
+
+def motion_from_text(text: str, source: str) -> Motion:
+    """A capture from BVH text; :class:`FormatError` naming ``source`` when it does not read."""
+    if not isinstance(text, str):
+        raise FormatError(source, "the capture is not BVH text")
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "capture.bvh"
+        p.write_text(text, encoding="utf-8")
+        try:
+            return read_bvh(p)
+        except FormatError as e:
+            raise FormatError(source, e.reason) from None
+
+
+class PoseEditCommand(QUndoCommand):
+    """One finished drag (or graph-editor key move): the edit, applied on redo, taken back on undo."""
+
+    def __init__(self, capture: CaptureEditor, edit: Edit, text: str) -> None:
+        super().__init__(text)
+        self.capture, self.edit, self.generation = capture, edit, capture.generation
+
+    def redo(self) -> None:
+        if self.capture.generation == self.generation and self.capture.attached:
+            self.capture.push(self.edit)
+
+    def undo(self) -> None:
+        if self.capture.generation == self.generation and self.capture.attached:
+            self.capture.pop()
+
+
+class JointDrag:
+    """The viewport's drag target on a capture: picks a joint handle in screen space (so Alt can
+    mean "whole limb" there rather than orbit) and solves the IK on every move."""
+
+    def __init__(self, capture: CaptureEditor) -> None:
+        self.c = capture
+        self.edit: PoseEdit | None = None
+        self.last_target: np.ndarray | None = None
+        self._start: tuple[int, int, np.ndarray, np.ndarray] | None = None  # frame, joint, p0, cursor0
+
+    # The press / drag / end protocol (viewport): screen positions, modifiers.
+    def press(self, pos: QPointF, modifiers: Qt.KeyboardModifier) -> bool:
+        c = self.c
+        if not c.attached or c.editor is None:
+            return False
+        j = c.handle_at(pos)
+        if j is None:
+            return False
+        c.select(c.original.joint_names[j])
+        m = c.model
+        if not c.at_key():
+            c.window.statusBar().showMessage(NOT_A_KEY, 4000)
+            return True  # the press selected the joint; nothing to drag off a key
+        m.pause()
+        alt = bool(modifiers & Qt.KeyboardModifier.AltModifier)
+        depth = int(c.original.depths()[j])
+        chain = max(depth - 1, 1) if alt else min(c.chain, depth)
+        p0 = c.pose_positions()[j]
+        self._start = (m.frame, j, p0, c.window.viewport.cursor_on_plane(pos, p0))
+        self._chain = chain
+        self.edit = None
+        return True
+
+    def drag(self, pos: QPointF) -> None:
+        if self._start is None:
+            return
+        frame, j, p0, cursor0 = self._start
+        target = p0 + (self.c.window.viewport.cursor_on_plane(pos, p0) - cursor0)
+        self.last_target = target
+        self.edit = PoseEdit(
+            frame, self.c.original.joint_names[j], tuple(float(v) for v in target), self._chain
+        )
+        self.c.preview(self.edit)
+
+    def end(self) -> None:
+        start, edit = self._start, self.edit
+        self._start = self.edit = None
+        if start is None:
+            return
+        self.c.preview(None)
+        if edit is not None:
+            self.c.commit(edit, f"Pose {edit.joint} at key {edit.frame}")
+
+    # The older protocol (a 3-D cursor): on a capture the old position drag is replaced.
+    def begin(self, cursor: np.ndarray) -> bool:
+        self.c.window.statusBar().showMessage(NO_HANDLE if self.c.at_key() else NOT_A_KEY, 4000)
+        return False
+
+    def move(self, cursor: np.ndarray) -> None:
+        return None
+
+
+class CaptureEditor(QObject):
+    """Owned by the window (``window.capture``); see the module docstring."""
+
+    changed = Signal()  # the edited capture changed (an edit, an undo, new keys)
+    selection_changed = Signal(str)  # the selected joint's name ("" for none)
+    preview_changed = Signal()
+
+    def __init__(self, window: StudioHost) -> None:
+        super().__init__(window)
+        self.window, self.model = window, window.animation
+        self.original: Motion | None = None
+        self.source = ""
+        self.generation = -1
+        self.editor: PoseEditor | None = None
+        self.edits: list[Edit] = []
+        self.applied: list[bool] = []
+        self.chain = 2
+        self.joint = ""  # the selected joint
+        self.ghosts: list[np.ndarray] = []  # (P, 3) joint positions of neighbouring frames in a drag
+        self._preview: tuple[int, np.ndarray] | None = None  # frame, (J, 3) joints being dragged
+        self.drag = JointDrag(self)
+        self.model.animation_changed.connect(self._on_animation_changed)
+        self.model.keys_changed.connect(self._on_keys_changed)
+        self.box = self._tool_box()
+        from app.ui.joint_handles import JointHandles
+
+        self.handles = JointHandles(self, window.viewport)
+
+    # -- state -------------------------------------------------------------------------------
+    @property
+    def attached(self) -> bool:
+        return self.original is not None and self.generation == self.model.generation
+
+    def at_key(self) -> bool:
+        return self.editor is not None and bool(np.any(self.editor.keys == self.model.frame))
+
+    def attach(self, motion: Motion, source: str = "") -> None:
+        """The animation just loaded is this capture's skeleton: keep the capture beside it."""
+        self.original, self.source = motion, str(source)
+        self.generation = self.model.generation
+        self.model.key_source = skeleton_animation(motion)  # keys of the capture as captured
+        self.edits, self.applied, self.joint = [], [], ""
+        self.window.viewport.brush_target = self.drag
+        self._rebuild(show=False)
+        self._sync_box()
+        self.selection_changed.emit("")
+        self.changed.emit()
+
+    def _on_animation_changed(self) -> None:
+        if self.original is not None and self.generation != self.model.generation:
+            self.original, self.editor, self.edits, self.applied = None, None, [], []
+            self.joint, self._preview, self.ghosts = "", None, []
+            self._sync_box()
+            self.selection_changed.emit("")
+            self.changed.emit()
+
+    def _on_keys_changed(self) -> None:
+        if self.attached:
+            self._rebuild()
+
+    def _rebuild(self, show: bool = True) -> None:
+        """A PoseEditor on the timeline's keys, with every edit at a frame that is still a key."""
+        m = self.model
+        if m.dp_keys is None:
+            self.editor = None
+            return
+        interp = m.dp_poses.interp if m.dp_poses is not None else m.settings.interp
+        self.editor = PoseEditor(self.original, m.dp_keys, interp)
+        self.applied = []
+        for e in self.edits:
+            ok = bool(np.any(self.editor.keys == e.frame))
+            if ok:
+                self._apply(e)
+            self.applied.append(ok)
+        waiting = self.applied.count(False)
+        if waiting:
+            self.window.statusBar().showMessage(
+                f"{waiting} pose edit(s) are at frames that are no longer keys: "
+                "they come back with those keys",
+                8000,
+            )
+        if show:
+            self._show()
+        self.changed.emit()
+
+    def _apply(self, edit: Edit) -> None:
+        self.editor.apply_all([edit])
+
+    def motion(self) -> Motion:
+        """The edited capture at every frame (the capture itself before any edit or keys)."""
+        return self.editor.motion() if self.editor is not None else self.original
+
+    def _show(self) -> None:
+        """The timeline's skeleton becomes the edited capture (only the frames that changed)."""
+        anim = self.model.animation
+        frames = skeleton_animation(self.motion()).frames
+        rows = np.flatnonzero(np.any(frames != anim.frames, axis=(1, 2)))
+        if rows.size:
+            lo, hi = int(rows[0]), int(rows[-1])
+            self.model.replace_frames(lo, frames[lo : hi + 1])
+
+    # -- editing -----------------------------------------------------------------------------
+    def push(self, edit: Edit) -> None:
+        """Apply one more edit (the undo command's redo)."""
+        self.edits.append(edit)
+        ok = self.editor is not None and bool(np.any(self.editor.keys == edit.frame))
+        if ok:
+            self._apply(edit)
+        self.applied.append(ok)
+        self._show()
+        self.changed.emit()
+
+    def pop(self) -> None:
+        """Take back the last edit (the undo command's undo)."""
+        if not self.edits:
+            return
+        self.edits.pop()
+        if self.applied.pop():
+            self.editor.undo()
+        self._show()
+        self.changed.emit()
+
+    def commit(self, edit: Edit, text: str) -> bool:
+        """One undo step for ``edit`` (refused with a message when it cannot be solved)."""
+        if self.editor is None:
+            return False
+        try:  # solved once here so the undo step's redo cannot fail; undone exactly
+            self._apply(edit)
+            self.editor.undo()
+        except HairtoolError as e:
+            self.window.show_error("Cannot pose the capture", str(e))
+            return False
+        self.window.undo_stack.push(PoseEditCommand(self, edit, text))
+        if isinstance(edit, PoseEdit) and self.editor.reports:
+            r = self.editor.reports[-1]
+            reach = "reached" if r.miss_share <= r.tolerance_share else "out of reach; nearest pose"
+            self.report.setText(f"{edit.joint}: {reach} ({r.miss_share:.1e} of the figure's height)")
+        return True
+
+    def select(self, joint: str) -> None:
+        if joint != self.joint:
+            self.joint = joint
+            self.selection_changed.emit(joint)
+            self.handles.update()
+
+    # -- the live drag -----------------------------------------------------------------------
+    def preview(self, edit: Edit | None) -> None:
+        """Show ``edit`` solved at its key, with the frames around it as ghosts (None: stop)."""
+        m = self.model
+        if edit is None or self.editor is None:
+            self._preview, self.ghosts = None, []
+            m.set_preview(m.frame, None)
+            self.preview_changed.emit()
+            self.handles.update()
+            return
+        self._apply(edit)
+        try:
+            out = self.editor.motion()
+        finally:
+            self.editor.undo()
+        first, last = self.editor.span(edit.frame)
+        inner = np.setdiff1d(np.arange(first, last + 1), [edit.frame])
+        if inner.size:
+            inner = inner[
+                np.unique(np.linspace(0, inner.size - 1, min(GHOSTS, inner.size)).round().astype(int))
+            ]
+        frames = np.r_[edit.frame, inner].astype(np.int64)
+        sub = out.with_values(out.values[frames])
+        joints = sub.joint_positions(end_sites=True)
+        self._preview = (edit.frame, joints[0])
+        self.ghosts = list(joints[1:])
+        m.set_preview(edit.frame, skeleton_animation(sub).frames[0])
+        self.preview_changed.emit()
+        self.handles.update()
+
+    def pose_positions(self) -> np.ndarray:
+        """``(J + E, 3)`` joint and End Site positions drawn now (a drag's preview, else the frame)."""
+        if self._preview is not None and self._preview[0] == self.model.frame:
+            return self._preview[1]
+        m = self.motion()
+        f = self.model.frame
+        return m.with_values(m.values[f : f + 1]).joint_positions(end_sites=True)[0]
+
+    def handle_at(self, pos: QPointF) -> int | None:
+        """The joint whose handle is under ``pos`` (widget pixels), or None; the root is no handle
+        (it has no parents to turn)."""
+        m = self.original
+        p = self.pose_positions()[: m.n_joints]
+        xy = self.window.viewport.project(p)
+        d = np.hypot(xy[:, 0] - pos.x(), xy[:, 1] - pos.y())
+        d[m.depths() == 0] = np.inf
+        j = int(np.argmin(d))
+        return j if d[j] <= PICK_PX else None
+
+    # -- files -------------------------------------------------------------------------------
+    def export_bvh(self, path: str | os.PathLike[str]) -> bool:
+        """The edited capture at every frame as BVH (the capture's skeleton, channels, frame time)."""
+        try:
+            if not self.attached:
+                raise HairtoolError("BVH is written for a motion capture: open a .bvh first")
+            write_bvh(path, self.motion())
+        except HairtoolError as e:
+            self.window.show_error("Cannot export animation", str(e))
+            return False
+        self.window.statusBar().showMessage(f"exported {path}", 5000)
+        return True
+
+    def to_settings(self) -> dict | None:
+        """What a project keeps: the capture (BVH text), where it came from and its edits."""
+        if not self.attached:
+            return None
+        return {
+            "bvh": motion_text(self.original),
+            "source": self.source,
+            "edits": [e.to_dict() for e in self.edits],
+            "chain": self.chain,
+        }
+
+    def apply_settings(self, saved: object, where: str = "project capture") -> None:
+        """Attach a project's capture to the animation it opened with and apply its edits again."""
+        if saved is None or self.model.animation is None:
+            return
+        try:
+            if not isinstance(saved, dict):
+                raise FormatError(where, "expected an object with the capture and its edits")
+            motion = motion_from_text(saved.get("bvh"), where)
+            if skeleton_animation(motion).topology != self.model.animation.topology:
+                raise FormatError(where, "the capture's skeleton is not the project's animation")
+            edits = parse_edit_list(saved.get("edits", []), motion, where)
+        except HairtoolError as e:
+            self.window.show_error("Some project settings were not applied", str(e))
+            return
+        self.attach(motion, str(saved.get("source", "")))
+        if isinstance(saved.get("chain"), int):
+            self.set_chain(saved["chain"])
+        self.edits = list(edits)
+        if np.array_equal(self.model.key_source.frames, self.model.animation.frames):
+            self._rebuild()
+        else:  # the project's frames are the edited ones: key the capture (rebuilt on its keys)
+            self.model.request_solve()
+
+    # -- the tool dock's box -----------------------------------------------------------------
+    def _tool_box(self) -> QGroupBox:
+        box = QGroupBox("Capture pose")
+        form = QFormLayout(box)
+        self.chain_spin = QSpinBox()
+        self.chain_spin.setRange(1, 16)
+        self.chain_spin.setValue(self.chain)
+        self.chain_spin.setToolTip(
+            "How many joints above the dragged one turn: 2 is the upper and lower limb, solved "
+            "exactly (two-bone IK); longer chains by damped least squares. Alt-drag turns the "
+            "whole limb up to the root's child"
+        )
+        self.chain_spin.valueChanged.connect(self.set_chain)
+        form.addRow("Chain length", self.chain_spin)
+        self.report = QLabel("")
+        self.report.setWordWrap(True)
+        form.addRow(self.report)
+        dock = self.window.dock.widget()
+        body = dock.widget() if isinstance(dock, QScrollArea) else dock
+        layout = body.layout()
+        layout.insertWidget(max(layout.count() - 1, 0), box)
+        box.setVisible(False)
+        return box
+
+    def set_chain(self, n: int) -> None:
+        self.chain = int(n)
+        if self.chain_spin.value() != self.chain:
+            self.chain_spin.setValue(self.chain)
+
+    def _sync_box(self) -> None:
+        self.box.setVisible(self.attached)
+        self.report.setText("")
