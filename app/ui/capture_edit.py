@@ -88,16 +88,13 @@ class JointDrag:
     # The press / drag / end protocol (viewport): screen positions, modifiers.
     def press(self, pos: QPointF, modifiers: Qt.KeyboardModifier) -> bool:
         c = self.c
-        if not c.attached or c.editor is None:
-            return False
+        if not c.attached or c.editor is None or not c.at_key():
+            return False  # off a key no handle is drawn: the press is the viewport's
         j = c.handle_at(pos)
         if j is None:
             return False
         c.select(c.original.joint_names[j])
         m = c.model
-        if not c.at_key():
-            c.window.statusBar().showMessage(NOT_A_KEY, 4000)
-            return True  # the press selected the joint; nothing to drag off a key
         m.pause()
         alt = bool(modifiers & Qt.KeyboardModifier.AltModifier)
         depth = int(c.original.depths()[j])

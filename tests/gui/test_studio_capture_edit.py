@@ -91,7 +91,10 @@ def test_off_a_key_or_off_a_handle_a_drag_poses_nothing(ui, capture):
     start = _handle(w, HAND)
     w.animation.set_frame(int(c.editor.keys[1]) + 1)  # not a key
     assert not c.handles.shown()
+    selected = c.original.joint_names[0]
+    c.select(selected)  # not the hand: a press on the hand's place would select it
     ui.drag(w.viewport, _handle(w, HAND), _handle(w, HAND) + np.array([30, 0]))
+    assert c.joint == selected  # no handle is drawn there: the press selects nothing
     w.animation.set_frame(int(c.editor.keys[1]))
     ui.drag(w.viewport, start + np.array([200, 200]), start + np.array([230, 200]))  # empty space: no edit
     assert c.edits == [] and w.undo_stack.count() == 0
