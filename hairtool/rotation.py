@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 EPS = 1e-12
@@ -48,3 +49,22 @@ def axis_angle_matrix(axis: ArrayLike, angle: float) -> NDArray[np.float64]:
     a = np.asarray(axis, dtype=np.float64)
     k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
     return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def turn_between(vx, vy, vz, ax, ay, az, bx, by, bz):
+    """v turned by the smallest rotation taking unit a to unit b (Rodrigues with k = a × b,
+    c = a·b: v·c + k × v + k (k·v)/(1 + c)); a half turn (c ≈ −1) reflects across a instead."""
+    c = ax * bx + ay * by + az * bz
+    kx = ay * bz - az * by
+    ky = az * bx - ax * bz
+    kz = ax * by - ay * bx
+    if 1.0 + c < 1e-12:
+        d = vx * ax + vy * ay + vz * az
+        return vx - 2.0 * d * ax, vy - 2.0 * d * ay, vz - 2.0 * d * az
+    kv = (kx * vx + ky * vy + kz * vz) / (1.0 + c)
+    return (
+        vx * c + (ky * vz - kz * vy) + kx * kv,
+        vy * c + (kz * vx - kx * vz) + ky * kv,
+        vz * c + (kx * vy - ky * vx) + kz * kv,
+    )

@@ -27,6 +27,7 @@ from hairtool.errors import ParameterError
 from hairtool.frozen.brushes import BrushSample, check_sample
 from hairtool.frozen.sculpt import end_weights
 from hairtool.groom import Groom
+from hairtool.rotation import turn_between
 
 F64 = NDArray[np.float64]
 
@@ -41,23 +42,6 @@ def no_surface() -> ParameterError:
     return ParameterError("scalp", None, "a head mesh for the slide brush (--scalp MESH.obj)")
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _turn(vx, vy, vz, ax, ay, az, bx, by, bz):  # pragma: no cover - compiled
-    """v turned by the smallest rotation taking unit a to unit b (Rodrigues with k = a × b,
-    c = a·b); a half turn (c ≈ −1) reflects across a instead."""
-    c = ax * bx + ay * by + az * bz
-    kx, ky, kz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-    if 1.0 + c < 1e-12:
-        d = vx * ax + vy * ay + vz * az
-        return vx - 2.0 * d * ax, vy - 2.0 * d * ay, vz - 2.0 * d * az
-    kv = (kx * vx + ky * vy + kz * vz) / (1.0 + c)
-    return (
-        vx * c + (ky * vz - kz * vy) + kx * kv,
-        vy * c + (kz * vx - kx * vz) + ky * kv,
-        vz * c + (kx * vy - ky * vx) + kz * kv,
-    )
-
-
 @njit(cache=True, nogil=True, parallel=True)
 def _slide_kernel(p, offsets, ids, roots, n0, n1, out):  # pragma: no cover - compiled
     out[:] = p
@@ -65,7 +49,7 @@ def _slide_kernel(p, offsets, ids, roots, n0, n1, out):  # pragma: no cover - co
         s = ids[k]
         o, e = offsets[s], offsets[s + 1]
         for i in range(o, e):
-            vx, vy, vz = _turn(p[i, 0] - p[o, 0], p[i, 1] - p[o, 1], p[i, 2] - p[o, 2],
+            vx, vy, vz = turn_between(p[i, 0] - p[o, 0], p[i, 1] - p[o, 1], p[i, 2] - p[o, 2],
                                n0[k, 0], n0[k, 1], n0[k, 2], n1[k, 0], n1[k, 1], n1[k, 2])  # fmt: skip
             out[i, 0], out[i, 1], out[i, 2] = roots[k, 0] + vx, roots[k, 1] + vy, roots[k, 2] + vz
 

@@ -16,27 +16,9 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.groom import Groom
+from hairtool.rotation import turn_between
 
 TINY = 1e-30
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _turn(vx, vy, vz, ax, ay, az, bx, by, bz):
-    """v turned by the smallest rotation taking unit a to unit b (Rodrigues with k = a × b,
-    c = a·b: v·c + k × v + k (k·v)/(1 + c)); a half turn (c ≈ −1) reflects across a instead."""
-    c = ax * bx + ay * by + az * bz
-    kx = ay * bz - az * by
-    ky = az * bx - ax * bz
-    kz = ax * by - ay * bx
-    if 1.0 + c < 1e-12:
-        d = vx * ax + vy * ay + vz * az
-        return vx - 2.0 * d * ax, vy - 2.0 * d * ay, vz - 2.0 * d * az
-    kv = (kx * vx + ky * vy + kz * vz) / (1.0 + c)
-    return (
-        vx * c + (ky * vz - kz * vy) + kx * kv,
-        vy * c + (kz * vx - kx * vz) + ky * kv,
-        vz * c + (kx * vy - ky * vx) + kz * kv,
-    )
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -100,12 +82,12 @@ def _guide_rows(points, offsets, counts, n, rest_tangent, axes, row0, seg, segle
     tx, ty, tz, ok = _unit(seg[a + 1, 0], seg[a + 1, 1], seg[a + 1, 2])
     if not ok:
         tx, ty, tz = rx, ry, rz
-    nx, ny, nz = _turn(nx, ny, nz, rx, ry, rz, tx, ty, tz)  # rest root frame → current
+    nx, ny, nz = turn_between(nx, ny, nz, rx, ry, rz, tx, ty, tz)  # rest root frame → current
     for i in range(n):
         if i >= 2:
             ux, uy, uz, ok = _unit(seg[a + i, 0], seg[a + i, 1], seg[a + i, 2])
             if ok:
-                nx, ny, nz = _turn(nx, ny, nz, tx, ty, tz, ux, uy, uz)
+                nx, ny, nz = turn_between(nx, ny, nz, tx, ty, tz, ux, uy, uz)
                 tx, ty, tz = ux, uy, uz
         d = nx * tx + ny * ty + nz * tz  # keep n ⟂ t and unit against drift
         nx, ny, nz, _ = _unit(nx - d * tx, ny - d * ty, nz - d * tz)
