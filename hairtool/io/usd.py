@@ -676,6 +676,44 @@ def _static_xforms(parts: list[_Curves]) -> tuple:
     return tuple(sorted(table.items()))
 
 
+def _memory_bytes() -> int:
+    """The memory this process may use: physical memory, or less under an address-space or data
+    limit (a farm worker's ``ulimit -v``); 0 where the OS says neither."""
+    sizes = []
+    try:
+        sizes.append(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        pass
+    try:
+        import resource
+
+        for limit in (resource.RLIMIT_AS, resource.RLIMIT_DATA):
+            soft = resource.getrlimit(limit)[0]
+            if soft != resource.RLIM_INFINITY:
+                sizes.append(soft)
+    except (ImportError, ValueError, OSError):
+        pass
+    return min(sizes, default=0)
+
+
+def _require_room(path: Path, frames: int, points: int) -> None:
+    """Refuse an animation whose frames cannot fit in half of memory, before allocating them.
+
+    A transform sampled at a million time codes over a groom of a million points is a small
+    file that asks for 12 TB: the frames are counted from the union of every sample, so the
+    file's size says nothing of what it unpacks to.
+    """
+    need = frames * points * 3 * 4
+    room = _memory_bytes() // 2
+    if room and need > room:
+        raise FormatError(
+            path,
+            f"{frames:,} time samples of {points:,} points need {need / 2**30:,.1f} GiB, more than "
+            f"half of the memory this process may use ({room * 2 / 2**30:,.1f} GiB); "
+            "split the shot into shorter ranges",
+        )
+
+
 def _read_stage(path: Path, stage) -> Groom | Animation:
     from pxr import Usd, UsdGeom
 
@@ -700,6 +738,7 @@ def _read_stage(path: Path, stage) -> Groom | Animation:
         points = np.concatenate([c.at(code, xforms) for c in parts])
         meta = Metadata(**stage_meta, curves=curves, color_primvar=color_source)
         return Groom(points, counts, **attrs, metadata=meta)
+    _require_room(path, len(times), int(counts.sum()))
     frames = np.empty((len(times), int(counts.sum()), 3), dtype=np.float32)
     for f, t in enumerate(times):
         code = Usd.TimeCode(t)

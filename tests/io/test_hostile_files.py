@@ -21,6 +21,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from hairtool import io as hairtool_io
+from hairtool.errors import FormatError
+
 from . import hostile
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="wait4 and RLIMIT_AS as on Linux")
@@ -336,3 +339,31 @@ def test_usda_of_ten_million_widths_is_refused_before_usd_core_parses_it(tmp_pat
     assert_one_line_error(run, "convert", path, words)
     assert run.max_rss_mb < 600, run.max_rss_mb  # the imports alone take about 260 MB
     assert not out.exists()
+
+
+
+def test_usd_animation_larger_than_memory_is_refused_before_allocating(tmp_path, monkeypatch):
+    """Frames come from the union of every time sample, so a small file can ask for terabytes;
+    the reader compares frames × points with half of the memory it may use before allocating."""
+    from hairtool.io import usd
+
+    samples = ", ".join(f"{t}: {t % 360}" for t in range(1, 1001))
+    path = hostile.write_usda(tmp_path / "long.usda", "{1: 0, 2: 30}", "{" + samples + "}")
+    monkeypatch.setattr(usd, "_memory_bytes", lambda: 2 * 1000 * 7 * 12 - 2)  # one byte short
+    with pytest.raises(FormatError, match=r"1,000 time samples of 7 points need .* half of the memory") as e:
+        hairtool_io.read(path)
+    assert e.value.path == str(path)
+    monkeypatch.setattr(usd, "_memory_bytes", lambda: 2 * 1000 * 7 * 12)  # exactly enough
+    assert hairtool_io.read(path).frames.shape == (1000, 7, 3)
+
+
+def test_usd_transform_sampled_100000_times_under_a_memory_cap(tmp_path):
+    """1.3 MB of text asking for 840 MB of frames, under the 1.5 GB address-space cap: one line."""
+    points = ", ".join(f"({i % 2}, 0, {i // 2})" for i in range(700))
+    samples = ", ".join(f"{t}: {t % 360}" for t in range(1, 100_001))
+    text = hostile.USDA_CURVES.replace("{1: 0, 2: 30}", "{" + samples + "}").replace("[4, 3]", "[350, 350]")
+    start = text.index("point3f[] points = [")
+    text = text[:start] + f"point3f[] points = [{points}" + text[text.index("]\n", start) :]
+    path = tmp_path / "long.usda"
+    path.write_text(text)
+    assert_one_line_error(run_cli(tmp_path, "info", path), "info", path, "100,000 time samples of 700 points")
