@@ -111,7 +111,8 @@ class AnimationSources(QObject):
                 problems.append(f"anime: {e}")
         if "simulate" in settings:
             try:
-                self.simulate_options = SimulateOptions.from_dict(settings["simulate"])
+                upm = self.window.scene.result.metadata.units_per_meter
+                self.simulate_options = SimulateOptions.from_dict(settings["simulate"], upm)
             except (HairtoolError, TypeError, ValueError) as e:
                 problems.append(f"simulate: {e}")
         if problems:

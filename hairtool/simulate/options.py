@@ -14,6 +14,8 @@ from hairtool.groom import Animation, Groom
 from hairtool.simulate.dynamics import GRAVITY, scaled_accelerations, simulate
 from hairtool.simulate.head_motion import fit_head, parse_motion
 
+GRAVITY_UNIT = "m/s²"
+
 
 @dataclass(frozen=True)
 class SimulateOptions:
@@ -45,7 +47,9 @@ class SimulateOptions:
         return d
 
     def to_dict(self) -> dict:
-        return dataclasses.asdict(self)
+        # The unit is written so that a reader can tell these from the gravity of projects saved
+        # before it was in m/s² (scene units/s², 98.1 by default), which :meth:`from_dict` converts.
+        return dataclasses.asdict(self) | {"gravity_unit": GRAVITY_UNIT}
 
     def fitted_to(self, groom: Groom) -> SimulateOptions:
         """The head sphere fitted to ``groom``'s roots, with wind and gusts scaled by the change
@@ -62,8 +66,16 @@ class SimulateOptions:
         )
 
     @classmethod
-    def from_dict(cls, d: dict) -> SimulateOptions:
+    def from_dict(cls, d: dict, units_per_meter: float = 1.0) -> SimulateOptions:
+        """The options :meth:`to_dict` wrote. A gravity without ``gravity_unit`` is from a project
+        saved when gravity was in scene units/s²: it is converted with the groom's
+        ``units_per_meter``, so a reopened simulation falls as it did."""
         d = dict(d)
+        unit = d.pop("gravity_unit", None)
+        if unit is None and "gravity" in d:
+            d["gravity"] = float(d["gravity"]) / units_per_meter
+        elif unit is not None and unit != GRAVITY_UNIT:
+            raise ParameterError("simulate options gravity_unit", unit, f"{GRAVITY_UNIT!r}")
         for name in ("wind", "head_center"):
             if name in d:
                 d[name] = tuple(float(v) for v in d[name])

@@ -170,3 +170,25 @@ def test_declined_recovery_is_removed(ui, make_window, settings_path):
     finally:
         w2.close()
         w2.deleteLater()
+
+
+def test_a_project_saved_with_gravity_in_scene_units_reopens_in_metres(make_window, tmp_path):
+    """Projects written before gravity was in m/s² store the default 98.1 scene units/s² on
+    0.1 m-per-unit samples: reopened, the Simulate dialog shows 9.81 m/s²."""
+    import dataclasses
+
+    from hairtool import project as project_file
+
+    w = make_window(groom=samples.portrait(strands=14, vertices=7))
+    path = tmp_path / "old.hairproj"
+    assert w.project.save_to(path), w.errors
+    saved = project_file.load(path)
+    simulate = {k: v for k, v in saved.settings["simulate"].items() if k != "gravity_unit"}
+    old = dataclasses.replace(saved, settings=saved.settings | {"simulate": simulate | {"gravity": 98.1}})
+    project_file.save(path, old)
+    assert w.scene.result.metadata.units_per_meter == pytest.approx(10.0)
+
+    w2 = make_window()
+    assert w2.project.open_project(path), w2.errors
+    assert w2.sources.simulate_options.gravity == pytest.approx(9.81)
+    assert w2.errors == []

@@ -50,3 +50,16 @@ def test_fitted_to_a_groom_scales_wind_and_gusts_with_the_head_not_gravity():
     scale = fitted.head_radius / base.head_radius
     assert fitted.gravity == base.gravity == 9.81  # m/s²: the groom's unit converts it
     assert fitted.gust_strength == pytest.approx(base.gust_strength * scale)
+
+
+def test_gravity_of_a_project_saved_in_scene_units_is_converted():
+    """Before gravity was in m/s² a project stored scene units/s² (98.1 by default, no unit);
+    reopened, it must fall as it did, not ten times harder."""
+    o = SimulateOptions(gravity=4.0)
+    assert o.to_dict()["gravity_unit"] == "m/s²"
+    assert SimulateOptions.from_dict(o.to_dict(), units_per_meter=10.0) == o  # marked: kept as is
+    old = {k: v for k, v in o.to_dict().items() if k != "gravity_unit"} | {"gravity": 98.1}
+    assert SimulateOptions.from_dict(old, units_per_meter=10.0).gravity == pytest.approx(9.81)
+    assert SimulateOptions.from_dict(old, units_per_meter=100.0).gravity == pytest.approx(0.981)
+    with pytest.raises(ParameterError, match="gravity_unit"):
+        SimulateOptions.from_dict(o.to_dict() | {"gravity_unit": "ft/s²"})
