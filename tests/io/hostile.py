@@ -265,3 +265,26 @@ def write_usdc_bad_prim_name(path: Path) -> Path:
     assert data.count(b"Head\0") == 1, "usd-core stored the tokens in a way this builder does not know"
     path.write_bytes(data.replace(b"Head\0", b";-) \0"))
     return path
+
+
+def write_usdc_array_count(path: Path, which: str, count: int = 2**34) -> Path:
+    """A crate whose ``which`` array ("points": stored raw; "counts": 100 ints, stored
+    compressed) claims ``count`` elements in its u64 length prefix."""
+    from pxr import Sdf, Usd
+
+    n = 100
+    text = USDA_CURVES.replace("[4, 3]", "[" + ", ".join(["2"] * n) + "]")
+    text = text.replace("[0.1, 0.2]", "[" + ", ".join(["0.1"] * n) + "]")
+    start = text.index("point3f[] points = [")
+    points = ", ".join(f"({i}.5, 0, 0)" for i in range(2 * n))
+    text = text[:start] + f"point3f[] points = [{points}" + text[text.index("]\n", start) :]
+    layer = Sdf.Layer.CreateAnonymous(".usda")
+    layer.ImportFromString(text)
+    Usd.Stage.Open(layer).Export(str(path))
+    data = bytearray(path.read_bytes())
+    prefix = struct.pack("<Q", 2 * n) + struct.pack("<f", 0.5) if which == "points" else struct.pack("<Q", n)
+    at = data.find(prefix)
+    assert at >= 0 and (which == "points" or data.find(prefix, at + 1) >= 0), "crate layout not as expected"
+    data[at : at + 8] = struct.pack("<Q", count)
+    path.write_bytes(bytes(data))
+    return path

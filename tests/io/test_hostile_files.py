@@ -329,6 +329,17 @@ def test_usdc_with_an_invalid_prim_name(tmp_path):
     assert not out.exists()
 
 
+
+@pytest.mark.parametrize("which", ["points", "counts"])
+def test_usdc_array_claiming_2_34_elements(tmp_path, which):
+    """A crate array's length prefix is read before its values: usd-core checks a raw array
+    against the mapping and a compressed one while unpacking, so neither allocates what it claims."""
+    path = hostile.write_usdc_array_count(tmp_path / f"{which}.usdc", which)
+    run = run_cli(tmp_path, "info", path)
+    assert_one_line_error(run, "info", path, "usd-core cannot read it")
+    assert run.max_rss_mb < 600, run.max_rss_mb
+
+
 def test_usda_of_ten_million_widths_is_refused_before_usd_core_parses_it(tmp_path):
     """A 20 MB file: usd-core's text parser peaked at 1.9 GB on it before the reader refused it."""
     path = hostile.write_usda_widths(tmp_path / "widths.usda", 10**7)
