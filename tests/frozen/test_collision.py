@@ -18,22 +18,11 @@ from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.strokes import read_strokes, strokes_from_log, write_strokes
 from hairtool.groom import vertex_ids_of
 from hairtool.guides.surface import MeshSurface, closest_points
-from hairtool.io.obj import Mesh, read_mesh
+from hairtool.io.obj import read_mesh
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "grooms"
 PLAIN = FrozenParams(freeze=False, clump=False)
 LUT = tuple(falloff_lut("smooth").tolist())
-
-
-def plane(n=6) -> Mesh:
-    """y = 0 over [−1, 1.5]², normals along −y: the head is the side y > 0 (the comb hangs below)."""
-    t = np.linspace(-1.0, 1.5, n)
-    x, z = np.meshgrid(t, t, indexing="ij")
-    v = np.column_stack([x.ravel(), np.zeros(n * n), z.ravel()])
-    f = [(i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
-    f += [(i * n + j, (i + 1) * n + j + 1, i * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
-    normals = np.tile([0.0, -1.0, 0.0], (n * n, 1))
-    return Mesh(v.astype(np.float32), np.array(f, np.int32), normals.astype(np.float32))
 
 
 @pytest.fixture(scope="module")
@@ -70,9 +59,9 @@ def test_the_face_grid_finds_the_brute_forces_closest_points(sintel):
     assert np.all(np.isinf(sd[~inside_box]))
 
 
-def test_a_comb_up_through_a_plane_stops_at_it():
+def test_a_comb_up_through_a_plane_stops_at_it(plane):
     comb = samples.comb(36, 12)
-    surface = MeshSurface(plane())
+    surface = MeshSurface(plane)
     c = comb.points[comb.offsets[14] + 8].astype(np.float64)
     results = {}
     for collide in (True, False):
