@@ -28,3 +28,28 @@ def plane_mesh(lo: float = PLANE_LO, hi: float = PLANE_HI, n: int = PLANE_CELLS 
 def plane() -> Mesh:
     """The flat head (module docstring): a mesh, to wrap in a MeshSurface or HeadSurface."""
     return plane_mesh()
+
+
+FOLD_SLOPE = 4.0  # the fold's walls rise 4 in y per 1 in x: the outside is a wedge of about 28°
+
+
+def fold_mesh(n: int = 9, hard: bool = True) -> Mesh:
+    """A harsh fold: the surface y = −FOLD_SLOPE·|x| over x, z in [−1, 1], the head above it
+    (y > −FOLD_SLOPE·|x|), so the outside is a narrow wedge below the crease x = 0; normals
+    point out of the head, into the wedge. ``hard``: a hard crease, its vertices given the
+    x > 0 wall's normal (as a file with split normals gives one of them), else their mean."""
+    t = np.linspace(-1.0, 1.0, n)  # (n odd: the crease is a row of vertices)
+    x, z = np.meshgrid(t, t, indexing="ij")
+    v = np.column_stack([x.ravel(), -FOLD_SLOPE * np.abs(x.ravel()), z.ravel()])
+    f = [(i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
+    f += [(i * n + j, (i + 1) * n + j + 1, i * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
+    side = np.sign(v[:, 0]) + (hard & (v[:, 0] == 0))
+    normals = np.column_stack([-FOLD_SLOPE * side, -np.ones(n * n), np.zeros(n * n)])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    return Mesh(v.astype(np.float32), np.array(f, np.int32), normals.astype(np.float32))
+
+
+@pytest.fixture(scope="session")
+def fold() -> Mesh:
+    """:func:`fold_mesh` with a hard crease: walls a brush pushes strands into."""
+    return fold_mesh()
