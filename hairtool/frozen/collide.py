@@ -1,14 +1,25 @@
 """Surface collision: after a brush sample no vertex of a strand it moved stays inside the head.
 
 The strands a sample changed are checked against the head's signed distance (< 0 inside: behind
-the surface normal at the closest point). In a strand with a vertex inside, from the first such
-vertex to the tip, each vertex in turn is put back at its segment's length from the (already
-solved) one before, toward where the brush left it; if it is then inside, it is pushed out to
-the closest surface point plus a margin along the normal there and put back at its length
-toward that point, up to PUSHES times, each time lifted 4× further out (at most a segment's
-length): the length pulls it back part of the way. A vertex the strand cannot get outside (in
-a fold of the mesh) stays as close as it gets. Roots never move, and every segment keeps the
-length the brush gave it.
+the normal of the face, edge or corner the closest point lies on, which reads folds and ridges
+the right way round). In a strand with a vertex inside, from the first such vertex to the tip,
+each vertex in turn is put back at its segment's length from the (already solved) one before,
+toward where the brush left it; if it is then inside, it is pushed out to the closest surface
+point plus a margin along the normal there and put back at its length toward that point, up to
+PUSHES times, each time lifted 4× further out (at most a segment's length): the length pulls
+it back part of the way.
+
+In a harsh fold those pushes can bounce between the fold's two walls and end inside (the
+length pulls the vertex back through the wall it was pushed off). A vertex still inside then
+*escapes*: on the sphere of its segment's length around the vertex before, directions are
+tried from the one the brush wanted toward the way out there (the normal at that vertex's
+closest point) and over the whole sphere (a fixed spiral of directions); of those that land
+at least the margin outside, the one closest to the wanted direction is taken, then moved back
+toward the wanted one by bisection while it stays outside, so the vertex rests against the
+surface. Only where no direction of the sphere is outside (the vertex before is sealed in)
+does a vertex stay inside, as far out as it got. Every tried point is rounded to float32 first,
+as the groom stores it, so a vertex found outside stays outside. Roots never move, and every
+segment keeps the length the brush gave it.
 
 The surface is anything with ``signed_distance(points) -> (distances, closest points,
 normals)`` (:class:`CollisionSurface`), e.g. :class:`hairtool.guides.surface.MeshSurface`.
@@ -27,6 +38,20 @@ from hairtool.groom import Groom, vertex_ids_of
 PUSHES = 10
 MARGIN = 1e-5  # of the groom's size: how far outside a pushed vertex lands
 EPS = 1e-12
+TOWARD_OUT = 8  # directions tried from the wanted one to the way out
+BISECTIONS = 12  # steps back toward the wanted direction
+
+
+def _spiral(n: int) -> np.ndarray:
+    """``(n, 3)`` unit directions spread evenly over the sphere (a golden-angle spiral)."""
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    t = np.pi * (3.0 - np.sqrt(5.0)) * k
+    r = np.sqrt(1.0 - z * z)
+    return np.column_stack([r * np.cos(t), r * np.sin(t), z])
+
+
+SPHERE = _spiral(96)
 
 
 class CollisionSurface(Protocol):
@@ -39,6 +64,47 @@ def _unit_toward(prev: np.ndarray, x: np.ndarray, length: np.ndarray, fallback: 
     small = n < EPS
     d[small], n[small] = fallback[small], np.sqrt(np.einsum("ij,ij->i", fallback[small], fallback[small]))
     return prev + d * (length / np.maximum(n, EPS))[:, None]
+
+
+def _f32(x: np.ndarray) -> np.ndarray:
+    return x.astype(np.float32).astype(np.float64)
+
+
+def _unit(x: np.ndarray) -> np.ndarray:
+    return x / np.maximum(np.sqrt(np.einsum("...i,...i->...", x, x)), EPS)[..., None]
+
+
+def escape(
+    prev: np.ndarray, want: np.ndarray, length: np.ndarray, surface: CollisionSurface, margin: float
+) -> np.ndarray:
+    """``(M, 3)`` points at ``length`` from ``prev`` (float32-exact), each outside the surface
+    by at least ``margin`` and as near the direction toward ``want`` as found (module
+    docstring); where no tried direction is outside, the one farthest out."""
+    m = len(prev)
+    d0 = _unit(want - prev)
+    _, _, n_p = surface.signed_distance(prev)
+    out_dir = np.where(np.isfinite(n_p), n_p, d0)
+    t = (np.arange(1, TOWARD_OUT + 1) / TOWARD_OUT)[None, :, None]
+    dirs = np.concatenate(
+        [_unit((1.0 - t) * d0[:, None] + t * out_dir[:, None]), np.broadcast_to(SPHERE, (m, *SPHERE.shape))],
+        axis=1,
+    )  # (M, C, 3)
+    cand = _f32(prev[:, None] + length[:, None, None] * dirs)
+    sd = surface.signed_distance(cand.reshape(-1, 3))[0].reshape(m, -1)
+    clear = sd >= margin
+    score = np.where(clear, np.einsum("mci,mi->mc", dirs, d0), -np.inf)
+    best = np.where(clear.any(axis=1), np.argmax(score, axis=1), np.argmax(sd, axis=1))
+    rows = np.arange(m)
+    hi, lo = dirs[rows, best], d0.copy()
+    ok = clear[rows, best]
+    for _ in range(BISECTIONS):  # toward the wanted direction while outside
+        mid = lo + hi
+        fine = ok & (np.einsum("ij,ij->i", mid, mid) > EPS)
+        mid = np.where(fine[:, None], _unit(mid), hi)
+        inside = surface.signed_distance(_f32(prev + length[:, None] * mid))[0] < margin
+        hi = np.where((fine & ~inside)[:, None], mid, hi)
+        lo = np.where((fine & inside)[:, None], mid, lo)
+    return _f32(prev + length[:, None] * hi)
 
 
 def collide(before: Groom, after: Groom, surface: CollisionSurface, margin: float) -> Groom:
@@ -71,7 +137,8 @@ def collide(before: Groom, after: Groom, surface: CollisionSurface, margin: floa
         v = s0[act] + i
         seg = given[v] - given[v - 1]
         length = np.sqrt(np.einsum("ij,ij->i", seg, seg))
-        x = _unit_toward(p[v - 1], given[v], length, seg)
+        x = _f32(_unit_toward(p[v - 1], given[v], length, seg))
+        out = np.zeros(len(v), bool)
         for t in range(PUSHES):
             d, q, nrm = surface.signed_distance(x)
             out = ~(d < 0)
@@ -79,6 +146,10 @@ def collide(before: Groom, after: Groom, surface: CollisionSurface, margin: floa
                 break
             lift = np.minimum(margin * 4.0**t, np.maximum(length[~out], margin))  # further out each time
             pushed = q[~out] + lift[:, None] * nrm[~out]
-            x[~out] = _unit_toward(p[v - 1][~out], pushed, length[~out], seg[~out])
+            x[~out] = _f32(_unit_toward(p[v - 1][~out], pushed, length[~out], seg[~out]))
+        else:
+            out = ~(surface.signed_distance(x)[0] < 0)
+        if not out.all():  # bounced in a fold: escape along the sphere of the segment's length
+            x[~out] = escape(p[v - 1][~out], given[v][~out], length[~out], surface, margin)
         p[v] = x
     return after.with_points(p.astype(np.float32))

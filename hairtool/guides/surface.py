@@ -350,6 +350,7 @@ class MeshSurface:
         if not np.all(np.isfinite(mesh.vertices)):
             raise ParameterError("scalp", "a mesh with non-finite vertices", "finite vertex coordinates")
         self.mesh = mesh
+        self._pseudo = None  # the inside test's normals, made when first asked
         self._v = mesh.vertices.astype(np.float64)
         self._n = mesh.normals.astype(np.float64)
         self._f = mesh.faces.astype(np.int64)
@@ -384,16 +385,23 @@ class MeshSurface:
         return q, self._normals(q, face)
 
     def signed_distance(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(P,)`` signed distance to the head (< 0 inside: behind the surface's normal at the
-        closest point), the closest points and the normals there; points outside the mesh's box
-        get +inf (and NaN points and normals)."""
+        """``(P,)`` signed distance to the head (< 0 inside: behind the pseudo-normal of the
+        face, edge or corner the closest point lies on, :mod:`hairtool.guides.inside`), the
+        closest points and those normals, the way out; points outside the mesh's box get +inf
+        (and NaN points and normals)."""
+        if self._pseudo is None:
+            from hairtool.guides.inside import PseudoNormals
+
+            self._pseudo = PseudoNormals(self.mesh)
         pts = np.asarray(points, np.float64)
         q, face = self.nearest(pts)
         n = np.full_like(q, np.nan)
         near = face >= 0
-        n[near] = self._normals(q[near], face[near])
+        n[near] = self._pseudo.normals_at(q[near], face[near])
         sd = np.full(len(pts), np.inf)
-        sd[near] = np.einsum("ij,ij->i", pts[near] - q[near], n[near])
+        d = pts[near] - q[near]
+        side = np.einsum("ij,ij->i", d, n[near])
+        sd[near] = np.copysign(np.sqrt(np.einsum("ij,ij->i", d, d)), side) * (side != 0)
         return sd, q, n
 
     def ray_hit(self, origin, direction) -> np.ndarray | None:

@@ -16,21 +16,11 @@ from hairtool.frozen.brushes import BrushSample, falloff_lut
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.strokes import strokes_from_log, write_strokes
 from hairtool.guides.planting import HeadSurface
-from hairtool.io.obj import Mesh, read_mesh
+from hairtool.io.obj import read_mesh
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "grooms"
 PLAIN = FrozenParams(freeze=False, clump=False)
 LUT = tuple(falloff_lut("smooth").tolist())
-
-
-def plane(n=6) -> Mesh:
-    t = np.linspace(-1.0, 1.5, n)
-    x, z = np.meshgrid(t, t, indexing="ij")
-    v = np.column_stack([x.ravel(), np.zeros(n * n), z.ravel()])
-    f = [(i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
-    f += [(i * n + j, (i + 1) * n + j + 1, i * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
-    normals = np.tile([0.0, -1.0, 0.0], (n * n, 1)).astype(np.float32)
-    return Mesh(v.astype(np.float32), np.array(f, np.int32), normals)
 
 
 @pytest.fixture(scope="module")
@@ -44,9 +34,9 @@ def add(cursor, radius, count, seed=0, view=None):
     return BrushSample("add", c, (0.0, 0.0, 0.0), radius, 1.0, LUT, v, count=count, seed=seed)
 
 
-def test_on_a_plane_planted_strands_hang_like_their_neighbours(tmp_path):
+def test_on_a_plane_planted_strands_hang_like_their_neighbours(plane, tmp_path):
     comb = samples.comb(36, 12)
-    pipe = FrozenPipeline(comb, PLAIN, HeadSurface(plane()))
+    pipe = FrozenPipeline(comb, PLAIN, HeadSurface(plane))
     out = pipe.brush(add((0.125, -0.2, 0.125), 0.1, 6))
     assert out.strand_count == 42
     new = out.subset(np.arange(36, 42))

@@ -1,5 +1,6 @@
 """Surface collision: with a head surface, brushed strands end with no vertex inside it (a plane
-under a flat comb; Sintel's head), roots fixed and lengths kept; off per stroke, strands pass
+under a flat comb; a harsh fold whose walls a brush presses strands into; Sintel's head under
+aggressive strokes of every moving brush), roots fixed and lengths kept; off per stroke, strands pass
 through; the face grid finds the brute force's closest points bit for bit; logs record the
 option and replay with --scalp to the same bytes."""
 
@@ -16,24 +17,13 @@ from hairtool.cli import main
 from hairtool.frozen.brushes import BrushSample, falloff_lut, root_normals
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.strokes import read_strokes, strokes_from_log, write_strokes
-from hairtool.groom import vertex_ids_of
+from hairtool.groom import Groom, vertex_ids_of
 from hairtool.guides.surface import MeshSurface, closest_points
-from hairtool.io.obj import Mesh, read_mesh
+from hairtool.io.obj import read_mesh
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "grooms"
 PLAIN = FrozenParams(freeze=False, clump=False)
 LUT = tuple(falloff_lut("smooth").tolist())
-
-
-def plane(n=6) -> Mesh:
-    """y = 0 over [−1, 1.5]², normals along −y: the head is the side y > 0 (the comb hangs below)."""
-    t = np.linspace(-1.0, 1.5, n)
-    x, z = np.meshgrid(t, t, indexing="ij")
-    v = np.column_stack([x.ravel(), np.zeros(n * n), z.ravel()])
-    f = [(i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
-    f += [(i * n + j, (i + 1) * n + j + 1, i * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
-    normals = np.tile([0.0, -1.0, 0.0], (n * n, 1))
-    return Mesh(v.astype(np.float32), np.array(f, np.int32), normals.astype(np.float32))
 
 
 @pytest.fixture(scope="module")
@@ -70,9 +60,9 @@ def test_the_face_grid_finds_the_brute_forces_closest_points(sintel):
     assert np.all(np.isinf(sd[~inside_box]))
 
 
-def test_a_comb_up_through_a_plane_stops_at_it():
+def test_a_comb_up_through_a_plane_stops_at_it(plane):
     comb = samples.comb(36, 12)
-    surface = MeshSurface(plane())
+    surface = MeshSurface(plane)
     c = comb.points[comb.offsets[14] + 8].astype(np.float64)
     results = {}
     for collide in (True, False):
@@ -132,3 +122,92 @@ def test_logs_record_collision_and_replay_with_scalp(sintel, tmp_path):
     args += ["--strokes", str(tmp_path / "s.json")]
     assert main([*args, "--scalp", str(DATA / "sintel_head.obj")]) == 0
     np.testing.assert_array_equal(io.read(tmp_path / "o.npz").points, pipe.result.points)
+
+
+FOLD_SLOPE = 4.0  # as tests/frozen/conftest.py's fold
+
+
+def in_the_crease(strands=24, n=12, length=0.6) -> Groom:
+    """Straight strands hanging down the fold's wedge from roots just outside its crease."""
+    rng = np.random.default_rng(5)
+    x = rng.uniform(-0.04, 0.04, strands)
+    roots = np.column_stack([x, -FOLD_SLOPE * np.abs(x) - 1e-3, np.linspace(-0.5, 0.5, strands)])
+    t = np.linspace(0.0, length, n)
+    pts = roots[:, None, :] - t[None, :, None] * np.array([0.0, 1.0, 0.0])
+    return Groom(pts.reshape(-1, 3).astype(np.float32), np.full(strands, n))
+
+
+FOLD_STROKES = {  # (brush, cursor, direction, strength): each pushes the strands into a wall
+    "comb": ((0.0, -0.3, 0.0), (1.0, 1.0, 0.0), 1.0),
+    "pinch": ((0.6, 0.2, 0.0), (0.0, 0.0, 0.0), 1.0),
+    "snake_hook": ((0.0, -0.6, 0.0), (0.1, 0.25, 0.0), 1.0),
+}
+
+
+@pytest.mark.parametrize("brush", ["comb", "pinch", "snake_hook"])
+def test_in_a_harsh_fold_no_vertex_ends_inside(fold, brush):
+    hair = in_the_crease()
+    surface = MeshSurface(fold)
+    cursor, direction, strength = FOLD_STROKES[brush]
+    const = tuple(falloff_lut("constant").tolist())
+    out = {}
+    for collide in (True, False):
+        pipe = FrozenPipeline(hair, PLAIN, surface)
+        c = np.array(cursor)
+        for i in range(6):
+            if brush == "snake_hook":
+                c = c + np.array(direction)
+            s = BrushSample(brush, tuple(c), direction, 2.0, strength, const, start=i == 0, collide=collide)
+            pipe.brush(s)
+        out[collide] = pipe.result
+    p = out[True].points.astype(np.float64)
+    inner = hair.topology.index_in_strand > 0
+    depth = p[:, 1] + FOLD_SLOPE * np.abs(p[:, 0])  # > 0: inside the head (exactly, from the fold's shape)
+    q = out[False].points.astype(np.float64)
+    assert np.sum((q[:, 1] + FOLD_SLOPE * np.abs(q[:, 0]))[inner] > 1e-3) > 20  # the stroke goes in
+    assert depth[inner].max() <= 1e-6
+    assert np.all(surface.signed_distance(p[inner])[0] >= 0)
+    np.testing.assert_array_equal(out[True].roots, hair.roots)
+    np.testing.assert_allclose(lengths(out[True]), lengths(hair), atol=1e-5)
+
+
+def test_on_sintel_aggressive_strokes_of_every_moving_brush_leave_no_vertex_inside(sintel):
+    groom, surface = sintel
+    n = root_normals(groom)
+    const = tuple(falloff_lut("constant").tolist())
+    rng = np.random.default_rng(0)
+    inside_off = 0
+    for trial in range(10):
+        k = int(rng.integers(groom.strand_count))
+        brush = ["comb", "pinch", "snake_hook", "comb", "smooth"][trial % 5]
+        c = groom.points[groom.offsets[k] + 16].astype(np.float64)
+        moves = [(-4.0 * n[k] + rng.normal(0, 2, 3)) for _ in range(6)]
+        out = {}
+        for collide in (True, False):
+            pipe = FrozenPipeline(groom, PLAIN, surface)
+            for i, d in enumerate(moves):  # into the head, 8 units wide, full strength
+                cc = c - 3.0 * n[k] if brush == "pinch" else c + i * d * (brush == "snake_hook")
+                s = BrushSample(brush, tuple(cc), tuple(d), 8.0, 1.0, const, start=i == 0, collide=collide)
+                pipe.brush(s)
+            out[collide] = pipe.result
+        v = moved_vertices(groom, out[True])
+        inside_off += int(np.sum(surface.signed_distance(out[False].points[v].astype(np.float64))[0] < 0))
+        sd, _, _ = surface.signed_distance(out[True].points[v].astype(np.float64))
+        assert np.all(sd >= 0), (trial, brush, np.sort(sd)[:3])
+        np.testing.assert_array_equal(out[True].roots, groom.roots)
+        np.testing.assert_allclose(lengths(out[True]), lengths(groom), atol=5e-5)
+    assert inside_off > 100
+
+
+def test_the_inside_test_reads_a_fold_by_its_edge_normal(fold):
+    """The fold's hard crease, its vertex normals one wall's: a point inside the head beside
+    the crease, whose closest point is the crease, reads as outside by the vertex normals
+    blended there; the edge's pseudo-normal reads it right."""
+    hard = MeshSurface(fold)
+    inside = np.array([[-0.01, 0.02, 0.1]])  # y > −4·|x|: in the head, the crease the closest
+    q, smooth = hard.project(inside)
+    np.testing.assert_allclose(q, [[0.0, 0.0, 0.1]], atol=1e-7)
+    assert float((inside - q)[0] @ smooth[0]) > 0  # the blended normals: outside
+    assert hard.signed_distance(inside)[0][0] < 0
+    for outside in ([0.01, -0.06, 0.1], [-0.01, -0.06, 0.1], [0.0, -0.5, 0.0]):
+        assert hard.signed_distance(np.array([outside]))[0][0] > 0

@@ -16,21 +16,11 @@ from hairtool.frozen.density import accept, accept_reference, thin, thin_referen
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.strokes import strokes_from_log, write_strokes
 from hairtool.guides.planting import HeadSurface
-from hairtool.io.obj import Mesh, read_mesh
+from hairtool.io.obj import read_mesh
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "grooms"
 PLAIN = FrozenParams(freeze=False, clump=False)
 LUT = tuple(falloff_lut("smooth").tolist())
-
-
-def plane(n=6) -> Mesh:
-    t = np.linspace(-1.0, 1.5, n)
-    x, z = np.meshgrid(t, t, indexing="ij")
-    v = np.column_stack([x.ravel(), np.zeros(n * n), z.ravel()])
-    f = [(i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
-    f += [(i * n + j, (i + 1) * n + j + 1, i * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
-    normals = np.tile([0.0, -1.0, 0.0], (n * n, 1)).astype(np.float32)
-    return Mesh(v.astype(np.float32), np.array(f, np.int32), normals)
 
 
 def density(cursor, radius, spacing, seed=0):
@@ -58,9 +48,9 @@ def check_spacing(g, surface, centre, radius, spacing):
 
 
 @pytest.mark.parametrize("spacing", [0.12, 0.03])
-def test_on_a_plane_the_comb_is_thinned_or_filled_to_the_spacing(spacing):
+def test_on_a_plane_the_comb_is_thinned_or_filled_to_the_spacing(plane, spacing):
     comb = samples.comb(100, 8)  # roots 0.05 apart
-    surface = HeadSurface(plane())
+    surface = HeadSurface(plane)
     pipe = FrozenPipeline(comb, PLAIN, surface)
     c, r = (0.225, 0.0, 0.225), 0.15
     pipe.brush(density((0.225, -0.1, 0.225), 0.15, spacing))

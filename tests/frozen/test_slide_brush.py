@@ -19,24 +19,10 @@ from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.slide import _turn_reference, slide, slide_reference
 from hairtool.frozen.strokes import strokes_from_log, write_strokes
 from hairtool.guides.surface import MeshSurface
-from hairtool.io.obj import Mesh, read_mesh
+from hairtool.io.obj import read_mesh
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "grooms"
 PLAIN = FrozenParams(freeze=False, clump=False)
-
-
-def plane_mesh(lo=-1.0, hi=1.5, n=6) -> Mesh:
-    """The plane y = 0 as a triangle grid, normals along −y (the comb grows that way)."""
-    t = np.linspace(lo, hi, n)
-    x, z = np.meshgrid(t, t, indexing="ij")
-    v = np.column_stack([x.ravel(), np.zeros(n * n), z.ravel()])
-    faces = []
-    for i in range(n - 1):
-        for j in range(n - 1):
-            a, b, c, d = i * n + j, (i + 1) * n + j, (i + 1) * n + j + 1, i * n + j + 1
-            faces += [(a, b, c), (a, c, d)]
-    normals = np.tile([0.0, -1.0, 0.0], (n * n, 1))
-    return Mesh(v.astype(np.float32), np.array(faces, np.int32), normals.astype(np.float32))
 
 
 @pytest.fixture(scope="module")
@@ -56,8 +42,8 @@ def sample(cursor, radius, strength, direction, falloff="smooth", view=None):
     return BrushSample("slide", c, d, radius, strength, lut, v)
 
 
-def test_on_a_plane_strands_translate_along_it_by_the_weighted_drag(flat):
-    surface = MeshSurface(plane_mesh())
+def test_on_a_plane_strands_translate_along_it_by_the_weighted_drag(flat, plane):
+    surface = MeshSurface(plane)
     c = flat.roots[14].astype(np.float64)
     s = sample(c, 0.08, 0.8, (0.1, 0.4, 0.0), falloff="linear")  # the y part leaves the plane
     out = slide(flat, s, np.zeros(flat.strand_count, bool), surface)
@@ -98,9 +84,9 @@ def test_on_sintel_roots_land_on_the_head_and_shapes_keep_their_root_frames(sint
 
 
 @pytest.mark.parametrize("where", ["flat", "sintel"])
-def test_the_slide_kernel_matches_its_twin(where, flat, sintel):
+def test_the_slide_kernel_matches_its_twin(where, flat, sintel, plane):
     if where == "flat":
-        g, surface = flat, MeshSurface(plane_mesh())
+        g, surface = flat, MeshSurface(plane)
     else:
         g, surface = sintel
     locked = np.zeros(g.strand_count, bool)
@@ -112,12 +98,12 @@ def test_the_slide_kernel_matches_its_twin(where, flat, sintel):
     np.testing.assert_array_equal(ours.points, twin.points)
 
 
-def test_without_a_surface_slide_is_refused_by_name(flat):
+def test_without_a_surface_slide_is_refused_by_name(flat, plane):
     pipe = FrozenPipeline(flat, PLAIN)
     with pytest.raises(ParameterError, match="scalp"):
         pipe.brush(sample(flat.roots[0], 0.1, 1.0, (0.1, 0, 0)))
     assert pipe.strokes == ()
-    pipe.set_surface(MeshSurface(plane_mesh()))
+    pipe.set_surface(MeshSurface(plane))
     assert np.any(pipe.brush(sample(flat.roots[0], 0.1, 1.0, (0.1, 0, 0))).roots != flat.roots)
     with pytest.raises(ParameterError, match="scalp"):
         pipe.set_surface(None)  # the slide stroke needs one
