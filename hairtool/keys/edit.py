@@ -10,14 +10,17 @@ samples, so the locality holds for both interpolations.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation
-from hairtool.keys.reconstruct import KeyPoses, interpolate_keys, key_poses
+from hairtool.keys.reconstruct import KeyPoses, check_keys, interpolate_at, interpolate_keys, key_poses
 
 F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
 
 
 class KeyEditor:
@@ -71,3 +74,73 @@ def edit_animation(
     for frame, pose in edits.items():
         editor.set_key_pose(int(frame), pose)
     return animation.with_frames(editor.frames(np.float32))
+
+
+# -- a key moved in time --------------------------------------------------------------------
+def time_warp(frames: ArrayLike, keys_now: ArrayLike, keys_then: ArrayLike) -> F64:
+    """The (fractional) frame of the motion as keyed before that each frame shows now: the
+    piecewise-linear map taking each key's frame now back to its frame before, so a key moved
+    in time takes the frames between its neighbouring keys with it (stretched on one side,
+    squeezed on the other); the identity wherever no key moved."""
+    return np.interp(np.asarray(frames, dtype=np.float64), keys_now, keys_then)
+
+
+def residual_at(values: NDArray, base_at: Callable[[I64], NDArray], at: ArrayLike) -> F64:
+    """The residual ``values − base_at(frames)`` (``values`` ``(F, ...)``, ``base_at`` the key
+    curve at whole frames) at fractional frames ``at``, linear between the frames either side;
+    at a whole frame, that frame's residual exactly."""
+    u = np.asarray(at, dtype=np.float64).reshape(-1)
+    n = values.shape[0]
+    i0 = np.clip(np.floor(u).astype(np.int64), 0, max(n - 2, 0))
+    i1 = np.minimum(i0 + 1, n - 1)
+    s = (u - i0).reshape((-1,) + (1,) * (values.ndim - 1))
+    r0 = values[i0].astype(np.float64) - base_at(i0)
+    r1 = values[i1].astype(np.float64) - base_at(i1)
+    return r0 * (1.0 - s) + r1 * s
+
+
+def check_retime(keys: ArrayLike, n_frames: int, key_frame: int, new_frame: int) -> tuple[int, I64]:
+    """``(key index, keys after)`` for moving the key at ``key_frame`` to ``new_frame``: an inner
+    key (the first and last frame are always keys) to a frame strictly between its neighbouring
+    keys (a key never passes another); :class:`ParameterError` naming the allowed frames."""
+    k = check_keys(keys, n_frames)
+    hit = np.flatnonzero(k == int(key_frame))
+    if hit.size == 0:
+        raise ParameterError("key frame", key_frame, f"one of the keys {k.tolist()}")
+    a = int(hit[0])
+    if a == 0 or a == k.size - 1:
+        raise ParameterError("key frame", key_frame, "an inner key (the first and last frame stay keys)")
+    lo, hi = int(k[a - 1]), int(k[a + 1])
+    if int(new_frame) != new_frame or not lo < new_frame < hi:
+        raise ParameterError("new frame", new_frame, f"a frame strictly between the keys {lo} and {hi}")
+    out = k.copy()
+    out[a] = int(new_frame)
+    return a, out
+
+
+def retime_key(
+    frames: NDArray, keys: ArrayLike, interp: str, key_frame: int, new_frame: int
+) -> tuple[int, NDArray, I64]:
+    """``(start, block, keys after)``: the key at ``key_frame`` moved to ``new_frame`` with the
+    residuals kept (seed 003 §5 with a knot moved in time). The key curve keeps every key pose
+    and its tangents (per frame) and takes the new knot; each frame t between the neighbouring
+    keys gets the curve there plus the residual of the frame it now shows, r(w(t)) with w
+    :func:`time_warp` (the captured detail moves with the key). So the pose at the key is the
+    key pose exactly, with linear keys the stretch is the old motion retimed, and frames
+    outside ``start .. start + len(block) − 1`` (strictly between the neighbours) are untouched."""
+    f = np.asarray(frames)
+    n = f.shape[0]
+    a, after = check_retime(keys, n, key_frame, new_frame)
+    before = check_keys(keys, n)
+    lo, hi = int(before[a - 1]), int(before[a + 1])
+    s0, s1 = max(lo - 1, 0), min(hi + 1, n - 1)  # one frame each side keeps the tangents
+    sub = f[s0 : s1 + 1]
+    sub_keys = np.array(sorted({s0, lo, int(key_frame), hi, s1}), dtype=np.int64) - s0
+    base = key_poses(sub, sub_keys, interp)
+    moved = sub_keys.copy()
+    moved[moved == int(key_frame) - s0] = int(new_frame) - s0
+    warped = KeyPoses(moved, base.poses, base.tangents, base.n_frames, base.interp, base.tangents_in)
+    t = np.arange(lo + 1, hi) - s0
+    curve = interpolate_at(warped, t)
+    block = curve + residual_at(sub, lambda i: interpolate_at(base, i), time_warp(t, moved, sub_keys))
+    return lo + 1, block.astype(f.dtype), after
