@@ -27,7 +27,7 @@ from PySide6.QtWidgets import QFormLayout, QGroupBox, QLabel, QScrollArea, QSpin
 from app.ui.animation_io import skeleton_animation
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.mocap.bvh import Motion, read_bvh, write_bvh
-from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, parse_edit_list
+from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, RetimeEdit, parse_edit_list
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
@@ -60,19 +60,22 @@ def motion_from_text(text: str, source: str) -> Motion:
 
 
 class PoseEditCommand(QUndoCommand):
-    """One finished drag (or graph-editor key move): the edit, applied on redo, taken back on undo."""
+    """One finished drag (or graph-editor key move): its edits (a key dragged in time and value
+    is two: the move, then the value at the new frame), applied on redo, taken back on undo."""
 
-    def __init__(self, capture: CaptureEditor, edit: Edit, text: str) -> None:
+    def __init__(self, capture: CaptureEditor, edit: Edit | list[Edit], text: str) -> None:
         super().__init__(text)
-        self.capture, self.edit, self.generation = capture, edit, capture.generation
+        self.capture, self.generation = capture, capture.generation
+        self.edits = list(edit) if isinstance(edit, list) else [edit]
+        self.edit = self.edits[-1]
 
     def redo(self) -> None:
         if self.capture.generation == self.generation and self.capture.attached:
-            self.capture.push(self.edit)
+            self.capture.push(self.edits)
 
     def undo(self) -> None:
         if self.capture.generation == self.generation and self.capture.attached:
-            self.capture.pop()
+            self.capture.pop(len(self.edits))
 
 
 class JointDrag:
@@ -155,6 +158,7 @@ class CaptureEditor(QObject):
         self.ghosts: list[np.ndarray] = []  # (P, 3) joint positions of neighbouring frames in a drag
         self._preview: tuple[int, np.ndarray] | None = None  # frame, (J, 3) joints being dragged
         self.drag = JointDrag(self)
+        self._syncing = False  # the timeline's keys are being set to the edited ones
         self.model.animation_changed.connect(self._on_animation_changed)
         self.model.keys_changed.connect(self._on_keys_changed)
         self.box = self._tool_box()
@@ -191,23 +195,32 @@ class CaptureEditor(QObject):
             self.changed.emit()
 
     def _on_keys_changed(self) -> None:
-        if self.attached:
+        if self.attached and not self._syncing:
             self._rebuild()
 
+    def _sync_keys(self) -> None:
+        """The timeline's keys become the edited ones (a key moved in time, or moved back)."""
+        if self.editor is not None:
+            self._syncing = True
+            try:
+                self.model.set_edited_keys(self.editor.keys)
+            finally:
+                self._syncing = False
+
     def _rebuild(self, show: bool = True) -> None:
-        """A PoseEditor on the timeline's keys, with every edit at a frame that is still a key."""
+        """A PoseEditor on the solved keys, with every edit at a frame that is still a key
+        (a key moved in time moves again where its neighbours still let it)."""
         m = self.model
-        if m.dp_keys is None:
+        keys = m.solved_keys if m.solved_keys is not None else m.dp_keys
+        if keys is None:
             self.editor = None
             return
         interp = m.dp_poses.interp if m.dp_poses is not None else m.settings.interp
-        self.editor = PoseEditor(self.original, m.dp_keys, interp)
+        self.editor = PoseEditor(self.original, keys, interp)
         self.applied = []
         for e in self.edits:
-            ok = bool(np.any(self.editor.keys == e.frame))
-            if ok:
-                self._apply(e)
-            self.applied.append(ok)
+            self.applied.append(self._try(e))
+        self._sync_keys()
         waiting = self.applied.count(False)
         if waiting:
             self.window.statusBar().showMessage(
@@ -219,8 +232,18 @@ class CaptureEditor(QObject):
             self._show()
         self.changed.emit()
 
-    def _apply(self, edit: Edit) -> None:
-        self.editor.apply_all([edit])
+    def _apply(self, edit: Edit | list[Edit]) -> None:
+        self.editor.apply_all(edit if isinstance(edit, list) else [edit])
+
+    def _try(self, edit: Edit) -> bool:
+        """Apply one edit where it still applies (its frame a key, a move between neighbours)."""
+        if self.editor is None or not np.any(self.editor.keys == edit.frame):
+            return False
+        try:
+            self._apply(edit)
+        except HairtoolError:
+            return False
+        return True
 
     def motion(self) -> Motion:
         """The edited capture at every frame (the capture itself before any edit or keys)."""
@@ -236,37 +259,44 @@ class CaptureEditor(QObject):
             self.model.replace_frames(lo, frames[lo : hi + 1])
 
     # -- editing -----------------------------------------------------------------------------
-    def push(self, edit: Edit) -> None:
-        """Apply one more edit (the undo command's redo)."""
-        self.edits.append(edit)
-        ok = self.editor is not None and bool(np.any(self.editor.keys == edit.frame))
-        if ok:
-            self._apply(edit)
-        self.applied.append(ok)
+    def push(self, edits: Edit | list[Edit]) -> None:
+        """Apply more edits (the undo command's redo)."""
+        for edit in edits if isinstance(edits, list) else [edits]:
+            self.edits.append(edit)
+            self.applied.append(self._try(edit))
+        self._sync_keys()
         self._show()
         self.changed.emit()
 
-    def pop(self) -> None:
-        """Take back the last edit (the undo command's undo)."""
-        if not self.edits:
-            return
-        self.edits.pop()
-        if self.applied.pop():
-            self.editor.undo()
+    def pop(self, count: int = 1) -> None:
+        """Take back the last ``count`` edits (the undo command's undo)."""
+        for _ in range(min(count, len(self.edits))):
+            self.edits.pop()
+            if self.applied.pop():
+                self.editor.undo()
+        self._sync_keys()
         self._show()
         self.changed.emit()
 
-    def commit(self, edit: Edit, text: str) -> bool:
-        """One undo step for ``edit`` (refused with a message when it cannot be solved)."""
+    def commit(self, edit: Edit | list[Edit], text: str) -> bool:
+        """One undo step for ``edit`` (or a list of edits; refused with a message when one
+        cannot be solved)."""
         if self.editor is None:
             return False
+        edits = edit if isinstance(edit, list) else [edit]
+        done = 0
         try:  # solved once here so the undo step's redo cannot fail; undone exactly
-            self._apply(edit)
-            self.editor.undo()
+            for one in edits:
+                self._apply(one)
+                done += 1
         except HairtoolError as e:
             self.window.show_error("Cannot pose the capture", str(e))
             return False
-        self.window.undo_stack.push(PoseEditCommand(self, edit, text))
+        finally:
+            for _ in range(done):
+                self.editor.undo()
+        self.window.undo_stack.push(PoseEditCommand(self, list(edits), text))
+        edit = edits[-1]
         if isinstance(edit, PoseEdit) and self.editor.reports:
             r = self.editor.reports[-1]
             reach = "reached" if r.miss_share <= r.tolerance_share else "out of reach; nearest pose"
@@ -280,8 +310,9 @@ class CaptureEditor(QObject):
             self.handles.update()
 
     # -- the live drag -----------------------------------------------------------------------
-    def preview(self, edit: Edit | None) -> None:
-        """Show ``edit`` solved at its key, with the frames around it as ghosts (None: stop)."""
+    def preview(self, edit: Edit | list[Edit] | None) -> None:
+        """Show ``edit`` (or edits) solved at its key, with the frames around it as ghosts
+        (None: stop)."""
         m = self.model
         if edit is None or self.editor is None:
             self._preview, self.ghosts = None, []
@@ -289,23 +320,26 @@ class CaptureEditor(QObject):
             self.preview_changed.emit()
             self.handles.update()
             return
-        self._apply(edit)
+        edits = edit if isinstance(edit, list) else [edit]
+        self._apply(edits)
         try:
             out = self.editor.motion()
+            key = edits[-1].to if isinstance(edits[-1], RetimeEdit) else edits[-1].frame
+            first, last = self.editor.span(key)
         finally:
-            self.editor.undo()
-        first, last = self.editor.span(edit.frame)
-        inner = np.setdiff1d(np.arange(first, last + 1), [edit.frame])
+            for _ in edits:
+                self.editor.undo()
+        inner = np.setdiff1d(np.arange(first, last + 1), [key])
         if inner.size:
             inner = inner[
                 np.unique(np.linspace(0, inner.size - 1, min(GHOSTS, inner.size)).round().astype(int))
             ]
-        frames = np.r_[edit.frame, inner].astype(np.int64)
+        frames = np.r_[key, inner].astype(np.int64)
         sub = out.with_values(out.values[frames])
         joints = sub.joint_positions(end_sites=True)
-        self._preview = (edit.frame, joints[0])
+        self._preview = (key, joints[0])
         self.ghosts = list(joints[1:])
-        m.set_preview(edit.frame, skeleton_animation(sub).frames[0])
+        m.set_preview(key, skeleton_animation(sub).frames[0])
         self.preview_changed.emit()
         self.handles.update()
 

@@ -22,13 +22,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPainter, QPainterPath, QPen, QWheelEvent
+from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPainter, QPen, QWheelEvent
 from PySide6.QtWidgets import QDockWidget, QHBoxLayout, QLabel, QSpinBox, QVBoxLayout, QWidget
 
+from app.ui import view_range
 from app.ui.capture_edit import CaptureEditor
 from app.ui.hair_channels import HairChannels
+from app.ui.timeline_plots import polygon
 from hairtool.mocap import ik
-from hairtool.mocap.pose_edit import ChannelEdit, TangentEdit
+from hairtool.mocap.pose_edit import ChannelEdit, Edit, RetimeEdit, TangentEdit
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
@@ -113,6 +115,7 @@ class GraphView(QWidget):
         self.x_range = (0.0, 1.0)
         self.y_range = (-1.0, 1.0)
         self.last_value: float | None = None  # the value the last key drag asked for
+        self.last_frame = 0  # and the frame
         self._drag: tuple | None = None
         self._framed_for: tuple | None = None
         self.setMinimumSize(240, 120)
@@ -141,17 +144,20 @@ class GraphView(QWidget):
             MARGIN * 2, MARGIN / 2, max(self.width() - MARGIN * 2.5, 1), max(self.height() - MARGIN * 1.5, 1)
         )
 
-    def to_px(self, frame: np.ndarray | float, value: np.ndarray | float) -> tuple:
+    def _axes(self) -> tuple[view_range.Axis, view_range.Axis]:
         r = self._plot()
-        (x0, x1), (y0, y1) = self.x_range, self.y_range
-        px = r.left() + (np.asarray(frame, float) - x0) / (x1 - x0) * r.width()
-        py = r.bottom() - (np.asarray(value, float) - y0) / (y1 - y0) * r.height()
-        return px, py
+        return (
+            view_range.Axis(self.x_range, r.left(), r.width()),
+            view_range.Axis(self.y_range, r.top(), r.height(), flip=True),
+        )
+
+    def to_px(self, frame: np.ndarray | float, value: np.ndarray | float) -> tuple:
+        ax, ay = self._axes()
+        return ax.to_px(frame), ay.to_px(value)
 
     def from_px(self, px: float, py: float) -> tuple[float, float]:
-        r = self._plot()
-        (x0, x1), (y0, y1) = self.x_range, self.y_range
-        return x0 + (px - r.left()) / r.width() * (x1 - x0), y0 + (r.bottom() - py) / r.height() * (y1 - y0)
+        ax, ay = self._axes()
+        return ax.from_px(px), ay.from_px(py)
 
     def frame_all(self) -> None:
         """Home: every curve (and every frame) in view, with a little room around."""
@@ -171,20 +177,16 @@ class GraphView(QWidget):
         """Scale the view by ``factor`` (> 1 zooms in) about the pixel ``(px, py)``."""
         fx, fy = self.from_px(px, py)
         if "x" in axes:
-            x0, x1 = self.x_range
-            self.x_range = (fx + (x0 - fx) / factor, fx + (x1 - fx) / factor)
+            self.x_range = view_range.zoom(self.x_range, factor, fx)
         if "y" in axes:
-            y0, y1 = self.y_range
-            self.y_range = (fy + (y0 - fy) / factor, fy + (y1 - fy) / factor)
+            self.y_range = view_range.zoom(self.y_range, factor, fy)
         self.view_changed.emit()
         self.update()
 
     def pan(self, dx_px: float, dy_px: float) -> None:
-        r = self._plot()
-        (x0, x1), (y0, y1) = self.x_range, self.y_range
-        dx = -dx_px / r.width() * (x1 - x0)
-        dy = dy_px / r.height() * (y1 - y0)
-        self.x_range, self.y_range = (x0 + dx, x1 + dx), (y0 + dy, y1 + dy)
+        ax, ay = self._axes()
+        self.x_range = view_range.pan(self.x_range, -dx_px * ax.per_px)
+        self.y_range = view_range.pan(self.y_range, dy_px * ay.per_px)
         self.view_changed.emit()
         self.update()
 
@@ -268,7 +270,7 @@ class GraphView(QWidget):
                 if self.capture.model.frame != int(c.keys[k]):
                     self.capture.model.set_frame(int(c.keys[k]))  # the key's pose in the viewport
                 if hit is not None:
-                    self._drag = ("key", p, hit, float(c.values[k]))
+                    self._drag = ("key", p, hit, float(c.values[k]), int(c.keys[k]))
                 elif self.on_hair:
                     self.capture.window.statusBar().showMessage(HANDLES_FIXED, 4000)
                 else:
@@ -291,21 +293,30 @@ class GraphView(QWidget):
             self.zoom(ZOOM_STEP ** ((last.y() - p.y()) / 20.0), start.x(), start.y(), "y")
             self._drag = ("zoom", start, p)
         elif kind == "key":
-            _, start, (i, k), v0 = self._drag
-            value = v0 + (self.from_px(p.x(), p.y())[1] - self.from_px(start.x(), start.y())[1])
-            self.last_value = value
+            _, start, (i, k), v0, f0 = self._drag
+            (fx, fy), (sx, sy) = self.from_px(p.x(), p.y()), self.from_px(start.x(), start.y())
+            value, to = v0 + (fy - sy), self.snap(i, k, f0 + (fx - sx))
+            if event.modifiers() & Qt.KeyboardModifier.ShiftModifier:  # one axis: the longer move
+                if abs(p.x() - start.x()) >= abs(p.y() - start.y()):
+                    value = v0
+                else:
+                    to = f0
+            self.last_value, self.last_frame = value, to
+            if self.capture.model.frame != to:
+                self.capture.model.set_frame(to)  # the key's pose at its new frame in the viewport
             if self.on_hair:
                 c = self.curves[i]
-                result = self.hair.preview(i, int(c.keys[k]), value)
-                values = c.values.copy()
-                values[k] = value
+                result = self.hair.preview(i, f0, value, to)
+                values, keys = c.values.copy(), c.keys.copy()
+                values[k], keys[k] = value, to
                 self.curves[i] = Curve(
-                    c.name, c.colour, c.original, result, c.key_curve, c.keys, values, c.slope_in, c.slope_out
+                    c.name, c.colour, c.original, result, c.key_curve, keys, values, c.slope_in, c.slope_out
                 )
                 self.update()
             else:
-                self.capture.preview(self._edit(i, k, value))
-                self._preview_curve(i, self._edit(i, k, value))
+                edits = self._edits(i, f0, to, v0, value)
+                self.capture.preview(edits or None)
+                self._preview_curves(edits)
         elif kind == "handle":
             _, _, (i, k, side), _ = self._drag
             c = self.curves[i]
@@ -315,20 +326,24 @@ class GraphView(QWidget):
             self.last_value = (value - float(c.values[k])) / df
             edit = self._tangent(i, k, self.last_value)
             self.capture.preview(edit)
-            self._preview_curve(i, edit)
+            self._preview_curves([edit])
         event.accept()
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         drag, self._drag = self._drag, None
         if drag is not None and drag[0] == "key" and self.last_value is not None and self.on_hair:
-            _, _, (i, k), _ = drag
+            _, _, (i, k), v0, f0 = drag
             self.hair.preview(None)
-            self.hair.commit(i, int(self.curves[i].keys[k]), self.last_value)
+            if self.last_value != v0 or self.last_frame != f0:
+                self.hair.commit(i, f0, self.last_value, self.last_frame)
         elif drag is not None and drag[0] == "key" and self.last_value is not None:
-            _, _, (i, k), _ = drag
+            _, _, (i, _k), v0, f0 = drag
             self.capture.preview(None)
-            edit = self._edit(i, k, self.last_value)
-            self.capture.commit(edit, f"Move {edit.joint} {edit.channel} key at {edit.frame}")
+            edits = self._edits(i, f0, self.last_frame, v0, self.last_value)
+            if edits:
+                name = f"{self.capture.joint} {self.curves[i].name}"
+                moved = f" to {self.last_frame}" if self.last_frame != f0 else ""
+                self.capture.commit(edits, f"Move {name} key at {f0}{moved}")
         elif drag is not None and drag[0] == "handle" and self.last_value is not None:
             _, _, (i, k, _), _ = drag
             self.capture.preview(None)
@@ -337,32 +352,36 @@ class GraphView(QWidget):
         self.last_value = None
         event.accept()
 
-    def _edit(self, i: int, k: int, value: float) -> ChannelEdit:
-        c = self.curves[i]
-        return ChannelEdit(int(c.keys[k]), self.capture.joint, c.name, float(value))
+    def snap(self, curve: int, key: int, frame: float) -> int:
+        """The frame a key dragged to ``frame`` lands on: a whole frame strictly between its
+        neighbouring keys (the first and last key stay on their frames)."""
+        keys = self.curves[curve].keys
+        if key == 0 or key == keys.size - 1:
+            return int(keys[key])
+        return int(min(max(round(frame), int(keys[key - 1]) + 1), int(keys[key + 1]) - 1))
+
+    def _edits(self, i: int, frame: int, to: int, start: float, value: float) -> list[Edit]:
+        """A key dragged from ``frame`` and value ``start`` to ``to`` and ``value``: the move in
+        time (the key frame after it is ``to``), then the new value there; none when it went
+        nowhere."""
+        out: list[Edit] = [] if to == frame else [RetimeEdit(frame, to)]
+        if value != start:
+            out.append(ChannelEdit(int(to), self.capture.joint, self.curves[i].name, float(value)))
+        return out
 
     def _tangent(self, i: int, k: int, slope: float) -> TangentEdit:
         c = self.curves[i]
         return TangentEdit(int(c.keys[k]), self.capture.joint, c.name, float(slope))
 
-    def _preview_curve(self, i: int, edit: ChannelEdit | TangentEdit) -> None:
-        """The dragged channel as the edit would make it (the capture's editor, then undone)."""
-        editor, m = self.capture.editor, self.capture.original
-        editor.apply_all([edit])
+    def _preview_curves(self, edits: list[Edit]) -> None:
+        """The joint's channels as the edits would make them (the capture's editor, then undone)."""
+        editor = self.capture.editor
+        editor.apply_all(edits)
         try:
-            j = m.joint_names.index(self.capture.joint)
-            cols = ik.rotation_columns(m, j)[0]
-            result = editor.motion().values[:, cols]
-            key_curve = editor.key_curve(j, result)
-            slopes = editor.key_slopes(j)
+            self.curves = capture_curves(self.capture)
         finally:
-            editor.undo()
-        c = self.curves[i]
-        s_in, s_out = (None, None) if slopes is None else (slopes[0][:, i], slopes[1][:, i])
-        keyed = key_curve[:, i]
-        self.curves[i] = Curve(
-            c.name, c.colour, c.original, result[:, i], keyed, c.keys, keyed[c.keys], s_in, s_out
-        )
+            for _ in edits:
+                editor.undo()
         self.update()
 
     # -- drawing -----------------------------------------------------------------------------
@@ -411,12 +430,9 @@ class GraphView(QWidget):
         step = max(1, (hi - lo) // max(int(self._plot().width()), 1))
         frames = np.arange(lo, hi, step)
         px, py = self.to_px(frames, values[frames])
-        path = QPainterPath(QPointF(float(px[0]), float(py[0])))
-        for x, y in zip(px[1:], py[1:], strict=True):
-            path.lineTo(float(x), float(y))
         painter.setPen(pen)
         painter.setBrush(Qt.BrushStyle.NoBrush)
-        painter.drawPath(path)
+        painter.drawPolyline(polygon(px, py))
 
     def _keys(self, painter: QPainter, c: Curve) -> None:
         kx, ky = self.to_px(c.keys, c.values)
