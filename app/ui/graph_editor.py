@@ -36,7 +36,6 @@ if TYPE_CHECKING:
     from app.ui.host import StudioHost
 
 AXIS_COLOURS = {"X": QColor(230, 80, 80), "Y": QColor(110, 200, 90), "Z": QColor(80, 140, 240)}
-HANDLES_FIXED = "Hair keys move in value here; their handles are the sampled tangents"
 PICK_PX = 8.0
 MARGIN = 24.0  # pixels around the plot
 ZOOM_STEP = 1.15  # per wheel notch
@@ -271,8 +270,6 @@ class GraphView(QWidget):
                     self.capture.model.set_frame(int(c.keys[k]))  # the key's pose in the viewport
                 if hit is not None:
                     self._drag = ("key", p, hit, float(c.values[k]), int(c.keys[k]))
-                elif self.on_hair:
-                    self.capture.window.statusBar().showMessage(HANDLES_FIXED, 4000)
                 else:
                     self._drag = ("handle", p, handle, 0.0)
         event.accept()
@@ -324,9 +321,18 @@ class GraphView(QWidget):
             df = frame - float(c.keys[k])
             df = max(df, 0.25) if side > 0 else min(df, -0.25)  # a handle stays on its side
             self.last_value = (value - float(c.values[k])) / df
-            edit = self._tangent(i, k, self.last_value)
-            self.capture.preview(edit)
-            self._preview_curves([edit])
+            if self.on_hair:
+                result = self.hair.preview_slope(i, int(c.keys[k]), self.last_value)
+                s_in, s_out = np.array(c.slope_in, dtype=float), np.array(c.slope_out, dtype=float)
+                s_in[k] = s_out[k] = self.last_value
+                self.curves[i] = Curve(
+                    c.name, c.colour, c.original, result, c.key_curve, c.keys, c.values, s_in, s_out
+                )
+                self.update()
+            else:
+                edit = self._tangent(i, k, self.last_value)
+                self.capture.preview(edit)
+                self._preview_curves([edit])
         event.accept()
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
@@ -344,6 +350,9 @@ class GraphView(QWidget):
                 name = f"{self.capture.joint} {self.curves[i].name}"
                 moved = f" to {self.last_frame}" if self.last_frame != f0 else ""
                 self.capture.commit(edits, f"Move {name} key at {f0}{moved}")
+        elif drag is not None and drag[0] == "handle" and self.last_value is not None and self.on_hair:
+            _, _, (i, k, _), _ = drag
+            self.hair.commit_slope(i, int(self.curves[i].keys[k]), self.last_value)
         elif drag is not None and drag[0] == "handle" and self.last_value is not None:
             _, _, (i, k, _), _ = drag
             self.capture.preview(None)

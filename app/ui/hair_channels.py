@@ -5,8 +5,12 @@ The curves are the animation as it was opened (faint), as edited (the key curve 
 residuals) and the key curve alone through the timeline's DP keys, with the key poses' Hermite
 tangents as handles. A key dragged in value is the timeline's own residual-keeping key edit
 (:func:`hairtool.keys.session.key_edit_block`, the same as brushing the key pose, one undo step):
-the vertex moves at the key and the frames between its neighbouring keys follow. Hair handles
-show the sampled tangents and are not dragged (the hair key edit keeps them).
+the vertex moves at the key and the frames between its neighbouring keys follow. A key dragged
+sideways moves in time (:func:`hairtool.keys.edit.retime_key`: the frames between its neighbours
+retimed with it, the timeline's keys the moved ones). The handles are the key poses' Hermite
+tangents, which the timeline takes from the frames themselves; a handle dragged turns the
+frames between the neighbouring keys so that their own tangent at the key is the slope dragged
+to (:func:`hairtool.keys.edit.key_slope_block`), so the handle stays where it was dropped.
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ import numpy as np
 from PySide6.QtGui import QUndoCommand
 
 from app.ui.animation_ui import KeyEditCommand
-from hairtool.keys.edit import check_retime, retime_key
+from hairtool.keys.edit import check_retime, key_slope_block, retime_key
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at
 from hairtool.keys.session import key_edit_block
 
@@ -141,6 +145,31 @@ class HairChannels:
         else:
             command = HairKeyTimeCommand(m, start, before, block, m.dp_keys.copy(), keys)
             command.setText(f"Move key {key} to {to}")
+        self.window.undo_stack.push(command)
+
+
+    # -- handles --------------------------------------------------------------------------------
+    def slope_block(self, axis: int, key: int, slope: float) -> tuple[int, np.ndarray]:
+        """The frames after the vertex's ``axis`` handle at key ``key`` is turned to ``slope``
+        (per frame, both handles): :func:`hairtool.keys.edit.key_slope_block`, so the key poses
+        the timeline takes from the edited frames have that slope there."""
+        m = self.model
+        index = self.index() * 3 + axis
+        return key_slope_block(m.animation.frames, m.dp_keys, m.dp_poses.interp, key, index, slope)
+
+    def preview_slope(self, axis: int, key: int, slope: float) -> np.ndarray:
+        """The dragged axis's edited curve while a handle is dragged."""
+        start, block = self.slope_block(axis, key, slope)
+        result = self.model.animation.frames[:, self.index(), axis].astype(np.float64)
+        result[start : start + len(block)] = block[:, self.index(), axis]
+        return result
+
+    def commit_slope(self, axis: int, key: int, slope: float) -> None:
+        m = self.model
+        start, block = self.slope_block(axis, key, slope)
+        before = np.array(m.animation.frames[start : start + len(block)])
+        command = KeyEditCommand(m, m.generation, key, start, before, block)
+        command.setText(f"Turn vertex {AXES[axis]} handle at {key}")
         self.window.undo_stack.push(command)
 
 

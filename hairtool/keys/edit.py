@@ -144,3 +144,73 @@ def retime_key(
     curve = interpolate_at(warped, t)
     block = curve + residual_at(sub, lambda i: interpolate_at(base, i), time_warp(t, moved, sub_keys))
     return lo + 1, block.astype(f.dtype), after
+
+
+# -- a key's handle set -----------------------------------------------------------------------
+def _stretch(n: int, keys: I64, key_frame: int) -> tuple[int, int, I64]:
+    """``(s0, s1, sub keys)``: the frames between the key's neighbours and one more each side
+    (which keeps the Hermite tangents at the neighbours those of the whole animation), and the
+    keys there counted from s0."""
+    hit = np.flatnonzero(keys == int(key_frame))
+    if hit.size == 0:
+        raise ParameterError("key frame", key_frame, f"one of the keys {keys.tolist()}")
+    a = int(hit[0])
+    lo = int(keys[a - 1]) if a > 0 else int(key_frame)
+    hi = int(keys[a + 1]) if a < keys.size - 1 else int(key_frame)
+    s0, s1 = max(lo - 1, 0), min(hi + 1, n - 1)
+    return s0, s1, np.array(sorted({s0, lo, int(key_frame), hi, s1}), dtype=np.int64) - s0
+
+
+def key_slope_block(
+    frames: NDArray, keys: ArrayLike, interp: str, key_frame: int, index: int, slope: float
+) -> tuple[int, NDArray]:
+    """``(start, block)``: the frames after one component's handle at ``key_frame`` is turned so
+    that the edited frames' own key tangents there (leaving and arriving, as
+    :func:`~hairtool.keys.reconstruct.key_poses` takes them from the frames) are ``slope`` per
+    frame: a hair key's handle dragged in a graph editor, both handles aligned.
+
+    ``index`` is the component in a frame's flattened values (vertex·3 + axis). The change is
+    the residual-keeping edit of the key's tangents, Δ(t) = h10·L·δ_out + h11·L·δ_in between
+    the neighbouring keys (the key poses stay); the tangents read back from the edited frames
+    are affine in (δ_out, δ_in), so two trial edits give the δ that reads back ``slope``. Only
+    that component changes; linear keys have no handles (ParameterError)."""
+    if interp == "linear":
+        raise ParameterError("interp", interp, "hermite or hermite-fit (linear keys have no handles)")
+    f = np.asarray(frames)
+    n = f.shape[0]
+    k = check_keys(keys, n)
+    s0, s1, sub_keys = _stretch(n, k, key_frame)
+    a = int(np.flatnonzero(sub_keys == int(key_frame) - s0)[0])
+    flat = f[s0 : s1 + 1].reshape(s1 - s0 + 1, -1)
+    if not 0 <= index < flat.shape[1]:
+        raise ParameterError("index", index, f"a component 0..{flat.shape[1] - 1}")
+    y = flat[:, index].astype(np.float64)[:, None]
+    t = np.arange(y.shape[0])
+
+    def edited(d_out: float, d_in: float) -> F64:
+        out, inn = np.zeros((sub_keys.size, 1)), np.zeros((sub_keys.size, 1))
+        out[a], inn[a] = d_out, d_in
+        zero = np.zeros((sub_keys.size, 1))
+        return y + interpolate_at(KeyPoses(sub_keys, zero, out, y.shape[0], "hermite", inn), t)
+
+    def read(z: F64) -> F64:
+        kp = key_poses(z, sub_keys, interp)
+        arriving = kp.tangents if kp.tangents_in is None else kp.tangents_in
+        return np.array([kp.tangents[a, 0], arriving[a, 0]])
+
+    now = read(y)
+    gain = np.column_stack([read(edited(1.0, 0.0)) - now, read(edited(0.0, 1.0)) - now])
+    want = np.array([slope, slope], dtype=np.float64) - now
+    if interp == "hermite":  # one tangent per key: the same δ on both sides
+        g = gain.sum(axis=1)
+        d = float(g @ want / (g @ g)) if g @ g > 1e-12 else float(want[0])
+        delta = (d, d)
+    else:
+        try:
+            delta = tuple(np.linalg.solve(gain, want))
+        except np.linalg.LinAlgError:
+            delta = (float(want[0]), float(want[1]))
+    block = np.array(f[s0 : s1 + 1])
+    flat_out = block.reshape(s1 - s0 + 1, -1)
+    flat_out[:, index] = edited(*delta)[:, 0].astype(block.dtype)
+    return s0, block

@@ -127,3 +127,48 @@ def test_on_hair_a_key_dragged_sideways_is_the_librarys_retime(ui, make_window):
     w.undo_stack.undo()
     np.testing.assert_array_equal(m.animation.frames, anim.frames)
     assert np.array_equal(m.dp_keys, keys)
+
+
+def _hair(make_window, interp="hermite"):
+    from hairtool import samples
+    from hairtool.simulate.sway import sway_animation
+
+    w = make_window(groom=samples.comb(strands=6, vertices=5))
+    anim = sway_animation(w.scene.result, 30, 24.0, flick_frame=20)
+    w.animation.set_settings(interp=interp)
+    w.animation.load_animation(anim, "sway")
+    w.graph_editor.show()
+    view = w.graph_editor.view
+    view.resize(700, 260)
+    return w, view, anim
+
+
+@pytest.mark.parametrize("interp", ["hermite", "hermite-fit"])
+def test_on_hair_a_handle_drag_is_the_librarys_slope_edit_and_stays_where_dropped(ui, make_window, interp):
+    from hairtool.keys.edit import key_slope_block
+
+    w, view, anim = _hair(make_window, interp)
+    m = w.animation
+    assert view.on_hair and view.curves[0].slope_out is not None
+    k = 1
+    key = int(m.dp_keys[k])
+    hair, asked = w.graph_editor.hair, []
+    commit = hair.commit_slope
+    hair.commit_slope = lambda axis, key, slope: (asked.append(slope), commit(axis, key, slope))
+    before = float(view.curves[0].slope_out[k])
+    p = np.array(view.handle_point(0, k, 1))
+    ui.drag(view, p, p + np.array([0.0, -30.0]))
+    assert w.undo_stack.count() == 1 and len(asked) == 1
+    slope = asked[0]
+    assert slope > before
+    v = int(anim.topology.offsets[1]) - 1  # strand 0's tip: the dock's default vertex
+    start, block = key_slope_block(anim.frames, m.dp_keys, interp, key, v * 3, slope)
+    expected = np.array(anim.frames)
+    expected[start : start + len(block)] = block
+    np.testing.assert_allclose(m.animation.frames, expected, atol=1e-6)
+    assert not np.allclose(m.animation.frames, anim.frames)
+    # the handle stays where it was dropped: the frames' own tangent there is the slope
+    assert view.curves[0].slope_out[k] == pytest.approx(slope, abs=1e-5)
+    assert view.curves[0].slope_in[k] == pytest.approx(slope, abs=1e-5)
+    w.undo_stack.undo()
+    np.testing.assert_array_equal(m.animation.frames, anim.frames)
