@@ -23,19 +23,23 @@ from typing import TYPE_CHECKING
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPainter, QPen, QWheelEvent
-from PySide6.QtWidgets import QDockWidget, QHBoxLayout, QLabel, QSpinBox, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QCheckBox, QDockWidget, QHBoxLayout, QLabel, QSpinBox, QVBoxLayout, QWidget
 
 from app.ui import view_range
 from app.ui.capture_edit import CaptureEditor
 from app.ui.hair_channels import HairChannels
 from app.ui.timeline_plots import polygon
+from hairtool.keys.channels import per_channel_keys
+from hairtool.keys.reconstruct import interpolate_keys, key_poses
 from hairtool.mocap import ik
+from hairtool.mocap.channel_edit import channel_features
 from hairtool.mocap.pose_edit import ChannelEdit, Edit, RetimeEdit, TangentEdit
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
 
 AXIS_COLOURS = {"X": QColor(230, 80, 80), "Y": QColor(110, 200, 90), "Z": QColor(80, 140, 240)}
+VIEW_ONLY = "Per-channel keys are shown to compare: switch them off to drag the pose keys"
 PICK_PX = 8.0
 MARGIN = 24.0  # pixels around the plot
 ZOOM_STEP = 1.15  # per wheel notch
@@ -102,6 +106,50 @@ def capture_curves(capture: CaptureEditor) -> list[Curve]:
     return out
 
 
+def channel_curves(capture: CaptureEditor, cache: dict) -> list[Curve]:
+    """The selected joint's rotation channels with seed 003's per-channel keys: each channel
+    keyed on its own (at the timeline's price per key, on the capture as captured, angles
+    unwrapped) and drawn with its own key points and key curve through the edited capture's
+    values there; for viewing (keys are dragged with the pose keys)."""
+    if not capture.attached or capture.editor is None or not capture.joint:
+        return []
+    m = capture.original
+    j = m.joint_names.index(capture.joint)
+    cols, order = ik.rotation_columns(m, j)
+    if not cols:
+        return []
+    settings = capture.model.settings
+    interp = capture.editor.interp
+    what = (capture.generation, j, settings.tau, interp)
+    if cache.get("what") != what:
+        x = channel_features(m)[:, cols]
+        cache.update(what=what, keys=per_channel_keys(x, settings.tau, interp=interp, relative=True).keys)
+    motion = capture.motion()
+    result = motion.values[:, cols]
+    edited = channel_features(motion)[:, cols]
+    out = []
+    for i, c in enumerate(cols):
+        keys = cache["keys"][i]
+        kp = key_poses(edited[:, i : i + 1], keys, interp)
+        curve = interpolate_keys(kp)[:, 0] + (result[:, i] - edited[:, i])  # the capture's own turns
+        slopes = None if kp.tangents is None else kp.tangents[:, 0]
+        arriving = slopes if kp.tangents_in is None else kp.tangents_in[:, 0]
+        out.append(
+            Curve(
+                m.channels[j][c - int(m._starts[j])],
+                AXIS_COLOURS.get(order[i], QColor(200, 200, 200)),
+                m.values[:, c],
+                result[:, i],
+                curve,
+                keys,
+                curve[keys],
+                arriving,
+                slopes,
+            )
+        )
+    return out
+
+
 class GraphView(QWidget):
     """The plot: curves, keys and handles; key drags, zoom and pan (module docstring)."""
 
@@ -117,6 +165,8 @@ class GraphView(QWidget):
         self.last_frame = 0  # and the frame
         self._drag: tuple | None = None
         self._framed_for: tuple | None = None
+        self.per_channel = False  # a capture's channels with their own keys (seed 003), to view
+        self._channel_keys: dict = {}
         self.setMinimumSize(240, 120)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMouseTracking(False)
@@ -127,7 +177,12 @@ class GraphView(QWidget):
         return not self.capture.attached and self.hair.active
 
     def refresh(self) -> None:
-        self.curves = hair_curves(self.hair) if self.on_hair else capture_curves(self.capture)
+        if self.on_hair:
+            self.curves = hair_curves(self.hair)
+        elif self.per_channel:
+            self.curves = channel_curves(self.capture, self._channel_keys)
+        else:
+            self.curves = capture_curves(self.capture)
         if self.on_hair:
             what = ("hair", self.capture.model.generation, self.hair.strand, self.hair.vertex)
         else:
@@ -257,6 +312,11 @@ class GraphView(QWidget):
 
     def mousePressEvent(self, event: QMouseEvent) -> None:
         p = event.position()
+        viewing = self.per_channel and not self.on_hair
+        if event.button() == Qt.MouseButton.LeftButton and viewing and self.key_at(p.x(), p.y()):
+            self.capture.window.statusBar().showMessage(VIEW_ONLY, 5000)
+            event.accept()
+            return
         if event.button() == Qt.MouseButton.MiddleButton:
             ctrl = bool(event.modifiers() & Qt.KeyboardModifier.ControlModifier)
             self._drag = ("zoom" if ctrl else "pan", p, p)
@@ -483,6 +543,13 @@ class GraphEditorDock(QDockWidget):
         self.vertex.valueChanged.connect(self._pick_vertex)
         top = QHBoxLayout()
         top.addWidget(self.title, 1)
+        self.per_channel = QCheckBox("Per-channel keys")
+        self.per_channel.setToolTip(
+            "Each rotation channel keyed on its own at the timeline's price per key (seed 003: "
+            "every degree of freedom its own curve and keys), to compare with the pose keys"
+        )
+        self.per_channel.toggled.connect(self._set_per_channel)
+        top.addWidget(self.per_channel)
         self.pickers = [QLabel("Strand"), self.strand, QLabel("Vertex"), self.vertex]
         for widget in self.pickers:
             top.addWidget(widget)
@@ -511,6 +578,10 @@ class GraphEditorDock(QDockWidget):
         model.frame_changed.connect(lambda *_: self.view.update())
         self.refresh()
 
+    def _set_per_channel(self, on: bool) -> None:
+        self.view.per_channel = bool(on)
+        self.refresh()
+
     def _pick_vertex(self, *_: object) -> None:
         self.hair.strand, self.hair.vertex = self.strand.value(), self.vertex.value()
         self.view.refresh()
@@ -520,6 +591,7 @@ class GraphEditorDock(QDockWidget):
         on_hair = self.view.on_hair
         for widget in self.pickers:
             widget.setVisible(on_hair)
+        self.per_channel.setVisible(c.attached)
         if on_hair:
             topo = self.window.animation.animation.topology
             self.strand.setMaximum(topo.strand_count - 1)
@@ -527,5 +599,7 @@ class GraphEditorDock(QDockWidget):
             self.vertex.setMaximum(int(topo.offsets[s + 1] - topo.offsets[s]) - 1)
             self.title.setText("strand vertex: x, y, z")
         else:
-            self.title.setText(f"{c.joint}: rotation channels (degrees)" if c.attached and c.joint else "")
+            each = ", each with its own keys" if self.view.per_channel else ""
+            shown = c.attached and c.joint
+            self.title.setText(f"{c.joint}: rotation channels (degrees){each}" if shown else "")
         self.view.refresh()

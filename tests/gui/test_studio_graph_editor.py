@@ -172,3 +172,28 @@ def test_on_hair_a_handle_drag_is_the_librarys_slope_edit_and_stays_where_droppe
     assert view.curves[0].slope_in[k] == pytest.approx(slope, abs=1e-5)
     w.undo_stack.undo()
     np.testing.assert_array_equal(m.animation.frames, anim.frames)
+
+
+def test_per_channel_keys_show_each_channels_own_keys(ui, graph):
+    from hairtool.keys.channels import per_channel_keys
+    from hairtool.mocap import ik
+    from hairtool.mocap.channel_edit import channel_features
+
+    w, view, motion = graph
+    dock = w.graph_editor
+    assert dock.per_channel.isVisibleTo(dock)
+    dock.per_channel.setChecked(True)
+    j = motion.joint_names.index(ARM)
+    cols, _ = ik.rotation_columns(motion, j)
+    tau, interp = w.animation.settings.tau, w.capture.editor.interp
+    expected = per_channel_keys(channel_features(motion)[:, cols], tau, interp=interp, relative=True).keys
+    assert [c.keys.tolist() for c in view.curves] == [k.tolist() for k in expected]
+    assert len({tuple(c.keys.tolist()) for c in view.curves}) > 1  # the channels keep different keys
+    for i, c in enumerate(view.curves):
+        np.testing.assert_array_equal(c.original, motion.values[:, cols[i]])
+        np.testing.assert_allclose(c.key_curve[c.keys], motion.values[c.keys, cols[i]], atol=1e-9)
+    p = np.array(view.key_point(0, 1))
+    ui.drag(view, p, p + np.array([10.0, -20.0]))  # for viewing: no edit
+    assert w.undo_stack.count() == 0 and "Per-channel" in w.statusBar().currentMessage()
+    dock.per_channel.setChecked(False)
+    assert all(np.array_equal(c.keys, w.capture.editor.keys) for c in view.curves)
