@@ -26,7 +26,14 @@ from PySide6.QtWidgets import QFormLayout, QGroupBox, QLabel, QScrollArea, QSpin
 
 from app.ui.animation_io import skeleton_animation
 from hairtool.errors import FormatError, HairtoolError
+from hairtool.keys.channels import per_channel_keys
 from hairtool.mocap.bvh import Motion, read_bvh, write_bvh
+from hairtool.mocap.channel_edit import (
+    ChannelEditor,
+    ChannelRetimeEdit,
+    channel_features,
+    parse_channel_edits,
+)
 from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, RetimeEdit, parse_edit_list
 
 if TYPE_CHECKING:
@@ -76,6 +83,22 @@ class PoseEditCommand(QUndoCommand):
     def undo(self) -> None:
         if self.capture.generation == self.generation and self.capture.attached:
             self.capture.pop(len(self.edits))
+
+
+class ChannelKeyCommand(QUndoCommand):
+    """A per-channel key dragged in the graph editor (its moves in time, value or slope)."""
+
+    def __init__(self, capture: CaptureEditor, edits: list, text: str) -> None:
+        super().__init__(text)
+        self.capture, self.generation, self.edits = capture, capture.generation, edits
+
+    def redo(self) -> None:
+        if self.capture.generation == self.generation and self.capture.attached:
+            self.capture.push_channel(self.edits)
+
+    def undo(self) -> None:
+        if self.capture.generation == self.generation and self.capture.attached:
+            self.capture.pop_channel(len(self.edits))
 
 
 class JointDrag:
@@ -159,6 +182,10 @@ class CaptureEditor(QObject):
         self._preview: tuple[int, np.ndarray] | None = None  # frame, (J, 3) joints being dragged
         self.drag = JointDrag(self)
         self._syncing = False  # the timeline's keys are being set to the edited ones
+        self.channel_edits: list = []  # per-channel key edits, over the pose edits
+        self.channel_applied: list[bool] = []
+        self._column_keys: dict = {}
+        self._layer: ChannelEditor | None = None
         self.model.animation_changed.connect(self._on_animation_changed)
         self.model.keys_changed.connect(self._on_keys_changed)
         self.box = self._tool_box()
@@ -180,6 +207,7 @@ class CaptureEditor(QObject):
         self.generation = self.model.generation
         self.model.key_source = skeleton_animation(motion)  # keys of the capture as captured
         self.edits, self.applied, self.joint = [], [], ""
+        self.channel_edits, self.channel_applied, self._column_keys, self._layer = [], [], {}, None
         self.window.viewport.brush_target = self.drag
         self._rebuild(show=False)
         self._sync_box()
@@ -189,6 +217,7 @@ class CaptureEditor(QObject):
     def _on_animation_changed(self) -> None:
         if self.original is not None and self.generation != self.model.generation:
             self.original, self.editor, self.edits, self.applied = None, None, [], []
+            self.channel_edits, self.channel_applied, self._column_keys, self._layer = [], [], {}, None
             self.joint, self._preview, self.ghosts = "", None, []
             self._sync_box()
             self.selection_changed.emit("")
@@ -217,6 +246,7 @@ class CaptureEditor(QObject):
             return
         interp = m.dp_poses.interp if m.dp_poses is not None else m.settings.interp
         self.editor = PoseEditor(self.original, keys, interp)
+        self._layer = None
         self.applied = []
         for e in self.edits:
             self.applied.append(self._try(e))
@@ -246,8 +276,112 @@ class CaptureEditor(QObject):
         return True
 
     def motion(self) -> Motion:
-        """The edited capture at every frame (the capture itself before any edit or keys)."""
-        return self.editor.motion() if self.editor is not None else self.original
+        """The edited capture at every frame (the capture itself before any edit or keys): the
+        pose-key edits, then the per-channel key edits on top."""
+        if self.editor is None:
+            return self.original
+        if self.channel_edits:
+            return self.channel_layer().motion()
+        return self.editor.motion()
+
+    # -- per-channel keys (seed 003: each channel its own keys) --------------------------------
+    def column_keys(self, cols: list[int]) -> list[np.ndarray]:
+        """Each column's own keys, solved on the capture as captured at the timeline's price per
+        key (relative), angles unwrapped; cached per column until the price or interpolation
+        changes."""
+        interp = self.editor.interp if self.editor is not None else self.model.settings.interp
+        what = (self.generation, self.model.settings.tau, interp)
+        if self._column_keys.get("what") != what:
+            self._column_keys = {"what": what}
+            self._layer = None
+        missing = [c for c in cols if c not in self._column_keys]
+        if missing:
+            x = channel_features(self.original)[:, missing]
+            found = per_channel_keys(x, self.model.settings.tau, interp=interp, relative=True).keys
+            self._column_keys.update(zip(missing, found, strict=True))
+        return [self._column_keys[c] for c in cols]
+
+    def channel_layer(self) -> ChannelEditor | None:
+        """The per-channel key edits over the pose-edited capture (a ChannelEditor on it, its
+        edits applied where they still apply); None before keys."""
+        if self.editor is None:
+            return None
+        cols = sorted({self._column(e) for e in self.channel_edits})
+        solved = dict(zip(cols, self.column_keys(cols), strict=True))
+        if self._layer is None:
+            m = self.original
+            two = np.array([0, m.n_frames - 1], dtype=np.int64)
+            keys = [solved.get(c, self._column_keys.get(c, two)) for c in range(m.n_channels)]
+            layer = ChannelEditor(self.editor.motion(), keys, self.editor.interp)
+            self.channel_applied = []
+            for e in self.channel_edits:
+                try:
+                    layer.apply_all([e])
+                    self.channel_applied.append(True)
+                except HairtoolError:
+                    self.channel_applied.append(False)
+            self._layer = layer
+        return self._layer
+
+    def _column(self, edit: object) -> int:
+        m = self.original
+        j = m.joint_names.index(edit.joint)
+        return int(m._starts[j]) + m.channels[j].index(edit.channel)
+
+    def push_channel(self, edits: list) -> None:
+        """Per-channel key edits (the undo command's redo)."""
+        self.channel_edits.extend(edits)
+        self._layer = None
+        self._show()
+        self.changed.emit()
+
+    def pop_channel(self, count: int) -> None:
+        del self.channel_edits[len(self.channel_edits) - count :]
+        self._layer = None
+        self._show()
+        self.changed.emit()
+
+    def commit_channel(self, edits: list, text: str) -> bool:
+        """One undo step for a per-channel key dragged (refused with a message when it cannot be)."""
+        for c in {self._column(e) for e in edits}:
+            self.column_keys([c])
+        self._layer = None
+        layer = self.channel_layer()
+        if layer is None:
+            return False
+        done = 0
+        try:
+            for e in edits:
+                layer.apply_all([e])
+                done += 1
+        except HairtoolError as e:
+            self.window.show_error("Cannot move the key", str(e))
+            return False
+        finally:
+            for _ in range(done):
+                layer.undo()
+        self.window.undo_stack.push(ChannelKeyCommand(self, list(edits), text))
+        return True
+
+    def preview_channel(self, edits: list | None) -> Motion | None:
+        """Show per-channel key edits at the dragged key's frame (None: stop); the edited capture
+        is returned."""
+        m = self.model
+        layer = self.channel_layer()
+        if not edits or layer is None:
+            m.set_preview(m.frame, None)
+            return None
+        layer.apply_all(edits)
+        try:
+            out = layer.motion()
+        finally:
+            for _ in edits:
+                layer.undo()
+        last = edits[-1]
+        key = last.to if isinstance(last, ChannelRetimeEdit) else last.frame
+        sub = out.with_values(out.values[key : key + 1])
+        m.set_preview(key, skeleton_animation(sub).frames[0])
+        return out
 
     def _show(self) -> None:
         """The timeline's skeleton becomes the edited capture (only the frames that changed)."""
@@ -264,6 +398,7 @@ class CaptureEditor(QObject):
         for edit in edits if isinstance(edits, list) else [edits]:
             self.edits.append(edit)
             self.applied.append(self._try(edit))
+        self._layer = None
         self._sync_keys()
         self._show()
         self.changed.emit()
@@ -274,6 +409,7 @@ class CaptureEditor(QObject):
             self.edits.pop()
             if self.applied.pop():
                 self.editor.undo()
+        self._layer = None
         self._sync_keys()
         self._show()
         self.changed.emit()
@@ -383,6 +519,7 @@ class CaptureEditor(QObject):
             "bvh": motion_text(self.original),
             "source": self.source,
             "edits": [e.to_dict() for e in self.edits],
+            "channel_edits": [e.to_dict() for e in self.channel_edits],
             "chain": self.chain,
         }
 
@@ -397,6 +534,7 @@ class CaptureEditor(QObject):
             if skeleton_animation(motion).topology != self.model.animation.topology:
                 raise FormatError(where, "the capture's skeleton is not the project's animation")
             edits = parse_edit_list(saved.get("edits", []), motion, where)
+            channel_edits = parse_channel_edits(saved.get("channel_edits", []), motion, where)
         except HairtoolError as e:
             self.window.show_error("Some project settings were not applied", str(e))
             return
@@ -404,6 +542,7 @@ class CaptureEditor(QObject):
         if isinstance(saved.get("chain"), int):
             self.set_chain(saved["chain"])
         self.edits = list(edits)
+        self.channel_edits = list(channel_edits)
         if np.array_equal(self.model.key_source.frames, self.model.animation.frames):
             self._rebuild()
         else:  # the project's frames are the edited ones: key the capture (rebuilt on its keys)

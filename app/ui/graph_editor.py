@@ -29,17 +29,14 @@ from app.ui import view_range
 from app.ui.capture_edit import CaptureEditor
 from app.ui.hair_channels import HairChannels
 from app.ui.timeline_plots import polygon
-from hairtool.keys.channels import per_channel_keys
-from hairtool.keys.reconstruct import interpolate_keys, key_poses
 from hairtool.mocap import ik
-from hairtool.mocap.channel_edit import channel_features
+from hairtool.mocap.channel_edit import ChannelRetimeEdit
 from hairtool.mocap.pose_edit import ChannelEdit, Edit, RetimeEdit, TangentEdit
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
 
 AXIS_COLOURS = {"X": QColor(230, 80, 80), "Y": QColor(110, 200, 90), "Z": QColor(80, 140, 240)}
-VIEW_ONLY = "Per-channel keys are shown to compare: switch them off to drag the pose keys"
 PICK_PX = 8.0
 MARGIN = 24.0  # pixels around the plot
 ZOOM_STEP = 1.15  # per wheel notch
@@ -106,11 +103,11 @@ def capture_curves(capture: CaptureEditor) -> list[Curve]:
     return out
 
 
-def channel_curves(capture: CaptureEditor, cache: dict) -> list[Curve]:
+def channel_curves(capture: CaptureEditor) -> list[Curve]:
     """The selected joint's rotation channels with seed 003's per-channel keys: each channel
     keyed on its own (at the timeline's price per key, on the capture as captured, angles
-    unwrapped) and drawn with its own key points and key curve through the edited capture's
-    values there; for viewing (keys are dragged with the pose keys)."""
+    unwrapped), with its own key points, key curve and handles; their edits lie over the pose
+    keys' (:meth:`CaptureEditor.channel_layer`)."""
     if not capture.attached or capture.editor is None or not capture.joint:
         return []
     m = capture.original
@@ -118,33 +115,25 @@ def channel_curves(capture: CaptureEditor, cache: dict) -> list[Curve]:
     cols, order = ik.rotation_columns(m, j)
     if not cols:
         return []
-    settings = capture.model.settings
-    interp = capture.editor.interp
-    what = (capture.generation, j, settings.tau, interp)
-    if cache.get("what") != what:
-        x = channel_features(m)[:, cols]
-        cache.update(what=what, keys=per_channel_keys(x, settings.tau, interp=interp, relative=True).keys)
-    motion = capture.motion()
-    result = motion.values[:, cols]
-    edited = channel_features(motion)[:, cols]
+    capture.column_keys(cols)
+    layer = capture.channel_layer()
+    result = layer.motion().values
     out = []
     for i, c in enumerate(cols):
-        keys = cache["keys"][i]
-        kp = key_poses(edited[:, i : i + 1], keys, interp)
-        curve = interpolate_keys(kp)[:, 0] + (result[:, i] - edited[:, i])  # the capture's own turns
-        slopes = None if kp.tangents is None else kp.tangents[:, 0]
-        arriving = slopes if kp.tangents_in is None else kp.tangents_in[:, 0]
+        keys = layer.keys(c)
+        curve = layer.key_curve(c)
+        slopes = layer.key_slopes(c)
         out.append(
             Curve(
                 m.channels[j][c - int(m._starts[j])],
                 AXIS_COLOURS.get(order[i], QColor(200, 200, 200)),
                 m.values[:, c],
-                result[:, i],
+                result[:, c],
                 curve,
                 keys,
                 curve[keys],
-                arriving,
-                slopes,
+                None if slopes is None else slopes[0],
+                None if slopes is None else slopes[1],
             )
         )
     return out
@@ -165,8 +154,7 @@ class GraphView(QWidget):
         self.last_frame = 0  # and the frame
         self._drag: tuple | None = None
         self._framed_for: tuple | None = None
-        self.per_channel = False  # a capture's channels with their own keys (seed 003), to view
-        self._channel_keys: dict = {}
+        self.per_channel = False  # a capture's channels with their own keys (seed 003)
         self.setMinimumSize(240, 120)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMouseTracking(False)
@@ -180,7 +168,7 @@ class GraphView(QWidget):
         if self.on_hair:
             self.curves = hair_curves(self.hair)
         elif self.per_channel:
-            self.curves = channel_curves(self.capture, self._channel_keys)
+            self.curves = channel_curves(self.capture)
         else:
             self.curves = capture_curves(self.capture)
         if self.on_hair:
@@ -312,11 +300,6 @@ class GraphView(QWidget):
 
     def mousePressEvent(self, event: QMouseEvent) -> None:
         p = event.position()
-        viewing = self.per_channel and not self.on_hair
-        if event.button() == Qt.MouseButton.LeftButton and viewing and self.key_at(p.x(), p.y()):
-            self.capture.window.statusBar().showMessage(VIEW_ONLY, 5000)
-            event.accept()
-            return
         if event.button() == Qt.MouseButton.MiddleButton:
             ctrl = bool(event.modifiers() & Qt.KeyboardModifier.ControlModifier)
             self._drag = ("zoom" if ctrl else "pan", p, p)
@@ -372,8 +355,7 @@ class GraphView(QWidget):
                 self.update()
             else:
                 edits = self._edits(i, f0, to, v0, value)
-                self.capture.preview(edits or None)
-                self._preview_curves(edits)
+                self._preview(edits)
         elif kind == "handle":
             _, _, (i, k, side), _ = self._drag
             c = self.curves[i]
@@ -390,9 +372,7 @@ class GraphView(QWidget):
                 )
                 self.update()
             else:
-                edit = self._tangent(i, k, self.last_value)
-                self.capture.preview(edit)
-                self._preview_curves([edit])
+                self._preview([self._tangent(i, k, self.last_value)])
         event.accept()
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
@@ -409,7 +389,7 @@ class GraphView(QWidget):
             if edits:
                 name = f"{self.capture.joint} {self.curves[i].name}"
                 moved = f" to {self.last_frame}" if self.last_frame != f0 else ""
-                self.capture.commit(edits, f"Move {name} key at {f0}{moved}")
+                self._commit(edits, f"Move {name} key at {f0}{moved}")
         elif drag is not None and drag[0] == "handle" and self.last_value is not None and self.on_hair:
             _, _, (i, k, _), _ = drag
             self.hair.commit_slope(i, int(self.curves[i].keys[k]), self.last_value)
@@ -417,7 +397,7 @@ class GraphView(QWidget):
             _, _, (i, k, _), _ = drag
             self.capture.preview(None)
             edit = self._tangent(i, k, self.last_value)
-            self.capture.commit(edit, f"Turn {edit.joint} {edit.channel} handle at {edit.frame}")
+            self._commit([edit], f"Turn {edit.joint} {edit.channel} handle at {edit.frame}")
         self.last_value = None
         event.accept()
 
@@ -433,7 +413,13 @@ class GraphView(QWidget):
         """A key dragged from ``frame`` and value ``start`` to ``to`` and ``value``: the move in
         time (the key frame after it is ``to``), then the new value there; none when it went
         nowhere."""
-        out: list[Edit] = [] if to == frame else [RetimeEdit(frame, to)]
+        name = self.curves[i].name
+        if to == frame:
+            out: list[Edit] = []
+        elif self.per_channel:  # that channel's key alone
+            out = [ChannelRetimeEdit(frame, self.capture.joint, name, to)]
+        else:  # the pose key, every channel
+            out = [RetimeEdit(frame, to)]
         if value != start:
             out.append(ChannelEdit(int(to), self.capture.joint, self.curves[i].name, float(value)))
         return out
@@ -442,16 +428,29 @@ class GraphView(QWidget):
         c = self.curves[i]
         return TangentEdit(int(c.keys[k]), self.capture.joint, c.name, float(slope))
 
-    def _preview_curves(self, edits: list[Edit]) -> None:
-        """The joint's channels as the edits would make them (the capture's editor, then undone)."""
-        editor = self.capture.editor
+    def _preview(self, edits: list[Edit]) -> None:
+        """The viewport and the joint's channels as the edits would make them (the capture's
+        editor, or its per-channel layer, then undone)."""
+        if self.per_channel:
+            self.capture.preview_channel(edits or None)
+            editor, curves = self.capture.channel_layer(), channel_curves
+        else:
+            self.capture.preview(edits or None)
+            editor, curves = self.capture.editor, capture_curves
         editor.apply_all(edits)
         try:
-            self.curves = capture_curves(self.capture)
+            self.curves = curves(self.capture)
         finally:
             for _ in edits:
                 editor.undo()
         self.update()
+
+    def _commit(self, edits: list[Edit], text: str) -> None:
+        if self.per_channel:
+            self.capture.preview_channel(None)
+            self.capture.commit_channel(edits, text)
+        else:
+            self.capture.commit(edits, text)
 
     # -- drawing -----------------------------------------------------------------------------
     def paintEvent(self, event) -> None:
@@ -546,7 +545,8 @@ class GraphEditorDock(QDockWidget):
         self.per_channel = QCheckBox("Per-channel keys")
         self.per_channel.setToolTip(
             "Each rotation channel keyed on its own at the timeline's price per key (seed 003: "
-            "every degree of freedom its own curve and keys), to compare with the pose keys"
+            "every degree of freedom its own curve and keys). Its keys drag like the pose keys, "
+            "in value, time and handles, one channel at a time, over the pose keys' edits"
         )
         self.per_channel.toggled.connect(self._set_per_channel)
         top.addWidget(self.per_channel)

@@ -22,12 +22,12 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hairtool.errors import ParameterError
+from hairtool.errors import FormatError, ParameterError
 from hairtool.keys.edit import check_retime, residual_at, time_warp
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at, interpolate_keys, key_poses
 from hairtool.mocap import ik
 from hairtool.mocap.bvh import MAX_VALUE, Motion
-from hairtool.mocap.pose_edit import INTERPS, ChannelEdit, EditReport, PoseEdit, TangentEdit
+from hairtool.mocap.pose_edit import INTERPS, ChannelEdit, EditReport, PoseEdit, TangentEdit, parse_edit_list
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -84,6 +84,37 @@ class ChannelRetimeEdit:
 
 
 ChannelKeyEdit = ChannelEdit | TangentEdit | ChannelRetimeEdit
+
+
+def parse_channel_edits(data: object, motion: Motion, source: str = "edits") -> list[ChannelKeyEdit]:
+    """Per-channel key edits from JSON data (what a studio project keeps): value and handle
+    edits as :func:`~hairtool.mocap.pose_edit.parse_edit_list` reads them, and key moves
+    ``{"frame", "joint", "channel", "to"}``; faults raise FormatError naming ``source``."""
+    if not isinstance(data, list):
+        raise FormatError(source, "expected a list of per-channel key edits")
+    out: list[ChannelKeyEdit] = []
+    for i, e in enumerate(data, 1):
+        if isinstance(e, dict) and "to" in e and "channel" in e:
+            fields = ("frame", "joint", "channel", "to")
+            if set(e) != set(fields):
+                raise FormatError(source, f"channel edit {i} needs exactly the fields {', '.join(fields)}")
+            try:
+                (value,) = parse_edit_list([{**{k: e[k] for k in fields[:3]}, "value": 0.0}], motion, source)
+            except FormatError as err:
+                raise FormatError(source, err.reason.replace("edit 1", f"channel edit {i}", 1)) from None
+            to = e["to"]
+            if not isinstance(to, int) or isinstance(to, bool) or not 0 <= to < motion.n_frames:
+                raise FormatError(source, f"channel edit {i}: to {str(to)[:40]} is not a frame number")
+            out.append(ChannelRetimeEdit(value.frame, value.joint, value.channel, int(to)))
+            continue
+        try:
+            (edit,) = parse_edit_list([e], motion, source)
+        except FormatError as err:
+            raise FormatError(source, err.reason.replace("edit 1", f"channel edit {i}", 1)) from None
+        if not isinstance(edit, ChannelEdit | TangentEdit):
+            raise FormatError(source, f"channel edit {i} is not a key's value, slope or move of one channel")
+        out.append(edit)
+    return out
 
 
 @dataclass

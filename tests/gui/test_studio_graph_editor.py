@@ -174,26 +174,74 @@ def test_on_hair_a_handle_drag_is_the_librarys_slope_edit_and_stays_where_droppe
     np.testing.assert_array_equal(m.animation.frames, anim.frames)
 
 
-def test_per_channel_keys_show_each_channels_own_keys(ui, graph):
+def test_per_channel_keys_show_each_channels_own_keys_and_drag_like_the_library(ui, graph):
     from hairtool.keys.channels import per_channel_keys
     from hairtool.mocap import ik
-    from hairtool.mocap.channel_edit import channel_features
+    from hairtool.mocap.channel_edit import ChannelEditor, ChannelRetimeEdit, channel_features
+    from hairtool.mocap.pose_edit import TangentEdit
 
     w, view, motion = graph
-    dock = w.graph_editor
+    dock, c = w.graph_editor, w.capture
     assert dock.per_channel.isVisibleTo(dock)
     dock.per_channel.setChecked(True)
     j = motion.joint_names.index(ARM)
     cols, _ = ik.rotation_columns(motion, j)
-    tau, interp = w.animation.settings.tau, w.capture.editor.interp
+    tau, interp = w.animation.settings.tau, c.editor.interp
     expected = per_channel_keys(channel_features(motion)[:, cols], tau, interp=interp, relative=True).keys
-    assert [c.keys.tolist() for c in view.curves] == [k.tolist() for k in expected]
-    assert len({tuple(c.keys.tolist()) for c in view.curves}) > 1  # the channels keep different keys
-    for i, c in enumerate(view.curves):
-        np.testing.assert_array_equal(c.original, motion.values[:, cols[i]])
-        np.testing.assert_allclose(c.key_curve[c.keys], motion.values[c.keys, cols[i]], atol=1e-9)
-    p = np.array(view.key_point(0, 1))
-    ui.drag(view, p, p + np.array([10.0, -20.0]))  # for viewing: no edit
-    assert w.undo_stack.count() == 0 and "Per-channel" in w.statusBar().currentMessage()
+    assert [cv.keys.tolist() for cv in view.curves] == [k.tolist() for k in expected]
+    assert len({tuple(cv.keys.tolist()) for cv in view.curves}) > 1  # the channels keep different keys
+    for i, cv in enumerate(view.curves):
+        np.testing.assert_array_equal(cv.original, motion.values[:, cols[i]])
+        np.testing.assert_allclose(cv.key_curve[cv.keys], motion.values[cv.keys, cols[i]], atol=1e-9)
+    # one channel's key dragged in time and value: one step, that channel's keys alone move
+    i = 1
+    keys = view.curves[i].keys.copy()
+    k = int(np.argmax(np.minimum(np.diff(keys)[:-1], np.diff(keys)[1:]))) + 1
+    f0 = int(keys[k])
+    p = np.array(view.key_point(i, k))
+    ui.drag(view, p, p + np.array([_frames_px(view, 1), -25.0]))
+    assert w.undo_stack.count() == 1 and c.edits == []
+    move, value = c.channel_edits
+    name = view.curves[i].name
+    assert move == ChannelRetimeEdit(f0, ARM, name, f0 + 1) and value.frame == f0 + 1
+    lib = ChannelEditor(motion, c.channel_layer()._keys0, interp)
+    lib.apply_all(c.channel_edits)
+    assert np.array_equal(c.motion().values, lib.motion().values)
+    assert view.curves[i].keys.tolist() == lib.keys(cols[i]).tolist()
+    assert [cv.keys.tolist() for n, cv in enumerate(view.curves) if n != i] == [
+        e.tolist() for n, e in enumerate(expected) if n != i
+    ]
+    np.testing.assert_array_equal(w.animation.animation.frames, skeleton_animation(lib.motion()).frames)
+    # its handle
+    if view.curves[i].slope_out is not None:
+        h = np.array(view.handle_point(i, k, 1))
+        ui.drag(view, h, h + np.array([0.0, -20.0]))
+        assert w.undo_stack.count() == 2 and isinstance(c.channel_edits[-1], TangentEdit)
+        lib.apply_all(c.channel_edits[2:])
+        assert np.array_equal(c.motion().values, lib.motion().values)
+        w.undo_stack.undo()
+    w.undo_stack.undo()
+    assert c.channel_edits == [] and np.array_equal(c.motion().values, motion.values)
     dock.per_channel.setChecked(False)
-    assert all(np.array_equal(c.keys, w.capture.editor.keys) for c in view.curves)
+    assert all(np.array_equal(cv.keys, c.editor.keys) for cv in view.curves)
+
+
+def test_a_project_keeps_the_moved_keys(ui, graph, make_window, tmp_path):
+    w, view, _ = graph
+    c = w.capture
+    keys = c.editor.keys.copy()
+    p = np.array(view.key_point(1, 2))
+    ui.drag(view, p, p + np.array([_frames_px(view, 2), 0.0]))  # a pose key moved in time
+    w.graph_editor.per_channel.setChecked(True)
+    p = np.array(view.key_point(0, 1))
+    ui.drag(view, p, p + np.array([0.0, -20.0]))  # a per-channel key moved in value
+    assert c.edits and c.channel_edits
+    edited = c.motion().values
+    path = tmp_path / "moved.hairproj"
+    assert w.project.save_to(path)
+    w2 = make_window()
+    assert w2.open_path(path) and not w2.errors
+    c2 = w2.capture
+    assert c2.edits == c.edits and c2.channel_edits == c.channel_edits
+    np.testing.assert_array_equal(c2.motion().values, edited)
+    assert w2.animation.dp_keys.tolist() == w.animation.dp_keys.tolist() != keys.tolist()
