@@ -23,7 +23,7 @@ from hairtool.errors import GroomError, HairtoolError, ParameterError
 from hairtool.groom import Animation
 from hairtool.keys import session as ks
 from hairtool.keys.dp import keys_cost, uniform_keys
-from hairtool.keys.reconstruct import KeyPoses, interpolate_at
+from hairtool.keys.reconstruct import KeyPoses, check_keys, interpolate_at
 
 VIEW_MODES = {
     "original": "Original",
@@ -53,6 +53,7 @@ class _Committed:
     solve: ks.KeySession | None
     dp_keys: np.ndarray | None
     analysis: ks.Analysis | None
+    solved_keys: np.ndarray | None = None
 
 
 class AnimationModel(QObject):
@@ -102,7 +103,8 @@ class AnimationModel(QObject):
     def _clear_keys(self) -> None:
         self.key_solve: ks.KeySession | None = None
         self.solve_stale = False  # the animation was edited after the solve
-        self.dp_keys: np.ndarray | None = None
+        self.dp_keys: np.ndarray | None = None  # the keys shown and edited (moved in time)
+        self.solved_keys: np.ndarray | None = None  # the solve's, before any key was moved
         self.uniform_keys: np.ndarray | None = None
         self.dp_poses: KeyPoses | None = None
         self.uniform_poses: KeyPoses | None = None
@@ -462,12 +464,29 @@ class AnimationModel(QObject):
         self._show_keys(keys, force=True)
 
     def _show_keys(self, keys: np.ndarray, force: bool = False) -> None:
-        if not force and self.dp_keys is not None and np.array_equal(keys, self.dp_keys):
+        if not force and self.solved_keys is not None and np.array_equal(keys, self.solved_keys):
             if self.analysis is None and self._analysis_job is None:
                 self.request_analysis()
             return
-        self.dp_keys = keys
+        self.dp_keys = self.solved_keys = keys
         self.uniform_keys = uniform_keys(self.n_frames, keys.size)
+        self._set_key_poses()
+        self.keys_changed.emit()
+        if self.view_mode != "original":
+            self.display_changed.emit()
+        self.request_analysis()
+
+    def set_edited_keys(self, keys: np.ndarray) -> None:
+        """The keys after a key was moved in time (a graph editor's drag, or its undo): shown in
+        the dope sheet, and the key poses, the reconstruction and the errors follow, with the
+        same count, so the uniform keys stay; :attr:`solved_keys` stays the solve's. The next
+        solve that gives other keys replaces them."""
+        keys = check_keys(keys, self.n_frames)
+        if self.dp_keys is not None and np.array_equal(keys, self.dp_keys):
+            return
+        self.dp_keys = keys
+        if self.uniform_keys is None or self.uniform_keys.size != keys.size:
+            self.uniform_keys = uniform_keys(self.n_frames, keys.size)
         self._set_key_poses()
         self.keys_changed.emit()
         if self.view_mode != "original":
@@ -517,7 +536,9 @@ class AnimationModel(QObject):
         if not np.array_equal(keys, self.dp_keys):
             return  # the keys moved on while it ran; their own pass is on its way
         self.analysis = result
-        self._committed = _Committed(self.settings, self.key_solve, self.dp_keys, result)
+        self._committed = _Committed(
+            self.settings, self.key_solve, self.dp_keys, result, self.solved_keys
+        )
         self.analysis_changed.emit()
         if self.view_mode == "error":
             self.display_changed.emit()
@@ -559,7 +580,7 @@ class AnimationModel(QObject):
             self.key_solve = c.solve
             self.curve_changed.emit()
         if not np.array_equal(c.dp_keys, self.dp_keys):
-            self.dp_keys = c.dp_keys
+            self.dp_keys, self.solved_keys = c.dp_keys, c.solved_keys
             self.uniform_keys = uniform_keys(self.n_frames, c.dp_keys.size)
             self._set_key_poses()
             self.keys_changed.emit()

@@ -26,8 +26,15 @@ from PySide6.QtWidgets import QFormLayout, QGroupBox, QLabel, QScrollArea, QSpin
 
 from app.ui.animation_io import skeleton_animation
 from hairtool.errors import FormatError, HairtoolError
+from hairtool.keys.channels import per_channel_keys
 from hairtool.mocap.bvh import Motion, read_bvh, write_bvh
-from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, parse_edit_list
+from hairtool.mocap.channel_edit import (
+    ChannelEditor,
+    ChannelRetimeEdit,
+    channel_features,
+    parse_channel_edits,
+)
+from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, RetimeEdit, parse_edit_list
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
@@ -60,19 +67,38 @@ def motion_from_text(text: str, source: str) -> Motion:
 
 
 class PoseEditCommand(QUndoCommand):
-    """One finished drag (or graph-editor key move): the edit, applied on redo, taken back on undo."""
+    """One finished drag (or graph-editor key move): its edits (a key dragged in time and value
+    is two: the move, then the value at the new frame), applied on redo, taken back on undo."""
 
-    def __init__(self, capture: CaptureEditor, edit: Edit, text: str) -> None:
+    def __init__(self, capture: CaptureEditor, edit: Edit | list[Edit], text: str) -> None:
         super().__init__(text)
-        self.capture, self.edit, self.generation = capture, edit, capture.generation
+        self.capture, self.generation = capture, capture.generation
+        self.edits = list(edit) if isinstance(edit, list) else [edit]
+        self.edit = self.edits[-1]
 
     def redo(self) -> None:
         if self.capture.generation == self.generation and self.capture.attached:
-            self.capture.push(self.edit)
+            self.capture.push(self.edits)
 
     def undo(self) -> None:
         if self.capture.generation == self.generation and self.capture.attached:
-            self.capture.pop()
+            self.capture.pop(len(self.edits))
+
+
+class ChannelKeyCommand(QUndoCommand):
+    """A per-channel key dragged in the graph editor (its moves in time, value or slope)."""
+
+    def __init__(self, capture: CaptureEditor, edits: list, text: str) -> None:
+        super().__init__(text)
+        self.capture, self.generation, self.edits = capture, capture.generation, edits
+
+    def redo(self) -> None:
+        if self.capture.generation == self.generation and self.capture.attached:
+            self.capture.push_channel(self.edits)
+
+    def undo(self) -> None:
+        if self.capture.generation == self.generation and self.capture.attached:
+            self.capture.pop_channel(len(self.edits))
 
 
 class JointDrag:
@@ -155,6 +181,11 @@ class CaptureEditor(QObject):
         self.ghosts: list[np.ndarray] = []  # (P, 3) joint positions of neighbouring frames in a drag
         self._preview: tuple[int, np.ndarray] | None = None  # frame, (J, 3) joints being dragged
         self.drag = JointDrag(self)
+        self._syncing = False  # the timeline's keys are being set to the edited ones
+        self.channel_edits: list = []  # per-channel key edits, over the pose edits
+        self.channel_applied: list[bool] = []
+        self._column_keys: dict = {}
+        self._layer: ChannelEditor | None = None
         self.model.animation_changed.connect(self._on_animation_changed)
         self.model.keys_changed.connect(self._on_keys_changed)
         self.box = self._tool_box()
@@ -176,6 +207,7 @@ class CaptureEditor(QObject):
         self.generation = self.model.generation
         self.model.key_source = skeleton_animation(motion)  # keys of the capture as captured
         self.edits, self.applied, self.joint = [], [], ""
+        self.channel_edits, self.channel_applied, self._column_keys, self._layer = [], [], {}, None
         self.window.viewport.brush_target = self.drag
         self._rebuild(show=False)
         self._sync_box()
@@ -185,29 +217,40 @@ class CaptureEditor(QObject):
     def _on_animation_changed(self) -> None:
         if self.original is not None and self.generation != self.model.generation:
             self.original, self.editor, self.edits, self.applied = None, None, [], []
+            self.channel_edits, self.channel_applied, self._column_keys, self._layer = [], [], {}, None
             self.joint, self._preview, self.ghosts = "", None, []
             self._sync_box()
             self.selection_changed.emit("")
             self.changed.emit()
 
     def _on_keys_changed(self) -> None:
-        if self.attached:
+        if self.attached and not self._syncing:
             self._rebuild()
 
+    def _sync_keys(self) -> None:
+        """The timeline's keys become the edited ones (a key moved in time, or moved back)."""
+        if self.editor is not None:
+            self._syncing = True
+            try:
+                self.model.set_edited_keys(self.editor.keys)
+            finally:
+                self._syncing = False
+
     def _rebuild(self, show: bool = True) -> None:
-        """A PoseEditor on the timeline's keys, with every edit at a frame that is still a key."""
+        """A PoseEditor on the solved keys, with every edit at a frame that is still a key
+        (a key moved in time moves again where its neighbours still let it)."""
         m = self.model
-        if m.dp_keys is None:
+        keys = m.solved_keys if m.solved_keys is not None else m.dp_keys
+        if keys is None:
             self.editor = None
             return
         interp = m.dp_poses.interp if m.dp_poses is not None else m.settings.interp
-        self.editor = PoseEditor(self.original, m.dp_keys, interp)
+        self.editor = PoseEditor(self.original, keys, interp)
+        self._layer = None
         self.applied = []
         for e in self.edits:
-            ok = bool(np.any(self.editor.keys == e.frame))
-            if ok:
-                self._apply(e)
-            self.applied.append(ok)
+            self.applied.append(self._try(e))
+        self._sync_keys()
         waiting = self.applied.count(False)
         if waiting:
             self.window.statusBar().showMessage(
@@ -219,12 +262,126 @@ class CaptureEditor(QObject):
             self._show()
         self.changed.emit()
 
-    def _apply(self, edit: Edit) -> None:
-        self.editor.apply_all([edit])
+    def _apply(self, edit: Edit | list[Edit]) -> None:
+        self.editor.apply_all(edit if isinstance(edit, list) else [edit])
+
+    def _try(self, edit: Edit) -> bool:
+        """Apply one edit where it still applies (its frame a key, a move between neighbours)."""
+        if self.editor is None or not np.any(self.editor.keys == edit.frame):
+            return False
+        try:
+            self._apply(edit)
+        except HairtoolError:
+            return False
+        return True
 
     def motion(self) -> Motion:
-        """The edited capture at every frame (the capture itself before any edit or keys)."""
-        return self.editor.motion() if self.editor is not None else self.original
+        """The edited capture at every frame (the capture itself before any edit or keys): the
+        pose-key edits, then the per-channel key edits on top."""
+        if self.editor is None:
+            return self.original
+        if self.channel_edits:
+            return self.channel_layer().motion()
+        return self.editor.motion()
+
+    # -- per-channel keys (seed 003: each channel its own keys) --------------------------------
+    def column_keys(self, cols: list[int]) -> list[np.ndarray]:
+        """Each column's own keys, solved on the capture as captured at the timeline's price per
+        key (relative), angles unwrapped; cached per column until the price or interpolation
+        changes."""
+        interp = self.editor.interp if self.editor is not None else self.model.settings.interp
+        what = (self.generation, self.model.settings.tau, interp)
+        if self._column_keys.get("what") != what:
+            self._column_keys = {"what": what}
+            self._layer = None
+        missing = [c for c in cols if c not in self._column_keys]
+        if missing:
+            x = channel_features(self.original)[:, missing]
+            found = per_channel_keys(x, self.model.settings.tau, interp=interp, relative=True).keys
+            self._column_keys.update(zip(missing, found, strict=True))
+        return [self._column_keys[c] for c in cols]
+
+    def channel_layer(self) -> ChannelEditor | None:
+        """The per-channel key edits over the pose-edited capture (a ChannelEditor on it, its
+        edits applied where they still apply); None before keys."""
+        if self.editor is None:
+            return None
+        cols = sorted({self._column(e) for e in self.channel_edits})
+        solved = dict(zip(cols, self.column_keys(cols), strict=True))
+        if self._layer is None:
+            m = self.original
+            two = np.array([0, m.n_frames - 1], dtype=np.int64)
+            keys = [solved.get(c, self._column_keys.get(c, two)) for c in range(m.n_channels)]
+            layer = ChannelEditor(self.editor.motion(), keys, self.editor.interp)
+            self.channel_applied = []
+            for e in self.channel_edits:
+                try:
+                    layer.apply_all([e])
+                    self.channel_applied.append(True)
+                except HairtoolError:
+                    self.channel_applied.append(False)
+            self._layer = layer
+        return self._layer
+
+    def _column(self, edit: object) -> int:
+        m = self.original
+        j = m.joint_names.index(edit.joint)
+        return int(m._starts[j]) + m.channels[j].index(edit.channel)
+
+    def push_channel(self, edits: list) -> None:
+        """Per-channel key edits (the undo command's redo)."""
+        self.channel_edits.extend(edits)
+        self._layer = None
+        self._show()
+        self.changed.emit()
+
+    def pop_channel(self, count: int) -> None:
+        del self.channel_edits[len(self.channel_edits) - count :]
+        self._layer = None
+        self._show()
+        self.changed.emit()
+
+    def commit_channel(self, edits: list, text: str) -> bool:
+        """One undo step for a per-channel key dragged (refused with a message when it cannot be)."""
+        for c in {self._column(e) for e in edits}:
+            self.column_keys([c])
+        self._layer = None
+        layer = self.channel_layer()
+        if layer is None:
+            return False
+        done = 0
+        try:
+            for e in edits:
+                layer.apply_all([e])
+                done += 1
+        except HairtoolError as e:
+            self.window.show_error("Cannot move the key", str(e))
+            return False
+        finally:
+            for _ in range(done):
+                layer.undo()
+        self.window.undo_stack.push(ChannelKeyCommand(self, list(edits), text))
+        return True
+
+    def preview_channel(self, edits: list | None) -> Motion | None:
+        """Show per-channel key edits at the dragged key's frame (None: stop); the edited capture
+        is returned."""
+        m = self.model
+        layer = self.channel_layer()
+        if not edits or layer is None:
+            m.set_preview(m.frame, None)
+            return None
+        layer.apply_all(edits)
+        try:
+            out = layer.motion()
+        finally:
+            for _ in edits:
+                layer.undo()
+        last = edits[-1]
+        key = last.to if isinstance(last, ChannelRetimeEdit) else last.frame
+        sub = out.with_values(out.values[key : key + 1])
+        m.set_preview(key, skeleton_animation(sub).frames[0])
+        return out
 
     def _show(self) -> None:
         """The timeline's skeleton becomes the edited capture (only the frames that changed)."""
@@ -236,37 +393,46 @@ class CaptureEditor(QObject):
             self.model.replace_frames(lo, frames[lo : hi + 1])
 
     # -- editing -----------------------------------------------------------------------------
-    def push(self, edit: Edit) -> None:
-        """Apply one more edit (the undo command's redo)."""
-        self.edits.append(edit)
-        ok = self.editor is not None and bool(np.any(self.editor.keys == edit.frame))
-        if ok:
-            self._apply(edit)
-        self.applied.append(ok)
+    def push(self, edits: Edit | list[Edit]) -> None:
+        """Apply more edits (the undo command's redo)."""
+        for edit in edits if isinstance(edits, list) else [edits]:
+            self.edits.append(edit)
+            self.applied.append(self._try(edit))
+        self._layer = None
+        self._sync_keys()
         self._show()
         self.changed.emit()
 
-    def pop(self) -> None:
-        """Take back the last edit (the undo command's undo)."""
-        if not self.edits:
-            return
-        self.edits.pop()
-        if self.applied.pop():
-            self.editor.undo()
+    def pop(self, count: int = 1) -> None:
+        """Take back the last ``count`` edits (the undo command's undo)."""
+        for _ in range(min(count, len(self.edits))):
+            self.edits.pop()
+            if self.applied.pop():
+                self.editor.undo()
+        self._layer = None
+        self._sync_keys()
         self._show()
         self.changed.emit()
 
-    def commit(self, edit: Edit, text: str) -> bool:
-        """One undo step for ``edit`` (refused with a message when it cannot be solved)."""
+    def commit(self, edit: Edit | list[Edit], text: str) -> bool:
+        """One undo step for ``edit`` (or a list of edits; refused with a message when one
+        cannot be solved)."""
         if self.editor is None:
             return False
+        edits = edit if isinstance(edit, list) else [edit]
+        done = 0
         try:  # solved once here so the undo step's redo cannot fail; undone exactly
-            self._apply(edit)
-            self.editor.undo()
+            for one in edits:
+                self._apply(one)
+                done += 1
         except HairtoolError as e:
             self.window.show_error("Cannot pose the capture", str(e))
             return False
-        self.window.undo_stack.push(PoseEditCommand(self, edit, text))
+        finally:
+            for _ in range(done):
+                self.editor.undo()
+        self.window.undo_stack.push(PoseEditCommand(self, list(edits), text))
+        edit = edits[-1]
         if isinstance(edit, PoseEdit) and self.editor.reports:
             r = self.editor.reports[-1]
             reach = "reached" if r.miss_share <= r.tolerance_share else "out of reach; nearest pose"
@@ -280,8 +446,9 @@ class CaptureEditor(QObject):
             self.handles.update()
 
     # -- the live drag -----------------------------------------------------------------------
-    def preview(self, edit: Edit | None) -> None:
-        """Show ``edit`` solved at its key, with the frames around it as ghosts (None: stop)."""
+    def preview(self, edit: Edit | list[Edit] | None) -> None:
+        """Show ``edit`` (or edits) solved at its key, with the frames around it as ghosts
+        (None: stop)."""
         m = self.model
         if edit is None or self.editor is None:
             self._preview, self.ghosts = None, []
@@ -289,23 +456,26 @@ class CaptureEditor(QObject):
             self.preview_changed.emit()
             self.handles.update()
             return
-        self._apply(edit)
+        edits = edit if isinstance(edit, list) else [edit]
+        self._apply(edits)
         try:
             out = self.editor.motion()
+            key = edits[-1].to if isinstance(edits[-1], RetimeEdit) else edits[-1].frame
+            first, last = self.editor.span(key)
         finally:
-            self.editor.undo()
-        first, last = self.editor.span(edit.frame)
-        inner = np.setdiff1d(np.arange(first, last + 1), [edit.frame])
+            for _ in edits:
+                self.editor.undo()
+        inner = np.setdiff1d(np.arange(first, last + 1), [key])
         if inner.size:
             inner = inner[
                 np.unique(np.linspace(0, inner.size - 1, min(GHOSTS, inner.size)).round().astype(int))
             ]
-        frames = np.r_[edit.frame, inner].astype(np.int64)
+        frames = np.r_[key, inner].astype(np.int64)
         sub = out.with_values(out.values[frames])
         joints = sub.joint_positions(end_sites=True)
-        self._preview = (edit.frame, joints[0])
+        self._preview = (key, joints[0])
         self.ghosts = list(joints[1:])
-        m.set_preview(edit.frame, skeleton_animation(sub).frames[0])
+        m.set_preview(key, skeleton_animation(sub).frames[0])
         self.preview_changed.emit()
         self.handles.update()
 
@@ -349,6 +519,7 @@ class CaptureEditor(QObject):
             "bvh": motion_text(self.original),
             "source": self.source,
             "edits": [e.to_dict() for e in self.edits],
+            "channel_edits": [e.to_dict() for e in self.channel_edits],
             "chain": self.chain,
         }
 
@@ -363,6 +534,7 @@ class CaptureEditor(QObject):
             if skeleton_animation(motion).topology != self.model.animation.topology:
                 raise FormatError(where, "the capture's skeleton is not the project's animation")
             edits = parse_edit_list(saved.get("edits", []), motion, where)
+            channel_edits = parse_channel_edits(saved.get("channel_edits", []), motion, where)
         except HairtoolError as e:
             self.window.show_error("Some project settings were not applied", str(e))
             return
@@ -370,6 +542,7 @@ class CaptureEditor(QObject):
         if isinstance(saved.get("chain"), int):
             self.set_chain(saved["chain"])
         self.edits = list(edits)
+        self.channel_edits = list(channel_edits)
         if np.array_equal(self.model.key_source.frames, self.model.animation.frames):
             self._rebuild()
         else:  # the project's frames are the edited ones: key the capture (rebuilt on its keys)

@@ -22,19 +22,21 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPainter, QPainterPath, QPen, QWheelEvent
-from PySide6.QtWidgets import QDockWidget, QHBoxLayout, QLabel, QSpinBox, QVBoxLayout, QWidget
+from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPainter, QPen, QWheelEvent
+from PySide6.QtWidgets import QCheckBox, QDockWidget, QHBoxLayout, QLabel, QSpinBox, QVBoxLayout, QWidget
 
+from app.ui import view_range
 from app.ui.capture_edit import CaptureEditor
 from app.ui.hair_channels import HairChannels
+from app.ui.timeline_plots import polygon
 from hairtool.mocap import ik
-from hairtool.mocap.pose_edit import ChannelEdit, TangentEdit
+from hairtool.mocap.channel_edit import ChannelRetimeEdit
+from hairtool.mocap.pose_edit import ChannelEdit, Edit, RetimeEdit, TangentEdit
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
 
 AXIS_COLOURS = {"X": QColor(230, 80, 80), "Y": QColor(110, 200, 90), "Z": QColor(80, 140, 240)}
-HANDLES_FIXED = "Hair keys move in value here; their handles are the sampled tangents"
 PICK_PX = 8.0
 MARGIN = 24.0  # pixels around the plot
 ZOOM_STEP = 1.15  # per wheel notch
@@ -101,6 +103,42 @@ def capture_curves(capture: CaptureEditor) -> list[Curve]:
     return out
 
 
+def channel_curves(capture: CaptureEditor) -> list[Curve]:
+    """The selected joint's rotation channels with seed 003's per-channel keys: each channel
+    keyed on its own (at the timeline's price per key, on the capture as captured, angles
+    unwrapped), with its own key points, key curve and handles; their edits lie over the pose
+    keys' (:meth:`CaptureEditor.channel_layer`)."""
+    if not capture.attached or capture.editor is None or not capture.joint:
+        return []
+    m = capture.original
+    j = m.joint_names.index(capture.joint)
+    cols, order = ik.rotation_columns(m, j)
+    if not cols:
+        return []
+    capture.column_keys(cols)
+    layer = capture.channel_layer()
+    result = layer.motion().values
+    out = []
+    for i, c in enumerate(cols):
+        keys = layer.keys(c)
+        curve = layer.key_curve(c)
+        slopes = layer.key_slopes(c)
+        out.append(
+            Curve(
+                m.channels[j][c - int(m._starts[j])],
+                AXIS_COLOURS.get(order[i], QColor(200, 200, 200)),
+                m.values[:, c],
+                result[:, c],
+                curve,
+                keys,
+                curve[keys],
+                None if slopes is None else slopes[0],
+                None if slopes is None else slopes[1],
+            )
+        )
+    return out
+
+
 class GraphView(QWidget):
     """The plot: curves, keys and handles; key drags, zoom and pan (module docstring)."""
 
@@ -113,8 +151,10 @@ class GraphView(QWidget):
         self.x_range = (0.0, 1.0)
         self.y_range = (-1.0, 1.0)
         self.last_value: float | None = None  # the value the last key drag asked for
+        self.last_frame = 0  # and the frame
         self._drag: tuple | None = None
         self._framed_for: tuple | None = None
+        self.per_channel = False  # a capture's channels with their own keys (seed 003)
         self.setMinimumSize(240, 120)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMouseTracking(False)
@@ -125,7 +165,12 @@ class GraphView(QWidget):
         return not self.capture.attached and self.hair.active
 
     def refresh(self) -> None:
-        self.curves = hair_curves(self.hair) if self.on_hair else capture_curves(self.capture)
+        if self.on_hair:
+            self.curves = hair_curves(self.hair)
+        elif self.per_channel:
+            self.curves = channel_curves(self.capture)
+        else:
+            self.curves = capture_curves(self.capture)
         if self.on_hair:
             what = ("hair", self.capture.model.generation, self.hair.strand, self.hair.vertex)
         else:
@@ -141,17 +186,20 @@ class GraphView(QWidget):
             MARGIN * 2, MARGIN / 2, max(self.width() - MARGIN * 2.5, 1), max(self.height() - MARGIN * 1.5, 1)
         )
 
-    def to_px(self, frame: np.ndarray | float, value: np.ndarray | float) -> tuple:
+    def _axes(self) -> tuple[view_range.Axis, view_range.Axis]:
         r = self._plot()
-        (x0, x1), (y0, y1) = self.x_range, self.y_range
-        px = r.left() + (np.asarray(frame, float) - x0) / (x1 - x0) * r.width()
-        py = r.bottom() - (np.asarray(value, float) - y0) / (y1 - y0) * r.height()
-        return px, py
+        return (
+            view_range.Axis(self.x_range, r.left(), r.width()),
+            view_range.Axis(self.y_range, r.top(), r.height(), flip=True),
+        )
+
+    def to_px(self, frame: np.ndarray | float, value: np.ndarray | float) -> tuple:
+        ax, ay = self._axes()
+        return ax.to_px(frame), ay.to_px(value)
 
     def from_px(self, px: float, py: float) -> tuple[float, float]:
-        r = self._plot()
-        (x0, x1), (y0, y1) = self.x_range, self.y_range
-        return x0 + (px - r.left()) / r.width() * (x1 - x0), y0 + (r.bottom() - py) / r.height() * (y1 - y0)
+        ax, ay = self._axes()
+        return ax.from_px(px), ay.from_px(py)
 
     def frame_all(self) -> None:
         """Home: every curve (and every frame) in view, with a little room around."""
@@ -171,20 +219,16 @@ class GraphView(QWidget):
         """Scale the view by ``factor`` (> 1 zooms in) about the pixel ``(px, py)``."""
         fx, fy = self.from_px(px, py)
         if "x" in axes:
-            x0, x1 = self.x_range
-            self.x_range = (fx + (x0 - fx) / factor, fx + (x1 - fx) / factor)
+            self.x_range = view_range.zoom(self.x_range, factor, fx)
         if "y" in axes:
-            y0, y1 = self.y_range
-            self.y_range = (fy + (y0 - fy) / factor, fy + (y1 - fy) / factor)
+            self.y_range = view_range.zoom(self.y_range, factor, fy)
         self.view_changed.emit()
         self.update()
 
     def pan(self, dx_px: float, dy_px: float) -> None:
-        r = self._plot()
-        (x0, x1), (y0, y1) = self.x_range, self.y_range
-        dx = -dx_px / r.width() * (x1 - x0)
-        dy = dy_px / r.height() * (y1 - y0)
-        self.x_range, self.y_range = (x0 + dx, x1 + dx), (y0 + dy, y1 + dy)
+        ax, ay = self._axes()
+        self.x_range = view_range.pan(self.x_range, -dx_px * ax.per_px)
+        self.y_range = view_range.pan(self.y_range, dy_px * ay.per_px)
         self.view_changed.emit()
         self.update()
 
@@ -268,9 +312,7 @@ class GraphView(QWidget):
                 if self.capture.model.frame != int(c.keys[k]):
                     self.capture.model.set_frame(int(c.keys[k]))  # the key's pose in the viewport
                 if hit is not None:
-                    self._drag = ("key", p, hit, float(c.values[k]))
-                elif self.on_hair:
-                    self.capture.window.statusBar().showMessage(HANDLES_FIXED, 4000)
+                    self._drag = ("key", p, hit, float(c.values[k]), int(c.keys[k]))
                 else:
                     self._drag = ("handle", p, handle, 0.0)
         event.accept()
@@ -291,21 +333,29 @@ class GraphView(QWidget):
             self.zoom(ZOOM_STEP ** ((last.y() - p.y()) / 20.0), start.x(), start.y(), "y")
             self._drag = ("zoom", start, p)
         elif kind == "key":
-            _, start, (i, k), v0 = self._drag
-            value = v0 + (self.from_px(p.x(), p.y())[1] - self.from_px(start.x(), start.y())[1])
-            self.last_value = value
+            _, start, (i, k), v0, f0 = self._drag
+            (fx, fy), (sx, sy) = self.from_px(p.x(), p.y()), self.from_px(start.x(), start.y())
+            value, to = v0 + (fy - sy), self.snap(i, k, f0 + (fx - sx))
+            if event.modifiers() & Qt.KeyboardModifier.ShiftModifier:  # one axis: the longer move
+                if abs(p.x() - start.x()) >= abs(p.y() - start.y()):
+                    value = v0
+                else:
+                    to = f0
+            self.last_value, self.last_frame = value, to
+            if self.capture.model.frame != to:
+                self.capture.model.set_frame(to)  # the key's pose at its new frame in the viewport
             if self.on_hair:
                 c = self.curves[i]
-                result = self.hair.preview(i, int(c.keys[k]), value)
-                values = c.values.copy()
-                values[k] = value
+                result = self.hair.preview(i, f0, value, to)
+                values, keys = c.values.copy(), c.keys.copy()
+                values[k], keys[k] = value, to
                 self.curves[i] = Curve(
-                    c.name, c.colour, c.original, result, c.key_curve, c.keys, values, c.slope_in, c.slope_out
+                    c.name, c.colour, c.original, result, c.key_curve, keys, values, c.slope_in, c.slope_out
                 )
                 self.update()
             else:
-                self.capture.preview(self._edit(i, k, value))
-                self._preview_curve(i, self._edit(i, k, value))
+                edits = self._edits(i, f0, to, v0, value)
+                self._preview(edits)
         elif kind == "handle":
             _, _, (i, k, side), _ = self._drag
             c = self.curves[i]
@@ -313,57 +363,94 @@ class GraphView(QWidget):
             df = frame - float(c.keys[k])
             df = max(df, 0.25) if side > 0 else min(df, -0.25)  # a handle stays on its side
             self.last_value = (value - float(c.values[k])) / df
-            edit = self._tangent(i, k, self.last_value)
-            self.capture.preview(edit)
-            self._preview_curve(i, edit)
+            if self.on_hair:
+                result = self.hair.preview_slope(i, int(c.keys[k]), self.last_value)
+                s_in, s_out = np.array(c.slope_in, dtype=float), np.array(c.slope_out, dtype=float)
+                s_in[k] = s_out[k] = self.last_value
+                self.curves[i] = Curve(
+                    c.name, c.colour, c.original, result, c.key_curve, c.keys, c.values, s_in, s_out
+                )
+                self.update()
+            else:
+                self._preview([self._tangent(i, k, self.last_value)])
         event.accept()
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         drag, self._drag = self._drag, None
         if drag is not None and drag[0] == "key" and self.last_value is not None and self.on_hair:
-            _, _, (i, k), _ = drag
+            _, _, (i, k), v0, f0 = drag
             self.hair.preview(None)
-            self.hair.commit(i, int(self.curves[i].keys[k]), self.last_value)
+            if self.last_value != v0 or self.last_frame != f0:
+                self.hair.commit(i, f0, self.last_value, self.last_frame)
         elif drag is not None and drag[0] == "key" and self.last_value is not None:
-            _, _, (i, k), _ = drag
+            _, _, (i, _k), v0, f0 = drag
             self.capture.preview(None)
-            edit = self._edit(i, k, self.last_value)
-            self.capture.commit(edit, f"Move {edit.joint} {edit.channel} key at {edit.frame}")
+            edits = self._edits(i, f0, self.last_frame, v0, self.last_value)
+            if edits:
+                name = f"{self.capture.joint} {self.curves[i].name}"
+                moved = f" to {self.last_frame}" if self.last_frame != f0 else ""
+                self._commit(edits, f"Move {name} key at {f0}{moved}")
+        elif drag is not None and drag[0] == "handle" and self.last_value is not None and self.on_hair:
+            _, _, (i, k, _), _ = drag
+            self.hair.commit_slope(i, int(self.curves[i].keys[k]), self.last_value)
         elif drag is not None and drag[0] == "handle" and self.last_value is not None:
             _, _, (i, k, _), _ = drag
             self.capture.preview(None)
             edit = self._tangent(i, k, self.last_value)
-            self.capture.commit(edit, f"Turn {edit.joint} {edit.channel} handle at {edit.frame}")
+            self._commit([edit], f"Turn {edit.joint} {edit.channel} handle at {edit.frame}")
         self.last_value = None
         event.accept()
 
-    def _edit(self, i: int, k: int, value: float) -> ChannelEdit:
-        c = self.curves[i]
-        return ChannelEdit(int(c.keys[k]), self.capture.joint, c.name, float(value))
+    def snap(self, curve: int, key: int, frame: float) -> int:
+        """The frame a key dragged to ``frame`` lands on: a whole frame strictly between its
+        neighbouring keys (the first and last key stay on their frames)."""
+        keys = self.curves[curve].keys
+        if key == 0 or key == keys.size - 1:
+            return int(keys[key])
+        return int(min(max(round(frame), int(keys[key - 1]) + 1), int(keys[key + 1]) - 1))
+
+    def _edits(self, i: int, frame: int, to: int, start: float, value: float) -> list[Edit]:
+        """A key dragged from ``frame`` and value ``start`` to ``to`` and ``value``: the move in
+        time (the key frame after it is ``to``), then the new value there; none when it went
+        nowhere."""
+        name = self.curves[i].name
+        if to == frame:
+            out: list[Edit] = []
+        elif self.per_channel:  # that channel's key alone
+            out = [ChannelRetimeEdit(frame, self.capture.joint, name, to)]
+        else:  # the pose key, every channel
+            out = [RetimeEdit(frame, to)]
+        if value != start:
+            out.append(ChannelEdit(int(to), self.capture.joint, self.curves[i].name, float(value)))
+        return out
 
     def _tangent(self, i: int, k: int, slope: float) -> TangentEdit:
         c = self.curves[i]
         return TangentEdit(int(c.keys[k]), self.capture.joint, c.name, float(slope))
 
-    def _preview_curve(self, i: int, edit: ChannelEdit | TangentEdit) -> None:
-        """The dragged channel as the edit would make it (the capture's editor, then undone)."""
-        editor, m = self.capture.editor, self.capture.original
-        editor.apply_all([edit])
+    def _preview(self, edits: list[Edit]) -> None:
+        """The viewport and the joint's channels as the edits would make them (the capture's
+        editor, or its per-channel layer, then undone)."""
+        if self.per_channel:
+            self.capture.preview_channel(edits or None)
+            editor, curves = self.capture.channel_layer(), channel_curves
+        else:
+            self.capture.preview(edits or None)
+            editor, curves = self.capture.editor, capture_curves
+        editor.apply_all(edits)
         try:
-            j = m.joint_names.index(self.capture.joint)
-            cols = ik.rotation_columns(m, j)[0]
-            result = editor.motion().values[:, cols]
-            key_curve = editor.key_curve(j, result)
-            slopes = editor.key_slopes(j)
+            self.curves = curves(self.capture)
         finally:
-            editor.undo()
-        c = self.curves[i]
-        s_in, s_out = (None, None) if slopes is None else (slopes[0][:, i], slopes[1][:, i])
-        keyed = key_curve[:, i]
-        self.curves[i] = Curve(
-            c.name, c.colour, c.original, result[:, i], keyed, c.keys, keyed[c.keys], s_in, s_out
-        )
+            for _ in edits:
+                editor.undo()
         self.update()
+
+    def _commit(self, edits: list[Edit], text: str) -> None:
+        if self.per_channel:
+            self.capture.preview_channel(None)
+            self.capture.commit_channel(edits, text)
+        else:
+            self.capture.commit(edits, text)
 
     # -- drawing -----------------------------------------------------------------------------
     def paintEvent(self, event) -> None:
@@ -411,12 +498,9 @@ class GraphView(QWidget):
         step = max(1, (hi - lo) // max(int(self._plot().width()), 1))
         frames = np.arange(lo, hi, step)
         px, py = self.to_px(frames, values[frames])
-        path = QPainterPath(QPointF(float(px[0]), float(py[0])))
-        for x, y in zip(px[1:], py[1:], strict=True):
-            path.lineTo(float(x), float(y))
         painter.setPen(pen)
         painter.setBrush(Qt.BrushStyle.NoBrush)
-        painter.drawPath(path)
+        painter.drawPolyline(polygon(px, py))
 
     def _keys(self, painter: QPainter, c: Curve) -> None:
         kx, ky = self.to_px(c.keys, c.values)
@@ -458,6 +542,14 @@ class GraphEditorDock(QDockWidget):
         self.vertex.valueChanged.connect(self._pick_vertex)
         top = QHBoxLayout()
         top.addWidget(self.title, 1)
+        self.per_channel = QCheckBox("Per-channel keys")
+        self.per_channel.setToolTip(
+            "Each rotation channel keyed on its own at the timeline's price per key (seed 003: "
+            "every degree of freedom its own curve and keys). Its keys drag like the pose keys, "
+            "in value, time and handles, one channel at a time, over the pose keys' edits"
+        )
+        self.per_channel.toggled.connect(self._set_per_channel)
+        top.addWidget(self.per_channel)
         self.pickers = [QLabel("Strand"), self.strand, QLabel("Vertex"), self.vertex]
         for widget in self.pickers:
             top.addWidget(widget)
@@ -486,6 +578,10 @@ class GraphEditorDock(QDockWidget):
         model.frame_changed.connect(lambda *_: self.view.update())
         self.refresh()
 
+    def _set_per_channel(self, on: bool) -> None:
+        self.view.per_channel = bool(on)
+        self.refresh()
+
     def _pick_vertex(self, *_: object) -> None:
         self.hair.strand, self.hair.vertex = self.strand.value(), self.vertex.value()
         self.view.refresh()
@@ -495,6 +591,7 @@ class GraphEditorDock(QDockWidget):
         on_hair = self.view.on_hair
         for widget in self.pickers:
             widget.setVisible(on_hair)
+        self.per_channel.setVisible(c.attached)
         if on_hair:
             topo = self.window.animation.animation.topology
             self.strand.setMaximum(topo.strand_count - 1)
@@ -502,5 +599,7 @@ class GraphEditorDock(QDockWidget):
             self.vertex.setMaximum(int(topo.offsets[s + 1] - topo.offsets[s]) - 1)
             self.title.setText("strand vertex: x, y, z")
         else:
-            self.title.setText(f"{c.joint}: rotation channels (degrees)" if c.attached and c.joint else "")
+            each = ", each with its own keys" if self.view.per_channel else ""
+            shown = c.attached and c.joint
+            self.title.setText(f"{c.joint}: rotation channels (degrees){each}" if shown else "")
         self.view.refresh()

@@ -5,8 +5,12 @@ The curves are the animation as it was opened (faint), as edited (the key curve 
 residuals) and the key curve alone through the timeline's DP keys, with the key poses' Hermite
 tangents as handles. A key dragged in value is the timeline's own residual-keeping key edit
 (:func:`hairtool.keys.session.key_edit_block`, the same as brushing the key pose, one undo step):
-the vertex moves at the key and the frames between its neighbouring keys follow. Hair handles
-show the sampled tangents and are not dragged (the hair key edit keeps them).
+the vertex moves at the key and the frames between its neighbouring keys follow. A key dragged
+sideways moves in time (:func:`hairtool.keys.edit.retime_key`: the frames between its neighbours
+retimed with it, the timeline's keys the moved ones). The handles are the key poses' Hermite
+tangents, which the timeline takes from the frames themselves; a handle dragged turns the
+frames between the neighbouring keys so that their own tangent at the key is the slope dragged
+to (:func:`hairtool.keys.edit.key_slope_block`), so the handle stays where it was dropped.
 """
 
 from __future__ import annotations
@@ -14,8 +18,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+from PySide6.QtGui import QUndoCommand
 
 from app.ui.animation_ui import KeyEditCommand
+from hairtool.keys.edit import check_retime, key_slope_block, retime_key
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at
 from hairtool.keys.session import key_edit_block
 
@@ -84,33 +90,109 @@ class HairChannels:
             )
         return out
 
-    def edited_block(self, axis: int, key: int, value: float) -> tuple[int, np.ndarray, np.ndarray]:
-        """``(start, block, pose)``: the frames after the vertex's ``axis`` at key frame ``key``
-        is set to ``value`` (the timeline's key edit), and the key pose."""
+    def edited_block(
+        self, axis: int, key: int, value: float, to: int | None = None
+    ) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+        """``(start, block, pose, keys)``: the frames after the key at ``key`` is moved to the
+        frame ``to`` (:func:`hairtool.keys.edit.retime_key`; None: it stays) and the vertex's
+        ``axis`` there set to ``value`` (the timeline's key edit), the key pose and the keys.
+        Worked on the stretch between the key's neighbours and one frame each side, which gives
+        the same frames as the whole animation would."""
         m = self.model
-        frames = m.animation.frames
-        pose = np.array(frames[key])
+        frames, keys, interp = m.animation.frames, m.dp_keys, m.dp_poses.interp
+        to = key if to is None else int(to)
+        a = int(np.flatnonzero(keys == key)[0])
+        lo = int(keys[a - 1]) if a > 0 else key
+        hi = int(keys[a + 1]) if a < keys.size - 1 else key
+        s0, s1 = max(lo - 1, 0), min(hi + 1, m.n_frames - 1)
+        sub = np.array(frames[s0 : s1 + 1])
+        sub_keys = np.array(sorted({0, lo - s0, key - s0, hi - s0, s1 - s0}), dtype=np.int64)
+        new_keys = keys
+        if to != key:
+            start, block, sub_keys = retime_key(sub, sub_keys, interp, key - s0, to - s0)
+            sub[start : start + len(block)] = block
+            _, new_keys = check_retime(keys, m.n_frames, key, to)
+        pose = np.array(sub[to - s0])
         pose[self.index(), axis] = value
-        start, block = key_edit_block(frames, m.dp_keys, m.dp_poses.interp, key, pose)
-        return start, block, pose
+        if value != float(sub[to - s0, self.index(), axis]):
+            start, block = key_edit_block(sub, sub_keys, interp, to - s0, pose)
+            sub[start : start + len(block)] = block
+        return s0, sub, pose, new_keys
 
-    def preview(self, axis: int | None, key: int = 0, value: float = 0.0) -> np.ndarray | None:
-        """Show the key pose being dragged in the viewport (None: stop); the dragged axis's
-        edited curve is returned."""
+    def preview(
+        self, axis: int | None, key: int = 0, value: float = 0.0, to: int | None = None
+    ) -> np.ndarray | None:
+        """Show the key pose being dragged in the viewport at its frame (None: stop); the
+        dragged axis's edited curve is returned."""
         m = self.model
         if axis is None:
             m.set_preview(m.frame, None)
             return None
-        start, block, pose = self.edited_block(axis, key, value)
-        m.set_preview(key, pose.astype(np.float32))
+        start, block, pose, _ = self.edited_block(axis, key, value, to)
+        m.set_preview(key if to is None else to, pose.astype(np.float32))
         result = m.animation.frames[:, self.index(), axis].astype(np.float64)
         result[start : start + len(block)] = block[:, self.index(), axis]
         return result
 
-    def commit(self, axis: int, key: int, value: float) -> None:
+    def commit(self, axis: int, key: int, value: float, to: int | None = None) -> None:
+        """One undo step: the key moved (in value, in time or both)."""
         m = self.model
-        start, block, _ = self.edited_block(axis, key, value)
+        start, block, _, keys = self.edited_block(axis, key, value, to)
+        before = np.array(m.animation.frames[start : start + len(block)])
+        if to is None or to == key:
+            command = KeyEditCommand(m, m.generation, key, start, before, block)
+            command.setText(f"Move vertex {AXES[axis]} key at {key}")
+        else:
+            command = HairKeyTimeCommand(m, start, before, block, m.dp_keys.copy(), keys)
+            command.setText(f"Move key {key} to {to}")
+        self.window.undo_stack.push(command)
+
+
+    # -- handles --------------------------------------------------------------------------------
+    def slope_block(self, axis: int, key: int, slope: float) -> tuple[int, np.ndarray]:
+        """The frames after the vertex's ``axis`` handle at key ``key`` is turned to ``slope``
+        (per frame, both handles): :func:`hairtool.keys.edit.key_slope_block`, so the key poses
+        the timeline takes from the edited frames have that slope there."""
+        m = self.model
+        index = self.index() * 3 + axis
+        return key_slope_block(m.animation.frames, m.dp_keys, m.dp_poses.interp, key, index, slope)
+
+    def preview_slope(self, axis: int, key: int, slope: float) -> np.ndarray:
+        """The dragged axis's edited curve while a handle is dragged."""
+        start, block = self.slope_block(axis, key, slope)
+        result = self.model.animation.frames[:, self.index(), axis].astype(np.float64)
+        result[start : start + len(block)] = block[:, self.index(), axis]
+        return result
+
+    def commit_slope(self, axis: int, key: int, slope: float) -> None:
+        m = self.model
+        start, block = self.slope_block(axis, key, slope)
         before = np.array(m.animation.frames[start : start + len(block)])
         command = KeyEditCommand(m, m.generation, key, start, before, block)
-        command.setText(f"Move vertex {AXES[axis]} key at {key}")
+        command.setText(f"Turn vertex {AXES[axis]} handle at {key}")
         self.window.undo_stack.push(command)
+
+
+class HairKeyTimeCommand(QUndoCommand):
+    """A hair key moved in time (and maybe in value): the frames between its neighbours before
+    and after, and the keys before and after (the dope sheet, the reconstruction and the
+    errors follow the moved key)."""
+
+    def __init__(
+        self, model, start: int, before: np.ndarray, after: np.ndarray, keys_before, keys_after
+    ) -> None:
+        super().__init__("Move key")
+        self.model, self.generation, self.start = model, model.generation, start
+        self.before, self.after = before, after
+        self.keys_before, self.keys_after = keys_before, keys_after
+
+    def _apply(self, block: np.ndarray, keys: np.ndarray) -> None:
+        if self.model.generation == self.generation:  # an older animation's step does nothing
+            self.model.replace_frames(self.start, block)
+            self.model.set_edited_keys(keys)
+
+    def redo(self) -> None:
+        self._apply(self.after, self.keys_after)
+
+    def undo(self) -> None:
+        self._apply(self.before, self.keys_before)

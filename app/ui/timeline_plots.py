@@ -26,6 +26,7 @@ from PySide6.QtGui import (
 )
 from PySide6.QtWidgets import QApplication, QSizePolicy, QToolTip, QWidget
 
+from app.ui import view_range
 from app.ui.animation_model import AnimationModel
 from hairtool.keys.dp import keys_cost, uniform_keys
 
@@ -50,6 +51,14 @@ KEY_LEGEND = (
     "✕ never a key: a key was moved away from it (or Delete excluded it; Insert or undo frees it) · "
     "□ uniform keys of the same count · Ctrl+wheel zoom, middle-drag pan, Home all frames"
 )
+
+
+def polygon(xs: np.ndarray, ys: np.ndarray) -> QPolygonF:
+    """Points ``(xs[i], ys[i])`` as a QPolygonF for one drawPolyline (the graph editor's curves
+    too). Not a QPainterPath.lineTo per point: in PySide6 6.12 each lineTo call takes a
+    reference from Python 3.11's None (50,000 calls end the process with none_dealloc), and it
+    is one Python call per frame either way."""
+    return QPolygonF(list(map(QPointF, np.asarray(xs, float).tolist(), np.asarray(ys, float).tolist())))
 
 
 def _nice_step(span: float, pixels: float, min_px: float = 50.0) -> int:
@@ -134,10 +143,7 @@ class TimelineView(QWidget):
 
     def set_view(self, first: float, last: float) -> None:
         """Show frames ``first .. last`` (kept inside the animation, at least :data:`MIN_SPAN`)."""
-        n = float(max(self.model.n_frames - 1, 1))
-        span = min(max(last - first, min(MIN_SPAN, n)), n)
-        first = min(max(first, 0.0), n - span)
-        view = None if span >= n else (first, first + span)
+        view = view_range.fit((first, last), 0.0, float(max(self.model.n_frames - 1, 1)), MIN_SPAN)
         if view != self._view:
             self._view = view
             self.invalidate()
@@ -147,13 +153,10 @@ class TimelineView(QWidget):
 
     def zoom(self, factor: float, about_x: float) -> None:
         """Zoom by ``factor`` (> 1: fewer frames across) keeping the frame under ``about_x`` put."""
-        v0, v1 = self.view_range
-        at = self._x_to_f(about_x)
-        self.set_view(at - (at - v0) / factor, at + (v1 - at) / factor)
+        self.set_view(*view_range.zoom(self.view_range, factor, self._x_to_f(about_x)))
 
     def pan(self, frames: float) -> None:
-        v0, v1 = self.view_range
-        self.set_view(v0 + frames, v1 + frames)
+        self.set_view(*view_range.pan(self.view_range, frames))
 
     def _follow_frame(self, frame: int) -> None:
         """Zoomed in, a frame outside the view (playback, the arrows) brings the view with it."""
@@ -166,16 +169,17 @@ class TimelineView(QWidget):
         self.update()
 
     # -- geometry (tests use these to find pixels) --------------------------------------------
+    def _axis(self) -> view_range.Axis:
+        return view_range.Axis(self.view_range, LEFT, max(self.width() - LEFT - RIGHT, 1))
+
     def _frames_per_px(self) -> float:
-        v0, v1 = self.view_range
-        return (v1 - v0) / max(self.width() - LEFT - RIGHT, 1)
+        return self._axis().per_px
 
     def frame_to_x(self, frame: float) -> float:
-        v0, _ = self.view_range
-        return LEFT + (float(frame) - v0) / self._frames_per_px()
+        return float(self._axis().to_px(float(frame)))
 
     def _x_to_f(self, x: float) -> float:
-        return self.view_range[0] + (x - LEFT) * self._frames_per_px()
+        return self._axis().from_px(x)
 
     def x_to_frame(self, x: float) -> int:
         return round(self._x_to_f(x))
@@ -224,8 +228,8 @@ class TimelineView(QWidget):
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
         x = event.position().x()
         if self._pan is not None and event.buttons() & Qt.MouseButton.MiddleButton:
-            start, (v0, v1) = self._pan
-            self.set_view(v0 - (x - start) * self._frames_per_px(), v1 - (x - start) * self._frames_per_px())
+            start, view = self._pan
+            self.set_view(*view_range.pan(view, -(x - start) * self._frames_per_px()))
             event.accept()
         elif event.buttons() & Qt.MouseButton.LeftButton:
             if self._grab is not None and not self._dragging:
@@ -439,13 +443,13 @@ class TimelineView(QWidget):
                 p.drawRect(QRectF(x - half + 0.8, cy - half + 0.8, 2 * half - 1.6, 2 * half - 1.6))
         p.setBrush(Qt.BrushStyle.NoBrush)
 
-    def _curve_path(self, values: np.ndarray, top: float, height: float, scale: float) -> QPainterPath:
-        path = QPainterPath()
-        frames = self.visible_frames()
-        for i, f in enumerate(frames):
-            pt = QPointF(self.frame_to_x(f), top + height - height * float(values[f]) / scale)
-            path.lineTo(pt) if i else path.moveTo(pt)
-        return path
+    def _curve_points(self, values: np.ndarray, top: float, height: float, scale: float) -> QPolygonF:
+        """The visible frames of a per-frame curve as one polygon (drawn by drawPolyline, not a
+        lineTo per frame)."""
+        frames = np.asarray(self.visible_frames(), dtype=np.int64)
+        xs = self._axis().to_px(frames.astype(np.float64))
+        ys = top + height - height * np.asarray(values, dtype=np.float64)[frames] / scale
+        return polygon(xs, ys)
 
     def _paint_curves(self, p: QPainter) -> None:
         m, r = self.model, self.row_rect("curves")
@@ -459,20 +463,22 @@ class TimelineView(QWidget):
             p.drawText(QRect(LEFT, r.top(), 300, 14), Qt.AlignmentFlag.AlignLeft, text)
             return
         if a.speed is not None and a.speed.max() > 0:
-            area = self._curve_path(a.speed, top, height, float(a.speed.max()))
+            area = self._curve_points(a.speed, top, height, float(a.speed.max()))
             frames = self.visible_frames()
-            area.lineTo(self.frame_to_x(frames[-1]), top + height)
-            area.lineTo(self.frame_to_x(frames[0]), top + height)
-            area.closeSubpath()
-            p.fillPath(area, SPEED_COLOUR)
+            area.append(QPointF(self.frame_to_x(frames[-1]), top + height))
+            area.append(QPointF(self.frame_to_x(frames[0]), top + height))
+            path = QPainterPath()
+            path.addPolygon(area)
+            path.closeSubpath()
+            p.fillPath(path, SPEED_COLOUR)
         scale = max(
             float(max(a.dp.tip.max(), a.dp.mean.max(), a.uniform.tip.max(), a.uniform.mean.max())), 1e-12
         )
         for err, colour in ((a.uniform, UNIFORM_COLOUR), (a.dp, DP_COLOUR)):
             p.setPen(QPen(colour, 1.6))
-            p.drawPath(self._curve_path(err.mean, top, height, scale))
+            p.drawPolyline(self._curve_points(err.mean, top, height, scale))
             p.setPen(QPen(colour, 1.2, Qt.PenStyle.DashLine))
-            p.drawPath(self._curve_path(err.tip, top, height, scale))
+            p.drawPolyline(self._curve_points(err.tip, top, height, scale))
         p.setPen(TEXT)
         legend = (
             f"distance on the vertices (max {scale:.3g}): — mean  - - tip   DP {a.dp.mean.mean():.3g}  "
@@ -579,18 +585,11 @@ class KeyCountPlot(QWidget):
             QRectF(r.left(), r.bottom() + 2, r.width(), 12), Qt.AlignmentFlag.AlignCenter, "keys (log error)"
         )
         if self._uniform is not None:
-            path = QPainterPath()
-            for i, (k, v) in enumerate(zip(curve[:, 0], self._uniform, strict=True)):
-                pt = self._point(k, v, lo, hi)
-                path.lineTo(pt) if i else path.moveTo(pt)
             p.setPen(QPen(UNIFORM_COLOUR, 1.2, Qt.PenStyle.DashLine))
-            p.drawPath(path)
-        path = QPainterPath()
-        for i, (k, v) in enumerate(curve):
-            pt = self._point(k, v, lo, hi)
-            path.lineTo(pt) if i else path.moveTo(pt)
+            points = zip(curve[:, 0], self._uniform, strict=True)
+            p.drawPolyline(QPolygonF([self._point(k, v, lo, hi) for k, v in points]))
         p.setPen(QPen(DP_COLOUR, 1.6))
-        p.drawPath(path)
+        p.drawPolyline(QPolygonF([self._point(k, v, lo, hi) for k, v in curve]))
         keys = self.model.dp_keys
         current = self.current_point()
         if current is not None:

@@ -16,16 +16,18 @@ choose.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hairtool.errors import ParameterError
+from hairtool.errors import FormatError, ParameterError
+from hairtool.keys.edit import check_retime, residual_at, time_warp
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at, interpolate_keys, key_poses
 from hairtool.mocap import ik
-from hairtool.mocap.bvh import Motion
-from hairtool.mocap.pose_edit import INTERPS, EditReport, PoseEdit
+from hairtool.mocap.bvh import MAX_VALUE, Motion
+from hairtool.mocap.pose_edit import INTERPS, ChannelEdit, EditReport, PoseEdit, TangentEdit, parse_edit_list
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -67,14 +69,89 @@ def channel_key_curve(motion: Motion, keys: list[ArrayLike], interp: str = "herm
     return motion.with_values(values)
 
 
+@dataclass(frozen=True)
+class ChannelRetimeEdit:
+    """Move one channel's key at ``frame`` to the frame ``to`` (strictly between that channel's
+    neighbouring keys): a per-channel key dragged in time; the other channels keep their keys."""
+
+    frame: int
+    joint: str
+    channel: str
+    to: int
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+ChannelKeyEdit = ChannelEdit | TangentEdit | ChannelRetimeEdit
+
+
+def parse_channel_edits(data: object, motion: Motion, source: str = "edits") -> list[ChannelKeyEdit]:
+    """Per-channel key edits from JSON data (what a studio project keeps): value and handle
+    edits as :func:`~hairtool.mocap.pose_edit.parse_edit_list` reads them, and key moves
+    ``{"frame", "joint", "channel", "to"}``; faults raise FormatError naming ``source``."""
+    if not isinstance(data, list):
+        raise FormatError(source, "expected a list of per-channel key edits")
+    out: list[ChannelKeyEdit] = []
+    for i, e in enumerate(data, 1):
+        if isinstance(e, dict) and "to" in e and "channel" in e:
+            fields = ("frame", "joint", "channel", "to")
+            if set(e) != set(fields):
+                raise FormatError(source, f"channel edit {i} needs exactly the fields {', '.join(fields)}")
+            try:
+                (value,) = parse_edit_list([{**{k: e[k] for k in fields[:3]}, "value": 0.0}], motion, source)
+            except FormatError as err:
+                raise FormatError(source, err.reason.replace("edit 1", f"channel edit {i}", 1)) from None
+            to = e["to"]
+            if not isinstance(to, int) or isinstance(to, bool) or not 0 <= to < motion.n_frames:
+                raise FormatError(source, f"channel edit {i}: to {str(to)[:40]} is not a frame number")
+            out.append(ChannelRetimeEdit(value.frame, value.joint, value.channel, int(to)))
+            continue
+        try:
+            (edit,) = parse_edit_list([e], motion, source)
+        except FormatError as err:
+            raise FormatError(source, err.reason.replace("edit 1", f"channel edit {i}", 1)) from None
+        if not isinstance(edit, ChannelEdit | TangentEdit):
+            raise FormatError(source, f"channel edit {i} is not a key's value, slope or move of one channel")
+        out.append(edit)
+    return out
+
+
 @dataclass
 class _Step:
+    """One edit: per channel, the value change at its keys ({original frame: Δ}; a frame that
+    was no key of the channel becomes one), the slope change ({original frame: δ}) and keys
+    moved in time ({original frame: frame now})."""
+
     report: EditReport
     changes: dict[int, dict[int, float]]
+    slopes: dict[int, dict[int, float]] = field(default_factory=dict)
+    moves: dict[int, dict[int, int]] = field(default_factory=dict)
+
+
+@dataclass
+class _Channel:
+    """A channel's keys as edited: ``knots`` the key frames before any move (the residuals are
+    measured against the key curve through them), ``keys`` where they are now, and the value
+    and slope changes at each."""
+
+    knots: I64
+    keys: I64
+    change: F64
+    slope: F64
 
 
 class ChannelEditor:
-    """A capture, each channel's keys, and the key changes of the edits so far (undoable)."""
+    """A capture, each channel's keys, and the edits so far (undoable): IK edits (:meth:`apply`),
+    and a channel's key moved in value, slope or time (:meth:`apply_channel`,
+    :meth:`apply_tangent`, :meth:`apply_retime`, as a graph editor drags them).
+
+    A channel's edited values are its key curve through the edited keys plus the residual of
+    every frame against the captured key curve: where a segment kept its keys, the capture plus
+    the key changes spread by the curve's basis (exact elsewhere); in a segment a moved key
+    stretched, the curve there plus the residual of the frame it now shows
+    (:func:`hairtool.keys.edit.retime_key`), on the unwrapped angles, written back within the
+    capture's own whole turns."""
 
     def __init__(self, motion: Motion, keys: list[ArrayLike], interp: str = "hermite") -> None:
         if interp not in INTERPS:
@@ -84,6 +161,8 @@ class ChannelEditor:
         self._keys0 = _check_channel_keys(motion, keys)
         self.height = ik.figure_height(motion)
         self._history: list[_Step] = []
+        self._unwrapped = channel_features(motion)
+        self._base_curves: dict[tuple, KeyPoses] = {}
 
     # -- state -----------------------------------------------------------------------------
     def _changes(self) -> dict[int, dict[int, float]]:
@@ -95,10 +174,28 @@ class ChannelEditor:
                     total.setdefault(c, {})[f] = total.get(c, {}).get(f, 0.0) + d
         return total
 
+    def _touched(self) -> set[int]:
+        return {c for s in self._history for part in (s.changes, s.slopes, s.moves) for c in part}
+
+    def _channel(self, c: int) -> _Channel:
+        knots = self._keys0[c]
+        added = [f for s in self._history for f in s.changes.get(c, {})]
+        if added:
+            knots = np.union1d(knots, np.asarray(added, dtype=np.int64))
+        change, slope, moved = np.zeros(knots.size), np.zeros(knots.size), knots.copy()
+        for s in self._history:
+            for f, d in s.changes.get(c, {}).items():
+                change[np.searchsorted(knots, f)] += d
+            for f, d in s.slopes.get(c, {}).items():
+                slope[np.searchsorted(knots, f)] += d
+            for f, to in s.moves.get(c, {}).items():
+                moved[np.searchsorted(knots, f)] = to
+        return _Channel(knots, moved, change, slope)
+
     def keys(self, channel: int) -> I64:
-        """A channel's keys: its solved keys and the frames edits added to it."""
-        added = [f for step in self._history for f in step.changes.get(channel, {})]
-        return np.union1d(self._keys0[channel], np.asarray(added, dtype=np.int64))
+        """A channel's keys now: its solved keys, the frames edits added to it, moved ones where
+        they were moved to."""
+        return self._channel(channel).keys
 
     @property
     def union(self) -> I64:
@@ -109,14 +206,51 @@ class ChannelEditor:
     def reports(self) -> list[EditReport]:
         return [s.report for s in self._history]
 
-    def _delta(self, c: int, moves: dict[int, float], frames: I64) -> F64:
-        k = self.keys(c)
-        change = np.zeros((k.size, 1))
-        for f, d in moves.items():
-            change[np.searchsorted(k, f), 0] = d
-        zero = None if self.interp == "linear" else np.zeros_like(change)
-        kind = "linear" if self.interp == "linear" else "hermite"
-        return interpolate_at(KeyPoses(k, change, zero, self.original.n_frames, kind), frames)[:, 0]
+    def _base(self, c: int, knots: I64) -> KeyPoses:
+        """Channel c's captured key curve (unwrapped) through ``knots``."""
+        key = (c, knots.tobytes())
+        if key not in self._base_curves:
+            self._base_curves[key] = key_poses(self._unwrapped[:, c : c + 1], knots, self.interp)
+        return self._base_curves[key]
+
+    def _warped(self, ch: _Channel) -> I64:
+        """Frames in a segment next to a moved key (its own frame included)."""
+        moved = np.flatnonzero(ch.keys != ch.knots)
+        if moved.size == 0:
+            return np.zeros(0, dtype=np.int64)
+        k = ch.keys
+        return np.unique(np.concatenate([np.arange(k[a - 1] + 1, k[a + 1]) for a in moved]))
+
+    def _edited_curve(self, c: int, ch: _Channel) -> KeyPoses:
+        """Channel c's key curve as edited (unwrapped): the captured key poses and tangents plus
+        the changes, at the keys' frames now."""
+        base = self._base(c, ch.knots)
+        poses = base.poses + ch.change[:, None]
+        if base.tangents is None:
+            return KeyPoses(ch.keys, poses, None, base.n_frames, base.interp)
+        out = base.tangents + ch.slope[:, None]
+        inn = None if base.tangents_in is None else base.tangents_in + ch.slope[:, None]
+        return KeyPoses(ch.keys, poses, out, base.n_frames, base.interp, inn)
+
+    def _values(self, c: int, ch: _Channel, frames: I64) -> F64:
+        """The edited channel at ``frames``."""
+        m = self.original
+        out = m.values[frames, c].astype(np.float64)
+        warped = np.isin(frames, self._warped(ch))
+        still = frames[~warped]
+        if still.size and (np.any(ch.change) or np.any(ch.slope)):
+            zero = None if self.interp == "linear" else ch.slope[:, None]
+            kind = "linear" if self.interp == "linear" else "hermite"
+            kp = KeyPoses(ch.keys, ch.change[:, None], zero, m.n_frames, kind)
+            out[~warped] = m.values[still, c] + interpolate_at(kp, still)[:, 0]
+        if warped.any():
+            t = frames[warped]
+            base = self._base(c, ch.knots)
+            x = self._unwrapped[:, c : c + 1]
+            curve = interpolate_at(self._edited_curve(c, ch), t)[:, 0]
+            r = residual_at(x, lambda i: interpolate_at(base, i), time_warp(t, ch.keys, ch.knots))[:, 0]
+            out[warped] = curve + r + (m.values[t, c] - self._unwrapped[t, c])
+        return out
 
     def _span(self, c: int, f: int) -> tuple[int, int]:
         """``[start, stop)``: the frames a move of channel c's key at f changes."""
@@ -128,12 +262,90 @@ class ChannelEditor:
 
     def pose(self, frame: int) -> F64:
         """``(C,)`` the edited capture's channels at one frame."""
-        v = self.original.values[frame].copy()
-        for c, moves in self._changes().items():
-            v[c] += self._delta(c, moves, np.array([frame]))[0]
+        v = self.original.values[frame].astype(np.float64)
+        for c in self._touched():
+            v[c] = self._values(c, self._channel(c), np.array([frame]))[0]
         return v
 
+    # -- what a graph editor draws -----------------------------------------------------------
+    def column(self, joint: str, channel: str) -> int:
+        """The capture's column of a joint's channel (ParameterError naming the choices)."""
+        m = self.original
+        if joint not in m.joint_names:
+            raise ParameterError("joint", joint, "a joint of the skeleton")
+        j = m.joint_names.index(joint)
+        if channel not in m.channels[j]:
+            raise ParameterError("channel", channel, f"a channel of '{joint}': {', '.join(m.channels[j])}")
+        return int(m._starts[j]) + m.channels[j].index(channel)
+
+    def key_curve(self, c: int) -> F64:
+        """``(F,)`` channel c's edited key curve alone (no residuals), within the capture's turns."""
+        ch = self._channel(c)
+        frames = np.arange(self.original.n_frames)
+        curve = interpolate_at(self._edited_curve(c, ch), frames)[:, 0]
+        return curve + (self.original.values[:, c] - self._unwrapped[:, c])
+
+    def key_slopes(self, c: int) -> tuple[F64, F64] | None:
+        """``(in, out)`` slopes (per frame) of channel c's key curve at its keys; None for linear."""
+        kp = self._edited_curve(c, self._channel(c))
+        if kp.tangents is None:
+            return None
+        arriving = kp.tangents if kp.tangents_in is None else kp.tangents_in
+        return arriving[:, 0].copy(), kp.tangents[:, 0].copy()
+
     # -- editing ---------------------------------------------------------------------------
+    def _knot(self, c: int, frame: int, what: str) -> tuple[_Channel, int]:
+        ch = self._channel(c)
+        hit = np.flatnonzero(ch.keys == frame)
+        if hit.size == 0:
+            keys = " ".join(map(str, ch.keys.tolist()[:12]))
+            raise ParameterError("frame", frame, f"a key of the {what} channel: {keys}")
+        return ch, int(hit[0])
+
+    def _report(self, edit: object, joint: str, method: str, c: int, frame: int) -> EditReport:
+        first, stop = self._span(c, frame)
+        return EditReport(edit, [joint], method, 0, 0.0, 0.0, first, stop - 1)
+
+    def apply_channel(self, edit: ChannelEdit) -> EditReport:
+        """Set one channel's key at ``edit.frame`` (a key of that channel) to ``edit.value``."""
+        c = self.column(edit.joint, edit.channel)
+        if not (math.isfinite(edit.value) and abs(edit.value) <= MAX_VALUE):
+            raise ParameterError("value", edit.value, "a finite number")
+        ch, a = self._knot(c, edit.frame, edit.channel)
+        now = self._values(c, ch, np.array([edit.frame]))[0]
+        step = _Step(None, {c: {int(ch.knots[a]): float(edit.value - now)}})
+        self._history.append(step)
+        step.report = self._report(edit, edit.joint, "channel", c, edit.frame)
+        return step.report
+
+    def apply_tangent(self, edit: TangentEdit) -> EditReport:
+        """Set the slope (per frame) one channel's key curve passes its key at ``edit.frame``
+        with (the leaving handle; the arriving one turns by as much, so seed 003's handles stay
+        aligned); linear keys have none (ParameterError)."""
+        if self.interp == "linear":
+            raise ParameterError("interp", self.interp, "hermite or hermite-fit (linear keys: no handles)")
+        if not (math.isfinite(edit.slope) and abs(edit.slope) <= MAX_VALUE):
+            raise ParameterError("slope", edit.slope, "a finite slope per frame")
+        c = self.column(edit.joint, edit.channel)
+        ch, a = self._knot(c, edit.frame, edit.channel)
+        _, s_out = self.key_slopes(c)
+        change = {int(ch.knots[a]): float(edit.slope - s_out[a])}
+        step = _Step(None, {}, slopes={c: change})
+        self._history.append(step)
+        step.report = self._report(edit, edit.joint, "handle", c, edit.frame)
+        return step.report
+
+    def apply_retime(self, edit: ChannelRetimeEdit) -> EditReport:
+        """Move one channel's key in time, strictly between that channel's neighbouring keys (the
+        first and last frame stay keys); ParameterError otherwise."""
+        c = self.column(edit.joint, edit.channel)
+        ch, a = self._knot(c, edit.frame, edit.channel)
+        check_retime(ch.keys, self.original.n_frames, edit.frame, edit.to)
+        step = _Step(None, {}, moves={c: {int(ch.knots[a]): int(edit.to)}})
+        self._history.append(step)
+        step.report = self._report(edit, edit.joint, "retime", c, edit.to)
+        return step.report
+
     def apply(self, edit: PoseEdit, method: str = "auto") -> EditReport:
         m = self.original
         union = self.union
@@ -147,11 +359,18 @@ class ChannelEditor:
         s = ik.solve(m, current, e, edit.chain, edit.target, ik.TOLERANCE * self.height, method)
         turned = ik.ancestors(m, e, edit.chain)
         # A channel's key at the frame moves by what the IK changed; where the frame was not one
-        # of its keys it becomes one, holding the value the edits before gave it there too.
+        # of its keys it becomes one, holding the value the edits before gave it there too (a
+        # frame a moved key stretched cannot take a new key: the segment has no captured frame there).
         moves: dict[int, dict[int, float]] = {}
         for c in np.flatnonzero(s.values != current).tolist():
-            knot = edit.frame in self.keys(c)
-            moves[c] = {edit.frame: float(s.values[c] - (current[c] if knot else m.values[edit.frame, c]))}
+            ch = self._channel(c)
+            hit = np.flatnonzero(ch.keys == edit.frame)
+            if hit.size:
+                moves[c] = {int(ch.knots[hit[0]]): float(s.values[c] - current[c])}
+            elif edit.frame in self._warped(ch):
+                raise ParameterError("frame", edit.frame, "a frame no moved key of the chain stretched")
+            else:
+                moves[c] = {edit.frame: float(s.values[c] - m.values[edit.frame, c])}
         names = [m.joint_names[j] for j in turned]
         f = edit.frame
         report = EditReport(edit, names, s.method, s.iterations, s.miss, s.miss / self.height, f, f)
@@ -163,21 +382,35 @@ class ChannelEditor:
             report.last = max(b for _, b in spans) - 1
         return step.report
 
-    def apply_all(self, edits: list[PoseEdit], method: str = "auto") -> list[EditReport]:
-        return [self.apply(e, method) for e in edits]
+    def apply_all(self, edits: list, method: str = "auto") -> list[EditReport]:
+        out = []
+        for e in edits:
+            if isinstance(e, ChannelEdit):
+                out.append(self.apply_channel(e))
+            elif isinstance(e, TangentEdit):
+                out.append(self.apply_tangent(e))
+            elif isinstance(e, ChannelRetimeEdit):
+                out.append(self.apply_retime(e))
+            else:
+                out.append(self.apply(e, method))
+        return out
 
-    def undo(self) -> PoseEdit | None:
+    def undo(self) -> object | None:
         return self._history.pop().report.edit if self._history else None
 
     def reset(self) -> None:
         self._history.clear()
 
     def motion(self) -> Motion:
-        """The edited capture: each moved channel plus its keys' changes spread by the basis,
-        only between the neighbouring keys of each moved key (elsewhere the capture itself)."""
+        """The edited capture: each edited channel changed only between the neighbouring keys
+        of its edited keys (elsewhere the capture itself)."""
         m = self.original
         values = m.values.copy()
-        for c, moves in self._changes().items():
-            frames = np.unique(np.concatenate([np.arange(*self._span(c, f)) for f in moves]))
-            values[frames, c] = m.values[frames, c] + self._delta(c, moves, frames)
+        for c in sorted(self._touched()):
+            ch = self._channel(c)
+            edited = [f for s in self._history for part in (s.changes, s.slopes) for f in part.get(c, {})]
+            spans = [np.arange(*self._span(c, int(ch.keys[np.searchsorted(ch.knots, f)]))) for f in edited]
+            frames = np.unique(np.concatenate([self._warped(ch), *spans])).astype(np.int64)
+            if frames.size:
+                values[frames, c] = self._values(c, ch, frames)
         return m.with_values(values)

@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import FormatError, ParameterError
+from hairtool.keys.edit import check_retime, residual_at, time_warp
 from hairtool.keys.reconstruct import KeyPoses, check_keys, interpolate_at, key_poses
 from hairtool.mocap import ik
 from hairtool.mocap import quaternion as quat
@@ -43,6 +44,7 @@ I64 = NDArray[np.int64]
 INTERPS = ("linear", "hermite", "hermite-fit")
 FIELDS = ("frame", "joint", "target", "chain")
 CHANNEL_FIELDS = ("frame", "joint", "channel", "value")
+RETIME_FIELDS = ("frame", "to")
 TANGENT_FIELDS = ("frame", "joint", "channel", "slope")
 
 
@@ -71,7 +73,7 @@ class ChannelEdit:
     value: float
 
     def to_dict(self) -> dict:
-        return {"frame": self.frame, "joint": self.joint, "channel": self.channel, "value": self.value}
+        return asdict(self)
 
 
 @dataclass(frozen=True)
@@ -86,10 +88,24 @@ class TangentEdit:
     slope: float
 
     def to_dict(self) -> dict:
-        return {"frame": self.frame, "joint": self.joint, "channel": self.channel, "slope": self.slope}
+        return asdict(self)
 
 
-Edit = PoseEdit | ChannelEdit | TangentEdit
+@dataclass(frozen=True)
+class RetimeEdit:
+    """Move the key at ``frame`` to the frame ``to`` (strictly between its neighbouring keys):
+    a key dragged in time in a graph editor. The key pose keeps its values and handles, the key
+    curve takes the new knot and the frames between the neighbours show the capture's residuals
+    retimed with it (:func:`hairtool.keys.edit.retime_key`); later edits of that key name ``to``."""
+
+    frame: int
+    to: int
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+Edit = PoseEdit | ChannelEdit | TangentEdit | RetimeEdit
 
 
 @dataclass
@@ -175,8 +191,9 @@ def parse_edits(data: object, motion: Motion, source: str = "edits") -> list[Pos
 
 
 def parse_edit_list(data: object, motion: Motion, source: str = "edits") -> list[Edit]:
-    """Pose edits (:func:`parse_edits`), channel edits ``{"frame", "joint", "channel", "value"}``
-    and handle edits ``{"frame", "joint", "channel", "slope"}`` in one list, in order (what a
+    """Pose edits (:func:`parse_edits`), channel edits ``{"frame", "joint", "channel", "value"}``,
+    handle edits ``{"frame", "joint", "channel", "slope"}`` and key moves ``{"frame", "to"}`` in
+    one list, in order (what a
     studio project keeps); faults raise :class:`FormatError` naming ``source`` and the edit
     (counted from 1)."""
     if isinstance(data, dict) and set(data) == {"edits"}:
@@ -185,6 +202,9 @@ def parse_edit_list(data: object, motion: Motion, source: str = "edits") -> list
         raise FormatError(source, "expected a list of edits")
     out: list[Edit] = []
     for i, e in enumerate(data, 1):
+        if isinstance(e, dict) and "to" in e and "joint" not in e:
+            out.append(_parse_retime(e, motion, source, i))
+            continue
         if not (isinstance(e, dict) and "channel" in e):
             try:
                 out += parse_edits([e], motion, source)
@@ -217,6 +237,19 @@ def parse_edit_list(data: object, motion: Motion, source: str = "edits") -> list
     return out
 
 
+def _parse_retime(e: dict, motion: Motion, source: str, i: int) -> RetimeEdit:
+    extra = sorted(str(k)[:40] for k in e if k not in RETIME_FIELDS)
+    if "frame" not in e or extra:
+        what = "lacks frame" if "frame" not in e else f"has unknown fields {', '.join(extra)}"
+        raise FormatError(source, f"edit {i} {what} (fields: {', '.join(RETIME_FIELDS)})")
+    for name in RETIME_FIELDS:
+        v = e[name]
+        if not _is_int(v) or not 0 <= v < motion.n_frames:
+            last = motion.n_frames - 1
+            raise FormatError(source, f"edit {i}: {name} {str(v)[:40]} is not a frame number 0..{last}")
+    return RetimeEdit(int(e["frame"]), int(e["to"]))
+
+
 def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
     """:func:`parse_edits` of a JSON file; unreadable or invalid JSON raises :class:`FormatError`."""
     p = os.fspath(path)
@@ -243,17 +276,21 @@ class PoseEditor:
             raise ParameterError("interp", interp, " or ".join(INTERPS))
         self.original = motion
         self.interp = interp
-        self.keys: I64 = check_keys(keys, motion.n_frames)
+        # the keys the residuals are measured against (the solved ones) and the keys as edited
+        # (a key moved in time, RetimeEdit): the same until a key moves
+        self._keys0: I64 = check_keys(keys, motion.n_frames)
+        self.keys: I64 = self._keys0.copy()
         self.height = ik.figure_height(motion)
         self._q = quat.align_hemisphere(motion.local_rotations(), axis=0)
-        self._base_values = motion.values[self.keys].copy()
+        self._base_values = motion.values[self._keys0].copy()
         self._key_values = self._base_values.copy()
-        self._key_q = self._q[self.keys].copy()
-        # report, key index, its values and quaternions before, and for a handle edit the
-        # joint and its tangents before (None: the captured ones)
-        self._history: list[tuple[EditReport, int, F64, F64, tuple | None]] = []
+        self._key_q = self._q[self._keys0].copy()
+        # report, key index, its values and quaternions before, for a handle edit the joint and
+        # its tangents before (None: the captured ones), for a key move the keys before
+        self._history: list[tuple[EditReport, int, F64, F64, tuple | None, I64 | None]] = []
         self._curves: dict[int, KeyPoses] = {}
         self._angle_curves: dict[int, KeyPoses] = {}
+        self._other_curve: KeyPoses | None = None  # the channels no joint turns (positions)
         self._tangents: dict[int, tuple[F64, F64]] = {}  # joint → edited (out, in) tangents (K, D)
 
     # -- keys ------------------------------------------------------------------------------
@@ -295,12 +332,12 @@ class PoseEditor:
             cols, order = ik.rotation_columns(m, j)
             if ik.is_ball_joint(m, j):
                 q = quat.from_euler(s.values[cols], order)
-                ref = self._q[self.keys[a], j]
+                ref = self._q[self._keys0[a], j]
                 self._key_q[a, j] = -q if np.dot(q, ref) < 0 else q
         first, last = self.span(edit.frame)
         names = [m.joint_names[j] for j in turned]
         report = EditReport(edit, names, s.method, s.iterations, s.miss, s.miss / self.height, first, last)
-        self._history.append((report, *saved, None))
+        self._history.append((report, *saved, None, None))
         return report
 
     def apply_channel(self, edit: ChannelEdit) -> EditReport:
@@ -316,11 +353,25 @@ class PoseEditor:
         self._key_values[a, cols[i]] = float(edit.value)
         if ik.is_ball_joint(m, j):
             q = quat.from_euler(self._key_values[a, cols], order)
-            ref = self._q[self.keys[a], j]
+            ref = self._q[self._keys0[a], j]
             self._key_q[a, j] = -q if np.dot(q, ref) < 0 else q
         first, last = self.span(edit.frame)
         report = EditReport(edit, [edit.joint], "channel", 0, 0.0, 0.0, first, last)
-        self._history.append((report, *saved, None))
+        self._history.append((report, *saved, None, None))
+        return report
+
+    def apply_retime(self, edit: RetimeEdit) -> EditReport:
+        """Move a key in time (a key dragged sideways): the key keeps its pose and handles, the
+        frames between its neighbouring keys follow with the residuals retimed
+        (:func:`hairtool.keys.edit.retime_key`, every channel of the pose, positions too, as
+        pose keys are shared); ParameterError for an end key or a frame not strictly between
+        the neighbours."""
+        a, after = check_retime(self.keys, self.original.n_frames, edit.frame, edit.to)
+        saved = (a, self._key_values[a].copy(), self._key_q[a].copy())
+        before, self.keys = self.keys, after
+        first, last = self.span(edit.to)
+        report = EditReport(edit, [], "retime", 0, 0.0, 0.0, first, last)
+        self._history.append((report, *saved, None, before))
         return report
 
     def _channel(self, edit: ChannelEdit | TangentEdit) -> tuple[int, list[int], str, int]:
@@ -364,7 +415,9 @@ class PoseEditor:
         self._tangents[j] = (out, inn)
         first, last = self.span(edit.frame)
         report = EditReport(edit, [edit.joint], "handle", 0, 0.0, 0.0, first, last)
-        self._history.append((report, a, self._key_values[a].copy(), self._key_q[a].copy(), (j, before)))
+        self._history.append(
+            (report, a, self._key_values[a].copy(), self._key_q[a].copy(), (j, before), None)
+        )
         return report
 
     def key_slopes(self, joint: int) -> tuple[F64, F64] | None:
@@ -401,11 +454,15 @@ class PoseEditor:
         if ik.is_ball_joint(self.original, j):
             kp = self._kp(j)
         else:
-            if j not in self._angle_curves:
-                cols, _ = ik.rotation_columns(self.original, j)
-                self._angle_curves[j] = key_poses(self.original.values[:, cols], self.keys, self.interp)
-            kp = self._angle_curves[j]
+            kp = self._angle_kp(j)
         return kp.tangents, kp.tangents if kp.tangents_in is None else kp.tangents_in
+
+    def _angle_kp(self, j: int) -> KeyPoses:
+        """A hinge joint's key curve on its captured angles at the solved keys."""
+        if j not in self._angle_curves:
+            cols, _ = ik.rotation_columns(self.original, j)
+            self._angle_curves[j] = key_poses(self.original.values[:, cols], self._keys0, self.interp)
+        return self._angle_curves[j]
 
     def _current_tangents(self, j: int) -> tuple[F64, F64]:
         return self._tangents[j] if j in self._tangents else self._base_tangents(j)
@@ -426,6 +483,8 @@ class PoseEditor:
                 out.append(self.apply_channel(e))
             elif isinstance(e, TangentEdit):
                 out.append(self.apply_tangent(e))
+            elif isinstance(e, RetimeEdit):
+                out.append(self.apply_retime(e))
             else:
                 out.append(self.apply(e, method))
         return out
@@ -434,8 +493,10 @@ class PoseEditor:
         """Take back the last edit (None when there is none)."""
         if not self._history:
             return None
-        report, a, values, q, tangents = self._history.pop()
+        report, a, values, q, tangents, keys = self._history.pop()
         self._key_values[a], self._key_q[a] = values, q
+        if keys is not None:
+            self.keys = keys
         if tangents is not None:
             j, before = tangents
             if before is None:
@@ -453,56 +514,120 @@ class PoseEditor:
         """A ball joint's key curve on its captured quaternions (tangents kept through edits)."""
         if j not in self._curves:
             kind = "linear" if self.interp == "linear" else self.interp
-            self._curves[j] = key_poses(self._q[:, j], self.keys, kind)
+            self._curves[j] = key_poses(self._q[:, j], self._keys0, kind)
         return self._curves[j]
 
-    def _curve(self, j: int, poses: F64, frames: I64, tangents: tuple[F64, F64] | None = None) -> F64:
-        """``(len(frames), 4)`` joint j's key curve through the key quaternions ``poses`` (with
-        the ``(out, in)`` tangents given, else the captured ones)."""
+    def _curve(
+        self,
+        j: int,
+        poses: F64,
+        frames: I64,
+        tangents: tuple[F64, F64] | None = None,
+        knots: I64 | None = None,
+    ) -> F64:
+        """``(len(frames), 4)`` joint j's key curve through the key quaternions ``poses`` at the
+        key frames ``knots`` (default the keys as edited), with the ``(out, in)`` tangents
+        given, else the captured ones."""
+        knots = self.keys if knots is None else knots
         if self.interp == "linear":  # slerp, as reconstruct_motion rebuilds it
-            k = self.keys
+            k = knots
             a = np.clip(np.searchsorted(k, frames, side="right") - 1, 0, k.size - 2)
             s = (frames - k[a]) / (k[a + 1] - k[a]).astype(np.float64)
             return quat.slerp(poses[a], poses[a + 1], s)
         kp = self._kp(j)
         if tangents is not None:
-            edited = KeyPoses(kp.keys, poses, tangents[0], kp.n_frames, kp.interp, tangents[1])
+            edited = KeyPoses(knots, poses, tangents[0], kp.n_frames, kp.interp, tangents[1])
         else:
-            edited = KeyPoses(kp.keys, poses, kp.tangents, kp.n_frames, kp.interp, kp.tangents_in)
+            edited = KeyPoses(knots, poses, kp.tangents, kp.n_frames, kp.interp, kp.tangents_in)
         return interpolate_at(edited, frames)
 
     def motion(self) -> Motion:
-        """The edited capture at every frame: the edited key curves plus the stored residuals."""
+        """The edited capture at every frame: the edited key curves plus the stored residuals
+        (retimed between the neighbours of a key moved in time)."""
         m = self.original
         values = m.values.copy()
         changed = np.any(self._key_values != self._base_values, axis=0)  # (C,) columns any edit moved
+        warped = self._warped_frames()
         for j in range(m.n_joints):
             cols, order = ik.rotation_columns(m, j)
             handles = self._tangent_rows(j) if cols else np.zeros(0, dtype=np.int64)
-            if not cols or not (np.any(changed[cols]) or handles.size):
+            if not cols or not (np.any(changed[cols]) or handles.size or warped.size):
                 continue
             rows = np.flatnonzero(np.any(self._key_values[:, cols] != self._base_values[:, cols], axis=1))
             rows = np.union1d(rows, handles)
             tangents = self._tangents.get(j) if handles.size else None
-            frames = np.unique(np.concatenate([np.arange(*self._span_of(a)) for a in rows]))
+            spans = [np.arange(*self._span_of(a)) for a in rows]
+            frames = np.unique(np.concatenate([warped, *spans]))
+            moved = np.isin(frames, warped)
+            still = frames[~moved]
             ball = ik.is_ball_joint(m, j)
-            # The edit's spread on the angles themselves: the key's change of angles weighted by
-            # the curve's basis (the tangents are the same before and after, so they cancel).
+            # Frames whose segment kept its keys: the edit's spread is the key's change of angles
+            # weighted by the curve's basis (the tangents are the same before and after, so they
+            # cancel). Frames in a segment a moved key stretched: the curve plus the residual of
+            # the frame they now show.
             if ball:
-                base = self._q[self.keys, j]
-                delta = self._curve(j, self._key_q[:, j], frames, tangents) - self._curve(j, base, frames)
-                q = quat.normalize(self._q[frames, j] + delta)
+                base = self._q[self._keys0, j]
+                q = np.empty((frames.size, 4))
+                if still.size:
+                    delta = self._curve(j, self._key_q[:, j], still, tangents) - self._curve(j, base, still)
+                    q[~moved] = self._q[still, j] + delta
+                if moved.any():
+                    q[moved] = self._curve(j, self._key_q[:, j], frames[moved], self._tangents.get(j))
+                    q[moved] += residual_at(
+                        self._q[:, j],
+                        lambda i, j=j, base=base: self._curve(j, base, i, knots=self._keys0),
+                        time_warp(frames[moved], self.keys, self._keys0),
+                    )
+                q = quat.normalize(q)
                 for run in np.split(np.arange(frames.size), np.flatnonzero(np.diff(frames) > 1) + 1):
                     values[np.ix_(frames[run], cols)] = self._track(frames[run], cols, order, q[run])
             else:
-                change = self._key_values[:, cols] - self._base_values[:, cols]
-                if tangents is not None:
-                    (out, inn), (b_out, b_in) = tangents, self._base_tangents(j)
-                    spread = self._spread(change, frames, (out - b_out, inn - b_in))
-                else:
-                    spread = self._spread(change, frames)
-                values[np.ix_(frames, cols)] = m.values[np.ix_(frames, cols)] + spread
+                if still.size:
+                    change = self._key_values[:, cols] - self._base_values[:, cols]
+                    if tangents is not None:
+                        (out, inn), (b_out, b_in) = tangents, self._base_tangents(j)
+                        spread = self._spread(change, still, (out - b_out, inn - b_in))
+                    else:
+                        spread = self._spread(change, still)
+                    values[np.ix_(still, cols)] = m.values[np.ix_(still, cols)] + spread
+                if moved.any():
+                    out, inn = self._current_tangents(j)
+                    kp = self._angle_kp(j)
+                    edited = KeyPoses(self.keys, self._key_values[:, cols], out, kp.n_frames, kp.interp, inn)
+                    retimed = self._retimed(m.values[:, cols], kp, edited, frames[moved])
+                    values[np.ix_(frames[moved], cols)] = retimed
+        if warped.size:  # the channels no joint turns (the root's position) move in time too
+            others = self._other_columns()
+            if others:
+                kp = self._others()
+                edited = KeyPoses(self.keys, kp.poses, kp.tangents, kp.n_frames, kp.interp, kp.tangents_in)
+                values[np.ix_(warped, others)] = self._retimed(m.values[:, others], kp, edited, warped)
         return m.with_values(values)
+
+    def _retimed(self, x: F64, base: KeyPoses, edited: KeyPoses, frames: I64) -> F64:
+        """Channels ``x`` at ``frames`` in a stretched segment: the edited key curve there plus
+        the residual against the captured key curve ``base`` at the frame each now shows."""
+        u = time_warp(frames, self.keys, self._keys0)
+        return interpolate_at(edited, frames) + residual_at(x, lambda i: interpolate_at(base, i), u)
+
+    def _warped_frames(self) -> I64:
+        """Frames in a segment next to a key moved in time (the moved key's own frame included)."""
+        moved = np.flatnonzero(self.keys != self._keys0)
+        if moved.size == 0:
+            return np.zeros(0, dtype=np.int64)
+        k = self.keys
+        return np.unique(np.concatenate([np.arange(k[a - 1] + 1, k[a + 1]) for a in moved]))
+
+    def _other_columns(self) -> list[int]:
+        m = self.original
+        turned = {c for j in range(m.n_joints) for c in ik.rotation_columns(m, j)[0]}
+        return [c for c in range(m.n_channels) if c not in turned]
+
+    def _others(self) -> KeyPoses:
+        if self._other_curve is None:
+            x = self.original.values[:, self._other_columns()]
+            self._other_curve = key_poses(x, self._keys0, self.interp)
+        return self._other_curve
 
     def key_curve(self, joint: int, reference: F64 | None = None) -> F64:
         """``(F, n)`` a joint's rotation channels on its edited key curve alone (no residuals):
@@ -518,10 +643,9 @@ class PoseEditor:
             return np.array([ik.euler_nearest(q[f], order, reference[f]) for f in frames]).reshape(
                 -1, len(cols)
             )
-        kind = "linear" if self.interp == "linear" else self.interp
-        kp = key_poses(m.values[:, cols], self.keys, kind)
-        out, inn = self._tangents.get(joint, (kp.tangents, kp.tangents_in))
-        edited = KeyPoses(kp.keys, self._key_values[:, cols], out, kp.n_frames, kp.interp, inn)
+        out, inn = self._current_tangents(joint)
+        kp = self._angle_kp(joint)
+        edited = KeyPoses(self.keys, self._key_values[:, cols], out, kp.n_frames, kp.interp, inn)
         return interpolate_at(edited, frames)
 
     def _span_of(self, a: int) -> tuple[int, int]:

@@ -1,0 +1,107 @@
+"""Per-channel keys (seed 003: each channel its own keys) moved as a graph editor drags them: in
+value, in slope and in time, one channel at a time, the residuals kept, undoable."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hairtool.errors import ParameterError
+from hairtool.keys.channels import per_channel_keys
+from hairtool.keys.edit import retime_key
+from hairtool.mocap import ik
+from hairtool.mocap.bvh import read_bvh
+from hairtool.mocap.channel_edit import ChannelEditor, ChannelRetimeEdit, channel_features
+from hairtool.mocap.pose_edit import ChannelEdit, TangentEdit
+
+ARM = "mixamorig:LeftForeArm"
+
+
+@pytest.fixture(scope="module")
+def keyed(motion_dir):
+    m = read_bvh(motion_dir / "freebvh.bvh")
+    keys = per_channel_keys(channel_features(m), 0.01, interp="hermite", relative=True).keys
+    j = m.joint_names.index(ARM)
+    col = ik.rotation_columns(m, j)[0][1]
+    name = m.channels[j][col - int(m._starts[j])]
+    return m, keys, col, name
+
+
+def _inner(keys):
+    """An inner key with room on both sides."""
+    gaps = np.diff(keys)
+    a = int(np.argmax(np.minimum(gaps[:-1], gaps[1:]))) + 1
+    return a, int(keys[a])
+
+
+@pytest.mark.parametrize("interp", ["linear", "hermite", "hermite-fit"])
+def test_a_channel_key_moved_in_value_changes_that_channel_between_its_neighbours(keyed, interp):
+    m, keys, col, name = keyed
+    editor = ChannelEditor(m, keys, interp)
+    k = editor.keys(col)
+    a, f = _inner(k)
+    value = float(m.values[f, col] + 15.0)
+    report = editor.apply_channel(ChannelEdit(f, ARM, name, value))
+    assert (report.first, report.last) == (int(k[a - 1]) + 1, int(k[a + 1]) - 1)
+    out = editor.motion()
+    assert out.values[f, col] == pytest.approx(value, abs=1e-9)
+    others = np.setdiff1d(np.arange(m.n_channels), [col])
+    assert np.array_equal(out.values[:, others], m.values[:, others])
+    outside = np.r_[0 : k[a - 1] + 1, k[a + 1] : m.n_frames]
+    assert np.array_equal(out.values[outside, col], m.values[outside, col])
+    assert editor.key_curve(col)[f] == pytest.approx(value, abs=1e-9)
+    assert editor.undo() == ChannelEdit(f, ARM, name, value)
+    assert np.array_equal(editor.motion().values, m.values)
+
+
+@pytest.mark.parametrize("interp", ["hermite", "hermite-fit"])
+def test_a_channel_handle_turned_sets_its_slope_and_keeps_the_keys(keyed, interp):
+    m, keys, col, name = keyed
+    editor = ChannelEditor(m, keys, interp)
+    k = editor.keys(col)
+    a, f = _inner(k)
+    before = editor.key_slopes(col)[1][a]
+    editor.apply_tangent(TangentEdit(f, ARM, name, before + 2.0))
+    assert editor.key_slopes(col)[1][a] == pytest.approx(before + 2.0, abs=1e-9)
+    out = editor.motion()
+    assert np.array_equal(out.values[k, col], m.values[k, col])  # the key values stay
+    assert not np.allclose(out.values[:, col], m.values[:, col])
+    outside = np.r_[0 : k[a - 1] + 1, k[a + 1] : m.n_frames]
+    assert np.array_equal(out.values[outside, col], m.values[outside, col])
+    editor.reset()
+    with pytest.raises(ParameterError, match="no handles"):
+        ChannelEditor(m, keys, "linear").apply_tangent(TangentEdit(f, ARM, name, 1.0))
+
+
+@pytest.mark.parametrize("interp", ["linear", "hermite", "hermite-fit"])
+def test_a_channel_key_moved_in_time_is_the_array_retime_of_that_channel(keyed, interp):
+    m, keys, col, name = keyed
+    editor = ChannelEditor(m, keys, interp)
+    k = editor.keys(col)
+    a, f = _inner(k)
+    to = f + max((int(k[a + 1]) - f) // 2, 1)
+    editor.apply_retime(ChannelRetimeEdit(f, ARM, name, to))
+    assert editor.keys(col).tolist() == [*k[:a].tolist(), to, *k[a + 1 :].tolist()]
+    assert all(np.array_equal(editor.keys(c), keys[c]) for c in range(m.n_channels) if c != col)
+    out = editor.motion()
+    x = channel_features(m)[:, col : col + 1]
+    start, block, _ = retime_key(x, k, interp, f, to)
+    turns = m.values[:, col] - x[:, 0]
+    span = slice(start, start + len(block))
+    np.testing.assert_allclose(out.values[span, col], block[:, 0] + turns[span], atol=1e-9)
+    others = np.setdiff1d(np.arange(m.n_channels), [col])
+    assert np.array_equal(out.values[:, others], m.values[:, others])
+    # then moved in value at its new frame, and its handle: each on the moved key
+    editor.apply_channel(ChannelEdit(to, ARM, name, float(out.values[to, col] + 10.0)))
+    assert editor.motion().values[to, col] == pytest.approx(out.values[to, col] + 10.0, abs=1e-9)
+    if interp != "linear":
+        editor.apply_tangent(TangentEdit(to, ARM, name, 0.5))
+        assert editor.key_slopes(col)[1][a] == pytest.approx(0.5, abs=1e-9)
+    with pytest.raises(ParameterError, match="a key of the"):
+        editor.apply_channel(ChannelEdit(f, ARM, name, 0.0))  # no longer one of its keys
+    with pytest.raises(ParameterError, match="strictly between"):
+        editor.apply_retime(ChannelRetimeEdit(to, ARM, name, int(k[a + 1])))
+    editor.reset()
+    assert np.array_equal(editor.motion().values, m.values) and np.array_equal(editor.keys(col), k)
+    as_dict = {"frame": f, "joint": ARM, "channel": name, "to": to}
+    assert ChannelRetimeEdit(f, ARM, name, to).to_dict() == as_dict
