@@ -407,7 +407,7 @@ class Scene(QObject):
 
             clump = self._child_clump()  # (the engine's settings are part of the key)
             clumper = self.cached(("clumped", clump), lambda: RenderHair(b, clump))
-            drawn[: b.vertex_count] = clumper.update(self.result).points
+            drawn[: b.vertex_count] = clumper.update_points(self.result)
             source[...] = np.nan  # built whole: the next unclumped build starts afresh
         else:
             build_points(b, self.result, out=drawn[: b.vertex_count], moved=moved_guides(self.result, source))

@@ -1,6 +1,6 @@
 """Render hair: the children of a binding rebuilt from the guides, then, if switched on,
-ClumpWithGaps among the children themselves (the paper's adhesion at render density, with the
-engine's spatial hashing, :func:`hairtool.frozen.clump.clump_points`).
+ClumpWithGaps among the children themselves (the paper's adhesion at render density), the
+children of each guide with each other (:mod:`hairtool.guides.child_clumps`).
 
 The clump radius defaults to the children's own: 2× the median distance between neighbouring
 child roots (:func:`~hairtool.frozen.strand_clumps.auto_clump_radius` of the rest children),
@@ -11,11 +11,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
+import numpy as np
+
+from hairtool.frozen.clump import check_clump_params
 from hairtool.frozen.noise import check_seed
 from hairtool.frozen.strand_clumps import auto_clump_radius
 from hairtool.groom import Groom
 from hairtool.guides.binding import ChildBinding
+from hairtool.guides.child_clumps import ChildClumps
+from hairtool.guides.children import build_points, moved_guides
 
 
 @dataclass(frozen=True)
@@ -39,13 +43,19 @@ class ChildClump:
 
 
 class RenderHair:
-    """The children of ``binding`` for any pose of its guides; ``clump`` None: no adhesion."""
+    """The children of ``binding`` for any pose of its guides; ``clump`` None: no adhesion.
+
+    Clumping runs among the children of each guide (:mod:`hairtool.guides.child_clumps`). An
+    update after another rebuilds only the children that follow a guide which moved since, and
+    clumps again only the clumps holding them, with the bytes of a fresh run."""
 
     def __init__(self, binding: ChildBinding, clump: ChildClump | None = None) -> None:
         self.binding = binding
         self.clump = None if clump is None else clump.validate()
-        self.workspace = ClumpWorkspace()
         self._radius: float | None = None
+        self._clumps: ChildClumps | None = None
+        self._children: np.ndarray | None = None  # the children as built, before clumping …
+        self._built_from: np.ndarray | None = None  # … from these guide points
 
     @property
     def clump_radius(self) -> float:
@@ -57,20 +67,38 @@ class RenderHair:
             self._radius = auto_clump_radius(self.binding.build())
         return self._radius
 
-    def update(self, guides: Groom | None = None) -> Groom:
-        """The render strands for the guides' current shapes (their rest shapes by default)."""
-        children = self.binding.build(guides)
+    @property
+    def clumps(self) -> ChildClumps | None:
+        """The clumps' runs (None before the first clumped update); ``mean_neighbours`` and
+        ``clumps_run`` say what the last one did."""
+        return self._clumps
+
+    def update_points(self, guides: Groom | None = None) -> np.ndarray:
+        """float32 ``(V, 3)``: the render strands' points for the guides' current shapes (their
+        rest shapes by default), in an array this object keeps and rewrites on the next update
+        (copy it to keep it)."""
+        b = self.binding
+        pose = b.rest_guides if guides is None else guides
+        b.check_guides(pose)
+        moved = None
+        if self._children is not None:
+            moved = moved_guides(pose, self._built_from)
+        self._children = build_points(b, pose, out=self._children, moved=moved)
+        self._built_from = np.array(pose.points, np.float32)
         c = self.clump
         if c is None or c.iterations == 0:
-            return children
-        pts = clump_points(
-            children,
-            self.clump_radius,
-            c.iterations,
-            c.step,
-            c.gap_mode,
-            c.seed,
-            self.workspace,
-            c.keep_lengths,
-        )
-        return children.with_points(pts)
+            return self._children
+        if self._clumps is None:
+            self._clumps = ChildClumps(
+                b.guide_ids, b.rest_guides.strand_count, self.clump_radius, c.iterations, c.step,
+                c.gap_mode, c.seed, c.keep_lengths,
+            )  # fmt: skip
+            moved = None
+        redo = None if moved is None else self._clumps.redo_for(moved)
+        return self._clumps.run(self._children, b.topology, redo)
+
+    def update(self, guides: Groom | None = None) -> Groom:
+        """The render strands for the guides' current shapes (their rest shapes by default)."""
+        b = self.binding
+        points = self.update_points(guides).copy()
+        return Groom(points, b.topology, **b.attributes, metadata=b.metadata)

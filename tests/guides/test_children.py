@@ -194,7 +194,7 @@ def test_clumping_the_children_pulls_them_together_and_keeps_lengths(sintel):
     plain = RenderHair(b).update()
     rh = RenderHair(b, ChildClump(iterations=3))
     clumped = rh.update()
-    assert rh.workspace.mean_neighbours > 0
+    assert rh.clumps.mean_neighbours > 0
     np.testing.assert_array_equal(clumped.roots, plain.roots)
     assert np.abs(clumped.points - plain.points).max() > 1e-3
     np.testing.assert_allclose(clumped.segment_lengths, plain.segment_lengths, rtol=1e-4)
