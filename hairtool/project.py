@@ -39,6 +39,7 @@ import hairtool
 from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterError
 from hairtool.frozen.brushes import BRUSHES, LUT_SIZE, BrushSample, check_sample, check_view
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
+from hairtool.frozen.selection import OPS, SelectionSample, check_selection
 from hairtool.groom import Animation, Groom
 from hairtool.guides.binding import MAX_FRIZZ, ChildBinding, bind_exactly, curl
 from hairtool.io import text_limits
@@ -49,8 +50,8 @@ from hairtool.io.obj import Mesh
 from hairtool.metadata import Metadata, from_record, to_record
 
 FORMAT = "hairtool project"
-FORMAT_VERSION = 2  # 2: brush strokes or render hair (children); version 1 files still read
-READABLE_VERSIONS = (1, 2)
+FORMAT_VERSION = 3  # 2: brush strokes or render hair (children); 3: selection; 1 and 2 still read
+READABLE_VERSIONS = (1, 2, 3)
 SUFFIX = ".hairproj"
 MANIFEST = "manifest.json"
 MAX_MANIFEST_BYTES = 64 * 1024**2
@@ -179,6 +180,8 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
     manifest["strokes"]["aligned"] = project.aligned is not None
     if "brushes" not in manifest["strokes"]:
         manifest["version"] = 1  # align strokes only: readable by the hairtool before brushes
+    elif "selection" not in manifest["strokes"] and "only_selected" not in manifest["strokes"]:
+        manifest["version"] = 2  # readable by the hairtool before the selection
     if project.aligned is not None:
         if project.aligned.topology != project.rest.topology:
             raise GroomError("the aligned state must have the rest groom's strands")
@@ -193,7 +196,7 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
     manifest["mesh"] = _mesh_arrays(project.mesh, arrays)
     manifest["children"] = _children_arrays(project, arrays)
     if manifest["children"] is not None:
-        manifest["version"] = FORMAT_VERSION  # render hair an older hairtool would drop unseen
+        manifest["version"] = max(manifest["version"], 2)  # render hair an older hairtool would drop unseen
     manifest["arrays"] = sorted(arrays)
     return manifest, arrays
 
@@ -324,7 +327,7 @@ class _Reader:
         version = manifest.get("version")
         if version not in READABLE_VERSIONS:
             raise FormatError(
-                self.path, f"project format version {version!r}; this hairtool reads versions 1 and 2"
+                self.path, f"project format version {version!r}; this hairtool reads versions 1, 2 and 3"
             )
         listed = manifest.get("arrays")
         if not isinstance(listed, list) or not all(isinstance(n, str) for n in listed):
@@ -436,29 +439,33 @@ def _write_strokes(log, arrays: dict) -> dict:
     falloff (one table of distinct falloff curves)."""
     n = len(log)
     aligns = [s for s in log if isinstance(s, AlignSample)]
+    selections = [s for s in log if isinstance(s, SelectionSample)]
     modes = sorted({s.mode for s in aligns})
-    arrays["strokes/cursor.npy"] = np.array([s.cursor for s in log], np.float64).reshape(n, 3)
-    arrays["strokes/radius.npy"] = np.array([s.radius for s in log], np.float64)
+    origin = (0.0, 0.0, 0.0)
+    arrays["strokes/cursor.npy"] = np.array(
+        [origin if isinstance(s, SelectionSample) else s.cursor for s in log], np.float64
+    ).reshape(n, 3)
+    arrays["strokes/radius.npy"] = np.array([getattr(s, "radius", 0.0) for s in log], np.float64)
     arrays["strokes/intensity.npy"] = np.array(
-        [s.intensity if isinstance(s, AlignSample) else s.strength for s in log], np.float64
+        [s.intensity if isinstance(s, AlignSample) else getattr(s, "strength", 0.0) for s in log], np.float64
     )
     arrays["strokes/mode.npy"] = np.array(
         [modes.index(s.mode) if isinstance(s, AlignSample) else -1 for s in log], np.int64
     )
     info: dict = {"count": n, "modes": modes}
-    if len(aligns) < n:
+    if len(aligns) + len(selections) < n or selections:
         luts: list[tuple] = []
         for s in log:
             if isinstance(s, BrushSample) and s.lut not in luts:
                 luts.append(s.lut)
         arrays["strokes/brush.npy"] = np.array(
-            [-1 if isinstance(s, AlignSample) else BRUSHES.index(s.brush) for s in log], np.int64
+            [BRUSHES.index(s.brush) if isinstance(s, BrushSample) else -1 for s in log], np.int64
         )
         arrays["strokes/direction.npy"] = np.array(
-            [(0.0, 0.0, 0.0) if isinstance(s, AlignSample) else s.direction for s in log], np.float64
+            [s.direction if isinstance(s, BrushSample) else origin for s in log], np.float64
         ).reshape(n, 3)
         arrays["strokes/falloff.npy"] = np.array(
-            [-1 if isinstance(s, AlignSample) else luts.index(s.lut) for s in log], np.int64
+            [luts.index(s.lut) if isinstance(s, BrushSample) else -1 for s in log], np.int64
         )
         arrays["strokes/falloffs.npy"] = np.array(luts, np.float64).reshape(len(luts), LUT_SIZE)
         info["brushes"] = list(BRUSHES)
@@ -468,8 +475,8 @@ def _write_strokes(log, arrays: dict) -> dict:
         ).reshape(n, 3)
         arrays["strokes/has_view.npy"] = np.array([s.view is not None for s in log], np.int64)
         info["views"] = True
-    if not all(s.collide for s in log):  # strokes that may pass through the head
-        arrays["strokes/collide.npy"] = np.array([s.collide for s in log], np.int64)
+    if not all(getattr(s, "collide", True) for s in log):  # strokes that may pass through the head
+        arrays["strokes/collide.npy"] = np.array([getattr(s, "collide", True) for s in log], np.int64)
         info["collide"] = True
     if any(isinstance(s, BrushSample) and s.brush in ("add", "density") for s in log):  # what to plant
         arrays["strokes/count.npy"] = np.array([getattr(s, "count", 1) for s in log], np.int64)
@@ -480,7 +487,27 @@ def _write_strokes(log, arrays: dict) -> dict:
         starts = [isinstance(s, BrushSample) and s.start for s in log]
         arrays["strokes/start.npy"] = np.array(starts, np.int64)
         info["starts"] = True
+    if any(getattr(s, "only_selected", False) for s in log):  # strokes that kept to the selection
+        only = [getattr(s, "only_selected", False) for s in log]
+        arrays["strokes/only_selected.npy"] = np.array(only, np.int64)
+        info["only_selected"] = True
+    if selections:  # selection steps (version 3): their op, and a box's camera and rectangle
+        info["selection"] = list(OPS)
+        arrays["strokes/selection.npy"] = np.array(
+            [OPS.index(s.op) if isinstance(s, SelectionSample) else -1 for s in log], np.int64
+        )
+        arrays["strokes/box.npy"] = np.array([_box_row(s) for s in log], np.float64).reshape(n, 21)
     return info
+
+
+_BOX_MODES = ("set", "add", "subtract")
+
+
+def _box_row(s) -> list[float]:
+    """A box selection as 21 numbers: its matrix (16), rectangle (4) and mode; zeros otherwise."""
+    if not isinstance(s, SelectionSample) or s.op != "box":
+        return [0.0] * 21
+    return [*s.matrix, *s.rect, float(_BOX_MODES.index(s.mode))]
 
 
 def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | None]:
@@ -537,11 +564,28 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
         collides = r.array("strokes/collide.npy", 1, "iu")
         if collides.shape != (n,):
             raise FormatError(r.path, f"the stroke collision flags do not hold {n} strokes")
-    if n and np.any((brush < 0) & ((mode < 0) | (mode >= len(modes)))):
+    only = np.zeros(n, np.int64)
+    if info.get("only_selected"):
+        only = r.array("strokes/only_selected.npy", 1, "iu")
+        if only.shape != (n,):
+            raise FormatError(r.path, f"the stroke selection flags do not hold {n} strokes")
+    select_op, box = np.full(n, -1, np.int64), np.zeros((n, 21))
+    if "selection" in info:
+        ops = info["selection"]
+        if not isinstance(ops, list) or any(o not in OPS for o in ops):
+            raise FormatError(r.path, "manifest.json: the strokes name an unknown selection step")
+        select_op, box = r.array("strokes/selection.npy", 1, "iu"), r.array("strokes/box.npy", 2, "f")
+        if select_op.shape != (n,) or box.shape != (n, 21) or np.any(select_op >= len(ops)):
+            raise FormatError(r.path, f"the selection arrays do not all hold {n} strokes")
+        require_finite(r.path, box, "box selections")
+    if n and np.any((brush < 0) & (select_op < 0) & ((mode < 0) | (mode >= len(modes)))):
         raise FormatError(r.path, "a stroke names an unknown align mode")
     strokes = []
     for k in range(n):
         c = (float(cursor[k, 0]), float(cursor[k, 1]), float(cursor[k, 2]))
+        if select_op[k] >= 0:
+            strokes.append(_selection_sample(r, k, ops[select_op[k]], box[k], views[k]))
+            continue
         if brush[k] < 0:
             try:
                 v = check_view(views[k])
@@ -549,12 +593,13 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
                 raise FormatError(r.path, f"stroke {k}: {e}") from None
             mode_k = str(modes[mode[k]])
             hit = bool(collides[k])
-            strokes.append(AlignSample(c, float(radius[k]), float(intensity[k]), mode_k, v, hit))
+            r_k, i_k = float(radius[k]), float(intensity[k])
+            strokes.append(AlignSample(c, r_k, i_k, mode_k, v, hit, bool(only[k])))
             continue
         sample = BrushSample(
             names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
             float(intensity[k]), tuple(luts[which[k]].tolist()), views[k], bool(starts[k]), bool(collides[k]),
-            int(counts[k]), int(seeds[k]), float(spacings[k]),
+            int(counts[k]), int(seeds[k]), float(spacings[k]), bool(only[k]),
         )
         try:
             strokes.append(check_sample(sample))
@@ -568,6 +613,22 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
             raise FormatError(r.path, f"aligned points have shape {pts.shape}, expected {rest.points.shape}")
         aligned = rest.with_points(float32_finite(r.path, pts, "aligned points"))
     return strokes, aligned
+
+
+def _selection_sample(r: _Reader, k: int, op: str, row: np.ndarray, view) -> SelectionSample:
+    """Stroke ``k``, a selection step, from its op and its row of the box array."""
+    if op != "box":
+        return SelectionSample(op)
+    m = int(row[20])
+    if m not in (0, 1, 2) or m != row[20]:
+        raise FormatError(r.path, f"stroke {k}: a box selection's mode is {row[20]!r}")
+    sample = SelectionSample(
+        "box", tuple(float(x) for x in row[:16]), tuple(float(x) for x in row[16:20]), _BOX_MODES[m], view
+    )
+    try:
+        return check_selection(sample)
+    except HairtoolError as e:
+        raise FormatError(r.path, f"stroke {k}: {e}") from None
 
 
 def _read_mesh(r: _Reader, info: Any) -> Mesh | None:

@@ -136,7 +136,7 @@ def _surface(args: argparse.Namespace, strokes):
     from hairtool.errors import ParameterError
     from hairtool.frozen.brushes import NEED_SURFACE
 
-    needs = sorted({s.brush for s in strokes or () if s.brush in NEED_SURFACE})
+    needs = sorted({s.brush for s in strokes or () if getattr(s, "brush", None) in NEED_SURFACE})
     if needs and args.scalp is None:
         raise ParameterError("scalp", None, f"a head mesh (--scalp MESH.obj) for {', '.join(needs)} strokes")
     if args.scalp is None or not (strokes or args.align):

@@ -17,6 +17,9 @@ Masked strands are locked for every brush. A sample may be mirrored across the p
   normal (outward from the sphere fitted to the roots) by strength·w at the root: tips lift
   away from the scalp, lengths kept.
 - mask: strength > 0 locks the strands a sample touches, < 0 frees them.
+- select: strength > 0 selects the strands a sample touches, < 0 deselects them
+  (:mod:`hairtool.frozen.selection`); a sample with ``only_selected`` leaves the unselected
+  strands as if locked, and hidden strands are locked for every brush.
 - clump: paints each strand's clump strength s in [0, 1], which ClumpWithGaps scales its
   adhesion step by: s moves toward 1 (strength > 0) or 0 (< 0) by |strength|·w, w the largest
   weight over the strand's vertices.
@@ -34,7 +37,7 @@ Every kernel has a numpy twin (``*_reference``) computing the same definition.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit, prange
@@ -47,16 +50,16 @@ F64 = NDArray[np.float64]
 
 BRUSHES = (
     "align", "comb", "smooth", "length", "puff", "mask", "clump", "delete", "pinch", "snake_hook", "slide",
-    "add", "density",
+    "add", "density", "select",
 )  # fmt: skip
 #: The brushes of :mod:`hairtool.frozen.sculpt` and :mod:`hairtool.frozen.slide`, those that
 #: add or remove strands, and those that need the head's surface.
 SCULPT = ("delete", "pinch", "snake_hook", "slide", "add", "density")
 CHANGE_STRANDS = ("delete", "add", "density")
-MOVE_NONE = ("mask", "clump", "delete", "add", "density")  # they move no vertex: nothing to collide
+MOVE_NONE = ("mask", "clump", "delete", "add", "density", "select")  # they move no vertex: nothing to collide
 NEED_SURFACE = ("slide", "add", "density")
 MAX_COUNT = 1000  # strands one add sample may plant
-SIGNED = ("length", "mask", "clump", "pinch")  # strength in [-1, 1]; the others in [0, 1]
+SIGNED = ("length", "mask", "clump", "pinch", "select")  # strength in [-1, 1]; the others in [0, 1]
 FALLOFFS = ("smooth", "linear", "constant")
 LUT_SIZE = 257  # samples of a falloff curve over [0, 1]: interpolated linearly between
 MAX_FALLOFF_POINTS = 4 * LUT_SIZE  # a curve of more points than this says nothing more
@@ -115,7 +118,8 @@ class BrushSample:
     snake hook hooks its strands there). ``collide``: with a head surface, no vertex the
     sample moves ends inside it (:mod:`hairtool.frozen.collide`). ``count`` and ``seed``: the
     strands an add sample plants, and the seed of where (density's too); ``spacing``: the
-    distance a density sample leaves between roots."""
+    distance a density sample leaves between roots. ``only_selected``: the strands not
+    selected are left as if locked (:mod:`hairtool.frozen.selection`)."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -129,14 +133,12 @@ class BrushSample:
     count: int = 1
     seed: int = 0
     spacing: float = 0.0
+    only_selected: bool = False
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
-        return BrushSample(
-            self.brush, cursor, direction, self.radius, self.strength, self.lut, mirrored_view(self.view),
-            self.start, self.collide, self.count, self.seed, self.spacing,
-        )
+        return replace(self, cursor=cursor, direction=direction, view=mirrored_view(self.view))
 
 
 def mirrored_view(view: tuple[float, float, float] | None) -> tuple[float, float, float] | None:

@@ -19,6 +19,11 @@ Built for dragging in the studio:
   the same ones. The result has the stroked state's strands, not necessarily the rest groom's.
 - With a head surface (:meth:`FrozenPipeline.set_surface`), a sample with ``collide`` (the
   default) leaves no vertex it moved inside the head (:mod:`hairtool.frozen.collide`).
+- Selection (:mod:`hairtool.frozen.selection`): every strand is selected or not, shown or
+  hidden, kept per strand with the mask (deleted with its strand; a planted strand comes
+  selected and shown) and in the snapshots. Selection steps (:class:`SelectionSample`) and the
+  selection brush are samples of the log like the others; hidden strands are locked for every
+  sample, and a sample with ``only_selected`` also locks the unselected ones.
 - Snake hook hooks strands at a stroke's first sample (``start``) and drags them through the
   stroke's later samples; the hooked weights are part of the state (one set per sample of a
   stroke's start: its mirrored sample has its own, used in turn).
@@ -54,6 +59,7 @@ from hairtool.frozen.density import accept, disc_candidates, thin
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.noise import check_seed, draw_seed
 from hairtool.frozen.sculpt import hook_weights, pinch, snake_hook, strands_to_delete
+from hairtool.frozen.selection import SelectionSample, apply_selection
 from hairtool.frozen.slide import Surface, slide
 from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
 from hairtool.groom import Groom, vertex_ids_of
@@ -160,16 +166,18 @@ class AlignSample(NamedTuple):
     mode: str
     view: tuple[float, float, float] | None = None
     collide: bool = True  # as BrushSample's
+    only_selected: bool = False  # as BrushSample's
 
 
-Sample = AlignSample | BrushSample
+Sample = AlignSample | BrushSample | SelectionSample
 
 
 @dataclass(frozen=True)
 class FrozenSnapshot:
     """Undo/redo state: the stroke log and the stroked points it produced (shared, read-only),
     the mask and the clump strengths it painted (None: replay the log to find them), the rest
-    strand of each stroked strand (None: every rest strand, in order) and a snake hook's state."""
+    strand of each stroked strand (None: every rest strand, in order), a snake hook's state, and
+    the selected and hidden strands (None: replay the log to find them)."""
 
     log: tuple[Sample, ...]
     aligned: Groom
@@ -179,6 +187,8 @@ class FrozenSnapshot:
     clump_strength: np.ndarray | None = None
     origin: np.ndarray | None = None
     hooks: tuple[tuple, int, bool] = ((), 0, False)
+    selected: np.ndarray | None = None
+    hidden: np.ndarray | None = None
 
 
 class FrozenPipeline:
@@ -197,6 +207,8 @@ class FrozenPipeline:
         self._locked = np.zeros(rest.strand_count, dtype=bool)
         self._clump_strength = np.ones(rest.strand_count)
         self._origin = np.arange(rest.strand_count, dtype=np.int64)
+        self._selected = np.ones(rest.strand_count, dtype=bool)
+        self._hidden = np.zeros(rest.strand_count, dtype=bool)
         self._hooks: list[tuple] = []  # a snake hook's (weights, tips, cursor) at each start sample
         self._hook_next = 0  # the set the next sample of the stroke uses
         self._hooking = False  # the last sample was a snake hook's start
@@ -243,6 +255,16 @@ class FrozenPipeline:
     def locked(self) -> np.ndarray:
         """``(S,)`` the strands the mask brush has locked (a copy)."""
         return self._locked.copy()
+
+    @property
+    def selected(self) -> np.ndarray:
+        """``(S',)`` the selected strands of the stroked state (a copy; all until a selection step)."""
+        return self._selected.copy()
+
+    @property
+    def hidden(self) -> np.ndarray:
+        """``(S',)`` the hidden strands of the stroked state (a copy), locked for every brush."""
+        return self._hidden.copy()
 
     @property
     def origin(self) -> np.ndarray:
@@ -395,16 +417,17 @@ class FrozenPipeline:
         clumping: what a replayed stroke log does."""
         self._timings = dict.fromkeys(self._timings, 0.0)
         t0 = time.perf_counter()
-        before = (self._aligned, self._locked, self._clump_strength, self._origin, len(self._log))
+        before = (self._aligned, *self._strand_state(), len(self._log))
         hooks = self._hook_state()
         try:
             for sample in samples:
                 self._aligned = self._apply(self._aligned, sample)
                 self._log.append(sample)
         except BaseException:  # a refused sample: none of these samples happened
-            self._aligned, self._locked, self._clump_strength, self._origin = before[:4]
+            self._aligned = before[0]
+            self._set_strand_state(before[1:-1])
             self._set_hooks(hooks)
-            del self._log[before[4] :]
+            del self._log[before[-1] :]
             raise
         self._timings["align"] = (time.perf_counter() - t0) * 1e3
         self._reclump()
@@ -433,7 +456,8 @@ class FrozenPipeline:
         """Cheap state for undo/redo (no copies: grooms are immutable)."""
         return FrozenSnapshot(
             tuple(self._log), self._aligned, self._freeze_key or (), self._draw, self._locked.copy(),
-            self._clump_strength.copy(), self._origin.copy(), self._hook_state(),
+            self._clump_strength.copy(), self._origin.copy(), self._hook_state(), self._selected.copy(),
+            self._hidden.copy(),
         )
 
     def restore(self, snapshot: FrozenSnapshot) -> Groom:
@@ -453,8 +477,13 @@ class FrozenPipeline:
             snapshot.freeze_key == self._freeze_key
             and snapshot.draw == self._draw
             and (
-                (snapshot.locked is not None and snapshot.clump_strength is not None)
-                or not any(isinstance(s, BrushSample) for s in snapshot.log)
+                (
+                    snapshot.locked is not None
+                    and snapshot.clump_strength is not None
+                    and snapshot.selected is not None
+                    and snapshot.hidden is not None
+                )
+                or all(isinstance(s, AlignSample) for s in snapshot.log)
             )
         ):
             aligned = snapshot.aligned
@@ -467,6 +496,9 @@ class FrozenPipeline:
             self._clump_strength = np.ones(n) if cs is None else cs.astype(np.float64)
             o = snapshot.origin
             self._origin = np.arange(n, dtype=np.int64) if o is None else o.astype(np.int64)
+            sel, hid = snapshot.selected, snapshot.hidden
+            self._selected = np.ones(n, bool) if sel is None else sel.astype(bool)
+            self._hidden = np.zeros(n, bool) if hid is None else hid.astype(bool)
             self._set_hooks(snapshot.hooks)
         else:
             self._replay()
@@ -510,7 +542,36 @@ class FrozenPipeline:
         self._locked = np.zeros(n, dtype=bool)
         self._clump_strength = np.ones(n)
         self._origin = np.arange(n, dtype=np.int64)
+        self._selected = np.ones(n, dtype=bool)
+        self._hidden = np.zeros(n, dtype=bool)
         self._set_hooks(((), 0, False))
+
+    def _strand_state(self) -> tuple[np.ndarray, ...]:
+        """What the pipeline keeps per strand of the stroked state, in one order."""
+        return (self._locked, self._clump_strength, self._origin, self._selected, self._hidden)
+
+    def _set_strand_state(self, state: Sequence[np.ndarray]) -> None:
+        self._locked, self._clump_strength, self._origin, self._selected, self._hidden = state
+
+    def _keep_strands(self, kept: np.ndarray) -> None:
+        """Only the strands ``kept`` (indices) remain: their per-strand state with them."""
+        self._set_strand_state([a[kept] for a in self._strand_state()])
+
+    def _planted(self, m: int) -> None:
+        """``m`` strands appended: unmasked, clump strength 1, no rest strand, selected, shown."""
+        fill = (np.zeros(m, bool), np.ones(m), np.full(m, -1, np.int64), np.ones(m, bool), np.zeros(m, bool))
+        now = self._strand_state()
+        self._set_strand_state([np.concatenate([a, b]) for a, b in zip(now, fill, strict=True)])
+
+    def _lock(self, sample: Sample, away: np.ndarray | None, mask: bool = True) -> np.ndarray:
+        """The strands a sample leaves as they are: masked (``mask``), hidden, facing away from
+        its camera, and with ``only_selected`` the unselected ones."""
+        locked = self._locked | self._hidden if mask else self._hidden
+        if away is not None:
+            locked = locked | away
+        if getattr(sample, "only_selected", False):
+            locked = locked | ~self._selected
+        return locked
 
     def _hook_state(self) -> tuple[tuple, int, bool]:
         return (tuple(self._hooks), self._hook_next, self._hooking)
@@ -542,10 +603,7 @@ class FrozenPipeline:
         if new is None:
             return g
         out = append_strands(g, new)
-        m = new.strand_count
-        self._locked = np.concatenate([self._locked, np.zeros(m, bool)])
-        self._clump_strength = np.concatenate([self._clump_strength, np.ones(m)])
-        self._origin = np.concatenate([self._origin, np.full(m, -1, np.int64)])
+        self._planted(new.strand_count)
         return out
 
     def _density(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
@@ -570,8 +628,7 @@ class FrozenPipeline:
             raise ParameterError("density", "every strand", "a stroke that leaves at least one strand")
         if gone.any():
             kept = np.flatnonzero(~gone)
-            self._locked, self._clump_strength = self._locked[kept], self._clump_strength[kept]
-            self._origin = self._origin[kept]
+            self._keep_strands(kept)
             g = g.subset(kept)
         bits = np.asarray(sample.cursor, np.float64).view(np.uint32)
         rng = np.random.default_rng([int(sample.seed), *(int(b) for b in bits), 0xDE5])
@@ -586,10 +643,7 @@ class FrozenPipeline:
         if len(new_roots) == 0:
             return g
         new = surface.grow(g, new_roots)
-        m = new.strand_count
-        self._locked = np.concatenate([self._locked, np.zeros(m, bool)])
-        self._clump_strength = np.concatenate([self._clump_strength, np.ones(m)])
-        self._origin = np.concatenate([self._origin, np.full(m, -1, np.int64)])
+        self._planted(new.strand_count)
         return append_strands(g, new)
 
     def _delete(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
@@ -599,11 +653,15 @@ class FrozenPipeline:
         if gone.all():
             raise ParameterError("delete", "every strand", "a stroke that leaves at least one strand")
         keep = np.flatnonzero(~gone)
-        self._locked, self._clump_strength = self._locked[keep], self._clump_strength[keep]
-        self._origin = self._origin[keep]
+        self._keep_strands(keep)
         return g.subset(keep)
 
     def _apply(self, g: Groom, sample: Sample) -> Groom:
+        if isinstance(sample, SelectionSample):
+            self._set_hooks(((), 0, False))
+            away = self._away(sample.view)
+            self._selected, self._hidden = apply_selection(g, sample, self._selected, self._hidden, away)
+            return g
         out = self._apply_one(g, sample)
         moves = isinstance(sample, AlignSample) or sample.brush not in MOVE_NONE
         surface = self._surface
@@ -617,10 +675,14 @@ class FrozenPipeline:
         if not (isinstance(sample, BrushSample) and sample.brush == "snake_hook"):
             self._set_hooks(((), 0, False))  # another brush ends a snake hook's stroke
         away = self._away(sample.view)
-        if isinstance(sample, BrushSample) and sample.brush == "mask":
-            self._locked = paint_mask(g, sample, self._locked, away)
+        if isinstance(sample, BrushSample) and sample.brush == "select":
+            skip = self._hidden if away is None else self._hidden | away
+            self._selected = paint_mask(g, sample, self._selected, skip)
             return g
-        locked = self._locked if away is None else self._locked | away  # this sample's lock
+        locked = self._lock(sample, away)  # this sample's lock
+        if isinstance(sample, BrushSample) and sample.brush == "mask":
+            self._locked = paint_mask(g, sample, self._locked, self._lock(sample, away, mask=False))
+            return g
         if isinstance(sample, AlignSample):
             out = align(g, sample.cursor, sample.radius, sample.intensity, sample.mode)
             if locked.any():  # masked strands are locked for the align brush too

@@ -18,7 +18,12 @@ A stroke log is a JSON list of strokes, in groom units::
   or ``add`` (plants ``params.count`` strands per sample, default 1, around the head's point
   nearest the cursor, drawn from ``params.seed``, default 0, and the cursor; needs a head) or
   ``density`` (removes and plants strands under the brush until the roots are
-  ``params.spacing`` apart, in groom units; ``params.seed`` as add's; needs a head).
+  ``params.spacing`` apart, in groom units; ``params.seed`` as add's; needs a head) or
+  ``select`` (> 0 selects the strands touched, < 0 deselects them; hidden strands stay as
+  they are).
+- ``only_selected`` (per stroke, optional, default false): the stroke leaves the strands that
+  are not selected as they are (the studio's "Affect selection only"). Hidden strands are left
+  alone by every stroke.
 - ``collision`` (per stroke, optional, default true): with a head surface (``--scalp``), no
   vertex the stroke moves ends inside it; false: strands may pass through the head.
 - ``start`` (per sample, optional): true where a stroke begins (a snake hook hooks its strands
@@ -30,6 +35,18 @@ A stroke log is a JSON list of strokes, in groom units::
   distance / radius from 0 to 1 (align keeps the paper's own weighting and ignores it).
 - ``symmetry``: ``"x"`` mirrors every sample across the plane x = ``mirror_x`` (default: the
   centre of the sphere fitted to the roots), into the same stroke; null for none.
+
+Besides strokes, a log holds selection steps (:mod:`hairtool.frozen.selection`), each an
+object with a ``selection`` field instead of ``brush``::
+
+    {"selection": "all"}  {"selection": "none"}  {"selection": "invert"}
+    {"selection": "hide_selected"}  {"selection": "hide_unselected"}  {"selection": "reveal"}
+    {"selection": "box", "mode": "set", "matrix": [16 numbers], "rect": [x0, y0, x1, y1],
+     "view": [vx, vy, vz]}
+
+- ``box``: the strands with a point inside the rectangle ``rect`` (normalised device
+  coordinates, −1 … 1, y up) of the camera whose world-to-clip matrix is ``matrix`` (4×4,
+  row-major); ``mode`` ``set`` (default), ``add`` or ``subtract``; ``view`` as a sample's.
 
 Fields a reader does not know are ignored and missing optional ones take their defaults, so
 logs written by older and newer versions stay readable.
@@ -60,6 +77,7 @@ from hairtool.frozen.brushes import (
     mirrored_view,
 )
 from hairtool.frozen.pipeline import AlignSample
+from hairtool.frozen.selection import SelectionSample, check_selection
 from hairtool.io.atomic import atomic_open
 from hairtool.io.text_limits import check_text
 
@@ -87,6 +105,7 @@ class Stroke:
     mirror_x: float | None = None
     params: dict = field(default_factory=dict)
     collision: bool = True  # with a head surface, no vertex the stroke moves ends inside it
+    only_selected: bool = False  # the unselected strands are left as they are
 
     def validate(self) -> Stroke:
         if self.brush not in BRUSHES:
@@ -109,7 +128,9 @@ class Stroke:
         for i, s in enumerate(self.samples):
             if self.brush == "align":
                 mode = self.params.get("mode", "paper")
-                first = AlignSample(s.cursor, s.radius, s.strength, mode, check_view(s.view), self.collision)
+                v = check_view(s.view)
+                only = self.only_selected
+                first = AlignSample(s.cursor, s.radius, s.strength, mode, v, self.collision, only)
                 out.append(first)
                 if self.symmetry == "x":
                     cursor = (2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])
@@ -125,7 +146,7 @@ class Stroke:
                 spacing = _number("params.spacing", spacing) if spacing is not None else 0.0
             sample = BrushSample(
                 self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start, self.collision,
-                count, seed, spacing,
+                count, seed, spacing, self.only_selected,
             )
             sample = check_sample(sample)
             out.append(sample)
@@ -142,6 +163,7 @@ class Stroke:
             "mirror_x": self.mirror_x,
             "params": dict(self.params),
             **({} if self.collision else {"collision": False}),
+            **({"only_selected": True} if self.only_selected else {}),
             "samples": [
                 {
                     "cursor": list(s.cursor),
@@ -156,18 +178,47 @@ class Stroke:
         }
 
 
-def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
+@dataclass(frozen=True)
+class SelectionStep:
+    """One selection step of a log (:class:`~hairtool.frozen.selection.SelectionSample`)."""
+
+    sample: SelectionSample
+
+    def validate(self) -> SelectionStep:
+        check_selection(self.sample)
+        return self
+
+    def pipeline_samples(self, default_mirror_x: float = 0.0) -> list[SelectionSample]:
+        return [self.validate().sample]
+
+    def to_dict(self) -> dict:
+        s = self.sample
+        if s.op != "box":
+            return {"selection": s.op}
+        view = None if s.view is None else list(s.view)
+        box = {"mode": s.mode, "matrix": list(s.matrix), "rect": list(s.rect), "view": view}
+        return {"selection": "box", **box}
+
+
+def strokes_from_log(
+    log: Sequence[AlignSample | BrushSample | SelectionSample],
+) -> list[Stroke | SelectionStep]:
     """A pipeline's log as strokes that replay to the same bytes: runs of samples of one brush
-    and falloff become one stroke, mirrored samples stay explicit (no symmetry flag)."""
-    runs: list[tuple[tuple, Stroke]] = []
+    and falloff become one stroke, mirrored samples stay explicit (no symmetry flag); each
+    selection step stays one."""
+    runs: list[tuple[tuple, Stroke | SelectionStep]] = []
     for s in log:
         split = False
+        if isinstance(s, SelectionSample):
+            runs.append((("selection", len(runs)), SelectionStep(s)))
+            continue
         if isinstance(s, AlignSample):
-            key: tuple = ("align", s.mode, s.collide)
+            key: tuple = ("align", s.mode, s.collide, s.only_selected)
             sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view))
-            start = Stroke("align", (sample,), params={"mode": s.mode}, collision=s.collide)
+            start = Stroke("align", (sample,), params={"mode": s.mode}, collision=s.collide,
+                           only_selected=s.only_selected)  # fmt: skip
         else:
-            key = (s.brush, s.lut, s.collide, s.count, s.seed, s.spacing)
+            key = (s.brush, s.lut, s.collide, s.count, s.seed, s.spacing, s.only_selected)
             hook = s.brush == "snake_hook"
             sample = StrokeSample(
                 tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view),
@@ -176,13 +227,15 @@ def strokes_from_log(log: Sequence[AlignSample | BrushSample]) -> list[Stroke]:
             params = {"count": s.count, "seed": s.seed} if s.brush == "add" else {}
             if s.brush == "density":
                 params = {"spacing": s.spacing, "seed": s.seed}
-            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut), params=params, collision=s.collide)
+            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut), params=params, collision=s.collide,
+                           only_selected=s.only_selected)  # fmt: skip
             # a snake hook's start (not its mirror's) begins a new stroke, with its own strands
-            split = hook and s.start and bool(runs) and not runs[-1][1].samples[-1].start
+            last = runs[-1][1] if runs else None
+            split = hook and s.start and isinstance(last, Stroke) and not last.samples[-1].start
         if runs and runs[-1][0] == key and not split:
             last = runs[-1][1]
             more = Stroke(last.brush, (*last.samples, sample), last.falloff, params=last.params)
-            runs[-1] = (key, replace(more, collision=last.collision))
+            runs[-1] = (key, replace(more, collision=last.collision, only_selected=last.only_selected))
         else:
             runs.append((key, start))
     return [stroke for _, stroke in runs]
@@ -237,10 +290,36 @@ def _short(value: Any) -> Any:
     return value
 
 
-def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
-    """A :class:`Stroke` from its JSON form; ParameterError naming the field on anything wrong."""
+def selection_from_dict(d: dict, where: str = "stroke") -> SelectionStep:
+    """A :class:`SelectionStep` from its JSON form; ParameterError naming the field."""
+    op = d.get("selection")
+    if op not in ("box",):
+        step = SelectionStep(SelectionSample(op))
+    else:
+        matrix, rect = d.get("matrix"), d.get("rect")
+        if not isinstance(matrix, list) or len(matrix) != 16:
+            raise ParameterError(f"{where}.matrix", _short(matrix), "16 numbers (a 4×4 matrix, row-major)")
+        if not isinstance(rect, list) or len(rect) != 4:
+            raise ParameterError(f"{where}.rect", _short(rect), "four numbers [x0, y0, x1, y1]")
+        view = d.get("view")
+        step = SelectionStep(SelectionSample(
+            "box", tuple(_number(f"{where}.matrix", v) for v in matrix),
+            tuple(_number(f"{where}.rect", v) for v in rect),  # type: ignore[arg-type]
+            d.get("mode", "set"), None if view is None else _vector(f"{where}.view", view),
+        ))  # fmt: skip
+    try:
+        return step.validate()
+    except ParameterError as e:
+        raise ParameterError(f"{where}.{e.name}", _short(e.value), str(e).split("expected ", 1)[-1]) from None
+
+
+def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke | SelectionStep:
+    """A :class:`Stroke` (or :class:`SelectionStep`) from its JSON form; ParameterError naming
+    the field on anything wrong."""
     if not isinstance(d, dict):
         raise ParameterError(where, type(d).__name__, "an object with brush and samples")
+    if "selection" in d and "brush" not in d:
+        return selection_from_dict(d, where)
     raw_samples = d.get("samples")
     if not isinstance(raw_samples, list):
         raise ParameterError(f"{where}.samples", _short(raw_samples), "a list of samples")
@@ -280,6 +359,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
         mirror_x=None if mirror is None else _number(f"{where}.mirror_x", mirror),
         params=params,
         collision=_flag(f"{where}.collision", d.get("collision")) is not False,
+        only_selected=_flag(f"{where}.only_selected", d.get("only_selected")) is True,
     )
     try:
         stroke.pipeline_samples(0.0)  # every sample checked (radius, strength range) as it will run
@@ -288,7 +368,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke:
         raise ParameterError(f"{where}.{e.name}", _short(e.value), str(e).split("expected ", 1)[-1]) from None
 
 
-def read_strokes(path: str | os.PathLike[str]) -> list[Stroke]:
+def read_strokes(path: str | os.PathLike[str]) -> list[Stroke | SelectionStep]:
     """A stroke log file; :class:`FormatError` naming the file and the bad entry."""
     p = Path(path)
     try:
@@ -311,7 +391,7 @@ def read_strokes(path: str | os.PathLike[str]) -> list[Stroke]:
         raise FormatError(p, str(e)) from None
 
 
-def write_strokes(path: str | os.PathLike[str], strokes: Sequence[Stroke]) -> None:
+def write_strokes(path: str | os.PathLike[str], strokes: Sequence[Stroke | SelectionStep]) -> None:
     """Write a stroke log (atomically)."""
     try:
         with atomic_open(path, "w", encoding="utf-8") as f:

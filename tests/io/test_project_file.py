@@ -122,7 +122,7 @@ def _set(path, value):
 @pytest.mark.parametrize(
     "kind,needle",
     [
-        (dict(manifest_edit=_set(["version"], 3)), "version 3; this hairtool reads versions 1 and 2"),
+        (dict(manifest_edit=_set(["version"], 4)), "version 4; this hairtool reads versions 1, 2 and 3"),
         (dict(manifest_edit=_set(["format"], "x")), "not a hairtool project"),
         (dict(drop=(project.MANIFEST,)), "no manifest"),
         (dict(drop=("groom/points.npy",)), "missing member 'groom/points.npy'"),

@@ -1,0 +1,124 @@
+"""Selecting and hiding strands, as a Blender artist does with hair curves.
+
+Each strand of the stroked state is selected or not, and shown or hidden (two ``(S,)`` bool
+arrays the pipeline keeps beside the mask). A new groom has every strand selected and none
+hidden, as a Blender curves object without a ``.selection`` attribute counts as all selected.
+
+The selection is a bool per strand, not Blender sculpt mode's soft float: the pipeline locks
+strands for a brush sample by one bool path (the mask, front-facing, and now "only the
+selection" and hidden), every brush honours it unchanged, and box select, select all and the
+selection brush (touched or not, as the mask brush) only ever make whole values.
+
+The steps that change them (:class:`SelectionSample`) are part of the stroke log like brush
+samples, so undo, projects and a replayed log see the same selection at every stroke:
+
+- ``all``: every shown strand selected (hidden ones stay unselected); ``none``: none;
+  ``invert``: the shown strands flip.
+- ``box``: the shown strands with a vertex inside a screen rectangle (``rect`` x0, y0, x1, y1
+  in normalised device coordinates, −1 … 1, y up) of a camera (``matrix``: its 4×4
+  world-to-clip matrix, row-major); ``mode`` "set" (only those), "add" or "subtract"; with a
+  ``view``, only the strands facing that camera (as the brushes' front faces only).
+- ``hide_selected``: the selected strands hidden (and deselected, as Blender hides);
+  ``hide_unselected``: the unselected shown strands hidden; ``reveal``: every hidden strand
+  shown again, selected.
+
+Hidden strands are locked for every brush, whatever "only the selection" says. The selection
+brush itself (``BrushSample`` of brush "select") is :func:`~hairtool.frozen.brushes.paint_mask`
+with hidden strands skipped: > 0 selects what it touches, < 0 deselects.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from hairtool.errors import ParameterError
+from hairtool.groom import Groom
+
+OPS = ("all", "none", "invert", "box", "hide_selected", "hide_unselected", "reveal")
+BOX_MODES = ("set", "add", "subtract")
+
+
+class SelectionSample(NamedTuple):
+    """One selection step (module docstring); ``matrix`` (16 floats), ``rect`` and ``mode``
+    only for ``box``; ``view`` as a brush sample's (None: every strand)."""
+
+    op: str
+    matrix: tuple[float, ...] | None = None
+    rect: tuple[float, float, float, float] | None = None
+    mode: str = "set"
+    view: tuple[float, float, float] | None = None
+
+
+def check_selection(sample: SelectionSample) -> SelectionSample:
+    """The sample, or a ParameterError naming its bad field."""
+    if sample.op not in OPS:
+        raise ParameterError("selection", sample.op, "one of " + ", ".join(OPS))
+    if sample.op != "box":
+        return sample
+    if sample.mode not in BOX_MODES:
+        raise ParameterError("mode", sample.mode, " or ".join(BOX_MODES))
+    m = np.asarray(sample.matrix if sample.matrix is not None else (), dtype=np.float64)
+    if m.shape != (16,) or not np.all(np.isfinite(m)):
+        raise ParameterError("matrix", "box", "16 finite numbers (a 4×4 world-to-clip matrix, row-major)")
+    r = np.asarray(sample.rect if sample.rect is not None else (), dtype=np.float64)
+    if r.shape != (4,) or not np.all(np.isfinite(r)):
+        raise ParameterError("rect", sample.rect, "four finite numbers [x0, y0, x1, y1]")
+    return sample
+
+
+def in_box(groom: Groom, matrix, rect) -> np.ndarray:
+    """``(S,)`` the strands with a vertex in front of the camera whose projection lies inside
+    ``rect`` (either corner order)."""
+    m = np.asarray(matrix, np.float64).reshape(4, 4)
+    p = groom.points.astype(np.float64)
+    clip = p @ m[:3, :3].T + m[:3, 3]
+    w = p @ m[3, :3] + m[3, 3]
+    x0, y0, x1, y1 = (float(v) for v in rect)
+    ok = w > 1e-12
+    safe = np.where(ok, w, 1.0)
+    x, y = clip[:, 0] / safe, clip[:, 1] / safe
+    inside = ok & (x >= min(x0, x1)) & (x <= max(x0, x1)) & (y >= min(y0, y1)) & (y <= max(y0, y1))
+    if groom.strand_count == 0:
+        return np.zeros(0, bool)
+    return np.maximum.reduceat(inside, groom.offsets[:-1]).astype(bool)
+
+
+def apply_selection(
+    groom: Groom,
+    sample: SelectionSample,
+    selected: np.ndarray,
+    hidden: np.ndarray,
+    away: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(selected, hidden)`` after one step (new arrays); ``away``: the strands facing away
+    from the sample's camera (a box leaves them as they are)."""
+    check_selection(sample)
+    sel, hid = np.array(selected, dtype=bool), np.array(hidden, dtype=bool)
+    op = sample.op
+    if op == "all":
+        sel = ~hid
+    elif op == "none":
+        sel[:] = False
+    elif op == "invert":
+        sel = ~sel & ~hid
+    elif op == "box":
+        touched = in_box(groom, sample.matrix, sample.rect) & ~hid
+        if away is not None:
+            touched &= ~np.asarray(away, dtype=bool)
+        if sample.mode == "set":
+            sel = touched
+        elif sample.mode == "add":
+            sel |= touched
+        else:
+            sel &= ~touched
+    elif op == "hide_selected":
+        hid |= sel
+        sel[:] = False
+    elif op == "hide_unselected":
+        hid |= ~sel
+    else:  # reveal
+        sel |= hid
+        hid[:] = False
+    return sel, hid
