@@ -310,7 +310,7 @@ class AnimationController(QObject):
     def build_menu(self) -> dict[str, QAction]:
         """The Animation menu; returns its actions by name (the timeline's buttons show them)."""
         w, m = self.window, self.model
-        menu = w.menuBar().addMenu("&Animation")
+        menu = w.menuBar().addMenu("A&nimation")  # (Alt+A deselects, as in Blender)
         a = self.actions
         a["play"] = add_action(w, menu, "&Play / Pause", m.toggle_play, "Space")
         a["loop"] = add_action(w, menu, "&Loop", lambda on: m.set_loop(on), "Ctrl+L", checkable=True)

@@ -20,8 +20,8 @@ from hairtool.frozen.pipeline import AlignSample
 #: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
 #: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump, K snake hook; X deletes as
 #: in Blender's editors; pinch, with P taken by clump, is Shift+P; slide G as Blender's grab;
-#: add Shift+A as Blender's Add menu;
-#: the others by their initial).
+#: add Shift+A as Blender's Add menu; select W, Blender's key for its select tools; align
+#: Shift+C, since A selects all as in Blender; the others by their initial).
 LABELS = {
     "align": "Align",
     "comb": "Comb",
@@ -36,11 +36,12 @@ LABELS = {
     "slide": "Slide",
     "add": "Add",
     "density": "Density",
+    "select": "Select",
 }
 SHORTCUTS = {
-    "align": "A", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M",
+    "align": "Shift+C", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M",
     "pinch": "Shift+P", "snake_hook": "K", "delete": "X", "slide": "G",
-    "add": "Shift+A", "density": "D",
+    "add": "Shift+A", "density": "D", "select": "W",
 }  # fmt: skip
 TIPS = {
     "align": "Strands turn toward the cursor's path (UserAlign, Kim 2026 eqs. 8–13)",
@@ -60,15 +61,17 @@ TIPS = {
     "(needs the head mesh)",
     "density": "Removes or plants strands under the brush until the roots are the spacing apart "
     "(needs the head mesh)",
+    "select": "Paints the selection: the strands it touches are selected (Ctrl deselects); with "
+    "Affect selection only, the other brushes keep to them",
 }
 #: Brushes with a signed strength: (label of > 0, label of < 0).
 SIGNED = {
     "length": ("Grow", "Shrink"), "clump": ("Paint", "Erase"), "mask": ("Paint", "Erase"),
-    "pinch": ("Gather", "Spread"),
+    "pinch": ("Gather", "Spread"), "select": ("Select", "Deselect"),
 }  # fmt: skip
 SIGN_LABELS = {
     "length": "Grow or shrink", "clump": "Paint or erase", "mask": "Paint or erase",
-    "pinch": "Gather or spread",
+    "pinch": "Gather or spread", "select": "Select or deselect",
 }  # fmt: skip
 DEFAULT_STRENGTH = {
     "align": 0.8,
@@ -84,6 +87,7 @@ DEFAULT_STRENGTH = {
     "slide": 1.0,
     "add": 1.0,
     "density": 1.0,
+    "select": 1.0,
 }
 FALLOFF_LABELS = {"smooth": "Smooth", "linear": "Linear", "constant": "Constant"}
 
@@ -120,6 +124,7 @@ class BrushTool:
     add_count: int = 2  # strands the add brush plants per mouse move
     spacing: float = 0.05  # between roots, the density brush's (groom units)
     align_mode: str = "paper"
+    only_selected: bool = True  # brushes keep to the selected strands (Blender's selection toggle)
     _lut: tuple[Falloff, tuple[float, ...]] | None = field(default=None, repr=False)
 
     def reset_radius(self, radius: float) -> None:
@@ -163,8 +168,9 @@ class BrushTool:
         v = None if view is None or not self.front_only else tuple(float(x) for x in view)
         r, name = self.radius[self.brush], self.brush
         hit = self.collide.get(name, True)
+        only = self.only_selected and name != "select"
         if name == "align":
-            first = AlignSample(c, r, self.strength["align"], self.align_mode, v, hit)
+            first = AlignSample(c, r, self.strength["align"], self.align_mode, v, hit, only)
             if not self.symmetry:
                 return [first]
             return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
@@ -174,7 +180,7 @@ class BrushTool:
         count = self.add_count if name == "add" else 1
         spacing = self.spacing if name == "density" else 0.0
         strength = self.signed_strength(invert)
-        first = BrushSample(name, c, d, r, strength, self.lut(), v, hook, hit, count, 0, spacing)
+        first = BrushSample(name, c, d, r, strength, self.lut(), v, hook, hit, count, 0, spacing, only)
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
     def touches(self, points: np.ndarray, cursor: Sequence[float], plane_x: float) -> bool:

@@ -1,5 +1,6 @@
-"""Undo steps: one per brush stroke (or replayed stroke log), one per (merged) parameter edit, one
-per render hair grown or removed, one per head mesh loaded or removed, one per up axis set."""
+"""Undo steps: one per brush stroke (or replayed stroke log) or selection step, one per (merged)
+parameter edit, one per render hair grown or removed, one per head mesh loaded or removed, one
+per up axis set."""
 
 from __future__ import annotations
 
@@ -32,6 +33,14 @@ class StrokeCommand(QUndoCommand):
 
     def undo(self) -> None:
         self._scene.restore(self._before)
+
+
+class SelectionCommand(StrokeCommand):
+    """A selection step (select all, box select, hide, reveal …), already applied."""
+
+    def __init__(self, scene: Scene, before: object, after: object, text: str) -> None:
+        super().__init__(scene, before, after)
+        self.setText(text)
 
 
 class ParamCommand(QUndoCommand):

@@ -10,6 +10,7 @@ from app.render.drawn import Drawn
 from app.render.hair_shading import HAIR_TAPER
 from app.ui.colouring import vertex_colors
 from app.ui.scene import Scene
+from app.ui.selection_look import dimmed, shown_part
 
 
 def drawn(
@@ -22,7 +23,9 @@ def drawn(
     """What the viewport draws of ``scene``: ``frame`` (``(V, 3)`` points of the groom's strands,
     an animation frame; None: the groom as edited) with render hair following it, coloured by the
     scene's colour mode (``frame_colors``: an animation's own per-vertex colours, used where no
-    render hair is drawn over the frame); ``mask``: the mask brush's tint (a working overlay)."""
+    render hair is drawn over the frame); ``mask``: the working overlays, the mask brush's tint
+    and the selection (unselected strands dimmed, hidden ones left out:
+    :mod:`app.ui.selection_look`)."""
     s = scene
     if frame is not None and len(frame) != s.result.vertex_count:
         frame = None  # another groom's frame: the scene's own strands are drawn
@@ -41,14 +44,38 @@ def drawn(
         def make_colors():
             return vertex_colors(s, mask=mask)
 
+    topology = s.drawn_topology
+    if mask:
+        shown = shown_part(s)
+        all_colors = make_colors
+
+        def make_colors():
+            return dimmed(s, all_colors())
+
+        if shown is not None:
+            ids, topology = shown
+            points = points[ids]
+            dim = make_colors
+
+            def make_colors():
+                c = dim()
+                return None if c is None else c[ids]
+
     hair = s.colour_mode == "hair"
     return Drawn(
         points,
-        s.drawn_topology,
-        guides=s.drawn_guides if children else 0,
+        topology,
+        guides=_shown_guides(s, topology) if children else 0,
         ramp=s.ramp,
         line_width=s.line_width,
         taper=HAIR_TAPER if hair else 0.0,
         shaded=hair,
         make_colors=make_colors,
     )
+
+
+def _shown_guides(scene: Scene, topology) -> int:
+    """The guides among the drawn strands (the last ones), hidden guides left out."""
+    if not scene.drawn_guides or topology is scene.drawn_topology:
+        return scene.drawn_guides
+    return int((~scene.hidden).sum())

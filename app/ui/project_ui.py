@@ -348,7 +348,8 @@ class ProjectController(QObject):
 def _brush_settings(tool) -> dict:
     """The brush as a project keeps it: the current brush's radius, strength and mode (what
     older projects hold), and every brush's own, the falloff, symmetry, front faces only and
-    each brush's collision with the head, add's strands per move and density's spacing."""
+    each brush's collision with the head, add's strands per move, density's spacing and
+    whether brushes keep to the selection."""
     falloff = tool.falloff if isinstance(tool.falloff, str) else [list(p) for p in tool.falloff]
     return {
         "radius": tool.radius[tool.brush],
@@ -365,6 +366,7 @@ def _brush_settings(tool) -> dict:
         "collide": dict(tool.collide),
         "add_count": tool.add_count,
         "spacing": tool.spacing,
+        "only_selected": tool.only_selected,
     }
 
 
@@ -393,6 +395,7 @@ def _brush_setters(scene, brush: dict) -> tuple:
         lambda: scene.tool.collide.update({k: bool(v) for k, v in brush["collide"].items() if k in names}),
         lambda: scene.set_add_count(int(brush["add_count"])),
         lambda: scene.set_spacing(float(brush["spacing"])),
+        lambda: scene.set_only_selected(bool(brush["only_selected"])),
     )
 
 

@@ -20,8 +20,9 @@ from PySide6.QtCore import QObject, Signal
 from app.render.ramps import DEFAULT_RAMP
 from app.ui.brush_tool import LABELS, SIGNED, BrushTool, check_falloff
 from hairtool.errors import HairtoolError, ParameterError
-from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, scalp_centre
+from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, facing_away, scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+from hairtool.frozen.selection import SelectionSample, apply_selection
 from hairtool.groom import Groom, Topology, vertex_ids_of
 from hairtool.guides.binding import ChildBinding
 from hairtool.io.obj import Mesh
@@ -47,6 +48,7 @@ class Scene(QObject):
     params_changed = Signal(object)  # FrozenParams
     tool_changed = Signal()  # the brush, its radius, strength, falloff, symmetry …
     mask_changed = Signal()  # the strands the mask brush locked changed (their colour shows it)
+    selection_changed = Signal(bool)  # the selected or hidden strands changed (True: hidden ones too)
     refused = Signal(str)  # a stroke the brush cannot make, in words for the status bar
     display_changed = Signal()  # colour mode, ramp or line width
     mesh_changed = Signal()
@@ -86,6 +88,10 @@ class Scene(QObject):
         self.path: Path | None = None
         self.tool = BrushTool()
         self.locked = np.zeros(0, dtype=bool)  # the masked strands (a copy of the pipeline's)
+        self.selected = np.ones(0, dtype=bool)  # the selected strands (a copy of the pipeline's)
+        self.hidden = np.zeros(0, dtype=bool)  # … and the hidden ones
+        self.hidden_version = 0  # counts changes of ``hidden`` (what the drawn strands are made for)
+        self.shown_cache: tuple | None = None  # :func:`app.ui.selection_look.shown_part`'s
         self.last_update_ms = 0.0
         #: Callables naming what holds the strands as they are (e.g. an animation of them), or
         #: None: brushes that add or remove strands are refused while one names something.
@@ -108,6 +114,9 @@ class Scene(QObject):
         self.tool.reset_radius(0.25 * extent if extent > 0 else 1.0)
         self.tool.mirror_x = None  # the new groom's own centre
         self.locked = np.zeros(groom.strand_count, dtype=bool)
+        self.selected = np.ones(groom.strand_count, dtype=bool)
+        self.hidden = np.zeros(groom.strand_count, dtype=bool)
+        self.hidden_version += 1
         self.binding = None
         self._subsets = {}
         self._cache = {}
@@ -254,6 +263,10 @@ class Scene(QObject):
         label = LABELS.get(self.tool.brush, self.tool.brush)
         if self.tool.brush in NEED_SURFACE and (self.pipeline is None or self.pipeline.surface is None):
             return f"{label} works on the head's surface: load its mesh first (File → Load head mesh…)"
+        if self.tool.only_selected and self.tool.brush not in ("select", "add", "density"):
+            if not (self.selected & ~self.hidden).any():
+                return (f"{label}: no shown strand is selected: Select ▸ All (A) selects them, or "
+                        "switch off Affect selection only")  # fmt: skip
         if self.tool.brush not in CHANGE_STRANDS:
             return None
         reasons = ["the render hair follows these guides"] if self.binding is not None else []
@@ -284,6 +297,33 @@ class Scene(QObject):
         if not np.array_equal(locked, self.locked):
             self.locked = locked
             self.mask_changed.emit()
+        selected, hidden = self.pipeline.selected, self.pipeline.hidden
+        hid = not np.array_equal(hidden, self.hidden)
+        if hid or not np.array_equal(selected, self.selected):
+            self.selected, self.hidden = selected, hidden
+            self.hidden_version += hid
+            self.selection_changed.emit(hid)
+
+    def selection_step(self, sample: SelectionSample) -> bool:
+        """One selection step (:class:`~hairtool.frozen.selection.SelectionSample`: select all,
+        box, hide …) through the pipeline; False, logging nothing, where it changes nothing."""
+        self.start_engine()
+        p = self.pipeline
+        away = None if sample.view is None else facing_away(p.strand_normals, sample.view)
+        sel, hid = apply_selection(p.aligned, sample, self.selected, self.hidden, away)
+        if np.array_equal(sel, self.selected) and np.array_equal(hid, self.hidden):
+            return False
+        if hid.all():  # (the viewport draws at least one strand)
+            self.refused.emit("Hide: that would hide every strand, leaving nothing to see or groom")
+            return False
+        self.apply_samples([sample])
+        return True
+
+    def set_only_selected(self, on: bool) -> None:
+        """Brushes keep to the selected strands (Blender's selection toggle of sculpt mode)."""
+        if bool(on) != self.tool.only_selected:
+            self.tool.only_selected = bool(on)
+            self.tool_changed.emit()
 
     def snapshot(self) -> object:
         """The pipeline's stroke state (for one undo step); strokes need the engine running."""

@@ -123,6 +123,7 @@ class ToolDock(QDockWidget):
         layout.addWidget(self._display_box())
         layout.addWidget(RenderHairBox(scene))
         layout.addStretch(1)
+        self._layout = layout
         self.setWidget(scrolling(body))
         scene.params_changed.connect(lambda _p: self.refresh_params())
         scene.tool_changed.connect(self.refresh_brush)
@@ -220,6 +221,10 @@ class ToolDock(QDockWidget):
         form.addRow(self.front_only)
         form.addRow(self.collide)
         return box
+
+    def add_group(self, box: QWidget) -> None:
+        """Another group (the Selection's, :mod:`app.ui.selection_ui`) after the Brush group."""
+        self._layout.insertWidget(1, box)
 
     def _on_falloff_preset(self, i: int) -> None:
         key = self.falloff.itemData(i)
@@ -329,7 +334,7 @@ class ToolDock(QDockWidget):
                 self.sign.setCurrentIndex(1 if tool.subtract[s.brush] else 0)
                 self._brush_form.labelForField(self.sign).setText(SIGN_LABELS[s.brush])
             self._brush_form.setRowVisible(self.mode, s.brush == "align")
-            self._brush_form.setRowVisible(self.intensity, s.brush != "mask")  # a mask is on or off
+            self._brush_form.setRowVisible(self.intensity, s.brush not in ("mask", "select"))  # on or off
             self._brush_form.setRowVisible(self.sign, labels is not None)
             custom = not isinstance(tool.falloff, str)
             preset = self.falloff.count() - 1 if custom else self.falloff.findData(tool.falloff)

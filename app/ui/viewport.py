@@ -12,6 +12,11 @@ cursor its view (front faces only), and every move runs the frozen-hair pipeline
 told what changed by the scene's signals and uploads it at the next paint (positions only while
 dragging).
 
+Box select (:meth:`Viewport.arm_box`, the B key): the next left-drag draws a rectangle and its
+release emits the selection step (:attr:`Viewport.box_finished`): the strands with a point
+inside it are added to the selection, or with Ctrl held taken from it; Esc or a right-click
+cancels.
+
 With an animation loaded the window shows one of its frames instead of the scene's groom
 (:meth:`Viewport.show_frame`: positions, optional per-vertex colours and a ghost, all for the
 groom's strands), and a ``brush_target`` may take over the left-drag (editing a key pose).
@@ -27,7 +32,7 @@ from typing import Protocol
 import moderngl
 import numpy as np
 from PySide6.QtCore import QPointF, Qt, Signal
-from PySide6.QtGui import QMouseEvent, QWheelEvent
+from PySide6.QtGui import QKeyEvent, QMouseEvent, QWheelEvent
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 
 from app.render.camera import Camera
@@ -37,6 +42,7 @@ from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.drawn import drawn
 from app.ui.scene import Scene
 from hairtool.frozen.brushes import NEED_SURFACE, facing_away
+from hairtool.frozen.selection import SelectionSample
 
 BRUSH_STEP = 1.1  # radius factor per wheel notch or [ / ] press
 # The reconstruction behind the original: one flat cyan no ramp uses, opaque enough to read on the
@@ -66,6 +72,7 @@ class Viewport(QOpenGLWidget):
     cursor_moved = Signal(object)  # (3,) float array on the interaction plane, or None
     frame_drawn = Signal()
     engine_wait = Signal()  # a stroke began before the engine is ready: nothing was done
+    box_finished = Signal(object)  # a box select's SelectionSample, when its drag ends
 
     def __init__(self, scene: Scene, parent=None) -> None:
         super().__init__(parent)
@@ -98,6 +105,9 @@ class Viewport(QOpenGLWidget):
         self._pending_frame: int | None = None
         self.brush_target: BrushTarget | None = None
         self._drag_target: BrushTarget | None = None  # the target that took the current drag
+        self.box_armed = False  # the next left-drag is a box select (B)
+        self._box: list[QPointF] | None = None  # its corners while it drags
+        self._box_mode = "add"
         self.setMouseTracking(True)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMinimumSize(200, 150)
@@ -109,6 +119,7 @@ class Viewport(QOpenGLWidget):
         scene.drawn_changed.connect(lambda: self._mark("groom", "colors"))
         scene.tool_changed.connect(self.update)
         scene.mask_changed.connect(lambda: self._mark("colors"))
+        scene.selection_changed.connect(self._on_selection_changed)
         scene.engine_started.connect(self._on_engine_started)
         scene.up_axis_changed.connect(self._on_up_axis_changed)
 
@@ -133,6 +144,13 @@ class Viewport(QOpenGLWidget):
             *self.scene.result.bounds, ortho=ortho, aspect=self._aspect(), up_axis=self.scene.up_axis
         )
         self.frame_all()
+
+    def _on_selection_changed(self, hidden: bool) -> None:
+        """Unselected strands dim; hidden ones leave the drawn strands (a new upload)."""
+        if hidden:
+            self._mark("groom", "colors")
+        else:
+            self._mark("colors")
 
     def _on_groom_loaded(self) -> None:
         self.camera = self._fresh_camera()
@@ -276,8 +294,9 @@ class Viewport(QOpenGLWidget):
         return Overlays(circle, self.mirror_outline(w, h))
 
     def _overlay(self, w: int, h: int) -> None:
-        self.renderer.set_overlay_outline(self.mirror_outline(w, h), (w, h))
-        if self._hover is None or self._drag not in (None, "align"):
+        box = self.box_outline(self.devicePixelRatioF())
+        self.renderer.set_overlay_outline(self.mirror_outline(w, h) if box is None else box, (w, h))
+        if self._hover is None or self._drag not in (None, "align") or self.box_armed:
             self.renderer.set_overlay_circle(None, 0.0, (w, h))
             return
         dpr = self.devicePixelRatioF()
@@ -339,6 +358,42 @@ class Viewport(QOpenGLWidget):
             self.renderer = None
             self.doneCurrent()
 
+    # -- box select ----------------------------------------------------------------------------
+    def arm_box(self, on: bool = True) -> None:
+        """The next left-drag draws a box select (off: cancelled)."""
+        self.box_armed = bool(on)
+        if not on and self._drag == "box":
+            self._drag, self._box = None, None
+        if on:
+            self.setCursor(Qt.CursorShape.CrossCursor)
+        else:
+            self.unsetCursor()
+        self.update()
+
+    def box_outline(self, scale: float = 1.0) -> np.ndarray | None:
+        """``(4, 2)`` pixels (times ``scale``) of the box being dragged, or None."""
+        if self._box is None:
+            return None
+        a, b = self._box
+        x0, y0, x1, y1 = a.x() * scale, a.y() * scale, b.x() * scale, b.y() * scale
+        return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], np.float64)
+
+    def box_sample(self, a: QPointF, b: QPointF, mode: str = "add") -> SelectionSample:
+        """The selection step of a box from ``a`` to ``b`` (widget pixels) in this view."""
+        w, h = max(self.width(), 1), max(self.height(), 1)
+        cam = self.camera
+        vp = cam.view_matrix().astype(np.float64) @ cam.projection_matrix(w / h).astype(np.float64)
+        rect = (2.0 * a.x() / w - 1.0, 1.0 - 2.0 * a.y() / h, 2.0 * b.x() / w - 1.0, 1.0 - 2.0 * b.y() / h)
+        view = tuple(float(v) for v in cam.forward()) if self.scene.tool.front_only else None
+        return SelectionSample("box", tuple(vp.T.ravel().tolist()), rect, mode, view)
+
+    def keyPressEvent(self, event: QKeyEvent) -> None:
+        if event.key() == Qt.Key.Key_Escape and self.box_armed:
+            self.arm_box(False)
+            event.accept()
+            return
+        super().keyPressEvent(event)
+
     # -- picking -------------------------------------------------------------------------------
     def cursor_on_plane(self, pos: QPointF, through: np.ndarray | None = None) -> np.ndarray:
         """The 3-D point under ``pos`` (widget pixels) on the plane facing the camera through
@@ -367,6 +422,18 @@ class Viewport(QOpenGLWidget):
 
     def mousePressEvent(self, event: QMouseEvent) -> None:
         if self._drag is not None:
+            return
+        if self.box_armed and event.button() == Qt.MouseButton.RightButton:
+            self.arm_box(False)
+            event.accept()
+            return
+        alt = bool(event.modifiers() & Qt.KeyboardModifier.AltModifier)
+        if self.box_armed and event.button() == Qt.MouseButton.LeftButton and not alt:
+            self._drag, self._drag_button = "box", event.button()
+            self._box = [event.position(), event.position()]
+            ctrl = bool(event.modifiers() & Qt.KeyboardModifier.ControlModifier)
+            self._box_mode = "subtract" if ctrl else "add"
+            event.accept()
             return
         target = self.brush_target
         if event.button() == Qt.MouseButton.LeftButton and hasattr(target, "press"):
@@ -413,6 +480,8 @@ class Viewport(QOpenGLWidget):
             self._drag_target.move(self._cursor_at(pos))
         elif self._drag == "align":
             self._brush_at(pos)
+        elif self._drag == "box" and self._box is not None:
+            self._box[1] = pos
         elif self._drag == "orbit":
             self._auto_frame = False
             self.camera.orbit(dx, dy)
@@ -469,7 +538,12 @@ class Viewport(QOpenGLWidget):
         if self._drag is None or event.button() != self._drag_button:
             return
         drag, self._drag = self._drag, None
-        if drag == "align" and self._drag_target is not None:
+        if drag == "box" and self._box is not None:
+            (a, _), b = self._box, event.position()
+            self._box = None
+            self.arm_box(False)
+            self.box_finished.emit(self.box_sample(a, b, self._box_mode))
+        elif drag == "align" and self._drag_target is not None:
             target, self._drag_target = self._drag_target, None
             target.end()
         elif drag == "align" and self._stroke_before is not None:

@@ -44,6 +44,7 @@ from app.ui.legend import RampLegend, readable_length
 from app.ui.qt_utils import add_action, set_available
 from app.ui.render_hair_dialog import DENSE, GrowOptions, ask_grow_options, grow
 from app.ui.scene import COLOUR_MODES, Scene
+from app.ui.selection_ui import SelectionUI
 from app.ui.simulate_dialog import ask_simulate_options
 from app.ui.status_line import ElidedLabel, StatusLine
 from app.ui.stroke_files import StrokeFiles
@@ -109,6 +110,7 @@ class MainWindow(QMainWindow):
         self._build_menus()
         self._build_animation_ui()
         self._build_part2_menus()
+        self.selection = SelectionUI(self)
         self.setAcceptDrops(True)
         self.setDockOptions(
             QMainWindow.DockOption.AnimatedDocks
@@ -426,7 +428,7 @@ class MainWindow(QMainWindow):
             made[text] = action
         self.exporter.bind_actions(made["Export &Animation…"], made["Export &Keys…"])
         file.setToolTipsVisible(True)  # a greyed-out entry's tooltip says why
-        animation = menus["&Animation"]
+        animation = menus["A&nimation"]
         animation.addSeparator()
         add_action(self, animation, "&Simulate…", self.sources.simulate_dialog, "Ctrl+Alt+M")
         menus["&View"].addAction(self.sources.dock.toggleViewAction())

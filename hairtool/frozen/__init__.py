@@ -6,7 +6,8 @@
   over the neighbour lists of :mod:`.spatial`; :mod:`.clump_region` redoes it only near the
   strands that moved; :mod:`.strand_clumps` labels clumps and picks the automatic radius;
 - :mod:`.brushes` comb, smooth, length, puff, clump and mask, falloff, symmetry and
-  front-facing strands; :mod:`.strokes` stroke logs as JSON files;
+  front-facing strands; :mod:`.selection` selecting and hiding strands; :mod:`.strokes`
+  stroke logs as JSON files;
 - :mod:`.pipeline` the three in order, with the stroke log the studio and the CLI replay;
 - :mod:`.noise` the counter-based noise they share.
 """

@@ -375,7 +375,7 @@ def test_each_brush_remembers_its_size_and_strength_and_keys_pick_brushes(make_w
     s.set_brush("comb")
     assert (s.radius, s.intensity) == (pytest.approx(0.3), pytest.approx(0.9))
     assert w.dock.brush.currentData() == "comb" and w.brush_actions["comb"].isChecked()
-    for key, brush in (("S", "smooth"), ("M", "mask"), ("A", "align")):
+    for key, brush in (("S", "smooth"), ("M", "mask"), ("W", "select"), ("Shift+C", "align")):
         action = w.brush_actions[brush]
         assert action.shortcut().toString() == key  # (Xvfb without a window manager activates no window)
         action.trigger()
