@@ -56,7 +56,7 @@ class PseudoNormals:
         """``(P, 3)`` the pseudo-normal of the feature of ``face`` that ``q`` (on it) lies on."""
         f = self.faces[face]
         a, b, c = self.vertices[f[:, 0]], self.vertices[f[:, 1]], self.vertices[f[:, 2]]
-        w = _barycentric(q, a, b, c)  # (P, 3) weights of corners 0, 1, 2
+        w = barycentric(q, a, b, c)  # (P, 3) weights of corners 0, 1, 2
         low = w < ON_EDGE
         n = self.face[face].copy()
         rows = np.arange(len(face))
@@ -71,7 +71,8 @@ class PseudoNormals:
         return n
 
 
-def _barycentric(q: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+def barycentric(q: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """``(P, 3)`` weights of ``q`` on triangles ``abc`` (a third each where a triangle is degenerate)."""
     e0, e1, e2 = b - a, c - a, q - a
     d00, d01, d11 = (e0 * e0).sum(1), (e0 * e1).sum(1), (e1 * e1).sum(1)
     d20, d21 = (e2 * e0).sum(1), (e2 * e1).sum(1)

@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.errors import ParameterError
+from hairtool.guides.inside import barycentric
 from hairtool.io.obj import Mesh
 
 
@@ -429,15 +430,8 @@ class MeshSurface:
     def _normals(self, q: np.ndarray, face: np.ndarray) -> np.ndarray:
         tri = self._f[face]
         a, b, c = self._v[tri[:, 0]], self._v[tri[:, 1]], self._v[tri[:, 2]]
-        e0, e1, e2 = b - a, c - a, q - a
-        d00, d01, d11 = (e0 * e0).sum(1), (e0 * e1).sum(1), (e1 * e1).sum(1)
-        d20, d21 = (e2 * e0).sum(1), (e2 * e1).sum(1)
-        den = d00 * d11 - d01 * d01
-        ok = np.abs(den) > 1e-300
-        den = np.where(ok, den, 1.0)
-        v = np.where(ok, (d11 * d20 - d01 * d21) / den, 1.0 / 3.0)
-        w = np.where(ok, (d00 * d21 - d01 * d20) / den, 1.0 / 3.0)
-        u = 1.0 - v - w
+        e0, e1 = b - a, c - a
+        u, v, w = barycentric(q, a, b, c).T
         nv = self._n
         n = u[:, None] * nv[tri[:, 0]] + v[:, None] * nv[tri[:, 1]] + w[:, None] * nv[tri[:, 2]]
         length = np.linalg.norm(n, axis=1)
