@@ -10,6 +10,15 @@ median carries the other processes' load); ``reference_ms``: the numpy twin on t
 ``bind_ms``: making the binding, once (scatter, surface distances, weights, variation);
 ``clump_ms``: ClumpWithGaps on the children with their automatic radius and a built neighbour
 list (``--clump``); ``threads``: numba threads.
+
+``--release``: what a release costs with "Clump children" on and off, Sintel with 30,000 and
+100,000 children (10,000 with ``--quick``). ``stroke``: the 10 % of the guides nearest one
+guide root swung (one brush stroke), the release rebuilding what followed them, as the studio
+does; ``all``: every guide moved (a parameter change). ``release_ms`` unclumped,
+``clumped_ms`` with ClumpWithGaps among each guide's children (only the clumps the stroke
+reached run again), ``ratio`` the two; ``whole_ms``: one run over all children at once (the
+studio's clumping before), ``clumps_run``: clumps redone. Children only: the draw after a
+release, the same either way, is ``python -m app.bench``'s.
 """
 
 from __future__ import annotations
@@ -27,6 +36,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--guides", type=int, default=1_000, help="guides in the target case")
     parser.add_argument("--vertices", type=int, default=16, help="vertices per child in the target case")
     parser.add_argument("--clump", action="store_true", help="also time ClumpWithGaps on the children")
+    parser.add_argument(
+        "--release", action="store_true", help="only the release with and without Clump children (Sintel)"
+    )
 
 
 def _resources():
@@ -92,6 +104,64 @@ def _row(name, guides, binding, bind_ms, repeat, clump) -> dict:
     return row
 
 
+def _stroke(guides, share: float = 0.1):
+    """Two poses a stroke apart: the ``share`` of the guides nearest guide 0's root swung."""
+    import numpy as np
+
+    near = np.argsort(np.linalg.norm(guides.roots - guides.roots[0], axis=1))[: max(1, int(share * len(guides)))]
+    moved = _moved(guides).points
+    pts = guides.points.copy()
+    for s in near:
+        a, b = guides.offsets[s], guides.offsets[s + 1]
+        pts[a:b] = moved[a:b]
+    return guides.with_points(pts)
+
+
+def _release_rows(guides, binding, repeat: int) -> list[dict]:
+    from hairtool.frozen.clump import ClumpWorkspace, clump_points
+    from hairtool.guides.children import build_points, moved_guides
+    from hairtool.guides.render import ChildClump, RenderHair
+
+    rows = []
+    clump = ChildClump()
+    h = RenderHair(binding, clump).clump_radius
+    for case, pose in (("stroke", _stroke(guides)), ("all", _moved(guides))):
+        poses = [guides, pose]
+        plain_out = build_points(binding, guides)
+        last = [guides.points.copy()]
+        flip = [0]
+
+        def plain():  # the studio's unclumped release: the children of moved guides rebuilt
+            flip[0] ^= 1
+            g = poses[flip[0]]
+            build_points(binding, g, out=plain_out, moved=moved_guides(g, last[0]))
+            last[0] = g.points.copy()
+
+        rh = RenderHair(binding, clump)
+        rh.update_points(guides)
+
+        def clumped():
+            flip[0] ^= 1
+            rh.update_points(poses[flip[0]])
+
+        kids = binding.build(pose)
+        ws = ClumpWorkspace()
+
+        def whole():
+            ws.invalidate()
+            clump_points(kids, h, clump.iterations, None, clump.gap_mode, 0, ws, True)
+
+        row = {"case": f"release, {case}", "children": binding.child_count, "vertices": binding.vertex_count}
+        row["release_ms"] = median_ms(plain, repeat)
+        row["clumped_ms"] = median_ms(clumped, repeat)
+        row["ratio"] = row["clumped_ms"] / row["release_ms"]
+        row["clumps_run"] = rh.clumps.clumps_run
+        row["whole_ms"] = median_ms(whole, max(1, min(repeat, 3)))
+        row["threads"] = threads()
+        rows.append(row)
+    return rows
+
+
 def run(args: argparse.Namespace) -> list[dict]:
     import time
 
@@ -101,6 +171,12 @@ def run(args: argparse.Namespace) -> list[dict]:
 
     repeat = setup(args, quick_repeat=3)
     rows = []
+    if args.release:
+        res = _resources()
+        sintel, head = io.read_groom(res / "sintel_hair.tfx"), read_mesh(res / "sintel_head.obj")
+        for n in [10_000] if args.quick else [30_000, 100_000]:
+            rows += _release_rows(sintel, bind_scalp(sintel, head, n, seed=1), max(3, min(repeat, 5)))
+        return rows
 
     def timed(fn):
         t0 = time.perf_counter()

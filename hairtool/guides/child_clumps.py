@@ -170,6 +170,7 @@ def _pairs(P, strand, radius):
                     rr = (z + dz) * ny + y + dy
                     first[d] = last[d] = start[rr]
                     end[d] = start[rr + 1]
+        room = 0
         for d in range(5):
             while first[d] < end[d] and sx[first[d]] < x - 1:
                 first[d] += 1
@@ -177,25 +178,25 @@ def _pairs(P, strand, radius):
                 last[d] = first[d]
             while last[d] < end[d] and sx[last[d]] <= x + 1:
                 last[d] += 1
+            room += last[d] - first[d]
+        if m + room >= cap:  # room for every candidate: the writes below need no test
+            cap = 2 * (m + room) + 16
+            na = np.empty(cap, np.int32)
+            nb = np.empty(cap, np.int32)
+            na[:m] = pa[:m]
+            nb[:m] = pb[:m]
+            pa, pb = na, nb
+        for d in range(5):
             q0 = max(first[d], p + 1) if d == 0 else first[d]
+            # Branch-free (the outcome is unpredictable): always write, count the hits.
             for q in range(q0, last[d]):
-                if ss[q] == si:
-                    continue
                 ex = sp[q, 0] - px
                 ey = sp[q, 1] - py
                 ez = sp[q, 2] - pz
-                if ex * ex + ey * ey + ez * ez < r2:
-                    j = order[q]
-                    if m == cap:
-                        cap *= 2
-                        na = np.empty(cap, np.int32)
-                        nb = np.empty(cap, np.int32)
-                        na[:m] = pa[:m]
-                        nb[:m] = pb[:m]
-                        pa, pb = na, nb
-                    pa[m] = min(i, j)
-                    pb[m] = max(i, j)
-                    m += 1
+                j = order[q]
+                pa[m] = min(i, j)
+                pb[m] = max(i, j)
+                m += np.int64((ex * ex + ey * ey + ez * ez < r2) & (ss[q] != si))
     return pa[:m], pb[:m]
 
 
