@@ -6,6 +6,14 @@ segment from it), besides the float32 copy on the CPU that the ``"cpu"`` method 
 a brush drags, :meth:`PointSet.write` uploads only the form the last draw used (none after a CPU
 draw) and marks the others stale; a draw with another method refreshes its form first. Index
 buffers are made once per topology, when a method first needs them.
+
+A move that changed a few strands writes only theirs: :meth:`PointSet.write` finds the strands
+whose points differ bit for bit from the last (or takes the caller's list of them), and a form
+that was up to date gets ``Buffer.write(..., offset=)`` for each run of those strands' vertices,
+runs closer than :data:`COALESCE_VERTICES` merged into one write (each write is a driver call),
+or one whole write when they cover most of the buffer (:func:`write_runs`). The colours work the
+same way (:meth:`StrandGPU.colors_written` with the strands shaded again). Every byte goes
+through :func:`write_buffer`, which the tests count.
 """
 
 from __future__ import annotations
@@ -19,6 +27,60 @@ from hairtool.groom import Topology
 RESTART_INDEX = 0xFFFFFFFF
 TEXTURE_WIDTH = 4096  # texels per row of the point and colour textures (vertex v at v % W, v // W)
 _QUAD_CORNERS = np.array([0, 1, 2, 2, 1, 3], dtype=np.uint32)
+COALESCE_VERTICES = 1024  # changed runs of vertices closer than this are written as one (12 KiB of points)
+WHOLE_SHARE = 0.5  # runs covering more than this share of a buffer: one write of all of it
+MAX_WRITES = 64  # … or needing more writes than this
+
+
+def write_buffer(buffer: moderngl.Buffer, data: NDArray, offset: int = 0) -> int:
+    """``data`` into ``buffer`` at byte ``offset``; returns the bytes written (every upload of
+    points and colours goes through here)."""
+    buffer.write(data, offset=offset)
+    return int(data.nbytes)
+
+
+def changed_strands(old: NDArray, new: NDArray, offsets: NDArray) -> NDArray[np.int64]:
+    """Sorted ids of the strands (``offsets``: S + 1 starts) with a vertex whose row of ``new``
+    differs bit for bit from ``old``'s (a −0.0 for a 0.0 too: the bytes are what is uploaded)."""
+    a = np.ascontiguousarray(old).view(np.uint32).reshape(len(old), -1)
+    b = np.ascontiguousarray(new).view(np.uint32).reshape(len(new), -1)
+    differ = (a != b).any(axis=1)
+    count = np.zeros(len(differ) + 1, np.int64)
+    np.cumsum(differ, out=count[1:])
+    return np.flatnonzero(count[offsets[1:]] > count[offsets[:-1]])
+
+
+def vertex_runs(offsets: NDArray, strands: NDArray, gap: int = COALESCE_VERTICES) -> NDArray[np.int64]:
+    """``(R, 2)`` vertex ranges [a, b) covering the sorted ``strands``, neighbouring ranges
+    less than ``gap`` vertices apart merged."""
+    s = np.asarray(strands, np.int64)
+    if s.size == 0:
+        return np.zeros((0, 2), np.int64)
+    a, b = offsets[s], offsets[s + 1]
+    cut = np.flatnonzero(a[1:] - b[:-1] >= gap) + 1  # a new run where the gap is wide
+    first = np.concatenate([[0], cut])
+    last = np.concatenate([cut - 1, [s.size - 1]])
+    return np.stack([a[first], b[last]], axis=1).astype(np.int64)
+
+
+def strand_rows(offsets: NDArray, strands: NDArray) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The vertex ids of ``strands`` one strand after another, and their offsets (S' + 1) in
+    that list: the strands as a groom of their own."""
+    s = np.asarray(strands, np.int64)
+    counts = offsets[s + 1] - offsets[s]
+    sub = np.zeros(s.size + 1, np.int64)
+    np.cumsum(counts, out=sub[1:])
+    rows = np.arange(sub[-1], dtype=np.int64) + np.repeat(offsets[s] - sub[:-1], counts)
+    return rows, sub
+
+
+def write_runs(buffer: moderngl.Buffer, data: NDArray, runs: NDArray | None) -> int:
+    """Rows ``runs`` (``(R, 2)`` [a, b), None: all) of ``data`` into ``buffer`` (row r at byte
+    r · row size), all of it at once when the runs are many or cover most of it; the bytes."""
+    row = data.nbytes // max(len(data), 1)
+    if runs is None or len(runs) > MAX_WRITES or (runs[:, 1] - runs[:, 0]).sum() > WHOLE_SHARE * len(data):
+        return write_buffer(buffer, data)
+    return sum(write_buffer(buffer, data[a:b], int(a) * row) for a, b in runs if b > a)
 
 
 def strip_indices(topology: Topology) -> NDArray[np.uint32]:
@@ -76,7 +138,10 @@ class StrandGPU:
         self._color_texture: moderngl.Texture | None = None
         self._color_texture_stale = False
         self._color_buffer_stale = False
+        self._color_runs: list[NDArray] = []  # rows written since the last upload, per GL form
+        self._color_texture_runs: list[NDArray] = []
         self._index: dict[str, moderngl.Buffer] = {}
+        self.uploaded_bytes = 0  # colours uploaded so far (all written through write_buffer)
 
     # GL buffers are made when a GL draw first reads them: a groom only rasterized on the CPU
     # (the studio on llvmpipe) uploads no t and reserves no colour buffer.
@@ -112,17 +177,29 @@ class StrandGPU:
         self._colors[:] = colors
         self.colors_written()
 
-    def colors_written(self) -> None:
+    def colors_written(self, runs: NDArray | None = None) -> None:
         """:attr:`colors` were written in place (e.g. shaded straight into them): upload them
-        before the next GL draw that reads them."""
-        self._color_buffer_stale = self._color_texture_stale = True
+        before the next GL draw that reads them; ``runs`` (``(R, 2)`` vertex ranges): only
+        those rows changed (None: any)."""
+        if runs is None:
+            self._color_buffer_stale = self._color_texture_stale = True
+            self._color_runs.clear()
+            self._color_texture_runs.clear()
+            return
+        if not self._color_buffer_stale:
+            self._color_runs.append(runs)
+        if not self._color_texture_stale:
+            self._color_texture_runs.append(runs)
 
     def sync_color_buffer(self) -> None:
         """Bring the colour vertex buffer up to date before a draw that reads it."""
         buffer = self.color_buffer  # made, and marked stale, on first use
         if self._color_buffer_stale:
-            buffer.write(self._colors)
-            self._color_buffer_stale = False
+            self.uploaded_bytes += write_buffer(buffer, self._colors)
+        elif self._color_runs:
+            self.uploaded_bytes += write_runs(buffer, self._colors, merged_runs(self._color_runs))
+        self._color_buffer_stale = False
+        self._color_runs.clear()
 
     def color_texture(self) -> moderngl.Texture:
         if self._color_texture is None:
@@ -130,7 +207,10 @@ class StrandGPU:
             self._color_texture_stale = True
         if self._color_texture_stale:
             _write_texture(self._color_texture, self._colors)
-            self._color_texture_stale = False
+        elif self._color_texture_runs:
+            _write_texture_runs(self._color_texture, self._colors, merged_runs(self._color_texture_runs))
+        self._color_texture_stale = False
+        self._color_texture_runs.clear()
         return self._color_texture
 
     def release(self) -> None:
@@ -153,7 +233,9 @@ class PointSet:
         self._texels: NDArray[np.float32] | None = None  # the texture's RGBA: xyz and t
         self._texture: moderngl.Texture | None = None
         self._stale = {"buffer": True, "texture": True}
+        self._runs: dict[str, list[NDArray]] = {"buffer": [], "texture": []}  # rows to upload
         self.last_used = "buffer"  # the form the last draw read ("buffer", "texture", "cpu")
+        self.uploaded_bytes = 0  # points uploaded to the vertex buffer so far
 
     @property
     def buffer(self) -> moderngl.Buffer:
@@ -170,14 +252,37 @@ class PointSet:
         view.flags.writeable = False
         return view
 
-    def write(self, points: NDArray[np.float32]) -> None:
-        """New positions (same topology): upload the form in use now, the other when needed."""
+    def write(
+        self, points: NDArray[np.float32], changed: NDArray | None = None, find: bool = False
+    ) -> NDArray[np.int64] | None:
+        """New positions (same topology): upload the form in use now, the other when needed.
+
+        ``changed``: sorted ids of the only strands whose points may differ from the last
+        (None: any). A form in use that was up to date then gets only those strands' vertices;
+        without ``changed`` they are found by comparing (when a form will be written now, or
+        with ``find``). Returns the changed strands where known, else None."""
+        form = self.last_used
+        partial = form in ("buffer", "texture") and not self._stale[form]
+        partial = partial and (self._buffer if form == "buffer" else self._texture) is not None
+        moved = None
+        offsets = self.gpu.topology.offsets
+        if changed is not None:
+            moved = np.asarray(changed, np.int64)
+        elif partial or find:
+            moved = changed_strands(self._points, points, offsets)
         self._points[:] = points
-        self._stale = {"buffer": True, "texture": True}
-        if self.last_used == "buffer":
+        runs = None if moved is None else vertex_runs(offsets, moved)
+        for name in self._stale:
+            if runs is None or name != form or not partial:
+                self._stale[name] = True
+                self._runs[name].clear()
+            else:
+                self._runs[name].append(runs)
+        if form == "buffer":
             self.vertex_buffer()
-        elif self.last_used == "texture" and self._texture is not None:
+        elif form == "texture" and self._texture is not None:
             self.texture()
+        return moved
 
     def cpu_points(self) -> NDArray[np.float32]:
         """The positions for a CPU draw (a view, current); later writes upload nothing at once."""
@@ -191,8 +296,11 @@ class PointSet:
             self.last_used = "buffer"
         buffer = self.buffer
         if self._stale["buffer"]:
-            buffer.write(self._points)
-            self._stale["buffer"] = False
+            self.uploaded_bytes += write_buffer(buffer, self._points)
+        elif self._runs["buffer"]:
+            self.uploaded_bytes += write_runs(buffer, self._points, merged_runs(self._runs["buffer"]))
+        self._stale["buffer"] = False
+        self._runs["buffer"].clear()
         return buffer
 
     def texture(self) -> moderngl.Texture:
@@ -206,7 +314,13 @@ class PointSet:
         if self._stale["texture"]:
             self._texels[:v, :3] = self._points
             _write_texture(self._texture, self._texels)
-            self._stale["texture"] = False
+        elif self._runs["texture"]:
+            runs = merged_runs(self._runs["texture"])
+            for a, b in runs:
+                self._texels[a:b, :3] = self._points[a:b]
+            _write_texture_runs(self._texture, self._texels, runs)
+        self._stale["texture"] = False
+        self._runs["texture"].clear()
         return self._texture
 
     def release(self) -> None:
@@ -219,6 +333,26 @@ class PointSet:
             self._texels = None
 
 
+def merged_runs(parts: list[NDArray]) -> NDArray[np.int64]:
+    """The union of several ``(R, 2)`` lists of ranges [a, b): sorted, overlapping or touching
+    ranges joined."""
+    if len(parts) == 1:
+        return parts[0]  # one list from vertex_runs: sorted and disjoint already
+    return joined(np.concatenate(parts))
+
+
+def joined(runs: NDArray) -> NDArray[np.int64]:
+    """``(R, 2)`` ranges [a, b) sorted, the overlapping or touching ones joined."""
+    if len(runs) < 2:
+        return runs
+    runs = runs[np.argsort(runs[:, 0], kind="stable")]
+    ends = np.maximum.accumulate(runs[:, 1])
+    cut = np.flatnonzero(runs[1:, 0] > ends[:-1]) + 1
+    first = np.concatenate([[0], cut])
+    last = np.concatenate([cut - 1, [len(runs) - 1]])
+    return np.stack([runs[first, 0], ends[last]], axis=1)
+
+
 def _texture(ctx: moderngl.Context, v: int, components: int) -> moderngl.Texture:
     tex = ctx.texture((TEXTURE_WIDTH, _rows(v)), components, dtype="f4")
     tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
@@ -226,17 +360,31 @@ def _texture(ctx: moderngl.Context, v: int, components: int) -> moderngl.Texture
     return tex
 
 
-def _write_texture(tex: moderngl.Texture, data: NDArray[np.float32]) -> None:
-    """Rows of ``data`` (``(n, components)``) into the texture, vertex v at (v % W, v // W)."""
-    rows = tex.height
+def _write_texture(tex: moderngl.Texture, data: NDArray[np.float32], row0: int = 0) -> None:
+    """Rows of ``data`` (``(n, components)``) into the texture from texel row ``row0`` on,
+    vertex v at (v % W, row0 + v // W)."""
     c = tex.components
-    if len(data) == rows * TEXTURE_WIDTH:
+    if row0 == 0 and len(data) == tex.height * TEXTURE_WIDTH:
         tex.write(np.ascontiguousarray(data))
         return
     full = len(data) // TEXTURE_WIDTH
     if full:
-        tex.write(np.ascontiguousarray(data[: full * TEXTURE_WIDTH]), viewport=(0, 0, TEXTURE_WIDTH, full))
+        rows = np.ascontiguousarray(data[: full * TEXTURE_WIDTH])
+        tex.write(rows, viewport=(0, row0, TEXTURE_WIDTH, full))
     rest = len(data) - full * TEXTURE_WIDTH
     if rest:
         tail = np.ascontiguousarray(data[full * TEXTURE_WIDTH :], np.float32).reshape(rest, c)
-        tex.write(tail, viewport=(0, full, rest, 1))
+        tex.write(tail, viewport=(0, row0 + full, rest, 1))
+
+
+def _write_texture_runs(tex: moderngl.Texture, data: NDArray[np.float32], runs: NDArray) -> None:
+    """The texel rows holding the vertex ranges ``runs`` of ``data`` (whole rows, rows shared
+    by neighbouring runs written once; all of it when they cover most of it)."""
+    if (runs[:, 1] - runs[:, 0]).sum() > WHOLE_SHARE * len(data) or len(runs) > MAX_WRITES:
+        _write_texture(tex, data)
+        return
+    w = TEXTURE_WIDTH
+    rows = np.stack([runs[:, 0] // w, (runs[:, 1] + w - 1) // w], axis=1)
+    for r0, r1 in joined(rows):
+        if r1 > r0:
+            _write_texture(tex, data[r0 * w : min(r1 * w, len(data))], int(r0))

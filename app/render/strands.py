@@ -58,7 +58,7 @@ from app.render.overlay import CircleOverlay, OutlineOverlay
 from app.render.ramps import DEFAULT_RAMP, ramp_stops, ramp_texture, sample_linear
 from app.render.raster_layer import RasterLayer
 from app.render.shaders import load_program
-from app.render.strand_gpu import RESTART_INDEX, PointSet, StrandGPU, strip_indices
+from app.render.strand_gpu import RESTART_INDEX, PointSet, StrandGPU, strand_rows, strip_indices, vertex_runs
 from hairtool.bounds import box
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Groom, Topology
@@ -170,6 +170,9 @@ class StrandRenderer:
         self._kept: list[_Kept] = []  # the last topologies drawn before this one (KEEP_TOPOLOGIES)
         self._version = 0  # bumped by every change of points or base colours
         self._shade_key: tuple | None = None
+        # Strands moved since the last shade by update_points alone (None: shade them all).
+        self._reshade: NDArray[np.int64] | None = None
+        self.last_moved: NDArray[np.int64] | None = None  # the strands the last update_points changed
 
     # -- what is drawn and how -------------------------------------------------------
     def line_method(self) -> str:
@@ -272,6 +275,7 @@ class StrandRenderer:
             self._taper_scale, self._base_store = kept.taper_scale, kept.base_store
             self._main.write(p)
         self._version += 1
+        self._reshade = None
         self.bounds = bounds
         self.set_vertex_colors(colors)
         if ghost is not None:
@@ -330,12 +334,25 @@ class StrandRenderer:
         while len(self._kept) > KEEP_TOPOLOGIES:
             self._kept.pop().release()
 
-    def update_points(self, points: ArrayLike) -> None:
-        """Rewrite only the positions (same strands), e.g. every mouse move of a brush stroke."""
+    def update_points(self, points: ArrayLike, changed: ArrayLike | None = None) -> None:
+        """Rewrite only the positions (same strands), e.g. every mouse move of a brush stroke.
+
+        Only the strands that changed are uploaded and shaded again: ``changed``, the sorted ids
+        of the only strands that may differ from the last points (the engine knows them), or
+        without it the strands whose points differ bit for bit (found by comparing)."""
         if self.topology is None or self._main is None:
             raise GroomError("update_points needs a groom: call set_groom first")
         p, self.bounds = self._checked_points(points, self.topology.vertex_count, "points")
-        self._main.write(p)
+        if changed is not None:
+            changed = np.unique(np.asarray(changed, np.int64))
+            if changed.size and (changed[0] < 0 or changed[-1] >= self.topology.strand_count):
+                raise ParameterError(
+                    "changed", "a strand id out of range", f"ids in [0, {self.topology.strand_count})"
+                )
+        moved = self._main.write(p, changed, find=self.hair_shading)
+        self.last_moved = moved
+        if self._reshade is not None:
+            self._reshade = None if moved is None else np.union1d(self._reshade, moved)
         self._version += 1
 
     def set_ghost_points(
@@ -410,6 +427,7 @@ class StrandRenderer:
         self.use_vertex_colors = True
         self._version += 1
         self._shade_key = None
+        self._reshade = None
 
     def set_ramp(self, name: str) -> None:
         """Colour ramp used while no vertex colours are set (see :data:`app.render.ramps.RAMPS`)."""
@@ -577,7 +595,8 @@ class StrandRenderer:
                 self._gpu.write_colors(self._base_colors)
 
     def _shade(self, camera: Camera) -> None:
-        """Write the shaded colours into the colour buffer when points, colours or view changed."""
+        """Write the shaded colours into the colour buffer when points, colours or view changed:
+        after moves alone (same view, colours and look), only the strands they moved."""
         if not self.hair_shading or self._main is None:
             return
         right, up, forward = camera.basis()
@@ -587,9 +606,19 @@ class StrandRenderer:
         base = self._base_colors if self.use_vertex_colors else self._ramp_vertex_colors()
         light, eye = light_and_eye(right, up, forward)
         gpu = self._gpu
-        shade(self._main.points, self.topology.offsets, base, light, eye, self.hair_look, out=gpu.colors)
-        gpu.colors_written()  # shaded in place: no (V, 3) array made and copied per frame
+        offsets = self.topology.offsets
+        some = self._reshade is not None and self._shade_key is not None and self._shade_key[1:] == key[1:]
+        if some:
+            moved = self._reshade
+            if moved.size:
+                rows, sub = strand_rows(offsets, moved)
+                gpu.colors[rows] = shade(self._main.points[rows], sub, base[rows], light, eye, self.hair_look)
+                gpu.colors_written(vertex_runs(offsets, moved))
+        else:
+            shade(self._main.points, offsets, base, light, eye, self.hair_look, out=gpu.colors)
+            gpu.colors_written()  # shaded in place: no (V, 3) array made and copied per frame
         self._shade_key = key
+        self._reshade = np.zeros(0, np.int64)
 
     def _draw(self, method: str, points: PointSet, ghost: bool) -> None:
         if method == "quads":
