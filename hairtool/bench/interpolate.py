@@ -108,13 +108,25 @@ def _stroke(guides, share: float = 0.1):
     """Two poses a stroke apart: the ``share`` of the guides nearest guide 0's root swung."""
     import numpy as np
 
-    near = np.argsort(np.linalg.norm(guides.roots - guides.roots[0], axis=1))[: max(1, int(share * len(guides)))]
+    count = max(1, int(share * len(guides)))
+    near = np.argsort(np.linalg.norm(guides.roots - guides.roots[0], axis=1))[:count]
     moved = _moved(guides).points
     pts = guides.points.copy()
     for s in near:
         a, b = guides.offsets[s], guides.offsets[s + 1]
         pts[a:b] = moved[a:b]
     return guides.with_points(pts)
+
+
+def _alternating(guides, pose, update):
+    """A call that gives ``update`` the rest guides and ``pose`` by turns (each call a move)."""
+    poses, flip = [guides, pose], [0]
+
+    def call():
+        flip[0] ^= 1
+        update(poses[flip[0]])
+
+    return call
 
 
 def _release_rows(guides, binding, repeat: int) -> list[dict]:
@@ -126,34 +138,25 @@ def _release_rows(guides, binding, repeat: int) -> list[dict]:
     clump = ChildClump()
     h = RenderHair(binding, clump).clump_radius
     for case, pose in (("stroke", _stroke(guides)), ("all", _moved(guides))):
-        poses = [guides, pose]
         plain_out = build_points(binding, guides)
         last = [guides.points.copy()]
-        flip = [0]
 
-        def plain():  # the studio's unclumped release: the children of moved guides rebuilt
-            flip[0] ^= 1
-            g = poses[flip[0]]
-            build_points(binding, g, out=plain_out, moved=moved_guides(g, last[0]))
+        def plain(g, out=plain_out, last=last):  # the studio's unclumped release
+            build_points(binding, g, out=out, moved=moved_guides(g, last[0]))
             last[0] = g.points.copy()
 
         rh = RenderHair(binding, clump)
         rh.update_points(guides)
-
-        def clumped():
-            flip[0] ^= 1
-            rh.update_points(poses[flip[0]])
-
         kids = binding.build(pose)
         ws = ClumpWorkspace()
 
-        def whole():
+        def whole(kids=kids, ws=ws):
             ws.invalidate()
             clump_points(kids, h, clump.iterations, None, clump.gap_mode, 0, ws, True)
 
         row = {"case": f"release, {case}", "children": binding.child_count, "vertices": binding.vertex_count}
-        row["release_ms"] = median_ms(plain, repeat)
-        row["clumped_ms"] = median_ms(clumped, repeat)
+        row["release_ms"] = median_ms(_alternating(guides, pose, plain), repeat)
+        row["clumped_ms"] = median_ms(_alternating(guides, pose, rh.update_points), repeat)
         row["ratio"] = row["clumped_ms"] / row["release_ms"]
         row["clumps_run"] = rh.clumps.clumps_run
         row["whole_ms"] = median_ms(whole, max(1, min(repeat, 3)))
