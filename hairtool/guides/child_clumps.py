@@ -25,6 +25,7 @@ between guides, as clumps do around their guides in production render hair.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from numba import njit, prange
 
@@ -291,30 +292,56 @@ def _write(P, vid, out):
             out[vid[i], ax] = P[i, ax]
 
 
+@njit(cache=True, nogil=True)
+def _one_clump(points, offsets, kids, seed, h, iterations, step, gap, raw, out, stats, g):
+    """Clump g's run: its children's rows of ``raw`` (clumped, before the length pass); a clump
+    of one child, which has nothing to clump with, is written as built to ``out`` too.
+    ``stats[g]`` = (within-h pairs, moving vertices, step) of its run."""
+    P, strand, root, vid = _local(points, offsets, kids)
+    stats[g, 0] = 0.0
+    stats[g, 1] = 0.0
+    stats[g, 2] = 0.0
+    if kids.size < 2:
+        _write(P, vid, raw)
+        _write(P, vid, out)
+        return
+    pa, pb = _pairs(P, strand, h * (1.0 + MARGIN))
+    Q, pairs, moving, used = _clump_run(P, root, pa, pb, h, iterations, step, gap, seed)
+    _write(Q, vid, raw)
+    stats[g, 0] = pairs
+    stats[g, 1] = moving
+    stats[g, 2] = used
+
+
 @njit(cache=True, nogil=True, parallel=True)
-def _clumps_kernel(points, offsets, start, children, seeds, redo, h, iterations, step, gap, raw, out, stats):
-    """Every clump with ``redo`` set (all where it is empty): its children's rows of ``raw``
-    (clumped, before the length pass); a clump of one child, which has nothing to clump with,
-    is written as built to ``out`` too. ``stats[g]`` = (within-h pairs, moving vertices, step)
-    of clump g's run."""
-    for g in prange(start.size - 1):
-        if redo.size and not redo[g]:
-            continue
-        kids = children[start[g] : start[g + 1]]
-        P, strand, root, vid = _local(points, offsets, kids)
-        stats[g, 0] = 0.0
-        stats[g, 1] = 0.0
-        stats[g, 2] = 0.0
-        if kids.size < 2:
-            _write(P, vid, raw)
-            _write(P, vid, out)
-            continue
-        pa, pb = _pairs(P, strand, h * (1.0 + MARGIN))
-        Q, pairs, moving, used = _clump_run(P, root, pa, pb, h, iterations, step, gap, seeds[g])
-        _write(Q, vid, raw)
-        stats[g, 0] = pairs
-        stats[g, 1] = moving
-        stats[g, 2] = used
+def _clumps_kernel(
+    points, offsets, start, children, seeds, jobs, job_start, h, iterations, step, gap, raw, out, stats
+):
+    """The clumps ``jobs[job_start[j]:job_start[j + 1]]`` of each job j (one job a thread, see
+    :func:`clump_jobs`), each by :func:`_one_clump`."""
+    for j in prange(job_start.size - 1):
+        for k in range(job_start[j], job_start[j + 1]):
+            g = jobs[k]
+            kids = children[start[g] : start[g + 1]]
+            _one_clump(points, offsets, kids, seeds[g], h, iterations, step, gap, raw, out, stats, g)
+
+
+def clump_jobs(work: np.ndarray, clumps: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``clumps`` dealt into ``n`` jobs of about equal ``work`` (per clump; heaviest first, each to
+    the lightest job so far), as a CSR ``(clump ids, job starts)``. prange hands each thread one
+    block of consecutive iterations: over all clumps, with only a stroke's to redo (neighbours,
+    so next to each other in the guides' order) one thread had nearly all of them. Each clump's
+    bytes are its own whatever job runs it."""
+    clumps = np.asarray(clumps, np.int64)
+    n = max(1, min(int(n), clumps.size))
+    job = np.zeros(clumps.size, np.int64)
+    load = np.zeros(n)
+    for k in np.argsort(-work[clumps], kind="stable"):
+        j = int(np.argmin(load))
+        job[k] = j
+        load[j] += work[clumps[k]] + 64.0  # a clump's fixed cost: its grid and arrays
+    order = np.lexsort((clumps, job))
+    return clumps[order], np.searchsorted(job[order], np.arange(n + 1)).astype(np.int64)
 
 
 class ChildClumps:
@@ -344,6 +371,7 @@ class ChildClumps:
         self.seeds = clump_seeds(check_seed(seed), self.guide_count).astype(np.uint64)
         self.start, self.children = clump_of_children(self.guide_ids, self.guide_count)
         sizes = np.diff(self.start)
+        self._work: np.ndarray | None = None  # per clump: its vertices (its run's cost, about)
         self._clumped_kids = self.children[np.repeat(sizes >= 2, sizes)]  # those the length pass redoes
         self.stats = np.zeros((self.guide_count, 3))  # per clump: within-h pairs, moving vertices, step
         self.raw: np.ndarray | None = None
@@ -367,6 +395,10 @@ class ChildClumps:
         and the next run rewrites (copy it to keep it). ``redo``: per guide, whether its clump is
         run again; the others keep what the last run wrote (None, or a first run: all)."""
         v = topology.vertex_count
+        if self._work is None:
+            total = np.zeros(self.children.size + 1)
+            np.cumsum(topology.counts[self.children], out=total[1:])
+            self._work = total[self.start[1:]] - total[self.start[:-1]]
         if self.out is None or self.out.shape != (v, 3):
             self.out = np.empty((v, 3), np.float32)
             self.raw = np.empty((v, 3), np.float32) if self.keep_lengths else self.out
@@ -382,8 +414,11 @@ class ChildClumps:
         if self.iterations == 0:
             self.out[:] = points
             return self.out
+        todo = np.flatnonzero(flags) if flags.size else np.arange(self.guide_count)
+        todo = todo[np.diff(self.start)[todo] > 0]
+        jobs, job_start = clump_jobs(self._work, todo, numba.get_num_threads())
         _clumps_kernel(
-            points, topology.offsets, self.start, self.children, self.seeds, flags, self.radius,
+            points, topology.offsets, self.start, self.children, self.seeds, jobs, job_start, self.radius,
             self.iterations, -1.0 if self.step is None else float(self.step), _GAP_CODE[self.gap_mode],
             self.raw, self.out, self.stats,
         )  # fmt: skip

@@ -16,6 +16,7 @@ from hairtool.guides.child_clumps import (
     ChildClumps,
     clump_children,
     clump_children_reference,
+    clump_jobs,
     clump_of_children,
     clump_seeds,
 )
@@ -114,3 +115,38 @@ def test_bad_input_gives_one_clear_error(sintel_children):
         clump_children(kids, b.guide_ids, guides.strand_count, h, gap_mode="wet")
     with pytest.raises(ParameterError, match="seed"):
         ChildClumps(b.guide_ids, guides.strand_count, h, seed=-1)
+
+
+def test_clump_jobs_deal_every_clump_once_and_balance_the_work():
+    work = np.random.default_rng(3).uniform(0, 3000, 40)
+    clumps = np.arange(0, 40, 3)
+    jobs, start = clump_jobs(work, clumps, 2)
+    assert sorted(jobs.tolist()) == clumps.tolist() and start[0] == 0 and start[-1] == clumps.size
+    loads = [work[jobs[start[j] : start[j + 1]]].sum() + 64 * (start[j + 1] - start[j]) for j in range(2)]
+    assert abs(loads[0] - loads[1]) <= work[clumps].max() + 64  # greedy: within one clump
+    for j in range(2):
+        assert np.all(np.diff(jobs[start[j] : start[j + 1]]) > 0)  # each job in increasing order
+    one, s1 = clump_jobs(work, np.array([4]), 2)
+    assert one.tolist() == [4] and s1.tolist() == [0, 1]  # never more jobs than clumps
+
+
+def test_the_bytes_are_the_same_at_one_and_two_threads(sintel_children):
+    import numba
+
+    guides, b, kids, h = sintel_children
+    before = numba.get_num_threads()
+    got = []
+    try:
+        for n in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
+            numba.set_num_threads(n)
+            run = ChildClumps(b.guide_ids, guides.strand_count, h, 2)
+            whole = run.run(kids.points, kids.topology).copy()
+            redo = np.zeros(guides.strand_count, bool)
+            redo[::7] = True
+            shifted = kids.points + np.float32(0.01) * kids.topology.vertex_param[:, None]
+            got.append(
+                (whole.tobytes(), run.run(shifted, kids.topology, redo).tobytes(), run.stats.tobytes())
+            )
+    finally:
+        numba.set_num_threads(before)
+    assert got[0] == got[-1]
