@@ -82,6 +82,7 @@ DEFAULT_GHOST_RGBA = (0.55, 0.75, 1.0, 0.35)
 RASTER_ENV = "HAIRTOOL_STRAND_RASTER"
 STRAND_RASTERS = ("auto", "gl", "cpu")
 SOFTWARE_GL = ("llvmpipe", "softpipe", "swrast")
+RESHADE_SHARE = 0.25  # moves that changed more of the vertices than this shade them all again
 KEEP_TOPOLOGIES = 1  # sets of strands kept besides the current one (the studio's drag / release pair)
 
 
@@ -608,6 +609,9 @@ class StrandRenderer:
         gpu = self._gpu
         offsets = self.topology.offsets
         some = self._reshade is not None and self._shade_key is not None and self._shade_key[1:] == key[1:]
+        if some and self._reshade.size:  # a gather and scatter beat shading all only for a few
+            share = (offsets[self._reshade + 1] - offsets[self._reshade]).sum() / max(offsets[-1], 1)
+            some = share <= RESHADE_SHARE
         if some:
             moved = self._reshade
             if moved.size:

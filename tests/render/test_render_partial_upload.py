@@ -54,7 +54,7 @@ def test_changed_strands_and_runs_are_the_plain_definitions():
     moved[g.offsets[25]] = -0.0 * moved[g.offsets[25]]  # a sign bit alone is a change of bytes
     want = [s for s in range(40) if moved[g.offsets[s] : g.offsets[s + 1]].tobytes()
             != g.points[g.offsets[s] : g.offsets[s + 1]].tobytes()]  # fmt: skip
-    assert changed_strands(g.points, moved, g.offsets).tolist() == want
+    assert changed_strands(g.points, moved, g.topology).tolist() == want
     runs = vertex_runs(g.offsets, np.array([3, 4, 17, 39]), gap=1)
     assert runs.tolist() == [[18, 30], [102, 108], [234, 240]]
     assert vertex_runs(g.offsets, np.array([3, 4, 17, 39]), gap=100).tolist() == [[18, 108], [234, 240]]
