@@ -58,7 +58,15 @@ from app.render.overlay import CircleOverlay, OutlineOverlay
 from app.render.ramps import DEFAULT_RAMP, ramp_stops, ramp_texture, sample_linear
 from app.render.raster_layer import RasterLayer
 from app.render.shaders import load_program
-from app.render.strand_gpu import RESTART_INDEX, PointSet, StrandGPU, strand_rows, strip_indices, vertex_runs
+from app.render.strand_gpu import (
+    RESTART_INDEX,
+    PointSet,
+    StrandGPU,
+    changed_strands,
+    strand_rows,
+    strip_indices,
+    vertex_runs,
+)
 from hairtool.bounds import box
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Groom, Topology
@@ -420,6 +428,9 @@ class StrandRenderer:
             raise ParameterError("colors", c.shape, f"shape ({v}, 3) (one RGB per vertex)")
         if not np.all(np.isfinite(c)):
             raise ParameterError("colors", "non-finite", "finite RGB values in [0, 1]")
+        if self.use_vertex_colors and self._base_colors is not None and self._base_colors.shape == c.shape:
+            self._recolour(np.clip(c, 0.0, 1.0))
+            return
         if self._base_store is None or self._base_store.shape != c.shape:
             self._base_store = np.empty_like(c)
         self._base_colors = np.clip(c, 0.0, 1.0, out=self._base_store)
@@ -429,6 +440,23 @@ class StrandRenderer:
         self._version += 1
         self._shade_key = None
         self._reshade = None
+
+    def _recolour(self, c: NDArray[np.float32]) -> None:
+        """New vertex colours over vertex colours (a colour mode that follows the brush, such as
+        displacement): only the strands whose colours changed are uploaded, or shaded again."""
+        moved = changed_strands(self._base_colors, c, self.topology)
+        if moved.size == 0:
+            return
+        runs = vertex_runs(self.topology.offsets, moved)
+        for a, b in runs:
+            self._base_colors[a:b] = c[a:b]
+        if not self.hair_shading:
+            for a, b in runs:
+                self._gpu.colors[a:b] = c[a:b]
+            self._gpu.colors_written(runs)
+        elif self._reshade is not None:
+            self._reshade = np.union1d(self._reshade, moved)
+        self._version += 1
 
     def set_ramp(self, name: str) -> None:
         """Colour ramp used while no vertex colours are set (see :data:`app.render.ramps.RAMPS`)."""

@@ -174,3 +174,37 @@ def test_the_quads_texture_takes_the_moved_rows_only_and_matches_a_fresh_one(gl_
             fresh.release()
     finally:
         r.release()
+
+
+@pytest.mark.parametrize("shaded", [False, True])
+def test_new_vertex_colours_upload_and_shade_only_the_strands_they_change(gl_ctx, written, shaded):
+    """A colour mode that follows the brush (displacement) sends every vertex's colour each move."""
+    g = samples.scalp(strands=500, vertices=10, seed=8)
+    cam = Camera.for_groom(g, aspect=SIZE[0] / SIZE[1])
+    colours = np.random.default_rng(4).uniform(0.0, 1.0, (g.vertex_count, 3)).astype(np.float32)
+    r = StrandRenderer(gl_ctx)
+    try:
+        r.strand_raster = "gl"
+        r.set_hair_shading(shaded)
+        r.set_strands(g.points, g.topology, colours)
+        _frame(r, gl_ctx, cam)
+        buffer = id(r._gpu.color_buffer)
+        written.clear()
+        for few in ([3, 4], [250], [499]):
+            rows, _ = strand_rows(g.offsets, np.array(few))
+            colours = colours.copy()
+            colours[rows] = np.float32(1.3) - colours[rows]  # some go past 1: clipped as before
+            r.set_vertex_colors(colours)
+            got = _frame(r, gl_ctx, cam)
+        assert sum(written[buffer]) <= 3 * 2 * 10 * 12  # the changed strands' rows alone
+        fresh = StrandRenderer(gl_ctx)
+        try:
+            fresh.strand_raster = "gl"
+            fresh.set_hair_shading(shaded)
+            fresh.set_strands(g.points, g.topology, colours)
+            np.testing.assert_array_equal(got, _frame(fresh, gl_ctx, cam))
+            assert r.color_buffer.read() == fresh.color_buffer.read()
+        finally:
+            fresh.release()
+    finally:
+        r.release()
