@@ -232,16 +232,18 @@ class Scene(QObject):
         invert: bool = False,
         check_touch: bool = True,
         start: bool = False,
+        pressure: float = 1.0,
     ) -> bool:
         """One mouse move of the current brush (its mirror too with symmetry on), applied through
         the pipeline in one call; ``direction`` the mouse's motion in the world, ``view`` the
         camera's direction at the cursor, ``invert`` Ctrl held. Returns whether the brush
         reached a strand (its circle held a vertex; False unchecked with ``check_touch`` off).
-        ``start``: the stroke's first move. A move the engine refuses (a delete that would leave
-        no strand) changes nothing and says why (``refused``)."""
+        ``start``: the stroke's first move; ``pressure`` a pen's (1 for a mouse). A move the
+        engine refuses (a delete that would leave no strand) changes nothing and says why
+        (``refused``)."""
         self.start_engine()
         plane = self.mirror_plane_x()
-        samples = self.tool.samples(cursor, direction, view, plane, invert, start)
+        samples = self.tool.samples(cursor, direction, view, plane, invert, start, pressure)
         if samples:
             try:
                 self.apply_samples(samples)
@@ -250,7 +252,7 @@ class Scene(QObject):
                 return False
         else:  # a comb standing still: nothing to apply; the view still follows the cursor
             self.points_changed.emit()
-        return check_touch and self.tool.touches(self.pipeline.aligned.points, cursor, plane)
+        return check_touch and self.tool.touches(self.pipeline.aligned.points, cursor, plane, pressure)
 
     def apply_samples(self, samples: list) -> None:
         """Samples of any brush (a replayed stroke log) in one pipeline call."""
@@ -632,6 +634,16 @@ class Scene(QObject):
             raise ParameterError("spacing", spacing, "a positive distance between roots")
         if float(spacing) != self.tool.spacing:
             self.tool.spacing = float(spacing)
+            self.tool_changed.emit()
+
+    def set_pressure(self, what: str, on: bool) -> None:
+        """A pen's pressure scales the current brush's ``what`` ("radius" or "strength"; each
+        brush has its own toggles, as Blender's pressure buttons)."""
+        toggles = {"radius": self.tool.pressure_radius, "strength": self.tool.pressure_strength}
+        if what not in toggles:
+            raise ParameterError("pressure toggle", what, "radius or strength")
+        if bool(on) != toggles[what].get(self.tool.brush, False):
+            toggles[what][self.tool.brush] = bool(on)
             self.tool_changed.emit()
 
     def set_collide(self, on: bool) -> None:

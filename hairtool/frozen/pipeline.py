@@ -167,6 +167,7 @@ class AlignSample(NamedTuple):
     view: tuple[float, float, float] | None = None
     collide: bool = True  # as BrushSample's
     only_selected: bool = False  # as BrushSample's
+    pressure: float = 1.0  # as BrushSample's (already applied to radius and intensity)
 
 
 Sample = AlignSample | BrushSample | SelectionSample
