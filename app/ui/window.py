@@ -549,7 +549,7 @@ class MainWindow(QMainWindow):
             self.legend.hide()
 
     def _update_counts(self) -> None:
-        g, b = self.scene.result, self.scene.binding
+        g, b = self.scene.result, self.scene.children_binding()
         text = f"{g.strand_count:,} strands · {g.vertex_count:,} vertices"
         if b is not None:
             text = f"{g.strand_count:,} guides · {b.child_count:,} children · {b.vertex_count:,} vertices"
