@@ -21,6 +21,11 @@ does a vertex stay inside, as far out as it got. Every tried point is rounded to
 as the groom stores it, so a vertex found outside stays outside. Roots never move, and every
 segment keeps the length the brush gave it.
 
+Clumping comes after the strokes and pulls strands toward their clumps, which on a curved head
+can cut back through it: :func:`keep_out` (run by the pipeline after ClumpWithGaps wherever its
+strokes collide) lets a strand that was outside before clumping clump only as far as it stays
+outside, its segments at their clumped lengths.
+
 The surface is anything with ``signed_distance(points) -> (distances, closest points,
 normals)`` (:class:`CollisionSurface`), e.g. :class:`hairtool.guides.surface.MeshSurface`.
 The loop runs along the strands' vertex indices with all the strands being solved at once
@@ -105,6 +110,106 @@ def escape(
         hi = np.where((fine & ~inside)[:, None], mid, hi)
         lo = np.where((fine & inside)[:, None], mid, lo)
     return _f32(prev + length[:, None] * hi)
+
+
+BLEND_STEPS = 8  # bisection steps of how far a strand may clump before it enters the head
+
+
+def _with_lengths(x: np.ndarray, like: np.ndarray, n: int) -> np.ndarray:
+    """``(S, n, 3)`` strands ``x`` with each segment back to its length in ``like``, directions
+    kept, root to tip."""
+    seg = np.linalg.norm(np.diff(like, axis=1), axis=2)
+    out = x.copy()
+    for i in range(1, n):
+        d = x[:, i] - x[:, i - 1]
+        norm = np.sqrt(np.einsum("ij,ij->i", d, d))
+        fallback = like[:, i] - like[:, i - 1]
+        d = np.where((norm > EPS)[:, None], d, fallback)
+        norm = np.where(norm > EPS, norm, np.maximum(seg[:, i - 1], EPS))
+        out[:, i] = out[:, i - 1] + d * (seg[:, i - 1] / norm)[:, None]
+    return out
+
+
+def _any_inside(surface: CollisionSurface, x: np.ndarray) -> np.ndarray:
+    """``(S,)`` whether a point of each strand ``x`` ``(S, n, 3)`` but its root is inside."""
+    d = surface.signed_distance(x.reshape(-1, 3))[0].reshape(x.shape[:2])
+    return (d[:, 1:] < 0).any(axis=1)
+
+
+def keep_out(
+    before: Groom,
+    after: Groom,
+    surface: CollisionSurface,
+    margin: float,
+    sd_before: np.ndarray | None = None,
+    sd_after: np.ndarray | None = None,
+) -> Groom:
+    """``after`` (the clumped ``before``, same strands) where clumping pulled a strand into the
+    head: a strand wholly outside in ``before`` (roots aside) and not in ``after`` clumps only as
+    far as it stays outside, the largest share t of its clumping move (``before`` + t·(``after`` −
+    ``before``), t found by bisection over the strands at once, each tried shape rounded to
+    float32 first) with its segments back at their clumped lengths; where that put it inside
+    again, it keeps its shape from before clumping. On a curved head a clump's pull can cut
+    through it. A strand already inside before (a stroke with collision off put it there) is
+    left as it is. ``margin`` is unused (kept for :func:`collide`'s signature).
+    ``sd_before`` / ``sd_after``: the points' signed distances where known (:class:`KeepOut`)."""
+    del margin
+    top = before.topology
+    if before.vertex_count == 0:
+        return after
+    if sd_before is None:
+        sd_before = surface.signed_distance(before.points.astype(np.float64))[0]
+    if sd_after is None:
+        sd_after = surface.signed_distance(after.points.astype(np.float64))[0]
+    deep = top.index_in_strand > 0
+    starts = top.offsets[:-1]
+    was_in = np.logical_or.reduceat((sd_before < 0) & deep, starts)
+    now_in = np.logical_or.reduceat((sd_after < 0) & deep, starts)
+    fix = np.flatnonzero(now_in & ~was_in)
+    if fix.size == 0:
+        return after
+    out = after.points.copy()
+    for n in np.unique(top.counts[fix]):  # strands of one vertex count at a time, as arrays
+        ids = fix[top.counts[fix] == n]
+        vids = vertex_ids_of(top, ids)
+        b = before.points[vids].astype(np.float64).reshape(len(ids), n, 3)
+        a = after.points[vids].astype(np.float64).reshape(len(ids), n, 3)
+        lo, hi = np.zeros(len(ids)), np.ones(len(ids))  # outside at lo, inside at hi
+        for _ in range(BLEND_STEPS):
+            mid = 0.5 * (lo + hi)
+            hit = _any_inside(surface, _f32(b + mid[:, None, None] * (a - b)))
+            hi, lo = np.where(hit, mid, hi), np.where(hit, lo, mid)
+        x = _f32(_with_lengths(b + lo[:, None, None] * (a - b), a, n))
+        x = np.where(_any_inside(surface, x)[:, None, None], b, x)  # (before clumping it was outside)
+        out[vids] = x.reshape(-1, 3).astype(np.float32)
+    return after.with_points(out)
+
+
+class KeepOut:
+    """:func:`keep_out` with a memory: the signed distances of the points it saw at its last
+    call are reused for those that did not change (a brush moves a few strands per update and
+    clumping redoes only the region around them), so an update queries the head for those
+    alone. The same bytes as :func:`keep_out` without it."""
+
+    def __init__(self) -> None:
+        self._last: dict[str, tuple] = {}
+
+    def _distances(self, key: str, points: np.ndarray, surface: CollisionSurface) -> np.ndarray:
+        last = self._last.get(key)
+        if last is None or last[0] is not surface or last[1].shape != points.shape:
+            sd = surface.signed_distance(points.astype(np.float64))[0]
+        else:
+            changed = np.any(points != last[1], axis=1)
+            sd = last[2].copy()
+            if changed.any():
+                sd[changed] = surface.signed_distance(points[changed].astype(np.float64))[0]
+        self._last[key] = (surface, points.copy(), sd)
+        return sd
+
+    def __call__(self, before: Groom, after: Groom, surface: CollisionSurface, margin: float) -> Groom:
+        sd_before = self._distances("before", before.points, surface)
+        sd_after = self._distances("after", after.points, surface)
+        return keep_out(before, after, surface, margin, sd_before, sd_after)
 
 
 def collide(before: Groom, after: Groom, surface: CollisionSurface, margin: float) -> Groom:
