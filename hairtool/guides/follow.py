@@ -14,9 +14,10 @@ pipeline records, for each strand it now has, the rest strand it comes from (its
   the guide roots, on the head's tangent plane there and moved onto the head when there is one)
   and bound to their k nearest guides by root distance; they are the plain blend of their guides
   (no offsets, length scale 1, a dense groom's exact points none), so they depend on nothing
-  but the guides' roots and shapes, and their vertex count and own attributes (a dense groom's)
-  are those of the nearest child kept. The draws come from the seed and the planted root's
-  bytes, so the same strokes give the same children.
+  but the guides' roots and shapes; their vertex count is the children's (where children differ
+  in it, or carry their own attributes as a dense groom's do: those of the nearest child kept).
+  The draws come from the seed and the planted root's bytes, so the same strokes give the same
+  children.
 
 The rest guides of the result are the kept guides' rest strands and the planted guides' shapes
 as given (they have no rest: their root frames serve only their own children, which carry no
@@ -135,23 +136,22 @@ def follow_guides(
         at = guides.roots[planted].astype(np.float64)
         # the disc's plane: the head's tangent plane, or without a head across the first segment
         normals = guides.points[guides.offsets[planted] + 1].astype(np.float64) - at
-        new_roots = []
-        for p, n in zip(at, normals, strict=True):
-            if surface is not None:
-                n = surface.project(p[None])[1][0]
-            q = planted_roots(p, n, per, radius, seed)
-            new_roots.append(q if surface is None else surface.project(q)[0])
-        new_roots = np.concatenate(new_roots)
+        if surface is not None:  # (one query of the head for all of them: each costs a kernel launch)
+            normals = surface.project(at)[1]
+        new_roots = np.concatenate(
+            [planted_roots(p, n, per, radius, seed) for p, n in zip(at, normals, strict=True)]
+        )
+        if surface is not None:
+            new_roots = surface.project(new_roots)[0]
         k = min(binding.guides_per_child, guides.strand_count)
         new_ids, new_w = weights(*euclidean_nearest(guides.roots.astype(np.float64), new_roots, k), k)
         if k < binding.guides_per_child:  # fewer guides than a child follows: the nearest, weight 0
             pad = binding.guides_per_child - k
             new_ids = np.hstack([new_ids, np.repeat(new_ids[:, :1], pad, axis=1)])
             new_w = np.hstack([new_w, np.zeros((len(new_w), pad))])
-        if len(stay):  # vertex count and own attributes from the nearest child kept
+        like = None  # the nearest child kept, where children differ in vertex count or attributes
+        if len(stay) and (len(binding.vertex_counts) > 1 or own is not None):
             like = euclidean_nearest(roots, new_roots, 1)[0][:, 0]
-        else:
-            like = None
         n_new = binding.counts[:1].repeat(len(new_roots)) if like is None else counts[like]
         ids = np.vstack([ids, new_ids])
         w = np.vstack([w, new_w])
