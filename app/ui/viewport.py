@@ -115,6 +115,7 @@ class Viewport(QOpenGLWidget):
         self._box: list[QPointF] | None = None  # its corners while it drags
         self._box_mode = "add"
         self.pressure = 1.0  # the pen's at the last event (a mouse's: 1), for the brush
+        self._pen_down = False  # a pen touches: the mouse events a platform makes of it are dropped
         self.sizing = CanvasSizing(self)  # F / Shift+F: the brush sized on the canvas
         scene.groom_loaded.connect(self.sizing.cancel)
         self.setMouseTracking(True)
@@ -457,10 +458,21 @@ class Viewport(QOpenGLWidget):
         if handler is None:
             super().tabletEvent(event)
             return
+        self._pen_down = event.type() != QEvent.Type.TabletRelease
         handler(event)
         event.accept()
 
+    def _from_pen(self, event) -> bool:
+        """A mouse event while a pen touches (X11 also sends the pen as the core pointer): the
+        pen's own events drive the brush, with their pressure, so this one is dropped."""
+        if self._pen_down and not isinstance(event, QTabletEvent):
+            event.accept()
+            return True
+        return False
+
     def mousePressEvent(self, event: QMouseEvent) -> None:
+        if self._from_pen(event):
+            return
         self.pressure = pen_pressure(event)
         if self.sizing.active:
             self.sizing.mouse_press(event)
@@ -515,6 +527,8 @@ class Viewport(QOpenGLWidget):
         event.accept()
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        if self._from_pen(event):
+            return
         pos = event.position()
         self._hover = pos
         self.pressure = pen_pressure(event)
@@ -585,6 +599,8 @@ class Viewport(QOpenGLWidget):
         self.stroke_touched = self.stroke_touched or touched
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        if self._from_pen(event):
+            return
         if self._drag is None or event.button() != self._drag_button:
             return
         drag, self._drag = self._drag, None
@@ -618,6 +634,8 @@ class Viewport(QOpenGLWidget):
         self.scene.set_radius(self.scene.radius * factor)
 
     def leaveEvent(self, event) -> None:
+        if self._drag is None:
+            self._pen_down = False  # (a pen lifted where its release never reached the view)
         self._hover = None
         self.cursor_moved.emit(None)
         self.update()

@@ -82,6 +82,7 @@ def test_a_pens_pressure_scales_radius_and_strength_where_the_toggles_say(ui, ma
     pressures = (0.5, 0.25, 1.0)
     for k, p in enumerate(pressures):
         send_tablet(v, "move", pos + np.array([10.0 * (k + 1), 0.0]), p)
+        ui.send_mouse(v, "move", pos + np.array([10.0 * k + 5.0, 0.0]), None, LEFT)  # (X11's copy: dropped)
     send_tablet(v, "release", pos + np.array([30.0, 0.0]), 0.0)
     log = s.pipeline.strokes
     assert [x.pressure for x in log] == list(pressures)  # (the press has no direction: no sample)
