@@ -104,3 +104,17 @@ def test_freeze_with_render_hair_replays_add_and_delete_strokes(sintel, tmp_path
     f = followed(pipe, bind_scalp(groom, mesh, 3000, seed=1))
     assert hair.strand_count == f.child_count
     np.testing.assert_array_equal(hair.points, f.build(pipe.result).points)
+
+
+def test_density_with_render_hair_thins_and_plants_guides_and_their_children_follow(sintel):
+    groom, _, surface, b = sintel
+    pipe = FrozenPipeline(groom, PLAIN, surface)
+    pipe.brush(sample("density", groom.roots[100], 4.0, spacing=2.5, seed=1))
+    origin = pipe.origin
+    gone = np.setdiff1d(np.arange(groom.strand_count), origin)
+    planted = int((origin < 0).sum())
+    assert gone.size and planted
+    f = followed(pipe, b)
+    per = round(b.child_count / groom.strand_count)
+    assert f.child_count == b.child_count - int(np.isin(b.guide_ids[:, 0], gone).sum()) + planted * per
+    assert np.all(np.isfinite(f.build(pipe.result).points))
