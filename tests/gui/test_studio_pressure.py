@@ -139,6 +139,18 @@ def action_named(w, text: str):
     return next(a for a in w.findChildren(type(w.brush_actions["comb"])) if a.text() == text)
 
 
+def record_calls(obj, name: str) -> list:
+    """Every call of ``obj.name`` from now on, as (args, kwargs); the method still runs."""
+    calls, method = [], getattr(obj, name)
+
+    def spy(*args, **kwargs):
+        calls.append((args, kwargs))
+        return method(*args, **kwargs)
+
+    setattr(obj, name, spy)
+    return calls
+
+
 def hover(ui, v, pos) -> None:
     ui.send_mouse(v, "move", pos)
 
@@ -161,6 +173,13 @@ def test_f_sizes_the_brush_on_the_canvas_click_keeps_esc_cancels(ui, make_window
     assert s.radius == pytest.approx(2.0 * r0)
     assert w.dock.radius.value() == pytest.approx(2.0 * r0, rel=1e-3)
     assert f"{s.radius:.4g}" in w.statusBar().currentMessage()
+    ui.grab(v)  # paints once the renderer exists
+    drawn = record_calls(v.renderer, "set_overlay_circle")
+    v.update()
+    ui.grab(v)  # the circle, round the sizing's centre, at the new size
+    (c, r, _), _ = drawn[-1]
+    np.testing.assert_allclose(c, centre * v.devicePixelRatioF())
+    assert r == pytest.approx(2.0 * r0 * ppu * v.devicePixelRatioF())
     ui.send_mouse(v, "press", centre + np.array([0.0, 2.0 * r0 * ppu]), LEFT, LEFT)
     ui.send_mouse(v, "release", centre + np.array([0.0, 2.0 * r0 * ppu]), LEFT, None)
     assert not v.sizing.active and s.radius == pytest.approx(2.0 * r0)
