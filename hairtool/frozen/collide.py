@@ -112,7 +112,10 @@ def escape(
     return _f32(prev + length[:, None] * hi)
 
 
-BLEND_STEPS = 8  # bisection steps of how far a strand may clump before it enters the head
+#: How far a strand may clump before it enters the head is searched on a grid of SPLIT shares
+#: of its clumping move, then of the best cell, ROUNDS times (a share within 1/64): all the
+#: shares of a round go to the head in one query, each query being a kernel launch.
+SPLIT, ROUNDS = 8, 2
 
 
 def _with_lengths(x: np.ndarray, like: np.ndarray, n: int) -> np.ndarray:
@@ -147,12 +150,13 @@ def keep_out(
     """``after`` (the clumped ``before``, same strands) where clumping pulled a strand into the
     head: a strand wholly outside in ``before`` (roots aside) and not in ``after`` clumps only as
     far as it stays outside, the largest share t of its clumping move (``before`` + t·(``after`` −
-    ``before``), t found by bisection over the strands at once, each tried shape rounded to
-    float32 first) with its segments back at their clumped lengths; where that put it inside
-    again, it keeps its shape from before clumping. On a curved head a clump's pull can cut
-    through it. A strand already inside before (a stroke with collision off put it there) is
-    left as it is. ``margin`` is unused (kept for :func:`collide`'s signature).
-    ``sd_before`` / ``sd_after``: the points' signed distances where known (:class:`KeepOut`)."""
+    ``before``), t the largest outside on a grid of :data:`SPLIT` shares refined :data:`ROUNDS`
+    times, over the strands at once, each tried shape rounded to float32 first) with its
+    segments back at their clumped lengths; where that put it inside again, it keeps its shape
+    from before clumping. On a curved head a clump's pull can cut through it. A strand already
+    inside before (a stroke with collision off put it there) is left as it is. ``margin`` is
+    unused (kept for :func:`collide`'s signature). ``sd_before`` / ``sd_after``: the points'
+    signed distances where known (:class:`KeepOut`)."""
     del margin
     top = before.topology
     if before.vertex_count == 0:
@@ -174,11 +178,23 @@ def keep_out(
         vids = vertex_ids_of(top, ids)
         b = before.points[vids].astype(np.float64).reshape(len(ids), n, 3)
         a = after.points[vids].astype(np.float64).reshape(len(ids), n, 3)
-        lo, hi = np.zeros(len(ids)), np.ones(len(ids))  # outside at lo, inside at hi
-        for _ in range(BLEND_STEPS):
-            mid = 0.5 * (lo + hi)
-            hit = _any_inside(surface, _f32(b + mid[:, None, None] * (a - b)))
-            hi, lo = np.where(hit, mid, hi), np.where(hit, lo, mid)
+        # The signed distance changes no faster than a point moves: a vertex farther out before
+        # clumping than its whole clumping move stays outside at every share (the tolerance
+        # covers float32 rounding), so only the others are asked about.
+        tol = 1e-4 * (1.0 + float(np.abs(b).max()))
+        near = sd_before[vids].reshape(len(ids), n) <= np.linalg.norm(a - b, axis=2) + tol
+        near[:, 0] = False  # (roots never count)
+        lo, step = np.zeros(len(ids)), 1.0  # outside at lo (before clumping: it was outside)
+        for _ in range(ROUNDS):
+            step /= SPLIT
+            t = lo[:, None] + step * np.arange(1, SPLIT)[None, :]  # (S, SPLIT − 1) shares to try
+            ask = np.broadcast_to(near[:, None, :], (*t.shape, n))
+            x = _f32(b[:, None] + t[..., None, None] * (a - b)[:, None])
+            d = np.full(ask.shape, np.inf)
+            d[ask] = surface.signed_distance(x[ask])[0] if ask.any() else 0.0
+            clear = ~(d < 0).any(axis=2)
+            last = np.where(clear.any(axis=1), SPLIT - 2 - np.argmax(clear[:, ::-1], axis=1), -1)
+            lo = np.where(last >= 0, t[np.arange(len(ids)), np.maximum(last, 0)], lo)  # the largest outside
         x = _f32(_with_lengths(b + lo[:, None, None] * (a - b), a, n))
         x = np.where(_any_inside(surface, x)[:, None, None], b, x)  # (before clumping it was outside)
         out[vids] = x.reshape(-1, 3).astype(np.float32)
@@ -188,28 +204,29 @@ def keep_out(
 class KeepOut:
     """:func:`keep_out` with a memory: the signed distances of the points it saw at its last
     call are reused for those that did not change (a brush moves a few strands per update and
-    clumping redoes only the region around them), so an update queries the head for those
-    alone. The same bytes as :func:`keep_out` without it."""
+    clumping redoes only the region around them), so an update asks the head about those alone,
+    before and after clumping in one query. The same bytes as :func:`keep_out` without it."""
 
     def __init__(self) -> None:
         self._last: dict[str, tuple] = {}
 
-    def _distances(self, key: str, points: np.ndarray, surface: CollisionSurface) -> np.ndarray:
-        last = self._last.get(key)
-        if last is None or last[0] is not surface or last[1].shape != points.shape:
-            sd = surface.signed_distance(points.astype(np.float64))[0]
-        else:
-            changed = np.any(points != last[1], axis=1)
-            sd = last[2].copy()
-            if changed.any():
-                sd[changed] = surface.signed_distance(points[changed].astype(np.float64))[0]
-        self._last[key] = (surface, points.copy(), sd)
-        return sd
-
     def __call__(self, before: Groom, after: Groom, surface: CollisionSurface, margin: float) -> Groom:
-        sd_before = self._distances("before", before.points, surface)
-        sd_after = self._distances("after", after.points, surface)
-        return keep_out(before, after, surface, margin, sd_before, sd_after)
+        parts = []  # per groom: its points, which changed since last time, the distances known
+        for key, points in (("before", before.points), ("after", after.points)):
+            last = self._last.get(key)
+            if last is None or last[0] is not surface or last[1].shape != points.shape:
+                parts.append((key, points, np.ones(len(points), bool), np.empty(len(points))))
+            else:
+                parts.append((key, points, np.any(points != last[1], axis=1), last[2].copy()))
+        ask = np.concatenate([p[changed] for _, p, changed, _ in parts]).astype(np.float64)
+        found = surface.signed_distance(ask)[0] if len(ask) else np.zeros(0)
+        at = 0
+        for key, points, changed, sd in parts:
+            k = int(changed.sum())
+            sd[changed] = found[at : at + k]
+            at += k
+            self._last[key] = (surface, points.copy(), sd)
+        return keep_out(before, after, surface, margin, parts[0][3], parts[1][3])
 
 
 def collide(before: Groom, after: Groom, surface: CollisionSurface, margin: float) -> Groom:
