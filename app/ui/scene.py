@@ -261,9 +261,8 @@ class Scene(QObject):
 
     def stroke_refusal(self) -> str | None:
         """Why a stroke of the current brush cannot start now (None: it can): slide needs the
-        head mesh; brushes that add or remove strands wait while render hair or an animation
-        holds the strands (render hair follows the guides planted and removed: see
-        :meth:`children_binding`)."""
+        head mesh; brushes that add or remove strands wait while an animation holds the strands
+        (render hair follows the guides they plant and remove: see :meth:`children_binding`)."""
         label = LABELS.get(self.tool.brush, self.tool.brush)
         if self.tool.brush in NEED_SURFACE and (self.pipeline is None or self.pipeline.surface is None):
             return f"{label} works on the head's surface: load its mesh first (File → Load head mesh…)"

@@ -241,3 +241,19 @@ def test_the_period_key_frames_all(ui, make_window, qtbot):
     w = plain(make_window)
     action = action_named(w, "&Frame all")
     assert [k.toString() for k in action.shortcuts()] == ["."]
+
+
+def test_a_project_keeps_each_brushs_pen_toggles(make_window, tmp_path):
+    w = plain(make_window)
+    w.brush_actions["smooth"].trigger()
+    w.dock.pressure_radius.setChecked(True)
+    w.dock.pressure_strength.setChecked(False)
+    path = tmp_path / "pen.hairproj"
+    assert w.project.save_to(path)
+    w2 = plain(make_window)
+    assert w2.project.open_project(path), w2.errors
+    tool = w2.scene.tool
+    assert tool.pressure_radius["smooth"] and not tool.pressure_strength["smooth"]
+    assert not tool.pressure_radius["comb"] and tool.pressure_strength["comb"]
+    w2.brush_actions["smooth"].trigger()
+    assert w2.dock.pressure_radius.isChecked() and not w2.dock.pressure_strength.isChecked()
