@@ -491,6 +491,9 @@ def _write_strokes(log, arrays: dict) -> dict:
         only = [getattr(s, "only_selected", False) for s in log]
         arrays["strokes/only_selected.npy"] = np.array(only, np.int64)
         info["only_selected"] = True
+    if any(getattr(s, "pressure", 1.0) != 1.0 for s in log):  # a pen's pressure (already applied)
+        arrays["strokes/pressure.npy"] = np.array([getattr(s, "pressure", 1.0) for s in log], np.float64)
+        info["pressure"] = True
     if selections:  # selection steps (version 3): their op, and a box's camera and rectangle
         info["selection"] = list(OPS)
         arrays["strokes/selection.npy"] = np.array(
@@ -569,6 +572,11 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
         only = r.array("strokes/only_selected.npy", 1, "iu")
         if only.shape != (n,):
             raise FormatError(r.path, f"the stroke selection flags do not hold {n} strokes")
+    pressure = np.ones(n)
+    if info.get("pressure"):
+        pressure = r.array("strokes/pressure.npy", 1, "f")
+        if pressure.shape != (n,) or not np.all((pressure >= 0.0) & (pressure <= 1.0)):
+            raise FormatError(r.path, f"the stroke pressures are not {n} numbers in [0, 1]")
     select_op, box = np.full(n, -1, np.int64), np.zeros((n, 21))
     if "selection" in info:
         ops = info["selection"]
@@ -594,12 +602,12 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
             mode_k = str(modes[mode[k]])
             hit = bool(collides[k])
             r_k, i_k = float(radius[k]), float(intensity[k])
-            strokes.append(AlignSample(c, r_k, i_k, mode_k, v, hit, bool(only[k])))
+            strokes.append(AlignSample(c, r_k, i_k, mode_k, v, hit, bool(only[k]), float(pressure[k])))
             continue
         sample = BrushSample(
             names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
             float(intensity[k]), tuple(luts[which[k]].tolist()), views[k], bool(starts[k]), bool(collides[k]),
-            int(counts[k]), int(seeds[k]), float(spacings[k]), bool(only[k]),
+            int(counts[k]), int(seeds[k]), float(spacings[k]), bool(only[k]), float(pressure[k]),
         )
         try:
             strokes.append(check_sample(sample))

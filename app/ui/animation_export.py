@@ -399,7 +399,7 @@ class AnimationExporter(QObject):
         """The children an animation can be written as: the groom's, when the animation is of
         its guides (simulations, cycles and recordings are; an opened file may not be)."""
         anim = self.window.animation.animation if animation is None else animation
-        binding = self.window.scene.binding
+        binding = self.window.scene.children_binding()  # (of the guides as they are now)
         if anim is None or binding is None or anim.topology != binding.rest_guides.topology:
             return None
         return binding

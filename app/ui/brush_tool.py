@@ -89,6 +89,11 @@ DEFAULT_STRENGTH = {
     "density": 1.0,
     "select": 1.0,
 }
+#: Brushes whose strength is only a direction (paint or erase, on or off): a pen's pressure
+#: never scales it (a light touch would otherwise erase, or do nothing).
+STRENGTHLESS = ("mask", "select", "delete", "add", "density")
+#: The smallest share of its radius a brush keeps under the lightest touch (a radius is never 0).
+MIN_PRESSURE_RADIUS = 0.05
 FALLOFF_LABELS = {"smooth": "Smooth", "linear": "Linear", "constant": "Constant"}
 
 Falloff = str | tuple[tuple[float, float], ...]
@@ -125,6 +130,12 @@ class BrushTool:
     spacing: float = 0.05  # between roots, the density brush's (groom units)
     align_mode: str = "paper"
     only_selected: bool = True  # brushes keep to the selected strands (Blender's selection toggle)
+    #: per brush: a pen's pressure scales the radius / the strength (Blender's pressure buttons;
+    #: strength on by default as in Blender's sculpt brushes, radius off)
+    pressure_radius: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(brushes(), False))
+    pressure_strength: dict[str, bool] = field(
+        default_factory=lambda: {b: b not in STRENGTHLESS for b in brushes()}
+    )
     _lut: tuple[Falloff, tuple[float, ...]] | None = field(default=None, repr=False)
 
     def reset_radius(self, radius: float) -> None:
@@ -143,9 +154,24 @@ class BrushTool:
             self._lut = (self.falloff, tuple(falloff_lut(self.falloff).tolist()))
         return self._lut[1]
 
-    def signed_strength(self, invert: bool = False) -> float:
-        """The current brush's strength, negative for shrink / erase (``invert``: Ctrl held)."""
+    def radius_at(self, pressure: float = 1.0) -> float:
+        """The current brush's radius under a pen's ``pressure`` (the radius itself with the
+        brush's radius toggle off, or at full pressure)."""
+        r = self.radius[self.brush]
+        if not self.pressure_radius.get(self.brush, False):
+            return r
+        return r * max(float(pressure), MIN_PRESSURE_RADIUS)
+
+    def strength_at(self, pressure: float = 1.0) -> float:
+        """The current brush's strength (unsigned) under a pen's ``pressure``."""
         s = self.strength[self.brush]
+        if self.brush in STRENGTHLESS or not self.pressure_strength.get(self.brush, False):
+            return s
+        return s * float(pressure)
+
+    def signed_strength(self, invert: bool = False, pressure: float = 1.0) -> float:
+        """The current brush's strength, negative for shrink / erase (``invert``: Ctrl held)."""
+        s = self.strength_at(pressure)
         if self.brush in SIGNED and self.subtract.get(self.brush, False) != bool(invert):
             return -s
         return s
@@ -158,19 +184,23 @@ class BrushTool:
         plane_x: float,
         invert: bool = False,
         start: bool = False,
+        pressure: float = 1.0,
     ) -> list[AlignSample | BrushSample]:
         """The samples of one mouse move at ``cursor`` (groom units), mirrored one right after it
         with symmetry on. ``direction``: the mouse's motion in the world (comb needs one: none
         while it stands still). ``view``: the camera's direction, given to the engine with
-        "front faces only". ``start``: the stroke's first move (a snake hook hooks there)."""
+        "front faces only". ``start``: the stroke's first move (a snake hook hooks there).
+        ``pressure``: a pen's, in [0, 1] (1 for a mouse), scaling the radius and the strength as
+        the brush's toggles say; the samples carry it for the stroke log."""
+        p = min(max(float(pressure), 0.0), 1.0)
         c = tuple(float(x) for x in cursor)
         d = tuple(float(x) for x in direction)
         v = None if view is None or not self.front_only else tuple(float(x) for x in view)
-        r, name = self.radius[self.brush], self.brush
+        r, name = self.radius_at(p), self.brush
         hit = self.collide.get(name, True)
         only = self.only_selected and name != "select"
         if name == "align":
-            first = AlignSample(c, r, self.strength["align"], self.align_mode, v, hit, only)
+            first = AlignSample(c, r, self.strength_at(p), self.align_mode, v, hit, only, p)
             if not self.symmetry:
                 return [first]
             return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
@@ -179,13 +209,16 @@ class BrushTool:
         hook = start and name == "snake_hook"
         count = self.add_count if name == "add" else 1
         spacing = self.spacing if name == "density" else 0.0
-        strength = self.signed_strength(invert)
-        first = BrushSample(name, c, d, r, strength, self.lut(), v, hook, hit, count, 0, spacing, only)
+        strength = self.signed_strength(invert, p)
+        first = BrushSample(name, c, d, r, strength, self.lut(), v, hook, hit, count, 0, spacing, only, p)
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
-    def touches(self, points: np.ndarray, cursor: Sequence[float], plane_x: float) -> bool:
-        """Whether a move at ``cursor`` (and its mirror) reaches any of ``points`` ``(V, 3)``."""
-        r = self.radius[self.brush]
+    def touches(
+        self, points: np.ndarray, cursor: Sequence[float], plane_x: float, pressure: float = 1.0
+    ) -> bool:
+        """Whether a move at ``cursor`` (and its mirror) reaches any of ``points`` ``(V, 3)``
+        (at the radius a pen's ``pressure`` gives)."""
+        r = self.radius_at(pressure)
         centres = [np.asarray(cursor, np.float64)]
         if self.symmetry:
             centres.append(np.array([2.0 * plane_x - centres[0][0], centres[0][1], centres[0][2]]))

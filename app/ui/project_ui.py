@@ -348,8 +348,9 @@ class ProjectController(QObject):
 def _brush_settings(tool) -> dict:
     """The brush as a project keeps it: the current brush's radius, strength and mode (what
     older projects hold), and every brush's own, the falloff, symmetry, front faces only and
-    each brush's collision with the head, add's strands per move, density's spacing and
-    whether brushes keep to the selection."""
+    each brush's collision with the head and pen toggles (pressure scales its radius, its
+    strength), add's strands per move, density's spacing and whether brushes keep to the
+    selection."""
     falloff = tool.falloff if isinstance(tool.falloff, str) else [list(p) for p in tool.falloff]
     return {
         "radius": tool.radius[tool.brush],
@@ -367,6 +368,8 @@ def _brush_settings(tool) -> dict:
         "add_count": tool.add_count,
         "spacing": tool.spacing,
         "only_selected": tool.only_selected,
+        "pressure_radius": dict(tool.pressure_radius),
+        "pressure_strength": dict(tool.pressure_strength),
     }
 
 
@@ -385,6 +388,10 @@ def _brush_setters(scene, brush: dict) -> tuple:
                 scene.set_intensity(float(brush["strengths"][name]))
         scene.set_brush(str(current))
 
+    def pens(key: str) -> None:  # each brush's pen toggles (the dock shows the current one's)
+        getattr(scene.tool, key).update({k: bool(v) for k, v in brush[key].items() if k in names})
+        scene.tool_changed.emit()
+
     return (
         per_brush,
         lambda: [scene.set_subtract(k, bool(v)) for k, v in brush["subtract"].items()],
@@ -396,6 +403,8 @@ def _brush_setters(scene, brush: dict) -> tuple:
         lambda: scene.set_add_count(int(brush["add_count"])),
         lambda: scene.set_spacing(float(brush["spacing"])),
         lambda: scene.set_only_selected(bool(brush["only_selected"])),
+        lambda: pens("pressure_radius"),
+        lambda: pens("pressure_strength"),
     )
 
 

@@ -45,8 +45,8 @@ class RenderHairBox(QGroupBox):
 
     def refresh(self) -> None:
         s = self.scene
-        b = s.binding
-        grown = None if b is None else f"{b.child_count:,} from {s.rest.strand_count:,} guides"
+        b = s.children_binding()
+        grown = None if b is None else f"{b.child_count:,} from {s.result.strand_count:,} guides"
         self.children_label.setText(grown or "none: Groom ▸ Grow render hair…")
         for w in (self.show_guides, self.clump_children, self.drag_percent, self.release_percent):
             w.setEnabled(b is not None)

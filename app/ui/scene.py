@@ -72,6 +72,7 @@ class Scene(QObject):
         # paper's printed ClumpWithGaps, which stretches them).
         self._params = params if params is not None else FrozenParams(keep_lengths=True)
         self.binding: ChildBinding | None = None  # render hair interpolated from the groom (the guides)
+        self._followed: tuple | None = None  # (key, binding): the children of the guides planted / removed
         self.show_guides = True
         self.clump_children = False  # ClumpWithGaps among the children once the mouse is released
         self.drag_percent = DRAG_PERCENT
@@ -232,16 +233,18 @@ class Scene(QObject):
         invert: bool = False,
         check_touch: bool = True,
         start: bool = False,
+        pressure: float = 1.0,
     ) -> bool:
         """One mouse move of the current brush (its mirror too with symmetry on), applied through
         the pipeline in one call; ``direction`` the mouse's motion in the world, ``view`` the
         camera's direction at the cursor, ``invert`` Ctrl held. Returns whether the brush
         reached a strand (its circle held a vertex; False unchecked with ``check_touch`` off).
-        ``start``: the stroke's first move. A move the engine refuses (a delete that would leave
-        no strand) changes nothing and says why (``refused``)."""
+        ``start``: the stroke's first move; ``pressure`` a pen's (1 for a mouse). A move the
+        engine refuses (a delete that would leave no strand) changes nothing and says why
+        (``refused``)."""
         self.start_engine()
         plane = self.mirror_plane_x()
-        samples = self.tool.samples(cursor, direction, view, plane, invert, start)
+        samples = self.tool.samples(cursor, direction, view, plane, invert, start, pressure)
         if samples:
             try:
                 self.apply_samples(samples)
@@ -250,7 +253,7 @@ class Scene(QObject):
                 return False
         else:  # a comb standing still: nothing to apply; the view still follows the cursor
             self.points_changed.emit()
-        return check_touch and self.tool.touches(self.pipeline.aligned.points, cursor, plane)
+        return check_touch and self.tool.touches(self.pipeline.aligned.points, cursor, plane, pressure)
 
     def apply_samples(self, samples: list) -> None:
         """Samples of any brush (a replayed stroke log) in one pipeline call."""
@@ -258,8 +261,8 @@ class Scene(QObject):
 
     def stroke_refusal(self) -> str | None:
         """Why a stroke of the current brush cannot start now (None: it can): slide needs the
-        head mesh; brushes that add or remove strands wait while render hair or an animation
-        holds the strands."""
+        head mesh; brushes that add or remove strands wait while an animation holds the strands
+        (render hair follows the guides they plant and remove: see :meth:`children_binding`)."""
         label = LABELS.get(self.tool.brush, self.tool.brush)
         if self.tool.brush in NEED_SURFACE and (self.pipeline is None or self.pipeline.surface is None):
             return f"{label} works on the head's surface: load its mesh first (File → Load head mesh…)"
@@ -269,8 +272,7 @@ class Scene(QObject):
                         "switch off Affect selection only")  # fmt: skip
         if self.tool.brush not in CHANGE_STRANDS:
             return None
-        reasons = ["the render hair follows these guides"] if self.binding is not None else []
-        reasons += [r for r in (h() for h in self.strand_holders) if r]
+        reasons = [r for r in (h() for h in self.strand_holders) if r]
         if not reasons:
             return None
         return f"{label} changes the strands, but {' and '.join(reasons)}: remove it first"
@@ -280,10 +282,12 @@ class Scene(QObject):
         on the running engine, timed; the render hair, the mask and the views follow."""
         self.start_engine()
         t0 = time.perf_counter()
-        topology = self.result.topology
+        topology, children = self.result.topology, self.children_binding()
         self.result = step()
-        if self.result.topology != topology:  # strands deleted, or brought back by an undo
+        # strands deleted or planted (or brought back by an undo): the render hair follows them
+        if self.result.topology != topology or self.children_binding() is not children:
             self._cache = {}
+            self._subsets = {}
             self._rest_drawn = None
             self._rebuild_drawn()
             self.drawn_changed.emit()
@@ -344,10 +348,31 @@ class Scene(QObject):
                 f"children bound to this groom's {self.rest.strand_count} strands",
             )
         self.binding = binding
+        self._followed = None
         self._subsets = {}
         self._cache = {}
         self._rebuild_drawn()
         self.drawn_changed.emit()
+
+    def children_binding(self) -> ChildBinding | None:
+        """The render hair of the guides as they are now: :attr:`binding` itself while every
+        guide it was bound to is there; after add, delete or density strokes, its children
+        following the guides planted and removed (:func:`hairtool.guides.follow.follow_guides`:
+        a removed guide's children go, a planted one gets its own), made once per state."""
+        b = self.binding
+        if b is None or self.pipeline is None:
+            return b
+        origin = self.pipeline.origin
+        if len(origin) == b.rest_guides.strand_count and np.array_equal(origin, np.arange(len(origin))):
+            return b
+        aligned = self.pipeline.aligned
+        key = (id(b), origin.tobytes(), aligned.roots[origin < 0].tobytes())
+        if self._followed is None or self._followed[0] != key:
+            from hairtool.guides.follow import follow_guides, guides_now
+
+            guides = guides_now(b.rest_guides, aligned, origin)
+            self._followed = (key, follow_guides(b, guides, origin, self.pipeline.surface))
+        return self._followed[1]
 
     @property
     def has_children(self) -> bool:
@@ -405,7 +430,7 @@ class Scene(QObject):
     def drawn_binding(self) -> ChildBinding | None:
         """The children drawn now: p % of them (the drag or the release percentage), evenly
         spaced over the binding's order (its scattering is random, so they cover the scalp)."""
-        b = self.binding
+        b = self.children_binding()
         if b is None:
             return None
         p = self.display_percent
@@ -495,13 +520,14 @@ class Scene(QObject):
     def render_hair(self) -> Groom | None:
         """Every child at the guides' current shapes (full density; clumped when switched on),
         or None without children."""
-        if self.binding is None:
+        b = self.children_binding()
+        if b is None:
             return None
         if self.clump_children:
             from hairtool.guides.render import RenderHair
 
-            return RenderHair(self.binding, self._child_clump()).update(self.result)
-        return self.binding.build(self.result)
+            return RenderHair(b, self._child_clump()).update(self.result)
+        return b.build(self.result)
 
     def export_groom(self) -> Groom:
         """What a save or export writes: the edited groom, or with children the render hair
@@ -632,6 +658,16 @@ class Scene(QObject):
             raise ParameterError("spacing", spacing, "a positive distance between roots")
         if float(spacing) != self.tool.spacing:
             self.tool.spacing = float(spacing)
+            self.tool_changed.emit()
+
+    def set_pressure(self, what: str, on: bool) -> None:
+        """A pen's pressure scales the current brush's ``what`` ("radius" or "strength"; each
+        brush has its own toggles, as Blender's pressure buttons)."""
+        toggles = {"radius": self.tool.pressure_radius, "strength": self.tool.pressure_strength}
+        if what not in toggles:
+            raise ParameterError("pressure toggle", what, "radius or strength")
+        if bool(on) != toggles[what].get(self.tool.brush, False):
+            toggles[what][self.tool.brush] = bool(on)
             self.tool_changed.emit()
 
     def set_collide(self, on: bool) -> None:

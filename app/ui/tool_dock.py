@@ -22,12 +22,22 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QPushButton,
     QSpinBox,
+    QToolButton,
     QVBoxLayout,
     QWidget,
 )
 
 from app.render.ramps import RAMPS
-from app.ui.brush_tool import FALLOFF_LABELS, LABELS, SHORTCUTS, SIGN_LABELS, SIGNED, TIPS, brushes
+from app.ui.brush_tool import (
+    FALLOFF_LABELS,
+    LABELS,
+    SHORTCUTS,
+    SIGN_LABELS,
+    SIGNED,
+    STRENGTHLESS,
+    TIPS,
+    brushes,
+)
 from app.ui.falloff_editor import FalloffEditor
 from app.ui.qt_utils import signals_blocked
 from app.ui.render_hair_box import RenderHairBox
@@ -208,9 +218,19 @@ class ToolDock(QDockWidget):
             "no gap wider than twice it"
         )
         self.spacing.valueChanged.connect(lambda x: self.scene.set_spacing(float(x)))
+        self.pressure_radius = self._pressure_button(
+            "radius", "a pen's pressure scales the brush size (a light touch: a smaller brush; "
+            "each brush its own; a mouse always presses fully)",
+        )  # fmt: skip
+        self.pressure_strength = self._pressure_button(
+            "strength", "a pen's pressure scales the strength (a light touch: a gentler brush; "
+            "each brush its own; a mouse always presses fully)",
+        )  # fmt: skip
+        self.radius_row = self._with_button(self.radius, self.pressure_radius)
+        self.intensity_row = self._with_button(self.intensity, self.pressure_strength)
         form.addRow("Brush", self.brush)
-        form.addRow("Brush size", self.radius)
-        form.addRow("Strength", self.intensity)
+        form.addRow("Brush size", self.radius_row)
+        form.addRow("Strength", self.intensity_row)
         form.addRow("Mode", self.mode)
         form.addRow("Direction", self.sign)
         form.addRow("Strands per move", self.add_count)
@@ -221,6 +241,25 @@ class ToolDock(QDockWidget):
         form.addRow(self.front_only)
         form.addRow(self.collide)
         return box
+
+    def _pressure_button(self, what: str, tip: str) -> QToolButton:
+        """A toggle beside a slider, as Blender's pressure buttons: the pen scales ``what``."""
+        button = QToolButton()
+        button.setText("Pen")
+        button.setCheckable(True)
+        button.setToolTip(tip)
+        button.setObjectName(f"pressure_{what}")
+        button.toggled.connect(lambda on: self.scene.set_pressure(what, on))
+        return button
+
+    @staticmethod
+    def _with_button(slider: QWidget, button: QWidget) -> QWidget:
+        row = QWidget()
+        layout = QHBoxLayout(row)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(slider, 1)
+        layout.addWidget(button)
+        return row
 
     def add_group(self, box: QWidget) -> None:
         """Another group (the Selection's, :mod:`app.ui.selection_ui`) after the Brush group."""
@@ -316,7 +355,8 @@ class ToolDock(QDockWidget):
         extent = max(float((hi - lo).max()), 1e-3)
         widgets = (self.brush, self.radius, self.intensity, self.mode, self.sign, self.falloff, self.curve)
         more = (self.symmetry, self.mirror_x, self.front_only, self.collide, self.add_count, self.spacing)
-        with signals_blocked(*widgets, *more):
+        pens = (self.pressure_radius, self.pressure_strength)
+        with signals_blocked(*widgets, *more, *pens):
             self.brush.setCurrentIndex(self.brush.findData(s.brush))
             self.radius.set_range(extent * 1e-3, extent * 2.0)
             self.radius.set_value(s.radius)
@@ -334,7 +374,10 @@ class ToolDock(QDockWidget):
                 self.sign.setCurrentIndex(1 if tool.subtract[s.brush] else 0)
                 self._brush_form.labelForField(self.sign).setText(SIGN_LABELS[s.brush])
             self._brush_form.setRowVisible(self.mode, s.brush == "align")
-            self._brush_form.setRowVisible(self.intensity, s.brush not in ("mask", "select"))  # on or off
+            self._brush_form.setRowVisible(self.intensity_row, s.brush not in ("mask", "select"))  # on or off
+            self.pressure_radius.setChecked(tool.pressure_radius.get(s.brush, False))
+            self.pressure_strength.setChecked(tool.pressure_strength.get(s.brush, False))
+            self.pressure_strength.setVisible(s.brush not in STRENGTHLESS)
             self._brush_form.setRowVisible(self.sign, labels is not None)
             custom = not isinstance(tool.falloff, str)
             preset = self.falloff.count() - 1 if custom else self.falloff.findData(tool.falloff)

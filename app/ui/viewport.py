@@ -12,6 +12,11 @@ cursor its view (front faces only), and every move runs the frozen-hair pipeline
 told what changed by the scene's signals and uploads it at the next paint (positions only while
 dragging).
 
+A pen (tablet events) does what the mouse does, with its pressure (:attr:`Viewport.pressure`,
+1 for a mouse) given to the brush. F / Shift+F (:attr:`Viewport.sizing`,
+:mod:`app.ui.brush_sizing`) size the brush or its strength with the mouse until a click or Enter
+keeps the value, Esc or a right click cancels.
+
 Box select (:meth:`Viewport.arm_box`, the B key): the next left-drag draws a rectangle and its
 release emits the selection step (:attr:`Viewport.box_finished`): the strands with a point
 inside it are added to the selection, or with Ctrl held taken from it; Esc or a right-click
@@ -31,14 +36,15 @@ from typing import Protocol
 
 import moderngl
 import numpy as np
-from PySide6.QtCore import QPointF, Qt, Signal
-from PySide6.QtGui import QKeyEvent, QMouseEvent, QWheelEvent
+from PySide6.QtCore import QEvent, QPointF, Qt, Signal
+from PySide6.QtGui import QKeyEvent, QMouseEvent, QTabletEvent, QWheelEvent
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 
 from app.render.camera import Camera
 from app.render.drawn import Drawn
 from app.render.offscreen import Overlays
 from app.render.strands import StrandRenderer, default_strand_raster
+from app.ui.brush_sizing import CanvasSizing, pen_pressure
 from app.ui.drawn import drawn
 from app.ui.scene import Scene
 from hairtool.frozen.brushes import NEED_SURFACE, facing_away
@@ -108,7 +114,12 @@ class Viewport(QOpenGLWidget):
         self.box_armed = False  # the next left-drag is a box select (B)
         self._box: list[QPointF] | None = None  # its corners while it drags
         self._box_mode = "add"
+        self.pressure = 1.0  # the pen's at the last event (a mouse's: 1), for the brush
+        self._pen_down = False  # a pen touches: the mouse events a platform makes of it are dropped
+        self.sizing = CanvasSizing(self)  # F / Shift+F: the brush sized on the canvas
+        scene.groom_loaded.connect(self.sizing.cancel)
         self.setMouseTracking(True)
+        self.setTabletTracking(True)  # a pen hovering moves the circle, as the mouse does
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMinimumSize(200, 150)
         scene.groom_loaded.connect(self._on_groom_loaded)
@@ -296,12 +307,17 @@ class Viewport(QOpenGLWidget):
     def _overlay(self, w: int, h: int) -> None:
         box = self.box_outline(self.devicePixelRatioF())
         self.renderer.set_overlay_outline(self.mirror_outline(w, h) if box is None else box, (w, h))
+        dpr = self.devicePixelRatioF()
+        if self.sizing.active:  # the circle being sized, round its centre
+            c, r = self.sizing.centre, self.sizing.circle_px()
+            self.renderer.set_overlay_circle((c.x() * dpr, c.y() * dpr), r * dpr, (w, h))
+            return
         if self._hover is None or self._drag not in (None, "align") or self.box_armed:
             self.renderer.set_overlay_circle(None, 0.0, (w, h))
             return
-        dpr = self.devicePixelRatioF()
         depth = self.scene.centre if self._stroke_depth is None or self._drag is None else self._stroke_depth
-        radius_px = self.scene.radius * self.camera.pixels_per_unit_at(depth, h)
+        radius = self.scene.tool.radius_at(self.pressure if self._drag else 1.0)  # a pen's, while it presses
+        radius_px = radius * self.camera.pixels_per_unit_at(depth, h)
         centre = (self._hover.x() * dpr, self._hover.y() * dpr)
         self.renderer.set_overlay_circle(centre, radius_px, (w, h))
 
@@ -388,6 +404,9 @@ class Viewport(QOpenGLWidget):
         return SelectionSample("box", tuple(vp.T.ravel().tolist()), rect, mode, view)
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
+        if self.sizing.active and self.sizing.key_press(event):
+            event.accept()
+            return
         if event.key() == Qt.Key.Key_Escape and self.box_armed:
             self.arm_box(False)
             event.accept()
@@ -420,7 +439,45 @@ class Viewport(QOpenGLWidget):
             return "align"
         return None
 
+    def is_dragging(self) -> bool:
+        """A button is held for a stroke, a box or navigation."""
+        return self._drag is not None
+
+    def hover_pos(self) -> QPointF | None:
+        """The mouse over the view (widget pixels), None while it is outside."""
+        return self._hover
+
+    def tabletEvent(self, event: QTabletEvent) -> None:
+        """A pen: its press, moves and release do what the mouse's would, with its pressure
+        (accepted, so Qt sends no mouse event after it)."""
+        handler = {
+            QEvent.Type.TabletPress: self.mousePressEvent,
+            QEvent.Type.TabletMove: self.mouseMoveEvent,
+            QEvent.Type.TabletRelease: self.mouseReleaseEvent,
+        }.get(event.type())
+        if handler is None:
+            super().tabletEvent(event)
+            return
+        self._pen_down = event.type() != QEvent.Type.TabletRelease
+        handler(event)
+        event.accept()
+
+    def _from_pen(self, event) -> bool:
+        """A mouse event while a pen touches (X11 also sends the pen as the core pointer): the
+        pen's own events drive the brush, with their pressure, so this one is dropped."""
+        if self._pen_down and not isinstance(event, QTabletEvent):
+            event.accept()
+            return True
+        return False
+
     def mousePressEvent(self, event: QMouseEvent) -> None:
+        if self._from_pen(event):
+            return
+        self.pressure = pen_pressure(event)
+        if self.sizing.active:
+            self.sizing.mouse_press(event)
+            event.accept()
+            return
         if self._drag is not None:
             return
         if self.box_armed and event.button() == Qt.MouseButton.RightButton:
@@ -470,8 +527,15 @@ class Viewport(QOpenGLWidget):
         event.accept()
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        if self._from_pen(event):
+            return
         pos = event.position()
         self._hover = pos
+        self.pressure = pen_pressure(event)
+        if self.sizing.active:
+            self.sizing.move(pos)
+            self.update()
+            return
         dx, dy = pos.x() - self._last_pos.x(), pos.y() - self._last_pos.y()
         self._last_pos = pos
         if self._drag == "align" and self._drag_target is not None and hasattr(self._drag_target, "drag"):
@@ -530,11 +594,13 @@ class Viewport(QOpenGLWidget):
         direction = np.zeros(3) if last is None else cursor - last
         view = self.view_at(pos)
         touched = self.scene.brush_move(
-            cursor, direction, view, self._stroke_invert, not self.stroke_touched, start=last is None
+            cursor, direction, view, self._stroke_invert, not self.stroke_touched, last is None, self.pressure
         )
         self.stroke_touched = self.stroke_touched or touched
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        if self._from_pen(event):
+            return
         if self._drag is None or event.button() != self._drag_button:
             return
         drag, self._drag = self._drag, None
@@ -568,6 +634,8 @@ class Viewport(QOpenGLWidget):
         self.scene.set_radius(self.scene.radius * factor)
 
     def leaveEvent(self, event) -> None:
+        if self._drag is None:
+            self._pen_down = False  # (a pen lifted where its release never reached the view)
         self._hover = None
         self.cursor_moved.emit(None)
         self.update()

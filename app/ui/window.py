@@ -287,7 +287,8 @@ class MainWindow(QMainWindow):
         edit.addAction(redo)
 
         view = bar.addMenu("&View")
-        add_action(self, view, "&Frame all", self.viewport.frame_all, "F")  # Home: first frame
+        # ("." as Blender's View Selected: F sizes the brush as in Blender; Home is the first frame)
+        add_action(self, view, "&Frame all", self.viewport.frame_all, ".")
         self.ortho_action = add_action(self, view, "&2-D view", self.toggle_ortho, "5", checkable=True)
         view.aboutToShow.connect(self._sync_view_menu)
         up = view.addMenu("&Up axis")
@@ -324,6 +325,16 @@ class MainWindow(QMainWindow):
         brush.addSeparator()
         add_action(self, brush, "&Smaller", lambda: self.viewport.scale_brush(1.0 / BRUSH_STEP), "[")
         add_action(self, brush, "&Bigger", lambda: self.viewport.scale_brush(BRUSH_STEP), "]")
+        size = add_action(self, brush, "Si&ze on canvas", lambda: self.viewport.sizing.start("radius"), "F")
+        size.setToolTip("Move the mouse to size the brush, click or Enter keeps it, Esc or right-click "
+                        "cancels (Blender's F)")  # fmt: skip
+        strength = add_action(
+            self, brush, "S&trength on canvas", lambda: self.viewport.sizing.start("strength"), "Shift+F"
+        )
+        strength.setToolTip("Move the mouse to set the strength (farther: stronger), click or Enter "
+                            "keeps it, Esc or right-click cancels (Blender's Shift+F)")  # fmt: skip
+        sizing = self.viewport.sizing  # (its last word, once it ends, fades as other messages do)
+        sizing.message.connect(lambda text: self.statusBar().showMessage(text, 0 if sizing.active else 4000))
         brush.addSeparator()
         self.symmetry_action = add_action(
             self, brush, "&X mirror", lambda on: self.scene.set_symmetry(on), "Shift+X", checkable=True
@@ -538,7 +549,7 @@ class MainWindow(QMainWindow):
             self.legend.hide()
 
     def _update_counts(self) -> None:
-        g, b = self.scene.result, self.scene.binding
+        g, b = self.scene.result, self.scene.children_binding()
         text = f"{g.strand_count:,} strands · {g.vertex_count:,} vertices"
         if b is not None:
             text = f"{g.strand_count:,} guides · {b.child_count:,} children · {b.vertex_count:,} vertices"

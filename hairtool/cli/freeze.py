@@ -224,8 +224,11 @@ def run(args: argparse.Namespace) -> int:
         timings.append(pipe.timings)
     report = {}
     if binding is not None and not np.array_equal(pipe.origin, np.arange(groom.strand_count)):
-        what = "add, delete or density strokes with render hair"
-        raise ParameterError("strokes", what, "none where children follow the guides")
+        # add, delete or density strokes: the children follow the guides planted and removed
+        from hairtool.guides.follow import follow_guides, guides_now
+
+        origin = pipe.origin
+        binding = follow_guides(binding, guides_now(groom, pipe.aligned, origin), origin, pipe.surface)
     if binding is not None:
         hair = _guides.render(args, binding).update(pipe.result)
         report = _guides.write(args, hair, pipe.result)

@@ -119,7 +119,9 @@ class BrushSample:
     sample moves ends inside it (:mod:`hairtool.frozen.collide`). ``count`` and ``seed``: the
     strands an add sample plants, and the seed of where (density's too); ``spacing``: the
     distance a density sample leaves between roots. ``only_selected``: the strands not
-    selected are left as if locked (:mod:`hairtool.frozen.selection`)."""
+    selected are left as if locked (:mod:`hairtool.frozen.selection`). ``pressure``: the pen's
+    pressure in [0, 1] at this move (1 for a mouse), already applied to ``radius`` and
+    ``strength`` where the brush's pressure toggles said so: kept so a stroke log records it."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -134,6 +136,7 @@ class BrushSample:
     seed: int = 0
     spacing: float = 0.0
     only_selected: bool = False
+    pressure: float = 1.0
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction
@@ -182,7 +185,16 @@ def check_sample(sample: BrushSample) -> BrushSample:
         raise ParameterError("spacing", sample.spacing, "a positive distance between roots (groom units)")
     if len(sample.lut) != LUT_SIZE:
         raise ParameterError("falloff", f"{len(sample.lut)} samples", f"{LUT_SIZE}")
+    check_pressure(sample.pressure)
     return sample
+
+
+def check_pressure(pressure: object) -> float:
+    """A pen's pressure: a number in [0, 1] (ParameterError naming ``pressure``)."""
+    number = isinstance(pressure, int | float | np.integer | np.floating) and not isinstance(pressure, bool)
+    if not number or not 0.0 <= float(pressure) <= 1.0:  # (NaN fails the comparison)
+        raise ParameterError("pressure", pressure, "a number in [0, 1]")
+    return float(pressure)
 
 
 # -- shared pieces -----------------------------------------------------------------------------

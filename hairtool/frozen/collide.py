@@ -21,6 +21,11 @@ does a vertex stay inside, as far out as it got. Every tried point is rounded to
 as the groom stores it, so a vertex found outside stays outside. Roots never move, and every
 segment keeps the length the brush gave it.
 
+Clumping comes after the strokes and pulls strands toward their clumps, which on a curved head
+can cut back through it: :func:`keep_out` (run by the pipeline after ClumpWithGaps wherever its
+strokes collide) lets a strand that was outside before clumping clump only as far as it stays
+outside, its segments at their clumped lengths.
+
 The surface is anything with ``signed_distance(points) -> (distances, closest points,
 normals)`` (:class:`CollisionSurface`), e.g. :class:`hairtool.guides.surface.MeshSurface`.
 The loop runs along the strands' vertex indices with all the strands being solved at once
@@ -105,6 +110,123 @@ def escape(
         hi = np.where((fine & ~inside)[:, None], mid, hi)
         lo = np.where((fine & inside)[:, None], mid, lo)
     return _f32(prev + length[:, None] * hi)
+
+
+#: How far a strand may clump before it enters the head is searched on a grid of SPLIT shares
+#: of its clumping move, then of the best cell, ROUNDS times (a share within 1/64): all the
+#: shares of a round go to the head in one query, each query being a kernel launch.
+SPLIT, ROUNDS = 8, 2
+
+
+def _with_lengths(x: np.ndarray, like: np.ndarray, n: int) -> np.ndarray:
+    """``(S, n, 3)`` strands ``x`` with each segment back to its length in ``like``, directions
+    kept, root to tip."""
+    seg = np.linalg.norm(np.diff(like, axis=1), axis=2)
+    out = x.copy()
+    for i in range(1, n):
+        d = x[:, i] - x[:, i - 1]
+        norm = np.sqrt(np.einsum("ij,ij->i", d, d))
+        fallback = like[:, i] - like[:, i - 1]
+        d = np.where((norm > EPS)[:, None], d, fallback)
+        norm = np.where(norm > EPS, norm, np.maximum(seg[:, i - 1], EPS))
+        out[:, i] = out[:, i - 1] + d * (seg[:, i - 1] / norm)[:, None]
+    return out
+
+
+def _any_inside(surface: CollisionSurface, x: np.ndarray) -> np.ndarray:
+    """``(S,)`` whether a point of each strand ``x`` ``(S, n, 3)`` but its root is inside."""
+    d = surface.signed_distance(x.reshape(-1, 3))[0].reshape(x.shape[:2])
+    return (d[:, 1:] < 0).any(axis=1)
+
+
+def keep_out(
+    before: Groom,
+    after: Groom,
+    surface: CollisionSurface,
+    margin: float,
+    sd_before: np.ndarray | None = None,
+    sd_after: np.ndarray | None = None,
+) -> Groom:
+    """``after`` (the clumped ``before``, same strands) where clumping pulled a strand into the
+    head: a strand wholly outside in ``before`` (roots aside) and not in ``after`` clumps only as
+    far as it stays outside, the largest share t of its clumping move (``before`` + t·(``after`` −
+    ``before``), t the largest outside on a grid of :data:`SPLIT` shares refined :data:`ROUNDS`
+    times, over the strands at once, each tried shape rounded to float32 first) with its
+    segments back at their clumped lengths; where that put it inside again, it keeps its shape
+    from before clumping. On a curved head a clump's pull can cut through it. A strand already
+    inside before (a stroke with collision off put it there) is left as it is. ``margin`` is
+    unused (kept for :func:`collide`'s signature). ``sd_before`` / ``sd_after``: the points'
+    signed distances where known (:class:`KeepOut`)."""
+    del margin
+    top = before.topology
+    if before.vertex_count == 0:
+        return after
+    if sd_before is None:
+        sd_before = surface.signed_distance(before.points.astype(np.float64))[0]
+    if sd_after is None:
+        sd_after = surface.signed_distance(after.points.astype(np.float64))[0]
+    deep = top.index_in_strand > 0
+    starts = top.offsets[:-1]
+    was_in = np.logical_or.reduceat((sd_before < 0) & deep, starts)
+    now_in = np.logical_or.reduceat((sd_after < 0) & deep, starts)
+    fix = np.flatnonzero(now_in & ~was_in)
+    if fix.size == 0:
+        return after
+    out = after.points.copy()
+    for n in np.unique(top.counts[fix]):  # strands of one vertex count at a time, as arrays
+        ids = fix[top.counts[fix] == n]
+        vids = vertex_ids_of(top, ids)
+        b = before.points[vids].astype(np.float64).reshape(len(ids), n, 3)
+        a = after.points[vids].astype(np.float64).reshape(len(ids), n, 3)
+        # The signed distance changes no faster than a point moves: a vertex farther out before
+        # clumping than its whole clumping move stays outside at every share (the tolerance
+        # covers float32 rounding), so only the others are asked about.
+        tol = 1e-4 * (1.0 + float(np.abs(b).max()))
+        near = sd_before[vids].reshape(len(ids), n) <= np.linalg.norm(a - b, axis=2) + tol
+        near[:, 0] = False  # (roots never count)
+        lo, step = np.zeros(len(ids)), 1.0  # outside at lo (before clumping: it was outside)
+        for _ in range(ROUNDS):
+            step /= SPLIT
+            t = lo[:, None] + step * np.arange(1, SPLIT)[None, :]  # (S, SPLIT − 1) shares to try
+            ask = np.broadcast_to(near[:, None, :], (*t.shape, n))
+            x = _f32(b[:, None] + t[..., None, None] * (a - b)[:, None])
+            d = np.full(ask.shape, np.inf)
+            d[ask] = surface.signed_distance(x[ask])[0] if ask.any() else 0.0
+            clear = ~(d < 0).any(axis=2)
+            last = np.where(clear.any(axis=1), SPLIT - 2 - np.argmax(clear[:, ::-1], axis=1), -1)
+            lo = np.where(last >= 0, t[np.arange(len(ids)), np.maximum(last, 0)], lo)  # the largest outside
+        x = _f32(_with_lengths(b + lo[:, None, None] * (a - b), a, n))
+        x = np.where(_any_inside(surface, x)[:, None, None], b, x)  # (before clumping it was outside)
+        out[vids] = x.reshape(-1, 3).astype(np.float32)
+    return after.with_points(out)
+
+
+class KeepOut:
+    """:func:`keep_out` with a memory: the signed distances of the points it saw at its last
+    call are reused for those that did not change (a brush moves a few strands per update and
+    clumping redoes only the region around them), so an update asks the head about those alone,
+    before and after clumping in one query. The same bytes as :func:`keep_out` without it."""
+
+    def __init__(self) -> None:
+        self._last: dict[str, tuple] = {}
+
+    def __call__(self, before: Groom, after: Groom, surface: CollisionSurface, margin: float) -> Groom:
+        parts = []  # per groom: its points, which changed since last time, the distances known
+        for key, points in (("before", before.points), ("after", after.points)):
+            last = self._last.get(key)
+            if last is None or last[0] is not surface or last[1].shape != points.shape:
+                parts.append((key, points, np.ones(len(points), bool), np.empty(len(points))))
+            else:
+                parts.append((key, points, np.any(points != last[1], axis=1), last[2].copy()))
+        ask = np.concatenate([p[changed] for _, p, changed, _ in parts]).astype(np.float64)
+        found = surface.signed_distance(ask)[0] if len(ask) else np.zeros(0)
+        at = 0
+        for key, points, changed, sd in parts:
+            k = int(changed.sum())
+            sd[changed] = found[at : at + k]
+            at += k
+            self._last[key] = (surface, points.copy(), sd)
+        return keep_out(before, after, surface, margin, parts[0][3], parts[1][3])
 
 
 def collide(before: Groom, after: Groom, surface: CollisionSurface, margin: float) -> Groom:

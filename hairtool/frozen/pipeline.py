@@ -54,7 +54,7 @@ from hairtool.frozen.brushes import (
 )
 from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
 from hairtool.frozen.clump_region import clump_points_interactive
-from hairtool.frozen.collide import MARGIN, collide
+from hairtool.frozen.collide import MARGIN, KeepOut, collide
 from hairtool.frozen.density import accept, disc_candidates, thin
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.noise import check_seed, draw_seed
@@ -167,6 +167,7 @@ class AlignSample(NamedTuple):
     view: tuple[float, float, float] | None = None
     collide: bool = True  # as BrushSample's
     only_selected: bool = False  # as BrushSample's
+    pressure: float = 1.0  # as BrushSample's (already applied to radius and intensity)
 
 
 Sample = AlignSample | BrushSample | SelectionSample
@@ -729,9 +730,26 @@ class FrozenPipeline:
                 bool(p.keep_lengths),
                 self._clump_strength,
             )
-            self._result = self._aligned.with_points(pts)
+            self._result = self._kept_out(self._aligned.with_points(pts))
         else:
             self._workspace.mean_neighbours = 0.0
             self._result = self._aligned
         self._timings["clump"] = (time.perf_counter() - t0) * 1e3
         self._timings["total"] = self._timings["freeze"] + self._timings["align"] + self._timings["clump"]
+
+    def _kept_out(self, clumped: Groom) -> Groom:
+        """Clumping respects the head: where strokes collide with it (a sample that moves points
+        with ``collide``), the strands clumping pulled back inside are pushed out again
+        (:func:`~hairtool.frozen.collide.keep_out`), so no brushed vertex ends inside."""
+        surface = self._surface
+        if surface is None or not hasattr(surface, "signed_distance"):
+            return clumped
+        if not any(
+            getattr(s, "collide", False) and (isinstance(s, AlignSample) or s.brush not in MOVE_NONE)
+            for s in self._log
+        ):
+            return clumped
+        lo, hi = self._rest.bounds
+        margin = MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
+        kept = self.__dict__.setdefault("_kept", KeepOut())  # (its memory: the head's distances)
+        return kept(self._aligned, clumped, surface, margin)

@@ -4,7 +4,8 @@ A stroke log is a JSON list of strokes, in groom units::
 
     [{"brush": "comb", "falloff": "smooth", "symmetry": "x", "mirror_x": 0.0,
       "params": {}, "samples": [{"cursor": [x, y, z], "direction": [dx, dy, dz],
-                                 "radius": r, "strength": s, "view": [vx, vy, vz]}, ...]}, ...]
+                                 "radius": r, "strength": s, "view": [vx, vy, vz],
+                                 "pressure": p}, ...]}, ...]
 
 - ``brush``: ``align`` (the paper's UserAlign; ``params.mode`` "paper" or "preserve-length",
   ``strength`` its intensity, no direction needed), ``comb``, ``smooth``, ``length`` (a signed
@@ -29,6 +30,11 @@ A stroke log is a JSON list of strokes, in groom units::
 - ``start`` (per sample, optional): true where a stroke begins (a snake hook hooks its strands
   there); missing: true for a stroke's first sample only. Written for snake hooks, whose
   mirrored first sample is a start too.
+- ``pressure`` (per sample, optional, default 1.0): the pen's pressure in [0, 1] at that
+  sample (a mouse presses 1.0). ``radius`` and ``strength`` are what the brush used there, the
+  pressure already applied (the studio scales them by it where the brush's pressure toggles
+  are on), so a replay reads them as they are and gives the same bytes; the pressure says how
+  the stroke was drawn.
 - ``view`` (per sample, optional): the camera's viewing direction, from the eye into the scene;
   only the strands facing that camera are touched. null or missing (older logs): every strand.
 - ``falloff``: ``smooth``, ``linear``, ``constant``, or a curve ``[[t, w], ...]`` over t =
@@ -71,6 +77,7 @@ from hairtool.frozen.brushes import (
     BRUSHES,
     MAX_FALLOFF_POINTS,
     BrushSample,
+    check_pressure,
     check_sample,
     check_view,
     falloff_lut,
@@ -92,6 +99,7 @@ class StrokeSample:
     direction: tuple[float, float, float] = (0.0, 0.0, 0.0)
     view: tuple[float, float, float] | None = None
     start: bool | None = None  # None: the stroke's first sample starts it
+    pressure: float = 1.0  # the pen's, already applied to radius and strength (1: a mouse's)
 
 
 @dataclass(frozen=True)
@@ -130,7 +138,8 @@ class Stroke:
                 mode = self.params.get("mode", "paper")
                 v = check_view(s.view)
                 only = self.only_selected
-                first = AlignSample(s.cursor, s.radius, s.strength, mode, v, self.collision, only)
+                first = AlignSample(s.cursor, s.radius, s.strength, mode, v, self.collision, only,
+                                    check_pressure(s.pressure))  # fmt: skip
                 out.append(first)
                 if self.symmetry == "x":
                     cursor = (2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])
@@ -146,7 +155,7 @@ class Stroke:
                 spacing = _number("params.spacing", spacing) if spacing is not None else 0.0
             sample = BrushSample(
                 self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start, self.collision,
-                count, seed, spacing, self.only_selected,
+                count, seed, spacing, self.only_selected, s.pressure,
             )
             sample = check_sample(sample)
             out.append(sample)
@@ -171,6 +180,7 @@ class Stroke:
                     "radius": s.radius,
                     "strength": s.strength,
                     "view": None if s.view is None else list(s.view),
+                    "pressure": s.pressure,
                 }
                 | ({} if s.start is None else {"start": s.start})
                 for s in self.samples
@@ -214,7 +224,9 @@ def strokes_from_log(
             continue
         if isinstance(s, AlignSample):
             key: tuple = ("align", s.mode, s.collide, s.only_selected)
-            sample = StrokeSample(tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view))
+            sample = StrokeSample(
+                tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view), pressure=s.pressure
+            )
             start = Stroke("align", (sample,), params={"mode": s.mode}, collision=s.collide,
                            only_selected=s.only_selected)  # fmt: skip
         else:
@@ -222,7 +234,7 @@ def strokes_from_log(
             hook = s.brush == "snake_hook"
             sample = StrokeSample(
                 tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view),
-                bool(s.start) if hook else None,
+                bool(s.start) if hook else None, s.pressure,
             )  # fmt: skip
             params = {"count": s.count, "seed": s.seed} if s.brush == "add" else {}
             if s.brush == "density":
@@ -267,6 +279,13 @@ def _vector(where: str, value: Any, default: tuple | None = None) -> tuple[float
         raise ParameterError(where, _short(value), "three numbers [x, y, z]")
     v = tuple(_number(where, c) for c in value)
     return v  # type: ignore[return-value]
+
+
+def _pressure(where: str, value: Any) -> float:
+    try:
+        return check_pressure(value)
+    except ParameterError:
+        raise ParameterError(where, _short(value), "a pen's pressure in [0, 1]") from None
 
 
 def _number(where: str, value: Any) -> float:
@@ -336,6 +355,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke | SelectionStep:
                 _vector(f"{at}.direction", s.get("direction"), (0.0, 0.0, 0.0)),
                 None if s.get("view") is None else _vector(f"{at}.view", s.get("view")),
                 _flag(f"{at}.start", s.get("start")),
+                _pressure(f"{at}.pressure", s.get("pressure", 1.0)),
             )
         )
     falloff = d.get("falloff", "smooth")

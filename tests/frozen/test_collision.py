@@ -211,3 +211,43 @@ def test_the_inside_test_reads_a_fold_by_its_edge_normal(fold):
     assert hard.signed_distance(inside)[0][0] < 0
     for outside in ([0.01, -0.06, 0.1], [-0.01, -0.06, 0.1], [0.0, -0.5, 0.0]):
         assert hard.signed_distance(np.array([outside]))[0][0] > 0
+
+
+def test_clumping_after_collision_pulls_no_strand_back_inside_the_head(sintel):
+    """ClumpWithGaps pulls strands toward their clumps: on a curved head the pull can cut
+    through it, so a strand the collision left outside ended inside once clumped (138 vertices
+    here before clumping respected the head); now it clumps only as far as it stays out."""
+    from hairtool.frozen.collide import KeepOut, keep_out
+
+    groom, surface = sintel
+    pipe = FrozenPipeline(groom, FrozenParams(freeze=False, keep_lengths=True), surface)
+    constant = tuple(falloff_lut("constant").tolist())
+    centre = groom.roots.mean(axis=0).astype(np.float64)
+    for _ in range(5):  # everything combed toward the head's centre: collision keeps it out
+        tips = pipe.aligned.tips.astype(np.float64).mean(axis=0)
+        d = centre - tips
+        pipe.brush(BrushSample("comb", tuple(tips), tuple(0.3 * d / np.linalg.norm(d)), 40.0, 1.0, constant))
+    top = groom.topology
+    deep = top.index_in_strand > 0
+    was_in = np.logical_or.reduceat(
+        (surface.signed_distance(pipe.aligned.points.astype(np.float64))[0] < 0) & deep, top.offsets[:-1]
+    )
+    now = (surface.signed_distance(pipe.result.points.astype(np.float64))[0] < 0) & deep
+    assert not now[~np.repeat(was_in, top.counts)].any()  # no strand outside before clumping is inside
+    assert was_in.sum() <= 3  # (the few the collision could not free stay as they were)
+    np.testing.assert_array_equal(pipe.result.roots, groom.roots)
+    np.testing.assert_allclose(lengths(pipe.result), lengths(groom), rtol=2e-4)  # lengths kept
+    unclumped = FrozenPipeline(groom, FrozenParams(freeze=False, clump=False), surface)
+    unclumped.apply_samples(pipe.strokes)
+    assert np.abs(pipe.result.points - unclumped.result.points).max() > 0.1  # it still clumps
+    raw = FrozenPipeline(groom, pipe.params, surface)  # clumping as it was: blind to the head
+    raw._kept_out = lambda clumped: clumped
+    raw.apply_samples(pipe.strokes)
+    np.testing.assert_array_equal(raw.aligned.points, pipe.aligned.points)
+    pulled = (surface.signed_distance(raw.result.points.astype(np.float64))[0] < 0) & deep
+    assert pulled[~np.repeat(was_in, top.counts)].sum() > 20
+    plain = keep_out(raw.aligned, raw.result, surface, 0.0)
+    np.testing.assert_array_equal(plain.points, pipe.result.points)
+    memo = KeepOut()  # the memory of the head's distances changes no byte
+    for _ in range(2):
+        np.testing.assert_array_equal(memo(raw.aligned, raw.result, surface, 0.0).points, plain.points)

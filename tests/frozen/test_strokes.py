@@ -83,6 +83,10 @@ def test_symmetry_and_defaults_in_a_hand_written_log(tmp_path):
         ('[{"brush": "comb", "samples": [{"cursor": [0, 0, 0], "radius": 1, "strength": 5}]}]', "strength"),
         ('[{"brush": "comb", "falloff": "bumpy", "samples": []}]', "falloff"),
         ('[{"brush": "comb", "symmetry": "y", "samples": []}]', "symmetry"),
+        ('[{"brush": "comb", "samples": [{"cursor": [0, 0, 0], "radius": 1, "strength": 0.5, '
+         '"pressure": 1.5}]}]', "strokes[0].samples[0].pressure"),
+        ('[{"brush": "align", "samples": [{"cursor": [0, 0, 0], "radius": 1, "strength": 0.5, '
+         '"pressure": "hard"}]}]', "strokes[0].samples[0].pressure"),
     ],
 )
 def test_bad_logs_are_one_line(tmp_path, capsys, log, words):
@@ -197,3 +201,69 @@ def test_an_integer_beyond_float64_is_refused_before_float(big):
         stroke_from_dict(stroke)
     stroke["samples"][0]["radius"] = 10**300  # within float64: a radius, just a large one
     assert stroke_from_dict(stroke).samples[0].radius == 1e300
+
+
+def pen_session(groom):
+    """Samples drawn with a pen: radius and strength already scaled by its pressure (the
+    studio's), align and brush samples, one at full pressure."""
+    pipe = FrozenPipeline(groom, FrozenParams(seed=3))
+    tips = groom.points[groom.topology.tip_indices].astype(np.float64)
+    c, r = tips[len(tips) // 2], 0.5 * float(np.ptp(groom.points, axis=0).max())
+    smooth = tuple(falloff_lut("smooth").tolist())
+    pipe.apply_samples([AlignSample(tuple(c), r * 0.4, 0.7 * 0.4, "paper", pressure=0.4)])
+    for k, p in enumerate((0.8, 0.3, 1.0)):
+        pipe.brush(BrushSample("comb", tuple(c + k * 0.05), (0.05, 0.0, 0.0), r, 0.9 * p, smooth, pressure=p))
+    return pipe
+
+
+def test_a_pens_pressure_is_kept_in_the_log_and_replays_to_the_bytes(tmp_path):
+    groom = samples.scalp(150, 12, seed=2)
+    io.write(tmp_path / "groom.npz", groom)
+    pipe = pen_session(groom)
+    strokes = strokes_from_log(pipe.strokes)
+    write_strokes(tmp_path / "strokes.json", strokes)
+    raw = json.loads((tmp_path / "strokes.json").read_text())
+    assert [x["pressure"] for st in raw for x in st["samples"]] == [0.4, 0.8, 0.3, 1.0]
+    back = read_strokes(tmp_path / "strokes.json")
+    assert back == strokes
+    replay = FrozenPipeline(groom, FrozenParams(seed=3))
+    for st in back:
+        replay.apply_samples(st.pipeline_samples(0.0))
+    assert replay.strokes == pipe.strokes
+    out = tmp_path / "replayed.npz"
+    argv = ["freeze", str(tmp_path / "groom.npz"), str(out), "--seed", "3"]
+    assert main([*argv, "--strokes", str(tmp_path / "strokes.json")]) == 0
+    np.testing.assert_array_equal(io.read(out).points, pipe.result.points)
+
+
+def test_an_older_log_without_pressure_reads_as_full_pressure(tmp_path):
+    comb = {"cursor": [0.1, 0.2, 0.3], "direction": [0.1, 0, 0], "radius": 1.0, "strength": 0.4}
+    log = [
+        {"brush": "comb", "symmetry": "x", "samples": [comb]},
+        {"brush": "align", "samples": [{"cursor": [0, 1, 0], "radius": 1.0, "strength": 0.3}]},
+    ]
+    (tmp_path / "old.json").write_text(json.dumps(log))
+    comb, align = read_strokes(tmp_path / "old.json")
+    assert [x.pressure for x in comb.pipeline_samples(0.0) + align.pipeline_samples(0.0)] == [1.0] * 3
+
+
+def test_a_pens_pressure_survives_a_project_round_trip(tmp_path):
+    from hairtool import project as pf
+
+    groom = samples.scalp(60, 10, seed=1)
+    pipe = pen_session(groom)
+    pf.save(tmp_path / "p.hairproj", pf.Project.from_pipeline(pipe))
+    back = pf.load(tmp_path / "p.hairproj")
+    assert back.strokes == pipe.strokes and back.strokes[1].pressure == 0.8
+    np.testing.assert_array_equal(back.pipeline().result.points, pipe.result.points)
+
+
+def test_a_pressure_outside_0_1_is_refused():
+    from hairtool.frozen.brushes import check_sample
+
+    smooth = tuple(falloff_lut("smooth").tolist())
+    sample = BrushSample("comb", (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), 1.0, 0.5, smooth)
+
+    for bad in (-0.1, 1.01, float("nan"), True):
+        with pytest.raises(ParameterError, match="pressure"):
+            check_sample(BrushSample(**{**sample.__dict__, "pressure": bad}))

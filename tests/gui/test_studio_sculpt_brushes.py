@@ -3,8 +3,8 @@ and tool dock entries with keys that clash with no other action; each drag is on
 delete removes the strands under the brush and undo brings them back bit for bit (the view
 redraws either way); snake hook drags the tips it hooked; slide, add and density wait for a head
 mesh; the brushes keep strands out of the head unless told not to; exported stroke logs replay
-in the CLI to the studio's bytes; a delete that render hair depends on is refused with a
-message."""
+in the CLI to the studio's bytes; with render hair a delete takes the children of the guides it
+removes with them, and while an animation holds the strands it is refused with a message."""
 
 from __future__ import annotations
 
@@ -121,7 +121,7 @@ def test_pinch_and_snake_hook_strokes_replay_in_the_cli_to_the_studios_bytes(ui,
     np.testing.assert_array_equal(io.read_groom(tmp_path / "out.npz").points, s.result.points)
 
 
-def test_delete_waits_while_render_hair_follows_the_guides(ui, make_window):
+def test_delete_takes_the_children_of_its_guides_and_waits_while_an_animation_holds_them(ui, make_window):
     from hairtool.guides.binding import bind_roots
 
     w = plain(make_window, groom=samples.scalp(strands=60, vertices=12, seed=4))
@@ -131,9 +131,17 @@ def test_delete_waits_while_render_hair_follows_the_guides(ui, make_window):
     w.brush_actions["delete"].trigger()
     pos = v.project(s.result.roots[front_strand(w)])[0]
     ui.drag(v, pos, pos + np.array([5.0, 0.0]), steps=2)
-    assert s.result.strand_count == 60 and w.undo_stack.count() == 0
-    assert messages and "render hair" in messages[0][0]
-    assert "render hair" in w.statusBar().currentMessage()
+    assert s.result.strand_count < 60 and w.undo_stack.count() == 1 and not messages
+    gone = np.setdiff1d(np.arange(60), s.pipeline.origin)
+    kept = ~np.isin(s.binding.guide_ids[:, 0], gone)
+    assert s.children_binding().child_count == kept.sum() < 300
+    w.undo_stack.undo()
+    assert s.result.strand_count == 60 and s.children_binding() is s.binding
+    s.strand_holders.append(lambda: "the timeline holds an animation of them")
+    ui.drag(v, pos, pos + np.array([5.0, 0.0]), steps=2)
+    assert s.result.strand_count == 60 and w.undo_stack.count() == 1
+    assert messages and "animation" in messages[0][0]
+    assert "animation" in w.statusBar().currentMessage()
 
 
 def test_slide_moves_roots_along_the_head_and_waits_for_a_head_mesh(ui, make_window, tmp_path):

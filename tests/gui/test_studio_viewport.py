@@ -142,7 +142,7 @@ def test_keys_resize_the_brush_and_frame_all(ui, make_window, qtbot):
     assert w.scene.radius == pytest.approx(r / 1.1)
     assert w.dock.radius.value() == pytest.approx(r / 1.1, rel=1e-3)
     w.viewport.camera.zoom(3)
-    qtbot.keyClick(w.viewport, Qt.Key.Key_F)  # frame all
+    qtbot.keyClick(w.viewport, Qt.Key.Key_Period)  # frame all
     framed = w.viewport.camera.copy()
     w.viewport.frame_all()
     assert w.viewport.camera.state() == framed.state()
