@@ -245,3 +245,62 @@ def test_a_project_keeps_the_moved_keys(ui, graph, make_window, tmp_path):
     assert c2.edits == c.edits and c2.channel_edits == c.channel_edits
     np.testing.assert_array_equal(c2.motion().values, edited)
     assert w2.animation.dp_keys.tolist() == w.animation.dp_keys.tolist() != keys.tolist()
+
+
+def test_on_hair_the_strands_feature_channels_are_read_only_views_of_the_key_choice(ui, make_window):
+    """Issue 30 point 4 on hair: the selected strand's feature channels (seed 000's space) drawn
+    beside the vertex's coordinates, original faint behind the key curve through the keys;
+    a press on one of their keys drags nothing and says why; they follow a vertex key's edit."""
+    from app.ui.hair_channels import READ_ONLY
+    from hairtool.keys.features import strand_features
+    from hairtool.keys.reconstruct import interpolate_keys, key_poses
+
+    w, view, anim = _hair(make_window, "hermite")
+    m, dock = w.animation, w.graph_editor
+    assert view.on_hair and dock.features.isVisibleTo(dock) and dock.features.isChecked()
+    assert [c.name for c in view.curves] == ["x", "y", "z", "feature x", "feature y", "feature z"]
+    assert [c.editable for c in view.curves] == [True] * 3 + [False] * 3
+    options = m.settings.feature_options()
+    sample = options.samples - 1  # the tip vertex: the last sample
+    feats = strand_features(anim, 0, options)[:, sample]
+    curve = interpolate_keys(key_poses(feats, m.dp_keys, "hermite"))
+    for a, c in enumerate(view.curves[3:]):
+        np.testing.assert_array_equal(c.original, feats[:, a])
+        np.testing.assert_array_equal(c.result, feats[:, a])
+        np.testing.assert_array_equal(c.key_curve, curve[:, a])
+        assert c.keys.tolist() == m.dp_keys.tolist()
+        np.testing.assert_array_equal(c.values, feats[m.dp_keys, a])
+    # a press on a feature key (away from the vertex's keys) drags nothing and says why
+    editable = np.concatenate([np.column_stack(view.to_px(c.keys, c.values)) for c in view.curves[:3]])
+    picked = None
+    for i in (3, 4, 5):
+        for k in range(1, m.dp_keys.size - 1):
+            p = np.array(view.key_point(i, k))
+            if np.min(np.hypot(*(editable - p).T)) > 3 * 8.0:
+                picked = p
+                break
+        if picked is not None:
+            break
+    assert picked is not None
+    ui.drag(view, picked, picked + np.array([0.0, -30.0]))
+    assert w.undo_stack.count() == 0 and view.refused == READ_ONLY
+    np.testing.assert_array_equal(m.animation.frames, anim.frames)
+    assert "read-only" in dock.features.toolTip().lower() or "not edited" in dock.features.toolTip()
+    # a vertex key moved in value: the features follow the edited hair, the original stays
+    k = 1
+    p = np.array(view.key_point(1, k))
+    ui.drag(view, p, p + np.array([0.0, -40.0]))
+    assert w.undo_stack.count() == 1
+    edited = strand_features(m.animation, 0, options)[:, sample]
+    assert not np.array_equal(edited, feats)
+    for a, c in enumerate(view.curves[3:]):
+        np.testing.assert_array_equal(c.original, feats[:, a])
+        np.testing.assert_array_equal(c.result, edited[:, a])
+    # another strand, another sample along it; the box hides them
+    dock.strand.setValue(3)
+    dock.vertex.setValue(0)
+    assert w.graph_editor.hair.sample() == 0
+    root = strand_features(m.animation, 3, options)[:, 0]
+    np.testing.assert_array_equal(view.curves[3].result, root[:, 0])
+    dock.features.setChecked(False)
+    assert [c.name for c in view.curves] == ["x", "y", "z"]
