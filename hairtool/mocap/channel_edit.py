@@ -27,7 +27,15 @@ from hairtool.keys.edit import check_retime, residual_at, time_warp
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at, interpolate_keys, key_poses
 from hairtool.mocap import ik
 from hairtool.mocap.bvh import MAX_VALUE, Motion
-from hairtool.mocap.pose_edit import INTERPS, ChannelEdit, EditReport, PoseEdit, TangentEdit, parse_edit_list
+from hairtool.mocap.pose_edit import (
+    INTERPS,
+    ChannelEdit,
+    EditReport,
+    PoseEdit,
+    TangentEdit,
+    apply_edits,
+    parse_edit_list,
+)
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -152,6 +160,12 @@ class ChannelEditor:
     stretched, the curve there plus the residual of the frame it now shows
     (:func:`hairtool.keys.edit.retime_key`), on the unwrapped angles, written back within the
     capture's own whole turns."""
+
+    RETIME = ChannelRetimeEdit  # the key moves it makes: one channel's key
+    KINDS = (
+        "an edit of per-channel keys: an IK pose, one channel's key value, handle or move in "
+        "time (a pose key moved in time moves every channel: the pose keys' edits)"
+    )
 
     def __init__(self, motion: Motion, keys: list[ArrayLike], interp: str = "hermite") -> None:
         if interp not in INTERPS:
@@ -383,17 +397,8 @@ class ChannelEditor:
         return step.report
 
     def apply_all(self, edits: list, method: str = "auto") -> list[EditReport]:
-        out = []
-        for e in edits:
-            if isinstance(e, ChannelEdit):
-                out.append(self.apply_channel(e))
-            elif isinstance(e, TangentEdit):
-                out.append(self.apply_tangent(e))
-            elif isinstance(e, ChannelRetimeEdit):
-                out.append(self.apply_retime(e))
-            else:
-                out.append(self.apply(e, method))
-        return out
+        """Edits in order, each on what the ones before left (:func:`.pose_edit.apply_edits`)."""
+        return apply_edits(self, edits, method)
 
     def undo(self) -> object | None:
         return self._history.pop().report.edit if self._history else None

@@ -105,3 +105,24 @@ def test_a_channel_key_moved_in_time_is_the_array_retime_of_that_channel(keyed, 
     assert np.array_equal(editor.motion().values, m.values) and np.array_equal(editor.keys(col), k)
     as_dict = {"frame": f, "joint": ARM, "channel": name, "to": to}
     assert ChannelRetimeEdit(f, ARM, name, to).to_dict() == as_dict
+
+
+def test_each_editor_refuses_the_other_ones_key_moves(keyed):
+    """One dispatcher (pose_edit.apply_edits) for both editors: a pose key's move is no edit of
+    per-channel keys, one channel's key move none of the pose keys (each read as the other
+    before, or failed deep inside), and neither editor is changed by the refusal."""
+    from hairtool.mocap.pose_edit import PoseEditor, RetimeEdit, apply_edits
+
+    m, keys, col, name = keyed
+    per = ChannelEditor(m, keys, "hermite")
+    _, f = _inner(keys[col])
+    with pytest.raises(ParameterError, match="an edit of per-channel keys"):
+        per.apply_all([RetimeEdit(f, f + 1)])
+    assert per.reports == [] and np.array_equal(per.motion().values, m.values)
+    pose = PoseEditor(m, keys[col], "hermite")
+    with pytest.raises(ParameterError, match="an edit of the pose keys"):
+        pose.apply_all([ChannelRetimeEdit(f, ARM, name, f + 1)])
+    assert pose.reports == [] and np.array_equal(pose.keys, keys[col])
+    with pytest.raises(ParameterError, match="edit="):
+        apply_edits(pose, ["retime"])
+    assert [r.method for r in apply_edits(pose, [RetimeEdit(f, f + 1)])] == ["retime"]
