@@ -304,3 +304,45 @@ def test_on_hair_the_strands_feature_channels_are_read_only_views_of_the_key_cho
     np.testing.assert_array_equal(view.curves[3].result, root[:, 0])
     dock.features.setChecked(False)
     assert [c.name for c in view.curves] == ["x", "y", "z"]
+
+
+def test_a_projects_capture_edits_replay_through_the_cli_to_the_studios_motion(ui, graph, tmp_path, capsys):
+    """Issue 30: ``hairtool keys --edit`` reads what the studio keeps of a capture (an IK drag, a
+    pose key moved in time and value, a per-channel key moved in time and value) and writes the
+    studio's edited capture, the same BVH bytes, given the studio's keys and price per key."""
+    import json
+
+    from hairtool.cli import main
+    from hairtool.mocap.bvh import write_bvh
+
+    w, view, motion = graph
+    c, m = w.capture, w.animation
+    j = motion.joint_names.index("mixamorig:LeftHand")
+    start = w.viewport.project(c.pose_positions()[j][None])[0]
+    ui.drag(w.viewport, start, start + np.array([30, -25]))  # an IK pose at the key
+    assert len(c.edits) == 1
+    c.select(ARM)  # the drag selected the hand
+    keys = c.editor.keys.copy()
+    k = 2
+    p = np.array(view.key_point(1, k))
+    ui.drag(view, p, p + np.array([_frames_px(view, 1), -20.0]))  # a pose key in time and value
+    w.graph_editor.per_channel.setChecked(True)
+    i = 2
+    own = view.curves[i].keys
+    k = int(np.argmax(np.minimum(np.diff(own)[:-1], np.diff(own)[1:]))) + 1
+    p = np.array(view.key_point(i, k))
+    ui.drag(view, p, p + np.array([_frames_px(view, -1), 25.0]))  # one channel's key
+    assert len(c.edits) == 3 and len(c.channel_edits) == 2 and w.undo_stack.count() == 3
+    studio = tmp_path / "studio.bvh"
+    write_bvh(studio, c.motion())
+    path = tmp_path / "capture.json"
+    path.write_text(json.dumps(c.to_settings()))  # the project's capture object as is
+    out = tmp_path / "cli.bvh"
+    src = tmp_path / "in.bvh"
+    src.write_text(c.to_settings()["bvh"])  # the capture the project keeps
+    argv = ["keys", str(src), "--keys", str(keys.size), "--pin", ",".join(map(str, m.solved_keys.tolist()))]
+    argv += ["--interp", c.editor.interp, "--edit", str(path), "--export", str(out)]
+    argv += ["--channel-price", str(m.settings.tau)]
+    assert main(argv) == 0, capsys.readouterr().err
+    assert out.read_bytes() == studio.read_bytes()
+    assert not np.array_equal(read_bvh(out).values, motion.values)
