@@ -470,11 +470,7 @@ class AnimationModel(QObject):
             return
         self.dp_keys = self.solved_keys = keys
         self.uniform_keys = uniform_keys(self.n_frames, keys.size)
-        self._set_key_poses()
-        self.keys_changed.emit()
-        if self.view_mode != "original":
-            self.display_changed.emit()
-        self.request_analysis()
+        self._keys_set()
 
     def set_edited_keys(self, keys: np.ndarray) -> None:
         """The keys after a key was moved in time (a graph editor's drag, or its undo): shown in
@@ -487,6 +483,10 @@ class AnimationModel(QObject):
         self.dp_keys = keys
         if self.uniform_keys is None or self.uniform_keys.size != keys.size:
             self.uniform_keys = uniform_keys(self.n_frames, keys.size)
+        self._keys_set()
+
+    def _keys_set(self) -> None:
+        """New keys are in place: their poses, the dope sheet, the display and the errors follow."""
         self._set_key_poses()
         self.keys_changed.emit()
         if self.view_mode != "original":

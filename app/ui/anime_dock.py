@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
-from PySide6.QtGui import QColor, QPainter, QPainterPath, QPen
+from PySide6.QtGui import QColor, QPainter, QPen
 from PySide6.QtWidgets import (
     QDockWidget,
     QDoubleSpinBox,
@@ -37,6 +37,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.ui.qt_utils import signals_blocked
+from app.ui.timeline_plots import polygon
 from app.ui.widgets import SliderSpin
 from hairtool.anime.schedule import Schedule
 from hairtool.anime.settings import AnimeSettings, wave_curves
@@ -89,12 +90,11 @@ class WavePlot(QWidget):
         p.drawEllipse(to_px(0.0, 0.0), 3.5, 3.5)  # the root
         n = len(self.curves)
         for i, c in enumerate(self.curves):
-            path = QPainterPath(to_px(*c[0]))
-            for x, y in c[1:]:
-                path.lineTo(to_px(x, y))
+            xy = np.asarray(c, dtype=np.float64).reshape(-1, 2)
             p.setPen(QPen(picture_colour(i, n), 2.0))
             p.setBrush(Qt.BrushStyle.NoBrush)
-            p.drawPath(path)
+            xs, ys = m + w * xy[:, 0] / np.pi, m + h * (hi - xy[:, 1]) / (hi - lo)
+            p.drawPolyline(polygon(xs, ys))  # one call: QPainterPath.lineTo leaks in PySide6 6.12
 
 
 class ExposureStrip(QWidget):

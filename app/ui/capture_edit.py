@@ -28,13 +28,9 @@ from app.ui.animation_io import skeleton_animation
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.keys.channels import per_channel_keys
 from hairtool.mocap.bvh import Motion, read_bvh, write_bvh
-from hairtool.mocap.channel_edit import (
-    ChannelEditor,
-    ChannelRetimeEdit,
-    channel_features,
-    parse_channel_edits,
-)
-from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, RetimeEdit, parse_edit_list
+from hairtool.mocap.channel_edit import ChannelEditor, ChannelRetimeEdit, channel_features
+from hairtool.mocap.edit_file import parse_capture_edits
+from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, RetimeEdit
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
@@ -533,8 +529,9 @@ class CaptureEditor(QObject):
             motion = motion_from_text(saved.get("bvh"), where)
             if skeleton_animation(motion).topology != self.model.animation.topology:
                 raise FormatError(where, "the capture's skeleton is not the project's animation")
-            edits = parse_edit_list(saved.get("edits", []), motion, where)
-            channel_edits = parse_channel_edits(saved.get("channel_edits", []), motion, where)
+            lists = {k: saved[k] for k in ("edits", "channel_edits") if k in saved}
+            read = parse_capture_edits(lists, motion, where)  # what `hairtool keys --edit` reads
+            edits, channel_edits = read.edits, read.channel_edits
         except HairtoolError as e:
             self.window.show_error("Some project settings were not applied", str(e))
             return

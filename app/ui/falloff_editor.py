@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
-from PySide6.QtGui import QColor, QMouseEvent, QPainter, QPainterPath, QPen
+from PySide6.QtGui import QColor, QMouseEvent, QPainter, QPen
 from PySide6.QtWidgets import QSizePolicy, QWidget
 
+from app.ui.timeline_plots import polygon
 from hairtool.frozen.brushes import falloff_lut
 
 PICK_PX = 8.0  # a press this close to a point grabs it
@@ -150,12 +151,11 @@ class FalloffEditor(QWidget):
         p.drawRect(r)
         lut = falloff_lut(self._falloff)
         t = np.linspace(0.0, 1.0, len(lut))
-        path = QPainterPath(self._to_px(0.0, float(lut[0])))
-        for a, b in zip(t[1:], lut[1:], strict=True):
-            path.lineTo(self._to_px(float(a), float(b)))
+        xs, ys = r.left() + t * r.width(), r.bottom() - np.asarray(lut, dtype=np.float64) * r.height()
         enabled = self.isEnabled()
         p.setPen(QPen(QColor(255, 140, 26) if enabled else QColor(120, 120, 120), 2.0))
-        p.drawPath(path)
+        p.setBrush(Qt.BrushStyle.NoBrush)
+        p.drawPolyline(polygon(xs, ys))  # one call: QPainterPath.lineTo leaks in PySide6 6.12
         if enabled:  # a preset's handles are where its points will be once edited
             p.setBrush(QColor(255, 255, 255))
             p.setPen(QPen(QColor(40, 40, 40), 1.0))

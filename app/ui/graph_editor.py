@@ -9,10 +9,13 @@ moves it in value — one :class:`hairtool.mocap.pose_edit.ChannelEdit`, carried
 around the key with the residuals kept, exactly as an IK drag is, one undo step — and dragging
 a handle end sets the slope the key curve passes the key with (a
 :class:`~hairtool.mocap.pose_edit.TangentEdit`, both handles aligned on it); the viewport, the
-timeline's errors and the curves follow. Keys do not move in time here: the
-library's edit keeps the key frames (they are the timeline's solved keys; pin or move them in
-the dope sheet). Navigation as in Blender's Graph Editor: the wheel zooms about the cursor,
-middle-drag pans, Ctrl+middle-drag zooms each axis, Home frames every curve.
+timeline's errors and the curves follow. Dragged sideways a key moves in time, snapped to a
+whole frame strictly between its neighbours (a :class:`~hairtool.mocap.pose_edit.RetimeEdit`).
+With "Per-channel keys" each rotation channel shows its own keys (seed 003), edited the same way
+on that channel alone. On a hair animation the curves are a strand vertex's x, y, z (editable
+the same three ways, :mod:`app.ui.hair_channels`) and the strand's feature channels, read-only.
+Navigation as in Blender's Graph Editor: the wheel zooms about the cursor, middle-drag pans,
+Ctrl+middle-drag zooms each axis, Home frames every curve.
 """
 
 from __future__ import annotations
@@ -23,11 +26,20 @@ from typing import TYPE_CHECKING
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPainter, QPen, QWheelEvent
-from PySide6.QtWidgets import QCheckBox, QDockWidget, QHBoxLayout, QLabel, QSpinBox, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QDockWidget,
+    QHBoxLayout,
+    QLabel,
+    QSpinBox,
+    QToolTip,
+    QVBoxLayout,
+    QWidget,
+)
 
 from app.ui import view_range
 from app.ui.capture_edit import CaptureEditor
-from app.ui.hair_channels import HairChannels
+from app.ui.hair_channels import READ_ONLY, HairChannels
 from app.ui.timeline_plots import polygon
 from hairtool.mocap import ik
 from hairtool.mocap.channel_edit import ChannelRetimeEdit
@@ -61,13 +73,20 @@ class Curve:
     values: np.ndarray
     slope_in: np.ndarray | None
     slope_out: np.ndarray | None
+    editable: bool = True  # False: a view (a hair strand's feature channels), keys not dragged
 
 
 def hair_curves(hair: HairChannels) -> list[Curve]:
-    """The chosen strand vertex's x, y, z of a hair animation (none without one)."""
+    """The chosen strand vertex's x, y, z of a hair animation (none without one), then, when
+    shown, the strand's feature channels at the matching sample (read-only, lighter)."""
     if not hair.active:
         return []
-    return [Curve(n, AXIS_COLOURS[n.upper()], *rest) for n, *rest in hair.channels()]
+    out = [Curve(n, AXIS_COLOURS[n.upper()], *rest) for n, *rest in hair.channels()]
+    if hair.features:
+        for n, *rest in hair.feature_channels():
+            colour = QColor(AXIS_COLOURS[n[-1].upper()]).lighter(160)
+            out.append(Curve(n, colour, *rest, editable=False))
+    return out
 
 
 def capture_curves(capture: CaptureEditor) -> list[Curve]:
@@ -155,6 +174,7 @@ class GraphView(QWidget):
         self._drag: tuple | None = None
         self._framed_for: tuple | None = None
         self.per_channel = False  # a capture's channels with their own keys (seed 003)
+        self.refused = ""  # why the last press on a read-only curve did not drag
         self.setMinimumSize(240, 120)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMouseTracking(False)
@@ -237,6 +257,8 @@ class GraphView(QWidget):
         """``(curve, key index)`` of the key point under the pixel, or None."""
         best, hit = PICK_PX, None
         for i, c in enumerate(self.curves):
+            if not c.editable:
+                continue
             kx, ky = self.to_px(c.keys, c.values)
             d = np.hypot(kx - px, ky - py)
             k = int(np.argmin(d))
@@ -264,7 +286,7 @@ class GraphView(QWidget):
         """``(curve, key index, side)`` of the handle end under the pixel, or None."""
         best, hit = PICK_PX, None
         for i, c in enumerate(self.curves):
-            if c.slope_in is None:
+            if c.slope_in is None or not c.editable:
                 continue
             for k in range(c.keys.size):
                 left, right = self._arms(c, k)
@@ -276,6 +298,17 @@ class GraphView(QWidget):
                     if d <= best:
                         best, hit = d, (i, k, side)
         return hit
+
+    def read_only_at(self, px: float, py: float) -> int | None:
+        """The read-only curve whose key point is under the pixel (a press there says why it
+        does not drag), or None."""
+        for i, c in enumerate(self.curves):
+            if c.editable:
+                continue
+            kx, ky = self.to_px(c.keys, c.values)
+            if np.min(np.hypot(kx - px, ky - py)) <= PICK_PX:
+                return i
+        return None
 
     def key_point(self, curve: int, key: int) -> tuple[float, float]:
         """A key's pixel position (tests press there)."""
@@ -315,6 +348,12 @@ class GraphView(QWidget):
                     self._drag = ("key", p, hit, float(c.values[k]), int(c.keys[k]))
                 else:
                     self._drag = ("handle", p, handle, 0.0)
+            elif self.read_only_at(p.x(), p.y()) is not None:
+                self.refused = READ_ONLY
+                QToolTip.showText(self.mapToGlobal(p.toPoint()), READ_ONLY, self)
+                window = self.window()
+                if hasattr(window, "statusBar"):
+                    window.statusBar().showMessage(READ_ONLY, 8000)
         event.accept()
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
@@ -476,7 +515,7 @@ class GraphView(QWidget):
             faint.setAlpha(60)
             self._line(painter, c.original, QPen(faint, 1.0))
             self._line(painter, c.key_curve, QPen(c.colour, 1.0, Qt.PenStyle.DashLine))
-            self._line(painter, c.result, QPen(c.colour, 1.6))
+            self._line(painter, c.result, QPen(c.colour, 1.6 if c.editable else 1.0))
             self._keys(painter, c)
         painter.end()
 
@@ -504,7 +543,7 @@ class GraphView(QWidget):
 
     def _keys(self, painter: QPainter, c: Curve) -> None:
         kx, ky = self.to_px(c.keys, c.values)
-        if c.slope_in is not None:
+        if c.slope_in is not None and c.editable:
             painter.setPen(QPen(QColor(220, 220, 220, 160), 1))
             i = self.curves.index(c)
             for k in range(c.keys.size):
@@ -513,8 +552,12 @@ class GraphView(QWidget):
                 painter.drawLine(a, b)
                 for h in (a, b):
                     painter.drawEllipse(h, 2.5, 2.5)
-        painter.setPen(QPen(QColor(20, 20, 20), 1))
-        painter.setBrush(c.colour)
+        if c.editable:
+            painter.setPen(QPen(QColor(20, 20, 20), 1))
+            painter.setBrush(c.colour)
+        else:  # hollow: a view, not dragged
+            painter.setPen(QPen(c.colour, 1))
+            painter.setBrush(Qt.BrushStyle.NoBrush)
         for x, y in zip(kx, ky, strict=True):
             painter.drawRect(QRectF(float(x) - 3.5, float(y) - 3.5, 7.0, 7.0))
 
@@ -550,7 +593,19 @@ class GraphEditorDock(QDockWidget):
         )
         self.per_channel.toggled.connect(self._set_per_channel)
         top.addWidget(self.per_channel)
-        self.pickers = [QLabel("Strand"), self.strand, QLabel("Vertex"), self.vertex]
+        self.features = QCheckBox("Feature channels")
+        self.features.setChecked(self.hair.features)
+        self.features.setToolTip(
+            "Also show the strand's feature channels at the sample as far along it as the vertex "
+            "(lighter curves, hollow keys): the strand resampled along its length, relative to its "
+            "root, the mean root removed, weighted toward the tip, which is what the key choice "
+            "measures, with the key curve it fits through the keys (seed 000). Read-only: a "
+            "resampled point slides between the vertices, so a value set there names no single "
+            "pose; drag the vertex's x, y, z keys to edit"
+        )
+        self.features.toggled.connect(self._set_features)
+        top.addWidget(self.features)
+        self.pickers = [self.features, QLabel("Strand"), self.strand, QLabel("Vertex"), self.vertex]
         for widget in self.pickers:
             top.addWidget(widget)
         body = QWidget()
@@ -560,8 +615,9 @@ class GraphEditorDock(QDockWidget):
         layout.addWidget(self.view, 1)
         self.setWidget(body)
         self.setToolTip(
-            "Drag a key up or down to move it in value (the change spreads to the frames around it "
-            "with the captured detail kept; keys stay on their frames). Wheel: zoom; middle-drag: "
+            "Drag a key up or down to move it in value, sideways to move it in time, or a handle "
+            "end to turn it (the change spreads to the frames around it with the captured detail "
+            "kept). Hollow keys are feature channels, shown, not edited. Wheel: zoom; middle-drag: "
             "pan; Ctrl+middle-drag: zoom each axis; Home: frame all"
         )
         window.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self)
@@ -582,6 +638,10 @@ class GraphEditorDock(QDockWidget):
         self.view.per_channel = bool(on)
         self.refresh()
 
+    def _set_features(self, on: bool) -> None:
+        self.hair.features = bool(on)
+        self.refresh()
+
     def _pick_vertex(self, *_: object) -> None:
         self.hair.strand, self.hair.vertex = self.strand.value(), self.vertex.value()
         self.view.refresh()
@@ -597,7 +657,8 @@ class GraphEditorDock(QDockWidget):
             self.strand.setMaximum(topo.strand_count - 1)
             s = min(self.strand.value(), topo.strand_count - 1)
             self.vertex.setMaximum(int(topo.offsets[s + 1] - topo.offsets[s]) - 1)
-            self.title.setText("strand vertex: x, y, z")
+            shown = ", its strand's features (read-only)" if self.hair.features else ""
+            self.title.setText(f"strand vertex: x, y, z{shown}")
         else:
             each = ", each with its own keys" if self.view.per_channel else ""
             shown = c.attached and c.joint

@@ -11,6 +11,16 @@ retimed with it, the timeline's keys the moved ones). The handles are the key po
 tangents, which the timeline takes from the frames themselves; a handle dragged turns the
 frames between the neighbouring keys so that their own tangent at the key is the slope dragged
 to (:func:`hairtool.keys.edit.key_slope_block`), so the handle stays where it was dropped.
+
+Beside them, the chosen strand's feature channels (seed 000: what the key choice measures, the
+strand resampled by arc length, root-relative, the mean root removed, weighted toward the tip;
+:func:`hairtool.keys.features.strand_features`) at the sample as far along the strand as the
+chosen vertex: as opened (faint), as edited, and the key curve the DP fits through the keys in
+that space. They are read-only: a resampled point lies between vertices and slides along the
+strand as its segments stretch, so a feature value set at a key names no single pose of the
+strand's vertices (many poses resample to it), and there is no residual-keeping edit to give
+it; without resampling a feature is a vertex's coordinates moved and scaled, which the vertex
+curves edit already.
 """
 
 from __future__ import annotations
@@ -22,13 +32,20 @@ from PySide6.QtGui import QUndoCommand
 
 from app.ui.animation_ui import KeyEditCommand
 from hairtool.keys.edit import check_retime, key_slope_block, retime_key
-from hairtool.keys.reconstruct import KeyPoses, interpolate_at
+from hairtool.keys.features import strand_features
+from hairtool.keys.reconstruct import KeyPoses, interpolate_at, key_poses
 from hairtool.keys.session import key_edit_block
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
 
 AXES = ("x", "y", "z")
+READ_ONLY = (
+    "Feature channels are what the key choice measures (the strand resampled along its length, "
+    "relative to its root, weighted toward the tip): shown, not edited, because a resampled "
+    "point slides between the strand's vertices, so a value set here names no single pose. "
+    "Drag the vertex's x, y and z keys to edit"
+)
 
 
 class HairChannels:
@@ -37,6 +54,7 @@ class HairChannels:
     def __init__(self, window: StudioHost) -> None:
         self.window, self.model = window, window.animation
         self.strand, self.vertex = 0, -1
+        self.features = True  # the strand's feature channels beside the vertex's coordinates
         self.loaded = None  # the animation as opened (the faint curves)
         self.model.animation_changed.connect(self._on_animation_changed)
         self._on_animation_changed()
@@ -88,6 +106,42 @@ class HairChannels:
             out.append(
                 (name, original[:, i], result[:, i], key_curve[:, i], kp.keys, kp.poses[:, i], s_in, s_out)
             )
+        return out
+
+    def sample(self) -> int:
+        """The feature sample shown: as far along the strand as the chosen vertex (the tip: the
+        last sample; the original vertices when the features do not resample)."""
+        topo = self.model.animation.topology
+        s = int(np.clip(self.strand, 0, topo.strand_count - 1))
+        n = int(topo.offsets[s + 1] - topo.offsets[s])
+        v = self.index() - int(topo.offsets[s])
+        m = self.model.settings.feature_options().samples
+        if m is None:
+            return v
+        return round(v / max(n - 1, 1) * (int(m) - 1))
+
+    def feature_channels(self) -> list[tuple]:
+        """Per axis of the chosen strand's feature sample (:meth:`sample`): (name, original,
+        result, key curve, keys, key values, slope in, slope out), the key curve and its handles
+        those the key choice fits through the timeline's keys in feature space
+        (:func:`hairtool.keys.features.strand_features` of the animation as opened and as now)."""
+        m = self.model
+        anim, options = m.animation, m.settings.feature_options()
+        s = int(np.clip(self.strand, 0, anim.topology.strand_count - 1))
+        i = self.sample()
+        result = strand_features(anim, s, options)[:, i]
+        loaded = self.loaded
+        same = loaded is not None and loaded.frames.shape == anim.frames.shape
+        original = strand_features(loaded, s, options)[:, i] if same else result
+        kp = key_poses(result, m.dp_keys, m.dp_poses.interp)
+        key_curve = interpolate_at(kp, np.arange(anim.n_frames))
+        arriving = kp.tangents if kp.tangents_in is None else kp.tangents_in
+        out = []
+        for a, name in enumerate(AXES):
+            s_in = None if arriving is None else arriving[:, a]
+            s_out = None if kp.tangents is None else kp.tangents[:, a]
+            curves = (original[:, a], result[:, a], key_curve[:, a])
+            out.append((f"feature {name}", *curves, kp.keys, kp.poses[:, a], s_in, s_out))
         return out
 
     def edited_block(
@@ -146,7 +200,6 @@ class HairChannels:
             command = HairKeyTimeCommand(m, start, before, block, m.dp_keys.copy(), keys)
             command.setText(f"Move key {key} to {to}")
         self.window.undo_stack.push(command)
-
 
     # -- handles --------------------------------------------------------------------------------
     def slope_block(self, axis: int, key: int, slope: float) -> tuple[int, np.ndarray]:

@@ -95,8 +95,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--edit",
         type=Path,
         metavar="EDITS.json",
-        help="BVH: key poses moved by IK, a list of {frame (a key), joint, target [x, y, z], chain (how many "
-        "joints above it turn)}; with --export OUT.bvh writes the edited capture, the captured detail kept",
+        help="BVH: the edits a studio project keeps, replayed: a list of edits of the pose keys, or a "
+        'project\'s capture object {"edits": [...], "channel_edits": [...]}; each edit a pose by IK {frame '
+        "(a key), joint, target [x, y, z], chain (how many joints above it turn)}, a key moved in time "
+        "{frame, to}, a key's value {frame, joint, channel, value} or handle {frame, joint, channel, "
+        "slope}, or (channel_edits) one channel's key moved {frame, joint, channel, to}; with --export "
+        "OUT.bvh writes the edited capture, the captured detail kept",
+    )
+    parser.add_argument(
+        "--channel-price",
+        type=float,
+        default=0.01,
+        metavar="TAU",
+        help="with --edit: the price per key (a share of each channel's two-key error) of the channels' "
+        "own keys that channel_edits move, as the studio's price per key (default 0.01, the studio's)",
     )
     parser.add_argument(
         "--storage",
@@ -361,15 +373,15 @@ def _read_edits(args: argparse.Namespace, kind: str, data):
 
     if kind != "bvh":
         raise ParameterError("edit", str(args.edit), "a .bvh input (edits move a skeleton's joints)")
-    from hairtool.mocap.pose_edit import read_edits
+    from hairtool.mocap.edit_file import read_capture_edits
 
-    return read_edits(args.edit, data)
+    return read_capture_edits(args.edit, data)
 
 
 def _export_bvh(args: argparse.Namespace, kind: str, data, keys, result: dict) -> None:
     """``--export OUT.bvh``: the capture with ``--edit``'s key poses (residuals kept), or the key
     curve itself (the reduced motion); the input's hierarchy, offsets, channels and frame time."""
-    from hairtool.errors import FormatError, ParameterError
+    from hairtool.errors import ParameterError
     from hairtool.mocap.bvh import write_bvh
 
     if kind != "bvh":
@@ -382,21 +394,28 @@ def _export_bvh(args: argparse.Namespace, kind: str, data, keys, result: dict) -
     if args.bake:
         why = "no --edit: --bake writes the key curve, --edit the edited capture"
         raise ParameterError("bake", True, why)
-    from hairtool.mocap.pose_edit import PoseEditor
+    from hairtool.mocap.edit_file import replay
 
-    listed = " ".join(map(str, keys.tolist()))
-    for i, e in enumerate(args.edits, 1):
-        if e.frame not in keys:
-            raise FormatError(args.edit, f"edit {i}: frame {e.frame} is not a key; the keys are {listed}")
-    editor = PoseEditor(data, keys, args.interp)
-    result["edits"] = [r.to_dict() for r in editor.apply_all(args.edits)]
-    write_bvh(args.export, editor.motion())
+    price = args.channel_price
+    if not (price >= 0 and price == price and price != float("inf")):
+        raise ParameterError("channel-price", price, "a finite share >= 0")
+    motion, reports = replay(data, keys, args.interp, args.edits, price=price, source=str(args.edit))
+    result["edits"] = [r.to_dict() for r in reports]
+    write_bvh(args.export, motion)
 
 
 def _edit_lines(result: dict) -> str:
     """One line per edit of ``result["edits"]``: where the joint got to, what turned, what followed."""
     text = ""
     for i, r in enumerate(result.get("edits", []), 1):
+        e = r["edit"]
+        if "target" not in e:  # a key's value, handle or move: no effector to reach
+            what = {"channel": "value", "handle": "handle", "retime": "move"}.get(r["method"], r["method"])
+            where = f"{e['joint']} {e['channel']} " if "channel" in e else ""
+            moved = f" to {e['to']}" if "to" in e else ""
+            span = f"frames {r['first']}-{r['last']} follow"
+            text += f"\nedit {i}: {where}key {what} at frame {e['frame']}{moved}; {span}"
+            continue
         text += (
             f"\nedit {i}: {r['edit']['joint']} at frame {r['edit']['frame']} within {r['miss']:.3g} of its "
             f"target ({r['miss_share']:.2g} of the figure's height), turning {', '.join(r['turned'])} "
@@ -413,18 +432,18 @@ def _export_channels_bvh(args: argparse.Namespace, data, keys: list, result: dic
     from hairtool.errors import FormatError
     from hairtool.mocap.bvh import write_bvh
     from hairtool.mocap.channel_edit import ChannelEditor, channel_key_curve
+    from hairtool.mocap.edit_file import apply_each
 
     if args.edits is None:
         write_bvh(args.export, channel_key_curve(data, keys, args.interp))
         return
+    edits = args.edits
+    if edits.project and edits.edits:
+        why = 'the project\'s "edits" are of the pose keys: replay them without --per-channel'
+        raise FormatError(args.edit, why)
     editor = ChannelEditor(data, keys, args.interp)
-    union = editor.union
-    for i, e in enumerate(args.edits, 1):
-        if e.frame not in union:
-            listed = " ".join(map(str, union.tolist()))
-            why = f"edit {i}: frame {e.frame} is not a key of any channel; the keys are {listed}"
-            raise FormatError(args.edit, why)
-    result["edits"] = [r.to_dict() for r in editor.apply_all(args.edits)]
+    todo, label = (edits.channel_edits, "channel edit") if edits.project else (edits.edits, "edit")
+    result["edits"] = [r.to_dict() for r in apply_each(editor, todo, str(args.edit), label)]
     write_bvh(args.export, editor.motion())
 
 

@@ -234,3 +234,35 @@ def frame_features(source: Animation | ArrayLike, options: FeatureOptions | None
             raise GroomError(f"keyframes need an animation of at least 2 frames, got {source.n_frames}")
         return hair_features(source, options)
     return raw_features(source)
+
+
+def strand_features(animation: Animation, strand: int, options: FeatureOptions | None = None) -> F64:
+    """``(F, M, 3)`` one strand's part of :func:`hair_features` (its M points; its vertices
+    without resampling), computed from that strand and the roots alone: what a graph editor
+    draws of the space the keys are fitted in."""
+    o = options or FeatureOptions()
+    o.validate()
+    topo = animation.topology
+    if not 0 <= strand < topo.strand_count:
+        raise ParameterError("strand", strand, f"a strand 0..{topo.strand_count - 1}")
+    lo, hi = int(topo.offsets[strand]), int(topo.offsets[strand + 1])
+    own = animation.frames[:, lo:hi]
+    if o.samples is not None:
+        pts = resample_frames(own, np.array([hi - lo]), int(o.samples))[:, 0]  # (F, M, 3)
+        u = np.linspace(0.0, 1.0, int(o.samples))
+    else:
+        pts = own.astype(np.float64)
+        counts = animation.counts
+        u = (
+            topo.vertex_param[lo:hi].astype(np.float64)
+            if np.any(counts != counts[0])
+            else np.linspace(0.0, 1.0, hi - lo)
+        )
+    roots = animation.frames[:, topo.root_indices].astype(np.float64)  # (F, S, 3)
+    if o.relative:
+        pts = pts - pts[:, :1] if o.samples is not None else pts - roots[:, strand][:, None]
+    if o.center:
+        pts = pts - roots.mean(axis=1)[:, None, :]
+    if o.weighting:
+        pts = pts * strand_weights(u, o)[None, :, None]
+    return pts

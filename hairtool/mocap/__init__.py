@@ -7,7 +7,8 @@ joint features and seed 003's quaternion-distance segment table.
   reconstruction of a motion from its keys;
 - :mod:`.ik` inverse kinematics on one pose (analytic two-bone, damped least squares);
 - :mod:`.pose_edit` seed 003 §5: key poses edited by IK, carried to every frame with the
-  residuals kept; :mod:`.channel_edit` the same on per-channel keys of the BVH channels.
+  residuals kept; :mod:`.channel_edit` the same on per-channel keys of the BVH channels;
+  :mod:`.edit_file` the edits a studio project keeps, read and replayed (``keys --edit``).
 """
 
 from hairtool.mocap.bvh import Motion, read_bvh, write_bvh

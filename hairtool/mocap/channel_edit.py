@@ -11,7 +11,9 @@ then changes by Δ_c times the curve's basis (linear: the hat 1 − s; Hermite: 
 tangents being the same before and after), so only the frames strictly between c's neighbouring
 keys around f change, fading to nothing at them; every other frame and channel stays the capture
 bit for bit. Angles add directly: continuous by construction, with no Euler representation to
-choose.
+choose. At a frame inside a stretch a moved key of c retimed (which shows the capture at a
+fractional frame, so no captured key can go there) the key is added on top of the stretch: its
+change spread by the same basis with flat tangents to c's neighbouring keys there.
 """
 
 from __future__ import annotations
@@ -27,7 +29,15 @@ from hairtool.keys.edit import check_retime, residual_at, time_warp
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at, interpolate_keys, key_poses
 from hairtool.mocap import ik
 from hairtool.mocap.bvh import MAX_VALUE, Motion
-from hairtool.mocap.pose_edit import INTERPS, ChannelEdit, EditReport, PoseEdit, TangentEdit, parse_edit_list
+from hairtool.mocap.pose_edit import (
+    INTERPS,
+    ChannelEdit,
+    EditReport,
+    PoseEdit,
+    TangentEdit,
+    apply_edits,
+    parse_edit_list,
+)
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
@@ -127,18 +137,38 @@ class _Step:
     changes: dict[int, dict[int, float]]
     slopes: dict[int, dict[int, float]] = field(default_factory=dict)
     moves: dict[int, dict[int, int]] = field(default_factory=dict)
+    late: dict[int, dict[int, float]] = field(default_factory=dict)  # keys added in a stretch
 
 
 @dataclass
 class _Channel:
     """A channel's keys as edited: ``knots`` the key frames before any move (the residuals are
-    measured against the key curve through them), ``keys`` where they are now, and the value
-    and slope changes at each."""
+    measured against the key curve through them), ``keys`` where they are now, the value and
+    slope changes at each, and ``late``: keys an edit added at frames a moved key stretched
+    ({frame now: the change there}, see :meth:`ChannelEditor.apply`)."""
 
     knots: I64
     keys: I64
     change: F64
     slope: F64
+    late: dict[int, float] = field(default_factory=dict)
+
+    @property
+    def all_keys(self) -> I64:
+        return np.union1d(self.keys, np.fromiter(self.late, dtype=np.int64)) if self.late else self.keys
+
+
+def _hermite_slope(kp: KeyPoses, t: float) -> float:
+    """d/dt of a one-channel Hermite key curve at frame t strictly inside a segment."""
+    a = int(np.searchsorted(kp.keys, t, side="right") - 1)
+    k0, k1 = float(kp.keys[a]), float(kp.keys[a + 1])
+    span = k1 - k0
+    s = (t - k0) / span
+    arriving = kp.tangents if kp.tangents_in is None else kp.tangents_in
+    p0, p1 = float(kp.poses[a, 0]), float(kp.poses[a + 1, 0])
+    m0, m1 = float(kp.tangents[a, 0]), float(arriving[a + 1, 0])
+    d00, d10, d01, d11 = 6 * s * s - 6 * s, 3 * s * s - 4 * s + 1, 6 * s - 6 * s * s, 3 * s * s - 2 * s
+    return (d00 * p0 + d01 * p1) / span + d10 * m0 + d11 * m1
 
 
 class ChannelEditor:
@@ -152,6 +182,12 @@ class ChannelEditor:
     stretched, the curve there plus the residual of the frame it now shows
     (:func:`hairtool.keys.edit.retime_key`), on the unwrapped angles, written back within the
     capture's own whole turns."""
+
+    RETIME = ChannelRetimeEdit  # the key moves it makes: one channel's key
+    KINDS = (
+        "an edit of per-channel keys: an IK pose, one channel's key value, handle or move in "
+        "time (a pose key moved in time moves every channel: the pose keys' edits)"
+    )
 
     def __init__(self, motion: Motion, keys: list[ArrayLike], interp: str = "hermite") -> None:
         if interp not in INTERPS:
@@ -175,7 +211,7 @@ class ChannelEditor:
         return total
 
     def _touched(self) -> set[int]:
-        return {c for s in self._history for part in (s.changes, s.slopes, s.moves) for c in part}
+        return {c for s in self._history for part in (s.changes, s.slopes, s.moves, s.late) for c in part}
 
     def _channel(self, c: int) -> _Channel:
         knots = self._keys0[c]
@@ -190,12 +226,13 @@ class ChannelEditor:
                 slope[np.searchsorted(knots, f)] += d
             for f, to in s.moves.get(c, {}).items():
                 moved[np.searchsorted(knots, f)] = to
-        return _Channel(knots, moved, change, slope)
+        late = {f: v for s in self._history for f, v in s.late.get(c, {}).items()}  # the last wins
+        return _Channel(knots, moved, change, slope, late)
 
     def keys(self, channel: int) -> I64:
         """A channel's keys now: its solved keys, the frames edits added to it, moved ones where
         they were moved to."""
-        return self._channel(channel).keys
+        return self._channel(channel).all_keys
 
     @property
     def union(self) -> I64:
@@ -250,7 +287,21 @@ class ChannelEditor:
             curve = interpolate_at(self._edited_curve(c, ch), t)[:, 0]
             r = residual_at(x, lambda i: interpolate_at(base, i), time_warp(t, ch.keys, ch.knots))[:, 0]
             out[warped] = curve + r + (m.values[t, c] - self._unwrapped[t, c])
+        if ch.late:
+            out += self._late(ch, frames)
         return out
+
+    def _late(self, ch: _Channel, frames: I64) -> F64:
+        """The change the keys added in a stretch give ``frames``: each key's change there spread
+        by the curve's basis to its neighbouring keys (flat tangents: the curve it was added to
+        keeps its slope there), so it fades to nothing at them."""
+        knots = ch.all_keys
+        values = np.array([ch.late.get(int(k), 0.0) for k in knots])[:, None]
+        if self.interp == "linear":
+            kp = KeyPoses(knots, values, None, self.original.n_frames, "linear")
+        else:
+            kp = KeyPoses(knots, values, np.zeros_like(values), self.original.n_frames, "hermite")
+        return interpolate_at(kp, frames)[:, 0]
 
     def _span(self, c: int, f: int) -> tuple[int, int]:
         """``[start, stop)``: the frames a move of channel c's key at f changes."""
@@ -283,20 +334,33 @@ class ChannelEditor:
         ch = self._channel(c)
         frames = np.arange(self.original.n_frames)
         curve = interpolate_at(self._edited_curve(c, ch), frames)[:, 0]
+        if ch.late:
+            curve = curve + self._late(ch, frames)
         return curve + (self.original.values[:, c] - self._unwrapped[:, c])
 
     def key_slopes(self, c: int) -> tuple[F64, F64] | None:
-        """``(in, out)`` slopes (per frame) of channel c's key curve at its keys; None for linear."""
-        kp = self._edited_curve(c, self._channel(c))
+        """``(in, out)`` slopes (per frame) of channel c's key curve at its keys; None for linear.
+        A key added in a stretch has the slope the curve had there (its handle is not turned)."""
+        ch = self._channel(c)
+        kp = self._edited_curve(c, ch)
         if kp.tangents is None:
             return None
         arriving = kp.tangents if kp.tangents_in is None else kp.tangents_in
-        return arriving[:, 0].copy(), kp.tangents[:, 0].copy()
+        s_in, s_out = arriving[:, 0].copy(), kp.tangents[:, 0].copy()
+        late = [f for f in sorted(ch.late) if f not in ch.keys]
+        if late:  # the slope the curve had there: the added key's change spreads with flat tangents
+            slopes = [_hermite_slope(kp, float(f)) for f in late]
+            at = np.searchsorted(ch.keys, late)
+            s_in, s_out = np.insert(s_in, at, slopes), np.insert(s_out, at, slopes)
+        return s_in, s_out
 
     # -- editing ---------------------------------------------------------------------------
     def _knot(self, c: int, frame: int, what: str) -> tuple[_Channel, int]:
         ch = self._channel(c)
         hit = np.flatnonzero(ch.keys == frame)
+        if hit.size == 0 and frame in ch.late:
+            why = f"a key of the {what} channel other than one a pose added where a moved key stretched"
+            raise ParameterError("frame", frame, f"{why} (that key moves in value only)")
         if hit.size == 0:
             keys = " ".join(map(str, ch.keys.tolist()[:12]))
             raise ParameterError("frame", frame, f"a key of the {what} channel: {keys}")
@@ -311,6 +375,13 @@ class ChannelEditor:
         c = self.column(edit.joint, edit.channel)
         if not (math.isfinite(edit.value) and abs(edit.value) <= MAX_VALUE):
             raise ParameterError("value", edit.value, "a finite number")
+        ch = self._channel(c)
+        if edit.frame in ch.late and edit.frame not in ch.keys:  # a key a pose added in a stretch
+            now = self._values(c, ch, np.array([edit.frame]))[0]
+            step = _Step(None, {}, late={c: {edit.frame: ch.late[edit.frame] + float(edit.value - now)}})
+            self._history.append(step)
+            step.report = self._report(edit, edit.joint, "channel", c, edit.frame)
+            return step.report
         ch, a = self._knot(c, edit.frame, edit.channel)
         now = self._values(c, ch, np.array([edit.frame]))[0]
         step = _Step(None, {c: {int(ch.knots[a]): float(edit.value - now)}})
@@ -340,7 +411,7 @@ class ChannelEditor:
         first and last frame stay keys); ParameterError otherwise."""
         c = self.column(edit.joint, edit.channel)
         ch, a = self._knot(c, edit.frame, edit.channel)
-        check_retime(ch.keys, self.original.n_frames, edit.frame, edit.to)
+        check_retime(ch.all_keys, self.original.n_frames, edit.frame, edit.to)  # never past a key
         step = _Step(None, {}, moves={c: {int(ch.knots[a]): int(edit.to)}})
         self._history.append(step)
         step.report = self._report(edit, edit.joint, "retime", c, edit.to)
@@ -359,41 +430,38 @@ class ChannelEditor:
         s = ik.solve(m, current, e, edit.chain, edit.target, ik.TOLERANCE * self.height, method)
         turned = ik.ancestors(m, e, edit.chain)
         # A channel's key at the frame moves by what the IK changed; where the frame was not one
-        # of its keys it becomes one, holding the value the edits before gave it there too (a
-        # frame a moved key stretched cannot take a new key: the segment has no captured frame there).
+        # of its keys it becomes one, holding the value the edits before gave it there too. In a
+        # stretch a moved key retimed, the frame shows a fractional frame of the capture, so no
+        # captured key can be put there: the key is added on top ("late"), its change spread to
+        # its neighbouring keys by the curve's basis with flat tangents, so the curve there keeps
+        # its slope and the stretch keeps its retimed detail.
         moves: dict[int, dict[int, float]] = {}
+        late: dict[int, dict[int, float]] = {}
+        f = edit.frame
         for c in np.flatnonzero(s.values != current).tolist():
             ch = self._channel(c)
-            hit = np.flatnonzero(ch.keys == edit.frame)
+            hit = np.flatnonzero(ch.keys == f)
+            delta = float(s.values[c] - current[c])
             if hit.size:
-                moves[c] = {int(ch.knots[hit[0]]): float(s.values[c] - current[c])}
-            elif edit.frame in self._warped(ch):
-                raise ParameterError("frame", edit.frame, "a frame no moved key of the chain stretched")
+                moves[c] = {int(ch.knots[hit[0]]): delta}
+            elif f in self._warped(ch):
+                there = float(self._late(ch, np.array([f]))[0]) if ch.late else 0.0
+                late[c] = {f: there + delta}
             else:
-                moves[c] = {edit.frame: float(s.values[c] - m.values[edit.frame, c])}
+                moves[c] = {f: float(s.values[c] - m.values[f, c])}
         names = [m.joint_names[j] for j in turned]
-        f = edit.frame
         report = EditReport(edit, names, s.method, s.iterations, s.miss, s.miss / self.height, f, f)
-        step = _Step(report, moves)
+        step = _Step(report, moves, late=late)
         self._history.append(step)
-        if moves:
-            spans = [self._span(c, edit.frame) for c in moves]
+        if moves or late:
+            spans = [self._span(c, edit.frame) for c in (*moves, *late)]
             report.first = min(a for a, _ in spans)
             report.last = max(b for _, b in spans) - 1
         return step.report
 
     def apply_all(self, edits: list, method: str = "auto") -> list[EditReport]:
-        out = []
-        for e in edits:
-            if isinstance(e, ChannelEdit):
-                out.append(self.apply_channel(e))
-            elif isinstance(e, TangentEdit):
-                out.append(self.apply_tangent(e))
-            elif isinstance(e, ChannelRetimeEdit):
-                out.append(self.apply_retime(e))
-            else:
-                out.append(self.apply(e, method))
-        return out
+        """Edits in order, each on what the ones before left (:func:`.pose_edit.apply_edits`)."""
+        return apply_edits(self, edits, method)
 
     def undo(self) -> object | None:
         return self._history.pop().report.edit if self._history else None

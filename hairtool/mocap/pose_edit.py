@@ -252,6 +252,11 @@ def _parse_retime(e: dict, motion: Motion, source: str, i: int) -> RetimeEdit:
 
 def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
     """:func:`parse_edits` of a JSON file; unreadable or invalid JSON raises :class:`FormatError`."""
+    return parse_edits(read_json(path), motion, os.fspath(path))
+
+
+def read_json(path: str | os.PathLike[str]) -> object:
+    """A JSON file's data; unreadable or invalid JSON raises :class:`FormatError` naming it."""
     p = os.fspath(path)
     try:
         with open(p, "rb") as f:
@@ -264,12 +269,38 @@ def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
         raise FormatError(p, f"not valid JSON ({str(e)[:80]})") from None
     except RecursionError:
         raise FormatError(p, "not valid JSON (nested too deep)") from None
-    return parse_edits(data, motion, p)
+    return data
+
+
+def apply_edits(editor, edits: list, method: str = "auto") -> list[EditReport]:
+    """Edits in order on ``editor`` (a :class:`PoseEditor` or a
+    :class:`~hairtool.mocap.channel_edit.ChannelEditor`), each on what the ones before left: a
+    key's value (``apply_channel``), its handle (``apply_tangent``), a key moved in time of the
+    kind that editor keys (``editor.RETIME``: the pose key, or one channel's key;
+    ``apply_retime``), an IK pose edit (``apply``). Another kind raises
+    :class:`ParameterError` naming it, so no edit is read as another."""
+    out = []
+    for e in edits:
+        if isinstance(e, ChannelEdit):
+            out.append(editor.apply_channel(e))
+        elif isinstance(e, TangentEdit):
+            out.append(editor.apply_tangent(e))
+        elif isinstance(e, editor.RETIME):
+            out.append(editor.apply_retime(e))
+        elif isinstance(e, PoseEdit):
+            out.append(editor.apply(e, method))
+        else:
+            shown = e.to_dict() if hasattr(e, "to_dict") else repr(e)[:80]
+            raise ParameterError("edit", shown, editor.KINDS)
+    return out
 
 
 class PoseEditor:
     """A capture, its keys, and its key poses as edited so far; the original is kept, so
     edits undo (:meth:`undo`, :meth:`reset`) and compose (each solve starts from the edited pose)."""
+
+    RETIME = RetimeEdit  # the key moves it makes: the pose key, every channel
+    KINDS = "an edit of the pose keys: an IK pose, a key's value, its handle or its move in time"
 
     def __init__(self, motion: Motion, keys: ArrayLike, interp: str = "linear") -> None:
         if interp not in INTERPS:
@@ -475,19 +506,8 @@ class PoseEditor:
         return np.flatnonzero(np.any(out != b_out, axis=1) | np.any(inn != b_in, axis=1))
 
     def apply_all(self, edits: list[Edit], method: str = "auto") -> list[EditReport]:
-        """Edits in order, each on the pose the ones before it left (channel and handle edits as
-        :meth:`apply_channel` and :meth:`apply_tangent`)."""
-        out = []
-        for e in edits:
-            if isinstance(e, ChannelEdit):
-                out.append(self.apply_channel(e))
-            elif isinstance(e, TangentEdit):
-                out.append(self.apply_tangent(e))
-            elif isinstance(e, RetimeEdit):
-                out.append(self.apply_retime(e))
-            else:
-                out.append(self.apply(e, method))
-        return out
+        """Edits in order, each on the pose the ones before it left (:func:`apply_edits`)."""
+        return apply_edits(self, edits, method)
 
     def undo(self) -> Edit | None:
         """Take back the last edit (None when there is none)."""

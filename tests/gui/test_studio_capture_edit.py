@@ -231,7 +231,8 @@ def test_on_hair_the_graph_editor_moves_a_vertex_key_through_the_timelines_edit(
     view = dock.view
     view.resize(600, 260)
     dock.strand.setValue(2)
-    assert view.on_hair and [c.name for c in view.curves] == ["x", "y", "z"]
+    names = [c.name for c in view.curves]
+    assert view.on_hair and names == ["x", "y", "z", "feature x", "feature y", "feature z"]
     v = int(anim.topology.offsets[3]) - 1  # strand 2's tip
     np.testing.assert_array_equal(view.curves[0].original, anim.frames[:, v, 0])
     keys = w.animation.dp_keys

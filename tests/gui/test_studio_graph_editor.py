@@ -245,3 +245,104 @@ def test_a_project_keeps_the_moved_keys(ui, graph, make_window, tmp_path):
     assert c2.edits == c.edits and c2.channel_edits == c.channel_edits
     np.testing.assert_array_equal(c2.motion().values, edited)
     assert w2.animation.dp_keys.tolist() == w.animation.dp_keys.tolist() != keys.tolist()
+
+
+def test_on_hair_the_strands_feature_channels_are_read_only_views_of_the_key_choice(ui, make_window):
+    """Issue 30 point 4 on hair: the selected strand's feature channels (seed 000's space) drawn
+    beside the vertex's coordinates, original faint behind the key curve through the keys;
+    a press on one of their keys drags nothing and says why; they follow a vertex key's edit."""
+    from app.ui.hair_channels import READ_ONLY
+    from hairtool.keys.features import strand_features
+    from hairtool.keys.reconstruct import interpolate_keys, key_poses
+
+    w, view, anim = _hair(make_window, "hermite")
+    m, dock = w.animation, w.graph_editor
+    assert view.on_hair and dock.features.isVisibleTo(dock) and dock.features.isChecked()
+    assert [c.name for c in view.curves] == ["x", "y", "z", "feature x", "feature y", "feature z"]
+    assert [c.editable for c in view.curves] == [True] * 3 + [False] * 3
+    options = m.settings.feature_options()
+    sample = options.samples - 1  # the tip vertex: the last sample
+    feats = strand_features(anim, 0, options)[:, sample]
+    curve = interpolate_keys(key_poses(feats, m.dp_keys, "hermite"))
+    for a, c in enumerate(view.curves[3:]):
+        np.testing.assert_array_equal(c.original, feats[:, a])
+        np.testing.assert_array_equal(c.result, feats[:, a])
+        np.testing.assert_array_equal(c.key_curve, curve[:, a])
+        assert c.keys.tolist() == m.dp_keys.tolist()
+        np.testing.assert_array_equal(c.values, feats[m.dp_keys, a])
+    # a press on a feature key (away from the vertex's keys) drags nothing and says why
+    editable = np.concatenate([np.column_stack(view.to_px(c.keys, c.values)) for c in view.curves[:3]])
+    picked = None
+    for i in (3, 4, 5):
+        for k in range(1, m.dp_keys.size - 1):
+            p = np.array(view.key_point(i, k))
+            if np.min(np.hypot(*(editable - p).T)) > 3 * 8.0:
+                picked = p
+                break
+        if picked is not None:
+            break
+    assert picked is not None
+    ui.drag(view, picked, picked + np.array([0.0, -30.0]))
+    assert w.undo_stack.count() == 0 and view.refused == READ_ONLY
+    np.testing.assert_array_equal(m.animation.frames, anim.frames)
+    assert "read-only" in dock.features.toolTip().lower() or "not edited" in dock.features.toolTip()
+    # a vertex key moved in value: the features follow the edited hair, the original stays
+    k = 1
+    p = np.array(view.key_point(1, k))
+    ui.drag(view, p, p + np.array([0.0, -40.0]))
+    assert w.undo_stack.count() == 1
+    edited = strand_features(m.animation, 0, options)[:, sample]
+    assert not np.array_equal(edited, feats)
+    for a, c in enumerate(view.curves[3:]):
+        np.testing.assert_array_equal(c.original, feats[:, a])
+        np.testing.assert_array_equal(c.result, edited[:, a])
+    # another strand, another sample along it; the box hides them
+    dock.strand.setValue(3)
+    dock.vertex.setValue(0)
+    assert w.graph_editor.hair.sample() == 0
+    root = strand_features(m.animation, 3, options)[:, 0]
+    np.testing.assert_array_equal(view.curves[3].result, root[:, 0])
+    dock.features.setChecked(False)
+    assert [c.name for c in view.curves] == ["x", "y", "z"]
+
+
+def test_a_projects_capture_edits_replay_through_the_cli_to_the_studios_motion(ui, graph, tmp_path, capsys):
+    """Issue 30: ``hairtool keys --edit`` reads what the studio keeps of a capture (an IK drag, a
+    pose key moved in time and value, a per-channel key moved in time and value) and writes the
+    studio's edited capture, the same BVH bytes, given the studio's keys and price per key."""
+    import json
+
+    from hairtool.cli import main
+    from hairtool.mocap.bvh import write_bvh
+
+    w, view, motion = graph
+    c, m = w.capture, w.animation
+    j = motion.joint_names.index("mixamorig:LeftHand")
+    start = w.viewport.project(c.pose_positions()[j][None])[0]
+    ui.drag(w.viewport, start, start + np.array([30, -25]))  # an IK pose at the key
+    assert len(c.edits) == 1
+    c.select(ARM)  # the drag selected the hand
+    keys = c.editor.keys.copy()
+    k = 2
+    p = np.array(view.key_point(1, k))
+    ui.drag(view, p, p + np.array([_frames_px(view, 1), -20.0]))  # a pose key in time and value
+    w.graph_editor.per_channel.setChecked(True)
+    i = 2
+    own = view.curves[i].keys
+    k = int(np.argmax(np.minimum(np.diff(own)[:-1], np.diff(own)[1:]))) + 1
+    p = np.array(view.key_point(i, k))
+    ui.drag(view, p, p + np.array([_frames_px(view, -1), 25.0]))  # one channel's key
+    assert len(c.edits) == 3 and len(c.channel_edits) == 2 and w.undo_stack.count() == 3
+    studio = tmp_path / "studio.bvh"
+    write_bvh(studio, c.motion())
+    path = tmp_path / "capture.json"
+    path.write_text(json.dumps(c.to_settings()))  # the project's capture object as is
+    out = tmp_path / "cli.bvh"
+    src = tmp_path / "in.bvh"
+    src.write_text(c.to_settings()["bvh"])  # the capture the project keeps
+    argv = ["keys", str(src), "--keys", str(keys.size), "--pin", ",".join(map(str, m.solved_keys.tolist()))]
+    argv += ["--interp", c.editor.interp, "--edit", str(path), "--export", str(out)]
+    argv += ["--channel-price", str(m.settings.tau)]
+    assert main(argv) == 0, capsys.readouterr().err
+    assert out.read_bytes() == studio.read_bytes()
+    assert not np.array_equal(read_bvh(out).values, motion.values)

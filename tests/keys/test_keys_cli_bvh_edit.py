@@ -158,3 +158,140 @@ def test_per_channel_keys_of_the_bvh_channels_edit_the_same_way(motion_dir, tmp_
 
     want = channel_key_curve(m, got["channels"], "hermite").values
     np.testing.assert_allclose(read_bvh(reduced).values, want, rtol=0, atol=5.1e-7)
+
+
+def _bvh_bytes(path, motion):
+    from hairtool.mocap.bvh import write_bvh
+
+    write_bvh(path, motion)
+    return path.read_bytes()
+
+
+def _studio_kinds(m, keys):
+    """One edit of every kind a project keeps of the pose keys: an IK pose, a key moved in time,
+    a key's value at its new frame, a handle."""
+    h = ik.figure_height(m)
+    hand = m.joint_names.index("mixamorig:LeftHand")
+    f = keys[3]
+    target = (m.joint_positions()[f, hand] + [0.0, 0.1 * h, 0.02 * h]).tolist()
+    gaps = np.diff(keys)
+    k = next(i for i in range(1, len(keys) - 1) if i != 3 and gaps[i - 1] > 2 and gaps[i] > 2)
+    to = keys[k] + 1
+    arm = "mixamorig:LeftForeArm"
+    c = m.channels[m.joint_names.index(arm)].index("Yrotation")
+    col = int(m._starts[m.joint_names.index(arm)]) + c
+    return [
+        {"frame": f, "joint": "mixamorig:LeftHand", "target": target, "chain": 2},
+        {"frame": keys[k], "to": to},
+        {"frame": to, "joint": arm, "channel": "Yrotation", "value": float(m.values[to, col]) + 12.0},
+        {"frame": keys[2], "joint": arm, "channel": "Zrotation", "slope": 1.5},
+    ]
+
+
+def test_every_edit_kind_of_a_project_replays_through_the_cli_as_in_the_library(motion_dir, tmp_path, capsys):
+    """Issue 30 (--edit reads what the studio keeps): a list of pose-key edits of every kind, and
+    a project's capture object with per-channel key edits over them, give the library's motion
+    bit for bit (the same BVH bytes)."""
+    from hairtool.keys.channels import per_channel_keys
+    from hairtool.mocap.channel_edit import ChannelEditor, channel_features
+    from hairtool.mocap.edit_file import parse_capture_edits
+    from hairtool.mocap.pose_edit import PoseEditor
+
+    src = motion_dir / "freebvh.bvh"
+    m = read_bvh(src)
+    argv = [src, "--keys", 10, "--interp", "hermite"]
+    keys = _keys(capsys, *argv)["keys"]
+    edits = _studio_kinds(m, keys)
+    out = tmp_path / "cli.bvh"
+    got = _keys(capsys, *argv, "--edit", _write(tmp_path / "list.json", edits), "--export", out)
+    assert [r["method"] for r in got["edits"]][1:] == ["retime", "channel", "handle"]
+    lib = PoseEditor(m, keys, "hermite")
+    lib.apply_all(parse_capture_edits(edits, m).edits)
+    assert out.read_bytes() == _bvh_bytes(tmp_path / "lib.bvh", lib.motion())
+    assert not np.array_equal(read_bvh(out).values, m.values)
+    # the project's capture object: the same pose edits, then per-channel key edits over them
+    price = 0.02
+    ck = per_channel_keys(channel_features(m), price, interp="hermite", relative=True).keys
+    arm = "mixamorig:RightForeArm"
+    col = int(m._starts[m.joint_names.index(arm)]) + m.channels[m.joint_names.index(arm)].index("Xrotation")
+    own = ck[col]
+    k = int(np.argmax(np.minimum(np.diff(own)[:-1], np.diff(own)[1:]))) + 1
+    f0 = int(own[k])
+    channel_edits = [
+        {"frame": f0, "joint": arm, "channel": "Xrotation", "to": f0 + 1},
+        {"frame": f0 + 1, "joint": arm, "channel": "Xrotation", "value": float(m.values[f0, col]) - 9.0},
+        {"frame": int(own[k - 1]), "joint": arm, "channel": "Xrotation", "slope": -0.8},
+    ]
+    project = {
+        "bvh": "(not read)",
+        "source": str(src),
+        "chain": 2,
+        "edits": edits,
+        "channel_edits": channel_edits,
+    }
+    path = _write(tmp_path / "project.json", project)
+    got = _keys(capsys, *argv, "--edit", path, "--export", out, "--channel-price", price)
+    assert len(got["edits"]) == 7
+    layer = ChannelEditor(lib.motion(), ck, "hermite")
+    layer.apply_all(parse_capture_edits(project, m).channel_edits)
+    assert out.read_bytes() == _bvh_bytes(tmp_path / "lib2.bvh", layer.motion())
+    assert not np.array_equal(layer.motion().values, lib.motion().values)
+    # the printed lines say what each edit did
+    assert (
+        main(
+            [
+                "keys",
+                *map(str, argv),
+                "--edit",
+                str(path),
+                "--export",
+                str(out),
+                "--channel-price",
+                str(price),
+            ]
+        )
+        == 0
+    )
+    text = capsys.readouterr().out
+    assert "key move at frame" in text and "Xrotation key value" in text and "handle" in text
+
+
+def test_edits_of_no_kind_or_in_the_wrong_list_are_refused_naming_the_entry(motion_dir, tmp_path, capsys):
+    src = motion_dir / "freebvh.bvh"
+    m = read_bvh(src)
+    keys = _keys(capsys, src, "--keys", 10, "--interp", "hermite")["keys"]
+    edits = _studio_kinds(m, keys)
+    out = tmp_path / "out.bvh"
+    base = [src, "--keys", 10, "--interp", "hermite", "--export", out, "--edit"]
+    path = tmp_path / "edits.json"
+    move = {"frame": keys[2], "joint": "mixamorig:LeftForeArm", "channel": "Yrotation", "to": keys[2] + 1}
+    cases = [
+        ([edits[0], {"frame": keys[2], "scale": 2}], "edit 2 {'frame': "),
+        ([edits[0], {"frame": keys[2], "scale": 2}], "is no edit the studio keeps"),
+        ([edits[1], "retime"], "edit 2 retime is no edit"),
+        ([edits[0], move], "edit 2: edit={'frame'"),  # a channel's own key: not a pose key
+        ([edits[0], move], "an edit of the pose keys"),
+        ({"edits": edits, "channel_edits": [edits[1]]}, "channel edit 1 is a pose key's move in time"),
+        ({"edits": edits, "channel_edits": [edits[0]]}, "channel edit 1 is a pose by IK"),
+        ({"edits": edits, "keys": [0, 1]}, "unknown fields keys"),
+        ({"edits": {"frame": 1}}, '"edits" is not a list'),
+        ({"edits": [], "channel_edits": [{**move, "channel": "Qrotation"}]}, "channel edit 1: 'Qrotation'"),
+        (
+            [edits[1], {**edits[1], "frame": edits[1]["frame"]}],
+            f"edit 2: frame {edits[1]['frame']} is not a key",
+        ),
+    ]
+    for data, words in cases:
+        _write(path, data)
+        _refused(capsys, tmp_path, [*base, path], words)
+    # the moved key is named by its new frame afterwards: a value there replays
+    _write(path, edits[1:3])
+    assert main(["keys", *map(str, [*base, path])]) == 0
+    capsys.readouterr()
+    out.unlink()
+    # per-channel keys take a list of their own edits or a project's channel_edits alone
+    per = [src, "--per-channel", "--penalty", 0.01, "--bvh-features", "channels", "--export", out, "--edit"]
+    _write(path, {"edits": edits, "channel_edits": []})
+    _refused(capsys, tmp_path, [*per, path], "replay them without --per-channel")
+    _write(path, [edits[1]])
+    _refused(capsys, tmp_path, [*per, path], "an edit of per-channel keys")

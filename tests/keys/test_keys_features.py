@@ -121,3 +121,20 @@ def test_raw_features_are_checked():
 def test_one_frame_animation_is_rejected(anim):
     with pytest.raises(GroomError):
         frame_features(anim.with_frames(anim.frames[:1]))
+
+
+@pytest.mark.parametrize("samples_", [16, None, 5])
+def test_one_strands_features_are_its_columns_of_the_frame_vectors(samples_):
+    from hairtool.keys.features import strand_features
+    from hairtool.simulate.sway import sway_animation
+
+    anim = sway_animation(samples.portrait(30, 10, seed=4), 12, flick_frame=6)
+    o = FeatureOptions(samples=samples_, tip_weight=3.0)
+    full = hair_features(anim, o)
+    s_count = anim.topology.strand_count
+    m = full.shape[1] // (s_count * 3)
+    for s in (0, 7, s_count - 1):
+        ref = full.reshape(anim.n_frames, s_count, m, 3)[:, s]
+        np.testing.assert_array_equal(strand_features(anim, s, o), ref)
+    with pytest.raises(ParameterError, match="strand"):
+        strand_features(anim, s_count, o)
