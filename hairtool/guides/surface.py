@@ -22,7 +22,7 @@ from hairtool.guides.inside import barycentric
 from hairtool.io.obj import Mesh
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _closest_on_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
     """Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5)."""
     abx, aby, abz = bx - ax, by - ay, bz - az
@@ -202,7 +202,7 @@ def _child_kernel(points, cface, faces, vertices, label_g, label_d, groots, gfac
                 insert_nearest(out_g, out_d, c, g, d, kk)
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def insert_nearest(out_g, out_d, c, g, d, kk):
     """Put (d, g) into row c's sorted list of the kk best (a guide already there keeps the
     smaller distance)."""
@@ -286,57 +286,142 @@ def _bin_faces(vertices, faces, lo, cell, dims, start, items):  # pragma: no cov
                         fill[c] += 1
 
 
+@njit(cache=True, nogil=True)
+def _empty_rings_kernel(start, dims, rings):  # pragma: no cover - compiled
+    """``rings[c]``: the Chebyshev distance in cells from cell ``c`` to the nearest cell holding a
+    face (0 for such a cell), by sweeping the 26-neighbour minimum until nothing changes."""
+    big = dims[0] + dims[1] + dims[2]
+    for c in range(rings.size):
+        rings[c] = 0 if start[c + 1] > start[c] else big
+    n, forward, changed = rings.size, True, True
+    while changed:  # sweeps forward then backward (a chamfer): a few passes, not one per cell
+        changed = False
+        for t in range(n):
+            c = t if forward else n - 1 - t
+            i, rest = c // (dims[1] * dims[2]), c % (dims[1] * dims[2])
+            j, k = rest // dims[2], rest % dims[2]
+            best = rings[c]
+            for di in range(max(i - 1, 0), min(i + 1, dims[0] - 1) + 1):
+                for dj in range(max(j - 1, 0), min(j + 1, dims[1] - 1) + 1):
+                    for dk in range(max(k - 1, 0), min(k + 1, dims[2] - 1) + 1):
+                        best = min(best, rings[(di * dims[1] + dj) * dims[2] + dk] + 1)
+            if best < rings[c]:
+                rings[c] = best
+                changed = True
+        forward = not forward
+
+
+def empty_rings_numpy(start: np.ndarray, dims: np.ndarray) -> np.ndarray:
+    """:func:`_empty_rings_kernel`'s twin: grow the non-empty cells one 3×3×3 dilation at a time."""
+    shape = tuple(int(d) for d in dims)
+    full = (np.diff(start) > 0).reshape(shape)
+    rings = np.where(full, 0, -1)
+    reached, r = full.copy(), 0
+    while not reached.all() and reached.any():
+        r += 1
+        pad = np.pad(reached, 1)
+        grown = np.zeros_like(reached)
+        for di in (0, 1, 2):
+            for dj in (0, 1, 2):
+                for dk in (0, 1, 2):
+                    grown |= pad[di : di + shape[0], dj : dj + shape[1], dk : dk + shape[2]]
+        rings[grown & ~reached] = r
+        reached = grown
+    return rings.reshape(-1).astype(np.int64)
+
+
+@njit(cache=True, nogil=True)
+def _faces_in_cell(c, px, py, pz, vertices, faces, start, items, best, bf, out, k):  # pragma: no cover
+    for t in range(start[c], start[c + 1]):
+        f = items[t]
+        a, b, e = faces[f, 0], faces[f, 1], faces[f, 2]
+        va, vb, ve = vertices[a], vertices[b], vertices[e]
+        qx, qy, qz = _closest_on_triangle(
+            px, py, pz, va[0], va[1], va[2], vb[0], vb[1], vb[2], ve[0], ve[1], ve[2]
+        )
+        d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
+        if d < best or (d == best and f < bf):
+            best, bf = d, f
+            out[k, 0], out[k, 1], out[k, 2] = qx, qy, qz
+    return best, bf
+
+
+@njit(cache=True, nogil=True)
+def _closest_one(  # pragma: no cover - compiled
+    k, points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of
+):
+    """:func:`closest_points` (same ties: the lower face, whatever the order faces are met in)
+    for points inside the grid's box, visiting shells of cells outward, from the first shell
+    that can hold a face (``rings``), until no unvisited cell can hold a closer one; face −1 for
+    points outside the box. Only a shell's cells are visited: a point far from the mesh costs
+    the shells' surfaces, not their volumes."""
+    px, py, pz = points[k, 0], points[k, 1], points[k, 2]
+    ci = np.empty(3, np.int64)
+    inside = True
+    for a in range(3):
+        f = (points[k, a] - lo[a]) / cell
+        if not (0.0 <= f < dims[a]):
+            inside = False
+        else:
+            ci[a] = int(f)
+    face_of[k] = -1
+    if not inside:
+        return
+    best, bf = np.inf, -1
+    r = rings[(ci[0] * dims[1] + ci[1]) * dims[2] + ci[2]]  # the shells inside hold no face
+    while True:
+        k0, k1 = max(ci[2] - r, 0), min(ci[2] + r, dims[2] - 1)
+        for i in range(max(ci[0] - r, 0), min(ci[0] + r, dims[0] - 1) + 1):
+            for j in range(max(ci[1] - r, 0), min(ci[1] + r, dims[1] - 1) + 1):
+                row = (i * dims[1] + j) * dims[2]
+                if abs(i - ci[0]) == r or abs(j - ci[1]) == r:  # a side of the shell: all of it
+                    for kk in range(k0, k1 + 1):
+                        best, bf = _faces_in_cell(
+                            row + kk, px, py, pz, vertices, faces, start, items, best, bf, out, k
+                        )
+                else:  # inside the shell's cross-section: its two ends along z
+                    if ci[2] - r >= 0:
+                        best, bf = _faces_in_cell(
+                            row + ci[2] - r, px, py, pz, vertices, faces, start, items, best, bf, out, k
+                        )
+                    if r > 0 and ci[2] + r <= dims[2] - 1:
+                        best, bf = _faces_in_cell(
+                            row + ci[2] + r, px, py, pz, vertices, faces, start, items, best, bf, out, k
+                        )
+        # the nearest an unvisited cell can be: across the visited block's unclipped sides
+        reach = np.inf
+        for a in range(3):
+            if ci[a] - r > 0:
+                reach = min(reach, points[k, a] - (lo[a] + (ci[a] - r) * cell))
+            if ci[a] + r < dims[a] - 1:
+                reach = min(reach, lo[a] + (ci[a] + r + 1) * cell - points[k, a])
+        if reach == np.inf or (bf >= 0 and best <= reach * reach):
+            break
+        r += 1
+    face_of[k] = bf
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def _grid_closest_kernel(  # pragma: no cover - compiled
-    points, vertices, faces, lo, cell, dims, start, items, out, face_of
+    points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of
 ):
-    """:func:`closest_points` (same ties: the lower face) for points inside the grid's box,
-    visiting rings of cells outward until no unvisited cell can hold a closer face; face −1
-    for points outside the box."""
+    """:func:`_closest_one` for every point, on every thread."""
     for k in prange(points.shape[0]):
-        px, py, pz = points[k, 0], points[k, 1], points[k, 2]
-        ci = np.empty(3, np.int64)
-        inside = True
-        for a in range(3):
-            f = (points[k, a] - lo[a]) / cell
-            if not (0.0 <= f < dims[a]):
-                inside = False
-            else:
-                ci[a] = int(f)
-        face_of[k] = -1
-        if not inside:
-            continue
-        best, bf = np.inf, -1
-        r = 0
-        while True:
-            for i in range(max(ci[0] - r, 0), min(ci[0] + r, dims[0] - 1) + 1):
-                for j in range(max(ci[1] - r, 0), min(ci[1] + r, dims[1] - 1) + 1):
-                    for kk in range(max(ci[2] - r, 0), min(ci[2] + r, dims[2] - 1) + 1):
-                        if max(abs(i - ci[0]), abs(j - ci[1]), abs(kk - ci[2])) != r:
-                            continue
-                        c = (i * dims[1] + j) * dims[2] + kk
-                        for t in range(start[c], start[c + 1]):
-                            f = items[t]
-                            a, b, e = faces[f, 0], faces[f, 1], faces[f, 2]
-                            va, vb, ve = vertices[a], vertices[b], vertices[e]
-                            qx, qy, qz = _closest_on_triangle(
-                                px, py, pz, va[0], va[1], va[2], vb[0], vb[1], vb[2], ve[0], ve[1], ve[2]
-                            )
-                            d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
-                            if d < best or (d == best and f < bf):
-                                best, bf = d, f
-                                out[k, 0], out[k, 1], out[k, 2] = qx, qy, qz
-            # the nearest an unvisited cell can be: across the visited block's unclipped sides
-            reach = np.inf
-            for a in range(3):
-                if ci[a] - r > 0:
-                    reach = min(reach, points[k, a] - (lo[a] + (ci[a] - r) * cell))
-                if ci[a] + r < dims[a] - 1:
-                    reach = min(reach, lo[a] + (ci[a] + r + 1) * cell - points[k, a])
-            if reach == np.inf or (bf >= 0 and best <= reach * reach):
-                break
-            r += 1
-        face_of[k] = bf
+        _closest_one(k, points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of)
+
+
+@njit(cache=True, nogil=True)
+def _grid_closest_serial(  # pragma: no cover - compiled
+    points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of
+):
+    """:func:`_closest_one` for every point on this thread: the collision pass asks a few dozen
+    points at a time, vertex by vertex along the strands, and waking the other threads for each
+    ask costs more than the ask (ten times more on a busy machine)."""
+    for k in range(points.shape[0]):
+        _closest_one(k, points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of)
+
+
+SERIAL_POINTS = 512  # asks of fewer points than this run on the calling thread
 
 
 class MeshSurface:
@@ -364,6 +449,8 @@ class MeshSurface:
         np.cumsum(self._start, out=self._start)
         self._items = np.empty(int(self._start[-1]), np.int64)
         _bin_faces(self._v, self._f, self.lo, self.cell, self.dims, self._start, self._items)
+        self._rings = np.empty(int(np.prod(self.dims)), np.int64)
+        _empty_rings_kernel(self._start, self.dims, self._rings)
 
     def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:func:`closest_points` through the grid of faces (the same bytes): ``(P, 3)`` points
@@ -372,8 +459,10 @@ class MeshSurface:
         pts = np.ascontiguousarray(points, np.float64)
         out = np.full_like(pts, np.nan)
         face_of = np.empty(len(pts), np.int64)
-        _grid_closest_kernel(
-            pts, self._v, self._f, self.lo, self.cell, self.dims, self._start, self._items, out, face_of
+        kernel = _grid_closest_serial if len(pts) < SERIAL_POINTS else _grid_closest_kernel
+        kernel(
+            pts, self._v, self._f, self.lo, self.cell, self.dims, self._start, self._items, self._rings,
+            out, face_of,
         )
         return out, face_of
 

@@ -18,7 +18,7 @@ from hairtool.frozen.brushes import BrushSample, falloff_lut, root_normals
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.strokes import read_strokes, strokes_from_log, write_strokes
 from hairtool.groom import Groom, vertex_ids_of
-from hairtool.guides.surface import MeshSurface, closest_points
+from hairtool.guides.surface import SERIAL_POINTS, MeshSurface, closest_points
 from hairtool.io.obj import read_mesh
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "grooms"
@@ -58,6 +58,11 @@ def test_the_face_grid_finds_the_brute_forces_closest_points(sintel):
     np.testing.assert_array_equal(face[inside_box], face2)
     sd, _, _ = surface.signed_distance(pts)
     assert np.all(np.isinf(sd[~inside_box]))
+    few = SERIAL_POINTS - 1  # a small ask runs on the calling thread: the same bytes
+    assert len(pts) > SERIAL_POINTS
+    q3, face3 = surface.nearest(pts[-few:])
+    np.testing.assert_array_equal(q3, q[-few:])
+    np.testing.assert_array_equal(face3, face[-few:])
 
 
 def test_a_comb_up_through_a_plane_stops_at_it(plane):
@@ -251,3 +256,23 @@ def test_clumping_after_collision_pulls_no_strand_back_inside_the_head(sintel):
     memo = KeepOut()  # the memory of the head's distances changes no byte
     for _ in range(2):
         np.testing.assert_array_equal(memo(raw.aligned, raw.result, surface, 0.0).points, plain.points)
+
+
+def test_the_face_grids_empty_shells_are_their_numpy_twins(sintel):
+    """The shells the closest-point search skips: each cell's distance in cells to one holding a
+    face, the kernel's sweeps equal to the twin's dilations (Sintel's head and a lone triangle,
+    whose far cells are many shells away)."""
+    from hairtool.guides.surface import empty_rings_numpy
+    from hairtool.io.obj import Mesh
+
+    _, surface = sintel
+    lone = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [20, 30, 5]], np.float32)
+    normals = np.tile(np.array([0, 0, 1], np.float32), (4, 1))
+    tiny = MeshSurface(Mesh(lone, np.array([[0, 1, 2]], np.int32), normals))
+    for s in (surface, tiny):
+        np.testing.assert_array_equal(s._rings, empty_rings_numpy(s._start, s.dims))
+    assert tiny._rings.max() > 20
+    far = np.array([[19.0, 29.0, 4.0], [10.0, 15.0, 2.5], [0.2, 0.2, 0.0]])
+    q, face = tiny.nearest(far)
+    np.testing.assert_array_equal(q, closest_points(tiny.mesh, far)[0])
+    assert np.all(face == 0)

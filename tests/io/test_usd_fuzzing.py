@@ -27,30 +27,22 @@ from hairtool.errors import FormatError
 from hairtool.groom import Animation, Groom
 from hairtool.io import read, write
 
+from .hostile import USDA_CURVES
+
 INTEROP = Path(__file__).resolve().parents[1] / "data" / "interop"
 
-VALID_USDA = """#usda 1.0
-(
-    upAxis = "Z"
-    metersPerUnit = 1
+# The hostile module's two-curve stage, made cubic Catmull-Rom with a colour per curve, so every
+# declaration the swaps below break is present in the valid file.
+VALID_USDA = USDA_CURVES.replace(
+    '        uniform token type = "linear"\n',
+    '        uniform token type = "cubic"\n'
+    '        uniform token basis = "catmullRom"\n'
+    '        uniform token wrap = "pinned"\n',
+).replace(
+    '        float[] widths = [0.1, 0.2] (interpolation = "uniform")\n',
+    '        float[] widths = [0.1, 0.2] (interpolation = "uniform")\n'
+    '        color4f[] primvars:color = [(1, 0, 0, 1), (0, 1, 0, 1)] (interpolation = "uniform")\n',
 )
-def Xform "Head"
-{
-    double3 xformOp:translate = (0, 0, 1)
-    float xformOp:rotateZ.timeSamples = {1: 0, 2: 30}
-    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateZ"]
-    def BasisCurves "Hair"
-    {
-        uniform token type = "cubic"
-        uniform token basis = "catmullRom"
-        uniform token wrap = "pinned"
-        int[] curveVertexCounts = [4, 3]
-        point3f[] points = [(0, 0, 0), (0, 0, 1), (0, 0, 2), (0, 0, 3), (1, 0, 0), (1, 0, 1), (1, 0, 2)]
-        float[] widths = [0.1, 0.2] (interpolation = "uniform")
-        color4f[] primvars:color = [(1, 0, 0, 1), (0, 1, 0, 1)] (interpolation = "uniform")
-    }
-}
-"""
 
 # (what is declared wrongly, the text that replaces the valid declaration)
 HOSTILE = [
