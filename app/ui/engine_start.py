@@ -51,6 +51,7 @@ class EngineStart(QObject):
         self.done: set[str] = set()
         self.processes = [QProcess(self) for _ in LANES]
         self._failed = False
+        self._ended = False
         for process in self.processes:
             process.setProcessChannelMode(QProcess.ProcessChannelMode.ForwardedErrorChannel)
             process.readyReadStandardOutput.connect(lambda p=process: self._read(p))
@@ -73,7 +74,8 @@ class EngineStart(QObject):
     def start(self) -> None:
         # --with-parent: each warm-up ends when this process does (its stdin is our pipe)
         for lane, process in enumerate(self.processes, start=1):
-            process.start(sys.executable, ["-m", "app.ui.kernel_warmup", "--lane", str(lane), "--with-parent"])
+            args = ["-m", "app.ui.kernel_warmup", "--lane", str(lane), "--with-parent"]
+            process.start(sys.executable, args)
 
     def stop(self, closing: bool = True) -> None:
         """End the warm-up; the kernels compiled so far stay cached. ``closing`` (the window
@@ -100,11 +102,12 @@ class EngineStart(QObject):
                 self.step_ready.emit(label)
 
     def _on_finished(self, code: int, status: QProcess.ExitStatus) -> None:
-        if self._closing:
+        if self._closing or self._ended:
             return
         self._failed = self._failed or status != QProcess.ExitStatus.NormalExit or code != 0
         if self.running:  # the other lane still compiles
             return
+        self._ended = True  # both lanes may have exited before the first's signal came
         self.ended.emit()
         if self.scene.engine_ready:
             self._remove_progress()

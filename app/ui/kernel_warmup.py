@@ -11,8 +11,8 @@ the window as surely as compiling in it.
 
 Compiling is single-threaded, so the studio runs one process per :data:`LANES` entry
 (``--lane K``): on two cores the engine's kernels and the render hair's compile side by side.
-``--progress`` (what ``./dev`` runs after installing) runs the lanes and prints one progress line
-for a terminal instead; ``--if-needed`` does nothing when the kernels are cached already.
+:mod:`app.ui.warm_cache` (what ``./dev`` runs after installing) runs the lanes from a terminal
+with one progress line.
 
 :func:`kernels_cached` tells a start whether that is needed: the warm-up records the kernels it
 compiled (one record per lane), and they are cached when numba's index for each still matches
@@ -393,10 +393,6 @@ def _record(lane: int | None, steps: list[str]) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if "--progress" in argv:
-        from app.ui.warm_cache import warm
-
-        return warm(if_needed="--if-needed" in argv)
     lane = _lane(argv)
     if "--with-parent" in argv:
         _end_with_parent()

@@ -1,7 +1,7 @@
-"""Warming numba's kernel cache from a terminal (``./dev`` runs it after installing), so the
-studio's first start loads its kernels instead of compiling them: the warm-up's lanes
-(:data:`app.ui.kernel_warmup.LANES`) run side by side as child processes and one line shows
-their progress. No Qt here.
+"""Warming numba's kernel cache from a terminal (``./dev`` runs ``python -m app.ui.warm_cache
+--if-needed`` after installing), so the studio's first start loads its kernels instead of
+compiling them: the warm-up's lanes (:data:`app.ui.kernel_warmup.LANES`) run side by side as
+child processes and one line shows their progress. No Qt here.
 """
 
 from __future__ import annotations
@@ -20,6 +20,11 @@ def _line(done: int, total: int, label: str, started: float) -> str:
     return f"Compiling the studio's kernels (once) [{bar}] {done}/{total} {label}, {took:.0f} s"
 
 
+def lane_command(lane: int) -> list[str]:
+    """The command line of warm-up lane ``lane`` (1-based)."""
+    return [sys.executable, "-m", "app.ui.kernel_warmup", "--lane", str(lane)]
+
+
 def warm(if_needed: bool = False, out=None) -> int:
     """Run every lane; print progress on ``out`` (standard output). ``if_needed``: nothing when
     the kernels are cached already. 0 when every lane finished, else the first failure's code."""
@@ -31,9 +36,8 @@ def warm(if_needed: bool = False, out=None) -> int:
     done: list[str] = []
     lock = threading.Lock()
     tty = out.isatty()
-    command = [sys.executable, "-m", "app.ui.kernel_warmup", "--lane"]
     lanes = range(1, len(kernel_warmup.LANES) + 1)
-    procs = [subprocess.Popen([*command, str(k)], stdout=subprocess.PIPE, text=True) for k in lanes]
+    procs = [subprocess.Popen(lane_command(k), stdout=subprocess.PIPE, text=True) for k in lanes]
 
     def follow(proc: subprocess.Popen) -> None:
         for raw in proc.stdout:
@@ -65,3 +69,12 @@ def warm(if_needed: bool = False, out=None) -> int:
         return failed[0]
     print(f"The studio's kernels are cached ({time.time() - started:.0f} s)", file=out, flush=True)
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    return warm(if_needed="--if-needed" in argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
