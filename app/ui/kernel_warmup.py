@@ -152,6 +152,19 @@ def _engine_step() -> None:
         tool.touches(pipe.aligned.points, cursor, plane)
 
 
+def _head_step() -> None:
+    """Sintel's head as the engine's strokes meet it (closest points, inside test), compiled
+    apart from the engine's step so that the other process can do it first: the largest of
+    the drag's kernels, and one whose types do not depend on the groom's (float64 always)."""
+    from hairtool.guides.planting import HeadSurface
+
+    groom, head = _sintel()
+    surface = HeadSurface(head)
+    points = groom.points.astype(np.float64)
+    surface.project(points)
+    surface.signed_distance(points)
+
+
 def _scalp_engine_step() -> None:
     """The engine with the engine's own defaults (keep lengths off) on a procedural groom."""
     from hairtool import samples
@@ -290,10 +303,12 @@ RENDER_HAIR_STEP = "render hair"
 ENGINE_STEP = "hair engine"
 #: The step after which the viewport can draw with the CPU strand rasterizer (on software GL).
 RASTER_STEP = "strand drawing"
+#: Part of the align drag's kernels (the head's closest points), apart so the lanes share them.
+HEAD_STEP = "head surface"
 
 #: The steps after which the first screen (Sintel, her render hair shaded and drawn, an align
 #: drag) compiles nothing: tests/gui/test_studio_first_screen_kernels.py checks it.
-FIRST_SCREEN = (ENGINE_STEP, RENDER_HAIR_STEP, RASTER_STEP)
+FIRST_SCREEN = (HEAD_STEP, ENGINE_STEP, RENDER_HAIR_STEP, RASTER_STEP)
 
 #: (label, step) in the order a single process runs them: the engine for the first groom, the
 #: render hair (the bundled sample's children wait for it), the rasterizer for software GL, then
@@ -301,6 +316,7 @@ FIRST_SCREEN = (ENGINE_STEP, RENDER_HAIR_STEP, RASTER_STEP)
 #: needs (simulation, anime waves, keys): without these, the first use of each compiled it inside
 #: the studio, on a job or the GUI thread.
 _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
+    (HEAD_STEP, _head_step),
     (ENGINE_STEP, _engine_step),
     (RENDER_HAIR_STEP, _render_hair_step),
     (RASTER_STEP, _raster_step),
@@ -312,12 +328,13 @@ _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
 )
 
 #: The studio's warm-up processes, one per core of the two-core reference machine, each a list
-#: of step labels: the engine in one and the render hair in the other, so the first screen's two
-#: longest compiles run side by side (measured CPU seconds on the reference machine, empty cache:
-#: engine ~45, render hair ~21, strand drawing ~18, grooming brushes ~14, animation ~29).
+#: of step labels: the engine in one, the head surface (part of the engine's align drag) and
+#: the render hair in the other, so the first screen's compiles run side by side (CPU seconds on
+#: a busy two-core host, empty cache: engine ~57 of which the head's closest points ~7, render
+#: hair ~30, strand drawing ~35, grooming brushes ~19, animation ~29).
 LANES: tuple[tuple[str, ...], ...] = (
     (ENGINE_STEP, "brush modes and settings", "engine defaults", "grooming brushes"),
-    (RENDER_HAIR_STEP, RASTER_STEP, "clumped render hair", "animation and keys"),
+    (HEAD_STEP, RENDER_HAIR_STEP, RASTER_STEP, "clumped render hair", "animation and keys"),
 )
 
 

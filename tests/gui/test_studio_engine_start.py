@@ -166,8 +166,7 @@ def test_the_lanes_share_out_every_step_once_the_first_screen_first():
     lanes = kernel_warmup.LANES
     flat = [label for lane in lanes for label in lane]
     assert sorted(flat) == sorted(label for label, _ in kernel_warmup.STEPS)
-    firsts = {lane[0] for lane in lanes}
-    assert {kernel_warmup.ENGINE_STEP, kernel_warmup.RENDER_HAIR_STEP} <= firsts
+    assert lanes[0][0] == kernel_warmup.ENGINE_STEP  # the engine's lane starts at once
     for lane in lanes:  # no step of the rest before one of the first screen
         ranks = [label in kernel_warmup.FIRST_SCREEN for label in lane]
         assert ranks == sorted(ranks, reverse=True), lane
@@ -196,3 +195,12 @@ def test_the_warm_up_runs_its_steps_and_records_the_kernels(tmp_path, monkeypatc
     ):
         assert kernel in names
     assert kernel_warmup.kernels_cached()
+
+
+def test_the_head_step_compiles_the_drags_closest_points_kernel():
+    """The other lane takes the align drag's head kernel off the engine's lane: its step must
+    reach it (its types are float64 whatever the groom, so the drag then loads it)."""
+    from hairtool.guides import surface
+
+    dict(kernel_warmup.STEPS)[kernel_warmup.HEAD_STEP]()
+    assert surface._grid_closest_kernel.signatures and surface._bin_faces.signatures
