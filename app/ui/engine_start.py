@@ -1,7 +1,8 @@
-"""A first start without cached kernels: the window shows at once, the kernels compile in another
-process (:mod:`app.ui.kernel_warmup`) with their progress in the status bar, and the scene's engine
-starts when they are cached. Until then the groom shows as it is, parameter edits are kept for the
-engine, and a stroke says in the status bar that the engine is on its way.
+"""A first start without cached kernels: the window shows at once, the kernels compile in other
+processes (:mod:`app.ui.kernel_warmup`, one per lane: the engine's and the render hair's side by
+side) with their progress in the status bar, and the scene's engine starts when its kernels are
+cached. Until then the groom shows as it is, parameter edits are kept for the engine, and a
+stroke says in the status bar that the engine is on its way.
 """
 
 from __future__ import annotations
@@ -12,20 +13,19 @@ from PySide6.QtCore import QEventLoop, QObject, QProcess, Qt, Signal
 from PySide6.QtGui import QGuiApplication
 from PySide6.QtWidgets import QProgressBar, QStatusBar
 
-from app.ui.kernel_warmup import STEPS
+from app.ui.kernel_warmup import ENGINE_STEP, LANES, STEPS
 from app.ui.scene import Scene
 from app.ui.status_line import ElidedLabel
 
-STARTUP_STEPS = 2  # the warm-up's steps the engine and the first paint need (the rest follow)
 WAIT_MESSAGE = "The hair engine is still being prepared (first start): strokes work in a moment"
 
 
 class EngineStart(QObject):
-    """Runs the warm-up process and starts ``scene``'s engine when it is done (or failed: then
-    the engine compiles in the studio, with a wait cursor and a message).
+    """Runs the warm-up processes and starts ``scene``'s engine when its step is done (or the
+    warm-up failed: then the engine compiles in the studio, with a wait cursor and a message).
 
     ``step_ready(label)`` says which warm-up step's kernels are cached now, ``ended()`` that the
-    warm-up is over (done or not), so what waits for a step can go ahead."""
+    warm-up is over (every process done or not), so what waits for a step can go ahead."""
 
     step_ready = Signal(str)
     ended = Signal()
@@ -47,65 +47,83 @@ class EngineStart(QObject):
         )
         for w in (self.label, self.progress):
             bar.addPermanentWidget(w)
-        self.step = 0
-        self.process = QProcess(self)
-        self.process.setProcessChannelMode(QProcess.ProcessChannelMode.ForwardedErrorChannel)
-        self.process.readyReadStandardOutput.connect(self._read)
-        self.process.finished.connect(self._on_finished)
-        self.process.errorOccurred.connect(self._on_error)
+        self.step = 0  # warm-up steps done, all processes together
+        self.done: set[str] = set()
+        self.processes = [QProcess(self) for _ in LANES]
+        self._failed = False
+        self._ended = False
+        for process in self.processes:
+            process.setProcessChannelMode(QProcess.ProcessChannelMode.ForwardedErrorChannel)
+            process.readyReadStandardOutput.connect(lambda p=process: self._read(p))
+            process.finished.connect(self._on_finished)
+            process.errorOccurred.connect(lambda error, p=process: self._on_error(p, error))
         scene.engine_starting.connect(self._on_starting)
         scene.engine_started.connect(self._on_started)
         self._waiting_cursor = False
         self._closing = False
 
     @property
+    def process(self) -> QProcess:
+        """The first lane's process (the engine's)."""
+        return self.processes[0]
+
+    @property
     def running(self) -> bool:
-        return self.process.state() != QProcess.ProcessState.NotRunning
+        return any(p.state() != QProcess.ProcessState.NotRunning for p in self.processes)
 
     def start(self) -> None:
-        # --with-parent: the warm-up ends when this process does (its stdin is our pipe)
-        self.process.start(sys.executable, ["-m", "app.ui.kernel_warmup", "--with-parent"])
+        # --with-parent: each warm-up ends when this process does (its stdin is our pipe)
+        for lane, process in enumerate(self.processes, start=1):
+            args = ["-m", "app.ui.kernel_warmup", "--lane", str(lane), "--with-parent"]
+            process.start(sys.executable, args)
 
     def stop(self, closing: bool = True) -> None:
         """End the warm-up; the kernels compiled so far stay cached. ``closing`` (the window
         closes): nothing follows, the engine is not started here (it would compile every kernel
         on the GUI thread of a window being closed) and ``ended`` is not emitted."""
         self._closing = self._closing or closing
-        if self.running:
-            self.process.kill()
-            self.process.waitForFinished(3000)
+        for process in self.processes:
+            if process.state() != QProcess.ProcessState.NotRunning:
+                process.kill()
+                process.waitForFinished(3000)
 
-    def _read(self) -> None:
-        while self.process.canReadLine():
-            parts = bytes(self.process.readLine()).decode(errors="replace").split(maxsplit=3)
-            if len(parts) == 4 and parts[0] == "step":
-                done, total, label = int(parts[1]), int(parts[2]), parts[3].strip()
-                self.step = done
+    def _read(self, process: QProcess) -> None:
+        while process.canReadLine():
+            parts = bytes(process.readLine()).decode(errors="replace").split(maxsplit=3)
+            if len(parts) == 4 and parts[0] == "step" and parts[1].isdigit() and parts[2].isdigit():
+                total, label = int(parts[2]), parts[3].strip()
+                self.done.add(label)
+                self.step = done = len(self.done)
                 self.progress.setRange(0, total)
                 self.progress.setValue(done)
                 self.label.setText(f"Preparing the hair engine (first start): {label} ready, {done}/{total}")
-                if done >= STARTUP_STEPS and not self.scene.engine_ready:
-                    self.scene.start_engine()  # what a stroke and a paint need is cached now
+                if label == ENGINE_STEP and not self.scene.engine_ready:
+                    self.scene.start_engine()  # what a stroke needs is cached now
                 self.step_ready.emit(label)
 
     def _on_finished(self, code: int, status: QProcess.ExitStatus) -> None:
-        if self._closing:
+        if self._closing or self._ended:
             return
-        ok = status == QProcess.ExitStatus.NormalExit and code == 0
+        self._failed = self._failed or status != QProcess.ExitStatus.NormalExit or code != 0
+        if self.running:  # the other lane still compiles
+            return
+        self._ended = True  # both lanes may have exited before the first's signal came
         self.ended.emit()
         if self.scene.engine_ready:
             self._remove_progress()
             return
-        if not ok:
+        if self._failed:
             self.bar.showMessage("Preparing the hair engine in the studio: the window pauses once", 8000)
         self.scene.start_engine()
 
-    def _on_error(self, error: QProcess.ProcessError) -> None:
+    def _on_error(self, process: QProcess, error: QProcess.ProcessError) -> None:
         if error == QProcess.ProcessError.FailedToStart:
-            self._on_finished(1, QProcess.ExitStatus.CrashExit)
+            self._failed = True
+            if not self.running:
+                self._on_finished(1, QProcess.ExitStatus.CrashExit)
 
     def _on_starting(self) -> None:
-        if self.step < STARTUP_STEPS:  # compiling here, not loading the cache: show the wait
+        if ENGINE_STEP not in self.done:  # compiling here, not loading the cache: show the wait
             self.label.setText("Preparing the hair engine…")
             QGuiApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)
             self._waiting_cursor = True
@@ -116,7 +134,7 @@ class EngineStart(QObject):
             QGuiApplication.restoreOverrideCursor()
             self._waiting_cursor = False
         self.bar.showMessage("The hair engine is ready", 4000)
-        if self.step < STARTUP_STEPS:  # started before the warm-up got there: it compiled here
+        if ENGINE_STEP not in self.done:  # started before the warm-up got there: compiled here
             self.stop(closing=False)
         if not self.running:
             self._remove_progress()
@@ -124,7 +142,8 @@ class EngineStart(QObject):
     def _remove_progress(self) -> None:
         if self.label is None:
             return
-        self.process.readyReadStandardOutput.disconnect(self._read)
+        for process in self.processes:
+            process.readyReadStandardOutput.disconnect()
         for w in (self.label, self.progress):
             self.bar.removeWidget(w)
             w.deleteLater()

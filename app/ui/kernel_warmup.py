@@ -1,15 +1,22 @@
-"""Compiling the studio's numba kernels in a separate process, so a first start shows the window
+"""Compiling the studio's numba kernels in separate processes, so a first start shows the window
 at once (no Qt here: :mod:`app.ui.engine_start` runs this and shows its progress).
 
 ``python -m app.ui.kernel_warmup`` runs the engine and the strand rasterizer once on a small
 groom, in the order the studio needs them, which compiles every kernel they call into numba's
-on-disk cache; each finished step prints ``step I N LABEL``. The studio then loads the kernels
-from the cache (a fraction of a second) instead of compiling them on its GUI thread (half a
-minute on two cores, with the window frozen). A second process, not a thread: numba compiles
-holding the GIL, so a compiling thread would stall the window as surely as compiling in it.
+on-disk cache; each finished step prints ``step I N LABEL`` (I: the step's place in
+:data:`STEPS`). The studio then loads the kernels from the cache (a fraction of a second)
+instead of compiling them on its GUI thread (a minute on two cores, with the window frozen).
+Other processes, not threads: numba compiles holding the GIL, so a compiling thread would stall
+the window as surely as compiling in it.
+
+Compiling is single-threaded, so the studio runs one process per :data:`LANES` entry
+(``--lane K``): on two cores the engine's kernels and the render hair's compile side by side.
+:mod:`app.ui.warm_cache` (what ``./dev`` runs after installing) runs the lanes from a terminal
+with one progress line.
 
 :func:`kernels_cached` tells a start whether that is needed: the warm-up records the kernels it
-compiled, and they are cached when numba's index for each still matches its source.
+compiled (one record per lane), and they are cached when numba's index for each still matches
+its source and the records cover every step.
 
 Started by the studio (``--with-parent``), the warm-up ends quietly as soon as the studio does,
 however it ends (Quit, a crash, a kill): its standard input is the studio's pipe, and a thread
@@ -43,10 +50,12 @@ KERNEL_PACKAGES = (
 KERNEL_MODULES = ("hairtool.bounds", "app.render.soft_raster", "app.render.hair_shading")
 
 
-def record_path() -> Path:
-    """Where the warm-up records the kernels it compiled (the user's cache folder)."""
+def record_path(lane: int | None = None) -> Path:
+    """Where the warm-up records the kernels it compiled (the user's cache folder): one file for
+    a warm-up of every step, one per lane (1, 2, …) for the studio's lanes."""
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "hairtool" / "studio-kernels.json"
+    name = "studio-kernels.json" if lane is None else f"studio-kernels-lane{lane}.json"
+    return Path(base) / "hairtool" / name
 
 
 def _dispatchers() -> dict[str, object]:
@@ -78,15 +87,29 @@ def _has_cache(dispatcher: object) -> bool:
         return False
 
 
-def kernels_cached() -> bool:
-    """True when every kernel the last warm-up compiled is still in numba's cache; False on a
-    first start, after the caches were cleared, or after a kernel's source changed."""
+def _read_record(path: Path) -> tuple[set[str], set[str]]:
+    """(steps, kernels) of one record; empty sets when it is missing or unreadable."""
     try:
-        names = json.loads(record_path().read_text())["kernels"]
+        record = json.loads(path.read_text())
+        return set(map(str, record["steps"])), set(map(str, record["kernels"]))
     except (OSError, ValueError, KeyError, TypeError):
+        return set(), set()
+
+
+def kernels_cached() -> bool:
+    """True when the warm-up's records cover every step and every kernel they name is still in
+    numba's cache; False on a first start, after the caches were cleared, after a kernel's
+    source changed, or when a warm-up was stopped before its end."""
+    steps, names = _read_record(record_path())
+    if not {label for label, _ in STEPS} <= steps:  # no whole warm-up: the lanes' records together
+        steps, names = set(), set()
+        for lane in range(1, len(LANES) + 1):
+            lane_steps, lane_names = _read_record(record_path(lane))
+            steps, names = steps | lane_steps, names | lane_names
+    if not names or not {label for label, _ in STEPS} <= steps:
         return False
     found = _dispatchers()
-    return bool(names) and all(n in found and _has_cache(found[n]) for n in names)
+    return all(n in found and _has_cache(found[n]) for n in names)
 
 
 #: The studio's engine parameters for a new scene (``app.ui.scene.Scene``'s default; that module
@@ -127,6 +150,19 @@ def _engine_step() -> None:
         cursor = centre + np.array([0.05 * i * extent, 0.0, 0.0])
         pipe.apply_samples(tool.samples(cursor, (1.0, 0.0, 0.0), (0.0, 0.0, -1.0), plane))
         tool.touches(pipe.aligned.points, cursor, plane)
+
+
+def _head_step() -> None:
+    """Sintel's head as the engine's strokes meet it (closest points, inside test), compiled
+    apart from the engine's step so that the other process can do it first: the largest of
+    the drag's kernels, and one whose types do not depend on the groom's (float64 always)."""
+    from hairtool.guides.planting import HeadSurface
+
+    groom, head = _sintel()
+    surface = HeadSurface(head)
+    points = groom.points.astype(np.float64)
+    surface.project(points)
+    surface.signed_distance(points)
 
 
 def _scalp_engine_step() -> None:
@@ -263,26 +299,42 @@ def _animation_step() -> None:
 
 #: The step after which the bundled sample's render hair can be bound and shaded without compiling.
 RENDER_HAIR_STEP = "render hair"
+#: The step after which the engine can start: Sintel's pipeline on her head and an align drag.
+ENGINE_STEP = "hair engine"
+#: The step after which the viewport can draw with the CPU strand rasterizer (on software GL).
+RASTER_STEP = "strand drawing"
+#: Part of the align drag's kernels (the head's closest points), apart so the lanes share them.
+HEAD_STEP = "head surface"
 
 #: The steps after which the first screen (Sintel, her render hair shaded and drawn, an align
 #: drag) compiles nothing: tests/gui/test_studio_first_screen_kernels.py checks it.
-FIRST_SCREEN_STEPS = 3
+FIRST_SCREEN = (HEAD_STEP, ENGINE_STEP, RENDER_HAIR_STEP, RASTER_STEP)
 
-#: (label, step) in the order the studio needs them: the engine for the first groom, the
-#: rasterizer for the first paint (the studio starts its engine after these two:
-#: :data:`app.ui.engine_start.STARTUP_STEPS`), render hair (the bundled sample's children wait for
-#: it), then what other brush modes and settings reach, the other brushes, and what opening an
-#: animation needs (simulation, anime waves, keys):
-#: without these, the first use of each compiled it inside the studio, on a job or the GUI thread.
+#: (label, step) in the order a single process runs them: the engine for the first groom, the
+#: render hair (the bundled sample's children wait for it), the rasterizer for software GL, then
+#: what other brush modes and settings reach, the other brushes, and what opening an animation
+#: needs (simulation, anime waves, keys): without these, the first use of each compiled it inside
+#: the studio, on a job or the GUI thread.
 _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
-    ("hair engine", _engine_step),
-    ("strand drawing", _raster_step),
+    (HEAD_STEP, _head_step),
+    (ENGINE_STEP, _engine_step),
     (RENDER_HAIR_STEP, _render_hair_step),
+    (RASTER_STEP, _raster_step),
     ("brush modes and settings", _more_engine_step),
     ("engine defaults", _scalp_engine_step),
     ("clumped render hair", _clumped_hair_step),
     ("grooming brushes", _brushes_step),
     ("animation and keys", _animation_step),
+)
+
+#: The studio's warm-up processes, one per core of the two-core reference machine, each a list
+#: of step labels: the engine in one, the head surface (part of the engine's align drag) and
+#: the render hair in the other, so the first screen's compiles run side by side (CPU seconds on
+#: a busy two-core host, empty cache: engine ~57 of which the head's closest points ~7, render
+#: hair ~30, strand drawing ~35, grooming brushes ~19, animation ~29).
+LANES: tuple[tuple[str, ...], ...] = (
+    (ENGINE_STEP, "brush modes and settings", "engine defaults", "grooming brushes"),
+    (HEAD_STEP, RENDER_HAIR_STEP, RASTER_STEP, "clumped render hair", "animation and keys"),
 )
 
 
@@ -298,6 +350,13 @@ def _traced(i: int, label: str, step: Callable[[], None]) -> Callable[[], None]:
 
 
 STEPS = tuple((label, _traced(i, label, step)) for i, (label, step) in enumerate(_STEPS))
+
+
+def lane_steps(lane: int | None) -> list[tuple[int, str, Callable[[], None]]]:
+    """(index in :data:`STEPS`, label, step) of lane ``lane`` (1-based), or of every step."""
+    labels = [label for label, _ in STEPS] if lane is None else LANES[lane - 1]
+    index = {label: i for i, (label, _) in enumerate(STEPS)}
+    return [(index[label], label, STEPS[index[label]][1]) for label in labels]
 
 
 def _end_with_parent() -> None:
@@ -325,25 +384,46 @@ def _quietly_gone() -> int:
     return 0
 
 
+def _lane(argv: list[str]) -> int | None:
+    if "--lane" not in argv:
+        return None
+    try:
+        lane = int(argv[argv.index("--lane") + 1])
+    except (IndexError, ValueError):
+        lane = 0
+    if not 1 <= lane <= len(LANES):
+        raise SystemExit(f"kernel_warmup: --lane takes 1 to {len(LANES)}")
+    return lane
+
+
+def _record(lane: int | None, steps: list[str]) -> None:
+    compiled = sorted(n for n, d in _dispatchers().items() if d.signatures)
+    path = record_path(lane)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_suffix(f".tmp{os.getpid()}")
+        tmp.write_text(json.dumps({"steps": steps, "kernels": compiled}, indent=1))
+        tmp.replace(path)  # a lane's record whole or not at all
+    except OSError:  # a read-only home: the next start warms up again, no worse than now
+        pass
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    lane = _lane(argv)
     if "--with-parent" in argv:
         _end_with_parent()
+    done: list[str] = []
     try:
-        for i, (label, step) in enumerate(STEPS):
+        for i, label, step in lane_steps(lane):
             step()
+            done.append(label)
             print(f"step {i + 1} {len(STEPS)} {label}", flush=True)
     except BrokenPipeError:
         return _quietly_gone()
     except KeyboardInterrupt:
         return 130
-    compiled = sorted(n for n, d in _dispatchers().items() if d.signatures)
-    path = record_path()
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps({"kernels": compiled}, indent=1))
-    except OSError:  # a read-only home: the next start warms up again, no worse than now
-        pass
+    _record(lane, done)
     return 0
 
 

@@ -86,6 +86,10 @@ class Viewport(QOpenGLWidget):
         self.camera = self._fresh_camera()
         self.ctx: moderngl.Context | None = None
         self.renderer: StrandRenderer | None = None
+        # a first start draws GL's lines until the CPU rasterizer's kernels are cached: when the
+        # engine starts, or when a running warm-up says so (``wait_for_raster``; set_raster_ready)
+        self.raster_ready = scene.engine_ready
+        self.wait_for_raster = False
         self.finish_frames = False  # glFinish after upload and draw, so timings are real (benchmark)
         # Samples per pixel of Qt's framebuffer: the requested format's (format() reports the
         # context's, 0, once GL is up), since moderngl cannot tell for a framebuffer it did not make.
@@ -235,13 +239,21 @@ class Viewport(QOpenGLWidget):
     def initializeGL(self) -> None:
         self.ctx = moderngl.create_context()
         self.renderer = StrandRenderer(self.ctx)
-        if not self.scene.engine_ready:  # the CPU rasterizer's kernels are still compiling
+        if not self.raster_ready:  # the CPU rasterizer's kernels are still compiling
             self.renderer.strand_raster = "gl"
         self._dirty = {"groom", "colors", "display", "mesh"}
 
-    def _on_engine_started(self) -> None:
+    def set_raster_ready(self) -> None:
+        """The CPU strand rasterizer's kernels are cached now (a first start's warm-up said so, or
+        it ended): draw strands as the renderer chooses again, instead of GL's lines."""
+        self.raster_ready = True
         if self.renderer is not None:
             self.renderer.strand_raster = default_strand_raster()
+        self.update()
+
+    def _on_engine_started(self) -> None:
+        if not self.wait_for_raster:  # no warm-up to wait for: the engine's start compiled what it needs
+            self.set_raster_ready()
         self._mark("groom", "colors", "display")
 
     def drawn(self, mask: bool = True) -> Drawn:

@@ -39,7 +39,7 @@ from app.ui.commands import MeshCommand, ParamCommand, RenderHairCommand, Stroke
 from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import Job, JobRunner, JobStatus
-from app.ui.kernel_warmup import RENDER_HAIR_STEP
+from app.ui.kernel_warmup import RASTER_STEP, RENDER_HAIR_STEP
 from app.ui.legend import RampLegend, readable_length
 from app.ui.qt_utils import add_action, set_available
 from app.ui.render_hair_dialog import DENSE, GrowOptions, ask_grow_options, grow
@@ -203,11 +203,19 @@ class MainWindow(QMainWindow):
             self.engine_start = EngineStart(self.scene, self.statusBar(), self)
             self.engine_start.step_ready.connect(self._on_warmup_step)
             self.engine_start.ended.connect(self._bind_pending_render_hair)
+            self.engine_start.ended.connect(self._on_warmup_ended)
+            self.viewport.wait_for_raster = True
             self.engine_start.start()
 
     def _on_warmup_step(self, label: str) -> None:
         if label == RENDER_HAIR_STEP:
             self._bind_pending_render_hair()
+        elif label == RASTER_STEP:
+            self.viewport.set_raster_ready()
+
+    def _on_warmup_ended(self) -> None:
+        if not self.viewport.raster_ready:  # what is not cached compiles when first used
+            self.viewport.set_raster_ready()
 
     def _bind_pending_render_hair(self) -> None:
         pending, self._pending_render_hair = self._pending_render_hair, None

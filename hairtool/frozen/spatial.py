@@ -263,14 +263,15 @@ def _forward_kernel(
 
 
 @njit(cache=True, nogil=True)
-def _row_run(start, sx, r, cy, cz, dy, dz, ny, nz, sweep):
-    """Row (cy + dy, cz + dz)'s run in sorted order from where its window may start for a vertex
-    whose sweep line is ``sweep`` (empty where the row lies outside the grid). Bisection: on x
-    sorted to within the quantisation slack it ends just past an entry left of ``sweep``, and
-    those before that one lie left of it plus the slack, out of reach."""
-    if not (0 <= cy + dy < ny and 0 <= cz + dz < nz):
+def _row_run(start, sx, y, z, ny, nz, sweep):
+    """Row (y, z)'s run in sorted order from where its window may start for a vertex whose sweep
+    line is ``sweep`` (empty where the row lies outside the grid). Bisection: on x sorted to
+    within the quantisation slack it ends just past an entry left of ``sweep``, and those before
+    that one lie left of it plus the slack, out of reach. The row comes as computed integers,
+    not as constant offsets: numba would compile one version per constant."""
+    if not (0 <= y < ny and 0 <= z < nz):
         return 0, 0
-    rr = r + dz * ny + dy
+    rr = z * ny + y
     a, b = start[rr], start[rr + 1]
     end = b
     while a < b:
@@ -311,14 +312,14 @@ def _region_kernel(
             if r != row:  # a new row: its neighbour rows' pointers afresh
                 row = r
                 y0, z0 = lo[1] + cy * cell, lo[2] + cz * cell
-                j1, e1 = _row_run(start, sx, r, cy, cz, 1, 0, ny, nz, px - reach)
-                j2, e2 = _row_run(start, sx, r, cy, cz, -1, 1, ny, nz, px - reach)
-                j3, e3 = _row_run(start, sx, r, cy, cz, 0, 1, ny, nz, px - reach)
-                j4, e4 = _row_run(start, sx, r, cy, cz, 1, 1, ny, nz, px - reach)
-                j5, e5 = _row_run(start, sx, r, cy, cz, -1, -1, ny, nz, px - reach)
-                j6, e6 = _row_run(start, sx, r, cy, cz, 0, -1, ny, nz, px - reach)
-                j7, e7 = _row_run(start, sx, r, cy, cz, 1, -1, ny, nz, px - reach)
-                j8, e8 = _row_run(start, sx, r, cy, cz, -1, 0, ny, nz, px - reach)
+                j1, e1 = _row_run(start, sx, cy + 1, cz, ny, nz, px - reach)
+                j2, e2 = _row_run(start, sx, cy - 1, cz + 1, ny, nz, px - reach)
+                j3, e3 = _row_run(start, sx, cy, cz + 1, ny, nz, px - reach)
+                j4, e4 = _row_run(start, sx, cy + 1, cz + 1, ny, nz, px - reach)
+                j5, e5 = _row_run(start, sx, cy - 1, cz - 1, ny, nz, px - reach)
+                j6, e6 = _row_run(start, sx, cy, cz - 1, ny, nz, px - reach)
+                j7, e7 = _row_run(start, sx, cy + 1, cz - 1, ny, nz, px - reach)
+                j8, e8 = _row_run(start, sx, cy - 1, cz, ny, nz, px - reach)
                 j0 = start[r]
             si = sstrand[i]
             pos = n * cap

@@ -44,20 +44,53 @@ def test_before_the_engine_the_groom_shows_as_it_is_and_strokes_wait(ui, make_wi
 
 
 def test_the_warm_up_reports_progress_and_starts_the_engine(make_window, qtbot, monkeypatch):
-    from app.ui.engine_start import EngineStart
-
-    steps = "import time\nfor i in (1, 2, 3):\n    print(f'step {i} 3 part', flush=True)\n    time.sleep(0.3)"
-    monkeypatch.setattr(
-        EngineStart, "start", lambda self: self.process.start(sys.executable, ["-c", steps])
-    )
+    """The engine starts when its own step is cached, whatever else is still compiling; the CPU
+    strand rasterizer takes over from GL's lines only once its step is cached too."""
+    labels = [kernel_warmup.ENGINE_STEP, kernel_warmup.RENDER_HAIR_STEP, kernel_warmup.RASTER_STEP]
+    _fake_warm_up(monkeypatch, labels, 0.4)
     w = make_window(groom=samples.comb(strands=10, vertices=6), engine_ready=False)
+    v = w.viewport
+    at_start = []  # what the engine's start found
+    w.scene.engine_started.connect(lambda: at_start.append((set(es.done), v.renderer.strand_raster)))
     w.start_warmup()
     es = w.engine_start
-    qtbot.waitUntil(lambda: es.step >= 1, timeout=10_000)
-    qtbot.waitUntil(lambda: w.scene.engine_ready, timeout=10_000)  # after step 2 of 3
-    assert es.step >= 2
+    qtbot.waitUntil(lambda: w.scene.engine_ready, timeout=10_000)
+    # started on its own step, drawn with GL's lines while the rasterizer's kernels may compile
+    assert at_start == [({kernel_warmup.ENGINE_STEP}, "gl")]
+    qtbot.waitUntil(lambda: v.raster_ready, timeout=10_000)
+    from app.render.strands import default_strand_raster
+
+    assert es.step == 3 and v.renderer.strand_raster == default_strand_raster()
     qtbot.waitUntil(lambda: not es.running and es.label is None, timeout=10_000)
     assert w.scene.pipeline is not None
+
+
+def test_two_lanes_start_the_engine_from_either_and_end_together(make_window, qtbot, monkeypatch):
+    """Each warm-up lane reports its own steps (numbered in the whole warm-up); the progress counts
+    both, the engine starts on its step, and ``ended`` comes once, after the slower lane."""
+    from app.ui.engine_start import EngineStart
+
+    scripts = [
+        "import time\ntime.sleep(2.0)\nprint('step 1 3 hair engine', flush=True)",
+        "print('step 2 3 render hair', flush=True)\nprint('step 3 3 strand drawing', flush=True)",
+    ]
+
+    def start(self):
+        for process, script in zip(self.processes, scripts, strict=True):
+            process.start(sys.executable, ["-c", script])
+
+    monkeypatch.setattr(EngineStart, "start", start)
+    w = make_window(groom=samples.comb(strands=10, vertices=6), engine_ready=False)
+    ended = []
+    w.start_warmup()
+    es = w.engine_start
+    es.ended.connect(lambda: ended.append(es.step))
+    qtbot.waitUntil(lambda: w.viewport.raster_ready, timeout=10_000)
+    assert not w.scene.engine_ready  # the rasterizer's lane was first
+    qtbot.waitUntil(lambda: w.scene.engine_ready, timeout=10_000)
+    qtbot.waitUntil(lambda: not es.running, timeout=10_000)
+    qtbot.waitUntil(lambda: bool(ended), timeout=10_000)
+    assert ended == [3]
 
 
 def _fake_warm_up(monkeypatch, labels: list[str], pause_s: float = 0.2) -> None:
@@ -110,14 +143,35 @@ def test_kernels_cached_reads_the_warm_up_record(tmp_path, monkeypatch):
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
     assert not kernel_warmup.kernels_cached()  # no record: a first start
     assert samples.comb(strands=4, vertices=3).bounds is not None  # compiles or loads bounds' kernel
+    every = [label for label, _ in kernel_warmup.STEPS]
     record = kernel_warmup.record_path()
     record.parent.mkdir(parents=True)
-    record.write_text(json.dumps({"kernels": ["hairtool.bounds:_box"]}))
+    record.write_text(json.dumps({"steps": every, "kernels": ["hairtool.bounds:_box"]}))
     assert kernel_warmup.kernels_cached()
-    record.write_text(json.dumps({"kernels": ["hairtool.bounds:_box", "hairtool.frozen.nothing:_here"]}))
+    record.write_text(json.dumps({"steps": every[:-1], "kernels": ["hairtool.bounds:_box"]}))
+    assert not kernel_warmup.kernels_cached()  # a warm-up stopped before its end
+    gone = ["hairtool.bounds:_box", "hairtool.frozen.nothing:_here"]
+    record.write_text(json.dumps({"steps": every, "kernels": gone}))
     assert not kernel_warmup.kernels_cached()
     record.write_text("not json")
     assert not kernel_warmup.kernels_cached()
+    # the studio's lanes record apart: cached when their records together cover every step
+    for lane, labels in enumerate(kernel_warmup.LANES, start=1):
+        lane_record = {"steps": list(labels), "kernels": ["hairtool.bounds:_box"]}
+        kernel_warmup.record_path(lane).write_text(json.dumps(lane_record))
+        assert kernel_warmup.kernels_cached() == (lane == len(kernel_warmup.LANES))
+
+
+def test_the_lanes_share_out_every_step_once_the_first_screen_first():
+    lanes = kernel_warmup.LANES
+    flat = [label for lane in lanes for label in lane]
+    assert sorted(flat) == sorted(label for label, _ in kernel_warmup.STEPS)
+    assert lanes[0][0] == kernel_warmup.ENGINE_STEP  # the engine's lane starts at once
+    for lane in lanes:  # no step of the rest before one of the first screen
+        ranks = [label in kernel_warmup.FIRST_SCREEN for label in lane]
+        assert ranks == sorted(ranks, reverse=True), lane
+    with pytest.raises(SystemExit, match="--lane takes"):
+        kernel_warmup.main(["--lane", "9"])
 
 
 def test_the_warm_up_runs_its_steps_and_records_the_kernels(tmp_path, monkeypatch, capsys):
@@ -141,3 +195,12 @@ def test_the_warm_up_runs_its_steps_and_records_the_kernels(tmp_path, monkeypatc
     ):
         assert kernel in names
     assert kernel_warmup.kernels_cached()
+
+
+def test_the_head_step_compiles_the_drags_closest_points_kernel():
+    """The other lane takes the align drag's head kernel off the engine's lane: its step must
+    reach it (its types are float64 whatever the groom, so the drag then loads it)."""
+    from hairtool.guides import surface
+
+    dict(kernel_warmup.STEPS)[kernel_warmup.HEAD_STEP]()
+    assert surface._grid_closest_kernel.signatures and surface._bin_faces.signatures

@@ -32,8 +32,9 @@ event.register("numba:compile", Compiles())
 
 if sys.argv[1] == "startup":
     from app.ui import kernel_warmup
-    for label, step in kernel_warmup.STEPS[: kernel_warmup.FIRST_SCREEN_STEPS]:
-        step()
+    for label, step in kernel_warmup.STEPS:
+        if label in kernel_warmup.FIRST_SCREEN:
+            step()
 else:
     import tempfile
     import numpy as np
@@ -54,6 +55,7 @@ else:
     del compiled[:]  # what compiled before the window showed is not the first start's concern
     w.scene.start_engine()  # what the warm-up's startup steps let the studio do
     w._bind_pending_render_hair()  # and its render hair step
+    w.viewport.set_raster_ready()  # and its strand drawing step
     v = w.viewport
     v.draw_now()
     s = w.scene

@@ -10,6 +10,8 @@ import time
 
 import pytest
 
+from app.ui import kernel_warmup
+
 pytestmark = pytest.mark.gui
 
 
@@ -73,7 +75,7 @@ start = window.MainWindow.start_warmup
 
 def start_then_quit(self):
     start(self)
-    print("warm-up", self.engine_start.process.processId(), flush=True)
+    print("warm-up", *(p.processId() for p in self.engine_start.processes), flush=True)
     QTimer.singleShot(1500, self.close)  # the artist quits while the kernels compile
 
 window.MainWindow.start_warmup = start_then_quit
@@ -95,5 +97,8 @@ def test_quitting_during_the_first_start_warm_up_is_quiet(tmp_path):
         pytest.fail("Quit during the warm-up did not end the studio within a minute")
     assert run.returncode == 0, run.stderr[-3000:]
     assert "Traceback" not in run.stderr and "Fatal" not in run.stderr, run.stderr[-3000:]
-    pid = int(next(line for line in run.stdout.splitlines() if line.startswith("warm-up")).split()[1])
-    assert pid > 0 and _gone(pid), "the warm-up outlived the studio"
+    line = next(line for line in run.stdout.splitlines() if line.startswith("warm-up"))
+    pids = [int(p) for p in line.split()[1:]]
+    assert len(pids) == len(kernel_warmup.LANES)  # one process per lane
+    for pid in pids:
+        assert pid > 0 and _gone(pid), "a warm-up outlived the studio"
