@@ -161,8 +161,10 @@ def _head_step() -> None:
     groom, head = _sintel()
     surface = HeadSurface(head)
     points = groom.points.astype(np.float64)
-    surface.project(points)
-    surface.signed_distance(points)
+    few = np.concatenate([points[:: max(len(points) // 64, 1)], points[:1] + 1e3])  # one far away
+    for ask in (points, few):  # a whole groom on every thread, a stroke's few on this one
+        surface.project(ask)
+        surface.signed_distance(ask)
 
 
 def _scalp_engine_step() -> None:
@@ -260,6 +262,8 @@ def _render_hair_step() -> None:
     light, eye = light_and_eye(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, -1.0]))
     base = np.ones((len(drawn), 3), np.float32)
     shade(points, offsets, base, light, eye, out=np.empty((len(drawn), 3), np.float32))
+    # and a move's changed strands, gathered into writable arrays of their own
+    shade(drawn.copy(), binding.offsets.copy(), base, light, eye, out=np.empty((len(drawn), 3), np.float32))
 
 
 def _clumped_hair_step() -> None:
