@@ -39,7 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         nargs="+",
         default=None,
         metavar="SIZE",
-        help="STRANDSxVERTICES (scalp samples), 'real' (every groom in tests/data/grooms, or $HAIRTOOL_BENCH_DATA/grooms) or a path",
+        help="STRANDSxVERTICES (scalp samples), 'real' (every groom in tests/data/grooms, "
+        "or $HAIRTOOL_BENCH_DATA/grooms) or a path",
     )
     parser.add_argument("--quick", action="store_true", help="100x20 and 500x20 only, fewer repeats")
     parser.add_argument("--repeat", type=int, default=15, help="timed runs per number (median)")
