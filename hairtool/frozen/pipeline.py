@@ -840,7 +840,7 @@ class FrozenPipeline:
         local, p = self._local, self._params
         if local is None or self._grid_points is None or local.topology is not self._aligned.topology:
             return False
-        if not all(isinstance(s, AlignSample) or s.brush in LOCAL_BRUSHES for s in samples):
+        if not all(isinstance(s, AlignSample | SelectionSample) or s.brush in LOCAL_BRUSHES for s in samples):
             return False
         rec = self._workspace.recorded
         h, seed = self.clump_radius, draw_seed(p.seed, self._draw)
@@ -859,16 +859,16 @@ class FrozenPipeline:
         assert local is not None and self._grid_points is not None
         old = self._grid_points
         cur = old.copy()
-        state = (self._locked, self._clump_strength, self._hook_state())
+        state = (self._strand_state(), self._hook_state())
         touched = np.zeros(g.strand_count, bool)  # strands a sample of this batch ran on
         painted = np.zeros(0, np.int64)  # strands whose clump strength changed
         planar = self._nonplanar == 0
         try:
             for sample in samples:
                 painted = np.union1d(painted, self._local_sample(cur, sample, touched, planar))
-        except BaseException:
-            self._locked, self._clump_strength = state[0], state[1]
-            self._set_hooks(state[2])
+        except BaseException:  # a refused sample: none of these samples happened
+            self._set_strand_state(state[0])
+            self._set_hooks(state[1])
             raise
         self._log.extend(samples)
         moved = changed_strands(old, cur, top, np.flatnonzero(touched))
@@ -921,6 +921,11 @@ class FrozenPipeline:
             self._set_hooks(((), 0, False))  # another brush ends a snake hook's stroke
         local, top = self._local, self._aligned.topology
         assert local is not None and self._grid_points is not None
+        if isinstance(sample, SelectionSample):  # no strand moves: on the whole groom
+            away = self._away(sample.view)
+            g = self._aligned.with_points(cur)
+            self._selected, self._hidden = apply_selection(g, sample, self._selected, self._hidden, away)
+            return np.zeros(0, np.int64)
         if isinstance(sample, AlignSample):
             check_align_params(sample.cursor, sample.radius, sample.intensity, sample.mode)
         else:
@@ -948,12 +953,21 @@ class FrozenPipeline:
         away = (
             None if check_view(sample.view) is None else facing_away(self.strand_normals[cand], sample.view)
         )
+        if isinstance(sample, BrushSample) and sample.brush == "select":
+            skip = self._hidden[cand] if away is None else self._hidden[cand] | away
+            selected = self._selected.copy()
+            selected[cand] = paint_mask(sub, sample, self._selected[cand], skip)
+            self._selected = selected
+            return None, none
         if isinstance(sample, BrushSample) and sample.brush == "mask":
+            skip = self._lock(sample, None, mask=False)[cand]
             locked = self._locked.copy()
-            locked[cand] = paint_mask(sub, sample, self._locked[cand], away)
+            locked[cand] = paint_mask(sub, sample, self._locked[cand], skip if away is None else skip | away)
             self._locked = locked
             return None, none
-        lock = self._locked[cand] if away is None else self._locked[cand] | away
+        lock = self._lock(sample, None)[cand]  # masked, hidden, and unselected with only_selected
+        if away is not None:
+            lock = lock | away
         if isinstance(sample, AlignSample):
             out = align(sub, sample.cursor, sample.radius, sample.intensity, sample.mode, planar=planar)
             if lock.any():
@@ -981,4 +995,4 @@ class FrozenPipeline:
 
 
 #: The brushes a move runs on the strands under it only (the others on the whole groom).
-LOCAL_BRUSHES = ("comb", "smooth", "length", "puff", "pinch", "clump", "mask")
+LOCAL_BRUSHES = ("comb", "smooth", "length", "puff", "pinch", "clump", "mask", "select")
