@@ -330,8 +330,13 @@ class Scene(QObject):
             self.tool_changed.emit()
 
     def snapshot(self) -> object:
-        """The pipeline's stroke state (for one undo step); strokes need the engine running."""
+        """The pipeline's stroke state (for one undo step); strokes need the engine running.
+        After brush-local moves (a stroke just released) the whole groom is clumped once more
+        first (:meth:`~hairtool.frozen.pipeline.FrozenPipeline.settle`), so what is kept is what
+        a replay gives."""
         self.start_engine()
+        if self.pipeline.unsettled:
+            self._stroke_step(self.pipeline.settle)
         return self.pipeline.snapshot()
 
     def restore(self, snap: object) -> None:

@@ -5,10 +5,17 @@ and the real grooms. Clump radius h = 2× the median root spacing, k = 3. ``pipe
 groom → result (freeze + one align sample + clump), run again on the same input, so
 ClumpWithGaps keeps its neighbour list; ``cold_ms``: the same with the list built every time;
 ``clump_ms``: ClumpWithGaps alone with its list built, ``list_ms`` of it; ``update_ms``: one
-studio mouse move with the cursor held still (align + clump, freeze cached); ``drag_ms``: one
-mouse move of a drag with the studio's brush (the cursor circling a tip), where the strands
-move and ClumpWithGaps is redone near them (:mod:`hairtool.frozen.clump_region`): on ``drag_redone``
-of the vertices per move (1: a full run);
+studio mouse move with the cursor held still (align + clump, freeze cached).
+
+Brush-local moves (:mod:`hairtool.frozen.local`): ``drag_ms`` is one mouse move of a drag with a
+brush of 0.05× the groom's extent, the cursor circling a tip near the middle, where the brush,
+ClumpWithGaps and the length pass run on the strands under the brush and those their clumps
+reach (``drag_redone`` of the vertices per move); ``crop_ms`` the same moves on a groom made only
+of the strands within two brush radii of the path (``crop_strands`` of them; the same h and
+step), and ``drag_per_crop`` their ratio: near 1 when a move costs the brush, not the groom
+(target: drag_ms ≤ 1.5 × crop_ms + 1 ms). ``lists_ms``: of a drag move, the kept grid's update
+and the region's neighbour lists, against ``list_ms``, the list built cold for the whole groom,
+and ``grid_ms``, the kept grid's cold build (once per groom).
 ``reference_ms``: the pipeline with the numpy twins (null above ``--reference-limit`` vertices).
 ``mean_neighbours``: other-strand vertices within h per moving vertex; ``threads``: numba threads.
 """
@@ -32,7 +39,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         nargs="+",
         default=None,
         metavar="SIZE",
-        help="STRANDSxVERTICES (scalp samples), 'real' (every groom in tests/data/grooms) or a path",
+        help="STRANDSxVERTICES (scalp samples), 'real' (every groom in tests/data/grooms, "
+        "or $HAIRTOOL_BENCH_DATA/grooms) or a path",
     )
     parser.add_argument("--quick", action="store_true", help="100x20 and 500x20 only, fewer repeats")
     parser.add_argument("--repeat", type=int, default=15, help="timed runs per number (median)")
@@ -50,8 +58,7 @@ def _grooms(sizes: list[str]):
 
     for size in sizes:
         if size == "real":
-            for path in sorted(GROOMS_DIR.glob("*.tfx")):
-                yield path.stem, read_groom(path)
+            yield from _real_grooms(GROOMS_DIR)
         elif "x" in size and all(p.isdigit() for p in size.split("x")):
             s, v = (int(p) for p in size.split("x"))
             yield f"scalp {size}", scalp(s, v, seed=0)
@@ -61,38 +68,94 @@ def _grooms(sizes: list[str]):
             raise ParameterError("sizes", size, "STRANDSxVERTICES, 'real' or a groom file")
 
 
+REAL_SUFFIXES = (".tfx", ".hair", ".usd", ".usda", ".usdc", ".npz")  # (.obj there are head meshes)
+
+
+def _real_grooms(folder: Path):
+    """Every groom file in ``folder`` (the checkout's tests/data/grooms, or
+    ``$HAIRTOOL_BENCH_DATA``/grooms), by name."""
+    from hairtool.io import read_groom
+
+    for path in sorted(folder.iterdir()) if folder.is_dir() else ():
+        if path.suffix.lower() in REAL_SUFFIXES:
+            yield path.stem, read_groom(path)
+
+
 def _fresh(ws):
     """The workspace with its neighbour list forgotten, so the time includes building one."""
     ws.invalidate()
     return ws
 
 
-def _drag_ms(pipe, moves: int = 40) -> tuple[float, float]:
-    """Median ms per move of a drag like the studio's (its brush of 0.25× the groom's extent,
-    the cursor circling a tip near the middle) and the mean share of the vertices that
-    ClumpWithGaps redid per move."""
+BRUSH = 0.05  # of the groom's extent: the drag's brush radius
+
+
+def _drag_path(rest, moves: int = 40):
+    """The drag's cursor positions: a loop of radius 0.1× the extent around the tip nearest the
+    middle, and the brush radius."""
     import numpy as np
+
+    lo, hi = rest.bounds
+    extent = float(np.max(hi - lo))
+    tips = rest.tips.astype(np.float64)
+    tip = tips[np.argmin(np.linalg.norm(tips - (lo + hi) / 2.0, axis=1))]
+    a = np.linspace(0.0, 2.0 * np.pi, moves, endpoint=False)
+    return tip + 0.1 * extent * np.column_stack([np.cos(a), np.sin(a), np.zeros(moves)]), BRUSH * extent
+
+
+def _drag_ms(pipe, path, radius: float) -> tuple[float, float, float]:
+    """Median ms per move of the drag (after one untimed move), the mean share of the vertices
+    ClumpWithGaps redid per move, and the median ms of the grid update and region lists."""
+    import statistics
 
     from hairtool.bench import median_ms
 
-    lo, hi = pipe.rest.bounds
-    extent = float(np.max(hi - lo))
-    tips = pipe.rest.tips.astype(np.float64)
-    tip = tips[np.argmin(np.linalg.norm(tips - (lo + hi) / 2.0, axis=1))]
-    a = np.linspace(0.0, 2.0 * np.pi, moves, endpoint=False)
-    path = itertools.cycle(tip + 0.1 * extent * np.column_stack([np.cos(a), np.sin(a), np.zeros(moves)]))
+    moves = itertools.cycle(path)
+    redone, lists = [], []
 
     def move():
-        pipe.align(next(path), 0.25 * extent, 0.8)
-
-    redone = []
-
-    def move_and_count():
-        move()
+        pipe.align(next(moves), radius, 0.8)
         redone.append(pipe.clump_redone)
+        local = pipe._local
+        lists.append(0.0 if local is None or pipe.clump_redone >= 1.0 else local.lists_ms)
 
     move()
-    return median_ms(move_and_count, moves, warmup=0), sum(redone) / len(redone)
+    redone.clear()
+    lists.clear()
+    ms = median_ms(move, len(path), warmup=0)
+    return ms, sum(redone) / len(redone), statistics.median(lists)
+
+
+def _crop(rest, path, radius: float):
+    """The strands of ``rest`` with a vertex within two brush radii of the path."""
+    import numpy as np
+
+    p = rest.points.astype(np.float64)
+    near = np.zeros(rest.vertex_count, bool)
+    for c in path:
+        e = p - c
+        near |= np.einsum("ij,ij->i", e, e) < (2.0 * radius) ** 2
+    ids = np.flatnonzero(np.logical_or.reduceat(near, rest.offsets[:-1]))
+    return rest.subset(ids)
+
+
+def _drag_and_crop(rest) -> dict:
+    from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+
+    path, radius = _drag_path(rest)
+    pipe = FrozenPipeline(rest)
+    drag, redone, lists = _drag_ms(pipe, path, radius)
+    crop = _crop(rest, path, radius)
+    same = FrozenParams(clump_radius=pipe.clump_radius, clump_step=pipe.clump_step)
+    crop_ms = _drag_ms(FrozenPipeline(crop, same), path, radius)[0]
+    return {
+        "drag_ms": drag,
+        "crop_ms": crop_ms,
+        "drag_per_crop": drag / crop_ms if crop_ms > 0 else None,
+        "crop_strands": crop.strand_count,
+        "drag_redone": redone,
+        "lists_ms": lists,
+    }
 
 
 def _cursor(groom):
@@ -117,6 +180,7 @@ def run(args: argparse.Namespace) -> list[dict]:
     from hairtool.frozen.freeze import freeze, freeze_reference
     from hairtool.frozen.pipeline import FrozenPipeline
     from hairtool.frozen.strand_clumps import auto_clump_radius
+    from hairtool.frozen.vertex_grid import VertexGrid
 
     if args.repeat < 1:
         raise ParameterError("repeat", args.repeat, "a whole number ≥ 1")
@@ -155,7 +219,10 @@ def run(args: argparse.Namespace) -> list[dict]:
             "cold_ms": median_ms(lambda ws=ws, run=pipeline: (_fresh(ws), run()), repeat),
             "update_ms": median_ms(lambda p=pipe, c=c, r=r: p.align(c, r, 0.8), repeat),
         }
-        row["drag_ms"], row["drag_redone"] = _drag_ms(FrozenPipeline(rest))
+        row.update(_drag_and_crop(rest))
+        row["grid_ms"] = median_ms(
+            lambda r=rest, h=h: VertexGrid(r.points, r.topology.strand_index, 1.1 * h), max(1, min(repeat, 5))
+        )
         row["mean_neighbours"] = ws.mean_neighbours
         if rest.vertex_count <= args.reference_limit:
             row["reference_ms"] = median_ms(reference, max(1, min(repeat, 3)), warmup=0)

@@ -222,6 +222,7 @@ def run(args: argparse.Namespace) -> int:
     for stroke in strokes or ():
         pipe.apply_samples(stroke.pipeline_samples(float(pipe.scalp_centre[0])))
         timings.append(pipe.timings)
+    pipe.settle()  # the result of the whole groom's clumping, as the studio's after a release
     report = {}
     if binding is not None and not np.array_equal(pipe.origin, np.arange(groom.strand_count)):
         # add, delete or density strokes: the children follow the guides planted and removed

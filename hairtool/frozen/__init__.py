@@ -3,8 +3,9 @@
 - :mod:`.freeze` FreezeDeform, eqs. 2–7: seeded stretch and bend of every rest segment;
 - :mod:`.align` UserAlign, eqs. 8–13: strands near the cursor turn toward it, root to tip;
 - :mod:`.clump` ClumpWithGaps, eqs. 14–19: the adhesion kernel with the gap-keeping correction,
-  over the neighbour lists of :mod:`.spatial`; :mod:`.clump_region` redoes it only near the
-  strands that moved; :mod:`.strand_clumps` labels clumps and picks the automatic radius;
+  over the neighbour lists of :mod:`.spatial`; :mod:`.local` redoes it (and the brush) only on
+  the strands under the brush and those their clumps reach, through the kept grid of
+  :mod:`.vertex_grid`; :mod:`.strand_clumps` labels clumps and picks the automatic radius;
 - :mod:`.brushes` comb, smooth, length, puff, clump and mask, falloff, symmetry and
   front-facing strands; :mod:`.selection` selecting and hiding strands; :mod:`.strokes`
   stroke logs as JSON files;

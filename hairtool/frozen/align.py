@@ -126,15 +126,22 @@ def _align_kernel(p, offsets, c, radius, x, preserve, planar, out):
 
 
 def align(
-    groom: Groom, cursor: ArrayLike, radius: float, intensity: float = 0.8, mode: str = "paper"
+    groom: Groom,
+    cursor: ArrayLike,
+    radius: float,
+    intensity: float = 0.8,
+    mode: str = "paper",
+    planar: bool | None = None,
 ) -> Groom:
     """UserAlign: one align sample (one mouse move) applied to ``groom``; roots stay fixed.
 
     ``cursor``: (3,) point (the mouse unprojected), ``radius``: the tips within it take part,
-    ``intensity`` x ∈ [0, 1]: 1 turns a strand like a rod, 0 mostly its tip.
+    ``intensity`` x ∈ [0, 1]: 1 turns a strand like a rod, 0 mostly its tip. ``planar``: whether
+    the groom counts as 2-D (None: :attr:`~hairtool.groom.Groom.is_planar`; the brush-local
+    pipeline passes the whole groom's for the strands it runs on).
     """
     c = check_align_params(cursor, radius, intensity, mode)
-    planar = groom.is_planar
+    planar = groom.is_planar if planar is None else bool(planar)
     if planar:
         c[2] = 0.0
     out = np.empty_like(groom.points)

@@ -19,7 +19,7 @@ within h. (A pair farther apart than 1.1·h at the start never interacts in that
 :func:`clump` runs numba kernels on a cell-sorted list of them, built when the points change
 (an update on the points of the last one, e.g. a clump-only parameter change or a cursor held
 still, reuses it). :func:`clump_reference` is the plain numpy twin of the same definition.
-While a brush drags, :mod:`hairtool.frozen.clump_region` redoes a run only near what changed.
+While a brush drags, :mod:`hairtool.frozen.local` redoes a run only on the strands near the brush.
 
 ``keep_lengths``: after the k iterations every segment is set back to its length before
 clumping, root to tip, direction kept (:mod:`hairtool.frozen.lengths`); off by default, as printed.
@@ -294,7 +294,7 @@ def _clump_run(points, strength, order, lists, sroot, h, iterations, step, gap, 
     """The k Jacobi iterations on the cell-sorted list, one call (no Python between kernels).
     ``step`` < 0: automatic. Writes the result to ``out`` (original order, float32); returns
     (mean neighbours within h per moving vertex, the step used). ``record`` = (iterates (k, V, 3),
-    forces (k, V, 3), counts, Σg), in original order, for :mod:`hairtool.frozen.clump_region`; empty
+    forces (k, V, 3), counts, Σg), in original order, for :mod:`hairtool.frozen.local`; empty
     arrays: not recorded."""
     P, Pn, f, best, count, weight, heads, S = bufs
     aflat, aoff, acnt, bflat, bstart = lists
@@ -330,7 +330,7 @@ RECORD_LIMIT = 8_000_000  # vertices × iterations at most in a record (2 × 24 
 
 
 class ClumpRecord:
-    """What a run leaves for :mod:`hairtool.frozen.clump_region` to redo only where its input changed:
+    """What a run leaves for :mod:`hairtool.frozen.local` to redo only where its input changed:
     its parameters, input and output, and each iteration's points and forces, the first one's
     neighbour counts and Σg (original vertex order)."""
 
@@ -345,11 +345,6 @@ class ClumpRecord:
         self.strength = np.empty(vertices)  # each vertex's clump strength in the run
         self.step = 0.0
         self.mean_neighbours = 0.0
-        self.lists = np.empty((vertices, 16), np.int32)  # each vertex's list, original indices
-        self.list_count = np.empty(vertices, np.int64)
-        self.lists_ready = False
-        self.dense = False  # the run's lists came from the row grid
-        self.frame: tuple | None = None  # that grid's corner and size: its lists' order
         self.valid = False  # all of the above is one run's (False while being rewritten)
 
     def fits(self, vertices: int, iterations: int) -> bool:
@@ -375,7 +370,6 @@ class ClumpWorkspace:
         self.builds = 0  # neighbour lists built so far (the rest of the runs reused one)
         self.record = False  # keep a ClumpRecord of each run (the studio's updates in a region)
         self.recorded: ClumpRecord | None = None  # kept for its buffers even when not valid
-        self.region = None  # hairtool.frozen.clump_region's scratch, when it updates this workspace
         self._mask_for: object = None
         self._mask = np.zeros(0, bool)
         self._buffers: tuple = ()
@@ -408,10 +402,6 @@ class ClumpWorkspace:
         self._built = (top, radius, groom.points.copy())
         self.builds += 1
         return self.neighbours
-
-    def holds_list_of(self, points: np.ndarray) -> bool:
-        """Whether the kept neighbour list is the one built for ``points``."""
-        return self._built is not None and _same_points(points, self._built[2])
 
     def buffers(self, v: int) -> tuple:
         """Iterates, f, nearest neighbour, counts, Σg, hash heads and clump strengths for V
@@ -468,9 +458,6 @@ def clump_points(
         _NO_RECORD if rec is None else (rec.iterates, rec.forces, rec.count, rec.weight),
     )  # fmt: skip
     if rec is not None:
-        rec.dense = nl.dense
-        rec.frame = (tuple(nl.lo), tuple(nl.dims)) if nl.dense else None
-        rec.lists_ready = False  # filled from the workspace's list when an update first needs them
         rec.key = record_key(groom, h, k, step, gap_mode, seed)
         rec.points[:] = groom.points
         rec.strength[:] = sv

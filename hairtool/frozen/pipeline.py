@@ -12,6 +12,12 @@ Built for dragging in the studio:
 - The clump brush paints a per-strand clump strength (1 everywhere until painted), kept with the
   mask in the state and the snapshots, which ClumpWithGaps scales each strand's step by.
 - Clumping is recomputed from the aligned state at every update and never accumulates.
+- Brush-local moves (:mod:`hairtool.frozen.local`): a sample of align, comb, smooth, length,
+  puff, pinch, clump or mask runs only on the strands with a vertex within its radius (found in a
+  vertex grid kept across moves), and ClumpWithGaps and the length pass only on those it changed
+  and the strands within the clump kernel's reach of them; the rest of the groom is read, never
+  written, and keeps its last result bit for bit. The other brushes, parameter changes, undo and
+  replays run on the whole groom (a full run, after which the grid follows what moved).
 - Delete (:mod:`hairtool.frozen.sculpt`) changes the strands: a stage like the others, applied
   to the stroked state, which takes the kept strands with their mask and clump strength; the
   pipeline records the rest strand each remaining strand comes from (:attr:`FrozenPipeline.origin`),
@@ -45,6 +51,7 @@ from hairtool.frozen.brushes import (
     MOVE_NONE,
     BrushSample,
     apply_brush,
+    check_sample,
     check_view,
     facing_away,
     paint_clump,
@@ -52,11 +59,18 @@ from hairtool.frozen.brushes import (
     root_normals,
     scalp_centre,
 )
-from hairtool.frozen.clump import ClumpWorkspace, check_clump_params, clump_points
-from hairtool.frozen.clump_region import clump_points_interactive
+from hairtool.frozen.clump import (
+    ClumpWorkspace,
+    check_clump_params,
+    clump_points,
+    record_key,
+    vertex_strength,
+)
 from hairtool.frozen.collide import MARGIN, KeepOut, collide
 from hairtool.frozen.density import accept, disc_candidates, thin
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
+from hairtool.frozen.lengths import restore_lengths
+from hairtool.frozen.local import LocalClump, changed_strands, threads_for
 from hairtool.frozen.noise import check_seed, draw_seed
 from hairtool.frozen.sculpt import hook_weights, pinch, snake_hook, strands_to_delete
 from hairtool.frozen.selection import SelectionSample, apply_selection
@@ -69,14 +83,14 @@ from hairtool.groom import Groom, vertex_ids_of
 class FrozenParams:
     """Everything the pipeline needs besides the strokes. Angles in radians, lengths in groom units.
 
-    ``strand_variation``: spread of the per-strand stiffness multiplier (0 … 4) or an ``(S,)``
-    array of multipliers. ``clump_radius`` None: :func:`~hairtool.frozen.strand_clumps.auto_clump_radius`.
-    ``clump_step`` None: :func:`~hairtool.frozen.clump.auto_step` of the frozen groom, before any stroke
-    (so that a stroke does not change how strongly the whole groom clumps while it drags, and
-    the studio can redo ClumpWithGaps only near the strands it moves). ``keep_lengths``: after
-ClumpWithGaps every segment goes back to its length before it (off: the paper's printed form,
-which stretches segments). ``redraw_noise``: new
-    freeze noise at every :meth:`update` (the paper's behaviour; flickers while dragging).
+        ``strand_variation``: spread of the per-strand stiffness multiplier (0 … 4) or an ``(S,)``
+        array of multipliers. ``clump_radius`` None: :func:`~hairtool.frozen.strand_clumps.auto_clump_radius`.
+        ``clump_step`` None: :func:`~hairtool.frozen.clump.auto_step` of the frozen groom, before any stroke
+        (so that a stroke does not change how strongly the whole groom clumps while it drags, and
+        the studio can redo ClumpWithGaps only near the strands it moves). ``keep_lengths``: after
+    ClumpWithGaps every segment goes back to its length before it (off: the paper's printed form,
+    which stretches segments). ``redraw_noise``: new
+        freeze noise at every :meth:`update` (the paper's behaviour; flickers while dragging).
     """
 
     stretch_stiffness: float = 7.0
@@ -177,8 +191,10 @@ Sample = AlignSample | BrushSample | SelectionSample
 class FrozenSnapshot:
     """Undo/redo state: the stroke log and the stroked points it produced (shared, read-only),
     the mask and the clump strengths it painted (None: replay the log to find them), the rest
-    strand of each stroked strand (None: every rest strand, in order), a snake hook's state, and
-    the selected and hidden strands (None: replay the log to find them)."""
+    strand of each stroked strand (None: every rest strand, in order), a snake hook's state, the
+    selected and hidden strands (None: replay the log to find them), and the result shown then
+    with the parameters it was clumped with (a brush-local move's result is not a full run's:
+    undo and redo bring back what was shown)."""
 
     log: tuple[Sample, ...]
     aligned: Groom
@@ -190,6 +206,8 @@ class FrozenSnapshot:
     hooks: tuple[tuple, int, bool] = ((), 0, False)
     selected: np.ndarray | None = None
     hidden: np.ndarray | None = None
+    result: Groom | None = None
+    clump_key: tuple = ()
 
 
 class FrozenPipeline:
@@ -217,6 +235,15 @@ class FrozenPipeline:
         self._root_normals: np.ndarray | None = None
         self._draw = 0
         self._workspace = ClumpWorkspace()
+        self._workspace.record = True  # the record brush-local moves update
+        self._local: LocalClump | None = None  # brush-local state after a full, recorded run
+        self._grid_points: np.ndarray | None = None  # the clump input the grid holds
+        self._sv = np.zeros(0)  # (V,) clump strength per vertex of that input
+        self._kept = np.zeros((0, 3), np.float32)  # the last result's points, writable
+        self._nonplanar = 0  # vertices of the stroked state off z = 0
+        self._redone = 1.0  # share of the vertices the last clumping computed
+        self._region: np.ndarray | None = None  # strands the last update redid (None: all)
+        self._unsettled = False  # brush-local moves since the last full run
         self._timings = {"freeze": 0.0, "align": 0.0, "clump": 0.0, "total": 0.0}
         self._freeze_key: tuple | None = None
         self._frozen: Groom = rest
@@ -350,10 +377,15 @@ class FrozenPipeline:
 
     @property
     def clump_redone(self) -> float:
-        """Share of the vertices the last clumping computed (1: all; less: only those near the
-        vertices that changed since the one before, :mod:`hairtool.frozen.clump_region`)."""
-        region = self._workspace.region
-        return 1.0 if region is None else region.fraction
+        """Share of the vertices the last clumping computed (1: all; less: a brush-local move,
+        :mod:`hairtool.frozen.local`)."""
+        return self._redone
+
+    @property
+    def changed(self) -> np.ndarray | None:
+        """Sorted ids of the strands of the result the last update may have changed (a brush-local
+        move's region; the others keep their points bit for bit), or None: any strand (a full run)."""
+        return None if self._region is None else self._region.copy()
 
     @property
     def mean_neighbours(self) -> float:
@@ -413,10 +445,14 @@ class FrozenPipeline:
         where it is applied: a refused sample leaves no trace in the log)."""
         return self.apply_samples([sample])
 
-    def apply_samples(self, samples: Sequence[Sample]) -> Groom:
+    def apply_samples(self, samples: Sequence[Sample], local: bool = True) -> Groom:
         """Samples of any brush (a stroke's, mirrored ones included), applied in order, then one
-        clumping: what a replayed stroke log does."""
+        clumping: what a replayed stroke log does. ``local``: a brush-local move where it can
+        (:mod:`hairtool.frozen.local`); False: on the whole groom, as a replay after a parameter
+        change does."""
         self._timings = dict.fromkeys(self._timings, 0.0)
+        if local and samples and self._local_ready(samples):
+            return self._apply_local(samples)
         t0 = time.perf_counter()
         before = (self._aligned, *self._strand_state(), len(self._log))
         hooks = self._hook_state()
@@ -432,6 +468,21 @@ class FrozenPipeline:
             raise
         self._timings["align"] = (time.perf_counter() - t0) * 1e3
         self._reclump()
+        return self._result
+
+    @property
+    def unsettled(self) -> bool:
+        """Whether the result comes from brush-local moves since the last full run (:meth:`settle`)."""
+        return self._unsettled
+
+    def settle(self) -> Groom:
+        """After brush-local moves, ClumpWithGaps once more on the whole groom: the result any
+        replay of the strokes gives (the studio does it when the mouse is released; the
+        strokes' points are the same either way, only the clumping of the strands near the
+        moved ones differs a little). Without local moves since the last full run: the result."""
+        if self._unsettled:
+            self._timings = dict.fromkeys(self._timings, 0.0)
+            self._reclump()
         return self._result
 
     def update(self) -> Groom:
@@ -456,9 +507,18 @@ class FrozenPipeline:
     def snapshot(self) -> FrozenSnapshot:
         """Cheap state for undo/redo (no copies: grooms are immutable)."""
         return FrozenSnapshot(
-            tuple(self._log), self._aligned, self._freeze_key or (), self._draw, self._locked.copy(),
-            self._clump_strength.copy(), self._origin.copy(), self._hook_state(), self._selected.copy(),
+            tuple(self._log),
+            self._aligned,
+            self._freeze_key or (),
+            self._draw,
+            self._locked.copy(),
+            self._clump_strength.copy(),
+            self._origin.copy(),
+            self._hook_state(),
+            self._selected.copy(),
             self._hidden.copy(),
+            self._result,
+            self._params._key,
         )
 
     def restore(self, snapshot: FrozenSnapshot) -> Groom:
@@ -501,9 +561,21 @@ class FrozenPipeline:
             self._selected = np.ones(n, bool) if sel is None else sel.astype(bool)
             self._hidden = np.zeros(n, bool) if hid is None else hid.astype(bool)
             self._set_hooks(snapshot.hooks)
+            shown = snapshot.result
         else:
             self._replay()
+            shown = None
         self._reclump()
+        if shown is not None and snapshot.clump_key == self._params._key and self._local is not None:
+            if shown.metadata is not self._rest.metadata:
+                shown = shown.with_metadata(self._rest.metadata)
+            if (
+                shown.topology is self._aligned.topology
+                or shown.counts.tobytes() == self._aligned.counts.tobytes()
+            ):
+                # What was shown (the record is the full run's: later moves hold the rest to it).
+                self._result = self._aligned.with_points(shown.points)
+                self._kept = self._result.points.copy()
         return self._result
 
     def clump_ids(self) -> np.ndarray:
@@ -716,24 +788,50 @@ class FrozenPipeline:
             self._aligned = self._apply(self._aligned, s)
 
     def _reclump(self) -> None:
+        """A full run on the stroked state (recorded: brush-local moves start from it)."""
         p = self._params
         t0 = time.perf_counter()
+        self._redone, self._region, self._unsettled = 1.0, None, False
+        g = self._aligned
         if p.clump and p.clump_iterations > 0:
-            pts = clump_points_interactive(
-                self._aligned,
-                self.clump_radius,
+            h, step, seed = self.clump_radius, self._step(), draw_seed(p.seed, self._draw)
+            ws = self._workspace
+            ws.record = True
+            pts = clump_points(
+                g,
+                h,
                 p.clump_iterations,
-                self._step(),
+                step,
                 p.gap_mode,
-                draw_seed(p.seed, self._draw),
-                self._workspace,
+                seed,
+                ws,
                 bool(p.keep_lengths),
                 self._clump_strength,
             )
-            self._result = self._kept_out(self._aligned.with_points(pts))
+            self._result = self._kept_out(g.with_points(pts))
+            rec = ws.recorded
+            key = record_key(g, h, p.clump_iterations, step, p.gap_mode, seed)
+            if g.strand_count >= 2 and rec is not None and rec.valid and rec.key == key:
+                local = self._local
+                if (
+                    local is not None
+                    and local.topology is g.topology
+                    and local.h == h
+                    and local.record is rec
+                ):
+                    local.resync(g.points, self._grid_points)  # the grid follows what moved
+                else:
+                    self._local = LocalClump(g.points, g.topology, h, rec)
+                self._grid_points = g.points
+                self._sv = vertex_strength(g, self._clump_strength)
+                self._kept = pts
+                self._nonplanar = int(np.count_nonzero(g.points[:, 2]))
+            else:
+                self._local = None
         else:
             self._workspace.mean_neighbours = 0.0
-            self._result = self._aligned
+            self._result = g
+            self._local = None
         self._timings["clump"] = (time.perf_counter() - t0) * 1e3
         self._timings["total"] = self._timings["freeze"] + self._timings["align"] + self._timings["clump"]
 
@@ -751,5 +849,168 @@ class FrozenPipeline:
             return clumped
         lo, hi = self._rest.bounds
         margin = MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
-        kept = self.__dict__.setdefault("_kept", KeepOut())  # (its memory: the head's distances)
+        kept = self.__dict__.setdefault("_keep_out", KeepOut())  # (its memory: the head's distances)
         return kept(self._aligned, clumped, surface, margin)
+
+    # -- brush-local moves (hairtool.frozen.local) ---------------------------------------
+    def _local_ready(self, samples: Sequence[Sample]) -> bool:
+        """Whether these samples can run on the strands under their brushes only."""
+        local, p = self._local, self._params
+        if local is None or self._grid_points is None or local.topology is not self._aligned.topology:
+            return False
+        if not all(isinstance(s, AlignSample | SelectionSample) or s.brush in LOCAL_BRUSHES for s in samples):
+            return False
+        rec = self._workspace.recorded
+        h, seed = self.clump_radius, draw_seed(p.seed, self._draw)
+        if self._auto_step is None and p.clump_step is None:
+            return False
+        step = self._step()
+        return (
+            rec is local.record
+            and rec.valid
+            and rec.key == record_key(self._aligned, h, p.clump_iterations, step, p.gap_mode, seed)
+        )
+
+    def _apply_local(self, samples: Sequence[Sample]) -> Groom:
+        t0 = time.perf_counter()
+        g, top, local = self._aligned, self._aligned.topology, self._local
+        assert local is not None and self._grid_points is not None
+        old = self._grid_points
+        cur = old.copy()
+        state = (self._strand_state(), self._hook_state())
+        touched = np.zeros(g.strand_count, bool)  # strands a sample of this batch ran on
+        painted = np.zeros(0, np.int64)  # strands whose clump strength changed
+        planar = self._nonplanar == 0
+        try:
+            for sample in samples:
+                painted = np.union1d(painted, self._local_sample(cur, sample, touched, planar))
+        except BaseException:  # a refused sample: none of these samples happened
+            self._set_strand_state(state[0])
+            self._set_hooks(state[1])
+            raise
+        self._log.extend(samples)
+        moved = changed_strands(old, cur, top, np.flatnonzero(touched))
+        seeds = np.union1d(moved, painted)
+        if moved.size:
+            mv = vertex_ids_of(top, moved)
+            self._nonplanar += int(np.count_nonzero(cur[mv, 2])) - int(np.count_nonzero(old[mv, 2]))
+            self._aligned = g.with_points(cur)
+        t1 = time.perf_counter()
+        self._timings["align"] = (t1 - t0) * 1e3
+        if seeds.size == 0:
+            local.lists_ms = 0.0
+            self._redone, self._region = 0.0, seeds
+            self._timings["total"] = self._timings["align"]
+            return self._result
+        p = self._params
+        sv = self._sv
+        if painted.size:
+            pv = vertex_ids_of(top, painted)
+            sv[pv] = self._clump_strength[top.strand_index[pv]]
+        now = self._aligned.points
+        seed_ = draw_seed(p.seed, self._draw)
+        done = local.update(old, now, seeds, sv, p.clump_iterations, self._step(), p.gap_mode, seed_)
+        if done is None:  # most of the groom: a full run costs less
+            self._reclump()
+            self._timings["clump"] = (time.perf_counter() - t1) * 1e3
+            self._timings["total"] = self._timings["align"] + self._timings["clump"]
+            return self._result
+        region, vids = done
+        self._unsettled = True
+        rec = local.record
+        if p.keep_lengths:
+            restore_lengths(now, rec.result, top, region, self._kept)
+            still = vids[sv[vids] == 0.0]
+            self._kept[still] = now[still]
+        else:
+            self._kept[vids] = rec.result[vids]
+        self._grid_points = now
+        self._result = self._kept_out(self._aligned.with_points(self._kept))  # (a copy: _kept moves on)
+        self._redone, self._region = vids.size / max(top.vertex_count, 1), region
+        self._timings["clump"] = (time.perf_counter() - t1) * 1e3
+        self._timings["total"] = self._timings["align"] + self._timings["clump"]
+        return self._result
+
+    def _local_sample(self, cur: np.ndarray, sample: Sample, touched: np.ndarray, planar: bool) -> np.ndarray:
+        """One sample on the strands with a vertex within its radius (where the grid holds the
+        unmoved ones) and those this batch has moved, written into ``cur``; returns the strands
+        whose clump strength it changed."""
+        if not (isinstance(sample, BrushSample) and sample.brush == "snake_hook"):
+            self._set_hooks(((), 0, False))  # another brush ends a snake hook's stroke
+        local, top = self._local, self._aligned.topology
+        assert local is not None and self._grid_points is not None
+        if isinstance(sample, SelectionSample):  # no strand moves: on the whole groom
+            away = self._away(sample.view)
+            g = self._aligned.with_points(cur)
+            self._selected, self._hidden = apply_selection(g, sample, self._selected, self._hidden, away)
+            return np.zeros(0, np.int64)
+        if isinstance(sample, AlignSample):
+            check_align_params(sample.cursor, sample.radius, sample.intensity, sample.mode)
+        else:
+            check_sample(sample)
+        reach = float(sample.radius) * (1.0 + 1e-6)  # a little wider: the brush itself decides
+        near = local.near(self._grid_points, np.asarray(sample.cursor, np.float64).reshape(1, 3), reach)
+        cand = np.union1d(near, np.flatnonzero(touched))
+        none = np.zeros(0, np.int64)
+        if cand.size == 0:
+            return none
+        vids = vertex_ids_of(top, cand)
+        with threads_for(vids.size):
+            out, painted = self._local_brush(Groom(cur[vids], top.counts[cand]), cand, sample, planar)
+        if out is not None:
+            cur[vids] = out.points
+            touched[cand] = True
+        return painted
+
+    def _local_brush(
+        self, sub: Groom, cand: np.ndarray, sample: Sample, planar: bool
+    ) -> tuple[Groom | None, np.ndarray]:
+        """One sample on the groom ``sub`` of the strands ``cand``: (the moved strands, or None
+        for mask and clump, which paint; the strands whose clump strength it changed)."""
+        none = np.zeros(0, np.int64)
+        away = (
+            None if check_view(sample.view) is None else facing_away(self.strand_normals[cand], sample.view)
+        )
+        if isinstance(sample, BrushSample) and sample.brush == "select":
+            skip = self._hidden[cand] if away is None else self._hidden[cand] | away
+            selected = self._selected.copy()
+            selected[cand] = paint_mask(sub, sample, self._selected[cand], skip)
+            self._selected = selected
+            return None, none
+        if isinstance(sample, BrushSample) and sample.brush == "mask":
+            skip = self._lock(sample, None, mask=False)[cand]
+            locked = self._locked.copy()
+            locked[cand] = paint_mask(sub, sample, self._locked[cand], skip if away is None else skip | away)
+            self._locked = locked
+            return None, none
+        lock = self._lock(sample, None)[cand]  # masked, hidden, and unselected with only_selected
+        if away is not None:
+            lock = lock | away
+        if isinstance(sample, AlignSample):
+            out = align(sub, sample.cursor, sample.radius, sample.intensity, sample.mode, planar=planar)
+            if lock.any():
+                keep = vertex_ids_of(sub.topology, np.flatnonzero(lock))
+                pts = out.points.copy()
+                pts[keep] = sub.points[keep]
+                out = sub.with_points(pts)
+        elif sample.brush == "clump":
+            was = self._clump_strength[cand]
+            now = paint_clump(sub, sample, was, lock)
+            strength = self._clump_strength.copy()
+            strength[cand] = now
+            self._clump_strength = strength
+            return None, cand[now != was]
+        elif sample.brush == "pinch":
+            out = pinch(sub, sample, lock)
+        else:
+            out = apply_brush(sub, sample, lock, self.scalp_centre)
+        surface = self._surface
+        if sample.collide and surface is not None and hasattr(surface, "signed_distance"):
+            lo, hi = self._rest.bounds
+            margin = MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
+            out = collide(sub, out, surface, margin)  # type: ignore[arg-type]
+        return out, none
+
+
+#: The brushes a move runs on the strands under it only (the others on the whole groom).
+LOCAL_BRUSHES = ("comb", "smooth", "length", "puff", "pinch", "clump", "mask", "select")

@@ -263,115 +263,6 @@ def _forward_kernel(
 
 
 @njit(cache=True, nogil=True)
-def _row_run(start, sx, y, z, ny, nz, sweep):
-    """Row (y, z)'s run in sorted order from where its window may start for a vertex whose sweep
-    line is ``sweep`` (empty where the row lies outside the grid). Bisection: on x sorted to
-    within the quantisation slack it ends just past an entry left of ``sweep``, and those before
-    that one lie left of it plus the slack, out of reach. The row comes as computed integers,
-    not as constant offsets: numba would compile one version per constant."""
-    if not (0 <= y < ny and 0 <= z < nz):
-        return 0, 0
-    rr = z * ny + y
-    a, b = start[rr], start[rr + 1]
-    end = b
-    while a < b:
-        m = (a + b) >> 1
-        if sx[m] <= sweep:
-            a = m + 1
-        else:
-            b = m
-    return a, end
-
-
-@njit(cache=True, nogil=True, parallel=True)
-def _region_kernel(
-    sx, sy, sz, sstrand, start, ny, nz, lo, cell, r2, slack, order, positions, chunks, cap, flat, cnt
-):
-    """The lists of the vertices at sorted ``positions`` (increasing) in the order of a full
-    build: what :func:`_forward_kernel` finds (own row to the right, then rows (y+1, z),
-    (y−1, z+1), (y, z+1), (y+1, z+1)), then the vertices that would have found them in
-    increasing sorted position, as :func:`_transpose` leaves them (rows (y−1, z−1), (y, z−1),
-    (y+1, z−1), (y−1, z), then the own row to the left); as original indices, ``cap`` slots per
-    vertex in ``flat`` (the last one scratch). One task per chunk of ``positions``; within a
-    row the window pointers only move forward, as in the forward kernel. The distance test,
-    which decides, is the forward kernel's (a − b = −(b − a) in floating point)."""
-    grow = 2.0 * slack
-    reach = np.sqrt(r2) * (1.0 + 1e-6) + grow + 1e-12 * cell
-    e = 1e-7 * cell
-    inv_cell = 1.0 / cell
-    for c in prange(chunks.size - 1):
-        row = -1
-        j1 = e1 = j2 = e2 = j3 = e3 = j4 = e4 = j5 = e5 = j6 = e6 = j7 = e7 = j8 = e8 = j0 = 0
-        y0 = z0 = 0.0
-        for n in range(chunks[c], chunks[c + 1]):
-            i = positions[n]
-            px, py, pz = sx[i], sy[i], sz[i]
-            cy = min(np.int64(np.floor((py - lo[1]) * inv_cell)), ny - 1)  # as _row_sort
-            cz = min(np.int64(np.floor((pz - lo[2]) * inv_cell)), nz - 1)
-            r = cz * ny + cy
-            if r != row:  # a new row: its neighbour rows' pointers afresh
-                row = r
-                y0, z0 = lo[1] + cy * cell, lo[2] + cz * cell
-                j1, e1 = _row_run(start, sx, cy + 1, cz, ny, nz, px - reach)
-                j2, e2 = _row_run(start, sx, cy - 1, cz + 1, ny, nz, px - reach)
-                j3, e3 = _row_run(start, sx, cy, cz + 1, ny, nz, px - reach)
-                j4, e4 = _row_run(start, sx, cy + 1, cz + 1, ny, nz, px - reach)
-                j5, e5 = _row_run(start, sx, cy - 1, cz - 1, ny, nz, px - reach)
-                j6, e6 = _row_run(start, sx, cy, cz - 1, ny, nz, px - reach)
-                j7, e7 = _row_run(start, sx, cy + 1, cz - 1, ny, nz, px - reach)
-                j8, e8 = _row_run(start, sx, cy - 1, cz, ny, nz, px - reach)
-                j0 = start[r]
-            si = sstrand[i]
-            pos = n * cap
-            lim = pos + cap - 1
-            sw = px - reach
-            ya, yb, za, zb = y0 - e, y0 + cell + e, z0 - e, z0 + cell + e  # own row's square
-            _, pos = _scan_row(
-                sx, sy, sz, sstrand, i + 1, start[r + 1], px, py, pz, si, -np.inf, ya, yb, za, zb, r2, i + 1,
-                grow, flat, pos, lim,
-            )  # fmt: skip
-            j1, pos = _scan_row(
-                sx, sy, sz, sstrand, j1, e1, px, py, pz, si, sw, ya + cell, yb + cell, za, zb, r2, 0, grow,
-                flat, pos, lim,
-            )  # fmt: skip
-            j2, pos = _scan_row(
-                sx, sy, sz, sstrand, j2, e2, px, py, pz, si, sw, ya - cell, yb - cell, za + cell, zb + cell,
-                r2, 0, grow, flat, pos, lim,
-            )  # fmt: skip
-            j3, pos = _scan_row(
-                sx, sy, sz, sstrand, j3, e3, px, py, pz, si, sw, ya, yb, za + cell, zb + cell, r2, 0, grow,
-                flat, pos, lim,
-            )  # fmt: skip
-            j4, pos = _scan_row(
-                sx, sy, sz, sstrand, j4, e4, px, py, pz, si, sw, ya + cell, yb + cell, za + cell, zb + cell,
-                r2, 0, grow, flat, pos, lim,
-            )  # fmt: skip
-            j5, pos = _scan_row(
-                sx, sy, sz, sstrand, j5, e5, px, py, pz, si, sw, ya - cell, yb - cell, za - cell, zb - cell,
-                r2, 0, grow, flat, pos, lim,
-            )  # fmt: skip
-            j6, pos = _scan_row(
-                sx, sy, sz, sstrand, j6, e6, px, py, pz, si, sw, ya, yb, za - cell, zb - cell, r2, 0, grow,
-                flat, pos, lim,
-            )  # fmt: skip
-            j7, pos = _scan_row(
-                sx, sy, sz, sstrand, j7, e7, px, py, pz, si, sw, ya + cell, yb + cell, za - cell, zb - cell,
-                r2, 0, grow, flat, pos, lim,
-            )  # fmt: skip
-            j8, pos = _scan_row(
-                sx, sy, sz, sstrand, j8, e8, px, py, pz, si, sw, ya - cell, yb - cell, za, zb, r2, 0, grow,
-                flat, pos, lim,
-            )  # fmt: skip
-            j0, pos = _scan_row(
-                sx, sy, sz, sstrand, j0, i, px, py, pz, si, sw, ya, yb, za, zb, r2, 0, grow, flat, pos, lim
-            )  # fmt: skip
-            p0 = n * cap
-            cnt[n] = pos - p0
-            for m in range(p0, p0 + min(pos - p0, cap - 1)):
-                flat[m] = order[flat[m]]
-
-
-@njit(cache=True, nogil=True)
 def _transpose(chunks, start, base, fflat, fcnt, bstart, bflat):
     """The backward lists: every i that found j (i < j), in increasing i (deterministic), as CSR
     ``bstart`` (V+1,) into ``bflat``. Returns the number of entries (``bflat`` must hold them)."""
@@ -477,14 +368,6 @@ class NeighbourList:
         else:
             self._build_hashed(points, strand, skip, lo, float(radius))
 
-    def sort(self, points: np.ndarray, strand: np.ndarray, skip: np.ndarray, radius: float) -> bool:
-        """Only the row grid's sort (``order``, the sorted coordinates, ``start``), for
-        :meth:`region_lists`; False (and nothing sorted) where the grid would be hashed."""
-        lo, hi, dims = self._grid(points, radius, None)
-        if self.dense:
-            self._sort_rows(points, strand, skip, lo, hi, dims)
-        return self.dense
-
     def _grid(self, points, radius, dense):
         v = points.shape[0]
         lo, hi = (b.astype(np.float64) for b in box(points))
@@ -496,7 +379,8 @@ class NeighbourList:
         self._buffers(v)
         self.radius = float(radius)
         # The grid on a lattice of SNAP radii around the box: an edit that moves the box a little
-        # leaves the grid, and so the order of every list, as it was (hairtool.frozen.clump_region).
+        # leaves the grid, and so the order of every list, as it was (brush-local moves sum their
+        # lists in that order, hairtool.frozen.vertex_grid.list_frame).
         snap = SNAP * self.radius
         lo, hi = np.floor(lo / snap) * snap, (np.floor(hi / snap) + 1.0) * snap
         dims = (np.floor((hi - lo) / self.radius).astype(np.int64) + 1).tolist()  # rows r wide in y, z
@@ -551,31 +435,6 @@ class NeighbourList:
                 break
             self.bflat = np.empty(int(total * 1.25) + 16, np.int32)
 
-    def region_lists(self, positions: np.ndarray, capacity: int) -> tuple[np.ndarray, np.ndarray]:
-        """After :meth:`sort`: for the sorted positions ``positions``, their lists as a full
-        :meth:`build` would make them (the forward run, then the backward one, same order), in
-        original vertex indices: ``(nbr (n, capacity) int32, cnt (n,))``; where a count exceeds
-        ``capacity`` − 1 the lists are cut (call again with a larger one)."""
-        n = positions.size
-        flat = np.empty(n * capacity, np.int32)
-        cnt = np.empty(n, np.int64)
-        chunks = np.linspace(0, n, max(1, min(_CHUNKS, n // 64)) + 1).astype(np.int64)
-        _region_kernel(
-            self.x, self.y, self.z, self.strand, self.start, self.dims[1], self.dims[2], self.lo, self.radius,
-            self.radius**2, self.slack, self.order, positions, chunks, capacity, flat, cnt,
-        )  # fmt: skip
-        return flat.reshape(n, capacity), cnt
-
-    def padded_lists(self, lists: np.ndarray, counts: np.ndarray) -> int:
-        """After a row-grid :meth:`build`: every vertex's list in original indices, in row
-        ``order[k]`` of ``lists`` (V, cap) for sorted position k, its length in ``counts``.
-        Returns the longest length: when it is not below cap, the rows are cut."""
-        return int(
-            _padded_kernel(
-                self.order, self.aflat, self.aoff, self.acnt, self.bflat, self.bstart, lists, counts
-            )
-        )
-
     def _build_hashed(self, points, strand, skip, lo, radius) -> None:
         # Sparse hair in a large box: hash the 3-D cells into ~2V buckets.
         v = points.shape[0]
@@ -609,28 +468,6 @@ class NeighbourList:
         _compact_padded(self._nbr, cnt, offsets, self.aflat)
         self.aoff[:] = offsets[:-1]
         self.bstart[:] = 0  # the hashed lists are complete
-
-
-@njit(cache=True, nogil=True, parallel=True)
-def _padded_kernel(order, aflat, aoff, acnt, bflat, bstart, lists, counts):
-    """The forward then the backward run of each sorted position, in original indices, into the
-    row of its original vertex (cut at the row's width). Returns the longest list."""
-    cap = lists.shape[1]
-    longest = 0
-    for k in prange(order.size):
-        i = order[k]
-        n = 0
-        for e in range(aoff[k], aoff[k] + acnt[k]):
-            if n < cap:
-                lists[i, n] = order[aflat[e]]
-            n += 1
-        for e in range(bstart[k], bstart[k + 1]):
-            if n < cap:
-                lists[i, n] = order[bflat[e]]
-            n += 1
-        counts[i] = n
-        longest = max(longest, n)
-    return longest
 
 
 @njit(cache=True, nogil=True)

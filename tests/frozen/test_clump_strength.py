@@ -14,8 +14,7 @@ import pytest
 from hairtool import samples
 from hairtool.errors import ParameterError
 from hairtool.frozen.brushes import BrushSample, falloff_lut
-from hairtool.frozen.clump import ClumpWorkspace, clump, clump_points, clump_reference
-from hairtool.frozen.clump_region import clump_points_interactive
+from hairtool.frozen.clump import clump, clump_reference
 from hairtool.frozen.freeze import freeze
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.strand_clumps import auto_clump_radius
@@ -109,47 +108,6 @@ def test_a_bad_strength_is_refused(frozen_groom):
             clump_reference(g, 0.1, 2, strength=bad)
 
 
-@pytest.mark.parametrize(
-    ("gap_mode", "iterations", "step", "keep_lengths"),
-    [("printed", 3, None, False), ("text", 2, None, True), ("off", 2, 0.004, False)],
-)
-@pytest.mark.parametrize("n_threads", [1, 2])
-def test_painting_strength_in_a_region_gives_the_bytes_of_full_runs(
-    gap_mode, iterations, step, keep_lengths, n_threads, threads
-):
-    """Strength painted alone (points unchanged), then with moved points, then back to all
-    ones: each region update equals a full run, and most are done in a region."""
-    threads(n_threads)
-    g = samples.scalp(strands=500, vertices=12, seed=3)
-    h = auto_clump_radius(g)
-    tips = g.tips.astype(np.float64)
-    near = np.argsort(np.linalg.norm(tips - tips[17], axis=1))
-    ws = ClumpWorkspace()
-    s = np.ones(g.strand_count)
-    clump_points_interactive(g, h, iterations, step, gap_mode, 11, ws, keep_lengths, s)
-    points = g.points.copy()
-    regions = 0
-    for k in range(6):
-        s = s.copy()
-        s[near[5 * k : 5 * k + 12]] = [0.0, 0.3, 0.7] * 4
-        if k in (2, 4):  # a brush moved some strands too
-            for strand in near[40 + k : 44 + k]:
-                o, e = g.offsets[strand], g.offsets[strand + 1]
-                points[o + 1 : e] += np.float32([0.002 * k, -0.001, 0.0015])
-        if k == 5:
-            s[:] = 1.0
-        moved = g.with_points(points.copy())
-        got = clump_points_interactive(moved, h, iterations, step, gap_mode, 11, ws, keep_lengths, s)
-        full = ClumpWorkspace()
-        want = clump_points(moved, h, iterations, step, gap_mode, 11, full, keep_lengths, s)
-        assert same_bytes(got, want)
-        assert ws.step == full.step and ws.mean_neighbours == full.mean_neighbours
-        regions += ws.region.fraction < 1.0
-    assert regions >= 4
-    again = clump_points_interactive(moved, h, iterations, step, gap_mode, 11, ws, keep_lengths, s)
-    assert ws.region.fraction == 0.0 and same_bytes(again, want)  # nothing changed: the last output
-
-
 def clump_sample(groom, cursor, strength, radius):
     lut = tuple(falloff_lut("constant").tolist())
     return BrushSample("clump", tuple(map(float, cursor)), (0.0, 0.0, 0.0), radius, strength, lut)
@@ -181,7 +139,7 @@ def test_the_pipeline_paints_undoes_and_replays_clump_strength():
     stiffer = FrozenParams(seed=2, stretch_stiffness=5.0)
     pipe.set_params(stiffer)  # a new frozen groom: the strokes replayed on it
     other = FrozenPipeline(g, stiffer)
-    other.apply_samples(pipe.strokes)
+    other.apply_samples(pipe.strokes, local=False)  # a replay runs on the whole groom
     np.testing.assert_array_equal(pipe.clump_strength, other.clump_strength)
     assert same_bytes(pipe.result.points, other.result.points)
     assert np.mean(pipe.clump_strength[off] == 0.5) > 0.8  # (the brush sees the new frozen groom)

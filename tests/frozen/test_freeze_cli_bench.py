@@ -88,6 +88,11 @@ def test_bench_freeze_json_rows(capsys):
         assert r["vertices"] == r["strands"] * (8 if r["strands"] == 50 else 10)
         for key in ("pipeline_ms", "reference_ms", "mean_neighbours", "freeze_ms", "align_ms", "clump_ms"):
             assert r[key] is not None and r[key] >= 0
+        # a drag's moves against the same moves on the strands near its path (issue 28)
+        for key in ("drag_ms", "crop_ms", "lists_ms", "grid_ms"):
+            assert r[key] >= 0
+        assert 0 < r["crop_strands"] <= r["strands"] and 0 <= r["drag_redone"] <= 1
+        assert r["drag_per_crop"] is None or r["drag_per_crop"] > 0
 
 
 def test_bench_freeze_skips_the_reference_above_the_limit(capsys):

@@ -9,9 +9,7 @@ import pytest
 
 from hairtool import io, samples
 from hairtool.cli import main
-from hairtool.frozen.align import align
-from hairtool.frozen.clump import ClumpWorkspace, clump, clump_points, clump_reference
-from hairtool.frozen.clump_region import clump_points_interactive
+from hairtool.frozen.clump import clump, clump_reference
 from hairtool.frozen.lengths import restore_lengths, restore_lengths_reference
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.strand_clumps import auto_clump_radius
@@ -63,25 +61,20 @@ def test_clumping_keeps_lengths_and_directions_when_asked(grooms_dir):
 
 
 @pytest.mark.parametrize("n_threads", [1, 2])
-def test_a_drag_with_lengths_kept_gives_the_bytes_of_full_runs(n_threads, threads):
+def test_a_drag_with_lengths_kept_keeps_them_move_after_move(n_threads, threads):
     threads(n_threads)
     g = samples.scalp(strands=400, vertices=12, seed=3)
-    h = auto_clump_radius(g)
-    ws = ClumpWorkspace()
+    pipe = FrozenPipeline(g, FrozenParams(keep_lengths=True, seed=5))
     lo, hi = g.bounds
     extent = float(np.max(hi - lo))
     tip = g.tips[np.argmin(np.linalg.norm(g.tips - (lo + hi) / 2, axis=1))].astype(np.float64)
-    aligned = g
+    local = 0
     for k in range(6):
         a = 2 * np.pi * k / 6
-        cursor = tip + 0.1 * extent * np.array([np.cos(a), np.sin(a), 0.0])
-        aligned = align(aligned, cursor, 0.2 * extent, 0.8)
-        got = clump_points_interactive(aligned, h, 3, None, "printed", 5, ws, keep_lengths=True)
-        want = clump_points(aligned, h, 3, None, "printed", 5, ClumpWorkspace(), keep_lengths=True)
-        assert np.array_equal(got.view(np.uint32), want.view(np.uint32))
-        lengths = aligned.with_points(got).segment_lengths
-        np.testing.assert_allclose(lengths, aligned.segment_lengths, rtol=1e-4)
-    assert ws.region.updates >= 4
+        got = pipe.align(tip + 0.1 * extent * np.array([np.cos(a), np.sin(a), 0.0]), 0.2 * extent, 0.8)
+        np.testing.assert_allclose(got.segment_lengths, pipe.aligned.segment_lengths, rtol=1e-4)
+        local += pipe.clump_redone < 1.0
+    assert local == 6  # each move brush-local (hairtool.frozen.local)
 
 
 def test_the_pipeline_and_the_cli_take_keep_lengths(tmp_path):

@@ -37,6 +37,7 @@ def studio_session(groom):
     pipe.brush(BrushSample("mask", tuple(tips[3]), (0, 0, 0), 0.3 * r, 1.0, constant))
     pipe.brush(BrushSample("smooth", tuple(c), (0, 0, 0), r, 0.6, tuple(falloff_lut("linear").tolist())))
     pipe.brush(BrushSample("length", tuple(c), (0, 0, 0), r, -0.2, tuple(falloff_lut("smooth").tolist())))
+    pipe.settle()  # the mouse released: the whole groom clumped (brush-local moves before)
     return pipe
 
 
@@ -132,6 +133,7 @@ def painted_session(groom):
     pipe.brush(BrushSample("comb", tuple(c), (0.05, 0.02, 0.0), r, 0.9, smooth, view))
     pipe.brush(BrushSample("clump", tuple(c), (0, 0, 0), r, -0.8, linear, view))
     pipe.brush(BrushSample("clump", tuple(tips[5]), (0, 0, 0), 0.5 * r, 0.6, smooth))
+    pipe.settle()  # the mouse released
     return pipe
 
 

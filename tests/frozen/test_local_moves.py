@@ -1,0 +1,220 @@
+"""Brush-local moves: the strands under the brush and those their clumps reach, the rest untouched."""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import pytest
+
+from hairtool import samples
+from hairtool.frozen.brushes import BrushSample, falloff_lut
+from hairtool.frozen.clump import clump_points
+from hairtool.frozen.local import clump_region_reference
+from hairtool.frozen.noise import draw_seed
+from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+from hairtool.frozen.vertex_grid import VertexGrid, list_frame, lists_reference, strands_near_reference
+from hairtool.groom import Groom, vertex_ids_of
+
+
+@pytest.fixture
+def threads():
+    before = numba.get_num_threads()
+    yield lambda n: numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
+    numba.set_num_threads(before)
+
+
+def same_bytes(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+def bundles(spacing: float, per_side: int = 6, h: float = 1.0) -> Groom:
+    """Bundles of 4 straight-ish strands 0.3 h apart (every strand within the clump reach of
+    the others of its bundle), the bundles ``spacing`` h apart: a move's clump stays in its bundle."""
+    rng = np.random.default_rng(7)
+    strands = []
+    for bx in range(per_side):
+        for by in range(per_side):
+            base = np.array([bx * spacing * h, by * spacing * h, 0.0])
+            for dx, dy in ((0, 0), (0.3, 0), (0, 0.3), (0.3, 0.3)):
+                root = base + np.array([dx * h, dy * h, 0.0])
+                t = np.linspace(0.0, 1.0, 8)[:, None]
+                line = root + t * np.array([0.0, 0.0, 4.0 * h]) + rng.normal(scale=0.02 * h, size=(8, 3))
+                line[0] = root
+                strands.append(line)
+    return Groom.from_strands(strands)
+
+
+def comb(cursor, direction, radius):
+    lut = tuple(falloff_lut("smooth").tolist())
+    return BrushSample(
+        "comb", tuple(map(float, cursor)), tuple(map(float, direction)), float(radius), 0.8, lut
+    )
+
+
+def clump_paint(cursor, radius, strength):
+    lut = tuple(falloff_lut("constant").tolist())
+    return BrushSample("clump", tuple(map(float, cursor)), (0.0, 0.0, 0.0), float(radius), strength, lut)
+
+
+def full_run(pipe: FrozenPipeline) -> np.ndarray:
+    p = pipe.params
+    return clump_points(
+        pipe.aligned, pipe.clump_radius, p.clump_iterations, pipe.clump_step, p.gap_mode,
+        draw_seed(p.seed, 0), None, p.keep_lengths, pipe.clump_strength,
+    )  # fmt: skip
+
+
+# -- the vertex grid ----------------------------------------------------------------------------
+@pytest.mark.parametrize("spacing", [3.0, 50_000.0])  # the list build's row grid, then its hashed one
+def test_the_grid_gives_the_lists_of_a_full_build_in_its_order_before_and_after_moves(spacing):
+    g = bundles(spacing, per_side=5)
+    top, r = g.topology, 1.1
+    assert list_frame(g.points, r)[0] == (spacing < 100)
+    grid = VertexGrid(g.points, top.strand_index, r)
+    vids = np.arange(0, g.vertex_count, 3)
+    for k in range(3):
+        flat, cnt, cap = grid.lists(g.points, vids, r, list_frame(g.points, r))
+        want = lists_reference(g.points, top.strand_index, vids, r)
+        for n, w in enumerate(want):
+            assert np.array_equal(flat[n * cap : n * cap + cnt[n]], w)
+        assert cnt.sum() > vids.size  # (neighbours there are)
+        queries = g.points[[3, 40, 100]]
+        mark = np.zeros(g.strand_count, bool)
+        grid.strands_near(g.points, queries, 2.5, mark)
+        assert np.array_equal(
+            mark, strands_near_reference(g.points, top.strand_index, queries, 2.5, g.strand_count)
+        )
+        pts = g.points.copy()  # some strands move across cells
+        moved = vertex_ids_of(top, np.arange(k, g.strand_count, 5))
+        pts[moved] += np.float32([0.7, -0.4, 0.2])
+        g = g.with_points(pts)
+        assert grid.move(g.points, moved) > 0
+
+
+def test_a_brush_wider_than_the_grid_scans_every_vertex():
+    g = bundles(3.0, per_side=4)
+    grid = VertexGrid(g.points, g.topology.strand_index, 0.05)  # tiny cells: the scan
+    mark = np.zeros(g.strand_count, bool)
+    grid.strands_near(g.points, g.points[[7]], 30.0, mark)
+    assert mark.all()
+
+
+# -- moves against full runs -------------------------------------------------------------------
+@pytest.mark.parametrize(("gap_mode", "keep_lengths"), [("printed", False), ("text", True), ("off", False)])
+@pytest.mark.parametrize("n_threads", [1, 2])
+def test_where_a_move_stays_in_its_region_it_gives_a_full_runs_bytes(
+    gap_mode, keep_lengths, n_threads, threads
+):
+    threads(n_threads)
+    g = bundles(3.0)
+    pipe = FrozenPipeline(g, FrozenParams(clump_radius=1.0, gap_mode=gap_mode, keep_lengths=keep_lengths))
+    assert same_bytes(pipe.result.points, full_run(pipe))
+    tips = g.tips.astype(np.float64)
+    for k in range(6):
+        shown = pipe.result.points.copy()
+        target = tips[4 * (7 * k % 36) + 1]  # one strand of a bundle
+        if k % 3 == 2:
+            out = pipe.brush(clump_paint(target, 0.2, -0.6))
+        elif k % 3 == 1:
+            out = pipe.brush(comb(target, (0.2, 0.1, 0.0), 0.2))
+        else:
+            out = pipe.align(target + np.array([0.5, 0.3, 0.0]), 0.6, 0.8)
+        region = pipe.changed
+        assert region is not None and 0 < region.size <= 8 and pipe.clump_redone < 0.06
+        assert same_bytes(out.points, full_run(pipe))  # the clump reaches no farther: a full run's bytes
+        outside = np.ones(g.vertex_count, bool)
+        outside[vertex_ids_of(g.topology, region)] = False
+        assert same_bytes(out.points[outside], shown[outside])  # the rest: untouched
+    assert np.any(pipe.clump_strength < 1.0)
+
+
+@pytest.mark.parametrize("keep_lengths", [False, True])
+def test_a_drag_on_dense_hair_equals_its_numpy_twin_and_leaves_the_rest_alone(keep_lengths):
+    g = samples.scalp(1500, 12, seed=3)
+    pipe = FrozenPipeline(g, FrozenParams(keep_lengths=keep_lengths, seed=4))
+    lo, hi = g.bounds
+    extent = float(np.max(hi - lo))
+    tips = g.tips.astype(np.float64)
+    tip = tips[np.argmin(np.linalg.norm(tips - (lo + hi) / 2, axis=1))]
+    h = pipe.clump_radius
+    local_moves = 0
+    for k in range(5):
+        rec = pipe._workspace.recorded  # the last run's trajectories, which the rest is held to
+        iterates, forces = rec.iterates.copy(), rec.forces.copy()
+        shown = pipe.result.points.copy()
+        a = 2 * np.pi * k / 5
+        if k == 3:
+            out = pipe.brush(comb(tip, (0.05 * extent, 0.0, 0.0), 0.05 * extent))
+        else:
+            out = pipe.align(tip + 0.04 * extent * np.array([np.cos(a), np.sin(a), 0.0]), 0.08 * extent, 0.8)
+        region = pipe.changed
+        assert region is not None and pipe.clump_redone < 0.5
+        local_moves += region.size > 0
+        inside = vertex_ids_of(g.topology, region)
+        sv = np.asarray(pipe.clump_strength)[g.topology.strand_index]
+        want = clump_region_reference(
+            pipe.aligned.points, g.topology, region, iterates, forces, sv, h, 3, pipe.clump_step, "printed",
+            draw_seed(4, 0), keep_lengths,
+        )  # fmt: skip
+        # The same definition; the twin sums the pulls in another order (np.bincount): float32
+        # results agree to an ulp or two.
+        np.testing.assert_allclose(out.points[inside], want[inside], rtol=0, atol=2e-6 * extent)
+        outside = np.ones(g.vertex_count, bool)
+        outside[inside] = False
+        assert same_bytes(out.points[outside], shown[outside])
+        # Everything the move reaches within h·1.1 is in the region.
+        moved = np.flatnonzero(np.any(pipe.aligned.points != pipe._local.record.points, axis=1))
+        assert moved.size == 0  # (the record holds this input)
+    assert local_moves >= 3
+
+
+def test_local_moves_are_deterministic_at_1_and_2_threads(threads):
+    g = samples.scalp(400, 12, seed=5)
+    lo, hi = g.bounds
+    extent = float(np.max(hi - lo))
+    tip = g.tips[100].astype(np.float64)
+    results = []
+    for n in (1, 2):
+        threads(n)
+        pipe = FrozenPipeline(g, FrozenParams(keep_lengths=True))
+        for k in range(4):
+            pipe.align(tip + 0.04 * extent * np.array([np.cos(k), np.sin(k), 0.0]), 0.12 * extent, 0.8)
+        assert pipe.clump_redone < 1.0
+        results.append(pipe.result.points.copy())
+    assert same_bytes(*results)
+
+
+def test_undo_and_redo_bring_back_the_moves_result_and_a_replay_runs_in_full():
+    g = samples.scalp(300, 10, seed=2)
+    pipe = FrozenPipeline(g)
+    lo, hi = g.bounds
+    extent = float(np.max(hi - lo))
+    before, snap = pipe.result.points.copy(), pipe.snapshot()
+    pipe.align(g.tips[50].astype(np.float64) + 0.05 * extent, 0.15 * extent, 0.8)
+    moved, moved_snap = pipe.result.points.copy(), pipe.snapshot()
+    assert pipe.clump_redone < 1.0
+    assert same_bytes(pipe.restore(snap).points, before)
+    assert same_bytes(pipe.restore(moved_snap).points, moved)
+    other = FrozenPipeline(g)
+    other.apply_samples(pipe.strokes, local=False)
+    assert other.clump_redone == 1.0 and same_bytes(other.result.points, full_run(other))
+    # a full run of the same strokes moves the same strands, and clumps a little differently
+    # beyond the region (the local move holds the rest to its last run)
+    assert same_bytes(other.aligned.points, pipe.aligned.points)
+    np.testing.assert_allclose(other.result.points, moved, atol=0.02 * pipe.clump_radius)
+
+
+def test_delete_and_parameter_changes_run_in_full_and_moves_go_local_again():
+    g = samples.scalp(300, 10, seed=2)
+    pipe = FrozenPipeline(g)
+    tip = g.tips[20].astype(np.float64)
+    lut = tuple(falloff_lut("constant").tolist())
+    root = tuple(map(float, g.roots[20]))
+    pipe.brush(BrushSample("delete", root, (0.0, 0.0, 0.0), 0.05, 1.0, lut))
+    assert pipe.clump_redone == 1.0 and pipe.changed is None and pipe.result.strand_count < 300
+    pipe.align(tip, 0.2, 0.8)
+    assert pipe.clump_redone < 1.0
+    pipe.set_params(pipe.params.replace(clump_iterations=2))
+    assert pipe.clump_redone == 1.0
+    out = pipe.align(tip + 0.02, 0.2, 0.8)
+    assert pipe.clump_redone < 1.0 and np.all(np.isfinite(out.points))
