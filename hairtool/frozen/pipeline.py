@@ -956,7 +956,8 @@ class FrozenPipeline:
             return none
         vids = vertex_ids_of(top, cand)
         with threads_for(vids.size):
-            out, painted = self._local_brush(Groom(cur[vids], top.counts[cand]), cand, sample, planar)
+            sub = Groom(cur[vids], top.counts[cand], metadata=self._aligned.metadata)  # in the scene's frame
+            out, painted = self._local_brush(sub, cand, sample, planar)
         if out is not None:
             cur[vids] = out.points
             touched[cand] = True
