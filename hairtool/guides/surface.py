@@ -401,27 +401,17 @@ def _closest_one(  # pragma: no cover - compiled
     face_of[k] = bf
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def _grid_closest_kernel(  # pragma: no cover - compiled
     points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of
 ):
-    """:func:`_closest_one` for every point, on every thread."""
-    for k in prange(points.shape[0]):
-        _closest_one(k, points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of)
-
-
-@njit(cache=True, nogil=True)
-def _grid_closest_serial(  # pragma: no cover - compiled
-    points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of
-):
-    """:func:`_closest_one` for every point on this thread: the collision pass asks a few dozen
-    points at a time, vertex by vertex along the strands, and waking the other threads for each
-    ask costs more than the ask (ten times more on a busy machine)."""
+    """:func:`_closest_one` for every point, on the calling thread: the collision pass asks a
+    few dozen points at a time, vertex by vertex along the strands, where waking other threads
+    cost more than the ask (ten times more on a busy machine), and a whole groom's ask is fast
+    enough on one thread now that a point visits only the shells near the mesh (a parallel
+    twin doubled the kernel's compile, the largest of the first stroke's)."""
     for k in range(points.shape[0]):
         _closest_one(k, points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of)
-
-
-SERIAL_POINTS = 512  # asks of fewer points than this run on the calling thread
 
 
 class MeshSurface:
@@ -459,8 +449,7 @@ class MeshSurface:
         pts = np.ascontiguousarray(points, np.float64)
         out = np.full_like(pts, np.nan)
         face_of = np.empty(len(pts), np.int64)
-        kernel = _grid_closest_serial if len(pts) < SERIAL_POINTS else _grid_closest_kernel
-        kernel(
+        _grid_closest_kernel(
             pts, self._v, self._f, self.lo, self.cell, self.dims, self._start, self._items, self._rings,
             out, face_of,
         )
