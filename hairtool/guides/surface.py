@@ -331,22 +331,6 @@ def empty_rings_numpy(start: np.ndarray, dims: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _faces_in_cell(c, px, py, pz, vertices, faces, start, items, best, bf, out, k):  # pragma: no cover
-    for t in range(start[c], start[c + 1]):
-        f = items[t]
-        a, b, e = faces[f, 0], faces[f, 1], faces[f, 2]
-        va, vb, ve = vertices[a], vertices[b], vertices[e]
-        qx, qy, qz = _closest_on_triangle(
-            px, py, pz, va[0], va[1], va[2], vb[0], vb[1], vb[2], ve[0], ve[1], ve[2]
-        )
-        d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
-        if d < best or (d == best and f < bf):
-            best, bf = d, f
-            out[k, 0], out[k, 1], out[k, 2] = qx, qy, qz
-    return best, bf
-
-
-@njit(cache=True, nogil=True)
 def _closest_one(  # pragma: no cover - compiled
     k, points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of
 ):
@@ -370,24 +354,26 @@ def _closest_one(  # pragma: no cover - compiled
     best, bf = np.inf, -1
     r = rings[(ci[0] * dims[1] + ci[1]) * dims[2] + ci[2]]  # the shells inside hold no face
     while True:
-        k0, k1 = max(ci[2] - r, 0), min(ci[2] + r, dims[2] - 1)
         for i in range(max(ci[0] - r, 0), min(ci[0] + r, dims[0] - 1) + 1):
             for j in range(max(ci[1] - r, 0), min(ci[1] + r, dims[1] - 1) + 1):
                 row = (i * dims[1] + j) * dims[2]
-                if abs(i - ci[0]) == r or abs(j - ci[1]) == r:  # a side of the shell: all of it
-                    for kk in range(k0, k1 + 1):
-                        best, bf = _faces_in_cell(
-                            row + kk, px, py, pz, vertices, faces, start, items, best, bf, out, k
+                # a side of the shell: all of its column; inside its cross-section: the two ends
+                step = 1 if (abs(i - ci[0]) == r or abs(j - ci[1]) == r) else max(2 * r, 1)
+                for kk in range(ci[2] - r, ci[2] + r + 1, step):
+                    if kk < 0 or kk >= dims[2]:
+                        continue
+                    c = row + kk
+                    for t in range(start[c], start[c + 1]):
+                        f = items[t]
+                        a, b, e = faces[f, 0], faces[f, 1], faces[f, 2]
+                        va, vb, ve = vertices[a], vertices[b], vertices[e]
+                        qx, qy, qz = _closest_on_triangle(
+                            px, py, pz, va[0], va[1], va[2], vb[0], vb[1], vb[2], ve[0], ve[1], ve[2]
                         )
-                else:  # inside the shell's cross-section: its two ends along z
-                    if ci[2] - r >= 0:
-                        best, bf = _faces_in_cell(
-                            row + ci[2] - r, px, py, pz, vertices, faces, start, items, best, bf, out, k
-                        )
-                    if r > 0 and ci[2] + r <= dims[2] - 1:
-                        best, bf = _faces_in_cell(
-                            row + ci[2] + r, px, py, pz, vertices, faces, start, items, best, bf, out, k
-                        )
+                        d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
+                        if d < best or (d == best and f < bf):
+                            best, bf = d, f
+                            out[k, 0], out[k, 1], out[k, 2] = qx, qy, qz
         # the nearest an unvisited cell can be: across the visited block's unclipped sides
         reach = np.inf
         for a in range(3):
@@ -401,17 +387,27 @@ def _closest_one(  # pragma: no cover - compiled
     face_of[k] = bf
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _grid_closest_kernel(  # pragma: no cover - compiled
     points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of
 ):
-    """:func:`_closest_one` for every point, on the calling thread: the collision pass asks a
-    few dozen points at a time, vertex by vertex along the strands, where waking other threads
-    cost more than the ask (ten times more on a busy machine), and a whole groom's ask is fast
-    enough on one thread now that a point visits only the shells near the mesh (a parallel
-    twin doubled the kernel's compile, the largest of the first stroke's)."""
+    """:func:`_closest_one` for every point, on every thread (a whole groom's ask)."""
+    for k in prange(points.shape[0]):
+        _closest_one(k, points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of)
+
+
+@njit(cache=True, nogil=True)
+def _grid_closest_serial(  # pragma: no cover - compiled
+    points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of
+):
+    """:func:`_closest_one` for every point on the calling thread: the collision pass asks a few
+    dozen points at a time, vertex by vertex along the strands, where waking the other threads
+    costs more than the ask (ten times more on a busy machine)."""
     for k in range(points.shape[0]):
         _closest_one(k, points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of)
+
+
+SERIAL_POINTS = 512  # asks of fewer points than this run on the calling thread
 
 
 class MeshSurface:
@@ -449,7 +445,8 @@ class MeshSurface:
         pts = np.ascontiguousarray(points, np.float64)
         out = np.full_like(pts, np.nan)
         face_of = np.empty(len(pts), np.int64)
-        _grid_closest_kernel(
+        kernel = _grid_closest_serial if len(pts) < SERIAL_POINTS else _grid_closest_kernel
+        kernel(
             pts, self._v, self._f, self.lo, self.cell, self.dims, self._start, self._items, self._rings,
             out, face_of,
         )

@@ -18,7 +18,7 @@ from hairtool.frozen.brushes import BrushSample, falloff_lut, root_normals
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.strokes import read_strokes, strokes_from_log, write_strokes
 from hairtool.groom import Groom, vertex_ids_of
-from hairtool.guides.surface import MeshSurface, closest_points
+from hairtool.guides.surface import SERIAL_POINTS, MeshSurface, closest_points
 from hairtool.io.obj import read_mesh
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "grooms"
@@ -58,6 +58,11 @@ def test_the_face_grid_finds_the_brute_forces_closest_points(sintel):
     np.testing.assert_array_equal(face[inside_box], face2)
     sd, _, _ = surface.signed_distance(pts)
     assert np.all(np.isinf(sd[~inside_box]))
+    few = SERIAL_POINTS - 1  # a small ask runs on the calling thread: the same bytes
+    assert len(pts) > SERIAL_POINTS
+    q3, face3 = surface.nearest(pts[-few:])
+    np.testing.assert_array_equal(q3, q[-few:])
+    np.testing.assert_array_equal(face3, face[-few:])
 
 
 def test_a_comb_up_through_a_plane_stops_at_it(plane):
