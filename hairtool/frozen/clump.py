@@ -501,6 +501,28 @@ def clump(
     return groom.with_points(pts)
 
 
+def gap_factors_reference(i, j, r, P, dp, h, seed, it, gap_mode) -> np.ndarray:
+    """The gap-keeping factor λ per vertex (eqs. 17-18) of one iteration, from the pairs
+    ``(i, j)`` at distances ``r`` and the adhesion steps ``dp``: each vertex's nearest pair
+    (ties: the lowest index) before and after the step; 1 where gaps are off or no pair."""
+    lam = np.ones(len(P))
+    if gap_mode != "off" and len(i):
+        first = np.lexsort((j, r, i))  # per vertex: nearest, then lowest index
+        i_s = i[first]
+        head = np.r_[True, i_s[1:] != i_s[:-1]]
+        pi, qj = i_s[head], j[first][head]
+        r0 = np.linalg.norm(P[qj] - P[pi], axis=1)
+        r1 = np.linalg.norm(P[qj] + dp[qj] - P[pi] - dp[pi], axis=1)
+        zeta = hash_u01(seed, pi, it, CH_CLUMP)
+        if gap_mode == "printed":
+            delta = np.clip((r1 - r0) / h, 0.0, 1.0)  # (17)
+            lam[pi] = (1.0 - delta) * zeta + delta  # (18)
+        else:
+            delta = np.clip(np.abs(r1 - r0) / h, 0.0, 1.0)
+            lam[pi] = (1.0 - delta) * zeta
+    return lam
+
+
 def clump_reference(
     groom: Groom,
     radius: float,
@@ -540,21 +562,7 @@ def clump_reference(
             wsum = np.bincount(i, weights=g, minlength=v)
             k_step = auto_step(h, wsum, np.bincount(i, minlength=v)) if step is None else float(step)
         dp = sv[:, None] * (k_step * f)  # (16), scaled by the clump strength
-        lam = np.ones(v)
-        if gap_mode != "off" and len(i):
-            first = np.lexsort((j, r, i))  # per vertex: nearest, then lowest index
-            i_s = i[first]
-            head = np.r_[True, i_s[1:] != i_s[:-1]]
-            pi, qj = i_s[head], j[first][head]
-            r0 = np.linalg.norm(P[qj] - P[pi], axis=1)
-            r1 = np.linalg.norm(P[qj] + dp[qj] - P[pi] - dp[pi], axis=1)
-            zeta = hash_u01(seed, pi, it, CH_CLUMP)
-            if gap_mode == "printed":
-                delta = np.clip((r1 - r0) / h, 0.0, 1.0)  # (17)
-                lam[pi] = (1.0 - delta) * zeta + delta  # (18)
-            else:
-                delta = np.clip(np.abs(r1 - r0) / h, 0.0, 1.0)
-                lam[pi] = (1.0 - delta) * zeta
+        lam = gap_factors_reference(i, j, r, P, dp, h, seed, it, gap_mode)
         P = P + lam[:, None] * dp  # (19)
     if keep_lengths and iterations > 0:
         P = restore_lengths_reference(groom.points, P.astype(np.float32), top)

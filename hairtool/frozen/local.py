@@ -33,11 +33,12 @@ from hairtool.frozen.clump import (
     MARGIN,
     ClumpRecord,
     auto_step,
+    gap_factors_reference,
     moved_vertex,
     vertex_force,
 )
 from hairtool.frozen.lengths import restore_lengths_reference
-from hairtool.frozen.noise import CH_CLUMP, hash_head_nb, hash_tail_u01_nb, hash_u01, seed_u64
+from hairtool.frozen.noise import CH_CLUMP, hash_head_nb, hash_tail_u01_nb, seed_u64
 from hairtool.frozen.spatial import pairs_within_reference
 from hairtool.frozen.vertex_grid import VertexGrid, list_frame
 from hairtool.groom import Topology, vertex_ids_of
@@ -233,21 +234,7 @@ def clump_region_reference(
         if it == 0 and step is None:
             step = auto_step(h, np.bincount(i, weights=g, minlength=v), np.bincount(i, minlength=v))
         dp = sv[:, None] * (float(step) * f)
-        lam = np.ones(v)
-        if gap_mode != "off" and len(i):
-            first = np.lexsort((j, r, i))
-            i_s = i[first]
-            head = np.r_[True, i_s[1:] != i_s[:-1]]
-            pi, qj = i_s[head], j[first][head]
-            r0 = np.linalg.norm(P[qj] - P[pi], axis=1)
-            r1 = np.linalg.norm(P[qj] + dp[qj] - P[pi] - dp[pi], axis=1)
-            zeta = hash_u01(seed, pi, it, CH_CLUMP)
-            if gap_mode == "printed":
-                delta = np.clip((r1 - r0) / h, 0.0, 1.0)
-                lam[pi] = (1.0 - delta) * zeta + delta
-            else:
-                delta = np.clip(np.abs(r1 - r0) / h, 0.0, 1.0)
-                lam[pi] = (1.0 - delta) * zeta
+        lam = gap_factors_reference(i, j, r, P, dp, h, seed, it, gap_mode)
         step_all = np.where(inside[:, None] & moving[:, None], lam[:, None] * dp, 0.0)
         P = P + step_all
     if keep_lengths and iterations > 0:
