@@ -5,7 +5,11 @@ module keeps the capture itself beside it. At a key frame its joints are handles
 (:mod:`app.ui.joint_handles`): dragging one moves that joint to the cursor by inverse
 kinematics on the chain above it (the tool dock's chain length, or Alt-drag for the whole limb
 up to the root's child), solved live through :class:`hairtool.mocap.pose_edit.PoseEditor`
-while the frames around the key follow as faint ghosts. A finished drag is one undo step; the
+while the frames around the key follow as faint ghosts. With per-channel keys on (the graph
+editor's box ticked, or per-channel key edits made) the drag poses the top layer, the one shown:
+the IK keys each channel it turns on that channel's own keys (a ``channel_edits`` pose, which
+``hairtool keys --edit`` replays the same way), so the joint lands on the cursor there too. A
+finished drag is one undo step; the
 timeline's skeleton is the edited capture (the key curves plus the captured residuals), so the
 key errors and the viewport follow. File ▸ Export Animation writes it as BVH, and a project
 keeps the capture and its list of edits (the ``hairtool keys --edit`` EDITS.json dicts, plus the
@@ -27,6 +31,7 @@ from PySide6.QtWidgets import QFormLayout, QGroupBox, QLabel, QScrollArea, QSpin
 from app.ui.animation_io import skeleton_animation
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.keys.channels import per_channel_keys
+from hairtool.mocap import ik
 from hairtool.mocap.bvh import Motion, read_bvh, write_bvh
 from hairtool.mocap.channel_edit import ChannelEditor, ChannelRetimeEdit, channel_features
 from hairtool.mocap.edit_file import parse_capture_edits
@@ -121,6 +126,8 @@ class JointDrag:
         alt = bool(modifiers & Qt.KeyboardModifier.AltModifier)
         depth = int(c.original.depths()[j])
         chain = max(depth - 1, 1) if alt else min(c.chain, depth)
+        if c.layered:  # the chain's channels keyed on their own before the first solve
+            c.column_keys(c.chain_columns(j, chain))
         p0 = c.pose_positions()[j]
         self._start = (m.frame, j, p0, c.window.viewport.cursor_on_plane(pos, p0))
         self._chain = chain
@@ -145,7 +152,7 @@ class JointDrag:
             return
         self.c.preview(None)
         if edit is not None:
-            self.c.commit(edit, f"Pose {edit.joint} at key {edit.frame}")
+            self.c.commit_pose(edit, f"Pose {edit.joint} at key {edit.frame}")
 
     # The older protocol (a 3-D cursor): on a capture the old position drag is replaced.
     def begin(self, cursor: np.ndarray) -> bool:
@@ -178,7 +185,8 @@ class CaptureEditor(QObject):
         self._preview: tuple[int, np.ndarray] | None = None  # frame, (J, 3) joints being dragged
         self.drag = JointDrag(self)
         self._syncing = False  # the timeline's keys are being set to the edited ones
-        self.channel_edits: list = []  # per-channel key edits, over the pose edits
+        self.channel_edits: list = []  # per-channel key edits (and IK poses), over the pose edits
+        self.per_channel = False  # the graph editor's "Per-channel keys" box
         self.channel_applied: list[bool] = []
         self._column_keys: dict = {}
         self._layer: ChannelEditor | None = None
@@ -193,6 +201,12 @@ class CaptureEditor(QObject):
     @property
     def attached(self) -> bool:
         return self.original is not None and self.generation == self.model.generation
+
+    @property
+    def layered(self) -> bool:
+        """Joint drags pose the per-channel layer: its box is ticked, or it holds edits (the
+        layer is what is shown, so a pose below it would not land on the cursor)."""
+        return self.per_channel or bool(self.channel_edits)
 
     def at_key(self) -> bool:
         return self.editor is not None and bool(np.any(self.editor.keys == self.model.frame))
@@ -295,6 +309,7 @@ class CaptureEditor(QObject):
             x = channel_features(self.original)[:, missing]
             found = per_channel_keys(x, self.model.settings.tau, interp=interp, relative=True).keys
             self._column_keys.update(zip(missing, found, strict=True))
+            self._layer = None  # those columns had two keys there
         return [self._column_keys[c] for c in cols]
 
     def channel_layer(self) -> ChannelEditor | None:
@@ -302,13 +317,13 @@ class CaptureEditor(QObject):
         edits applied where they still apply); None before keys."""
         if self.editor is None:
             return None
-        cols = sorted({self._column(e) for e in self.channel_edits})
+        cols = sorted({c for e in self.channel_edits for c in self._columns(e)})
         solved = dict(zip(cols, self.column_keys(cols), strict=True))
         if self._layer is None:
             m = self.original
             two = np.array([0, m.n_frames - 1], dtype=np.int64)
             keys = [solved.get(c, self._column_keys.get(c, two)) for c in range(m.n_channels)]
-            layer = ChannelEditor(self.editor.motion(), keys, self.editor.interp)
+            layer = ChannelEditor(self.editor.motion(), keys, self.editor.interp, pose_keys=self.editor.keys)
             self.channel_applied = []
             for e in self.channel_edits:
                 try:
@@ -319,10 +334,19 @@ class CaptureEditor(QObject):
             self._layer = layer
         return self._layer
 
-    def _column(self, edit: object) -> int:
+    def _columns(self, edit: object) -> list[int]:
+        """The capture's columns an edit of the layer keys: one channel's, or for an IK pose the
+        rotation channels of the joints its chain turns."""
         m = self.original
         j = m.joint_names.index(edit.joint)
-        return int(m._starts[j]) + m.channels[j].index(edit.channel)
+        if isinstance(edit, PoseEdit):
+            return self.chain_columns(j, edit.chain)
+        return [int(m._starts[j]) + m.channels[j].index(edit.channel)]
+
+    def chain_columns(self, joint: int, chain: int) -> list[int]:
+        """The rotation columns of the ``chain`` joints above ``joint`` (what its IK may turn)."""
+        m = self.original
+        return [c for a in ik.ancestors(m, joint, chain) for c in ik.rotation_columns(m, a)[0]]
 
     def push_channel(self, edits: list) -> None:
         """Per-channel key edits (the undo command's redo)."""
@@ -339,8 +363,7 @@ class CaptureEditor(QObject):
 
     def commit_channel(self, edits: list, text: str) -> bool:
         """One undo step for a per-channel key dragged (refused with a message when it cannot be)."""
-        for c in {self._column(e) for e in edits}:
-            self.column_keys([c])
+        self.column_keys(sorted({c for e in edits for c in self._columns(e)}))
         self._layer = None
         layer = self.channel_layer()
         if layer is None:
@@ -351,12 +374,16 @@ class CaptureEditor(QObject):
                 layer.apply_all([e])
                 done += 1
         except HairtoolError as e:
-            self.window.show_error("Cannot move the key", str(e))
+            title = "Cannot pose the capture" if isinstance(edits[-1], PoseEdit) else "Cannot move the key"
+            self.window.show_error(title, str(e))
             return False
         finally:
+            last = layer.reports[-1] if done else None
             for _ in range(done):
                 layer.undo()
         self.window.undo_stack.push(ChannelKeyCommand(self, list(edits), text))
+        if isinstance(edits[-1], PoseEdit):
+            self._say_reach(edits[-1], last, " on its channels' own keys")
         return True
 
     def preview_channel(self, edits: list | None) -> Motion | None:
@@ -430,10 +457,21 @@ class CaptureEditor(QObject):
         self.window.undo_stack.push(PoseEditCommand(self, list(edits), text))
         edit = edits[-1]
         if isinstance(edit, PoseEdit) and self.editor.reports:
-            r = self.editor.reports[-1]
-            reach = "reached" if r.miss_share <= r.tolerance_share else "out of reach; nearest pose"
-            self.report.setText(f"{edit.joint}: {reach} ({r.miss_share:.1e} of the figure's height)")
+            self._say_reach(edit, self.editor.reports[-1])
         return True
+
+    def commit_pose(self, edit: PoseEdit, text: str) -> bool:
+        """One undo step for a joint drag, on the layer shown (:attr:`layered`)."""
+        if self.layered:
+            return self.commit_channel([edit], text)
+        return self.commit(edit, text)
+
+    def _say_reach(self, edit: PoseEdit, r, where: str = "") -> None:
+        """The tool dock's line on how near the dragged joint got to the cursor."""
+        if r is None:
+            return
+        reach = "reached" if r.miss_share <= r.tolerance_share else "out of reach; nearest pose"
+        self.report.setText(f"{edit.joint}: {reach}{where} ({r.miss_share:.1e} of the figure's height)")
 
     def select(self, joint: str) -> None:
         if joint != self.joint:
@@ -453,14 +491,19 @@ class CaptureEditor(QObject):
             self.handles.update()
             return
         edits = edit if isinstance(edit, list) else [edit]
-        self._apply(edits)
+        layer = self.channel_layer() if self.layered and isinstance(edits[-1], PoseEdit) else None
+        editor = self.editor if layer is None else layer
+        editor.apply_all(edits)
         try:
-            out = self.editor.motion()
+            out = editor.motion()
             key = edits[-1].to if isinstance(edits[-1], RetimeEdit) else edits[-1].frame
-            first, last = self.editor.span(key)
+            if layer is None:
+                first, last = self.editor.span(key)
+            else:  # the frames the channels it keyed changed
+                first, last = layer.reports[-1].first, layer.reports[-1].last
         finally:
             for _ in edits:
-                self.editor.undo()
+                editor.undo()
         inner = np.setdiff1d(np.arange(first, last + 1), [key])
         if inner.size:
             inner = inner[

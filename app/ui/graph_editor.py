@@ -12,10 +12,12 @@ a handle end sets the slope the key curve passes the key with (a
 timeline's errors and the curves follow. Dragged sideways a key moves in time, snapped to a
 whole frame strictly between its neighbours (a :class:`~hairtool.mocap.pose_edit.RetimeEdit`).
 With "Per-channel keys" each rotation channel shows its own keys (seed 003), edited the same way
-on that channel alone. On a hair animation the curves are a strand vertex's x, y, z (editable
-the same three ways, :mod:`app.ui.hair_channels`) and the strand's feature channels, read-only.
-Navigation as in Blender's Graph Editor: the wheel zooms about the cursor, middle-drag pans,
-Ctrl+middle-drag zooms each axis, Home frames every curve.
+on that channel alone, and a joint dragged in the viewport keys the channels it turns on their own
+keys (:meth:`app.ui.capture_edit.CaptureEditor.commit_pose`). On a hair animation the curves
+are a strand vertex's x, y, z (editable the same three ways, :mod:`app.ui.hair_channels`) and
+the strand's feature channels, read-only. Navigation as in Blender's Graph Editor: the wheel
+zooms about the cursor, middle-drag pans, Ctrl+middle-drag zooms each axis, Home frames every
+curve.
 """
 
 from __future__ import annotations
@@ -589,7 +591,8 @@ class GraphEditorDock(QDockWidget):
         self.per_channel.setToolTip(
             "Each rotation channel keyed on its own at the timeline's price per key (seed 003: "
             "every degree of freedom its own curve and keys). Its keys drag like the pose keys, "
-            "in value, time and handles, one channel at a time, over the pose keys' edits"
+            "in value, time and handles, one channel at a time, over the pose keys' edits; a joint "
+            "dragged in the viewport then keys each channel it turns on that channel's own keys"
         )
         self.per_channel.toggled.connect(self._set_per_channel)
         top.addWidget(self.per_channel)
@@ -636,6 +639,7 @@ class GraphEditorDock(QDockWidget):
 
     def _set_per_channel(self, on: bool) -> None:
         self.view.per_channel = bool(on)
+        self.window.capture.per_channel = bool(on)  # joint drags then key the channels too
         self.refresh()
 
     def _set_features(self, on: bool) -> None:

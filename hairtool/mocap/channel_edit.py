@@ -189,12 +189,21 @@ class ChannelEditor:
         "time (a pose key moved in time moves every channel: the pose keys' edits)"
     )
 
-    def __init__(self, motion: Motion, keys: list[ArrayLike], interp: str = "hermite") -> None:
+    def __init__(
+        self,
+        motion: Motion,
+        keys: list[ArrayLike],
+        interp: str = "hermite",
+        pose_keys: ArrayLike | None = None,
+    ) -> None:
         if interp not in INTERPS:
             raise ParameterError("interp", interp, " or ".join(INTERPS))
         self.original = motion
         self.interp = interp
         self._keys0 = _check_channel_keys(motion, keys)
+        # the pose keys below this layer (the studio's handles are drawn at them): an IK pose may
+        # be made there too, each channel it turns keyed there (a knot inserted where none was)
+        self.pose_keys = np.zeros(0, dtype=np.int64) if pose_keys is None else np.asarray(pose_keys, np.int64)
         self.height = ik.figure_height(motion)
         self._history: list[_Step] = []
         self._unwrapped = channel_features(motion)
@@ -238,6 +247,12 @@ class ChannelEditor:
     def union(self) -> I64:
         """Frames that are a key of at least one channel (where an edit may be made)."""
         return np.unique(np.concatenate([self.keys(c) for c in range(self.original.n_channels)]))
+
+    @property
+    def pose_frames(self) -> I64:
+        """Frames an IK pose may be made at: a key of some channel, or one of the pose keys
+        below (``pose_keys``)."""
+        return np.union1d(self.union, self.pose_keys)
 
     @property
     def reports(self) -> list[EditReport]:
@@ -418,11 +433,15 @@ class ChannelEditor:
         return step.report
 
     def apply(self, edit: PoseEdit, method: str = "auto") -> EditReport:
+        """Move ``edit.joint`` to its target at ``edit.frame`` (a key of some channel or a pose
+        key, :attr:`pose_frames`) by IK on the pose shown there; each channel the solve turns
+        has its key there moved, or one added (module docstring)."""
         m = self.original
-        union = self.union
-        if edit.frame not in union:
-            listed = " ".join(map(str, union.tolist()))
-            raise ParameterError("frame", edit.frame, f"a key of some channel: {listed}")
+        frames = self.pose_frames
+        if edit.frame not in frames:
+            listed = " ".join(map(str, frames.tolist()))
+            what = "a key of some channel or a pose key" if self.pose_keys.size else "a key of some channel"
+            raise ParameterError("frame", edit.frame, f"{what}: {listed}")
         if edit.joint not in m.joint_names:
             raise ParameterError("joint", edit.joint, "a joint of the skeleton")
         e = m.joint_names.index(edit.joint)

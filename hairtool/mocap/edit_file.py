@@ -15,7 +15,9 @@ there and are not used: the capture is the command's input). Each entry is one o
 told apart by their fields; an entry of no kind is refused naming it. The ``edits`` apply in
 order on the pose keys (:class:`PoseEditor`), then the ``channel_edits`` in order on each
 channel's own keys over the pose-edited capture (:class:`ChannelEditor`), the keys solved as the
-studio solves them (:func:`channel_keys`): the studio's Per-channel keys layer.
+studio solves them (:func:`channel_keys`): the studio's Per-channel keys layer. A pose by IK in
+``channel_edits`` is a joint the studio dragged with per-channel keys on: it keys each channel it
+turns on that channel's own keys, at a key of some channel or at a pose key (as edited).
 """
 
 from __future__ import annotations
@@ -40,7 +42,6 @@ from hairtool.mocap.pose_edit import (
     EditReport,
     PoseEdit,
     PoseEditor,
-    RetimeEdit,
     TangentEdit,
     parse_edit_list,
     read_json,
@@ -53,7 +54,7 @@ KINDS = (
     "channel, value}, a handle {frame, joint, channel, slope} or a channel's key move {frame, "
     "joint, channel, to}"
 )
-CHANNEL_KINDS = (ChannelEdit, TangentEdit, ChannelRetimeEdit)  # what "channel_edits" holds
+CHANNEL_KINDS = (ChannelEdit, TangentEdit, ChannelRetimeEdit, PoseEdit)  # what "channel_edits" holds
 #: The studio's price per key (relative) of its per-channel keys (KeySettings().tau).
 STUDIO_CHANNEL_PRICE = 0.01
 
@@ -123,7 +124,7 @@ def parse_capture_edits(data: object, motion: Motion, source: str = "edits") -> 
         for i, e in enumerate(entries, 1):
             edit = parse_entry(e, motion, source, f"{label} {i}")
             if name == "channel_edits" and not isinstance(edit, CHANNEL_KINDS):
-                what = "a pose key's move in time" if isinstance(edit, RetimeEdit) else "a pose by IK"
+                what = "a pose key's move in time"
                 raise FormatError(source, f'{label} {i} is {what}: it belongs in "edits" (the pose keys)')
             into.append(edit)
     return out
@@ -145,11 +146,13 @@ def channel_keys(motion: Motion, interp: str, price: float = STUDIO_CHANNEL_PRIC
 def _not_a_key(editor, e: object) -> str | None:
     """Why an edit's frame is no key it can be made at (None: it is): the pose keys as edited
     so far (a key moved in time is named by its new frame), or for an IK pose on per-channel
-    keys a key of some channel; a channel's own keys are checked by its editor."""
+    keys a key of some channel or a pose key below them; a channel's own keys are checked by
+    its editor."""
     if isinstance(editor, PoseEditor):
         keys, what = editor.keys, "a key"
     elif isinstance(e, PoseEdit):
-        keys, what = editor.union, "a key of any channel"
+        keys = editor.pose_frames
+        what = "a key of any channel or a pose key" if editor.pose_keys.size else "a key of any channel"
     else:
         return None
     if e.frame in keys:
@@ -184,12 +187,13 @@ def replay(
 ) -> tuple[Motion, list[EditReport]]:
     """The edited capture and one report per edit: ``edits.edits`` on the pose ``keys``, then
     ``edits.channel_edits`` on each channel's own keys (:func:`channel_keys` at ``price``) over
-    the pose-edited capture, as the studio applies a project's edits."""
+    the pose-edited capture (an IK pose there may be at a pose key as edited), as the studio
+    applies a project's edits."""
     pose = PoseEditor(motion, np.asarray(keys), interp)
     reports = apply_each(pose, edits.edits, source, "edit", method)
     out = pose.motion()
     if edits.channel_edits:
-        layer = ChannelEditor(out, channel_keys(motion, interp, price), interp)
+        layer = ChannelEditor(out, channel_keys(motion, interp, price), interp, pose_keys=pose.keys)
         reports += apply_each(layer, edits.channel_edits, source, "channel edit", method)
         out = layer.motion()
     return out, reports

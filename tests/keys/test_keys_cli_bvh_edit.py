@@ -272,7 +272,6 @@ def test_edits_of_no_kind_or_in_the_wrong_list_are_refused_naming_the_entry(moti
         ([edits[0], move], "edit 2: edit={'frame'"),  # a channel's own key: not a pose key
         ([edits[0], move], "an edit of the pose keys"),
         ({"edits": edits, "channel_edits": [edits[1]]}, "channel edit 1 is a pose key's move in time"),
-        ({"edits": edits, "channel_edits": [edits[0]]}, "channel edit 1 is a pose by IK"),
         ({"edits": edits, "keys": [0, 1]}, "unknown fields keys"),
         ({"edits": {"frame": 1}}, '"edits" is not a list'),
         ({"edits": [], "channel_edits": [{**move, "channel": "Qrotation"}]}, "channel edit 1: 'Qrotation'"),
@@ -295,3 +294,57 @@ def test_edits_of_no_kind_or_in_the_wrong_list_are_refused_naming_the_entry(moti
     _refused(capsys, tmp_path, [*per, path], "replay them without --per-channel")
     _write(path, [edits[1]])
     _refused(capsys, tmp_path, [*per, path], "an edit of per-channel keys")
+
+
+def test_an_ik_pose_on_per_channel_keys_replays_at_a_pose_key_no_channel_keys(motion_dir, tmp_path, capsys):
+    """A joint the studio dragged with per-channel keys on is a pose in the project's
+    ``channel_edits``: replayed on each channel's own keys over the pose-edited capture, at a pose
+    key even where no channel has a key (each channel it turns gets one there), the effector on
+    its target; a frame that is neither is refused naming the frames it may be."""
+    from hairtool.errors import ParameterError
+    from hairtool.mocap.channel_edit import ChannelEditor
+    from hairtool.mocap.edit_file import channel_keys
+    from hairtool.mocap.pose_edit import PoseEdit, PoseEditor
+
+    src = motion_dir / "mocapbank_walk.bvh"
+    m = read_bvh(src)
+    h = ik.figure_height(m)
+    argv = [src, "--keys", 12, "--interp", "hermite"]
+    keys = np.asarray(_keys(capsys, *argv)["keys"])
+    price = 0.01
+    ck = channel_keys(m, "hermite", price)
+    union = np.unique(np.concatenate(ck))
+    f = int(next(k for k in keys[1:-1] if k not in union))  # a pose key no channel keys
+    hand = m.joint_names.index("LeftWrist")
+    target = m.joint_positions()[f, hand] + [0.03 * h, 0.08 * h, 0.0]
+    pose = {"frame": f, "joint": "LeftWrist", "target": target.tolist(), "chain": 2}
+    project = {"edits": [], "channel_edits": [pose]}
+    out = tmp_path / "cli.bvh"
+    path = _write(tmp_path / "project.json", project)
+    got = _keys(capsys, *argv, "--edit", path, "--export", out, "--channel-price", price)
+    assert got["edits"][0]["miss_share"] < 1e-4
+    edited = read_bvh(out)
+    assert np.linalg.norm(edited.joint_positions()[f, hand] - target) < 1e-4 * h
+    assert np.array_equal(edited.offsets, m.offsets)
+    # the library's layer, byte for byte; the turned channels change only between their own keys
+    edit = PoseEdit(f, "LeftWrist", tuple(target), 2)
+    layer = ChannelEditor(PoseEditor(m, keys, "hermite").motion(), ck, "hermite", pose_keys=keys)
+    layer.apply(edit)
+    assert out.read_bytes() == _bvh_bytes(tmp_path / "lib.bvh", layer.motion())
+    changed = np.flatnonzero(np.any(layer.motion().values != m.values, axis=0))
+    turned = {c for j in ik.ancestors(m, hand, 2) for c in ik.rotation_columns(m, j)[0]}
+    assert changed.size and set(changed.tolist()) <= turned
+    for c in changed:
+        own = ck[c]
+        a = int(np.searchsorted(own, f))
+        rows = np.flatnonzero(layer.motion().values[:, c] != m.values[:, c])
+        assert own[a - 1] < rows.min() and rows.max() < own[a]  # f was no key of c: one added there
+        assert f in layer.keys(c)
+    # without the pose keys the layer takes only its channels' keys
+    with pytest.raises(ParameterError, match="a key of some channel: "):
+        ChannelEditor(m, ck, "hermite").apply(edit)
+    # a frame that is neither a pose key nor any channel's key
+    off = int(next(g for g in range(1, m.n_frames - 1) if g not in union and g not in keys))
+    _write(path, {"edits": [], "channel_edits": [{**pose, "frame": off}]})
+    words = f"channel edit 1: frame {off} is not a key of any channel or a pose key"
+    _refused(capsys, tmp_path, [*argv, "--edit", path, "--export", out, "--channel-price", price], words)
