@@ -127,6 +127,7 @@ def make(argv: list[str] | None = None) -> None:
         both = _panel([(before, GHOST), (after, EDITED)], centre, half, ground, size)
         bottom.append(label(both, f"edited {f} {tag}".strip()))
     write(outdir / "mocap_fig9_jump.png", grid(top + bottom, columns=len(frames)))
+    print(f"jump at the key of frame {frame}: frames {lo + 1}-{hi - 1} follow (keys {lo}, {frame}, {hi})")
     for r in reports:
         where = f"{r.miss_share:.2g} of the figure's height from its target"
         print(f"{r.edit.joint} at frame {r.edit.frame}: {where}")

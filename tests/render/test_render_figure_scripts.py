@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import itertools
+import re
+from pathlib import Path
 
 import imageio.v3 as iio
 import numpy as np
@@ -11,6 +13,9 @@ import pytest
 from app.figures import anime
 from app.figures.sheet import GAP, LABEL_HEIGHT, grid, label, main_guard
 from hairtool.errors import HairtoolError, ParameterError
+from hairtool.mocap import ik
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_grid_places_panels_in_rows_with_gaps():
@@ -96,8 +101,36 @@ def test_the_fig9_jump_figure_edits_one_key_of_the_walk(tmp_path, capsys):
     assert not red(top).any() and red(bottom).sum() > 50  # the edited frames, in red, below
     edited = read_bvh(tmp_path / "mocap_fig9_jump.bvh")
     walk = read_bvh(mocap.CAPTURE)
-    changed = np.flatnonzero(np.any(np.abs(edited.values - walk.values) > 1e-6, axis=1))
-    assert 0 < changed.min() and changed.max() < walk.n_frames - 1  # one key's neighbourhood only
-    assert np.array_equal(edited.offsets, walk.offsets)
     out = capsys.readouterr().out
-    assert out.count("of the figure's height from its target") == 4
+    said = r"jump at the key of frame (\d+): frames (\d+)-(\d+) follow \(keys (\d+), \d+, (\d+)\)"
+    found = re.search(said, out)
+    assert found, out
+    key, first, last, lo, hi = map(int, found.groups())
+    assert (first, last) == (lo + 1, hi - 1) and lo < key < hi
+    # one key's neighbourhood only: the capture bit for bit (to the file's decimals) outside it
+    changed = np.flatnonzero(np.any(np.abs(edited.values - walk.values) > 1e-6, axis=1))
+    assert key in changed and changed.min() >= first and changed.max() <= last
+    assert np.array_equal(edited.offsets, walk.offsets)
+    assert np.array_equal(edited.end_offsets, walk.end_offsets)
+    # a jump at the key: both heels drawn up (the capture's up is y), fading toward the neighbours
+    h = ik.figure_height(walk)
+    p0, p1 = walk.joint_positions(), edited.joint_positions()
+    for foot in ("LeftFoot", "RightFoot"):
+        j = walk.joint_names.index(foot)
+        assert p1[key, j, 1] - p0[key, j, 1] > 0.15 * h
+    move = np.linalg.norm(p1 - p0, axis=2).max(axis=1)
+    assert move[key] > 0.9 * move.max() and move[first] < 0.2 * move[key] and move[last] < 0.2 * move[key]
+    assert move[first] < move[(first + key) // 2] < move[key] and move[last] < move[(key + last) // 2]
+    misses = [float(v) for v in re.findall(r": ([0-9.e+-]+) of the figure's height from its target", out)]
+    assert len(misses) == 4 and max(misses) <= 2e-5  # the README says: each within 2e-5
+    # the README's Fig. 9 section is this figure: its keys, its command, its picture's layout
+    readme = (ROOT / "README.md").read_text()
+    assert "python -m app.figures.mocap" in readme
+    assert f"keys at {lo}, {key} and {hi}" in readme and f"the key of frame {key}" in readme
+    assert f"{mocap.KEYS} keys (cubic Hermite)" in readme
+    picture = re.search(r"!\[Seed 003's Fig\. 9[^]]*\]\((resources/[^)]+\.png)\)", readme)
+    assert picture, "the README shows Fig. 9"
+    shown = iio.imread(ROOT / picture.group(1))
+    columns = sheet.shape[1] // (64 + GAP)  # the frames shown, one panel each
+    size = (shown.shape[1] - (columns + 1) * GAP) / columns
+    assert size == int(size) and shown.shape[0] == 2 * (int(size) + LABEL_HEIGHT) + 3 * GAP
