@@ -100,11 +100,44 @@ def hair_mask(image: np.ndarray, background=(0.16, 0.17, 0.19)) -> np.ndarray:
     return np.abs(image[..., :3].astype(np.float64) - bg).max(axis=-1) > 24
 
 
+def curves_match(view, lib, joint: str) -> None:
+    """The graph editor's curves of ``joint`` are the library editor ``lib``'s (a PoseEditor, or a
+    ChannelEditor for per-channel keys): the edited capture, the key curve, the keys, their
+    values and handles, channel by channel."""
+    from hairtool.mocap import ik
+    from hairtool.mocap.channel_edit import ChannelEditor
+
+    m = lib.original
+    j = m.joint_names.index(joint)
+    cols, _ = ik.rotation_columns(m, j)
+    result = lib.motion().values[:, cols]
+    assert [c.name for c in view.curves] == [m.channels[j][c - int(m._starts[j])] for c in cols]
+    per_channel = isinstance(lib, ChannelEditor)
+    if not per_channel:
+        curve, slopes = lib.key_curve(j, result), lib.key_slopes(j)
+    for i, (drawn, c) in enumerate(zip(view.curves, cols, strict=True)):
+        if per_channel:
+            keys, key_curve, slope = lib.keys(c), lib.key_curve(c), lib.key_slopes(c)
+        else:
+            keys, key_curve = lib.keys, curve[:, i]
+            slope = None if slopes is None else (slopes[0][:, i], slopes[1][:, i])
+        np.testing.assert_array_equal(drawn.result, result[:, i])
+        np.testing.assert_array_equal(drawn.key_curve, key_curve)
+        np.testing.assert_array_equal(drawn.keys, keys)
+        np.testing.assert_array_equal(drawn.values, key_curve[keys])
+        if slope is None:
+            assert drawn.slope_in is None and drawn.slope_out is None
+        else:
+            np.testing.assert_array_equal(drawn.slope_in, slope[0])
+            np.testing.assert_array_equal(drawn.slope_out, slope[1])
+
+
 @pytest.fixture
 def ui():
     """The helpers above, for test modules (importlib import mode cannot import conftest)."""
     from types import SimpleNamespace
 
     return SimpleNamespace(
-        grab=grab, drag=drag, leave=leave, send_mouse=send_mouse, hair_mask=hair_mask, record=record
+        grab=grab, drag=drag, leave=leave, send_mouse=send_mouse, hair_mask=hair_mask, record=record,
+        curves_match=curves_match,
     )

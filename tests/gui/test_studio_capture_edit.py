@@ -166,6 +166,7 @@ def test_the_graph_editor_drags_a_key_like_the_library_and_navigates(ui, capture
     lib = _library(w, motion)
     lib.apply_channel(edit)
     assert np.array_equal(c.motion().values, lib.motion().values)
+    ui.curves_match(view, lib, "mixamorig:LeftForeArm")  # the curves drawn are the library's
     assert w.animation.frame == edit.frame
     np.testing.assert_array_equal(w.animation.animation.frames, skeleton_animation(lib.motion()).frames)
     assert view.curves[1].values[k] == pytest.approx(edit.value, abs=1e-6)
@@ -211,6 +212,7 @@ def test_the_graph_editor_drags_a_handle_like_the_library(ui, capture):
     lib = _library(w, motion)
     lib.apply_tangent(edit)
     assert np.array_equal(c.motion().values, lib.motion().values)
+    ui.curves_match(view, lib, "mixamorig:LeftForeArm")
     assert view.curves[0].slope_out[k] == pytest.approx(edit.slope, abs=1e-6)
     assert view.curves[0].slope_in[k] == pytest.approx(edit.slope, abs=1e-6)
     np.testing.assert_array_equal(w.animation.animation.frames, skeleton_animation(lib.motion()).frames)

@@ -13,6 +13,7 @@ import pytest
 from app.ui.animation_io import skeleton_animation
 from hairtool.mocap import ik
 from hairtool.mocap.bvh import read_bvh, write_bvh
+from hairtool.mocap.channel_edit import ChannelEditor
 from hairtool.mocap.pose_edit import ChannelEdit, PoseEdit
 
 pytestmark = pytest.mark.gui
@@ -80,8 +81,15 @@ def test_a_joint_drag_with_per_channel_keys_lands_on_the_cursor_and_replays_thro
     edited = c.motion()
     np.testing.assert_array_equal(m.animation.frames, skeleton_animation(edited).frames)
     assert "reached on its channels' own keys" in c.report.text()
-    # the forearm key edited before stays on the layer, moved by the pose only where the IK turned it
     assert np.array_equal(edited.offsets, motion.offsets)
+    # the library's layer: the per-channel keys over the pose keys, the pose allowed at a pose key;
+    # the forearm's channels drawn with the key the pose added at the pose key
+    lib = ChannelEditor(c.editor.motion(), c.channel_layer()._keys0, c.editor.interp, pose_keys=c.editor.keys)
+    lib.apply_all(c.channel_edits)
+    assert np.array_equal(edited.values, lib.motion().values)
+    c.select(ARM)
+    ui.curves_match(w.graph_editor.view, lib, ARM)
+    assert all(f in cv.keys for cv in w.graph_editor.view.curves)
     # one undo step: the drag goes, the key edit before it stays; redo brings it back
     w.undo_stack.undo()
     assert len(c.channel_edits) == 1 and np.array_equal(c.motion().values, before)
