@@ -66,6 +66,8 @@ def test_an_edit_moves_the_joint_at_its_key_and_nothing_outside_the_neighbouring
     # Written to 6 decimals, the effectors are still on their targets.
     assert np.linalg.norm(q[f, wrist] - t1) < 1e-4 * h and np.linalg.norm(q[g, ankle] - t2) < 1e-4 * h
     assert np.array_equal(e.offsets, m.offsets) and e.channels == m.channels and e.frame_time == m.frame_time
+    assert np.array_equal(e.end_offsets, m.end_offsets) and np.array_equal(e.parents, m.parents)
+    assert np.array_equal(e.end_parents, m.end_parents) and e.joint_names == m.joint_names
     changed = np.flatnonzero(np.any(np.abs(e.values - m.values) > 1e-9, axis=1))
     assert changed.min() > keys[2] and changed.max() < keys[7]
     assert not np.any(np.abs(e.values[keys[4] + 1 : keys[5]] - m.values[keys[4] + 1 : keys[5]]) > 1e-9)

@@ -172,6 +172,7 @@ def test_an_edited_capture_round_trips_through_bvh(tmp_path, motion_dir):
     back = read_bvh(tmp_path / "e.bvh")
     assert back.joint_names == m.joint_names and back.channels == m.channels
     assert np.array_equal(back.offsets, m.offsets) and back.frame_time == m.frame_time
+    assert np.array_equal(back.end_offsets, m.end_offsets) and np.array_equal(back.parents, m.parents)
     np.testing.assert_allclose(back.values, out.values, rtol=0, atol=5e-7)
     d = np.linalg.norm(back.joint_positions() - out.joint_positions(), axis=2)
     assert d.max() < 1e-6 * ik.figure_height(m)
