@@ -62,10 +62,27 @@ def pytest_report_header(config: pytest.Config) -> str | None:
     return config.missing_system_packages
 
 
+def _slow_seconds(item: pytest.Item) -> float:
+    """What a test's ``slow`` mark says it takes (``seconds=``, a warm run here), 0 unmarked."""
+    marks = list(item.iter_markers("slow"))
+    return max((float(m.kwargs.get("seconds", 10)) for m in marks), default=0.0)
+
+
+def _slowest_files_first(items: list[pytest.Item]) -> None:
+    """The workers take whole files in this order (``./dev test`` turns off xdist's reordering by
+    test count): the files whose slow tests add up to the most start first, so the run does not
+    end with one worker alone on a two-minute file while the others wait."""
+    seconds: dict[Path, float] = {}
+    for item in items:
+        seconds[item.path] = seconds.get(item.path, 0.0) + _slow_seconds(item)
+    items.sort(key=lambda item: -seconds[item.path])  # stable: a file's tests keep their order
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Without Qt's system libraries (on a developer's machine: CI refuses to start) the GUI and
-    render tests are skipped with the one line that names the packages (Qt would otherwise abort
-    the whole run at the first window)."""
+    """The slowest files first (:func:`_slowest_files_first`). Without Qt's system libraries (on a
+    developer's machine: CI refuses to start) the GUI and render tests are skipped with the one
+    line that names the packages (Qt would otherwise abort the whole run at the first window)."""
+    _slowest_files_first(items)
     reason = config.missing_system_packages
     if reason is None:
         return

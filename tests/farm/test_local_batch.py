@@ -44,6 +44,7 @@ def batch(capsys, *args: str) -> tuple[int, dict]:
     return rc, json.loads(capsys.readouterr().out)
 
 
+@pytest.mark.slow(seconds=11)
 def test_a_local_batch_runs_resumes_and_reports(project, capsys, grooms_dir, motion_dir):
     jobs = project / "jobs.toml"
     jobs.write_text(JOBS_TOML.replace("MOTION", str(motion_dir)).replace("GROOMS", str(grooms_dir)))

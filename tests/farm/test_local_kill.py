@@ -62,6 +62,7 @@ def _kill_a_worker_running(client, pids: dict[str, int], wanted: set[int], threa
     raise AssertionError("no worker was seen running a simulate job")
 
 
+@pytest.mark.slow(seconds=12)
 def test_a_local_batch_survives_a_worker_killed_mid_job_and_resumes(made_shots, tmp_path, capfd):
     from hairtool.farm.cluster import open_client
 

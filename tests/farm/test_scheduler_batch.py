@@ -124,6 +124,7 @@ def _kill_a_worker_running_a_job(client, pids: dict[str, int], thread: threading
     raise AssertionError("no worker was seen running a job")
 
 
+@pytest.mark.slow(seconds=15)
 def test_a_batch_on_a_running_scheduler_survives_a_killed_worker_and_resumes(
     project, dask_pair, capsys, grooms_dir
 ):

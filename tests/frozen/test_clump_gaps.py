@@ -54,6 +54,7 @@ def test_vertices_of_the_same_strand_do_not_attract_each_other():
     np.testing.assert_array_equal(clump(g, 1.0, 5, 0.1, "off").points, g.points)
 
 
+@pytest.mark.slow(seconds=29)
 def test_gap_correction_keeps_more_space_than_plain_adhesion():
     for g in (samples.scalp(600, 20, seed=1), read_groom_or_scalp()):
         h = auto_clump_radius(g)

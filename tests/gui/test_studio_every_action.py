@@ -42,6 +42,7 @@ def _order() -> list[str]:
     return list(STATES) * rounds if rounds > 0 else [*STATES, *REPEATED]
 
 
+@pytest.mark.slow(seconds=130)
 def test_every_action_in_every_state(tmp_path):
     order = _order()
     command = [sys.executable, "-X", "faulthandler", str(WALK), str(tmp_path / "walk"), "--states", *order]

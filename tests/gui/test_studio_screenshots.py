@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from PIL import Image
 from PySide6.QtWidgets import QApplication
 
 
+@pytest.mark.slow(seconds=16)
 def test_screenshot_script_drives_the_studio_and_writes_both_pictures(qapp, tmp_path):
     from app.figures import screenshots
 

@@ -37,6 +37,7 @@ def sintel_children():
     return guides, b, b.build(moved), RenderHair(b, ChildClump()).clump_radius
 
 
+@pytest.mark.slow(seconds=4)
 @pytest.mark.parametrize("gap_mode", ["printed", "text", "off"])
 @pytest.mark.parametrize("keep_lengths", [True, False])
 def test_each_clump_is_the_whole_groom_run_on_its_children(sintel_children, gap_mode, keep_lengths):

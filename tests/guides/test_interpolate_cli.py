@@ -54,6 +54,7 @@ def test_from_dense_writes_render_strands_and_guides(tmp_path, grooms_dir):
     assert io.read_groom(chosen).strand_count == 30
 
 
+@pytest.mark.slow(seconds=18)
 def test_freeze_outputs_render_hair(tmp_path, capsys):
     out = tmp_path / "render.npz"
     args = [

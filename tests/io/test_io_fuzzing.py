@@ -183,6 +183,7 @@ def fuzz_reports() -> dict[str, dict]:
     return reports
 
 
+@pytest.mark.slow(seconds=3)
 @pytest.mark.parametrize("reader", sorted(MUTANTS))
 def test_every_mutant_is_read_finite_or_refused_in_one_line(fuzz_reports, reader):
     report = fuzz_reports[reader]

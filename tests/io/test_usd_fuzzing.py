@@ -278,7 +278,7 @@ def _seed_crate(path) -> None:
     stage.Export(str(path))
 
 
-@pytest.mark.slow
+@pytest.mark.slow(seconds=3)
 def test_mutated_crates_in_a_memory_capped_child(tmp_path):
     seed = tmp_path / "seed.usdc"
     _seed_crate(seed)

@@ -105,6 +105,7 @@ def test_per_channel(files, capsys):
     assert len(out["channels"]) == 3 and all(c[0] == 0 and c[-1] == 29 for c in out["channels"])
 
 
+@pytest.mark.slow(seconds=13)
 def test_bvh_input(motion_dir, capsys):
     out = run_json(capsys, motion_dir / "freebvh.bvh", "--keys", 10)
     assert len(out["keys"]) == 10 and out["frames"] == 69
