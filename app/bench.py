@@ -82,6 +82,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=["align", "comb", "smooth", "length", "puff", "clump", "mask"],
         help="the brush dragged (default align)",
     )
+    parser.add_argument(
+        "--radius",
+        type=float,
+        metavar="SHARE",
+        help="brush radius as a share of the groom's largest side (default: the studio's, 0.25)",
+    )
     parser.add_argument("--symmetry", action="store_true", help="X symmetry on: each move and its mirror")
     parser.add_argument(
         "--groom", metavar="PATH", help="time this groom file (any readable one) instead of the samples"
@@ -188,6 +194,9 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
         window.scene.set_clump_children(True)
     window.scene.set_brush(getattr(args, "brush", "align"))
     window.scene.set_symmetry(bool(getattr(args, "symmetry", False)))
+    if getattr(args, "radius", None) is not None:
+        lo, hi = window.scene.rest.bounds
+        window.scene.set_radius(float(args.radius) * float(np.max(hi - lo)))
     if args.line_width is not None:
         window.scene.set_line_width(args.line_width)
     window.resize(*args.size)
@@ -205,7 +214,7 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     path = _drag_path(window, args.moves)
     send_mouse(v, "press", path[0], left, left)
     v.draw_now()  # the first update compiles kernels and allocates: not timed
-    totals, pipeline, upload, draw, stages, children, cpu = [], [], [], [], [], [], []
+    totals, pipeline, upload, draw, stages, children, cpu, redone = [], [], [], [], [], [], [], []
     for p in path[1:]:
         t0, c0 = time.perf_counter(), time.process_time()
         send_mouse(v, "move", p, None, left)
@@ -217,6 +226,7 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
         draw.append(v.last_draw_ms)
         stages.append(window.scene.pipeline.timings)
         children.append(window.scene.last_children_ms)
+        redone.append(window.scene.pipeline.clump_redone if window.scene.pipeline is not None else 1.0)
     drawn_strands = v.renderer.topology.strand_count if v.renderer is not None else 0
     children_ms = statistics.median(children) if children else 0.0
     t0, c0 = time.perf_counter(), time.process_time()
@@ -248,6 +258,7 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     }
     for stage in ("freeze", "align", "clump"):
         row[f"{stage}_ms"] = statistics.median(float(t.get(stage, 0.0)) for t in stages)
+    row["redone_share"] = statistics.median(redone)  # of the vertices a move's clumping redid
     row["release_ms"] = release_ms
     row["release_cpu_ms"] = release_cpu_ms
     row["clump_children"] = clump_children

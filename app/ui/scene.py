@@ -38,6 +38,9 @@ COLOUR_MODES = {
 }
 DRAG_PERCENT = 10.0  # children drawn while a brush drags (XGen's preview density)
 RELEASE_PERCENT = 100.0  # … and once the mouse is released
+BRUSH_SHARE = 0.1  # a new groom's brush radius, of its largest side: about Blender's 50 px brush at
+# the framed view, which is how artists start (a quarter of the side, as before, combed half the
+# bear at once and made every move a whole-groom run: 120 ms against 28 at this size)
 
 
 class Scene(QObject):
@@ -112,7 +115,7 @@ class Scene(QObject):
         lo, hi = groom.bounds
         self.centre = ((lo.astype(np.float64) + hi) * 0.5).astype(np.float32)
         extent = float(np.max(hi - lo))
-        self.tool.reset_radius(0.25 * extent if extent > 0 else 1.0)
+        self.tool.reset_radius(BRUSH_SHARE * extent if extent > 0 else 1.0)
         self.tool.mirror_x = None  # the new groom's own centre
         self.locked = np.zeros(groom.strand_count, dtype=bool)
         self.selected = np.ones(groom.strand_count, dtype=bool)

@@ -92,6 +92,8 @@ def test_length_grows_and_ctrl_shrinks_by_the_stated_fraction(ui, make_window):
     s.set_intensity(0.2)
     s.set_falloff("constant")  # every strand the brush reaches: the whole fraction
     before = s.result
+    lo, hi = before.bounds
+    s.set_radius(0.25 * float(np.max(hi - lo)))  # wide enough to reach the grown tips again
     pos = v.project(before.tips[front_strand(w)])[0]
     click(ui, v, pos)  # one sample: the press
     grown = s.result.strand_lengths / before.strand_lengths
