@@ -86,7 +86,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--radius",
         type=float,
         metavar="SHARE",
-        help="brush radius as a share of the groom's largest side (default: the studio's, 0.25)",
+        help="brush radius as a share of the groom's largest side (default: the size a groom opens with)",
     )
     parser.add_argument("--symmetry", action="store_true", help="X symmetry on: each move and its mirror")
     parser.add_argument(
@@ -226,7 +226,7 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
         draw.append(v.last_draw_ms)
         stages.append(window.scene.pipeline.timings)
         children.append(window.scene.last_children_ms)
-        redone.append(window.scene.pipeline.clump_redone if window.scene.pipeline is not None else 1.0)
+        redone.append(window.scene.pipeline.clump_redone)
     drawn_strands = v.renderer.topology.strand_count if v.renderer is not None else 0
     children_ms = statistics.median(children) if children else 0.0
     t0, c0 = time.perf_counter(), time.process_time()
