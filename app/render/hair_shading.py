@@ -22,6 +22,8 @@ import numpy as np
 from numba import njit, prange
 from numpy.typing import NDArray
 
+from hairtool.serial_twins import twin_njit
+
 LIGHT_IN_VIEW = (-0.35, 0.6, 0.72)  # toward the key light: (right, up, toward the viewer)
 HAIR_TAPER = 0.75  # shaded hair narrows to a quarter of its width at the tip (StrandRenderer.taper)
 
@@ -107,7 +109,7 @@ def _strand(pf, bf, of, a, b, light, half, ambient, kd, ks, e, bits, whole):
 # vertex gets the same instructions whatever the thread count (the bytes stay deterministic);
 # the tests hold the kernels to their numpy twin. Two kernels, so that the common one's loop has
 # no pow() call in it (a branch between the two, even on an argument, kept it scalar).
-@njit(cache=True, nogil=True, parallel=True, fastmath=True)
+@twin_njit(nogil=True, parallel=True, fastmath=True)
 def _shade_kernel(points, offsets, base, light, half, ambient, kd, ks, bits, out):
     """Shades for a whole exponent e < 2**_SQUARINGS given by its binary digits ``bits``."""
     pf, bf, of = points.reshape(-1), base.reshape(-1), out.reshape(-1)
@@ -132,6 +134,17 @@ def _half(light: NDArray, eye: NDArray) -> NDArray[np.float64]:
     return h / n if n > 0 else np.asarray(light, np.float64)
 
 
+def _read_only(a: NDArray) -> NDArray:
+    """``a`` as the kernels always see it, read-only (a view when it is writable): numba
+    compiles writable and read-only arrays apart, and the renderer's arrays are read-only, so
+    one specialisation serves every caller (a first start compiles half as much)."""
+    if not a.flags.writeable:
+        return a
+    view = a.view()
+    view.flags.writeable = False
+    return view
+
+
 def shade(
     points: NDArray,
     offsets: NDArray,
@@ -145,8 +158,8 @@ def shade(
     S + 1 strand starts) with per-vertex ``base`` colours, unit ``light`` and ``eye`` directions."""
     if out is None or out.shape != (len(points), 3):
         out = np.empty((len(points), 3), np.float32)
-    points, base = np.ascontiguousarray(points), np.ascontiguousarray(base)
-    offsets = np.ascontiguousarray(offsets, np.int64)
+    points, base = _read_only(np.ascontiguousarray(points)), np.ascontiguousarray(base)
+    offsets = _read_only(np.ascontiguousarray(offsets, np.int64))
     light, half = np.asarray(light, np.float64), _half(light, eye)
     terms = (float(look.ambient), float(look.diffuse), float(look.specular))
     e = 0.5 * float(look.exponent)

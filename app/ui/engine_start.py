@@ -2,7 +2,9 @@
 processes (:mod:`app.ui.kernel_warmup`, one per lane: the engine's and the render hair's side by
 side) with their progress in the status bar, and the scene's engine starts when its kernels are
 cached. Until then the groom shows as it is, parameter edits are kept for the engine, and a
-stroke says in the status bar that the engine is on its way.
+stroke says in the status bar that the engine is on its way. The engine and the render hair run
+on the serial twins of their kernels (:mod:`hairtool.serial_twins`: the warm-up compiles those
+first, in half the time) until the warm-up has cached the parallel kernels too.
 """
 
 from __future__ import annotations
@@ -13,7 +15,8 @@ from PySide6.QtCore import QEventLoop, QObject, QProcess, Qt, Signal
 from PySide6.QtGui import QGuiApplication
 from PySide6.QtWidgets import QProgressBar, QStatusBar
 
-from app.ui.kernel_warmup import ENGINE_STEP, LANES, STEPS
+from app.ui import kernel_warmup
+from app.ui.kernel_warmup import ENGINE_STEP, LANES, PARALLEL_STEPS, STEPS
 from app.ui.scene import Scene
 from app.ui.status_line import ElidedLabel
 
@@ -57,6 +60,9 @@ class EngineStart(QObject):
             process.readyReadStandardOutput.connect(lambda p=process: self._read(p))
             process.finished.connect(self._on_finished)
             process.errorOccurred.connect(lambda error, p=process: self._on_error(p, error))
+        # the serial twins until the parallel kernels are cached (the warm-up's first steps
+        # compile the twins: half the time); the engine and the render hair start later
+        kernel_warmup.use_parallel(False)
         scene.engine_starting.connect(self._on_starting)
         scene.engine_started.connect(self._on_started)
         self._waiting_cursor = False
@@ -82,6 +88,8 @@ class EngineStart(QObject):
         closes): nothing follows, the engine is not started here (it would compile every kernel
         on the GUI thread of a window being closed) and ``ended`` is not emitted."""
         self._closing = self._closing or closing
+        if closing:  # nothing of this start runs any more: the process's kernels as by default
+            kernel_warmup.use_parallel(True)
         for process in self.processes:
             if process.state() != QProcess.ProcessState.NotRunning:
                 process.kill()
@@ -99,6 +107,8 @@ class EngineStart(QObject):
                 self.label.setText(f"Preparing the hair engine (first start): {label} ready, {done}/{total}")
                 if label == ENGINE_STEP and not self.scene.engine_ready:
                     self.scene.start_engine()  # what a stroke needs is cached now
+                if label in PARALLEL_STEPS and set(PARALLEL_STEPS) <= self.done:
+                    kernel_warmup.use_parallel(True)  # the next engine run loads them
                 self.step_ready.emit(label)
 
     def _on_finished(self, code: int, status: QProcess.ExitStatus) -> None:

@@ -11,6 +11,10 @@ the window as surely as compiling in it.
 
 Compiling is single-threaded, so the studio runs one process per :data:`LANES` entry
 (``--lane K``): on two cores the engine's kernels and the render hair's compile side by side.
+The first screen's steps compile serial twins of its parallel kernels first (half numba's
+compile time, :mod:`hairtool.serial_twins`), the studio runs on those, and switches to the
+parallel kernels when their steps are done. ``--no-quick`` leaves the twins out: a warm-up
+ahead of a start (:mod:`app.ui.warm_cache`) caches every kernel, and that start runs parallel.
 :mod:`app.ui.warm_cache` (what ``./dev`` runs after installing) runs the lanes from a terminal
 with one progress line.
 
@@ -60,8 +64,11 @@ def record_path(lane: int | None = None) -> Path:
 
 def _dispatchers() -> dict[str, object]:
     """``module:function`` → numba dispatcher, for every cached kernel of :data:`KERNEL_PACKAGES`'
-    modules and of :data:`KERNEL_MODULES`."""
+    modules and of :data:`KERNEL_MODULES` (a twinned kernel twice: ``module:function`` the
+    parallel one, ``module:function_serial`` its serial twin, whichever the module names now)."""
     from numba.core.dispatcher import Dispatcher
+
+    from hairtool import serial_twins
 
     names = list(KERNEL_MODULES)
     for package in KERNEL_PACKAGES:
@@ -74,9 +81,23 @@ def _dispatchers() -> dict[str, object]:
         except ImportError:  # a module the engine no longer has
             continue
         for attr, value in vars(module).items():
-            if isinstance(value, Dispatcher) and getattr(value, "_cache", None) is not None:
-                found[f"{name}:{attr}"] = value
+            if not isinstance(value, Dispatcher) or getattr(value, "_cache", None) is None:
+                continue
+            if serial_twins.is_twinned(value):
+                value = serial_twins.parallel_of(value)
+                found[f"{name}:{attr}{serial_twins.SERIAL_SUFFIX}"] = serial_twins.serial(value)
+            found[f"{name}:{attr}"] = value
     return found
+
+
+def use_parallel(parallel: bool) -> None:
+    """Run the engine's and the render hair's kernels parallel (True) or on their quicker-to-
+    compile serial twins (:mod:`hairtool.serial_twins`), in this process from now on: every
+    kernel module is imported first, so each one's names are pointed at the chosen kernels."""
+    from hairtool import serial_twins
+
+    _dispatchers()
+    serial_twins.use_parallel(parallel)
 
 
 def _has_cache(dispatcher: object) -> bool:
@@ -97,16 +118,18 @@ def _read_record(path: Path) -> tuple[set[str], set[str]]:
 
 
 def kernels_cached() -> bool:
-    """True when the warm-up's records cover every step and every kernel they name is still in
-    numba's cache; False on a first start, after the caches were cleared, after a kernel's
-    source changed, or when a warm-up was stopped before its end."""
+    """True when the warm-up's records cover every step (the :data:`QUICK_STEPS` aside: a
+    start with all cached runs parallel) and every kernel they name is still in numba's cache;
+    False on a first start, after the caches were cleared, after a kernel's source changed, or
+    when a warm-up was stopped before its end."""
+    needed = set(lane_labels(None, quick=False))
     steps, names = _read_record(record_path())
-    if not {label for label, _ in STEPS} <= steps:  # no whole warm-up: the lanes' records together
+    if not needed <= steps:  # no whole warm-up: the lanes' records together
         steps, names = set(), set()
         for lane in range(1, len(LANES) + 1):
             lane_steps, lane_names = _read_record(record_path(lane))
             steps, names = steps | lane_steps, names | lane_names
-    if not names or not {label for label, _ in STEPS} <= steps:
+    if not names or not needed <= steps:
         return False
     found = _dispatchers()
     return all(n in found and _has_cache(found[n]) for n in names)
@@ -231,7 +254,6 @@ def _brushes_step() -> None:
         radius = float(np.max(hi - lo)) * (0.05 if brush == "delete" else 1.0)  # delete: not every strand
         pipe.brush(BrushSample(brush, centre, (1.0, 0.0, 0.0), radius, strength, lut, start=True))
 
-
     from hairtool.frozen.density import accept, thin
 
     pts = groom.roots.astype(np.float64)
@@ -314,16 +336,49 @@ HEAD_STEP = "head surface"
 #: drag) compiles nothing: tests/gui/test_studio_first_screen_kernels.py checks it.
 FIRST_SCREEN = (HEAD_STEP, ENGINE_STEP, RENDER_HAIR_STEP, RASTER_STEP)
 
+#: The first screen's steps that compile the serial twins of its parallel kernels
+#: (:mod:`hairtool.serial_twins`: half the compile time), on which a first start runs until
+#: the :data:`PARALLEL_STEPS` are done. A start with every kernel cached needs none of them.
+QUICK_STEPS = (HEAD_STEP, ENGINE_STEP, RENDER_HAIR_STEP)
+#: The engine's (with the head's) and the render hair's parallel kernels.
+PARALLEL_ENGINE_STEP = "hair engine, parallel"
+PARALLEL_RENDER_HAIR_STEP = "render hair, parallel"
+#: The steps after which the studio switches from the serial twins to the parallel kernels.
+PARALLEL_STEPS = (PARALLEL_ENGINE_STEP, PARALLEL_RENDER_HAIR_STEP)
+
+
+def _serially(step: Callable[[], None]) -> Callable[[], None]:
+    """``step`` run on the serial twins (and the process back on the parallel kernels after)."""
+
+    def run() -> None:
+        use_parallel(False)
+        try:
+            step()
+        finally:
+            use_parallel(True)
+
+    run.__name__ = run.__qualname__ = step.__name__
+    return run
+
+
+def _parallel_engine_step() -> None:
+    _head_step()
+    _engine_step()
+
+
 #: (label, step) in the order a single process runs them: the engine for the first groom, the
-#: render hair (the bundled sample's children wait for it), the rasterizer for software GL, then
-#: what other brush modes and settings reach, the other brushes, and what opening an animation
-#: needs (simulation, anime waves, keys): without these, the first use of each compiled it inside
-#: the studio, on a job or the GUI thread.
+#: render hair (the bundled sample's children wait for it), the rasterizer for software GL, the
+#: same engine and render hair on the parallel kernels, then what other brush modes and settings
+#: reach, the other brushes, and what opening an animation needs (simulation, anime waves,
+#: keys): without these, the first use of each compiled it inside the studio, on a job or the
+#: GUI thread.
 _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
-    (HEAD_STEP, _head_step),
-    (ENGINE_STEP, _engine_step),
-    (RENDER_HAIR_STEP, _render_hair_step),
+    (HEAD_STEP, _serially(_head_step)),
+    (ENGINE_STEP, _serially(_engine_step)),
+    (RENDER_HAIR_STEP, _serially(_render_hair_step)),
     (RASTER_STEP, _raster_step),
+    (PARALLEL_ENGINE_STEP, _parallel_engine_step),
+    (PARALLEL_RENDER_HAIR_STEP, _render_hair_step),
     ("brush modes and settings", _more_engine_step),
     ("engine defaults", _scalp_engine_step),
     ("clumped render hair", _clumped_hair_step),
@@ -333,13 +388,14 @@ _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
 
 #: The studio's warm-up processes, one per core of the two-core reference machine, each a list
 #: of step labels: the engine in one, the head surface (part of the engine's align drag) and
-#: the render hair in the other, so the first screen's compiles run side by side (CPU seconds on
-#: a busy two-core host, empty cache: engine ~57 of which the head's closest points ~7, render
-#: hair ~30, strand drawing ~35, grooming brushes ~19, animation ~29).
+#: the render hair in the other, so the first screen's compiles run side by side, then the
+#: parallel kernels and the rest (CPU seconds on a quiet two-core host, empty cache: engine 12.5
+#: serial, 25.6 parallel; head 2.9 / 4.4; render hair 5.8 / 11.6; strand drawing 10.7).
 LANES: tuple[tuple[str, ...], ...] = (
-    (ENGINE_STEP, "brush modes and settings", "engine defaults", "grooming brushes"),
-    (HEAD_STEP, RENDER_HAIR_STEP, RASTER_STEP, "clumped render hair", "animation and keys"),
-)
+    (ENGINE_STEP, PARALLEL_ENGINE_STEP, "brush modes and settings", "engine defaults", "grooming brushes"),
+    (HEAD_STEP, RENDER_HAIR_STEP, RASTER_STEP, PARALLEL_RENDER_HAIR_STEP, "clumped render hair",
+     "animation and keys"),
+)  # fmt: skip
 
 
 def _traced(i: int, label: str, step: Callable[[], None]) -> Callable[[], None]:
@@ -356,11 +412,17 @@ def _traced(i: int, label: str, step: Callable[[], None]) -> Callable[[], None]:
 STEPS = tuple((label, _traced(i, label, step)) for i, (label, step) in enumerate(_STEPS))
 
 
-def lane_steps(lane: int | None) -> list[tuple[int, str, Callable[[], None]]]:
-    """(index in :data:`STEPS`, label, step) of lane ``lane`` (1-based), or of every step."""
-    labels = [label for label, _ in STEPS] if lane is None else LANES[lane - 1]
+def lane_labels(lane: int | None, quick: bool = True) -> list[str]:
+    """The step labels of lane ``lane`` (1-based) or of every step; ``quick=False``: without the
+    :data:`QUICK_STEPS` (a warm-up ahead of the studio's start, as ``./dev`` runs)."""
+    labels = [label for label, _ in STEPS] if lane is None else list(LANES[lane - 1])
+    return [label for label in labels if quick or label not in QUICK_STEPS]
+
+
+def lane_steps(lane: int | None, quick: bool = True) -> list[tuple[int, str, Callable[[], None]]]:
+    """(index in :data:`STEPS`, label, step) of :func:`lane_labels`."""
     index = {label: i for i, (label, _) in enumerate(STEPS)}
-    return [(index[label], label, STEPS[index[label]][1]) for label in labels]
+    return [(index[label], label, STEPS[index[label]][1]) for label in lane_labels(lane, quick)]
 
 
 def _end_with_parent() -> None:
@@ -419,7 +481,7 @@ def main(argv: list[str] | None = None) -> int:
         _end_with_parent()
     done: list[str] = []
     try:
-        for i, label, step in lane_steps(lane):
+        for i, label, step in lane_steps(lane, quick="--no-quick" not in argv):
             step()
             done.append(label)
             print(f"step {i + 1} {len(STEPS)} {label}", flush=True)

@@ -22,7 +22,7 @@ def _line(done: int, total: int, label: str, started: float) -> str:
 
 def lane_command(lane: int) -> list[str]:
     """The command line of warm-up lane ``lane`` (1-based)."""
-    return [sys.executable, "-m", "app.ui.kernel_warmup", "--lane", str(lane)]
+    return [sys.executable, "-m", "app.ui.kernel_warmup", "--lane", str(lane), "--no-quick"]
 
 
 def warm(if_needed: bool = False, out=None) -> int:
@@ -32,7 +32,7 @@ def warm(if_needed: bool = False, out=None) -> int:
     if if_needed and kernel_warmup.kernels_cached():
         return 0
     started = time.time()
-    total = len(kernel_warmup.STEPS)
+    total = len(kernel_warmup.lane_labels(None, quick=False))  # the serial twins are not needed
     done: list[str] = []
     lock = threading.Lock()
     tty = out.isatty()

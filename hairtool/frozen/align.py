@@ -20,12 +20,13 @@ same angle as (11)'s arccos but accurate near 0 and pi.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Groom
 from hairtool.rotation import any_perpendicular, rotate
+from hairtool.serial_twins import twin_njit
 
 MODES = ("paper", "preserve-length")
 PHI_MIN = 1e-7  # radians: below this a strand counts as aligned
@@ -53,7 +54,7 @@ def check_align_params(cursor: ArrayLike, radius: float, intensity: float, mode:
     return c
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _align_kernel(p, offsets, c, radius, x, preserve, planar, out):
     s_count = offsets.size - 1
     for s in prange(s_count):

@@ -45,6 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Groom
+from hairtool.serial_twins import twin_njit
 
 F64 = NDArray[np.float64]
 
@@ -398,7 +399,7 @@ def root_normals(groom: Groom) -> F64:
     return out
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _facing_away_kernel(normals, view, out):  # pragma: no cover - compiled
     for s in prange(normals.shape[0]):
         out[s] = normals[s, 0] * view[0] + normals[s, 1] * view[1] + normals[s, 2] * view[2] > 0.0

@@ -51,6 +51,7 @@ from hairtool.frozen.noise import (
 )
 from hairtool.frozen.spatial import NeighbourList, pairs_within_reference
 from hairtool.groom import Groom
+from hairtool.serial_twins import twin_njit
 
 GAP_MODES = ("printed", "text", "off")
 _GAP_CODE = {"printed": 0, "text": 1, "off": 2}
@@ -82,7 +83,7 @@ def vertex_strength(groom: Groom, strength: ArrayLike | None) -> np.ndarray:
     return s[groom.topology.strand_index]
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def keep_still(points, sv, out):
     """The vertices at clump strength 0 back to ``points`` in ``out`` after the length pass
     (which recomputes every segment and may round the last bit of an unmoved one)."""
@@ -97,13 +98,13 @@ def keep_still_reference(points: np.ndarray, sv: np.ndarray, out: np.ndarray) ->
     return np.where((sv == 0.0)[:, None], points, out).astype(out.dtype)
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _gather_strength(sv, order, S):
     for k in prange(order.size):
         S[k] = sv[order[k]]
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _gather_points(points, order, P):
     """The current points (float64) in the list's sorted order."""
     for k in prange(order.size):
@@ -171,7 +172,7 @@ def vertex_force(P, aflat, a0, a1, bflat, b0, b1, px, py, pz, root, h, inv_h, st
     return fx, fy, fz, bj, c, wsum
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, stats, f, best, count, weight):
     """f (15) of every vertex from its two list runs and its nearest neighbour within h (ties:
     the lower original index); with ``stats`` (the first iteration) also how many are within h
@@ -188,7 +189,7 @@ def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, stats, f
             weight[i] = wsum
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _hash_heads(sorig, seed, heads):
     for i in prange(sorig.size):
         heads[i] = hash_head_nb(seed, sorig[i], CH_CLUMP)
@@ -233,7 +234,7 @@ def moved_vertex(P, f, S, step, i, j, zeta, h, gap, Pout, o):
         Pout[o, a] = P[i, a] + lam * (step * f[i, a])  # (16), (19)
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _gap_kernel(P, f, S, step, best, heads, h, gap, it, Pout):
     for i in prange(P.shape[0]):
         j = best[i]
@@ -260,14 +261,14 @@ def _first_stats(count, weight, sroot):
     return pairs, moving, w_sum, w_count
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _scatter(order, P, out):
     for k in prange(order.size):
         for a in range(3):
             out[order[k], a] = P[k, a]
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _scatter_stats(order, count, weight, out_count, out_weight):
     for k in prange(order.size):
         out_count[order[k]] = count[k]
@@ -289,7 +290,7 @@ def step_from_stats(h, w_sum, w_count):
     return STEP_FRACTION * h / max(w_sum / max(w_count, 1), 1.0)
 
 
-@njit(cache=True, nogil=True)
+@twin_njit(nogil=True)
 def _clump_run(points, strength, order, lists, sroot, h, iterations, step, gap, seed, bufs, out, record):
     """The k Jacobi iterations on the cell-sorted list, one call (no Python between kernels).
     ``step`` < 0: automatic. Writes the result to ``out`` (original order, float32); returns

@@ -11,7 +11,7 @@ its plain numpy twin.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
@@ -28,6 +28,7 @@ from hairtool.frozen.noise import (
 )
 from hairtool.groom import Groom
 from hairtool.rotation import any_perpendicular, normalize, rotate
+from hairtool.serial_twins import twin_njit
 
 AXIS_EPS = 1e-6  # |t̂[i−1] × t̂[i]| below this: the tangents are parallel, the cross gives no axis
 MAX_STIFFNESS = 1e9
@@ -75,7 +76,7 @@ def _effective(groom, stretch_stiffness, bend_stiffness, max_bend_angle, seed, s
     return np.maximum(float(stretch_stiffness) * m, 1.0), float(bend_stiffness) * m, seed
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _freeze_kernel(rest, offsets, ks, kb, theta_max, seed, planar, out):
     s_count = offsets.size - 1
     for s in prange(s_count):

@@ -12,12 +12,13 @@ that gives a full run's clumped bytes gives a full run's restored bytes too.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
 from hairtool.groom import Topology
+from hairtool.serial_twins import twin_njit
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _restore_kernel(before, after, offsets, strands, out):
     """The strands ``strands`` (all where it is empty) of ``after``, lengths from ``before``."""
     count = strands.size if strands.size > 0 else offsets.size - 1

@@ -25,7 +25,7 @@ from contextlib import contextmanager
 
 import numba
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
 from hairtool.frozen.clump import (
     _GAP_CODE,
@@ -42,6 +42,7 @@ from hairtool.frozen.noise import CH_CLUMP, hash_head_nb, hash_tail_u01_nb, seed
 from hairtool.frozen.spatial import pairs_within_reference
 from hairtool.frozen.vertex_grid import VertexGrid, list_frame
 from hairtool.groom import Topology, vertex_ids_of
+from hairtool.serial_twins import twin_njit
 
 MAX_SEEDS = 0.1  # of the vertices: a move that changes more runs in full (cheaper then)
 MAX_REGION = 0.25  # of the vertices: a region larger than this, too (measured on ratboy_mohawk: a
@@ -63,7 +64,7 @@ def threads_for(vertices: int):
         numba.set_num_threads(threads)
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _local_force(P, flat, cap, cnt, vids, roots, h, ident, F, best):
     """f (15) and the nearest neighbour of each vertex ``vids[n]``, its list at
     ``flat[n·cap :][: cnt[n]]`` (original indices; ``P``, ``F`` in original order)."""
@@ -78,7 +79,7 @@ def _local_force(P, flat, cap, cnt, vids, roots, h, ident, F, best):
         F[i, 0], F[i, 1], F[i, 2] = fx, fy, fz
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _local_gap(P, F, S, step, best, vids, h, gap, it, seed, out):
     """The next iterate (or the float32 result) of each vertex ``vids[n]`` into ``out``."""
     for n in prange(vids.size):
@@ -90,7 +91,7 @@ def _local_gap(P, F, S, step, best, vids, h, gap, it, seed, out):
         moved_vertex(P, F, S, step, i, j, zeta, h, gap, out, i)
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _set_rows(dst, src, vids):
     for n in prange(vids.size):
         i = vids[n]

@@ -22,6 +22,7 @@ from numba import njit, prange
 
 from hairtool.bounds import box
 from hairtool.errors import GroomError, ParameterError
+from hairtool.serial_twins import twin_njit
 
 _BITS = 21  # bits per cell coordinate in a packed 64-bit cell key
 _MAXC = (1 << _BITS) - 2
@@ -118,7 +119,7 @@ def _compact_padded(nbr, cnt, start, flat):
 
 
 # -- the row grid (the usual path) ---------------------------------------------------------------
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _row_keys(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx):
     """Each vertex's row ``cz·ny + cy`` and quantised x."""
     for i in prange(p.shape[0]):
@@ -128,7 +129,7 @@ def _row_keys(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx):
         qx[i] = min(np.int64(np.floor((p[i, 0] - lo[0]) * inv_q)), nq - 1)
 
 
-@njit(cache=True, nogil=True)
+@twin_njit(nogil=True)
 def _row_sort(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx, start, order, tmp):
     """Vertices by row ``cz·ny + cy``, inside a row by x quantised to ``nq`` steps over the box:
     two stable counting sorts (quantised x, then row), no comparisons. ``start``: row offsets."""
@@ -159,7 +160,7 @@ def _row_sort(p, lo, inv_cell, ny, nz, inv_q, nq, keys, qx, start, order, tmp):
     start[0] = 0
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _gather(order, points, strand, skip, sx, sy, sz, sstrand, sskip):
     """The sorted coordinates (float64), strands and skip flags."""
     for k in prange(order.size):
@@ -198,7 +199,7 @@ def _scan_row(
     return j, pos
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _forward_kernel(
     sx, sy, sz, sstrand, start, ny, nz, lo, cell, r2, slack, chunks, base, limit, flat, fcnt, used
 ):

@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.bounds import box
+from hairtool.serial_twins import twin_njit
 
 _OFF = 1 << 20  # cell coordinates are clipped to [−_OFF, _OFF − 1]
 _BITS = 21
@@ -138,7 +139,7 @@ def _order_key(x, y, z, i, dense, lo, inv_cell, ny, nz, inv_q, nq, ox, oy, oz):
     return (((cz - oz + 1) * 9 + (cy - oy + 1) * 3 + (cx - ox + 1)) << IDX_BITS) | i
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _region_lists(
     points,
     strand,

@@ -22,9 +22,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
 from hairtool.guides.frames import TINY, guide_tables, guide_tables_reference, resampled, root_tangents
+from hairtool.serial_twins import twin_njit
 
 if TYPE_CHECKING:
     from hairtool.groom import Groom
@@ -87,7 +88,7 @@ class GuideTables:
         return self.bases[np.searchsorted(self.counts, binding.counts)]
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _children_kernel(
     coff, tbase, roots, gid, w, scale, local, seg, seglen, frm, exact_x, exact_y, moved, out
 ):
@@ -203,7 +204,7 @@ def moved_guides(guides: Groom, last: np.ndarray) -> np.ndarray:
     return out
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _moved_kernel(points, last, offsets, out):
     for g in prange(out.size):
         differs = False

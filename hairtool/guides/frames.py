@@ -17,6 +17,7 @@ from numba import njit, prange
 
 from hairtool.groom import Groom
 from hairtool.rotation import turn_between
+from hairtool.serial_twins import twin_njit
 
 TINY = 1e-30
 
@@ -97,7 +98,7 @@ def _guide_rows(points, offsets, counts, n, rest_tangent, axes, row0, seg, segle
         out[v, 6], out[v, 7], out[v, 8] = ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _tables_kernel(points, offsets, counts, n, rest_tangent, axes, row0, seg, seglen, out):
     """:func:`_guide_rows` of every guide, a guide per thread (threads pay from 10 guides on)."""
     for g in prange(counts.size):

@@ -20,6 +20,7 @@ from numba import njit, prange
 from hairtool.errors import ParameterError
 from hairtool.guides.inside import barycentric
 from hairtool.io.obj import Mesh
+from hairtool.serial_twins import twin_njit
 
 
 @njit(cache=True, nogil=True)
@@ -60,7 +61,7 @@ def _closest_on_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
     return ax + abx * v + acx * w, ay + aby * v + acy * w, az + abz * v + acz * w
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _closest_kernel(points, vertices, faces, out, face_of):
     for k in prange(points.shape[0]):
         px, py, pz = points[k, 0], points[k, 1], points[k, 2]
@@ -175,7 +176,7 @@ def nearest_sources_reference(
     return np.where(np.isfinite(d), order, -1), d
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _child_kernel(points, cface, faces, vertices, label_g, label_d, groots, gface, k, out_g, out_d):
     """Per child: the k+1 nearest guides along the surface through its face's corners (the
     straight line for a guide on the same face), sorted by (distance, guide)."""
@@ -387,7 +388,7 @@ def _closest_one(  # pragma: no cover - compiled
     face_of[k] = bf
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@twin_njit(nogil=True, parallel=True)
 def _grid_closest_kernel(  # pragma: no cover - compiled
     points, vertices, faces, lo, cell, dims, start, items, rings, out, face_of
 ):

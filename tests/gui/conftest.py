@@ -14,6 +14,18 @@ from app.ui.qt_utils import send_mouse
 configure_gl()  # pytest-qt makes the QApplication later, on the first use of ``qapp``
 
 
+@pytest.fixture(autouse=True)
+def parallel_kernels_after():
+    """A first start's window puts the process on the serial twins (hairtool.serial_twins)
+    until its warm-up ends or it closes: the next test starts on the parallel kernels whatever
+    this one left."""
+    yield
+    from hairtool import serial_twins
+
+    if not serial_twins.parallel_in_use():
+        serial_twins.use_parallel(True)
+
+
 @pytest.fixture
 def settings_path(tmp_path):
     return str(tmp_path / "studio.ini")

@@ -65,6 +65,35 @@ def test_the_warm_up_reports_progress_and_starts_the_engine(make_window, qtbot, 
     assert w.scene.pipeline is not None
 
 
+def test_a_first_start_runs_the_serial_twins_until_the_parallel_kernels_are_cached(
+    ui, make_window, qtbot, monkeypatch
+):
+    """Strokes work on either; the switch comes once both parallel steps are cached."""
+    from hairtool import serial_twins
+
+    labels = [kernel_warmup.ENGINE_STEP, kernel_warmup.PARALLEL_ENGINE_STEP, kernel_warmup.RENDER_HAIR_STEP,
+              kernel_warmup.PARALLEL_RENDER_HAIR_STEP, "more"]  # fmt: skip
+    _fake_warm_up(monkeypatch, labels, 0.4)
+    w = make_window(groom=samples.comb(strands=10, vertices=6), engine_ready=False)
+    modes = []
+    w.scene.engine_started.connect(lambda: modes.append(serial_twins.parallel_in_use()))
+    w.start_warmup()
+    es = w.engine_start
+    assert not serial_twins.parallel_in_use()
+    qtbot.waitUntil(lambda: kernel_warmup.PARALLEL_ENGINE_STEP in es.done, timeout=10_000)
+    assert modes == [False] and not serial_twins.parallel_in_use()  # one of the two is not enough
+    v = w.viewport
+    centre = v.project(w.scene.centre[None])[0]
+    ui.drag(v, centre, centre + np.array([30.0, 10.0]))  # on the serial twins
+    qtbot.waitUntil(lambda: kernel_warmup.PARALLEL_RENDER_HAIR_STEP in es.done, timeout=10_000)
+    assert serial_twins.parallel_in_use()
+    ui.drag(v, centre + np.array([30.0, 10.0]), centre)  # on the parallel kernels
+    assert w.undo_stack.count() == 2 and not w.errors
+    serial_twins.use_parallel(False)
+    w.close()  # a start ended early leaves the process on the parallel kernels, as by default
+    assert serial_twins.parallel_in_use()
+
+
 def test_two_lanes_start_the_engine_from_either_and_end_together(make_window, qtbot, monkeypatch):
     """Each warm-up lane reports its own steps (numbered in the whole warm-up); the progress counts
     both, the engine starts on its step, and ``ended`` comes once, after the slower lane."""
@@ -170,6 +199,11 @@ def test_the_lanes_share_out_every_step_once_the_first_screen_first():
     for lane in lanes:  # no step of the rest before one of the first screen
         ranks = [label in kernel_warmup.FIRST_SCREEN for label in lane]
         assert ranks == sorted(ranks, reverse=True), lane
+    for lane in lanes:  # the serial twins first: the parallel kernels are the later starts'
+        quick = [label in kernel_warmup.QUICK_STEPS for label in lane]
+        assert quick == sorted(quick, reverse=True), lane
+    # every start after the first: the steps it needs leave the serial twins out
+    assert not set(kernel_warmup.QUICK_STEPS) & set(kernel_warmup.lane_labels(None, quick=False))
     with pytest.raises(SystemExit, match="--lane takes"):
         kernel_warmup.main(["--lane", "9"])
 

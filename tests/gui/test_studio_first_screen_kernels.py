@@ -1,6 +1,7 @@
 """The warm-up's first steps compile every kernel the first screen uses: after them, Sintel with
 her render hair, shaded, drawn and combed with the align brush loads every kernel from numba's
-cache and compiles none on the GUI thread (which would freeze the window on a first start)."""
+cache and compiles none on the GUI thread (which would freeze the window on a first start). So
+do the parallel steps for a start on the parallel kernels (every start after the first)."""
 
 from __future__ import annotations
 
@@ -13,9 +14,11 @@ import pytest
 
 pytestmark = pytest.mark.gui
 
-#: ``startup``: run the warm-up's first-screen steps; ``screen``: the studio's first screen
-#: (window, engine, render hair, a frame, an align drag). Either prints the numba dispatchers'
-#: signatures in the process afterwards and the kernels it compiled (cache misses).
+#: ``startup MODE``: run the warm-up's first-screen steps (MODE ``serial``: the first start's,
+#: on the serial twins; ``parallel``: the parallel kernels' steps); ``screen MODE``: the studio's
+#: first screen (window, engine, render hair, a frame, an align drag) on those kernels. Either
+#: prints the numba dispatchers' signatures in the process afterwards, the kernels it compiled
+#: (cache misses) and the parallel kernels it ran.
 SCRIPT = r"""
 import gc, json, sys
 from numba.core import event
@@ -30,10 +33,13 @@ class Compiles(event.Listener):
         pass
 event.register("numba:compile", Compiles())
 
+from app.ui import kernel_warmup
 if sys.argv[1] == "startup":
-    from app.ui import kernel_warmup
+    labels = kernel_warmup.FIRST_SCREEN
+    if sys.argv[2] == "parallel":
+        labels = (*kernel_warmup.PARALLEL_STEPS, kernel_warmup.RASTER_STEP)
     for label, step in kernel_warmup.STEPS:
-        if label in kernel_warmup.FIRST_SCREEN:
+        if label in labels:
             step()
 else:
     import tempfile
@@ -53,6 +59,7 @@ else:
     w.show()
     app.processEvents()
     del compiled[:]  # what compiled before the window showed is not the first start's concern
+    kernel_warmup.use_parallel(sys.argv[2] == "parallel")  # as the studio's start sets it
     w.scene.start_engine()  # what the warm-up's startup steps let the studio do
     w._bind_pending_render_hair()  # and its render hair step
     w.viewport.set_raster_ready()  # and its strand drawing step
@@ -75,25 +82,40 @@ sigs = sorted(
     f"{d.py_func.__module__}:{d.py_func.__qualname__} {s}"
     for d in gc.get_objects() if isinstance(d, Dispatcher) for s in d.signatures
 )
-print(json.dumps({"signatures": sigs, "compiled": compiled}))
+parallel = sorted(
+    f"{d.py_func.__module__}:{d.py_func.__qualname__}"
+    for d in gc.get_objects() if isinstance(d, Dispatcher) and d.signatures
+    and d.targetoptions.get("parallel")
+)
+print(json.dumps({"signatures": sigs, "compiled": compiled, "parallel": parallel}))
 """
 
 
-def _run(mode: str, env: dict) -> dict:
-    command = [sys.executable, "-c", SCRIPT, mode]
+def _run(what: str, mode: str, env: dict) -> dict:
+    command = [sys.executable, "-c", SCRIPT, what, mode]
     out = subprocess.run(command, env=env, capture_output=True, text=True, timeout=900, check=False)
     assert out.returncode == 0, out.stderr[-3000:]
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def test_the_first_screen_compiles_nothing_after_the_startup_steps():
+@pytest.mark.parametrize("mode", ["serial", "parallel"])
+def test_the_first_screen_compiles_nothing_after_the_startup_steps(mode):
     """Both processes use the same cache (the worktree's, usually warm: then both load, and the
     first screen's signatures must be among those the startup steps loaded or compiled; from
-    an empty cache the startup steps compile them and the first screen must compile nothing)."""
+    an empty cache the startup steps compile them and the first screen must compile nothing).
+    On the serial twins, the only parallel kernels are the strand rasterizer's (not twinned: the
+    viewport draws with GL until they are cached)."""
     env = dict(os.environ)
-    startup = _run("startup", env)
-    screen = _run("screen", env)
+    startup = _run("startup", mode, env)
+    screen = _run("screen", mode, env)
     missing = sorted(set(screen["signatures"]) - set(startup["signatures"]))
     needed = "the first screen needs kernels the startup steps do not compile:\n"
     assert not missing, needed + "\n".join(missing)
     assert not screen["compiled"], "compiled on the GUI thread:\n" + "\n".join(screen["compiled"])
+    if mode == "serial":
+        ran = [name for name in screen["parallel"] if not name.startswith("app.render.soft_raster:")]
+        assert not ran, "parallel kernels on the serial start:\n" + "\n".join(ran)
+    else:
+        assert {"hairtool.frozen.freeze:_freeze_kernel", "hairtool.frozen.align:_align_kernel"} <= set(
+            screen["parallel"]
+        )

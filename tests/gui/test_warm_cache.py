@@ -18,7 +18,8 @@ def _fake_lanes(monkeypatch, code: int = 0) -> None:
     total = len(kernel_warmup.STEPS)
 
     def command(lane: int) -> list[str]:
-        lines = [f"step {index[label] + 1} {total} {label}" for label in kernel_warmup.LANES[lane - 1]]
+        labels = kernel_warmup.lane_labels(lane, quick=False)
+        lines = [f"step {index[label] + 1} {total} {label}" for label in labels]
         script = f"import sys\nfor line in {lines!r}:\n    print(line, flush=True)\nsys.exit({code})"
         return [sys.executable, "-c", script]
 
@@ -30,7 +31,7 @@ def test_the_progress_line_counts_both_lanes_steps(monkeypatch):
     out = io.StringIO()
     assert warm_cache.warm(out=out) == 0
     lines = out.getvalue().splitlines()
-    total = len(kernel_warmup.STEPS)
+    total = len(kernel_warmup.lane_labels(None, quick=False))
     counts = [line.split("] ")[1].split()[0] for line in lines[:-1]]
     assert counts == [f"{i}/{total}" for i in range(1, total + 1)]
     assert lines[-1].startswith("The studio's kernels are cached")
