@@ -626,8 +626,11 @@ class Viewport(QOpenGLWidget):
             target.end()
         elif drag == "align" and self._stroke_before is not None:
             before, self._stroke_before = self._stroke_before, None
+            # the whole groom settled first (snapshot), so the full-density render hair is
+            # built (and clumped) once, from the settled guides, not once before and once after
+            after = self.scene.snapshot()
             self.scene.set_dragging(False)  # full density again
-            self.stroke_finished.emit(before, self.scene.snapshot())
+            self.stroke_finished.emit(before, after)
         self.update()
 
     def wheelEvent(self, event: QWheelEvent) -> None:

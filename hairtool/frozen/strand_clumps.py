@@ -23,7 +23,20 @@ from hairtool.groom import Groom
 
 
 def median_root_spacing(groom: Groom) -> float:
-    """Median distance from each root to the nearest distinct root of another strand (0 if none)."""
+    """Median distance from each root to the nearest distinct root of another strand (0 if none).
+
+    The numba neighbour list over the roots (100,000 children's roots: ~10 ms, where
+    :func:`median_root_spacing_reference` takes most of a second, a pause when Clump children
+    is switched on); the search radius doubles until most roots have a neighbour."""
+    return _median_root_spacing(groom, _nearest_roots)
+
+
+def median_root_spacing_reference(groom: Groom) -> float:
+    """Numpy twin of :func:`median_root_spacing`."""
+    return _median_root_spacing(groom, _nearest_roots_reference)
+
+
+def _median_root_spacing(groom: Groom, nearest_roots) -> float:
     roots = groom.roots.astype(np.float64)
     s = len(roots)
     lo, hi = roots.min(axis=0), roots.max(axis=0)
@@ -31,17 +44,49 @@ def median_root_spacing(groom: Groom) -> float:
     if s < 2 or diag == 0.0:
         return 0.0
     r = diag / np.sqrt(s)
-    ids = np.arange(s)
     while True:
-        i, j = pairs_within_reference(roots, ids, r)
-        d = np.linalg.norm(roots[j] - roots[i], axis=1)
-        keep = d > 1e-9 * diag
-        nearest = np.full(s, np.inf)
-        np.minimum.at(nearest, i[keep], d[keep])
+        nearest = nearest_roots(roots, r, 1e-9 * diag)
         if np.count_nonzero(np.isinf(nearest)) < s // 2 or r > 2 * diag:
             m = float(np.median(nearest))
             return m if np.isfinite(m) else 0.0
         r *= 2.0
+
+
+def _nearest_roots_reference(roots: np.ndarray, r: float, tiny: float) -> np.ndarray:
+    """``(S,)`` each root's distance to the nearest other root within ``r`` and beyond ``tiny``
+    (inf: none)."""
+    i, j = pairs_within_reference(roots, np.arange(len(roots)), r)
+    e = roots[j] - roots[i]
+    d = np.sqrt(e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1] + e[:, 2] * e[:, 2])
+    keep = d > tiny
+    nearest = np.full(len(roots), np.inf)
+    np.minimum.at(nearest, i[keep], d[keep])
+    return nearest
+
+
+def _nearest_roots(roots: np.ndarray, r: float, tiny: float) -> np.ndarray:
+    nl = neighbour_list(roots, np.arange(len(roots)), r)
+    nearest = np.empty(len(roots))
+    lists = (nl.aflat, nl.aoff, nl.acnt, nl.bflat, nl.bstart)
+    _nearest_kernel(nl.x, nl.y, nl.z, nl.order, *lists, tiny, nearest)
+    return nearest
+
+
+@njit(cache=True, nogil=True)
+def _nearest_kernel(x, y, z, order, aflat, aoff, acnt, bflat, bstart, tiny, nearest):
+    """``nearest[order[k]]``: the distance from sorted position k to its nearest listed
+    neighbour beyond ``tiny`` (inf: none)."""
+    for k in range(x.size):
+        best = np.inf
+        for run in range(2):
+            lo, hi = (aoff[k], aoff[k] + acnt[k]) if run == 0 else (bstart[k], bstart[k + 1])
+            for n in range(lo, hi):
+                j = aflat[n] if run == 0 else bflat[n]
+                ex, ey, ez = x[j] - x[k], y[j] - y[k], z[j] - z[k]
+                d = np.sqrt(ex * ex + ey * ey + ez * ez)
+                if tiny < d < best:
+                    best = d
+        nearest[order[k]] = best
 
 
 def auto_clump_radius(groom: Groom) -> float:

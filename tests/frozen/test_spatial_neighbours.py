@@ -11,6 +11,7 @@ from hairtool.frozen.spatial import neighbour_list, pairs_within_reference
 from hairtool.frozen.strand_clumps import (
     auto_clump_radius,
     median_root_spacing,
+    median_root_spacing_reference,
     strand_clumps,
     strand_clumps_reference,
     strand_components,
@@ -71,6 +72,28 @@ def test_auto_clump_radius_is_twice_the_median_root_spacing():
     # one strand: no spacing, falls back to segment lengths
     one = g.subset([0])
     assert auto_clump_radius(one) == pytest.approx(2 * float(np.median(one.segment_lengths)))
+
+
+@pytest.mark.parametrize("name", ["bear.tfx", "ratboy_mohawk.tfx", "sintel_hair.tfx", "ponytail_tail.tfx"])
+def test_the_median_root_spacing_kernel_matches_its_numpy_twin(grooms_dir, name):
+    g = read_groom(grooms_dir / name)
+    assert median_root_spacing(g) == median_root_spacing_reference(g) > 0.0
+
+
+def test_the_median_root_spacing_on_render_hair_roots_and_awkward_grooms():
+    from hairtool.guides.binding import bind_roots
+
+    guides = samples.scalp(strands=40, vertices=6)
+    roots = guides.points[guides.topology.offsets[:-1]].astype(np.float64)
+    rng = np.random.default_rng(3)
+    kids = bind_roots(guides, roots[rng.integers(0, 40, 3000)] + rng.normal(0, 1e-3, (3000, 3)), k=3, seed=0)
+    children = kids.build(guides)
+    assert median_root_spacing(children) == median_root_spacing_reference(children) > 0.0
+    same_place = Groom(np.zeros((8, 3), np.float32), np.full(4, 2))  # every root in one place
+    assert median_root_spacing(same_place) == median_root_spacing_reference(same_place) == 0.0
+    pairs = samples.comb(6, 3, spacing=0.05)  # few strands: the radius doubles until they meet
+    pairs = pairs.subset([0, 5])
+    assert median_root_spacing(pairs) == median_root_spacing_reference(pairs) > 0.0
 
 
 def test_auto_clump_radius_on_real_grooms(grooms_dir):

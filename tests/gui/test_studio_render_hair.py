@@ -196,3 +196,31 @@ def test_clumping_the_children_is_a_switch_applied_on_release_and_saved(make_win
     assert w.project.save_to(path)
     w2 = _window(make_window, children=10)
     assert w2.project.open_project(path) and w2.scene.clump_children
+
+
+def test_a_release_clumps_the_render_hair_once_from_the_settled_guides(ui, make_window, monkeypatch):
+    """The release settles the groom (the whole-groom clump after brush-local moves) before the
+    full-density children are built, so Clump children runs once per release, on what is kept."""
+    from hairtool.guides.child_clumps import ChildClumps
+
+    w = make_window(groom=samples.scalp(strands=600, vertices=10, seed=4))
+    s, v = w.scene, w.viewport
+    s.set_binding(bind_roots(s.rest, count=3000, seed=2))
+    s.set_display_percent(drag=10.0, release=100.0)
+    s.set_clump_children(True)
+    v.frame_all()
+    lo, hi = s.rest.bounds
+    s.set_radius(0.12 * float(np.max(hi - lo)))  # a brush on some strands: brush-local moves
+    runs = []
+    run = ChildClumps.run
+    monkeypatch.setattr(ChildClumps, "run", lambda self, *a, **k: runs.append(1) or run(self, *a, **k))
+    start = _drag_start(w)
+    left = Qt.MouseButton.LeftButton
+    ui.send_mouse(v, "press", start, left, left, None)
+    for f in np.linspace(0.0, 1.0, 6)[1:]:
+        ui.send_mouse(v, "move", start + f * np.array([30.0, 10.0]), None, left, None)
+    assert s.pipeline.unsettled and not runs  # local moves, drawn unclumped at the drag density
+    ui.send_mouse(v, "release", start + np.array([30.0, 10.0]), left, None, None)
+    assert w.undo_stack.count() == 1 and not s.dragging and not s.pipeline.unsettled
+    assert len(runs) == 1
+    np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], s.render_hair().points)

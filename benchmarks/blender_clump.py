@@ -1,0 +1,194 @@
+"""hairtool's ClumpWithGaps against Blender 5's Clump Hair Curves node, in the same run.
+
+Run it with hairtool's Python and point it at a Python that imports ``bpy`` (the Blender module,
+``pip install bpy==5.0.1`` in a venv of its own)::
+
+    .venv/bin/python benchmarks/blender_clump.py --bpy /work/bpyvenv/bin/python \
+        [--sizes 500x20 5000x20 50000x20 tests/data/grooms/bear.tfx] [--repeat 7] [--out clump.json]
+
+Not part of the package or of CI. Each groom (scalp samples ``STRANDSxVERTICES`` or a groom
+file) goes to Blender as a hair Curves object with the Essentials asset *Clump Hair Curves*
+(``procedural_hair_node_assets.blend``) as a Geometry Nodes modifier: guides picked at least the
+clump radius h apart (no existing guide map), every other curve pulled toward its nearest guide,
+factor 1, shape 0.5. Its time is one evaluation of the object (``Depsgraph.update`` after a
+change of the node's seed, so nothing is reused), minus nothing: ``passthrough_ms`` is the same
+evaluation with an empty node group, Blender's fixed cost of evaluating the object at all.
+
+hairtool's side is ``hairtool.frozen.clump.clump`` at the same h (2× the median root spacing, as
+``hairtool bench freeze`` uses), k = 3 iterations, gaps as printed: ``cold_ms`` with its
+neighbour list built each time (what an evaluation that reuses nothing costs, as Blender's
+does), ``kept_ms`` with the list of the last run (the studio's repeated runs on the same
+points). Both tools use every core. ClumpWithGaps does more than Blender's node (three
+iterations of an adhesion force over every pair within h, a gap correction, lengths kept),
+so the comparison is of what an artist waits for, not of equal work.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+WORKER_FLAG = "--blender-worker"
+ASSET = "assets/nodes/procedural_hair_node_assets.blend"
+NODE_GROUP = "Clump Hair Curves"
+
+
+# ---------------------------------------------------------------------------------------
+# The Blender side (runs in the bpy Python; numpy and bpy only)
+# ---------------------------------------------------------------------------------------
+def _asset_path() -> str:
+    import bpy
+
+    base = os.path.dirname(bpy.__file__)  # bpy/<version>/scripts/modules/bpy
+    version = os.path.normpath(os.path.join(base, "..", "..", ".."))
+    return os.path.join(version, "datafiles", ASSET)
+
+
+def _blender_times(points: np.ndarray, sizes: np.ndarray, h: float, repeat: int) -> dict:
+    import bpy
+
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    with bpy.data.libraries.load(_asset_path()) as (src, dst):
+        dst.node_groups = [n for n in src.node_groups if n == NODE_GROUP]
+    clump = bpy.data.node_groups[NODE_GROUP]
+    empty = bpy.data.node_groups.new("passthrough", "GeometryNodeTree")
+    empty.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    empty.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    gin, gout = empty.nodes.new("NodeGroupInput"), empty.nodes.new("NodeGroupOutput")
+    empty.links.new(gin.outputs[0], gout.inputs[0])
+
+    curves = bpy.data.hair_curves.new("groom")
+    curves.add_curves(sizes.tolist())
+    curves.position_data.foreach_set("vector", points.astype(np.float32).ravel())
+    obj = bpy.data.objects.new("groom", curves)
+    bpy.context.scene.collection.objects.link(obj)
+    mod = obj.modifiers.new("clump", "NODES")
+    sockets = {i.name: i.identifier for i in clump.interface.items_tree if i.item_type == "SOCKET"}
+
+    def evaluate(seed: int) -> float:
+        if mod.node_group is clump:
+            mod[sockets["Seed"]] = seed
+        obj.update_tag()
+        t0 = time.perf_counter()
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        depsgraph.update()
+        evaluated = obj.evaluated_get(depsgraph)
+        n = len(evaluated.data.points)
+        took = time.perf_counter() - t0
+        if n != len(points):
+            raise RuntimeError(f"Blender's evaluated groom has {n} points, not {len(points)}")
+        return took
+
+    out = {}
+    for name, group in (("passthrough", empty), ("clump", clump)):
+        mod.node_group = group
+        if group is clump:
+            mod[sockets["Guide Distance"]] = float(h)
+            mod[sockets["Existing Guide Map"]] = False
+            mod[sockets["Factor"]] = 1.0
+        evaluate(0)  # the first evaluation builds what later ones keep (the node tree's code)
+        out[f"{name}_ms"] = 1e3 * float(np.median([evaluate(1 + i) for i in range(repeat)]))
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    moved = np.empty(len(points) * 3, np.float32)
+    obj.evaluated_get(depsgraph).data.position_data.foreach_get("vector", moved)
+    out["moved_share"] = float(np.mean(np.any(moved.reshape(-1, 3) != points.astype(np.float32), axis=1)))
+    return out
+
+
+def _worker(argv: list[str]) -> None:
+    """``--blender-worker IN.npz OUT.json``: Blender's times for IN's groom."""
+    src, dst = argv
+    data = np.load(src)
+    out = _blender_times(data["points"], data["sizes"], float(data["h"]), int(data["repeat"]))
+    Path(dst).write_text(json.dumps(out))
+
+
+# ---------------------------------------------------------------------------------------
+# The hairtool side
+# ---------------------------------------------------------------------------------------
+def _grooms(sizes: list[str]):
+    from hairtool.io import read_groom
+    from hairtool.samples import scalp
+
+    for size in sizes:
+        if "x" in size and all(p.isdigit() for p in size.split("x")):
+            s, v = (int(p) for p in size.split("x"))
+            yield f"scalp {size}", scalp(s, v, seed=0)
+        else:
+            yield Path(size).stem, read_groom(size)
+
+
+def _hairtool_times(groom, h: float, repeat: int) -> dict:
+    from hairtool.bench import median_ms
+    from hairtool.frozen.clump import ClumpWorkspace, clump
+
+    ws = ClumpWorkspace()
+
+    def cold():
+        ws.invalidate()
+        clump(groom, h, 3, None, "printed", 0, ws)
+
+    return {
+        "cold_ms": median_ms(cold, repeat),
+        "kept_ms": median_ms(lambda: clump(groom, h, 3, None, "printed", 0, ws), repeat),
+    }
+
+
+def compare(size: str, groom, bpy_python: str, repeat: int) -> dict:
+    from hairtool.frozen.strand_clumps import auto_clump_radius
+
+    h = float(auto_clump_radius(groom))
+    row = {"groom": size, "strands": groom.strand_count, "vertices": groom.vertex_count, "h": h}
+    with tempfile.TemporaryDirectory(prefix="blender-clump-") as tmp:
+        src, dst = os.path.join(tmp, "in.npz"), os.path.join(tmp, "out.json")
+        sizes = np.diff(groom.offsets)
+        np.savez(src, points=groom.points, sizes=sizes, h=h, repeat=repeat)
+        done = subprocess.run(
+            [bpy_python, os.path.abspath(__file__), WORKER_FLAG, src, dst],
+            capture_output=True, text=True, check=False,
+        )  # fmt: skip
+        if done.returncode != 0:
+            raise SystemExit(f"Blender failed on {size}:\n{done.stderr[-3000:]}")
+        row.update({f"blender_{k}": v for k, v in json.loads(Path(dst).read_text()).items()})
+    row.update(_hairtool_times(groom, h, repeat))
+    row["speedup_cold"] = row["blender_clump_ms"] / row["cold_ms"]
+    row["speedup_kept"] = row["blender_clump_ms"] / row["kept_ms"]
+    return row
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == [WORKER_FLAG]:
+        _worker(argv[1:])
+        return 0
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--bpy", required=True, help="a Python that imports bpy 5.0")
+    parser.add_argument("--sizes", nargs="+", default=["500x20", "5000x20", "50000x20"])
+    parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--out", type=Path, default=None, help="also write the rows as JSON")
+    args = parser.parse_args(argv)
+    import numba
+
+    from hairtool.bench import format_table
+
+    rows = []
+    for size, groom in _grooms(args.sizes):
+        rows.append(compare(size, groom, args.bpy, args.repeat))
+        rows[-1]["threads"] = numba.get_num_threads()
+        print(json.dumps(rows[-1]), flush=True)
+    print(format_table(rows))
+    if args.out is not None:
+        args.out.write_text(json.dumps(rows, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
