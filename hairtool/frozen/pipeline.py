@@ -821,7 +821,8 @@ class FrozenPipeline:
                 ):
                     local.resync(g.points, self._grid_points)  # the grid follows what moved
                 else:
-                    self._local = LocalClump(g.points, g.topology, h, rec)
+                    longest = int(ws.neighbours.cnt.max(initial=0))
+                    self._local = LocalClump(g.points, g.topology, h, rec, longest)
                 self._grid_points = g.points
                 self._sv = vertex_strength(g, self._clump_strength)
                 self._kept = pts

@@ -88,13 +88,15 @@ def _move(points, vids, inv, shift, key, head, nxt, prv):
     return moved
 
 
-@njit(cache=True, nogil=True)
+@twin_njit(nogil=True, parallel=True)
 def _mark_near(points, strand, qx, qy, qz, r2, inv, shift, key, head, nxt, mark):
     """Flag in ``mark`` (per strand) every strand with a vertex closer than sqrt(r2) to a query
-    point (``qx``, ``qy``, ``qz``); a scan of every vertex where a query covers more cells than that."""
+    point (``qx``, ``qy``, ``qz``); a scan of every vertex where a query covers more cells than that.
+    The queries run in parallel: each only ever sets flags, so the flags come out the same
+    whichever thread sets one first (a flag another thread has not seen set yet is tested again)."""
     reach = np.sqrt(r2)
     v = points.shape[0]
-    for q in range(qx.size):
+    for q in prange(qx.size):
         px, py, pz = qx[q], qy[q], qz[q]
         x0, x1 = _coord(px - reach, inv), _coord(px + reach, inv)
         y0, y1 = _coord(py - reach, inv), _coord(py + reach, inv)
@@ -259,6 +261,11 @@ class VertexGrid:
     def vertex_count(self) -> int:
         return self.key.size
 
+    def reserve(self, longest: int) -> None:
+        """Room in :meth:`lists` for lists of ``longest`` neighbours (it grows by itself too)."""
+        if longest + 1 >= self.capacity:
+            self.capacity = (longest + 1 + 32) // 32 * 32
+
     def move(self, points: np.ndarray, vids: np.ndarray) -> int:
         """The vertices ``vids`` now at ``points[vids]``; returns how many changed cell."""
         ids = np.ascontiguousarray(vids, np.int64)
@@ -292,7 +299,7 @@ class VertexGrid:
             most = int(cnt.max(initial=0))
             if most < cap - 1:
                 return flat, cnt, cap
-            self.capacity = (most + 1 + 32) // 32 * 32
+            self.reserve(most)
 
 
 def strands_near_reference(
