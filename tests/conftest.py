@@ -15,13 +15,17 @@ GROOMS = TEST_DATA / "grooms"
 MOTION = TEST_DATA / "motion"
 
 _xvfb: subprocess.Popen | None = None
+_OWN_DISPLAY = "HAIRTOOL_TEST_XVFB"  # set where this conftest started the display
 
 
 def _start_xvfb() -> None:
     """Start ``Xvfb -displayfd`` and export DISPLAY, so plain ``pytest`` runs the GUI tests, on a
-    1366×768 screen: the laptop size the studio must fit."""
+    1366×768 screen: the laptop size the studio must fit. Each xdist worker gets a display of
+    its own: with no window manager, windows of two workers on one display took the keyboard
+    focus from each other (a test waiting for its window to be active timed out under load)."""
     global _xvfb
-    if os.environ.get("DISPLAY") or shutil.which("Xvfb") is None:
+    ours = os.environ.get(_OWN_DISPLAY) and os.environ.get("PYTEST_XDIST_WORKER")
+    if (os.environ.get("DISPLAY") and not ours) or shutil.which("Xvfb") is None:
         return
     read_fd, write_fd = os.pipe()
     _xvfb = subprocess.Popen(
@@ -36,6 +40,7 @@ def _start_xvfb() -> None:
     if not number:
         raise RuntimeError("Xvfb did not report a display number")
     os.environ["DISPLAY"] = f":{number}"
+    os.environ[_OWN_DISPLAY] = "1"
 
 
 def missing_system_packages() -> str | None:

@@ -131,8 +131,12 @@ def test_navigation_orbit_pan_zoom_frame(ui, make_window):
 
 def test_keys_resize_the_brush_and_frame_all(ui, make_window, qtbot):
     w = make_window()
-    w.windowHandle().requestActivate()  # no window manager under Xvfb: ask for focus directly
-    qtbot.waitUntil(w.isActiveWindow, timeout=3000)
+    def active() -> bool:  # no window manager under Xvfb: ask for the focus directly, again
+        if not w.isActiveWindow():  # while it has not come (a loaded host answers late)
+            w.windowHandle().requestActivate()
+        return w.isActiveWindow()
+
+    qtbot.waitUntil(active, timeout=15_000)
     w.viewport.setFocus()
     r = w.scene.radius
     qtbot.keyClick(w.viewport, Qt.Key.Key_BracketRight)
