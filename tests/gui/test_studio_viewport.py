@@ -131,6 +131,7 @@ def test_navigation_orbit_pan_zoom_frame(ui, make_window):
 
 def test_keys_resize_the_brush_and_frame_all(ui, make_window, qtbot):
     w = make_window()
+
     def active() -> bool:  # no window manager under Xvfb: ask for the focus directly, again
         if not w.isActiveWindow():  # while it has not come (a loaded host answers late)
             w.windowHandle().requestActivate()
