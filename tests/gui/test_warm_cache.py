@@ -49,3 +49,13 @@ def test_if_needed_does_nothing_when_cached(monkeypatch):
     monkeypatch.setattr(warm_cache, "lane_command", lambda lane: pytest.fail("a lane started"))
     out = io.StringIO()
     assert warm_cache.warm(if_needed=True, out=out) == 0 and out.getvalue() == ""
+
+
+def test_the_terminal_warm_up_caches_the_parallel_kernels_only():
+    """A start after ``./dev``'s warm-up finds every kernel cached and runs parallel: the serial
+    twins of a first start are not compiled for it."""
+    for lane in range(1, len(kernel_warmup.LANES) + 1):
+        assert "--no-quick" in warm_cache.lane_command(lane)
+        labels = kernel_warmup.lane_labels(lane, quick=False)
+        assert labels and not set(labels) & set(kernel_warmup.QUICK_STEPS)
+    assert set(kernel_warmup.PARALLEL_STEPS) <= set(kernel_warmup.lane_labels(None, quick=False))
