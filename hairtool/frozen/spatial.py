@@ -430,6 +430,9 @@ class NeighbourList:
                 break
             self._per_vertex = 1.5 * need + 2.0
         _vertex_offsets(chunks, start, base, self.acnt, self.aoff)
+        backward = int(self.acnt.sum())  # each forward entry (i finds j) is one of j's backward ones
+        if self.bflat.size < backward:  # room before the transpose, not after a first try
+            self.bflat = np.empty(int(backward * 1.25) + 16, np.int32)
         while True:
             total = _transpose(chunks, start, base, self.aflat, self.acnt, self.bstart, self.bflat)
             if self.bflat.size >= total:
