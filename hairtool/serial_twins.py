@@ -126,11 +126,6 @@ def _read_by_jitted_code() -> set[int]:
     return read
 
 
-def twins() -> list[Dispatcher]:
-    """Every :func:`twin_njit` kernel defined so far (the parallel dispatchers)."""
-    return [twin.parallel for twin in _TWINS.values()]
-
-
 def parallel_of(kernel: Dispatcher) -> Dispatcher:
     """The parallel kernel of a twin (``kernel`` itself, or the kernel of a serial twin)."""
     twin = _TWINS.get(id(kernel)) or _SERIAL.get(id(kernel))

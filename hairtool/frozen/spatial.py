@@ -431,13 +431,9 @@ class NeighbourList:
             self._per_vertex = 1.5 * need + 2.0
         _vertex_offsets(chunks, start, base, self.acnt, self.aoff)
         backward = int(self.acnt.sum())  # each forward entry (i finds j) is one of j's backward ones
-        if self.bflat.size < backward:  # room before the transpose, not after a first try
+        if self.bflat.size < backward:  # so the transpose always has its room, in one pass
             self.bflat = np.empty(int(backward * 1.25) + 16, np.int32)
-        while True:
-            total = _transpose(chunks, start, base, self.aflat, self.acnt, self.bstart, self.bflat)
-            if self.bflat.size >= total:
-                break
-            self.bflat = np.empty(int(total * 1.25) + 16, np.int32)
+        _transpose(chunks, start, base, self.aflat, self.acnt, self.bstart, self.bflat)
 
     def _build_hashed(self, points, strand, skip, lo, radius) -> None:
         # Sparse hair in a large box: hash the 3-D cells into ~2V buckets.
