@@ -11,8 +11,9 @@ file) goes to Blender as a hair Curves object with the Essentials asset *Clump H
 (``procedural_hair_node_assets.blend``) as a Geometry Nodes modifier: guides picked at least the
 clump radius h apart (no existing guide map), every other curve pulled toward its nearest guide,
 factor 1, shape 0.5. Its time is one evaluation of the object (``Depsgraph.update`` after a
-change of the node's seed, so nothing is reused), minus nothing: ``passthrough_ms`` is the same
-evaluation with an empty node group, Blender's fixed cost of evaluating the object at all.
+change of the node's seed, so nothing is reused); ``passthrough_ms`` is the same evaluation with
+an empty node group (Blender shares the unchanged geometry, so it is next to nothing: the clump
+time is the node's own).
 
 hairtool's side is ``hairtool.frozen.clump.clump`` at the same h (2× the median root spacing, as
 ``hairtool bench freeze`` uses), k = 3 iterations, gaps as printed: ``cold_ms`` with its
@@ -114,18 +115,6 @@ def _worker(argv: list[str]) -> None:
 # ---------------------------------------------------------------------------------------
 # The hairtool side
 # ---------------------------------------------------------------------------------------
-def _grooms(sizes: list[str]):
-    from hairtool.io import read_groom
-    from hairtool.samples import scalp
-
-    for size in sizes:
-        if "x" in size and all(p.isdigit() for p in size.split("x")):
-            s, v = (int(p) for p in size.split("x"))
-            yield f"scalp {size}", scalp(s, v, seed=0)
-        else:
-            yield Path(size).stem, read_groom(size)
-
-
 def _hairtool_times(groom, h: float, repeat: int) -> dict:
     from hairtool.bench import median_ms
     from hairtool.frozen.clump import ClumpWorkspace, clump
@@ -171,7 +160,10 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--bpy", required=True, help="a Python that imports bpy 5.0")
-    parser.add_argument("--sizes", nargs="+", default=["500x20", "5000x20", "50000x20"])
+    parser.add_argument(
+        "--sizes", nargs="+", default=["500x20", "5000x20", "50000x20"],
+        help="STRANDSxVERTICES (scalp samples), 'real' (the checkout's real grooms) or groom files",
+    )  # fmt: skip
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--out", type=Path, default=None, help="also write the rows as JSON")
     args = parser.parse_args(argv)
@@ -180,6 +172,8 @@ def main(argv: list[str] | None = None) -> int:
     from hairtool.bench import format_table
 
     rows = []
+    from hairtool.bench.freeze import _grooms  # the sizes `hairtool bench freeze --sizes` takes
+
     for size, groom in _grooms(args.sizes):
         rows.append(compare(size, groom, args.bpy, args.repeat))
         rows[-1]["threads"] = numba.get_num_threads()
