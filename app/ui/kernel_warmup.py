@@ -493,5 +493,22 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
+def entry(argv: list[str] | None = None) -> None:
+    """``python -m app.ui.kernel_warmup``: :func:`main`, then the exit. Started by the studio
+    (``--with-parent``), the process leaves by ``os._exit`` once its output is flushed: the thread
+    that waits on standard input holds that stream's lock, and Python's own shutdown aborted on it
+    ("could not acquire lock for <stdin>", exit 134) at the end of every lane that went well."""
+    argv = sys.argv[1:] if argv is None else argv
+    code = main(argv)
+    if "--with-parent" in argv:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):  # nobody reads it any more
+                pass
+        os._exit(code)
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    entry()

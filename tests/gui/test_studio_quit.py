@@ -65,6 +65,33 @@ def test_the_warm_up_ends_quietly_when_its_studio_is_gone(tmp_path):
     assert code == 0 and "Traceback" not in err and "Error" not in err, err
 
 
+ONE_STEP_LANE = r"""
+from app.ui import kernel_warmup as kw
+kw.STEPS = (("one step", lambda: None),)
+kw.LANES = (("one step",),)
+kw.entry(["--lane", "1", "--with-parent"])
+"""
+
+
+def test_a_lane_the_studio_started_ends_cleanly_when_its_steps_are_done(tmp_path):
+    """Its studio still there (standard input open): the lane reports its step, records it and
+    exits 0, with nothing on standard error (it used to abort at shutdown, exit 134)."""
+    lane = subprocess.Popen(
+        [sys.executable, "-c", ONE_STEP_LANE],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=_cold_env(tmp_path),
+    )
+    try:
+        code = lane.wait(timeout=120)  # stdin stays open: the studio is still running
+    finally:
+        lane.stdin.close()
+    out, err = lane.stdout.read().decode(), lane.stderr.read().decode(errors="replace")
+    assert code == 0 and err == "", err
+    assert out.splitlines() == ["step 1 1 one step"]
+
+
 QUIT_SOON = r"""
 import sys
 from PySide6.QtCore import QTimer
