@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import QObject, Signal
+from PySide6.QtCore import QObject, QTimer, Signal
 
 from app.render.ramps import DEFAULT_RAMP
 from app.ui.brush_tool import LABELS, SIGNED, BrushTool, check_falloff
@@ -101,6 +101,10 @@ class Scene(QObject):
         #: None: brushes that add or remove strands are refused while one names something.
         self.strand_holders: list = []
         self.mesh_changed.connect(self._on_mesh_changed)
+        # what a first stroke needs, prepared at the next idle turn after an engine is built
+        self._prepare_timer = QTimer(self)
+        self._prepare_timer.setSingleShot(True)
+        self._prepare_timer.timeout.connect(self.prepare_strokes)
         self._set_groom(groom)
 
     # -- strands -----------------------------------------------------------------------
@@ -108,6 +112,7 @@ class Scene(QObject):
         if self.engine_ready:
             self.pipeline: FrozenPipeline | None = FrozenPipeline(groom, self._params, self._surface())
             self.result: Groom = self.pipeline.result
+            self._prepare_timer.start(0)
         else:
             self._params.validate()
             self.pipeline, self.result = None, groom
@@ -170,12 +175,19 @@ class Scene(QObject):
         t0 = time.perf_counter()
         self.pipeline = FrozenPipeline(self.rest, self._params, self._surface())
         self.result = self.pipeline.result
+        self._prepare_timer.start(0)
         self._children_moved()  # the render hair follows the frozen guides
         self.engine_ready = True
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
         self.params_changed.emit(self._params)
         self.points_changed.emit()
         self.engine_started.emit()
+
+    def prepare_strokes(self) -> None:
+        """The engine computes and allocates now what a first brush move would otherwise wait
+        for (:meth:`~hairtool.frozen.pipeline.FrozenPipeline.prepare_strokes`)."""
+        if self.pipeline is not None:
+            self.pipeline.prepare_strokes()
 
     @property
     def up_axis(self) -> str:
@@ -200,6 +212,7 @@ class Scene(QObject):
             snap = self.pipeline.snapshot()
             self.pipeline = FrozenPipeline(rest, self._params)
             self.result = self.pipeline.restore(snap)
+            self._prepare_timer.start(0)
         self._children_moved()
         self.up_axis_changed.emit()
         self.points_changed.emit()

@@ -88,6 +88,84 @@ def _move(points, vids, inv, shift, key, head, nxt, prv):
     return moved
 
 
+@njit(cache=True, nogil=True)
+def _cell_groups(qx, qy, qz, inv):
+    """The queries by grid cell: ``(order, starts)``, the queries of group g being
+    ``order[starts[g] : starts[g + 1]]``. Queries of one cell share the cells around it, so a
+    group walks those cells' linked lists once for all its queries."""
+    n = qx.size
+    keys = np.empty(n, np.int64)
+    for q in range(n):
+        keys[q] = _pack(_coord(qx[q], inv), _coord(qy[q], inv), _coord(qz[q], inv))
+    order = np.argsort(keys)
+    starts = np.empty(n + 1, np.int64)
+    g = 0
+    for k in range(n):
+        if k == 0 or keys[order[k]] != keys[order[k - 1]]:
+            starts[g] = k
+            g += 1
+    starts[g] = n
+    return order, starts[: g + 1]
+
+
+@njit(cache=True, nogil=True)
+def _gather_block(gx, gy, gz, shift, key, head, nxt, out):
+    """The vertices of the 3 × 3 × 3 cells around cell (gx, gy, gz) into ``out`` (as many as
+    fit); returns how many there are (more than ``out`` holds: call again with a larger one)."""
+    m = 0
+    for cz in range(max(gz - 1, -_OFF), min(gz + 1, _OFF - 1) + 1):
+        for cy in range(max(gy - 1, -_OFF), min(gy + 1, _OFF - 1) + 1):
+            for cx in range(max(gx - 1, -_OFF), min(gx + 1, _OFF - 1) + 1):
+                k = _pack(cx, cy, cz)
+                j = head[_bucket(k, shift)]
+                while j >= 0:
+                    if key[j] == k:
+                        if m < out.size:
+                            out[m] = j
+                        m += 1
+                    j = nxt[j]
+    return m
+
+
+@njit(cache=True, nogil=True)
+def _block_of(gx, gy, gz, shift, key, head, nxt, room):
+    """:func:`_gather_block` into a fresh array (``room`` entries to start with)."""
+    out = np.empty(room, np.int64)
+    m = _gather_block(gx, gy, gz, shift, key, head, nxt, out)
+    if m > out.size:
+        out = np.empty(m, np.int64)
+        _gather_block(gx, gy, gz, shift, key, head, nxt, out)
+    return out[:m]
+
+
+_BLOCK_ROOM = 512  # first guess at the vertices of a 3 × 3 × 3 block of cells
+
+
+@twin_njit(nogil=True, parallel=True)
+def _mark_near_grouped(points, strand, qx, qy, qz, r2, inv, shift, key, head, nxt, mark):
+    """:func:`_mark_near` for a reach of at most one cell: the queries grouped by cell, each
+    group testing the vertices of the 27 cells around its own (every vertex within the reach
+    of a query lies there), read from the grid once per group rather than once per query."""
+    order, starts = _cell_groups(qx, qy, qz, inv)
+    for g in prange(starts.size - 1):
+        q0 = order[starts[g]]
+        gx, gy, gz = _coord(qx[q0], inv), _coord(qy[q0], inv), _coord(qz[q0], inv)
+        block = _block_of(gx, gy, gz, shift, key, head, nxt, _BLOCK_ROOM)
+        for c in range(block.size):
+            j = block[c]
+            if mark[strand[j]]:
+                continue
+            x, y, z = np.float64(points[j, 0]), np.float64(points[j, 1]), np.float64(points[j, 2])
+            for k in range(starts[g], starts[g + 1]):
+                q = order[k]
+                ex = x - qx[q]
+                ey = y - qy[q]
+                ez = z - qz[q]
+                if ex * ex + ey * ey + ez * ez < r2:
+                    mark[strand[j]] = True
+                    break
+
+
 @twin_njit(nogil=True, parallel=True)
 def _mark_near(points, strand, qx, qy, qz, r2, inv, shift, key, head, nxt, mark):
     """Flag in ``mark`` (per strand) every strand with a vertex closer than sqrt(r2) to a query
@@ -111,18 +189,36 @@ def _mark_near(points, strand, qx, qy, qz, r2, inv, shift, key, head, nxt, mark)
                     mark[strand[j]] = True
             continue
         for cz in range(z0, z1 + 1):
-            for cy in range(y0, y1 + 1):
-                for cx in range(x0, x1 + 1):
-                    k = _pack(cx, cy, cz)
-                    j = head[_bucket(k, shift)]
-                    while j >= 0:
-                        if key[j] == k and not mark[strand[j]]:
-                            ex = np.float64(points[j, 0]) - px
-                            ey = np.float64(points[j, 1]) - py
-                            ez = np.float64(points[j, 2]) - pz
-                            if ex * ex + ey * ey + ez * ez < r2:
-                                mark[strand[j]] = True
-                        j = nxt[j]
+            _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz)
+
+
+@njit(cache=True, nogil=True)
+def _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz):
+    """The strands with a vertex closer than sqrt(r2) to p among the cells [x0, x1] × [y0, y1]
+    of the slab cz."""
+    for cy in range(y0, y1 + 1):
+        for cx in range(x0, x1 + 1):
+            k = _pack(cx, cy, cz)
+            j = head[_bucket(k, shift)]
+            while j >= 0:
+                if key[j] == k and not mark[strand[j]]:
+                    ex = np.float64(points[j, 0]) - px
+                    ey = np.float64(points[j, 1]) - py
+                    ez = np.float64(points[j, 2]) - pz
+                    if ex * ex + ey * ey + ez * ez < r2:
+                        mark[strand[j]] = True
+                j = nxt[j]
+
+
+@twin_njit(nogil=True, parallel=True)
+def _mark_near_wide(points, strand, px, py, pz, r2, inv, shift, key, head, nxt, mark):
+    """:func:`_mark_near` for one query over many cells (a brush): its slabs of cells in parallel."""
+    reach = np.sqrt(r2)
+    x0, x1 = _coord(px - reach, inv), _coord(px + reach, inv)
+    y0, y1 = _coord(py - reach, inv), _coord(py + reach, inv)
+    z0, z1 = _coord(pz - reach, inv), _coord(pz + reach, inv)
+    for cz in prange(z0, z1 + 1):
+        _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -166,53 +262,71 @@ def _region_lists(
     """The list of each vertex ``vids[n]``: the other strands' vertices closer than sqrt(r2)
     (float64 differences of the float32 points, summed x, y, z: the build's test), into
     ``flat[n·cap :]`` in the build's order; ``cnt[n]`` how many (cut at cap − 1 slots: call again
-    wider)."""
-    for n in prange(vids.size):
-        i = vids[n]
-        px, py, pz = np.float64(points[i, 0]), np.float64(points[i, 1]), np.float64(points[i, 2])
-        si = strand[i]
-        ox = np.int64(np.floor((px - lo[0]) * inv_cell))
-        oy = np.int64(np.floor((py - lo[1]) * inv_cell))
-        oz = np.int64(np.floor((pz - lo[2]) * inv_cell))
-        gx, gy, gz = _coord(points[i, 0], inv), _coord(points[i, 1], inv), _coord(points[i, 2], inv)
-        base = n * cap
-        m = 0
-        for cz in range(max(gz - 1, -_OFF), min(gz + 1, _OFF - 1) + 1):
-            for cy in range(max(gy - 1, -_OFF), min(gy + 1, _OFF - 1) + 1):
-                for cx in range(max(gx - 1, -_OFF), min(gx + 1, _OFF - 1) + 1):
-                    k = _pack(cx, cy, cz)
-                    j = head[_bucket(k, shift)]
-                    while j >= 0:
-                        if key[j] == k and strand[j] != si:
-                            x, y, z = (
-                                np.float64(points[j, 0]),
-                                np.float64(points[j, 1]),
-                                np.float64(points[j, 2]),
-                            )
-                            ex, ey, ez = x - px, y - py, z - pz
-                            if ex * ex + ey * ey + ez * ez < r2:
-                                if m < cap - 1:
-                                    flat[base + m] = _order_key(
-                                        x, y, z, j, dense, lo, inv_cell, ny, nz, inv_q, nq, ox, oy, oz
-                                    )
-                                m += 1
-                        j = nxt[j]
-        cnt[n] = m
-        if m >= cap - 1:
-            continue
-        row = flat[base : base + m]
-        row.sort()
-        split = 0  # the row grid's list: those after i in sorted order, then those before
-        if dense:
-            own = _order_key(px, py, pz, i, dense, lo, inv_cell, ny, nz, inv_q, nq, ox, oy, oz)
-            while split < m and row[split] < own:
-                split += 1
-        # rotate by split in place: reverse the two parts, then the whole
-        _reverse(flat, base, base + split)
-        _reverse(flat, base + split, base + m)
-        _reverse(flat, base, base + m)
-        for e in range(base, base + m):
-            flat[e] = flat[e] & _IDX_MASK
+    wider). The vertices go by grid cell: a cell's vertices test the block of 27 cells around
+    it, read from the grid once (coordinates, strands and, on the row grid, build-order keys)."""
+    nv = vids.size
+    qx, qy, qz = np.empty(nv), np.empty(nv), np.empty(nv)
+    for n in range(nv):
+        qx[n], qy[n], qz[n] = points[vids[n], 0], points[vids[n], 1], points[vids[n], 2]
+    order, starts = _cell_groups(qx, qy, qz, inv)
+    for g in prange(starts.size - 1):
+        n0 = order[starts[g]]
+        gx, gy, gz = _coord(qx[n0], inv), _coord(qy[n0], inv), _coord(qz[n0], inv)
+        block = _block_of(gx, gy, gz, shift, key, head, nxt, _BLOCK_ROOM)
+        nb = block.size
+        bxyz = np.empty((nb, 3))
+        bsk = np.empty((nb, 2), np.int64)  # strand, build-order key (row grid)
+        for c in range(nb):
+            j = block[c]
+            x, y, z = np.float64(points[j, 0]), np.float64(points[j, 1]), np.float64(points[j, 2])
+            bxyz[c, 0], bxyz[c, 1], bxyz[c, 2] = x, y, z
+            bsk[c, 0] = strand[j]
+            if dense:
+                bsk[c, 1] = _order_key(x, y, z, j, dense, lo, inv_cell, ny, nz, inv_q, nq, 0, 0, 0)
+        for e in range(starts[g], starts[g + 1]):
+            n = order[e]
+            i = vids[n]
+            px, py, pz = qx[n], qy[n], qz[n]
+            si = strand[i]
+            ox = np.int64(np.floor((px - lo[0]) * inv_cell))
+            oy = np.int64(np.floor((py - lo[1]) * inv_cell))
+            oz = np.int64(np.floor((pz - lo[2]) * inv_cell))
+            base = n * cap
+            m = 0
+            if dense:  # branch-free (a hit is unpredictable): write always, count hits
+                last = cap - 1  # the slot past a full list is scratch
+                for c in range(nb):
+                    ex, ey, ez = bxyz[c, 0] - px, bxyz[c, 1] - py, bxyz[c, 2] - pz
+                    hit = (ex * ex + ey * ey + ez * ez < r2) & (bsk[c, 0] != si)
+                    flat[base + min(m, last)] = bsk[c, 1]
+                    m += np.int64(hit)
+            for c in range(0 if not dense else nb, nb):
+                if bsk[c, 0] == si:
+                    continue
+                ex, ey, ez = bxyz[c, 0] - px, bxyz[c, 1] - py, bxyz[c, 2] - pz
+                if ex * ex + ey * ey + ez * ez < r2:
+                    if m < cap - 1:
+                        flat[base + m] = _order_key(
+                            bxyz[c, 0], bxyz[c, 1], bxyz[c, 2], block[c], dense, lo, inv_cell, ny, nz, inv_q,
+                            nq, ox, oy, oz,
+                        )  # fmt: skip
+                    m += 1
+            cnt[n] = m
+            if m >= cap - 1:
+                continue
+            row = flat[base : base + m]
+            row.sort()
+            split = 0  # the row grid's list: those after i in sorted order, then those before
+            if dense:
+                own = _order_key(px, py, pz, i, dense, lo, inv_cell, ny, nz, inv_q, nq, ox, oy, oz)
+                while split < m and row[split] < own:
+                    split += 1
+            # rotate by split in place: reverse the two parts, then the whole
+            _reverse(flat, base, base + split)
+            _reverse(flat, base + split, base + m)
+            _reverse(flat, base, base + m)
+            for e2 in range(base, base + m):
+                flat[e2] = flat[e2] & _IDX_MASK
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -255,6 +369,7 @@ class VertexGrid:
         self.prv = np.empty(v, np.int64)
         self.strand = np.ascontiguousarray(strand, np.int64)
         self.capacity = 64  # list slots per vertex (grows to the longest list + 1)
+        self._flat = np.empty(0, np.int64)  # the lists' buffer (:meth:`prepare`)
         _build(points, self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
 
     @property
@@ -266,6 +381,16 @@ class VertexGrid:
         if longest + 1 >= self.capacity:
             self.capacity = (longest + 1 + 32) // 32 * 32
 
+    def prepare(self, vertices: int) -> None:
+        """Room in :meth:`lists` for the lists of this many vertices, its memory touched now: a
+        buffer kept from move to move (a fresh one per move cost a move its page faults, ~13 ms
+        for the bear's first region of 6,000 vertices). The lists :meth:`lists` returns live in it
+        until the next call."""
+        need = vertices * self.capacity
+        if self._flat.size < need:
+            self._flat = np.empty(max(need, int(1.5 * self._flat.size)), np.int64)
+            self._flat.fill(0)
+
     def move(self, points: np.ndarray, vids: np.ndarray) -> int:
         """The vertices ``vids`` now at ``points[vids]``; returns how many changed cell."""
         ids = np.ascontiguousarray(vids, np.int64)
@@ -275,22 +400,27 @@ class VertexGrid:
         """Flag in ``mark`` ((S,) bool) the strands with a vertex of ``points`` (where the grid
         holds them) closer than ``radius`` to one of ``queries`` ((n, 3))."""
         q = np.asarray(queries, np.float64).reshape(-1, 3)
-        _mark_near(
-            points, self.strand, np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1]),
-            np.ascontiguousarray(q[:, 2]), float(radius) ** 2, self.inv, self.shift, self.key, self.head,
-            self.nxt, mark,
-        )  # fmt: skip
+        r2 = float(radius) ** 2
+        grid = (self.inv, self.shift, self.key, self.head, self.nxt, mark)
+        if len(q) == 1 and _cells_within(q[0], float(radius), self.cell) <= self.vertex_count:
+            _mark_near_wide(points, self.strand, float(q[0, 0]), float(q[0, 1]), float(q[0, 2]), r2, *grid)
+            return
+        xyz = np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1]), np.ascontiguousarray(q[:, 2])
+        near = _mark_near_grouped if float(radius) <= self.cell else _mark_near
+        near(points, self.strand, *xyz, r2, *grid)
 
     def lists(self, points: np.ndarray, vids: np.ndarray, radius: float, frame: tuple) -> tuple:
         """``(flat, cnt, cap)``: the list of each vertex ``vids[n]`` (other strands within
         ``radius``, original indices) at ``flat[n·cap :][: cnt[n]]``, in the order of a full build
-        whose grid is ``frame`` (:func:`list_frame`); ``radius`` must not exceed the cell."""
+        whose grid is ``frame`` (:func:`list_frame`); ``radius`` must not exceed the cell.
+        ``flat`` is the grid's buffer: read it before the next call."""
         dense, lo, inv_cell, ny, nz, inv_q, nq = frame
         ids = np.ascontiguousarray(vids, np.int64)
         r2 = float(radius) ** 2
         while True:
             cap = self.capacity
-            flat = np.empty(ids.size * cap, np.int64)
+            self.prepare(ids.size)
+            flat = self._flat[: ids.size * cap]
             cnt = np.empty(ids.size, np.int64)
             _region_lists(
                 points, self.strand, ids, r2, self.inv, self.shift, self.key, self.head, self.nxt, dense, lo,
@@ -300,6 +430,13 @@ class VertexGrid:
             if most < cap - 1:
                 return flat, cnt, cap
             self.reserve(most)
+
+
+def _cells_within(q: np.ndarray, radius: float, cell: float) -> int:
+    """How many grid cells the box of half-side ``radius`` around ``q`` spans (as _mark_near counts)."""
+    lo = np.floor((q - radius) / cell)
+    hi = np.floor((q + radius) / cell)
+    return int(np.prod(np.clip(hi, -_OFF, _OFF - 1) - np.clip(lo, -_OFF, _OFF - 1) + 1))
 
 
 def strands_near_reference(

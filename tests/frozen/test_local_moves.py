@@ -91,6 +91,36 @@ def test_the_grid_gives_the_lists_of_a_full_build_in_its_order_before_and_after_
         assert grid.move(g.points, moved) > 0
 
 
+@pytest.mark.parametrize("spacing", [3.0, 50_000.0])
+def test_each_way_of_finding_the_strands_near_queries_matches_the_reference(spacing, monkeypatch):
+    """Many queries within a cell's reach go by cell (one walk of the 27 cells per cell of
+    queries), one brush over many cells by slabs in parallel, the rest query by query."""
+    from hairtool.frozen import vertex_grid
+
+    g = bundles(spacing, per_side=5)
+    top, r = g.topology, 1.1
+    grid = VertexGrid(g.points, top.strand_index, r)
+    rng = np.random.default_rng(3)
+    many = g.points[rng.choice(g.vertex_count, 80, replace=False)] + rng.normal(scale=0.4, size=(80, 3))
+    used = []
+    for name in ("_mark_near_grouped", "_mark_near_wide", "_mark_near"):
+        kernel = getattr(vertex_grid, name)
+        monkeypatch.setattr(vertex_grid, name, lambda *a, k=kernel, n=name: (used.append(n), k(*a)))
+    cases = [
+        (many, r, "_mark_near_grouped"),
+        (many, 0.4 * r, "_mark_near_grouped"),
+        (many, 2.5, "_mark_near"),
+    ]
+    cases += [(g.points[[5]], 4.0 * r, "_mark_near_wide"), (g.points[[5]], 1e6, "_mark_near")]
+    for queries, radius, path in cases:
+        used.clear()
+        mark = np.zeros(g.strand_count, bool)
+        grid.strands_near(g.points, queries, radius, mark)
+        assert used == [path]
+        want = strands_near_reference(g.points, top.strand_index, queries, radius, g.strand_count)
+        assert np.array_equal(mark, want) and 0 < want.sum()
+
+
 def test_a_brush_wider_than_the_grid_scans_every_vertex():
     g = bundles(3.0, per_side=4)
     grid = VertexGrid(g.points, g.topology.strand_index, 0.05)  # tiny cells: the scan
@@ -232,3 +262,22 @@ def test_the_region_lists_have_room_for_the_full_runs_longest_list_from_the_firs
     held = pipe._grid_points  # the points the grid and the full run's list were made of
     _, cnt, _ = grid.lists(held, ids, pipe._local.radius, list_frame(held, pipe._local.radius))
     assert int(cnt.max()) == longest and grid.capacity == before
+
+
+def test_strokes_prepared_ahead_give_the_same_bytes_and_the_first_move_uses_the_room():
+    """prepare_strokes (the studio's idle step after an open) computes the scalp's normals and
+    centre and makes the region lists' room, touched, before the first move needs them."""
+    g = bundles(3.0)
+    plain, prepared = (FrozenPipeline(g, FrozenParams(clump_radius=1.0, keep_lengths=True)) for _ in range(2))
+    prepared.prepare_strokes(region_share=0.5)
+    grid = prepared._local.grid
+    room = grid._flat
+    assert room.size >= 0.5 * g.vertex_count * grid.capacity
+    assert prepared._root_normals is not None and prepared._scalp_centre is not None
+    tip = g.tips[3].astype(np.float64)
+    for pipe in (plain, prepared):
+        for k in range(3):
+            pipe.brush(comb(tip + np.array([0.1 * k, 0.0, 0.0]), (1.0, 0.0, 0.0), 0.6))
+        assert pipe.clump_redone < 0.5
+    assert same_bytes(plain.result.points, prepared.result.points)
+    assert grid._flat is room  # the moves' lists fitted the room made ahead
