@@ -5,7 +5,10 @@ sample grooms and a 5,000 strands × 20 vertices scalp. A real window with a rea
 receives a left-drag of QMouseEvents; per move we time the event (the frozen-hair pipeline runs
 in the handler) plus a synchronous paintGL with glFinish after upload and after draw, so the
 draw time is the GPU's (llvmpipe's) real time; Qt's compositing of the widget onto the screen
-is not included. Numbers are medians over the moves.
+is not included. Numbers are medians over the moves; ``p90_total_ms`` the 90th percentile,
+``first_move_ms`` the first move after the press (with ``--json``, ``move_ms`` lists every move).
+The stroke starts once the studio has loaded its cached kernels (:mod:`app.ui.kernel_preload`,
+what it does in the idle second after an open, before an artist's first stroke).
 Target: total under 33 ms (30 frames/s) for the 5,000-strand groom.
 The guides case (``--only guides``): 1,000 guides × 32 vertices with 100,000 interpolated children
 shaded as hair, drawn at 10 % while dragging (target: median under 33 ms), and the full-density
@@ -49,6 +52,7 @@ import numpy as np
 HELP = "time from mouse move to finished frame in the studio (pipeline / upload / draw)"
 TARGET_MS = 33.0
 RELEASE_TARGET_MS = 250.0  # the guides case: the full-density frame after the release
+PRELOAD_WAIT_S = 10.0  # at most, for the studio to load its cached kernels before the stroke
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -203,6 +207,11 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     window.show()
     for _ in range(20):
         app.processEvents()
+    # the cached kernels load while the studio idles after an open (app.ui.kernel_preload): an
+    # artist's first stroke comes later than that, so the timed one does too
+    deadline = time.perf_counter() + PRELOAD_WAIT_S
+    while not window.kernel_preload.done and time.perf_counter() < deadline:
+        app.processEvents()
     v = window.viewport
     if args.fast_lines and v.renderer is not None:
         v.renderer.fast_lines = True
@@ -254,6 +263,8 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
         "upload_ms": statistics.median(upload),
         "draw_ms": statistics.median(draw),
         "p90_total_ms": float(np.percentile(totals, 90)),
+        "first_move_ms": totals[0],  # the stroke's first move (an open's first stroke: what is not ready yet)
+        "move_ms": [round(t, 2) for t in totals],  # each move in order
         "cpu_ms": statistics.median(cpu),
     }
     for stage in ("freeze", "align", "clump"):
@@ -398,7 +409,10 @@ def main(argv: list[str] | None = None) -> int:
         print("app.bench: --moves >= 2, --strands >= 1 and --vertices in [2, 1024] please", file=sys.stderr)
         return 2
     rows = cold_start(args.timeout) if args.cold_start else run(args)
-    print(json.dumps(rows, indent=2) if args.json else format_table(rows))
+    if args.json:
+        print(json.dumps(rows, indent=2))
+    else:  # (each move's time, a list, in the JSON only)
+        print(format_table([{k: v for k, v in r.items() if not isinstance(v, list)} for r in rows]))
     return 0
 
 

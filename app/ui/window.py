@@ -39,6 +39,7 @@ from app.ui.commands import MeshCommand, ParamCommand, RenderHairCommand, Stroke
 from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import Job, JobRunner, JobStatus
+from app.ui.kernel_preload import KernelPreload
 from app.ui.kernel_warmup import RASTER_STEP, RENDER_HAIR_STEP
 from app.ui.legend import RampLegend, readable_length
 from app.ui.qt_utils import add_action, set_available
@@ -104,6 +105,8 @@ class MainWindow(QMainWindow):
         self.grow_options = GrowOptions()  # the Grow render hair… dialog's last choices
         self.viewport = Viewport(self.scene, self)
         self.setCentralWidget(self.viewport)
+        # the cached kernels loaded while the studio idles (started once the engine runs on them)
+        self.kernel_preload = KernelPreload(self.viewport.is_dragging, self)
         self.dock = ToolDock(self.scene, self)
         self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
         self._build_status_bar()
@@ -204,6 +207,7 @@ class MainWindow(QMainWindow):
             self.engine_start.step_ready.connect(self._on_warmup_step)
             self.engine_start.ended.connect(self._bind_pending_render_hair)
             self.engine_start.ended.connect(self._on_warmup_ended)
+            self.engine_start.ended.connect(self.kernel_preload.start)
             self.viewport.wait_for_raster = True
             self.engine_start.start()
 
@@ -242,6 +246,8 @@ class MainWindow(QMainWindow):
         if not self._shown_once:  # docks can only be sized once they are laid out
             self._shown_once = True
             self.timeline.fit_height()
+            if self.scene.engine_ready:  # (a first start loads them after its warm-up)
+                self.kernel_preload.start()
 
     def save_layout(self) -> None:
         self.settings.setValue("geometry", self.saveGeometry())
