@@ -172,10 +172,12 @@ class LocalClump:
         if seed_v.size > MAX_SEEDS * v:
             self.grid.move(new, seed_v)
             return None
-        before = self.near(old, old[seed_v], self.radius)  # the strands whose lists held them
         self.grid.move(new, seed_v)
-        after = self.near(new, new[seed_v], self.radius)  # and those whose lists hold them now
-        region = np.union1d(np.union1d(before, after), seeds)
+        # The strands whose lists held the seeds' vertices and those whose lists hold them now, in
+        # one query on the grid as it is now: a vertex within reach of a seed's old place that
+        # moved is a seed's own (in the region anyway); the others are where they were.
+        both = np.concatenate([old[seed_v], new[seed_v]])
+        region = np.union1d(self.near(new, both, self.radius), seeds)
         vids = vertex_ids_of(top, region)
         if vids.size > MAX_REGION * v:
             return None

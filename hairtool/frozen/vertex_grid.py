@@ -314,8 +314,8 @@ def _region_lists(
             cnt[n] = m
             if m >= cap - 1:
                 continue
+            _sort_short(flat, base, base + m)
             row = flat[base : base + m]
-            row.sort()
             split = 0  # the row grid's list: those after i in sorted order, then those before
             if dense:
                 own = _order_key(px, py, pz, i, dense, lo, inv_cell, ny, nz, inv_q, nq, ox, oy, oz)
@@ -327,6 +327,22 @@ def _region_lists(
             _reverse(flat, base, base + m)
             for e2 in range(base, base + m):
                 flat[e2] = flat[e2] & _IDX_MASK
+
+
+@njit(cache=True, nogil=True)
+def _sort_short(a, b, e):
+    """``a[b:e]`` sorted in place: by insertion where short (a vertex's hits come nearly in
+    order, the 27 cells walked row by row as the list build orders them), else numpy's sort."""
+    if e - b > 64:
+        a[b:e].sort()
+        return
+    for k in range(b + 1, e):
+        x = a[k]
+        m = k
+        while m > b and a[m - 1] > x:
+            a[m] = a[m - 1]
+            m -= 1
+        a[m] = x
 
 
 @njit(cache=True, nogil=True, inline="always")
