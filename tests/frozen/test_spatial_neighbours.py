@@ -162,3 +162,25 @@ def test_real_grooms_give_many_clumps_of_sensible_size(grooms_dir, name):
     # What the old membership gave: one component holding (nearly) everything.
     components = np.bincount(strand_components(pipe.result, pipe.clump_radius))
     assert components.max() >= 0.5 * g.strand_count
+
+
+@pytest.mark.parametrize("name", ["bear", "sintel_hair", "ponytail_back"])
+def test_the_backward_lists_are_the_numpy_twins_and_the_serial_passes(grooms_dir, name):
+    """The parallel transpose (each chunk counting into a window of its own) gives every vertex
+    the vertices that found it in increasing order, as the numpy twin and the one-pass kernel do."""
+    from hairtool.frozen import spatial
+
+    g = read_groom(grooms_dir / f"{name}.tfx")
+    nl = neighbour_list(g.points, g.topology.strand_index, 1.1 * auto_clump_radius(g))
+    v = len(nl.order)
+    finder = np.repeat(np.arange(v), nl.acnt)  # forward entries: i (sorted position) found j
+    first = np.repeat(nl.aoff - np.cumsum(np.r_[0, nl.acnt[:-1]]), nl.acnt)
+    found = nl.aflat[first + np.arange(finder.size)].astype(np.int64)
+    assert np.all(found > finder) and finder.size > v
+    bstart, bflat = spatial.transpose_reference(finder, found, v)
+    assert np.array_equal(nl.bstart, bstart) and np.array_equal(nl.bflat[: bstart[-1]], bflat)
+    chunks = spatial._chunk_rows(nl.start, v)
+    base = nl.aoff[nl.start[chunks[:-1]]]  # each chunk's first entry (its vertices' runs follow)
+    serial_start, serial_flat = np.empty(v + 1, np.int64), np.empty(bflat.size, np.int32)
+    spatial._transpose_serial(chunks, nl.start, base, nl.aflat, nl.acnt, serial_start, serial_flat)
+    assert np.array_equal(serial_start, bstart) and np.array_equal(serial_flat, bflat)
