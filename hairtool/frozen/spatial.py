@@ -250,7 +250,7 @@ def _forward_kernel(
 
 
 @njit(cache=True, nogil=True)
-def _transpose_serial(chunks, start, base, fflat, fcnt, bstart, bflat):
+def _transpose_serial(chunks, start, base, fflat, fcnt, bstart, bflat, bmap):
     """The backward lists in one pass on one thread (:func:`_transpose`'s twin and oracle)."""
     v = fcnt.size
     bstart[:] = 0
@@ -269,6 +269,7 @@ def _transpose_serial(chunks, start, base, fflat, fcnt, bstart, bflat):
             for n in range(p, p + fcnt[i]):
                 j = fflat[n]
                 bflat[fill[j]] = i
+                bmap[fill[j]] = n
                 fill[j] += 1
             p += fcnt[i]
 
@@ -332,22 +333,26 @@ def _backward_starts(vlo, count, chunk_start, bstart):
 
 
 @twin_njit(nogil=True, parallel=True)
-def _window_fill(chunks, start, base, fflat, fcnt, lo, woff, wcnt, bstart, bflat):
+def _window_fill(chunks, start, base, fflat, fcnt, lo, woff, wcnt, bstart, bflat, bmap):
     for c in prange(chunks.size - 1):
         w = woff[c] - lo[c]
         p = base[c]
         for i in range(start[chunks[c]], start[chunks[c + 1]]):
             for n in range(p, p + fcnt[i]):
                 k = w + fflat[n]
-                bflat[bstart[fflat[n]] + wcnt[k]] = i
+                e = bstart[fflat[n]] + wcnt[k]
+                bflat[e] = i
+                bmap[e] = n
                 wcnt[k] += 1
             p += fcnt[i]
 
 
 @twin_njit(nogil=True)
-def _transpose(chunks, start, ny, base, fflat, fcnt, bstart, bflat):
+def _transpose(chunks, start, ny, base, fflat, fcnt, bstart, bflat, bmap):
     """The backward lists: every i that found j (i < j), in increasing i (deterministic), as CSR
-    ``bstart`` (V+1,) into ``bflat`` (which holds them all). In parallel over the chunks: chunk
+    ``bstart`` (V+1,) into ``bflat`` (which holds them all), and ``bmap``: for each backward
+    entry, where the same pair is among i's forward entries (a pair's distance and weight are
+    computed once there, :mod:`hairtool.frozen.clump`). In parallel over the chunks: chunk
     c's entries point into a window of vertices from its own first one to the end of the rows
     after its last (the forward search reaches ``ny + 1`` rows on), so each chunk counts into a
     window of its own, the windows' counts become each chunk's offsets per vertex, and each chunk
@@ -373,16 +378,18 @@ def _transpose(chunks, start, ny, base, fflat, fcnt, bstart, bflat):
     for c in range(1, n):
         chunk_start[c] = chunk_start[c - 1] + total[c - 1]
     _backward_starts(vlo, count, chunk_start, bstart)
-    _window_fill(chunks, start, base, fflat, fcnt, lo, woff, wcnt, bstart, bflat)
+    _window_fill(chunks, start, base, fflat, fcnt, lo, woff, wcnt, bstart, bflat, bmap)
 
 
-def transpose_reference(order_i: np.ndarray, order_j: np.ndarray, v: int) -> tuple[np.ndarray, np.ndarray]:
-    """numpy twin of :func:`_transpose`: forward pairs (i finds j) → (bstart, bflat), each j's
-    finders in increasing i."""
+def transpose_reference(
+    order_i: np.ndarray, order_j: np.ndarray, entry: np.ndarray, v: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """numpy twin of :func:`_transpose`: forward pairs (i finds j, at ``entry`` among the
+    forward entries) → (bstart, bflat, bmap), each j's finders in increasing i."""
     by_j = np.lexsort((order_i, order_j))
     bstart = np.zeros(v + 1, np.int64)
     np.cumsum(np.bincount(order_j, minlength=v), out=bstart[1:])
-    return bstart, order_i[by_j]
+    return bstart, order_i[by_j], entry[by_j]
 
 
 def _chunk_rows(start: np.ndarray, vertex_count: int) -> np.ndarray:
@@ -399,7 +406,9 @@ class NeighbourList:
 
     ``order[k]``: the original vertex at sorted position k. Its neighbours (sorted positions)
     come in two runs: ``aflat[aoff[k] : aoff[k] + acnt[k]]`` (found from k: the forward half)
-    then ``bflat[bstart[k] : bstart[k + 1]]`` (those that found k), see :meth:`of`. ``x``, ``y``,
+    then ``bflat[bstart[k] : bstart[k + 1]]`` (those that found k), see :meth:`of`; on the row
+    grid (``dense``) ``bmap`` names each backward entry's pair among the forward entries (the
+    hashed grid's lists are whole in ``aflat``, ``bstart`` all zero). ``x``, ``y``,
     ``z``, ``strand``, ``skip``: the sorted coordinates (float64) and attributes. Vertices flagged
     in ``skip`` still have lists, and appear in others'; kernels skip them. Buffers are reused
     while the vertex count stays, so a build per mouse move allocates (almost) nothing.
@@ -410,6 +419,8 @@ class NeighbourList:
         self._per_vertex = 8.0  # forward entries per vertex to reserve room for (adapts)
         self.aflat = np.empty(0, np.int32)
         self.bflat = np.empty(0, np.int32)
+        self.bmap = np.empty(0, np.int64)  # backward entry → the same pair's forward entry (row grid)
+        self.forward_entries = 0  # of the row grid's last build
         self.capacity = 16  # padded row width of the hashed path; grows with the densest vertex
         self._nbr = np.empty((0, self.capacity), np.int32)
         self._start = np.empty(0, np.int64)
@@ -524,9 +535,13 @@ class NeighbourList:
             self._per_vertex = 1.5 * need + 2.0
         _vertex_offsets(chunks, start, base, self.acnt, self.aoff)
         backward = int(self.acnt.sum())  # each forward entry (i finds j) is one of j's backward ones
+        self.forward_entries = backward
         if self.bflat.size < backward:  # so the transpose always has its room, in one pass
             self.bflat = np.empty(int(backward * 1.25) + 16, np.int32)
-        _transpose(chunks, start, self.dims[1], base, self.aflat, self.acnt, self.bstart, self.bflat)
+            self.bmap = np.empty(self.bflat.size, np.int64)
+        _transpose(
+            chunks, start, self.dims[1], base, self.aflat, self.acnt, self.bstart, self.bflat, self.bmap
+        )
 
     def _build_hashed(self, points, strand, skip, lo, radius) -> None:
         # Sparse hair in a large box: hash the 3-D cells into ~2V buckets.

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import importlib
+
 import numba
 import numpy as np
 import pytest
@@ -158,3 +160,40 @@ def test_equally_near_partners_go_to_the_lower_vertex_index():
         a = clump(g, 0.4, 3, 0.05, gap_mode, seed=2)
         b = clump_reference(g, 0.4, 3, 0.05, gap_mode, seed=2)
         np.testing.assert_allclose(a.points, b.points, atol=1e-7)
+
+
+@pytest.mark.parametrize("name", ["sintel_hair", "ponytail_back"])
+@pytest.mark.parametrize("n_threads", [1, 2])
+def test_each_pair_computed_once_gives_the_bytes_of_each_pair_computed_twice(
+    grooms_dir, name, n_threads, monkeypatch
+):
+    """Dense lists take each pair's r and weight from one pass over the forward entries
+    (clump.HALF_FROM); that sums the same numbers in the same order as the kernel that computes
+    each pair from both ends, so the result is the same to the bit, ties to the lower index too."""
+    clump_module = importlib.import_module("hairtool.frozen.clump")  # (the package's name is the function)
+    g = read_groom(grooms_dir / f"{name}.tfx")
+    h = auto_clump_radius(g)
+    before = numba.get_num_threads()
+    numba.set_num_threads(min(n_threads, numba.config.NUMBA_NUM_THREADS))
+    try:
+        out = {}
+        for half, threshold in ((True, 0.0), (False, np.inf)):
+            monkeypatch.setattr(clump_module, "HALF_FROM", threshold)
+            ws = ClumpWorkspace()
+            pts = clump_module.clump_points(g, h, 3, None, "printed", 3, ws, keep_lengths=True)
+            assert (ws.pair_buffers(ws.neighbours)[1].size > 0) == half
+            out[half] = (pts, ws.step, ws.mean_neighbours)
+    finally:
+        numba.set_num_threads(before)
+    assert out[True][0].tobytes() == out[False][0].tobytes() and out[True][1:] == out[False][1:]
+    # and ties: strands through one point, every neighbour of a vertex equally near
+    pts = np.zeros((6, 3, 3))
+    pts[:, :, 1] = np.linspace(0.0, -1.0, 3)
+    pts[:, 1:, 0] = np.cos(np.arange(6) * np.pi / 3)[:, None] * 0.05
+    pts[:, 1:, 2] = np.sin(np.arange(6) * np.pi / 3)[:, None] * 0.05
+    tied = Groom(pts.reshape(-1, 3), np.full(6, 3))
+    runs = []
+    for threshold in (0.0, np.inf):
+        monkeypatch.setattr(clump_module, "HALF_FROM", threshold)
+        runs.append(clump_module.clump_points(tied, 0.3, 2, 0.01, "printed", 1).tobytes())
+    assert runs[0] == runs[1]

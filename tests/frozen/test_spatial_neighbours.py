@@ -175,12 +175,17 @@ def test_the_backward_lists_are_the_numpy_twins_and_the_serial_passes(grooms_dir
     v = len(nl.order)
     finder = np.repeat(np.arange(v), nl.acnt)  # forward entries: i (sorted position) found j
     first = np.repeat(nl.aoff - np.cumsum(np.r_[0, nl.acnt[:-1]]), nl.acnt)
-    found = nl.aflat[first + np.arange(finder.size)].astype(np.int64)
+    entry = first + np.arange(finder.size)
+    found = nl.aflat[entry].astype(np.int64)
     assert np.all(found > finder) and finder.size > v
-    bstart, bflat = spatial.transpose_reference(finder, found, v)
-    assert np.array_equal(nl.bstart, bstart) and np.array_equal(nl.bflat[: bstart[-1]], bflat)
+    bstart, bflat, bmap = spatial.transpose_reference(finder, found, entry, v)
+    n = bstart[-1]
+    assert np.array_equal(nl.bstart, bstart) and np.array_equal(nl.bflat[:n], bflat)
+    assert np.array_equal(nl.bmap[:n], bmap) and np.array_equal(
+        nl.aflat[bmap], np.repeat(np.arange(v), np.diff(bstart))
+    )
     chunks = spatial._chunk_rows(nl.start, v)
     base = nl.aoff[nl.start[chunks[:-1]]]  # each chunk's first entry (its vertices' runs follow)
-    serial_start, serial_flat = np.empty(v + 1, np.int64), np.empty(bflat.size, np.int32)
-    spatial._transpose_serial(chunks, nl.start, base, nl.aflat, nl.acnt, serial_start, serial_flat)
-    assert np.array_equal(serial_start, bstart) and np.array_equal(serial_flat, bflat)
+    serial = np.empty(v + 1, np.int64), np.empty(n, np.int32), np.empty(n, np.int64)
+    spatial._transpose_serial(chunks, nl.start, base, nl.aflat, nl.acnt, *serial)
+    assert all(np.array_equal(a, b) for a, b in zip(serial, (bstart, bflat, bmap), strict=True))
