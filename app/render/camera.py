@@ -201,6 +201,10 @@ class Camera:
             m = pyrr.matrix44.create_perspective_projection(self.fov_y, aspect, near, far, dtype=np.float64)
         return m.astype(np.float32)
 
+    def view_projection(self, width: float, height: float) -> NDArray[np.float64]:
+        """``(4, 4)`` float64: a row vector ``[x, y, z, 1]`` times it gives clip coordinates."""
+        return self._view_proj(width, height)
+
     def _view_proj(self, width: float, height: float) -> NDArray[np.float64]:
         w, h = _positive(width, "width"), _positive(height, "height")
         view = self.view_matrix().astype(np.float64)

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hairtool.errors import ParameterError
-from hairtool.frozen.brushes import BRUSHES, BrushSample, falloff_lut, mirrored_view
+from hairtool.frozen.brushes import BRUSHES, BrushSample, any_within, falloff_lut, mirrored_view
 from hairtool.frozen.pipeline import AlignSample
 
 #: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
@@ -222,6 +222,4 @@ class BrushTool:
         centres = [np.asarray(cursor, np.float64)]
         if self.symmetry:
             centres.append(np.array([2.0 * plane_x - centres[0][0], centres[0][1], centres[0][2]]))
-        p = np.asarray(points, np.float64)
-        return any(bool(np.any(np.einsum("ij,ij->i", p - c, p - c) <= r * r)) for c in centres)
-
+        return any(any_within(points, c, r) for c in centres)

@@ -51,7 +51,12 @@ KERNEL_PACKAGES = (
     "hairtool.anime",
     "hairtool.simulate",
 )
-KERNEL_MODULES = ("hairtool.bounds", "app.render.soft_raster", "app.render.hair_shading")
+KERNEL_MODULES = (
+    "hairtool.bounds",
+    "app.render.soft_raster",
+    "app.render.hair_shading",
+    "app.render.screen_pick",
+)
 
 
 def record_path(lane: int | None = None) -> Path:
@@ -173,6 +178,23 @@ def _engine_step() -> None:
         cursor = centre + np.array([0.05 * i * extent, 0.0, 0.0])
         pipe.apply_samples(tool.samples(cursor, (1.0, 0.0, 0.0), (0.0, 0.0, -1.0), plane))
         tool.touches(pipe.aligned.points, cursor, plane)
+    _press_step(pipe)
+
+
+def _press_step(pipe) -> None:
+    """What a press asks before a stroke: the vertex nearest the mouse on screen, front faces
+    only or not (the viewport's hair_under, without a viewport)."""
+    from app.render.camera import Camera
+    from app.render.screen_pick import nearest_on_screen
+    from hairtool.frozen.brushes import facing_away
+
+    result = pipe.result
+    view = Camera().view_projection(640, 480)
+    away = facing_away(pipe.strand_normals, (0.0, 0.0, -1.0))
+    for skip in (None, away):
+        nearest_on_screen(
+            result.points, view, (640, 480), (320.0, 240.0), 40.0, result.topology.strand_index, skip
+        )
 
 
 def _head_step() -> None:

@@ -43,6 +43,7 @@ from PySide6.QtOpenGLWidgets import QOpenGLWidget
 from app.render.camera import Camera
 from app.render.drawn import Drawn
 from app.render.offscreen import Overlays
+from app.render.screen_pick import nearest_on_screen
 from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.brush_sizing import CanvasSizing, pen_pressure
 from app.ui.drawn import drawn
@@ -589,16 +590,16 @@ class Viewport(QOpenGLWidget):
             if hit is not None:
                 return hit
         pts = s.result.points
-        xy = self.project(pts)
-        d2 = np.einsum("ij,ij->i", xy - (pos.x(), pos.y()), xy - (pos.x(), pos.y()))
         r_px = s.radius * self.camera.pixels_per_unit_at(s.centre, self.height())
-        near = d2 <= r_px * r_px
+        away = None
         if s.tool.front_only and s.pipeline is not None:
             away = facing_away(s.pipeline.strand_normals, self.view_at(pos))
-            near &= ~np.repeat(away, s.result.topology.counts)
-        if not near.any():
+        size = (self.width(), self.height())
+        vp = self.camera.view_projection(*size)
+        i = nearest_on_screen(pts, vp, size, (pos.x(), pos.y()), r_px, s.result.topology.strand_index, away)
+        if i < 0:
             return np.asarray(s.centre, np.float64)
-        return pts[int(np.argmin(np.where(near, d2, np.inf)))].astype(np.float64)
+        return pts[i].astype(np.float64)
 
     def _brush_at(self, pos: QPointF) -> None:
         cursor = self._cursor_at(pos, self._stroke_depth)

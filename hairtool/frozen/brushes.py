@@ -421,6 +421,31 @@ def facing_away_reference(normals: ArrayLike, view: ArrayLike) -> np.ndarray:
     return n[:, 0] * v[0] + n[:, 1] * v[1] + n[:, 2] * v[2] > 0.0
 
 
+@njit(cache=True, nogil=True)
+def _any_within_kernel(points, cx, cy, cz, r2):
+    for i in range(points.shape[0]):
+        ex = np.float64(points[i, 0]) - cx
+        ey = np.float64(points[i, 1]) - cy
+        ez = np.float64(points[i, 2]) - cz
+        if ex * ex + ey * ey + ez * ez <= r2:
+            return True
+    return False
+
+
+def any_within(points: np.ndarray, centre: ArrayLike, radius: float) -> bool:
+    """Whether a vertex of ``points`` ``(V, 3)`` lies within ``radius`` of ``centre`` (float64
+    differences): the press asks it of the whole groom, so it stops at the first one found and
+    makes no array the groom's size (the numpy twin made four: 5-7 ms on the bear)."""
+    c = np.asarray(centre, np.float64)
+    return bool(_any_within_kernel(points, float(c[0]), float(c[1]), float(c[2]), float(radius) ** 2))
+
+
+def any_within_reference(points: np.ndarray, centre: ArrayLike, radius: float) -> bool:
+    """Numpy twin of :func:`any_within`."""
+    d = np.asarray(points, np.float64) - np.asarray(centre, np.float64)
+    return bool(np.any(np.einsum("ij,ij->i", d, d) <= float(radius) ** 2))
+
+
 def apply_brush(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike) -> Groom:
     """One comb, smooth, length or puff sample (numba); ``locked``: ``(S,)`` masked strands."""
     check_sample(sample)

@@ -12,6 +12,8 @@ from hairtool import samples
 from hairtool.errors import ParameterError
 from hairtool.frozen.brushes import (
     BrushSample,
+    any_within,
+    any_within_reference,
     apply_brush,
     apply_brush_reference,
     falloff_lut,
@@ -213,3 +215,17 @@ def test_a_refused_sample_leaves_the_pipeline_as_it_was(groom):
     np.testing.assert_array_equal(pipe.locked, locked)
     pipe.update()
     np.testing.assert_array_equal(pipe.result.points, points)
+
+
+def test_whether_a_brush_reaches_the_groom_is_the_numpy_twins(groom):
+    pts = groom.points
+    rng = np.random.default_rng(5)
+    lo, hi = groom.bounds
+    answers = []
+    for _ in range(40):
+        c = rng.uniform(lo.astype(np.float64) - 0.3, hi.astype(np.float64) + 0.3)
+        r = float(rng.choice([1e-3, 0.02, 0.2]))
+        answers.append(any_within(pts, c, r))
+        assert answers[-1] == any_within_reference(pts, c, r)
+    assert any(answers) and not all(answers)
+    assert any_within(pts, pts[7].astype(np.float64) + np.array([0.5, 0.0, 0.0]), 0.5)  # on the circle
