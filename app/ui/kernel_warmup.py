@@ -311,19 +311,29 @@ def _render_hair_step() -> None:
 
 
 def _clumped_hair_step() -> None:
-    """Render hair bound to given roots, clumped (what Grow render hair… and clumped children reach)."""
+    """Render hair bound to given roots (what Grow render hair… reaches), and clumped as the
+    studio's Clump children clumps it (its engine's passes, gaps and length rule)."""
     from app.render.hair_shading import light_and_eye, shade
     from hairtool import samples
+    from hairtool.frozen.pipeline import FrozenParams
     from hairtool.guides.binding import bind_roots
     from hairtool.guides.children import moved_guides
-    from hairtool.guides.render import RenderHair
+    from hairtool.guides.render import ChildClump, RenderHair
 
     guides = samples.scalp(strands=12, vertices=8)
     roots = guides.points[guides.topology.offsets[:-1]].astype(np.float64)
     rng = np.random.default_rng(0)
     roots = roots[rng.integers(0, len(roots), 60)] + rng.normal(0.0, 1e-3, (60, 3))
-    children = RenderHair(bind_roots(guides, roots, k=3, seed=0)).update(guides)
+    binding = bind_roots(guides, roots, k=3, seed=0)
+    children = RenderHair(binding).update(guides)
     moved_guides(guides, np.array(guides.points))
+    p = FrozenParams(**STUDIO_PARAMS)
+    clump = ChildClump(iterations=p.clump_iterations, gap_mode=p.gap_mode, keep_lengths=p.keep_lengths)
+    clumped = RenderHair(binding, clump)
+    clumped.update_points(guides)
+    bent = guides.points.copy()
+    bent[guides.topology.tip_indices[::2]] += np.float32([0.0, 0.0, 1e-3])
+    clumped.update_points(guides.with_points(bent))  # a release after a stroke: the moved guides' clumps
     light, eye = light_and_eye(np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, 0, -1.0]))
     base = np.ones((len(children.points), 3), np.float32)
     shade(children.points, children.topology.offsets, base, light, eye)
@@ -351,6 +361,9 @@ RENDER_HAIR_STEP = "render hair"
 ENGINE_STEP = "hair engine"
 #: The step after which the viewport can draw with the CPU strand rasterizer (on software GL).
 RASTER_STEP = "strand drawing"
+#: The step after which Clump children clumps the render hair without compiling (on a first
+#: start the render hair shows unclumped until then, and until the studio runs parallel).
+CLUMPED_HAIR_STEP = "clumped render hair"
 #: Part of the align drag's kernels (the head's closest points), apart so the lanes share them.
 HEAD_STEP = "head surface"
 
@@ -403,7 +416,7 @@ _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
     (PARALLEL_RENDER_HAIR_STEP, _render_hair_step),
     ("brush modes and settings", _more_engine_step),
     ("engine defaults", _scalp_engine_step),
-    ("clumped render hair", _clumped_hair_step),
+    (CLUMPED_HAIR_STEP, _clumped_hair_step),
     ("grooming brushes", _brushes_step),
     ("animation and keys", _animation_step),
 )
@@ -415,7 +428,7 @@ _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
 #: serial, 25.6 parallel; head 2.9 / 4.4; render hair 5.8 / 11.6; strand drawing 10.7).
 LANES: tuple[tuple[str, ...], ...] = (
     (ENGINE_STEP, PARALLEL_ENGINE_STEP, "brush modes and settings", "engine defaults", "grooming brushes"),
-    (HEAD_STEP, RENDER_HAIR_STEP, RASTER_STEP, PARALLEL_RENDER_HAIR_STEP, "clumped render hair",
+    (HEAD_STEP, RENDER_HAIR_STEP, RASTER_STEP, PARALLEL_RENDER_HAIR_STEP, CLUMPED_HAIR_STEP,
      "animation and keys"),
 )  # fmt: skip
 

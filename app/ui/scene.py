@@ -78,6 +78,9 @@ class Scene(QObject):
         self._followed: tuple | None = None  # (key, binding): the children of the guides planted / removed
         self.show_guides = True
         self.clump_children = False  # ClumpWithGaps among the children once the mouse is released
+        # A first start clumps the children once the warm-up has cached their kernels (until
+        # then the render hair shows unclumped, rather than the window freezing to compile them)
+        self.children_clump_ready = engine_ready
         self.drag_percent = DRAG_PERCENT
         self.release_percent = RELEASE_PERCENT
         self.dragging = False
@@ -409,6 +412,16 @@ class Scene(QObject):
                 self._rebuild_drawn()
                 self.drawn_changed.emit()
 
+    def set_children_clump_ready(self) -> None:
+        """The children's clumping kernels are cached now (a first start's warm-up): Clump
+        children clumps the render hair from here on."""
+        if self.children_clump_ready:
+            return
+        self.children_clump_ready = True
+        if self.binding is not None and self.clump_children and not self.dragging:
+            self._rebuild_drawn()
+            self.drawn_changed.emit()
+
     def _child_clump(self):
         from hairtool.guides.render import ChildClump
 
@@ -488,7 +501,7 @@ class Scene(QObject):
             ("built from",), lambda: np.full((self.result.vertex_count, 3), np.nan, np.float32)
         )
         t0 = time.perf_counter()
-        if self.clump_children and not self.dragging:
+        if self.clump_children and self.children_clump_ready and not self.dragging:
             from hairtool.guides.render import RenderHair
 
             clump = self._child_clump()  # (the engine's settings are part of the key)

@@ -40,7 +40,7 @@ from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, as
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.jobs import Job, JobRunner, JobStatus
 from app.ui.kernel_preload import KernelPreload
-from app.ui.kernel_warmup import RASTER_STEP, RENDER_HAIR_STEP
+from app.ui.kernel_warmup import CLUMPED_HAIR_STEP, RASTER_STEP, RENDER_HAIR_STEP
 from app.ui.legend import RampLegend, readable_length
 from app.ui.qt_utils import add_action, set_available
 from app.ui.render_hair_dialog import DENSE, GrowOptions, ask_grow_options, grow
@@ -53,7 +53,7 @@ from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
 from app.ui.viewport import BRUSH_STEP, Viewport
 from app.ui.widgets import WheelGuard, keep_controls_put
-from hairtool import io, samples
+from hairtool import io, samples, serial_twins
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.groom import Animation, Groom
 from hairtool.guides.files import split_guides
@@ -216,10 +216,15 @@ class MainWindow(QMainWindow):
             self._bind_pending_render_hair()
         elif label == RASTER_STEP:
             self.viewport.set_raster_ready()
+        start = self.engine_start
+        # the children's clumping on the kernels the warm-up compiled: the parallel ones
+        if start is not None and CLUMPED_HAIR_STEP in start.done and serial_twins.parallel_in_use():
+            self.scene.set_children_clump_ready()
 
     def _on_warmup_ended(self) -> None:
         if not self.viewport.raster_ready:  # what is not cached compiles when first used
             self.viewport.set_raster_ready()
+        self.scene.set_children_clump_ready()
 
     def _bind_pending_render_hair(self) -> None:
         pending, self._pending_render_hair = self._pending_render_hair, None

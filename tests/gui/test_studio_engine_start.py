@@ -238,3 +238,52 @@ def test_the_head_step_compiles_the_drags_closest_points_kernel():
 
     dict(kernel_warmup.STEPS)[kernel_warmup.HEAD_STEP]()
     assert surface._grid_closest_kernel.signatures and surface._bin_faces.signatures
+
+
+def test_clump_children_on_a_first_start_waits_for_its_kernels_and_the_parallel_ones(
+    make_window, qtbot, monkeypatch
+):
+    """Switched on before the warm-up has cached the children's clumping (an artist's click, a
+    project saved with it), the render hair shows unclumped rather than the window compiling;
+    it clumps once that step is cached and the studio runs on the parallel kernels it compiled."""
+    from hairtool import serial_twins
+    from hairtool.guides.binding import bind_roots
+
+    k = kernel_warmup
+    labels = [k.ENGINE_STEP, k.RENDER_HAIR_STEP, k.CLUMPED_HAIR_STEP, k.PARALLEL_ENGINE_STEP,
+              k.PARALLEL_RENDER_HAIR_STEP, "more"]  # fmt: skip
+    _fake_warm_up(monkeypatch, labels, 0.4)
+    w = make_window(groom=samples.scalp(strands=60, vertices=12, seed=4), engine_ready=False)
+    w.start_warmup()
+    s = w.scene
+    qtbot.waitUntil(lambda: s.engine_ready, timeout=10_000)
+    s.set_binding(bind_roots(s.rest, count=300, seed=2))
+    s.set_clump_children(True)
+    plain = s.binding.build(s.result).points
+    drawn = lambda: s.drawn_points[: s.binding.vertex_count]  # noqa: E731
+    np.testing.assert_array_equal(drawn(), plain)  # not yet cached
+    qtbot.waitUntil(lambda: k.CLUMPED_HAIR_STEP in w.engine_start.done, timeout=10_000)
+    assert not serial_twins.parallel_in_use() and not s.children_clump_ready  # its kernels are parallel
+    np.testing.assert_array_equal(drawn(), plain)
+    qtbot.waitUntil(lambda: s.children_clump_ready, timeout=10_000)
+    assert serial_twins.parallel_in_use()
+    clumped = s.render_hair().points
+    assert np.abs(clumped - plain).max() > 1e-4
+    np.testing.assert_array_equal(drawn(), clumped)
+
+
+def test_the_clumped_hair_step_compiles_clump_children_as_the_studio_runs_it():
+    """In a process of its own (nothing else compiled there): the step reaches the children's
+    clumping and its length pass, with the types the studio's Clump children gives them."""
+    import subprocess
+
+    code = (
+        "from app.ui import kernel_warmup as k; dict(k.STEPS)[k.CLUMPED_HAIR_STEP]()\n"
+        "from hairtool.guides import child_clumps; from hairtool.frozen import lengths\n"
+        "print(len(child_clumps._clumps_kernel.signatures), "
+        "sum('float32' in str(s) for s in lengths._restore_kernel.signatures))"
+    )
+    run = [sys.executable, "-c", code]
+    out = subprocess.run(run, capture_output=True, text=True, check=True, timeout=600)
+    clumps, restores = map(int, out.stdout.split())
+    assert clumps >= 1 and restores >= 1
