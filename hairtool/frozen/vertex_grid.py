@@ -18,6 +18,7 @@ numpy twins.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 from numba import njit, prange
 
@@ -138,7 +139,7 @@ def _block_of(gx, gy, gz, shift, key, head, nxt, room):
     return out[:m]
 
 
-_BLOCK_ROOM = 512  # first guess at the vertices of a 3 × 3 × 3 block of cells
+_BLOCK_ROOM = 512  # vertices of a 3 × 3 × 3 block of cells a thread keeps room for (more: arrays of its own)
 
 
 @twin_njit(nogil=True, parallel=True)
@@ -269,13 +270,21 @@ def _region_lists(
     for n in range(nv):
         qx[n], qy[n], qz[n] = points[vids[n], 0], points[vids[n], 1], points[vids[n], 2]
     order, starts = _cell_groups(qx, qy, qz, inv)
+    threads = numba.config.NUMBA_NUM_THREADS
+    scratch_j = np.empty((threads, _BLOCK_ROOM), np.int64)  # each thread's block, reused
+    scratch_xyz = np.empty((threads, _BLOCK_ROOM, 3))
+    scratch_sk = np.empty((threads, _BLOCK_ROOM, 2), np.int64)
     for g in prange(starts.size - 1):
         n0 = order[starts[g]]
         gx, gy, gz = _coord(qx[n0], inv), _coord(qy[n0], inv), _coord(qz[n0], inv)
-        block = _block_of(gx, gy, gz, shift, key, head, nxt, _BLOCK_ROOM)
-        nb = block.size
-        bxyz = np.empty((nb, 3))
-        bsk = np.empty((nb, 2), np.int64)  # strand, build-order key (row grid)
+        t = numba.get_thread_id()
+        block = scratch_j[t]
+        nb = _gather_block(gx, gy, gz, shift, key, head, nxt, block)
+        bxyz, bsk = scratch_xyz[t], scratch_sk[t]  # strand, build-order key (row grid)
+        if nb > _BLOCK_ROOM:  # a crowded block: arrays of its own
+            block = np.empty(nb, np.int64)
+            _gather_block(gx, gy, gz, shift, key, head, nxt, block)
+            bxyz, bsk = np.empty((nb, 3)), np.empty((nb, 2), np.int64)
         for c in range(nb):
             j = block[c]
             x, y, z = np.float64(points[j, 0]), np.float64(points[j, 1]), np.float64(points[j, 2])

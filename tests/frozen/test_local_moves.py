@@ -121,6 +121,22 @@ def test_each_way_of_finding_the_strands_near_queries_matches_the_reference(spac
         assert np.array_equal(mark, want) and 0 < want.sum()
 
 
+def test_a_crowded_block_of_cells_gives_the_full_builds_lists_too():
+    """More vertices around a cell than a thread's scratch holds (vertex_grid._BLOCK_ROOM):
+    that block gets arrays of its own, and the lists are the full build's all the same."""
+    rng = np.random.default_rng(4)
+    roots = rng.uniform(-0.2, 0.2, (300, 3))
+    pts = roots[:, None, :] + np.linspace(0.0, 0.3, 3)[None, :, None] * np.array([0.0, 1.0, 0.0])
+    g = Groom(pts.reshape(-1, 3), np.full(300, 3))
+    grid = VertexGrid(g.points, g.topology.strand_index, 1.0)
+    vids = np.arange(0, g.vertex_count, 7)
+    flat, cnt, cap = grid.lists(g.points, vids, 1.0, list_frame(g.points, 1.0))
+    want = lists_reference(g.points, g.topology.strand_index, vids, 1.0)
+    assert int(cnt.min()) > 600  # every vertex sees nearly all the others
+    for n, w in enumerate(want):
+        assert np.array_equal(flat[n * cap : n * cap + cnt[n]], w)
+
+
 def test_a_brush_wider_than_the_grid_scans_every_vertex():
     g = bundles(3.0, per_side=4)
     grid = VertexGrid(g.points, g.topology.strand_index, 0.05)  # tiny cells: the scan
