@@ -2,11 +2,12 @@
 
 The usual path groups vertices into rows along x (a 2-D grid of cells r wide over y and z,
 counting sort) and sorts each row by x; a vertex then scans the non-empty rows of the 3 × 3
-around it that come within r, each only over the x-window where the sphere of radius r
-crosses that row, with sweep pointers that only move forward. Only the forward half of the
-pairs is searched (in parallel over chunks of rows balanced by vertex count); a serial pass
-mirrors them into one compact list (CSR: ``start``/``cnt`` into ``flat``), small enough to stay
-in cache while ClumpWithGaps iterates over it. Grooms in a box too large for a row table fall
+around it, each over the x-window within r of the vertex's x, with sweep pointers that only
+move forward. Only the forward half of the
+pairs is searched (in parallel over chunks of rows balanced by vertex count); a parallel
+transpose mirrors them into backward lists (CSR: ``start``/``cnt`` into ``flat``), with a map
+from each backward entry to its pair's forward one, so that ClumpWithGaps can compute a pair's
+distance once for both its vertices. Grooms in a box too large for a row table fall
 back to a spatial hash of 3-D cells (~2V buckets; a candidate counts only if its exact cell
 matches, so collisions never count twice). Lists come in the same order whatever the thread
 count or the chunking, and the grid's corners lie on a lattice of :data:`SNAP` radii, so that an
