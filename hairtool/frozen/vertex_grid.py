@@ -129,14 +129,15 @@ def _gather_block(gx, gy, gz, shift, key, head, nxt, out):
 
 
 @njit(cache=True, nogil=True)
-def _block_of(gx, gy, gz, shift, key, head, nxt, room):
-    """:func:`_gather_block` into a fresh array (``room`` entries to start with)."""
-    out = np.empty(room, np.int64)
-    m = _gather_block(gx, gy, gz, shift, key, head, nxt, out)
-    if m > out.size:
-        out = np.empty(m, np.int64)
-        _gather_block(gx, gy, gz, shift, key, head, nxt, out)
-    return out[:m]
+def _block_in(gx, gy, gz, shift, key, head, nxt, scratch):
+    """:func:`_gather_block` into ``scratch`` (a thread's, reused: allocating on the parallel
+    threads cost more than the work), or into an array of its own where the block is crowded."""
+    m = _gather_block(gx, gy, gz, shift, key, head, nxt, scratch)
+    if m <= scratch.size:
+        return scratch[:m]
+    out = np.empty(m, np.int64)
+    _gather_block(gx, gy, gz, shift, key, head, nxt, out)
+    return out
 
 
 _BLOCK_ROOM = 512  # vertices of a 3 × 3 × 3 block of cells a thread keeps room for (more: arrays of its own)
@@ -148,10 +149,11 @@ def _mark_near_grouped(points, strand, qx, qy, qz, r2, inv, shift, key, head, nx
     group testing the vertices of the 27 cells around its own (every vertex within the reach
     of a query lies there), read from the grid once per group rather than once per query."""
     order, starts = _cell_groups(qx, qy, qz, inv)
+    scratch = np.empty((numba.config.NUMBA_NUM_THREADS, _BLOCK_ROOM), np.int64)  # each thread's block
     for g in prange(starts.size - 1):
         q0 = order[starts[g]]
         gx, gy, gz = _coord(qx[q0], inv), _coord(qy[q0], inv), _coord(qz[q0], inv)
-        block = _block_of(gx, gy, gz, shift, key, head, nxt, _BLOCK_ROOM)
+        block = _block_in(gx, gy, gz, shift, key, head, nxt, scratch[numba.get_thread_id()])
         for c in range(block.size):
             j = block[c]
             if mark[strand[j]]:
@@ -278,12 +280,10 @@ def _region_lists(
         n0 = order[starts[g]]
         gx, gy, gz = _coord(qx[n0], inv), _coord(qy[n0], inv), _coord(qz[n0], inv)
         t = numba.get_thread_id()
-        block = scratch_j[t]
-        nb = _gather_block(gx, gy, gz, shift, key, head, nxt, block)
+        block = _block_in(gx, gy, gz, shift, key, head, nxt, scratch_j[t])
+        nb = block.size
         bxyz, bsk = scratch_xyz[t], scratch_sk[t]  # strand, build-order key (row grid)
         if nb > _BLOCK_ROOM:  # a crowded block: arrays of its own
-            block = np.empty(nb, np.int64)
-            _gather_block(gx, gy, gz, shift, key, head, nxt, block)
             bxyz, bsk = np.empty((nb, 3)), np.empty((nb, 2), np.int64)
         for c in range(nb):
             j = block[c]
@@ -309,17 +309,18 @@ def _region_lists(
                     hit = (ex * ex + ey * ey + ez * ez < r2) & (bsk[c, 0] != si)
                     flat[base + min(m, last)] = bsk[c, 1]
                     m += np.int64(hit)
-            for c in range(0 if not dense else nb, nb):
-                if bsk[c, 0] == si:
-                    continue
-                ex, ey, ez = bxyz[c, 0] - px, bxyz[c, 1] - py, bxyz[c, 2] - pz
-                if ex * ex + ey * ey + ez * ez < r2:
-                    if m < cap - 1:
-                        flat[base + m] = _order_key(
-                            bxyz[c, 0], bxyz[c, 1], bxyz[c, 2], block[c], dense, lo, inv_cell, ny, nz, inv_q,
-                            nq, ox, oy, oz,
-                        )  # fmt: skip
-                    m += 1
+            else:  # the hashed grid's keys depend on the query's cell: made for the hits only
+                for c in range(nb):
+                    if bsk[c, 0] == si:
+                        continue
+                    ex, ey, ez = bxyz[c, 0] - px, bxyz[c, 1] - py, bxyz[c, 2] - pz
+                    if ex * ex + ey * ey + ez * ez < r2:
+                        if m < cap - 1:
+                            flat[base + m] = _order_key(
+                                bxyz[c, 0], bxyz[c, 1], bxyz[c, 2], block[c], dense, lo, inv_cell, ny, nz,
+                                inv_q, nq, ox, oy, oz,
+                            )  # fmt: skip
+                        m += 1
             cnt[n] = m
             if m >= cap - 1:
                 continue
