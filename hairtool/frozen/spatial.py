@@ -197,7 +197,7 @@ def _scan_row(sx, sy, sz, sstrand, j, end, px, py, pz, si, sweep, xb, r2, jmin, 
 
 @twin_njit(nogil=True, parallel=True)
 def _forward_kernel(
-    sx, sy, sz, sstrand, start, ny, nz, lo, cell, r2, slack, chunks, base, limit, flat, fcnt, used
+    sx, sy, sz, sstrand, start, ny, nz, cell, r2, slack, chunks, base, limit, flat, fcnt, used
 ):
     """Forward half of the pairs: vertex i (sorted position) finds the j > i within r: in its
     own row to its right and in the 4 rows after it ((y+1, z), (y−1..y+1, z+1)), each over the
@@ -248,31 +248,6 @@ def _forward_kernel(
                 )
                 fcnt[i] = pos - p0
         used[c] = pos - base[c]
-
-
-@njit(cache=True, nogil=True)
-def _transpose_serial(chunks, start, base, fflat, fcnt, bstart, bflat, bmap):
-    """The backward lists in one pass on one thread (:func:`_transpose`'s twin and oracle)."""
-    v = fcnt.size
-    bstart[:] = 0
-    for c in range(chunks.size - 1):
-        p = base[c]
-        for i in range(start[chunks[c]], start[chunks[c + 1]]):
-            for n in range(p, p + fcnt[i]):
-                bstart[fflat[n] + 1] += 1
-            p += fcnt[i]
-    for i in range(v):
-        bstart[i + 1] += bstart[i]
-    fill = bstart[:-1].copy()
-    for c in range(chunks.size - 1):
-        p = base[c]
-        for i in range(start[chunks[c]], start[chunks[c + 1]]):
-            for n in range(p, p + fcnt[i]):
-                j = fflat[n]
-                bflat[fill[j]] = i
-                bmap[fill[j]] = n
-                fill[j] += 1
-            p += fcnt[i]
 
 
 @twin_njit(nogil=True, parallel=True)
@@ -357,7 +332,7 @@ def _transpose(chunks, start, ny, base, fflat, fcnt, bstart, bflat, bmap):
     c's entries point into a window of vertices from its own first one to the end of the rows
     after its last (the forward search reaches ``ny + 1`` rows on), so each chunk counts into a
     window of its own, the windows' counts become each chunk's offsets per vertex, and each chunk
-    writes its own entries; the result is :func:`_transpose_serial`'s."""
+    writes its own entries; the result is :func:`transpose_reference`'s."""
     n = chunks.size - 1
     n_rows = start.size - 1
     lo = np.empty(n, np.int64)
@@ -470,7 +445,7 @@ class NeighbourList:
         lo, hi, dims = self._grid(points, radius, dense)
         if self.dense:
             self._sort_rows(points, strand, skip, lo, hi, dims)
-            self._search_rows(points.shape[0], lo)
+            self._search_rows(points.shape[0])
         else:
             self._build_hashed(points, strand, skip, lo, float(radius))
 
@@ -511,7 +486,7 @@ class NeighbourList:
         self.start = start
         self.lo = lo
 
-    def _search_rows(self, v, lo) -> None:
+    def _search_rows(self, v) -> None:
         start, dims, cell = self.start, self.dims, self.radius
         chunks = _chunk_rows(start, v)
         per_chunk = np.diff(start[chunks])
@@ -525,7 +500,7 @@ class NeighbourList:
                 self.aflat = np.empty(int(total * 1.25), np.int32)
             used = np.empty(room.size, np.int64)
             _forward_kernel(
-                self.x, self.y, self.z, self.strand, start, dims[1], dims[2], lo, cell, r2, self.slack,
+                self.x, self.y, self.z, self.strand, start, dims[1], dims[2], cell, r2, self.slack,
                 chunks, base, base + room - 1, self.aflat, self.acnt, used,
             )  # fmt: skip
             need = float(np.max(used / np.maximum(per_chunk, 1)))
