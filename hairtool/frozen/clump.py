@@ -117,12 +117,29 @@ def _gather_points(points, order, P):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _pull(P, flat, a, b, px, py, pz, h, inv_h, stats, acc):
-    """Add the pulls of the list entries ``flat[a:b]`` on p to ``acc`` = (fx, fy, fz, nearest r,
-    its index, whether another entry is exactly as near, within h, Σg). Selects, not branches,
-    for the nearest (which entry wins is unpredictable); exact ties are settled afterwards by
-    :func:`_lowest_of_nearest`, since looking up original indices here costs 1.5×."""
+def _take(acc, j, r, s, ex, ey, ez, h, inv_h, stats):
+    """One list entry j at distance r, weight s = g/(r + ε), difference e, into ``acc`` = (fx, fy,
+    fz, nearest r, its index, whether another entry is exactly as near, within h, Σg). Selects,
+    not branches, for the nearest (which entry wins is unpredictable); exact ties are settled
+    afterwards by :func:`_lowest_of_nearest`, since looking up original indices here costs 1.5×."""
     fx, fy, fz, br, bj, tie, c, wsum = acc
+    fx += s * ex
+    fy += s * ey
+    fz += s * ez
+    better = r < br
+    tie = (r == br) | (tie & ~better)
+    bj = j if better else bj
+    br = min(r, br)
+    if stats:
+        t = max(1.0 - r * inv_h, 0.0)
+        c += np.int64(r < h)
+        wsum += t * t
+    return fx, fy, fz, br, bj, tie, c, wsum
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _pull(P, flat, a, b, px, py, pz, h, inv_h, stats, acc):
+    """Add the pulls of the list entries ``flat[a:b]`` on p to ``acc`` (:func:`_take`)."""
     for n in range(a, b):
         j = flat[n]
         ex = P[j, 0] - px
@@ -131,18 +148,8 @@ def _pull(P, flat, a, b, px, py, pz, h, inv_h, stats, acc):
         r = np.sqrt(ex * ex + ey * ey + ez * ez)
         t = max(1.0 - r * inv_h, 0.0)  # list entries beyond h (the margin): g = 0
         g = t * t  # (14)
-        s = g / (r + EPS)  # (15)
-        fx += s * ex
-        fy += s * ey
-        fz += s * ez
-        better = r < br
-        tie = (r == br) | (tie & ~better)
-        bj = j if better else bj
-        br = min(r, br)
-        if stats:
-            c += np.int64(r < h)
-            wsum += g
-    return fx, fy, fz, br, bj, tie, c, wsum
+        acc = _take(acc, j, r, g / (r + EPS), ex, ey, ez, h, inv_h, stats)  # (15)
+    return acc
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -214,25 +221,13 @@ def _pair_kernel(P, aflat, aoff, acnt, inv_h, pr, ps):
 def _sum_run(P, flat, a, b, emap, pr, ps, px, py, pz, h, stats, acc):
     """:func:`_pull` with each entry's r and weight read from the pair arrays (entry n's at
     ``emap[n]``, or at n itself where ``emap`` is empty): the same sums in the same order."""
-    fx, fy, fz, br, bj, tie, c, wsum = acc
     same = emap.size == 0
     inv_h = 1.0 / h
     for n in range(a, b):
         j = flat[n]
         m = n if same else emap[n]
-        r, s = pr[m], ps[m]
-        fx += s * (P[j, 0] - px)
-        fy += s * (P[j, 1] - py)
-        fz += s * (P[j, 2] - pz)
-        better = r < br
-        tie = (r == br) | (tie & ~better)
-        bj = j if better else bj
-        br = min(r, br)
-        if stats:
-            t = max(1.0 - r * inv_h, 0.0)
-            c += np.int64(r < h)
-            wsum += t * t
-    return fx, fy, fz, br, bj, tie, c, wsum
+        acc = _take(acc, j, pr[m], ps[m], P[j, 0] - px, P[j, 1] - py, P[j, 2] - pz, h, inv_h, stats)
+    return acc
 
 
 @njit(cache=True, nogil=True, inline="always")
