@@ -18,25 +18,36 @@ import os
 from numba.core.dispatcher import Dispatcher
 
 
+def cache_index(kernel: object) -> dict:
+    """numba's on-disk index of ``kernel``'s cache (index key → data file name); empty when the
+    kernel has no cache, its index is missing or was written for other source, or numba's cache
+    internals moved. The one place that reads them."""
+    files = getattr(getattr(kernel, "_cache", None), "_cache_file", None)
+    if files is None:
+        return {}
+    try:
+        return files._load_index()
+    except Exception:  # an unreadable index, or internals that moved: as if nothing were cached
+        return {}
+
+
 def cached_signatures(kernel: Dispatcher) -> list[tuple]:
     """The argument types of every overload of ``kernel`` its cache can load without compiling,
     less those already loaded; empty for a kernel without a cache or with an unreadable one."""
-    cache = getattr(kernel, "_cache", None)
-    files = getattr(cache, "_cache_file", None)
-    if files is None:
+    index = cache_index(kernel)
+    if not index:
         return []
     try:
-        index = files._load_index()  # {} when missing or written for other source
-        codegen = kernel.targetctx.codegen()
+        cache, codegen = kernel._cache, kernel.targetctx.codegen()
         out = []
         for key, data_name in index.items():
             sig = key[0]
             if sig in kernel.overloads or cache._index_key(sig, codegen) != key:
                 continue
-            if os.path.exists(files._data_path(data_name)):
+            if os.path.exists(cache._cache_file._data_path(data_name)):
                 out.append(sig)
         return out
-    except Exception:  # numba's cache internals moved, or a cache file is unreadable: load at the call
+    except Exception:  # numba's cache internals moved: load at the call
         return []
 
 

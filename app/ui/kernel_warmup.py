@@ -107,10 +107,9 @@ def use_parallel(parallel: bool) -> None:
 
 def _has_cache(dispatcher: object) -> bool:
     """True when numba's on-disk index for ``dispatcher`` exists and matches its source."""
-    try:
-        return bool(dispatcher._cache._cache_file._load_index())  # {} when missing or stale
-    except Exception:  # numba's cache internals moved: count it as not cached
-        return False
+    from hairtool.kernel_loading import cache_index
+
+    return bool(cache_index(dispatcher))
 
 
 def _read_record(path: Path) -> tuple[set[str], set[str]]:
