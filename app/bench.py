@@ -21,8 +21,9 @@ MSAA unless HAIRTOOL_MSAA is set (the ``msaa`` column says which ran); the ``lin
 how strands were drawn (a GL line method, or rasterized on the CPU: ``--strand-raster``).
 ``--brush`` drags another brush than align (``--symmetry``: mirrored, two samples per move).
 ``--groom PATH`` times that groom file instead (any readable one, e.g. the bear; with
-``--only guides`` it is the guides of the children case); ``--clump-children`` turns Clump children
-on (ClumpWithGaps among the render-hair children once the mouse is released). Every row reports
+``--only guides`` it is the guides of the children case); ``--clump-children`` and
+``--no-clump-children`` turn Clump children on or off (ClumpWithGaps among the render-hair
+children once the mouse is released; by default on, as for any grown children). Every row reports
 the release (``release_ms``, ``release_cpu_ms``): the frame after the mouse is let go.
 
 ``--cold-start``: a first start instead. The studio starts in a subprocess on an empty kernel
@@ -97,7 +98,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--groom", metavar="PATH", help="time this groom file (any readable one) instead of the samples"
     )
     parser.add_argument(
-        "--clump-children", action="store_true", help="Clump children on (render hair clumped once released)"
+        "--clump-children",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="Clump children on or off (default: the studio's, on for grown children)",
     )
     parser.add_argument("--json", action="store_true", help="print the rows as JSON")
     parser.add_argument(
@@ -194,8 +198,8 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
         _bind_children(window, args)
     if args.no_clump:
         window.scene.set_params(window.scene.params.replace(clump=False))
-    if getattr(args, "clump_children", False):
-        window.scene.set_clump_children(True)
+    if getattr(args, "clump_children", None) is not None:
+        window.scene.set_clump_children(bool(args.clump_children))
     window.scene.set_brush(getattr(args, "brush", "align"))
     window.scene.set_symmetry(bool(getattr(args, "symmetry", False)))
     if getattr(args, "radius", None) is not None:

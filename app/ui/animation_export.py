@@ -44,6 +44,7 @@ from hairtool.errors import Cancelled, FormatError, HairtoolError, ParameterErro
 from hairtool.groom import Animation, Groom
 from hairtool.guides.animate import RenderHairAnimation
 from hairtool.guides.files import write_animation
+from hairtool.guides.render import ChildClump
 from hairtool.io.atomic import atomic_path
 from hairtool.keys.export import export_keys as write_keys
 from hairtool.keys.export import keys_record
@@ -231,15 +232,17 @@ def write_render_hair_data(
     animation: Animation,
     binding: ChildBinding,
     *,
+    clump: ChildClump | None = None,
     progress: Progress = _ignore,
     cancelled: CancelCheck = _never,
 ) -> dict[str, str]:
-    """The render hair of ``binding`` following ``animation`` (of its guides), with the guides:
-    USD one file (guide prim), ``.npz`` the guides beside (:func:`hairtool.guides.files.write_animation`).
+    """The render hair of ``binding`` following ``animation`` (of its guides), clumped on every
+    frame with ``clump`` (the scene's Clump children), with the guides: USD one file (guide
+    prim), ``.npz`` the guides beside (:func:`hairtool.guides.files.write_animation`).
     :class:`Cancelled` between frames leaves no file."""
     if Path(path).suffix.lower() not in DATA_SUFFIXES:
         raise FormatError(path, f"animations are written as {', '.join(DATA_SUFFIXES)}")
-    hair = RenderHairAnimation(binding, animation)
+    hair = RenderHairAnimation(binding, animation, clump)
 
     def step(done: int, total: int) -> None:
         if cancelled():
@@ -581,8 +584,10 @@ class AnimationExporter(QObject):
         """Every child on every frame is a long write (30,000 children × 32 vertices are 11.5 MB a
         frame): a job with progress and Cancel."""
 
+        clump = self.window.scene.children_clump()
+
         def work(progress: Progress, cancelled: CancelCheck) -> str:
-            write_render_hair_data(path, anim, binding, progress=progress, cancelled=cancelled)
+            write_render_hair_data(path, anim, binding, clump=clump, progress=progress, cancelled=cancelled)
             return str(path)
 
         self.job = self.window.jobs.run(

@@ -85,12 +85,15 @@ class RenderHairCommand(QUndoCommand):
         self._scene = scene
         self._before = before
         self._after = after
+        self._clump_before = scene.clump_children  # Clump children as the artist left it …
+        self._clump_after: bool | None = None  # … and, once undone, as it was after (None: the default)
 
     def redo(self) -> None:
-        self._scene.set_binding(self._after)
+        self._scene.set_binding(self._after, clump=self._clump_after)
 
     def undo(self) -> None:
-        self._scene.set_binding(self._before)
+        self._clump_after = self._scene.clump_children
+        self._scene.set_binding(self._before, clump=self._clump_before)
 
 
 class MeshCommand(QUndoCommand):

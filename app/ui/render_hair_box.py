@@ -25,7 +25,9 @@ class RenderHairBox(QGroupBox):
         self.clump_children.setToolTip(
             "ClumpWithGaps among the render strands (the paper's adhesion, at render density), "
             "with the engine's clump passes, gaps and Keep lengths; applied when the mouse is "
-            "released and in saved files, not while a brush drags"
+            "released and in saved files, not while a brush drags. On for grown children, off "
+            "for authored hair (strands you picked guides among, render hair opened beside its "
+            "guides), which stays as it was made"
         )
         self.clump_children.toggled.connect(scene.set_clump_children)
         self.drag_percent = SliderSpin(0.1, 100.0, decimals=1, log=True)

@@ -24,7 +24,7 @@ from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, facing_away, s
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.selection import SelectionSample, apply_selection
 from hairtool.groom import Groom, Topology, vertex_ids_of
-from hairtool.guides.binding import ChildBinding
+from hairtool.guides.binding import ChildBinding, clumps_by_default
 from hairtool.io.obj import Mesh
 from hairtool.metadata import UP_AXES
 
@@ -77,7 +77,9 @@ class Scene(QObject):
         self.binding: ChildBinding | None = None  # render hair interpolated from the groom (the guides)
         self._followed: tuple | None = None  # (key, binding): the children of the guides planted / removed
         self.show_guides = True
-        self.clump_children = False  # ClumpWithGaps among the children once the mouse is released
+        # ClumpWithGaps among the children once the mouse is released (each binding's default
+        # on set_binding: on for grown children, off for authored ones)
+        self.clump_children = False
         # A first start clumps the children once the warm-up has cached their kernels (until
         # then the render hair shows unclumped, rather than the window freezing to compile them)
         self.children_clump_ready = engine_ready
@@ -362,9 +364,11 @@ class Scene(QObject):
         self._stroke_step(lambda: self.pipeline.restore(snap))
 
     # -- render hair ---------------------------------------------------------------------
-    def set_binding(self, binding: ChildBinding | None) -> None:
+    def set_binding(self, binding: ChildBinding | None, clump: bool | None = None) -> None:
         """Render hair interpolated from the groom, which becomes its guides (None: no children).
-        The engine and the brushes keep running on the guides; the children follow."""
+        The engine and the brushes keep running on the guides; the children follow. ``clump``:
+        Clump children for them; None: on for grown children, off for authored hair
+        (:func:`hairtool.guides.binding.clumps_by_default`)."""
         if binding is not None and binding.rest_guides.topology != self.rest.topology:
             raise ParameterError(
                 "binding",
@@ -372,6 +376,8 @@ class Scene(QObject):
                 f"children bound to this groom's {self.rest.strand_count} strands",
             )
         self.binding = binding
+        if binding is not None:
+            self.clump_children = clumps_by_default(binding) if clump is None else bool(clump)
         self._followed = None
         self._subsets = {}
         self._cache = {}
@@ -427,6 +433,17 @@ class Scene(QObject):
 
         p = self._params
         return ChildClump(iterations=p.clump_iterations, gap_mode=p.gap_mode, keep_lengths=p.keep_lengths)
+
+    def children_clump(self):
+        """The children's :class:`~hairtool.guides.render.ChildClump` as Clump children sets it
+        (the engine's passes, gaps and length rule), or None while it is off: what saves and
+        exports write."""
+        return self._child_clump() if self.clump_children else None
+
+    def _clumps_drawn(self) -> bool:
+        """Whether the drawn children are clumped now (not while a brush drags, and on a first
+        start not before the warm-up has their kernels)."""
+        return self.clump_children and self.children_clump_ready and not self.dragging
 
     def set_show_guides(self, on: bool) -> None:
         if bool(on) != self.show_guides:
@@ -501,7 +518,7 @@ class Scene(QObject):
             ("built from",), lambda: np.full((self.result.vertex_count, 3), np.nan, np.float32)
         )
         t0 = time.perf_counter()
-        if self.clump_children and self.children_clump_ready and not self.dragging:
+        if self._clumps_drawn():
             from hairtool.guides.render import RenderHair
 
             clump = self._child_clump()  # (the engine's settings are part of the key)
@@ -544,11 +561,22 @@ class Scene(QObject):
         self._build_drawn()
 
     def drawn_for(self, guide_points: np.ndarray) -> np.ndarray:
-        """The drawn strands' points for the guides at ``guide_points`` (an animation frame)."""
+        """The drawn strands' points for the guides at ``guide_points`` (an animation frame),
+        the children clumped as the groom's are."""
         g = Groom(guide_points, self.result.topology)
+        b = self.drawn_binding()
+        if self._clumps_drawn():
+            from hairtool.guides.render import RenderHair
+
+            clump = self._child_clump()
+            # one of its own (the groom's keeps its last run): frame after frame redoes the
+            # clumps of the guides that moved between them
+            frames = self.cached(("frames clumped", clump), lambda: RenderHair(b, clump))
+            children = frames.update_points(g)  # (its own array: copied below)
+            return np.concatenate([children, g.points]) if self.drawn_guides else children.copy()
         from hairtool.guides.children import build_points
 
-        children = build_points(self.drawn_binding(), g)
+        children = build_points(b, g)
         return np.concatenate([children, g.points]) if self.drawn_guides else children
 
     def render_hair(self) -> Groom | None:
@@ -560,7 +588,7 @@ class Scene(QObject):
         if self.clump_children:
             from hairtool.guides.render import RenderHair
 
-            return RenderHair(b, self._child_clump()).update(self.result)
+            return RenderHair(b, self.children_clump()).update(self.result)
         return b.build(self.result)
 
     def export_groom(self) -> Groom:

@@ -31,7 +31,7 @@ if TYPE_CHECKING:
 _RENDER_ONLY = (
     ("scalp", "--scalp"), ("guides_per_child", "--guides-per-child"), ("vertices", "--vertices"),
     ("length_variation", "--length-variation"), ("frizz", "--frizz"), ("region", "--region"),
-    ("density", "--density"), ("clump_children", "--clump-children"), ("guides_out", "--guides-out"),
+    ("density", "--density"), ("guides_out", "--guides-out"),
 )  # fmt: skip
 
 
@@ -75,7 +75,13 @@ def add_arguments(
     g.add_argument(
         "--density", metavar="FILE", default=None, help="density per triangle or vertex (.npy or text)"
     )
-    g.add_argument("--clump-children", action="store_true", help="ClumpWithGaps among the children")
+    g.add_argument(
+        "--clump-children",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="ClumpWithGaps among the children (default: on for grown children, off for authored "
+        "hair: --from-dense, or render hair read beside its guides)",
+    )
     g.add_argument(
         "--from-dense", action="store_true", help="the input is a dense groom: pick --guides G of it"
     )
@@ -128,6 +134,14 @@ def prepare(
     if not keep_hair:
         args.bound_hair = None
     if not wanted(args):
+        if args.clump_children:  # (known only now: the input may have brought render hair)
+            from hairtool.errors import ParameterError
+
+            raise ParameterError(
+                "clump-children",
+                True,
+                "--clump-children with --count N, --from-dense or render hair in the input",
+            )
         return groom, None, 0.0
     return bind(args, groom)
 
@@ -139,13 +153,19 @@ def guides_path(args: argparse.Namespace) -> Path:
 
 
 def check(
-    args: argparse.Namespace, *, animated: bool = False, guides_option: bool = True, required: bool = False
+    args: argparse.Namespace,
+    *,
+    animated: bool = False,
+    guides_option: bool = True,
+    required: bool = False,
+    input_hair: bool = True,
 ) -> None:
     """Refuse contradictory options, options that would do nothing, and unwritable outputs,
     before any work (``animated``: the output is an animation, whose guides go beside it in
     formats other than USD; ``guides_option`` False where ``--guides`` is the command's own and
     means something without ``--from-dense``; ``required``: the command makes render hair or
-    nothing)."""
+    nothing; ``input_hair`` False: there is no input file that could bring render hair of its
+    own, so ``--clump-children`` alone is refused here too, not only in :func:`prepare`)."""
     from hairtool import io
     from hairtool.errors import ParameterError
 
@@ -153,6 +173,7 @@ def check(
         raise ParameterError("count", None, "a number of children (or --from-dense --guides G)")
     if not wanted(args):
         options = _RENDER_ONLY + ((("guides", "--guides"),) if guides_option else ())
+        options += () if input_hair else (("clump_children", "--clump-children"),)
         for dest, flag in options:
             if getattr(args, dest) not in (None, False):
                 value = getattr(args, dest)
@@ -238,13 +259,17 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
 
 
 def render(args: argparse.Namespace, binding: ChildBinding) -> RenderHair:
-    """The children, clumped with ``--clump-children``: at their own automatic radius (they are
-    far denser than the guides), with the command's clump passes, gap mode and length rule
+    """The children, clumped as ``--clump-children`` says (by default grown children are and
+    authored hair is not, as in the studio:
+    :func:`~hairtool.guides.binding.clumps_by_default`): at their own automatic radius (they
+    are far denser than the guides), with the command's clump passes, gap mode and length rule
     where it has them (``freeze``: ``--clump-iterations``, ``--gap-mode``, ``--keep-lengths``),
     else three passes, printed gaps and lengths kept."""
+    from hairtool.guides.binding import clumps_by_default
     from hairtool.guides.render import ChildClump, RenderHair
 
-    if not args.clump_children:
+    on = clumps_by_default(binding) if args.clump_children is None else args.clump_children
+    if not on:
         return RenderHair(binding, None)
     clump = ChildClump(
         iterations=getattr(args, "clump_iterations", 3),

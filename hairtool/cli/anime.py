@@ -123,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
                 raise ParameterError(flag, getattr(args, flag), "an IN groom to make the cycle from")
         if render:
             raise ParameterError("count", args.count, "an IN groom and an OUT file for render hair")
-        _guides.check(args, guides_option=False)  # render-hair options without render hair: refused
+        _guides.check(args, guides_option=False, input_hair=False)  # render-hair options alone: refused
     else:
         from hairtool.io import format_for
 

@@ -89,6 +89,15 @@ class ChildBinding:
     def guides_per_child(self) -> int:
         return int(self.guide_ids.shape[1])
 
+    @property
+    def authored(self) -> bool:
+        """Whether the children are strands somebody made (a dense groom's, render hair read
+        beside its guides), bound to come back bit for bit, rather than grown from the guides.
+        Authored hair is never clumped by default: it is shaped already (and hair a studio
+        saved clumped would be clumped twice), while grown children are clumped, as XGen's
+        and Blender's interpolated hair are (:func:`clumps_by_default`)."""
+        return self.exact_points is not None
+
     def rest_tangents(self, n: int) -> np.ndarray:
         """``(G, 3)`` the rest guides' root tangents at n vertices (cached)."""
         if n not in self._tangents:
@@ -369,3 +378,10 @@ def bind_exactly(b: ChildBinding, points: np.ndarray) -> None:
     b.local = local.astype(np.float32)  # the rest blend below uses these very offsets
     b.exact_blend = _children.build_points(b, guides, np.float64)
     b.exact_points = points
+
+
+def clumps_by_default(binding: ChildBinding) -> bool:
+    """Whether render hair of ``binding`` runs ClumpWithGaps among its children unless told
+    otherwise: grown children do (interpolated hair without adhesion reads as a fuzz of
+    parallel strands), authored ones (:attr:`ChildBinding.authored`) do not."""
+    return not binding.authored

@@ -8,6 +8,7 @@ from hairtool import io
 from hairtool.cli import main
 from hairtool.guides.binding import bind_roots
 from hairtool.guides.files import split_guides
+from hairtool.guides.render import ChildClump, RenderHair
 from hairtool.samples import scalp
 
 
@@ -24,6 +25,11 @@ def test_cycle_of_guides_written_as_render_hair(tmp_path, capsys):
     assert main(["anime", str(src), str(plain), "--frames", "6", "--seed", "1"]) == 0
     assert guides.frames.tobytes() == io.read(plain).frames.tobytes()
     binding = bind_roots(io.read_groom(src), count=250, seed=1)
+    clumped = RenderHair(binding, ChildClump(seed=1)).update(guides.frame(3))  # grown: clumped
+    assert hair.frames[3].tobytes() == clumped.points.tobytes()
+    loose = tmp_path / "loose.usda"
+    assert main([*argv[:2], str(loose), *argv[3:], "--no-clump-children"]) == 0
+    hair = split_guides(io.read(loose))[0]
     assert hair.frames[3].tobytes() == binding.build(guides.frame(3)).points.tobytes()
 
 

@@ -197,7 +197,18 @@ def test_animation_export_writes_render_hair_when_the_groom_has_children(render_
     children, guides = split_guides(io.read(out / "hair.usdc"))
     assert (children.strand_count, guides.strand_count, children.n_frames) == (300, 20, FRAMES)
     assert guides.frames.tobytes() == anim.frames.tobytes()
-    assert children.frames[6].tobytes() == binding.build(anim.frame(6)).points.tobytes()
+    # clumped on every frame, as the view draws them (Clump children: on for grown children)
+    from hairtool.guides.render import RenderHair
+
+    clump = w.scene.children_clump()
+    assert clump is not None
+    clumped = RenderHair(binding, clump).update(anim.frame(6)).points
+    assert children.frames[6].tobytes() == clumped.tobytes()
+    w.scene.set_clump_children(False)  # off: the interpolation itself
+    _wait(w, w.exporter.export_animation(out / "plain.usdc"))
+    plain = split_guides(io.read(out / "plain.usdc"))[0]
+    assert plain.frames[6].tobytes() == binding.build(anim.frame(6)).points.tobytes()
+    assert np.abs(plain.frames[6] - clumped).max() > 1e-4
     _wait(w, w.exporter.export_animation(out / "hair.npz"))
     assert io.read(out / "hair.npz").strand_count == 300
     assert io.read(out / "hair.guides.npz").frames.tobytes() == anim.frames.tobytes()
@@ -240,9 +251,12 @@ def test_a_video_of_render_hair_draws_the_children(render_hair_window, out):
     guides = w.exporter.renderer(anim, (96, 64), render_hair=False)
     drawn = hair.frame_groom(6)
     assert drawn.strand_count == w.scene.drawn_topology.strand_count
-    assert drawn.points[: w.scene.binding.vertex_count].tobytes() == (
-        w.scene.binding.build(anim.frame(6)).points.tobytes()
-    )
+    from hairtool.guides.render import RenderHair
+
+    clumped = RenderHair(w.scene.binding, w.scene.children_clump()).update(anim.frame(6))
+    assert drawn.points[: w.scene.binding.vertex_count].tobytes() == clumped.points.tobytes()
+    again = hair.frame_groom(6)  # (the frames' clumper keeps its runs: the same bytes again)
+    assert again.points.tobytes() == drawn.points.tobytes()
     assert guides.frame_groom(6).strand_count == 20
     _wait(w, w.exporter.export_animation(out / "hair.gif", size=(96, 64)))
     _wait(w, w.exporter.export_animation(out / "guides.gif", size=(96, 64), render_hair=False))

@@ -110,4 +110,31 @@ def test_picking_guides_among_a_dense_groom_keeps_its_strands(make_window):
     s = w.scene
     assert s.rest.strand_count == 30 and s.binding.child_count == 400
     s.set_params(s.params.replace(freeze=False, clump=False))
-    np.testing.assert_array_equal(s.render_hair().points, dense.points)  # untouched: itself
+    assert not s.clump_children  # an artist's own strands are not clumped by default …
+    np.testing.assert_array_equal(s.render_hair().points, dense.points)  # … untouched: itself
+    np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], dense.points)
+
+
+def test_clump_children_follows_each_render_hairs_kind_and_the_artists_choice_through_undo(make_window):
+    w = make_window(groom=samples.scalp(strands=60, vertices=12, seed=4))
+    w.ask_grow_options = lambda options: GrowOptions(count=800, seed=5)
+    w.grow_render_hair_dialog()
+    assert w.jobs.wait()
+    s = w.scene
+    b = s.binding
+    assert s.clump_children  # grown children: clumped
+    s.set_clump_children(False)  # the artist's choice …
+    w.remove_render_hair()
+    w.undo_stack.undo()  # … comes back with the children
+    assert s.binding is b and not s.clump_children
+    np.testing.assert_array_equal(s.drawn_points[: b.vertex_count], b.build(s.result).points)
+    w.undo_stack.redo()
+    w.undo_stack.undo()
+    assert not s.clump_children
+    w.ask_grow_options = lambda options: GrowOptions(count=500, seed=6)
+    w.grow_render_hair_dialog()  # new children over them: their own default …
+    assert w.jobs.wait() and s.binding is not b and s.clump_children
+    w.undo_stack.undo()  # … and the old ones as the artist left them
+    assert s.binding is b and not s.clump_children
+    w.undo_stack.redo()
+    assert s.binding.child_count == 500 and s.clump_children

@@ -37,6 +37,7 @@ def test_children_follow_a_drag_at_the_drag_percentage_and_come_back_in_full_on_
     w = _window(make_window, children=2000, percent=10.0)
     s, v = w.scene, w.viewport
     b = s.binding
+    s.set_clump_children(False)  # the interpolation alone (clumped children: the tests below)
     ui.grab(v)
     assert v.renderer.topology.strand_count == 2000 + 60  # children, then the guides
     assert "60 guides · 2,000 children" in w.counts_label.text()
@@ -131,7 +132,10 @@ def test_export_writes_render_hair_and_guides_as_two_prims(make_window, tmp_path
     purposes = [(c.path, c.purpose) for c in back.metadata.curves]
     assert purposes == [("/Groom/Hair", "default"), ("/Groom/Guides", "guide")]
     hair, guides = split_guides(back)
-    np.testing.assert_array_equal(hair.points, w.scene.binding.build(w.scene.result).points)
+    s = w.scene
+    assert s.clump_children  # grown children are clumped by default, and so written
+    np.testing.assert_array_equal(hair.points, s.render_hair().points)
+    assert np.abs(hair.points - s.binding.build(s.result).points).max() > 1e-4
     np.testing.assert_array_equal(guides.points, w.scene.result.points)
     assert hair.thickness is not None and hair.thickness[0] > hair.thickness[11]  # tapered widths
 
@@ -174,8 +178,11 @@ def test_clumping_the_children_is_a_switch_applied_on_release_and_saved(make_win
 
     w = _window(make_window, children=1500, percent=100.0)
     s = w.scene
-    plain = s.drawn_points[: s.binding.vertex_count].copy()
     box = w.findChild(QtWidgets.QGroupBox, "RenderHairBox")
+    assert s.clump_children and box.clump_children.isChecked()  # on for grown children
+    box.clump_children.setChecked(False)
+    plain = s.drawn_points[: s.binding.vertex_count].copy()
+    np.testing.assert_array_equal(plain, s.binding.build(s.result).points)
     box.clump_children.setChecked(True)  # the artist's switch
     assert s.clump_children
     p = s.params
@@ -224,3 +231,27 @@ def test_a_release_clumps_the_render_hair_once_from_the_settled_guides(ui, make_
     assert w.undo_stack.count() == 1 and not s.dragging and not s.pipeline.unsettled
     assert len(runs) == 1
     np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], s.render_hair().points)
+
+
+def test_the_bundled_sample_saved_and_opened_again_is_clumped_once(make_window, tmp_path):
+    """Sintel's grown children are clumped (on by default), and so saved; the file opened again
+    holds authored render hair, which is drawn as written, not clumped a second time."""
+    w = make_window(size=(420, 320))
+    assert w.open_bundled_sample(), w.errors
+    s = w.scene
+    box = w.findChild(QtWidgets.QGroupBox, "RenderHairBox")
+    assert s.clump_children and box.clump_children.isChecked()
+    n = s.binding.vertex_count
+    written = s.render_hair().points
+    np.testing.assert_array_equal(s.drawn_points[:n], written)  # drawn as saved
+    assert np.abs(written - s.binding.build(s.result).points).max() > 1e-3  # and clumped
+    path = tmp_path / "sintel.usdc"
+    assert w.export_groom(path), w.errors
+    w2 = make_window(size=(420, 320))
+    assert w2.open_path(path), w2.errors
+    s2 = w2.scene
+    box2 = w2.findChild(QtWidgets.QGroupBox, "RenderHairBox")
+    assert s2.binding.authored and not s2.clump_children and not box2.clump_children.isChecked()
+    s2.set_params(s2.params.replace(freeze=False, clump=False))  # the guides as written
+    np.testing.assert_array_equal(s2.drawn_points[:n], written)
+    np.testing.assert_array_equal(s2.render_hair().points, written)

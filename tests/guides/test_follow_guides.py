@@ -96,7 +96,7 @@ def test_freeze_with_render_hair_replays_add_and_delete_strokes(sintel, tmp_path
     args = [
         "freeze", str(tmp_path / "guides.npz"), str(tmp_path / "hair.npz"), "--no-freeze", "--no-clump",
         "--count", "3000", "--seed", "1", "--scalp", str(DATA / "sintel_head.obj"),
-        "--strokes", str(tmp_path / "log.json"),
+        "--strokes", str(tmp_path / "log.json"), "--no-clump-children",
     ]  # fmt: skip
     assert main(args) == 0
     hair = io.read_groom(tmp_path / "hair.npz")

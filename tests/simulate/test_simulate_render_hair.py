@@ -12,6 +12,7 @@ from hairtool import io
 from hairtool.cli import main
 from hairtool.guides.binding import bind_roots
 from hairtool.guides.files import split_guides
+from hairtool.guides.render import ChildClump, RenderHair
 from hairtool.samples import scalp
 
 SIM = ["--frames", "8", "--gusts", "1", "--substeps", "2", "--seed", "2"]
@@ -38,8 +39,9 @@ def test_usd_holds_children_and_the_guide_prim_frame_for_frame(guides_file, tmp_
     sim = io.read(plain)
     assert guides.frames.tobytes() == sim.frames.tobytes()  # the guides move as they do alone
     binding = bind_roots(io.read_groom(guides_file), count=400, seed=5)
-    for f in (0, 7):  # the children are the interpolation of that frame's guides
-        assert hair.frames[f].tobytes() == binding.build(sim.frame(f)).points.tobytes()
+    render = RenderHair(binding, ChildClump(seed=5))  # grown children: clumped by default
+    for f in (0, 7):  # the children are that frame's guides' interpolation, clumped
+        assert hair.frames[f].tobytes() == render.update(sim.frame(f)).points.tobytes()
 
 
 def test_other_formats_write_the_guides_beside_and_keys_work_on_the_children(guides_file, tmp_path, capsys):
