@@ -210,6 +210,14 @@ class KeepOut:
     def __init__(self) -> None:
         self._last: dict[str, tuple] = {}
 
+    def remember(self, before: Groom, after: Groom, surface: CollisionSurface) -> None:
+        """Ask the head about ``before`` and ``after`` now, so that the next call asks only about
+        the points that differ from them (the first stroke after an open would otherwise ask
+        about every point twice)."""
+        for key, points in (("before", before.points), ("after", after.points)):
+            sd = surface.signed_distance(points.astype(np.float64))[0]
+            self._last[key] = (surface, points.copy(), sd)
+
     def __call__(self, before: Groom, after: Groom, surface: CollisionSurface, margin: float) -> Groom:
         parts = []  # per groom: its points, which changed since last time, the distances known
         for key, points in (("before", before.points), ("after", after.points)):

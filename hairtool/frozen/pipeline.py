@@ -80,6 +80,9 @@ from hairtool.groom import Groom, vertex_ids_of
 
 PREPARED_REGION = 0.05  # of the vertices: the region lists' room :meth:`FrozenPipeline.prepare_strokes`
 # makes (the studio's brush on the bear: regions of 3-4 %)
+PREPARED_HEAD = 40_000  # vertices at most whose distances to the head prepare_strokes asks for
+# (Sintel's 7,296: 70 ms on the 2-core VM, which a first stroke paid; a dense groom's would
+# hold the idle GUI thread for seconds, so its first stroke still asks)
 
 
 @dataclass(frozen=True, eq=False)
@@ -841,11 +844,20 @@ class FrozenPipeline:
 
     def prepare_strokes(self, region_share: float = PREPARED_REGION) -> None:
         """What a first brush move would otherwise compute or allocate, now (the studio calls
-        it while idle after an open): the scalp's normals and centre, and room for the lists of
-        a region of ``region_share`` of the vertices."""
+        it while idle after an open): the scalp's normals and centre, room for the lists of a
+        region of ``region_share`` of the vertices, and (up to :data:`PREPARED_HEAD` vertices)
+        each point's distance to the head, which keeping strokes out of it reads."""
         _ = self.root_normals, self.scalp_centre
         if self._local is not None:
             self._local.grid.prepare(int(region_share * self._aligned.vertex_count))
+        surface = self._surface
+        if (
+            surface is not None
+            and hasattr(surface, "signed_distance")
+            and self._aligned.vertex_count <= PREPARED_HEAD
+        ):  # the head's distances a first stroke that collides would ask for
+            kept = self.__dict__.setdefault("_keep_out", KeepOut())
+            kept.remember(self._aligned, self._result, surface)
 
     def _kept_out(self, clumped: Groom) -> Groom:
         """Clumping respects the head: where strokes collide with it (a sample that moves points

@@ -277,3 +277,27 @@ def test_the_face_grids_empty_shells_are_their_numpy_twins(sintel):
     q, face = tiny.nearest(far)
     np.testing.assert_array_equal(q, closest_points(tiny.mesh, far)[0])
     assert np.all(face == 0)
+
+
+def test_head_distances_asked_ahead_give_the_same_bytes_and_spare_the_first_stroke(sintel, monkeypatch):
+    """prepare_strokes (the studio's idle step after an open) asks the head about every point
+    once, so the first comb move that collides asks about the strands it changed, not about the
+    whole groom twice (70 ms of Sintel's first move on the 2-core VM)."""
+    groom, surface = sintel
+    params = FrozenParams(freeze=False, keep_lengths=True)
+    plain, prepared = (FrozenPipeline(groom, params, surface) for _ in range(2))
+    prepared.prepare_strokes()
+    asked = []
+    real = type(surface).signed_distance
+    monkeypatch.setattr(
+        type(surface), "signed_distance", lambda self, p: asked.append(len(p)) or real(self, p)
+    )
+    n = root_normals(groom)
+    c = groom.points[groom.offsets[40] + 20].astype(np.float64)
+    sample = BrushSample("comb", tuple(c), tuple(-2.0 * n[40]), 6.0, 1.0, LUT)
+    prepared.brush(sample)
+    assert asked and max(asked) < groom.vertex_count  # the changed points only
+    asked.clear()
+    plain.brush(sample)
+    assert max(asked) == 2 * groom.vertex_count  # unprepared: every point, before and after
+    np.testing.assert_array_equal(prepared.result.points, plain.result.points)
