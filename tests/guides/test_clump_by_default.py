@@ -62,3 +62,12 @@ def test_render_hair_read_beside_its_guides_is_not_clumped_again(tmp_path):
     twice = tmp_path / "twice.usda"
     assert main(["freeze", str(clumped), str(twice), "--no-freeze", "--no-clump", "--clump-children"]) == 0
     assert np.abs(split_guides(io.read_groom(twice))[0].points - want.points).max() > 1e-4
+
+
+def test_clump_children_without_render_hair_is_refused_naming_the_option(tmp_path, capsys):
+    out = tmp_path / "x.npz"
+    for argv in (["anime", "--clump-children"], ["freeze", GUIDES, str(out), "--clump-children"]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "clump-children" in err, err
+    assert not out.exists()
