@@ -494,7 +494,7 @@ class AnimationExporter(QObject):
         if binding is not None:
 
             def frame_drawn(f: int) -> Drawn:
-                d = drawn(scene, animation.frames[f], mask=overlays)
+                d = drawn(scene, animation.frames[f], mask=overlays, kept=True)
                 if scene.colour_mode == "displacement":  # the edit's distances, not the pose's
                     return dataclasses.replace(d, make_colors=lambda: None)
                 return d

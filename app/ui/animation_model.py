@@ -63,6 +63,7 @@ class AnimationModel(QObject):
     frames_edited = Signal(int, int)  # first and last frame a key edit changed
     frame_changed = Signal(int)
     playing_changed = Signal(bool)
+    scrubbing_changed = Signal(bool)  # the timeline's frame is being dragged (button held)
     loop_changed = Signal(bool)
     fps_changed = Signal(float)
     settings_changed = Signal(object)  # KeySettings
@@ -87,6 +88,7 @@ class AnimationModel(QObject):
         self.frame = 0
         self.fps = DEFAULT_FPS
         self.playing = False
+        self.scrubbing = False
         self.loop = True
         self.settings = ks.KeySettings()
         self.view_mode = "original"
@@ -292,6 +294,12 @@ class AnimationModel(QObject):
 
     def _interval_ms(self) -> int:
         return max(1, int(500.0 / self.fps))  # two ticks per frame, so each frame shows on time
+
+    def set_scrubbing(self, on: bool) -> None:
+        """The artist drags the timeline's frame (on) or lets go (off)."""
+        if bool(on) != self.scrubbing:
+            self.scrubbing = bool(on)
+            self.scrubbing_changed.emit(self.scrubbing)
 
     def pause(self) -> None:
         if self.playing:

@@ -175,6 +175,7 @@ class AnimationController(QObject):
         model.animation_changed.connect(self._on_animation_changed)
         model.frame_changed.connect(self._update_fps_label)
         model.playing_changed.connect(self._on_playing)
+        model.scrubbing_changed.connect(self._frames_live)
         model.fps_changed.connect(self._update_fps_label)
         self.viewport.frame_drawn.connect(self._on_frame_drawn)
         self.viewport.stroke_started.connect(self._on_stroke_started)
@@ -227,7 +228,17 @@ class AnimationController(QObject):
     # -- playback read-out ------------------------------------------------------------------
     def _on_playing(self, playing: bool) -> None:
         self._drawn.clear()
+        self._frames_live()
         self._update_fps_label()
+
+    def _frames_live(self, *_: object) -> None:
+        """Playing or scrubbing, the children of the frames are drawn unclumped (Scene.set_frames_live)."""
+        live = self.model.playing or self.model.scrubbing
+        if live == self.scene.frames_live:
+            return
+        self.scene.set_frames_live(live)
+        if not live and self.scene.clump_children and self.scene.has_children:
+            self.refresh_display()  # the frame it stopped on, with its children clumped
 
     def _on_frame_drawn(self) -> None:
         if self.model.playing and self.viewport.shown_frame is not None:

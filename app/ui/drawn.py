@@ -19,13 +19,15 @@ def drawn(
     frame_colors: np.ndarray | None = None,
     *,
     mask: bool = True,
+    kept: bool = False,
 ) -> Drawn:
     """What the viewport draws of ``scene``: ``frame`` (``(V, 3)`` points of the groom's strands,
     an animation frame; None: the groom as edited) with render hair following it, coloured by the
     scene's colour mode (``frame_colors``: an animation's own per-vertex colours, used where no
     render hair is drawn over the frame); ``mask``: the working overlays, the mask brush's tint
     and the selection (unselected strands dimmed, hidden ones left out:
-    :mod:`app.ui.selection_look`)."""
+    :mod:`app.ui.selection_look`); ``kept``: a frame written out (an export), whose children
+    are clumped (with Clump children on) even while the animation plays."""
     s = scene
     if frame is not None and len(frame) != s.result.vertex_count:
         frame = None  # another groom's frame: the scene's own strands are drawn
@@ -33,7 +35,7 @@ def drawn(
     if frame is None:
         points = s.drawn_points
     else:
-        points = s.drawn_for(frame) if children else np.asarray(frame, np.float32)
+        points = s.drawn_for(frame, kept=kept) if children else np.asarray(frame, np.float32)
     if frame is not None and frame_colors is not None and not children:
         own = frame_colors
 

@@ -219,6 +219,7 @@ class TimelineView(QWidget):
             event.accept()
         elif event.button() == Qt.MouseButton.LeftButton:
             self.model.pause()
+            self.model.set_scrubbing(True)
             self._grab = self.key_at(event.position()) if self.steer is not None else None
             self._press_x, self._dragging = event.position().x(), False
             frame = self._grab if self._grab is not None else self.x_to_frame(event.position().x())
@@ -244,6 +245,8 @@ class TimelineView(QWidget):
             self._pan = None
             return
         grabbed, self._grab = self._grab, None
+        if event.button() == Qt.MouseButton.LeftButton:
+            self.model.set_scrubbing(False)
         if event.button() != Qt.MouseButton.LeftButton or grabbed is None or self.steer is None:
             return
         target = min(max(self.x_to_frame(event.position().x()), 0), self.model.last_frame)

@@ -7,6 +7,7 @@ import json
 import imageio.v2 as imageio
 import numpy as np
 import pytest
+from PySide6.QtCore import Qt
 
 from hairtool import io, samples
 from hairtool.simulate.sway import sway_animation
@@ -264,3 +265,42 @@ def test_a_video_of_render_hair_draws_the_children(render_hair_window, out):
     background = frames["guides"][0, 0]
     covered = {n: int(np.any(f != background, axis=2).sum()) for n, f in frames.items()}
     assert covered["hair"] > covered["guides"]  # 300 children fill more pixels than 20 guides
+
+
+def test_a_playing_animation_draws_its_children_unclumped_and_the_frame_it_stops_on_clumped(
+    ui, render_hair_window
+):
+    """Clumping every child on every frame would hold playback to a few frames a second on
+    Sintel: while it plays the view draws them as interpolated, the frame it stops on (and any
+    exported frame, even during playback) clumped, as the groom's are."""
+    from hairtool.guides.render import RenderHair
+
+    w = render_hair_window
+    s, v, model = w.scene, w.viewport, w.animation
+    anim, b = model.animation, s.binding
+    n = b.vertex_count
+    clumped = RenderHair(b, s.children_clump()).update(anim.frame(6)).points
+    model.set_frame(6)
+    ui.grab(v)
+    np.testing.assert_array_equal(v.drawn().points[:n], clumped)
+    model.play()
+    assert s.frames_live
+    model.set_frame(6)
+    ui.grab(v)
+    np.testing.assert_array_equal(v.drawn().points[:n], b.build(anim.frame(6)).points)
+    frame = w.exporter.renderer(anim, (96, 64), render_hair=True).frame_groom(6)
+    np.testing.assert_array_equal(frame.points[:n], clumped)  # exported: clumped all the same
+    model.pause()
+    assert not s.frames_live
+    np.testing.assert_array_equal(v.drawn().points[:n], clumped)
+    view = w.timeline.view  # the timeline's frame dragged with the mouse: as while playing …
+    left = Qt.MouseButton.LeftButton
+    y = view.height() - 4  # (the ruler, below the key rows)
+    ui.send_mouse(view, "press", (view.frame_to_x(3), y), left, left)
+    ui.send_mouse(view, "move", (view.frame_to_x(5), y), None, left)
+    assert s.frames_live and model.frame == 5
+    np.testing.assert_array_equal(v.drawn().points[:n], b.build(anim.frame(5)).points)
+    ui.send_mouse(view, "release", (view.frame_to_x(5), y), left, None)  # … let go: clumped
+    assert not s.frames_live
+    want = RenderHair(b, s.children_clump()).update(anim.frame(5)).points
+    np.testing.assert_array_equal(v.drawn().points[:n], want)
