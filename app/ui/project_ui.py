@@ -164,7 +164,9 @@ class ProjectController(QObject):
         w.undo_stack.clear()
         scene.load(project.rest, path, params=project.params, mesh=project.mesh)
         scene.restore(project.stroke_snapshot(scene.pipeline))
-        scene.set_binding(project.children)
+        # Clump children as saved (a project from before the switch: off, as it looked then),
+        # given with the children so that they are not clumped first for nothing
+        scene.set_binding(project.children, clump=bool(project.display.get("clump_children", False)))
         _apply_each(
             w,
             (

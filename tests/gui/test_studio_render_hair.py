@@ -173,7 +173,7 @@ def test_a_saved_file_of_render_hair_and_guides_opens_as_guides_the_hair_follows
     assert np.abs(s.render_hair().points - hair).max() > 1e-4
 
 
-def test_clumping_the_children_is_a_switch_applied_on_release_and_saved(make_window, tmp_path):
+def test_clumping_the_children_is_a_switch_applied_on_release_and_saved(make_window, tmp_path, monkeypatch):
     from hairtool.guides.render import ChildClump, RenderHair
 
     w = _window(make_window, children=1500, percent=100.0)
@@ -203,6 +203,15 @@ def test_clumping_the_children_is_a_switch_applied_on_release_and_saved(make_win
     assert w.project.save_to(path)
     w2 = _window(make_window, children=10)
     assert w2.project.open_project(path) and w2.scene.clump_children
+    box.clump_children.setChecked(False)  # saved off: opened off, and never clumped on the way
+    assert w.project.save_to(path)
+    from hairtool.guides.child_clumps import ChildClumps
+
+    runs = []
+    run = ChildClumps.run
+    monkeypatch.setattr(ChildClumps, "run", lambda self, *a, **k: runs.append(1) or run(self, *a, **k))
+    assert w2.project.open_project(path) and not w2.scene.clump_children
+    assert runs == []
 
 
 def test_a_release_clumps_the_render_hair_once_from_the_settled_guides(ui, make_window, monkeypatch):
