@@ -247,8 +247,8 @@ def test_the_head_step_compiles_the_drags_closest_points_kernel():
 def test_clump_children_on_a_first_start_waits_for_its_kernels_and_the_parallel_ones(
     make_window, qtbot, monkeypatch
 ):
-    """Switched on before the warm-up has cached the children's clumping (an artist's click, a
-    project saved with it), the render hair shows unclumped rather than the window compiling;
+    """On before the warm-up has cached the children's clumping (grown children, on by default;
+    a project saved with it), the render hair shows unclumped rather than the window compiling;
     it clumps once that step is cached and the studio runs on the parallel kernels it compiled."""
     from hairtool import serial_twins
     from hairtool.guides.binding import bind_roots
@@ -262,7 +262,7 @@ def test_clump_children_on_a_first_start_waits_for_its_kernels_and_the_parallel_
     s = w.scene
     qtbot.waitUntil(lambda: s.engine_ready, timeout=10_000)
     s.set_binding(bind_roots(s.rest, count=300, seed=2))
-    s.set_clump_children(True)
+    assert s.clump_children  # grown children: on by default
     plain = s.binding.build(s.result).points
     drawn = lambda: s.drawn_points[: s.binding.vertex_count]  # noqa: E731
     np.testing.assert_array_equal(drawn(), plain)  # not yet cached
