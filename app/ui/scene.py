@@ -114,11 +114,16 @@ class Scene(QObject):
         self._set_groom(groom)
 
     # -- strands -----------------------------------------------------------------------
+    def _new_pipeline(self, rest: Groom, surface) -> FrozenPipeline:
+        """The engine on ``rest`` with the head ``surface``; what a first stroke needs is
+        prepared at the next idle turn."""
+        self.pipeline: FrozenPipeline | None = FrozenPipeline(rest, self._params, surface)
+        self._prepare_timer.start(0)
+        return self.pipeline
+
     def _set_groom(self, groom: Groom) -> None:
         if self.engine_ready:
-            self.pipeline: FrozenPipeline | None = FrozenPipeline(groom, self._params, self._surface())
-            self.result: Groom = self.pipeline.result
-            self._prepare_timer.start(0)
+            self.result: Groom = self._new_pipeline(groom, self._surface()).result
         else:
             self._params.validate()
             self.pipeline, self.result = None, groom
@@ -179,9 +184,7 @@ class Scene(QObject):
             return
         self.engine_starting.emit()
         t0 = time.perf_counter()
-        self.pipeline = FrozenPipeline(self.rest, self._params, self._surface())
-        self.result = self.pipeline.result
-        self._prepare_timer.start(0)
+        self.result = self._new_pipeline(self.rest, self._surface()).result
         self._children_moved()  # the render hair follows the frozen guides
         self.engine_ready = True
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
@@ -216,9 +219,7 @@ class Scene(QObject):
             self.result = rest
         else:
             snap = self.pipeline.snapshot()
-            self.pipeline = FrozenPipeline(rest, self._params)
-            self.result = self.pipeline.restore(snap)
-            self._prepare_timer.start(0)
+            self.result = self._new_pipeline(rest, self.pipeline.surface).restore(snap)  # the same head
         self._children_moved()
         self.up_axis_changed.emit()
         self.points_changed.emit()

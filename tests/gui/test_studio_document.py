@@ -187,3 +187,17 @@ def test_up_axis_switch_for_a_z_up_hair_file(ui, make_window, tmp_path):
 
     w.undo_stack.undo()
     assert s.up_axis == "Y" and v.camera.up_axis == "Y"
+
+
+def test_the_up_axis_switch_keeps_the_head_the_brushes_collide_with(make_window):
+    """Relabelling the up axis rebuilds the engine on the relabelled groom: it keeps the head
+    mesh's surface (it lost it once: strokes then went through the head, slide and add refused)."""
+    w = make_window(size=(420, 320))
+    assert w.open_bundled_sample(), w.errors
+    s = w.scene
+    head = s.pipeline.surface
+    assert head is not None and s.mesh is not None
+    w.up_axis_actions["Z"].trigger()
+    assert s.up_axis == "Z" and s.pipeline.surface is head
+    w.undo_stack.undo()
+    assert s.up_axis == "Y" and s.pipeline.surface is head
