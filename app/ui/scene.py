@@ -433,8 +433,7 @@ class Scene(QObject):
     def _child_clump(self):
         from hairtool.guides.render import ChildClump
 
-        p = self._params
-        return ChildClump(iterations=p.clump_iterations, gap_mode=p.gap_mode, keep_lengths=p.keep_lengths)
+        return ChildClump.following(self._params)
 
     def children_clump(self):
         """The children's :class:`~hairtool.guides.render.ChildClump` as Clump children sets it

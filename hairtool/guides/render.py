@@ -34,6 +34,15 @@ class ChildClump:
     seed: int = 0
     keep_lengths: bool = True
 
+    @classmethod
+    def following(cls, params) -> ChildClump:
+        """The children's ClumpWithGaps with an engine's clump passes, gap mode and length rule
+        (``params``: a :class:`~hairtool.frozen.pipeline.FrozenParams`), at the children's own
+        automatic radius and step: what the studio's Clump children runs."""
+        return cls(
+            iterations=params.clump_iterations, gap_mode=params.gap_mode, keep_lengths=params.keep_lengths
+        )
+
     def validate(self) -> ChildClump:
         check_clump_params(
             1.0 if self.radius is None else self.radius, self.iterations, self.step, self.gap_mode
