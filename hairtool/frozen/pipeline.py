@@ -37,6 +37,7 @@ Built for dragging in the studio:
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields, replace
@@ -66,7 +67,7 @@ from hairtool.frozen.clump import (
     record_key,
     vertex_strength,
 )
-from hairtool.frozen.collide import MARGIN, KeepOut, collide
+from hairtool.frozen.collide import MARGIN, CollisionSurface, KeepOut, collide
 from hairtool.frozen.density import accept, disc_candidates, thin
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.lengths import restore_lengths
@@ -402,6 +403,23 @@ class FrozenPipeline:
     def surface(self) -> Surface | None:
         """The head's surface (:class:`~hairtool.frozen.slide.Surface`) slide needs, or None."""
         return self._surface
+
+    @property
+    def _head(self) -> CollisionSurface | None:
+        """The surface strokes collide with (one that tells signed distances), or None."""
+        surface = self._surface
+        return surface if surface is not None and hasattr(surface, "signed_distance") else None
+
+    @property
+    def _collision_margin(self) -> float:
+        """How far outside the head a collision leaves a vertex: :data:`MARGIN` of the rest box's diagonal."""
+        lo, hi = self._rest.bounds
+        return MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
+
+    @functools.cached_property
+    def _keep_out(self) -> KeepOut:
+        """:func:`~hairtool.frozen.collide.keep_out` with its memory of the head's distances."""
+        return KeepOut()
 
     # -- operations ----------------------------------------------------------------------
     def set_surface(self, surface: Surface | None) -> Groom:
@@ -743,11 +761,9 @@ class FrozenPipeline:
             return g
         out = self._apply_one(g, sample)
         moves = isinstance(sample, AlignSample) or sample.brush not in MOVE_NONE
-        surface = self._surface
-        if moves and sample.collide and surface is not None and hasattr(surface, "signed_distance"):
-            lo, hi = self._rest.bounds
-            margin = MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
-            out = collide(g, out, surface, margin)  # type: ignore[arg-type]
+        head = self._head
+        if moves and sample.collide and head is not None:
+            out = collide(g, out, head, self._collision_margin)
         return out
 
     def _apply_one(self, g: Groom, sample: Sample) -> Groom:
@@ -850,31 +866,23 @@ class FrozenPipeline:
         _ = self.root_normals, self.scalp_centre
         if self._local is not None:
             self._local.grid.prepare(int(region_share * self._aligned.vertex_count))
-        surface = self._surface
-        if (
-            surface is not None
-            and hasattr(surface, "signed_distance")
-            and self._aligned.vertex_count <= PREPARED_HEAD
-        ):  # the head's distances a first stroke that collides would ask for
-            kept = self.__dict__.setdefault("_keep_out", KeepOut())
-            kept.remember(self._aligned, self._result, surface)
+        head = self._head
+        if head is not None and self._aligned.vertex_count <= PREPARED_HEAD:
+            self._keep_out.remember(self._aligned, self._result, head)  # what a first collision asks
 
     def _kept_out(self, clumped: Groom) -> Groom:
         """Clumping respects the head: where strokes collide with it (a sample that moves points
         with ``collide``), the strands clumping pulled back inside are pushed out again
         (:func:`~hairtool.frozen.collide.keep_out`), so no brushed vertex ends inside."""
-        surface = self._surface
-        if surface is None or not hasattr(surface, "signed_distance"):
+        head = self._head
+        if head is None:
             return clumped
         if not any(
             getattr(s, "collide", False) and (isinstance(s, AlignSample) or s.brush not in MOVE_NONE)
             for s in self._log
         ):
             return clumped
-        lo, hi = self._rest.bounds
-        margin = MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
-        kept = self.__dict__.setdefault("_keep_out", KeepOut())  # (its memory: the head's distances)
-        return kept(self._aligned, clumped, surface, margin)
+        return self._keep_out(self._aligned, clumped, head, self._collision_margin)
 
     # -- brush-local moves (hairtool.frozen.local) ---------------------------------------
     def _local_ready(self, samples: Sequence[Sample]) -> bool:
@@ -1029,11 +1037,9 @@ class FrozenPipeline:
             out = pinch(sub, sample, lock)
         else:
             out = apply_brush(sub, sample, lock, self.scalp_centre)
-        surface = self._surface
-        if sample.collide and surface is not None and hasattr(surface, "signed_distance"):
-            lo, hi = self._rest.bounds
-            margin = MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
-            out = collide(sub, out, surface, margin)  # type: ignore[arg-type]
+        head = self._head
+        if sample.collide and head is not None:
+            out = collide(sub, out, head, self._collision_margin)
         return out, none
 
 
