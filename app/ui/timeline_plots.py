@@ -218,8 +218,8 @@ class TimelineView(QWidget):
             self._pan = (event.position().x(), self.view_range)
             event.accept()
         elif event.button() == Qt.MouseButton.LeftButton:
+            self.model.set_scrubbing(True)  # (first: a pause stays live while the frame is dragged)
             self.model.pause()
-            self.model.set_scrubbing(True)
             self._grab = self.key_at(event.position()) if self.steer is not None else None
             self._press_x, self._dragging = event.position().x(), False
             frame = self._grab if self._grab is not None else self.x_to_frame(event.position().x())

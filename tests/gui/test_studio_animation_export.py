@@ -268,7 +268,7 @@ def test_a_video_of_render_hair_draws_the_children(render_hair_window, out):
 
 
 def test_a_playing_animation_draws_its_children_unclumped_and_the_frame_it_stops_on_clumped(
-    ui, render_hair_window
+    ui, render_hair_window, monkeypatch
 ):
     """Clumping every child on every frame would hold playback to a few frames a second on
     Sintel: while it plays the view draws them as interpolated, the frame it stops on (and any
@@ -304,3 +304,10 @@ def test_a_playing_animation_draws_its_children_unclumped_and_the_frame_it_stops
     assert not s.frames_live
     want = RenderHair(b, s.children_clump()).update(anim.frame(5)).points
     np.testing.assert_array_equal(v.drawn().points[:n], want)
+    model.play()  # a press while it plays: it pauses and stays live until the release
+    live = []
+    monkeypatch.setattr(s, "set_frames_live", lambda on: live.append(on) or setattr(s, "frames_live", on))
+    ui.send_mouse(view, "press", (view.frame_to_x(4), y), left, left)
+    assert not model.playing and s.frames_live and live == []
+    ui.send_mouse(view, "release", (view.frame_to_x(4), y), left, None)
+    assert live == [False]
