@@ -177,6 +177,7 @@ def _engine_step() -> None:
         cursor = centre + np.array([0.05 * i * extent, 0.0, 0.0])
         pipe.apply_samples(tool.samples(cursor, (1.0, 0.0, 0.0), (0.0, 0.0, -1.0), plane))
         tool.touches(pipe.aligned.points, cursor, plane)
+    pipe.settle()  # the release: its neighbour list brought up to date where the drag moved strands
     _press_step(pipe)
 
 

@@ -16,6 +16,11 @@ step), and ``drag_per_crop`` their ratio: near 1 when a move costs the brush, no
 (target: drag_ms ≤ 1.5 × crop_ms + 1 ms). ``lists_ms``: of a drag move, the kept grid's update
 and the region's neighbour lists, against ``list_ms``, the list built cold for the whole groom,
 and ``grid_ms``, the kept grid's cold build (once per groom).
+The release after a comb stroke (:func:`comb_stroke`: the strands within the brush of that tip,
+moved as a comb moves them): ``release_ms``, ClumpWithGaps on the whole groom with the list of
+the points before the stroke brought up to date (:mod:`hairtool.frozen.neighbour_update`, the
+studio's release), against ``release_cold_ms`` with it built from scratch (what every run cost
+before), ``stroke_moved`` the share of the vertices the stroke moved.
 ``reference_ms``: the pipeline with the numpy twins (null above ``--reference-limit`` vertices).
 ``mean_neighbours``: other-strand vertices within h per moving vertex; ``threads``: numba threads.
 """
@@ -25,6 +30,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import os
+import time
 from pathlib import Path
 
 HELP = "time FreezeDeform, UserAlign, ClumpWithGaps and the whole pipeline against numpy"
@@ -126,6 +132,59 @@ def _drag_ms(pipe, path, radius: float) -> tuple[float, float, float]:
     return ms, sum(redone) / len(redone), statistics.median(lists)
 
 
+def comb_stroke(rest, centre, radius: float, shift):
+    """``rest``'s points after a comb stroke: the strands with a vertex within ``radius`` of
+    ``centre`` moved by ``shift`` times their share of the way from root (0) to tip (1)."""
+    import numpy as np
+
+    p = rest.points.astype(np.float64)
+    e = p - np.asarray(centre, np.float64)
+    near = np.einsum("ij,ij->i", e, e) < radius * radius
+    top = rest.topology
+    hit = np.logical_or.reduceat(near, rest.offsets[:-1])[top.strand_index]
+    along = (np.arange(rest.vertex_count) - rest.offsets[top.strand_index]) / np.maximum(
+        np.diff(rest.offsets)[top.strand_index] - 1, 1
+    )
+    out = rest.points.copy()
+    out[hit] += (along[hit, None] * np.asarray(shift, np.float64)[None]).astype(out.dtype)
+    return out
+
+
+def release_times(rest, repeat: int, h: float | None = None) -> dict:
+    """The release after a comb stroke near the middle tip (see the module doc)."""
+    import numpy as np
+
+    from hairtool.bench import median_ms
+    from hairtool.frozen.clump import ClumpWorkspace, clump_points
+    from hairtool.frozen.strand_clumps import auto_clump_radius
+
+    h = float(auto_clump_radius(rest)) if h is None else h
+    path, radius = _drag_path(rest)
+    centre = path.mean(axis=0)  # the tip the drag circles
+    after = rest.with_points(comb_stroke(rest, centre, radius, (radius, 0.5 * radius, 0.0)))
+    ws = ClumpWorkspace()
+
+    def run(g):
+        clump_points(g, h, 3, None, "printed", 0, ws)
+
+    def stroked():  # back to the points before the stroke (untimed), then the release
+        run(rest)
+        t0 = time.perf_counter()
+        run(after)
+        return time.perf_counter() - t0
+
+    run(rest)
+    run(after)
+    updates = ws.updates
+    release = float(np.median([stroked() for _ in range(repeat)])) * 1e3
+    return {
+        "release_ms": release,
+        "release_cold_ms": median_ms(lambda: (ws.invalidate(), run(after)), repeat),
+        "release_updated": ws.updates > updates,
+        "stroke_moved": float(np.mean(np.any(after.points != rest.points, axis=1))),
+    }
+
+
 def _crop(rest, path, radius: float):
     """The strands of ``rest`` with a vertex within two brush radii of the path."""
     import numpy as np
@@ -220,6 +279,7 @@ def run(args: argparse.Namespace) -> list[dict]:
             "update_ms": median_ms(lambda p=pipe, c=c, r=r: p.align(c, r, 0.8), repeat),
         }
         row.update(_drag_and_crop(rest))
+        row.update(release_times(rest, max(1, min(repeat, 5)), h))
         row["grid_ms"] = median_ms(
             lambda r=rest, h=h: VertexGrid(r.points, r.topology.strand_index, 1.1 * h), max(1, min(repeat, 5))
         )

@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
 from hairtool.frozen.lengths import restore_lengths, restore_lengths_reference
+from hairtool.frozen.neighbour_update import moved_vertices, update_list
 from hairtool.frozen.noise import (
     CH_CLUMP,
     EPS,
@@ -354,15 +355,6 @@ def _scatter_stats(order, count, weight, out_count, out_weight):
 
 
 @njit(cache=True, nogil=True)
-def _same_points(points, ref):
-    for i in range(points.shape[0]):
-        for a in range(3):
-            if points[i, a] != ref[i, a]:
-                return False
-    return True
-
-
-@njit(cache=True, nogil=True)
 def step_from_stats(h, w_sum, w_count):
     """The automatic Δt²/m from Σg summed over the vertices with neighbours (see :func:`auto_step`)."""
     return STEP_FRACTION * h / max(w_sum / max(w_count, 1), 1.0)
@@ -472,7 +464,8 @@ class ClumpWorkspace:
         self.neighbours = NeighbourList()
         self.mean_neighbours = 0.0  # other-strand vertices within h per moving vertex, first iteration
         self.step = 0.0  # Δt²/m used in the last run
-        self.builds = 0  # neighbour lists built so far (the rest of the runs reused one)
+        self.builds = 0  # neighbour lists built so far (the rest of the runs reused or updated one)
+        self.updates = 0  # lists brought up to date where vertices moved (neighbour_update)
         self.record = False  # keep a ClumpRecord of each run (the studio's updates in a region)
         self.recorded: ClumpRecord | None = None  # kept for its buffers even when not valid
         self._mask_for: object = None
@@ -493,15 +486,23 @@ class ClumpWorkspace:
         return self._mask
 
     def neighbour_list(self, groom: Groom, h: float) -> NeighbourList:
-        """The list of the vertices of other strands within h·(1 + MARGIN), built again only when
-        the points differ from those of the last build. (A Verlet skin that lets a list outlive
-        small moves was measured and left out: in a drag the dragged strands move farther than a
-        skin worth its cost on every move.)"""
+        """The list of the vertices of other strands within h·(1 + MARGIN) at these points: the
+        last one as it is when no point moved, brought up to date where some did
+        (:mod:`hairtool.frozen.neighbour_update`: a stroke's release), built again otherwise.
+        (A Verlet skin that lets a list outlive small moves was measured and left out: in a drag
+        the dragged strands move farther than a skin worth its cost on every move.)"""
         top = groom.topology
         radius = h * (1.0 + MARGIN)
         b = self._built
         if b is not None and b[0] is top and b[1] == radius:
-            if _same_points(groom.points, b[2]):  # against a copy: any array may be passed in
+            moved = moved_vertices(groom.points, b[2])  # against a copy: any array may be passed in
+            if moved.size == 0:
+                return self.neighbours
+            self._built = None
+            if update_list(self.neighbours, groom.points, top.strand_index, self.roots_mask(top), moved):
+                b[2][moved] = groom.points[moved]
+                self._built = b
+                self.updates += 1
                 return self.neighbours
         self._built = None
         self.neighbours.build(groom.points, top.strand_index, self.roots_mask(top), radius)

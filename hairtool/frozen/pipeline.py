@@ -378,9 +378,15 @@ class FrozenPipeline:
 
     @property
     def neighbour_builds(self) -> int:
-        """ClumpWithGaps neighbour lists built so far (an update on the points of the last
-        build reuses its list)."""
+        """ClumpWithGaps neighbour lists built so far (a run on the points of the last one
+        reuses its list, and one after a stroke updates it: :attr:`neighbour_updates`)."""
         return self._workspace.builds
+
+    @property
+    def neighbour_updates(self) -> int:
+        """Neighbour lists brought up to date where strands moved, rather than built again
+        (:mod:`hairtool.frozen.neighbour_update`)."""
+        return self._workspace.updates
 
     @property
     def clump_redone(self) -> float:

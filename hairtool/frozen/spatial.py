@@ -195,6 +195,47 @@ def _scan_row(sx, sy, sz, sstrand, j, end, px, py, pz, si, sweep, xb, r2, jmin, 
     return j, pos
 
 
+@njit(cache=True, nogil=True)
+def _search_row(sx, sy, sz, sstrand, start, ny, nz, r, reach, r2, flat, pos, lim, fcnt):
+    """The forward entries of row r's vertices (see :func:`_forward_kernel`), written from
+    ``flat[pos]`` on; ``fcnt[i]`` of each. Returns the write position after them."""
+    a0, b0 = start[r], start[r + 1]
+    if a0 == b0:
+        return pos
+    cy = r % ny
+    cz = r // ny
+    # Missing rows (outside the grid) are empty runs [0, 0).
+    r1 = r + 1 if cy + 1 < ny else -1
+    r2_ = r + ny - 1 if cz + 1 < nz and cy >= 1 else -1
+    r3 = r + ny if cz + 1 < nz else -1
+    r4 = r + ny + 1 if cz + 1 < nz and cy + 1 < ny else -1
+    j1, e1 = (start[r1], start[r1 + 1]) if r1 >= 0 else (0, 0)
+    j2, e2 = (start[r2_], start[r2_ + 1]) if r2_ >= 0 else (0, 0)
+    j3, e3 = (start[r3], start[r3 + 1]) if r3 >= 0 else (0, 0)
+    j4, e4 = (start[r4], start[r4 + 1]) if r4 >= 0 else (0, 0)
+    for i in range(a0, b0):
+        px, py, pz = sx[i], sy[i], sz[i]
+        si = sstrand[i]
+        p0 = pos
+        sw, xb = px - reach, px + reach  # entries right of xb fail the distance test
+        _, pos = _scan_row(
+            sx, sy, sz, sstrand, i + 1, b0, px, py, pz, si, -np.inf, xb, r2, i + 1, flat, pos, lim
+        )
+        j1, pos = _scan_row(sx, sy, sz, sstrand, j1, e1, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim)
+        j2, pos = _scan_row(sx, sy, sz, sstrand, j2, e2, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim)
+        j3, pos = _scan_row(sx, sy, sz, sstrand, j3, e3, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim)
+        j4, pos = _scan_row(sx, sy, sz, sstrand, j4, e4, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim)
+        fcnt[i] = pos - p0
+    return pos
+
+
+@njit(cache=True, nogil=True)
+def search_reach(r2, slack, cell):
+    """How far right of a vertex's x its forward search looks: r, and the slack of the sort's
+    quantised x on both sides (each row is in x order to within it)."""
+    return np.sqrt(r2) * (1.0 + 1e-6) + 2.0 * slack + 1e-12 * cell
+
+
 @twin_njit(nogil=True, parallel=True)
 def _forward_kernel(
     sx, sy, sz, sstrand, start, ny, nz, cell, r2, slack, chunks, base, limit, flat, fcnt, used
@@ -206,47 +247,12 @@ def _forward_kernel(
     window's start only moves forward (a sweep line). One task per chunk of rows; vertex i's
     entries go to ``flat[base[c] + …]`` in the order found, ``fcnt[i]`` of them; ``used[c]``
     counts what chunk c needed (it overflowed when that exceeds its room)."""
-    grow = 2.0 * slack  # windows a little longer, for the quantised order
-    reach = np.sqrt(r2) * (1.0 + 1e-6) + grow + 1e-12 * cell
+    reach = search_reach(r2, slack, cell)
     for c in prange(chunks.size - 1):
         pos = base[c]
         lim = limit[c]  # the last slot is scratch for the branch-free writes
         for r in range(chunks[c], chunks[c + 1]):
-            a0, b0 = start[r], start[r + 1]
-            if a0 == b0:
-                continue
-            cy = r % ny
-            cz = r // ny
-            # Missing rows (outside the grid) are empty runs [0, 0).
-            r1 = r + 1 if cy + 1 < ny else -1
-            r2_ = r + ny - 1 if cz + 1 < nz and cy >= 1 else -1
-            r3 = r + ny if cz + 1 < nz else -1
-            r4 = r + ny + 1 if cz + 1 < nz and cy + 1 < ny else -1
-            j1, e1 = (start[r1], start[r1 + 1]) if r1 >= 0 else (0, 0)
-            j2, e2 = (start[r2_], start[r2_ + 1]) if r2_ >= 0 else (0, 0)
-            j3, e3 = (start[r3], start[r3 + 1]) if r3 >= 0 else (0, 0)
-            j4, e4 = (start[r4], start[r4 + 1]) if r4 >= 0 else (0, 0)
-            for i in range(a0, b0):
-                px, py, pz = sx[i], sy[i], sz[i]
-                si = sstrand[i]
-                p0 = pos
-                sw, xb = px - reach, px + reach  # entries right of xb fail the distance test
-                _, pos = _scan_row(
-                    sx, sy, sz, sstrand, i + 1, b0, px, py, pz, si, -np.inf, xb, r2, i + 1, flat, pos, lim
-                )
-                j1, pos = _scan_row(
-                    sx, sy, sz, sstrand, j1, e1, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
-                )
-                j2, pos = _scan_row(
-                    sx, sy, sz, sstrand, j2, e2, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
-                )
-                j3, pos = _scan_row(
-                    sx, sy, sz, sstrand, j3, e3, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
-                )
-                j4, pos = _scan_row(
-                    sx, sy, sz, sstrand, j4, e4, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
-                )
-                fcnt[i] = pos - p0
+            pos = _search_row(sx, sy, sz, sstrand, start, ny, nz, r, reach, r2, flat, pos, lim, fcnt)
         used[c] = pos - base[c]
 
 
@@ -400,6 +406,8 @@ class NeighbourList:
         self.capacity = 16  # padded row width of the hashed path; grows with the densest vertex
         self._nbr = np.empty((0, self.capacity), np.int32)
         self._start = np.empty(0, np.int64)
+        self.dense = False
+        self.chunks: np.ndarray | None = None  # the row grid's search chunks (rows), kept for updates
 
     def of(self, k: int) -> np.ndarray:
         """Sorted positions of the neighbours of the vertex at sorted position ``k``."""
@@ -442,6 +450,7 @@ class NeighbourList:
         dense: bool | None = None,
     ) -> None:
         """``dense``: force the row grid (True) or the hashed one (False); None picks by size."""
+        self.chunks = None
         lo, hi, dims = self._grid(points, radius, dense)
         if self.dense:
             self._sort_rows(points, strand, skip, lo, hi, dims)
@@ -482,9 +491,10 @@ class NeighbourList:
         )  # fmt: skip
         _gather(self.order, points, strand, skip, self.x, self.y, self.z, self.strand, self.skip)
         self.slack = width / nq
+        self.nq, self.inv_q = nq, nq / width
         self.dims = dims
         self.start = start
-        self.lo = lo
+        self.lo, self.hi = lo, hi
 
     def _search_rows(self, v) -> None:
         start, dims, cell = self.start, self.dims, self.radius
@@ -510,6 +520,8 @@ class NeighbourList:
                 break
             self._per_vertex = 1.5 * need + 2.0
         _vertex_offsets(chunks, start, base, self.acnt, self.aoff)
+        # Kept for hairtool.frozen.neighbour_update: chunk c's entries stay in [base, limit].
+        self.chunks, self.base, self.limit = chunks, base, base + room - 1
         backward = int(self.acnt.sum())  # each forward entry (i finds j) is one of j's backward ones
         self.forward_entries = backward
         if self.bflat.size < backward:  # so the transpose always has its room, in one pass
@@ -533,6 +545,7 @@ class NeighbourList:
             self.order, points, strand, skip, self.keys, self.x, self.y, self.z, self.strand, self.skip, skeys
         )
         self.dims = None
+        self.chunks = None
         self.start = start
         cnt = self.acnt
         while True:
