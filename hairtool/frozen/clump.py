@@ -499,7 +499,9 @@ class ClumpWorkspace:
             if moved.size == 0:
                 return self.neighbours
             self._built = None
-            if update_list(self.neighbours, groom.points, top.strand_index, self.roots_mask(top), moved):
+            if update_list(
+                self.neighbours, groom.points, b[2], top.strand_index, self.roots_mask(top), moved
+            ):
                 b[2][moved] = groom.points[moved]
                 self._built = b
                 self.updates += 1

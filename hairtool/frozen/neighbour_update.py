@@ -2,13 +2,15 @@
 
 A brush stroke moves the strands under the brush; the full run on release wants the list of
 the new points, and a build from scratch costs half of that run on a big groom. On the row grid
-(:class:`~hairtool.frozen.spatial.NeighbourList`), a vertex's lists depend only on the rows
-(y, z cells) around it, so an update:
+(:class:`~hairtool.frozen.spatial.NeighbourList`), a vertex's list is the vertices of other
+strands within r in the rows (y, z cells) around it, in those rows' order, so an update:
 
 1. re-sorts the rows that held or now hold a moved vertex (the others keep their order and
    only shift by their row's new start);
-2. searches again from the vertices whose forward search reaches such a row, and gives every
-   other vertex of the stretch its old entries with the shift applied;
+2. searches again from the moved vertices and from the vertices whose search found a moved
+   vertex where it was (its backward list) or can find it where it is (those near it in the
+   rows before it): no other list gained or lost an entry, so every other vertex of the
+   stretch keeps its old entries, each moved to its vertex's new sorted position;
 3. transposes again the backward lists of the stretch of rows the change reaches.
 
 Everything outside that stretch stays as it was. The result is the list a build from scratch
@@ -23,9 +25,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from hairtool.frozen.spatial import NeighbourList, _search_row, search_reach
+from hairtool.frozen.spatial import NeighbourList, _gather, _scan_row, search_reach
 from hairtool.serial_twins import twin_njit
 
+BACKWARD_BLOCKS = 16  # tasks of the backward lists' transpose (the lists do not depend on them)
 UPDATE_SHARE = 0.25  # moved vertices, as a share of all, above which a build is cheaper
 SPAN_SHARE = 0.8  # sorted positions between the first and last row that changed, as a share, above
 # which likewise (2-core VM: an update over 0.8 of the mohawk cost 0.6 of a build, over 0.8 of a
@@ -51,11 +54,12 @@ def moved_vertices_reference(points: np.ndarray, ref: np.ndarray) -> np.ndarray:
 
 
 @twin_njit(nogil=True, parallel=True)
-def _resort_rows(ra, rb, old_start, start, old_order, moved, arrivals, arr_start, qx, order):
+def _resort_rows(ra, rb, old_start, start, old_order, moved, arrivals, arr_start, qx, order, came, mold):
     """The new order of rows [ra, rb]: a row without a moved vertex, old or new, is its old run
     moved to its new start; another merges its unmoved vertices (already in (quantised x, index)
     order) with the moved vertices that now lie in it, in the same order, as the build's stable
-    counting sorts would."""
+    counting sorts would. ``came[w − p0]``: the old position of the vertex now at w (−1: moved);
+    ``mold[m]``: the old position of moved vertex m."""
     p0 = old_start[0]
     for r in prange(ra, rb + 1):
         a, b = old_start[r - ra] - p0, old_start[r - ra + 1] - p0
@@ -63,6 +67,7 @@ def _resort_rows(ra, rb, old_start, start, old_order, moved, arrivals, arr_start
         w = start[r]
         while a < b or m < e:
             if a < b and moved[old_order[a]]:
+                mold[old_order[a]] = p0 + a
                 a += 1
                 continue
             take_old = m == e
@@ -71,55 +76,129 @@ def _resort_rows(ra, rb, old_start, start, old_order, moved, arrivals, arr_start
                 take_old = qx[i] < qx[j] or (qx[i] == qx[j] and i < j)
             if a < b and take_old:
                 order[w] = old_order[a]
+                came[w - p0] = p0 + a
                 a += 1
             else:
                 order[w] = arrivals[m]
+                came[w - p0] = -1
                 m += 1
             w += 1
 
 
 @twin_njit(nogil=True, parallel=True)
-def _gather_span(p0, p1, order, points, strand, skip, sx, sy, sz, sstrand, sskip):
-    for k in prange(p0, p1):
-        i = order[k]
-        sx[k] = points[i, 0]
-        sy[k] = points[i, 1]
-        sz[k] = points[i, 2]
-        sstrand[k] = strand[i]
-        sskip[k] = skip[i]
+def _inverse(came, p0, to_new):
+    """``to_new[o − p0]``: where the vertex at old position o is now (−1: it moved)."""
+    for k in prange(to_new.size):
+        to_new[k] = -1
+    for k in prange(came.size):
+        if came[k] >= 0:
+            to_new[came[k] - p0] = p0 + k
 
 
 @njit(cache=True, nogil=True)
-def _search_rows_marked(changed, ny, nz, rw0, rb, search):
-    """``search[r − rw0]``: whether row r's forward search reaches a changed row (the search's
-    own rows: r, (y+1, z), (y−1..y+1, z+1))."""
-    n_rows = changed.size
-    for r in range(rw0, rb + 1):
+def _first_at(order, qx, a, b, q):
+    """The first position in [a, b) of a row (in quantised-x order) whose vertex's quantised x
+    is at least q (b: none)."""
+    while a < b:
+        m = (a + b) // 2
+        if qx[order[m]] < q:
+            a = m + 1
+        else:
+            b = m
+    return a
+
+
+@twin_njit(nogil=True, parallel=True)
+def _mark_finders(moved, mold, bstart, bflat, p0, to_new, mark):
+    """Mark the vertices that found a moved vertex where it was: its backward list before."""
+    p1 = p0 + to_new.size
+    for k in prange(moved.size):
+        o = mold[moved[k]]
+        for e in range(bstart[o], bstart[o + 1]):
+            i = bflat[e]
+            if p0 <= i < p1:
+                i = to_new[i - p0]
+            if i >= 0:
+                mark[i] = True
+
+
+@twin_njit(nogil=True, parallel=True)
+def _mark_new_finders(p0, came, lo0, inv_q, ny, nz, reach, sx, sy, sz, start, order, qx, keys, mark):
+    """Mark the vertices whose search can find a moved vertex where it is now: those within
+    ``reach`` of it before it in its row and in the rows before its own among the 3 × 3 around
+    it (the rows whose search reaches its row)."""
+    for k in prange(came.size):
+        if came[k] >= 0:
+            continue
+        w = p0 + k
+        x, y, z = sx[w], sy[w], sz[w]
+        qlo = np.int64(np.floor((x - reach - lo0) * inv_q)) - 1
+        qhi = np.int64(np.floor((x + reach - lo0) * inv_q)) + 1
+        r = keys[order[w]]
         cy, cz = r % ny, r // ny
-        s = changed[r]
-        if cy + 1 < ny:
-            s |= changed[r + 1]
-        if cz + 1 < nz:
-            s |= changed[r + ny]
-            if cy >= 1:
-                s |= changed[r + ny - 1]
-            if cy + 1 < ny and r + ny + 1 < n_rows:
-                s |= changed[r + ny + 1]
-        search[r - rw0] = s
+        for dz in range(-1, 1):
+            if cz + dz < 0:
+                continue
+            for dy in range(-1, 2):
+                if (dz == 0 and dy > 0) or cy + dy < 0 or cy + dy >= ny:
+                    continue
+                row = r + dz * ny + dy
+                end = w if dz == 0 and dy == 0 else start[row + 1]
+                j = _first_at(order, qx, start[row], end, qlo)
+                while j < end and qx[order[j]] <= qhi:
+                    ex, ey, ez = sx[j] - x, sy[j] - y, sz[j] - z
+                    if ex * ex + ey * ey + ez * ez < reach * reach:
+                        mark[j] = True
+                    j += 1
+
+
+@njit(cache=True, nogil=True)
+def _search_vertex(
+    i, r, sx, sy, sz, sstrand, start, order, qx, lo0, inv_q, ny, nz, reach, r2, flat, pos, lim
+):
+    """Vertex i's forward entries (it lies in row r), as :func:`~hairtool.frozen.spatial.
+    _search_row` finds them, each row's scan started where its quantised x reaches the window
+    (a search of its own row's neighbours would start where the row's earlier vertices left it:
+    the entries in between are not within reach, so the hits are the same, in the same order)."""
+    cy, cz = r % ny, r // ny
+    px, py, pz = sx[i], sy[i], sz[i]
+    si = sstrand[i]
+    xb = px + reach
+    q = np.int64(np.floor((px - reach - lo0) * inv_q)) - 1
+    _, pos = _scan_row(
+        sx, sy, sz, sstrand, i + 1, start[r + 1], px, py, pz, si, -np.inf, xb, r2, i + 1, flat, pos, lim
+    )
+    for k in range(4):
+        if k == 0:
+            row = r + 1 if cy + 1 < ny else -1
+        elif k == 1:
+            row = r + ny - 1 if cz + 1 < nz and cy >= 1 else -1
+        elif k == 2:
+            row = r + ny if cz + 1 < nz else -1
+        else:
+            row = r + ny + 1 if cz + 1 < nz and cy + 1 < ny else -1
+        if row < 0:
+            continue
+        a, e = start[row], start[row + 1]
+        j = _first_at(order, qx, a, e, q)
+        _, pos = _scan_row(sx, sy, sz, sstrand, j, e, px, py, pz, si, -np.inf, xb, r2, 0, flat, pos, lim)
+    return pos
 
 
 @twin_njit(nogil=True, parallel=True)
 def _rewrite_forward(
-    c0, c1, chunks, base, limit, rw0, rb, search, row_shift, p_lo, pos_shift,
+    c0, c1, chunks, base, limit, rw0, rb, mark, p0, came, to_new,
     old_aflat, old_aoff, old_acnt, a0,
-    sx, sy, sz, sstrand, start, ny, nz, reach, r2, aflat, aoff, acnt, over,
+    sx, sy, sz, sstrand, start, order, qx, lo0, inv_q, ny, nz, reach, r2, aflat, aoff, acnt, over,
 ):  # fmt: skip
     """Chunks c0..c1 of the forward entries again, each from its base: rows before ``rw0`` as
-    they were; rows [rw0, rb] searched again (``search``) or with their old entries; later rows
-    with their old entries, every old sorted position in them shifted (``pos_shift`` over the
-    old positions from ``p_lo``). ``old_*``: the chunks' entries and each vertex's offset and
-    count before (vertices from ``a0`` on); ``over[c − c0]``: the chunk outgrew its room."""
-    p_hi = p_lo + pos_shift.size
+    they were; in rows [rw0, rb] the moved vertices and those ``mark``ed searched again, the
+    others given their old entries; later rows their old entries. An old entry's sorted
+    position o in [p0, p0 + to_new.size) becomes ``to_new[o − p0]``, a vertex's old position
+    is ``came[p − p0]`` there (−1: moved). ``old_*``: the chunks' entries and each vertex's
+    offset and count before (vertices from ``a0`` on); ``over[c − c0]``: the chunk outgrew its
+    room."""
+    p1 = p0 + came.size
     for c in prange(c0, c1 + 1):
         pos = base[c]
         lim = limit[c]
@@ -128,61 +207,98 @@ def _rewrite_forward(
                 for p in range(start[r], start[r + 1]):
                     pos += old_acnt[p - a0]
                 continue
-            if r <= rb and search[r - rw0]:
-                q = pos
-                pos = _search_row(sx, sy, sz, sstrand, start, ny, nz, r, reach, r2, aflat, pos, lim, acnt)
-                for p in range(start[r], start[r + 1]):
-                    aoff[p] = q
-                    q += acnt[p]
-                continue
-            d = row_shift[r - rw0] if r <= rb else 0
             for p in range(start[r], start[r + 1]):
-                po = p - d  # the vertex's old position (its row kept its order)
-                o, n = old_aoff[po - a0] - base[c0], old_acnt[po - a0]
+                po = came[p - p0] if p0 <= p < p1 else p
                 aoff[p] = pos
+                if r <= rb and (po < 0 or mark[p]):
+                    q = pos
+                    pos = _search_vertex(
+                        p,
+                        r,
+                        sx,
+                        sy,
+                        sz,
+                        sstrand,
+                        start,
+                        order,
+                        qx,
+                        lo0,
+                        inv_q,
+                        ny,
+                        nz,
+                        reach,
+                        r2,
+                        aflat,
+                        pos,
+                        lim,
+                    )
+                    acnt[p] = pos - q
+                    continue
+                o, n = old_aoff[po - a0] - base[c0], old_acnt[po - a0]
                 acnt[p] = n
                 for k in range(o, o + n):
                     j = old_aflat[k]
-                    if p_lo <= j < p_hi:
-                        j += pos_shift[j - p_lo]
+                    if p0 <= j < p1:
+                        j = to_new[j - p0]
                     aflat[min(pos, lim)] = j
                     pos += 1
         over[c - c0] = pos > lim
 
 
-@njit(cache=True, nogil=True)
-def _backward_counts(s0, q0, q1, aflat, aoff, acnt, count):
-    """How many forward entries of the vertices [s0, q1) point at each vertex of [q0, q1)."""
-    count[:] = 0
-    for i in range(s0, q1):
-        for n in range(aoff[i], aoff[i] + acnt[i]):
-            j = aflat[n]
-            if q0 <= j < q1:
-                count[j - q0] += 1
+@twin_njit(nogil=True, parallel=True)
+def _backward_lists(blocks, sources, aflat, aoff, acnt, q0, count, bstart, bflat, bmap, write):
+    """The backward lists of the vertices [q0, …) in blocks of targets [blocks[b], blocks[b + 1]),
+    each from the vertices [sources[b], blocks[b + 1]) (the only ones whose search reaches it):
+    without ``write``, how many entries each gets (``count``); with it, the entries from
+    ``bstart`` on (``count`` the fill), each j's finders in increasing i and ``bmap`` each
+    entry's forward one, as the build's transpose writes them."""
+    for b in prange(blocks.size - 1):
+        t0, t1 = blocks[b], blocks[b + 1]
+        for j in range(t0, t1):
+            count[j - q0] = 0
+        for i in range(sources[b], t1):
+            for n in range(aoff[i], aoff[i] + acnt[i]):
+                j = aflat[n]
+                if t0 <= j < t1:
+                    if write:
+                        e = bstart[j] + count[j - q0]
+                        bflat[e] = i
+                        bmap[e] = n
+                    count[j - q0] += 1
 
 
-@njit(cache=True, nogil=True)
-def _backward_fill(s0, q0, q1, aflat, aoff, acnt, bstart, bflat, bmap, fill):
-    """The backward lists of [q0, q1) from the forward entries of [s0, q1): each j's finders
-    in increasing i, ``bmap`` each entry's forward one, as the build's transpose writes them."""
-    fill[:] = 0
-    for i in range(s0, q1):
-        for n in range(aoff[i], aoff[i] + acnt[i]):
-            j = aflat[n]
-            if q0 <= j < q1:
-                e = bstart[j] + fill[j - q0]
-                bflat[e] = i
-                bmap[e] = n
-                fill[j - q0] += 1
+def _target_blocks(start, ny, q0, q1, n):
+    """[q0, q1) in n blocks of positions, and for each the first vertex whose forward search
+    reaches it (ny + 1 rows before the block's first row)."""
+    blocks = np.unique(np.linspace(q0, q1, n + 1).astype(np.int64))
+    first_row = np.searchsorted(start, blocks[:-1], side="right") - 1
+    return blocks, start[np.maximum(first_row - ny - 1, 0)]
+
+
+def _moved_box(raw_box, old, new):
+    """The box of the points after a move of the points ``old`` to ``new``, from the box before,
+    without a pass over the others: where a moved point held an extreme of the box, None (the
+    box of all the points is needed)."""
+    lo, hi = raw_box
+    old = old.astype(np.float64)
+    if np.any(old == lo) or np.any(old == hi):
+        return None
+    new = new.astype(np.float64)
+    return np.minimum(lo, new.min(axis=0)), np.maximum(hi, new.max(axis=0))
 
 
 def update_list(
-    nl: NeighbourList, points: np.ndarray, strand: np.ndarray, skip: np.ndarray, moved: np.ndarray
+    nl: NeighbourList,
+    points: np.ndarray,
+    before: np.ndarray,
+    strand: np.ndarray,
+    skip: np.ndarray,
+    moved: np.ndarray,
 ) -> bool:
     """Bring ``nl``, a row-grid list built for the same vertices (``strand``, ``skip`` as then)
     at its radius, up to date for ``points``, where only the vertices ``moved`` (indices,
-    increasing) differ from its last points. False: not updated, and ``nl`` is left for a
-    build only."""
+    increasing) differ from ``before``, the points of its last build or update. False: not
+    updated, and ``nl`` is left for a build only."""
     v = len(nl.order)
     if not nl.dense or nl.chunks is None or points.shape[0] != v:
         return False
@@ -190,7 +306,7 @@ def update_list(
         return True
     if moved.size > UPDATE_SHARE * v:
         return False
-    lo, hi, dims = nl._grid(points, nl.radius, True)
+    lo, hi, dims = nl._grid(points, nl.radius, True, _moved_box(nl.raw_box, before[moved], points[moved]))
     if dims != nl.dims or not (np.array_equal(lo, nl.lo) and np.array_equal(hi, nl.hi)):
         return False
     ny, nz = dims[1], dims[2]
@@ -221,20 +337,36 @@ def update_list(
     is_moved = np.zeros(v, np.bool_)
     is_moved[moved] = True
     old_order = nl.order[p0:p1].copy()
-    _resort_rows(ra, rb, old_start, start, old_order, is_moved, arrivals, arr_start, nl._qx, nl.order)
-    _gather_span(p0, p1, nl.order, points, strand, skip, nl.x, nl.y, nl.z, nl.strand, nl.skip)
+    came = np.empty(p1 - p0, np.int64)
+    mold = np.empty(v, np.int64)  # (read at the moved vertices only)
+    _resort_rows(
+        ra, rb, old_start, start, old_order, is_moved, arrivals, arr_start, nl._qx, nl.order, came, mold
+    )
+    span = slice(p0, p1)
+    _gather(
+        nl.order[span],
+        points,
+        strand,
+        skip,
+        nl.x[span],
+        nl.y[span],
+        nl.z[span],
+        nl.strand[span],
+        nl.skip[span],
+    )
+    to_new = np.empty(p1 - p0, np.int64)
+    _inverse(came, p0, to_new)
 
     # 2. The forward entries of the chunks that hold rows [rw0, rb], rw0 the first row whose
-    # search reaches row ra.
-    changed = np.zeros(ny * nz, np.bool_)
-    changed[old_key] = True
-    changed[new_key] = True
+    # search reaches row ra: searched again for the vertices a moved vertex was or is near.
+    r2 = nl.radius**2
+    reach = search_reach(r2, nl.slack, nl.radius)
+    mark = np.zeros(v, np.bool_)
+    _mark_finders(moved, mold, nl.bstart, nl.bflat, p0, to_new, mark)
+    _mark_new_finders(
+        p0, came, lo[0], nl.inv_q, ny, nz, reach, nl.x, nl.y, nl.z, start, nl.order, nl._qx, nl.keys, mark
+    )
     rw0 = max(0, ra - ny - 1)
-    search = np.empty(rb - rw0 + 1, np.bool_)
-    _search_rows_marked(changed, ny, nz, rw0, rb, search)
-    row_shift = np.zeros(rb - rw0 + 1, np.int64)
-    row_shift[ra - rw0 :] = start[ra : rb + 1] - old_start[:-1]
-    pos_shift = np.repeat(row_shift[ra - rw0 :], np.diff(old_start))  # of each old position in [p0, p1)
     chunks, base, limit = nl.chunks, nl.base, nl.limit
     c0 = int(np.searchsorted(chunks, rw0, side="right") - 1)
     c1 = int(np.searchsorted(chunks, rb, side="right") - 1)
@@ -243,11 +375,10 @@ def update_list(
     old_acnt = nl.acnt[a0:a1].copy()
     old_aflat = nl.aflat[base[c0] : limit[c1] + 1].copy()
     over = np.zeros(c1 - c0 + 1, np.bool_)
-    r2 = nl.radius**2
     _rewrite_forward(
-        c0, c1, chunks, base, limit, rw0, rb, search, row_shift, p0, pos_shift,
+        c0, c1, chunks, base, limit, rw0, rb, mark, p0, came, to_new,
         old_aflat, old_aoff, old_acnt, a0,
-        nl.x, nl.y, nl.z, nl.strand, start, ny, nz, search_reach(r2, nl.slack, nl.radius), r2,
+        nl.x, nl.y, nl.z, nl.strand, start, nl.order, nl._qx, lo[0], nl.inv_q, ny, nz, reach, r2,
         nl.aflat, nl.aoff, nl.acnt, over,
     )  # fmt: skip
     if over.any():
@@ -259,9 +390,10 @@ def update_list(
     # last rewritten chunk's search reaches.
     qb = min(ny * nz - 1, int(chunks[c1 + 1]) - 1 + ny + 1)
     q0, q1 = int(start[rw0]), int(start[qb + 1])
-    s0 = int(start[max(0, rw0 - ny - 1)])
+    blocks, sources = _target_blocks(start, ny, q0, q1, BACKWARD_BLOCKS)
     count = np.empty(q1 - q0, np.int64)
-    _backward_counts(s0, q0, q1, nl.aflat, nl.aoff, nl.acnt, count)
+    lists = (nl.aflat, nl.aoff, nl.acnt, q0, count)
+    _backward_lists(blocks, sources, *lists, nl.bstart, nl.bflat, nl.bmap, False)
     bstart = nl.bstart
     total = int(bstart[-1])
     diff = int(count.sum()) - int(bstart[q1] - bstart[q0])
@@ -276,5 +408,5 @@ def update_list(
         nl.bmap[tail + diff : total + diff] = nl.bmap[tail:total]
         bstart[q1 + 1 :] += diff
     bstart[q0 + 1 : q1 + 1] = bstart[q0] + np.cumsum(count)
-    _backward_fill(s0, q0, q1, nl.aflat, nl.aoff, nl.acnt, bstart, nl.bflat, nl.bmap, count)
+    _backward_lists(blocks, sources, *lists, bstart, nl.bflat, nl.bmap, True)
     return True

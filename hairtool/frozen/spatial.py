@@ -458,9 +458,11 @@ class NeighbourList:
         else:
             self._build_hashed(points, strand, skip, lo, float(radius))
 
-    def _grid(self, points, radius, dense):
+    def _grid(self, points, radius, dense, raw_box=None):
+        """The grid of ``points``' box (``raw_box``: that box, when the caller knows it)."""
         v = points.shape[0]
-        lo, hi = (b.astype(np.float64) for b in box(points))
+        lo, hi = (b.astype(np.float64) for b in (box(points) if raw_box is None else raw_box))
+        self.raw_box = (lo, hi)
         extent = float((hi - lo).max())
         if not np.isfinite(extent):
             raise GroomError("the points have a non-finite coordinate")

@@ -93,6 +93,9 @@ def test_bench_freeze_json_rows(capsys):
             assert r[key] >= 0
         assert 0 < r["crop_strands"] <= r["strands"] and 0 <= r["drag_redone"] <= 1
         assert r["drag_per_crop"] is None or r["drag_per_crop"] > 0
+        # the release after a comb stroke, its list updated, against one built
+        assert r["release_ms"] > 0 and r["release_cold_ms"] > 0 and 0 < r["stroke_moved"] < 1
+        assert isinstance(r["release_updated"], bool)
 
 
 def test_bench_freeze_skips_the_reference_above_the_limit(capsys):

@@ -77,7 +77,7 @@ def test_strokes_update_the_list_to_the_one_a_build_gives(grooms_dir, name, upda
         new = stroke(pts, strand, is_root, centre, reach, rng.normal(size=3) * 3 * r)
         moved = moved_vertices(new, pts)
         assert np.array_equal(moved, moved_vertices_reference(new, pts))
-        if update_list(nl, new, strand, is_root, moved):
+        if update_list(nl, new, pts, strand, is_root, moved):
             updated += 1
         else:
             nl.build(new, strand, is_root, r)
@@ -96,14 +96,14 @@ def test_an_update_declines_when_the_grid_moves_or_too_much_moved():
     far = g.points.copy()
     tip = g.topology.offsets[1] - 1
     far[tip] += 100.0  # the box, and so the grid, grows
-    assert not update_list(nl, far, strand, is_root, np.array([tip]))
+    assert not update_list(nl, far, g.points, strand, is_root, np.array([tip]))
     most = g.points + np.float32(0.01)
     most[is_root] = g.points[is_root]
-    assert not update_list(nl, most, strand, is_root, moved_vertices(most, g.points))
-    assert update_list(nl, g.points.copy(), strand, is_root, np.zeros(0, np.int64))  # nothing moved
+    assert not update_list(nl, most, g.points, strand, is_root, moved_vertices(most, g.points))
+    assert update_list(nl, g.points.copy(), g.points, strand, is_root, np.zeros(0, np.int64))  # nothing moved
     hashed = NeighbourList()
     hashed.build(g.points, strand, is_root, r, dense=False)
-    assert not update_list(hashed, g.points, strand, is_root, np.array([tip]))
+    assert not update_list(hashed, g.points, g.points, strand, is_root, np.array([tip]))
 
 
 def test_a_chunk_that_outgrows_its_room_leaves_the_list_to_a_build():
@@ -114,9 +114,9 @@ def test_a_chunk_that_outgrows_its_room_leaves_the_list_to_a_build():
     nl.limit = nl.base + 1  # as if each chunk had room for one entry
     pts = g.points
     new = stroke(pts, strand, is_root, pts[len(pts) // 2], 0.1, (0.0, 0.0, 3 * r))
-    assert not update_list(nl, new, strand, is_root, moved_vertices(new, pts))
+    assert not update_list(nl, new, pts, strand, is_root, moved_vertices(new, pts))
     assert nl.chunks is None  # half rewritten: nothing updates it again
-    assert not update_list(nl, new, strand, is_root, moved_vertices(new, pts))
+    assert not update_list(nl, new, pts, strand, is_root, moved_vertices(new, pts))
 
 
 def test_a_clump_run_on_an_updated_list_gives_the_bytes_of_a_fresh_one(grooms_dir):
@@ -153,3 +153,28 @@ def test_a_stroke_on_the_bear_releases_on_its_updated_list_to_a_build_s_bytes(gr
     assert (updated.neighbour_builds, updated.neighbour_updates) == (1, 1)
     assert built.neighbour_builds == 2
     assert a.tobytes() == b.tobytes()
+
+
+@pytest.mark.parametrize("which", ["holds the box's extreme", "grows the box"])
+def test_the_box_after_an_update_is_the_box_of_the_points(which):
+    """An update finds the new box from the moved points alone, unless one of them held an
+    extreme of the old one; either way the list is a build's and its box the points' box."""
+    from hairtool.bounds import box
+
+    g = samples.scalp(1500, 12, seed=8)
+    r, strand, is_root = lists_of(g)
+    nl = NeighbourList()
+    nl.build(g.points, strand, is_root, r)
+    new = g.points.copy()
+    tip = int(np.argmax(np.where(is_root, -np.inf, g.points[:, 0])))  # the non-root vertex of largest x
+    assert g.points[tip, 0] == g.points[:, 0].max()  # it holds the box's largest x
+    new[tip, 0] += np.float32(-0.3 * r if which == "holds the box's extreme" else 0.2 * r)
+    updated = update_list(nl, new, g.points, strand, is_root, np.array([tip]))
+    if not updated:
+        nl.build(new, strand, is_root, r)
+    built = NeighbourList()
+    built.build(new, strand, is_root, r)
+    assert_same_lists(nl, built)
+    lo, hi = box(new)
+    assert np.array_equal(nl.raw_box[0], lo) and np.array_equal(nl.raw_box[1], hi)
+    assert updated
