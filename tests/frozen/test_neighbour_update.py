@@ -178,3 +178,23 @@ def test_the_box_after_an_update_is_the_box_of_the_points(which):
     lo, hi = box(new)
     assert np.array_equal(nl.raw_box[0], lo) and np.array_equal(nl.raw_box[1], hi)
     assert updated
+
+
+def test_undoing_a_stroke_on_the_bear_gives_back_the_result_before_it_on_an_updated_list(grooms_dir):
+    from hairtool.frozen.brushes import BrushSample, falloff_lut
+    from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+
+    g = read_groom(grooms_dir / "bear.tfx")
+    lut = tuple(falloff_lut("smooth").tolist())
+    ext = float(np.ptp(g.points[:, 0]))
+    pipe = FrozenPipeline(g, FrozenParams(seed=5))
+    before, shown = pipe.snapshot(), pipe.result.points.copy()
+    c = tuple(map(float, g.tips[900]))
+    pipe.apply_samples([BrushSample("comb", c, (0.02 * ext, 0.01 * ext, 0.0), 0.05 * ext, 0.9, lut)])
+    pipe.settle()
+    stroked = pipe.snapshot()
+    after = pipe.result.points.copy()
+    assert not np.array_equal(after, shown)
+    assert pipe.restore(before).points.tobytes() == shown.tobytes()  # undo
+    assert pipe.restore(stroked).points.tobytes() == after.tobytes()  # redo
+    assert pipe.neighbour_builds == 1 and pipe.neighbour_updates == 3
