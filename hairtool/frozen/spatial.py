@@ -196,40 +196,6 @@ def _scan_row(sx, sy, sz, sstrand, j, end, px, py, pz, si, sweep, xb, r2, jmin, 
 
 
 @njit(cache=True, nogil=True)
-def _search_row(sx, sy, sz, sstrand, start, ny, nz, r, reach, r2, flat, pos, lim, fcnt):
-    """The forward entries of row r's vertices (see :func:`_forward_kernel`), written from
-    ``flat[pos]`` on; ``fcnt[i]`` of each. Returns the write position after them."""
-    a0, b0 = start[r], start[r + 1]
-    if a0 == b0:
-        return pos
-    cy = r % ny
-    cz = r // ny
-    # Missing rows (outside the grid) are empty runs [0, 0).
-    r1 = r + 1 if cy + 1 < ny else -1
-    r2_ = r + ny - 1 if cz + 1 < nz and cy >= 1 else -1
-    r3 = r + ny if cz + 1 < nz else -1
-    r4 = r + ny + 1 if cz + 1 < nz and cy + 1 < ny else -1
-    j1, e1 = (start[r1], start[r1 + 1]) if r1 >= 0 else (0, 0)
-    j2, e2 = (start[r2_], start[r2_ + 1]) if r2_ >= 0 else (0, 0)
-    j3, e3 = (start[r3], start[r3 + 1]) if r3 >= 0 else (0, 0)
-    j4, e4 = (start[r4], start[r4 + 1]) if r4 >= 0 else (0, 0)
-    for i in range(a0, b0):
-        px, py, pz = sx[i], sy[i], sz[i]
-        si = sstrand[i]
-        p0 = pos
-        sw, xb = px - reach, px + reach  # entries right of xb fail the distance test
-        _, pos = _scan_row(
-            sx, sy, sz, sstrand, i + 1, b0, px, py, pz, si, -np.inf, xb, r2, i + 1, flat, pos, lim
-        )
-        j1, pos = _scan_row(sx, sy, sz, sstrand, j1, e1, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim)
-        j2, pos = _scan_row(sx, sy, sz, sstrand, j2, e2, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim)
-        j3, pos = _scan_row(sx, sy, sz, sstrand, j3, e3, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim)
-        j4, pos = _scan_row(sx, sy, sz, sstrand, j4, e4, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim)
-        fcnt[i] = pos - p0
-    return pos
-
-
-@njit(cache=True, nogil=True)
 def search_reach(r2, slack, cell):
     """How far right of a vertex's x its forward search looks: r, and the slack of the sort's
     quantised x on both sides (each row is in x order to within it)."""
@@ -247,12 +213,46 @@ def _forward_kernel(
     window's start only moves forward (a sweep line). One task per chunk of rows; vertex i's
     entries go to ``flat[base[c] + …]`` in the order found, ``fcnt[i]`` of them; ``used[c]``
     counts what chunk c needed (it overflowed when that exceeds its room)."""
-    reach = search_reach(r2, slack, cell)
+    reach = search_reach(r2, slack, cell)  # windows a little longer, for the quantised order
     for c in prange(chunks.size - 1):
         pos = base[c]
         lim = limit[c]  # the last slot is scratch for the branch-free writes
         for r in range(chunks[c], chunks[c + 1]):
-            pos = _search_row(sx, sy, sz, sstrand, start, ny, nz, r, reach, r2, flat, pos, lim, fcnt)
+            a0, b0 = start[r], start[r + 1]
+            if a0 == b0:
+                continue
+            cy = r % ny
+            cz = r // ny
+            # Missing rows (outside the grid) are empty runs [0, 0).
+            r1 = r + 1 if cy + 1 < ny else -1
+            r2_ = r + ny - 1 if cz + 1 < nz and cy >= 1 else -1
+            r3 = r + ny if cz + 1 < nz else -1
+            r4 = r + ny + 1 if cz + 1 < nz and cy + 1 < ny else -1
+            j1, e1 = (start[r1], start[r1 + 1]) if r1 >= 0 else (0, 0)
+            j2, e2 = (start[r2_], start[r2_ + 1]) if r2_ >= 0 else (0, 0)
+            j3, e3 = (start[r3], start[r3 + 1]) if r3 >= 0 else (0, 0)
+            j4, e4 = (start[r4], start[r4 + 1]) if r4 >= 0 else (0, 0)
+            for i in range(a0, b0):
+                px, py, pz = sx[i], sy[i], sz[i]
+                si = sstrand[i]
+                p0 = pos
+                sw, xb = px - reach, px + reach  # entries right of xb fail the distance test
+                _, pos = _scan_row(
+                    sx, sy, sz, sstrand, i + 1, b0, px, py, pz, si, -np.inf, xb, r2, i + 1, flat, pos, lim
+                )
+                j1, pos = _scan_row(
+                    sx, sy, sz, sstrand, j1, e1, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
+                )
+                j2, pos = _scan_row(
+                    sx, sy, sz, sstrand, j2, e2, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
+                )
+                j3, pos = _scan_row(
+                    sx, sy, sz, sstrand, j3, e3, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
+                )
+                j4, pos = _scan_row(
+                    sx, sy, sz, sstrand, j4, e4, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
+                )
+                fcnt[i] = pos - p0
         used[c] = pos - base[c]
 
 
