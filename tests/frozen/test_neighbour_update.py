@@ -6,12 +6,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from hairtool import samples
 from hairtool.frozen.clump import ClumpWorkspace, clump_points
 from hairtool.frozen.neighbour_update import moved_vertices, moved_vertices_reference, update_list
 from hairtool.frozen.spatial import NeighbourList
 from hairtool.frozen.strand_clumps import auto_clump_radius
+from hairtool.groom import Groom
 from hairtool.io import read_groom
 
 
@@ -198,3 +201,44 @@ def test_undoing_a_stroke_on_the_bear_gives_back_the_result_before_it_on_an_upda
     assert pipe.restore(before).points.tobytes() == shown.tobytes()  # undo
     assert pipe.restore(stroked).points.tobytes() == after.tobytes()  # redo
     assert pipe.neighbour_builds == 1 and pipe.neighbour_updates == 3
+
+
+# Any moves of the vertices in a ball: points on a coarse lattice (exact ties in x, so that rows
+# order by index, and vertices exactly r apart), moved a little or far, some onto other vertices,
+# roots too. Whatever the update accepts must be the build's list.
+MOVES = settings(derandomize=True, max_examples=60, deadline=None)
+
+
+@MOVES
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    ball=st.sampled_from([0.5, 1.0, 2.0]),
+    reach=st.sampled_from([0.3, 1.0, 4.0]),
+)
+def test_any_moves_update_to_the_list_a_build_gives(seed, ball, reach):
+    rng = np.random.default_rng(seed)
+    strands, per = 150, 6
+    r = 0.5
+    pts = (rng.integers(0, 24, size=(strands * per, 3)) * 0.25).astype(np.float32)  # ties on a 0.25 lattice
+    pts[0] = (0.0, 0.0, 0.0)  # the box: moves inside it keep the grid
+    pts[1] = (6.0, 6.0, 6.0)
+    g = Groom(pts, np.full(strands, per))
+    strand = np.asarray(g.topology.strand_index, np.int64)
+    is_root = np.zeros(len(pts), bool)
+    is_root[g.topology.root_indices] = True
+    nl = NeighbourList()
+    nl.build(pts, strand, is_root, r, dense=True)
+    centre = rng.random(3) * 6.0
+    moved = np.flatnonzero(np.linalg.norm(pts - centre, axis=1) < ball)
+    moved = moved[moved > 1]
+    new = pts.copy()
+    step = rng.normal(size=(moved.size, 3)) * reach * r
+    onto = rng.random(moved.size) < 0.2  # some exactly onto another vertex
+    step[onto] = pts[rng.integers(2, len(pts), onto.sum())] - pts[moved[onto]]
+    new[moved] = np.clip(pts[moved] + step, 0.0, 6.0).astype(np.float32)
+    moved = moved_vertices(new, pts)
+    if not update_list(nl, new, pts, strand, is_root, moved):
+        nl.build(new, strand, is_root, r, dense=True)
+    built = NeighbourList()
+    built.build(new, strand, is_root, r, dense=True)
+    assert_same_lists(nl, built)
