@@ -156,10 +156,11 @@ def _mark_new_finders(p0, came, lo0, inv_q, ny, nz, reach, sx, sy, sz, start, or
 def _search_vertex(
     i, r, sx, sy, sz, sstrand, start, order, qx, lo0, inv_q, ny, nz, reach, r2, flat, pos, lim
 ):
-    """Vertex i's forward entries (it lies in row r), as :func:`~hairtool.frozen.spatial.
-    _search_row` finds them, each row's scan started where its quantised x reaches the window
-    (a search of its own row's neighbours would start where the row's earlier vertices left it:
-    the entries in between are not within reach, so the hits are the same, in the same order)."""
+    """Vertex i's forward entries (it lies in row r), as the build's search
+    (:func:`~hairtool.frozen.spatial._forward_kernel`) finds them, each row's scan started where
+    its quantised x reaches the window (the build's starts where the row's earlier vertices left
+    it: the entries in between are not within reach, so the hits are the same, in the same
+    order)."""
     cy, cz = r % ny, r // ny
     px, py, pz = sx[i], sy[i], sz[i]
     si = sstrand[i]
@@ -213,25 +214,9 @@ def _rewrite_forward(
                 if r <= rb and (po < 0 or mark[p]):
                     q = pos
                     pos = _search_vertex(
-                        p,
-                        r,
-                        sx,
-                        sy,
-                        sz,
-                        sstrand,
-                        start,
-                        order,
-                        qx,
-                        lo0,
-                        inv_q,
-                        ny,
-                        nz,
-                        reach,
-                        r2,
-                        aflat,
-                        pos,
-                        lim,
-                    )
+                        p, r, sx, sy, sz, sstrand, start, order, qx, lo0, inv_q, ny, nz, reach, r2,
+                        aflat, pos, lim,
+                    )  # fmt: skip
                     acnt[p] = pos - q
                     continue
                 o, n = old_aoff[po - a0] - base[c0], old_acnt[po - a0]
