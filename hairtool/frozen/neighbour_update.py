@@ -16,8 +16,9 @@ strands within r in the rows (y, z cells) around it, in those rows' order, so an
 Everything outside that stretch stays as it was. The result is the list a build from scratch
 gives, entry for entry and in the same order (tests compare the two on real grooms), so a
 clump run's bytes do not depend on how its list came about; the build is this module's oracle.
-An update declines (returns False, and the caller builds) when the grid moved, when too much
-moved for an update to pay, or when a chunk of the forward entries outgrew its room.
+An update declines (returns False, and the caller builds) when the grid moved, when so much
+moved or the re-sorted stretch is so long that a build costs less (:func:`update_pays`), or when
+a chunk of the forward entries outgrew its room.
 """
 
 from __future__ import annotations
@@ -29,10 +30,19 @@ from hairtool.frozen.spatial import NeighbourList, _gather, _scan_row, search_re
 from hairtool.serial_twins import twin_njit
 
 BACKWARD_BLOCKS = 16  # tasks of the backward lists' transpose (the lists do not depend on them)
-UPDATE_SHARE = 0.25  # moved vertices, as a share of all, above which a build is cheaper
-SPAN_SHARE = 0.8  # sorted positions between the first and last row that changed, as a share, above
-# which likewise (2-core VM: an update over 0.8 of the mohawk cost 0.6 of a build, over 0.8 of a
-# ponytail piece as much as one)
+# An update's cost against a build's: per moved vertex (its searches and the marked vertices'),
+# per vertex of the re-sorted stretch, and a fixed part that matters on small grooms. Fitted on
+# the 2-core VM (update / build: 1M-vertex scalp 0.29 at 1.3 % moved over 0.28 of the groom, 0.84
+# at 7.6 % over 0.38, 1.85 at 20 % over 0.5; bear 0.43 at 3.5 % over 0.28, 1.26 at 18 % over 0.38;
+# mohawk 0.65 at 2 % over 0.8; a ponytail piece of 8,000 vertices 1.17 at 0.5 % over 0.85;
+# Sintel 0.6 at 1.7 % over 0.16, 1.14 at 14 % over 0.47).
+PER_MOVED, PER_SPAN, FIXED_VERTICES = 6.0, 0.8, 3000.0
+
+
+def update_pays(moved_share: float, span_share: float, vertices: int) -> bool:
+    """Whether an update that moves ``moved_share`` of the vertices and re-sorts ``span_share``
+    of them costs less than a build (the cost model above)."""
+    return PER_MOVED * moved_share + PER_SPAN * span_share + FIXED_VERTICES / max(vertices, 1) < 1.0
 
 
 @twin_njit(nogil=True, parallel=True)
@@ -289,7 +299,7 @@ def update_list(
         return False
     if moved.size == 0:
         return True
-    if moved.size > UPDATE_SHARE * v:
+    if not update_pays(moved.size / v, 0.0, v):
         return False
     lo, hi, dims = nl._grid(points, nl.radius, True, _moved_box(nl.raw_box, before[moved], points[moved]))
     if dims != nl.dims or not (np.array_equal(lo, nl.lo) and np.array_equal(hi, nl.hi)):
@@ -305,7 +315,7 @@ def update_list(
     ra = int(min(old_key.min(), new_key.min()))
     rb = int(max(old_key.max(), new_key.max()))
     p0, p1 = int(start[ra]), int(start[rb + 1])
-    if p1 - p0 > SPAN_SHARE * v:
+    if not update_pays(moved.size / v, (p1 - p0) / v, v):
         return False
 
     # 1. Rows [ra, rb] sorted again; the vertices between p0 and p1 gathered again.

@@ -119,3 +119,23 @@ def test_the_first_screen_compiles_nothing_after_the_startup_steps(mode):
         assert {"hairtool.frozen.freeze:_freeze_kernel", "hairtool.frozen.align:_align_kernel"} <= set(
             screen["parallel"]
         )
+
+
+def test_the_engine_step_releases_on_an_updated_list(monkeypatch):
+    """The warm-up's engine step ends with a release whose neighbour list is updated, not built
+    (neighbour_update's cost model could make it build): so the update's kernels are among
+    those it compiles, for the first release on any groom."""
+    from app.ui import kernel_warmup
+    from hairtool.frozen.pipeline import FrozenPipeline
+
+    settled = []
+    settle = FrozenPipeline.settle
+
+    def spy(self):
+        out = settle(self)
+        settled.append(self.neighbour_updates)
+        return out
+
+    monkeypatch.setattr(FrozenPipeline, "settle", spy)
+    kernel_warmup._engine_step()
+    assert settled and settled[-1] >= 1
