@@ -305,7 +305,6 @@ def update_list(
     if dims != nl.dims or not (np.array_equal(lo, nl.lo) and np.array_equal(hi, nl.hi)):
         return False
     ny, nz = dims[1], dims[2]
-    start = nl.start
     p = points[moved].astype(np.float64)
     inv_cell = 1.0 / nl.radius
     new_key = np.minimum(np.floor((p[:, 1] - lo[1]) * inv_cell).astype(np.int64), ny - 1)
@@ -314,11 +313,23 @@ def update_list(
     old_key = nl.keys[moved]
     ra = int(min(old_key.min(), new_key.min()))
     rb = int(max(old_key.max(), new_key.max()))
-    p0, p1 = int(start[ra]), int(start[rb + 1])
-    if not update_pays(moved.size / v, (p1 - p0) / v, v):
+    if not update_pays(moved.size / v, (nl.start[rb + 1] - nl.start[ra]) / v, v):
         return False
+    came, mold, to_new = _resort(nl, points, strand, skip, moved, old_key, new_key, new_qx, ra, rb)
+    mark = np.zeros(v, np.bool_)
+    _mark_finders(moved, mold, nl.bstart, nl.bflat, int(nl.start[ra]), to_new, mark)
+    if not _forward(nl, ra, rb, came, to_new, before, mark):
+        nl.chunks = None  # half rewritten: only a build can follow
+        return False
+    return True
 
-    # 1. Rows [ra, rb] sorted again; the vertices between p0 and p1 gathered again.
+
+def _resort(nl, points, strand, skip, moved, old_key, new_key, new_qx, ra, rb):
+    """Step 1: rows [ra, rb] sorted again, their vertices gathered again. Returns (``came``,
+    ``mold``, ``to_new``) as :func:`_resort_rows` and :func:`_inverse` give them."""
+    v = len(nl.order)
+    start = nl.start
+    p0, p1 = int(start[ra]), int(start[rb + 1])
     old_start = start[ra : rb + 2].copy()
     counts = np.diff(old_start)
     np.subtract.at(counts, old_key - ra, 1)
@@ -334,33 +345,28 @@ def update_list(
     old_order = nl.order[p0:p1].copy()
     came = np.empty(p1 - p0, np.int64)
     mold = np.empty(v, np.int64)  # (read at the moved vertices only)
-    _resort_rows(
-        ra, rb, old_start, start, old_order, is_moved, arrivals, arr_start, nl._qx, nl.order, came, mold
-    )
-    span = slice(p0, p1)
-    _gather(
-        nl.order[span],
-        points,
-        strand,
-        skip,
-        nl.x[span],
-        nl.y[span],
-        nl.z[span],
-        nl.strand[span],
-        nl.skip[span],
-    )
+    sort = (is_moved, arrivals, arr_start, nl._qx)
+    _resort_rows(ra, rb, old_start, start, old_order, *sort, nl.order, came, mold)
+    k = slice(p0, p1)
+    _gather(nl.order[k], points, strand, skip, nl.x[k], nl.y[k], nl.z[k], nl.strand[k], nl.skip[k])
     to_new = np.empty(p1 - p0, np.int64)
     _inverse(came, p0, to_new)
+    return came, mold, to_new
 
-    # 2. The forward entries of the chunks that hold rows [rw0, rb], rw0 the first row whose
-    # search reaches row ra: searched again for the vertices a moved vertex was or is near.
+
+def _forward(nl, ra, rb, came, to_new, before, mark) -> bool:
+    """Steps 2 and 3: the forward entries of the chunks that hold rows [rw0, rb] (rw0 the first
+    row whose search reaches row ra), searched again from the moved vertices and the ``mark``ed
+    ones (those that found a moved vertex where it was; here also those that can find it where
+    it is); then the backward lists those entries point into. False: a chunk outgrew its room."""
+    ny, nz = nl.dims[1], nl.dims[2]
+    start = nl.start
+    p0 = int(start[ra])
     r2 = nl.radius**2
     reach = search_reach(r2, nl.slack, nl.radius)
-    mark = np.zeros(v, np.bool_)
-    _mark_finders(moved, mold, nl.bstart, nl.bflat, p0, to_new, mark)
-    _mark_new_finders(
-        p0, came, lo[0], nl.inv_q, ny, nz, reach, nl.x, nl.y, nl.z, start, nl.order, nl._qx, nl.keys, mark
-    )
+    lo0 = nl.lo[0]
+    grid = (lo0, nl.inv_q, ny, nz, reach, nl.x, nl.y, nl.z, start, nl.order, nl._qx)
+    _mark_new_finders(p0, came, *grid, nl.keys, mark)
     rw0 = max(0, ra - ny - 1)
     chunks, base, limit = nl.chunks, nl.base, nl.limit
     c0 = int(np.searchsorted(chunks, rw0, side="right") - 1)
@@ -373,19 +379,22 @@ def update_list(
     _rewrite_forward(
         c0, c1, chunks, base, limit, rw0, rb, mark, p0, came, to_new,
         old_aflat, old_aoff, old_acnt, a0,
-        nl.x, nl.y, nl.z, nl.strand, start, nl.order, nl._qx, lo[0], nl.inv_q, ny, nz, reach, r2,
+        nl.x, nl.y, nl.z, nl.strand, start, nl.order, nl._qx, lo0, nl.inv_q, ny, nz, reach, r2,
         nl.aflat, nl.aoff, nl.acnt, over,
     )  # fmt: skip
     if over.any():
-        nl.chunks = None  # half rewritten: only a build can follow
         return False
     nl.forward_entries += int(nl.acnt[a0:a1].sum() - old_acnt.sum())
-
-    # 3. The backward lists of the rows those entries point into: from rw0 to the rows the
-    # last rewritten chunk's search reaches.
+    # The backward lists from rw0 to the rows the last rewritten chunk's search reaches.
     qb = min(ny * nz - 1, int(chunks[c1 + 1]) - 1 + ny + 1)
-    q0, q1 = int(start[rw0]), int(start[qb + 1])
-    blocks, sources = _target_blocks(start, ny, q0, q1, BACKWARD_BLOCKS)
+    _backward(nl, int(start[rw0]), int(start[qb + 1]))
+    return True
+
+
+def _backward(nl, q0, q1) -> None:
+    """The backward lists of the vertices [q0, q1) transposed again; those after them moved
+    along by the change in their number."""
+    blocks, sources = _target_blocks(nl.start, nl.dims[1], q0, q1, BACKWARD_BLOCKS)
     count = np.empty(q1 - q0, np.int64)
     lists = (nl.aflat, nl.aoff, nl.acnt, q0, count)
     _backward_lists(blocks, sources, *lists, nl.bstart, nl.bflat, nl.bmap, False)
@@ -404,4 +413,3 @@ def update_list(
         bstart[q1 + 1 :] += diff
     bstart[q0 + 1 : q1 + 1] = bstart[q0] + np.cumsum(count)
     _backward_lists(blocks, sources, *lists, bstart, nl.bflat, nl.bmap, True)
-    return True
