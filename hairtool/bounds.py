@@ -47,3 +47,20 @@ def box_reference(points: ArrayLike) -> tuple[NDArray, NDArray]:
     """numpy twin of :func:`box`."""
     p = np.asarray(points)
     return p.min(axis=0), p.max(axis=0)
+
+
+def moved_box(
+    raw_box: tuple[NDArray, NDArray], old: ArrayLike, new: ArrayLike
+) -> tuple[NDArray, NDArray] | None:
+    """The float64 box of points after the points ``old`` moved to ``new``, from the box before
+    (float64 of the points' own values), without a pass over the others: a brush move on
+    millions of vertices moves a few thousand. None where a moved point held an extreme (then
+    only a pass over every point knows the box)."""
+    lo, hi = raw_box
+    o = np.asarray(old, np.float64)
+    if o.size and (np.any(o == lo) or np.any(o == hi)):
+        return None
+    n = np.asarray(new, np.float64)
+    if n.size == 0:
+        return lo, hi
+    return np.minimum(lo, n.min(axis=0)), np.maximum(hi, n.max(axis=0))

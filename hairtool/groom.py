@@ -242,6 +242,33 @@ class Groom(_Attributes):
         """The same strands, attributes and metadata at new positions."""
         return Groom(points, self.topology, **self.attributes, metadata=self.metadata)
 
+    def with_moved_rows(self, points: NDArray[np.float32], rows: ArrayLike) -> Groom:
+        """:meth:`with_points` for points handed over whose rows other than ``rows`` (vertex ids)
+        are values a groom already held: a float32 C-ordered ``(V, 3)`` array of its own that
+        nobody writes afterwards (it is made read-only, not copied); ``rows`` alone are checked,
+        and the attributes are shared. A brush move on millions of vertices changes a few
+        thousand, and a copy and a check of all of them would cost more than the move. Anything
+        else goes through :meth:`with_points`."""
+        if not (
+            isinstance(points, np.ndarray)
+            and points.dtype == np.float32
+            and points.shape == self.points.shape
+            and points.flags.c_contiguous
+            and points.flags.owndata
+        ):
+            return self.with_points(points)
+        ids = np.asarray(rows, np.int64).reshape(-1)
+        finite = np.all(np.isfinite(points[ids]), axis=1)
+        if not finite.all():
+            bad = int(ids[np.argmin(finite)])
+            raise GroomError(f"points has a non-finite coordinate at vertex {bad}")
+        g = object.__new__(Groom)
+        g.topology = self.topology
+        g.points = _frozen(points)
+        g.thickness, g.transparency, g.colors = self.thickness, self.transparency, self.colors
+        g.metadata = self.metadata
+        return g
+
     # -- sizes -------------------------------------------------------------------------
     @property
     def offsets(self) -> I64:

@@ -27,6 +27,7 @@ import numba
 import numpy as np
 from numba import prange
 
+from hairtool.bounds import box, moved_box
 from hairtool.frozen.clump import (
     _GAP_CODE,
     EPS,
@@ -101,15 +102,15 @@ def _set_rows(dst, src, vids):
             dst[i, a] = src[i, a]
 
 
-def changed_strands(
-    before: np.ndarray, after: np.ndarray, topology: Topology, strands: np.ndarray
+def strands_differing(
+    before: np.ndarray, after: np.ndarray, counts: np.ndarray, strands: np.ndarray
 ) -> np.ndarray:
-    """Of ``strands``, those with a vertex whose bytes differ between ``before`` and ``after``."""
+    """Of ``strands`` (``counts`` vertices each), those with a vertex whose bytes differ between
+    ``before`` and ``after``, their vertices' rows one strand after another."""
     if strands.size == 0:
         return strands
-    vids = vertex_ids_of(topology, strands)
-    diff = np.any(before[vids].view(np.uint32) != after[vids].view(np.uint32), axis=1)
-    starts = np.concatenate([[0], np.cumsum(topology.counts[strands])[:-1]])
+    diff = np.any(before.view(np.uint32) != after.view(np.uint32), axis=1)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
     return strands[np.logical_or.reduceat(diff, starts)]
 
 
@@ -133,11 +134,26 @@ class LocalClump:
         self.ident = np.arange(topology.vertex_count, dtype=np.int64)
         self.region = np.zeros(0, np.int64)  # the strands the last update redid
         self.lists_ms = 0.0  # of the last update: grid moves and neighbour lists
+        self._box: tuple | None = None  # the grid's points' box (float64), None: not known
 
     def resync(self, points: np.ndarray, old: np.ndarray) -> None:
         """After another full run: the grid follows the vertices that moved since ``old``."""
         moved = np.flatnonzero(np.any(points.view(np.uint32) != old.view(np.uint32), axis=1))
         self.grid.move(points, moved)
+        self._follow(old[moved], points[moved])
+
+    def _follow(self, old: np.ndarray, new: np.ndarray) -> None:
+        """The box after the grid's points ``old`` moved to ``new`` (unknown where one held an
+        extreme: :meth:`frame` then looks at every point once)."""
+        if self._box is not None:
+            self._box = moved_box(self._box, old, new)
+
+    def frame(self, points: np.ndarray) -> tuple:
+        """:func:`~hairtool.frozen.vertex_grid.list_frame` of the grid's ``points``, from the box
+        kept across moves (a pass over millions of points costs more than a move)."""
+        if self._box is None:
+            self._box = tuple(b.astype(np.float64) for b in box(points))
+        return list_frame(points, self.radius, self._box)
 
     def near(self, points: np.ndarray, queries: np.ndarray, radius: float) -> np.ndarray:
         """Sorted ids of the strands with a vertex of ``points`` (as the grid holds them) closer
@@ -149,7 +165,7 @@ class LocalClump:
 
     def update(
         self,
-        old: np.ndarray,
+        was: np.ndarray,
         new: np.ndarray,
         seeds: np.ndarray,
         sv: np.ndarray,
@@ -158,31 +174,31 @@ class LocalClump:
         gap_mode: str,
         seed: int,
     ) -> tuple[np.ndarray, np.ndarray] | None:
-        """The input went from ``old`` to ``new`` on the strands ``seeds`` (those whose points or
-        clump strength ``sv`` (V,) changed). Returns the region's strands and vertices, after
-        writing their result rows into the record's ``result``; None where the region would be
-        most of the groom (:data:`MAX_SEEDS`, :data:`MAX_REGION`: the caller runs in full; the
-        grid holds ``new`` either way)."""
+        """The input went to ``new`` on the strands ``seeds`` (those whose points or clump
+        strength ``sv`` (V,) changed), whose vertices were at ``was`` before. Returns the
+        region's strands and vertices, after writing their result rows into the record's
+        ``result``; None where the region would be most of the groom (:data:`MAX_SEEDS`,
+        :data:`MAX_REGION`: the caller runs in full; the grid holds ``new`` either way)."""
         import time
 
         t0 = time.perf_counter()
         top, rec = self.topology, self.record
         seed_v = vertex_ids_of(top, seeds)
         v = top.vertex_count
-        if seed_v.size > MAX_SEEDS * v:
-            self.grid.move(new, seed_v)
-            return None
         self.grid.move(new, seed_v)
+        self._follow(was, new[seed_v])
+        if seed_v.size > MAX_SEEDS * v:
+            return None
         # The strands whose lists held the seeds' vertices and those whose lists hold them now, in
         # one query on the grid as it is now: a vertex within reach of a seed's old place that
         # moved is a seed's own (in the region anyway); the others are where they were.
-        both = np.concatenate([old[seed_v], new[seed_v]])
+        both = np.concatenate([was, new[seed_v]])
         region = np.union1d(self.near(new, both, self.radius), seeds)
         vids = vertex_ids_of(top, region)
         if vids.size > MAX_REGION * v:
             return None
         with threads_for(vids.size):
-            flat, cnt, cap = self.grid.lists(new, vids, self.radius, list_frame(new, self.radius))
+            flat, cnt, cap = self.grid.lists(new, vids, self.radius, self.frame(new))
             self.lists_ms = (time.perf_counter() - t0) * 1e3
             rec.points[vids] = new[vids]
             rec.strength[vids] = sv[vids]

@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from hairtool.bounds import moved_box
 from hairtool.frozen.spatial import NeighbourList, _gather, _scan_row, search_reach
 from hairtool.serial_twins import twin_njit
 
@@ -270,18 +271,6 @@ def _target_blocks(start, ny, q0, q1, n):
     return blocks, start[np.maximum(first_row - ny - 1, 0)]
 
 
-def _moved_box(raw_box, old, new):
-    """The box of the points after a move of the points ``old`` to ``new``, from the box before,
-    without a pass over the others: where a moved point held an extreme of the box, None (the
-    box of all the points is needed)."""
-    lo, hi = raw_box
-    old = old.astype(np.float64)
-    if np.any(old == lo) or np.any(old == hi):
-        return None
-    new = new.astype(np.float64)
-    return np.minimum(lo, new.min(axis=0)), np.maximum(hi, new.max(axis=0))
-
-
 def update_list(
     nl: NeighbourList,
     points: np.ndarray,
@@ -301,7 +290,7 @@ def update_list(
         return True
     if not update_pays(moved.size / v, 0.0, v):
         return False
-    lo, hi, dims = nl._grid(points, nl.radius, True, _moved_box(nl.raw_box, before[moved], points[moved]))
+    lo, hi, dims = nl._grid(points, nl.radius, True, moved_box(nl.raw_box, before[moved], points[moved]))
     if dims != nl.dims or not (np.array_equal(lo, nl.lo) and np.array_equal(hi, nl.hi)):
         return False
     ny, nz = dims[1], dims[2]

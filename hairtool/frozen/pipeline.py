@@ -38,6 +38,7 @@ Built for dragging in the studio:
 from __future__ import annotations
 
 import functools
+import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields, replace
@@ -71,7 +72,8 @@ from hairtool.frozen.collide import MARGIN, CollisionSurface, KeepOut, collide
 from hairtool.frozen.density import accept, disc_candidates, thin
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.lengths import restore_lengths
-from hairtool.frozen.local import LocalClump, changed_strands, threads_for
+from hairtool.frozen.local import LocalClump, strands_differing, threads_for
+from hairtool.frozen.move_points import MovePoints, held_by_at_most, may_write
 from hairtool.frozen.noise import check_seed, draw_seed
 from hairtool.frozen.sculpt import hook_weights, pinch, snake_hook, strands_to_delete
 from hairtool.frozen.selection import SelectionSample, apply_selection
@@ -909,12 +911,40 @@ class FrozenPipeline:
             and rec.key == record_key(self._aligned, h, p.clump_iterations, step, p.gap_mode, seed)
         )
 
+    def _owns_aligned(self) -> bool:
+        """Whether the aligned groom and its points are held by the pipeline alone (as the
+        grid's points too), so a move may write into them (:mod:`hairtool.frozen.move_points`).
+        (Read before any local name holds them.)"""
+        return (
+            self._grid_points is self._aligned.points
+            and may_write(self._aligned.points)
+            and held_by_at_most(sys.getrefcount(self._aligned), 1)
+            and held_by_at_most(sys.getrefcount(self._aligned.points), 2)
+        )
+
+    def _kept_writable(self) -> None:
+        """``_kept`` (the result's points as the moves leave them) ready for a move's rows: the
+        result handed out over it is written in place where the pipeline alone holds it, and
+        copied first where anything else does."""
+        if self._kept.flags.writeable:
+            return
+        if self._result.points is self._kept:
+            mine = held_by_at_most(sys.getrefcount(self._result), 1) and held_by_at_most(
+                sys.getrefcount(self._kept), 2
+            )
+        else:
+            mine = held_by_at_most(sys.getrefcount(self._kept), 1)
+        if mine and may_write(self._kept):
+            self._kept.flags.writeable = True
+        else:
+            self._kept = self._kept.copy()
+
     def _apply_local(self, samples: Sequence[Sample]) -> Groom:
         t0 = time.perf_counter()
+        in_place = self._owns_aligned()
         g, top, local = self._aligned, self._aligned.topology, self._local
         assert local is not None and self._grid_points is not None
-        old = self._grid_points
-        cur = old.copy()
+        cur = MovePoints(self._grid_points, in_place)
         state = (self._strand_state(), self._hook_state())
         touched = np.zeros(g.strand_count, bool)  # strands a sample of this batch ran on
         painted = np.zeros(0, np.int64)  # strands whose clump strength changed
@@ -923,16 +953,21 @@ class FrozenPipeline:
             for sample in samples:
                 painted = np.union1d(painted, self._local_sample(cur, sample, touched, planar))
         except BaseException:  # a refused sample: none of these samples happened
+            cur.undo()
             self._set_strand_state(state[0])
             self._set_hooks(state[1])
             raise
+        cur.done()
         self._log.extend(samples)
-        moved = changed_strands(old, cur, top, np.flatnonzero(touched))
+        ran = np.flatnonzero(touched)
+        rv = vertex_ids_of(top, ran)
+        moved = strands_differing(cur.before(rv), cur.points[rv], top.counts[ran], ran)
         seeds = np.union1d(moved, painted)
         if moved.size:
             mv = vertex_ids_of(top, moved)
-            self._nonplanar += int(np.count_nonzero(cur[mv, 2])) - int(np.count_nonzero(old[mv, 2]))
-            self._aligned = g.with_points(cur)
+            was = cur.before(mv)
+            self._nonplanar += int(np.count_nonzero(cur.points[mv, 2])) - int(np.count_nonzero(was[:, 2]))
+            self._aligned = g.with_moved_rows(cur.points, mv)  # (the pipeline's own: a copy, or its last)
         t1 = time.perf_counter()
         self._timings["align"] = (t1 - t0) * 1e3
         if seeds.size == 0:
@@ -947,7 +982,8 @@ class FrozenPipeline:
             sv[pv] = self._clump_strength[top.strand_index[pv]]
         now = self._aligned.points
         seed_ = draw_seed(p.seed, self._draw)
-        done = local.update(old, now, seeds, sv, p.clump_iterations, self._step(), p.gap_mode, seed_)
+        was = cur.before(vertex_ids_of(top, seeds))
+        done = local.update(was, now, seeds, sv, p.clump_iterations, self._step(), p.gap_mode, seed_)
         if done is None:  # most of the groom: a full run costs less
             self._reclump()
             self._timings["clump"] = (time.perf_counter() - t1) * 1e3
@@ -956,6 +992,7 @@ class FrozenPipeline:
         region, vids = done
         self._unsettled = True
         rec = local.record
+        self._kept_writable()
         if p.keep_lengths:
             restore_lengths(now, rec.result, top, region, self._kept)
             still = vids[sv[vids] == 0.0]
@@ -963,13 +1000,13 @@ class FrozenPipeline:
         else:
             self._kept[vids] = rec.result[vids]
         self._grid_points = now
-        self._result = self._kept_out(self._aligned.with_points(self._kept))  # (a copy: _kept moves on)
+        self._result = self._kept_out(self._aligned.with_moved_rows(self._kept, vids))  # (new: the region)
         self._redone, self._region = vids.size / max(top.vertex_count, 1), region
         self._timings["clump"] = (time.perf_counter() - t1) * 1e3
         self._timings["total"] = self._timings["align"] + self._timings["clump"]
         return self._result
 
-    def _local_sample(self, cur: np.ndarray, sample: Sample, touched: np.ndarray, planar: bool) -> np.ndarray:
+    def _local_sample(self, cur: MovePoints, sample: Sample, touched: np.ndarray, planar: bool) -> np.ndarray:
         """One sample on the strands with a vertex within its radius (where the grid holds the
         unmoved ones) and those this batch has moved, written into ``cur``; returns the strands
         whose clump strength it changed."""
@@ -979,7 +1016,7 @@ class FrozenPipeline:
         assert local is not None and self._grid_points is not None
         if isinstance(sample, SelectionSample):  # no strand moves: on the whole groom
             away = self._away(sample.view)
-            g = self._aligned.with_points(cur)
+            g = self._aligned.with_points(cur.points)
             self._selected, self._hidden = apply_selection(g, sample, self._selected, self._hidden, away)
             return np.zeros(0, np.int64)
         if isinstance(sample, AlignSample):
@@ -994,10 +1031,11 @@ class FrozenPipeline:
             return none
         vids = vertex_ids_of(top, cand)
         with threads_for(vids.size):
-            sub = Groom(cur[vids], top.counts[cand], metadata=self._aligned.metadata)  # in the scene's frame
+            meta = self._aligned.metadata  # (in the scene's frame)
+            sub = Groom(cur.points[vids], top.counts[cand], metadata=meta)
             out, painted = self._local_brush(sub, cand, sample, planar)
         if out is not None:
-            cur[vids] = out.points
+            cur.write(vids, out.points)
             touched[cand] = True
         return painted
 

@@ -364,12 +364,13 @@ def _reverse(a, b, e):
         e -= 1
 
 
-def list_frame(points: np.ndarray, radius: float) -> tuple:
+def list_frame(points: np.ndarray, radius: float, raw_box: tuple | None = None) -> tuple:
     """The grid a full :meth:`~hairtool.frozen.spatial.NeighbourList.build` of ``points`` at
     ``radius`` lays out (its corner, rows, x quantisation, row or hashed), which decides the
-    order of its lists: ``(dense, lo, inv_cell, ny, nz, inv_q, nq)``, computed as the build does."""
+    order of its lists: ``(dense, lo, inv_cell, ny, nz, inv_q, nq)``, computed as the build does.
+    ``raw_box``: the points' box in float64, where the caller keeps it (no pass over them)."""
     v = points.shape[0]
-    lo, hi = (b.astype(np.float64) for b in box(points))
+    lo, hi = (b.astype(np.float64) for b in (box(points) if raw_box is None else raw_box))
     radius = float(radius)
     snap = _SNAP * radius
     lo, hi = np.floor(lo / snap) * snap, (np.floor(hi / snap) + 1.0) * snap
