@@ -139,24 +139,9 @@ def _take(acc, j, r, s, ex, ey, ez, h, inv_h, stats):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _pull(P, flat, a, b, px, py, pz, h, inv_h, stats, acc):
-    """Add the pulls of the list entries ``flat[a:b]`` on p to ``acc`` (:func:`_take`)."""
-    for n in range(a, b):
-        j = flat[n]
-        ex = P[j, 0] - px
-        ey = P[j, 1] - py
-        ez = P[j, 2] - pz
-        r = np.sqrt(ex * ex + ey * ey + ez * ez)
-        t = max(1.0 - r * inv_h, 0.0)  # list entries beyond h (the margin): g = 0
-        g = t * t  # (14)
-        acc = _take(acc, j, r, g / (r + EPS), ex, ey, ez, h, inv_h, stats)  # (15)
-    return acc
-
-
-@njit(cache=True, nogil=True, inline="always")
 def _lowest_of_nearest(P, flat, a, b, px, py, pz, br, sorig, bj, bo):
     """Among the entries ``flat[a:b]`` exactly ``br`` away (the same arithmetic as
-    :func:`_pull`), the one of lowest original index, against the best so far (bj, bo)."""
+    :func:`vertex_force`), the one of lowest original index, against the best so far (bj, bo)."""
     for n in range(a, b):
         j = flat[n]
         ex = P[j, 0] - px
@@ -174,8 +159,15 @@ def vertex_force(P, aflat, a0, a1, bflat, b0, b1, px, py, pz, root, h, inv_h, st
     ``(fx, fy, fz, nearest or −1, neighbours within h, Σg)``, the last two with ``stats``."""
     acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
     if not root:
-        acc = _pull(P, aflat, a0, a1, px, py, pz, h, inv_h, stats, acc)
-        acc = _pull(P, bflat, b0, b1, px, py, pz, h, inv_h, stats, acc)
+        na = a1 - a0
+        for k in range(na + b1 - b0):  # both runs in one loop: one loop exit to mispredict, not two
+            j = aflat[a0 + k] if k < na else bflat[b0 + k - na]
+            ex = P[j, 0] - px
+            ey = P[j, 1] - py
+            ez = P[j, 2] - pz
+            r = np.sqrt(ex * ex + ey * ey + ez * ez)
+            t = max(1.0 - r * inv_h, 0.0)  # list entries beyond h (the margin): g = 0
+            acc = _take(acc, j, r, t * t / (r + EPS), ex, ey, ez, h, inv_h, stats)  # g (14), f (15)
     fx, fy, fz, br, bj, tie, c, wsum = acc
     if tie and bj >= 0:
         bj, bo = _lowest_of_nearest(P, aflat, a0, a1, px, py, pz, br, sorig, bj, sorig[bj])
@@ -220,7 +212,7 @@ def _pair_kernel(P, aflat, aoff, acnt, inv_h, pr, ps):
 
 @njit(cache=True, nogil=True, inline="always")
 def _sum_run(P, flat, a, b, emap, pr, ps, px, py, pz, h, stats, acc):
-    """:func:`_pull` with each entry's r and weight read from the pair arrays (entry n's at
+    """:func:`vertex_force`'s sums with each entry's r and weight read from the pair arrays (entry n's at
     ``emap[n]``, or at n itself where ``emap`` is empty): the same sums in the same order."""
     same = emap.size == 0
     inv_h = 1.0 / h
