@@ -4,7 +4,8 @@ Run it with hairtool's Python and point it at a Python that imports ``bpy`` (the
 ``pip install bpy==5.0.1`` in a venv of its own)::
 
     .venv/bin/python benchmarks/blender_clump.py --bpy /work/bpyvenv/bin/python \
-        [--sizes 500x20 5000x20 50000x20 tests/data/grooms/bear.tfx] [--repeat 7] [--out clump.json]
+        [--sizes 500x20 5000x20 50000x20 tests/data/grooms/bear.tfx] [--repeat 7] [--rounds 3] \
+        [--out clump.json]
 
 Not part of the package or of CI. Each groom (scalp samples ``STRANDSxVERTICES`` or a groom
 file) goes to Blender as a hair Curves object with the Essentials asset *Clump Hair Curves*
@@ -22,7 +23,9 @@ does), ``kept_ms`` with the list of the last run (the studio's repeated runs on 
 points), ``stroke_ms`` the run after a comb stroke near the middle tip, its list that of the
 points before the stroke brought up to date (the studio's release,
 ``hairtool.bench.freeze.release_times``; Blender evaluates its node anew after any edit).
-Both tools use every core. ClumpWithGaps does more than Blender's node (three iterations of an
+Both tools use every core. Each row is ``--rounds`` rounds of Blender then hairtool, each side's
+median over them, and the median of the rounds' speedups: the 2-core VM's speed drifts by tens
+of percent within minutes, and a round's two sides see about the same host. ClumpWithGaps does more than Blender's node (three iterations of an
 adhesion force over every pair within h, a gap correction, lengths kept), so the comparison is
 of what an artist waits for, not of equal work.
 """
@@ -137,11 +140,7 @@ def _hairtool_times(groom, h: float, repeat: int) -> dict:
     }
 
 
-def compare(size: str, groom, bpy_python: str, repeat: int) -> dict:
-    from hairtool.frozen.strand_clumps import auto_clump_radius
-
-    h = float(auto_clump_radius(groom))
-    row = {"groom": size, "strands": groom.strand_count, "vertices": groom.vertex_count, "h": h}
+def _blender(groom, h: float, bpy_python: str, repeat: int, size: str) -> dict:
     with tempfile.TemporaryDirectory(prefix="blender-clump-") as tmp:
         src, dst = os.path.join(tmp, "in.npz"), os.path.join(tmp, "out.json")
         sizes = np.diff(groom.offsets)
@@ -152,11 +151,25 @@ def compare(size: str, groom, bpy_python: str, repeat: int) -> dict:
         )  # fmt: skip
         if done.returncode != 0:
             raise SystemExit(f"Blender failed on {size}:\n{done.stderr[-3000:]}")
-        row.update({f"blender_{k}": v for k, v in json.loads(Path(dst).read_text()).items()})
-    row.update(_hairtool_times(groom, h, repeat))
-    row["speedup_cold"] = row["blender_clump_ms"] / row["cold_ms"]
-    row["speedup_kept"] = row["blender_clump_ms"] / row["kept_ms"]
-    row["speedup_stroke"] = row["blender_clump_ms"] / row["stroke_ms"]
+        return {f"blender_{k}": v for k, v in json.loads(Path(dst).read_text()).items()}
+
+
+def compare(size: str, groom, bpy_python: str, repeat: int, rounds: int = 1) -> dict:
+    """One row: each side's medians over ``rounds`` rounds of Blender then hairtool, and the
+    median of the rounds' speedups (a host whose speed drifts moves both sides of a round)."""
+    from hairtool.frozen.strand_clumps import auto_clump_radius
+
+    h = float(auto_clump_radius(groom))
+    row = {"groom": size, "strands": groom.strand_count, "vertices": groom.vertex_count, "h": h}
+    runs = []
+    for _ in range(rounds):
+        run = _blender(groom, h, bpy_python, repeat, size)
+        run.update(_hairtool_times(groom, h, repeat))
+        for case in ("cold", "kept", "stroke"):
+            run[f"speedup_{case}"] = run["blender_clump_ms"] / run[f"{case}_ms"]
+        runs.append(run)
+    row.update({k: float(np.median([r[k] for r in runs])) for k in runs[0]})
+    row["rounds"] = rounds
     return row
 
 
@@ -172,6 +185,9 @@ def main(argv: list[str] | None = None) -> int:
         help="STRANDSxVERTICES (scalp samples), 'real' (the checkout's real grooms) or groom files",
     )  # fmt: skip
     parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument(
+        "--rounds", type=int, default=3, help="rounds of Blender then hairtool; the median speedup of them"
+    )
     parser.add_argument("--out", type=Path, default=None, help="also write the rows as JSON")
     args = parser.parse_args(argv)
     import numba
@@ -182,7 +198,7 @@ def main(argv: list[str] | None = None) -> int:
     from hairtool.bench.freeze import _grooms  # the sizes `hairtool bench freeze --sizes` takes
 
     for size, groom in _grooms(args.sizes):
-        rows.append(compare(size, groom, args.bpy, args.repeat))
+        rows.append(compare(size, groom, args.bpy, args.repeat, args.rounds))
         rows[-1]["threads"] = numba.get_num_threads()
         print(json.dumps(rows[-1]), flush=True)
     print(format_table(rows))
