@@ -47,6 +47,25 @@ def test_with_points_shares_topology_and_attributes():
     np.testing.assert_array_equal(h.thickness, [1, 2, 3, 4])
 
 
+def test_moved_rows_adopt_the_array_and_check_only_those_rows():
+    g = Groom(np.random.default_rng(0).normal(size=(12, 3)), [4, 8], thickness=np.linspace(1, 2, 12))
+    p = g.points.copy()
+    p[[5, 6]] += 1.0
+    moved, plain = g.with_moved_rows(p, [5, 6]), g.with_points(p)
+    assert moved.points is p and not p.flags.writeable  # handed over, read-only
+    assert set(vars(moved)) == set(vars(plain))  # every field the constructor sets (and no cache)
+    for name in ("topology", "metadata", "thickness", "transparency", "colors"):
+        assert getattr(moved, name) is getattr(g, name)
+    assert moved.points.tobytes() == plain.points.tobytes()
+    bad = g.points.copy()
+    bad[7, 1] = np.nan
+    with pytest.raises(GroomError, match="vertex 7"):
+        g.with_moved_rows(bad, [6, 7])
+    view = np.zeros((24, 3), np.float32)[::2]  # not its own memory: copied as with_points does
+    assert g.with_moved_rows(view, []).points is not view
+    assert g.with_moved_rows(p.astype(np.float64), [5]).points.dtype == np.float32
+
+
 def test_attributes_name_the_constructor_keywords():
     g = Groom(np.zeros((4, 3)), [2, 2], thickness=[1, 2, 3, 4])
     assert list(g.attributes) == ["thickness", "transparency", "colors"]
