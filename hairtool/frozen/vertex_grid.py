@@ -31,6 +31,8 @@ _HASH = np.uint64(0x9E3779B97F4A7C15)
 IDX_BITS = 24  # vertex index bits in a list sort key: grooms of up to 16.7M vertices
 _IDX_MASK = (1 << IDX_BITS) - 1
 _SNAP = 16  # as hairtool.frozen.spatial.SNAP (the list build's grid lattice)
+_CELL_MASK = (1 << _BITS) - 1
+BLOCK_COUNTERS = 1 << 22  # at most (16 MB): blocks of 4³ cells or coarser over the groom's box
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -49,6 +51,34 @@ def _bucket(key, shift):
     return np.int64((np.uint64(key) * _HASH) >> shift)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _block_at(cx, cy, cz, origin, dims, shift):
+    """The counter of the block that holds cell (cx, cy, cz): blocks of 2**shift cells a side
+    from the cell ``origin``, ``dims`` of them; past them, the last counter (outside)."""
+    bx = (cx - origin[0]) >> shift
+    by = (cy - origin[1]) >> shift
+    bz = (cz - origin[2]) >> shift
+    if bx < 0 or by < 0 or bz < 0 or bx >= dims[0] or by >= dims[1] or bz >= dims[2]:
+        return dims[0] * dims[1] * dims[2]
+    return (bz * dims[1] + by) * dims[0] + bx
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _block_of(key, origin, dims, shift):
+    """:func:`_block_at` of a packed cell key."""
+    cx = (key & _CELL_MASK) - _OFF
+    cy = ((key >> _BITS) & _CELL_MASK) - _OFF
+    cz = ((key >> (2 * _BITS)) & _CELL_MASK) - _OFF
+    return _block_at(cx, cy, cz, origin, dims, shift)
+
+
+@njit(cache=True, nogil=True)
+def _count_blocks(key, origin, dims, shift, count):
+    count[:] = 0
+    for i in range(key.size):
+        count[_block_of(key[i], origin, dims, shift)] += 1
+
+
 @njit(cache=True, nogil=True)
 def _build(points, inv, shift, key, head, nxt, prv):
     head[:] = -1
@@ -64,8 +94,9 @@ def _build(points, inv, shift, key, head, nxt, prv):
 
 
 @njit(cache=True, nogil=True)
-def _move(points, vids, inv, shift, key, head, nxt, prv):
-    """The vertices ``vids`` into the cells of their new ``points``; returns how many changed cell."""
+def _move(points, vids, inv, shift, key, head, nxt, prv, blocks):
+    """The vertices ``vids`` into the cells of their new ``points`` (and their blocks' counts);
+    returns how many changed cell."""
     moved = 0
     for n in range(vids.size):
         i = vids[n]
@@ -73,6 +104,9 @@ def _move(points, vids, inv, shift, key, head, nxt, prv):
         if k == key[i]:
             continue
         moved += 1
+        origin, dims, bshift, count = blocks
+        count[_block_of(key[i], origin, dims, bshift)] -= 1
+        count[_block_of(k, origin, dims, bshift)] += 1
         if prv[i] >= 0:  # out of the old cell's list
             nxt[prv[i]] = nxt[i]
         else:
@@ -170,7 +204,7 @@ def _mark_near_grouped(points, strand, qx, qy, qz, r2, inv, shift, key, head, nx
 
 
 @twin_njit(nogil=True, parallel=True)
-def _mark_near(points, strand, qx, qy, qz, r2, inv, shift, key, head, nxt, mark):
+def _mark_near(points, strand, qx, qy, qz, r2, inv, shift, key, head, nxt, mark, bs):
     """Flag in ``mark`` (per strand) every strand with a vertex closer than sqrt(r2) to a query
     point (``qx``, ``qy``, ``qz``); a scan of every vertex where a query covers more cells than that.
     The queries run in parallel: each only ever sets flags, so the flags come out the same
@@ -192,16 +226,27 @@ def _mark_near(points, strand, qx, qy, qz, r2, inv, shift, key, head, nxt, mark)
                     mark[strand[j]] = True
             continue
         for cz in range(z0, z1 + 1):
-            _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz)
+            _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz, bs)
 
 
 @njit(cache=True, nogil=True)
-def _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz):
+def _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz, bs):
     """The strands with a vertex closer than sqrt(r2) to p among the cells [x0, x1] × [y0, y1]
-    of the slab cz."""
+    of the slab cz. ``bs``: the grid's block counters (:meth:`VertexGrid.blocks`): the cells of
+    a block that holds no vertex are passed over without a look at their buckets (a brush's
+    box is mostly empty cells, and the buckets, 16 bytes a vertex, miss the cache)."""
+    origin, dims, bshift, count = bs
+    outside = dims[0] * dims[1] * dims[2]
     for cy in range(y0, y1 + 1):
-        for cx in range(x0, x1 + 1):
+        cx = x0
+        while cx <= x1:
+            b = _block_at(cx, cy, cz, origin, dims, bshift)
+            if count[b] == 0:
+                # on to the next block's first cell (past the counted box: the next cell)
+                cx = cx + 1 if b == outside else ((((cx - origin[0]) >> bshift) + 1) << bshift) + origin[0]
+                continue
             k = _pack(cx, cy, cz)
+            cx += 1
             j = head[_bucket(k, shift)]
             while j >= 0:
                 if key[j] == k and not mark[strand[j]]:
@@ -214,14 +259,14 @@ def _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, 
 
 
 @twin_njit(nogil=True, parallel=True)
-def _mark_near_wide(points, strand, px, py, pz, r2, inv, shift, key, head, nxt, mark):
+def _mark_near_wide(points, strand, px, py, pz, r2, inv, shift, key, head, nxt, mark, bs):
     """:func:`_mark_near` for one query over many cells (a brush): its slabs of cells in parallel."""
     reach = np.sqrt(r2)
     x0, x1 = _coord(px - reach, inv), _coord(px + reach, inv)
     y0, y1 = _coord(py - reach, inv), _coord(py + reach, inv)
     z0, z1 = _coord(pz - reach, inv), _coord(pz + reach, inv)
     for cz in prange(z0, z1 + 1):
-        _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz)
+        _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz, bs)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -381,6 +426,20 @@ def list_frame(points: np.ndarray, radius: float, raw_box: tuple | None = None) 
     return dense, lo, 1.0 / radius, int(dims[1]), int(dims[2]), nq / width, nq
 
 
+def _blocks_over(points: np.ndarray, inv: float) -> tuple:
+    """Vertex counters for blocks of cells over the box of ``points`` (``(origin, dims, shift,
+    count)``, the last counter for the vertices that move out of the box): blocks of 4³ cells,
+    or 8³ and coarser where the box would need more than :data:`BLOCK_COUNTERS`."""
+    cells = (np.floor(b.astype(np.float64) * inv) for b in box(points))  # (as _coord computes them)
+    lo, hi = (np.clip(c, -_OFF, _OFF - 1).astype(np.int64) for c in cells)
+    span = hi - lo + 1
+    shift = 2
+    while int(np.prod(-(-span >> shift))) > BLOCK_COUNTERS:
+        shift += 1
+    dims = -(-span >> shift)
+    return lo, dims, np.int64(shift), np.empty(int(np.prod(dims)) + 1, np.int32)
+
+
 class VertexGrid:
     """Every vertex of one topology in hashed cells ``cell`` wide (see the module doc)."""
 
@@ -398,6 +457,8 @@ class VertexGrid:
         self.capacity = 64  # list slots per vertex (grows to the longest list + 1)
         self._flat = np.empty(0, np.int64)  # the lists' buffer (:meth:`prepare`)
         _build(points, self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
+        self.blocks = _blocks_over(points, self.inv)
+        _count_blocks(self.key, *self.blocks)
 
     @property
     def vertex_count(self) -> int:
@@ -421,7 +482,8 @@ class VertexGrid:
     def move(self, points: np.ndarray, vids: np.ndarray) -> int:
         """The vertices ``vids`` now at ``points[vids]``; returns how many changed cell."""
         ids = np.ascontiguousarray(vids, np.int64)
-        return int(_move(points, ids, self.inv, self.shift, self.key, self.head, self.nxt, self.prv))
+        grid = (self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
+        return int(_move(points, ids, *grid, self.blocks))
 
     def strands_near(self, points: np.ndarray, queries: np.ndarray, radius: float, mark: np.ndarray) -> None:
         """Flag in ``mark`` ((S,) bool) the strands with a vertex of ``points`` (where the grid
@@ -430,11 +492,14 @@ class VertexGrid:
         r2 = float(radius) ** 2
         grid = (self.inv, self.shift, self.key, self.head, self.nxt, mark)
         if len(q) == 1 and _cells_within(q[0], float(radius), self.cell) <= self.vertex_count:
-            _mark_near_wide(points, self.strand, float(q[0, 0]), float(q[0, 1]), float(q[0, 2]), r2, *grid)
+            x, y, z = float(q[0, 0]), float(q[0, 1]), float(q[0, 2])
+            _mark_near_wide(points, self.strand, x, y, z, r2, *grid, self.blocks)
             return
         xyz = np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1]), np.ascontiguousarray(q[:, 2])
-        near = _mark_near_grouped if float(radius) <= self.cell else _mark_near
-        near(points, self.strand, *xyz, r2, *grid)
+        if float(radius) <= self.cell:
+            _mark_near_grouped(points, self.strand, *xyz, r2, *grid)
+        else:
+            _mark_near(points, self.strand, *xyz, r2, *grid, self.blocks)
 
     def lists(self, points: np.ndarray, vids: np.ndarray, radius: float, frame: tuple) -> tuple:
         """``(flat, cnt, cap)``: the list of each vertex ``vids[n]`` (other strands within

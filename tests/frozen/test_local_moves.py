@@ -121,6 +121,33 @@ def test_each_way_of_finding_the_strands_near_queries_matches_the_reference(spac
         assert np.array_equal(mark, want) and 0 < want.sum()
 
 
+def test_the_blocks_count_their_vertices_across_moves_and_a_brush_skips_only_empty_ones():
+    """A brush's box of cells is mostly empty; blocks of 4 × 4 × 4 cells over the groom's box
+    count their vertices (one counter for those moved out of it), kept as vertices move, so a
+    brush skips the empty blocks' cells and finds what a scan finds."""
+    from hairtool.frozen import vertex_grid
+
+    g = bundles(3.0, per_side=5)
+    top, r = g.topology, 0.3
+    grid = VertexGrid(g.points, top.strand_index, r)
+    rng = np.random.default_rng(8)
+    pts = g.points.copy()
+    for k in range(6):
+        moved = np.sort(rng.choice(g.vertex_count, 60, replace=False))
+        pts[moved] += rng.normal(scale=2.0 if k % 2 else 0.2, size=(60, 3)).astype(np.float32)
+        grid.move(pts, moved)
+        origin, dims, shift, count = grid.blocks
+        fresh = np.empty_like(count)
+        vertex_grid._count_blocks(grid.key, origin, dims, shift, fresh)
+        assert np.array_equal(count, fresh) and fresh.sum() == g.vertex_count
+        assert 0 < count[-1] < g.vertex_count or k == 0  # (some moved out of the first box)
+        for q in pts[rng.choice(g.vertex_count, 3)] + rng.normal(scale=1.0, size=(3, 3)):
+            mark = np.zeros(g.strand_count, bool)
+            grid.strands_near(pts, q[None], 4.0 * r, mark)  # (the wide brush's path)
+            want = strands_near_reference(pts, top.strand_index, q[None], 4.0 * r, g.strand_count)
+            assert np.array_equal(mark, want)
+
+
 def test_a_crowded_block_of_cells_gives_the_full_builds_lists_too():
     """More vertices around a cell than a thread's scratch holds (vertex_grid._BLOCK_ROOM):
     that block gets arrays of its own, and the lists are the full build's all the same."""
