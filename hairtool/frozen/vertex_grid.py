@@ -97,6 +97,7 @@ def _build(points, inv, shift, key, head, nxt, prv):
 def _move(points, vids, inv, shift, key, head, nxt, prv, blocks):
     """The vertices ``vids`` into the cells of their new ``points`` (and their blocks' counts);
     returns how many changed cell."""
+    origin, dims, bshift, count = blocks
     moved = 0
     for n in range(vids.size):
         i = vids[n]
@@ -104,7 +105,6 @@ def _move(points, vids, inv, shift, key, head, nxt, prv, blocks):
         if k == key[i]:
             continue
         moved += 1
-        origin, dims, bshift, count = blocks
         count[_block_of(key[i], origin, dims, bshift)] -= 1
         count[_block_of(k, origin, dims, bshift)] += 1
         if prv[i] >= 0:  # out of the old cell's list
@@ -232,7 +232,7 @@ def _mark_near(points, strand, qx, qy, qz, r2, inv, shift, key, head, nxt, mark,
 @njit(cache=True, nogil=True)
 def _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz, bs):
     """The strands with a vertex closer than sqrt(r2) to p among the cells [x0, x1] × [y0, y1]
-    of the slab cz. ``bs``: the grid's block counters (:meth:`VertexGrid.blocks`): the cells of
+    of the slab cz. ``bs``: the grid's block counters (:attr:`VertexGrid.blocks`): the cells of
     a block that holds no vertex are passed over without a look at their buckets (a brush's
     box is mostly empty cells, and the buckets, 16 bytes a vertex, miss the cache)."""
     origin, dims, bshift, count = bs
@@ -457,7 +457,7 @@ class VertexGrid:
         self.capacity = 64  # list slots per vertex (grows to the longest list + 1)
         self._flat = np.empty(0, np.int64)  # the lists' buffer (:meth:`prepare`)
         _build(points, self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
-        self.blocks = _blocks_over(points, self.inv)
+        self.blocks = _blocks_over(points, self.inv)  # vertices per block of cells (_mark_slab skips)
         _count_blocks(self.key, *self.blocks)
 
     @property
