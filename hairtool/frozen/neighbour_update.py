@@ -310,7 +310,7 @@ def update_list(
     came, mold, to_new = _resort(nl, points, strand, skip, moved, old_key, new_key, new_qx, ra, rb)
     mark = np.zeros(v, np.bool_)
     _mark_finders(moved, mold, nl.bstart, nl.bflat, int(nl.start[ra]), to_new, mark)
-    if not _forward(nl, ra, rb, came, to_new, before, mark):
+    if not _forward(nl, ra, rb, came, to_new, mark):
         nl.chunks = None  # half rewritten: only a build can follow
         return False
     return True
@@ -346,7 +346,7 @@ def _resort(nl, points, strand, skip, moved, old_key, new_key, new_qx, ra, rb):
     return came, mold, to_new
 
 
-def _forward(nl, ra, rb, came, to_new, before, mark) -> bool:
+def _forward(nl, ra, rb, came, to_new, mark) -> bool:
     """Steps 2 and 3: the forward entries of the chunks that hold rows [rw0, rb] (rw0 the first
     row whose search reaches row ra), searched again from the moved vertices and the ``mark``ed
     ones (those that found a moved vertex where it was; here also those that can find it where
@@ -379,15 +379,15 @@ def _forward(nl, ra, rb, came, to_new, before, mark) -> bool:
     nl.forward_entries += int(nl.acnt[a0:a1].sum() - old_acnt.sum())
     # The backward lists from rw0 to the rows the last rewritten chunk's search reaches.
     qb = min(ny * nz - 1, int(chunks[c1 + 1]) - 1 + ny + 1)
-    _backward(nl, int(start[rw0]), int(start[qb + 1]))
+    _backward(nl, rw0, qb + 1)
     return True
 
 
-def _backward(nl, q0, q1) -> None:
-    """The backward lists of the vertices [q0, q1) transposed again; those after them moved
-    along by the change in their number."""
+def _backward(nl, r0, r1) -> None:
+    """The backward lists of the vertices of rows [r0, r1) transposed again; those after them
+    moved along by the change in their number."""
     ny = nl.dims[1]
-    r0, r1 = np.searchsorted(nl.start, (q0, q1), side="right") - 1
+    q0, q1 = int(nl.start[r0]), int(nl.start[r1])
     tasks = int(min(BACKWARD_BLOCKS, max(2, (r1 - r0) // (BLOCK_REACHES * (ny + 1)))))
     blocks, sources = _target_blocks(nl.start, ny, q0, q1, tasks)
     count = np.empty(q1 - q0, np.int64)
