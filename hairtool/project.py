@@ -269,6 +269,20 @@ def save(path: str | os.PathLike[str], project: Project, *, compress: bool = Fal
     ``compress``: deflate the arrays too. Off by default: float coordinates barely compress
     (8 % on a 2,000-strand groom with a 44-frame animation) while deflating made the save
     about 9× slower (1.4 s against 0.16 s). On any error the previous file is untouched.
+
+    Parameters
+    ----------
+    path
+        The ``.hairproj`` file to write.
+    project
+        The document: groom, strokes, settings, animation, render hair, head mesh, camera.
+    compress
+        Deflate the array members as well as the manifest.
+
+    Raises
+    ------
+    FormatError
+        The settings are not plain JSON, or the file cannot be written; the message names it.
     """
     manifest, arrays = manifest_and_arrays(project)
     try:
@@ -773,7 +787,24 @@ def _build(r: _Reader) -> Project:
 
 
 def load(path: str | os.PathLike[str]) -> Project:
-    """Read a project; :class:`FormatError` naming the file for anything but a valid project."""
+    """Read a project; :class:`FormatError` naming the file for anything but a valid project.
+
+    Parameters
+    ----------
+    path
+        A ``.hairproj`` file of version 1 to 3.
+
+    Returns
+    -------
+    Project
+        The document as it was saved; render hair is bound again from its definition.
+
+    Raises
+    ------
+    FormatError
+        The file is missing, truncated, corrupt, foreign or of a newer version; every member's
+        size and checksum is checked before it is trusted.
+    """
     p = Path(path)
     if not p.is_file():
         raise FormatError(path, "no such file" if not p.exists() else "not a regular file")

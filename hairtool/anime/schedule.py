@@ -145,6 +145,27 @@ def schedule(period: float, fps: float = 24.0, hold: int = 2) -> Schedule:
     Refuses inputs for which the scheme breaks: a cycle shorter than half a frame (N_Frame = 0),
     and K > N_Pict, where the pictures cannot share the frames with holds of N_Dup and N_Dup − 1
     (e.g. a one-frame cycle on threes).
+
+    Parameters
+    ----------
+    period
+        T, the cycle's length in seconds, > 0.
+    fps
+        N_FPS, frames per second, > 0.
+    hold
+        N_Dup, frames each picture is held (2: on twos).
+
+    Returns
+    -------
+    Schedule
+        N_Frame = round(N_FPS·T) frames, N_Pict = ⌈N_Frame/N_Dup⌉ pictures drawn Δt = T/N_Pict
+        apart, and each picture's hold: the first N_Pict − K held N_Dup frames, the last K held
+        N_Dup − 1.
+
+    Raises
+    ------
+    ParameterError
+        A value is out of range, or the scheme breaks for these values.
     """
     period = _check_positive("period", period, "a positive, finite number of seconds")
     fps = _check_positive("fps", fps, "a positive, finite frame rate")

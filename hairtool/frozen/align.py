@@ -140,6 +140,32 @@ def align(
     ``intensity`` x ∈ [0, 1]: 1 turns a strand like a rod, 0 mostly its tip. ``planar``: whether
     the groom counts as 2-D (None: :attr:`~hairtool.groom.Groom.is_planar`; the brush-local
     pipeline passes the whole groom's for the strands it runs on).
+
+    Parameters
+    ----------
+    groom
+        The groom to turn (in the pipeline, the frozen groom or the last sample's result).
+    cursor
+        ``(3,)`` the cursor c of eq. 9, in groom units.
+    radius
+        r of eq. 10, > 0: a strand takes part when its tip is within it of the cursor.
+    intensity
+        x of eq. 12, in [0, 1].
+    mode
+        ``"paper"``: eq. 13's blend of rotated and unrotated offsets, which shortens strands at
+        large angles; ``"preserve-length"``: each offset rotated by the weighted angle instead.
+    planar
+        Whether the groom is 2-D (its turning axis then the plane's normal); None: the groom's own.
+
+    Returns
+    -------
+    Groom
+        A new groom; strands out of reach keep their points bit for bit.
+
+    Raises
+    ------
+    ParameterError
+        A parameter is out of range or not finite.
     """
     c = check_align_params(cursor, radius, intensity, mode)
     planar = groom.is_planar if planar is None else bool(planar)

@@ -610,6 +610,39 @@ def clump(
     buffers across updates and read ``mean_neighbours`` afterwards. ``keep_lengths``: segments
     back to their lengths before clumping afterwards (off: as printed, for the paper's figures).
     ``strength``: ``(S,)`` clump strength of each strand in [0, 1] (None: all 1, as printed).
+
+    Parameters
+    ----------
+    groom
+        The groom to clump (in the pipeline, the aligned groom).
+    radius
+        h of eqs. 14–19, > 0, in groom units: vertices of other strands within it pull.
+    iterations
+        k of eq. 16, in [0, 100].
+    step
+        Δt²/m of eq. 16; None: a fraction of h over the mean kernel weight, so dense grooms do not
+        overshoot.
+    gap_mode
+        ``"printed"`` (eqs. 17–19 as printed), ``"text"`` (the reading that follows the paper's
+        words) or ``"off"``.
+    seed
+        The seed of ζ.
+    workspace
+        Buffers and neighbour lists kept across calls.
+    keep_lengths
+        Give every segment back its length after clumping.
+    strength
+        ``(S,)`` per-strand clump strength in [0, 1]; None: every strand 1.
+
+    Returns
+    -------
+    Groom
+        A new groom; roots unchanged.
+
+    Raises
+    ------
+    ParameterError
+        A parameter is out of range; the message names it.
     """
     pts = clump_points(groom, radius, iterations, step, gap_mode, seed, workspace, keep_lengths, strength)
     return groom.with_points(pts)

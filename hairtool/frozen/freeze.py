@@ -159,6 +159,31 @@ def freeze(
 
     ``strand_variation`` scales both stiffnesses per strand (see :func:`strand_multipliers`).
     The result depends only on the inputs: same seed, same bytes.
+
+    Parameters
+    ----------
+    groom
+        The rest groom; FreezeDeform always starts from it, never from its own output.
+    stretch_stiffness
+        k_s of eq. 3, > 0: a segment's length changes by at most 1/k_s (7: about ±14 %).
+    bend_stiffness
+        k_b of eq. 4, > 0: a segment turns by at most ``max_bend_angle``/k_b.
+    max_bend_angle
+        θ_max in radians.
+    seed
+        The noise's seed: η and ξ are a function of (seed, strand, vertex).
+    strand_variation
+        A spread of per-strand stiffness (0: none), or ``(S,)`` multipliers.
+
+    Returns
+    -------
+    Groom
+        A new groom of the same topology and attributes; roots unchanged.
+
+    Raises
+    ------
+    ParameterError
+        A parameter is out of range; the message names it and its range.
     """
     ks, kb, seed = _effective(
         groom, stretch_stiffness, bend_stiffness, max_bend_angle, seed, strand_variation

@@ -220,7 +220,22 @@ class FrozenSnapshot:
 
 
 class FrozenPipeline:
-    """FreezeDeform → UserAlign → ClumpWithGaps on a rest groom, for interactive use."""
+    """FreezeDeform → UserAlign → ClumpWithGaps on a rest groom, for interactive use.
+
+    Every call that changes something returns the new result (a new, immutable groom), and the
+    pipeline keeps the stroke log that :func:`~hairtool.frozen.strokes.read_strokes` files and
+    the studio replay.
+
+    Parameters
+    ----------
+    rest
+        The groom as authored; FreezeDeform always starts from it.
+    params
+        The engine's parameters; None: the defaults of :class:`FrozenParams`.
+    surface
+        The head the slide, add and density brushes work on and every brush keeps hair out of;
+        None: no head.
+    """
 
     def __init__(
         self, rest: Groom, params: FrozenParams | None = None, surface: Surface | None = None
@@ -465,7 +480,31 @@ class FrozenPipeline:
         view: ArrayLike | None = None,
     ) -> Groom:
         """One align sample (one mouse move); it persists. Returns the updated result. ``view``:
-        the camera's viewing direction, for front-facing strands only (None: every strand)."""
+        the camera's viewing direction, for front-facing strands only (None: every strand).
+
+        Parameters
+        ----------
+        cursor
+            ``(3,)`` the cursor, in groom units.
+        radius
+            The tips within it of the cursor take part.
+        intensity
+            In [0, 1]: 1 turns a strand like a rod, 0 mostly its tip.
+        mode
+            ``"paper"`` or ``"preserve-length"`` (see :func:`~hairtool.frozen.align.align`).
+        view
+            ``(3,)`` the camera's viewing direction; None: every strand.
+
+        Returns
+        -------
+        Groom
+            The pipeline's new result: the strokes so far, clumped.
+
+        Raises
+        ------
+        ParameterError
+            A parameter is out of range; the sample is not logged.
+        """
         c = check_align_params(cursor, radius, intensity, mode)
         v = check_view(view)
         cursor3 = (float(c[0]), float(c[1]), float(c[2]))
@@ -481,7 +520,26 @@ class FrozenPipeline:
         """Samples of any brush (a stroke's, mirrored ones included), applied in order, then one
         clumping: what a replayed stroke log does. ``local``: a brush-local move where it can
         (:mod:`hairtool.frozen.local`); False: on the whole groom, as a replay after a parameter
-        change does."""
+        change does.
+
+        Parameters
+        ----------
+        samples
+            Align, brush and selection samples, in order.
+        local
+            Allow a brush-local move.
+
+        Returns
+        -------
+        Groom
+            The pipeline's new result. After brush-local moves, :meth:`settle` gives the bytes a
+            full replay gives.
+
+        Raises
+        ------
+        HairtoolError
+            A sample is refused; none of ``samples`` is applied or logged.
+        """
         self._timings = dict.fromkeys(self._timings, 0.0)
         if local and samples and self._local_ready(samples):
             return self._apply_local(samples)

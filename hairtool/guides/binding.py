@@ -303,7 +303,43 @@ def bind_scalp(
 ) -> ChildBinding:
     """``count`` children scattered on the scalp ``mesh`` (over ``region``: a face set's name,
     a face mask or indices, default :func:`~hairtool.guides.scatter.default_region`; by area × ``density``),
-    each bound to its k nearest guides along the surface."""
+    each bound to its k nearest guides along the surface.
+
+    Parameters
+    ----------
+    guides
+        The guide strands; their roots should lie on or near the mesh.
+    mesh
+        The scalp or head the children grow on.
+    count
+        How many children.
+    k
+        Guides each child follows (its nearest, along the surface).
+    vertices
+        Vertices per child, 2 … 1024; None: the guides' largest count.
+    seed
+        Seed of the scattering, the length variation and the frizz.
+    length_variation
+        Seeded spread of the children's lengths.
+    frizz
+        Seeded waviness of the children.
+    region
+        Where children grow: a face set's name, a face mask or face indices; None: the triangles
+        near the guide roots.
+    density
+        Per-face weights of the scattering.
+
+    Returns
+    -------
+    ChildBinding
+        The children's definition: ``build(guides)`` gives their points for any pose of the
+        guides.
+
+    Raises
+    ------
+    ParameterError
+        A count, k or option is out of range; the message names it.
+    """
     check_mesh(mesh)
     k = check_k(k, guides.strand_count)
     count = check_count(count)

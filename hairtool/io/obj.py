@@ -135,6 +135,22 @@ def read_mesh(path: str | os.PathLike[str]) -> Mesh:
 
     Normals come from the file's ``vn`` records (averaged per vertex) when every face corner
     names one; otherwise they are computed, area-weighted, from the triangles.
+
+    Parameters
+    ----------
+    path
+        A Wavefront OBJ file with ``f`` records (``g``/``o`` names become face sets).
+
+    Returns
+    -------
+    Mesh
+        float32 vertices ``(n, 3)``, int32 triangles ``(m, 3)``, float32 unit normals ``(n, 3)``
+        and the face sets, each an array of triangle indices.
+
+    Raises
+    ------
+    FormatError
+        The file is missing, has no faces, or a face names a vertex or normal it lacks.
     """
     p = Path(path)
     if not p.is_file():

@@ -415,6 +415,46 @@ def find_keys(
 
     Exactly one of ``keys``, ``penalty``, ``budget``, ``max_error`` (which implies the worst-frame
     objective); ``table`` and ``constraints`` as in :func:`solve`.
+
+    Parameters
+    ----------
+    source
+        An animation (its frames become seed 000's features: strands resampled, root-relative,
+        tips weighted) or an ``(n_frames, D)`` feature array used as is.
+    keys
+        The number of keys K.
+    penalty
+        The price tau of one more key, in the cost's units.
+    budget
+        The largest total error allowed: the fewest keys within it.
+    max_error
+        The largest error of any frame allowed: the fewest keys within it.
+    objective
+        ``"total"`` (the sum over the key segments) or ``"worst"`` (the worst frame).
+    interp
+        How frames between keys are rebuilt: ``"linear"``, ``"hermite"`` or ``"hermite-fit"``.
+    curvature
+        Weight of the curvature regulariser (0: none).
+    features
+        How an animation becomes features; None: the defaults.
+    curve_keys
+        The error-versus-key-count curve covers K = 2 … this.
+    table
+        A cost table built by the caller (a BVH capture's quaternion-distance table), replacing
+        the features' Gram table.
+    constraints
+        Frames that must be keys and frames that must not; None: none.
+
+    Returns
+    -------
+    Selection
+        The keys (frame indices, ascending), their cost, uniform keys of the same count with
+        theirs, and the cost-versus-K curve.
+
+    Raises
+    ------
+    ParameterError
+        Not exactly one of the four, or a value out of range; the message names it.
     """
     if max_error is not None:
         objective = "worst"

@@ -304,7 +304,23 @@ def _frame_count(path: str, text: str) -> int:
 
 
 def read_bvh(path: str | os.PathLike[str]) -> Motion:
-    """Read a BVH file; any malformed input raises :class:`FormatError` naming the file."""
+    """Read a BVH file; any malformed input raises :class:`FormatError` naming the file.
+
+    Parameters
+    ----------
+    path
+        A BVH motion capture: its hierarchy (offsets, channels in their order) and motion.
+
+    Returns
+    -------
+    Motion
+        The skeleton and its channel values per frame, with the frame time.
+
+    Raises
+    ------
+    FormatError
+        The file is missing, malformed or truncated; the message names the file.
+    """
     p = os.fspath(path)
     try:
         with open(p, "rb") as f:
@@ -399,7 +415,21 @@ def _fmt(v: float) -> str:
 
 
 def write_bvh(path: str | os.PathLike[str], motion: Motion) -> None:
-    """Write ``motion`` as BVH (atomically); values keep 6 decimals."""
+    """Write ``motion`` as BVH (atomically); values keep 6 decimals.
+
+    Parameters
+    ----------
+    path
+        The file to write (a temporary file beside it is renamed into place).
+    motion
+        The skeleton and its channel values; the hierarchy, offsets, channel order and frame
+        time are written as the motion holds them.
+
+    Raises
+    ------
+    OSError
+        The file cannot be written; an earlier file at ``path`` is left as it was.
+    """
     children: list[list[int]] = [[] for _ in range(motion.n_joints)]
     for j in range(1, motion.n_joints):
         children[motion.parents[j]].append(j)
