@@ -1,4 +1,4 @@
-"""The README's pictures of the studio, made by driving the real window as an artist would.
+"""The manual's pictures of the studio, made by driving the real window as an artist would.
 
 ``python -m app.figures.screenshots OUTDIR`` (needs a display: Xvfb works) writes
 

@@ -1,4 +1,4 @@
-"""The README's screenshots are made by driving the real studio: the script must keep working."""
+"""The manual's screenshots are made by driving the real studio: the script must keep working."""
 
 from __future__ import annotations
 

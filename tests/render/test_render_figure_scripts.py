@@ -122,15 +122,18 @@ def test_the_fig9_jump_figure_edits_one_key_of_the_walk(tmp_path, capsys):
     assert move[key] > 0.9 * move.max() and move[first] < 0.2 * move[key] and move[last] < 0.2 * move[key]
     assert move[first] < move[(first + key) // 2] < move[key] and move[last] < move[(key + last) // 2]
     misses = [float(v) for v in re.findall(r": ([0-9.e+-]+) of the figure's height from its target", out)]
-    assert len(misses) == 4 and max(misses) <= 2e-5  # the README says: each within 2e-5
-    # the README's Fig. 9 section is this figure: its keys, its command, its picture's layout
-    readme = (ROOT / "README.md").read_text()
-    assert "python -m app.figures.mocap" in readme
-    assert f"keys at {lo}, {key} and {hi}" in readme and f"the key of frame {key}" in readme
-    assert f"{mocap.KEYS} keys (cubic Hermite)" in readme
-    picture = re.search(r"!\[Seed 003's Fig\. 9[^]]*\]\((resources/[^)]+\.png)\)", readme)
-    assert picture, "the README shows Fig. 9"
-    shown = iio.imread(ROOT / picture.group(1))
+    assert len(misses) == 4 and max(misses) <= 2e-5  # the manual says: each within 2e-5
+    # the manual's Fig. 9 section is this figure: its keys, its command, its picture's layout
+    page_path = ROOT / "docs" / "cli" / "key-edits.md"
+    page = page_path.read_text()
+    assert "python -m app.figures.mocap" in page
+    assert f"keys at {lo}, {key} and {hi}" in page and f"the key of frame {key}" in page
+    assert f"{mocap.KEYS} keys (cubic Hermite)" in page
+    picture = re.search(r"!\[Seed 003's Fig\. 9[^]]*\]\(([^)]+\.png)\)", page)
+    assert picture, "the manual shows Fig. 9"
+    shown_path = (page_path.parent / picture.group(1)).resolve()
+    assert shown_path == (ROOT / "resources" / "figure-keys-jump.png").resolve(), "the script's picture"
+    shown = iio.imread(shown_path)
     columns = sheet.shape[1] // (64 + GAP)  # the frames shown, one panel each
     size = (shown.shape[1] - (columns + 1) * GAP) / columns
     assert size == int(size) and shown.shape[0] == 2 * (int(size) + LABEL_HEIGHT) + 3 * GAP

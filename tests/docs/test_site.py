@@ -1,0 +1,105 @@
+"""The manual is a site: it builds with ``mkdocs build --strict`` offline, its generated pages are
+the ones the generator makes now, and the README stays a short door into it."""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+DOCS = ROOT / "docs"
+
+
+def _generator():
+    spec = importlib.util.spec_from_file_location("docs_generate", DOCS / "generate.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_generated_pages_are_up_to_date():
+    stale = [str(p.relative_to(ROOT)) for p in _generator().stale_pages()]
+    assert not stale, f"stale: {stale}; regenerate them with: python docs/generate.py"
+
+
+def test_a_changed_option_makes_the_cli_page_stale(monkeypatch):
+    import hairtool.cli
+
+    generate = _generator()
+    page = DOCS / "cli" / "reference.md"
+    original = hairtool.cli.command_parser
+
+    def parser_with_one_more_option(name):
+        parser = original(name)
+        if name == "info":
+            kwargs = {"prog": parser.prog, "description": parser.description, "add_help": False}
+            parser = type(parser)(parents=[parser], **kwargs)
+            parser.add_argument("--brand-new", help="an option the committed page does not know")
+        return parser
+
+    monkeypatch.setattr(hairtool.cli, "command_parser", parser_with_one_more_option)
+    text = generate.cli_reference()
+    assert "--brand-new" in text and text != page.read_text(encoding="utf-8")
+
+
+def test_every_command_and_its_options_are_on_the_reference_page():
+    from hairtool.cli import command_modules, command_parser
+
+    page = (DOCS / "cli" / "reference.md").read_text(encoding="utf-8")
+    for name in command_modules():
+        assert f"## hairtool {name}\n" in page
+        for action in command_parser(name)._actions:
+            if action.help == argparse.SUPPRESS or isinstance(action, argparse._HelpAction):
+                continue
+            for option in action.option_strings:
+                assert f"`{option}" in page or f", {option}" in page, f"hairtool {name} {option}"
+
+
+def test_every_brush_has_its_section_on_the_brushes_page():
+    from hairtool.frozen.brushes import BRUSHES
+
+    page = (DOCS / "studio" / "brushes.md").read_text(encoding="utf-8")
+    ids = re.findall(r"^## .*\{#brush-(\w+)\}$", page, re.M)
+    assert sorted(ids) == sorted(BRUSHES), "one section per brush, each described once"
+
+
+def test_the_readme_is_a_short_door_into_the_site():
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(readme.encode()) <= 10 * 1024
+    studio, test = readme.index("./dev studio"), readme.index("./dev test")
+    assert max(studio, test) < readme.index("](docs/"), "the two set-up commands come first"
+    pictures = re.findall(r"!\[[^]]*\]\(([^)]+)\)", readme)
+    assert len(pictures) == 1 and (ROOT / pictures[0]).is_file()
+    for link in re.findall(r"\]\((docs/[^)#]+)", readme):
+        assert (ROOT / link).is_file(), link
+
+
+@pytest.mark.slow(seconds=20)
+def test_the_site_builds_strict_without_the_network(tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(ROOT), NO_MKDOCS_2_WARNING="1")
+    for var in ("HTTP_PROXY", "HTTPS_PROXY", "http_proxy", "https_proxy", "ALL_PROXY", "all_proxy"):
+        env[var] = "http://127.0.0.1:9"  # a fetch at build time fails instead of reaching out
+    env.pop("NO_PROXY", None)
+    env.pop("no_proxy", None)
+    site = tmp_path / "site"
+    run = subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(site)],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert run.returncode == 0, run.stderr[-4000:]
+    assert (site / "cli" / "reference" / "index.html").is_file()
+    for picture in ("screenshot-studio.png", "screenshot-timeline.png", "figure-keys-jump.png"):
+        assert (site / "images" / picture).is_file()
+    api = (site / "api" / "io" / "index.html").read_text(encoding="utf-8")
+    assert "Parameters" in api and "Returns" in api  # the docstrings' sections, rendered
