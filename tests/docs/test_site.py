@@ -68,6 +68,13 @@ def test_every_brush_has_its_section_on_the_brushes_page():
     page = (DOCS / "studio" / "brushes.md").read_text(encoding="utf-8")
     ids = re.findall(r"^## .*\{#brush-(\w+)\}$", page, re.M)
     assert sorted(ids) == sorted(BRUSHES), "one section per brush, each described once"
+    for name in BRUSHES:  # and its picture, made by python -m app.figures.brushes resources
+        section = page.split(f"{{#brush-{name}}}", 1)[1].split("\n## ", 1)[0]
+        assert f"](../images/figure-brush-{name}.png)" in section, name
+        assert (ROOT / "resources" / f"figure-brush-{name}.png").is_file(), name
+        assert (DOCS / "images" / f"figure-brush-{name}.png").resolve() == (
+            ROOT / "resources" / f"figure-brush-{name}.png"
+        ).resolve(), f"docs/images/figure-brush-{name}.png links to the picture in resources/"
 
 
 def test_the_readme_is_a_short_door_into_the_site():
