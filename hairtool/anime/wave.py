@@ -225,6 +225,36 @@ def cycle_animation(
     variation; by default every strand is a bunch with a seeded phase and amplitude. The
     groom's attributes (thickness, colours) and source record (up axis, unit, prims) are kept,
     and "up" is the scene's.
+
+    Parameters
+    ----------
+    groom
+        The rest pose; its strands are the chains the wave bends.
+    params
+        The wave f(x, t) of eq. 1 and its period T; None: the defaults of :class:`WaveParams`.
+    fps
+        N_FPS, frames per second.
+    hold
+        N_Dup, frames each picture is held (2: on twos).
+    cycles
+        How many cycles the shot repeats.
+    frames
+        The shot's length in frames, instead of ``cycles``.
+    bunches
+        The strands grouped into bunches with their phase and amplitude.
+    **variation
+        Keywords of :func:`make_bunches`, when ``bunches`` is None.
+
+    Returns
+    -------
+    Animation
+        The frames at ``fps``, the first of them the first picture.
+
+    Raises
+    ------
+    ParameterError
+        A value is out of range, the schedule breaks for these values, or the animation would
+        be too large; the message names the parameter.
     """
     params = WaveParams() if params is None else params
     sched = schedule(params.period, fps, hold)

@@ -389,7 +389,26 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke | SelectionStep:
 
 
 def read_strokes(path: str | os.PathLike[str]) -> list[Stroke | SelectionStep]:
-    """A stroke log file; :class:`FormatError` naming the file and the bad entry."""
+    """A stroke log file; :class:`FormatError` naming the file and the bad entry.
+
+    Parameters
+    ----------
+    path
+        A JSON stroke log: a list of strokes and selection steps, or an object whose
+        ``strokes`` is that list. At most 256 MB.
+
+    Returns
+    -------
+    list of Stroke or SelectionStep
+        The entries in order, each checked as it will run; unknown fields are ignored and
+        missing ones take their defaults, so older logs read.
+
+    Raises
+    ------
+    FormatError
+        The file is unreadable, not JSON, too large or too deep, or an entry is bad; the message
+        names the file and the entry (``strokes[3]``).
+    """
     p = Path(path)
     try:
         if p.stat().st_size > MAX_LOG_BYTES:
@@ -412,7 +431,20 @@ def read_strokes(path: str | os.PathLike[str]) -> list[Stroke | SelectionStep]:
 
 
 def write_strokes(path: str | os.PathLike[str], strokes: Sequence[Stroke | SelectionStep]) -> None:
-    """Write a stroke log (atomically)."""
+    """Write a stroke log (atomically).
+
+    Parameters
+    ----------
+    path
+        The JSON file to write; a temporary file beside it is renamed into place.
+    strokes
+        Strokes and selection steps, in order, as :func:`read_strokes` gives them back.
+
+    Raises
+    ------
+    FormatError
+        The file cannot be written, or a value is not finite; the message names the file.
+    """
     try:
         with atomic_open(path, "w", encoding="utf-8") as f:
             json.dump([s.to_dict() for s in strokes], f, indent=1, allow_nan=False)
