@@ -140,6 +140,13 @@ def strokes_for(rest: Groom) -> dict[str, tuple[list[dict], str]]:
     }
 
 
+def default_stroke(name: str) -> tuple[list[dict], str]:
+    """A brush without its own stroke here: one drag down through the strands on the right, at
+    full strength, so a new brush has its picture before anyone tunes one."""
+    path = stroke(np.array([1.35, 1.1]), np.array([1.35, -1.0]))
+    return [{"brush": name, "falloff": "smooth", "samples": samples_along(path, 0.6, 1.0)}], f"after {name}"
+
+
 def colours(pipe, groom: Groom) -> np.ndarray:
     """The ramp; masked strands slate blue and unselected ones grey, as the studio tints them,
     planted ones green."""
@@ -193,7 +200,7 @@ def make(argv: list[str] | None = None) -> None:
     rest = samples.portrait(strands=90, vertices=20, seed=0)
     strokes = strokes_for(rest)
     for name in BRUSHES:
-        entries, caption = strokes[name]
+        entries, caption = strokes.get(name) or default_stroke(name)
         write(outdir / f"figure-brush-{name}.png", picture(name, entries, caption, rest, args.size))
 
 

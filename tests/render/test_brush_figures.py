@@ -31,6 +31,8 @@ def test_every_brush_has_a_stroke_and_the_head_is_a_closed_ring():
     assert set(strokes) == set(BRUSHES)
     for name, (entries, caption) in strokes.items():
         assert name in [e["brush"] for e in entries] and all(e["samples"] for e in entries) and caption
+    entries, caption = brushes.default_stroke("comb")  # a brush added later gets this one
+    assert entries[0]["brush"] == "comb" and len(entries[0]["samples"]) > 1 and caption
     mesh = brushes.head_mesh()
     radial = np.linalg.norm(mesh.vertices[:, :2], axis=1)
     assert np.allclose(radial, samples.HEAD_RADIUS, atol=1e-6)
