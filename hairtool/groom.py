@@ -203,6 +203,25 @@ class Groom(_Attributes):
 
     Build a new groom with :meth:`with_points` rather than writing into ``points``: engines
     return new positions and the topology (and its cached index arrays) is shared.
+
+    Parameters
+    ----------
+    points
+        ``(V, 3)`` vertex positions, strand after strand, root first; stored as float32.
+    counts
+        ``(S,)`` vertices per strand (each at least 2, adding up to V), or a shared
+        :class:`Topology`.
+    thickness, transparency
+        Optional ``(V,)`` per-vertex widths and transparency.
+    colors
+        Optional ``(V, 3)`` per-vertex RGB.
+    metadata
+        The source's scene description (up axis, unit, curve prims); None: the defaults.
+
+    Raises
+    ------
+    GroomError
+        A shape or count does not match, or a value is not finite.
     """
 
     def __init__(
@@ -383,7 +402,25 @@ def vertex_ids_of(topology: Topology, strand_ids: NDArray[np.int64]) -> I64:
 
 
 class Animation(_Attributes):
-    """The same strands over F frames: ``frames`` is float32 ``(F, V, 3)``, ``fps`` frames/s."""
+    """The same strands over F frames: ``frames`` is float32 ``(F, V, 3)``, ``fps`` frames/s.
+
+    Parameters
+    ----------
+    frames
+        ``(F, V, 3)`` vertex positions per frame, F ≥ 1; the first frame is the rest pose.
+    counts
+        ``(S,)`` vertices per strand, or a shared :class:`Topology`.
+    fps
+        Frames per second.
+    thickness, transparency, colors, metadata
+        As for :class:`Groom`; the metadata's time codes give each frame's time code in the
+        source.
+
+    Raises
+    ------
+    GroomError
+        A shape or count does not match, or a value is not finite.
+    """
 
     def __init__(
         self,
