@@ -221,12 +221,13 @@ class SelectionStep:
         return [self.validate().sample]
 
     def to_dict(self) -> dict:
-        s = self.sample
-        if s.op != "box":
-            return {"selection": s.op}
-        view = None if s.view is None else list(s.view)
-        box = {"mode": s.mode, "matrix": list(s.matrix), "rect": list(s.rect), "view": view}
-        return {"selection": "box", **box}
+        """The step's fields its op uses (a box's camera, rectangle, mode and view), by log name."""
+        s, out = self.sample, {}
+        for f in SELECTION.fields:
+            if f.used(s.op):
+                value = getattr(s, f.name)
+                out[f.json] = list(value) if isinstance(value, tuple) else value
+        return out
 
 
 def strokes_from_log(
@@ -339,25 +340,30 @@ def _short(value: Any) -> Any:
     return value
 
 
+_STEP_SHAPES = {
+    "matrix": (16, "16 numbers (a 4×4 matrix, row-major)"),
+    "rect": (4, "four numbers [x0, y0, x1, y1]"),
+}
+
+
 def selection_from_dict(d: dict, where: str = "stroke") -> SelectionStep:
     """A :class:`SelectionStep` from its JSON form; ParameterError naming the field."""
     op = d.get("selection")
-    if op not in ("box",):
-        step = SelectionStep(SelectionSample(op))
-    else:
-        matrix, rect = d.get("matrix"), d.get("rect")
-        if not isinstance(matrix, list) or len(matrix) != 16:
-            raise ParameterError(f"{where}.matrix", _short(matrix), "16 numbers (a 4×4 matrix, row-major)")
-        if not isinstance(rect, list) or len(rect) != 4:
-            raise ParameterError(f"{where}.rect", _short(rect), "four numbers [x0, y0, x1, y1]")
-        view = d.get("view")
-        step = SelectionStep(SelectionSample(
-            "box", tuple(_number(f"{where}.matrix", v) for v in matrix),
-            tuple(_number(f"{where}.rect", v) for v in rect),  # type: ignore[arg-type]
-            d.get("mode", "set"), None if view is None else _vector(f"{where}.view", view),
-        ))  # fmt: skip
+    values: dict[str, Any] = {"op": op}
+    for f in SELECTION.fields:
+        if f.name == "op" or not f.used(op):
+            continue
+        value = f.in_log(d)
+        if f.name in _STEP_SHAPES:
+            size, expected = _STEP_SHAPES[f.name]
+            if not isinstance(value, list) or len(value) != size:
+                raise ParameterError(f"{where}.{f.json}", _short(value), expected)
+            value = tuple(_number(f"{where}.{f.json}", v) for v in value)
+        elif f.kind == "view":
+            value = None if value is None else _vector(f"{where}.{f.json}", value)
+        values[f.name] = value
     try:
-        return step.validate()
+        return SelectionStep(SELECTION.make(**values)).validate()
     except ParameterError as e:
         raise ParameterError(f"{where}.{e.name}", _short(e.value), str(e).split("expected ", 1)[-1]) from None
 
