@@ -9,7 +9,9 @@ the children's points, since they are rebuilt from the guides; for a dense groom
 guides, its points alone, the offsets that return it exactly being bound again on loading).
 A zip keeps the manifest readable with any tool, the arrays exact (float32/float64 bit for
 bit), lets a reader check every member's size and checksum before it trusts it, and loads
-with ``allow_pickle=False``.
+with ``allow_pickle=False``. The stroke log is stored as one column per sample field
+(:mod:`hairtool.frozen.sample_columns`, from the descriptions of
+:mod:`hairtool.frozen.sample_schema`).
 
 Saving writes a temporary file beside the target and renames it, so an interrupted save never
 harms the previous project. Loading checks everything and raises one

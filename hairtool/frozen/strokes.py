@@ -56,6 +56,10 @@ object with a ``selection`` field instead of ``brush``::
 
 Fields a reader does not know are ignored and missing optional ones take their defaults, so
 logs written by older and newer versions stay readable.
+
+Which field sits where, its log name and its default come from the sample descriptions of
+:mod:`hairtool.frozen.sample_schema` (a brush's params: those its brush uses), which the
+project's columns and the studio's samples use too.
 """
 
 from __future__ import annotations
