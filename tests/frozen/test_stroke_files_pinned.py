@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from hairtool import project as pf
+from hairtool.errors import FormatError
 from hairtool.frozen.strokes import read_strokes, strokes_from_log, write_strokes
 
 DATA = Path(__file__).resolve().parent.parent / "data" / "strokes"
@@ -55,3 +56,39 @@ def test_a_project_and_its_stroke_log_hold_the_same_samples(tmp_path, name):
     assert (tmp_path / "from_project.json").read_bytes() == (DATA / f"{name}.json").read_bytes()
     replayed = [s for stroke in read_strokes(DATA / f"{name}.json") for s in stroke.pipeline_samples(0.0)]
     assert tuple(replayed) == log
+
+
+def _rewrite(src, dst, manifest_edit=None, member=None, array=None):
+    """``src`` copied to ``dst`` with its manifest's strokes section edited or one member replaced."""
+    import json
+
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w") as zout:
+        for name in zin.namelist():
+            data = zin.read(name)
+            if name == pf.MANIFEST and manifest_edit is not None:
+                manifest = json.loads(data)
+                manifest_edit(manifest["strokes"])
+                data = json.dumps(manifest).encode()
+            if name == member:
+                data = _npy(array)
+            zout.writestr(name, data)
+
+
+@pytest.mark.parametrize(
+    "edit, member, array, needle",
+    [
+        (lambda s: s.update(brushes=True), None, None, "unknown brush"),
+        (lambda s: s.update(selection=["all", "lasso"]), None, None, "unknown selection"),
+        (None, "strokes/pressure.npy", np.full(13, 1.5), "pressure"),
+        (None, "strokes/mode.npy", np.full(13, 7), "mode"),
+        (None, "strokes/box.npy", np.full((13, 21), 0.5), "box"),
+        (None, "strokes/radius.npy", np.zeros(12), "radius"),
+        (None, "strokes/view.npy", np.full((13, 3), np.nan), "view"),
+    ],
+)
+def test_damaged_stroke_columns_are_one_error_naming_the_file(tmp_path, edit, member, array, needle):
+    bad = tmp_path / "bad.hairproj"
+    _rewrite(DATA / "mixed.hairproj", bad, edit, member, array)
+    with pytest.raises(FormatError, match=needle) as e:
+        pf.load(bad)
+    assert "bad.hairproj" in str(e.value)
