@@ -100,13 +100,6 @@ class SampleType:
             raise TypeError(f"a {self.name} sample has no field {sorted(values)[0]}")
         return self.cls(**args)
 
-    def values(self, sample: Any) -> dict[str, Any]:
-        return {f.name: getattr(sample, f.name) for f in self.fields}
-
-
-def _strength_low(brush: str) -> float:
-    return -1.0 if brush in SIGNED else 0.0
-
 
 #: Brush samples, in a stroke log's order (brush, falloff, params, flags, then each sample's).
 BRUSH = SampleType("brush", BrushSample, "brush", (
@@ -160,7 +153,7 @@ def sample_type(sample: Any) -> SampleType:
 
 def strength_range(brush: str) -> tuple[float, float]:
     """The strengths a brush takes: signed brushes [-1, 1], the others [0, 1]."""
-    return _strength_low(brush), 1.0
+    return (-1.0 if brush in SIGNED else 0.0), 1.0
 
 
 def params_of(t: SampleType, by: str, sample: Any) -> dict[str, Any]:
