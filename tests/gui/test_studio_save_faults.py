@@ -105,3 +105,21 @@ def _Edit():
     from PySide6.QtGui import QUndoCommand
 
     return QUndoCommand("an edit")
+
+
+def test_quit_stays_open_when_the_save_question_itself_fails(ui, make_window, monkeypatch):
+    """Any fault on the way to saving (here the groom file's own Save) keeps the window open."""
+    w = make_window()
+    w.undo_stack.push(_Edit())
+    w.ask_save_changes = lambda: "save"
+
+    def broken():
+        raise RuntimeError("the writer broke")
+
+    monkeypatch.setattr(w.project, "save_changes", broken)
+    w.close()
+    assert w.isVisible() and w.errors[-1][0] == "Cannot close" and "the writer broke" in w.errors[-1][1]
+    monkeypatch.undo()
+    w.ask_save_changes = lambda: "discard"
+    w.close()
+    assert not w.isVisible()
