@@ -50,6 +50,15 @@ def test_each_sample_class_holds_the_fields_of_its_description(t):
     assert all(f.column and f.json and f.level in ("sample", "stroke", "params", "step") for f in t.fields)
 
 
+def test_a_stroke_logs_sample_holds_the_log_fields_of_brush_and_align_samples():
+    """StrokeSample is a log's sample: one field per log name of a brush's (and align's) sample fields."""
+    from hairtool.frozen.strokes import LOG_SAMPLE
+
+    names = [f.name for f in dataclasses.fields(StrokeSample)]
+    assert sorted(names) == sorted(f.json for f in LOG_SAMPLE)
+    assert {f.json for f in ALIGN.at("sample")} <= set(names)
+
+
 def test_make_fills_defaults_and_leaves_what_a_brush_does_not_use():
     d = (0.0, 0.0, 0.0)
     s = BRUSH.make(
