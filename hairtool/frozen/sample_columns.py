@@ -92,8 +92,7 @@ class _Tables:
     def index(self, f: Field, t: SampleType, value: Any) -> int:
         if f.kind == "falloff":
             return self.luts.index(value)
-        table = {ALIGN: self.modes, BRUSH: BRUSHES, SELECTION: OPS}[t]
-        return table.index(value)
+        return (self.modes if t is ALIGN else BRUSHES if t is BRUSH else OPS).index(value)
 
 
 def _cell(column: Column, s: Any, t: SampleType, tables: _Tables) -> Any:

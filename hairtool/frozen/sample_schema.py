@@ -14,6 +14,7 @@ writes it only for those, the studio sets it only for those, and the others keep
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 from hairtool.frozen.align import MODES
@@ -58,7 +59,7 @@ class Field:
         return self.used_by is None or by in self.used_by
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # (compared and hashed as itself: a dict key per sample)
 class SampleType:
     """A sample class and its fields; ``key`` is the field that names the brush or the step."""
 
@@ -74,7 +75,14 @@ class SampleType:
         raise KeyError(name)
 
     def by_column(self, column: str) -> tuple[Field, ...]:
-        return tuple(f for f in self.fields if f.column == column)
+        return self._columns.get(column, ())
+
+    @cached_property
+    def _columns(self) -> dict[str, tuple[Field, ...]]:  # (a project's save asks per sample)
+        out: dict[str, tuple[Field, ...]] = {}
+        for f in self.fields:
+            out[f.column] = (*out.get(f.column, ()), f)
+        return out
 
     def at(self, level: str) -> tuple[Field, ...]:
         return tuple(f for f in self.fields if f.level == level)
