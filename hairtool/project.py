@@ -9,7 +9,9 @@ the children's points, since they are rebuilt from the guides; for a dense groom
 guides, its points alone, the offsets that return it exactly being bound again on loading).
 A zip keeps the manifest readable with any tool, the arrays exact (float32/float64 bit for
 bit), lets a reader check every member's size and checksum before it trusts it, and loads
-with ``allow_pickle=False``.
+with ``allow_pickle=False``. The stroke log is stored as one column per sample field
+(:mod:`hairtool.frozen.sample_columns`, from the descriptions of
+:mod:`hairtool.frozen.sample_schema`).
 
 Saving writes a temporary file beside the target and renames it, so an interrupted save never
 harms the previous project. Loading checks everything and raises one
@@ -37,9 +39,10 @@ import numpy as np
 
 import hairtool
 from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterError
-from hairtool.frozen.brushes import BRUSHES, LUT_SIZE, BrushSample, check_sample, check_view
+from hairtool.frozen.brushes import BrushSample, check_pressure, check_sample, check_view
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
-from hairtool.frozen.selection import OPS, SelectionSample, check_selection
+from hairtool.frozen.sample_columns import ColumnError, read_columns, write_columns
+from hairtool.frozen.selection import SelectionSample, check_selection
 from hairtool.groom import Animation, Groom
 from hairtool.guides.binding import MAX_FRIZZ, ChildBinding, bind_exactly, curl
 from hairtool.io import text_limits
@@ -89,7 +92,7 @@ class Project:
 
     rest: Groom
     params: FrozenParams = field(default_factory=FrozenParams)
-    strokes: tuple[AlignSample | BrushSample, ...] = ()
+    strokes: tuple[AlignSample | BrushSample | SelectionSample, ...] = ()
     aligned: Groom | None = None
     brush: dict = field(default_factory=dict)
     display: dict = field(default_factory=dict)
@@ -176,7 +179,7 @@ def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
         },
         "params": _params_json(project.params, arrays),
     }
-    manifest["strokes"] = _write_strokes(project.strokes, arrays)
+    manifest["strokes"] = write_columns(project.strokes, arrays)  # (hairtool.frozen.sample_columns)
     manifest["strokes"]["aligned"] = project.aligned is not None
     if "brushes" not in manifest["strokes"]:
         manifest["version"] = 1  # align strokes only: readable by the hairtool before brushes
@@ -447,186 +450,23 @@ def _read_params(r: _Reader, raw: dict) -> FrozenParams:
         raise FormatError(r.path, f"engine parameters: {e}") from None
 
 
-def _write_strokes(log, arrays: dict) -> dict:
-    """The stroke log as columns: every sample's cursor, radius and intensity (a brush's
-    strength); align samples their mode; brush samples (version 2) their brush, direction and
-    falloff (one table of distinct falloff curves)."""
-    n = len(log)
-    aligns = [s for s in log if isinstance(s, AlignSample)]
-    selections = [s for s in log if isinstance(s, SelectionSample)]
-    modes = sorted({s.mode for s in aligns})
-    origin = (0.0, 0.0, 0.0)
-    arrays["strokes/cursor.npy"] = np.array(
-        [origin if isinstance(s, SelectionSample) else s.cursor for s in log], np.float64
-    ).reshape(n, 3)
-    arrays["strokes/radius.npy"] = np.array([getattr(s, "radius", 0.0) for s in log], np.float64)
-    arrays["strokes/intensity.npy"] = np.array(
-        [s.intensity if isinstance(s, AlignSample) else getattr(s, "strength", 0.0) for s in log], np.float64
-    )
-    arrays["strokes/mode.npy"] = np.array(
-        [modes.index(s.mode) if isinstance(s, AlignSample) else -1 for s in log], np.int64
-    )
-    info: dict = {"count": n, "modes": modes}
-    if len(aligns) + len(selections) < n or selections:
-        luts: list[tuple] = []
-        for s in log:
-            if isinstance(s, BrushSample) and s.lut not in luts:
-                luts.append(s.lut)
-        arrays["strokes/brush.npy"] = np.array(
-            [BRUSHES.index(s.brush) if isinstance(s, BrushSample) else -1 for s in log], np.int64
-        )
-        arrays["strokes/direction.npy"] = np.array(
-            [s.direction if isinstance(s, BrushSample) else origin for s in log], np.float64
-        ).reshape(n, 3)
-        arrays["strokes/falloff.npy"] = np.array(
-            [luts.index(s.lut) if isinstance(s, BrushSample) else -1 for s in log], np.int64
-        )
-        arrays["strokes/falloffs.npy"] = np.array(luts, np.float64).reshape(len(luts), LUT_SIZE)
-        info["brushes"] = list(BRUSHES)
-    if any(s.view is not None for s in log):  # front-facing samples: their cameras' directions
-        arrays["strokes/view.npy"] = np.array(
-            [(0.0, 0.0, 0.0) if s.view is None else s.view for s in log], np.float64
-        ).reshape(n, 3)
-        arrays["strokes/has_view.npy"] = np.array([s.view is not None for s in log], np.int64)
-        info["views"] = True
-    if not all(getattr(s, "collide", True) for s in log):  # strokes that may pass through the head
-        arrays["strokes/collide.npy"] = np.array([getattr(s, "collide", True) for s in log], np.int64)
-        info["collide"] = True
-    if any(isinstance(s, BrushSample) and s.brush in ("add", "density") for s in log):  # what to plant
-        arrays["strokes/count.npy"] = np.array([getattr(s, "count", 1) for s in log], np.int64)
-        arrays["strokes/seed.npy"] = np.array([getattr(s, "seed", 0) for s in log], np.int64)
-        arrays["strokes/spacing.npy"] = np.array([getattr(s, "spacing", 0.0) for s in log], np.float64)
-        info["plants"] = True
-    if any(isinstance(s, BrushSample) and s.start for s in log):  # where snake hooks hooked
-        starts = [isinstance(s, BrushSample) and s.start for s in log]
-        arrays["strokes/start.npy"] = np.array(starts, np.int64)
-        info["starts"] = True
-    if any(getattr(s, "only_selected", False) for s in log):  # strokes that kept to the selection
-        only = [getattr(s, "only_selected", False) for s in log]
-        arrays["strokes/only_selected.npy"] = np.array(only, np.int64)
-        info["only_selected"] = True
-    if any(getattr(s, "pressure", 1.0) != 1.0 for s in log):  # a pen's pressure (already applied)
-        arrays["strokes/pressure.npy"] = np.array([getattr(s, "pressure", 1.0) for s in log], np.float64)
-        info["pressure"] = True
-    if selections:  # selection steps (version 3): their op, and a box's camera and rectangle
-        info["selection"] = list(OPS)
-        arrays["strokes/selection.npy"] = np.array(
-            [OPS.index(s.op) if isinstance(s, SelectionSample) else -1 for s in log], np.int64
-        )
-        arrays["strokes/box.npy"] = np.array([_box_row(s) for s in log], np.float64).reshape(n, 21)
-    return info
-
-
-_BOX_MODES = ("set", "add", "subtract")
-
-
-def _box_row(s) -> list[float]:
-    """A box selection as 21 numbers: its matrix (16), rectangle (4) and mode; zeros otherwise."""
-    if not isinstance(s, SelectionSample) or s.op != "box":
-        return [0.0] * 21
-    return [*s.matrix, *s.rect, float(_BOX_MODES.index(s.mode))]
-
-
 def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | None]:
-    n, modes = info.get("count"), info.get("modes")
-    if not isinstance(n, int) or n < 0 or not isinstance(modes, list):
-        raise FormatError(r.path, "manifest.json: bad 'strokes' section")
-    cursor = r.array("strokes/cursor.npy", 2, "f")
-    radius = r.array("strokes/radius.npy", 1, "f")
-    intensity = r.array("strokes/intensity.npy", 1, "f")
-    mode = r.array("strokes/mode.npy", 1, "iu")
-    if cursor.shape != (n, 3) or radius.shape != (n,) or intensity.shape != (n,) or mode.shape != (n,):
-        raise FormatError(r.path, f"the stroke arrays do not all hold {n} strokes")
-    for name, a in (("stroke cursor", cursor), ("stroke radius", radius), ("stroke intensity", intensity)):
-        require_finite(r.path, a, name)
-    brush = np.full(n, -1, np.int64)
-    if "brushes" in info:
-        names = info["brushes"]
-        brush = r.array("strokes/brush.npy", 1, "iu")
-        direction = r.array("strokes/direction.npy", 2, "f")
-        which = r.array("strokes/falloff.npy", 1, "iu")
-        luts = r.array("strokes/falloffs.npy", 2, "f")
-        if not isinstance(names, list) or any(b not in BRUSHES for b in names):
-            raise FormatError(r.path, "manifest.json: the strokes name an unknown brush")
-        shapes = (brush.shape, direction.shape, which.shape, luts.shape[1:])
-        if shapes != ((n,), (n, 3), (n,), (LUT_SIZE,)):
-            raise FormatError(r.path, f"the brush arrays do not all hold {n} strokes")
-        require_finite(r.path, direction, "stroke direction")
-        require_finite(r.path, luts, "falloff curves")
-        is_brush = brush >= 0
-        if np.any(brush >= len(names)) or np.any(is_brush & ((which < 0) | (which >= len(luts)))):
-            raise FormatError(r.path, "a stroke names an unknown brush or falloff")
-    views: list = [None] * n
-    if info.get("views"):
-        view = r.array("strokes/view.npy", 2, "f")
-        has_view = r.array("strokes/has_view.npy", 1, "iu")
-        if view.shape != (n, 3) or has_view.shape != (n,):
-            raise FormatError(r.path, f"the stroke view arrays do not all hold {n} strokes")
-        require_finite(r.path, view, "stroke view")
-        views = [tuple(float(x) for x in view[k]) if has_view[k] else None for k in range(n)]
-    starts = np.zeros(n, np.int64)
-    if info.get("starts"):
-        starts = r.array("strokes/start.npy", 1, "iu")
-        if starts.shape != (n,):
-            raise FormatError(r.path, f"the stroke start flags do not hold {n} strokes")
-    counts, seeds, spacings = np.ones(n, np.int64), np.zeros(n, np.int64), np.zeros(n)
-    if info.get("plants"):
-        counts, seeds = r.array("strokes/count.npy", 1, "iu"), r.array("strokes/seed.npy", 1, "iu")
-        spacings = r.array("strokes/spacing.npy", 1, "f")
-        if counts.shape != (n,) or seeds.shape != (n,) or spacings.shape != (n,):
-            raise FormatError(r.path, f"the add strokes' counts and seeds do not hold {n} strokes")
-        require_finite(r.path, spacings, "stroke spacing")
-    collides = np.ones(n, np.int64)
-    if info.get("collide"):
-        collides = r.array("strokes/collide.npy", 1, "iu")
-        if collides.shape != (n,):
-            raise FormatError(r.path, f"the stroke collision flags do not hold {n} strokes")
-    only = np.zeros(n, np.int64)
-    if info.get("only_selected"):
-        only = r.array("strokes/only_selected.npy", 1, "iu")
-        if only.shape != (n,):
-            raise FormatError(r.path, f"the stroke selection flags do not hold {n} strokes")
-    pressure = np.ones(n)
-    if info.get("pressure"):
-        pressure = r.array("strokes/pressure.npy", 1, "f")
-        if pressure.shape != (n,) or not np.all((pressure >= 0.0) & (pressure <= 1.0)):
-            raise FormatError(r.path, f"the stroke pressures are not {n} numbers in [0, 1]")
-    select_op, box = np.full(n, -1, np.int64), np.zeros((n, 21))
-    if "selection" in info:
-        ops = info["selection"]
-        if not isinstance(ops, list) or any(o not in OPS for o in ops):
-            raise FormatError(r.path, "manifest.json: the strokes name an unknown selection step")
-        select_op, box = r.array("strokes/selection.npy", 1, "iu"), r.array("strokes/box.npy", 2, "f")
-        if select_op.shape != (n,) or box.shape != (n, 21) or np.any(select_op >= len(ops)):
-            raise FormatError(r.path, f"the selection arrays do not all hold {n} strokes")
-        require_finite(r.path, box, "box selections")
-    if n and np.any((brush < 0) & (select_op < 0) & ((mode < 0) | (mode >= len(modes)))):
-        raise FormatError(r.path, "a stroke names an unknown align mode")
+    try:
+        samples = read_columns(info, r.array)
+    except ColumnError as e:
+        raise FormatError(r.path, str(e)) from None
     strokes = []
-    for k in range(n):
-        c = (float(cursor[k, 0]), float(cursor[k, 1]), float(cursor[k, 2]))
-        if select_op[k] >= 0:
-            strokes.append(_selection_sample(r, k, ops[select_op[k]], box[k], views[k]))
-            continue
-        if brush[k] < 0:
-            try:
-                v = check_view(views[k])
-            except HairtoolError as e:
-                raise FormatError(r.path, f"stroke {k}: {e}") from None
-            mode_k = str(modes[mode[k]])
-            hit = bool(collides[k])
-            r_k, i_k = float(radius[k]), float(intensity[k])
-            strokes.append(AlignSample(c, r_k, i_k, mode_k, v, hit, bool(only[k]), float(pressure[k])))
-            continue
-        sample = BrushSample(
-            names[brush[k]], c, tuple(float(v) for v in direction[k]), float(radius[k]),
-            float(intensity[k]), tuple(luts[which[k]].tolist()), views[k], bool(starts[k]), bool(collides[k]),
-            int(counts[k]), int(seeds[k]), float(spacings[k]), bool(only[k]), float(pressure[k]),
-        )
+    for k, s in enumerate(samples):
         try:
-            strokes.append(check_sample(sample))
+            if isinstance(s, BrushSample):
+                s = check_sample(s)
+            elif isinstance(s, SelectionSample):
+                s = check_selection(s)
+            else:
+                s = s._replace(view=check_view(s.view), pressure=check_pressure(s.pressure))
         except HairtoolError as e:
             raise FormatError(r.path, f"stroke {k}: {e}") from None
+        strokes.append(s)
     strokes = tuple(strokes)
     aligned = None
     if info.get("aligned"):
@@ -635,22 +475,6 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
             raise FormatError(r.path, f"aligned points have shape {pts.shape}, expected {rest.points.shape}")
         aligned = rest.with_points(float32_finite(r.path, pts, "aligned points"))
     return strokes, aligned
-
-
-def _selection_sample(r: _Reader, k: int, op: str, row: np.ndarray, view) -> SelectionSample:
-    """Stroke ``k``, a selection step, from its op and its row of the box array."""
-    if op != "box":
-        return SelectionSample(op)
-    m = int(row[20])
-    if m not in (0, 1, 2) or m != row[20]:
-        raise FormatError(r.path, f"stroke {k}: a box selection's mode is {row[20]!r}")
-    sample = SelectionSample(
-        "box", tuple(float(x) for x in row[:16]), tuple(float(x) for x in row[16:20]), _BOX_MODES[m], view
-    )
-    try:
-        return check_selection(sample)
-    except HairtoolError as e:
-        raise FormatError(r.path, f"stroke {k}: {e}") from None
 
 
 def _read_mesh(r: _Reader, info: Any) -> Mesh | None:

@@ -16,6 +16,7 @@ import numpy as np
 from hairtool.errors import ParameterError
 from hairtool.frozen.brushes import BRUSHES, BrushSample, any_within, falloff_lut, mirrored_view
 from hairtool.frozen.pipeline import AlignSample
+from hairtool.frozen.sample_schema import ALIGN, BRUSH
 
 #: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
 #: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump, K snake hook; X deletes as
@@ -199,18 +200,21 @@ class BrushTool:
         r, name = self.radius_at(p), self.brush
         hit = self.collide.get(name, True)
         only = self.only_selected and name != "select"
+        # the sample's fields by name (hairtool.frozen.sample_schema): those a brush does not
+        # use (add's count, density's spacing, a snake hook's start) keep their defaults there
+        common = {"cursor": c, "radius": r, "view": v, "collide": hit, "only_selected": only, "pressure": p}
         if name == "align":
-            first = AlignSample(c, r, self.strength_at(p), self.align_mode, v, hit, only, p)
+            first = ALIGN.make(intensity=self.strength_at(p), mode=self.align_mode, **common)
             if not self.symmetry:
                 return [first]
             return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
         if name in ("comb", "slide") and math.hypot(*d) == 0.0:
             return []
-        hook = start and name == "snake_hook"
-        count = self.add_count if name == "add" else 1
-        spacing = self.spacing if name == "density" else 0.0
         strength = self.signed_strength(invert, p)
-        first = BrushSample(name, c, d, r, strength, self.lut(), v, hook, hit, count, 0, spacing, only, p)
+        first = BRUSH.make(
+            brush=name, direction=d, strength=strength, lut=self.lut(), start=start,
+            count=self.add_count, spacing=self.spacing, **common,
+        )  # fmt: skip
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
     def touches(

@@ -61,11 +61,18 @@ def recovery_question(path: str | os.PathLike[str], now: datetime | None = None)
     )
 
 
+def save_failure(path: str | os.PathLike[str], error: BaseException) -> str:
+    """Why a save of ``path`` failed, in one line that names the file."""
+    reason = str(error) if isinstance(error, HairtoolError) else f"{type(error).__name__}: {error}"
+    return reason if str(path) in reason else f"{path}: {reason}"
+
+
 class ProjectController(QObject):
     """Owned by the window (``window.project``); see the module docstring."""
 
     saved = Signal(str)
     opened = Signal(str)
+    autosave_failed = Signal(str)  # from the autosave thread, delivered in the window's
 
     def __init__(self, window: StudioHost, sources: AnimationSources, autosave_ms: int = AUTOSAVE_MS) -> None:
         super().__init__(window)
@@ -82,6 +89,7 @@ class ProjectController(QObject):
         window.scene.groom_loaded.connect(self._forget_path)
         model = window.animation
         model.animation_changed.connect(self._on_animation_changed)
+        self.autosave_failed.connect(self._show_autosave_failure)
         self.timer = QTimer(self)
         self.timer.setInterval(max(int(autosave_ms), 1000))
         self.timer.timeout.connect(self.autosave)
@@ -221,11 +229,13 @@ class ProjectController(QObject):
         return self.save_to(path)
 
     def save_to(self, path: str | os.PathLike[str]) -> bool:
-        """Write the project (atomically); the window adopts it as its current file."""
+        """Write the project (atomically); the window adopts it as its current file. A save that
+        fails, for whatever reason, says so in a dialog naming the file and returns False: the
+        work stays unsaved and whoever asked (Quit, Open) stays too."""
         try:
             pf.save(path, self.current_project())
-        except HairtoolError as e:
-            self.window.show_error("Cannot save project", str(e))
+        except Exception as e:  # (a fault in the writer too: never a silent loss of the work)
+            self.window.show_error("Cannot save project", save_failure(path, e))
             return False
         self.path = Path(path)
         self._mark_saved()
@@ -305,14 +315,21 @@ class ProjectController(QObject):
             return False  # nothing new, an unanswered recovery offer, or the engine not started
         if self._autosave_thread is not None and self._autosave_thread.is_alive():
             return False  # the previous one is still writing; the next tick catches up
-        project, path, changes = self.current_project(), self.recovery_path, self._changes
+        path, changes = self.recovery_path, self._changes
+        try:
+            project = self.current_project()
+        except Exception as e:  # reported in the status bar; the next tick tries again
+            self.autosave_error = save_failure(path, e)
+            self._show_autosave_failure(self.autosave_error)
+            return False
 
         def write() -> None:
             try:
                 path.parent.mkdir(parents=True, exist_ok=True)
                 pf.save(path, project)
-            except (HairtoolError, OSError) as e:  # reported in the status bar, never a dialog
-                self.autosave_error = str(e)
+            except Exception as e:  # the thread never dies silently: the status bar says why
+                self.autosave_error = save_failure(path, e)
+                self.autosave_failed.emit(self.autosave_error)
             else:
                 self.autosave_error = None
                 self._autosaved_at = changes
@@ -323,6 +340,9 @@ class ProjectController(QObject):
         if wait:
             self._join_autosave()
         return True
+
+    def _show_autosave_failure(self, message: str) -> None:
+        self.window.statusBar().showMessage(f"Autosave failed: {message}")
 
     def offer_recovery(self) -> bool:
         """Offer the recovery file left by a session that did not close cleanly; restore it if

@@ -13,6 +13,7 @@ from PySide6.QtWidgets import QGridLayout, QGroupBox, QLabel, QMenu, QToolBar, Q
 from app.ui.commands import SelectionCommand
 from app.ui.engine_start import WAIT_MESSAGE
 from app.ui.qt_utils import add_action
+from hairtool.frozen.sample_schema import SELECTION
 from hairtool.frozen.selection import SelectionSample
 
 #: (op, menu text, key, tooltip) of each selection step, in the menu's order (None: a separator).
@@ -118,7 +119,7 @@ class SelectionUI:
 
     def step(self, op: str) -> bool:
         """One selection step as an undo step (False: it changed nothing)."""
-        return self.apply(SelectionSample(op))
+        return self.apply(SELECTION.make(op=op))
 
     def apply(self, sample: SelectionSample) -> bool:
         if not self._ready():

@@ -49,6 +49,7 @@ from app.ui.brush_sizing import CanvasSizing, pen_pressure
 from app.ui.drawn import drawn
 from app.ui.scene import Scene
 from hairtool.frozen.brushes import NEED_SURFACE, facing_away
+from hairtool.frozen.sample_schema import SELECTION
 from hairtool.frozen.selection import SelectionSample
 
 BRUSH_STEP = 1.1  # radius factor per wheel notch or [ / ] press
@@ -414,7 +415,7 @@ class Viewport(QOpenGLWidget):
         vp = cam.view_matrix().astype(np.float64) @ cam.projection_matrix(w / h).astype(np.float64)
         rect = (2.0 * a.x() / w - 1.0, 1.0 - 2.0 * a.y() / h, 2.0 * b.x() / w - 1.0, 1.0 - 2.0 * b.y() / h)
         view = tuple(float(v) for v in cam.forward()) if self.scene.tool.front_only else None
-        return SelectionSample("box", tuple(vp.T.ravel().tolist()), rect, mode, view)
+        return SELECTION.make(op="box", matrix=tuple(vp.T.ravel().tolist()), rect=rect, mode=mode, view=view)
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
         if self.sizing.active and self.sizing.key_press(event):

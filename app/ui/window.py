@@ -260,7 +260,12 @@ class MainWindow(QMainWindow):
         self.settings.sync()
 
     def closeEvent(self, event) -> None:
-        if not self.project.confirm_discard():  # unsaved changes: the user chose Cancel
+        try:
+            go_on = self.project.confirm_discard()  # False: Cancel, or a save that failed
+        except Exception as e:  # a fault while saving: the window and its work stay
+            self.show_error("Cannot close", f"The work could not be saved, so the studio stays open.\n\n{e}")
+            go_on = False
+        if not go_on:
             event.ignore()
             return
         self.jobs.shutdown()

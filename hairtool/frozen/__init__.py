@@ -8,7 +8,8 @@
   :mod:`.vertex_grid`; :mod:`.strand_clumps` labels clumps and picks the automatic radius;
 - :mod:`.brushes` comb, smooth, length, puff, clump and mask, falloff, symmetry and
   front-facing strands; :mod:`.selection` selecting and hiding strands; :mod:`.strokes`
-  stroke logs as JSON files;
+  stroke logs as JSON files; :mod:`.sample_schema` one description per sample type, which the
+  stroke logs, the project's columns (:mod:`.sample_columns`) and the studio build from;
 - :mod:`.pipeline` the three in order, with the stroke log the studio and the CLI replay;
 - :mod:`.noise` the counter-based noise they share.
 """

@@ -56,6 +56,10 @@ object with a ``selection`` field instead of ``brush``::
 
 Fields a reader does not know are ignored and missing optional ones take their defaults, so
 logs written by older and newer versions stay readable.
+
+Which field sits where, its log name and its default come from the sample descriptions of
+:mod:`hairtool.frozen.sample_schema` (a brush's params: those its brush uses), which the
+project's columns and the studio's samples use too.
 """
 
 from __future__ import annotations
@@ -84,6 +88,16 @@ from hairtool.frozen.brushes import (
     mirrored_view,
 )
 from hairtool.frozen.pipeline import AlignSample
+from hairtool.frozen.sample_schema import (
+    ALIGN,
+    BRUSH,
+    REQUIRED,
+    SELECTION,
+    Field,
+    SampleType,
+    params_of,
+    sample_type,
+)
 from hairtool.frozen.selection import SelectionSample, check_selection
 from hairtool.io.atomic import atomic_open
 from hairtool.io.text_limits import check_text
@@ -132,31 +146,29 @@ class Stroke:
         self.validate()
         out: list[AlignSample | BrushSample] = []
         mirror = self.mirror_x if self.mirror_x is not None else default_mirror_x
-        lut = tuple(falloff_lut(self.falloff).tolist())
+        t = ALIGN if self.brush == "align" else BRUSH
+        shared = {"brush": self.brush, "lut": tuple(falloff_lut(self.falloff).tolist())}
+        for f in t.fields:  # what the stroke and its params give every sample
+            if f.level == "stroke" and f.name not in shared:
+                shared[f.name] = getattr(self, f.json)
+            elif f.level == "params" and f.used(self.brush):
+                value = f.in_log(self.params)
+                number = f.kind == "number" and value is not None
+                shared[f.name] = _number(f"params.{f.json}", value) if number else value
         for i, s in enumerate(self.samples):
-            if self.brush == "align":
-                mode = self.params.get("mode", "paper")
-                v = check_view(s.view)
-                only = self.only_selected
-                first = AlignSample(s.cursor, s.radius, s.strength, mode, v, self.collision, only,
-                                    check_pressure(s.pressure))  # fmt: skip
-                out.append(first)
+            values = dict(shared)
+            for f in t.at("sample"):
+                values[f.name] = getattr(s, f.json)
+            if "start" in values:  # missing: the stroke's first sample starts it
+                values["start"] = (i == 0) if s.start is None else s.start
+            sample = t.make(**{k: v for k, v in values.items() if k in _names(t)})
+            if t is ALIGN:
+                sample = sample._replace(view=check_view(s.view), pressure=check_pressure(s.pressure))
+                out.append(sample)
                 if self.symmetry == "x":
                     cursor = (2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])
-                    out.append(first._replace(cursor=cursor, view=mirrored_view(s.view)))
+                    out.append(sample._replace(cursor=cursor, view=mirrored_view(s.view)))
                 continue
-            start = (i == 0) if s.start is None else s.start
-            start = start and self.brush == "snake_hook"  # (the only brush a start changes)
-            count, seed, spacing = 1, 0, 0.0
-            if self.brush in ("add", "density"):  # (checked with the sample)
-                count, seed = self.params.get("count", 1), self.params.get("seed", 0)
-            if self.brush == "density":
-                spacing = self.params.get("spacing")
-                spacing = _number("params.spacing", spacing) if spacing is not None else 0.0
-            sample = BrushSample(
-                self.brush, s.cursor, s.direction, s.radius, s.strength, lut, s.view, start, self.collision,
-                count, seed, spacing, self.only_selected, s.pressure,
-            )
             sample = check_sample(sample)
             out.append(sample)
             if self.symmetry == "x":
@@ -165,27 +177,38 @@ class Stroke:
 
     def to_dict(self) -> dict:
         falloff = self.falloff if isinstance(self.falloff, str) else [list(p) for p in self.falloff]
+        flags = {}  # the stroke's flags, where they are not their defaults
+        for f in BRUSH.at("stroke"):
+            if f.kind == "flag" and getattr(self, f.json) != f.default:
+                flags[f.json] = getattr(self, f.json)
         return {
             "brush": self.brush,
             "falloff": falloff,
             "symmetry": self.symmetry,
             "mirror_x": self.mirror_x,
             "params": dict(self.params),
-            **({} if self.collision else {"collision": False}),
-            **({"only_selected": True} if self.only_selected else {}),
-            "samples": [
-                {
-                    "cursor": list(s.cursor),
-                    "direction": list(s.direction),
-                    "radius": s.radius,
-                    "strength": s.strength,
-                    "view": None if s.view is None else list(s.view),
-                    "pressure": s.pressure,
-                }
-                | ({} if s.start is None else {"start": s.start})
-                for s in self.samples
-            ],
+            **flags,
+            "samples": [_sample_dict(s) for s in self.samples],
         }
+
+
+def _names(t: SampleType) -> frozenset[str]:
+    return frozenset(f.name for f in t.fields)
+
+
+#: A stroke log's sample fields, in its order (align's are among a brush's, strength its intensity).
+LOG_SAMPLE = BRUSH.at("sample")
+
+
+def _sample_dict(s: StrokeSample) -> dict:
+    """A log sample's JSON object: every field, a start only where one is stated."""
+    out: dict[str, Any] = {}
+    for f in LOG_SAMPLE:
+        value = getattr(s, f.json)
+        if f.kind == "flag" and value is None:
+            continue
+        out[f.json] = list(value) if f.kind in ("vector", "view") and value is not None else value
+    return out
 
 
 @dataclass(frozen=True)
@@ -202,12 +225,13 @@ class SelectionStep:
         return [self.validate().sample]
 
     def to_dict(self) -> dict:
-        s = self.sample
-        if s.op != "box":
-            return {"selection": s.op}
-        view = None if s.view is None else list(s.view)
-        box = {"mode": s.mode, "matrix": list(s.matrix), "rect": list(s.rect), "view": view}
-        return {"selection": "box", **box}
+        """The step's fields its op uses (a box's camera, rectangle, mode and view), by log name."""
+        s, out = self.sample, {}
+        for f in SELECTION.fields:
+            if f.used(s.op):
+                value = getattr(s, f.name)
+                out[f.json] = list(value) if isinstance(value, tuple) else value
+        return out
 
 
 def strokes_from_log(
@@ -218,36 +242,32 @@ def strokes_from_log(
     selection step stays one."""
     runs: list[tuple[tuple, Stroke | SelectionStep]] = []
     for s in log:
-        split = False
-        if isinstance(s, SelectionSample):
+        t = sample_type(s)
+        if t is SELECTION:
             runs.append((("selection", len(runs)), SelectionStep(s)))
             continue
-        if isinstance(s, AlignSample):
-            key: tuple = ("align", s.mode, s.collide, s.only_selected)
-            sample = StrokeSample(
-                tuple(s.cursor), s.radius, s.intensity, view=_view_of(s.view), pressure=s.pressure
-            )
-            start = Stroke("align", (sample,), params={"mode": s.mode}, collision=s.collide,
-                           only_selected=s.only_selected)  # fmt: skip
-        else:
-            key = (s.brush, s.lut, s.collide, s.count, s.seed, s.spacing, s.only_selected)
-            hook = s.brush == "snake_hook"
-            sample = StrokeSample(
-                tuple(s.cursor), s.radius, s.strength, tuple(s.direction), _view_of(s.view),
-                bool(s.start) if hook else None, s.pressure,
-            )  # fmt: skip
-            params = {"count": s.count, "seed": s.seed} if s.brush == "add" else {}
-            if s.brush == "density":
-                params = {"spacing": s.spacing, "seed": s.seed}
-            start = Stroke(s.brush, (sample,), falloff=_falloff_of(s.lut), params=params, collision=s.collide,
-                           only_selected=s.only_selected)  # fmt: skip
-            # a snake hook's start (not its mirror's) begins a new stroke, with its own strands
-            last = runs[-1][1] if runs else None
-            split = hook and s.start and isinstance(last, Stroke) and not last.samples[-1].start
+        by = t.which(s)
+        once = [f for f in t.fields if f.level in ("stroke", "params")]
+        key: tuple = (by, *(getattr(s, f.name) for f in once))
+        fields = {}
+        for f in t.at("sample"):
+            if f.used(by):
+                value = getattr(s, f.name)
+                fields[f.json] = (
+                    _view_of(value) if f.kind == "view" else tuple(value) if f.kind == "vector" else value
+                )
+        if "start" in fields:
+            fields["start"] = bool(fields["start"])
+        sample = StrokeSample(**fields)
+        falloff = _falloff_of(s.lut) if t is BRUSH else "smooth"
+        flags = {f.json: getattr(s, f.name) for f in t.at("stroke") if f.kind == "flag"}
+        start = Stroke(by, (sample,), falloff=falloff, params=params_of(t, by, s), **flags)
+        # a snake hook's start (not its mirror's) begins a new stroke, with its own strands
+        last = runs[-1][1] if runs else None
+        split = bool(sample.start) and isinstance(last, Stroke) and not last.samples[-1].start
         if runs and runs[-1][0] == key and not split:
             last = runs[-1][1]
-            more = Stroke(last.brush, (*last.samples, sample), last.falloff, params=last.params)
-            runs[-1] = (key, replace(more, collision=last.collision, only_selected=last.only_selected))
+            runs[-1] = (key, replace(last, samples=(*last.samples, sample)))
         else:
             runs.append((key, start))
     return [stroke for _, stroke in runs]
@@ -255,6 +275,21 @@ def strokes_from_log(
 
 def _view_of(view: Sequence[float] | None) -> tuple[float, float, float] | None:
     return None if view is None else (float(view[0]), float(view[1]), float(view[2]))
+
+
+def _log_value(f: Field, raw: dict, at: str) -> Any:
+    """A log sample's field ``f`` from its JSON object, checked as its kind says."""
+    where, value = f"{at}.{f.json}", raw.get(f.json)
+    if f.kind == "vector":
+        default = None if f.log_default is REQUIRED else f.log_default
+        return _vector(where, value, default)
+    if f.kind == "view":
+        return None if value is None else _vector(where, value)
+    if f.kind == "flag":
+        return _flag(where, value)
+    if f.name == "pressure":
+        return _pressure(where, raw.get(f.json, f.default))
+    return _number(where, value)
 
 
 def _flag(where: str, value: Any) -> bool | None:
@@ -309,25 +344,30 @@ def _short(value: Any) -> Any:
     return value
 
 
+_STEP_SHAPES = {
+    "matrix": (16, "16 numbers (a 4×4 matrix, row-major)"),
+    "rect": (4, "four numbers [x0, y0, x1, y1]"),
+}
+
+
 def selection_from_dict(d: dict, where: str = "stroke") -> SelectionStep:
     """A :class:`SelectionStep` from its JSON form; ParameterError naming the field."""
     op = d.get("selection")
-    if op not in ("box",):
-        step = SelectionStep(SelectionSample(op))
-    else:
-        matrix, rect = d.get("matrix"), d.get("rect")
-        if not isinstance(matrix, list) or len(matrix) != 16:
-            raise ParameterError(f"{where}.matrix", _short(matrix), "16 numbers (a 4×4 matrix, row-major)")
-        if not isinstance(rect, list) or len(rect) != 4:
-            raise ParameterError(f"{where}.rect", _short(rect), "four numbers [x0, y0, x1, y1]")
-        view = d.get("view")
-        step = SelectionStep(SelectionSample(
-            "box", tuple(_number(f"{where}.matrix", v) for v in matrix),
-            tuple(_number(f"{where}.rect", v) for v in rect),  # type: ignore[arg-type]
-            d.get("mode", "set"), None if view is None else _vector(f"{where}.view", view),
-        ))  # fmt: skip
+    values: dict[str, Any] = {"op": op}
+    for f in SELECTION.fields:
+        if f.name == "op" or not f.used(op):
+            continue
+        value = f.in_log(d)
+        if f.name in _STEP_SHAPES:
+            size, expected = _STEP_SHAPES[f.name]
+            if not isinstance(value, list) or len(value) != size:
+                raise ParameterError(f"{where}.{f.json}", _short(value), expected)
+            value = tuple(_number(f"{where}.{f.json}", v) for v in value)
+        elif f.kind == "view":
+            value = None if value is None else _vector(f"{where}.{f.json}", value)
+        values[f.name] = value
     try:
-        return step.validate()
+        return SelectionStep(SELECTION.make(**values)).validate()
     except ParameterError as e:
         raise ParameterError(f"{where}.{e.name}", _short(e.value), str(e).split("expected ", 1)[-1]) from None
 
@@ -347,17 +387,8 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke | SelectionStep:
         at = f"{where}.samples[{i}]"
         if not isinstance(s, dict):
             raise ParameterError(at, type(s).__name__, "an object with cursor, radius and strength")
-        samples.append(
-            StrokeSample(
-                _vector(f"{at}.cursor", s.get("cursor")),
-                _number(f"{at}.radius", s.get("radius")),
-                _number(f"{at}.strength", s.get("strength")),
-                _vector(f"{at}.direction", s.get("direction"), (0.0, 0.0, 0.0)),
-                None if s.get("view") is None else _vector(f"{at}.view", s.get("view")),
-                _flag(f"{at}.start", s.get("start")),
-                _pressure(f"{at}.pressure", s.get("pressure", 1.0)),
-            )
-        )
+        samples.append(StrokeSample(**{f.json: _log_value(f, s, at) for f in LOG_SAMPLE if f.json in s or
+                                       f.default is REQUIRED or f.log_default is not REQUIRED}))  # fmt: skip
     falloff = d.get("falloff", "smooth")
     if isinstance(falloff, list):
         if len(falloff) > MAX_FALLOFF_POINTS:
