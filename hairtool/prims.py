@@ -16,7 +16,7 @@ import numpy as np
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Groom
-from hairtool.metadata import CurvesPrim
+from hairtool.metadata import CurvesPrim, join_attributes
 
 
 def prim_paths(groom: Groom) -> list[str]:
@@ -89,3 +89,39 @@ def per_prim(groom: Groom, work: Callable[[Groom], Groom], patterns: Sequence[st
     parts = split(groom)
     results = [work(g) if pick else g for g, pick in zip(parts, chosen, strict=True)]
     return join(parts, results)
+
+
+def concat(parts: Sequence[Groom]) -> Groom:
+    """Grooms each on prims of their own (render hair beside its guides, one part per source
+    prim) end to end as one groom, every part's prims kept; an attribute some parts lack is
+    filled with defaults there and those parts' prims say they lack it, so a writer leaves it
+    out of them again."""
+    if len(parts) == 1:
+        return parts[0]
+    meta = parts[0].metadata
+    attrs, lacks = join_attributes(
+        [dict(p.attributes) for p in parts], [p.vertex_count for p in parts], meta.meters_per_unit
+    )
+    curves = []
+    for part, lack in zip(parts, lacks, strict=True):
+        prims = part.metadata.for_strands(part.strand_count).curves
+        if not prims:
+            raise ParameterError("prims", repr(part), "a part on prims of its own")
+        curves += [
+            CurvesPrim(c.path, c.strands, c.basis, c.wrap, c.purpose, tuple(sorted(set(c.lacks) | set(lack))))
+            for c in prims
+        ]
+    points = np.concatenate([p.points for p in parts])
+    counts = np.concatenate([p.counts for p in parts])
+    return Groom(points, counts, **attrs, metadata=meta.with_(curves=tuple(curves)))
+
+
+def shares(total: int, weights: Sequence[int]) -> list[int]:
+    """``total`` split in proportion to ``weights`` (largest remainders), each share at least 1."""
+    w = np.asarray(weights, np.float64)
+    exact = total * w / w.sum()
+    out = np.maximum(np.floor(exact).astype(np.int64), 1)
+    order = np.argsort(-(exact - np.floor(exact)), kind="stable")
+    for k in order[: max(total - int(out.sum()), 0)]:
+        out[k] += 1
+    return [int(v) for v in out]

@@ -138,3 +138,40 @@ def test_split_and_join_are_inverse_and_work_sees_one_prim():
     assert seen == [(meta.curves[0],), (meta.curves[2],)]
     assert out.metadata.curves == (CurvesPrim("/A", 1, "bspline"), CurvesPrim("/B", 1), CurvesPrim("/C", 1))
     assert picked(g, None) == [True] * 3 and picked(g, ["/?"]) == [True] * 3
+
+
+def test_interpolate_grows_each_prims_children_into_its_own_render_prim(scenes, capsys):
+    d = scenes
+    assert main(["interpolate", str(d / "both.usda"), str(d / "kids.usda"), "--count", "100"]) == 0
+    out = io.read(d / "kids.usda")
+    got = [(c.path, c.strands, c.basis, c.purpose) for c in out.metadata.curves]
+    assert got == [
+        (HAIR + "Render", 79, "catmullRom", "default"),
+        (HAIR, 60, "catmullRom", "guide"),
+        (BROWS + "Render", 21, "linear", "default"),
+        (BROWS, 16, "linear", "guide"),
+    ]
+    hair_kids, hair, brow_kids, brows = split(out)
+    for kids, guides in ((hair_kids, hair), (brow_kids, brows)):
+        lo, hi = guides.bounds
+        pad = 0.25 * float(np.linalg.norm(hi - lo))
+        assert np.all(kids.roots >= lo - pad) and np.all(kids.roots <= hi + pad)
+    assert strand_lengths(brow_kids).max() < 0.025  # brows' children are brows
+    assert (
+        main(["interpolate", str(d / "both.usda"), str(d / "b.usda"), "--count", "30", "--prim", BROWS]) == 0
+    )
+    out = io.read(d / "b.usda")
+    assert [(c.path, c.strands, c.purpose) for c in out.metadata.curves] == [
+        (HAIR, 60, "default"),
+        (BROWS + "Render", 30, "default"),
+        (BROWS, 16, "guide"),
+    ]
+    np.testing.assert_allclose(
+        split(out)[0].points, split(io.read(d / "both.usda"))[0].points, rtol=0, atol=4e-7
+    )
+    capsys.readouterr()
+    assert (
+        main(["interpolate", str(d / "both.usda"), str(d / "x.usda"), "--from-dense", "--guides", "5"]) == 2
+    )
+    err = capsys.readouterr().err
+    assert "--prim" in err and HAIR in err and not (d / "x.usda").exists()
