@@ -1,7 +1,7 @@
 """Generated USD scenes (:mod:`usd_scenes`) through the commands: ``info``, ``convert``,
-``freeze`` and a stroke log replayed by ``freeze --strokes``. Prim paths, bases and the stage's
-conventions are kept, and the world-space results equal those of the scene's twin in the other
-up axis and unit.
+``freeze``, ``interpolate``, and a log of every brush that needs no head replayed by
+``freeze --strokes``. Prim paths, bases and the stage's conventions are kept, and the
+world-space results equal those of the scene's twin in the other up axis and unit.
 
 CI runs a few examples (a minute at most); a longer run:
 ``HAIRTOOL_SCENE_EXAMPLES=200 pytest -n 0 tests/io/test_generated_scenes.py``.
@@ -89,17 +89,45 @@ def test_info_and_convert_keep_prims_conventions_and_world_points(scene):
 COMB = [{"brush": "comb", "falloff": "smooth", "symmetry": None, "params": {}, "samples": []}]
 
 
-def comb_log(groom, path: Path) -> None:
-    """One comb sample at the middle strand's tip, radius a third of the groom's size."""
+#: The brushes that need no head: one stroke each in :func:`brush_log`'s log.
+HEADLESS = (
+    "align",
+    "comb",
+    "smooth",
+    "length",
+    "puff",
+    "pinch",
+    "clump",
+    "mask",
+    "select",
+    "snake_hook",
+    "delete",
+)
+
+
+def brush_log(groom, path: Path) -> None:
+    """A stroke of every brush that needs no head, at the middle strand's tip, radius a third of
+    the groom's size; delete at the root of the last strand of a prim of two or more, with a
+    radius that reaches no other root (a prim's last strand cannot be deleted)."""
     tip = groom.points[groom.topology.tip_indices][groom.strand_count // 2].astype(np.float64)
+    ends = np.cumsum([c.strands for c in groom.metadata.curves])
+    several = [int(e) - 1 for c, e in zip(groom.metadata.curves, ends, strict=True) if c.strands > 1]
+    root = groom.roots[several[0] if several else 0].astype(np.float64)
     size = float(np.linalg.norm(np.ptp(groom.points, axis=0)))
-    sample = {
-        "cursor": tip.tolist(),
-        "direction": [size * 0.05, 0.0, 0.0],
-        "radius": size / 3,
-        "strength": 0.8,
-    }
-    path.write_text(json.dumps([{**COMB[0], "samples": [sample]}]))
+    gaps = np.linalg.norm(groom.roots.astype(np.float64) - root, axis=1)
+    alone = float(np.min(gaps[gaps > 0], initial=size)) / 2
+    log = []
+    for brush in HEADLESS if several else HEADLESS[:-1]:
+        at, radius, strength = (root, alone, 1.0) if brush == "delete" else (tip, size / 3, 0.8)
+        sample = {
+            "cursor": at.tolist(),
+            "direction": [size * 0.05, 0, 0],
+            "radius": radius,
+            "strength": strength,
+        }
+        params = {"mode": "paper"} if brush == "align" else {}
+        log.append({**COMB[0], "brush": brush, "params": params, "samples": [sample]})
+    path.write_text(json.dumps(log))
 
 
 @RUN
@@ -115,10 +143,15 @@ def test_freeze_and_a_stroke_log_keep_prims_and_conventions(scene):
         check_kept(scene, src, out)
         assert out.strand_count == src.strand_count
         first = src.frame(0) if isinstance(src, Animation) else src
-        comb_log(first, d / "comb.json")
+        brush_log(first, d / "comb.json")
         args = ["freeze", str(d / "s.usda"), str(d / "c.usda"), "--strokes", str(d / "comb.json"), *pose]
         assert main(args) == 0
         check_kept(scene, src, io.read(d / "c.usda"))
+        assert main(["interpolate", str(d / "s.usda"), str(d / "k.usda"), "--count", "12"]) == 0
+        kids = io.read(d / "k.usda")
+        want = [x for p in curve_paths(src) for x in ((p + "Render", "default"), (p, "guide"))]
+        assert [(c.path, c.purpose) for c in kids.metadata.curves] == want
+        assert (kids.metadata.up_axis, kids.metadata.meters_per_unit) == (scene.up, scene.meters_per_unit)
         # --prim: the first prim frozen, the others as they were
         assert (
             main(["freeze", str(d / "s.usda"), str(d / "p.usda"), "--prim", scene.prims[0].path, *pose]) == 0

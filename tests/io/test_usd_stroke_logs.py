@@ -185,3 +185,52 @@ def test_a_batch_job_replays_a_comb_log_on_a_usd_groom(scene):
     by_hand = ["freeze", str(DATA / "b.usda"), str(d / "by_hand.usda"), "--strokes", str(d / "comb.json")]
     assert main(by_hand) == 0
     assert (d / "batch_out.usda").read_bytes() == (d / "by_hand.usda").read_bytes()
+
+
+def test_deleting_strands_keeps_the_prim_its_basis_and_its_parents_transforms(scene):
+    d, _ = scene
+    src = io.read(DATA / "b_xform.usdc")
+    assert src.metadata.xforms  # the hair's parent is translated, rotated and scaled
+    out = d / "deleted.usdc"
+    assert main(["freeze", str(DATA / "b_xform.usdc"), str(out), "--strokes", str(d / "xdelete.json")]) == 0
+    got = io.read(out)
+    (prim,) = got.metadata.curves
+    (was,) = src.metadata.curves
+    assert got.strand_count < src.strand_count
+    assert (prim.path, prim.basis, prim.wrap) == (was.path, was.basis, was.wrap)
+    assert got.metadata.xforms == src.metadata.xforms
+    from pxr import Usd, UsdGeom
+
+    stage = Usd.Stage.Open(str(out))
+    parent = stage.GetPrimAtPath(prim.path).GetParent()
+    assert UsdGeom.Xformable(parent).GetOrderedXformOps()  # the transform is on the parent again
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _xform_delete_log(scene):
+    d, _ = scene
+    g = io.read(DATA / "b_xform.usdc")
+    root = g.roots[len(g.roots) // 2].astype(np.float64)
+    size = float(np.linalg.norm(np.ptp(g.points, axis=0)))
+    (d / "xdelete.json").write_text(json.dumps([stroke("delete", root, radius=size / 8)]))
+
+
+def test_the_pipeline_keeps_the_prim_through_delete_and_add(scene):
+    """Below the command (which writes each result as its source's prim): the pipeline's own result."""
+    from hairtool.frozen.pipeline import FrozenPipeline
+    from hairtool.frozen.strokes import read_strokes
+    from hairtool.guides.planting import HeadSurface
+    from hairtool.io.obj import read_mesh
+
+    d, _ = scene
+    groom = io.read(DATA / "b.usda")
+    (was,) = groom.metadata.curves
+    head = HeadSurface(read_mesh(d / "head.obj"))
+    for brush in ("delete", "add"):
+        pipe = FrozenPipeline(groom, surface=head)
+        for s in read_strokes(d / f"{brush}.json"):
+            pipe.apply_samples(s.pipeline_samples(float(pipe.scalp_centre[0])))
+        pipe.settle()
+        (prim,) = pipe.result.metadata.curves
+        assert (prim.path, prim.basis, prim.wrap) == (was.path, was.basis, was.wrap)
+        assert prim.strands == pipe.result.strand_count != groom.strand_count
