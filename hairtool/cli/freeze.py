@@ -280,6 +280,9 @@ def run(args: argparse.Namespace) -> int:
         report |= {"guides": groom.strand_count, "children": binding.child_count, "bind_ms": bind_ms}
     else:
         io.write(args.output, result)
+    from hairtool.io.usd_carry import carry_between
+
+    carry_between(args.input, args.output)  # USD to USD: the scene beside the hair
     if args.json:
         one = len(pipes) == 1
         report |= {

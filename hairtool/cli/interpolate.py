@@ -62,6 +62,9 @@ def _several(args: argparse.Namespace, groom) -> dict:
         report["guides"] += guides.strand_count
         report["children"] += binding.child_count
     io.write(args.output, concat(out))
+    from hairtool.io.usd_carry import carry_between
+
+    carry_between(args.input, args.output)  # USD to USD: the scene beside the hair
     if args.guides_out:
         io.write(_guides.guides_path(args), concat(used))
     return report
@@ -104,6 +107,9 @@ def run(args: argparse.Namespace) -> int:
     out = hair.update(guides)
     build_ms = (time.perf_counter() - t0) * 1e3
     report = _guides.write(args, out, guides)
+    from hairtool.io.usd_carry import carry_between
+
+    carry_between(args.input, args.output)  # USD to USD: the scene beside the hair
     if args.json:
         report |= {
             "guides": guides.strand_count,
