@@ -5,9 +5,10 @@ transforms, the stage's axis, unit and time codes. A DCC's scene holds more, whi
 that reads and writes USD must not drop: the head mesh, materials, the ``customData`` Blender
 marks its root with (without it a re-import nests ``/root/root``), the parents' own properties
 and, on a curves prim whose curves are the same ones (the same vertex counts), its other
-primvars (Blender's ``surface_uv_coordinate``, ``rest_position``…) and its material binding.
-Each is copied spec for spec (its bytes as the source had them) from the source's composed
-stage; what the writer authored is never overwritten.
+primvars (Blender's ``surface_uv_coordinate``, ``rest_position``…) and its material binding,
+and a parent's translate/rotate/scale ops where the writer put its static transform back as one
+matrix (the same transform). Each is copied spec for spec (its bytes as the source had them)
+from the source's composed stage; nothing else the writer authored is overwritten.
 """
 
 from __future__ import annotations
@@ -78,6 +79,7 @@ def carry_scene(source: str | os.PathLike[str], written: str | os.PathLike[str])
             if Sdf.CopySpec(src, path, dst, path):
                 carried.append(str(path))
             return
+        carried.extend(_authored_ops(stage, src, dst, path))
         if path in curves:
             if src.GetPrimAtPath(path).typeName == "BasisCurves" and _same_counts(src, dst, path):
                 kept = ("primvars:", "material:", "userProperties:")
@@ -144,3 +146,25 @@ def _transformed(stage, path) -> bool:
     return xf.TransformMightBeTimeVarying() or xf.GetLocalTransformation(
         Usd.TimeCode.Default()
     ) != Gf.Matrix4d(1.0)
+
+
+def _authored_ops(stage, src, dst, path) -> list[str]:
+    """Where the writer put a prim's static source transform back as one matrix, the source's
+    own ops instead (translate, rotate, scale as authored: the same transform, and an artist's
+    channels kept); returns the ops carried."""
+    from pxr import Sdf, UsdGeom
+
+    mine, theirs = dst.GetPrimAtPath(path), src.GetPrimAtPath(path)
+    if "xformOpOrder" not in mine.properties or "xformOpOrder" not in theirs.properties:
+        return []
+    xf = UsdGeom.Xformable(stage.GetPrimAtPath(path))
+    if not xf or xf.TransformMightBeTimeVarying() or xf.GetResetXformStack():
+        return []
+    ours = [p.name for p in mine.properties if p.name.startswith("xformOp")]
+    for name in ours:
+        mine.RemoveProperty(mine.properties[name])
+    done = []
+    for prop in theirs.properties:
+        if prop.name.startswith("xformOp") and Sdf.CopySpec(src, prop.path, dst, prop.path):
+            done.append(str(prop.path))
+    return done

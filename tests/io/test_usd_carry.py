@@ -69,3 +69,24 @@ def test_a_groom_with_nothing_beside_it_is_written_as_before(tmp_path):
     io.write(tmp_path / "again.usda", groom)
     assert carry_scene(tmp_path / "plain.usda", tmp_path / "again.usda") == []
     assert (tmp_path / "again.usda").read_bytes() == before
+
+
+def test_a_parents_translate_rotate_scale_ops_are_kept_as_authored(tmp_path):
+    from pxr import Usd, UsdGeom
+
+    src = DATA / "b_xform.usdc"
+    for cmd in ("convert", "freeze"):
+        out = tmp_path / f"{cmd}.usda"
+        assert main([cmd, str(src), str(out)]) == 0
+        stages = {p: Usd.Stage.Open(str(p)) for p in (src, out)}
+        ops = {}
+        for p, stage in stages.items():
+            ops[p] = [
+                (str(q.GetPath()), o.GetOpName(), np.asarray(o.Get()).tobytes())
+                for q in stage.Traverse()
+                if q.IsA(UsdGeom.Xformable)
+                for o in UsdGeom.Xformable(q).GetOrderedXformOps()
+            ]
+        assert ops[out] == ops[src] and any("rotateXYZ" in name for _, name, _ in ops[src])
+    back, was = io.read(tmp_path / "convert.usda"), io.read(src)
+    np.testing.assert_allclose(back.points, was.points, rtol=0, atol=1e-6)
