@@ -332,7 +332,8 @@ class Groom(_Attributes):
         return Animation(frames, self.topology, fps, **self.attributes, metadata=meta)
 
     def subset(self, strand_ids: ArrayLike) -> Groom:
-        """A groom of the chosen strands, in the given order."""
+        """A groom of the chosen strands, in the given order; its record holds each source prim's
+        chosen strands (:meth:`~hairtool.metadata.Metadata.subset`)."""
         ids = np.asarray(strand_ids, dtype=np.int64).reshape(-1)
         if ids.size == 0:
             raise GroomError("a subset needs at least one strand")
@@ -340,7 +341,7 @@ class Groom(_Attributes):
             raise GroomError(f"strand ids must lie in [0, {self.strand_count})")
         vids = vertex_ids_of(self.topology, ids)
         pick = {k: (None if v is None else v[vids]) for k, v in self.attributes.items()}
-        return Groom(self.points[vids], self.counts[ids], **pick, metadata=self.metadata.with_(curves=()))
+        return Groom(self.points[vids], self.counts[ids], **pick, metadata=self.metadata.subset(ids))
 
     # -- per-vertex --------------------------------------------------------------------
     @property

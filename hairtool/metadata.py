@@ -170,6 +170,43 @@ class Metadata:
             return replace(self, curves=())
         return self
 
+    def subset(self, strand_ids) -> Metadata:
+        """The record of a groom of some of these strands (``strand_ids`` into the prims' strands,
+        end to end): each prim keeps its path, basis, wrap and purpose and holds the strands
+        chosen from it; a prim none is chosen from is left out. Ids that go back into an earlier
+        prim (a reordering across prims) cannot be laid out prim by prim: one default prim then."""
+        if not self.curves:
+            return self
+        ids = np.asarray(strand_ids, dtype=np.int64).reshape(-1)
+        ends = np.cumsum([c.strands for c in self.curves])
+        if ids.size == 0 or ids.min() < 0 or ids.max() >= ends[-1]:
+            raise ParameterError("strand ids", f"{ids.size} ids", f"ids in [0, {int(ends[-1])})")
+        owner = self.prim_of(ids)
+        if np.any(np.diff(owner) < 0):
+            return replace(self, curves=())
+        held = np.bincount(owner, minlength=len(self.curves))
+        prims = tuple(replace(c, strands=int(n)) for c, n in zip(self.curves, held, strict=True) if n)
+        return replace(self, curves=prims)
+
+    def prim_of(self, strand_ids) -> np.ndarray:
+        """The index into :attr:`curves` of the prim holding each strand (empty prims: all 0)."""
+        ids = np.asarray(strand_ids, dtype=np.int64).reshape(-1)
+        if not self.curves:
+            return np.zeros(ids.size, np.int64)
+        return np.searchsorted(np.cumsum([c.strands for c in self.curves]), ids, side="right")
+
+    def extended(self, prims) -> Metadata:
+        """The record after strands were appended to the groom, ``prims[k]`` the prim (index
+        into :attr:`curves`) the k-th new strand belongs to. Appended at the end, they can join
+        the last prim only: new strands of an earlier prim leave one default prim."""
+        owners = np.asarray(prims, dtype=np.int64).reshape(-1)
+        if not self.curves or owners.size == 0:
+            return self
+        if np.any(owners != len(self.curves) - 1):
+            return replace(self, curves=())
+        last = replace(self.curves[-1], strands=self.curves[-1].strands + int(owners.size))
+        return replace(self, curves=(*self.curves[:-1], last))
+
     # -- the scene's frame --------------------------------------------------------------
     @property
     def up(self) -> np.ndarray:

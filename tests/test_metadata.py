@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Animation, Groom
@@ -64,7 +66,8 @@ def test_what_carries_the_record():
     g = _groom(meta)
     assert g.with_points(g.points + 1).metadata == meta
     sub = g.subset([2, 0])
-    assert sub.metadata.curves == () and sub.metadata.up_axis == "Z"  # the prims no longer fit
+    assert sub.metadata.curves == () and sub.metadata.up_axis == "Z"  # across prims, backwards
+    assert g.subset([0, 2]).metadata.curves == (CurvesPrim("/A", 1), CurvesPrim("/B", 1, "bspline"))
     a = Animation.from_grooms([g, g.with_points(g.points * 2), g], fps=24)
     assert a.metadata == meta
     a = a.with_metadata(meta.with_(time_codes=(1, 2, 3)))
@@ -76,3 +79,39 @@ def test_what_carries_the_record():
     with pytest.raises(GroomError, match="2 time codes for 3 frames"):
         a.with_metadata(meta.with_(time_codes=(1, 2)))
     assert meta.for_strands(4).curves == () and meta.for_strands(3) is meta
+
+
+_PRIMS = st.lists(
+    st.tuples(st.integers(1, 6), st.sampled_from(("linear", "catmullRom", "bspline"))), min_size=1, max_size=4
+)
+
+
+@given(prims=_PRIMS, data=st.data())
+@settings(max_examples=80, deadline=None)
+def test_a_subset_holds_each_prims_chosen_strands(prims, data):
+    curves = tuple(CurvesPrim(f"/G{k}/Hair", n, basis) for k, (n, basis) in enumerate(prims))
+    scaled = (2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 1, 2, 3, 1)
+    meta = Metadata(up_axis="Z", curves=curves, xforms=(("/G0", scaled),))
+    total = sum(n for n, _ in prims)
+    ids = sorted(data.draw(st.sets(st.integers(0, total - 1), min_size=1)))
+    sub = meta.subset(ids)
+    owner = meta.prim_of(ids)
+    assert [c.path for c in sub.curves] == [curves[k].path for k in sorted(set(owner.tolist()))]
+    assert [c.strands for c in sub.curves] == [int((owner == k).sum()) for k in sorted(set(owner.tolist()))]
+    assert all(c.basis == curves[int(c.path[2:].split("/")[0])].basis for c in sub.curves)
+    assert (sub.up_axis, sub.xforms) == (meta.up_axis, meta.xforms)
+    back = list(reversed(ids))
+    if len(set(owner.tolist())) > 1:  # a reordering across prims: one default prim
+        assert meta.subset(back).curves == ()
+    grown = sub.extended([len(sub.curves) - 1] * 3)
+    assert grown.curves[-1].strands == sub.curves[-1].strands + 3 and grown.curves[:-1] == sub.curves[:-1]
+    if len(sub.curves) > 1:
+        assert sub.extended([0]).curves == ()
+
+
+def test_a_groom_subset_keeps_the_prims_it_draws_from():
+    meta = Metadata(curves=(CurvesPrim("/A", 1), CurvesPrim("/B", 2, "bspline", "pinned")))
+    sub = _groom(meta).subset([1, 2])
+    assert sub.metadata.curves == (CurvesPrim("/B", 2, "bspline", "pinned"),)
+    with pytest.raises(ParameterError, match="strand ids"):
+        meta.subset([3])

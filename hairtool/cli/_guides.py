@@ -225,7 +225,8 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
     from hairtool.guides.binding import bind_dense, bind_roots, bind_scalp, bind_to_guides
 
     t0 = time.perf_counter()
-    k = DEFAULT_K if args.guides_per_child is None else args.guides_per_child
+    # (by default no more guides than there are: a prim of eyebrows may have three)
+    k = min(DEFAULT_K, groom.strand_count) if args.guides_per_child is None else args.guides_per_child
     lv = DEFAULT_LENGTH_VARIATION if args.length_variation is None else args.length_variation
     shape = {"length_variation": lv, "frizz": DEFAULT_FRIZZ if args.frizz is None else args.frizz}
     mesh = None

@@ -120,6 +120,9 @@ def run(args: argparse.Namespace) -> int:
             raise FormatError(args.output, f"cannot write: {e}") from None
     else:
         write(args.output, obj)
+        from hairtool.io.usd_carry import carry_between
+
+        carry_between(args.input, args.output)  # USD to USD: the scene beside the hair
     kept = obj if out_fmt.animated or not isinstance(obj, Animation) else obj.rest
     frames = f", {kept.n_frames} frames" if isinstance(kept, Animation) else ""
     print(f"wrote {args.output} ({kept.strand_count} strands, {kept.vertex_count} vertices{frames})")

@@ -126,6 +126,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="give every segment back its length after clumping (default: as printed, lengths stretch)",
     )
     _guides.add_arguments(parser, seed=False)
+    parser.add_argument(
+        "--prim",
+        action="append",
+        default=None,
+        metavar="PATH",
+        help="the curve prim to freeze (repeatable; a glob such as '/root/*/Brows*'); each prim is "
+        "frozen as a groom of its own, and the prims not picked are written as they were (default: all)",
+    )
     parser.add_argument("--json", action="store_true", help="print timings and sizes as JSON")
 
 
@@ -149,6 +157,7 @@ def _surface(args: argparse.Namespace, strokes):
         args.scalp = None  # the surface's only: no children to grow on it
     return surface
 
+
 def _pose(args: argparse.Namespace):
     """The groom to freeze: IN, or the ``--frame`` pose of an animation IN (which is refused
     without it), as a static groom without the animation's frame range."""
@@ -171,6 +180,26 @@ def _pose(args: argparse.Namespace):
         return obj
     pose = obj.frame(f)
     return pose.with_metadata(pose.metadata.derived())
+
+
+def _one_prim(args: argparse.Namespace, groom):
+    """Render hair grows from one prim's guides at a time: with several hair prims, ``--prim``
+    must pick one, and only its render hair is written (said before any work)."""
+    from hairtool.errors import ParameterError
+    from hairtool.prims import picked, split
+
+    hair = [g for g in split(groom) if all(c.purpose != "guide" for c in g.metadata.curves)]
+    if not _guides.wanted(args) or len(split(groom)) != len(hair):
+        if args.prim and len(split(groom)) != len(hair):
+            expected = "no --prim: the input holds render hair and its guides"
+            raise ParameterError("prim", args.prim[0], expected)
+        return groom
+    chosen = [g for g, pick in zip(split(groom), picked(groom, args.prim), strict=True) if pick]
+    if len(chosen) != 1:
+        paths = ", ".join(c.path for g in chosen for c in g.metadata.curves)
+        expected = f"--prim picking one prim to grow render hair from ({paths}); OUT holds its hair"
+        raise ParameterError("prim", args.prim, expected)
+    return chosen[0]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -211,18 +240,33 @@ def run(args: argparse.Namespace) -> int:
     _guides.check(args)
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
     # With render hair (asked for, or the input's own), the pipeline runs on the guides.
-    groom, binding, bind_ms = _guides.prepare(args, _pose(args))
-    pipe = FrozenPipeline(groom, params, surface)
+    pose = _pose(args)
+    groom, binding, bind_ms = _guides.prepare(args, _one_prim(args, pose))
     lo, hi = groom.bounds
     radius = float(np.linalg.norm(hi - lo)) if args.radius is None else args.radius
-    timings = [pipe.timings]
-    for cursor in args.align:
-        pipe.align(cursor, radius, args.intensity, args.align_mode)
+    timings: list[dict] = []
+    pipes: list[FrozenPipeline] = []
+
+    def freeze(part):
+        pipe = FrozenPipeline(part, params, surface)
         timings.append(pipe.timings)
-    for stroke in strokes or ():
-        pipe.apply_samples(stroke.pipeline_samples(float(pipe.scalp_centre[0])))
-        timings.append(pipe.timings)
-    pipe.settle()  # the result of the whole groom's clumping, as the studio's after a release
+        for cursor in args.align:
+            pipe.align(cursor, radius, args.intensity, args.align_mode)
+            timings.append(pipe.timings)
+        for stroke in strokes or ():
+            pipe.apply_samples(stroke.pipeline_samples(float(pipe.scalp_centre[0])))
+            timings.append(pipe.timings)
+        pipe.settle()  # the result of the whole groom's clumping, as the studio's after a release
+        pipes.append(pipe)
+        return pipe.result
+
+    if binding is None and groom is pose:  # each prim a groom of its own (hairtool.prims)
+        from hairtool.prims import per_prim
+
+        result = per_prim(groom, freeze, args.prim)
+    else:
+        result = freeze(groom)
+    pipe = pipes[0] if pipes else None
     report = {}
     if binding is not None and not np.array_equal(pipe.origin, np.arange(groom.strand_count)):
         # add, delete or density strokes: the children follow the guides planted and removed
@@ -235,14 +279,19 @@ def run(args: argparse.Namespace) -> int:
         report = _guides.write(args, hair, pipe.result)
         report |= {"guides": groom.strand_count, "children": binding.child_count, "bind_ms": bind_ms}
     else:
-        io.write(args.output, pipe.result)
+        io.write(args.output, result)
+    from hairtool.io.usd_carry import carry_between
+
+    carry_between(args.input, args.output)  # USD to USD: the scene beside the hair
     if args.json:
+        one = len(pipes) == 1
         report |= {
             "strands": groom.strand_count,
-            "result_strands": pipe.result.strand_count,  # after add, delete and density strokes
+            "result_strands": result.strand_count,  # after add, delete and density strokes
             "vertices": groom.vertex_count,
-            "clump_radius": pipe.clump_radius,
-            "mean_neighbours": pipe.mean_neighbours,
+            # per prim where the input had several (hairtool.prims)
+            "clump_radius": pipe.clump_radius if one else [q.clump_radius for q in pipes],
+            "mean_neighbours": pipe.mean_neighbours if one else [q.mean_neighbours for q in pipes],
             "timings_ms": timings,
         }
         print(json.dumps(report, indent=1))

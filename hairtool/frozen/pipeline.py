@@ -157,10 +157,11 @@ class FrozenParams:
 
 def append_strands(g: Groom, new: Groom) -> Groom:
     """``g`` with ``new``'s strands after its own; each per-vertex attribute of ``g`` taken for a
-    new strand from the strand whose root is nearest, by the vertex parameter."""
+    new strand from the strand whose root is nearest, by the vertex parameter; a new strand
+    joins that strand's prim where it can (:meth:`~hairtool.metadata.Metadata.extended`)."""
     attrs = {}
+    near = np.argmin(((new.roots[:, None, :] - g.roots[None, :, :]) ** 2).sum(-1), axis=1)
     if any(a is not None for a in g.attributes.values()):
-        near = np.argmin(((new.roots[:, None, :] - g.roots[None, :, :]) ** 2).sum(-1), axis=1)
         for name, a in g.attributes.items():
             if a is None:
                 attrs[name] = None
@@ -176,7 +177,7 @@ def append_strands(g: Groom, new: Groom) -> Groom:
                     rows.append(np.column_stack([np.interp(tn, ts, src[:, c]) for c in range(a.shape[1])]))
             attrs[name] = np.concatenate([a, *rows]).astype(np.float32)
     points, counts = np.concatenate([g.points, new.points]), np.concatenate([g.counts, new.counts])
-    return Groom(points, counts, **attrs, metadata=g.metadata.with_(curves=()))
+    return Groom(points, counts, **attrs, metadata=g.metadata.extended(g.metadata.prim_of(near)))
 
 
 class AlignSample(NamedTuple):
@@ -1089,7 +1090,7 @@ class FrozenPipeline:
             return none
         vids = vertex_ids_of(top, cand)
         with threads_for(vids.size):
-            meta = self._aligned.metadata  # (in the scene's frame)
+            meta = self._aligned.metadata.subset(cand)  # (in the scene's frame; its prims' share)
             sub = Groom(cur.points[vids], top.counts[cand], metadata=meta)
             out, painted = self._local_brush(sub, cand, sample, planar)
         if out is not None:

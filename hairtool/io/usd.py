@@ -141,13 +141,16 @@ def _set_transform(prim, meta: Metadata) -> None:
 
 def _define_parents(stage, paths: Sequence[str], meta: Metadata) -> None:
     """Xforms for every ancestor of the curves prims, with the source's transforms where it had
-    them (:attr:`~hairtool.metadata.Metadata.xforms`); the first root is the default prim."""
+    them (:attr:`~hairtool.metadata.Metadata.xforms`); the first root is the default prim. Each
+    curves prim is declared after its ancestors and before the next prim's, so that a reader
+    traverses the prims in the source's order (a prim at the root listed first stays first)."""
     from pxr import Sdf, UsdGeom
 
     for p in paths:
         for parent in Sdf.Path(p).GetParentPath().GetPrefixes():
             if not stage.GetPrimAtPath(parent):
                 _set_transform(UsdGeom.Xform.Define(stage, parent).GetPrim(), meta)
+        UsdGeom.BasisCurves.Define(stage, p)
     first_root = Sdf.Path(paths[0]).GetPrefixes()[0]
     if not stage.GetPrimAtPath(first_root):
         UsdGeom.Xform.Define(stage, first_root)

@@ -209,9 +209,15 @@ def test_several_prims_are_written_back_as_the_same_prims(tmp_path):
     assert back.metadata.curves == meta.curves and back.points.tobytes() == g.points.tobytes()
     write(tmp_path / "again.usdc", back)
     assert read(tmp_path / "again.usdc").metadata.curves == meta.curves
-    # A subset is written as one default prim; counts a cubic basis cannot draw, as linear curves.
-    write(tmp_path / "sub.usda", g.subset([0, 1]))
-    assert read(tmp_path / "sub.usda").metadata.curves == (CurvesPrim(usd.PRIM_PATH, 2),)
+    # A subset keeps the prims it draws from (across prims backwards: one default prim);
+    # counts a cubic basis cannot draw, as linear curves.
+    write(tmp_path / "sub.usda", g.subset([0, 1, 4]))
+    assert read(tmp_path / "sub.usda").metadata.curves == (
+        CurvesPrim("/A/Left", 2),
+        CurvesPrim("/B", 1, "bspline"),
+    )
+    write(tmp_path / "back.usda", g.subset([4, 0]))
+    assert read(tmp_path / "back.usda").metadata.curves == (CurvesPrim(usd.PRIM_PATH, 2),)
     odd = Groom(g.points[:5], [5], metadata=Metadata(curves=(CurvesPrim("/Odd", 1, "bezier"),)))
     write(tmp_path / "odd.usda", odd)
     assert read(tmp_path / "odd.usda").metadata.curves == (CurvesPrim("/Odd", 1, "linear"),)

@@ -1,0 +1,170 @@
+"""What a hair command leaves alone in a USD scene, carried from its source into the file it writes.
+
+The USD writer (:mod:`hairtool.io.usd`) authors the hair: its curves prims, their parents and
+transforms, the stage's axis, unit and time codes. A DCC's scene holds more, which a command
+that reads and writes USD must not drop: the head mesh, materials, the ``customData`` Blender
+marks its root with (without it a re-import nests ``/root/root``), the parents' own properties
+and, on a curves prim whose curves are the same ones (the same vertex counts), its other
+primvars (Blender's ``surface_uv_coordinate``, ``rest_position``…) and its material binding,
+and a parent's translate/rotate/scale ops where the writer put its static transform back as one
+matrix (the same transform). Each is copied spec for spec (its bytes as the source had them)
+from the source's composed stage; nothing else the writer authored is overwritten.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from hairtool.io.atomic import atomic_path
+
+#: Properties of a curves prim the writer authors from the groom: never carried.
+_OWN = ("points", "extent", "curveVertexCounts", "widths", "type", "basis", "wrap", "purpose")
+
+
+def _copy_missing_properties(src, dst, path, prefixes: tuple[str, ...] | None) -> list[str]:
+    """The properties of ``src``'s prim at ``path`` that ``dst``'s lacks (those starting with one
+    of ``prefixes``, or any with None), copied; their names."""
+    from pxr import Sdf
+
+    s, d = src.GetPrimAtPath(path), dst.GetPrimAtPath(path)
+    done = []
+    for prop in s.properties:
+        name = prop.name
+        if name in d.properties or name in _OWN or name.startswith("xformOp") or name == "xformOpOrder":
+            continue
+        if prefixes is not None and not name.startswith(prefixes):
+            continue
+        if Sdf.CopySpec(src, prop.path, dst, prop.path):
+            done.append(str(prop.path))
+    return done
+
+
+USD_SUFFIXES = (".usd", ".usda", ".usdc")
+
+
+def carry_between(source: str | os.PathLike[str], written: str | os.PathLike[str]) -> list[str]:
+    """:func:`carry_scene` when both are USD files (a command's IN and OUT); else nothing."""
+    src, out = Path(source), Path(written)
+    if src.suffix.lower() not in USD_SUFFIXES or out.suffix.lower() not in USD_SUFFIXES or not src.is_file():
+        return []
+    from hairtool.io.usd import _diagnosed
+
+    return _diagnosed(src, lambda: carry_scene(src, out))
+
+
+def carry_scene(source: str | os.PathLike[str], written: str | os.PathLike[str]) -> list[str]:
+    """Copy into the USD file ``written`` (rewritten atomically, untouched when there is nothing
+    to carry) what its USD ``source`` holds beside the hair (module doc); returns the paths
+    carried."""
+    from pxr import Sdf
+
+    from hairtool.io.usd import _open_stage
+
+    stage = _open_stage(Path(source))  # (the reader's checks, and a cached layer reloaded)
+    src = stage.Flatten()
+    dst = Sdf.Layer.CreateAnonymous(Path(written).suffix)
+    dst.TransferContent(Sdf.Layer.OpenAsAnonymous(str(written)))  # (the file as now written)
+    curves = set(_curves_paths(dst, Sdf.Path.absoluteRootPath))
+    ancestors = {a for c in curves for a in c.GetParentPath().GetPrefixes()}
+    carried: list[str] = []
+
+    def visit(spec, placed: bool = True) -> None:
+        """``placed``: the prims written above this one stand where the source's do."""
+        path = spec.path
+        mine = dst.GetPrimAtPath(path)
+        if mine is None:
+            if path in ancestors or _curves_paths(src, path) or not placed:
+                return  # hair the command replaced (or dropped), or where its parents moved
+            if Sdf.CopySpec(src, path, dst, path):
+                carried.append(str(path))
+            return
+        carried.extend(_authored_ops(stage, src, dst, path))
+        if path in curves:
+            if src.GetPrimAtPath(path).typeName == "BasisCurves" and _same_counts(src, dst, path):
+                kept = ("primvars:", "material:", "userProperties:")
+                carried.extend(_copy_missing_properties(src, dst, path, kept))
+                schemas = src.GetPrimAtPath(path).GetInfo("apiSchemas")
+                if schemas and not mine.HasInfo("apiSchemas"):
+                    mine.SetInfo("apiSchemas", schemas)
+            return
+        if path in ancestors:
+            for key in ("customData", "kind", "active"):
+                if spec.HasInfo(key) and not mine.HasInfo(key):
+                    mine.SetInfo(key, spec.GetInfo(key))
+                    carried.append(f"{path}:{key}")
+            carried.extend(_copy_missing_properties(src, dst, path, None))
+            # an animated parent's transform is not written (the hair is in world space there):
+            # a mesh under it would not move with it, so it stays out
+            moved = "xformOpOrder" not in mine.properties and _transformed(stage, path)
+            for child in spec.nameChildren:
+                visit(child, placed and not moved)
+
+    for root in src.rootPrims:
+        visit(root)
+    data = src.customLayerData
+    if data and not dst.customLayerData:
+        dst.customLayerData = data
+        carried.append("customLayerData")
+    if not carried:
+        return carried
+    with atomic_path(Path(written)) as tmp:
+        if not dst.Export(str(tmp)):
+            from hairtool.errors import FormatError
+
+            raise FormatError(Path(written), "usd-core could not write it")
+    return carried
+
+
+def _same_counts(src, dst, path) -> bool:
+    """Whether the curves prim at ``path`` holds the same curves (vertex counts) in both layers."""
+    a = src.GetAttributeAtPath(path.AppendProperty("curveVertexCounts"))
+    b = dst.GetAttributeAtPath(path.AppendProperty("curveVertexCounts"))
+    return a is not None and b is not None and list(a.default or []) == list(b.default or [])
+
+
+def _curves_paths(layer, under) -> list:
+    """The BasisCurves prim specs at and below ``under`` in ``layer``."""
+    found = []
+
+    def look(p) -> None:
+        if p.IsPrimPath() and layer.GetPrimAtPath(p).typeName == "BasisCurves":
+            found.append(p)
+
+    layer.Traverse(under, look)
+    return found
+
+
+def _transformed(stage, path) -> bool:
+    """Whether the source prim at ``path`` moves what is under it (a transform that is not the
+    identity, or one that changes over time)."""
+    from pxr import Gf, Usd, UsdGeom
+
+    xf = UsdGeom.Xformable(stage.GetPrimAtPath(path))
+    if not xf:
+        return False
+    return xf.TransformMightBeTimeVarying() or xf.GetLocalTransformation(
+        Usd.TimeCode.Default()
+    ) != Gf.Matrix4d(1.0)
+
+
+def _authored_ops(stage, src, dst, path) -> list[str]:
+    """Where the writer put a prim's static source transform back as one matrix, the source's
+    own ops instead (translate, rotate, scale as authored: the same transform, and an artist's
+    channels kept); returns the ops carried."""
+    from pxr import Sdf, UsdGeom
+
+    mine, theirs = dst.GetPrimAtPath(path), src.GetPrimAtPath(path)
+    if "xformOpOrder" not in mine.properties or "xformOpOrder" not in theirs.properties:
+        return []
+    xf = UsdGeom.Xformable(stage.GetPrimAtPath(path))
+    if not xf or xf.TransformMightBeTimeVarying() or xf.GetResetXformStack():
+        return []
+    ours = [p.name for p in mine.properties if p.name.startswith("xformOp")]
+    for name in ours:
+        mine.RemoveProperty(mine.properties[name])
+    done = []
+    for prop in theirs.properties:
+        if prop.name.startswith("xformOp") and Sdf.CopySpec(src, prop.path, dst, prop.path):
+            done.append(str(prop.path))
+    return done

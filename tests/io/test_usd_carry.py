@@ -1,0 +1,92 @@
+"""What a command leaves alone in a USD scene reaches the file it writes: the head mesh, the
+root's customData, the parents' properties, and a curves prim's other primvars where its curves
+are the same ones, each value byte for byte; a groom with nothing beside it is written as before."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from hypothesis import given, settings
+
+from hairtool import io
+from hairtool.cli import main
+from hairtool.io.usd_carry import carry_scene
+
+from .usd_scenes import scenes, write_stage
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "interop"
+
+
+def values(path: Path, prim: str) -> dict[str, bytes]:
+    """Every authored attribute of ``prim`` (its default value's bytes) and its customData."""
+    from pxr import Usd
+
+    stage = Usd.Stage.Open(str(path))
+    p = stage.GetPrimAtPath(prim)
+    assert p, prim
+    out = {
+        a.GetName(): np.asarray(a.Get()).tobytes() for a in p.GetAuthoredAttributes() if a.Get() is not None
+    }
+    out["customData"] = repr(p.GetCustomData()).encode()
+    return out
+
+
+def test_convert_and_freeze_keep_blenders_head_root_and_parents(tmp_path):
+    src = DATA / "b.usda"
+    assert main(["convert", str(src), str(tmp_path / "c.usdc")]) == 0
+    assert main(["freeze", str(src), str(tmp_path / "f.usda")]) == 0
+    for out in (tmp_path / "c.usdc", tmp_path / "f.usda"):
+        for prim in ("/root", "/root/Head", "/root/Head/Icosphere", "/root/Head/Curves"):
+            assert values(out, prim) == values(src, prim), (out.name, prim)
+    hair = "/root/Head/Hair/HairData"
+    got, was = values(tmp_path / "c.usdc", hair), values(src, hair)
+    assert got["userProperties:blender:data_name"] == was["userProperties:blender:data_name"]
+
+
+@settings(max_examples=5, deadline=None, derandomize=True)
+@given(scene=scenes(animated=False))
+def test_a_custom_primvar_and_a_mesh_pass_through_convert_and_freeze(scene):
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        write_stage(d / "s.usda", scene)
+        assert main(["convert", str(d / "s.usda"), str(d / "c.usda")]) == 0
+        assert main(["freeze", str(d / "s.usda"), str(d / "f.usda")]) == 0
+        for out in (d / "c.usda", d / "f.usda"):
+            if scene.mesh:
+                assert values(out, "/Head") == values(d / "s.usda", "/Head")
+            for prim in scene.prims:
+                if prim.custom:
+                    key = "primvars:clump_weight"
+                    assert values(out, prim.path)[key] == values(d / "s.usda", prim.path)[key]
+
+
+def test_a_groom_with_nothing_beside_it_is_written_as_before(tmp_path):
+    groom = io.read(DATA / "b_poly.usda")
+    io.write(tmp_path / "plain.usda", groom)
+    before = (tmp_path / "plain.usda").read_bytes()
+    io.write(tmp_path / "again.usda", groom)
+    assert carry_scene(tmp_path / "plain.usda", tmp_path / "again.usda") == []
+    assert (tmp_path / "again.usda").read_bytes() == before
+
+
+def test_a_parents_translate_rotate_scale_ops_are_kept_as_authored(tmp_path):
+    from pxr import Usd, UsdGeom
+
+    src = DATA / "b_xform.usdc"
+    for cmd in ("convert", "freeze"):
+        out = tmp_path / f"{cmd}.usda"
+        assert main([cmd, str(src), str(out)]) == 0
+        stages = {p: Usd.Stage.Open(str(p)) for p in (src, out)}
+        ops = {}
+        for p, stage in stages.items():
+            ops[p] = [
+                (str(q.GetPath()), o.GetOpName(), np.asarray(o.Get()).tobytes())
+                for q in stage.Traverse()
+                if q.IsA(UsdGeom.Xformable)
+                for o in UsdGeom.Xformable(q).GetOrderedXformOps()
+            ]
+        assert ops[out] == ops[src] and any("rotateXYZ" in name for _, name, _ in ops[src])
+    back, was = io.read(tmp_path / "convert.usda"), io.read(src)
+    np.testing.assert_allclose(back.points, was.points, rtol=0, atol=1e-6)
