@@ -322,7 +322,7 @@ def _springs(names: list[str], chains: list[list[int]]) -> dict:
             },
             {
                 "node": spine,
-                "shape": {"capsule": {"offset": [0.0, 0.05, 0.0], "radius": 0.12, "tail": [0.0, 0.3, 0.0]}},
+                "shape": {"capsule": {"offset": [0.0, 0.05, 0.0], "radius": 0.09, "tail": [0.0, 0.3, 0.0]}},
             },
         ],
         "colliderGroups": [{"name": "Head and body", "colliders": [0, 1]}],

@@ -49,7 +49,7 @@ def world_rotations(character: Character, local: F64) -> F64:
 def chain_points(character: Character, chain: Chain, world: F64 | None = None) -> F64:
     """``(..., N, 3)`` world positions of a chain's nodes (rest pose unless ``world`` matrices given)."""
     w = character.nodes.world() if world is None else world
-    return w[..., list(chain.nodes), :3, 3]
+    return np.take(w[..., :3, 3], list(chain.nodes), axis=-2)
 
 
 def chain_axis(points: F64, wave: ChainWave) -> F64:

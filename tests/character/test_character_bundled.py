@@ -36,15 +36,18 @@ def test_a_head_a_body_and_at_least_twelve_bunches_each_on_its_own_chain():
     assert len(c.colliders) == 2 and c.colliders[1].tail is not None  # a sphere and a capsule
 
 
-def test_the_rest_hair_clears_the_head_collider_by_its_hit_radius():
+def test_the_rest_hair_clears_every_collider_by_its_hit_radius():
     c = load_character(DATA / "bunches.vrm")
     world = c.nodes.world()
-    sphere = c.colliders[0]
-    centre = world[sphere.node, :3, 3] + sphere.offset
-    for ch in c.chains:
-        tails = world[list(ch.nodes[1:]), :3, 3]
-        gap = np.linalg.norm(tails - centre, axis=1) - sphere.radius - ch.settings[0].hit_radius
-        assert gap.min() > 0, ch.name
+    for col in c.colliders:
+        p = world[col.node, :3, :3] @ col.offset + world[col.node, :3, 3]
+        q = p if col.tail is None else world[col.node, :3, :3] @ col.tail + world[col.node, :3, 3]
+        for ch in c.chains:
+            tails = world[list(ch.nodes[1:]), :3, 3]
+            u = np.clip((tails - p) @ (q - p) / max(float((q - p) @ (q - p)), 1e-30), 0.0, 1.0)
+            nearest = p + u[:, None] * (q - p)
+            gap = np.linalg.norm(tails - nearest, axis=1) - col.radius - ch.settings[0].hit_radius
+            assert gap.min() > 0, ch.name
 
 
 def test_the_plain_glb_finds_the_same_chains_by_name():
