@@ -85,6 +85,7 @@ class BufferWriter:
         self.document = document
         self.chunks: list[bytes] = []
         self.length = offset
+        self.views = 0  # bufferViews this writer added
 
     def add(self, values: np.ndarray, kind: str, *, target: int | None = None, bounds: bool = False) -> int:
         """Accessor index of ``values`` (float32, uint16, uint32 or uint8 rows of ``kind`` width)."""
@@ -106,6 +107,7 @@ class BufferWriter:
         self.length += len(data)
         views = self.document.setdefault("bufferViews", [])
         views.append(view)
+        self.views += 1
         rows = arr.reshape(len(arr), -1)
         accessor = {"bufferView": len(views) - 1, "componentType": component, "count": len(arr), "type": kind}
         if bounds:
