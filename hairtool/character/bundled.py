@@ -294,7 +294,8 @@ def _vrm_meta(names: list[str]) -> dict:
             "version": "1",
             "authors": ["hairtool"],
             "copyrightInformation": "made by hairtool's own code; MIT, as hairtool",
-            "licenseUrl": "https://opensource.org/licenses/MIT",
+            "licenseUrl": "https://vrm.dev/licenses/1.0/",  # the one VRM 1.0 readers accept
+            "otherLicenseUrl": "https://opensource.org/licenses/MIT",
             "avatarPermission": "everyone",
             "allowExcessivelyViolentUsage": True,
             "allowExcessivelySexualUsage": False,

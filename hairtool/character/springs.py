@@ -79,7 +79,10 @@ def _to_world(pos: F64, rot: F64, center: int, v: F64) -> F64:
     return v if center < 0 else pos[center] + quat.rotate(rot[center], v)
 
 
-def _collide(tail: F64, hit: float, colliders: list[tuple[F64, F64 | None, float]]) -> F64:
+def _collide(
+    tail: F64, hit: float, colliders: list[tuple[F64, F64 | None, float]], origin: F64, length: float
+) -> F64:
+    """Push ``tail`` out of each sphere or capsule in turn, back at ``length`` from ``origin`` after each."""
     for p, q, radius in colliders:
         if q is None:
             delta = tail - p
@@ -92,14 +95,17 @@ def _collide(tail: F64, hit: float, colliders: list[tuple[F64, F64 | None, float
         reach = radius + hit
         if dist < reach and dist > 0:
             tail = tail + delta / dist * (reach - dist)
+            d = tail - origin
+            tail = origin + d / max(float(np.linalg.norm(d)), 1e-12) * length
     return tail
 
 
 class SpringBones:
     """The spring state of a character's chains; :meth:`step` advances it on a driven pose."""
 
-    def __init__(self, character: Character, local: F64) -> None:
+    def __init__(self, character: Character, local: F64, *, stale_lengths: bool = False) -> None:
         self.character = character
+        self.stale_lengths = stale_lengths
         pos, rot = forward(character, local)
         self.chains: list[tuple[int, list[_Joint]]] = []
         nodes = character.nodes
@@ -138,6 +144,10 @@ class SpringBones:
                 )
             self.chains.append((chain.center, joints))
         self.rest = character.nodes.rotation.copy()
+        self.last = local.copy()
+        for _, joints in self.chains:
+            for joint in joints:
+                self.last[joint.node] = self.rest[joint.node]
 
     def _colliders(self, pos: F64, rot: F64, chain_index: int) -> list[tuple[F64, F64 | None, float]]:
         out = []
@@ -159,6 +169,13 @@ class SpringBones:
             for joint in joints:
                 out[joint.node] = self.rest[joint.node]
         pos, rot = forward(self.character, out)
+        stale = None
+        if self.stale_lengths:
+            before = local.copy()
+            for _, joints in self.chains:
+                for joint in joints:
+                    before[joint.node] = self.last[joint.node]
+            stale = forward(self.character, before)[0]
         translation = self.character.nodes.translation
         for ci, (center, joints) in enumerate(self.chains):
             colliders = self._colliders(pos, rot, ci)
@@ -172,10 +189,12 @@ class SpringBones:
                 ext = dt * joint.gravity
                 if to_center is not None:
                     stiff, ext = quat.rotate(to_center, stiff), quat.rotate(to_center, ext)
+                length = joint.length
+                if stale is not None and joint.child >= 0:
+                    length = float(np.linalg.norm(pos[j] - stale[joint.child]))
                 nxt = _to_world(pos, rot, center, joint.tail + inertia + stiff + ext)
-                nxt = pos[j] + (nxt - pos[j]) / max(np.linalg.norm(nxt - pos[j]), 1e-12) * joint.length
-                nxt = _collide(nxt, joint.hit_radius, colliders)
-                nxt = pos[j] + (nxt - pos[j]) / max(np.linalg.norm(nxt - pos[j]), 1e-12) * joint.length
+                nxt = pos[j] + (nxt - pos[j]) / max(np.linalg.norm(nxt - pos[j]), 1e-12) * length
+                nxt = _collide(nxt, joint.hit_radius, colliders, pos[j], length)
                 joint.prev = joint.tail
                 joint.tail = _to_center(pos, rot, center, nxt)
                 to = quat.rotate(quat.conjugate(frame), nxt - pos[j])
@@ -185,19 +204,25 @@ class SpringBones:
                 rot[j] = quat.multiply(parent_rot, out[j])
                 if joint.child >= 0:
                     pos[joint.child] = pos[j] + quat.rotate(rot[j], translation[joint.child])
+        self.last = out
         return out
 
 
-def simulate(character: Character, driver: F64, fps: float, substeps: int = 1) -> F64:
+def simulate(
+    character: Character, driver: F64, fps: float, substeps: int = 1, *, stale_lengths: bool = False
+) -> F64:
     """``(F, J, 4)`` local rotations: ``driver`` ``(F, J, 4)`` with the chains swung by their springs.
 
     The springs start at rest on the driver's first frame and step ``substeps`` times a frame.
+    ``stale_lengths`` reproduces three-vrm (3.x), which measures a bone's length to its child's
+    world position as it was before this step moved the bone, so its bones stretch and shrink a
+    little while the hair moves; the specification keeps them rigid (the default).
     """
     if driver.ndim != 3 or driver.shape[1:] != (character.nodes.count, 4):
         raise ParameterError("driver", driver.shape, f"(frames, {character.nodes.count}, 4) rotations")
     if not np.isfinite(fps) or fps <= 0 or int(substeps) != substeps or substeps < 1:
         raise ParameterError("fps", fps, "a positive frame rate and a whole number of substeps ≥ 1")
-    springs = SpringBones(character, driver[0])
+    springs = SpringBones(character, driver[0], stale_lengths=stale_lengths)
     out = np.empty_like(driver)
     dt = 1.0 / (fps * substeps)
     for f in range(len(driver)):
