@@ -9,6 +9,7 @@ import json
 from hairtool.errors import ParameterError
 
 CHAIN_PATTERN_HELP = "a regular expression on node names picking the hair chains (default: the VRM springs)"
+BVH_HELP = "IN a character: also write its hair chains' motion as BVH here"
 
 
 def _refuse(args: argparse.Namespace, names: tuple[str, ...], command: str) -> None:
@@ -28,6 +29,15 @@ def _print(args: argparse.Namespace, report: dict) -> None:
     for key, value in report.items():
         if not isinstance(value, (list, dict)):
             print(f"{key}: {value}")
+
+
+def _write_bvh(args: argparse.Namespace, character, rotations, report: dict) -> None:
+    if getattr(args, "bvh", None) is None:
+        return
+    from hairtool.character.bvh import write_chains_bvh
+
+    write_chains_bvh(args.bvh, character, rotations, args.fps)
+    report["bvh"] = args.bvh
 
 
 def run_anime(args: argparse.Namespace) -> int:
@@ -68,6 +78,7 @@ def run_anime(args: argparse.Namespace) -> int:
         report["written"] = write_animated(
             args.input, args.output, frames, rest, args.fps, name="anime cycle", step=True, loop_frames=loop
         )
+    _write_bvh(args, character, frames, report)
     _print(args, report)
     return 0
 

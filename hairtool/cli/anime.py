@@ -24,7 +24,7 @@ import argparse
 import json
 
 from hairtool.cli import _guides
-from hairtool.cli._character import CHAIN_PATTERN_HELP, run_anime
+from hairtool.cli._character import BVH_HELP, CHAIN_PATTERN_HELP, run_anime
 from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
 from hairtool.errors import ParameterError
 from hairtool.io.specs import load_groom
@@ -70,6 +70,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     o.add_argument(
         "--chains", metavar="PATTERN", help=f"IN a .vrm/.glb/.gltf character: {CHAIN_PATTERN_HELP}"
     )
+    o.add_argument("--bvh", metavar="BVH", help=BVH_HELP)
     _guides.add_arguments(parser, seed=False, guides=False)
 
 
@@ -104,8 +105,9 @@ def run(args: argparse.Namespace) -> int:
 
     if args.input is not None and is_character_path(args.input):
         return run_anime(args)
-    if args.chains is not None:
-        raise ParameterError("chains", args.chains, "a .vrm, .glb or .gltf character as IN")
+    for flag in ("chains", "bvh"):
+        if getattr(args, flag) is not None:
+            raise ParameterError(flag, getattr(args, flag), "a .vrm, .glb or .gltf character as IN")
 
     params = WaveParams(args.amplitude, args.wavelength, args.gravity, args.profile, args.period)
     sched = schedule(args.period, args.fps, args.hold)

@@ -28,7 +28,7 @@ import json
 import time
 
 from hairtool.cli import _guides
-from hairtool.cli._character import CHAIN_PATTERN_HELP, run_springs
+from hairtool.cli._character import BVH_HELP, CHAIN_PATTERN_HELP, run_springs
 from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
 from hairtool.io.specs import load_groom
 
@@ -78,6 +78,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     c = parser.add_argument_group("character (IN a .vrm, .glb or .gltf: motion shake, turn or still)")
     c.add_argument("--springs", action="store_true", help="swing the hair chains by their VRM spring bones")
     c.add_argument("--chains", metavar="PATTERN", help=CHAIN_PATTERN_HELP)
+    c.add_argument("--bvh", metavar="BVH", help=BVH_HELP)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -93,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
     from hairtool.simulate.dynamics import scaled_accelerations, simulate
     from hairtool.simulate.head_motion import fit_head, parse_motion
 
-    for flag in ("springs", "chains"):
+    for flag in ("springs", "chains", "bvh"):
         if getattr(args, flag):
             raise ParameterError(flag, getattr(args, flag), "a .vrm, .glb or .gltf character as IN")
     fmt = format_for(args.output, writing=True)  # refuse a bad extension before simulating

@@ -17,6 +17,7 @@ from hairtool.character.export import key_times, write_animated
 from hairtool.character.glb import unpack
 from hairtool.character.read import _gltf, load_document
 from hairtool.cli import main
+from hairtool.mocap.bvh import read_bvh
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "characters"
 VRM = DATA / "bunches.vrm"
@@ -79,12 +80,22 @@ def test_the_cycle_written_keeps_the_characters_bytes_and_plays_every_frame(tmp_
 
 
 def test_simulate_springs_writes_linear_keys_on_every_frame(tmp_path, capsys):
-    out = tmp_path / "springs.glb"
-    assert (
-        main(["simulate", str(VRM), str(out), "--springs", "--frames", "6", "--motion", "shake", "--json"])
-        == 0
-    )
+    out, bvh = tmp_path / "springs.glb", tmp_path / "hair.bvh"
+    args = [
+        "simulate",
+        str(VRM),
+        str(out),
+        "--springs",
+        "--frames",
+        "6",
+        "--motion",
+        "shake",
+        "--bvh",
+        str(bvh),
+    ]
+    assert main([*args, "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
+    assert read_bvh(bvh).n_frames == 6
     assert report["written"]["frames"] == 6 and report["written"]["interpolation"] == "LINEAR"
     assert load_character(out).clips[0].rotations
 
