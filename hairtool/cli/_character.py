@@ -109,5 +109,6 @@ def run_springs(args: argparse.Namespace) -> int:
         name="spring bones",
         step=False,
     )
+    _write_bvh(args, character, rotations, report)
     _print(args, report)
     return 0
