@@ -122,9 +122,22 @@ class Clip:
 
     name: str
     rotations: dict[int, tuple[F64, F64]] = field(default_factory=dict)  # node → (times, (K, 4))
+    step: frozenset[int] = frozenset()  # nodes whose keys hold (STEP) instead of slerping
+
+    @property
+    def duration(self) -> float:
+        return max((float(t[-1]) for t, _ in self.rotations.values()), default=0.0)
+
+    def frame_rate(self) -> float:
+        """The rate of the closest keys, snapped to a whole number within 0.1 % (float32 times)."""
+        gaps = [np.diff(t) for t, _ in self.rotations.values() if len(t) > 1]
+        if not gaps:
+            return 24.0
+        rate = 1.0 / float(np.min(np.concatenate(gaps)))
+        return float(round(rate)) if round(rate) > 0 and abs(rate - round(rate)) <= 1e-3 * rate else rate
 
     def sample(self, nodes: Nodes, t: float) -> F64:
-        """``(J, 4)`` local rotations at time ``t`` (seconds): keys slerped, rest where none."""
+        """``(J, 4)`` local rotations at time ``t`` (seconds): keys held or slerped, rest where none."""
         r = nodes.rotation.copy()
         for j, (times, q) in self.rotations.items():
             if t <= times[0]:
@@ -133,9 +146,17 @@ class Clip:
                 r[j] = q[-1]
             else:
                 i = int(np.searchsorted(times, t, side="right")) - 1
-                u = (t - times[i]) / (times[i + 1] - times[i])
-                r[j] = quat.slerp(q[i], q[i + 1], u)
+                if j in self.step:
+                    r[j] = q[i]
+                else:
+                    u = (t - times[i]) / (times[i + 1] - times[i])
+                    r[j] = quat.slerp(q[i], q[i + 1], u)
         return r
+
+    def frames(self, nodes: Nodes, fps: float) -> F64:
+        """``(F, J, 4)`` the clip sampled at every frame from 0 to its duration."""
+        n = round(self.duration * fps) + 1
+        return np.stack([self.sample(nodes, f / fps) for f in range(n)])
 
 
 @dataclass(frozen=True)

@@ -232,7 +232,7 @@ def read_clips(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple
     """Rotation channels of every animation (translations and scales are not posed here)."""
     clips = []
     for a, anim in enumerate(gltf.animations or []):
-        rot = {}
+        rot, step = {}, set()
         samplers = anim.samplers or []
         for c, ch in enumerate(anim.channels or []):
             tgt = ch.target
@@ -251,7 +251,9 @@ def read_clips(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple
             if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0) or not np.all(np.isfinite(q)):
                 raise FormatError(path, f"animation {a} channel {c}: key times must increase")
             rot[j] = (times, quat.normalize(np.roll(q, 1, axis=1)))
-        clips.append(Clip(anim.name if isinstance(anim.name, str) else f"animation{a}", rot))
+            if s.interpolation == "STEP":
+                step.add(j)
+        clips.append(Clip(anim.name if isinstance(anim.name, str) else f"animation{a}", rot, frozenset(step)))
     return tuple(clips)
 
 

@@ -126,3 +126,24 @@ def test_a_broken_character_is_one_line_and_exit_2(tmp_path, capsys):
 def test_character_options_on_a_groom_are_refused(tmp_path, capsys):
     assert main(["simulate", "sample:portrait:4:4", str(tmp_path / "o.npz"), "--springs"]) == 2
     assert "springs" in capsys.readouterr().err
+
+
+def test_keys_on_a_characters_animation(tmp_path, capsys):
+    out = tmp_path / "springs.glb"
+    assert main(["simulate", str(VRM), str(out), "--springs", "--frames", "12", "--motion", "shake"]) == 0
+    capsys.readouterr()
+    assert main(["keys", str(out), "--keys", "4", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["frames"] == 12 and report["fps"] == 24.0
+    assert len(report["keys"]) == 4 and report["keys"][0] == 0 and report["keys"][-1] == 11
+
+
+def test_a_step_clip_holds_its_drawings_when_read_back(tmp_path):
+    c = load_character(VRM)
+    cyc = character_cycle(c)
+    out = tmp_path / "cycle.glb"
+    write_animated(VRM, out, cyc.frames(), c.nodes.rotation, 24.0, name="cycle", step=True, loop_frames=11)
+    clip = load_character(out).clips[0]
+    assert clip.frame_rate() == 24.0  # drawings two frames apart, and the last one held one frame
+    frames = clip.frames(c.nodes, 24.0)
+    np.testing.assert_allclose(np.abs(np.sum(frames[:11] * cyc.frames(), axis=-1)), 1.0, atol=1e-6)
