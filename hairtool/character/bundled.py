@@ -334,6 +334,48 @@ def _springs(names: list[str], chains: list[list[int]]) -> dict:
     }
 
 
+def build_vrm0() -> tuple[dict, bytes]:
+    """The same character declared as VRM 0.x: bone groups of root bones (0.x's misspelled
+    ``stiffiness``), Unity-frame collider offsets (z flipped), a list of human bones. It has a
+    sphere per collider group only, so the body capsule is left out."""
+    doc, binary = build(vrm=True)
+    springs = doc["extensions"].pop("VRMC_springBone")
+    doc["extensions"].pop("VRMC_vrm")
+    doc["extensionsUsed"] = ["VRM"]
+    names = [n["name"] for n in doc["nodes"]]
+    sphere = springs["colliders"][0]
+    x, y, z = sphere["shape"]["sphere"]["offset"]
+    joint = springs["springs"][0]["joints"][0]
+    group = {
+        "comment": "hair",
+        "stiffiness": joint["stiffness"],
+        "gravityPower": joint["gravityPower"],
+        "gravityDir": {"x": 0.0, "y": -1.0, "z": 0.0},
+        "dragForce": joint["dragForce"],
+        "center": -1,
+        "hitRadius": joint["hitRadius"],
+        "bones": [s["joints"][0]["node"] for s in springs["springs"]],
+        "colliderGroups": [0],
+    }
+    collider = {"offset": {"x": x, "y": y, "z": -z}, "radius": sphere["shape"]["sphere"]["radius"]}
+    doc["extensions"]["VRM"] = {
+        "specVersion": "0.0",
+        "exporterVersion": "hairtool",
+        "meta": {
+            "title": "Bunches",
+            "author": "hairtool",
+            "licenseName": "Other",
+            "otherLicenseUrl": "https://opensource.org/licenses/MIT",
+        },
+        "humanoid": {"humanBones": [{"bone": HUMAN_BONE[n], "node": names.index(n)} for n, _, _ in BODY]},
+        "secondaryAnimation": {
+            "boneGroups": [group],
+            "colliderGroups": [{"node": sphere["node"], "colliders": [collider]}],
+        },
+    }
+    return doc, binary
+
+
 def write(folder: str | Path) -> list[Path]:
     """Write ``bunches.vrm`` and ``bunches.glb`` into ``folder`` (atomically); their paths."""
     out = []

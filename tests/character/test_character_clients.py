@@ -114,3 +114,23 @@ def test_three_vrm_swings_the_springs_as_we_do(node):
     assert _angles(c, rows, simulate(c, driver, 24.0, stale_lengths=True)).max() < 1e-6
     spec = _angles(c, rows, simulate(c, driver, 24.0))
     assert 1e-4 < spec.max() < np.radians(3.0)
+
+
+def test_three_vrm_swings_a_vrm0_character_as_we_do(node, tmp_path):
+    """VRM 0.x: every listed node is a joint, the last swinging a 7 cm virtual tail, and collider
+    offsets are stored with z flipped; a head sphere large enough to push the hair makes the
+    offset count."""
+    from hairtool.character import bundled
+    from hairtool.character.glb import pack
+
+    doc, binary = bundled.build_vrm0()
+    vrm = doc["extensions"]["VRM"]
+    sphere = vrm["secondaryAnimation"]["colliderGroups"][0]["colliders"][0]
+    sphere["radius"], sphere["offset"]["z"] = 0.14, -0.04
+    path = tmp_path / "zero.vrm"
+    path.write_bytes(pack(doc, binary))
+    c = load_character(path)
+    rows = _three_rotations(node, path, 24.0, 24, "springs", "30", "1", "Head")
+    assert len(rows[0]) == 14 * 5  # the last nodes swing too
+    ours = simulate(c, head_shake(c, 24, 24.0, turn_deg=30.0, period=1.0), 24.0, stale_lengths=True)
+    assert _angles(c, rows, ours).max() < 1e-6

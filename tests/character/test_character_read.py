@@ -18,46 +18,6 @@ from hairtool.errors import FormatError
 DATA = Path(__file__).resolve().parents[1] / "data" / "characters"
 
 
-def vrm0_document() -> tuple[dict, bytes]:
-    """The bundled character as VRM 0.x would declare its springs (root bones, flipped z offsets)."""
-    doc, binary = bundled.build(vrm=True)
-    springs = doc["extensions"].pop("VRMC_springBone")
-    doc["extensions"].pop("VRMC_vrm")
-    doc["extensionsUsed"] = ["VRM"]
-    sphere = springs["colliders"][0]
-    off = sphere["shape"]["sphere"]["offset"]
-    joint = springs["springs"][0]["joints"][0]
-    doc["extensions"]["VRM"] = {
-        "secondaryAnimation": {
-            "boneGroups": [
-                {
-                    "comment": "hair",
-                    "stiffiness": joint["stiffness"],
-                    "gravityPower": joint["gravityPower"],
-                    "gravityDir": {"x": 0, "y": -1, "z": 0},
-                    "dragForce": joint["dragForce"],
-                    "center": -1,
-                    "hitRadius": joint["hitRadius"],
-                    "bones": [s["joints"][0]["node"] for s in springs["springs"]],
-                    "colliderGroups": [0],
-                }
-            ],
-            "colliderGroups": [
-                {
-                    "node": sphere["node"],
-                    "colliders": [
-                        {
-                            "offset": {"x": off[0], "y": off[1], "z": -0.02},
-                            "radius": sphere["shape"]["sphere"]["radius"],
-                        }
-                    ],
-                }
-            ],
-        }
-    }
-    return doc, binary
-
-
 def test_vrm1_springs_settings_and_colliders():
     c = load_character(DATA / "bunches.vrm")
     ch = c.chains[0]
@@ -69,7 +29,10 @@ def test_vrm1_springs_settings_and_colliders():
 
 def test_vrm0_bone_groups_become_chains_with_a_virtual_tail(tmp_path):
     path = tmp_path / "zero.vrm"
-    path.write_bytes(pack(*vrm0_document()))
+    doc, binary = bundled.build_vrm0()
+    sphere = doc["extensions"]["VRM"]["secondaryAnimation"]["colliderGroups"][0]["colliders"][0]
+    sphere["offset"]["z"] = -0.02
+    path.write_bytes(pack(doc, binary))
     c = load_character(path)
     one = load_character(DATA / "bunches.vrm")
     assert c.vrm_version == "0.x"
