@@ -208,8 +208,89 @@ class SpringBones:
         return out
 
 
+class PackedSprings:
+    """:class:`SpringBones` as flat arrays, stepped by the numba kernel (same formulas)."""
+
+    def __init__(self, springs: SpringBones) -> None:
+        from hairtool.character.springs_kernel import collider_arrays
+
+        self.springs = springs
+        joints = [j for _, js in springs.chains for j in js]
+        self.node = np.array([j.node for j in joints], dtype=np.int64)
+        self.parent = np.array([j.parent for j in joints], dtype=np.int64)
+        self.child = np.array([j.child for j in joints], dtype=np.int64)
+        self.axis = np.array([j.axis for j in joints]).reshape(-1, 3)
+        self.length = np.array([j.length for j in joints], dtype=np.float64)
+        self.stiffness = np.array([j.stiffness for j in joints], dtype=np.float64)
+        self.gravity = np.array([j.gravity for j in joints]).reshape(-1, 3)
+        self.drag = np.array([j.drag for j in joints], dtype=np.float64)
+        self.hit = np.array([j.hit_radius for j in joints], dtype=np.float64)
+        self.tail = np.array([j.tail for j in joints]).reshape(-1, 3)
+        self.prev = np.array([j.prev for j in joints]).reshape(-1, 3)
+        self.chain_start = np.cumsum([0] + [len(js) for _, js in springs.chains]).astype(np.int64)
+        self.chain_center = np.array([c for c, _ in springs.chains], dtype=np.int64)
+        self.col_start, self.col_index, self.col_capsule, self.col_radius = collider_arrays(springs.character)
+        cols = springs.character.colliders
+        self.col_node = np.array([c.node for c in cols], dtype=np.int64)
+        self.col_offset = np.array([c.offset for c in cols], dtype=np.float64).reshape(-1, 3)
+        self.col_tail = np.array([c.offset if c.tail is None else c.tail for c in cols]).reshape(-1, 3)
+
+    def step(self, local: F64, dt: float) -> F64:
+        from hairtool.character.springs_kernel import spring_step_kernel
+
+        sb = self.springs
+        out = np.array(local, dtype=np.float64, copy=True)
+        out[self.node] = sb.rest[self.node]
+        pos, rot = forward(sb.character, out)
+        stale = np.zeros((0, 3))
+        if sb.stale_lengths:
+            before = np.array(local, dtype=np.float64, copy=True)
+            before[self.node] = sb.last[self.node]
+            stale = forward(sb.character, before)[0]
+        crot = rot[self.col_node]
+        col_p = pos[self.col_node] + quat.rotate(crot, self.col_offset)
+        col_q = pos[self.col_node] + quat.rotate(crot, self.col_tail)
+        spring_step_kernel(
+            out,
+            pos,
+            rot,
+            stale,
+            sb.stale_lengths,
+            self.node,
+            self.parent,
+            self.child,
+            self.axis,
+            self.length,
+            self.stiffness,
+            self.gravity,
+            self.drag,
+            self.hit,
+            self.tail,
+            self.prev,
+            self.chain_start,
+            self.chain_center,
+            self.col_start,
+            self.col_index,
+            col_p.reshape(-1, 3),
+            col_q.reshape(-1, 3),
+            self.col_capsule,
+            self.col_radius,
+            sb.rest,
+            sb.character.nodes.translation,
+            float(dt),
+        )
+        sb.last = out
+        return out
+
+
 def simulate(
-    character: Character, driver: F64, fps: float, substeps: int = 1, *, stale_lengths: bool = False
+    character: Character,
+    driver: F64,
+    fps: float,
+    substeps: int = 1,
+    *,
+    stale_lengths: bool = False,
+    use_numba: bool = True,
 ) -> F64:
     """``(F, J, 4)`` local rotations: ``driver`` ``(F, J, 4)`` with the chains swung by their springs.
 
@@ -217,17 +298,19 @@ def simulate(
     ``stale_lengths`` reproduces three-vrm (3.x), which measures a bone's length to its child's
     world position as it was before this step moved the bone, so its bones stretch and shrink a
     little while the hair moves; the specification keeps them rigid (the default).
+    ``use_numba=False`` steps with the numpy reference.
     """
     if driver.ndim != 3 or driver.shape[1:] != (character.nodes.count, 4):
         raise ParameterError("driver", driver.shape, f"(frames, {character.nodes.count}, 4) rotations")
     if not np.isfinite(fps) or fps <= 0 or int(substeps) != substeps or substeps < 1:
         raise ParameterError("fps", fps, "a positive frame rate and a whole number of substeps ≥ 1")
     springs = SpringBones(character, driver[0], stale_lengths=stale_lengths)
+    stepper = PackedSprings(springs) if use_numba else springs
     out = np.empty_like(driver)
     dt = 1.0 / (fps * substeps)
     for f in range(len(driver)):
         for _ in range(int(substeps)):
-            out[f] = springs.step(driver[f], dt)
+            out[f] = stepper.step(driver[f], dt)
     return out
 
 
