@@ -12,14 +12,58 @@ CHAIN_PATTERN_HELP = "a regular expression on node names picking the hair chains
 BVH_HELP = "IN a character: also write its hair chains' motion as BVH here"
 
 
-def _refuse(args: argparse.Namespace, names: tuple[str, ...], command: str) -> None:
-    """Options that mean nothing for a character are refused rather than ignored."""
-    for name in names:
-        value = getattr(args, name, None)
-        if value not in (None, False, 0):
+def _refuse(args: argparse.Namespace, command: str, used: set[str]) -> None:
+    """Options of ``command`` a character does not use, given other than their defaults, are
+    refused rather than ignored."""
+    from hairtool.cli import command_parser
+
+    parser = command_parser(command)
+    for action in parser._actions:
+        dest = action.dest
+        if dest in used or dest in ("help", "input", "output") or not hasattr(args, dest):
+            continue
+        if getattr(args, dest) != action.default:
+            flag = action.option_strings[-1] if action.option_strings else dest
             raise ParameterError(
-                name.replace("_", "-"), value, f"no value: it has no meaning for a character in {command}"
+                flag.lstrip("-"),
+                getattr(args, dest),
+                f"no value: hairtool {command} does not use it for a character",
             )
+
+
+ANIME_OPTIONS = {
+    "period",
+    "fps",
+    "hold",
+    "cycles",
+    "frames",
+    "amplitude",
+    "wavelength",
+    "gravity",
+    "profile",
+    "phase_spread",
+    "amplitude_spread",
+    "seed",
+    "compare",
+    "json",
+    "chains",
+    "bvh",
+    "export_sheet",
+    "command",
+    "_run",
+}
+SIMULATE_OPTIONS = {
+    "motion",
+    "frames",
+    "fps",
+    "substeps",
+    "json",
+    "springs",
+    "chains",
+    "bvh",
+    "command",
+    "_run",
+}
 
 
 def _print(args: argparse.Namespace, report: dict) -> None:
@@ -50,7 +94,7 @@ def run_anime(args: argparse.Namespace) -> int:
     from hairtool.character.read import load_character
     from hairtool.character.springs import head_shake, simulate
 
-    _refuse(args, ("guides", "sway", "export_sheet", "count", "from_dense", "scalp"), "hairtool anime")
+    _refuse(args, "anime", ANIME_OPTIONS)
     character = load_character(args.input, getattr(args, "chains", None))
     params = WaveParams(args.amplitude, args.wavelength, args.gravity, args.profile, args.period)
     scale, phase = bunch_variation(len(character.chains), args.amplitude_spread, args.phase_spread, args.seed)
@@ -65,6 +109,11 @@ def run_anime(args: argparse.Namespace) -> int:
     frames = cyc.frames(shot)
     report = {"character": args.input, "chains": len(character.chains), **cyc.schedule.to_dict(shot)}
     report.pop("exposure")
+    if args.export_sheet is not None:
+        from hairtool.anime.schedule import write_sheet
+
+        write_sheet(args.export_sheet, cyc.schedule, shot)
+        report["sheet"] = args.export_sheet
     if args.compare is not None:
         if args.compare != "springs":
             raise ParameterError(
@@ -91,6 +140,7 @@ def run_springs(args: argparse.Namespace) -> int:
 
     if not args.springs:
         raise ParameterError("springs", False, "--springs for a character (its VRM spring bones)")
+    _refuse(args, "simulate", SIMULATE_OPTIONS)
     character = load_character(args.input, getattr(args, "chains", None))
     motion = args.motion
     if motion not in ("shake", "turn", "still"):

@@ -128,6 +128,18 @@ def test_character_options_on_a_groom_are_refused(tmp_path, capsys):
     assert "springs" in capsys.readouterr().err
 
 
+def test_groom_options_on_a_character_are_refused_not_ignored(tmp_path, capsys):
+    out = str(tmp_path / "o.glb")
+    assert main(["anime", str(VRM), out, "--sway", "0,1,0"]) == 2
+    assert "sway" in capsys.readouterr().err
+    assert main(["simulate", str(VRM), out, "--springs", "--wind", "1,0,0"]) == 2
+    assert "wind" in capsys.readouterr().err
+    assert not (tmp_path / "o.glb").exists()
+    sheet = tmp_path / "sheet.csv"
+    assert main(["anime", str(VRM), out, "--export-sheet", str(sheet)]) == 0
+    assert sheet.read_text().splitlines()[0] == "frame,picture,time"
+
+
 def test_keys_on_a_characters_animation(tmp_path, capsys):
     out = tmp_path / "springs.glb"
     assert main(["simulate", str(VRM), str(out), "--springs", "--frames", "12", "--motion", "shake"]) == 0
