@@ -60,16 +60,29 @@ def add_animation(
     name: str,
     step: bool,
     loop_frames: int | None = None,
+    key_frames: NDArray[np.int64] | None = None,
 ) -> None:
     """Append one animation: ``rotations`` ``(F, J, 4)`` wxyz of ``nodes`` at ``fps``.
 
     ``step``: keys only where the pose of the animated nodes changes, ``STEP`` interpolation
     (one shared time accessor). ``loop_frames``: add a closing key at that frame showing frame 0
-    again, so the clip lasts the whole cycle. Otherwise a ``LINEAR`` key on every frame.
+    again, so the clip lasts the whole cycle. Otherwise a ``LINEAR`` key on every frame, or only
+    on ``key_frames`` (optimal keys, increasing frame numbers).
     """
     f = len(rotations)
     sub = rotations[:, nodes]
-    frames = hold_keys(sub) if step else np.arange(f, dtype=np.int64)
+    if key_frames is not None:
+        frames = np.asarray(key_frames, dtype=np.int64)
+        if (
+            frames.ndim != 1
+            or frames.size == 0
+            or frames.min() < 0
+            or frames.max() >= f
+            or np.any(np.diff(frames) <= 0)
+        ):
+            raise ParameterError("keys", frames.tolist()[:6], f"increasing frame numbers in [0, {f})")
+    else:
+        frames = hold_keys(sub) if step else np.arange(f, dtype=np.int64)
     values = sub[frames]
     if loop_frames is not None:
         frames = np.concatenate([frames, [loop_frames]])
@@ -109,6 +122,7 @@ def write_animated(
     name: str,
     step: bool,
     loop_frames: int | None = None,
+    key_frames: NDArray[np.int64] | None = None,
 ) -> dict:
     """Write ``source`` with its hair animated to ``out`` (.glb, .vrm or .gltf); a summary dict."""
     path = os.fspath(out)
@@ -125,7 +139,17 @@ def write_animated(
     buffers = document.get("buffers") or []
     if suffix == ".gltf":
         writer = BufferWriter(document)
-        add_animation(document, writer, rotations, fps, nodes, name=name, step=step, loop_frames=loop_frames)
+        add_animation(
+            document,
+            writer,
+            rotations,
+            fps,
+            nodes,
+            name=name,
+            step=step,
+            loop_frames=loop_frames,
+            key_frames=key_frames,
+        )
         data = writer.bytes()
         if binary is not None and buffers and buffers[0].get("uri") is None:  # from a GLB: embed its bytes
             buffers[0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(binary).decode(
@@ -142,7 +166,17 @@ def write_animated(
         own = binary or b""
         start = len(own) if not buffers else buffers[0].get("byteLength", len(own))
         writer = BufferWriter(document, offset=(start + 3) // 4 * 4)
-        add_animation(document, writer, rotations, fps, nodes, name=name, step=step, loop_frames=loop_frames)
+        add_animation(
+            document,
+            writer,
+            rotations,
+            fps,
+            nodes,
+            name=name,
+            step=step,
+            loop_frames=loop_frames,
+            key_frames=key_frames,
+        )
         data = own[:start] + b"\0" * (-start % 4) + writer.bytes()
         if buffers:
             buffers[0]["byteLength"] = len(data)
@@ -154,7 +188,13 @@ def write_animated(
     return {
         "output": path,
         "animated_nodes": len(nodes),
-        "keys": int(len(hold_keys(rotations[:, nodes])) if step else len(rotations)),
+        "keys": int(
+            len(key_frames)
+            if key_frames is not None
+            else len(hold_keys(rotations[:, nodes]))
+            if step
+            else len(rotations)
+        ),
         "interpolation": "STEP" if step else "LINEAR",
         "fps": fps,
         "frames": len(rotations),

@@ -91,7 +91,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="write the keys by suffix: .usd/.usda/.usdc key poses as time samples (animations), .json "
         "record, .csv sheet (one row per frame; with --interp hermite or hermite-fit, per channel the "
         "key values and tangents), .bvh (BVH input: the key curve at every frame, or with --edit the "
-        "edited capture)",
+        "edited capture), .glb/.vrm/.gltf (character input: the character with LINEAR keys on its bones)",
     )
     parser.add_argument(
         "--bake", action="store_true", help="with --export: every frame of the key curve, not just the keys"
@@ -165,7 +165,9 @@ def _character_motion(path: Path):
         raise FormatError(path, "has no animation to key")
     clip = character.clips[-1]
     fps = clip.frame_rate()
-    motion = chains_motion(character, clip.frames(character.nodes, fps), fps)
+    rotations = clip.frames(character.nodes, fps)
+    motion = chains_motion(character, rotations, fps)
+    motion.character = (character, rotations)  # for --export OUT.glb/.vrm: the keys on the bones
     if motion.n_frames < 2:
         raise FormatError(path, f"its animation has {motion.n_frames} frame; keyframes need at least 2")
     return motion, motion.fps
@@ -346,7 +348,23 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
         from hairtool.keys.storage import storage
 
         result["storage"] = storage(data, sel.keys, args.input) if kind == "animation" else None
-    if args.export is not None and args.export.suffix.lower() == ".bvh":
+    if args.export is not None and args.export.suffix.lower() in (".glb", ".vrm", ".gltf"):
+        if getattr(data, "character", None) is None:
+            raise ParameterError("export", str(args.export), "a character (.vrm/.glb/.gltf) as IN")
+        from hairtool.character.export import write_animated
+
+        character, rotations = data.character
+        result["written"] = write_animated(
+            args.input,
+            args.export,
+            rotations,
+            character.nodes.rotation,
+            data.fps,
+            name="optimal keys",
+            step=False,
+            key_frames=sel.keys,
+        )
+    elif args.export is not None and args.export.suffix.lower() == ".bvh":
         _export_bvh(args, kind, data, sel.keys, result)
     elif args.edits is not None:
         raise ParameterError("edit", str(args.edit), "an --export OUT.bvh to write the edited capture to")

@@ -148,6 +148,28 @@ def test_keys_on_a_characters_animation(tmp_path, capsys):
     report = json.loads(capsys.readouterr().out)
     assert report["frames"] == 12 and report["fps"] == 24.0
     assert len(report["keys"]) == 4 and report["keys"][0] == 0 and report["keys"][-1] == 11
+    keyed = tmp_path / "keys.vrm"
+    assert main(["keys", str(out), "--keys", "4", "--export", str(keyed)]) == 0
+    clip = load_character(keyed).clips[-1]
+    for times, _ in clip.rotations.values():
+        np.testing.assert_allclose(
+            times * 24.0, report["keys"], atol=1e-4
+        )  # LINEAR keys at the optimal frames
+    assert (
+        main(
+            [
+                "keys",
+                str(out),
+                "--keys",
+                "4",
+                "--export",
+                str(tmp_path / "x.glb"),
+                "--bvh-features",
+                "positions",
+            ]
+        )
+        == 0
+    )
 
 
 def test_a_step_clip_holds_its_drawings_when_read_back(tmp_path):
