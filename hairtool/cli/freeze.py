@@ -149,7 +149,6 @@ def _surface(args: argparse.Namespace, strokes):
         args.scalp = None  # the surface's only: no children to grow on it
     return surface
 
-
 def _pose(args: argparse.Namespace):
     """The groom to freeze: IN, or the ``--frame`` pose of an animation IN (which is refused
     without it), as a static groom without the animation's frame range."""
