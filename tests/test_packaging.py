@@ -43,6 +43,7 @@ def test_every_python_package_ships_in_the_wheel(wheel):
     assert found == shipped
     assert any(n.startswith("app/shaders/") and n.endswith(".glsl") for n in wheel.namelist())
     assert "app/resources/sintel_hair.tfx" in wheel.namelist()
+    assert "app/resources/bunches.vrm" in wheel.namelist()  # the bundled character
 
 
 def test_the_library_installs_without_the_studio(wheel):
@@ -54,7 +55,7 @@ def test_the_library_installs_without_the_studio(wheel):
 
     base = {name(r) for r in requires if "extra ==" not in r}
     studio = {name(r) for r in requires if 'extra == "studio"' in r}
-    assert base == {"numpy", "numba", "usd-core"}
+    assert base == {"numpy", "numba", "usd-core", "pygltflib"}  # pygltflib: characters (glTF, VRM)
     assert studio == STUDIO_ONLY
 
 

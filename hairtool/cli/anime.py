@@ -24,6 +24,7 @@ import argparse
 import json
 
 from hairtool.cli import _guides
+from hairtool.cli._character import BVH_HELP, CHAIN_PATTERN_HELP, run_anime
 from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
 from hairtool.errors import ParameterError
 from hairtool.io.specs import load_groom
@@ -66,6 +67,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     o.add_argument("--compare", metavar="REF", help="report angular and position errors against REF")
     o.add_argument("--export-sheet", metavar="CSV", help="write the exposure sheet: frame, picture, time")
     o.add_argument("--json", action="store_true", help="print a JSON object")
+    o.add_argument(
+        "--chains", metavar="PATTERN", help=f"IN a .vrm/.glb/.gltf character: {CHAIN_PATTERN_HELP}"
+    )
+    o.add_argument("--bvh", metavar="BVH", help=BVH_HELP)
     _guides.add_arguments(parser, seed=False, guides=False)
 
 
@@ -96,6 +101,13 @@ def _dense_guides(text: str | None) -> int | None:
 def run(args: argparse.Namespace) -> int:
     from hairtool.anime.schedule import schedule, write_sheet
     from hairtool.anime.wave import WaveParams, cycle_animation
+    from hairtool.character.read import is_character_path
+
+    if args.input is not None and is_character_path(args.input):
+        return run_anime(args)
+    for flag in ("chains", "bvh"):
+        if getattr(args, flag) is not None:
+            raise ParameterError(flag, getattr(args, flag), "a .vrm, .glb or .gltf character as IN")
 
     params = WaveParams(args.amplitude, args.wavelength, args.gravity, args.profile, args.period)
     sched = schedule(args.period, args.fps, args.hold)

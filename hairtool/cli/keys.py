@@ -1,6 +1,7 @@
 """Find globally optimal keyframes of an animation, a BVH capture or a feature array.
 
-IN is an animation file (.usd/.usda/.usdc/.npz cache), a .bvh, or an .npz holding an array
+IN is an animation file (.usd/.usda/.usdc/.npz cache), a .bvh, a character (.vrm/.glb/.gltf:
+its last animation, keyed as the BVH of its hair chains), or an .npz holding an array
 ``X`` of shape (frames, dims) used as raw features. At most one mode: --keys K, --penalty TAU
 (a price per key, as a share of the error of keying only the first and last frame, so it means
 the same on any animation), --penalty-abs TAU (an absolute price, Fei et al.'s τ, in squared
@@ -23,7 +24,11 @@ HELP = "find globally optimal keyframes (exact DP) and compare with uniform keys
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("input", metavar="IN", help="animation file, .bvh, or .npz with an array X")
+    parser.add_argument(
+        "input",
+        metavar="IN",
+        help="animation file, .bvh, character (.vrm/.glb/.gltf), or .npz with an array X",
+    )
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument(
         "--keys",
@@ -86,7 +91,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="write the keys by suffix: .usd/.usda/.usdc key poses as time samples (animations), .json "
         "record, .csv sheet (one row per frame; with --interp hermite or hermite-fit, per channel the "
         "key values and tangents), .bvh (BVH input: the key curve at every frame, or with --edit the "
-        "edited capture)",
+        "edited capture), .glb/.vrm/.gltf (character input: the character with LINEAR keys on its bones)",
     )
     parser.add_argument(
         "--bake", action="store_true", help="with --export: every frame of the key curve, not just the keys"
@@ -127,6 +132,8 @@ def _load(args: argparse.Namespace):
     if not path.is_file():
         raise FormatError(path, "no such file" if not path.exists() else "not a regular file")
     suffix = path.suffix.lower()
+    if suffix in (".vrm", ".glb", ".gltf"):
+        return "bvh", *_character_motion(path)
     if suffix == ".bvh":
         from hairtool.mocap.bvh import read_bvh
 
@@ -145,6 +152,25 @@ def _load(args: argparse.Namespace):
     if obj.n_frames < 2:
         raise GroomError(f"{path} has {obj.n_frames} frame; keyframes need at least 2")
     return "animation", obj, obj.fps
+
+
+def _character_motion(path: Path):
+    """A character's last animation as the BVH motion of its hair chains, at its keys' rate."""
+    from hairtool.character.bvh import chains_motion
+    from hairtool.character.read import load_character
+    from hairtool.errors import FormatError
+
+    character = load_character(path)
+    if not character.clips:
+        raise FormatError(path, "has no animation to key")
+    clip = character.clips[-1]
+    fps = clip.frame_rate()
+    rotations = clip.frames(character.nodes, fps)
+    motion = chains_motion(character, rotations, fps)
+    motion.character = (character, rotations)  # for --export OUT.glb/.vrm: the keys on the bones
+    if motion.n_frames < 2:
+        raise FormatError(path, f"its animation has {motion.n_frames} frame; keyframes need at least 2")
+    return motion, motion.fps
 
 
 def _mode(args: argparse.Namespace, session) -> dict:
@@ -322,7 +348,23 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
         from hairtool.keys.storage import storage
 
         result["storage"] = storage(data, sel.keys, args.input) if kind == "animation" else None
-    if args.export is not None and args.export.suffix.lower() == ".bvh":
+    if args.export is not None and args.export.suffix.lower() in (".glb", ".vrm", ".gltf"):
+        if getattr(data, "character", None) is None:
+            raise ParameterError("export", str(args.export), "a character (.vrm/.glb/.gltf) as IN")
+        from hairtool.character.export import write_animated
+
+        character, rotations = data.character
+        result["written"] = write_animated(
+            args.input,
+            args.export,
+            rotations,
+            character.nodes.rotation,
+            data.fps,
+            name="optimal keys",
+            step=False,
+            key_frames=sel.keys,
+        )
+    elif args.export is not None and args.export.suffix.lower() == ".bvh":
         _export_bvh(args, kind, data, sel.keys, result)
     elif args.edits is not None:
         raise ParameterError("edit", str(args.edit), "an --export OUT.bvh to write the edited capture to")

@@ -28,6 +28,7 @@ import json
 import time
 
 from hairtool.cli import _guides
+from hairtool.cli._character import BVH_HELP, CHAIN_PATTERN_HELP, run_springs
 from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
 from hairtool.io.specs import load_groom
 
@@ -46,7 +47,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     m.add_argument("--frames", type=int, default=120, help="frames to write (default 120)")
     m.add_argument("--fps", type=float, default=24.0, help="frames per second (default 24)")
-    m.add_argument("--substeps", type=int, default=8, help="solver steps per frame (default 8)")
+    m.add_argument(
+        "--substeps",
+        type=int,
+        help="solver steps per frame (default 8; 1 for a character's spring bones, as viewers step them)",
+    )
     f = parser.add_argument_group("forces")
     f.add_argument(
         "--gravity", type=float, default=GRAVITY, help=f"m/s² along the scene's −up (default {GRAVITY})"
@@ -70,16 +75,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     _guides.add_arguments(parser, seed=False)
     parser.add_argument("--json", action="store_true", help="print a JSON object")
+    c = parser.add_argument_group("character (IN a .vrm, .glb or .gltf: motion shake, turn or still)")
+    c.add_argument("--springs", action="store_true", help="swing the hair chains by their VRM spring bones")
+    c.add_argument("--chains", metavar="PATTERN", help=CHAIN_PATTERN_HELP)
+    c.add_argument("--bvh", metavar="BVH", help=BVH_HELP)
 
 
 def run(args: argparse.Namespace) -> int:
     import numpy as np
+
+    from hairtool.character.read import is_character_path
+
+    if is_character_path(args.input):
+        return run_springs(args)
 
     from hairtool.errors import ParameterError
     from hairtool.io import format_for, write
     from hairtool.simulate.dynamics import scaled_accelerations, simulate
     from hairtool.simulate.head_motion import fit_head, parse_motion
 
+    for flag in ("springs", "chains", "bvh"):
+        if getattr(args, flag):
+            raise ParameterError(flag, getattr(args, flag), "a .vrm, .glb or .gltf character as IN")
     fmt = format_for(args.output, writing=True)  # refuse a bad extension before simulating
     _guides.check(args, animated=True)
     motion = parse_motion(args.motion)
@@ -106,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
         motion=motion,
         frames=args.frames,
         fps=args.fps,
-        substeps=args.substeps,
+        substeps=8 if args.substeps is None else args.substeps,
         gravity=args.gravity,
         damping=args.damping,
         stiffness=args.stiffness,

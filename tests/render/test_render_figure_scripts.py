@@ -137,3 +137,13 @@ def test_the_fig9_jump_figure_edits_one_key_of_the_walk(tmp_path, capsys):
     columns = sheet.shape[1] // (64 + GAP)  # the frames shown, one panel each
     size = (shown.shape[1] - (columns + 1) * GAP) / columns
     assert size == int(size) and shown.shape[0] == 2 * (int(size) + LABEL_HEIGHT) + 3 * GAP
+
+
+def test_the_character_figure_draws_the_cycle_beside_the_springs(tmp_path, monkeypatch):
+    from app.figures import character
+
+    monkeypatch.setattr(character, "resource", lambda name: ROOT / "resources" / name)  # this checkout's
+    character.make([str(tmp_path), "--size", "64"])
+    sheet = iio.imread(tmp_path / "character_cycle_vs_springs.png")
+    assert sheet.shape[1] > 6 * 64 and sheet.shape[0] > 2 * 64  # six drawings over six spring frames
+    assert sheet[..., :3].min() < 128  # something is drawn

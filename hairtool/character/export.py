@@ -1,0 +1,201 @@
+"""Writing a character back with its hair animated: one glTF channel per bone rotation.
+
+The character's own JSON entries and binary bytes are kept as they were; the animation's key
+times and rotations are appended after its buffer, and one animation is added. Anime drawings
+are ``STEP`` keys exactly at the frames where a drawing starts (limited animation is a hold);
+simulations are ``LINEAR`` keys.
+
+glTF key times are 32-bit floats. A key time that rounds *above* i/fps makes three.js, which
+samples at i/fps in doubles, hold the previous drawing one frame longer, where Blender (which
+snaps to frames) shows the new one; every time is therefore written as the largest float32 not
+above i/fps, on which both agree.
+"""
+
+from __future__ import annotations
+
+import base64
+import copy
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from hairtool.character.glb import BufferWriter, pack
+from hairtool.character.read import load_document
+from hairtool.errors import FormatError, ParameterError
+from hairtool.io.atomic import atomic_open
+
+F64 = NDArray[np.float64]
+
+
+def key_times(frames: NDArray[np.int64], fps: float) -> NDArray[np.float32]:
+    """Float32 times of frame numbers, each the largest float32 ≤ frame/fps."""
+    exact = np.asarray(frames, dtype=np.float64) / fps
+    t = exact.astype(np.float32)
+    over = t.astype(np.float64) > exact
+    t[over] = np.nextafter(t[over], np.float32(-np.inf))
+    return t
+
+
+def hold_keys(frames: F64) -> NDArray[np.int64]:
+    """Frame numbers where a node's pose changes (frame 0 always): the STEP keys of held drawings."""
+    change = np.any(frames[1:] != frames[:-1], axis=tuple(range(1, frames.ndim)))
+    return np.concatenate([[0], 1 + np.flatnonzero(change)]).astype(np.int64)
+
+
+def animated_nodes(rotations: F64, rest: F64) -> list[int]:
+    """Nodes whose rotation differs from the rest pose on some frame."""
+    return np.flatnonzero(np.any(np.abs(rotations - rest[None]) > 0, axis=(0, 2))).tolist()
+
+
+def add_animation(
+    document: dict,
+    writer: BufferWriter,
+    rotations: F64,
+    fps: float,
+    nodes: list[int],
+    *,
+    name: str,
+    step: bool,
+    loop_frames: int | None = None,
+    key_frames: NDArray[np.int64] | None = None,
+) -> None:
+    """Append one animation: ``rotations`` ``(F, J, 4)`` wxyz of ``nodes`` at ``fps``.
+
+    ``step``: keys only where the pose of the animated nodes changes, ``STEP`` interpolation
+    (one shared time accessor). ``loop_frames``: add a closing key at that frame showing frame 0
+    again, so the clip lasts the whole cycle. Otherwise a ``LINEAR`` key on every frame, or only
+    on ``key_frames`` (optimal keys, increasing frame numbers).
+    """
+    f = len(rotations)
+    sub = rotations[:, nodes]
+    if key_frames is not None:
+        frames = np.asarray(key_frames, dtype=np.int64)
+        if (
+            frames.ndim != 1
+            or frames.size == 0
+            or frames.min() < 0
+            or frames.max() >= f
+            or np.any(np.diff(frames) <= 0)
+        ):
+            raise ParameterError("keys", frames.tolist()[:6], f"increasing frame numbers in [0, {f})")
+    else:
+        frames = hold_keys(sub) if step else np.arange(f, dtype=np.int64)
+    values = sub[frames]
+    if loop_frames is not None:
+        frames = np.concatenate([frames, [loop_frames]])
+        values = np.concatenate([values, sub[:1]])
+    values = _hemisphere(values)
+    times = writer.add(key_times(frames, fps), "SCALAR", bounds=True)
+    samplers, channels = [], []
+    for k, node in enumerate(nodes):
+        xyzw = np.roll(values[:, k], -1, axis=1).astype(np.float32)
+        samplers.append(
+            {
+                "input": times,
+                "output": writer.add(xyzw, "VEC4"),
+                "interpolation": "STEP" if step else "LINEAR",
+            }
+        )
+        channels.append({"sampler": k, "target": {"node": node, "path": "rotation"}})
+    document.setdefault("animations", []).append({"name": name, "channels": channels, "samplers": samplers})
+
+
+def _hemisphere(q: F64) -> F64:
+    """Consecutive keys on the same side of the double cover, so LINEAR interpolates the short way."""
+    out = q.copy()
+    for i in range(1, len(out)):
+        flip = np.sum(out[i] * out[i - 1], axis=-1) < 0
+        out[i][flip] *= -1.0
+    return out
+
+
+def write_animated(
+    source: str | os.PathLike[str],
+    out: str | os.PathLike[str],
+    rotations: F64,
+    rest: F64,
+    fps: float,
+    *,
+    name: str,
+    step: bool,
+    loop_frames: int | None = None,
+    key_frames: NDArray[np.int64] | None = None,
+) -> dict:
+    """Write ``source`` with its hair animated to ``out`` (.glb, .vrm or .gltf); a summary dict."""
+    path = os.fspath(out)
+    suffix = Path(path).suffix.lower()
+    if suffix not in (".glb", ".vrm", ".gltf"):
+        raise ParameterError("output", path, "a .glb, .vrm or .gltf file")
+    if not np.isfinite(fps) or fps <= 0:
+        raise ParameterError("fps", fps, "a positive frame rate")
+    document, binary = load_document(source)
+    document = copy.deepcopy(document)
+    nodes = animated_nodes(rotations, rest)
+    if not nodes:
+        raise ParameterError("chains", 0, f"hair chains to animate in {os.fspath(source)}")
+    buffers = document.get("buffers") or []
+    if suffix == ".gltf":
+        writer = BufferWriter(document)
+        add_animation(
+            document,
+            writer,
+            rotations,
+            fps,
+            nodes,
+            name=name,
+            step=step,
+            loop_frames=loop_frames,
+            key_frames=key_frames,
+        )
+        data = writer.bytes()
+        if binary is not None and buffers and buffers[0].get("uri") is None:  # from a GLB: embed its bytes
+            buffers[0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(binary).decode(
+                "ascii"
+            )
+        uri = "data:application/octet-stream;base64," + base64.b64encode(data).decode("ascii")
+        for view in document["bufferViews"][-writer.views :]:
+            view["buffer"] = len(buffers)
+        document["buffers"] = [*buffers, {"byteLength": len(data), "uri": uri}]
+        payload = json.dumps(document, separators=(",", ":")).encode("utf-8")
+    else:
+        if binary is None and buffers:
+            raise FormatError(source, "its buffers are outside the file: write the animation to a .gltf")
+        own = binary or b""
+        start = len(own) if not buffers else buffers[0].get("byteLength", len(own))
+        writer = BufferWriter(document, offset=(start + 3) // 4 * 4)
+        add_animation(
+            document,
+            writer,
+            rotations,
+            fps,
+            nodes,
+            name=name,
+            step=step,
+            loop_frames=loop_frames,
+            key_frames=key_frames,
+        )
+        data = own[:start] + b"\0" * (-start % 4) + writer.bytes()
+        if buffers:
+            buffers[0]["byteLength"] = len(data)
+        else:
+            document["buffers"] = [{"byteLength": len(data)}]
+        payload = pack(document, data)
+    with atomic_open(path, "wb") as f:
+        f.write(payload)
+    return {
+        "output": path,
+        "animated_nodes": len(nodes),
+        "keys": int(
+            len(key_frames)
+            if key_frames is not None
+            else len(hold_keys(rotations[:, nodes]))
+            if step
+            else len(rotations)
+        ),
+        "interpolation": "STEP" if step else "LINEAR",
+        "fps": fps,
+        "frames": len(rotations),
+    }
