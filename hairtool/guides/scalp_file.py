@@ -26,7 +26,7 @@ UP_AXES = ("y", "z")
 #: share of the groom's size (the diagonal of its bounding box).
 FAR_SHARE = 0.1
 #: Guide roots the fit is measured on at most (evenly picked), so a dense groom costs no more.
-FIT_ROOTS = 512
+FIT_ROOTS = 128
 
 
 def is_usd(path: str | os.PathLike[str]) -> bool:
