@@ -43,8 +43,13 @@ def add_arguments(
     g = parser.add_argument_group("render hair (children interpolated from guides)")
     g.add_argument("--count", type=int, default=None, help="children to grow from the guides")
     g.add_argument(
-        "--scalp", metavar="MESH.obj", default=None,
-        help="scalp mesh the children grow on (freeze: also the head strokes collide with and slide on)",
+        "--scalp", metavar="MESH", default=None,
+        help="scalp mesh the children grow on, a USD file (its Mesh prims, in its stage's up axis and unit) "
+        "or an OBJ (in the groom's unit); freeze: also the head strokes collide with and slide on",
+    )  # fmt: skip
+    g.add_argument(
+        "--scalp-up-axis", choices=("y", "z"), default=None,
+        help="the up axis of an OBJ --scalp (default: the groom's; Blender's OBJ export is y, its USD z)",
     )  # fmt: skip
     g.add_argument(
         "--guides-per-child", type=int, metavar="K", help=f"k nearest guides (default {DEFAULT_K})"
@@ -168,7 +173,9 @@ def check(
     own, so ``--clump-children`` alone is refused here too, not only in :func:`prepare`)."""
     from hairtool import io
     from hairtool.errors import ParameterError
+    from hairtool.guides.scalp_file import check_up_axis
 
+    check_up_axis(args.scalp, getattr(args, "scalp_up_axis", None))
     if required and not wanted(args):
         raise ParameterError("count", None, "a number of children (or --from-dense --guides G)")
     if not wanted(args):
@@ -231,9 +238,9 @@ def bind(args: argparse.Namespace, groom: Groom) -> tuple[Groom, ChildBinding, f
     shape = {"length_variation": lv, "frizz": DEFAULT_FRIZZ if args.frizz is None else args.frizz}
     mesh = None
     if args.scalp is not None:
-        from hairtool.io.obj import read_mesh
+        from hairtool.guides.scalp_file import load_scalp
 
-        mesh = read_mesh(args.scalp)
+        mesh = load_scalp(args.scalp, groom, getattr(args, "scalp_up_axis", None))
     if getattr(args, "bound_hair", None) is not None:
         guides, binding = groom, bind_to_guides(args.bound_hair, groom, k=k, mesh=mesh)
     elif args.from_dense:

@@ -138,24 +138,35 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _surface(args: argparse.Namespace, strokes):
-    """The head (``--scalp``, also without ``--count``) that strokes and align cursors collide
-    with and slide strokes slide on, or None; a log with slide strokes and no ``--scalp`` is
+    """The head (``--scalp`` and its ``--scalp-up-axis``, also without ``--count``) that strokes
+    and align cursors collide with and slide strokes slide on, as ``(path, up axis)`` to read in
+    the groom's frame (:func:`_head`), or None; a log with slide strokes and no ``--scalp`` is
     refused before any work."""
     from hairtool.errors import ParameterError
     from hairtool.frozen.brushes import NEED_SURFACE
 
     needs = sorted({s.brush for s in strokes or () if getattr(s, "brush", None) in NEED_SURFACE})
     if needs and args.scalp is None:
-        raise ParameterError("scalp", None, f"a head mesh (--scalp MESH.obj) for {', '.join(needs)} strokes")
+        raise ParameterError("scalp", None, f"a head mesh (--scalp MESH) for {', '.join(needs)} strokes")
     if args.scalp is None or not (strokes or args.align):
         return None
-    from hairtool.guides.planting import HeadSurface
-    from hairtool.io.obj import read_mesh
+    from hairtool.guides.scalp_file import check_up_axis
 
-    surface = HeadSurface(read_mesh(args.scalp))
+    head = (args.scalp, args.scalp_up_axis)
+    check_up_axis(*head)
     if not _guides.wanted(args):
-        args.scalp = None  # the surface's only: no children to grow on it
-    return surface
+        args.scalp = args.scalp_up_axis = None  # the surface's only: no children to grow on it
+    return head
+
+
+def _head(head, groom):
+    """The :func:`_surface` head read in ``groom``'s frame and checked to lie at its roots."""
+    if head is None:
+        return None
+    from hairtool.guides.planting import HeadSurface
+    from hairtool.guides.scalp_file import load_scalp
+
+    return HeadSurface(load_scalp(head[0], groom, head[1]))
 
 
 def _pose(args: argparse.Namespace):
@@ -236,11 +247,12 @@ def run(args: argparse.Namespace) -> int:
         from hairtool.frozen.strokes import read_strokes
 
         strokes = read_strokes(args.strokes)  # a bad log is refused before any work
-    surface = _surface(args, strokes)
+    head = _surface(args, strokes)
     _guides.check(args)
     io.format_for(args.output, writing=True)  # refuse an unwritable extension before working
-    # With render hair (asked for, or the input's own), the pipeline runs on the guides.
     pose = _pose(args)
+    surface = _head(head, pose)
+    # With render hair (asked for, or the input's own), the pipeline runs on the guides.
     groom, binding, bind_ms = _guides.prepare(args, _one_prim(args, pose))
     lo, hi = groom.bounds
     radius = float(np.linalg.norm(hi - lo)) if args.radius is None else args.radius

@@ -88,8 +88,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--export",
         type=Path,
         metavar="OUT",
-        help="write the keys by suffix: .usd/.usda/.usdc key poses as time samples (animations), .json "
-        "record, .csv sheet (one row per frame; with --interp hermite or hermite-fit, per channel the "
+        help="write the keys by suffix: .usd/.usda/.usdc key poses as time samples (animations; linear "
+        "keys, as USD plays them: a Hermite curve needs --bake), .json record, .csv sheet (one row per "
+        "frame with its time code in the source; with --interp hermite or hermite-fit, per channel the "
         "key values and tangents), .bvh (BVH input: the key curve at every frame, or with --edit the "
         "edited capture), .glb/.vrm/.gltf (character input: the character with LINEAR keys on its bones)",
     )
@@ -381,11 +382,12 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
         elif suffix in JSON_SUFFIXES + CSV_SUFFIXES:
             from hairtool.keys.export import export_keys, keys_record
 
-            export_keys(args.export, keys_record(result, args.input, time_codes=time_codes))
+            record = keys_record(result, args.input, time_codes=time_codes)
+            export_keys(args.export, record, time_codes=time_codes)
         else:
             from hairtool.keys.export import write_key_poses
 
-            write_key_poses(args.export, data, sel.keys)
+            write_key_poses(args.export, data, sel.keys, args.interp)  # linear keys only
     elif args.bake:
         raise ParameterError("bake", True, "an --export path to write the key curve to")
     uniform = f"uniform {sel.uniform_cost:.6g}"

@@ -11,11 +11,13 @@
   at and leaving the key, per frame): see :func:`sheet_rows` for the curve they give.
 - USD (``write_key_poses``): only the key poses as time samples at their time codes; USD
   readers interpolate linearly between samples, so the file plays back as the linear
-  reconstruction in any USD viewer.
+  reconstruction in any USD viewer. Keys of a Hermite curve are refused there: what would
+  play is not their curve (bake every frame instead, ``hairtool keys --bake``).
 
-Keys are frame indices 0…F−1 of the animation; the JSON record and the USD poses also give each
-key's time code in the source (an animation sampled at time codes 1…48 keys its first frame at
-1, not 0), so what is written lands where the source's frames are.
+Keys are frame indices 0…F−1 of the animation; the JSON record, the CSV sheet (its
+``time_code`` column) and the USD poses also give each frame's time code in the source (an
+animation sampled at time codes 1…48 keys its first frame at 1, not 0), so what is written lands
+where the source's frames are. All three give ``time`` in seconds as time code / fps.
 
 The CLI (``hairtool keys --out/--export``) and the studio both write through this module.
 """
@@ -222,11 +224,13 @@ def sheet_rows(
     uniform_keys: ArrayLike | None = None,
     curves: Mapping[str, Any] | None = None,
     pins: Sequence[int] = (),
+    time_codes: ArrayLike | None = None,
 ) -> list[list[Any]]:
-    """Rows of the key sheet (header first): frame, time, key, key number, previous and next
-    key, interpolation weight s (frame = (1 − s)·previous + s·next), pinned (1 on the key rows
-    of ``pins``, the frames the animator pinned, 0 on other key rows, blank between keys), the
-    uniform key column when ``uniform_keys`` is given, and with ``curves`` (``{"channels",
+    """Rows of the key sheet (header first): frame (0-based), time_code (the source's, from
+    ``time_codes``; default the frame), time (time code / fps, in seconds), key, key number,
+    previous and next key, interpolation weight s (frame = (1 − s)·previous + s·next), pinned
+    (1 on the key rows of ``pins``, the frames the animator pinned, 0 on other key rows, blank
+    between keys), the uniform key column when ``uniform_keys`` is given, and with ``curves`` (``{"channels",
     "values", "out", "in"}``, one row of C numbers per key) three columns per channel, filled on
     key rows: NAME, NAME:in, NAME:out.
 
@@ -237,7 +241,9 @@ def sheet_rows(
     are written with all their digits (Python's repr), so they read back to the same float64.
     """
     k = _check_keys(keys, n_frames)
-    header = ["frame", "time", "key", "key_number", "previous_key", "next_key", "weight", "pinned"]
+    codes = _check_time_codes(time_codes, n_frames)
+    header = ["frame", "time_code", "time", "key", "key_number", "previous_key", "next_key", "weight"]
+    header.append("pinned")
     pinned = {int(p) for p in pins}
     uni = None
     if uniform_keys is not None:
@@ -266,7 +272,8 @@ def sheet_rows(
         else:
             prev, nxt = int(k[j - 1]), int(k[j])
             weight = (f - prev) / (nxt - prev)
-        row = [f, repr(round(f / fps, 9)), int(is_key), j + 1 if is_key else "", prev, nxt]
+        code = float(codes[f])
+        row = [f, repr(code), repr(round(code / fps, 9)), int(is_key), j + 1 if is_key else "", prev, nxt]
         row += [repr(round(weight, 9)), int(f in pinned) if is_key else ""]
         if uni is not None:
             row.append(int(f in uni))
@@ -287,12 +294,40 @@ def _pins(record: Mapping[str, Any]) -> list[int]:
     return list(pins)
 
 
-def write_key_sheet(path: str | os.PathLike[str], record: Mapping[str, Any]) -> None:
-    """Write the CSV key sheet of a record (one row per frame), atomically."""
+def sheet_time_codes(record: Mapping[str, Any], time_codes: ArrayLike | None = None) -> F64:
+    """Every frame's time code for the sheet of ``record``: ``time_codes`` (the source's, checked
+    against the record's keys), or without them the record's own, where its keys carry time
+    codes one offset from their frames (a source at 1…48); the frame index for a record
+    without time codes."""
+    n = int(record["frames"])
+    keyed = [(int(k["frame"]), k["time_code"]) for k in record["keys"] if "time_code" in k]
+    if not all(isinstance(c, int | float) and not isinstance(c, bool) and math.isfinite(c) for _, c in keyed):
+        raise ParameterError("time_code", [c for _, c in keyed][:8], "a finite number on every key")
+    if time_codes is not None:
+        codes = _check_time_codes(time_codes, n)
+        wrong = [(f, c) for f, c in keyed if float(codes[f]) != c]
+        if wrong:
+            f, c = wrong[0]
+            raise ParameterError("time_codes", float(codes[f]), f"frame {f}'s time code in the keys, {c!r}")
+        return codes
+    offsets = {float(c) - f for f, c in keyed}
+    if len(offsets) > 1:
+        why = "the source's time code of every frame: the record's keys are not one offset from their frames"
+        raise ParameterError("time_codes", None, why)
+    return np.arange(n, dtype=np.float64) + (offsets.pop() if offsets else 0.0)
+
+
+def write_key_sheet(
+    path: str | os.PathLike[str], record: Mapping[str, Any], time_codes: ArrayLike | None = None
+) -> None:
+    """Write the CSV key sheet of a record (one row per frame), atomically; ``time_codes``: the
+    source's time code of every frame (:func:`sheet_time_codes`)."""
     uniform = record.get("uniform", {}).get("keys") if isinstance(record.get("uniform"), dict) else None
     curves = record.get("tangents")
     keys = record_keys(record)
-    rows = sheet_rows(int(record["frames"]), float(record["fps"]), keys, uniform, curves, _pins(record))
+    codes = sheet_time_codes(record, time_codes)
+    n, fps = int(record["frames"]), float(record["fps"])
+    rows = sheet_rows(n, fps, keys, uniform, curves, _pins(record), time_codes=codes)
     try:
         with atomic_open(path, "w", newline="", encoding="utf-8") as f:
             csv.writer(f).writerows(rows)
@@ -308,15 +343,31 @@ def key_poses_only(animation: Animation, keys: Sequence[int] | ArrayLike) -> Ani
     return animation.with_frames(animation.frames[k], time_codes=animation.time_codes[k])
 
 
+def linear_playback(path: str | os.PathLike[str], interp: str) -> None:
+    """Refuse key poses whose curve is not what USD plays: readers interpolate time samples
+    linearly, so Hermite keys written as poses would play as straight lines between them."""
+    if interp != "linear":
+        why = (
+            f"USD plays key poses back linearly, not as their {interp} curve; "
+            "bake every frame of the curve instead (--bake)"
+        )
+        raise FormatError(path, why)
+
+
 def write_key_poses(
-    path: str | os.PathLike[str], animation: Animation, keys: Sequence[int] | ArrayLike
+    path: str | os.PathLike[str],
+    animation: Animation,
+    keys: Sequence[int] | ArrayLike,
+    interp: str = "linear",
 ) -> None:
-    """Write USD with only the key poses (:func:`key_poses_only`), atomically."""
+    """Write USD with only the key poses (:func:`key_poses_only`), atomically; ``interp``, the
+    keys' interpolation, must be linear (:func:`linear_playback`)."""
     from hairtool.io import usd
 
-    poses = key_poses_only(animation, keys)
     if Path(path).suffix.lower() not in USD_SUFFIXES:
         raise FormatError(path, f"key poses are written as USD ({', '.join(USD_SUFFIXES)})")
+    linear_playback(path, interp)
+    poses = key_poses_only(animation, keys)
     try:
         usd.write(Path(path), poses)
     except OSError as e:
@@ -324,14 +375,21 @@ def write_key_poses(
 
 
 def export_keys(
-    path: str | os.PathLike[str], record: Mapping[str, Any], animation: Animation | None = None
+    path: str | os.PathLike[str],
+    record: Mapping[str, Any],
+    animation: Animation | None = None,
+    time_codes: ArrayLike | None = None,
 ) -> None:
-    """Write keys in the format the suffix names: .json record, .csv sheet, .usd/.usda/.usdc poses."""
+    """Write keys in the format the suffix names: .json record, .csv sheet, .usd/.usda/.usdc poses
+    (linear keys only). The sheet's time codes are ``time_codes``, else the animation's, else
+    the record's (:func:`sheet_time_codes`)."""
     suffix = Path(path).suffix.lower()
     if suffix in JSON_SUFFIXES:
         write_keys_json(path, record)
     elif suffix in CSV_SUFFIXES:
-        write_key_sheet(path, record)
+        if time_codes is None and animation is not None and animation.n_frames == int(record["frames"]):
+            time_codes = animation.time_codes
+        write_key_sheet(path, record, time_codes)
     elif suffix in USD_SUFFIXES:
         if animation is None:
             raise FormatError(path, "key poses need the animation the keys were chosen from")
@@ -339,7 +397,9 @@ def export_keys(
             raise FormatError(
                 path, f"the keys are for {record['frames']} frames but the animation has {animation.n_frames}"
             )
-        write_key_poses(path, animation, record_keys(record))
+        params = record.get("params")
+        interp = params.get("interp", "linear") if isinstance(params, Mapping) else "linear"
+        write_key_poses(path, animation, record_keys(record), str(interp))
     else:
         usd = ", ".join(USD_SUFFIXES)
         raise FormatError(path, f"keys are written as .json, .csv or {usd}, not '{suffix}'")

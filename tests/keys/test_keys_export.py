@@ -92,15 +92,15 @@ def test_csv_sheet_marks_the_pinned_keys(tmp_path):
         k: int(k in (7, 20)) for k in sel.keys.tolist()
     }
     free = keys_record({"frames": 30, "fps": 24.0, **select_keys(cost_table(x, "linear"), keys=6).to_dict()})
-    assert [r[7] for r in sheet_rows(30, 24.0, record_keys(free))[1:] if r[2]] == [0] * 6
+    assert [r[8] for r in sheet_rows(30, 24.0, record_keys(free))[1:] if r[3]] == [0] * 6
     with pytest.raises(ParameterError, match="pins"):
         export_keys(tmp_path / "bad.csv", {**record, "params": {"pins": ["7"]}})
 
 
 def test_sheet_rows_outside_the_keys_hold_the_nearest_key():
     rows = sheet_rows(6, 24.0, [1, 3])
-    assert rows[1][4:7] == [1, 1, "0.0"] and rows[6][4:7] == [3, 3, "0.0"]
-    assert rows[3][4:7] == [1, 3, "0.5"]
+    assert rows[1][5:8] == [1, 1, "0.0"] and rows[6][5:8] == [3, 3, "0.0"]
+    assert rows[3][5:8] == [1, 3, "0.5"]
 
 
 @pytest.mark.parametrize(
