@@ -61,8 +61,8 @@ from hairtool.frozen.clump import (
     record_key,
     vertex_strength,
 )
-from hairtool.frozen.collide import MARGIN, CollisionSurface, KeepOut, collide
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
+from hairtool.frozen.head_collision import HeadCollision
 from hairtool.frozen.lengths import restore_lengths
 from hairtool.frozen.local import LocalClump, strands_differing, threads_for
 from hairtool.frozen.move_points import MovePoints, held_by_at_most, may_write
@@ -360,22 +360,10 @@ class FrozenPipeline:
         """The head's surface (:class:`~hairtool.frozen.brushes.slide.Surface`) slide needs, or None."""
         return self._surface
 
-    @property
-    def _head(self) -> CollisionSurface | None:
-        """The surface strokes collide with (one that tells signed distances), or None."""
-        surface = self._surface
-        return surface if surface is not None and hasattr(surface, "signed_distance") else None
-
-    @property
-    def _collision_margin(self) -> float:
-        """How far outside the head a collision leaves a vertex: :data:`MARGIN` of the rest box's diagonal."""
-        lo, hi = self._rest.bounds
-        return MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
-
     @functools.cached_property
-    def _keep_out(self) -> KeepOut:
-        """:func:`~hairtool.frozen.collide.keep_out` with its memory of the head's distances."""
-        return KeepOut()
+    def _collision(self) -> HeadCollision:
+        """Strokes against the head (:mod:`hairtool.frozen.head_collision`)."""
+        return HeadCollision(self._rest)
 
     # -- operations ----------------------------------------------------------------------
     def set_surface(self, surface: Surface | None) -> Groom:
@@ -614,9 +602,8 @@ class FrozenPipeline:
         ctx = self._context(self._away(sample.view))
         out = brush.apply(ctx, g, sample)
         self._state = ctx.state
-        head = self._head
-        if brush.spec.moves_points and sample.collide and head is not None:
-            out = collide(g, out, head, self._collision_margin)
+        if brush.spec.moves_points and sample.collide:
+            out = self._collision.collide(self._surface, g, out)
         return out
 
     def _context(self, away: np.ndarray | None, state: StrandState | None = None, planar: bool | None = None):
@@ -694,23 +681,14 @@ class FrozenPipeline:
         _ = self.root_normals, self.scalp_centre
         if self._local is not None:
             self._local.grid.prepare(int(region_share * self._aligned.vertex_count))
-        head = self._head
-        if head is not None and self._aligned.vertex_count <= PREPARED_HEAD:
-            self._keep_out.remember(self._aligned, self._result, head)  # what a first collision asks
+        if self._aligned.vertex_count <= PREPARED_HEAD:
+            self._collision.remember(
+                self._surface, self._aligned, self._result
+            )  # what a first collision asks
 
     def _kept_out(self, clumped: Groom) -> Groom:
-        """Clumping respects the head: where strokes collide with it (a sample that moves points
-        with ``collide``), the strands clumping pulled back inside are pushed out again
-        (:func:`~hairtool.frozen.collide.keep_out`), so no brushed vertex ends inside."""
-        head = self._head
-        if head is None:
-            return clumped
-        if not any(
-            getattr(s, "collide", False) and registry.spec_of(registry.name_of(s)).moves_points
-            for s in self._log
-        ):
-            return clumped
-        return self._keep_out(self._aligned, clumped, head, self._collision_margin)
+        """The clumped result kept out of the head where strokes collide with it."""
+        return self._collision.kept_out(self._surface, self._log, self._aligned, clumped)
 
     # -- brush-local moves (hairtool.frozen.local) ---------------------------------------
     def _local_ready(self, samples: Sequence[Sample]) -> bool:
@@ -874,7 +852,6 @@ class FrozenPipeline:
         painted = cand[now != was.clump_strength] if now is not was.clump_strength else np.zeros(0, np.int64)
         if not brush.spec.moves_points:
             return None, painted
-        head = self._head
-        if sample.collide and head is not None:
-            out = collide(sub, out, head, self._collision_margin)
+        if sample.collide:
+            out = self._collision.collide(self._surface, sub, out)
         return out, painted
