@@ -32,6 +32,27 @@ def any_perpendicular(v: ArrayLike, frame: ArrayLike | None = None) -> NDArray[n
     return normalize(np.cross(a, helper))
 
 
+@njit(cache=True, nogil=True, inline="always")
+def perpendicular_axis(vx, vy, vz):  # pragma: no cover - compiled
+    """The unit vector :func:`any_perpendicular` picks for one vector (v × e_k, e_k the axis least
+    aligned with v), for kernels; (0, 0, 1) for a zero vector."""
+    k = 0
+    if abs(vy) < abs(vx):
+        k = 1
+    if abs(vz) < min(abs(vx), abs(vy)):
+        k = 2
+    if k == 0:
+        ax, ay, az = 0.0, vz, -vy
+    elif k == 1:
+        ax, ay, az = -vz, 0.0, vx
+    else:
+        ax, ay, az = vy, -vx, 0.0
+    an = np.sqrt(ax * ax + ay * ay + az * az)
+    if an > 0.0:
+        return ax / an, ay / an, az / an
+    return 0.0, 0.0, 1.0
+
+
 def rotate(vectors: ArrayLike, axes: ArrayLike, angles: ArrayLike) -> NDArray[np.float64]:
     """Rotate each row of ``vectors`` about the unit row of ``axes`` by ``angles`` (radians).
 

@@ -25,14 +25,6 @@ void main() {
 
 #elif defined FRAGMENT_SHADER
 
-uniform bool u_use_flat_color;
-uniform vec4 u_flat_color;
-
-in vec3 v_color;
-out vec4 f_color;
-
-void main() {
-    f_color = vec4(v_color, u_use_flat_color ? u_flat_color.a : 1.0);
-}
+#include "strands_fragment.glsl"
 
 #endif

@@ -137,6 +137,7 @@ def strokes_for(rest: Groom) -> dict[str, tuple[list[dict], str]]:
             [brush("select", samples_along(across, 0.6, -1.0))],
             "after Select, Ctrl",
         ),
+        "cut": ([brush("cut", samples_along(across, 0.35, 1.0))], "after Cut"),
     }
 
 

@@ -3,13 +3,17 @@
 Each file starts with its ``#version`` line and wraps the stages in
 ``#if defined VERTEX_SHADER … #elif defined GEOMETRY_SHADER … #elif defined FRAGMENT_SHADER``;
 the loader inserts the matching ``#define`` right after ``#version`` (GLSL requires the version
-first). Sources are read once per process; programs belong to the caller, who releases them.
+first). A line ``#include "name.glsl"`` is replaced by that file of ``shaders/`` (a piece two
+programs share, with no ``#version`` of its own), followed by a ``#line`` that keeps the
+including file's line numbers in compile errors. Sources are read once per process; programs
+belong to the caller, who releases them.
 """
 
 from __future__ import annotations
 
 import functools
 import importlib.resources
+import re
 
 import moderngl
 
@@ -31,10 +35,29 @@ def shader_source(name: str) -> str:
     return path.read_text(encoding="utf-8")
 
 
+INCLUDE = re.compile(r'^#include "(\w+)\.glsl"\s*$')
+
+
+@functools.cache
+def expanded_source(name: str, within: tuple[str, ...] = ()) -> str:
+    """``shaders/<name>.glsl`` with its ``#include`` lines replaced by the files they name."""
+    if name in within:
+        raise ParameterError("shader", name, "a file that does not include itself")
+    lines = []
+    for number, line in enumerate(shader_source(name).split("\n"), start=1):
+        found = INCLUDE.match(line)
+        if found is None:
+            lines.append(line)
+            continue
+        lines.append(expanded_source(found.group(1), (*within, name)).rstrip("\n"))
+        lines.append(f"#line {number + 1}")
+    return "\n".join(lines)
+
+
 @functools.cache
 def stage_sources(name: str) -> dict[str, str]:
     """``{moderngl keyword: source}`` for each stage the file defines."""
-    text = shader_source(name)
+    text = expanded_source(name)
     first, _, rest = text.partition("\n")
     if not first.startswith("#version"):
         raise ParameterError("shader", name, "a file whose first line is #version")

@@ -14,85 +14,28 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hairtool.errors import ParameterError
-from hairtool.frozen.brushes import BRUSHES, BrushSample, any_within, falloff_lut, mirrored_view
+from hairtool.frozen.brushes import BrushSample, any_within, falloff_lut, mirrored_view, registry
 from hairtool.frozen.pipeline import AlignSample
 from hairtool.frozen.sample_schema import ALIGN, BRUSH
 
-#: Brushes in the toolbar's order, with their artist's names and Blender-like keys (Blender's
-#: sculpt mode: S smooth, M mask, I inflate ≈ puff, P pinch ≈ clump, K snake hook; X deletes as
-#: in Blender's editors; pinch, with P taken by clump, is Shift+P; slide G as Blender's grab;
-#: add Shift+A as Blender's Add menu; select W, Blender's key for its select tools; align
-#: Shift+C, since A selects all as in Blender; the others by their initial).
-LABELS = {
-    "align": "Align",
-    "comb": "Comb",
-    "smooth": "Smooth",
-    "length": "Length",
-    "puff": "Puff",
-    "clump": "Clump",
-    "mask": "Mask",
-    "pinch": "Pinch",
-    "snake_hook": "Snake Hook",
-    "delete": "Delete",
-    "slide": "Slide",
-    "add": "Add",
-    "density": "Density",
-    "select": "Select",
-}
-SHORTCUTS = {
-    "align": "Shift+C", "comb": "C", "smooth": "S", "length": "L", "puff": "I", "clump": "P", "mask": "M",
-    "pinch": "Shift+P", "snake_hook": "K", "delete": "X", "slide": "G",
-    "add": "Shift+A", "density": "D", "select": "W",
-}  # fmt: skip
-TIPS = {
-    "align": "Strands turn toward the cursor's path (UserAlign, Kim 2026 eqs. 8–13)",
-    "comb": "Tips follow the drag, strand lengths kept",
-    "smooth": "Takes out kinks and curls; roots stay put (a Laplacian step, lengths kept)",
-    "length": "Grows or shrinks the strands under the brush (Ctrl: the other way)",
-    "puff": "Lifts strands away from the scalp near the root (turns them toward the scalp normal)",
-    "clump": "Paints how strongly strands clump (ClumpWithGaps' per-strand strength; Ctrl erases)",
-    "mask": "Paints a mask: masked strands are locked for every brush (Ctrl erases)",
-    "pinch": "Gathers strands toward the brush centre (Ctrl: spreads them); roots stay, lengths kept",
-    "snake_hook": "The strands whose tips are under the brush when you press follow the cursor, "
-    "roots fixed, lengths kept",
-    "delete": "Removes the strands whose roots are under the brush (undo brings them back)",
-    "slide": "Slides the roots under the brush along the head in the drag's direction; each strand "
-    "keeps its shape (needs the head mesh)",
-    "add": "Plants new strands on the head under the brush, shaped like their neighbours "
-    "(needs the head mesh)",
-    "density": "Removes or plants strands under the brush until the roots are the spacing apart "
-    "(needs the head mesh)",
-    "select": "Paints the selection: the strands it touches are selected (Ctrl deselects); with "
-    "Affect selection only, the other brushes keep to them",
-}
-#: Brushes with a signed strength: (label of > 0, label of < 0).
-SIGNED = {
-    "length": ("Grow", "Shrink"), "clump": ("Paint", "Erase"), "mask": ("Paint", "Erase"),
-    "pinch": ("Gather", "Spread"), "select": ("Select", "Deselect"),
-}  # fmt: skip
-SIGN_LABELS = {
-    "length": "Grow or shrink", "clump": "Paint or erase", "mask": "Paint or erase",
-    "pinch": "Gather or spread", "select": "Select or deselect",
-}  # fmt: skip
-DEFAULT_STRENGTH = {
-    "align": 0.8,
-    "comb": 0.5,
-    "smooth": 0.5,
-    "length": 0.05,
-    "puff": 0.2,
-    "clump": 0.5,
-    "mask": 1.0,
-    "pinch": 0.1,
-    "snake_hook": 1.0,
-    "delete": 1.0,
-    "slide": 1.0,
-    "add": 1.0,
-    "density": 1.0,
-    "select": 1.0,
-}
+#: The brushes as the studio shows them, read from their specs (each brush module's
+#: :class:`~hairtool.frozen.brushes.spec.Studio` row): in the toolbar's order, their artist's
+#: names and Blender-like keys (Blender's sculpt mode: S smooth, M mask, I inflate ≈ puff, P
+#: pinch ≈ clump, K snake hook; X deletes as in Blender's editors; pinch, with P taken by clump,
+#: is Shift+P; slide G as Blender's grab; add Shift+A as Blender's Add menu; select W, Blender's
+#: key for its select tools; align Shift+C, since A selects all as in Blender; the others by
+#: their initial), tooltips and default strengths.
+_SPECS = sorted(registry.specs(), key=lambda spec: (spec.studio.place, spec.order))
+LABELS = {spec.name: spec.studio.label for spec in _SPECS}
+SHORTCUTS = {spec.name: spec.studio.shortcut for spec in _SPECS}
+TIPS = {spec.name: spec.studio.tip for spec in _SPECS}
+#: Brushes with a signed strength: (label of > 0, label of < 0), and the toggle's label.
+SIGNED = {spec.name: spec.studio.signs for spec in _SPECS if spec.signed and spec.studio.signs}
+SIGN_LABELS = {spec.name: spec.studio.sign_label for spec in _SPECS if spec.signed and spec.studio.sign_label}
+DEFAULT_STRENGTH = {spec.name: spec.studio.strength for spec in _SPECS}
 #: Brushes whose strength is only a direction (paint or erase, on or off): a pen's pressure
 #: never scales it (a light touch would otherwise erase, or do nothing).
-STRENGTHLESS = ("mask", "select", "delete", "add", "density")
+STRENGTHLESS = tuple(spec.name for spec in _SPECS if not spec.takes_strength)
 #: The smallest share of its radius a brush keeps under the lightest touch (a radius is never 0).
 MIN_PRESSURE_RADIUS = 0.05
 FALLOFF_LABELS = {"smooth": "Smooth", "linear": "Linear", "constant": "Constant"}
@@ -102,7 +45,7 @@ Falloff = str | tuple[tuple[float, float], ...]
 
 def brushes() -> tuple[str, ...]:
     """The brushes the engine has, in the toolbar's order."""
-    return tuple(b for b in LABELS if b in BRUSHES) + tuple(b for b in BRUSHES if b not in LABELS)
+    return tuple(LABELS)
 
 
 def check_falloff(falloff: str | Sequence[Sequence[float]]) -> Falloff:
@@ -208,7 +151,8 @@ class BrushTool:
             if not self.symmetry:
                 return [first]
             return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
-        if name in ("comb", "slide") and math.hypot(*d) == 0.0:
+        spec = registry.spec_of(name)
+        if spec.needs_direction and math.hypot(*d) == 0.0:
             return []
         strength = self.signed_strength(invert, p)
         first = BRUSH.make(

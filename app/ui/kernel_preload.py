@@ -24,7 +24,6 @@ FIRST_MODULES = (
     "hairtool.frozen.vertex_grid",
     "hairtool.frozen.local",
     "hairtool.frozen.brushes",
-    "hairtool.frozen.sculpt",
     "hairtool.frozen.align",
     "hairtool.frozen.lengths",
     "hairtool.frozen.collide",
@@ -51,7 +50,8 @@ def kernels_in_use() -> list:
         module = name.split(":")[0]
         if serial_twins.is_twinned(kernel) and name.endswith(serial_twins.SERIAL_SUFFIX) == parallel:
             continue  # the twin not in use
-        picked.append((rank.get(module, len(rank)), name, kernel))
+        package = module.rpartition(".")[0]  # (a brush module ranks as its package)
+        picked.append((rank.get(module, rank.get(package, len(rank))), name, kernel))
     picked.sort(key=lambda t: t[:2])
     return [kernel for _, _, kernel in picked]
 

@@ -46,6 +46,7 @@ from app.ui import startup_trace
 #: Packages and modules whose kernels the warm-up's steps compile (searched for numba dispatchers).
 KERNEL_PACKAGES = (
     "hairtool.frozen",
+    "hairtool.frozen.brushes",
     "hairtool.guides",
     "hairtool.keys",
     "hairtool.anime",
@@ -257,7 +258,7 @@ def _raster_step() -> None:
 
 def _brushes_step() -> None:
     from hairtool import samples
-    from hairtool.frozen.brushes import BRUSHES, BrushSample, falloff_lut
+    from hairtool.frozen.brushes import BrushSample, falloff_lut, registry
     from hairtool.frozen.pipeline import FrozenPipeline
 
     class Flat:  # a surface for slide: the plane through each point, facing up
@@ -269,12 +270,12 @@ def _brushes_step() -> None:
     lo, hi = groom.bounds
     centre = tuple(float(v) for v in (lo.astype(np.float64) + hi) * 0.5)
     lut = tuple(falloff_lut("smooth").tolist())
-    for brush in BRUSHES[1:]:  # align has its own step
-        if brush in ("add", "density"):  # they plant with render hair's binding (warmed there)
+    for spec in registry.specs()[1:]:  # align has its own step
+        if spec.needs_surface and spec.changes_strands:  # they plant with render hair's binding (warmed)
             continue
-        strength = -0.5 if brush == "length" else 0.5
-        radius = float(np.max(hi - lo)) * (0.05 if brush == "delete" else 1.0)  # delete: not every strand
-        pipe.brush(BrushSample(brush, centre, (1.0, 0.0, 0.0), radius, strength, lut, start=True))
+        strength = -0.5 if spec.signed else 0.5
+        radius = float(np.max(hi - lo)) * (0.05 if spec.changes_strands else 1.0)  # not every strand
+        pipe.brush(BrushSample(spec.name, centre, (1.0, 0.0, 0.0), radius, strength, lut, start=True))
 
     from hairtool.frozen.density import accept, thin
 

@@ -43,7 +43,7 @@ from app.ui.qt_utils import signals_blocked
 from app.ui.render_hair_box import RenderHairBox
 from app.ui.scene import ALIGN_MODES, COLOUR_MODES, Scene
 from app.ui.widgets import SliderSpin, scrolling
-from hairtool.frozen.brushes import MOVE_NONE
+from hairtool.frozen.brushes import MOVE_NONE, registry
 from hairtool.frozen.pipeline import FrozenParams
 
 
@@ -374,7 +374,10 @@ class ToolDock(QDockWidget):
                 self.sign.setCurrentIndex(1 if tool.subtract[s.brush] else 0)
                 self._brush_form.labelForField(self.sign).setText(SIGN_LABELS[s.brush])
             self._brush_form.setRowVisible(self.mode, s.brush == "align")
-            self._brush_form.setRowVisible(self.intensity_row, s.brush not in ("mask", "select"))  # on or off
+            spec = registry.spec_of(s.brush)
+            fields = {p.field for p in spec.params}
+            on_or_off = spec.signed and not spec.takes_strength  # the sign says it all
+            self._brush_form.setRowVisible(self.intensity_row, not on_or_off)
             self.pressure_radius.setChecked(tool.pressure_radius.get(s.brush, False))
             self.pressure_strength.setChecked(tool.pressure_strength.get(s.brush, False))
             self.pressure_strength.setVisible(s.brush not in STRENGTHLESS)
@@ -393,11 +396,11 @@ class ToolDock(QDockWidget):
             self.collide.setChecked(tool.collide.get(s.brush, True))
             self._brush_form.setRowVisible(self.collide, s.brush not in MOVE_NONE)
             self.add_count.setValue(tool.add_count)
-            self._brush_form.setRowVisible(self.add_count, s.brush == "add")
+            self._brush_form.setRowVisible(self.add_count, "count" in fields)
             self.spacing.setRange(extent * 1e-4, extent)
             self.spacing.setSingleStep(extent / 200.0)
             self.spacing.setValue(tool.spacing)
-            self._brush_form.setRowVisible(self.spacing, s.brush == "density")
+            self._brush_form.setRowVisible(self.spacing, "spacing" in fields)
 
     def refresh_params(self) -> None:
         p: FrozenParams = self.scene.params

@@ -6,8 +6,9 @@
   over the neighbour lists of :mod:`.spatial`; :mod:`.local` redoes it (and the brush) only on
   the strands under the brush and those their clumps reach, through the kept grid of
   :mod:`.vertex_grid`; :mod:`.strand_clumps` labels clumps and picks the automatic radius;
-- :mod:`.brushes` comb, smooth, length, puff, clump and mask, falloff, symmetry and
-  front-facing strands; :mod:`.selection` selecting and hiding strands; :mod:`.strokes`
+- :mod:`.brushes` the brushes, one module each found by its registry, with the falloff,
+  symmetry and front-facing strands they share; :mod:`.strand_state` the per-strand state
+  they paint; :mod:`.selection` selecting and hiding strands; :mod:`.strokes`
   stroke logs as JSON files; :mod:`.sample_schema` one description per sample type, which the
   stroke logs, the project's columns (:mod:`.sample_columns`) and the studio build from;
 - :mod:`.pipeline` the three in order, with the stroke log the studio and the CLI replay;

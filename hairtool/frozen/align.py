@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Groom
-from hairtool.rotation import any_perpendicular, rotate
+from hairtool.rotation import any_perpendicular, perpendicular_axis, rotate
 from hairtool.serial_twins import twin_njit
 
 MODES = ("paper", "preserve-length")
@@ -88,19 +88,7 @@ def _align_kernel(p, offsets, c, radius, x, preserve, planar, out):
         elif planar:
             ax, ay, az = 0.0, 0.0, 1.0
         else:
-            k = 0
-            if abs(vy) < abs(vx):
-                k = 1
-            if abs(vz) < min(abs(vx), abs(vy)):
-                k = 2
-            if k == 0:
-                ax, ay, az = 0.0, vz, -vy
-            elif k == 1:
-                ax, ay, az = -vz, 0.0, vx
-            else:
-                ax, ay, az = vy, -vx, 0.0
-            an = np.sqrt(ax * ax + ay * ay + az * az)
-            ax, ay, az = ax / an, ay / an, az / an
+            ax, ay, az = perpendicular_axis(vx, vy, vz)
         qx, qy, qz = bx, by, bz  # running position (preserve-length)
         for i in range(1, n):
             w = (i / (n - 1)) * (1.0 - x) + x  # (12)

@@ -27,7 +27,7 @@ from hairtool.frozen.noise import (
     seed_u64,
 )
 from hairtool.groom import Groom
-from hairtool.rotation import any_perpendicular, normalize, rotate
+from hairtool.rotation import any_perpendicular, normalize, perpendicular_axis, rotate
 from hairtool.serial_twins import twin_njit
 
 AXIS_EPS = 1e-6  # |t̂[i−1] × t̂[i]| below this: the tangents are parallel, the cross gives no axis
@@ -110,24 +110,8 @@ def _freeze_kernel(rest, offsets, ks, kb, theta_max, seed, planar, out):
                 ax, ay, az = ax / an, ay / an, az / an
             elif planar:
                 ax, ay, az = 0.0, 0.0, 1.0
-            else:
-                # t̂ × e_k with k the axis least aligned with t̂ (as rotation.any_perpendicular)
-                k = 0
-                if abs(ty) < abs(tx):
-                    k = 1
-                if abs(tz) < min(abs(tx), abs(ty)):
-                    k = 2
-                if k == 0:
-                    ax, ay, az = 0.0, tz, -ty
-                elif k == 1:
-                    ax, ay, az = -tz, 0.0, tx
-                else:
-                    ax, ay, az = ty, -tx, 0.0
-                an = np.sqrt(ax * ax + ay * ay + az * az)
-                if an > 0.0:
-                    ax, ay, az = ax / an, ay / an, az / an
-                else:
-                    ax, ay, az = 0.0, 0.0, 1.0
+            else:  # t̂ × e_k with k the axis least aligned with t̂ (as rotation.any_perpendicular)
+                ax, ay, az = perpendicular_axis(tx, ty, tz)
             # Rodrigues (5)–(6): d̃ = d cosθ + (â × d) sinθ + â (â·d)(1 − cosθ)
             c = np.cos(theta)
             sn = np.sin(theta)

@@ -18,7 +18,7 @@ Built for dragging in the studio:
   and the strands within the clump kernel's reach of them; the rest of the groom is read, never
   written, and keeps its last result bit for bit. The other brushes, parameter changes, undo and
   replays run on the whole groom (a full run, after which the grid follows what moved).
-- Delete (:mod:`hairtool.frozen.sculpt`) changes the strands: a stage like the others, applied
+- Delete (:mod:`hairtool.frozen.brushes.delete`) changes the strands: a stage like the others, applied
   to the stroked state, which takes the kept strands with their mask and clump strength; the
   pipeline records the rest strand each remaining strand comes from (:attr:`FrozenPipeline.origin`),
   kept in the snapshots, so undo brings the deleted strands back bit for bit and a replay deletes
@@ -42,25 +42,18 @@ import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields, replace
-from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
-from hairtool.frozen.align import align, check_align_params
-from hairtool.frozen.brushes import (
-    MOVE_NONE,
-    BrushSample,
-    apply_brush,
-    check_sample,
-    check_view,
-    facing_away,
-    paint_clump,
-    paint_mask,
-    root_normals,
-    scalp_centre,
-)
+from hairtool.frozen.align import check_align_params
+from hairtool.frozen.brushes import registry
+from hairtool.frozen.brushes.align import AlignSample
+from hairtool.frozen.brushes.sample import BrushSample, check_view
+from hairtool.frozen.brushes.scalp import facing_away, root_normals, scalp_centre
+from hairtool.frozen.brushes.slide import Surface
+from hairtool.frozen.brushes.spec import StrokeContext, StrokeMemory
 from hairtool.frozen.clump import (
     ClumpWorkspace,
     check_clump_params,
@@ -68,17 +61,15 @@ from hairtool.frozen.clump import (
     record_key,
     vertex_strength,
 )
-from hairtool.frozen.collide import MARGIN, CollisionSurface, KeepOut, collide
-from hairtool.frozen.density import accept, disc_candidates, thin
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
+from hairtool.frozen.head_collision import HeadCollision
 from hairtool.frozen.lengths import restore_lengths
 from hairtool.frozen.local import LocalClump, strands_differing, threads_for
 from hairtool.frozen.move_points import MovePoints, held_by_at_most, may_write
 from hairtool.frozen.noise import check_seed, draw_seed
-from hairtool.frozen.sculpt import hook_weights, pinch, snake_hook, strands_to_delete
 from hairtool.frozen.selection import SelectionSample, apply_selection
-from hairtool.frozen.slide import Surface, slide
 from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
+from hairtool.frozen.strand_state import StrandState
 from hairtool.groom import Groom, vertex_ids_of
 
 PREPARED_REGION = 0.05  # of the vertices: the region lists' room :meth:`FrozenPipeline.prepare_strokes`
@@ -155,45 +146,6 @@ class FrozenParams:
         return replace(self, **changes)
 
 
-def append_strands(g: Groom, new: Groom) -> Groom:
-    """``g`` with ``new``'s strands after its own; each per-vertex attribute of ``g`` taken for a
-    new strand from the strand whose root is nearest, by the vertex parameter; a new strand
-    joins that strand's prim where it can (:meth:`~hairtool.metadata.Metadata.extended`)."""
-    attrs = {}
-    near = np.argmin(((new.roots[:, None, :] - g.roots[None, :, :]) ** 2).sum(-1), axis=1)
-    if any(a is not None for a in g.attributes.values()):
-        for name, a in g.attributes.items():
-            if a is None:
-                attrs[name] = None
-                continue
-            rows = []
-            for s, t in zip(near, new.topology.offsets[:-1], strict=True):
-                o, e = g.offsets[s], g.offsets[s + 1]
-                tn = new.vertex_param[t : t + new.counts[len(rows)]]
-                src, ts = a[o:e], g.vertex_param[o:e]
-                if a.ndim == 1:
-                    rows.append(np.interp(tn, ts, src))
-                else:
-                    rows.append(np.column_stack([np.interp(tn, ts, src[:, c]) for c in range(a.shape[1])]))
-            attrs[name] = np.concatenate([a, *rows]).astype(np.float32)
-    points, counts = np.concatenate([g.points, new.points]), np.concatenate([g.counts, new.counts])
-    return Groom(points, counts, **attrs, metadata=g.metadata.extended(g.metadata.prim_of(near)))
-
-
-class AlignSample(NamedTuple):
-    """One align sample; ``view`` as :class:`~hairtool.frozen.brushes.BrushSample`'s (None: every
-    strand, as before the field existed)."""
-
-    cursor: tuple[float, float, float]
-    radius: float
-    intensity: float
-    mode: str
-    view: tuple[float, float, float] | None = None
-    collide: bool = True  # as BrushSample's
-    only_selected: bool = False  # as BrushSample's
-    pressure: float = 1.0  # as BrushSample's (already applied to radius and intensity)
-
-
 Sample = AlignSample | BrushSample | SelectionSample
 
 
@@ -248,14 +200,8 @@ class FrozenPipeline:
         self._auto_h: float | None = None
         self._auto_step: tuple[tuple, float] | None = None  # (frozen groom's key, its auto step)
         self._log: list[Sample] = []
-        self._locked = np.zeros(rest.strand_count, dtype=bool)
-        self._clump_strength = np.ones(rest.strand_count)
-        self._origin = np.arange(rest.strand_count, dtype=np.int64)
-        self._selected = np.ones(rest.strand_count, dtype=bool)
-        self._hidden = np.zeros(rest.strand_count, dtype=bool)
-        self._hooks: list[tuple] = []  # a snake hook's (weights, tips, cursor) at each start sample
-        self._hook_next = 0  # the set the next sample of the stroke uses
-        self._hooking = False  # the last sample was a snake hook's start
+        self._state = StrandState.fresh(rest.strand_count)
+        self._memory = StrokeMemory()  # what a brush keeps over its stroke (a snake hook's hooks)
         self._scalp_centre: np.ndarray | None = None
         self._root_normals: np.ndarray | None = None
         self._draw = 0
@@ -307,28 +253,28 @@ class FrozenPipeline:
     @property
     def locked(self) -> np.ndarray:
         """``(S,)`` the strands the mask brush has locked (a copy)."""
-        return self._locked.copy()
+        return self._state.locked.copy()
 
     @property
     def selected(self) -> np.ndarray:
         """``(S',)`` the selected strands of the stroked state (a copy; all until a selection step)."""
-        return self._selected.copy()
+        return self._state.selected.copy()
 
     @property
     def hidden(self) -> np.ndarray:
         """``(S',)`` the hidden strands of the stroked state (a copy), locked for every brush."""
-        return self._hidden.copy()
+        return self._state.hidden.copy()
 
     @property
     def origin(self) -> np.ndarray:
         """``(S',)`` the rest strand each strand of the stroked state (and the result) comes from,
         in order: the strands delete has removed are missing (a copy)."""
-        return self._origin.copy()
+        return self._state.origin.copy()
 
     @property
     def clump_strength(self) -> np.ndarray:
         """``(S,)`` the clump strength the clump brush has painted, in [0, 1] (a copy)."""
-        return self._clump_strength.copy()
+        return self._state.clump_strength.copy()
 
     @property
     def root_normals(self) -> np.ndarray:
@@ -344,10 +290,11 @@ class FrozenPipeline:
         """``(S', 3)`` :attr:`root_normals` of the strands of the stroked state and the result
         (a planted strand's: the surface normal at its root)."""
         n = self.root_normals
-        if len(self._origin) == len(n) and self._origin.min(initial=0) >= 0:
+        origin = self._state.origin
+        if len(origin) == len(n) and origin.min(initial=0) >= 0:
             return n  # (deletes keep the order, plants come last: this is every rest strand)
-        out = n[np.maximum(self._origin, 0)]
-        new = self._origin < 0
+        out = n[np.maximum(origin, 0)]
+        new = origin < 0
         if new.any():
             _, out[new] = self._surface.project(self._aligned.roots[new].astype(np.float64))  # type: ignore[union-attr]
         return out
@@ -425,25 +372,13 @@ class FrozenPipeline:
 
     @property
     def surface(self) -> Surface | None:
-        """The head's surface (:class:`~hairtool.frozen.slide.Surface`) slide needs, or None."""
+        """The head's surface (:class:`~hairtool.frozen.brushes.slide.Surface`) slide needs, or None."""
         return self._surface
 
-    @property
-    def _head(self) -> CollisionSurface | None:
-        """The surface strokes collide with (one that tells signed distances), or None."""
-        surface = self._surface
-        return surface if surface is not None and hasattr(surface, "signed_distance") else None
-
-    @property
-    def _collision_margin(self) -> float:
-        """How far outside the head a collision leaves a vertex: :data:`MARGIN` of the rest box's diagonal."""
-        lo, hi = self._rest.bounds
-        return MARGIN * max(float(np.linalg.norm(hi.astype(np.float64) - lo)), 1e-9)
-
     @functools.cached_property
-    def _keep_out(self) -> KeepOut:
-        """:func:`~hairtool.frozen.collide.keep_out` with its memory of the head's distances."""
-        return KeepOut()
+    def _collision(self) -> HeadCollision:
+        """Strokes against the head (:mod:`hairtool.frozen.head_collision`)."""
+        return HeadCollision(self._rest)
 
     # -- operations ----------------------------------------------------------------------
     def set_surface(self, surface: Surface | None) -> Groom:
@@ -545,7 +480,7 @@ class FrozenPipeline:
         if local and samples and self._local_ready(samples):
             return self._apply_local(samples)
         t0 = time.perf_counter()
-        before = (self._aligned, *self._strand_state(), len(self._log))
+        before = (self._aligned, self._state, len(self._log))
         hooks = self._hook_state()
         try:
             for sample in samples:
@@ -553,7 +488,7 @@ class FrozenPipeline:
                 self._log.append(sample)
         except BaseException:  # a refused sample: none of these samples happened
             self._aligned = before[0]
-            self._set_strand_state(before[1:-1])
+            self._state = before[1]
             self._set_hooks(hooks)
             del self._log[before[-1] :]
             raise
@@ -602,12 +537,12 @@ class FrozenPipeline:
             self._aligned,
             self._freeze_key or (),
             self._draw,
-            self._locked.copy(),
-            self._clump_strength.copy(),
-            self._origin.copy(),
+            self._state.locked.copy(),
+            self._state.clump_strength.copy(),
+            self._state.origin.copy(),
             self._hook_state(),
-            self._selected.copy(),
-            self._hidden.copy(),
+            self._state.selected.copy(),
+            self._state.hidden.copy(),
             self._result,
             self._params._key,
         )
@@ -643,14 +578,14 @@ class FrozenPipeline:
                 aligned = aligned.with_metadata(self._rest.metadata)
             self._aligned = aligned
             n = aligned.strand_count
-            self._locked = np.zeros(n, bool) if snapshot.locked is None else snapshot.locked.copy()
-            cs = snapshot.clump_strength
-            self._clump_strength = np.ones(n) if cs is None else cs.astype(np.float64)
-            o = snapshot.origin
-            self._origin = np.arange(n, dtype=np.int64) if o is None else o.astype(np.int64)
-            sel, hid = snapshot.selected, snapshot.hidden
-            self._selected = np.ones(n, bool) if sel is None else sel.astype(bool)
-            self._hidden = np.zeros(n, bool) if hid is None else hid.astype(bool)
+            cs, o, sel, hid = snapshot.clump_strength, snapshot.origin, snapshot.selected, snapshot.hidden
+            self._state = StrandState(
+                np.zeros(n, bool) if snapshot.locked is None else snapshot.locked.copy(),
+                np.ones(n) if cs is None else cs.astype(np.float64),
+                np.arange(n, dtype=np.int64) if o is None else o.astype(np.int64),
+                np.ones(n, bool) if sel is None else sel.astype(bool),
+                np.zeros(n, bool) if hid is None else hid.astype(bool),
+            )
             self._set_hooks(snapshot.hooks)
             shown = snapshot.result
         else:
@@ -702,173 +637,44 @@ class FrozenPipeline:
         return facing_away(self.strand_normals, view)
 
     def _clear_state(self) -> None:
-        n = self._rest.strand_count
-        self._locked = np.zeros(n, dtype=bool)
-        self._clump_strength = np.ones(n)
-        self._origin = np.arange(n, dtype=np.int64)
-        self._selected = np.ones(n, dtype=bool)
-        self._hidden = np.zeros(n, dtype=bool)
+        self._state = StrandState.fresh(self._rest.strand_count)
         self._set_hooks(((), 0, False))
 
-    def _strand_state(self) -> tuple[np.ndarray, ...]:
-        """What the pipeline keeps per strand of the stroked state, in one order."""
-        return (self._locked, self._clump_strength, self._origin, self._selected, self._hidden)
-
-    def _set_strand_state(self, state: Sequence[np.ndarray]) -> None:
-        self._locked, self._clump_strength, self._origin, self._selected, self._hidden = state
-
-    def _keep_strands(self, kept: np.ndarray) -> None:
-        """Only the strands ``kept`` (indices) remain: their per-strand state with them."""
-        self._set_strand_state([a[kept] for a in self._strand_state()])
-
-    def _planted(self, m: int) -> None:
-        """``m`` strands appended: unmasked, clump strength 1, no rest strand, selected, shown."""
-        fill = (np.zeros(m, bool), np.ones(m), np.full(m, -1, np.int64), np.ones(m, bool), np.zeros(m, bool))
-        now = self._strand_state()
-        self._set_strand_state([np.concatenate([a, b]) for a, b in zip(now, fill, strict=True)])
-
-    def _lock(self, sample: Sample, away: np.ndarray | None, mask: bool = True) -> np.ndarray:
-        """The strands a sample leaves as they are: masked (``mask``), hidden, facing away from
-        its camera, and with ``only_selected`` the unselected ones."""
-        locked = self._locked | self._hidden if mask else self._hidden
-        if away is not None:
-            locked = locked | away
-        if getattr(sample, "only_selected", False):
-            locked = locked | ~self._selected
-        return locked
-
     def _hook_state(self) -> tuple[tuple, int, bool]:
-        return (tuple(self._hooks), self._hook_next, self._hooking)
+        return self._memory.frozen()
 
     def _set_hooks(self, state: tuple[tuple, int, bool]) -> None:
-        self._hooks, self._hook_next, self._hooking = list(state[0]), state[1], state[2]
-
-    def _snake(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
-        """A snake hook's sample: a start hooks strands (a run of starts, one set each: the
-        stroke's sample and its mirror); the later ones use the sets in turn."""
-        if sample.start or not self._hooks:
-            if not self._hooking:
-                self._hooks = []
-            hook = hook_weights(g, sample, locked)
-            self._hooks.append((hook, g.tips.astype(np.float64), np.asarray(sample.cursor, np.float64)))
-            self._hooking, self._hook_next = True, len(self._hooks) - 1
-        else:
-            self._hooking = False
-            self._hook_next = (self._hook_next + 1) % len(self._hooks)
-        hook, anchors, start = self._hooks[self._hook_next]
-        return snake_hook(g, hook, anchors, np.asarray(sample.cursor, np.float64) - start)
-
-    def _add(self, g: Groom, sample: BrushSample) -> Groom:
-        """An add sample: the strands the surface plants appended, unmasked, clump strength 1."""
-        surface = self._surface
-        if surface is None or not hasattr(surface, "plant"):
-            raise ParameterError("scalp", None, "a head mesh for the add brush (--scalp MESH.obj)")
-        new = surface.plant(g, sample.cursor, sample.radius, sample.count, sample.seed, sample.view)
-        if new is None:
-            return g
-        out = append_strands(g, new)
-        self._planted(new.strand_count)
-        return out
-
-    def _density(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
-        """A density sample (:mod:`hairtool.frozen.density`): thinned, then planted."""
-        surface = self._surface
-        if surface is None or not hasattr(surface, "grow"):
-            raise ParameterError("scalp", None, "a head mesh for the density brush (--scalp MESH.obj)")
-        if sample.strength <= 0:
-            return g
-        q, n = surface.project(np.asarray(sample.cursor, np.float64).reshape(1, 3))
-        q, n = q[0], n[0]
-        if sample.view is not None and float(n @ np.asarray(sample.view, np.float64)) > 0:
-            return g
-        spacing, r = float(sample.spacing), float(sample.radius)
-        roots = g.roots.astype(np.float64)
-        dist = np.linalg.norm(roots - q, axis=1)
-        near = np.flatnonzero(dist < r + spacing)
-        keep = thin(roots[near], (dist[near] >= r) | locked[near], spacing)
-        gone = np.zeros(g.strand_count, bool)
-        gone[near[~keep]] = True
-        if gone.all():
-            raise ParameterError("density", "every strand", "a stroke that leaves at least one strand")
-        if gone.any():
-            kept = np.flatnonzero(~gone)
-            self._keep_strands(kept)
-            g = g.subset(kept)
-        bits = np.asarray(sample.cursor, np.float64).view(np.uint32)
-        rng = np.random.default_rng([int(sample.seed), *(int(b) for b in bits), 0xDE5])
-        cands, cn = surface.project(disc_candidates(q, n, r, spacing, rng))
-        ok = np.linalg.norm(cands - q, axis=1) < r
-        if sample.view is not None:
-            ok &= cn @ np.asarray(sample.view, np.float64) <= 0
-        cands = cands[ok]
-        roots = g.roots.astype(np.float64)
-        around = roots[np.linalg.norm(roots - q, axis=1) < r + spacing]
-        new_roots = cands[accept(cands, around, spacing)]
-        if len(new_roots) == 0:
-            return g
-        new = surface.grow(g, new_roots)
-        self._planted(new.strand_count)
-        return append_strands(g, new)
-
-    def _delete(self, g: Groom, sample: BrushSample, locked: np.ndarray) -> Groom:
-        gone = strands_to_delete(g, sample, locked)
-        if not gone.any():
-            return g
-        if gone.all():
-            raise ParameterError("delete", "every strand", "a stroke that leaves at least one strand")
-        keep = np.flatnonzero(~gone)
-        self._keep_strands(keep)
-        return g.subset(keep)
+        self._memory = StrokeMemory.of(state)
 
     def _apply(self, g: Groom, sample: Sample) -> Groom:
         if isinstance(sample, SelectionSample):
             self._set_hooks(((), 0, False))
             away = self._away(sample.view)
-            self._selected, self._hidden = apply_selection(g, sample, self._selected, self._hidden, away)
+            st = self._state
+            selected, hidden = apply_selection(g, sample, st.selected, st.hidden, away)
+            self._state = st.with_(selected=selected, hidden=hidden)
             return g
-        out = self._apply_one(g, sample)
-        moves = isinstance(sample, AlignSample) or sample.brush not in MOVE_NONE
-        head = self._head
-        if moves and sample.collide and head is not None:
-            out = collide(g, out, head, self._collision_margin)
+        brush = registry.brush_of(registry.name_of(sample))
+        if not brush.spec.keeps_stroke:
+            self._set_hooks(((), 0, False))  # another brush ends a stroke-keeping brush's stroke
+        ctx = self._context(self._away(sample.view))
+        out = brush.apply(ctx, g, sample)
+        self._state = ctx.state
+        if brush.spec.moves_points and sample.collide:
+            out = self._collision.collide(self._surface, g, out)
         return out
 
-    def _apply_one(self, g: Groom, sample: Sample) -> Groom:
-        if not (isinstance(sample, BrushSample) and sample.brush == "snake_hook"):
-            self._set_hooks(((), 0, False))  # another brush ends a snake hook's stroke
-        away = self._away(sample.view)
-        if isinstance(sample, BrushSample) and sample.brush == "select":
-            skip = self._hidden if away is None else self._hidden | away
-            self._selected = paint_mask(g, sample, self._selected, skip)
-            return g
-        locked = self._lock(sample, away)  # this sample's lock
-        if isinstance(sample, BrushSample) and sample.brush == "mask":
-            self._locked = paint_mask(g, sample, self._locked, self._lock(sample, away, mask=False))
-            return g
-        if isinstance(sample, AlignSample):
-            out = align(g, sample.cursor, sample.radius, sample.intensity, sample.mode)
-            if locked.any():  # masked strands are locked for the align brush too
-                keep = vertex_ids_of(g.topology, np.flatnonzero(locked))
-                pts = out.points.copy()
-                pts[keep] = g.points[keep]
-                out = g.with_points(pts)
-            return out
-        if sample.brush == "clump":
-            self._clump_strength = paint_clump(g, sample, self._clump_strength, locked)
-            return g
-        if sample.brush == "delete":
-            return self._delete(g, sample, locked)
-        if sample.brush == "add":
-            return self._add(g, sample)
-        if sample.brush == "density":
-            return self._density(g, sample, locked)
-        if sample.brush == "pinch":
-            return pinch(g, sample, locked)
-        if sample.brush == "snake_hook":
-            return self._snake(g, sample, locked)
-        if sample.brush == "slide":
-            return slide(g, sample, locked, self._surface)
-        return apply_brush(g, sample, locked, self.scalp_centre)
+    def _context(self, away: np.ndarray | None, state: StrandState | None = None, planar: bool | None = None):
+        """What a sample works with (:class:`~hairtool.frozen.brushes.spec.StrokeContext`): the
+        pipeline's per-strand state (or ``state``), its surface, scalp centre and stroke memory."""
+        return StrokeContext(
+            self._state if state is None else state,
+            away,
+            self._surface,
+            lambda: self.scalp_centre,
+            self._memory,
+            planar,
+        )
 
     def _replay(self) -> None:
         self._aligned = self._frozen
@@ -895,7 +701,7 @@ class FrozenPipeline:
                 seed,
                 ws,
                 bool(p.keep_lengths),
-                self._clump_strength,
+                self._state.clump_strength,
             )
             self._result = self._kept_out(g.with_points(pts))
             rec = ws.recorded
@@ -913,7 +719,7 @@ class FrozenPipeline:
                     longest = int(ws.neighbours.cnt.max(initial=0))
                     self._local = LocalClump(g.points, g.topology, h, rec, longest)
                 self._grid_points = g.points
-                self._sv = vertex_strength(g, self._clump_strength)
+                self._sv = vertex_strength(g, self._state.clump_strength)
                 self._kept = pts
                 self._nonplanar = int(np.count_nonzero(g.points[:, 2]))
             else:
@@ -933,23 +739,14 @@ class FrozenPipeline:
         _ = self.root_normals, self.scalp_centre
         if self._local is not None:
             self._local.grid.prepare(int(region_share * self._aligned.vertex_count))
-        head = self._head
-        if head is not None and self._aligned.vertex_count <= PREPARED_HEAD:
-            self._keep_out.remember(self._aligned, self._result, head)  # what a first collision asks
+        if self._aligned.vertex_count <= PREPARED_HEAD:
+            self._collision.remember(
+                self._surface, self._aligned, self._result
+            )  # what a first collision asks
 
     def _kept_out(self, clumped: Groom) -> Groom:
-        """Clumping respects the head: where strokes collide with it (a sample that moves points
-        with ``collide``), the strands clumping pulled back inside are pushed out again
-        (:func:`~hairtool.frozen.collide.keep_out`), so no brushed vertex ends inside."""
-        head = self._head
-        if head is None:
-            return clumped
-        if not any(
-            getattr(s, "collide", False) and (isinstance(s, AlignSample) or s.brush not in MOVE_NONE)
-            for s in self._log
-        ):
-            return clumped
-        return self._keep_out(self._aligned, clumped, head, self._collision_margin)
+        """The clumped result kept out of the head where strokes collide with it."""
+        return self._collision.kept_out(self._surface, self._log, self._aligned, clumped)
 
     # -- brush-local moves (hairtool.frozen.local) ---------------------------------------
     def _local_ready(self, samples: Sequence[Sample]) -> bool:
@@ -957,7 +754,9 @@ class FrozenPipeline:
         local, p = self._local, self._params
         if local is None or self._grid_points is None or local.topology is not self._aligned.topology:
             return False
-        if not all(isinstance(s, AlignSample | SelectionSample) or s.brush in LOCAL_BRUSHES for s in samples):
+        if not all(
+            isinstance(s, SelectionSample) or registry.spec_of(registry.name_of(s)).local for s in samples
+        ):
             return False
         rec = self._workspace.recorded
         h, seed = self.clump_radius, draw_seed(p.seed, self._draw)
@@ -1004,7 +803,7 @@ class FrozenPipeline:
         g, top, local = self._aligned, self._aligned.topology, self._local
         assert local is not None and self._grid_points is not None
         cur = MovePoints(self._grid_points, in_place)
-        state = (self._strand_state(), self._hook_state())
+        state = (self._state, self._hook_state())
         touched = np.zeros(g.strand_count, bool)  # strands a sample of this batch ran on
         painted = np.zeros(0, np.int64)  # strands whose clump strength changed
         planar = self._nonplanar == 0
@@ -1013,7 +812,7 @@ class FrozenPipeline:
                 painted = np.union1d(painted, self._local_sample(cur, sample, touched, planar))
         except BaseException:  # a refused sample: none of these samples happened
             cur.undo()
-            self._set_strand_state(state[0])
+            self._state = state[0]
             self._set_hooks(state[1])
             raise
         cur.done()
@@ -1038,7 +837,7 @@ class FrozenPipeline:
         sv = self._sv
         if painted.size:
             pv = vertex_ids_of(top, painted)
-            sv[pv] = self._clump_strength[top.strand_index[pv]]
+            sv[pv] = self._state.clump_strength[top.strand_index[pv]]
         now = self._aligned.points
         seed_ = draw_seed(p.seed, self._draw)
         was = cur.before(vertex_ids_of(top, seeds))
@@ -1069,19 +868,15 @@ class FrozenPipeline:
         """One sample on the strands with a vertex within its radius (where the grid holds the
         unmoved ones) and those this batch has moved, written into ``cur``; returns the strands
         whose clump strength it changed."""
-        if not (isinstance(sample, BrushSample) and sample.brush == "snake_hook"):
-            self._set_hooks(((), 0, False))  # another brush ends a snake hook's stroke
         local, top = self._local, self._aligned.topology
         assert local is not None and self._grid_points is not None
         if isinstance(sample, SelectionSample):  # no strand moves: on the whole groom
-            away = self._away(sample.view)
-            g = self._aligned.with_points(cur.points)
-            self._selected, self._hidden = apply_selection(g, sample, self._selected, self._hidden, away)
+            self._apply(self._aligned.with_points(cur.points), sample)
             return np.zeros(0, np.int64)
-        if isinstance(sample, AlignSample):
-            check_align_params(sample.cursor, sample.radius, sample.intensity, sample.mode)
-        else:
-            check_sample(sample)
+        brush = registry.brush_of(registry.name_of(sample))
+        if not brush.spec.keeps_stroke:
+            self._set_hooks(((), 0, False))  # another brush ends a stroke-keeping brush's stroke
+        brush.check(sample)
         reach = float(sample.radius) * (1.0 + 1e-6)  # a little wider: the brush itself decides
         near = local.near(self._grid_points, np.asarray(sample.cursor, np.float64).reshape(1, 3), reach)
         cand = np.union1d(near, np.flatnonzero(touched))
@@ -1092,59 +887,29 @@ class FrozenPipeline:
         with threads_for(vids.size):
             meta = self._aligned.metadata.subset(cand)  # (in the scene's frame; its prims' share)
             sub = Groom(cur.points[vids], top.counts[cand], metadata=meta)
-            out, painted = self._local_brush(sub, cand, sample, planar)
+            out, painted = self._local_brush(brush, sub, cand, sample, planar)
         if out is not None:
             cur.write(vids, out.points)
             touched[cand] = True
         return painted
 
     def _local_brush(
-        self, sub: Groom, cand: np.ndarray, sample: Sample, planar: bool
+        self, brush, sub: Groom, cand: np.ndarray, sample: Sample, planar: bool
     ) -> tuple[Groom | None, np.ndarray]:
-        """One sample on the groom ``sub`` of the strands ``cand``: (the moved strands, or None
-        for mask and clump, which paint; the strands whose clump strength it changed)."""
-        none = np.zeros(0, np.int64)
+        """One sample on the groom ``sub`` of the strands ``cand``, their state taken out and
+        written back: (the moved strands, or None for a brush that moves none; the strands
+        whose clump strength it changed)."""
         away = (
             None if check_view(sample.view) is None else facing_away(self.strand_normals[cand], sample.view)
         )
-        if isinstance(sample, BrushSample) and sample.brush == "select":
-            skip = self._hidden[cand] if away is None else self._hidden[cand] | away
-            selected = self._selected.copy()
-            selected[cand] = paint_mask(sub, sample, self._selected[cand], skip)
-            self._selected = selected
-            return None, none
-        if isinstance(sample, BrushSample) and sample.brush == "mask":
-            skip = self._lock(sample, None, mask=False)[cand]
-            locked = self._locked.copy()
-            locked[cand] = paint_mask(sub, sample, self._locked[cand], skip if away is None else skip | away)
-            self._locked = locked
-            return None, none
-        lock = self._lock(sample, None)[cand]  # masked, hidden, and unselected with only_selected
-        if away is not None:
-            lock = lock | away
-        if isinstance(sample, AlignSample):
-            out = align(sub, sample.cursor, sample.radius, sample.intensity, sample.mode, planar=planar)
-            if lock.any():
-                keep = vertex_ids_of(sub.topology, np.flatnonzero(lock))
-                pts = out.points.copy()
-                pts[keep] = sub.points[keep]
-                out = sub.with_points(pts)
-        elif sample.brush == "clump":
-            was = self._clump_strength[cand]
-            now = paint_clump(sub, sample, was, lock)
-            strength = self._clump_strength.copy()
-            strength[cand] = now
-            self._clump_strength = strength
-            return None, cand[now != was]
-        elif sample.brush == "pinch":
-            out = pinch(sub, sample, lock)
-        else:
-            out = apply_brush(sub, sample, lock, self.scalp_centre)
-        head = self._head
-        if sample.collide and head is not None:
-            out = collide(sub, out, head, self._collision_margin)
-        return out, none
-
-
-#: The brushes a move runs on the strands under it only (the others on the whole groom).
-LOCAL_BRUSHES = ("comb", "smooth", "length", "puff", "pinch", "clump", "mask", "select")
+        was = self._state.subset(cand)
+        ctx = self._context(away, was, planar)
+        out = brush.apply(ctx, sub, sample)
+        self._state = self._state.scatter(cand, ctx.state, was)
+        now = ctx.state.clump_strength
+        painted = cand[now != was.clump_strength] if now is not was.clump_strength else np.zeros(0, np.int64)
+        if not brush.spec.moves_points:
+            return None, painted
+        if sample.collide:
+            out = self._collision.collide(self._surface, sub, out)
+        return out, painted

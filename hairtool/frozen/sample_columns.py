@@ -136,8 +136,21 @@ def write_columns(log: Sequence, arrays: dict[str, np.ndarray]) -> dict:
             arrays["strokes/falloffs.npy"] = luts
     for group in GROUPS:
         if group in stored:
-            info[group] = {"brushes": list(BRUSHES), "selection": list(OPS)}.get(group, True)
+            info[group] = {"brushes": _brush_table(log, types), "selection": list(OPS)}.get(group, True)
     return info
+
+
+#: The brush table every project wrote before a brush was added after select: a project
+#: whose strokes use none of the later brushes writes exactly that table, so its bytes stay.
+_TABLE_BEFORE_CUT = BRUSHES[: BRUSHES.index("select") + 1]
+
+
+def _brush_table(log: Sequence, types: list[SampleType]) -> list[str]:
+    """The brush names the ``brush`` column indexes: those up to the last brush the log uses,
+    and never fewer than :data:`_TABLE_BEFORE_CUT` (a table is read by name, so any length
+    that covers the log reads back)."""
+    used = [BRUSHES.index(s.brush) for s, t in zip(log, types, strict=True) if t is BRUSH]
+    return list(BRUSHES[: max(len(_TABLE_BEFORE_CUT), max(used, default=-1) + 1)])
 
 
 class ColumnError(ValueError):

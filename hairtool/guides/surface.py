@@ -413,7 +413,7 @@ SERIAL_POINTS = 512  # asks of fewer points than this run on the calling thread
 
 class MeshSurface:
     """A head mesh as the surface the frozen brushes slide roots on
-    (:class:`hairtool.frozen.slide.Surface`): the closest point of the mesh and the smooth normal
+    (:class:`hairtool.frozen.brushes.slide.Surface`): the closest point of the mesh and the smooth normal
     there (the vertex normals interpolated barycentrically, the face's own normal where they
     cancel)."""
 

@@ -17,17 +17,15 @@ from hairtool import io, samples
 from hairtool.cli import main
 from hairtool.errors import FormatError, ParameterError
 from hairtool.frozen.brushes import BrushSample, falloff_lut, root_normals
-from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
-from hairtool.frozen.sculpt import (
+from hairtool.frozen.brushes.delete import strands_to_delete, strands_to_delete_reference
+from hairtool.frozen.brushes.pinch import pinch, pinch_reference
+from hairtool.frozen.brushes.snake_hook import (
     hook_weights,
     hook_weights_reference,
-    pinch,
-    pinch_reference,
     snake_hook,
     snake_hook_reference,
-    strands_to_delete,
-    strands_to_delete_reference,
 )
+from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.strokes import read_strokes, strokes_from_log, write_strokes
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "grooms"

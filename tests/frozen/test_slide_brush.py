@@ -15,8 +15,8 @@ from hairtool import io, samples
 from hairtool.cli import main
 from hairtool.errors import ParameterError
 from hairtool.frozen.brushes import BrushSample, falloff_lut, root_normals
+from hairtool.frozen.brushes.slide import _turn_reference, slide, slide_reference
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
-from hairtool.frozen.slide import _turn_reference, slide, slide_reference
 from hairtool.frozen.strokes import strokes_from_log, write_strokes
 from hairtool.guides.surface import MeshSurface
 from hairtool.io.obj import read_mesh

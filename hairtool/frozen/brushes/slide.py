@@ -24,10 +24,27 @@ from numba import njit, prange
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
-from hairtool.frozen.brushes import BrushSample, check_sample
-from hairtool.frozen.sculpt import end_weights
+from hairtool.frozen.brushes.falloff import end_weights
+from hairtool.frozen.brushes.sample import BrushSample, check_sample
+from hairtool.frozen.brushes.spec import Brush, BrushSpec, StrokeContext, Studio
 from hairtool.groom import Groom
 from hairtool.rotation import turn_between
+
+SPEC = BrushSpec(
+    name="slide",
+    order=10,
+    needs_surface=True,
+    needs_direction=True,
+    studio=Studio(
+        "Slide",
+        "G",
+        "Slides the roots under the brush along the head in the drag's direction; each "
+        "strand keeps its shape (needs the head mesh)",
+        1.0,
+        place=10,
+    ),
+)
+
 
 F64 = NDArray[np.float64]
 
@@ -106,3 +123,16 @@ def slide_reference(groom: Groom, sample: BrushSample, locked: ArrayLike, surfac
         p = groom.points[o:e].astype(np.float64)
         out[o:e] = roots[k] + _turn_reference(p - p[0], n0[k], n1[k])
     return groom.with_points(out.astype(np.float32))
+
+
+class Slide(Brush):
+    spec = SPEC
+
+    def apply(self, ctx: StrokeContext, g: Groom, sample) -> Groom:
+        return slide(g, sample, ctx.lock(sample), ctx.surface)
+
+    def reference(self, ctx: StrokeContext, g: Groom, sample) -> Groom:
+        return slide_reference(g, sample, ctx.lock(sample), ctx.surface)
+
+
+BRUSH = Slide()

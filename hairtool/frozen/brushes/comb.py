@@ -1,0 +1,120 @@
+"""Comb: the vertices move along the drag direction, more toward the tip (weight × arc-length
+fraction), then every segment gets its length back root to tip: tips follow the drag, lengths
+stay."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+from numpy.typing import ArrayLike
+
+from hairtool.frozen.brushes.constraints import follow_lengths, follow_lengths_reference
+from hairtool.frozen.brushes.falloff import EPS, weight, weights_reference
+from hairtool.frozen.brushes.sample import BrushSample
+from hairtool.frozen.brushes.spec import BrushSpec, StrandMove, Studio
+from hairtool.frozen.brushes.strand_moves import checked, moved_groom
+from hairtool.groom import Groom
+
+SPEC = BrushSpec(
+    name="comb",
+    order=1,
+    local=True,
+    needs_direction=True,
+    studio=Studio("Comb", "C", "Tips follow the drag, strand lengths kept", 0.5, place=1),
+)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _segment(p, i, j):  # pragma: no cover - compiled
+    return np.sqrt((p[i, 0] - p[j, 0]) ** 2 + (p[i, 1] - p[j, 1]) ** 2 + (p[i, 2] - p[j, 2]) ** 2)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _comb_kernel(p, offsets, locked, c, direction, radius, strength, lut, out):  # pragma: no cover
+    for s in prange(offsets.size - 1):
+        o, e = offsets[s], offsets[s + 1]
+        n = e - o
+        for i in range(o, e):
+            out[i, 0], out[i, 1], out[i, 2] = p[i, 0], p[i, 1], p[i, 2]
+        if locked[s] or n < 2:
+            continue
+        total = 0.0
+        for i in range(o + 1, e):
+            total += _segment(p, i, i - 1)
+        run = 0.0
+        moved = False
+        for i in range(o + 1, e):
+            run += _segment(p, i, i - 1)
+            w = weight(p[i, 0], p[i, 1], p[i, 2], c, radius, lut) * strength
+            if w == 0.0:
+                continue
+            moved = True
+            u = run / total if total > EPS else 0.0
+            for a in range(3):
+                out[i, a] = p[i, a] + w * u * direction[a]
+        if moved:
+            follow_lengths(out, p, o, n)
+
+
+def comb(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike | None = None) -> Groom:
+    """One comb sample (numba).
+
+    Parameters
+    ----------
+    groom : Groom
+        The groom before the sample.
+    sample : BrushSample
+        A comb sample.
+    locked : array_like, ``(S,)`` bool
+        Strands left as they are.
+    centre : array_like, optional
+        Unused (every strand move takes the scalp's centre).
+
+    Returns
+    -------
+    Groom
+        The groom after the sample (float32 points).
+    """
+    checked(sample, "comb")
+    out = np.empty((groom.vertex_count, 3))
+    _comb_kernel(
+        groom.points.astype(np.float64), groom.offsets, np.asarray(locked, dtype=np.bool_),
+        np.asarray(sample.cursor, np.float64), np.asarray(sample.direction, np.float64),
+        float(sample.radius), float(sample.strength), np.asarray(sample.lut, np.float64), out,
+    )  # fmt: skip
+    return moved_groom(groom, out)
+
+
+def comb_reference(
+    groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike | None = None
+) -> Groom:
+    """Numpy twin of :func:`comb`."""
+    checked(sample, "comb")
+    p_all = groom.points.astype(np.float64)
+    out = p_all.copy()
+    c, d = np.asarray(sample.cursor, np.float64), np.asarray(sample.direction, np.float64)
+    lut = np.asarray(sample.lut, np.float64)
+    locked = np.asarray(locked, dtype=bool)
+    for s, (o, e) in enumerate(zip(groom.offsets[:-1], groom.offsets[1:], strict=True)):
+        p = p_all[o:e]
+        if locked[s] or len(p) < 2:
+            continue
+        wm = weights_reference(p, c, sample.radius, lut) * sample.strength
+        if not np.any(wm[1:] != 0):
+            continue
+        q = p.copy()
+        seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
+        u = np.concatenate([[0.0], np.cumsum(seg)]) / max(seg.sum(), EPS)
+        u = np.where(seg.sum() > EPS, u, 0.0)
+        q[1:] = p[1:] + (wm * u)[1:, None] * d
+        out[o:e] = follow_lengths_reference(q, p)
+    return moved_groom(groom, out)
+
+
+class Comb(StrandMove):
+    spec = SPEC
+    move = staticmethod(comb)
+    move_reference = staticmethod(comb_reference)
+
+
+BRUSH = Comb()

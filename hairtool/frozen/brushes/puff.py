@@ -1,0 +1,146 @@
+"""Puff: a strand turns rigidly about its root so that its root direction moves toward the scalp
+normal (outward from the sphere fitted to the roots, :func:`~.scalp.scalp_centre`) by
+strength·w at the root: tips lift away from the scalp, lengths kept."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+from numpy.typing import ArrayLike, NDArray
+
+from hairtool.frozen.brushes.falloff import EPS, weight, weights_reference
+from hairtool.frozen.brushes.sample import BrushSample
+from hairtool.frozen.brushes.spec import BrushSpec, StrandMove, Studio
+from hairtool.frozen.brushes.strand_moves import checked, moved_groom
+from hairtool.groom import Groom
+
+F64 = NDArray[np.float64]
+
+SPEC = BrushSpec(
+    name="puff",
+    order=4,
+    local=True,
+    studio=Studio(
+        "Puff",
+        "I",
+        "Lifts strands away from the scalp near the root (turns them toward the scalp normal)",
+        0.2,
+        place=4,
+    ),
+)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _puff_kernel(p, offsets, locked, c, radius, strength, lut, centre, out):  # pragma: no cover - compiled
+    for s in prange(offsets.size - 1):
+        o, e = offsets[s], offsets[s + 1]
+        for i in range(o, e):
+            out[i, 0], out[i, 1], out[i, 2] = p[i, 0], p[i, 1], p[i, 2]
+        if locked[s] or e - o < 2:
+            continue
+        w = weight(p[o, 0], p[o, 1], p[o, 2], c, radius, lut) * strength
+        if w > 0.0:
+            _puff_strand(p, o, e, w, centre, out)
+
+
+@njit(cache=True, nogil=True)
+def _puff_strand(p, o, e, w, centre, out):  # pragma: no cover - compiled
+    """Turn the strand rigidly about its root: its first segment toward the outward normal by
+    the fraction w of the angle between them (Rodrigues' rotation)."""
+    nx, ny, nz = p[o, 0] - centre[0], p[o, 1] - centre[1], p[o, 2] - centre[2]
+    nn = np.sqrt(nx * nx + ny * ny + nz * nz)
+    tx, ty, tz = p[o + 1, 0] - p[o, 0], p[o + 1, 1] - p[o, 1], p[o + 1, 2] - p[o, 2]
+    tn = np.sqrt(tx * tx + ty * ty + tz * tz)
+    if nn < EPS or tn < EPS:
+        return
+    nx, ny, nz, tx, ty, tz = nx / nn, ny / nn, nz / nn, tx / tn, ty / tn, tz / tn
+    ax, ay, az = ty * nz - tz * ny, tz * nx - tx * nz, tx * ny - ty * nx
+    sin_a = np.sqrt(ax * ax + ay * ay + az * az)
+    cos_a = tx * nx + ty * ny + tz * nz
+    if sin_a < 1e-9:
+        return  # already along the normal (or exactly against it: no unique way to turn)
+    ax, ay, az = ax / sin_a, ay / sin_a, az / sin_a
+    angle = w * np.arctan2(sin_a, cos_a)
+    cs, sn = np.cos(angle), np.sin(angle)
+    for i in range(o + 1, e):
+        vx, vy, vz = p[i, 0] - p[o, 0], p[i, 1] - p[o, 1], p[i, 2] - p[o, 2]
+        dot = ax * vx + ay * vy + az * vz
+        cx, cy, cz = ay * vz - az * vy, az * vx - ax * vz, ax * vy - ay * vx
+        out[i, 0] = p[o, 0] + vx * cs + cx * sn + ax * dot * (1.0 - cs)
+        out[i, 1] = p[o, 1] + vy * cs + cy * sn + ay * dot * (1.0 - cs)
+        out[i, 2] = p[o, 2] + vz * cs + cz * sn + az * dot * (1.0 - cs)
+
+
+def puff(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike) -> Groom:
+    """One puff sample (numba).
+
+    Parameters
+    ----------
+    groom : Groom
+        The groom before the sample.
+    sample : BrushSample
+        A puff sample.
+    locked : array_like, ``(S,)`` bool
+        Strands left as they are.
+    centre : array_like, ``(3,)``
+        The scalp's centre: the outward normal at a root points away from it.
+
+    Returns
+    -------
+    Groom
+        The groom after the sample.
+    """
+    checked(sample, "puff")
+    out = np.empty((groom.vertex_count, 3))
+    _puff_kernel(
+        groom.points.astype(np.float64), groom.offsets, np.asarray(locked, dtype=np.bool_),
+        np.asarray(sample.cursor, np.float64), float(sample.radius), float(sample.strength),
+        np.asarray(sample.lut, np.float64), np.asarray(centre, np.float64), out,
+    )  # fmt: skip
+    return moved_groom(groom, out)
+
+
+def puff_reference(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike) -> Groom:
+    """Numpy twin of :func:`puff`."""
+    checked(sample, "puff")
+    p_all = groom.points.astype(np.float64)
+    out = p_all.copy()
+    c, lut = np.asarray(sample.cursor, np.float64), np.asarray(sample.lut, np.float64)
+    locked = np.asarray(locked, dtype=bool)
+    for s, (o, e) in enumerate(zip(groom.offsets[:-1], groom.offsets[1:], strict=True)):
+        p = p_all[o:e]
+        if locked[s] or len(p) < 2:
+            continue
+        wr = weights_reference(p, c, sample.radius, lut)[0] * sample.strength
+        if wr > 0:
+            out[o:e] = _puff_reference(p, wr, np.asarray(centre, np.float64))
+    return moved_groom(groom, out)
+
+
+def _puff_reference(p: F64, w: float, centre: F64) -> F64:
+    n, t = p[0] - centre, p[1] - p[0]
+    if np.linalg.norm(n) < EPS or np.linalg.norm(t) < EPS:
+        return p
+    n, t = n / np.linalg.norm(n), t / np.linalg.norm(t)
+    axis = np.cross(t, n)
+    sin_a = np.linalg.norm(axis)
+    if sin_a < 1e-9:
+        return p
+    axis /= sin_a
+    angle = w * np.arctan2(sin_a, float(t @ n))
+    v = p - p[0]
+    rotated = (
+        v * np.cos(angle)
+        + np.cross(axis, v) * np.sin(angle)
+        + axis * (v @ axis)[:, None] * (1.0 - np.cos(angle))
+    )
+    return p[0] + rotated
+
+
+class Puff(StrandMove):
+    spec = SPEC
+    move = staticmethod(puff)
+    move_reference = staticmethod(puff_reference)
+
+
+BRUSH = Puff()

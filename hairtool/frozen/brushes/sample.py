@@ -1,0 +1,119 @@
+"""One mouse move of one brush (:class:`BrushSample`) and the checks every sample passes.
+
+What a sample may hold is the same for every brush; what its strength may be (signed or not)
+and which fields it must fill come from the brush's spec (:mod:`.registry`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from hairtool.errors import ParameterError
+from hairtool.frozen.brushes import registry
+from hairtool.frozen.brushes.falloff import LUT_SIZE
+
+MAX_COUNT = 1000  # strands one add sample may plant
+
+
+@dataclass(frozen=True)
+class BrushSample:
+    """One mouse move of one brush (groom units); ``lut`` from
+    :func:`~hairtool.frozen.brushes.falloff.falloff_lut`; ``view`` the camera's viewing
+    direction (from the eye into the scene): with it only the strands facing the camera are
+    touched; None: every strand. ``start``: the first sample of a stroke (a snake hook hooks its
+    strands there). ``collide``: with a head surface, no vertex the sample moves ends inside it
+    (:mod:`hairtool.frozen.collide`). ``count`` and ``seed``: the strands an add sample plants,
+    and the seed of where (density's too); ``spacing``: the distance a density sample leaves
+    between roots. ``only_selected``: the strands not selected are left as if locked
+    (:mod:`hairtool.frozen.selection`). ``pressure``: the pen's pressure in [0, 1] at this move
+    (1 for a mouse), already applied to ``radius`` and ``strength`` where the brush's pressure
+    toggles said so: kept so a stroke log records it."""
+
+    brush: str
+    cursor: tuple[float, float, float]
+    direction: tuple[float, float, float]
+    radius: float
+    strength: float
+    lut: tuple[float, ...]
+    view: tuple[float, float, float] | None = None
+    start: bool = False
+    collide: bool = True
+    count: int = 1
+    seed: int = 0
+    spacing: float = 0.0
+    only_selected: bool = False
+    pressure: float = 1.0
+
+    def mirrored(self, plane_x: float) -> BrushSample:
+        c, d = self.cursor, self.direction
+        cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
+        return replace(self, cursor=cursor, direction=direction, view=mirrored_view(self.view))
+
+
+def mirrored_view(view: tuple[float, float, float] | None) -> tuple[float, float, float] | None:
+    """A viewing direction mirrored across a plane x = const (None stays None)."""
+    return None if view is None else (-view[0], view[1], view[2])
+
+
+def check_view(view: object) -> tuple[float, float, float] | None:
+    """None, or three finite numbers not all zero (ParameterError naming ``view``)."""
+    if view is None:
+        return None
+    try:
+        v = np.asarray(view, dtype=np.float64) if not isinstance(view, str | bytes) else np.zeros(0)
+    except (TypeError, ValueError):
+        v = np.zeros(0)
+    if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.any(v != 0):
+        raise ParameterError("view", view, "null or three finite numbers, not all zero")
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def check_sample(sample: BrushSample) -> BrushSample:
+    """The sample itself, or ParameterError naming its first bad field.
+
+    Parameters
+    ----------
+    sample : BrushSample
+        A sample of any registered brush but align (whose samples are AlignSamples).
+
+    Returns
+    -------
+    BrushSample
+        ``sample``, unchanged.
+    """
+    names = registry.names()
+    if sample.brush not in names or sample.brush == "align":
+        raise ParameterError("brush", sample.brush, "one of " + ", ".join(n for n in names if n != "align"))
+    spec = registry.spec_of(sample.brush)
+    for name in ("cursor", "direction"):
+        v = np.asarray(getattr(sample, name), dtype=np.float64)
+        if v.shape != (3,) or not np.all(np.isfinite(v)):
+            raise ParameterError(name, getattr(sample, name), "three finite numbers")
+    if not np.isfinite(sample.radius) or sample.radius <= 0:
+        raise ParameterError("radius", sample.radius, "a positive finite distance")
+    check_view(sample.view)
+    low = -1.0 if spec.signed else 0.0
+    if not np.isfinite(sample.strength) or not low <= sample.strength <= 1.0:
+        raise ParameterError("strength", sample.strength, f"a number in [{low:g}, 1]")
+    c = sample.count
+    if isinstance(c, bool) or not isinstance(c, int | np.integer) or not 1 <= c <= MAX_COUNT:
+        raise ParameterError("count", c, f"a whole number of strands in [1, {MAX_COUNT}]")
+    s = sample.seed
+    if isinstance(s, bool) or not isinstance(s, int | np.integer) or not 0 <= s < 2**32:
+        raise ParameterError("seed", s, "a whole number in [0, 2^32)")
+    for param in spec.params:  # the brush's own fields, as its spec bounds them
+        param.check(getattr(sample, param.field))
+    if len(sample.lut) != LUT_SIZE:
+        raise ParameterError("falloff", f"{len(sample.lut)} samples", f"{LUT_SIZE}")
+    check_pressure(sample.pressure)
+    return sample
+
+
+def check_pressure(pressure: object) -> float:
+    """A pen's pressure: a number in [0, 1] (ParameterError naming ``pressure``)."""
+    number = isinstance(pressure, int | float | np.integer | np.floating) and not isinstance(pressure, bool)
+    if not number or not 0.0 <= float(pressure) <= 1.0:  # (NaN fails the comparison)
+        raise ParameterError("pressure", pressure, "a number in [0, 1]")
+    return float(pressure)
