@@ -260,6 +260,8 @@ class CaptureEditor(QObject):
         self.applied = []
         for e in self.edits:
             self.applied.append(self._try(e))
+        if self._pin_waiting():
+            return  # the solve under the new pins rebuilt everything (or will, when it lands)
         self._sync_keys()
         waiting = self.applied.count(False)
         if waiting:
@@ -271,6 +273,25 @@ class CaptureEditor(QObject):
         if show:
             self._show()
         self.changed.emit()
+
+    def _pin_waiting(self) -> bool:
+        """Edits at frames the keys lost (an interpolation or key-count change) pin those frames,
+        so the solve keeps them as keys and the edits stay in the capture. False when nothing
+        waits, or the settings refuse the pins (the edits then wait, and the status bar says so)."""
+        m = self.model
+        frames = {int(e.frame) for e, ok in zip(self.edits, self.applied, strict=True) if not ok}
+        pins = tuple(sorted(frames | set(m.settings.pins)))
+        if not frames or pins == m.settings.pins:
+            return False
+        try:
+            m.set_settings(pins=pins)
+        except HairtoolError:
+            return False
+        shown = ", ".join(str(f) for f in sorted(frames))
+        self.window.statusBar().showMessage(
+            f"Frame(s) {shown} pinned as keys: pose edits are there", 8000
+        )
+        return True
 
     def _apply(self, edit: Edit | list[Edit]) -> None:
         self.editor.apply_all(edit if isinstance(edit, list) else [edit])
@@ -547,7 +568,9 @@ class CaptureEditor(QObject):
         except HairtoolError as e:
             self.window.show_error("Cannot export animation", str(e))
             return False
-        self.window.statusBar().showMessage(f"exported {path}", 5000)
+        left = self.applied.count(False) + self.channel_applied.count(False)
+        without = f", without {left} edit(s) at frames that are no longer keys" if left else ""
+        self.window.statusBar().showMessage(f"exported {path}{without}", 8000 if left else 5000)
         return True
 
     def to_settings(self) -> dict | None:
