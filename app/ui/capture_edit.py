@@ -19,8 +19,6 @@ graph editor's key and handle edits) and applies them again on open.
 from __future__ import annotations
 
 import os
-import tempfile
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -28,11 +26,11 @@ from PySide6.QtCore import QObject, QPointF, Qt, Signal
 from PySide6.QtGui import QUndoCommand
 from PySide6.QtWidgets import QFormLayout, QGroupBox, QLabel, QScrollArea, QSpinBox
 
-from app.ui.animation_io import skeleton_animation
+from app.document.capture import motion_from_text, motion_text, skeleton_animation
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.keys.channels import per_channel_keys
 from hairtool.mocap import ik
-from hairtool.mocap.bvh import Motion, read_bvh, write_bvh
+from hairtool.mocap.bvh import Motion, write_bvh
 from hairtool.mocap.channel_edit import ChannelEditor, ChannelRetimeEdit, channel_features
 from hairtool.mocap.edit_file import parse_capture_edits
 from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, RetimeEdit
@@ -44,27 +42,6 @@ PICK_PX = 12.0  # a press this near a handle (widget pixels) takes that joint
 GHOSTS = 6  # neighbouring frames drawn faintly while a key pose is dragged
 NOT_A_KEY = "Capture poses are edited at a key frame: jump to one with ↑ / ↓"
 NO_HANDLE = "Drag a joint's handle (the dots) to pose the capture; Alt-drag moves the whole limb"
-
-
-def motion_text(motion: Motion) -> str:
-    """The capture as BVH text (what a project keeps)."""
-    with tempfile.TemporaryDirectory() as d:
-        p = Path(d) / "capture.bvh"
-        write_bvh(p, motion)
-        return p.read_text(encoding="utf-8")
-
-
-def motion_from_text(text: str, source: str) -> Motion:
-    """A capture from BVH text; :class:`FormatError` naming ``source`` when it does not read."""
-    if not isinstance(text, str):
-        raise FormatError(source, "the capture is not BVH text")
-    with tempfile.TemporaryDirectory() as d:
-        p = Path(d) / "capture.bvh"
-        p.write_text(text, encoding="utf-8")
-        try:
-            return read_bvh(p)
-        except FormatError as e:
-            raise FormatError(source, e.reason) from None
 
 
 class PoseEditCommand(QUndoCommand):
