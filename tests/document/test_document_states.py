@@ -341,7 +341,7 @@ def _run() -> None:
             stateful_step_count=steps,
             deadline=None,
             database=None,
-            phases=None if os.environ.get("DOCUMENT_SHRINK", "1") == "1" else [Phase.generate],
+            phases=tuple(Phase) if os.environ.get("DOCUMENT_SHRINK", "1") == "1" else [Phase.generate],
             suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
         ),
         _min_steps=steps,
