@@ -378,7 +378,8 @@ def keys_result(model: object) -> dict:
         "mode": model.settings.mode,
         "uniform": {"keys": np.asarray(uni).tolist(), "cost": keys_cost(solve.table, uni, objective)}
         | uniform_constraints(model.settings.pins, model.settings.excludes),
-        "params": dataclasses.asdict(model.settings),
+        # the keys chosen, whatever mode chose them (the settings' count is 0 for "the knee")
+        "params": dataclasses.asdict(model.settings) | {"count": int(np.size(keys))},
     }
     if model.analysis is not None:
         result["position_errors"] = {

@@ -12,8 +12,7 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-import numpy as np
-
+from app.document.capture import skeleton_animation
 from hairtool import io
 from hairtool.errors import FormatError
 from hairtool.groom import Animation, Groom
@@ -23,17 +22,6 @@ from hairtool.project import SUFFIX as PROJECT_SUFFIX  # opened by the window's 
 
 BVH_EXTENSIONS = (".bvh",)
 USD_EXTENSIONS = (".usda", ".usdc", ".usd")
-
-
-def skeleton_animation(motion: Motion) -> Animation:
-    """``(F, 2·B, 3)`` frames of the B bones of a capture, at its frame rate."""
-    pos = motion.joint_positions(end_sites=True)  # (F, J + E, 3), End Sites last
-    parents = np.concatenate([motion.parents, motion.end_parents])
-    child = np.flatnonzero(parents >= 0)
-    if child.size == 0:
-        raise FormatError("<bvh>", "the skeleton has a single joint and no End Site: no bones to draw")
-    ends = np.column_stack([parents[child], child]).reshape(-1)  # parent, child for each bone
-    return Animation(pos[:, ends], np.full(child.size, 2), motion.fps)
 
 
 def readable_extensions() -> list[str]:

@@ -134,9 +134,10 @@ class AnimationModel(QObject):
         ``source`` says where it came from (a path, "recording", "anime cycle", …); the other
         docks call this through ``window.animation.load_animation``. Frame 0, playback stopped,
         playback rate the animation's. The key settings stay, except the count, which goes back
-        to the knee of the error curve, and the pinned and excluded frames, which belonged to the
-        last animation; a reopened project passes its saved ``settings`` instead (one solve, with
-        those). ParameterError for invalid settings, before anything changes.
+        to the knee of the error curve, the pinned and excluded frames, which belonged to the
+        last animation, and an error budget (a figure in the last animation's units: the key mode
+        goes back to the count); a reopened project passes its saved ``settings`` instead (one
+        solve, with those). ParameterError for invalid settings, before anything changes.
         """
         if not isinstance(animation, Animation):
             raise GroomError(f"expected an Animation, got {type(animation).__name__}")
@@ -145,6 +146,9 @@ class AnimationModel(QObject):
             new_settings.constraints.check(animation.n_frames)
         else:
             new_settings = self.settings.replace(count=0, pins=(), excludes=())
+            if new_settings.mode == "budget":
+                d = ks.KeySettings()
+                new_settings = new_settings.replace(mode=d.mode, budget=d.budget)
         self.pause()
         self._cancel_jobs()
         self.generation += 1

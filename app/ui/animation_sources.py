@@ -52,6 +52,8 @@ class AnimationSources(QObject):
     def apply_anime(self, settings: AnimeSettings | None = None) -> bool:
         """The cycle on the edited groom (or the selected strands) into the timeline."""
         s = self.dock.settings() if settings is None else settings
+        if not self.may_replace():
+            return False
         try:
             anim = cycle_for_groom(self.window.scene.result, s, self.selected_strands())
         except HairtoolError as e:
@@ -59,6 +61,13 @@ class AnimationSources(QObject):
             return False
         self.window.animation.load_animation(anim, ANIME_SOURCE)
         return True
+
+    def may_replace(self) -> bool:
+        """Before a new animation replaces the one on the timeline: unsaved work asks Save /
+        Discard / Cancel, as Open does. True to go on."""
+        if self.window.animation.animation is None:
+            return True
+        return self.window.project.confirm_discard()
 
     def _follow_frame(self, *_: object) -> None:
         model = self.window.animation
@@ -69,6 +78,8 @@ class AnimationSources(QObject):
     def simulate_dialog(self) -> Job | None:
         """Ask for the options and start; until the user has chosen some, the dialog opens with
         the head fitted to the groom on screen, so a real groom of any scale simulates sensibly."""
+        if not self.may_replace():
+            return None
         options = self.simulate_options
         if options == SimulateOptions():
             try:

@@ -201,6 +201,14 @@ class AnimationController(QObject):
         self.window.undo_stack.push(SteerKeysCommand(m, text, before, after, self.show_status))
         return True
 
+    def close_animation(self) -> bool:
+        """Animation ▸ Close animation: unsaved work asks Save / Discard / Cancel first."""
+        if self.model.animation is None or not self.window.project.confirm_discard():
+            return False
+        self.model.clear()
+        self.window.undo_stack.resetClean()  # the document lost its animation: a change to save
+        return True
+
     def show_status(self, message: str) -> None:
         self.window.statusBar().showMessage(message, 6000)
 
@@ -219,11 +227,24 @@ class AnimationController(QObject):
             # their undo steps belong to the old strands, as when a file is opened)
             self.window.undo_stack.clear()
             self.scene.load(anim.rest, self.scene.path)
+        self._drop_stale_steps()
         self.viewport.brush_target = self.brush if anim is not None and self.recorder is None else None
         if anim is not None:
             self.viewport.frame_all()  # the groom, not the empty space its whole motion spans
         self.refresh_display()
         self._update_fps_label()
+
+    def _drop_stale_steps(self) -> None:
+        """Undo steps that edited a replaced (or closed) animation would do nothing: the history
+        goes, with a line saying so; the work stays unsaved if it was."""
+        stack, g = self.window.undo_stack, self.model.generation
+        if not any(getattr(stack.command(i), "generation", g) != g for i in range(stack.count())):
+            return
+        dirty = not stack.isClean()
+        stack.clear()
+        if dirty:
+            stack.resetClean()
+        self.show_status("Undo history cleared: its steps edited the animation that was replaced")
 
     # -- playback read-out ------------------------------------------------------------------
     def _on_playing(self, playing: bool) -> None:
@@ -337,7 +358,14 @@ class AnimationController(QObject):
         menu.addSeparator()
         a["record"] = add_action(w, menu, "&Record drags", self.set_recording, "Shift+R", checkable=True)
         a["resolve"] = add_action(w, menu, "Re-&solve keys", m.request_solve)
-        a["clear"] = add_action(w, menu, "&Close animation", m.clear)
+        a["clear"] = add_action(w, menu, "&Close animation", self.close_animation)
+
+        def enable() -> None:  # both need an animation (Re-solve one with frames to key)
+            a["resolve"].setEnabled(m.n_frames >= 2)
+            a["clear"].setEnabled(m.animation is not None)
+
+        m.animation_changed.connect(enable)
+        enable()
         view = menu.addMenu("&View")
         group = QActionGroup(w)
         for i, (key, label) in enumerate(VIEW_MODES.items()):

@@ -19,8 +19,6 @@ graph editor's key and handle edits) and applies them again on open.
 from __future__ import annotations
 
 import os
-import tempfile
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -28,11 +26,11 @@ from PySide6.QtCore import QObject, QPointF, Qt, Signal
 from PySide6.QtGui import QUndoCommand
 from PySide6.QtWidgets import QFormLayout, QGroupBox, QLabel, QScrollArea, QSpinBox
 
-from app.ui.animation_io import skeleton_animation
+from app.document.capture import motion_from_text, motion_text, skeleton_animation
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.keys.channels import per_channel_keys
 from hairtool.mocap import ik
-from hairtool.mocap.bvh import Motion, read_bvh, write_bvh
+from hairtool.mocap.bvh import Motion, write_bvh
 from hairtool.mocap.channel_edit import ChannelEditor, ChannelRetimeEdit, channel_features
 from hairtool.mocap.edit_file import parse_capture_edits
 from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, RetimeEdit
@@ -44,27 +42,6 @@ PICK_PX = 12.0  # a press this near a handle (widget pixels) takes that joint
 GHOSTS = 6  # neighbouring frames drawn faintly while a key pose is dragged
 NOT_A_KEY = "Capture poses are edited at a key frame: jump to one with ↑ / ↓"
 NO_HANDLE = "Drag a joint's handle (the dots) to pose the capture; Alt-drag moves the whole limb"
-
-
-def motion_text(motion: Motion) -> str:
-    """The capture as BVH text (what a project keeps)."""
-    with tempfile.TemporaryDirectory() as d:
-        p = Path(d) / "capture.bvh"
-        write_bvh(p, motion)
-        return p.read_text(encoding="utf-8")
-
-
-def motion_from_text(text: str, source: str) -> Motion:
-    """A capture from BVH text; :class:`FormatError` naming ``source`` when it does not read."""
-    if not isinstance(text, str):
-        raise FormatError(source, "the capture is not BVH text")
-    with tempfile.TemporaryDirectory() as d:
-        p = Path(d) / "capture.bvh"
-        p.write_text(text, encoding="utf-8")
-        try:
-            return read_bvh(p)
-        except FormatError as e:
-            raise FormatError(source, e.reason) from None
 
 
 class PoseEditCommand(QUndoCommand):
@@ -260,6 +237,8 @@ class CaptureEditor(QObject):
         self.applied = []
         for e in self.edits:
             self.applied.append(self._try(e))
+        if self._pin_waiting():
+            return  # the solve under the new pins rebuilt everything (or will, when it lands)
         self._sync_keys()
         waiting = self.applied.count(False)
         if waiting:
@@ -271,6 +250,25 @@ class CaptureEditor(QObject):
         if show:
             self._show()
         self.changed.emit()
+
+    def _pin_waiting(self) -> bool:
+        """Edits at frames the keys lost (an interpolation or key-count change) pin those frames,
+        so the solve keeps them as keys and the edits stay in the capture. False when nothing
+        waits, or the settings refuse the pins (the edits then wait, and the status bar says so)."""
+        m = self.model
+        frames = {int(e.frame) for e, ok in zip(self.edits, self.applied, strict=True) if not ok}
+        pins = tuple(sorted(frames | set(m.settings.pins)))
+        if not frames or pins == m.settings.pins:
+            return False
+        try:
+            m.set_settings(pins=pins)
+        except HairtoolError:
+            return False
+        shown = ", ".join(str(f) for f in sorted(frames))
+        self.window.statusBar().showMessage(
+            f"Frame(s) {shown} pinned as keys: pose edits are there", 8000
+        )
+        return True
 
     def _apply(self, edit: Edit | list[Edit]) -> None:
         self.editor.apply_all(edit if isinstance(edit, list) else [edit])
@@ -547,7 +545,9 @@ class CaptureEditor(QObject):
         except HairtoolError as e:
             self.window.show_error("Cannot export animation", str(e))
             return False
-        self.window.statusBar().showMessage(f"exported {path}", 5000)
+        left = self.applied.count(False) + self.channel_applied.count(False)
+        without = f", without {left} edit(s) at frames that are no longer keys" if left else ""
+        self.window.statusBar().showMessage(f"exported {path}{without}", 8000 if left else 5000)
         return True
 
     def to_settings(self) -> dict | None:

@@ -25,6 +25,12 @@ if TYPE_CHECKING:
     from hairtool.simulate.options import SimulateOptions
 
 
+class UnsavedWork(Protocol):
+    """The window's project controller, as the other controllers ask it about unsaved work."""
+
+    def confirm_discard(self) -> bool: ...
+
+
 class StudioHost(Protocol):
     settings: QSettings
     undo_stack: QUndoStack
@@ -33,6 +39,7 @@ class StudioHost(Protocol):
     viewport: Viewport
     dock: ToolDock
     animation: AnimationModel
+    project: UnsavedWork
 
     # -- asking the user (tests replace these) --------------------------------------------------
     def show_error(self, title: str, message: str) -> None: ...

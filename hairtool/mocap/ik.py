@@ -179,7 +179,10 @@ def solve_dls(
         it += 1
         e = t - pe
         a = jac.T @ jac + (lam * lam) * np.eye(len(dofs))
-        step = np.linalg.solve(a, jac.T @ e)
+        try:
+            step = np.linalg.solve(a, jac.T @ e)
+        except np.linalg.LinAlgError:  # a chain that cannot move the effector (J ≈ 0): no step helps
+            step = np.linalg.lstsq(a, jac.T @ e, rcond=None)[0]
         big = float(np.max(np.abs(step)))
         if big > _MAX_STEP_DEGREES:
             step *= _MAX_STEP_DEGREES / big

@@ -1,0 +1,249 @@
+"""The animation side of the document: the animation and where it came from, the capture it is
+the skeleton of, the key settings with their pins and exclusions, and the capture's key edits.
+
+Every change is a command on the document's one :class:`~app.document.undo.UndoStack`; a
+command keeps the whole state before and after it (:class:`AnimationState` is immutable and
+shares its arrays, so a step costs a few references), so undo is exact by construction and an
+animation replaced, then brought back by Undo, brings its own edits and their steps back too.
+
+The keys are derived, never stored: one solve of the animation under the settings, with the
+frames of the capture's edits pinned (:func:`app.document.capture.edit_frames`), so an edit
+survives a change of interpolation or key count as a key the solve must keep. A change the
+settings cannot meet (fewer keys than the pinned frames need, a budget no key set reaches) is
+refused with a ParameterError before anything changes. An edit that cannot apply (its frame
+excluded by the dope sheet, a key move its new neighbours block) waits, and
+:meth:`Document.notes` says so.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import OrderedDict
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from app.document.capture import edit_frames, skeleton_animation
+from app.document.undo import Command, UndoStack
+from hairtool.errors import GroomError, HairtoolError, ParameterError
+from hairtool.groom import Animation, Groom
+from hairtool.keys import session as ks
+from hairtool.mocap.bvh import Motion
+from hairtool.mocap.pose_edit import Edit, PoseEditor
+
+DERIVED_KEPT = 64  # derived states (keys, edited capture) remembered for undo and redo
+
+
+@dataclass(frozen=True, eq=False)
+class AnimationState:
+    """What a project holds of the animation (None: no animation)."""
+
+    animation: Animation | None = None
+    source: str = ""
+    capture: Motion | None = None  # the BVH the animation is the skeleton of, as captured
+    settings: ks.KeySettings = field(default_factory=ks.KeySettings)
+    edits: tuple[Edit, ...] = ()  # IK poses and graph-editor key edits, in the order made
+
+
+@dataclass(frozen=True, eq=False)
+class Keyed:
+    """What follows from a state: the keys, and the capture with the edits that apply."""
+
+    keys: np.ndarray | None
+    motion: Motion | None  # the edited capture (None without a capture)
+    shown: Animation | None  # what the timeline plays: the edited skeleton, or the animation
+    applied: tuple[bool, ...]
+
+
+def derive(
+    state: AnimationState, solve: Callable[[Animation, ks.KeySettings], ks.KeySession] = ks.solve
+) -> Keyed:
+    """The keys and edited capture of ``state``; ParameterError when its settings cannot be met.
+    ``solve`` may be a cached :func:`hairtool.keys.session.solve`."""
+    anim, s = state.animation, state.settings
+    if anim is None or anim.n_frames < 2:
+        return Keyed(None, state.capture, anim, (False,) * len(state.edits))
+    pins = set(s.pins) | (set(edit_frames(state.edits)) - set(s.excludes))
+    solving = s.replace(pins=tuple(sorted(pins)))
+    solving.constraints.check(anim.n_frames)
+    keys = solve(anim, solving).keys_for(solving)
+    if state.capture is None:
+        return Keyed(keys, None, anim, ())
+    if not state.edits:  # the capture as captured: its skeleton is the animation
+        return Keyed(keys, state.capture, anim, ())
+    editor = PoseEditor(state.capture, keys, s.interp)
+    applied = []
+    for e in state.edits:
+        try:
+            editor.apply_all([e])
+            applied.append(True)
+        except HairtoolError:
+            applied.append(False)
+    motion = editor.motion()
+    return Keyed(keys, motion, skeleton_animation(motion), tuple(applied))
+
+
+class SetState(Command):
+    """One edit of the document: the state before and after. Steps of one drag (the same
+    ``drag`` id) merge: the step keeps the first state before and the last after."""
+
+    def __init__(self, doc: Document, text: str, after: AnimationState, drag: object = None) -> None:
+        self.doc, self.text, self.before, self.after, self.drag = doc, text, doc.state, after, drag
+
+    def do(self) -> None:
+        self.doc._set(self.after)
+
+    def undo(self) -> None:
+        self.doc._set(self.before)
+
+    def merge(self, other: Command) -> bool:
+        if self.drag is None or not isinstance(other, SetState) or other.drag != self.drag:
+            return False
+        self.after = other.after
+        return True
+
+
+Confirm = Callable[[], bool]  # asks Save / Discard / Cancel: True to go on (saved or discarded)
+
+
+class Document:
+    """The studio's document (its animation side) over a groom; see the module docstring."""
+
+    def __init__(self, groom: Groom, state: AnimationState | None = None) -> None:
+        if not isinstance(groom, Groom):
+            raise GroomError(f"expected a Groom, got {type(groom).__name__}")
+        self.groom = groom
+        self.state = state if state is not None else AnimationState()
+        self.stack = UndoStack()
+        self._listeners: list[Callable[[], None]] = []
+        self._derived: OrderedDict[int, tuple[AnimationState, Keyed]] = OrderedDict()
+        self._skeletons: OrderedDict[int, tuple[Motion, Animation]] = OrderedDict()
+        self._solves: OrderedDict[tuple, tuple[Animation, ks.KeySession]] = OrderedDict()
+
+    # -- observing -----------------------------------------------------------------------------
+    def observe(self, callback: Callable[[], None]) -> None:
+        """``callback()`` after every change of the state (an edit, an undo, a redo)."""
+        self._listeners.append(callback)
+
+    def _set(self, state: AnimationState) -> None:
+        self.state = state
+        for callback in list(self._listeners):
+            callback()
+
+    @property
+    def changed(self) -> bool:
+        """Unsaved work: the undo stack is not at its clean state."""
+        return not self.stack.is_clean
+
+    # -- derived -------------------------------------------------------------------------------
+    def keyed(self, state: AnimationState | None = None) -> Keyed:
+        state = self.state if state is None else state
+        hit = self._derived.get(id(state))
+        if hit is not None and hit[0] is state:
+            self._derived.move_to_end(id(state))
+            return hit[1]
+        k = derive(state, self._solve)
+        self._derived[id(state)] = (state, k)
+        while len(self._derived) > DERIVED_KEPT:
+            self._derived.popitem(last=False)
+        return k
+
+    def _skeleton(self, capture: Motion) -> Animation:
+        """The capture's skeleton, made once per capture (reopening it draws the same bones)."""
+        hit = self._skeletons.get(id(capture))
+        if hit is None or hit[0] is not capture:
+            hit = self._skeletons[id(capture)] = (capture, skeleton_animation(capture))
+            while len(self._skeletons) > DERIVED_KEPT:
+                self._skeletons.popitem(last=False)
+        return hit[1]
+
+    def _solve(self, animation: Animation, settings: ks.KeySettings) -> ks.KeySession:
+        """One solve per animation, cost table and constraints (undo and redo solve nothing)."""
+        what = (id(animation), settings.table_key, settings.constraints)
+        hit = self._solves.get(what)
+        if hit is not None and hit[0] is animation:
+            self._solves.move_to_end(what)
+            return hit[1]
+        session = ks.solve(animation, settings)
+        self._solves[what] = (animation, session)
+        while len(self._solves) > DERIVED_KEPT:
+            self._solves.popitem(last=False)
+        return session
+
+    @property
+    def keys(self) -> np.ndarray | None:
+        return self.keyed().keys
+
+    def notes(self) -> list[str]:
+        """One line per edit that does not apply now (nothing waits without a word)."""
+        k = self.keyed()
+        return [
+            f"{type(e).__name__} at frame {e.frame} waits: its key is not there now "
+            "(the frame is excluded, or a key moved in time cannot move past its neighbours)"
+            for e, ok in zip(self.state.edits, k.applied, strict=True)
+            if not ok
+        ]
+
+    # -- commands ------------------------------------------------------------------------------
+    def _push(self, text: str, after: AnimationState, drag: object = None) -> None:
+        self.keyed(after)  # refused (ParameterError) before anything changes
+        self.stack.push(SetState(self, text, after, drag))
+
+    def replace_animation(
+        self,
+        animation: Animation | None,
+        source: str = "",
+        capture: Motion | None = None,
+        confirm: Confirm | None = None,
+    ) -> bool:
+        """A new animation (a cycle, a simulation, a capture opened) or none (Close animation):
+        one undo step. Unsaved work is asked about first (``confirm``), as Open does; False when
+        the answer was Cancel. The key settings stay but for the count (back to the knee), the
+        pins and exclusions and an error budget (the last animation's units)."""
+        if self.state.animation is not None and self.changed and confirm is not None and not confirm():
+            return False
+        if capture is not None:
+            animation = self._skeleton(capture)
+        if animation is not None and not isinstance(animation, Animation):
+            raise GroomError(f"expected an Animation, got {type(animation).__name__}")
+        s = self.state.settings.replace(count=0, pins=(), excludes=())
+        if s.mode == "budget":
+            d = ks.KeySettings()
+            s = s.replace(mode=d.mode, budget=d.budget)
+        after = AnimationState(animation, str(source) if animation is not None else "", capture, s, ())
+        text = "Close animation" if animation is None else f"New animation ({source or 'untitled'})"
+        self._push(text, after)
+        return True
+
+    def set_settings(self, text: str = "Key settings", **changes: object) -> None:
+        """Key count, mode, budget, price per key, interpolation…: one step (refused when the
+        animation cannot be keyed so)."""
+        s = self.state.settings.replace(**changes)
+        if s != self.state.settings:
+            self._push(text, dataclasses.replace(self.state, settings=s))
+
+    def steer(self, pins: Iterable[int], excludes: Iterable[int], text: str = "Steer keys") -> None:
+        """The dope sheet's pinned and excluded frames."""
+        self.set_settings(text, pins=tuple(pins), excludes=tuple(excludes))
+
+    def edit(self, edit: Edit, text: str = "", drag: object = None) -> None:
+        """A key edit of the capture (IK pose, key value, handle, move in time); moves of one
+        drag (the same ``drag``) are one undo step. Refused when it does not apply."""
+        if self.state.capture is None:
+            raise ParameterError("edit", type(edit).__name__, "an edit of a capture: open a .bvh first")
+        top = self.stack.top
+        again = isinstance(top, SetState) and drag is not None and top.drag == drag
+        again = again and top.after is self.state
+        edits = self.state.edits[:-1] if again else self.state.edits  # a drag's move replaces its last
+        state = dataclasses.replace(self.state, edits=(*edits, edit))
+        k = self.keyed(state)
+        if not k.applied[-1]:
+            raise ParameterError("edit", repr(edit), "an edit at a key frame it can reach")
+        self._push(text or f"{type(edit).__name__} at frame {edit.frame}", state, drag)
+
+    def undo(self) -> bool:
+        return self.stack.undo()
+
+    def redo(self) -> bool:
+        return self.stack.redo()

@@ -1,0 +1,99 @@
+"""The document written out, and read back: the project file (the same fields the studio
+writes: the animation, its source, the key settings, and the capture with its edits as
+``settings["capture"]``), the edited capture as BVH and the keys record.
+
+Save is the state written whole and marks the stack clean; load is its inverse (a new document,
+nothing to undo). Files are written to a temporary name and renamed by the writers used here.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+
+import numpy as np
+
+from app.document.animation import AnimationState, Document
+from app.document.capture import motion_from_text, motion_text
+from hairtool import project as pf
+from hairtool.errors import FormatError, HairtoolError
+from hairtool.keys import session as ks
+from hairtool.keys.export import keys_record, write_keys_json
+from hairtool.mocap.bvh import Motion, write_bvh
+from hairtool.mocap.edit_file import parse_capture_edits
+
+_TEXTS: dict[int, tuple[Motion, str]] = {}  # the last captures written, by identity
+
+
+def _text(capture: Motion) -> str:
+    """The capture's BVH text, written once per capture (captures are never changed in place)."""
+    hit = _TEXTS.get(id(capture))
+    if hit is None or hit[0] is not capture:
+        if len(_TEXTS) >= 8:
+            _TEXTS.clear()
+        hit = _TEXTS[id(capture)] = (capture, motion_text(capture))
+    return hit[1]
+
+
+def to_project(doc: Document) -> pf.Project:
+    s = doc.state
+    settings: dict = {}
+    if s.capture is not None:
+        settings["capture"] = {
+            "bvh": _text(s.capture),
+            "source": s.source,
+            "edits": [e.to_dict() for e in s.edits],
+            "channel_edits": [],
+        }
+    return pf.Project(
+        rest=doc.groom,
+        animation=s.animation,
+        animation_source=s.source,
+        key_settings=dataclasses.asdict(s.settings),
+        settings=settings,
+    )
+
+
+def from_project(project: pf.Project, where: str = "project") -> Document:
+    """A document of a project; FormatError naming ``where`` for settings it cannot use."""
+    try:
+        settings = ks.KeySettings(**project.key_settings).validate()
+    except (TypeError, ValueError, HairtoolError) as e:
+        raise FormatError(where, f"key settings: {e}") from None
+    capture, edits = None, ()
+    saved = project.settings.get("capture")
+    if saved is not None:
+        if not isinstance(saved, dict):
+            raise FormatError(where, "the capture is not an object with its BVH and edits")
+        capture = motion_from_text(saved.get("bvh"), where)
+        lists = {k: saved[k] for k in ("edits", "channel_edits") if k in saved}
+        edits = tuple(parse_capture_edits(lists, capture, where).edits)
+    state = AnimationState(project.animation, project.animation_source, capture, settings, edits)
+    return Document(project.rest, state)
+
+
+def save(doc: Document, path: str | os.PathLike[str]) -> None:
+    pf.save(path, to_project(doc))
+    doc.stack.set_clean()
+
+
+def load(path: str | os.PathLike[str]) -> Document:
+    return from_project(pf.load(path), str(path))
+
+
+def export_bvh(doc: Document, path: str | os.PathLike[str]) -> None:
+    """The edited capture at every frame as BVH."""
+    motion = doc.keyed().motion
+    if motion is None:
+        raise HairtoolError("BVH is written for a motion capture: open a .bvh first")
+    write_bvh(path, motion)
+
+
+def export_keys(doc: Document, path: str | os.PathLike[str]) -> None:
+    """The keys record (JSON) of the document's keys; its count is the keys chosen."""
+    anim, keys = doc.state.animation, doc.keys
+    if anim is None or keys is None:
+        raise HairtoolError("no keys to export: make or open an animation first")
+    params = dataclasses.asdict(doc.state.settings) | {"count": int(np.size(keys))}
+    result = {"frames": anim.n_frames, "fps": anim.fps, "keys": keys, "params": params}
+    write_keys_json(path, keys_record(result, doc.state.source or None, time_codes=anim.time_codes))

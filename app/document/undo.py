@@ -1,0 +1,124 @@
+"""One undo stack for every edit of the document.
+
+A :class:`Command` does, undoes, and may absorb the next command of the same drag
+(:meth:`Command.merge`), so a drag is one step however many moves it made. "Changed" is the
+stack's clean state: the index saved last, or none when work no step holds was added (an
+animation made here, a step undone past the save and replaced).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+
+class Command:
+    """One edit: ``do`` applies it, ``undo`` takes it back exactly. ``text`` is the menu's words."""
+
+    text = ""
+
+    def do(self) -> None:
+        raise TypeError(f"{type(self).__name__} does not say what it does")
+
+    def undo(self) -> None:
+        raise TypeError(f"{type(self).__name__} does not say how it is undone")
+
+    def merge(self, other: Command) -> bool:
+        """Absorb ``other`` (already done) into this step; True when it did (a drag's next move)."""
+        return False
+
+
+class UndoStack:
+    """Commands done (undoable) and undone (redoable); callbacks hear every change."""
+
+    def __init__(self) -> None:
+        self._done: list[Command] = []
+        self._undone: list[Command] = []
+        self._clean: int | None = 0
+        self._listeners: list[Callable[[], None]] = []
+
+    def observe(self, callback: Callable[[], None]) -> None:
+        self._listeners.append(callback)
+
+    def _tell(self) -> None:
+        for callback in list(self._listeners):
+            callback()
+
+    # -- editing ------------------------------------------------------------------------------
+    def push(self, command: Command) -> None:
+        """Do ``command`` and make it the step Undo takes back (merged into the last step when
+        that one absorbs it, unless the last step is the saved state)."""
+        command.do()
+        if self._undone:
+            if self._clean is not None and self._clean > len(self._done):
+                self._clean = None  # the saved state was a step undone: it cannot come back
+            self._undone.clear()
+        top = self._done[-1] if self._done else None
+        if top is None or len(self._done) == self._clean or not top.merge(command):
+            self._done.append(command)
+        self._tell()
+
+    def undo(self) -> bool:
+        if not self._done:
+            return False
+        command = self._done.pop()
+        command.undo()
+        self._undone.append(command)
+        self._tell()
+        return True
+
+    def redo(self) -> bool:
+        if not self._undone:
+            return False
+        command = self._undone.pop()
+        command.do()
+        self._done.append(command)
+        self._tell()
+        return True
+
+    def clear(self) -> None:
+        """No steps (a new document); clean if it was."""
+        clean = self.is_clean
+        self._done.clear()
+        self._undone.clear()
+        self._clean = 0 if clean else None
+        self._tell()
+
+    # -- state ----------------------------------------------------------------------------------
+    @property
+    def index(self) -> int:
+        return len(self._done)
+
+    @property
+    def top(self) -> Command | None:
+        """The step Undo takes back (None: none)."""
+        return self._done[-1] if self._done else None
+
+    @property
+    def can_undo(self) -> bool:
+        return bool(self._done)
+
+    @property
+    def can_redo(self) -> bool:
+        return bool(self._undone)
+
+    @property
+    def undo_text(self) -> str:
+        return self._done[-1].text if self._done else ""
+
+    @property
+    def redo_text(self) -> str:
+        return self._undone[-1].text if self._undone else ""
+
+    @property
+    def is_clean(self) -> bool:
+        return self._clean == len(self._done)
+
+    def set_clean(self) -> None:
+        """The document was saved here."""
+        self._clean = len(self._done)
+        self._tell()
+
+    def mark_changed(self) -> None:
+        """Work no step holds was added: unsaved until the next save."""
+        self._clean = None
+        self._tell()
