@@ -38,6 +38,7 @@ from app.ui.colouring import displacement_scale
 from app.ui.commands import MeshCommand, ParamCommand, RenderHairCommand, StrokeCommand, UpAxisCommand
 from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
+from app.ui.habits import install_habits
 from app.ui.jobs import Job, JobRunner, JobStatus
 from app.ui.kernel_preload import KernelPreload
 from app.ui.kernel_warmup import CLUMPED_HAIR_STEP, RASTER_STEP, RENDER_HAIR_STEP
@@ -114,6 +115,7 @@ class MainWindow(QMainWindow):
         self._build_animation_ui()
         self._build_part2_menus()
         self.selection = SelectionUI(self)
+        self.habit_actions = install_habits(self)  # numpad views, N / T, Ctrl+Space, Help and F3
         self.setAcceptDrops(True)
         self.setDockOptions(
             QMainWindow.DockOption.AnimatedDocks
