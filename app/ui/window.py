@@ -52,6 +52,7 @@ from app.ui.status_line import ElidedLabel, StatusLine
 from app.ui.stroke_files import StrokeFiles
 from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
+from app.ui.up_axis_guess import with_inferred_up_axis
 from app.ui.viewport import BRUSH_STEP, Viewport
 from app.ui.widgets import WheelGuard, keep_controls_put
 from hairtool import io, samples, serial_twins
@@ -789,11 +790,14 @@ class MainWindow(QMainWindow):
                 if capture is not None:  # a BVH: its key poses are edited by IK
                     self.capture.attach(capture, str(path))
         else:
+            obj, said = with_inferred_up_axis(path, obj)
             hair, guides = split_guides(obj)
             if guides is None:
                 self.set_groom(obj, path, mesh)
             else:
                 self._open_with_guides(hair, guides, path, mesh)
+            if said is not None:
+                self.statusBar().showMessage(said, 10_000)
         self._add_recent(path)
         return True
 
