@@ -125,7 +125,10 @@ class MoveEngine(QObject):
         except BaseException as e:  # handed to the GUI thread, raised there
             batch.error = e
         batch.done.set()
-        self._finished.emit(batch)
+        try:
+            self._finished.emit(batch)
+        except RuntimeError:  # the window closed meanwhile, its scene and this engine with it
+            pass
 
     def _apply(self, batch: Batch) -> None:
         pipeline, tool = self.scene.pipeline, self.scene.tool

@@ -8,9 +8,11 @@ vertex nearest to it on screen within the brush circle, of a front-facing strand
 faces only"; the groom's centre when the circle holds none), so that a brush reaches the hair the
 artist sees in a 3-D view, not the middle of the head; the mouse's motion
 between two moves on that plane is the brush's direction (comb), the camera's ray through the
-cursor its view (front faces only), and every move runs the frozen-hair pipeline. The view is
-told what changed by the scene's signals and uploads it at the next paint (positions only while
-dragging).
+cursor its view (front faces only), and every move runs the frozen-hair pipeline, in the
+engine's worker thread (:mod:`app.ui.engine_thread`). The view is told what changed by the
+scene's signals and uploads it at the next paint (positions only while dragging); a paint for
+the overlays alone (the circle, the sizing ring, the box) copies the last image instead of
+drawing the strands again (:mod:`app.render.last_image`), so the cursor keeps the input's rate.
 
 A pen (tablet events) does what the mouse does, with its pressure (:attr:`Viewport.pressure`,
 1 for a mouse) given to the brush. F / Shift+F (:attr:`Viewport.sizing`,
