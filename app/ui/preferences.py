@@ -33,17 +33,19 @@ from hairtool.errors import ParameterError
 GROUP = "preferences"
 THEMES = ("dark", "light")
 #: Shortcuts of the habit actions (:mod:`app.ui.habits`) per preset. Maya's own keys where they
-#: do not collide with the studio's brush keys: 1 and 3 are Maya's display-smoothness keys, so
-#: its preset leaves the views to the menu and F3; Shift+F is Maya's frame selected in all views,
-#: Ctrl+A its attribute editor, Ctrl+Space its hide-the-interface.
+#: do not collide with the studio's: 1 and 3 are Maya's display-smoothness keys, so its preset
+#: leaves the views to the menu and F3; its F / Shift+F (frame selected) are the studio's brush
+#: sizing, so frame selected stays on the numpad's period; Ctrl+A is its attribute editor,
+#: Ctrl+Space its hide-the-interface.
 KEYMAPS: dict[str, dict[str, str]] = {
     "blender": {
-        "front": "1", "back": "Ctrl+1", "right": "3", "left": "Ctrl+3", "top": "7", "bottom": "Ctrl+7",
+        "front": "1", "back": "Ctrl+Num+1", "right": "3", "left": "Ctrl+Num+3", "top": "7",
+        "bottom": "Ctrl+Num+7",
         "selected": "Num+.", "sidebar": "N", "timeline": "T", "maximise": "Ctrl+Space", "search": "F3",
     },
     "maya": {
         "front": "", "back": "", "right": "", "left": "", "top": "", "bottom": "",
-        "selected": "Shift+F", "sidebar": "Ctrl+A", "timeline": "Alt+T", "maximise": "Ctrl+Space",
+        "selected": "Num+.", "sidebar": "Ctrl+A", "timeline": "Alt+T", "maximise": "Ctrl+Space",
         "search": "F3",
     },
 }  # fmt: skip

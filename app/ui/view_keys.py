@@ -1,5 +1,6 @@
 """Blender's view keys: the numpad's front (1), right (3) and top (7) views, Ctrl for the
-opposite side, and the period to frame the selection.
+opposite side (on the numpad only: Ctrl+1…4 of the main row pick the animation's view mode),
+and the numpad's period to frame the selection.
 
 The views are the DCCs' own: front looks along the groom's forward axis (−z of a Y-up groom, +y
 of a Z-up one), right looks at the groom's right side, top looks down. A view keeps the camera's
@@ -28,11 +29,11 @@ VIEWS = {
 #: (menu label, view, key), in the order of the View menu: Blender's numpad keys.
 VIEW_KEYS = (
     ("&Front", "front", "1"),
-    ("Bac&k", "back", "Ctrl+1"),
+    ("Bac&k", "back", "Ctrl+Num+1"),
     ("&Right", "right", "3"),
-    ("&Left", "left", "Ctrl+3"),
+    ("&Left", "left", "Ctrl+Num+3"),
     ("&Top", "top", "7"),
-    ("&Bottom", "bottom", "Ctrl+7"),
+    ("&Bottom", "bottom", "Ctrl+Num+7"),
 )
 
 

@@ -122,3 +122,18 @@ def test_the_shortcut_sheet_lists_every_shortcut_of_the_menus(window):
         assert keys in sheet
     assert ("Help ▸ Search actions…", "F3") in rows
     assert ("View ▸ Maximise view", "Ctrl+Space") in rows
+
+
+@pytest.mark.parametrize("keymap", ["blender", "maya"])
+def test_no_two_actions_share_a_shortcut_in_either_keymap(window, keymap):
+    from PySide6.QtGui import QAction
+
+    from app.ui.preferences import Preferences, apply
+
+    apply(window, Preferences(keymap=keymap))
+    seen: dict[str, str] = {}
+    for a in window.findChildren(QAction):
+        for k in a.shortcuts():
+            text = k.toString()
+            assert text not in seen or seen[text] == a.text(), f"{text}: {seen.get(text)} and {a.text()}"
+            seen[text] = a.text()

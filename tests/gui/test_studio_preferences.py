@@ -76,7 +76,7 @@ def test_each_preference_is_at_work_in_the_window(make_window, settings_path):
     w = make_window(groom=samples.scalp(strands=80, vertices=8))
     prefs_mod.apply(w, Preferences(keymap="maya", theme="light", autosave_minutes=3.0))
     keys = {name: [k.toString() for k in a.shortcuts()] for name, a in w.habit_actions.items()}
-    assert keys["front"] == [] and keys["selected"] == ["Shift+F"] and keys["sidebar"] == ["Ctrl+A"]
+    assert keys["front"] == [] and keys["selected"] == ["Num+."] and keys["sidebar"] == ["Ctrl+A"]
     light = w.palette().color(QPalette.ColorRole.Window).lightness()
     assert w.project.timer.interval() == 180_000
     prefs_mod.apply(w, Preferences())
@@ -109,7 +109,7 @@ def test_the_dialog_stores_and_applies_what_it_says(make_window, monkeypatch):
         keymap="maya", brush_size=0.3, cache_folder="/tmp/kernels", autosave_minutes=7.0
     )
     assert w.project.timer.interval() == 7 * 60_000
-    assert w.habit_actions["selected"].shortcuts()[0].toString() == "Shift+F"
+    assert w.habit_actions["sidebar"].shortcuts()[0].toString() == "Ctrl+A"
 
 
 def test_the_cache_folder_is_used_from_the_next_start_unless_the_environment_names_one(scratch, monkeypatch):
