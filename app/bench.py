@@ -2,8 +2,10 @@
 
 ``python -m app.bench [--json]`` (or ``hairtool-studio --bench``). Each row is one groom: the
 sample grooms and a 5,000 strands × 20 vertices scalp. A real window with a real GL viewport
-receives a left-drag of QMouseEvents; per move we time the event (the frozen-hair pipeline runs
-in the handler) plus a synchronous paintGL with glFinish after upload and after draw, so the
+receives a left-drag of QMouseEvents; per move we time the event plus a synchronous paintGL
+with glFinish after upload and after draw (``cursor_ms``: the frame with the brush circle where
+the mouse is, while the frozen-hair pipeline runs in its worker thread, :mod:`app.ui.engine_thread`),
+then until the move's result has landed and is drawn (``total_ms``), so the
 draw time is the GPU's (llvmpipe's) real time; Qt's compositing of the widget onto the screen
 is not included. Numbers are medians over the moves; ``p90_total_ms`` the 90th percentile,
 ``first_move_ms`` the first move after the press (with ``--json``, ``move_ms`` lists every move).
@@ -228,10 +230,14 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     send_mouse(v, "press", path[0], left, left)
     v.draw_now()  # the first update compiles kernels and allocates: not timed
     totals, pipeline, upload, draw, stages, children, cpu, redone = [], [], [], [], [], [], [], []
+    cursor = []
     for p in path[1:]:
         t0, c0 = time.perf_counter(), time.process_time()
         send_mouse(v, "move", p, None, left)
-        v.draw_now()
+        v.draw_now()  # the frame with the circle where the mouse is (the engine runs meanwhile)
+        cursor.append((time.perf_counter() - t0) * 1e3)
+        window.scene.moves.drain()
+        v.draw_now()  # the frame with the move's result
         totals.append((time.perf_counter() - t0) * 1e3)
         cpu.append((time.process_time() - c0) * 1e3)
         pipeline.append(window.scene.last_update_ms)
@@ -263,6 +269,8 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
         "moves": len(totals),
         "clump": clump,
         "total_ms": statistics.median(totals),
+        "cursor_ms": statistics.median(cursor),
+        "p90_cursor_ms": float(np.percentile(cursor, 90)),
         "pipeline_ms": statistics.median(pipeline),
         "upload_ms": statistics.median(upload),
         "draw_ms": statistics.median(draw),

@@ -83,6 +83,11 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 2
+    from PySide6.QtCore import QSettings
+
+    from app.ui.cache_folder import use_preferred_cache_folder
+
+    use_preferred_cache_folder(QSettings("hairtool", "Hairtool Studio"))  # before numba is imported
     from app.surface import configure_gl
 
     configure_gl()

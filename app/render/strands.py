@@ -498,13 +498,15 @@ class StrandRenderer:
         camera: Camera,
         size: tuple[int, int],
         samples: int | None = None,
+        overlays: bool = True,
     ) -> None:
         """Clear ``fbo`` to the background and draw mesh, strands and overlay at ``size`` pixels
         (CPU strands over a bare background write every pixel instead of a clear, leaving the
         depth buffer as it was: nothing after them is depth-tested).
 
         ``samples``: the framebuffer's samples per pixel where ``fbo.samples`` does not know them
-        (moderngl reports 0 for framebuffers it did not make, such as Qt's).
+        (moderngl reports 0 for framebuffers it did not make, such as Qt's). ``overlays`` False
+        leaves them out (a view keeps the image without them: :meth:`render_overlays`).
         """
         w, h = int(size[0]), int(size[1])
         if w <= 0 or h <= 0:
@@ -540,9 +542,17 @@ class StrandRenderer:
             else:
                 self.programs[method]["u_use_flat_color"].value = False
                 self._draw(method, self._main, ghost=False)
+        ctx.disable(moderngl.DEPTH_TEST)
+        if overlays:
+            self.render_overlays(fbo, (w, h))
+
+    def render_overlays(self, fbo: moderngl.Framebuffer, size: tuple[int, int]) -> None:
+        """The symmetry outline and the brush circle over what ``fbo`` holds (``size`` pixels)."""
+        fbo.use()
+        self.ctx.viewport = (0, 0, int(size[0]), int(size[1]))
+        self.ctx.disable(moderngl.DEPTH_TEST)
         self.outline.render()
         self.overlay.render()
-        ctx.disable(moderngl.DEPTH_TEST)
 
     def _set_uniforms(self, method: str, mvp: NDArray, size: tuple[int, int], width: float) -> None:
         prog = self.programs[method]

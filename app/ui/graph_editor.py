@@ -33,6 +33,7 @@ from PySide6.QtWidgets import (
     QDockWidget,
     QHBoxLayout,
     QLabel,
+    QSizePolicy,
     QSpinBox,
     QToolTip,
     QVBoxLayout,
@@ -585,6 +586,8 @@ class GraphEditorDock(QDockWidget):
         self.vertex.setToolTip("The vertex along the strand, from the root (0); tip: the last one")
         self.strand.valueChanged.connect(self._pick_vertex)
         self.vertex.valueChanged.connect(self._pick_vertex)
+        # a long title gives way instead of widening the window past a laptop's screen
+        self.title.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         top = QHBoxLayout()
         top.addWidget(self.title, 1)
         self.per_channel = QCheckBox("Per-channel keys")

@@ -19,6 +19,7 @@ from PySide6.QtCore import QObject, QTimer, Signal
 
 from app.render.ramps import DEFAULT_RAMP
 from app.ui.brush_tool import LABELS, SIGNED, BrushTool, check_falloff
+from app.ui.engine_thread import MoveEngine
 from hairtool.errors import HairtoolError, ParameterError
 from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, facing_away, scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
@@ -111,6 +112,8 @@ class Scene(QObject):
         self._prepare_timer = QTimer(self)
         self._prepare_timer.setSingleShot(True)
         self._prepare_timer.timeout.connect(self.prepare_strokes)
+        # a stroke's moves run in a worker thread; whatever else uses the pipeline drains it first
+        self.moves = MoveEngine(self, self)
         self._set_groom(groom)
 
     # -- strands -----------------------------------------------------------------------
@@ -122,6 +125,7 @@ class Scene(QObject):
         return self.pipeline
 
     def _set_groom(self, groom: Groom) -> None:
+        self.moves.drain()
         if self.engine_ready:
             self.result: Groom = self._new_pipeline(groom, self._surface()).result
         else:
@@ -213,6 +217,7 @@ class Scene(QObject):
             raise ParameterError("up axis", axis, "Y or Z")
         if axis == self.up_axis:
             return
+        self.moves.drain()
         rest = self.rest.with_metadata(self.rest.metadata.with_(up_axis=axis))
         self.rest = rest
         if self.pipeline is None:
@@ -230,6 +235,7 @@ class Scene(QObject):
 
     def align(self, cursor: np.ndarray) -> Groom:
         """One mouse move of the align tool: align → freeze → clump, timed in ms."""
+        self.moves.drain()
         self.start_engine()
         t0 = time.perf_counter()
         self.result = self.pipeline.align(
@@ -265,6 +271,7 @@ class Scene(QObject):
         ``start``: the stroke's first move; ``pressure`` a pen's (1 for a mouse). A move the
         engine refuses (a delete that would leave no strand) changes nothing and says why
         (``refused``)."""
+        self.moves.drain()
         self.start_engine()
         plane = self.mirror_plane_x()
         samples = self.tool.samples(cursor, direction, view, plane, invert, start, pressure)
@@ -280,6 +287,7 @@ class Scene(QObject):
 
     def apply_samples(self, samples: list) -> None:
         """Samples of any brush (a replayed stroke log) in one pipeline call."""
+        self.moves.drain()
         self._stroke_step(lambda: self.pipeline.apply_samples(samples))
 
     def stroke_refusal(self) -> str | None:
@@ -334,6 +342,7 @@ class Scene(QObject):
     def selection_step(self, sample: SelectionSample) -> bool:
         """One selection step (:class:`~hairtool.frozen.selection.SelectionSample`: select all,
         box, hide …) through the pipeline; False, logging nothing, where it changes nothing."""
+        self.moves.drain()
         self.start_engine()
         p = self.pipeline
         away = None if sample.view is None else facing_away(p.strand_normals, sample.view)
@@ -357,12 +366,14 @@ class Scene(QObject):
         After brush-local moves (a stroke just released) the whole groom is clumped once more
         first (:meth:`~hairtool.frozen.pipeline.FrozenPipeline.settle`), so what is kept is what
         a replay gives."""
+        self.moves.drain()
         self.start_engine()
         if self.pipeline.unsettled:
             self._stroke_step(self.pipeline.settle)
         return self.pipeline.snapshot()
 
     def restore(self, snap: object) -> None:
+        self.moves.drain()
         self._stroke_step(lambda: self.pipeline.restore(snap))
 
     # -- render hair ---------------------------------------------------------------------
@@ -615,6 +626,7 @@ class Scene(QObject):
         return self._params
 
     def set_params(self, params: FrozenParams) -> None:
+        self.moves.drain()
         if params == self._params:
             return
         if not self.engine_ready:  # kept for the engine when it starts
@@ -776,6 +788,7 @@ class Scene(QObject):
         """A new head mesh is also the surface the brushes slide on, plant on and collide with
         (strokes are replayed on it; strokes that need a head keep the last one when the mesh is
         cleared)."""
+        self.moves.drain()
         if self.pipeline is None or getattr(self.pipeline.surface, "mesh", None) is self.mesh:
             return
         surface = self._surface()

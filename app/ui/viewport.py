@@ -8,9 +8,11 @@ vertex nearest to it on screen within the brush circle, of a front-facing strand
 faces only"; the groom's centre when the circle holds none), so that a brush reaches the hair the
 artist sees in a 3-D view, not the middle of the head; the mouse's motion
 between two moves on that plane is the brush's direction (comb), the camera's ray through the
-cursor its view (front faces only), and every move runs the frozen-hair pipeline. The view is
-told what changed by the scene's signals and uploads it at the next paint (positions only while
-dragging).
+cursor its view (front faces only), and every move runs the frozen-hair pipeline, in the
+engine's worker thread (:mod:`app.ui.engine_thread`). The view is told what changed by the
+scene's signals and uploads it at the next paint (positions only while dragging); a paint for
+the overlays alone (the circle, the sizing ring, the box) copies the last image instead of
+drawing the strands again (:mod:`app.render.last_image`), so the cursor keeps the input's rate.
 
 A pen (tablet events) does what the mouse does, with its pressure (:attr:`Viewport.pressure`,
 1 for a mouse) given to the brush. F / Shift+F (:attr:`Viewport.sizing`,
@@ -42,6 +44,7 @@ from PySide6.QtOpenGLWidgets import QOpenGLWidget
 
 from app.render.camera import Camera
 from app.render.drawn import Drawn
+from app.render.last_image import LastImage
 from app.render.offscreen import Overlays
 from app.render.screen_pick import nearest_on_screen
 from app.render.strands import StrandRenderer, default_strand_raster
@@ -99,6 +102,9 @@ class Viewport(QOpenGLWidget):
         self.last_upload_ms = 0.0
         self.last_draw_ms = 0.0
         self._dirty = {"groom", "colors", "display", "mesh"}
+        self.last_image: LastImage | None = None  # the scene drawn last, without its overlays
+        self._scene_stale = True  # something other than an overlay changed since the last paint
+        self.scene_draws = 0  # paints that drew the scene (the others copied the last image)
         self._drag: str | None = None  # "align" | "orbit" | "pan" while a button is held
         self._drag_button = Qt.MouseButton.NoButton
         self._last_pos = QPointF()
@@ -134,13 +140,23 @@ class Viewport(QOpenGLWidget):
         scene.display_changed.connect(lambda: self._mark("display", "colors"))
         scene.mesh_changed.connect(lambda: self._mark("mesh"))
         scene.drawn_changed.connect(lambda: self._mark("groom", "colors"))
-        scene.tool_changed.connect(self.update)
+        scene.tool_changed.connect(self.update_overlays)  # the brush's circle, the symmetry plane
         scene.mask_changed.connect(lambda: self._mark("colors"))
         scene.selection_changed.connect(self._on_selection_changed)
         scene.engine_started.connect(self._on_engine_started)
         scene.up_axis_changed.connect(self._on_up_axis_changed)
 
     # -- scene → view ----------------------------------------------------------------------
+    def update(self, *args) -> None:
+        """Repaint, drawing the scene again (QWidget.update's arguments)."""
+        self._scene_stale = True
+        super().update(*args)
+
+    def update_overlays(self) -> None:
+        """Repaint the overlays only (the circle, the sizing ring, the box): over the last image,
+        at the input's rate, unless something else asked for the scene meanwhile."""
+        super().update()
+
     def _mark(self, *what: str) -> None:
         self._dirty.update(what)
         self.update()
@@ -241,6 +257,7 @@ class Viewport(QOpenGLWidget):
     def initializeGL(self) -> None:
         self.ctx = moderngl.create_context()
         self.renderer = StrandRenderer(self.ctx)
+        self.last_image = LastImage(self.ctx)
         if not self.raster_ready:  # the CPU rasterizer's kernels are still compiling
             self.renderer.strand_raster = "gl"
         self._dirty = {"groom", "colors", "display", "mesh"}
@@ -343,16 +360,27 @@ class Viewport(QOpenGLWidget):
         if self.renderer is None:
             return
         t0 = time.perf_counter()
-        self._upload()
+        dpr = self.devicePixelRatioF()
+        w, h = max(1, round(self.width() * dpr)), max(1, round(self.height() * dpr))
+        cam = self.camera
+        key = (w, h, cam.view_matrix().tobytes(), cam.projection_matrix(w / h).tobytes())
+        redraw = self._scene_stale or bool(self._dirty) or not self.last_image.holds(key)
+        self._scene_stale = False
+        if redraw:
+            self._upload()
         if self.finish_frames:
             self.ctx.finish()
         t1 = time.perf_counter()
-        dpr = self.devicePixelRatioF()
-        w, h = max(1, round(self.width() * dpr)), max(1, round(self.height() * dpr))
         self._overlay(w, h)
         # Qt's framebuffer id changes on every resize: look it up each time, never draw to 0.
         fbo = self.ctx.detect_framebuffer(self.defaultFramebufferObject())
-        self.renderer.render(fbo, self.camera, (w, h), samples=self.samples)
+        if redraw:
+            self.renderer.render(fbo, cam, (w, h), samples=self.samples, overlays=False)
+            self.last_image.keep(fbo, (w, h), self.samples, key)
+            self.scene_draws += 1
+        else:
+            self.last_image.put(fbo)
+        self.renderer.render_overlays(fbo, (w, h))
         if self.finish_frames:
             self.ctx.finish()
         t2 = time.perf_counter()
@@ -386,6 +414,7 @@ class Viewport(QOpenGLWidget):
             self.makeCurrent()
             self.renderer.release()
             self.renderer = None
+            self.last_image.release()
             self.doneCurrent()
 
     # -- box select ----------------------------------------------------------------------------
@@ -535,6 +564,7 @@ class Viewport(QOpenGLWidget):
             self._stroke_depth = self.hair_under(event.position())
             self._stroke_invert = bool(event.modifiers() & Qt.KeyboardModifier.ControlModifier)
             self.stroke_touched = False
+            self.scene.moves.begin()
             self.stroke_started.emit()
             self.scene.set_dragging(True)  # children at the drag display percentage
             self._brush_at(event.position())
@@ -548,7 +578,7 @@ class Viewport(QOpenGLWidget):
         self.pressure = pen_pressure(event)
         if self.sizing.active:
             self.sizing.move(pos)
-            self.update()
+            self.update_overlays()
             return
         dx, dy = pos.x() - self._last_pos.x(), pos.y() - self._last_pos.y()
         self._last_pos = pos
@@ -557,7 +587,7 @@ class Viewport(QOpenGLWidget):
         elif self._drag == "align" and self._drag_target is not None:
             self._drag_target.move(self._cursor_at(pos))
         elif self._drag == "align":
-            self._brush_at(pos)
+            self._brush_at(pos)  # the strands follow when the engine's result lands
         elif self._drag == "box" and self._box is not None:
             self._box[1] = pos
         elif self._drag == "orbit":
@@ -568,7 +598,10 @@ class Viewport(QOpenGLWidget):
             self.camera.pan(dx, dy, self.height())
         else:
             self.cursor_moved.emit(self.cursor_on_plane(pos))
-        self.update()
+        if self._drag in ("orbit", "pan") or self._drag_target is not None:
+            self.update()
+        else:  # the circle or the box moved: drawn over the last image
+            self.update_overlays()
 
     def _cursor_at(self, pos: QPointF, through: np.ndarray | None = None) -> np.ndarray:
         cursor = self.cursor_on_plane(pos, through)
@@ -607,10 +640,8 @@ class Viewport(QOpenGLWidget):
         last, self._stroke_cursor = self._stroke_cursor, cursor
         direction = np.zeros(3) if last is None else cursor - last
         view = self.view_at(pos)
-        touched = self.scene.brush_move(
-            cursor, direction, view, self._stroke_invert, not self.stroke_touched, last is None, self.pressure
-        )
-        self.stroke_touched = self.stroke_touched or touched
+        # the engine runs it off this thread (app.ui.engine_thread): the circle moves on now
+        self.scene.moves.move(cursor, direction, view, self._stroke_invert, last is None, self.pressure)
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         if self._from_pen(event):
@@ -628,6 +659,8 @@ class Viewport(QOpenGLWidget):
             target.end()
         elif drag == "align" and self._stroke_before is not None:
             before, self._stroke_before = self._stroke_before, None
+            self.scene.moves.drain()  # every move of the stroke has run
+            self.stroke_touched = self.scene.moves.touched
             # the whole groom settled first (snapshot), so the full-density render hair is
             # built (and clumped) once, from the settled guides, not once before and once after
             after = self.scene.snapshot()
@@ -641,10 +674,11 @@ class Viewport(QOpenGLWidget):
             return
         if event.modifiers() & Qt.KeyboardModifier.ControlModifier:
             self.scale_brush(BRUSH_STEP**steps)
+            self.update_overlays()
         else:
             self._auto_frame = False
             self.camera.zoom(steps)
-        self.update()
+            self.update()
         event.accept()
 
     def scale_brush(self, factor: float) -> None:
@@ -655,4 +689,4 @@ class Viewport(QOpenGLWidget):
             self._pen_down = False  # (a pen lifted where its release never reached the view)
         self._hover = None
         self.cursor_moved.emit(None)
-        self.update()
+        self.update_overlays()

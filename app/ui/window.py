@@ -38,6 +38,7 @@ from app.ui.colouring import displacement_scale
 from app.ui.commands import MeshCommand, ParamCommand, RenderHairCommand, StrokeCommand, UpAxisCommand
 from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
+from app.ui.habits import install_habits
 from app.ui.jobs import Job, JobRunner, JobStatus
 from app.ui.kernel_preload import KernelPreload
 from app.ui.kernel_warmup import CLUMPED_HAIR_STEP, RASTER_STEP, RENDER_HAIR_STEP
@@ -51,6 +52,7 @@ from app.ui.status_line import ElidedLabel, StatusLine
 from app.ui.stroke_files import StrokeFiles
 from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
+from app.ui.up_axis_guess import with_inferred_up_axis
 from app.ui.viewport import BRUSH_STEP, Viewport
 from app.ui.widgets import WheelGuard, keep_controls_put
 from hairtool import io, samples, serial_twins
@@ -114,6 +116,7 @@ class MainWindow(QMainWindow):
         self._build_animation_ui()
         self._build_part2_menus()
         self.selection = SelectionUI(self)
+        self.habit_actions = install_habits(self)  # numpad views, N / T, Ctrl+Space, Help and F3
         self.setAcceptDrops(True)
         self.setDockOptions(
             QMainWindow.DockOption.AnimatedDocks
@@ -792,11 +795,14 @@ class MainWindow(QMainWindow):
                 if capture is not None:  # a BVH: its key poses are edited by IK
                     self.capture.attach(capture, str(path))
         else:
+            obj, said = with_inferred_up_axis(path, obj)
             hair, guides = split_guides(obj)
             if guides is None:
                 self.set_groom(obj, path, mesh)
             else:
                 self._open_with_guides(hair, guides, path, mesh)
+            if said is not None:
+                self.statusBar().showMessage(said, 10_000)
         self._add_recent(path)
         return True
 

@@ -38,6 +38,7 @@ FORMATS: tuple[Format, ...] = (
     Format("USD BasisCurves", (".usda", ".usdc", ".usd"), "usd", animated=True),
     Format("hairtool cache", (".npz",), "npz", animated=True),
     Format("Wavefront OBJ polylines", (".obj",), "obj"),
+    Format("USC-HairSalon strands", (".data",), "usc_data"),
 )
 
 

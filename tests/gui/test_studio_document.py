@@ -156,6 +156,8 @@ def test_up_axis_switch_for_a_z_up_hair_file(ui, make_window, tmp_path):
     w = make_window()
     assert w.open_path(path), w.errors
     s, v = w.scene, w.viewport
+    assert s.up_axis == "Z"  # inferred: her roots lie above her tips along Z
+    w.up_axis_actions["Y"].trigger()  # overridden (and switched back below)
     assert s.up_axis == "Y" and w.up_axis_actions["Y"].isChecked()
 
     def crown_above_tips() -> float:

@@ -47,6 +47,7 @@ def test_a_comb_move_uploads_the_strands_it_moved_and_the_buffer_is_a_whole_uplo
     per_move = []
     for k in range(1, 7):
         ui.send_mouse(v, "move", start + k * np.array([10.0, 2.0]), None, left)
+        s.moves.drain()  # the move's result (the engine runs it off the GUI thread)
         before_draw = sum(sent)
         v.draw_now()  # each move's frame, as the screen would show it
         per_move.append(sum(sent) - before_draw)
