@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import sys
 from collections.abc import Iterator
 from types import ModuleType
 
@@ -63,6 +64,27 @@ def local_workers(requested: int | None) -> int:
 
 
 @contextlib.contextmanager
+def _workers_write_no_tracebacks() -> Iterator[None]:
+    """fd 2 pointed at /dev/null while the local cluster starts its worker processes, which
+    inherit it. Ctrl+C in the terminal reaches the whole process group: a worker then raises
+    KeyboardInterrupt wherever it is (importing, or running a job), and its traceback must not
+    stand beside the command's one "interrupted" line. A worker has nothing else to say on fd 2:
+    its logs are silenced (:data:`LOCAL_LOG_LEVEL`) and a job's output comes back as its result.
+    (Ignoring SIGINT while the workers start, which they would inherit too, would lose a Ctrl+C
+    pressed meanwhile in this process.)"""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 2)
+    os.close(devnull)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+@contextlib.contextmanager
 def open_client(scheduler: str | None = None, workers: int | None = None) -> Iterator[object]:
     """A ``distributed.Client``: connected to ``scheduler`` (``tcp://HOST:PORT``), or to a local
     cluster of ``workers`` processes with one thread each, started here and closed on exit."""
@@ -82,7 +104,8 @@ def open_client(scheduler: str | None = None, workers: int | None = None) -> Ite
             client.close()
         return
     n = local_workers(workers)
-    with dask.config.set({"distributed.scheduler.allowed-failures": ALLOWED_FAILURES - 1, **QUIET_WORKERS}):
+    config = {"distributed.scheduler.allowed-failures": ALLOWED_FAILURES - 1, **QUIET_WORKERS}
+    with dask.config.set(config), _workers_write_no_tracebacks():
         try:
             cluster = distributed.LocalCluster(
                 n_workers=n,

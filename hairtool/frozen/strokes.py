@@ -85,8 +85,8 @@ from hairtool.frozen.brushes import (
 )
 from hairtool.frozen.pipeline import AlignSample
 from hairtool.frozen.selection import SelectionSample, check_selection
+from hairtool.io import user_text
 from hairtool.io.atomic import atomic_open
-from hairtool.io.text_limits import check_text
 
 MAX_LOG_BYTES = 256 * 1024**2
 
@@ -391,16 +391,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke | SelectionStep:
 def read_strokes(path: str | os.PathLike[str]) -> list[Stroke | SelectionStep]:
     """A stroke log file; :class:`FormatError` naming the file and the bad entry."""
     p = Path(path)
-    try:
-        if p.stat().st_size > MAX_LOG_BYTES:
-            raise FormatError(p, f"larger than {MAX_LOG_BYTES >> 20} MB: not a stroke log")
-        text = p.read_text(encoding="utf-8")
-        check_text(p, text, "json", "a stroke log")  # before the parser recurses or converts
-        data = json.loads(text)
-    except FormatError:
-        raise
-    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as e:
-        raise FormatError(p, f"not a readable stroke log ({type(e).__name__}: {e})") from None
+    data = user_text.read(p, "a stroke log", "json", MAX_LOG_BYTES)  # every user text limit
     if isinstance(data, dict) and isinstance(data.get("strokes"), list):
         data = data["strokes"]
     if not isinstance(data, list):
