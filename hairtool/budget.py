@@ -5,7 +5,7 @@ walked, neighbour entries, Gram tables, decoded arrays) and calls :func:`check` 
 limit it refuses in one line naming the parameter or file, the size and the limit, instead of
 asking the machine for 25 GiB or running for minutes. The limits fit a laptop (a command stays
 under about 1.5 GB and 20 s of CPU); a bigger machine raises all of them together with the
-command line's ``--budget FACTOR`` (or ``HAIRTOOL_BUDGET=FACTOR`` in the environment, which
+command line's ``--raise-limits FACTOR`` (or ``HAIRTOOL_BUDGET=FACTOR`` in the environment, which
 a batch's child commands inherit).
 """
 
@@ -41,22 +41,17 @@ LIMITS: dict[str, Limit] = {
         "candidate points a brush or a planting step draws at once: 20 million (480 MB as "
         "float64 xyz) is 40 times the densest groom a studio brush makes in one stroke",
     ),
-    "cells": Limit(
-        5e7,
-        "grid cells",
-        "grid cells a brush or a neighbour search walks: a compiled loop visits about 50 million "
-        "empty cells a second, so the walk stays near one second however large the radius",
-    ),
     "pairs": Limit(
-        5e7,
+        4e7,
         "neighbour pairs",
-        "neighbour entries a search may hold: 50 million pairs (400 MB of int32 pairs and "
-        "float32 distances) is 20 times what clumping the bear fur (48,113 strands) needs",
+        "neighbour entries a search may hold: 16 bytes each (the forward and backward lists and "
+        "their map), so 40 million take 640 MB, the most that fits beside the groom itself",
     ),
-    "dp": Limit(
-        2e9,
-        "segment costs",
-        "segment costs a key search evaluates: 2·10⁹ compiled steps is about 10 s of CPU",
+    "steps": Limit(
+        5e9,
+        "steps",
+        "steps of a compiled loop over pairs (density's candidates against those accepted, "
+        "its thinning): about 10⁹ simple steps a second, so about 5 s of CPU",
     ),
 }
 
@@ -79,7 +74,7 @@ def factor() -> float:
 def set_factor(value: float) -> None:
     """Raise (or lower) every limit by ``value`` for this process and the commands it starts."""
     if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
-        raise BudgetError(f"--budget={value!r} is invalid: expected a positive factor")
+        raise BudgetError(f"--raise-limits={value!r} is invalid: expected a positive factor")
     os.environ[ENV] = repr(float(value))
 
 
@@ -107,7 +102,7 @@ def check(kind: str, size: float, what: str) -> None:
     unit = LIMITS[kind].unit
     shown = "more than can be counted" if not math.isfinite(size) else _size(size, unit)
     raise BudgetError(
-        f"{what} needs {shown}; the limit is {_size(lim, unit)} (raise it with --budget FACTOR)"
+        f"{what} needs {shown}; the limit is {_size(lim, unit)} (raise it with hairtool --raise-limits FACTOR)"
     )
 
 

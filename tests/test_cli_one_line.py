@@ -1,5 +1,5 @@
 """The command line's own edges, each one line on stderr (issue 45): argparse errors, a full or
-closed stdout, Ctrl+C at any moment (the Dask workers' included), the ``--budget`` flag."""
+closed stdout, Ctrl+C at any moment (the Dask workers' included), the ``--raise-limits`` flag."""
 
 from __future__ import annotations
 
@@ -43,7 +43,7 @@ def _one_line(err: bytes) -> str:
         (["keys"], "required"),
         (["info", "a", "--frobnicate"], "unrecognized arguments"),
         (["frobnicate"], "invalid choice"),
-        (["--budget", "many", "info", "a"], "invalid float value"),
+        (["--raise-limits", "many", "info", "a"], "invalid float value"),
     ],
 )
 def test_argparse_errors_are_one_line(args, words):

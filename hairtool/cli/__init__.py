@@ -91,7 +91,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"hairtool {__version__}")
     parser.add_argument(
-        "--budget",
+        "--raise-limits",
         metavar="FACTOR",
         type=float,
         help="multiply every work and memory limit by FACTOR, for a machine bigger than a laptop "
@@ -110,10 +110,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        if args.budget is not None:
+        if args.raise_limits is not None:
             from hairtool import budget
 
-            budget.set_factor(args.budget)
+            budget.set_factor(args.raise_limits)
         return int(args._run(args) or EXIT_OK)
     except HairtoolError as e:
         print(f"hairtool {args.command}: error: {e}", file=sys.stderr)

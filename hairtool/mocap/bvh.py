@@ -300,7 +300,9 @@ def _frame_count(path: str, text: str) -> int:
         raise FormatError(path, f"Frames: '{text[:40]}' is not a number") from None
     if not (math.isfinite(v) and v >= 1 and v == math.floor(v)):
         raise FormatError(path, f"Frames: {text[:40]} is not a positive whole number")
-    return int(text) if text.isdigit() else int(v)  # digits: exact even beyond 2^53
+    # Digits: exact even beyond 2^53, leading zeros dropped first (a finite v has at most 309
+    # digits left; Python's int() refuses more than 4,300 however small the value).
+    return int(text.lstrip("0")) if text.isdigit() else int(v)
 
 
 def read_bvh(path: str | os.PathLike[str]) -> Motion:
