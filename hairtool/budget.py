@@ -102,7 +102,8 @@ def check(kind: str, size: float, what: str) -> None:
     unit = LIMITS[kind].unit
     shown = "more than can be counted" if not math.isfinite(size) else _size(size, unit)
     raise BudgetError(
-        f"{what} needs {shown}; the limit is {_size(lim, unit)} (raise it with hairtool --raise-limits FACTOR)"
+        f"{what} needs {shown}; the limit is {_size(lim, unit)} "
+        "(raise it with hairtool --raise-limits FACTOR)"
     )
 
 

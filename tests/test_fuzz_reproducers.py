@@ -320,3 +320,55 @@ def test_a_small_npz_is_refused_before_it_inflates(tmp_path):
     _inflating_npz(p, 800 * 1024**2 // 24)
     assert p.stat().st_size < 1_000_000
     _refused("info", p, words="member 'frames.npy' (inflated) needs 2.34 GiB; the limit is 1 GiB")
+
+
+# -- numpy's warnings before our line ------------------------------------------------------------
+HUGE_XFORM = """#usda 1.0
+def Xform "head" (
+)
+{
+    double3 xformOp:scale = (1e300, 1e300, 1e300)
+    uniform token[] xformOpOrder = ["xformOp:scale"]
+    def BasisCurves "hair"
+    {
+        int[] curveVertexCounts = [2]
+        point3f[] points = [(0, 0, 0), (0, 1e30, 0)]
+    }
+    def Mesh "scalp"
+    {
+        int[] faceVertexCounts = [3]
+        int[] faceVertexIndices = [0, 1, 2]
+        point3f[] points = [(0, 0, 0), (1e30, 0, 0), (0, 1e30, 0)]
+    }
+}
+"""
+
+
+def test_an_overflowing_transform_is_one_line_and_no_warning(tmp_path):
+    import warnings
+
+    from hairtool.io import read
+    from hairtool.io.usd_mesh import read_mesh
+
+    p = tmp_path / "huge.usda"
+    p.write_text(HUGE_XFORM)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(FormatError, match="finite"):
+            read(p)
+        with pytest.raises(FormatError, match="not a finite float32"):
+            read_mesh(p)
+
+
+def test_a_selection_box_through_an_overflowing_camera_warns_nothing():
+    import warnings
+
+    from hairtool import samples
+    from hairtool.frozen.selection import in_box
+
+    g = samples.scalp(10, 4, seed=1)
+    camera = np.full((4, 4), 1e308)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        picked = in_box(g, camera, (-1.0, -1.0, 1.0, 1.0))
+    assert picked.shape == (10,) and picked.dtype == bool

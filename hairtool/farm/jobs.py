@@ -23,7 +23,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from hairtool.errors import FormatError
+from hairtool.errors import FormatError, quoted
 from hairtool.io import user_text
 
 #: Commands a job may not run: a batch inside a worker would start a cluster of its own, and a
@@ -137,7 +137,8 @@ def _fill(path: Path, where: str, arg: str, values: dict[str, str]) -> str:
         name = m.group(1)
         if name not in values:
             valid = ", ".join("{" + p + "}" for p in PLACEHOLDERS)
-            raise FormatError(path, f"{where}: unknown placeholder {{{name}}} in {arg!r} (valid: {valid})")
+            shown = quoted("{" + name + "}")
+            raise FormatError(path, f"{where}: unknown placeholder {shown} in {quoted(arg)} (valid: {valid})")
         return values[name]
 
     return _TEMPLATE.sub(replace, arg)

@@ -558,7 +558,8 @@ class _Curves:
             m = np.asarray(m, dtype=np.float64)
             if not np.all(np.isfinite(m)):
                 raise FormatError(self.path, f"{self.name} has a non-finite transform")
-            p = (p.astype(np.float64) @ m[:3, :3] + m[3, :3]).astype(np.float32)
+            with np.errstate(over="ignore", invalid="ignore"):  # checked just below, as one line
+                p = (p.astype(np.float64) @ m[:3, :3] + m[3, :3]).astype(np.float32)
         require_finite(self.path, p, f"{self.name} points")
         return p
 
