@@ -80,8 +80,9 @@ def test_a_closed_pipe_is_quiet_and_141():
 
 # Delays from the start: Python's own start-up (about the first 0.1 s here, before any line of
 # hairtool runs) is out of a program's reach; from there on: the command line's modules, numpy
-# and numba, the command modules. (usd-core may swallow an interrupt inside its plugin loading
-# and go on: the command then still ends in 130, not 0, from the recorded interrupt.)
+# and numba, the command modules, the read and the write. (usd-core may swallow an interrupt
+# inside its plugin loading and go on: the command then still ends in 130, not 0, from the
+# recorded interrupt; a USD file is not the input here for that reason.)
 DELAYS = (0.25, 0.5, 0.9, 1.4)
 
 
@@ -89,7 +90,7 @@ DELAYS = (0.25, 0.5, 0.9, 1.4)
 def test_ctrl_c_at_any_moment_is_one_line_and_130(delay, tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     p = subprocess.Popen(
-        [sys.executable, "-m", "hairtool", "convert", DATA / "interop" / "b.usda", tmp_path / "o.usdc"],
+        [sys.executable, "-m", "hairtool", "convert", DATA / "grooms" / "bear.tfx", tmp_path / "o.npz"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env,
     )  # fmt: skip
     time.sleep(delay)
@@ -131,16 +132,16 @@ def test_ctrl_c_during_a_batch_is_one_line_from_the_command_alone(shots, delay):
 
 def test_budget_limits_name_what_asked_and_rise_with_the_factor(monkeypatch):
     monkeypatch.delenv(budget.ENV, raising=False)
-    lim = budget.limit("cells")
-    budget.check("cells", lim, "radius=1")
-    words = r"radius=1e\+06 needs 5e\+09 grid cells; the limit is 5e\+07"
+    lim = budget.limit("steps")
+    budget.check("steps", lim, "radius=1")
+    words = r"radius=1e\+06 needs 5e\+11 steps; the limit is 5e\+09 steps"
     with pytest.raises(budget.BudgetError, match=words):
-        budget.check("cells", 5e9, "radius=1e+06")
+        budget.check("steps", 5e11, "radius=1e+06")
     for bad in (float("inf"), float("nan")):
         with pytest.raises(budget.BudgetError, match="more than can be counted"):
-            budget.check("cells", bad, "radius")
+            budget.check("steps", bad, "radius")
     budget.set_factor(1000)
-    budget.check("cells", 5e9, "radius=1e+06")
+    budget.check("steps", 5e11, "radius=1e+06")
     with pytest.raises(budget.BudgetError, match="positive factor"):
         budget.set_factor(float("nan"))
     assert all(limit.reason for limit in budget.LIMITS.values())

@@ -58,11 +58,11 @@ def _parser(command: str, cls: type[argparse.ArgumentParser], **kwargs) -> argpa
 
 class OneLineParser(argparse.ArgumentParser):
     """argparse's parser whose usage errors are one line (``hairtool keys: error: argument
-    --keys: invalid int value: 'x' (see --help)``) and exit 2, not the usage block."""
+    --keys: invalid int value: 'x'``) and exit 2, not the usage block."""
 
     def error(self, message: str):
         one = " ".join(message.split("\n"))
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {one} (see {self.prog} --help)\n")
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {one}\n")
 
 
 @functools.cache
