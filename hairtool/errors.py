@@ -46,3 +46,13 @@ class GroomError(HairtoolError, ValueError):
 class Cancelled(Exception):
     """Raised inside a long call once its ``cancelled()`` callback turned True (a studio job's
     Cancel button, a superseded job): the work stops and its result is dropped."""
+
+
+def quoted(text: object, limit: int = 60) -> str:
+    """A user's string as a message shows it: quoted and escaped as ``repr`` does (a newline or
+    control character in a joint, channel or field name stays ``\\n``, so one line stays one
+    line), cut to ``limit`` characters with ``…``. The one way messages print user strings."""
+    s = text if isinstance(text, str) else str(text)
+    if len(s) > limit:
+        return repr(s[:limit])[:-1] + "…" + repr(s[:limit])[-1]
+    return repr(s)

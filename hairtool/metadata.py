@@ -153,7 +153,9 @@ class Metadata:
                 raise ParameterError("transform", "an entry", "(prim path, 16 numbers)") from None
             if not isinstance(path, str) or not path.startswith("/"):
                 raise ParameterError("transform path", path, "an absolute prim path")
-            if not np.all(np.isfinite(m)) or abs(np.linalg.det(m[:3, :3])) < 1e-12 or np.any(m[:3, 3] != 0):
+            with np.errstate(all="ignore"):  # a determinant past float64 is refused, not warned of
+                det = float(np.linalg.det(m[:3, :3])) if np.all(np.isfinite(m)) else np.nan
+            if not (np.isfinite(det) and abs(det) >= 1e-12) or np.any(m[:3, 3] != 0):
                 raise ParameterError("transform", path, "a finite, invertible affine 4×4 (row vectors)")
             xforms.append((path, tuple(float(v) for v in m.reshape(-1))))
         if len({p for p, _ in xforms}) != len(xforms):

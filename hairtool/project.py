@@ -45,7 +45,7 @@ from hairtool.frozen.sample_columns import ColumnError, read_columns, write_colu
 from hairtool.frozen.selection import SelectionSample, check_selection
 from hairtool.groom import Animation, Groom
 from hairtool.guides.binding import MAX_FRIZZ, ChildBinding, bind_exactly, curl
-from hairtool.io import text_limits
+from hairtool.io import user_text
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import float32_finite, require_finite, require_strand_counts
 from hairtool.io.npz import read_npy_header
@@ -334,11 +334,7 @@ class _Reader:
         if info.file_size > MAX_MANIFEST_BYTES:
             raise FormatError(self.path, "manifest.json is too large")
         text = self.zf.read(MANIFEST).decode("utf-8")
-        text_limits.check_text(self.path, text, "json", "a project's manifest.json")  # before json recurses
-        try:
-            manifest = json.loads(text)
-        except json.JSONDecodeError as e:
-            raise FormatError(self.path, f"manifest.json is not JSON: {e}") from None
+        manifest = user_text.parse(self.path, text, "json", "a project's manifest.json")  # all text limits
         if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
             raise FormatError(self.path, "not a hairtool project (manifest has no project format)")
         version = manifest.get("version")

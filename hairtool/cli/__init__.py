@@ -8,6 +8,7 @@ Heavy imports belong inside ``run`` so that ``hairtool --help`` stays fast.
 from __future__ import annotations
 
 import argparse
+import errno
 import functools
 import importlib
 import os
@@ -15,9 +16,8 @@ import pkgutil
 import signal
 import sys
 from collections.abc import Sequence
-from importlib.metadata import entry_points
 
-from hairtool import __version__
+from hairtool import __version__, interrupts
 from hairtool.errors import HairtoolError
 
 EXIT_OK = 0
@@ -35,6 +35,8 @@ PLUGIN_GROUP = "hairtool.commands"
 
 def command_modules(package: str = __name__, group: str = PLUGIN_GROUP) -> dict[str, str]:
     """Command name → module: each public module of ``package``, then the ``group`` entry points."""
+    from importlib.metadata import entry_points  # 35 ms: not before the Ctrl+C handling
+
     here = importlib.import_module(package)
     names = [m.name for m in pkgutil.iter_modules(here.__path__) if not m.name.startswith("_")]
     found = {name: f"{package}.{name}" for name in names}
@@ -54,10 +56,19 @@ def _parser(command: str, cls: type[argparse.ArgumentParser], **kwargs) -> argpa
     return parser
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """argparse's parser whose usage errors are one line (``hairtool keys: error: argument
+    --keys: invalid int value: 'x'``) and exit 2, not the usage block."""
+
+    def error(self, message: str):
+        one = " ".join(message.split("\n"))
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {one}\n")
+
+
 @functools.cache
 def command_parser(command: str) -> argparse.ArgumentParser:
     """The argument parser of one ``hairtool`` command, as ``hairtool COMMAND`` builds it."""
-    return _parser(command, argparse.ArgumentParser)
+    return _parser(command, OneLineParser)
 
 
 class _RaisingParser(argparse.ArgumentParser):
@@ -74,11 +85,18 @@ def quiet_parser(command: str) -> argparse.ArgumentParser:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="hairtool",
         description="Hair strand grooms: read, convert, freeze, animate and key them.",
     )
     parser.add_argument("--version", action="version", version=f"hairtool {__version__}")
+    parser.add_argument(
+        "--raise-limits",
+        metavar="FACTOR",
+        type=float,
+        help="multiply every work and memory limit by FACTOR, for a machine bigger than a laptop "
+        "(the limits and their reasons: hairtool.budget)",
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, path in command_modules().items():
         module = importlib.import_module(path)
@@ -92,13 +110,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        if args.raise_limits is not None:
+            from hairtool import budget
+
+            budget.set_factor(args.raise_limits)
         return int(args._run(args) or EXIT_OK)
     except HairtoolError as e:
         print(f"hairtool {args.command}: error: {e}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
-        print(f"hairtool {args.command}: interrupted", file=sys.stderr)
-        return 130
+        return interrupts.report(f"hairtool {args.command}")
 
 
 def entry() -> None:
@@ -107,14 +128,25 @@ def entry() -> None:
     Python ignores SIGPIPE and raises BrokenPipeError at the write instead: caught here (after
     every ``with`` block of the command has removed its temporary files, which the signal's
     default action would leave behind), stdout is pointed at /dev/null so that the flush at
-    exit cannot report the pipe again, and the status is :data:`EXIT_BROKEN_PIPE`.
+    exit cannot report the pipe again, and the status is :data:`EXIT_BROKEN_PIPE`. A stdout
+    closed from the start (``>&-``) is the same pipe when something was printed; a full one
+    (``> /dev/full``) is one line and exit 2. Ctrl+C at any moment is one line and exit 130
+    (:mod:`hairtool.interrupts`, installed first).
     """
+    interrupts.install()  # before any command module imports numpy, numba or usd-core
+    closed = _ClosedStdout.replace()
     try:
         try:
             status = main()
         except SystemExit as e:  # argparse's --help, --version and usage errors
             status = e.code
+        if interrupts.was_interrupted() and status != interrupts.EXIT_INTERRUPTED:
+            status = interrupts.report("hairtool")  # swallowed on its way (usd-core's plugin loading)
         sys.stdout.flush()  # now, where a closed pipe can still be caught
+        if closed is not None and closed.wrote and status == EXIT_OK:
+            status = EXIT_BROKEN_PIPE  # its output went nowhere, as into a closed pipe
+    except KeyboardInterrupt:  # while the command modules were imported, or in the flush
+        status = interrupts.report("hairtool")
     except BrokenPipeError:
         for stream in (sys.stdout, sys.stderr):
             try:
@@ -124,4 +156,58 @@ def entry() -> None:
                 os.dup2(devnull, stream.fileno())
                 os.close(devnull)
         status = EXIT_BROKEN_PIPE
+    except OSError as e:
+        if e.errno not in _FULL:
+            raise
+        _quiet_stdout()  # a full disk or device behind stdout: one line, the output is not whole
+        reason = os.strerror(e.errno) if e.errno else str(e)
+        print(f"hairtool: error: cannot write the output: {reason}", file=sys.stderr)
+        status = EXIT_BAD_INPUT
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the command is over: its status stands
+    if status == interrupts.EXIT_INTERRUPTED:
+        interrupts.silence_stderr()  # its line is said: nothing the interrupted libraries' exit hooks print
     sys.exit(status)
+
+
+#: A write to stdout failed because where it goes is full (``hairtool info F > /dev/full``).
+_FULL = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+
+
+class _ClosedStdout:
+    """Stands for ``sys.stdout`` when the command started with fd 1 closed (``>&-``): Python
+    then sets ``sys.stdout`` to None. Writes are counted and dropped, and fd 1 is held on
+    /dev/null, so a file the command opens cannot take fd 1 and receive what was printed."""
+
+    def __init__(self) -> None:
+        self.wrote = False
+
+    def write(self, text: str) -> int:
+        self.wrote = self.wrote or bool(text)
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+    @classmethod
+    def replace(cls) -> _ClosedStdout | None:
+        if sys.stdout is not None:
+            return None
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        if devnull != 1:
+            os.dup2(devnull, 1)
+            os.close(devnull)
+        sys.stdout = stand_in = cls()
+        return stand_in
+
+
+def _quiet_stdout() -> None:
+    """Point fd 1 at /dev/null and drop what is buffered, so the flush at exit fails no more."""
+    if sys.stdout is None:
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    os.close(devnull)
+    sys.stdout = open(os.devnull, "w")

@@ -9,9 +9,12 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import sys
+import threading
 from collections.abc import Iterator
 from types import ModuleType
 
+from hairtool import interrupts
 from hairtool.errors import HairtoolError, ParameterError
 
 INSTALL_HINT = "pip install 'hairtool[farm]' (or pip install 'dask[distributed]')"
@@ -62,6 +65,50 @@ def local_workers(requested: int | None) -> int:
     return requested
 
 
+#: Seconds a worker's line waits before it is passed on: a Ctrl+C reaches this process and the
+#: workers at once, and what a worker prints after it must not follow the "interrupted" line.
+HOLD_S = 0.3
+
+
+def _forward(read_fd: int) -> None:
+    """Pass what the workers write on to this process's stderr, each piece after
+    :data:`HOLD_S`, and nothing once an interrupt has arrived."""
+    import time
+
+    with os.fdopen(read_fd, "rb", buffering=0) as pipe:
+        while chunk := pipe.read(65536):
+            time.sleep(HOLD_S)
+            if interrupts.was_interrupted():
+                continue  # drained, so no worker blocks on a full pipe
+            try:
+                os.write(2, chunk)
+            except OSError:
+                pass
+
+
+@contextlib.contextmanager
+def _workers_write_through_a_filter() -> Iterator[threading.Thread]:
+    """The workers' fd 2 is a pipe this process passes on (:func:`_forward`), set while the local
+    cluster starts its processes, which inherit it. Ctrl+C in the terminal reaches the whole
+    process group: a worker then raises KeyboardInterrupt wherever it is (importing, or running
+    a job), and its traceback must not stand beside the command's one "interrupted" line, while
+    the lines distributed lets through (CRITICAL) still reach the terminal. (Ignoring SIGINT
+    while the workers start, which they would inherit too, would lose a Ctrl+C pressed
+    meanwhile in this process.)"""
+    sys.stderr.flush()
+    read_fd, write_fd = os.pipe()
+    forward = threading.Thread(target=_forward, args=(read_fd,), name="hairtool-worker-stderr", daemon=True)
+    forward.start()
+    saved = os.dup(2)
+    os.dup2(write_fd, 2)
+    os.close(write_fd)
+    try:
+        yield forward  # ends once every worker has closed the pipe (join it after the cluster)
+    finally:
+        os.dup2(saved, 2)  # this process's own stderr again; the pipe stays the workers'
+        os.close(saved)
+
+
 @contextlib.contextmanager
 def open_client(scheduler: str | None = None, workers: int | None = None) -> Iterator[object]:
     """A ``distributed.Client``: connected to ``scheduler`` (``tcp://HOST:PORT``), or to a local
@@ -82,7 +129,8 @@ def open_client(scheduler: str | None = None, workers: int | None = None) -> Ite
             client.close()
         return
     n = local_workers(workers)
-    with dask.config.set({"distributed.scheduler.allowed-failures": ALLOWED_FAILURES - 1, **QUIET_WORKERS}):
+    config = {"distributed.scheduler.allowed-failures": ALLOWED_FAILURES - 1, **QUIET_WORKERS}
+    with dask.config.set(config), _workers_write_through_a_filter() as forward:
         try:
             cluster = distributed.LocalCluster(
                 n_workers=n,
@@ -102,3 +150,4 @@ def open_client(scheduler: str | None = None, workers: int | None = None) -> Ite
             client.close()
     finally:
         cluster.close()
+        forward.join(timeout=5.0)  # the workers' last lines passed on before the command goes on

@@ -20,12 +20,11 @@ import hashlib
 import json
 import os
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from hairtool.errors import FormatError
-from hairtool.io.text_limits import check_text
+from hairtool.errors import FormatError, quoted
+from hairtool.io import user_text
 
 #: Commands a job may not run: a batch inside a worker would start a cluster of its own, and a
 #: benchmark's numbers mean nothing on a shared worker.
@@ -113,25 +112,7 @@ def _parse(path: Path) -> object:
     suffix = path.suffix.lower()
     if suffix not in (".json", ".toml"):
         raise FormatError(path, "a jobs file is .json or .toml")
-    try:
-        if path.stat().st_size > MAX_JOBS_BYTES:
-            raise FormatError(path, f"larger than {MAX_JOBS_BYTES >> 20} MB: not a jobs file")
-        data = path.read_bytes()
-    except OSError as e:
-        raise FormatError(path, f"cannot read: {e.strerror or e}") from None
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise FormatError(path, "not UTF-8 text") from None
-    check_text(path, text, suffix[1:], "a jobs file")  # before the parsers recurse or convert
-    try:
-        return json.loads(text) if suffix == ".json" else tomllib.loads(text)
-    except json.JSONDecodeError as e:
-        raise FormatError(path, f"not valid JSON: {e.msg} (line {e.lineno}, column {e.colno})") from None
-    except tomllib.TOMLDecodeError as e:
-        raise FormatError(path, f"not valid TOML: {e}") from None
-    except (RecursionError, ValueError) as e:  # past the checks above only on a deep call stack
-        raise FormatError(path, f"not a readable jobs file ({type(e).__name__})") from None
+    return user_text.read(path, "a jobs file", suffix[1:], MAX_JOBS_BYTES)
 
 
 def _args(path: Path, where: str, value: object) -> list[str]:
@@ -156,7 +137,8 @@ def _fill(path: Path, where: str, arg: str, values: dict[str, str]) -> str:
         name = m.group(1)
         if name not in values:
             valid = ", ".join("{" + p + "}" for p in PLACEHOLDERS)
-            raise FormatError(path, f"{where}: unknown placeholder {{{name}}} in {arg!r} (valid: {valid})")
+            shown = quoted("{" + name + "}")
+            raise FormatError(path, f"{where}: unknown placeholder {shown} in {quoted(arg)} (valid: {valid})")
         return values[name]
 
     return _TEMPLATE.sub(replace, arg)

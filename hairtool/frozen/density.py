@@ -25,6 +25,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
+from hairtool import budget
+
 F64 = NDArray[np.float64]
 
 DARTS = 30  # candidates drawn per spacing-sized square of the disc's area
@@ -50,6 +52,8 @@ def _thin_kernel(roots, fixed, spacing, keep):  # pragma: no cover - compiled
 
 def thin(roots: np.ndarray, fixed: np.ndarray, spacing: float) -> np.ndarray:
     """``(R,)`` the roots kept (step 1 of the module docstring) (numba)."""
+    n = float(len(roots))
+    budget.check("steps", n * n, f"thinning {len(roots)} roots within the brush (spacing={spacing:g})")
     keep = np.empty(len(roots), np.bool_)
     _thin_kernel(np.ascontiguousarray(roots, np.float64), np.asarray(fixed, np.bool_), float(spacing), keep)
     return keep
@@ -108,6 +112,25 @@ def accept_reference(candidates: np.ndarray, roots: np.ndarray, spacing: float) 
     return out
 
 
+def candidate_count(radius: float, spacing: float) -> float:
+    """How many candidates :func:`disc_candidates` draws: the darts, and the grid's square
+    before it is cut to the disc (a float: inf or nan where the ratio overflows)."""
+    with np.errstate(all="ignore"):
+        ratio = np.float64(radius) / np.float64(spacing)
+        return float(DARTS * np.pi * ratio * ratio + (4.0 * ratio + 1.0) ** 2)
+
+
+def check_candidates(radius: float, spacing: float) -> None:
+    """Refuse (:class:`~hairtool.budget.BudgetError`) a radius and spacing whose candidates
+    would not fit the budget, before any is drawn: their points, and the acceptance loop, which
+    tests each candidate against those accepted before it (about candidates² / 2 steps)."""
+    what = f"density radius={radius:g}, spacing={spacing:g}"
+    c = candidate_count(radius, spacing)
+    budget.check("points", c, what)
+    budget.check_bytes(c * 8 * 3 * 4, what)  # uv, their 3-D points, projected, with normals
+    budget.check("steps", c * c / 2, what)
+
+
 def disc_candidates(centre: F64, normal: F64, radius: float, spacing: float, rng: np.random.Generator) -> F64:
     """Darts (uniform over the disc) then the grid of step spacing / 2, in the tangent plane at
     ``centre`` (to be moved onto the head)."""
@@ -115,6 +138,7 @@ def disc_candidates(centre: F64, normal: F64, radius: float, spacing: float, rng
     u = np.cross(normal, a)
     u /= np.linalg.norm(u)
     v = np.cross(normal, u)
+    check_candidates(radius, spacing)
     n_darts = int(np.ceil(DARTS * np.pi * radius * radius / (spacing * spacing)))
     r = radius * np.sqrt(rng.random(n_darts))
     t = 2.0 * np.pi * rng.random(n_darts)

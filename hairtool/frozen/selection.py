@@ -73,12 +73,13 @@ def in_box(groom: Groom, matrix, rect) -> np.ndarray:
     ``rect`` (either corner order)."""
     m = np.asarray(matrix, np.float64).reshape(4, 4)
     p = groom.points.astype(np.float64)
-    clip = p @ m[:3, :3].T + m[:3, 3]
-    w = p @ m[3, :3] + m[3, 3]
-    x0, y0, x1, y1 = (float(v) for v in rect)
-    ok = w > 1e-12
-    safe = np.where(ok, w, 1.0)
-    x, y = clip[:, 0] / safe, clip[:, 1] / safe
+    with np.errstate(all="ignore"):  # a huge camera overflows: inf and NaN fall outside the box
+        clip = p @ m[:3, :3].T + m[:3, 3]
+        w = p @ m[3, :3] + m[3, 3]
+        x0, y0, x1, y1 = (float(v) for v in rect)
+        ok = w > 1e-12
+        safe = np.where(ok, w, 1.0)
+        x, y = clip[:, 0] / safe, clip[:, 1] / safe
     inside = ok & (x >= min(x0, x1)) & (x <= max(x0, x1)) & (y >= min(y0, y1)) & (y <= max(y0, y1))
     if groom.strand_count == 0:
         return np.zeros(0, bool)

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from hairtool import budget
 from hairtool.bounds import box
 from hairtool.errors import GroomError, ParameterError
 from hairtool.serial_twins import twin_njit
@@ -508,6 +509,8 @@ class NeighbourList:
             base = np.zeros(room.size, np.int64)
             np.cumsum(room[:-1], out=base[1:])
             total = int(base[-1] + room[-1])
+            what = f"the clumping neighbour search of {v} vertices (clump_radius={self.radius:g})"
+            budget.check("pairs", total, what)  # before the lists' room is asked for
             if self.aflat.size < total:
                 self.aflat = np.empty(int(total * 1.25), np.int32)
             used = np.empty(room.size, np.int64)

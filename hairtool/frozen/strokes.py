@@ -99,8 +99,8 @@ from hairtool.frozen.sample_schema import (
     sample_type,
 )
 from hairtool.frozen.selection import SelectionSample, check_selection
+from hairtool.io import user_text
 from hairtool.io.atomic import atomic_open
-from hairtool.io.text_limits import check_text
 
 MAX_LOG_BYTES = 256 * 1024**2
 
@@ -441,16 +441,7 @@ def read_strokes(path: str | os.PathLike[str]) -> list[Stroke | SelectionStep]:
         names the file and the entry (``strokes[3]``).
     """
     p = Path(path)
-    try:
-        if p.stat().st_size > MAX_LOG_BYTES:
-            raise FormatError(p, f"larger than {MAX_LOG_BYTES >> 20} MB: not a stroke log")
-        text = p.read_text(encoding="utf-8")
-        check_text(p, text, "json", "a stroke log")  # before the parser recurses or converts
-        data = json.loads(text)
-    except FormatError:
-        raise
-    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as e:
-        raise FormatError(p, f"not a readable stroke log ({type(e).__name__}: {e})") from None
+    data = user_text.read(p, "a stroke log", "json", MAX_LOG_BYTES)  # every user text limit
     if isinstance(data, dict) and isinstance(data.get("strokes"), list):
         data = data["strokes"]
     if not isinstance(data, list):

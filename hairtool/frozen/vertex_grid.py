@@ -489,7 +489,8 @@ class VertexGrid:
         """Flag in ``mark`` ((S,) bool) the strands with a vertex of ``points`` (where the grid
         holds them) closer than ``radius`` to one of ``queries`` ((n, 3))."""
         q = np.asarray(queries, np.float64).reshape(-1, 3)
-        r2 = float(radius) ** 2
+        radius = _within_reach(points, q, float(radius), self.cell)
+        r2 = radius**2
         grid = (self.inv, self.shift, self.key, self.head, self.nxt, mark)
         if len(q) == 1 and _cells_within(q[0], float(radius), self.cell) <= self.vertex_count:
             x, y, z = float(q[0, 0]), float(q[0, 1]), float(q[0, 2])
@@ -522,6 +523,23 @@ class VertexGrid:
             if most < cap - 1:
                 return flat, cnt, cap
             self.reserve(most)
+
+
+#: Radii beyond this many cells are cut to the points' reach (:func:`_within_reach`).
+_FAR_CELLS = 1024.0
+
+
+def _within_reach(points: np.ndarray, queries: np.ndarray, radius: float, cell: float) -> float:
+    """``radius``, or where it reaches far beyond the grid (1e6 walked empty cells for 20 s,
+    1e200 overflowed its square) the same answer's radius: twice the diagonal of the box
+    around the points and the queries, which every distance between them is within."""
+    if radius <= _FAR_CELLS * cell:
+        return radius
+    with np.errstate(all="ignore"):
+        lo = np.minimum(points.min(axis=0, initial=np.inf), queries.min(axis=0))
+        hi = np.maximum(points.max(axis=0, initial=-np.inf), queries.max(axis=0))
+        reach = 2.0 * float(np.linalg.norm((hi - lo).astype(np.float64))) + cell
+    return min(radius, reach) if np.isfinite(reach) else radius
 
 
 def _cells_within(q: np.ndarray, radius: float, cell: float) -> int:

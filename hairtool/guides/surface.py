@@ -79,14 +79,38 @@ def _closest_kernel(points, vertices, faces, out, face_of):
                 face_of[k] = f
 
 
+def usable_faces(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Indices of the faces with an area: a degenerate face (``f 1 1 4``, common in real heads,
+    or three points on a line) has none, and the closest-point kernels would divide by its zero
+    edge or area. Skipping it loses nothing: its points lie on its neighbours' edges."""
+    v = np.asarray(vertices, np.float64)
+    f = np.asarray(faces, np.int64)
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    area2 = np.einsum("ij,ij->i", *(2 * [np.cross(b - a, c - a)]))
+    return np.flatnonzero(area2 > 0)
+
+
+def finite_points(points: np.ndarray, what: str = "points") -> np.ndarray:
+    """``points`` as a float64 ``(P, 3)`` array, or a :class:`ParameterError` where one is not
+    finite (no kernel is asked where NaN is closest)."""
+    pts = np.ascontiguousarray(points, np.float64).reshape(-1, 3)
+    if not np.all(np.isfinite(pts)):
+        raise ParameterError(what, "a non-finite point", "finite coordinates")
+    return pts
+
+
 def closest_points(mesh: Mesh, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(P, 3)`` float64 closest points on the mesh and ``(P,)`` the face of each (every face
-    tried: meant for guide roots, a few thousand at most)."""
-    pts = np.ascontiguousarray(points, np.float64)
+    with an area tried: meant for guide roots, a few thousand at most)."""
+    pts = finite_points(points)
     out = np.empty_like(pts)
     face_of = np.empty(len(pts), np.int64)
-    _closest_kernel(pts, mesh.vertices.astype(np.float64), mesh.faces.astype(np.int64), out, face_of)
-    return out, face_of
+    keep = usable_faces(mesh.vertices, mesh.faces)
+    if keep.size == 0:
+        raise ParameterError("mesh", "a mesh whose every face is degenerate", "a triangle with an area")
+    faces = mesh.faces.astype(np.int64)[keep]
+    _closest_kernel(pts, mesh.vertices.astype(np.float64), faces, out, face_of)
+    return out, keep[face_of]
 
 
 def edge_graph(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -427,15 +451,19 @@ class MeshSurface:
         self._v = mesh.vertices.astype(np.float64)
         self._n = mesh.normals.astype(np.float64)
         self._f = mesh.faces.astype(np.int64)
+        self._keep = usable_faces(self._v, self._f)  # the kernels see these; ids map back
+        if self._keep.size == 0:
+            raise ParameterError("scalp", "a mesh whose every face is degenerate", "a triangle with an area")
+        self._kf = np.ascontiguousarray(self._f[self._keep])
         lo, hi = self._v.min(axis=0), self._v.max(axis=0)
         self.cell = max(float((hi - lo).max()) / GRID_CELLS, 1e-12)
         self.lo = lo - self.cell  # one cell of margin around the mesh
         self.dims = (np.floor((hi - self.lo) / self.cell).astype(np.int64) + 2).clip(1, None)
         self._start = np.zeros(int(np.prod(self.dims)) + 1, np.int64)
-        _bin_faces(self._v, self._f, self.lo, self.cell, self.dims, self._start, np.zeros(0, np.int64))
+        _bin_faces(self._v, self._kf, self.lo, self.cell, self.dims, self._start, np.zeros(0, np.int64))
         np.cumsum(self._start, out=self._start)
         self._items = np.empty(int(self._start[-1]), np.int64)
-        _bin_faces(self._v, self._f, self.lo, self.cell, self.dims, self._start, self._items)
+        _bin_faces(self._v, self._kf, self.lo, self.cell, self.dims, self._start, self._items)
         self._rings = np.empty(int(np.prod(self.dims)), np.int64)
         _empty_rings_kernel(self._start, self.dims, self._rings)
 
@@ -443,15 +471,15 @@ class MeshSurface:
         """:func:`closest_points` through the grid of faces (the same bytes): ``(P, 3)`` points
         and ``(P,)`` faces, face −1 (and NaN points) for points outside the mesh's box (plus a
         cell), which lie outside the head."""
-        pts = np.ascontiguousarray(points, np.float64)
+        pts = finite_points(points)
         out = np.full_like(pts, np.nan)
-        face_of = np.empty(len(pts), np.int64)
+        face_of = np.full(len(pts), -1, np.int64)
         kernel = _grid_closest_serial if len(pts) < SERIAL_POINTS else _grid_closest_kernel
         kernel(
-            pts, self._v, self._f, self.lo, self.cell, self.dims, self._start, self._items, self._rings,
+            pts, self._v, self._kf, self.lo, self.cell, self.dims, self._start, self._items, self._rings,
             out, face_of,
         )
-        return out, face_of
+        return out, np.where(face_of >= 0, self._keep[face_of], -1)
 
     def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(P, 3)`` float64 closest points on the mesh and ``(P, 3)`` unit normals there."""

@@ -21,8 +21,9 @@ from hairtool.errors import FormatError
 
 #: Deepest nesting of lists and objects a document may have (jobs files need 4, stroke logs 5).
 MAX_DEPTH = 64
-#: Longest run of digits outside strings: no count, index, coordinate or argument needs more
-#: (float64 keeps 17 significant digits; an int64 has 19).
+#: Longest run of digits outside strings, in any base (TOML's ``0x``, ``0o`` and ``0b``
+#: integers too): no count, index, coordinate or argument needs more (float64 keeps 17
+#: significant digits; an int64 has 19 decimal or 16 hex digits).
 MAX_DIGITS = 40
 #: Most parts of a TOML dotted key or table name (``[a.b.c]``): a jobs file needs one.
 MAX_KEY_PARTS = 16
@@ -33,7 +34,9 @@ _JSON_STRINGS = re.compile(r'"(?:[^"\\\x00-\x1f]|\\.)*"')
 _TOML_LONG = re.compile(r'"""(?:[^\\]|\\.)*?"""{0,2}|\'\'\'.*?\'\'\'\'{0,2}', re.S)
 _TOML_SHORT = re.compile(r'"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'|#[^\n]*')
 _NOT_BRACKET = re.compile(r"[^\[\]{}]+")
-_LONG_DIGITS = re.compile(rf"\d[\d_]{{{MAX_DIGITS},}}")
+# A token that starts with a digit: decimal runs, and hex, octal or binary integers after their
+# prefix (letters are hex digits there), all counted.
+_LONG_DIGITS = re.compile(rf"\d\w{{{MAX_DIGITS},}}")
 # A bare or (emptied) quoted key part, then more than MAX_KEY_PARTS - 1 dotted ones.
 _KEY_PART = r'(?:[\w-]+|"")'
 _LONG_KEY = re.compile(rf"{_KEY_PART}(?:[ \t]*\.[ \t]*{_KEY_PART}){{{MAX_KEY_PARTS},}}")
@@ -76,7 +79,8 @@ def check_text(
     m = _LONG_DIGITS.search(structure)
     if m is not None:
         line = structure.count("\n", 0, m.start()) + 1
-        digits = len(m.group()) - m.group().count("_")
+        token = m.group()
+        digits = len(token) - token.count("_") - (2 if token[:2].lower() in ("0x", "0o", "0b") else 0)
         raise FormatError(
             path, f"line {line}: a number of {digits} digits; {what} holds none longer than {MAX_DIGITS}"
         )

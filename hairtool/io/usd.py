@@ -52,7 +52,7 @@ import numpy as np
 from hairtool.bounds import box
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom, Topology
-from hairtool.io import usd_basis, usda_check, usdc_check
+from hairtool.io import usd_basis, usd_layers, usda_check, usdc_check
 from hairtool.io.atomic import atomic_path
 from hairtool.io.binary import require_finite, require_strand_counts
 from hairtool.metadata import PURPOSES, CurvesPrim, Metadata, join_attributes
@@ -384,6 +384,7 @@ def _open_stage(path: Path):
             layer = Sdf.Layer.FindOrOpen(str(path))
         if layer is not None:
             _check_specs(path, layer)
+            usd_layers.check_dependencies(path, layer)  # no FIFO or device for usd-core to follow
         stage = Usd.Stage.Open(layer) if layer is not None else None
     except Tf.ErrorException as e:
         raise FormatError(path, f"usd-core cannot open it: {_last_line(e)}") from None
@@ -560,7 +561,8 @@ class _Curves:
             m = np.asarray(m, dtype=np.float64)
             if not np.all(np.isfinite(m)):
                 raise FormatError(self.path, f"{self.name} has a non-finite transform")
-            p = (p.astype(np.float64) @ m[:3, :3] + m[3, :3]).astype(np.float32)
+            with np.errstate(over="ignore", invalid="ignore"):  # checked just below, as one line
+                p = (p.astype(np.float64) @ m[:3, :3] + m[3, :3]).astype(np.float32)
         require_finite(self.path, p, f"{self.name} points")
         return p
 

@@ -51,7 +51,8 @@ def _prim_mesh(path: Path, prim, xforms) -> tuple[np.ndarray, np.ndarray, np.nda
         m = np.asarray(m, np.float64)
         if not np.all(np.isfinite(m)):
             raise FormatError(path, f"{name} has a non-finite transform")
-        p = p @ m[:3, :3] + m[3, :3]
+        with np.errstate(over="ignore", invalid="ignore"):  # checked just below, as one line
+            p = p @ m[:3, :3] + m[3, :3]
     if not np.all(np.isfinite(p)) or (p.size and np.abs(p).max() > np.finfo(np.float32).max):
         raise FormatError(path, f"{name} has a point that is not a finite float32")
     return p, sizes, idx

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from hairtool.errors import FormatError
+from hairtool.io.text_limits import nesting_depth
 
 MAGIC = b"#usda"
 #: Files smaller than this are not scanned (usd-core parses them in under ~100 MB).
@@ -31,6 +32,10 @@ FLOOR = 1 << 16
 #: More braces than this (no real stage has them; usd-core stops at a stray one) and the prims
 #: are not told apart: every curve array is counted against the file's largest points array.
 MAX_BRACES = 1 << 22
+#: Deepest nesting of prims, dictionaries and arrays: usd-core's parse and composition of a
+#: 20,000-deep stage ran for minutes (each prim's path as long as its depth); real stages nest
+#: a few dozen levels (a character's skeleton under its rig under its asset).
+MAX_DEPTH = 512
 #: The attributes of a curves prim the reader sizes from its points, by name.
 CURVE_ARRAYS = (
     "curveVertexCounts",
@@ -107,12 +112,23 @@ def _blocks(text: bytes) -> list[tuple[int, int]]:
 
 
 def check(path: Path) -> None:
-    """Raise FormatError when a curves prim's array holds more values than its points can use."""
+    """Raise FormatError when a curves prim's array holds more values than its points can use,
+    or when the layer nests deeper than :data:`MAX_DEPTH` (any size of file)."""
     with open(path, "rb") as f:
-        if f.read(len(MAGIC)) != MAGIC or f.seek(0, 2) < MIN_SCAN_BYTES:
+        if f.read(len(MAGIC)) != MAGIC:
             return
+        size = f.seek(0, 2)
         f.seek(0)
         text = _SKIP.sub(b'""', f.read())
+    depth = nesting_depth(text.decode("latin-1"))  # strings and comments emptied above
+    if depth > MAX_DEPTH:
+        raise FormatError(
+            path,
+            f"nested {depth} levels deep; a stage nests at most {MAX_DEPTH} (refused before usd-core "
+            "parses it)",
+        )
+    if size < MIN_SCAN_BYTES:
+        return
     blocks = _blocks(text)
     if not blocks:
         return

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from hairtool import budget
 from hairtool.errors import ParameterError
 from hairtool.keys.gram import centered_gram, check_gram, frame_curvature
 from hairtool.keys.segment_fit import fit_table, fit_table_reference
@@ -22,17 +23,21 @@ F64 = NDArray[np.float64]
 #: linear (seed 000), Hermite with data tangents (seed 003), Hermite with fitted tangents
 INTERPOLATIONS = ("linear", "hermite", "hermite-fit")
 OBJECTIVES = ("total", "worst")
-#: A segment table of n frames holds n² float64 (and the DP a copy): beyond 4 GiB, refuse.
-MAX_TABLE_BYTES = 4 * 1024**3
+#: What a key search of n frames holds at once, in n × n float64 tables: the Gram matrix, the
+#: segment table and the DP's copy of it. The frames are refused when these exceed the budget's
+#: memory (:mod:`hairtool.budget`): a 22,750-frame capture (8.5 MB) asked for 3.9 GiB each.
+TABLES = 3
 
 
 def check_frame_count(n: int) -> int:
-    """``n`` when its n × n table fits :data:`MAX_TABLE_BYTES`, else one clear error (a hostile
+    """``n`` when its n × n tables fit the budget's memory, else one clear error (a hostile
     616-byte file can hold 50,000 frames of zeros, whose table alone is 18.6 GiB)."""
-    most = int((MAX_TABLE_BYTES / 8) ** 0.5)
+    most = int((budget.limit("memory") / (8 * TABLES)) ** 0.5)
     if n > most:
-        gib = 8.0 * n * n / 1024**3
-        raise ParameterError("frames", n, f"at most {most} frames at once (a table of {gib:.1f} GiB)")
+        gib = 8.0 * TABLES * n * n / 1024**3
+        raise ParameterError(
+            "frames", n, f"at most {most} frames at once (tables of {gib:.1f} GiB; hairtool --raise-limits)"
+        )
     return n
 
 

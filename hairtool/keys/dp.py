@@ -298,6 +298,10 @@ def select_keys(
             raise ParameterError("keys", value, f"{counts}{why}")
     elif not np.isfinite(value) or value < 0:
         raise ParameterError(mode, value, "a finite number >= 0")
+    elif mode == "penalty" and not np.isfinite(float(value) * 2.0 * n):
+        # n keys' prices and the errors beside them must sum to a number: past that every
+        # choice costs inf, no comparison decides, and the search runs without end
+        raise ParameterError("penalty", value, f"a price at most {np.finfo(np.float64).max / (2.0 * n):.3g}")
     if not np.isfinite(curve_keys) or int(curve_keys) != curve_keys or curve_keys < 0:
         raise ParameterError("curve_keys", curve_keys, "a whole number >= 0 (0: no curve)")
 

@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import FormatError, ParameterError
 from hairtool.groom import Animation
+from hairtool.io import user_text
 from hairtool.io.atomic import atomic_open
 
 FORMAT = "hairtool keys"
@@ -162,19 +163,7 @@ def read_keys_json(path: str | os.PathLike[str]) -> dict:
     Records written before the format field existed (``hairtool keys --out`` of version 0.1)
     are accepted when their keys, frames and fps are valid.
     """
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        raise FormatError(path, f"cannot read: {e}") from None
-    try:
-        record = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise FormatError(path, f"not JSON: {e}") from None
-    except RecursionError:
-        raise FormatError(path, "not a keys record: JSON nested too deeply") from None
-    except ValueError:  # Python refuses integers of more than 4,300 digits
-        raise FormatError(path, "not a keys record: it holds a number thousands of digits long") from None
+    record = user_text.read(path, "a keys record", "json", max_depth=MAX_NESTING)  # all text limits
     if not isinstance(record, dict):
         raise FormatError(path, "a keys record is a JSON object")
     if _nesting(record) > MAX_NESTING:

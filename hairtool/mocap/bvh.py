@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from hairtool.errors import FormatError, ParameterError
+from hairtool.errors import FormatError, ParameterError, quoted
 from hairtool.io.atomic import atomic_open
 from hairtool.mocap import quaternion as quat
 
@@ -213,18 +213,18 @@ class _Tokens:
     def expect(self, word: str) -> None:
         w = self.next(f"'{word}'")
         if w != word:
-            raise FormatError(self.path, f"expected '{word}', found '{w[:40]}'")
+            raise FormatError(self.path, f"expected '{word}', found {quoted(w, 40)}")
 
     def number(self, what: str) -> float:
         w = self.next(what)
         try:
             v = float(w)
         except ValueError:
-            raise FormatError(self.path, f"{what} is not a number: '{w[:40]}'") from None
+            raise FormatError(self.path, f"{what} is not a number: {quoted(w, 40)}") from None
         if not math.isfinite(v):
-            raise FormatError(self.path, f"{what} is not finite: '{w[:40]}'")
+            raise FormatError(self.path, f"{what} is not finite: {quoted(w, 40)}")
         if abs(v) > MAX_VALUE:
-            raise FormatError(self.path, f"{what} is beyond ±{MAX_VALUE:.2g}: '{w[:40]}'")
+            raise FormatError(self.path, f"{what} is beyond ±{MAX_VALUE:.2g}: {quoted(w, 40)}")
         return v
 
 
@@ -276,7 +276,7 @@ def _parse_hierarchy(tok: _Tokens, path: str):
     open_joints = [open_joint(-1)]
     while open_joints:
         me = open_joints[-1]
-        w = tok.next(f"'}}' closing joint '{names[me]}'")
+        w = tok.next(f"'}}' closing joint {quoted(names[me])}")
         if w == "}":
             open_joints.pop()
         elif w == "JOINT":
@@ -285,10 +285,10 @@ def _parse_hierarchy(tok: _Tokens, path: str):
             tok.expect("Site")
             tok.expect("{")
             end_parents.append(me)
-            end_offsets.append(offset(f"the End Site of '{names[me]}'"))
+            end_offsets.append(offset(f"the End Site of {quoted(names[me])}"))
             tok.expect("}")
         else:
-            raise FormatError(path, f"unexpected '{w[:40]}' inside joint '{names[me]}'")
+            raise FormatError(path, f"unexpected {quoted(w, 40)} inside joint {quoted(names[me])}")
     return names, parents, offsets, channels, end_parents, end_offsets
 
 
@@ -297,10 +297,12 @@ def _frame_count(path: str, text: str) -> int:
     try:
         v = float(text)
     except ValueError:
-        raise FormatError(path, f"Frames: '{text[:40]}' is not a number") from None
+        raise FormatError(path, f"Frames: {quoted(text, 40)} is not a number") from None
     if not (math.isfinite(v) and v >= 1 and v == math.floor(v)):
-        raise FormatError(path, f"Frames: {text[:40]} is not a positive whole number")
-    return int(text) if text.isdigit() else int(v)  # digits: exact even beyond 2^53
+        raise FormatError(path, f"Frames: {quoted(text, 40)} is not a positive whole number")
+    # Digits: exact even beyond 2^53, leading zeros dropped first (a finite v has at most 309
+    # digits left; Python's int() refuses more than 4,300 however small the value).
+    return int(text.lstrip("0")) if text.isdigit() else int(v)
 
 
 def read_bvh(path: str | os.PathLike[str]) -> Motion:

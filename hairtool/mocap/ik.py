@@ -113,6 +113,16 @@ class _Pose:
         return pos, rot
 
 
+def _solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The damped step: ``a`` is symmetric positive semi-definite plus λ²·I, but λ² can vanish
+    beside its other entries (two joints turning the effector the same way make two equal
+    columns): then the least-squares step, never ``LinAlgError: Singular matrix``."""
+    try:
+        return np.linalg.solve(a, b)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(a, b, rcond=None)[0]
+
+
 def _check_target(target: ArrayLike) -> F64:
     t = np.asarray(target, dtype=np.float64)
     if t.shape != (3,) or not np.all(np.isfinite(t)):
@@ -179,10 +189,7 @@ def solve_dls(
         it += 1
         e = t - pe
         a = jac.T @ jac + (lam * lam) * np.eye(len(dofs))
-        try:
-            step = np.linalg.solve(a, jac.T @ e)
-        except np.linalg.LinAlgError:  # a chain that cannot move the effector (J ≈ 0): no step helps
-            step = np.linalg.lstsq(a, jac.T @ e, rcond=None)[0]
+        step = _solve(a, jac.T @ e)
         big = float(np.max(np.abs(step)))
         if big > _MAX_STEP_DEGREES:
             step *= _MAX_STEP_DEGREES / big

@@ -23,7 +23,6 @@ jump together, once, at the frame nearest the lock (:meth:`PoseEditor._track`).
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from dataclasses import asdict, dataclass
@@ -32,6 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import FormatError, ParameterError
+from hairtool.io import user_text
 from hairtool.keys.edit import check_retime, residual_at, time_warp
 from hairtool.keys.reconstruct import KeyPoses, check_keys, interpolate_at, key_poses
 from hairtool.mocap import ik
@@ -257,19 +257,7 @@ def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
 
 def read_json(path: str | os.PathLike[str]) -> object:
     """A JSON file's data; unreadable or invalid JSON raises :class:`FormatError` naming it."""
-    p = os.fspath(path)
-    try:
-        with open(p, "rb") as f:
-            raw = f.read()
-    except OSError as e:
-        raise FormatError(p, f"cannot read: {e.strerror or e}") from None
-    try:
-        data = json.loads(raw.decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise FormatError(p, f"not valid JSON ({str(e)[:80]})") from None
-    except RecursionError:
-        raise FormatError(p, "not valid JSON (nested too deep)") from None
-    return data
+    return user_text.read(path, "an edit file", "json")  # every user text limit, as jobs files get
 
 
 def apply_edits(editor, edits: list, method: str = "auto") -> list[EditReport]:

@@ -145,7 +145,7 @@ def test_every_existing_command_but_batch_and_bench_is_a_job():
         (
             "j.json",
             {"glob": "shots/*.npz", "command": "keys", "args": ["{stme}"]},
-            "unknown placeholder {stme}",
+            "unknown placeholder '{stme}'",
         ),
         ("j.json", {"jobs": [{"command": "keys", "args": ["a"]}] * 2}, "jobs[1]: repeats jobs[0]"),
         ("j.json", {"jobs": [], "extra": 1}, "unknown top-level key 'extra'"),

@@ -18,12 +18,22 @@ again with valid checksums, so mutations reach the readers' own checks rather th
 a ``.npy`` member's header tokens (shapes, dtypes) or its data (counts, coordinates); members
 are duplicated, dropped and swapped there too.
 
-Documents (stroke logs, jobs files in JSON and TOML, a project's manifest) are also mutated by
-their structure, half of their mutants: a value is parsed out and replaced by itself nested
-65 to 100,000 levels deep (in lists, objects, or in TOML a dotted key), by an integer of 20 to
-5,000 digits, by a value of another type, or a list is made ragged (an element dropped, added,
-turned into a scalar or a list) or 5,000 long. Whatever a reader (or usd-core beneath it)
-prints on fd 2 is a failure too: the CLI's one line is the only line.
+Documents (stroke logs, IK edit files, jobs files in JSON and TOML, a project's manifest) are
+also mutated by their structure, half of their mutants: a value is parsed out and replaced by
+itself nested 65 to 100,000 levels deep (in lists, objects, or in TOML a dotted key), by an
+integer of 20 to 5,000 digits (in TOML also hex, octal and binary), by a value of another type,
+by an absurd number (radii and spacings of 1e200 or 5e-324), a name or string gets a control
+character, or a list is made ragged (an element dropped, added, turned into a scalar or a list)
+or 5,000 long. Head meshes also get degenerate faces (``f 1 1 4``, three points on a line) and
+non-finite vertices, and each good read is projected onto; ``.usda`` stages also get sublayers,
+references and payloads that are a FIFO, a device or a folder (issue 45). Whatever a reader (or
+usd-core beneath it) prints on fd 2 is a failure too: the CLI's one line is the only line.
+
+The CI run is bounded (tests/io/test_io_fuzzing.py: about 30 s on two cores). The longer run
+that goes with a change to a reader, 20 times the mutants under other seeds::
+
+    for r in edits jobs jobs-toml mesh strokes usda project bvh; do
+        python tests/io/fuzz_harness.py $r --count 10000 --seed 45 & done; wait
 """
 
 from __future__ import annotations
@@ -211,9 +221,17 @@ def mutate_zip(rng: np.random.Generator, data: bytes) -> tuple[bytes, list[str]]
 
 
 # -- structure-aware mutations of documents ------------------------------------------------------
-STRUCTURE_CLASSES = ("deep nesting", "huge integer", "wrong type", "ragged array")
+STRUCTURE_CLASSES = (
+    "deep nesting", "huge integer", "wrong type", "ragged array", "control character", "absurd number",
+)  # fmt: skip
 NESTING = (65, 1000, 100_000)
 HUGE_INTEGERS = ("1" + "0" * 19, "18446744073709551616", "9" * 41, "1" + "0" * 400, "-" + "9" * 5000)
+#: TOML integers in other bases: Python reads any length in base 16, 8 or 2 (issue 45).
+HUGE_BASED = ("0x" + "f" * 4301, "0o" + "7" * 60, "0b" + "1" * 200, "0x" + "dead_beef_" * 10 + "1")
+#: Numbers in range for the parser, absurd for the method: brush radii, spacings, targets (issue 45).
+ABSURD_NUMBERS = (1e200, -1e200, 1e6, 1e-200, 5e-324, 1.7976931348623157e308, 0.001, 0.0)
+#: Characters that split a one-line message or drive a terminal.
+CONTROL = ("\n", "\r", "\x1b[2J", "\x00", "\x7f", "\x85", "\u009b", "\t")
 OTHER_TYPES = ("text", True, None, {}, [], 3.5, -0.0, [1, "a"], {"x": {"y": []}}, float("inf"))
 
 
@@ -280,7 +298,7 @@ def mutate_document(rng: np.random.Generator, data: bytes, toml: bool) -> tuple[
     ops = []
     for k in range(int(rng.integers(1, 3))):
         nodes = _nodes(tree)
-        kind = int(rng.integers(0, 4))
+        kind = int(rng.integers(0, 6))
         if kind == 0:  # deep nesting of a value
             path, value = nodes[int(rng.integers(0, len(nodes)))]
             hole = f"\x00hole{k}\x00"
@@ -291,7 +309,9 @@ def mutate_document(rng: np.random.Generator, data: bytes, toml: bool) -> tuple[
             numbers = [n for n in nodes if isinstance(n[1], int | float) and not isinstance(n[1], bool)]
             path, _ = (numbers or nodes)[int(rng.integers(0, len(numbers or nodes)))]
             hole = f"\x00hole{k}\x00"
-            raw[hole] = HUGE_INTEGERS[int(rng.integers(0, len(HUGE_INTEGERS)))]
+            based = toml and rng.random() < 0.4
+            pool = HUGE_BASED if based else HUGE_INTEGERS
+            raw[hole] = pool[int(rng.integers(0, len(pool)))]
             op = f"bigint-{len(raw[hole].lstrip('-'))}"
             tree = _put(tree, path, hole)
         elif kind == 2:  # a value of another type
@@ -299,6 +319,29 @@ def mutate_document(rng: np.random.Generator, data: bytes, toml: bool) -> tuple[
             other = OTHER_TYPES[int(rng.integers(0, len(OTHER_TYPES)))]
             tree = _put(tree, path, json.loads(json.dumps(other)))
             op = f"type-{type(other).__name__}"
+        elif kind == 4:  # a control character in a name (a key) or a string
+            strings = [n for n in nodes if isinstance(n[1], str)]
+            keyed = [n for n in nodes if isinstance(n[1], dict) and n[1]]
+            char = CONTROL[int(rng.integers(0, len(CONTROL)))]
+            if keyed and (not strings or rng.random() < 0.4):
+                path, value = keyed[int(rng.integers(0, len(keyed)))]
+                key = list(value)[int(rng.integers(0, len(value)))]
+                cut = int(rng.integers(0, len(str(key)) + 1))
+                value[str(key)[:cut] + char + str(key)[cut:]] = value.pop(key)
+            elif strings:
+                path, value = strings[int(rng.integers(0, len(strings)))]
+                cut = int(rng.integers(0, len(value) + 1))
+                tree = _put(tree, path, value[:cut] + char + value[cut:])
+            op = "control-" + repr(char)[1:-1]
+        elif kind == 5:  # an absurd number where a number is
+            numbers = [n for n in nodes if isinstance(n[1], int | float) and not isinstance(n[1], bool)]
+            if not numbers:
+                ops.append("absurd-none")
+                continue
+            path, _ = numbers[int(rng.integers(0, len(numbers)))]
+            value = ABSURD_NUMBERS[int(rng.integers(0, len(ABSURD_NUMBERS)))]
+            tree = _put(tree, path, value)
+            op = f"absurd-{value:g}"
         else:  # a ragged (or a very long) list
             lists = [n for n in nodes if isinstance(n[1], list) and n[1]]
             if not lists:
@@ -337,6 +380,53 @@ def mutate_manifest(rng: np.random.Generator, data: bytes) -> tuple[bytes, list[
     return _zip(members), [f"{name}: {'+'.join(ops)}"]
 
 
+# -- geometry and layers: what real heads and pipelines hold (issue 45) ---------------------------
+_FACE = re.compile(rb"(?m)^f[ \t]+(\S+)[ \t]+(\S+)[ \t]+(\S+)")
+_VERTEX = re.compile(rb"(?m)^v[ \t]+\S+[ \t]+\S+[ \t]+\S+")
+
+
+def mutate_geometry(rng: np.random.Generator, data: bytes) -> tuple[bytes, list[str]]:
+    """A degenerate face (a corner repeated, as ``f 1 1 4`` in real heads, or three vertices on
+    a line), or a vertex made non-finite."""
+    out = bytearray(data)
+    faces = list(_FACE.finditer(out))
+    r = rng.random()
+    if faces and r < 0.7:
+        m = faces[int(rng.integers(0, len(faces)))]
+        a, b, c = m.group(1), m.group(2), m.group(3)
+        choice = int(rng.integers(0, 3))
+        line = (b"f %s %s %s" % (a, a, c), b"f %s %s %s" % (a, b, b), b"f %s %s %s" % (c, b, c))[choice]
+        out[m.start() : m.end()] = line
+        return bytes(out), ["degenerate-face"]
+    if r < 0.85:
+        out += b"\nv 0 0 0\nv 1 1 1\nv 2 2 2\nf -3 -2 -1\n"  # three points on a line
+        return bytes(out), ["degenerate-line"]
+    vertices = list(_VERTEX.finditer(out))
+    if vertices:
+        m = vertices[int(rng.integers(0, len(vertices)))]
+        bad = (b"nan", b"inf", b"-inf", b"1e39")[int(rng.integers(0, 4))]
+        out[m.start() : m.end()] = b"v 0 %s 0" % bad
+    return bytes(out), ["degenerate-nonfinite"]
+
+
+#: Where ``special`` layers point: set up by :func:`run` in its working folder.
+SPECIAL_TARGETS = ["/dev/zero", "/dev/null", "/dev/urandom", "fifo.usda", "folder.usda"]
+
+
+def mutate_layers(rng: np.random.Generator, data: bytes) -> tuple[bytes, list[str]]:
+    """A sublayer, reference or payload that is a FIFO, a device or a folder (usd-core blocked
+    forever on a FIFO)."""
+    target = SPECIAL_TARGETS[int(rng.integers(0, len(SPECIAL_TARGETS)))].encode()
+    r = rng.random()
+    head = data.find(b"(\n")
+    if r < 0.5 and head >= 0:
+        out = data[: head + 2] + b"    subLayers = [@" + target + b"@]\n" + data[head + 2 :]
+        return out, ["special-sublayer"]
+    arc = b"references" if r < 0.8 else b"payload"
+    out = data + b'\ndef Xform "extra" (\n    ' + arc + b" = @" + target + b"@\n)\n{\n}\n"
+    return out, [f"special-{arc.decode()}"]
+
+
 # -- the readers and what a good read looks like -------------------------------------------------
 def _finite(*arrays) -> None:
     for a in arrays:
@@ -357,6 +447,17 @@ def _check_groom(obj) -> None:
 def _check_mesh(mesh) -> None:
     assert mesh.faces.min() >= 0 and mesh.faces.max() < len(mesh.vertices)
     _finite(mesh.vertices, mesh.normals)
+    from hairtool.errors import HairtoolError
+    from hairtool.guides.surface import MeshSurface
+
+    try:  # a head the brushes slide on: projecting onto it never divides by a degenerate face
+        surface = MeshSurface(mesh)
+    except HairtoolError:
+        return
+    lo, hi = mesh.vertices.min(axis=0), mesh.vertices.max(axis=0)
+    pts = np.random.default_rng(0).uniform(lo - 1, hi + 1, (64, 3))
+    q, n = surface.project(pts)
+    _finite(q, n)
 
 
 def _check_motion(m) -> None:
@@ -434,6 +535,38 @@ def _check_strokes(strokes) -> None:
             _finite(np.array([*sample.cursor, sample.radius]))
 
 
+def _chain_motion():
+    from hairtool.mocap.bvh import read_bvh
+
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "chain.bvh"
+        p.write_bytes(_seed_bvh(Path(tmp))[0])
+        return read_bvh(p)
+
+
+_MOTION: list = []
+
+
+def _read_edits(path: Path):
+    """An IK edit file read against the chain capture (its IK solves: the reproducer tests)."""
+    from hairtool.mocap.pose_edit import read_edits
+
+    if not _MOTION:
+        _MOTION.append(_chain_motion())
+    return read_edits(path, _MOTION[0])
+
+
+def _check_edits(reports) -> None:
+    assert isinstance(reports, list)
+
+
+def _seed_edits(work: Path) -> list[bytes]:
+    reach = [{"frame": 2, "joint": "knee", "target": [0.5, 2.5, 0.5], "chain": 1}]
+    far = {"edits": [{"frame": 0, "joint": "knee", "target": [0, 40, 0], "chain": 1},
+                     {"frame": 2, "joint": "knee", "target": [0.0, -3.0, 0.0], "chain": 1}]}  # fmt: skip
+    return [json.dumps(reach).encode(), json.dumps(far, indent=1).encode()]
+
+
 def _read_jobs(path: Path):
     from hairtool.farm.jobs import load_jobs
 
@@ -456,6 +589,8 @@ class Reader:
     text: bool = False
     zipped: bool = False
     structured: bool = False  # a JSON or TOML document (a zip's manifest.json): structure mutations too
+    #: a mutation of its own, a quarter of the mutants: degenerate geometry, special layers
+    special: Callable[[np.random.Generator, bytes], tuple[bytes, list[str]]] | None = None
 
 
 def _small_groom(seed: int = 7, uniform: bool = False):
@@ -657,14 +792,15 @@ READERS: dict[str, Reader] = {
     "tfx": Reader("tfx", _seed_tfx, _read_any, _check_groom),
     "npz": Reader("npz", _seed_npz, _read_any, _check_groom, zipped=True),
     "obj": Reader("obj", _seed_obj, _read_any, _check_groom, text=True),
-    "mesh": Reader("obj", _seed_mesh, _read_mesh, _check_mesh, text=True),
+    "mesh": Reader("obj", _seed_mesh, _read_mesh, _check_mesh, text=True, special=mutate_geometry),
     "bvh": Reader("bvh", _seed_bvh, _read_bvh, _check_motion, text=True),
     "project": Reader("hairproj", _seed_project, _read_project, _check_project, zipped=True, structured=True),
     "keys": Reader("json", _seed_keys, _read_keys, _check_keys, text=True),
     "features": Reader("npz", _seed_features, _read_features, _check_features, zipped=True),
-    "usda": Reader("usda", _seed_usda, _read_any, _check_groom, text=True),
+    "usda": Reader("usda", _seed_usda, _read_any, _check_groom, text=True, special=mutate_layers),
     "strokes": Reader("json", _seed_strokes, _read_strokes, _check_strokes, text=True, structured=True),
     "jobs": Reader("json", _seed_jobs, _read_jobs, _check_jobs, text=True, structured=True),
+    "edits": Reader("json", _seed_edits, _read_edits, _check_edits, text=True, structured=True),
     "jobs-toml": Reader("toml", _seed_jobs_toml, _read_jobs, _check_jobs, text=True, structured=True),
 }
 
@@ -673,6 +809,8 @@ READERS: dict[str, Reader] = {
 def mutant(reader: Reader, seeds: list[bytes], seed: int, index: int) -> tuple[bytes, list[str]]:
     rng = np.random.default_rng([seed, index])
     base = seeds[index % len(seeds)]
+    if reader.special is not None and rng.random() < 0.25:
+        return reader.special(rng, base)
     if reader.structured and rng.random() < 0.5:
         if reader.zipped:
             return mutate_manifest(rng, base)
@@ -682,6 +820,8 @@ def mutant(reader: Reader, seeds: list[bytes], seed: int, index: int) -> tuple[b
     return mutate_bytes(rng, base, reader.text)
 
 
+#: The classes of the readers' own mutations.
+OWN_CLASSES = {mutate_geometry: ("degenerate geometry",), mutate_layers: ("special file",)}
 MUTATION_CLASSES = ("bit flip", "overwrite", "truncation", "huge count", "duplicated chunk", "token swap")
 _CLASS_OF = {
     "flip": "bit flip",
@@ -696,6 +836,10 @@ _CLASS_OF = {
     "bigint": "huge integer",
     "type": "wrong type",
     "ragged": "ragged array",
+    "control": "control character",
+    "absurd": "absurd number",
+    "degenerate": "degenerate geometry",
+    "special": "special file",
 }
 
 
@@ -798,12 +942,15 @@ def run(name: str, count: int, seed: int, only: int | None = None) -> dict:
             p.write_bytes(s)
             assert outcome(reader, p) is None, (name, i, outcome(reader, p))
         reader.read(work / f"seed0.{reader.ext}")  # every lazy import done before the cap
+        os.mkfifo(work / "fifo.usda")  # special files a layer may name (relative to the mutant)
+        (work / "folder.usda").mkdir()
         cap = cap_memory()
         # A warning is a finding too: an overflow in a cast, or text the CLI would print
         # on stderr beside its one line.
         warnings.simplefilter("error")
         counts = {"read": 0, "refused": 0}
-        classes = dict.fromkeys(MUTATION_CLASSES + (STRUCTURE_CLASSES if reader.structured else ()), 0)
+        own = OWN_CLASSES.get(reader.special, ())
+        classes = dict.fromkeys(MUTATION_CLASSES + (STRUCTURE_CLASSES if reader.structured else ()) + own, 0)
         failures = []
         path = work / f"case.{reader.ext}"
         for index in range(count) if only is None else [only]:

@@ -199,7 +199,7 @@ def test_jobs_file_integer_of_5000_digits(tmp_path, suffix):
 @pytest.mark.parametrize(
     ("pattern", "words"),
     [
-        ("shots/*.usdc" * 1000, "characters long"),
+        ("shots/*.usdc" * 1000, "of 12000 characters; at most 4096"),  # every user string
         ("*/" * 1000 + "x", "characters long"),
         ("a/" * 400 + "*.usdc", "path components"),
         ("**/" * 4 + "*.usdc", "more than two **"),
@@ -238,7 +238,7 @@ def hostile_groom():
         ([hostile.stroke(falloff=[[i / 10**5, 0.5] for i in range(10**5 + 1)])], "at most 1028"),
         ([hostile.stroke(falloff=[[0, 10**30], [1, 0]])], "weights in [0, 1]"),
         ([hostile.stroke(falloff=[[0, "heavy"], [1, 0]])], "a finite number"),
-        ([hostile.stroke(radius="x" * 100_000)], "a str of 100000 characters"),
+        ([hostile.stroke(radius="x" * 100_000)], "of 100000 characters; at most 4096"),
     ],
     ids=["radius-10^400", "ragged", "ragged-nested", "huge-falloff", "falloff-10^30", "falloff-text",
          "radius-long-text"],

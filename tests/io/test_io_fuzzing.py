@@ -133,7 +133,8 @@ def test_random_bytes(ext, tail, with_prefix):
 # tests/io/fuzz_harness.py mutates real and hand-made seed files (bit flips, overwrites,
 # truncations, huge header counts, duplicated chunks, token swaps; zip members one by one with
 # valid checksums; documents by their structure: deep nesting, huge integers, wrong types,
-# ragged lists) and reads each mutant in a child process whose address space is capped at its
+# ragged lists, control characters, absurd numbers; degenerate and non-finite head meshes; FIFOs
+# and devices as .usda layers) and reads each mutant in a child process whose address space is capped at its
 # size after imports plus 1 GiB, with fd 2 watched (nothing may print beside the CLI's line).
 # The children run side by side; the counts keep the whole
 # set near 30 s of wall time on two cores. Rerun one reader by hand with
@@ -150,9 +151,10 @@ MUTANTS = {
     "keys": 1000,
     "features": 1000,
     "usda": 600,  # usd-core parses slowly; its binary crates have tests/io/test_usd_fuzzing.py
-    "strokes": 500,  # these three and project: half of the mutants by their JSON/TOML structure
-    "jobs": 500,
-    "jobs-toml": 500,
+    "strokes": 700,  # these four and project: half of the mutants by their JSON/TOML structure
+    "jobs": 700,
+    "jobs-toml": 700,
+    "edits": 700,
 }
 
 

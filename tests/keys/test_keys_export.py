@@ -106,7 +106,7 @@ def test_sheet_rows_outside_the_keys_hold_the_nearest_key():
 @pytest.mark.parametrize(
     "text,needle",
     [
-        ("{", "not JSON"),
+        ("{", "not valid JSON"),
         ("[1, 2]", "JSON object"),
         ('{"format": "other"}', "format"),
         ('{"version": 9, "frames": 3, "fps": 24, "keys": []}', "version 9"),
@@ -143,9 +143,9 @@ def test_bad_exports_are_refused(tmp_path, solved):
 @pytest.mark.parametrize(
     ("text", "needle"),
     [
-        ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+        ("[" * 100_000 + "]" * 100_000, "nested 100000 levels deep"),
         ('{"frames": 5, "fps": 24, "keys": [], "x": ' + "[" * 100_000 + "]" * 100_000 + "}", "nested"),
-        ('{"frames": ' + "9" * 5000 + ', "fps": 24, "keys": []}', "digits long"),
+        ('{"frames": ' + "9" * 5000 + ', "fps": 24, "keys": []}', "a number of 5000 digits"),
         ('{"frames": 10, "fps": 24, "keys": [{"frame": ' + "9" * 30 + "}]}", "whole frame numbers"),
         ('{"frames": 10, "fps": 1e400, "keys": [{"frame": 1}]}', "fps"),
     ],
@@ -168,7 +168,7 @@ def test_a_record_read_back_can_always_be_written_again(tmp_path):
     base = '{"frames": 5, "fps": 24, "keys": [{"frame": 1}], "x": '
     path = tmp_path / "deep.json"
     path.write_text(base + "[" * 900 + "]" * 900 + "}", encoding="utf-8")
-    with pytest.raises(FormatError, match="nests deeper"):
+    with pytest.raises(FormatError, match="nested 901 levels deep"):
         read_keys_json(path)
     path.write_text(base + "[" * (MAX_NESTING - 1) + "]" * (MAX_NESTING - 1) + "}", encoding="utf-8")
     write_keys_json(tmp_path / "again.json", read_keys_json(path))
