@@ -3,7 +3,10 @@
 The character's own JSON entries and binary bytes are kept as they were; the animation's key
 times and rotations are appended after its buffer, and one animation is added. Anime drawings
 are ``STEP`` keys exactly at the frames where a drawing starts (limited animation is a hold);
-simulations are ``LINEAR`` keys.
+simulations are ``LINEAR`` keys. Optimal keys with Hermite curves (``--interp hermite-fit``) are
+``CUBICSPLINE`` keys: the keys module's curve through the hemisphere-aligned quaternion components,
+its in- and out-tangents per key rescaled from per frame to per second of the written key interval,
+so a glTF player (which normalises after interpolating) draws the same rotations.
 
 glTF key times are 32-bit floats. A key time that rounds *above* i/fps makes three.js, which
 samples at i/fps in doubles, hold the previous drawing one frame longer, where Blender (which
@@ -26,6 +29,8 @@ from hairtool.character.glb import BufferWriter, pack
 from hairtool.character.read import load_document
 from hairtool.errors import FormatError, ParameterError
 from hairtool.io.atomic import atomic_open
+from hairtool.keys.reconstruct import KeyPoses, key_poses
+from hairtool.mocap import quaternion as quat
 
 F64 = NDArray[np.float64]
 
@@ -61,14 +66,21 @@ def add_animation(
     step: bool,
     loop_frames: int | None = None,
     key_frames: NDArray[np.int64] | None = None,
+    interp: str = "linear",
 ) -> None:
     """Append one animation: ``rotations`` ``(F, J, 4)`` wxyz of ``nodes`` at ``fps``.
 
     ``step``: keys only where the pose of the animated nodes changes, ``STEP`` interpolation
     (one shared time accessor). ``loop_frames``: add a closing key at that frame showing frame 0
     again, so the clip lasts the whole cycle. Otherwise a ``LINEAR`` key on every frame, or only
-    on ``key_frames`` (optimal keys, increasing frame numbers).
+    on ``key_frames`` (optimal keys, increasing frame numbers); with ``interp`` "hermite" or
+    "hermite-fit" those keys are ``CUBICSPLINE`` with the keys module's tangents (the first and last
+    frame must then be keys, as the DP's always are).
     """
+    if interp != "linear" and (key_frames is None or step or loop_frames is not None):
+        raise ParameterError(
+            "interp", interp, "linear, unless optimal keys are written (no STEP, no loop key)"
+        )
     f = len(rotations)
     sub = rotations[:, nodes]
     if key_frames is not None:
@@ -83,6 +95,9 @@ def add_animation(
             raise ParameterError("keys", frames.tolist()[:6], f"increasing frame numbers in [0, {f})")
     else:
         frames = hold_keys(sub) if step else np.arange(f, dtype=np.int64)
+    if interp != "linear":
+        _add_cubic(document, writer, hermite_keys(sub, frames, interp), fps, nodes, name)
+        return
     values = sub[frames]
     if loop_frames is not None:
         frames = np.concatenate([frames, [loop_frames]])
@@ -99,6 +114,40 @@ def add_animation(
                 "interpolation": "STEP" if step else "LINEAR",
             }
         )
+        channels.append({"sampler": k, "target": {"node": node, "path": "rotation"}})
+    document.setdefault("animations", []).append({"name": name, "channels": channels, "samplers": samplers})
+
+
+def hermite_keys(rotations: F64, frames: NDArray[np.int64], interp: str) -> KeyPoses:
+    """The keys module's Hermite keys of ``rotations`` ``(F, J, 4)``: values and per-frame tangents
+    of the quaternion components, aligned to one hemisphere along time first (as
+    :func:`hairtool.mocap.costs.reconstruct_motion` does); the curve is
+    ``normalize(interpolate_keys(...))``."""
+    return key_poses(quat.align_hemisphere(rotations, axis=0), frames, interp)
+
+
+def _add_cubic(
+    document: dict, writer: BufferWriter, kp: KeyPoses, fps: float, nodes: list[int], name: str
+) -> None:
+    """One ``CUBICSPLINE`` sampler per node: in-tangent, value, out-tangent per key, per second.
+
+    glTF scales both tangents of a segment by its interval in seconds, here the difference of the
+    float32 key times; the keys module scales them by the interval in frames. Each tangent is
+    rescaled by its own segment's ratio, so the two curves agree up to float32 storage. The first
+    in-tangent and the last out-tangent lie outside the clip and are written at ``fps``.
+    """
+    times32 = key_times(kp.keys, fps)
+    ratio = np.diff(kp.keys).astype(np.float64) / np.diff(times32.astype(np.float64))
+    out_t = kp.tangents * fps
+    in_t = (kp.tangents if kp.tangents_in is None else kp.tangents_in) * fps
+    out_t[:-1] = kp.tangents[:-1] * ratio[:, None, None]
+    in_t[1:] = (kp.tangents if kp.tangents_in is None else kp.tangents_in)[1:] * ratio[:, None, None]
+    times = writer.add(times32, "SCALAR", bounds=True)
+    samplers, channels = [], []
+    for k, node in enumerate(nodes):
+        triple = np.stack([in_t[:, k], kp.poses[:, k], out_t[:, k]], axis=1)  # (K, 3, 4) wxyz
+        xyzw = np.roll(triple, -1, axis=2).reshape(-1, 4).astype(np.float32)
+        samplers.append({"input": times, "output": writer.add(xyzw, "VEC4"), "interpolation": "CUBICSPLINE"})
         channels.append({"sampler": k, "target": {"node": node, "path": "rotation"}})
     document.setdefault("animations", []).append({"name": name, "channels": channels, "samplers": samplers})
 
@@ -123,8 +172,10 @@ def write_animated(
     step: bool,
     loop_frames: int | None = None,
     key_frames: NDArray[np.int64] | None = None,
+    interp: str = "linear",
 ) -> dict:
-    """Write ``source`` with its hair animated to ``out`` (.glb, .vrm or .gltf); a summary dict."""
+    """Write ``source`` with its hair animated to ``out`` (.glb, .vrm or .gltf); a summary dict.
+    ``interp``: "linear", or "hermite"/"hermite-fit" for ``CUBICSPLINE`` keys on ``key_frames``."""
     path = os.fspath(out)
     suffix = Path(path).suffix.lower()
     if suffix not in (".glb", ".vrm", ".gltf"):
@@ -149,6 +200,7 @@ def write_animated(
             step=step,
             loop_frames=loop_frames,
             key_frames=key_frames,
+            interp=interp,
         )
         data = writer.bytes()
         if binary is not None and buffers and buffers[0].get("uri") is None:  # from a GLB: embed its bytes
@@ -176,6 +228,7 @@ def write_animated(
             step=step,
             loop_frames=loop_frames,
             key_frames=key_frames,
+            interp=interp,
         )
         data = own[:start] + b"\0" * (-start % 4) + writer.bytes()
         if buffers:
@@ -195,7 +248,7 @@ def write_animated(
             if step
             else len(rotations)
         ),
-        "interpolation": "STEP" if step else "LINEAR",
+        "interpolation": "STEP" if step else "LINEAR" if interp == "linear" else "CUBICSPLINE",
         "fps": fps,
         "frames": len(rotations),
     }

@@ -116,6 +116,17 @@ class Chain:
     virtual_tail: bool = False  # VRM 0.x: a 7 cm tail past the last node, along its parent's direction
 
 
+def cubic_spline(times: F64, values: F64, tangent_in: F64, tangent_out: F64, i: int, t: float) -> F64:
+    """glTF's CUBICSPLINE between keys ``i`` and ``i + 1`` at time ``t``: a cubic Hermite whose
+    tangents (per second) are scaled by the key interval, the rotation normalised after."""
+    span = times[i + 1] - times[i]
+    u = (t - times[i]) / span
+    u2, u3 = u * u, u * u * u
+    p = (2 * u3 - 3 * u2 + 1) * values[i] + span * (u3 - 2 * u2 + u) * tangent_out[i]
+    p = p + (-2 * u3 + 3 * u2) * values[i + 1] + span * (u3 - u2) * tangent_in[i + 1]
+    return quat.normalize(p)
+
+
 @dataclass(frozen=True)
 class Clip:
     """An animation in the file: per node, rotation keys (wxyz) on its own times."""
@@ -123,6 +134,8 @@ class Clip:
     name: str
     rotations: dict[int, tuple[F64, F64]] = field(default_factory=dict)  # node → (times, (K, 4))
     step: frozenset[int] = frozenset()  # nodes whose keys hold (STEP) instead of slerping
+    # CUBICSPLINE nodes → (in-tangents, out-tangents) ``(K, 4)`` wxyz, per second
+    cubic: dict[int, tuple[F64, F64]] = field(default_factory=dict)
 
     @property
     def duration(self) -> float:
@@ -137,17 +150,19 @@ class Clip:
         return float(round(rate)) if round(rate) > 0 and abs(rate - round(rate)) <= 1e-3 * rate else rate
 
     def sample(self, nodes: Nodes, t: float) -> F64:
-        """``(J, 4)`` local rotations at time ``t`` (seconds): keys held or slerped, rest where none."""
+        """``(J, 4)`` local rotations at time ``t`` (seconds): keys held, slerped or on their cubic
+        spline (normalised after, as glTF asks), rest where none."""
         r = nodes.rotation.copy()
         for j, (times, q) in self.rotations.items():
-            if t <= times[0]:
-                r[j] = q[0]
-            elif t >= times[-1]:
-                r[j] = q[-1]
+            if t <= times[0] or t >= times[-1]:
+                end = q[0] if t <= times[0] else q[-1]
+                r[j] = quat.normalize(end) if j in self.cubic else end
             else:
                 i = int(np.searchsorted(times, t, side="right")) - 1
                 if j in self.step:
                     r[j] = q[i]
+                elif j in self.cubic:
+                    r[j] = cubic_spline(times, q, *self.cubic[j], i, t)
                 else:
                     u = (t - times[i]) / (times[i + 1] - times[i])
                     r[j] = quat.slerp(q[i], q[i + 1], u)

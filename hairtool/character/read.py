@@ -232,7 +232,7 @@ def read_clips(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple
     """Rotation channels of every animation (translations and scales are not posed here)."""
     clips = []
     for a, anim in enumerate(gltf.animations or []):
-        rot, step = {}, set()
+        rot, step, cubic = {}, set(), {}
         samplers = anim.samplers or []
         for c, ch in enumerate(anim.channels or []):
             tgt = ch.target
@@ -244,16 +244,29 @@ def read_clips(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple
             ]
             times = accessors.read(path, gltf, data, s.input, f"animation {a} times").astype(np.float64)
             q = accessors.read(path, gltf, data, s.output, f"animation {a} rotations").astype(np.float64)
+            spline = None
             if s.interpolation == "CUBICSPLINE":
-                q = q.reshape(-1, 3, 4)[:, 1] if q.ndim == 2 and len(q) % 3 == 0 else q[:0]
+                if q.ndim != 2 or q.shape[1] != 4 or len(q) != 3 * times.size:
+                    raise FormatError(
+                        path, f"animation {a} channel {c}: in-tangent, value and out-tangent per key expected"
+                    )
+                spline = np.roll(q.reshape(-1, 3, 4), 1, axis=2)
+                q = q.reshape(-1, 3, 4)[:, 1]
             if times.ndim != 1 or times.size == 0 or q.shape != (times.size, 4):
                 raise FormatError(path, f"animation {a} channel {c}: one quaternion per key time expected")
             if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0) or not np.all(np.isfinite(q)):
                 raise FormatError(path, f"animation {a} channel {c}: key times must increase")
+            if spline is not None:
+                if not np.all(np.isfinite(spline)):
+                    raise FormatError(path, f"animation {a} channel {c}: tangents must be finite")
+                rot[j] = (times, spline[:, 1])  # the spline's own values: normalised after interpolation
+                cubic[j] = (spline[:, 0], spline[:, 2])
+                continue
             rot[j] = (times, quat.normalize(np.roll(q, 1, axis=1)))
             if s.interpolation == "STEP":
                 step.add(j)
-        clips.append(Clip(anim.name if isinstance(anim.name, str) else f"animation{a}", rot, frozenset(step)))
+        name = anim.name if isinstance(anim.name, str) else f"animation{a}"
+        clips.append(Clip(name, rot, frozenset(step), cubic))
     return tuple(clips)
 
 

@@ -92,7 +92,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "keys, as USD plays them: a Hermite curve needs --bake), .json record, .csv sheet (one row per "
         "frame with its time code in the source; with --interp hermite or hermite-fit, per channel the "
         "key values and tangents), .bvh (BVH input: the key curve at every frame, or with --edit the "
-        "edited capture), .glb/.vrm/.gltf (character input: the character with LINEAR keys on its bones)",
+        "edited capture), .glb/.vrm/.gltf (character input: the character with keys on its bones, LINEAR, or "
+        "CUBICSPLINE with --interp hermite or hermite-fit, their tangents the key curve's)",
     )
     parser.add_argument(
         "--bake", action="store_true", help="with --export: every frame of the key curve, not just the keys"
@@ -364,6 +365,7 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
             name="optimal keys",
             step=False,
             key_frames=sel.keys,
+            interp=args.interp,
         )
     elif args.export is not None and args.export.suffix.lower() == ".bvh":
         _export_bvh(args, kind, data, sel.keys, result)

@@ -88,9 +88,31 @@ def written(tmp_path_factory):
     return c, folder, cycle, springs
 
 
-def test_the_validator_reports_no_errors(node, written):
+@pytest.fixture(scope="module")
+def cubic(written):
+    """Optimal keys of the spring motion as CUBICSPLINE (hermite-fit tangents), and the rotations
+    our reader plays back from it at every frame."""
+    c, folder, _, springs = written
+    keys = np.array([0, 3, 7, 12, 18, 23])
+    path = folder / "keys.glb"
+    write_animated(
+        VRM,
+        path,
+        springs,
+        c.nodes.rotation,
+        24.0,
+        name="keys",
+        step=False,
+        key_frames=keys,
+        interp="hermite-fit",
+    )
+    back = load_character(path)
+    return path, back.clips[-1].frames(back.nodes, 24.0)
+
+
+def test_the_validator_reports_no_errors(node, written, cubic):
     _, folder, _, _ = written
-    files = [VRM, VRM.with_suffix(".glb"), folder / "cycle.vrm", folder / "springs.glb"]
+    files = [VRM, VRM.with_suffix(".glb"), folder / "cycle.vrm", folder / "springs.glb", cubic[0]]
     for line in _run(node, "validate.mjs", *map(str, files)).splitlines():
         report = json.loads(line)
         assert report["errors"] == 0 and report["warnings"] == 0, report
@@ -102,6 +124,15 @@ def test_three_js_plays_the_same_rotations_on_every_frame(node, written):
         rows = _three_rotations(node, folder / name, 24.0, len(ours), "clip")
         assert rows and len(rows[0]) >= 14 * 4  # every chain joint (and the shaken head)
         assert _angles(c, rows, ours).max() < 1e-4, name  # float32 keys
+
+
+def test_three_js_plays_cubic_spline_keys_as_our_reader_does(node, written, cubic):
+    """three.js's cubic-spline quaternion interpolant (normalised after) against our sampler."""
+    c = written[0]
+    path, ours = cubic
+    rows = _three_rotations(node, path, 24.0, len(ours), "clip")
+    assert rows and len(rows[0]) >= 14 * 4
+    assert _angles(c, rows, ours).max() < 1e-6  # float32 keys and tangents: a few 1e-8 rad
 
 
 def test_three_vrm_swings_the_springs_as_we_do(node):
