@@ -65,7 +65,7 @@ def add_animation(
     name: str,
     step: bool,
     loop_frames: int | None = None,
-    key_frames: NDArray[np.int64] | None = None,
+    key_frames: NDArray[np.int64] | dict[int, NDArray[np.int64]] | None = None,
     interp: str = "linear",
 ) -> None:
     """Append one animation: ``rotations`` ``(F, J, 4)`` wxyz of ``nodes`` at ``fps``.
@@ -73,7 +73,8 @@ def add_animation(
     ``step``: keys only where the pose of the animated nodes changes, ``STEP`` interpolation
     (one shared time accessor). ``loop_frames``: add a closing key at that frame showing frame 0
     again, so the clip lasts the whole cycle. Otherwise a ``LINEAR`` key on every frame, or only
-    on ``key_frames`` (optimal keys, increasing frame numbers); with ``interp`` "hermite" or
+    on ``key_frames`` (optimal keys, increasing frame numbers; or per node, a dict node → frames,
+    the nodes sharing a key set sharing its time accessor); with ``interp`` "hermite" or
     "hermite-fit" those keys are ``CUBICSPLINE`` with the keys module's tangents (the first and last
     frame must then be keys, as the DP's always are).
     """
@@ -81,6 +82,41 @@ def add_animation(
         raise ParameterError(
             "interp", interp, "linear, unless optimal keys are written (no STEP, no loop key)"
         )
+    if not isinstance(key_frames, dict):
+        samplers = _samplers(writer, rotations, nodes, fps, step, loop_frames, key_frames, interp)
+        channels = [
+            {"sampler": k, "target": {"node": node, "path": "rotation"}} for k, node in enumerate(nodes)
+        ]
+    else:
+        missing = [n for n in nodes if n not in key_frames]
+        if missing:
+            raise ParameterError("keys", f"none for node {missing[0]}", "key frames for every animated node")
+        groups: dict[tuple[int, ...], list[int]] = {}
+        for node in nodes:
+            groups.setdefault(tuple(int(v) for v in np.asarray(key_frames[node]).reshape(-1)), []).append(
+                node
+            )
+        samplers, channels = [], []
+        for frames, group in groups.items():
+            channels += [
+                {"sampler": len(samplers) + k, "target": {"node": node, "path": "rotation"}}
+                for k, node in enumerate(group)
+            ]
+            samplers += _samplers(writer, rotations, group, fps, step, loop_frames, np.array(frames), interp)
+    document.setdefault("animations", []).append({"name": name, "channels": channels, "samplers": samplers})
+
+
+def _samplers(
+    writer: BufferWriter,
+    rotations: F64,
+    nodes: list[int],
+    fps: float,
+    step: bool,
+    loop_frames: int | None,
+    key_frames: NDArray[np.int64] | None,
+    interp: str,
+) -> list[dict]:
+    """One sampler per node of ``nodes``, on one time accessor (see :func:`add_animation`)."""
     f = len(rotations)
     sub = rotations[:, nodes]
     if key_frames is not None:
@@ -96,16 +132,15 @@ def add_animation(
     else:
         frames = hold_keys(sub) if step else np.arange(f, dtype=np.int64)
     if interp != "linear":
-        _add_cubic(document, writer, hermite_keys(sub, frames, interp), fps, nodes, name)
-        return
+        return _cubic_samplers(writer, hermite_keys(sub, frames, interp), fps, len(nodes))
     values = sub[frames]
     if loop_frames is not None:
         frames = np.concatenate([frames, [loop_frames]])
         values = np.concatenate([values, sub[:1]])
     values = _hemisphere(values)
     times = writer.add(key_times(frames, fps), "SCALAR", bounds=True)
-    samplers, channels = [], []
-    for k, node in enumerate(nodes):
+    samplers = []
+    for k in range(len(nodes)):
         xyzw = np.roll(values[:, k], -1, axis=1).astype(np.float32)
         samplers.append(
             {
@@ -114,8 +149,7 @@ def add_animation(
                 "interpolation": "STEP" if step else "LINEAR",
             }
         )
-        channels.append({"sampler": k, "target": {"node": node, "path": "rotation"}})
-    document.setdefault("animations", []).append({"name": name, "channels": channels, "samplers": samplers})
+    return samplers
 
 
 def hermite_keys(rotations: F64, frames: NDArray[np.int64], interp: str) -> KeyPoses:
@@ -126,9 +160,7 @@ def hermite_keys(rotations: F64, frames: NDArray[np.int64], interp: str) -> KeyP
     return key_poses(quat.align_hemisphere(rotations, axis=0), frames, interp)
 
 
-def _add_cubic(
-    document: dict, writer: BufferWriter, kp: KeyPoses, fps: float, nodes: list[int], name: str
-) -> None:
+def _cubic_samplers(writer: BufferWriter, kp: KeyPoses, fps: float, count: int) -> list[dict]:
     """One ``CUBICSPLINE`` sampler per node: in-tangent, value, out-tangent per key, per second.
 
     glTF scales both tangents of a segment by its interval in seconds, here the difference of the
@@ -138,18 +170,17 @@ def _add_cubic(
     """
     times32 = key_times(kp.keys, fps)
     ratio = np.diff(kp.keys).astype(np.float64) / np.diff(times32.astype(np.float64))
-    out_t = kp.tangents * fps
-    in_t = (kp.tangents if kp.tangents_in is None else kp.tangents_in) * fps
+    arriving = kp.tangents if kp.tangents_in is None else kp.tangents_in
+    out_t, in_t = kp.tangents * fps, arriving * fps
     out_t[:-1] = kp.tangents[:-1] * ratio[:, None, None]
-    in_t[1:] = (kp.tangents if kp.tangents_in is None else kp.tangents_in)[1:] * ratio[:, None, None]
+    in_t[1:] = arriving[1:] * ratio[:, None, None]
     times = writer.add(times32, "SCALAR", bounds=True)
-    samplers, channels = [], []
-    for k, node in enumerate(nodes):
+    samplers = []
+    for k in range(count):
         triple = np.stack([in_t[:, k], kp.poses[:, k], out_t[:, k]], axis=1)  # (K, 3, 4) wxyz
         xyzw = np.roll(triple, -1, axis=2).reshape(-1, 4).astype(np.float32)
         samplers.append({"input": times, "output": writer.add(xyzw, "VEC4"), "interpolation": "CUBICSPLINE"})
-        channels.append({"sampler": k, "target": {"node": node, "path": "rotation"}})
-    document.setdefault("animations", []).append({"name": name, "channels": channels, "samplers": samplers})
+    return samplers
 
 
 def _hemisphere(q: F64) -> F64:
@@ -171,11 +202,12 @@ def write_animated(
     name: str,
     step: bool,
     loop_frames: int | None = None,
-    key_frames: NDArray[np.int64] | None = None,
+    key_frames: NDArray[np.int64] | dict[int, NDArray[np.int64]] | None = None,
     interp: str = "linear",
 ) -> dict:
     """Write ``source`` with its hair animated to ``out`` (.glb, .vrm or .gltf); a summary dict.
-    ``interp``: "linear", or "hermite"/"hermite-fit" for ``CUBICSPLINE`` keys on ``key_frames``."""
+    ``key_frames``: optimal keys, one set or per node (a dict node → frames, every animated node
+    in it); ``interp``: "linear", or "hermite"/"hermite-fit" for ``CUBICSPLINE`` keys on them."""
     path = os.fspath(out)
     suffix = Path(path).suffix.lower()
     if suffix not in (".glb", ".vrm", ".gltf"):
@@ -242,7 +274,9 @@ def write_animated(
         "output": path,
         "animated_nodes": len(nodes),
         "keys": int(
-            len(key_frames)
+            len(np.unique(np.concatenate([np.asarray(v).reshape(-1) for v in key_frames.values()])))
+            if isinstance(key_frames, dict)
+            else len(key_frames)
             if key_frames is not None
             else len(hold_keys(rotations[:, nodes]))
             if step

@@ -61,6 +61,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--per-channel", action="store_true", help="keys per degree of freedom (needs --penalty)"
     )
+    parser.add_argument(
+        "--per-chain",
+        action="store_true",
+        help="character input: keys per hair chain, each chain keyed on its own motion with the mode "
+        "given (default: one key set shared by all chains); nodes outside the chains key at every "
+        "frame a chain keys",
+    )
     parser.add_argument("--curve-keys", type=int, default=100, metavar="N", help="curve up to N keys")
     steer = parser.add_argument_group("frames the animator steers (0-based; lists and ranges, e.g. 10,30-34)")
     steer.add_argument("--pin", metavar="FRAMES", help="frames that must be keys")
@@ -233,14 +240,10 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
         tip_weight=args.tip_weight,
         exponent=args.weight_exponent,
     )
-    if kind == "bvh" and args.bvh_features == "channels":
-        from hairtool.mocap.channel_edit import channel_features
-
-        x = channel_features(data)
-    elif kind == "bvh":
-        from hairtool.mocap.costs import motion_features
-
-        x = motion_features(data, "positions" if args.bvh_features == "positions" else "rotations")
+    if args.per_chain:
+        return _per_chain(args, data, constraints)
+    if kind == "bvh":
+        x = _bvh_features(args, data)
     elif kind == "animation":
         x = frame_features(data, options)
     else:
@@ -301,6 +304,89 @@ def _keys(args: argparse.Namespace, constraints, bar: ProgressBar):
     result = _report(args, kind, data, n, fps, sel, options, session)
     bar(1.0, "done")
     return kind, data, n, sel, result
+
+
+def _bvh_features(args: argparse.Namespace, motion):
+    """The ``(F, D)`` features ``--bvh-features`` asks for (quaternion: rotations, its table aside)."""
+    if args.bvh_features == "channels":
+        from hairtool.mocap.channel_edit import channel_features
+
+        return channel_features(motion)
+    from hairtool.mocap.costs import motion_features
+
+    return motion_features(motion, "positions" if args.bvh_features == "positions" else "rotations")
+
+
+def _per_chain(args: argparse.Namespace, data, constraints) -> int:
+    """``--per-chain``: each hair chain of a character keyed on its own motion, in the mode given;
+    ``--export OUT.glb`` writes each chain's bones on its own keys."""
+    from hairtool.character.chain_keys import chain_motion, chain_weights, node_keys
+    from hairtool.errors import ParameterError
+    from hairtool.keys.session import KNEE_KEYS, KeySettings, solve
+    from hairtool.mocap.costs import motion_features, rotation_cost_table
+
+    if getattr(data, "character", None) is None:
+        raise ParameterError("per-chain", True, "a character (.vrm/.glb/.gltf) as IN")
+    if args.bvh_features == "channels":
+        raise ParameterError(
+            "bvh-features", "channels", "positions, rotations or quaternion with --per-chain"
+        )
+    refused = (
+        ("per-channel", args.per_channel),
+        ("edit", args.edit),
+        ("storage", args.storage),
+        ("out", args.out),
+    )
+    for flag, value in refused:
+        if value:
+            raise ParameterError(flag, str(value) if value is not True else True, "no value with --per-chain")
+    suffix = args.export.suffix.lower() if args.export is not None else None
+    if suffix is not None and suffix not in (".glb", ".vrm", ".gltf"):
+        raise ParameterError("export", str(args.export), "a .glb, .vrm or .gltf with --per-chain")
+    character, rotations = data.character
+    objective = "worst" if args.max_error is not None else args.objective
+    quaternion = args.bvh_features == "quaternion"
+    if quaternion and (args.interp != "linear" or args.curvature or objective != "total"):
+        raise ParameterError("bvh-features", "quaternion", "the linear (slerp) total objective only")
+    settings = KeySettings(objective=objective, interp=args.interp, curvature=args.curvature)
+    chains, keys = [], []
+    for c, chain in enumerate(character.chains):
+        motion = chain_motion(character, rotations, data.fps, c)
+        weights = chain_weights(motion)
+        table = rotation_cost_table(motion, weights) if quaternion else None
+        x = motion_features(motion, "positions" if args.bvh_features == "positions" else "rotations", weights)
+        session = solve(x, settings, table=table, layers=False, constraints=constraints, kmax=KNEE_KEYS)
+        sel = session.select(curve_keys=args.curve_keys, **_mode(args, session))
+        keys.append(sel.keys)
+        chains.append(
+            {"chain": chain.name, "n_keys": sel.n_keys, "keys": sel.keys.tolist(), "cost": sel.cost}
+        )
+    union = sorted(set().union(*(k.tolist() for k in keys)))
+    result = {
+        "frames": data.n_frames,
+        "fps": data.fps,
+        "objective": objective,
+        "chains": chains,
+        "union": union,
+    }
+    if args.export is not None:
+        from hairtool.character.export import animated_nodes, write_animated
+
+        nodes = animated_nodes(rotations, character.nodes.rotation)
+        result["written"] = write_animated(
+            args.input,
+            args.export,
+            rotations,
+            character.nodes.rotation,
+            data.fps,
+            name="optimal keys per chain",
+            step=False,
+            key_frames=node_keys(character, nodes, keys),
+            interp=args.interp,
+        )
+    line = "\n".join(f"{ch['chain']}: {ch['n_keys']} keys: {' '.join(map(str, ch['keys']))}" for ch in chains)
+    line += f"\n{len(union)} frames key at least one of {len(chains)} chains"
+    return _emit(args, result, line)
 
 
 def _report(args: argparse.Namespace, kind: str, data, n: int, fps: float, sel, options, session) -> dict:

@@ -90,29 +90,43 @@ def written(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def cubic(written):
-    """Optimal keys of the spring motion as CUBICSPLINE (hermite-fit tangents), and the rotations
-    our reader plays back from it at every frame."""
+    """Optimal keys of the spring motion as CUBICSPLINE (hermite-fit tangents), shared and per chain,
+    and the rotations our reader plays back from each at every frame."""
+    from hairtool.character.chain_keys import node_keys
+    from hairtool.character.export import animated_nodes
+
     c, folder, _, springs = written
     keys = np.array([0, 3, 7, 12, 18, 23])
-    path = folder / "keys.glb"
-    write_animated(
-        VRM,
-        path,
-        springs,
-        c.nodes.rotation,
-        24.0,
-        name="keys",
-        step=False,
-        key_frames=keys,
-        interp="hermite-fit",
-    )
-    back = load_character(path)
-    return path, back.clips[-1].frames(back.nodes, 24.0)
+    per_chain = [np.array([0, 2 + c_ % 9, 14, 23]) for c_ in range(len(c.chains))]
+    each = node_keys(c, animated_nodes(springs, c.nodes.rotation), per_chain)
+    out = []
+    for name, key_frames in (("keys.glb", keys), ("chains.vrm", each)):
+        path = folder / name
+        write_animated(
+            VRM,
+            path,
+            springs,
+            c.nodes.rotation,
+            24.0,
+            name="keys",
+            step=False,
+            key_frames=key_frames,
+            interp="hermite-fit",
+        )
+        back = load_character(path)
+        out.append((path, back.clips[-1].frames(back.nodes, 24.0)))
+    return out
 
 
 def test_the_validator_reports_no_errors(node, written, cubic):
     _, folder, _, _ = written
-    files = [VRM, VRM.with_suffix(".glb"), folder / "cycle.vrm", folder / "springs.glb", cubic[0]]
+    files = [
+        VRM,
+        VRM.with_suffix(".glb"),
+        folder / "cycle.vrm",
+        folder / "springs.glb",
+        *(p for p, _ in cubic),
+    ]
     for line in _run(node, "validate.mjs", *map(str, files)).splitlines():
         report = json.loads(line)
         assert report["errors"] == 0 and report["warnings"] == 0, report
@@ -129,10 +143,10 @@ def test_three_js_plays_the_same_rotations_on_every_frame(node, written):
 def test_three_js_plays_cubic_spline_keys_as_our_reader_does(node, written, cubic):
     """three.js's cubic-spline quaternion interpolant (normalised after) against our sampler."""
     c = written[0]
-    path, ours = cubic
-    rows = _three_rotations(node, path, 24.0, len(ours), "clip")
-    assert rows and len(rows[0]) >= 14 * 4
-    assert _angles(c, rows, ours).max() < 1e-6  # float32 keys and tangents: a few 1e-8 rad
+    for path, ours in cubic:
+        rows = _three_rotations(node, path, 24.0, len(ours), "clip")
+        assert rows and len(rows[0]) >= 14 * 4
+        assert _angles(c, rows, ours).max() < 1e-6, path.name  # float32 keys and tangents: a few 1e-8 rad
 
 
 def test_three_vrm_swings_the_springs_as_we_do(node):
