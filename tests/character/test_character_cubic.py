@@ -140,3 +140,28 @@ def test_hairtool_keys_writes_cubic_keys_of_a_character(tmp_path, capsys):
     back = load_character(out)
     assert all(np.allclose(t, key_times(keys, 24.0)) for t, _ in back.clips[-1].rotations.values())
     assert set(back.clips[-1].cubic) == set(back.clips[-1].rotations)
+
+
+def test_a_cubic_sampler_without_three_rows_per_key_is_one_line_naming_the_file(tmp_path, capsys):
+    from hairtool.character.glb import pack
+
+    out = tmp_path / "keys.glb"
+    keys = np.array([0, 6, FRAMES - 1])
+    write_animated(
+        VRM,
+        out,
+        SPRINGS,
+        CHARACTER.nodes.rotation,
+        24.0,
+        name="k",
+        step=False,
+        key_frames=keys,
+        interp="hermite",
+    )
+    doc, binary = load_document(out)
+    doc["accessors"][doc["animations"][-1]["samplers"][0]["output"]]["count"] = 2 * keys.size
+    bad = tmp_path / "bad.glb"
+    bad.write_bytes(pack(doc, binary))
+    assert main(["keys", str(bad), "--keys", "2"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bad.glb" in err[0] and "in-tangent, value and out-tangent" in err[0], err
