@@ -322,6 +322,32 @@ def test_a_small_npz_is_refused_before_it_inflates(tmp_path):
     _refused("info", p, words="member 'frames.npy' (inflated) needs 2.34 GiB; the limit is 1 GiB")
 
 
+@pytest.mark.parametrize(
+    ("strands", "points"),
+    [(7, 5), (4099, 2)],  # 7 curve counts are stored raw, 4,099 compressed
+)
+def test_a_crate_declaring_400m_curve_counts_is_refused_before_usd_core_reads_it(tmp_path, strands, points):
+    """A 28 KB .usdc whose curve counts array declares 400 million values peaked at 1.7-5.1 GB
+    in usd-core before its refusal: the count sits at the array's place in the value region."""
+    import struct
+
+    from hairtool.groom import Groom
+    from hairtool.io import write
+
+    rng = np.random.default_rng(0)
+    p = tmp_path / "counts.usdc"
+    write(p, Groom(rng.normal(size=(strands * points, 3)), np.full(strands, points)))
+    data = bytearray(p.read_bytes())
+    declared = struct.pack("<Q", strands)  # crate 0.7+: the array's u64 element count first
+    if strands < 16:
+        declared += struct.pack(f"<{strands}i", *[points] * strands)
+    assert data.count(declared) == 1
+    at = data.index(declared)
+    struct.pack_into("<Q", data, at, 400_000_000)
+    p.write_bytes(bytes(data))
+    _refused("info", p, words=f"a crate array at byte {at} claims 400000000 values")
+
+
 def _wide_bvh(path: Path, joints: int, end_sites: int, frames: int, size: int = 18 << 20) -> None:
     """A capture of ``joints`` joints without channels under a root of one, ``end_sites`` End
     Sites, and ``frames`` frames, each frame line padded so the file is ``size`` bytes (the
