@@ -24,7 +24,10 @@ element type in bits 48-55; there the array starts with its element count (u64 f
 before it reads a value. A count is refused when its elements cannot fit in the bytes left
 after it: raw, each element takes its size on disk; compressed (bit 61, integers from 0.5,
 floating point from 0.6, 16 elements or more) each takes at least 2 bits before LZ4, so 1,020
-per byte. A 28 KB crate declaring 400 million curve counts cost usd-core 1.7 to 5.1 GB before.
+per byte. Vectors of paths, tokens, doubles (the sample times), layer offsets and strings are
+read the same way, a u64 count first; a time samples value leads, by two relative jumps, to its
+times and to the representations of its values, which are checked in turn. A 28 KB crate
+declaring 400 million curve counts cost usd-core 1.7 to 5.1 GB before.
 """
 
 from __future__ import annotations
@@ -53,6 +56,10 @@ _DISK_BYTES = {
 #: an SdfAssetPath index becomes a pointer-sized handle, a string a std::string).
 _MEMORY_BYTES = {**_DISK_BYTES, 10: 32, 11: 8, 12: 64}
 _INTS, _FLOATS = {3, 4, 5, 6}, {7, 8, 9}
+#: Values held as a std::vector (not VtArray), read as a u64 count and its elements: (bytes on
+#: disk, bytes in memory) of one element of paths, tokens, doubles, layer offsets, strings.
+_VECTOR_BYTES = {40: (4, 8), 41: (4, 8), 48: (8, 8), 49: (16, 16), 50: (4, 32)}
+_TIME_SAMPLES = 46
 
 
 def _u64(data: bytes, at: int) -> int:
@@ -135,30 +142,62 @@ def _value_reps(path: Path, section: bytes) -> list[int]:
 
 
 def _check_arrays(path: Path, f, reps: list[int], size: int, version: tuple[int, int]) -> None:
-    """Every array's element count against the bytes after it (see the module docstring)."""
-    seen = set()
-    for rep in reps:
+    """Every array's and vector's element count against the bytes after it, the time samples'
+    value representations included (see the module docstring)."""
+    todo, seen = list(reps), set()
+    while todo:
+        rep = todo.pop()
         kind, at = (rep >> 48) & 0xFF, rep & _PAYLOAD
-        if not rep & _IS_ARRAY or rep & _IS_INLINED or at == 0 or at in seen or kind not in _DISK_BYTES:
+        if rep & _IS_INLINED or at == 0 or rep in seen:
             continue
-        seen.add(at)
-        head = 4 if version < (0, 5) else 0
-        width = 8 if version >= (0, 7) else 4
-        if at + head + width > size:
-            raise FormatError(path, f"a crate array at byte {at} lies outside the file ({size} bytes)")
-        f.seek(at + head)
-        n = int.from_bytes(f.read(width), "little")
-        left = size - (at + head + width)
-        compressed = (
-            rep & _IS_COMPRESSED
-            and n >= _MIN_COMPRESSED
-            and ((kind in _INTS and version >= (0, 5)) or (kind in _FLOATS and version >= (0, 6)))
-        )
-        bound = _INTS_PER_BYTE * left if compressed else left // _DISK_BYTES[kind]
-        if n > bound:
-            why = f"the {left} bytes after it hold at most {bound}"
-            raise FormatError(path, f"a crate array at byte {at} claims {n} values; {why}")
-        budget.check_bytes(n * _MEMORY_BYTES[kind], f"{path}: a crate array of {n} values")
+        seen.add(rep)
+        if rep & _IS_ARRAY and kind in _DISK_BYTES:
+            head = 4 if version < (0, 5) else 0
+            _check_count(path, f, rep, at + head, 8 if version >= (0, 7) else 4, size, version)
+        elif not rep & _IS_ARRAY and kind in _VECTOR_BYTES:
+            _check_count(path, f, rep, at, 8, size, version)
+        elif not rep & _IS_ARRAY and kind == _TIME_SAMPLES:
+            todo += _time_sample_reps(path, f, at, size)
+
+
+def _read_at(path: Path, f, at: int, n: int, size: int) -> bytes:
+    if at < 0 or at + n > size:
+        raise FormatError(path, f"a crate value at byte {at} lies outside the file ({size} bytes)")
+    f.seek(at)
+    return f.read(n)
+
+
+def _time_sample_reps(path: Path, f, at: int, size: int) -> list[int]:
+    """The representations of a time samples value: a jump (i64, from where it is read) to its
+    times' representation, then a jump to the u64 count of its values' representations."""
+    (jump,) = struct.unpack("<q", _read_at(path, f, at, 8, size))
+    times = at + jump
+    (times_rep,) = struct.unpack("<Q", _read_at(path, f, times, 8, size))
+    (jump,) = struct.unpack("<q", _read_at(path, f, times + 8, 8, size))
+    values = times + 8 + jump
+    (n,) = struct.unpack("<Q", _read_at(path, f, values, 8, size))
+    left = size - values - 8
+    if n > left // 8:
+        raise FormatError(path, f"crate time samples at byte {at} claim {n} values; {left} bytes hold fewer")
+    return [times_rep, *struct.unpack(f"<{n}Q", _read_at(path, f, values + 8, 8 * n, size))]
+
+
+def _check_count(path: Path, f, rep: int, at: int, width: int, size: int, version: tuple[int, int]) -> None:
+    kind = (rep >> 48) & 0xFF
+    n = int.from_bytes(_read_at(path, f, at, width, size), "little")
+    left = size - (at + width)
+    compressed = (
+        rep & _IS_ARRAY
+        and rep & _IS_COMPRESSED
+        and n >= _MIN_COMPRESSED
+        and ((kind in _INTS and version >= (0, 5)) or (kind in _FLOATS and version >= (0, 6)))
+    )
+    disk, memory = (_DISK_BYTES[kind], _MEMORY_BYTES[kind]) if rep & _IS_ARRAY else _VECTOR_BYTES[kind]
+    bound = _INTS_PER_BYTE * left if compressed else left // disk
+    if n > bound:
+        why = f"the {left} bytes after it hold at most {bound}"
+        raise FormatError(path, f"a crate array at byte {at} claims {n} values; {why}")
+    budget.check_bytes(n * memory, f"{path}: a crate array of {n} values")
 
 
 def _fast_decompress(path: Path, data: bytes, limit: int) -> bytes:

@@ -166,6 +166,35 @@ def test_a_crate_whose_error_comes_lazily_from_get(tmp_path, capsys, count):
     _one_line_error(p, capsys)
 
 
+@pytest.mark.parametrize("which", ["a frame's points", "the sample times"])
+def test_a_time_sampled_array_claiming_2_to_the_40_values_is_refused_first(tmp_path, which):
+    """Time samples lead by relative jumps to their times and to each frame's value: those counts
+    are checked too, before usd-core sizes them."""
+    rng = np.random.default_rng(5)
+    frames = rng.standard_normal((3, 12, 3)).astype(np.float32)
+    p = tmp_path / "anim.usdc"
+    write(p, Animation(frames, np.array([4, 8]), 24))
+    data = bytearray(p.read_bytes())
+    if which == "the sample times":
+        times = np.array(sorted(_sample_times(p)), "<f8")
+        at = bytes(data).find(struct.pack("<Q", len(times)) + times.tobytes())
+    else:
+        at = _points_count_offset(bytes(data), frames[2])
+    assert at > 0
+    struct.pack_into("<Q", data, at, 2**40)
+    p.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match=f"a crate array at byte {at} claims {2**40} values"):
+        read(p)
+
+
+def _sample_times(path) -> list[float]:
+    from pxr import Usd, UsdGeom
+
+    stage = Usd.Stage.Open(str(path))
+    curves = next(p for p in stage.Traverse() if p.IsA(UsdGeom.BasisCurves))
+    return UsdGeom.BasisCurves(curves).GetPointsAttr().GetTimeSamples()
+
+
 def _sections(data: bytes) -> dict[str, tuple[int, int]]:
     toc = struct.unpack_from("<Q", data, 16)[0]
     n = struct.unpack_from("<Q", data, toc)[0]
