@@ -43,6 +43,11 @@ class GroomError(HairtoolError, ValueError):
     """Arrays do not describe a valid groom or animation."""
 
 
+class ReaderNote(UserWarning):
+    """Something a reader left out of what a file holds (a USC-HairSalon bald scalp sample), said
+    as a warning so it is never silent: the CLI prints it as one line on stderr."""
+
+
 class Cancelled(Exception):
     """Raised inside a long call once its ``cancelled()`` callback turned True (a studio job's
     Cancel button, a superseded job): the work stops and its result is dropped."""

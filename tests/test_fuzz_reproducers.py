@@ -322,6 +322,76 @@ def test_a_small_npz_is_refused_before_it_inflates(tmp_path):
     _refused("info", p, words="member 'frames.npy' (inflated) needs 2.34 GiB; the limit is 1 GiB")
 
 
+@pytest.mark.parametrize(
+    ("strands", "points"),
+    [(7, 5), (4099, 2)],  # 7 curve counts are stored raw, 4,099 compressed
+)
+def test_a_crate_declaring_400m_curve_counts_is_refused_before_usd_core_reads_it(tmp_path, strands, points):
+    """A 28 KB .usdc whose curve counts array declares 400 million values peaked at 1.7-5.1 GB
+    in usd-core before its refusal: the count sits at the array's place in the value region."""
+    import struct
+
+    from hairtool.groom import Groom
+    from hairtool.io import write
+
+    rng = np.random.default_rng(0)
+    p = tmp_path / "counts.usdc"
+    write(p, Groom(rng.normal(size=(strands * points, 3)), np.full(strands, points)))
+    data = bytearray(p.read_bytes())
+    declared = struct.pack("<Q", strands)  # crate 0.7+: the array's u64 element count first
+    if strands < 16:
+        declared += struct.pack(f"<{strands}i", *[points] * strands)
+    assert data.count(declared) == 1
+    at = data.index(declared)
+    struct.pack_into("<Q", data, at, 400_000_000)
+    p.write_bytes(bytes(data))
+    _refused("info", p, words=f"a crate array at byte {at} claims 400000000 values")
+
+
+def _wide_bvh(path: Path, joints: int, end_sites: int, frames: int, size: int = 18 << 20) -> None:
+    """A capture of ``joints`` joints without channels under a root of one, ``end_sites`` End
+    Sites, and ``frames`` frames, each frame line padded so the file is ``size`` bytes (the
+    file bounds frames × joints, so the biggest pose tables need a big file)."""
+    one = "JOINT a\n{\nOFFSET 0 1 0\n}\n"
+    end = "End Site\n{\nOFFSET 0 1 0\n}\n"
+    head = "HIERARCHY\nROOT r\n{\nOFFSET 0 0 0\nCHANNELS 1 Xposition\n" + one * joints + end * end_sites
+    motion = f"}}\nMOTION\nFrames: {frames}\nFrame Time: 0.04\n"
+    pad = (size - len(head) - len(motion)) // frames - 2
+    path.write_text(head + motion + ("0" + " " * pad + "\n") * frames)
+
+
+@pytest.mark.parametrize(
+    ("joints", "end_sites", "frames", "words"),
+    [
+        (99_999, 0, 188, "more than 10000 joints"),  # was 2.2 GB and 22 s of CPU posing it
+        (0, 600_000, 31, "more than 10000 End Sites"),  # was past 3 GB
+        (9_999, 0, 1_800, "1800 frames of 10000 joints and End Sites (posed) needs 3.35 GiB"),
+    ],
+)
+def test_an_18_mb_capture_of_empty_joints_is_refused_before_it_is_posed(
+    tmp_path, joints, end_sites, frames, words
+):
+    """An 18 MB BVH took 4.6 GB and 67 s: joints and End Sites cost the file a few bytes each and
+    no channel values, yet forward kinematics (``keys``) poses every one in every frame."""
+    p = tmp_path / "wide.bvh"
+    _wide_bvh(p, joints, end_sites, frames)
+    assert p.stat().st_size > 18_000_000
+    _refused("keys", p, words=words)
+
+
+def test_an_18_mb_capture_of_many_frames_reads(tmp_path):
+    """1.5 million frames of six channels: read and summarised within the caps."""
+    p = tmp_path / "long.bvh"
+    head = (
+        "HIERARCHY\nROOT hips\n{\nOFFSET 0 0 0\n"
+        "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+        "End Site\n{\nOFFSET 0 2 0\n}\n}\nMOTION\nFrames: 1572864\nFrame Time: 0.04\n"
+    )
+    p.write_text(head + "0 0 0 0 0 0\n" * 1_572_864)
+    status, err, peak_mb = _capped("info", p, "--json")
+    assert status == 0 and peak_mb < CAP_BYTES >> 20, err[-2000:]
+
+
 # -- numpy's warnings before our line ------------------------------------------------------------
 HUGE_XFORM = """#usda 1.0
 def Xform "head" (

@@ -9,12 +9,13 @@ the root-to-tip colour ramp then shows each bone's direction.
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
 from app.document.capture import skeleton_animation
 from hairtool import io
-from hairtool.errors import FormatError
+from hairtool.errors import FormatError, ReaderNote
 from hairtool.groom import Animation, Groom
 from hairtool.io.obj import Mesh
 from hairtool.mocap.bvh import Motion, read_bvh
@@ -48,6 +49,24 @@ def read_with_capture(path: str | os.PathLike[str]) -> tuple[Groom | Animation, 
         except FormatError as e:
             raise FormatError(path, e.reason) from None
     return io.read(path), None
+
+
+def read_with_notes(
+    path: str | os.PathLike[str],
+) -> tuple[Groom | Animation, Motion | None, list[str]]:
+    """:func:`read_with_capture`, and what the reader left out of the file (its
+    :class:`~hairtool.errors.ReaderNote` lines, for the status bar); other warnings go on as
+    Python shows them."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ReaderNote)
+        obj, capture = read_with_capture(path)
+    notes = []
+    for w in caught:
+        if issubclass(w.category, ReaderNote):
+            notes.append(str(w.message))
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return obj, capture, notes
 
 
 def surface_of(path: str | os.PathLike[str]) -> Mesh | None:

@@ -27,7 +27,7 @@ from app.ui.animation_io import (
     PROJECT_SUFFIX,
     USD_EXTENSIONS,
     open_filters,
-    read_with_capture,
+    read_with_notes,
     save_filters,
     surface_of,
 )
@@ -783,7 +783,7 @@ class MainWindow(QMainWindow):
                 self._add_recent(path)
             return ok
         try:
-            obj, capture = read_with_capture(path)
+            obj, capture, notes = read_with_notes(path)
             mesh = surface_of(path)
         except HairtoolError as e:
             self.show_error("Cannot open file", str(e))
@@ -802,7 +802,9 @@ class MainWindow(QMainWindow):
             else:
                 self._open_with_guides(hair, guides, path, mesh)
             if said is not None:
-                self.statusBar().showMessage(said, 10_000)
+                notes.append(said)
+        if notes:  # what the reader dropped, and the up axis it chose
+            self.statusBar().showMessage("; ".join(notes), 10_000)
         self._add_recent(path)
         return True
 

@@ -15,10 +15,11 @@ import os
 import pkgutil
 import signal
 import sys
+import warnings
 from collections.abc import Sequence
 
 from hairtool import __version__, interrupts
-from hairtool.errors import HairtoolError
+from hairtool.errors import HairtoolError, ReaderNote
 
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2
@@ -106,6 +107,22 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _say_notes(command: str):
+    """A ``warnings.showwarning`` that prints a reader's note (:class:`ReaderNote`: what it left
+    out of a file) as one line, ``hairtool COMMAND: warning: FILE: what``; other warnings as
+    Python prints them."""
+    shown = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, ReaderNote):
+            one = " ".join(str(message).splitlines())
+            print(f"hairtool {command}: warning: {one}", file=sys.stderr)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    return show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -114,7 +131,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             from hairtool import budget
 
             budget.set_factor(args.raise_limits)
-        return int(args._run(args) or EXIT_OK)
+        with warnings.catch_warnings():
+            warnings.simplefilter("always", ReaderNote)  # every file's note, each time it is read
+            warnings.showwarning = _say_notes(args.command)
+            return int(args._run(args) or EXIT_OK)
     except HairtoolError as e:
         print(f"hairtool {args.command}: error: {e}", file=sys.stderr)
         return EXIT_BAD_INPUT

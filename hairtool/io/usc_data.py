@@ -5,18 +5,20 @@ point_count`` and that many points of ``f32 x, y, z``. Nothing else: no header, 
 
 Every count is checked against the bytes the file still holds before anything is allocated, so
 a truncated file or a count of two billion is one clear error naming the file. A strand needs a
-root and a tip: the database marks a bald scalp sample as a strand of one point, and such a file
-is refused with that said, rather than losing strands without a word.
+root and a tip: the database marks a bald scalp sample as a strand of one point, which most of
+its files hold, so those strands are dropped and a :class:`~hairtool.errors.ReaderNote` says how
+many (the CLI prints it as one warning line); a file of nothing else is refused.
 """
 
 from __future__ import annotations
 
 import struct
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from hairtool.errors import FormatError
+from hairtool.errors import FormatError, ReaderNote
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import array_at, read_bytes, require_finite, require_strand_counts
@@ -25,8 +27,8 @@ INT32_MAX = 2**31 - 1
 
 
 def strand_counts(path: Path, data: bytes) -> np.ndarray:
-    """``(S,)`` points per strand, walking the file's counts; each one is checked against what
-    is left of the file before the next is read."""
+    """``(S,)`` points per strand (a bald scalp sample's one included), walking the file's
+    counts; each one is checked against what is left of the file before the next is read."""
     (n,) = struct.unpack_from("<i", data, 0)
     if n <= 0:
         raise FormatError(path, f"the strand count is {n}; a .data file holds at least one strand")
@@ -38,9 +40,8 @@ def strand_counts(path: Path, data: bytes) -> np.ndarray:
         if offset + 4 > len(data):
             raise FormatError(path, f"truncated: strand {s} of {n} has no point count (the file ends)")
         (c,) = struct.unpack_from("<i", data, offset)
-        if c < 2:
-            why = " (a bald scalp sample)" if c == 1 else ""
-            raise FormatError(path, f"strand {s} has {c} points{why}; every strand needs at least 2")
+        if c < 1:
+            raise FormatError(path, f"strand {s} has {c} points; every strand needs at least 1")
         end = offset + 4 + 12 * c
         if end > len(data):
             raise FormatError(
@@ -57,14 +58,24 @@ def read(path: Path) -> Groom:
     """Read a ``.data`` file (see the module docstring)."""
     data = read_bytes(path, 4, "USC-HairSalon .data")
     counts = strand_counts(path, data)
-    total = require_strand_counts(path, counts)
+    hair = counts >= 2
+    bald = len(counts) - int(hair.sum())
+    if bald == len(counts):
+        raise FormatError(path, f"all {bald} strands have one point (bald scalp samples); no hair to read")
     # The points are interleaved with the counts: point g of strand s starts at float word
     # 1 + (s + 1) + 3·g (the strand count, the counts up to its own, the points before it).
     words = array_at(path, data, 0, "<f4", len(data) // 4, "points")
     strand = np.repeat(np.arange(len(counts), dtype=np.int64), counts)
-    first = strand + 2 + 3 * np.arange(total, dtype=np.int64)
+    first = strand + 2 + 3 * np.arange(int(counts.sum()), dtype=np.int64)
+    if bald:
+        first = first[hair[strand]]
+        counts = counts[hair]
+    require_strand_counts(path, counts)
     points = words[first[:, None] + np.arange(3)]
     require_finite(path, points, "points")
+    if bald:
+        said = f"{path}: dropped {bald} of {bald + len(counts)} strands of one point (bald scalp samples)"
+        warnings.warn(ReaderNote(said), stacklevel=2)
     return Groom(points, counts)
 
 

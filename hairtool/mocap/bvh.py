@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from hairtool import budget
 from hairtool.errors import FormatError, ParameterError, quoted
 from hairtool.io.atomic import atomic_open
 from hairtool.mocap import quaternion as quat
@@ -29,7 +30,14 @@ from hairtool.mocap import quaternion as quat
 F64 = NDArray[np.float64]
 
 CHANNEL_NAMES = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
-_MAX_JOINTS = 100_000
+#: Joints, and End Sites apart: forward kinematics walks the joints one by one in Python (0.1 to
+#: 0.5 ms each a pass, by the frames), so 10,000 stay within seconds, where 100,000 took 22 s of
+#: CPU; the largest production rigs, faces included, have a few thousand.
+_MAX_JOINTS = 10_000
+#: Bytes forward kinematics holds per pose (a joint or End Site in one frame): local and world
+#: rotations and translations, the End Sites' gathered copies and the joined result, measured
+#: at about 100 (joints) to 160 (End Sites) and rounded up; the budget bounds their total.
+_POSE_BYTES = 200
 _MAX_VALUES = 500_000_000  # frames × channels: refuse absurd headers before allocating
 _MIN_POSES = 1_000_000  # frames × joints any file may have; beyond, at most one per byte of the file
 _MIN_FRAME_TIME = 1e-6  # seconds; shorter would make the frame rate overflow (1 / 5e-324 is inf)
@@ -284,6 +292,8 @@ def _parse_hierarchy(tok: _Tokens, path: str):
         elif w == "End":
             tok.expect("Site")
             tok.expect("{")
+            if len(end_parents) >= _MAX_JOINTS:
+                raise FormatError(path, f"more than {_MAX_JOINTS} End Sites")
             end_parents.append(me)
             end_offsets.append(offset(f"the End Site of {quoted(names[me])}"))
             tok.expect("}")
@@ -375,6 +385,8 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
             f"{n_frames} frames of {len(names) + len(end_parents)} joints and End Sites is more "
             f"than a file of {len(raw)} bytes can describe (joints without channels?)",
         )
+    what = f"{p}: {n_frames} frames of {len(names) + len(end_parents)} joints and End Sites (posed)"
+    budget.check_bytes(poses * _POSE_BYTES, what)
 
     lines = [ln for ln in body[m.end() :].splitlines() if ln.strip()]
     if len(lines) < n_frames:

@@ -1,7 +1,10 @@
 """Opening hair from a format without an up axis: the studio takes the axis the hair hangs along,
-says so in the status bar, and View ▸ Up axis overrides it; a format that says one is kept."""
+says so in the status bar, and View ▸ Up axis overrides it; a format that says one is kept. What
+a reader drops (USC-HairSalon's bald scalp samples) is said there too."""
 
 from __future__ import annotations
+
+import struct
 
 import numpy as np
 import pytest
@@ -45,3 +48,17 @@ def test_a_format_that_says_its_up_axis_keeps_it(make_window, tmp_path):
     assert w.open_path(path), w.errors
     assert w.scene.up_axis == io.read_groom(path).metadata.up_axis
     assert "Up axis" not in w.statusBar().currentMessage()
+
+
+def test_bald_scalp_samples_dropped_are_said_in_the_status_bar(make_window, tmp_path):
+    w = make_window()
+    hair = samples.scalp(strands=30, vertices=6, seed=3)
+    path = tmp_path / "bald.data"
+    io.write(path, hair)
+    data = path.read_bytes()  # two one-point strands added after the hair, the count raised
+    bald = (struct.pack("<i", 1) + np.zeros(3, "<f4").tobytes()) * 2
+    path.write_bytes(struct.pack("<i", 32) + data[4:] + bald)
+    assert w.open_path(path), w.errors
+    assert w.scene.rest.strand_count == 30
+    said = w.statusBar().currentMessage()
+    assert "dropped 2 of 32 strands of one point (bald scalp samples)" in said and "Y up" in said

@@ -1,12 +1,14 @@
 """USC-HairSalon ``.data``: the layout byte for byte, generated grooms written and read back the
-same, and hostile files (cut anywhere, huge or negative counts, non-finite points, a bald scalp
-sample's one-point strand) refused with one clear error, through the library and the CLI."""
+same, and hostile files (cut anywhere, huge or negative counts, non-finite points, nothing but bald
+scalp samples) refused with one clear error, through the library and the CLI. Bald scalp samples
+(strands of one point) among hair are dropped with one warning line."""
 
 from __future__ import annotations
 
 import struct
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -14,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hairtool import io as hairtool_io
-from hairtool.errors import FormatError
+from hairtool.errors import FormatError, ReaderNote
 from hairtool.groom import Groom
 
 from .conftest import make_groom
@@ -122,3 +124,35 @@ def test_hostile_counts_are_one_line_and_exit_2_in_the_cli(tmp_path, body, words
     assert run.returncode == 2
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and str(path) in lines[0] and words in lines[0], lines
+
+
+@settings(max_examples=60, deadline=None)
+@given(groom=grooms(), bald=st.lists(st.integers(0, 10**6), min_size=1, max_size=8))
+def test_bald_scalp_samples_are_dropped_with_a_note(tmp_path_factory, groom, bald):
+    """One-point strands put anywhere among the hair: the hair reads as written, and one note
+    counts what was dropped."""
+    strands = np.split(groom.points, np.cumsum(groom.counts)[:-1])
+    for b in bald:
+        strands.insert(b % (len(strands) + 1), np.full((1, 3), 7.0, np.float32))
+    path = tmp_path_factory.mktemp("bald") / "g.data"
+    path.write_bytes(data_bytes(strands))
+    with warnings.catch_warnings(record=True) as notes:
+        warnings.simplefilter("always")
+        back = hairtool_io.read_groom(path)
+    assert np.array_equal(back.counts, groom.counts)
+    assert back.points.tobytes() == groom.points.astype("<f4").tobytes()
+    assert [str(n.message) for n in notes if n.category is ReaderNote] == [
+        f"{path}: dropped {len(bald)} of {len(strands)} strands of one point (bald scalp samples)"
+    ]
+
+
+def test_the_cli_says_what_it_dropped_in_one_line(tmp_path):
+    path = tmp_path / "bald.data"
+    path.write_bytes(data_bytes([np.zeros((1, 3)), np.zeros((3, 3)), np.ones((1, 3)), np.ones((2, 3))]))
+    run = subprocess.run(
+        [sys.executable, "-m", "hairtool", "info", str(path)], capture_output=True, text=True, timeout=120
+    )
+    assert run.returncode == 0, run.stderr
+    assert run.stderr.splitlines() == [
+        f"hairtool info: warning: {path}: dropped 2 of 4 strands of one point (bald scalp samples)"
+    ]

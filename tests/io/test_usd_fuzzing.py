@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from hairtool.cli import main
 from hairtool.errors import FormatError
@@ -155,12 +157,42 @@ def test_a_crate_whose_error_comes_lazily_from_get(tmp_path, capsys, count):
     p = tmp_path / "lazy.usdc"
     write(p, g)
     data = bytearray(p.read_bytes())
-    struct.pack_into("<Q", data, _points_count_offset(bytes(data), g.points), count)
+    at = _points_count_offset(bytes(data), g.points)
+    struct.pack_into("<Q", data, at, count)
     p.write_bytes(bytes(data))
-    assert Usd.Stage.Open(str(p)) is not None  # the stage opens: the error comes later, inside Get()
-    with pytest.raises(FormatError, match="usd-core cannot read it"):
-        read(p)
+    assert Usd.Stage.Open(str(p)) is not None  # the stage opens: usd-core's error comes inside Get()
+    with pytest.raises(FormatError, match=f"a crate array at byte {at} claims {count} values"):
+        read(p)  # refused from the count before usd-core sizes the array
     _one_line_error(p, capsys)
+
+
+@pytest.mark.parametrize("which", ["a frame's points", "the sample times"])
+def test_a_time_sampled_array_claiming_2_to_the_40_values_is_refused_first(tmp_path, which):
+    """Time samples lead by relative jumps to their times and to each frame's value: those counts
+    are checked too, before usd-core sizes them."""
+    rng = np.random.default_rng(5)
+    frames = rng.standard_normal((3, 12, 3)).astype(np.float32)
+    p = tmp_path / "anim.usdc"
+    write(p, Animation(frames, np.array([4, 8]), 24))
+    data = bytearray(p.read_bytes())
+    if which == "the sample times":
+        times = np.array(sorted(_sample_times(p)), "<f8")
+        at = bytes(data).find(struct.pack("<Q", len(times)) + times.tobytes())
+    else:
+        at = _points_count_offset(bytes(data), frames[2])
+    assert at > 0
+    struct.pack_into("<Q", data, at, 2**40)
+    p.write_bytes(bytes(data))
+    with pytest.raises(FormatError, match=f"a crate array at byte {at} claims {2**40} values"):
+        read(p)
+
+
+def _sample_times(path) -> list[float]:
+    from pxr import Usd, UsdGeom
+
+    stage = Usd.Stage.Open(str(path))
+    curves = next(p for p in stage.Traverse() if p.IsA(UsdGeom.BasisCurves))
+    return UsdGeom.BasisCurves(curves).GetPointsAttr().GetTimeSamples()
 
 
 def _sections(data: bytes) -> dict[str, tuple[int, int]]:
@@ -211,6 +243,52 @@ def test_real_crates_pass_the_count_checks(tmp_path):
         usdc_check.check(INTEROP / name)
     write(tmp_path / "big.usdc", Groom(np.zeros((200_000, 3)) + np.arange(3), np.full(1000, 200)))
     usdc_check.check(tmp_path / "big.usdc")
+
+
+def _lz4_literals(data: bytes) -> bytes:
+    """``data`` as one LZ4 block of literals only (lengths of 15 and more go on in bytes)."""
+    n = len(data)
+    if n < 15:
+        return bytes([n << 4]) + data
+    rest, tail = n - 15, b""
+    while rest >= 255:
+        tail += b"\xff"
+        rest -= 255
+    return b"\xf0" + tail + bytes([rest]) + data
+
+
+@settings(max_examples=200, deadline=None)
+@given(data=st.binary(max_size=600), repeat=st.integers(1, 300), back=st.integers(1, 8))
+def test_the_value_tables_lz4_blocks_decode(data, repeat, back):
+    """Literals, then a match of ``back`` bytes repeated (overlapping when shorter than the match)."""
+    from hairtool.io.usdc_check import _lz4_block
+
+    assert _lz4_block(Path("f"), _lz4_literals(data), len(data)) == data
+    head = bytes(range(1, back + 1))
+    m = repeat + 4
+    token = (back << 4) | min(m - 4, 15)
+    ext = b""
+    if m - 4 >= 15:
+        rest = m - 4 - 15
+        ext = b"\xff" * (rest // 255) + bytes([rest % 255])
+    block = bytes([token]) + head + back.to_bytes(2, "little") + ext
+    want = head + (head * (m // back + 1))[:m]
+    assert _lz4_block(Path("f"), block, len(want)) == want
+    with pytest.raises(FormatError, match="LZ4"):
+        _lz4_block(Path("f"), block, len(want) - 1)  # never past the table it fills
+
+
+@settings(max_examples=200, deadline=None)
+@given(block=st.binary(max_size=200), limit=st.integers(0, 4096))
+def test_any_bytes_as_a_value_table_are_decoded_or_refused(block, limit):
+    from hairtool.io.usdc_check import _lz4_block
+
+    try:
+        out = _lz4_block(Path("f"), block, limit)
+    except FormatError as e:
+        assert "LZ4" in str(e)
+    else:
+        assert len(out) <= limit
 
 
 # -- mutated crates in a memory-capped child -----------------------------------------------
