@@ -58,6 +58,8 @@ READABLE_VERSIONS = (1, 2, 3)
 SUFFIX = ".hairproj"
 MANIFEST = "manifest.json"
 MAX_MANIFEST_BYTES = 64 * 1024**2
+#: Manifest strings that hold a whole file: the studio keeps a capture's BVH text there.
+EMBEDDED_TEXTS = frozenset({"settings.capture.bvh"})
 _MAX_DEFLATE_RATIO = 1100  # zlib never expands more than about 1032:1; more is a corrupt header
 _ATTRIBUTES = ("thickness", "transparency", "colors")
 _PARAM_FIELDS = tuple(f.name for f in dataclasses.fields(FrozenParams) if f.init)
@@ -334,7 +336,9 @@ class _Reader:
         if info.file_size > MAX_MANIFEST_BYTES:
             raise FormatError(self.path, "manifest.json is too large")
         text = self.zf.read(MANIFEST).decode("utf-8")
-        manifest = user_text.parse(self.path, text, "json", "a project's manifest.json")  # all text limits
+        manifest = user_text.parse(
+            self.path, text, "json", "a project's manifest.json", texts=EMBEDDED_TEXTS
+        )  # all text limits
         if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
             raise FormatError(self.path, "not a hairtool project (manifest has no project format)")
         version = manifest.get("version")

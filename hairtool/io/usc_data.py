@@ -22,6 +22,7 @@ from hairtool.errors import FormatError, ReaderNote
 from hairtool.groom import Animation, Groom
 from hairtool.io.atomic import atomic_open
 from hairtool.io.binary import array_at, read_bytes, require_finite, require_strand_counts
+from hairtool.metadata import Metadata
 
 INT32_MAX = 2**31 - 1
 
@@ -76,7 +77,7 @@ def read(path: Path) -> Groom:
     if bald:
         said = f"{path}: dropped {bald} of {bald + len(counts)} strands of one point (bald scalp samples)"
         warnings.warn(ReaderNote(said), stacklevel=2)
-    return Groom(points, counts)
+    return Groom(points, counts, metadata=Metadata())  # no scene: Y-up, centimetres, as .hair and .tfx
 
 
 def write(path: Path, obj: Groom | Animation) -> None:

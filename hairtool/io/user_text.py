@@ -29,10 +29,18 @@ _CONTROL = re.compile(r"[\x00-\x08\x0a-\x1f\x7f-\x9f]")
 
 
 def parse(
-    source: str | os.PathLike[str], text: str, kind: str, what: str, max_depth: int = MAX_DEPTH
+    source: str | os.PathLike[str],
+    text: str,
+    kind: str,
+    what: str,
+    max_depth: int = MAX_DEPTH,
+    texts: frozenset[str] = frozenset(),
 ) -> object:
     """``text``, a ``kind`` ("json" or "toml") document, parsed and checked; a
-    :class:`FormatError` naming ``source`` and ``what`` the document is ("a stroke log")."""
+    :class:`FormatError` naming ``source`` and ``what`` the document is ("a stroke log").
+    ``texts``: the places (``"settings.capture.bvh"``) that hold a whole file's text, such as a
+    capture's BVH a project carries: their lines and length are that file's, bounded by the
+    document's size, and the reader of that text checks it."""
     check_text(source, text, kind, what, max_depth)
     unreadable = f"not a readable {what.split(' ', 1)[-1]}"  # "a stroke log" -> "stroke log"
     try:
@@ -44,13 +52,16 @@ def parse(
         raise FormatError(source, f"{unreadable} (not valid TOML: {str(e).splitlines()[0]})") from None
     except (RecursionError, ValueError, OverflowError) as e:  # past the text checks only on a deep stack
         raise FormatError(source, f"{unreadable} ({type(e).__name__})") from None
-    check_strings(source, data)
+    check_strings(source, data, texts)
     return data
 
 
-def check_strings(source: str | os.PathLike[str], data: object) -> None:
+def check_strings(
+    source: str | os.PathLike[str], data: object, texts: frozenset[str] = frozenset()
+) -> None:
     """Refuse a string or key in ``data`` longer than :data:`MAX_STRING` or holding a control
-    character, naming where it is (walked without recursion)."""
+    character, naming where it is (walked without recursion); the strings at ``texts`` are
+    embedded files (see :func:`parse`)."""
     stack: list[tuple[str, object]] = [("", data)]
     while stack:
         where, v = stack.pop()
@@ -60,7 +71,7 @@ def check_strings(source: str | os.PathLike[str], data: object) -> None:
                 stack.append((f"{where}.{k}" if where else str(k), c))
         elif isinstance(v, list):
             stack.extend((f"{where}[{i}]", c) for i, c in enumerate(v))
-        elif isinstance(v, str):
+        elif isinstance(v, str) and where not in texts:
             _check_string(source, where or "the document", v, "string")
 
 
@@ -105,9 +116,11 @@ def read(
     kind: str | None = None,
     max_bytes: int = MAX_BYTES,
     max_depth: int = MAX_DEPTH,
+    texts: frozenset[str] = frozenset(),
 ) -> object:
     """A JSON or TOML file (``kind``, else its suffix: ``.toml`` is TOML, anything else JSON)
-    read and parsed under every limit; a :class:`FormatError` names the file."""
+    read and parsed under every limit (``texts`` as :func:`parse`'s); a :class:`FormatError`
+    names the file."""
     p = os.fspath(path)
     kind = kind or ("toml" if p.lower().endswith(".toml") else "json")
-    return parse(p, read_text(p, what, max_bytes), kind, what, max_depth)
+    return parse(p, read_text(p, what, max_bytes), kind, what, max_depth, texts)

@@ -257,7 +257,9 @@ def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
 
 def read_json(path: str | os.PathLike[str]) -> object:
     """A JSON file's data; unreadable or invalid JSON raises :class:`FormatError` naming it."""
-    return user_text.read(path, "an edit file", "json")  # every user text limit, as jobs files get
+    # every user text limit, as jobs files get; a project's capture section (an edit file
+    # too) carries the capture's BVH text whole
+    return user_text.read(path, "an edit file", "json", texts=frozenset({"bvh"}))
 
 
 def apply_edits(editor, edits: list, method: str = "auto") -> list[EditReport]:

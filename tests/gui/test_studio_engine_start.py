@@ -218,7 +218,7 @@ def test_the_warm_up_runs_its_steps_and_records_the_kernels(tmp_path, monkeypatc
     assert "app.render.soft_raster:draw_bands" in names and "hairtool.frozen.clump:_clump_run" in names
     # what an artist reaches after the first groom: other brushes, render hair, keys, waves, sims
     for kernel in (
-        "hairtool.frozen.brushes:_brush_kernel",
+        "hairtool.frozen.brushes.comb:_comb_kernel",
         "hairtool.guides.children:_children_kernel",
         "hairtool.guides.children:_moved_kernel",
         "app.render.hair_shading:_shade_kernel",

@@ -75,6 +75,8 @@ def brush_logs(groom) -> dict[str, list[dict]]:
     roots = groom.roots.astype(np.float64)
     s = len(tips) // 2
     tip, root, d = tips[s], roots[s], (0.01, 0.0, -0.005)
+    o = int(groom.offsets[s])
+    middle = groom.points[o + int(groom.counts[s]) // 2].astype(np.float64)
     return {
         "align": [
             {**stroke("align", tip + np.array([0.02, 0.0, 0.0]), strength=0.7), "params": {"mode": "paper"}}
@@ -98,6 +100,7 @@ def brush_logs(groom) -> dict[str, list[dict]]:
         "slide": [stroke("slide", root, direction=d, radius=0.03)],
         "add": [stroke("add", root, params={"count": 3, "seed": 1})],
         "density": [stroke("density", root, params={"spacing": 0.004, "seed": 2})],
+        "cut": [stroke("cut", middle, radius=0.01)],
     }
 
 
@@ -130,6 +133,7 @@ BRUSHES = (
     "slide",
     "add",
     "density",
+    "cut",
 )
 
 

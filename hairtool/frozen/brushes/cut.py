@@ -28,7 +28,10 @@ SPEC = BrushSpec(
     changes_strands=True,
     takes_strength=False,
     studio=Studio(
-        "Cut", "T", "Cuts the strands under the brush where they enter it (undo brings the ends back)", 1.0
+        "Cut",
+        "Shift+T",
+        "Cuts the strands under the brush where they enter it (undo brings the ends back)",
+        1.0,
     ),
 )
 
