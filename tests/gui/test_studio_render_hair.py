@@ -235,6 +235,7 @@ def test_a_release_clumps_the_render_hair_once_from_the_settled_guides(ui, make_
     ui.send_mouse(v, "press", start, left, left, None)
     for f in np.linspace(0.0, 1.0, 6)[1:]:
         ui.send_mouse(v, "move", start + f * np.array([30.0, 10.0]), None, left, None)
+    s.moves.drain()  # the engine thread's moves landed, still within the drag
     assert s.pipeline.unsettled and not runs  # local moves, drawn unclumped at the drag density
     ui.send_mouse(v, "release", start + np.array([30.0, 10.0]), left, None, None)
     assert w.undo_stack.count() == 1 and not s.dragging and not s.pipeline.unsettled
