@@ -4,7 +4,7 @@ One row per command line of :data:`hairtool.first_runs.RECIPES` (a seeded 2,000-
 sample, its children and a hemisphere scalp), plus ``freeze sintel``, the bundled Sintel guides
 (``resources/`` of a checkout), the command the cold-start target is set on. Each run is a child
 process ``python -m hairtool …``: ``cold_s`` with ``NUMBA_CACHE_DIR`` a new empty folder,
-``warm_s`` the same command again on the cache that run filled (the fastest of ``--repeat``);
+``warm_s`` the same command again on the cache that run filled (the median of ``--repeat``);
 ``compile_share`` is (cold - warm) / cold, the share of the first run numba spent compiling and
 caching. Both include the interpreter's start and the imports (about 1 s), as a user's do.
 Print ``hairtool bench host`` beside it on a shared machine.
@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import shutil
+import statistics
 import tempfile
 from pathlib import Path
 
@@ -65,10 +66,12 @@ def run(args: argparse.Namespace) -> list[dict]:
             cache = folder / f"cache-{len(rows)}"
             cache.mkdir()
             env = first_runs.child_env(cache)
+            if args.threads is not None:
+                env["NUMBA_NUM_THREADS"] = str(args.threads)
             rc, cold, message = first_runs.run_child(argv, env)
             row = {"command": label, "cold_s": cold, "warm_s": None, "compile_share": None, "status": rc}
             if rc == 0:
-                warm = min(first_runs.run_child(argv, env)[1] for _ in range(repeat))
+                warm = statistics.median(first_runs.run_child(argv, env)[1] for _ in range(repeat))
                 row.update(warm_s=warm, compile_share=(cold - warm) / cold)
             else:
                 row["error"] = message

@@ -157,9 +157,7 @@ def _run_on_dask(client, todo: list[Job], threads, manifests, rows, progress, wa
     from distributed import as_completed
 
     from hairtool.farm.runner import run_job
-    from hairtool.farm.warm import warm_workers
 
-    warm_workers(client, sorted({job.command for job in todo}))
     batch_id = secrets.token_hex(4)
     sizes = {job.index: input_bytes(job) for job in todo}
     order = sorted(todo, key=lambda job: -sizes[job.index])  # stable: equal sizes keep file order

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import pickle
-
 import pytest
 
 pytest.importorskip("distributed")
@@ -12,33 +10,28 @@ from hairtool import first_runs
 from hairtool.farm import warm
 
 
-class _Client:
-    def __init__(self) -> None:
-        self.plugins: list = []
-
-    def register_plugin(self, plugin) -> None:
-        self.plugins.append(pickle.loads(pickle.dumps(plugin)))  # as it travels to the workers
-
-
-def test_workers_warm_the_batch_commands_they_know(monkeypatch):
-    monkeypatch.setenv(first_runs.WARM_WORKERS_VARIABLE, "1")
-    client = _Client()
-    warm.warm_workers(client, ["keys", "freeze", "info"])  # info runs no kernel recipe
-    (plugin,) = client.plugins
-    assert plugin.commands == ("freeze", "keys")
-    assert plugin.name == "hairtool-warm:freeze,keys"
-    seen = []
+@pytest.fixture
+def warm_calls(monkeypatch):
+    """``first_runs.warm_once`` recorded, and a fresh process's memory of what it warmed."""
+    seen: list = []
     monkeypatch.setattr(first_runs, "warm_once", lambda commands=None, **kw: seen.append(commands) or [])
-    plugin.setup(worker=None)
-    assert seen == [("freeze", "keys")] and plugin.failed == []
+    monkeypatch.setattr(warm, "_warmed", set())
+    return seen
 
 
-@pytest.mark.parametrize(("value", "commands"), [("0", ["freeze"]), ("1", ["info"]), ("1", [])])
-def test_no_warm_up_when_turned_off_or_nothing_to_warm(monkeypatch, value, commands):
-    monkeypatch.setenv(first_runs.WARM_WORKERS_VARIABLE, value)
-    client = _Client()
-    warm.warm_workers(client, commands)
-    assert client.plugins == []
+def test_a_worker_warms_each_command_once_before_its_first_job(monkeypatch, warm_calls):
+    monkeypatch.setenv(first_runs.WARM_WORKERS_VARIABLE, "1")
+    assert warm.warm_before_job("keys") == []
+    assert warm.warm_before_job("keys") is None
+    assert warm.warm_before_job("freeze") == []
+    assert warm.warm_before_job("info") is None  # no kernel recipe
+    assert warm_calls == [["keys"], ["freeze"]]
+
+
+def test_no_warm_up_when_turned_off(monkeypatch, warm_calls):
+    monkeypatch.setenv(first_runs.WARM_WORKERS_VARIABLE, "0")
+    assert warm.warm_before_job("freeze") is None
+    assert warm_calls == []
 
 
 @pytest.mark.slow(seconds=15)
