@@ -113,6 +113,15 @@ def test_cache_warm_command(fake_warm, capsys):
     assert captured.err.strip() == "hairtool cache: error: not warmed: keys"
 
 
+def test_cache_warm_without_a_writable_cache_folder_is_one_line_and_2(monkeypatch, tmp_path, capsys):
+    blocked = tmp_path / "file"
+    blocked.write_text("")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(blocked / "cache"))
+    assert main(["cache", "warm"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("hairtool cache: error: ") and str(blocked) in err and err.count("\n") == 1
+
+
 def test_bench_cold_times_a_command_cold_then_warm(capsys):
     assert main(["bench", "cold", "--commands", "sample", "--repeat", "1", "--json"]) == 0
     (row,) = json.loads(capsys.readouterr().out)

@@ -42,7 +42,14 @@ def run(args: argparse.Namespace) -> int:
     from hairtool import first_runs
 
     t0 = time.perf_counter()
-    failed = first_runs.warm_once(report=_report, force=not args.if_needed)
+    try:
+        failed = first_runs.warm_once(report=_report, force=not args.if_needed)
+    except OSError as e:  # the record's folder cannot be made or written
+        print(
+            f"hairtool cache: error: {e.filename or first_runs.stamp_path()}: {e.strerror or e}",
+            file=sys.stderr,
+        )
+        return 2
     if failed is None:
         print("the kernel cache is warm already")
         return 0

@@ -36,6 +36,8 @@ def warm_before_job(command: str) -> list[str] | None:
     with _lock:
         if command in _warmed:
             return None
-        failed = first_runs.warm_once(commands=[command])
         _warmed.add(command)
-        return failed
+        try:
+            return first_runs.warm_once(commands=[command])
+        except OSError:  # no writable cache folder here: the job compiles what it needs, as before
+            return None

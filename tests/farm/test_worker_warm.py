@@ -34,6 +34,16 @@ def test_no_warm_up_when_turned_off(monkeypatch, warm_calls):
     assert warm_calls == []
 
 
+def test_a_worker_without_a_writable_cache_folder_runs_its_jobs_unwarmed(monkeypatch, tmp_path):
+    monkeypatch.setenv(first_runs.WARM_WORKERS_VARIABLE, "1")
+    monkeypatch.setattr(warm, "_warmed", set())
+    blocked = tmp_path / "file"
+    blocked.write_text("")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(blocked / "cache"))  # under a file: cannot be made
+    assert warm.warm_before_job("freeze") is None
+    assert warm.warm_before_job("freeze") is None  # and does not try again
+
+
 @pytest.mark.slow(seconds=15)
 def test_a_local_batch_warms_its_workers_once(project, capsys, monkeypatch, tmp_path):
     import os
