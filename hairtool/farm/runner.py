@@ -70,10 +70,12 @@ def run_job(job: Job, threads: int | None = None) -> dict:
     numbers from the command's ``--json`` object (:mod:`hairtool.farm.fields`). ``threads``:
     numba threads for this job.
     """
+    from hairtool.farm.warm import warm_before_job
     from hairtool.io.atomic import recording_writes, stale_temporaries
 
     argv = job.argv + [o for o in report_options(job.command) if o not in job.args]
     with _LOCK:
+        warm_before_job(job.command)  # once per command in this process, before its clock starts
         previous = os.getcwd()
         t0 = time.perf_counter()
         try:

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from hairtool.cli import main
+from hairtool.first_runs import WARM_WORKERS_VARIABLE
 
 #: name → ``hairtool simulate`` arguments of a 24-frame shot.
 SHOTS = {
@@ -16,6 +17,13 @@ SHOTS = {
     "b": ["sample:scalp:40:8", "--frames", "24", "--motion", "nod", "--gusts", "1", "--seed", "1"],
     "c": ["sample:scalp:30:10", "--frames", "30", "--motion", "shake"],
 }
+
+
+@pytest.fixture(autouse=True)
+def _no_worker_warmup(monkeypatch):
+    """The batch tests' jobs are tiny: their workers skip the kernel warm-up (its own tests:
+    tests/farm/test_worker_warm.py)."""
+    monkeypatch.setenv(WARM_WORKERS_VARIABLE, "0")
 
 
 @pytest.fixture(scope="session")

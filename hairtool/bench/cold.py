@@ -1,0 +1,80 @@
+"""Each command's first run on an empty kernel cache, against its run on the cache it filled.
+
+One row per command line of :data:`hairtool.first_runs.RECIPES` (a seeded 2,000-strand scalp
+sample, its children and a hemisphere scalp), plus ``freeze sintel``, the bundled Sintel guides
+(``resources/`` of a checkout), the command the cold-start target is set on. Each run is a child
+process ``python -m hairtool …``: ``cold_s`` with ``NUMBA_CACHE_DIR`` a new empty folder,
+``warm_s`` the same command again on the cache that run filled (the median of ``--repeat``);
+``compile_share`` is (cold - warm) / cold, the share of the first run numba spent compiling and
+caching. Both include the interpreter's start and the imports (about 1 s), as a user's do.
+Print ``hairtool bench host`` beside it on a shared machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import statistics
+import tempfile
+from pathlib import Path
+
+from hairtool import first_runs
+from hairtool.bench import add_common_arguments, setup
+
+HELP = "cold and warm seconds of each command's first run (a fresh kernel cache per command)"
+#: The command the cold-start target is set on (issue 44): ``freeze`` of the bundled guides.
+SINTEL = "freeze sintel"
+QUICK = ("sample", "freeze", SINTEL)
+
+
+def _sintel() -> Path:
+    return Path(first_runs.__file__).resolve().parents[1] / "resources" / "sintel_hair.tfx"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    names = [*first_runs.labels(), SINTEL]
+    parser.add_argument(
+        "--commands",
+        nargs="+",
+        metavar="LABEL",
+        choices=names,
+        help=f"of: {', '.join(repr(n) for n in names)} (default all; 'sample' writes the others' input)",
+    )
+    add_common_arguments(parser, quick="sample, freeze and freeze sintel only, one warm run", repeat=2)
+
+
+def _argv(label: str, folder: Path) -> list[str] | None:
+    if label == SINTEL:
+        src = _sintel()
+        return ["freeze", str(src), str(folder / "sintel-frozen.hair")] if src.is_file() else None
+    return first_runs.argv(label, folder)
+
+
+def run(args: argparse.Namespace) -> list[dict]:
+    repeat = setup(args)
+    names = args.commands or (list(QUICK) if args.quick else [*first_runs.labels(), SINTEL])
+    if any(n != "sample" and n != SINTEL for n in names) and "sample" not in names:
+        names = ["sample", *names]  # the others read its groom
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="hairtool-cold-") as tmp:
+        folder = Path(tmp)
+        first_runs.prepare(folder)
+        for label in names:
+            argv = _argv(label, folder)
+            if argv is None:
+                continue
+            cache = folder / f"cache-{len(rows)}"
+            cache.mkdir()
+            env = first_runs.child_env(cache)
+            if args.threads is not None:
+                env["NUMBA_NUM_THREADS"] = str(args.threads)
+            rc, cold, message = first_runs.run_child(argv, env)
+            row = {"command": label, "cold_s": cold, "warm_s": None, "compile_share": None, "status": rc}
+            if rc == 0:
+                warm = statistics.median(first_runs.run_child(argv, env)[1] for _ in range(repeat))
+                row.update(warm_s=warm, compile_share=(cold - warm) / cold)
+            else:
+                row["error"] = message
+            rows.append(row)
+            shutil.rmtree(cache, ignore_errors=True)
+    return rows
