@@ -72,6 +72,9 @@ class BrushTool:
     collide: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(brushes(), True))
     add_count: int = 2  # strands the add brush plants per mouse move
     spacing: float = 0.05  # between roots, the density brush's (groom units)
+    #: delete takes the strands with any segment under the brush (Blender's rule), else only
+    #: those whose root is
+    delete_any_segment: bool = True
     align_mode: str = "paper"
     only_selected: bool = True  # brushes keep to the selected strands (Blender's selection toggle)
     #: per brush: a pen's pressure scales the radius / the strength (Blender's pressure buttons;
@@ -144,7 +147,8 @@ class BrushTool:
         hit = self.collide.get(name, True)
         only = self.only_selected and name != "select"
         # the sample's fields by name (hairtool.frozen.sample_schema): those a brush does not
-        # use (add's count, density's spacing, a snake hook's start) keep their defaults there
+        # use (add's count, density's spacing, delete's rule, a snake hook's start) keep their
+        # defaults there
         common = {"cursor": c, "radius": r, "view": v, "collide": hit, "only_selected": only, "pressure": p}
         if name == "align":
             first = ALIGN.make(intensity=self.strength_at(p), mode=self.align_mode, **common)
@@ -157,7 +161,7 @@ class BrushTool:
         strength = self.signed_strength(invert, p)
         first = BRUSH.make(
             brush=name, direction=d, strength=strength, lut=self.lut(), start=start,
-            count=self.add_count, spacing=self.spacing, **common,
+            count=self.add_count, spacing=self.spacing, any_segment=self.delete_any_segment, **common,
         )  # fmt: skip
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 

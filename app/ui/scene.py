@@ -734,6 +734,13 @@ class Scene(QObject):
             self.tool.add_count = int(count)
             self.tool_changed.emit()
 
+    def set_delete_any_segment(self, on: bool) -> None:
+        """Delete takes the strands with any segment under the brush (Blender's rule), or off:
+        only those whose root is."""
+        if bool(on) != self.tool.delete_any_segment:
+            self.tool.delete_any_segment = bool(on)
+            self.tool_changed.emit()
+
     def set_spacing(self, spacing: float) -> None:
         """The distance the density brush leaves between roots (groom units)."""
         if not np.isfinite(spacing) or spacing <= 0:

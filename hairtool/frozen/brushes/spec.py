@@ -36,7 +36,12 @@ class Param:
     open_low: bool = False
 
     def check(self, value: object) -> None:
-        """ParameterError naming the field where ``value`` is not of the type or out of range."""
+        """ParameterError naming the field where ``value`` is not of the type or out of range
+        (a ``bool`` field: True or False, nothing else)."""
+        if self.kind is bool:
+            if not isinstance(value, bool | np.bool_):
+                raise ParameterError(self.field, value, self.expects)
+            return
         number = isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool)
         if self.kind is int and not isinstance(value, int | np.integer):
             number = False
