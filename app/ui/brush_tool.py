@@ -33,6 +33,8 @@ TIPS = {spec.name: spec.studio.tip for spec in _SPECS}
 SIGNED = {spec.name: spec.studio.signs for spec in _SPECS if spec.signed and spec.studio.signs}
 SIGN_LABELS = {spec.name: spec.studio.sign_label for spec in _SPECS if spec.signed and spec.studio.sign_label}
 DEFAULT_STRENGTH = {spec.name: spec.studio.strength for spec in _SPECS}
+#: The direction each signed brush starts in (True: its second, shrink or erase).
+DEFAULT_SUBTRACT = {name: registry.spec_of(name).studio.starts_second for name in SIGNED}
 #: Brushes whose strength is only a direction (paint or erase, on or off): a pen's pressure
 #: never scales it (a light touch would otherwise erase, or do nothing).
 STRENGTHLESS = tuple(spec.name for spec in _SPECS if not spec.takes_strength)
@@ -63,7 +65,7 @@ class BrushTool:
     brush: str = "align"
     radius: dict[str, float] = field(default_factory=dict)
     strength: dict[str, float] = field(default_factory=lambda: dict(DEFAULT_STRENGTH))
-    subtract: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(SIGNED, False))
+    subtract: dict[str, bool] = field(default_factory=lambda: dict(DEFAULT_SUBTRACT))
     falloff: Falloff = "smooth"
     symmetry: bool = False
     mirror_x: float | None = None

@@ -54,8 +54,10 @@ class Param:
 @dataclass(frozen=True)
 class Studio:
     """How the studio shows a brush: its artist's name, key, tooltip and default strength;
-    for a signed brush the labels of its two directions and of the toggle between them;
-    ``place``: its place in the toolbar (last: after the brushes that say where they go)."""
+    for a signed brush the labels of its two directions and of the toggle between them, and
+    ``starts_second``: it starts in the second direction (where the first shows nothing on a new
+    groom: every strand already clumps fully); ``place``: its place in the toolbar (last: after
+    the brushes that say where they go)."""
 
     label: str
     shortcut: str
@@ -64,6 +66,7 @@ class Studio:
     signs: tuple[str, str] | None = None
     sign_label: str | None = None
     place: int = 1000
+    starts_second: bool = False
 
 
 @dataclass(frozen=True)
