@@ -323,3 +323,14 @@ def test_delete_by_either_rule_equals_its_twin_over_every_tip_and_middle(any_seg
             sample = BrushSample("delete", cursor, (0.0,) * 3, radius, 1.0, LUTS[0], any_segment=any_segment)
             got = strands_to_delete(GROOM, sample, locked)
             assert got.tobytes() == strands_to_delete_reference(GROOM, sample, locked).tobytes()
+
+
+@pytest.mark.parametrize("value", ("yes", 1, None, [True]))
+def test_a_log_whose_delete_rule_is_not_true_or_false_is_refused_naming_it(value):
+    from hairtool.errors import ParameterError
+    from hairtool.frozen.strokes import stroke_from_dict
+
+    raw = {"brush": "delete", "params": {"any_segment": value},
+           "samples": [{"cursor": [0, 0, 0], "radius": 0.1, "strength": 1.0}]}  # fmt: skip
+    with pytest.raises(ParameterError, match=r"params\.any_segment"):
+        stroke_from_dict(raw).pipeline_samples(0.0)
