@@ -33,6 +33,8 @@ TIPS = {spec.name: spec.studio.tip for spec in _SPECS}
 SIGNED = {spec.name: spec.studio.signs for spec in _SPECS if spec.signed and spec.studio.signs}
 SIGN_LABELS = {spec.name: spec.studio.sign_label for spec in _SPECS if spec.signed and spec.studio.sign_label}
 DEFAULT_STRENGTH = {spec.name: spec.studio.strength for spec in _SPECS}
+#: The direction each signed brush starts in (True: its second, shrink or erase).
+DEFAULT_SUBTRACT = {name: registry.spec_of(name).studio.starts_second for name in SIGNED}
 #: Brushes whose strength is only a direction (paint or erase, on or off): a pen's pressure
 #: never scales it (a light touch would otherwise erase, or do nothing).
 STRENGTHLESS = tuple(spec.name for spec in _SPECS if not spec.takes_strength)
@@ -63,7 +65,7 @@ class BrushTool:
     brush: str = "align"
     radius: dict[str, float] = field(default_factory=dict)
     strength: dict[str, float] = field(default_factory=lambda: dict(DEFAULT_STRENGTH))
-    subtract: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(SIGNED, False))
+    subtract: dict[str, bool] = field(default_factory=lambda: dict(DEFAULT_SUBTRACT))
     falloff: Falloff = "smooth"
     symmetry: bool = False
     mirror_x: float | None = None
@@ -72,6 +74,9 @@ class BrushTool:
     collide: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(brushes(), True))
     add_count: int = 2  # strands the add brush plants per mouse move
     spacing: float = 0.05  # between roots, the density brush's (groom units)
+    #: delete takes the strands with any segment under the brush (Blender's rule), else only
+    #: those whose root is
+    delete_any_segment: bool = True
     align_mode: str = "paper"
     only_selected: bool = True  # brushes keep to the selected strands (Blender's selection toggle)
     #: per brush: a pen's pressure scales the radius / the strength (Blender's pressure buttons;
@@ -144,7 +149,8 @@ class BrushTool:
         hit = self.collide.get(name, True)
         only = self.only_selected and name != "select"
         # the sample's fields by name (hairtool.frozen.sample_schema): those a brush does not
-        # use (add's count, density's spacing, a snake hook's start) keep their defaults there
+        # use (add's count, density's spacing, delete's rule, a snake hook's start) keep their
+        # defaults there
         common = {"cursor": c, "radius": r, "view": v, "collide": hit, "only_selected": only, "pressure": p}
         if name == "align":
             first = ALIGN.make(intensity=self.strength_at(p), mode=self.align_mode, **common)
@@ -157,7 +163,7 @@ class BrushTool:
         strength = self.signed_strength(invert, p)
         first = BRUSH.make(
             brush=name, direction=d, strength=strength, lut=self.lut(), start=start,
-            count=self.add_count, spacing=self.spacing, **common,
+            count=self.add_count, spacing=self.spacing, any_segment=self.delete_any_segment, **common,
         )  # fmt: skip
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 

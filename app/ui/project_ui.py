@@ -371,7 +371,7 @@ def _brush_settings(tool) -> dict:
     """The brush as a project keeps it: the current brush's radius, strength and mode (what
     older projects hold), and every brush's own, the falloff, symmetry, front faces only and
     each brush's collision with the head and pen toggles (pressure scales its radius, its
-    strength), add's strands per move, density's spacing and whether brushes keep to the
+    strength), add's strands per move, density's spacing, delete's rule and whether brushes keep to the
     selection."""
     falloff = tool.falloff if isinstance(tool.falloff, str) else [list(p) for p in tool.falloff]
     return {
@@ -389,6 +389,7 @@ def _brush_settings(tool) -> dict:
         "collide": dict(tool.collide),
         "add_count": tool.add_count,
         "spacing": tool.spacing,
+        "delete_any_segment": tool.delete_any_segment,
         "only_selected": tool.only_selected,
         "pressure_radius": dict(tool.pressure_radius),
         "pressure_strength": dict(tool.pressure_strength),
@@ -424,6 +425,7 @@ def _brush_setters(scene, brush: dict) -> tuple:
         lambda: scene.tool.collide.update({k: bool(v) for k, v in brush["collide"].items() if k in names}),
         lambda: scene.set_add_count(int(brush["add_count"])),
         lambda: scene.set_spacing(float(brush["spacing"])),
+        lambda: scene.set_delete_any_segment(bool(brush["delete_any_segment"])),
         lambda: scene.set_only_selected(bool(brush["only_selected"])),
         lambda: pens("pressure_radius"),
         lambda: pens("pressure_strength"),

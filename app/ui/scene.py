@@ -51,7 +51,7 @@ class Scene(QObject):
     points_changed = Signal()  # same strands at new positions: re-upload positions only
     params_changed = Signal(object)  # FrozenParams
     tool_changed = Signal()  # the brush, its radius, strength, falloff, symmetry …
-    mask_changed = Signal()  # the strands the mask brush locked changed (their colour shows it)
+    mask_changed = Signal()  # the mask or the painted clump strengths changed (their colours show them)
     selection_changed = Signal(bool)  # the selected or hidden strands changed (True: hidden ones too)
     refused = Signal(str)  # a stroke the brush cannot make, in words for the status bar
     display_changed = Signal()  # colour mode, ramp or line width
@@ -99,6 +99,7 @@ class Scene(QObject):
         self.path: Path | None = None
         self.tool = BrushTool()
         self.locked = np.zeros(0, dtype=bool)  # the masked strands (a copy of the pipeline's)
+        self.clump_strength = np.ones(0)  # each strand's painted clump strength (a copy too)
         self.selected = np.ones(0, dtype=bool)  # the selected strands (a copy of the pipeline's)
         self.hidden = np.zeros(0, dtype=bool)  # … and the hidden ones
         self.hidden_version = 0  # counts changes of ``hidden`` (what the drawn strands are made for)
@@ -138,6 +139,7 @@ class Scene(QObject):
         self.tool.reset_radius(BRUSH_SHARE * extent if extent > 0 else 1.0)
         self.tool.mirror_x = None  # the new groom's own centre
         self.locked = np.zeros(groom.strand_count, dtype=bool)
+        self.clump_strength = np.ones(groom.strand_count)
         self.selected = np.ones(groom.strand_count, dtype=bool)
         self.hidden = np.zeros(groom.strand_count, dtype=bool)
         self.hidden_version += 1
@@ -328,9 +330,9 @@ class Scene(QObject):
         self.points_changed.emit()
 
     def _sync_mask(self) -> None:
-        locked = self.pipeline.locked
-        if not np.array_equal(locked, self.locked):
-            self.locked = locked
+        locked, clump = self.pipeline.locked, self.pipeline.clump_strength
+        if not (np.array_equal(locked, self.locked) and np.array_equal(clump, self.clump_strength)):
+            self.locked, self.clump_strength = locked, clump
             self.mask_changed.emit()
         selected, hidden = self.pipeline.selected, self.pipeline.hidden
         hid = not np.array_equal(hidden, self.hidden)
@@ -732,6 +734,13 @@ class Scene(QObject):
             raise ParameterError("strands per move", count, f"a whole number in [1, {MAX_COUNT}]")
         if int(count) != self.tool.add_count:
             self.tool.add_count = int(count)
+            self.tool_changed.emit()
+
+    def set_delete_any_segment(self, on: bool) -> None:
+        """Delete takes the strands with any segment under the brush (Blender's rule), or off:
+        only those whose root is."""
+        if bool(on) != self.tool.delete_any_segment:
+            self.tool.delete_any_segment = bool(on)
             self.tool_changed.emit()
 
     def set_spacing(self, spacing: float) -> None:

@@ -210,6 +210,16 @@ class ToolDock(QDockWidget):
         self.add_count.setRange(1, 1000)
         self.add_count.setToolTip("how many strands the add brush plants at each mouse move")
         self.add_count.valueChanged.connect(self.scene.set_add_count)
+        self.delete_rule = QComboBox()
+        self.delete_rule.addItem("Any part under the brush", True)
+        self.delete_rule.addItem("Root under the brush", False)
+        self.delete_rule.setToolTip(
+            "which strands delete removes: every strand with any segment under the brush "
+            "(as Blender), or only those whose root is"
+        )
+        self.delete_rule.currentIndexChanged.connect(
+            lambda i: self.scene.set_delete_any_segment(bool(self.delete_rule.itemData(i)))
+        )
         self.spacing = QDoubleSpinBox()
         self.spacing.setDecimals(4)
         self.spacing.setKeyboardTracking(False)
@@ -235,6 +245,7 @@ class ToolDock(QDockWidget):
         form.addRow("Direction", self.sign)
         form.addRow("Strands per move", self.add_count)
         form.addRow("Spacing", self.spacing)
+        form.addRow("Removes", self.delete_rule)
         form.addRow("Falloff", self.falloff)
         form.addRow(self.curve)
         form.addRow("Symmetry", mirror_row)
@@ -354,7 +365,10 @@ class ToolDock(QDockWidget):
         lo, hi = s.rest.bounds
         extent = max(float((hi - lo).max()), 1e-3)
         widgets = (self.brush, self.radius, self.intensity, self.mode, self.sign, self.falloff, self.curve)
-        more = (self.symmetry, self.mirror_x, self.front_only, self.collide, self.add_count, self.spacing)
+        more = (
+            self.symmetry, self.mirror_x, self.front_only, self.collide, self.add_count, self.spacing,
+            self.delete_rule,
+        )  # fmt: skip
         pens = (self.pressure_radius, self.pressure_strength)
         with signals_blocked(*widgets, *more, *pens):
             self.brush.setCurrentIndex(self.brush.findData(s.brush))
@@ -401,6 +415,8 @@ class ToolDock(QDockWidget):
             self.spacing.setSingleStep(extent / 200.0)
             self.spacing.setValue(tool.spacing)
             self._brush_form.setRowVisible(self.spacing, "spacing" in fields)
+            self.delete_rule.setCurrentIndex(self.delete_rule.findData(tool.delete_any_segment))
+            self._brush_form.setRowVisible(self.delete_rule, "any_segment" in fields)
 
     def refresh_params(self) -> None:
         p: FrozenParams = self.scene.params

@@ -7,7 +7,9 @@ when the log needs it (a log of align samples alone is written as a version 1 pr
 the manifest's ``strokes`` section names the groups stored: ``brushes`` (the brush, direction
 and falloff columns, with ``falloffs``, the table of distinct falloff curves), ``views``,
 ``collide``, ``plants`` (add and density's count, seed and spacing), ``starts``,
-``only_selected``, ``pressure`` and ``selection`` (a step's op, and a box's matrix, rectangle
+``only_selected``, ``pressure``, ``any_segment`` (a delete's rule: stored only where a
+sample takes Blender's, so older projects, which meant the root rule, read as they did) and
+``selection`` (a step's op, and a box's matrix, rectangle
 and mode in ``box``). Choices are stored as indices into a list: the align modes in ``modes``,
 the brushes in ``brushes``, the steps in ``selection``.
 """
@@ -54,10 +56,13 @@ COLUMNS = (
     Column("start", "starts", np.int64, 0, 0),
     Column("only_selected", "only_selected", np.int64, 0, 0),
     Column("pressure", "pressure", np.float64, 0, 1.0),
+    Column("any_segment", "any_segment", np.int64, 0, 0),
     Column("selection", "selection", np.int64, 0, -1),
     Column("box", "selection", np.float64, BOX_WIDTH, (0.0,) * BOX_WIDTH),
 )
-GROUPS = ("brushes", "views", "collide", "plants", "starts", "only_selected", "pressure", "selection")
+GROUPS = (
+    "brushes", "views", "collide", "plants", "starts", "only_selected", "pressure", "any_segment", "selection"
+)  # fmt: skip
 
 
 def _differs(log: Sequence, name: str, fill: Any) -> bool:

@@ -50,6 +50,7 @@ class Field:
     choices: tuple[str, ...] = ()
     used_by: tuple[str, ...] | None = None  # None: every brush or step of the type
     log_default: Any = REQUIRED  # what a stroke log that leaves it out means (REQUIRED: default)
+    quiet: bool = False  # a stroke log leaves it out at its default (logs before it stay as they were)
 
     def in_log(self, raw: dict) -> Any:
         """Its value in a stroke log's object ``raw`` (its default where left out)."""
@@ -116,6 +117,8 @@ BRUSH = SampleType("brush", BrushSample, "brush", (
     Field("count", "whole", 1, "count", "params", "count", 1, MAX_COUNT, used_by=("add",)),
     Field("spacing", "number", 0.0, "spacing", "params", "spacing", 0.0, None, True, used_by=("density",)),
     Field("seed", "whole", 0, "seed", "params", "seed", 0, 2**32 - 1, used_by=("add", "density")),
+    Field("any_segment", "flag", False, "any_segment", "params", "any_segment", used_by=("delete",),
+          quiet=True),
     Field("collide", "flag", True, "collision", "stroke", "collide"),
     Field("only_selected", "flag", False, "only_selected", "stroke", "only_selected"),
     Field("cursor", "vector", json="cursor", column="cursor"),
@@ -166,5 +169,9 @@ def strength_range(brush: str) -> tuple[float, float]:
 
 def params_of(t: SampleType, by: str, sample: Any) -> dict[str, Any]:
     """The params a stroke log writes for ``sample`` (a ``by`` brush): those its brush uses, in
-    the description's order, by their log names."""
-    return {f.json: getattr(sample, f.name) for f in t.at("params") if f.used(by)}
+    the description's order, by their log names (a quiet one only where it is not its default)."""
+    return {
+        f.json: getattr(sample, f.name)
+        for f in t.at("params")
+        if f.used(by) and not (f.quiet and getattr(sample, f.name) == f.default)
+    }

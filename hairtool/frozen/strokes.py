@@ -12,7 +12,9 @@ A stroke log is a JSON list of strokes, in groom units::
   strength: > 0 grows, < 0 shrinks, as a fraction of the strand's length at the brush centre),
   ``puff``, ``mask`` (> 0 locks the strands touched, < 0 frees them) or ``clump`` (> 0 paints
   clumping on, < 0 off: each strand's clump strength moves toward 1 or 0), ``delete`` (removes
-  the strands whose root lies within the radius; strength > 0, falloff ignored), ``pinch`` (> 0
+  the strands with any segment within the radius where ``params.any_segment`` is true, as
+  Blender does, else those whose root lies within it, as a log without it meant; strength > 0,
+  falloff ignored), ``pinch`` (> 0
   gathers toward the brush centre, < 0 spreads) or ``snake_hook`` (the strands whose tip lies
   within the radius at the stroke's first sample follow the cursor; ``direction`` is the
   cursor's motion since the sample before), ``slide`` (roots slide along the head; needs one)
@@ -153,6 +155,8 @@ class Stroke:
                 shared[f.name] = getattr(self, f.json)
             elif f.level == "params" and f.used(self.brush):
                 value = f.in_log(self.params)
+                if f.kind == "flag" and not isinstance(value, bool):
+                    raise ParameterError(f"params.{f.json}", value, "true or false")
                 number = f.kind == "number" and value is not None
                 shared[f.name] = _number(f"params.{f.json}", value) if number else value
         for i, s in enumerate(self.samples):

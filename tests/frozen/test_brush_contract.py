@@ -76,7 +76,9 @@ def brush_samples(
     direction = tuple(draw(st.floats(-0.3, 0.3)) for _ in range(3))
     fields = {}
     for p in spec.params:
-        if p.kind is int:
+        if p.kind is bool:  # (a rule: both ways)
+            fields[p.field] = draw(st.booleans())
+        elif p.kind is int:
             fields[p.field] = draw(st.integers(int(p.low), int(min(p.high, p.low + 4))))
         else:
             low = max(p.low, 0.05 * radius)
@@ -273,3 +275,62 @@ def test_the_studio_has_a_label_a_key_and_a_tip_for_every_brush(name):
     assert LABELS[name] and TIPS[name] and SHORTCUTS[name]
     assert list(SHORTCUTS.values()).count(SHORTCUTS[name]) == 1
     assert 0.0 < DEFAULT_STRENGTH[name] <= 1.0
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_brushs_own_flags_are_read_from_a_log_that_leaves_them_out_as_their_defaults(name):
+    """A stroke log written before a flag was added (no such param) replays as it did: the
+    flag at its default, and the log written again without it (the pinned logs stay bytes)."""
+    flags = [p for p in registry.spec_of(name).params if p.kind is bool]
+    if not flags or name == "align":
+        return
+    sample = BrushSample(name, (0.0, 0.1, 0.0), (0.0, 0.0, 0.0), 0.2, 0.5 * (name != "add") + 0.5, LUTS[0])
+    (written,) = strokes_from_log([sample])
+    assert all(p.log_name not in written.params for p in flags)
+    (back,) = written.pipeline_samples(0.0)
+    assert all(getattr(back, p.field) == p.default for p in flags)
+    for p in flags:
+        (other,) = strokes_from_log([replace(sample, **{p.field: not p.default})])
+        assert other.params[p.log_name] is (not p.default)
+
+
+def test_delete_by_any_segment_takes_strands_whose_roots_are_elsewhere():
+    """Blender's rule removes the strands with a segment under the brush; the root rule only
+    those whose root is: a brush over the tips alone removes strands by the first, none by the
+    second."""
+    tips = GROOM.points[GROOM.topology.tip_indices].astype(np.float64)
+    cursor = tuple(float(x) for x in tips[len(tips) // 2])
+    brush = registry.brush_of("delete")
+    by_root = BrushSample("delete", cursor, (0.0, 0.0, 0.0), 0.05, 1.0, LUTS[0], any_segment=False)
+    by_segment = replace(by_root, any_segment=True)
+    free = StrandState.fresh(GROOM.strand_count)
+    kept_root = brush.apply(StrokeContext(free, centre_of=lambda: scalp_centre(GROOM)), GROOM, by_root)
+    kept_any = brush.apply(StrokeContext(free, centre_of=lambda: scalp_centre(GROOM)), GROOM, by_segment)
+    assert kept_root.strand_count == GROOM.strand_count
+    assert kept_any.strand_count < GROOM.strand_count
+
+
+@pytest.mark.parametrize("any_segment", (True, False))
+def test_delete_by_either_rule_equals_its_twin_over_every_tip_and_middle(any_segment):
+    """(The drawn samples above rarely sit where the two rules differ: here every cursor does.)"""
+    from hairtool.frozen.brushes.delete import strands_to_delete, strands_to_delete_reference
+
+    locked = np.arange(GROOM.strand_count) % 7 == 3
+    middle = GROOM.topology.offsets[:-1] + 3
+    for at in np.concatenate([GROOM.topology.tip_indices, middle]):
+        cursor = tuple(float(x) for x in GROOM.points[at] + np.float32([0.01, 0.0, 0.0]))
+        for radius in (0.02, 0.11, 0.4):
+            sample = BrushSample("delete", cursor, (0.0,) * 3, radius, 1.0, LUTS[0], any_segment=any_segment)
+            got = strands_to_delete(GROOM, sample, locked)
+            assert got.tobytes() == strands_to_delete_reference(GROOM, sample, locked).tobytes()
+
+
+@pytest.mark.parametrize("value", ("yes", 1, None, [True]))
+def test_a_log_whose_delete_rule_is_not_true_or_false_is_refused_naming_it(value):
+    from hairtool.errors import ParameterError
+    from hairtool.frozen.strokes import stroke_from_dict
+
+    raw = {"brush": "delete", "params": {"any_segment": value},
+           "samples": [{"cursor": [0, 0, 0], "radius": 0.1, "strength": 1.0}]}  # fmt: skip
+    with pytest.raises(ParameterError, match=r"params\.any_segment"):
+        stroke_from_dict(raw).pipeline_samples(0.0)

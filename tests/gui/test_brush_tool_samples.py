@@ -27,6 +27,7 @@ def moves(draw):
         only_selected=draw(st.booleans()),
         add_count=draw(st.integers(1, 20)),
         spacing=draw(st.floats(0.01, 0.5)),
+        delete_any_segment=draw(st.booleans()),
         falloff=draw(st.sampled_from(("smooth", "linear", "constant"))),
         align_mode=draw(st.sampled_from(("paper", "preserve-length"))),
     )

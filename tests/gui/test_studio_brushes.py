@@ -175,6 +175,7 @@ def _ramp(scene):
 
 
 def test_clump_brush_paints_each_strands_clump_strength(ui, make_window):
+    from app.ui.colouring import CLUMP_RGB, CLUMP_TINT, vertex_colors
     from app.ui.window import CLUMP_FULL
     w = plain(make_window, clump=True)
     s, v = w.scene, w.viewport
@@ -183,18 +184,28 @@ def test_clump_brush_paints_each_strands_clump_strength(ui, make_window):
     s.set_intensity(1.0)
     before = s.result
     pos = v.project(before.tips[front_strand(w)])[0]
+    assert w.dock.sign.currentText() == "Erase"  # a new groom clumps fully: the brush starts erasing
+    s.set_subtract("clump", False)
+    assert w.dock.sign.currentText() == "Paint"
     click(ui, v, pos)  # paint where every strand clumps fully already: nothing to do, and it says so
     assert w.statusBar().currentMessage() == CLUMP_FULL
-    assert w.dock.sign.currentText() == "Paint"
+    colours_before = vertex_colors(s)
     click(ui, v, pos, CTRL)  # erase: those strands no longer clump
     strength = s.pipeline.clump_strength
     off = strength < 1.0
     assert off.sum() >= 2 and np.all(strength[off] == 0.0)
+    off_v = np.repeat(off, s.result.topology.counts)  # drawn in the clump brush's own colour
+    colours = vertex_colors(s)
+    loose = (1 - CLUMP_TINT) * _ramp(s)[off_v] + CLUMP_TINT * CLUMP_RGB
+    np.testing.assert_allclose(colours[off_v], loose, atol=1e-5)
+    if colours_before is not None:
+        np.testing.assert_array_equal(colours[~off_v], colours_before[~off_v])
     assert not np.array_equal(s.result.points, before.points)
     s.set_subtract("clump", False)
     click(ui, v, pos)  # paint back: full clumping, the first result again
     assert np.all(s.pipeline.clump_strength == 1.0)
     np.testing.assert_array_equal(s.result.points, before.points)
+    assert vertex_colors(s) is colours_before or np.array_equal(vertex_colors(s), colours_before)
     w.undo_stack.undo()
     np.testing.assert_array_equal(s.pipeline.clump_strength, strength)
     assert w.undo_stack.count() == 3
@@ -518,7 +529,8 @@ def test_one_move_gives_its_sample_and_the_mirrored_one_for_every_brush():
             assert first.intensity == 0.8 and first.mode == "paper"
         else:
             assert first.brush == name and second.direction == (-0.1, 0.0, 0.0)
-            sign = -1.0 if name in SIGNED else 1.0  # Ctrl inverts the signed ones
+            # Ctrl inverts the signed ones (from the direction each starts in: clump erases)
+            sign = (1.0 if tool.subtract[name] else -1.0) if name in SIGNED else 1.0
             assert first.strength == sign * tool.strength[name]
     tool.set_brush("comb")
     assert tool.samples((0, 0, 0), (0, 0, 0), None, 0.0) == []  # a comb standing still does nothing

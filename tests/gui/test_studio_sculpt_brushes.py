@@ -55,10 +55,14 @@ def test_the_new_brushes_have_entries_and_keys_that_clash_with_nothing(make_wind
 
 
 def test_delete_removes_the_strands_under_the_brush_and_undo_brings_them_back(ui, make_window):
+    """(By the root rule, chosen in the dock; Blender's rule is the next test's.)"""
     w = plain(make_window)
     s, v = w.scene, w.viewport
     rest = s.result
     w.brush_actions["delete"].trigger()
+    assert w.dock.delete_rule.isVisibleTo(w.dock) and s.tool.delete_any_segment
+    w.dock.delete_rule.setCurrentIndex(w.dock.delete_rule.findData(False))
+    assert not s.tool.delete_any_segment
     s.set_radius(0.25)
     s_front = front_strand(w)
     pos = v.project(rest.roots[s_front])[0]
@@ -119,6 +123,28 @@ def test_pinch_and_snake_hook_strokes_replay_in_the_cli_to_the_studios_bytes(ui,
     args = ["freeze", str(tmp_path / "rest.npz"), str(tmp_path / "out.npz"), "--keep-lengths"]
     assert main([*args, "--strokes", str(tmp_path / "strokes.json")]) == 0
     np.testing.assert_array_equal(io.read_groom(tmp_path / "out.npz").points, s.result.points)
+
+
+def test_delete_by_default_removes_the_strands_with_any_segment_under_the_brush(ui, make_window):
+    """Blender's rule, the studio's default: a brush over a tip removes its strand though its
+    root is not under the brush, and the stroke log says which rule each move used."""
+    w = plain(make_window)
+    s, v = w.scene, w.viewport
+    rest = s.result
+    w.brush_actions["delete"].trigger()
+    s.set_radius(0.1)
+    tip = rest.points[rest.topology.tip_indices[front_strand(w)]]
+    pos = v.project(tip)[0]
+    ui.grab(v)
+    ui.drag(v, pos, pos + np.array([4.0, 0.0]), steps=2)
+    assert all(x.any_segment for x in s.pipeline.strokes)
+    gone = np.setdiff1d(np.arange(rest.strand_count), s.pipeline.origin)
+    rooted = np.zeros(rest.strand_count, bool)  # roots under some move's brush
+    for x in s.pipeline.strokes:
+        rooted |= np.linalg.norm(rest.roots - np.array(x.cursor), axis=1) / x.radius < 1.0
+    assert gone.size and not rooted[gone].all()  # taken by a segment, its root elsewhere
+    w.scene.set_brush("comb")
+    assert not w.dock.delete_rule.isVisibleTo(w.dock)
 
 
 def test_delete_takes_the_children_of_its_guides_and_waits_while_an_animation_holds_them(ui, make_window):
@@ -271,8 +297,10 @@ def test_a_project_keeps_the_new_brush_settings(make_window, tmp_path):
     s.set_spacing(0.07)
     s.set_brush("pinch")
     s.set_collide(False)
+    s.set_delete_any_segment(False)
     assert w.project.save_to(tmp_path / "p.hairproj")
     w2 = plain(make_window, groom=samples.scalp(strands=50, vertices=8))
     assert w2.project.open_project(tmp_path / "p.hairproj")
     t = w2.scene.tool
     assert (t.add_count, t.spacing, t.collide["pinch"], t.collide["comb"]) == (5, 0.07, False, True)
+    assert not t.delete_any_segment

@@ -23,11 +23,13 @@ SPEC = BrushSpec(
     studio=Studio(
         "Clump",
         "P",
-        "Paints how strongly strands clump (ClumpWithGaps' per-strand strength; Ctrl erases)",
+        "Paints how strongly strands clump (ClumpWithGaps' per-strand strength): a new groom "
+        "clumps fully, so it starts erasing (Ctrl paints clumping back)",
         0.5,
         ("Paint", "Erase"),
         "Paint or erase",
         place=5,
+        starts_second=True,
     ),
 )
 

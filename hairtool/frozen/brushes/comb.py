@@ -20,7 +20,7 @@ SPEC = BrushSpec(
     order=1,
     local=True,
     needs_direction=True,
-    studio=Studio("Comb", "C", "Tips follow the drag, strand lengths kept", 0.5, place=1),
+    studio=Studio("Comb", "C", "Tips follow the drag, strand lengths kept", 1.0, place=1),
 )
 
 

@@ -1,5 +1,8 @@
-"""Delete: the strands whose root lies within the radius of the cursor (falloff ignored; masked
-and back-facing strands spared) leave the groom. The pipeline records which strands remain
+"""Delete: the strands under the brush leave the groom (falloff ignored; masked and back-facing
+strands spared). Two rules say which are under it: Blender's, any segment within the radius of
+the cursor (``any_segment``, the studio's default), and the root rule, the root within it (what
+every stroke log and project written before the choice meant, so they replay as they did). The
+pipeline records which strands remain
 (:attr:`~hairtool.frozen.pipeline.FrozenPipeline.origin`), so undo and replay are exact."""
 
 from __future__ import annotations
@@ -10,9 +13,12 @@ from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
 from hairtool.frozen.brushes.sample import BrushSample
-from hairtool.frozen.brushes.spec import Brush, BrushSpec, StrokeContext, Studio
+from hairtool.frozen.brushes.spec import Brush, BrushSpec, Param, StrokeContext, Studio
 from hairtool.frozen.brushes.strand_moves import checked
 from hairtool.groom import Groom
+
+#: Blender's rule (True) or the root rule (False: a sample that does not say, as older logs).
+ANY_SEGMENT = Param("any_segment", bool, 0, 1, 0, "any_segment", "true (any segment) or false (the root)")
 
 SPEC = BrushSpec(
     name="delete",
@@ -23,10 +29,12 @@ SPEC = BrushSpec(
     studio=Studio(
         "Delete",
         "X",
-        "Removes the strands whose roots are under the brush (undo brings them back)",
+        "Removes the strands under the brush: those with any segment under it, or only those "
+        "whose root is (undo brings them back)",
         1.0,
         place=9,
     ),
+    params=(ANY_SEGMENT,),
 )
 
 
@@ -37,24 +45,78 @@ def _under_kernel(roots, c, radius, locked, out):  # pragma: no cover - compiled
         out[s] = not locked[s] and np.sqrt(dx * dx + dy * dy + dz * dz) / radius < 1.0
 
 
+@njit(cache=True, nogil=True, parallel=True)
+def _segment_kernel(p, offsets, c, radius, locked, out):  # pragma: no cover - compiled
+    r2 = radius * radius
+    for s in prange(offsets.size - 1):
+        if locked[s]:
+            continue
+        a0, a1 = offsets[s], offsets[s + 1]
+        hit = False
+        if a1 == a0:
+            continue
+        for i in range(a0, max(a1 - 1, a0 + 1)):
+            j = min(i + 1, a1 - 1)
+            ax, ay, az = p[i, 0], p[i, 1], p[i, 2]
+            ex, ey, ez = p[j, 0] - ax, p[j, 1] - ay, p[j, 2] - az
+            wx, wy, wz = c[0] - ax, c[1] - ay, c[2] - az
+            len2 = ex * ex + ey * ey + ez * ez
+            t = 0.0
+            if len2 > 0.0:
+                t = min(max((wx * ex + wy * ey + wz * ez) / len2, 0.0), 1.0)
+            qx, qy, qz = ax + t * ex - c[0], ay + t * ey - c[1], az + t * ez - c[2]
+            if qx * qx + qy * qy + qz * qz < r2:
+                hit = True
+                break
+        out[s] = hit
+
+
 def strands_to_delete(groom: Groom, sample: BrushSample, locked: ArrayLike) -> np.ndarray:
-    """``(S,)`` the strands one delete sample removes: root within the radius, not ``locked``
-    (masked or facing away), and only with strength > 0 (numba)."""
+    """``(S,)`` the strands one delete sample removes: any segment within the radius (with
+    ``any_segment``) or the root within it, not ``locked`` (masked or facing away), and only
+    with strength > 0 (numba)."""
     checked(sample, "delete")
     out = np.zeros(groom.strand_count, dtype=np.bool_)
-    if sample.strength > 0:
-        _under_kernel(
-            groom.roots.astype(np.float64), np.asarray(sample.cursor, np.float64), float(sample.radius),
-            np.asarray(locked, np.bool_), out,
-        )  # fmt: skip
+    if sample.strength <= 0:
+        return out
+    c, r, lock = np.asarray(sample.cursor, np.float64), float(sample.radius), np.asarray(locked, np.bool_)
+    if sample.any_segment:
+        _segment_kernel(groom.points.astype(np.float64), groom.offsets, c, r, lock, out)
+    else:
+        _under_kernel(groom.roots.astype(np.float64), c, r, lock, out)
+    return out
+
+
+def _segments_within(groom: Groom, c: np.ndarray, radius: float) -> np.ndarray:
+    """``(S,)`` the strands with a segment (or, for a one-vertex strand, the vertex) closer
+    than ``radius`` to ``c``, as the kernel computes it, operation for operation."""
+    p, off = groom.points.astype(np.float64), groom.offsets
+    last = off[1:] - 1
+    i = np.arange(p.shape[0] - 1 if p.shape[0] > 1 else 0)
+    i = i[groom.topology.strand_index[i] == groom.topology.strand_index[i + 1]]
+    single = off[:-1][last == off[:-1]]
+    i, j = np.concatenate([i, single]), np.concatenate([i + 1, single])
+    a, e, w = p[i], p[j] - p[i], c - p[i]
+    len2 = e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1] + e[:, 2] * e[:, 2]
+    dot = w[:, 0] * e[:, 0] + w[:, 1] * e[:, 1] + w[:, 2] * e[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(len2 > 0.0, np.minimum(np.maximum(dot / len2, 0.0), 1.0), 0.0)
+    q = a + t[:, None] * e - c
+    d2 = q[:, 0] * q[:, 0] + q[:, 1] * q[:, 1] + q[:, 2] * q[:, 2]
+    out = np.zeros(groom.strand_count, bool)
+    out[groom.topology.strand_index[i[d2 < radius * radius]]] = True
     return out
 
 
 def strands_to_delete_reference(groom: Groom, sample: BrushSample, locked: ArrayLike) -> np.ndarray:
     """Numpy twin of :func:`strands_to_delete`."""
     checked(sample, "delete")
-    r = groom.roots.astype(np.float64)
-    inside = np.linalg.norm(r - np.asarray(sample.cursor, np.float64), axis=1) / sample.radius < 1.0
+    c = np.asarray(sample.cursor, np.float64)
+    if sample.any_segment:
+        inside = _segments_within(groom, c, float(sample.radius))
+    else:
+        r = groom.roots.astype(np.float64)
+        inside = np.linalg.norm(r - c, axis=1) / sample.radius < 1.0
     return inside & ~np.asarray(locked, bool) & (sample.strength > 0)
 
 

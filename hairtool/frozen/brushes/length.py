@@ -22,7 +22,7 @@ SPEC = BrushSpec(
         "Length",
         "L",
         "Grows or shrinks the strands under the brush (Ctrl: the other way)",
-        0.05,
+        0.1,
         ("Grow", "Shrink"),
         "Grow or shrink",
         place=3,

@@ -24,7 +24,7 @@ SPEC = BrushSpec(
         "Pinch",
         "Shift+P",
         "Gathers strands toward the brush centre (Ctrl: spreads them); roots stay, lengths kept",
-        0.1,
+        0.4,
         ("Gather", "Spread"),
         "Gather or spread",
         place=7,

@@ -24,7 +24,7 @@ SPEC = BrushSpec(
         "Puff",
         "I",
         "Lifts strands away from the scalp near the root (turns them toward the scalp normal)",
-        0.2,
+        0.6,
         place=4,
     ),
 )

@@ -29,7 +29,9 @@ class BrushSample:
     between roots. ``only_selected``: the strands not selected are left as if locked
     (:mod:`hairtool.frozen.selection`). ``pressure``: the pen's pressure in [0, 1] at this move
     (1 for a mouse), already applied to ``radius`` and ``strength`` where the brush's pressure
-    toggles said so: kept so a stroke log records it."""
+    toggles said so: kept so a stroke log records it. ``any_segment``: a delete sample removes
+    the strands with any segment under it (Blender's rule), else those whose root is (the rule
+    of every log written before the choice, so its default)."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -45,6 +47,7 @@ class BrushSample:
     spacing: float = 0.0
     only_selected: bool = False
     pressure: float = 1.0
+    any_segment: bool = False
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction

@@ -36,7 +36,12 @@ class Param:
     open_low: bool = False
 
     def check(self, value: object) -> None:
-        """ParameterError naming the field where ``value`` is not of the type or out of range."""
+        """ParameterError naming the field where ``value`` is not of the type or out of range
+        (a ``bool`` field: True or False, nothing else)."""
+        if self.kind is bool:
+            if not isinstance(value, bool | np.bool_):
+                raise ParameterError(self.field, value, self.expects)
+            return
         number = isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool)
         if self.kind is int and not isinstance(value, int | np.integer):
             number = False
@@ -49,8 +54,10 @@ class Param:
 @dataclass(frozen=True)
 class Studio:
     """How the studio shows a brush: its artist's name, key, tooltip and default strength;
-    for a signed brush the labels of its two directions and of the toggle between them;
-    ``place``: its place in the toolbar (last: after the brushes that say where they go)."""
+    for a signed brush the labels of its two directions and of the toggle between them, and
+    ``starts_second``: it starts in the second direction (where the first shows nothing on a new
+    groom: every strand already clumps fully); ``place``: its place in the toolbar (last: after
+    the brushes that say where they go)."""
 
     label: str
     shortcut: str
@@ -59,6 +66,7 @@ class Studio:
     signs: tuple[str, str] | None = None
     sign_label: str | None = None
     place: int = 1000
+    starts_second: bool = False
 
 
 @dataclass(frozen=True)
