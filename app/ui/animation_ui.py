@@ -17,7 +17,7 @@ from PySide6.QtWidgets import QLabel, QStyle, QWidget
 
 from app.ui.animation_model import VIEW_MODES, AnimationModel
 from app.ui.engine_start import WAIT_MESSAGE
-from app.ui.qt_utils import add_action
+from app.ui.qt_utils import add_action, set_available
 from app.ui.recording import Recorder
 from hairtool.errors import HairtoolError
 from hairtool.frozen.align import align
@@ -361,8 +361,10 @@ class AnimationController(QObject):
         a["clear"] = add_action(w, menu, "&Close animation", self.close_animation)
 
         def enable() -> None:  # both need an animation (Re-solve one with frames to key)
-            a["resolve"].setEnabled(m.n_frames >= 2)
-            a["clear"].setEnabled(m.animation is not None)
+            set_available(
+                a["resolve"], m.n_frames >= 2, "Re-solve keys needs an animation of two frames or more"
+            )
+            set_available(a["clear"], m.animation is not None, "No animation to close")
 
         m.animation_changed.connect(enable)
         enable()
