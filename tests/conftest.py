@@ -9,6 +9,12 @@ from pathlib import Path
 
 import pytest
 
+# numba's parallel kernels run on GNU OpenMP here, whose idle threads spin at every barrier. Two
+# xdist workers, each with a pool per core, then spin against each other's work: the brush
+# pictures took 31 s of CPU where passive waiting takes 3 s. Set before any kernel loads libgomp,
+# and inherited by the commands the tests run as children.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 ROOT = Path(__file__).resolve().parent.parent
 TEST_DATA = ROOT / "tests" / "data"  # real grooms, captures and Blender exports, licences beside
 GROOMS = TEST_DATA / "grooms"
