@@ -37,6 +37,8 @@ import stat
 from collections.abc import Iterator
 from pathlib import Path
 
+from hairtool import interrupts
+
 _CREATE_FLAGS = (
     os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOFOLLOW", 0)
 )
@@ -199,6 +201,8 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     tmp_path, new_file_mode = _create_temp(target)
     try:
         yield tmp_path
+        if interrupts.was_interrupted():  # a Ctrl+C a library swallowed (usd-core's plugin loading)
+            raise KeyboardInterrupt
         # After the writer: some (usd-core) replace the file at tmp_path with their own.
         os.chmod(tmp_path, _final_mode(target, new_file_mode))
         os.replace(tmp_path, target)

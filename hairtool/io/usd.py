@@ -49,6 +49,7 @@ from typing import Protocol
 
 import numpy as np
 
+from hairtool import interrupts
 from hairtool.bounds import box
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom, Topology
@@ -808,7 +809,7 @@ def _usd_diagnostics(notes: list[str]):
         try:
             yield
         finally:
-            os.dup2(saved, 2)
+            interrupts.restore_stderr(saved)
             os.close(saved)
             f.seek(0)
             text = f.read().decode("utf-8", "replace")
