@@ -116,12 +116,34 @@ class Schedule:
         return self.n_frames / self.fps
 
     def shot_exposure(self, frames: int) -> NDArray[np.int64]:
-        """``(frames,)`` the picture on each frame of a shot that repeats the cycle."""
+        """``(frames,)`` the picture on each frame of a shot that repeats the cycle.
+
+        Parameters
+        ----------
+        frames : int
+            The shot's length in frames, 1 … ``MAX_SHOT_FRAMES``.
+
+        Returns
+        -------
+        ndarray
+            ``(frames,)`` int64 picture indices, the cycle's exposure repeated.
+        """
         n = _check_count("frames", frames, 1, MAX_SHOT_FRAMES, f"a whole number in [1, {MAX_SHOT_FRAMES}]")
         return self.exposure[np.arange(n) % self.n_frames]
 
     def to_dict(self, frames: int | None = None) -> dict:
-        """Plain JSON-ready numbers; ``exposure`` covers ``frames`` (default one cycle)."""
+        """Plain JSON-ready numbers; ``exposure`` covers ``frames`` (default one cycle).
+
+        Parameters
+        ----------
+        frames : int, optional
+            The shot's length the exposure covers (None: one cycle).
+
+        Returns
+        -------
+        dict
+            Period, fps, hold, counts, picture times and the exposure, as plain numbers and lists.
+        """
         exposure = self.exposure if frames is None else self.shot_exposure(frames)
         return {
             "period": self.period,

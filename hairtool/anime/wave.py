@@ -139,6 +139,28 @@ def make_bunches(
     Without ``guides`` every strand is a bunch; with them each strand follows its nearest
     guide. ``amplitude_scale``/``phase`` (one value or one per bunch; phase in cycles) override
     the seeded draws of 1 ± ``amplitude_spread`` and [0, ``phase_spread``). Lock step: spreads 0.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands to group.
+    guides : array_like, optional
+        Indices of guide strands; each strand follows its nearest (None: every strand alone).
+    sway : array_like, optional
+        The direction the bunches bend in (None: each bunch's own, from its shape).
+    amplitude_scale, phase : array_like, optional
+        One value or one per bunch, overriding the seeded draws.
+    amplitude_spread : float, default 0.1
+        Each bunch's amplitude is 1 ± this, drawn from ``seed``.
+    phase_spread : float, default 0.25
+        Each bunch's phase offset is drawn from [0, this) cycles.
+    seed : int, default 0
+        The draws' seed: the same seed, the same bunches.
+
+    Returns
+    -------
+    Bunches
+        The bunch of every strand and each bunch's axis, scale and phase.
     """
     if guides is None:
         of_strand = np.arange(groom.strand_count, dtype=np.int64)
@@ -170,6 +192,24 @@ def pose_pictures(
     Each strand samples y = scale_b·f(x, t + phase_b·T) at its nodes; its segments turn by the
     sampled angles about its bunch's axis, so segment lengths are kept exactly.
     ``use_numba=False`` runs the plain numpy reference.
+
+    Parameters
+    ----------
+    groom : Groom
+        The rest pose.
+    params : WaveParams
+        The wave f of eq. (1).
+    times : array_like
+        ``(P,)`` wave times in seconds.
+    bunches : Bunches, optional
+        Grouping and variation (None: every strand a bunch, no variation).
+    use_numba : bool, default True
+        False runs the numpy twin (the tests' oracle).
+
+    Returns
+    -------
+    ndarray
+        ``(P, V, 3)`` float64 poses.
     """
     t = np.asarray(times, dtype=np.float64).reshape(-1)
     if t.size == 0 or not np.all(np.isfinite(t)):

@@ -42,6 +42,18 @@ class Nodes:
         return len(self.names)
 
     def children(self, j: int) -> list[int]:
+        """The nodes whose parent is ``j``, in order.
+
+        Parameters
+        ----------
+        j : int
+            A node's index.
+
+        Returns
+        -------
+        list of int
+            Its children's indices.
+        """
         return [int(c) for c in np.flatnonzero(self.parents == j)]
 
     def world(self, rotation: F64 | None = None, root: F64 | None = None) -> F64:
@@ -49,6 +61,18 @@ class Nodes:
 
         ``root`` ``(..., 4, 4)``: a transform applied above every root node (a head turn on the
         whole character is better given as a rotation of its head node).
+
+        Parameters
+        ----------
+        rotation : ndarray, optional
+            ``(..., J, 4)`` local rotations (None: the rest pose).
+        root : ndarray, optional
+            ``(..., 4, 4)`` a transform above every root node.
+
+        Returns
+        -------
+        ndarray
+            ``(..., J, 4, 4)`` float64 world matrices.
         """
         r = self.rotation if rotation is None else rotation
         lead = r.shape[:-2]

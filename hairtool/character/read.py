@@ -271,7 +271,20 @@ def read_clips(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple
 
 
 def load_character(path: str | os.PathLike[str], pattern: str | None = None) -> Character:
-    """Read a character; its hair chains from VRM springs, or ``pattern`` (a regex on node names)."""
+    """Read a character; its hair chains from VRM springs, or ``pattern`` (a regex on node names).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.glb``, ``.gltf`` or ``.vrm`` file.
+    pattern : str, optional
+        A regular expression on node names picking the hair chains (None: the VRM springs).
+
+    Returns
+    -------
+    Character
+        Its nodes, meshes, clips, chains and colliders.
+    """
     p = os.fspath(path)
     doc, binary = load_document(p)
     gltf = _gltf(p, doc)

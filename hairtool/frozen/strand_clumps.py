@@ -94,6 +94,16 @@ def auto_clump_radius(groom: Groom) -> float:
 
     Falls back to 2× the median rest segment length when the roots give no spacing (one strand,
     or all roots in one place).
+
+    Parameters
+    ----------
+    groom : Groom
+        The groom whose roots set the spacing.
+
+    Returns
+    -------
+    float
+        The radius h in the groom's units, > 0.
     """
     spacing = median_root_spacing(groom)
     if spacing > 0:

@@ -99,12 +99,30 @@ class ChildBinding:
         return self.exact_points is not None
 
     def rest_tangents(self, n: int) -> np.ndarray:
-        """``(G, 3)`` the rest guides' root tangents at n vertices (cached)."""
+        """``(G, 3)`` the rest guides' root tangents at n vertices (cached).
+
+        Parameters
+        ----------
+        n : int
+            Vertices per guide the tangents are taken at.
+
+        Returns
+        -------
+        ndarray
+            ``(G, 3)`` float64 unit tangents.
+        """
         if n not in self._tangents:
             self._tangents[n] = _children.root_tangents_of(self.rest_guides, n)
         return self._tangents[n]
 
     def check_guides(self, guides: Groom) -> None:
+        """A ParameterError unless ``guides`` are the strands the children were bound to (same counts).
+
+        Parameters
+        ----------
+        guides : Groom
+            The guides about to drive the children.
+        """
         if guides.topology != self.rest_guides.topology:
             raise ParameterError(
                 "guides",
@@ -114,7 +132,18 @@ class ChildBinding:
 
     def subset(self, child_ids: np.ndarray) -> ChildBinding:
         """The children ``child_ids`` only (e.g. every tenth, for a display percentage while
-        dragging): they build to the same points as in the whole binding."""
+        dragging): they build to the same points as in the whole binding.
+
+        Parameters
+        ----------
+        child_ids : ndarray
+            Indices of the children to keep.
+
+        Returns
+        -------
+        ChildBinding
+            A binding of those children to the same guides.
+        """
         ids = np.asarray(child_ids, np.int64).reshape(-1)
         if ids.size == 0 or ids.min() < 0 or ids.max() >= self.child_count:
             raise ParameterError("children", f"{ids.size} ids", f"child indices in [0, {self.child_count})")
@@ -159,7 +188,18 @@ class ChildBinding:
 
     def build(self, guides: Groom | None = None) -> Groom:
         """The children from the guides' current shapes (the rest guides by default), with
-        their widths and colours (:attr:`attributes`) and the guides' scene (:attr:`metadata`)."""
+        their widths and colours (:attr:`attributes`) and the guides' scene (:attr:`metadata`).
+
+        Parameters
+        ----------
+        guides : Groom, optional
+            The guides' current shapes, the same strands as the rest guides (None: the rest guides).
+
+        Returns
+        -------
+        Groom
+            The children.
+        """
         pose = self.rest_guides if guides is None else guides
         return Groom(
             _children.build_points(self, pose), self.topology, **self.attributes, metadata=self.metadata
@@ -271,7 +311,34 @@ def bind_roots(
     """Children at given ``roots`` ``(N, 3)``, or ``count`` of them around the guide roots,
     bound to their k nearest guide roots in space (along the surface of ``mesh`` if given);
     ``vertices`` per child (default: the guides' largest count). The children come in order
-    of their nearest guide (their roots are ``binding.roots``), not in the order of ``roots``."""
+    of their nearest guide (their roots are ``binding.roots``), not in the order of ``roots``.
+
+    Parameters
+    ----------
+    guides : Groom
+        The guides at rest.
+    roots : ndarray, optional
+        ``(N, 3)`` finite child roots.
+    count : int, optional
+        Without ``roots``: how many children to scatter around the guide roots.
+    k : int, default DEFAULT_K
+        Guides each child blends.
+    vertices : int, optional
+        Vertices per child (None: the guides' largest count).
+    seed : int, default 0
+        The seed of the scatter, the length variation and the frizz.
+    length_variation : float, default DEFAULT_LENGTH_VARIATION
+        v: child lengths × [1 − v, 1 + v].
+    frizz : float, default DEFAULT_FRIZZ
+        The curl radius at a child's tip, a share of its length.
+    mesh : Mesh, optional
+        The head: nearest guides are found along its surface.
+
+    Returns
+    -------
+    ChildBinding
+        The children's binding; :meth:`ChildBinding.build` makes their strands.
+    """
     k = check_k(k, guides.strand_count)
     seed = check_seed(seed)
     _check_variation(length_variation, frizz)
@@ -357,7 +424,22 @@ def bind_scalp(
 
 def choose_guides(dense: Groom, guide_count: int, seed: int = 0) -> np.ndarray:
     """``(G,)`` strands of ``dense`` to serve as guides: farthest-point sampling of the roots
-    from a seeded first strand."""
+    from a seeded first strand.
+
+    Parameters
+    ----------
+    dense : Groom
+        The render hair.
+    guide_count : int
+        G, 1 … the strand count.
+    seed : int, default 0
+        Picks the first strand.
+
+    Returns
+    -------
+    ndarray
+        ``(G,)`` int64 strand indices.
+    """
     s = dense.strand_count
     if isinstance(guide_count, bool) or int(guide_count) != guide_count or not 1 <= guide_count <= s:
         raise ParameterError("guides", guide_count, f"a whole number in [1, {s}] (the strand count)")
@@ -370,7 +452,26 @@ def bind_dense(
 ) -> tuple[Groom, ChildBinding]:
     """A dense groom as G guides and every strand bound to them (guides by root distance, along
     the surface of ``mesh`` if given): ``(guides, binding)``; the binding built on the guides
-    at rest gives back ``dense``'s points bit for bit."""
+    at rest gives back ``dense``'s points bit for bit.
+
+    Parameters
+    ----------
+    dense : Groom
+        The render hair.
+    guide_count : int
+        G, 1 … the strand count.
+    k : int, default DEFAULT_K
+        Guides each strand blends.
+    seed : int, default 0
+        Picks the first guide.
+    mesh : Mesh, optional
+        The head: nearest guides are found along its surface.
+
+    Returns
+    -------
+    tuple of (Groom, ChildBinding)
+        The guides and every strand's binding to them.
+    """
     guides = dense.subset(choose_guides(dense, guide_count, seed))
     return guides, bind_to_guides(dense, guides, k=k, mesh=mesh)
 
@@ -381,7 +482,24 @@ def bind_to_guides(
     """Every strand of ``hair`` bound to the given ``guides`` (its k nearest by root distance,
     along the surface of ``mesh`` if given), storing its offset from their blend: render hair
     read beside its guides (a USD file's guide prim) follows them, and comes back bit for bit
-    while they are untouched."""
+    while they are untouched.
+
+    Parameters
+    ----------
+    hair : Groom
+        The render hair.
+    guides : Groom
+        Its guides.
+    k : int, default DEFAULT_K
+        Guides each strand blends.
+    mesh : Mesh, optional
+        The head: nearest guides are found along its surface.
+
+    Returns
+    -------
+    ChildBinding
+        Every strand's binding; built on the guides at rest it gives ``hair`` back.
+    """
     k = check_k(k, guides.strand_count)
     roots = hair.roots.astype(np.float64)
     near, faces = _nearest(guides, roots, k, mesh)

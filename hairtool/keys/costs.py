@@ -60,7 +60,26 @@ def cost_table(
     use_numba: bool = True,
 ) -> F64:
     """``(n, n)`` segment costs of ``(n, D)`` features: O(n²D) Gram product, then O(n²) (total)
-    or O(n³) (worst) from the Gram matrix. Entries i < j are meaningful; the rest are 0."""
+    or O(n³) (worst) from the Gram matrix. Entries i < j are meaningful; the rest are 0.
+
+    Parameters
+    ----------
+    x : ndarray
+        ``(n, D)`` float64 frame features.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The curve a segment is judged by.
+    curvature : float, default 0.0
+        Weight of the curvature term (≥ 0).
+    objective : {"total", "worst"}, default "total"
+        Sum over a segment's frames, or its worst frame.
+    use_numba : bool, default True
+        False runs the numpy twin (the tests' oracle).
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64 costs; ``[i, j]`` for i < j is keying i and j and interpolating between.
+    """
     if interp not in INTERPOLATIONS:
         raise ParameterError("interp", interp, " or ".join(INTERPOLATIONS))
     if objective not in OBJECTIVES:

@@ -152,7 +152,20 @@ def _trace(back_row_of, n: int) -> I64:
 
 # -- public ------------------------------------------------------------------------------------
 def uniform_keys(n: int, k: int) -> I64:
-    """K keys spread evenly over n frames (rounded; first and last included)."""
+    """K keys spread evenly over n frames (rounded; first and last included).
+
+    Parameters
+    ----------
+    n : int
+        Frames.
+    k : int
+        Keys wanted (≥ 2; past n, rounding merges some).
+
+    Returns
+    -------
+    ndarray
+        ``(k,)`` int64 frame numbers, ascending (fewer where k > n).
+    """
     return np.unique(np.round(np.linspace(0, n - 1, k)).astype(np.int64))
 
 
@@ -270,7 +283,31 @@ def select_keys(
     ``curve_keys``: the curve covers K = 2..min(n, curve_keys) (and at least the chosen K), the
     counts no key set under the constraints reaches left out. ``constraints``: pinned frames are
     keys and excluded frames are not, in an exact optimum (:mod:`hairtool.keys.constraints`).
-    ``progress(share)`` after each block of the DP's layers."""
+    ``progress(share)`` after each block of the DP's layers.
+
+    Parameters
+    ----------
+    table : array_like
+        ``(n, n)`` segment costs (:func:`~hairtool.keys.costs.cost_table`).
+    keys, penalty, budget, max_error : optional
+        Exactly one: the key count K, the price tau per key, the total error allowed, or the
+        worst frame's error allowed.
+    objective : {"total", "worst"}, default "total"
+        What the table's entries are.
+    curve_keys : int, default DEFAULT_CURVE_KEYS
+        The error curve covers K = 2 … this.
+    constraints : KeyConstraints, optional
+        Pinned and excluded frames.
+    use_numba : bool, default True
+        False runs the numpy twin.
+    progress : callable, optional
+        ``progress(share)`` with share in [0, 1].
+
+    Returns
+    -------
+    Selection
+        The keys, their cost, uniform keys of the same count and theirs, and the error curve.
+    """
     c = check_table(table)
     n = c.shape[0]
     cons = (constraints or KeyConstraints()).check(n)

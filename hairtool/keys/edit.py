@@ -27,6 +27,17 @@ class KeyEditor:
     """Original frames ``(F, ...)``, their keys, and the key poses as edited so far."""
 
     def __init__(self, frames: ArrayLike, keys: ArrayLike, interp: str = "linear") -> None:
+        """Take the key poses out of ``frames``; the residuals are what the key curve misses.
+
+        Parameters
+        ----------
+        frames : array_like
+            ``(F, ...)`` the animation's frames (points or channels), kept as given.
+        keys : array_like
+            Key frame numbers, ascending, first and last frame included.
+        interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+            The key curve.
+        """
         self.original = np.asarray(frames)
         self._base = key_poses(self.original, keys, interp)
         self._base_frames = interpolate_keys(self._base)
@@ -42,14 +53,33 @@ class KeyEditor:
         return self.original.astype(np.float64) - self._base_frames
 
     def set_key_pose(self, key_frame: int, pose: ArrayLike) -> None:
-        """Replace the pose at a key frame (the frames follow on the next :meth:`frames`)."""
+        """Replace the pose at a key frame (the frames follow on the next :meth:`frames`).
+
+        Parameters
+        ----------
+        key_frame : int
+            A frame that is a key.
+        pose : array_like
+            The new pose, shaped as one frame.
+        """
         self.key_poses = self.key_poses.with_pose(key_frame, pose)
 
     def reset(self) -> None:
         self.key_poses = self._base
 
     def affected_frames(self, key_frame: int) -> tuple[int, int]:
-        """``(lo, hi)``: an edit of this key changes frames lo < f < hi only (−1 / F at the ends)."""
+        """``(lo, hi)``: an edit of this key changes frames lo < f < hi only (−1 / F at the ends).
+
+        Parameters
+        ----------
+        key_frame : int
+            A frame that is a key (ParameterError otherwise).
+
+        Returns
+        -------
+        tuple of (int, int)
+            ``(lo, hi)``, the neighbouring keys.
+        """
         k = self.keys
         hit = np.flatnonzero(k == key_frame)
         if hit.size == 0:
@@ -60,7 +90,18 @@ class KeyEditor:
         return lo, hi
 
     def frames(self, dtype: type | None = None) -> NDArray:
-        """``(F, ...)`` the edited animation: x̂_new + r, exactly the original where nothing moved."""
+        """``(F, ...)`` the edited animation: x̂_new + r, exactly the original where nothing moved.
+
+        Parameters
+        ----------
+        dtype : type, optional
+            The result's dtype (None: the original frames').
+
+        Returns
+        -------
+        ndarray
+            ``(F, ...)`` the edited frames.
+        """
         delta = interpolate_keys(self.key_poses) - self._base_frames
         out = self.original.astype(np.float64) + delta
         return out.astype(dtype or self.original.dtype)
@@ -69,7 +110,24 @@ class KeyEditor:
 def edit_animation(
     animation: Animation, keys: ArrayLike, edits: dict[int, ArrayLike], interp: str = "linear"
 ) -> Animation:
-    """The animation with the given key poses ``{key_frame: (V, 3) points}`` replaced."""
+    """The animation with the given key poses ``{key_frame: (V, 3) points}`` replaced.
+
+    Parameters
+    ----------
+    animation : Animation
+        The captured animation.
+    keys : array_like
+        Its key frames.
+    edits : dict of int to array_like
+        New ``(V, 3)`` points by key frame.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The key curve the edit is carried by.
+
+    Returns
+    -------
+    Animation
+        The edited animation: unchanged outside the edited keys' neighbours.
+    """
     editor = KeyEditor(animation.frames, keys, interp)
     for frame, pose in edits.items():
         editor.set_key_pose(int(frame), pose)

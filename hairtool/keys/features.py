@@ -171,7 +171,20 @@ def strand_weights(u: ArrayLike, options: FeatureOptions) -> F64:
 
 
 def hair_features(animation: Animation, options: FeatureOptions | None = None) -> F64:
-    """``(F, D)`` float64 frame vectors of an animation; D = S·M·3 (S·N·3 without resampling)."""
+    """``(F, D)`` float64 frame vectors of an animation; D = S·M·3 (S·N·3 without resampling).
+
+    Parameters
+    ----------
+    animation : Animation
+        The hair's frames.
+    options : FeatureOptions, optional
+        Resampling, root removal and weights (None: seed 000's defaults).
+
+    Returns
+    -------
+    ndarray
+        ``(F, D)`` float64 frame vectors.
+    """
     o = options or FeatureOptions()
     o.validate()
     if o.samples is not None:
@@ -228,7 +241,20 @@ def raw_features(x: ArrayLike, name: str = "X") -> F64:
 
 
 def frame_features(source: Animation | ArrayLike, options: FeatureOptions | None = None) -> F64:
-    """Features of an animation (hair_features) or a raw ``(n_frames, D)`` array (as is)."""
+    """Features of an animation (hair_features) or a raw ``(n_frames, D)`` array (as is).
+
+    Parameters
+    ----------
+    source : Animation or array_like
+        An animation, or ``(n_frames, D)`` features used as they are.
+    options : FeatureOptions, optional
+        For an animation: see :func:`hair_features`.
+
+    Returns
+    -------
+    ndarray
+        ``(n_frames, D)`` float64.
+    """
     if isinstance(source, Animation):
         if source.n_frames < 2:
             raise GroomError(f"keyframes need an animation of at least 2 frames, got {source.n_frames}")

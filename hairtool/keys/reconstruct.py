@@ -57,7 +57,20 @@ class KeyPoses:
     tangents_in: F64 | None = None
 
     def with_pose(self, key_frame: int, pose: ArrayLike) -> KeyPoses:
-        """A copy with the pose at ``key_frame`` (a frame number that is a key) replaced."""
+        """A copy with the pose at ``key_frame`` (a frame number that is a key) replaced.
+
+        Parameters
+        ----------
+        key_frame : int
+            A frame that is a key.
+        pose : array_like
+            The new pose, shaped as one frame.
+
+        Returns
+        -------
+        KeyPoses
+            The copy; its tangents stay as they were.
+        """
         hit = np.flatnonzero(self.keys == key_frame)
         if hit.size == 0:
             raise ParameterError("key_frame", key_frame, f"one of the keys {self.keys.tolist()}")
@@ -72,7 +85,22 @@ class KeyPoses:
 def key_poses(frames: ArrayLike, keys: ArrayLike, interp: str = "linear") -> KeyPoses:
     """Take the key poses (and Hermite tangents) out of the full-rate frames; "hermite-fit"
     fits each segment's two handles to its frames by least squares
-    (:func:`hairtool.keys.segment_fit.fit_segment`)."""
+    (:func:`hairtool.keys.segment_fit.fit_segment`).
+
+    Parameters
+    ----------
+    frames : array_like
+        ``(F, ...)`` the full-rate frames.
+    keys : array_like
+        Key frame numbers, ascending, first and last frame included.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The curve through the keys.
+
+    Returns
+    -------
+    KeyPoses
+        The keys' poses and, for Hermite curves, their tangents.
+    """
     if interp not in INTERPOLATIONS:
         raise ParameterError("interp", interp, " or ".join(INTERPOLATIONS))
     f = np.asarray(frames)
@@ -271,7 +299,23 @@ def _curve_errors(animation, kp, cancelled, progress, reference: bool) -> Positi
 
 
 def compare_with_uniform(animation: Animation, keys: ArrayLike, interp: str = "linear") -> dict:
-    """Position errors of the given keys and of uniform keys of the same count."""
+    """Position errors of the given keys and of uniform keys of the same count.
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    keys : array_like
+        The key frames to judge.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The curve through the keys.
+
+    Returns
+    -------
+    dict
+        ``{"keys": ..., "uniform": ...}``: each set's frames and its mean, worst and tip
+        position errors, in the groom's units.
+    """
     k = check_keys(keys, animation.n_frames)
     uni = uniform_keys(animation.n_frames, k.size)
     out = {}

@@ -118,6 +118,18 @@ class KeySettings:
         return self
 
     def replace(self, **changes: object) -> KeySettings:
+        """These settings with ``changes``, checked again.
+
+        Parameters
+        ----------
+        **changes : object
+            New values by field name.
+
+        Returns
+        -------
+        KeySettings
+            The changed, validated copy.
+        """
         return replace(self, **changes).validate()
 
     @property
@@ -145,6 +157,25 @@ class KeySession:
         table_key: tuple = (),
         constraints: KeyConstraints | None = None,
     ) -> None:
+        """A session over ``table``; nothing is solved until :meth:`layers`.
+
+        Parameters
+        ----------
+        table : array_like
+            ``(n, n)`` segment costs.
+        objective : {"total", "worst"}, default "total"
+            What the table's entries are.
+        interp : str, default "linear"
+            The curve the table was built for (reported, and kept in :attr:`table_key`).
+        curvature : float, default 0.0
+            The table's curvature weight (reported likewise).
+        kmax : int, default MAX_CURVE_KEYS
+            The most keys the layered DP solves for.
+        table_key : tuple, default ()
+            What the table depends on (empty: built from the above).
+        constraints : KeyConstraints, optional
+            Pinned and excluded frames.
+        """
         self.table = check_table(table)
         if objective not in OBJECTIVES:
             raise ParameterError("objective", objective, " or ".join(OBJECTIVES))
@@ -162,7 +193,18 @@ class KeySession:
 
     def constrain(self, constraints: KeyConstraints | None) -> KeySession:
         """The same table under other pins and exclusions (the layers are solved again, the
-        table is not rebuilt): what a dope sheet edit asks for."""
+        table is not rebuilt): what a dope sheet edit asks for.
+
+        Parameters
+        ----------
+        constraints : KeyConstraints or None
+            The new pins and exclusions (None: none).
+
+        Returns
+        -------
+        KeySession
+            A session sharing this one's table.
+        """
         constraints = (constraints or KeyConstraints()).check(self.n_frames)
         if constraints != self.constraints:
             self.constraints, self.energy, self.back = constraints, None, None
@@ -176,7 +218,18 @@ class KeySession:
 
     def layers(self, progress: Callable[[float], None] | None = None) -> KeySession:
         """Solve the DP for every K up to ``kmax`` (once; later calls return at once);
-        ``progress(share)`` as it goes."""
+        ``progress(share)`` as it goes.
+
+        Parameters
+        ----------
+        progress : callable, optional
+            ``progress(share)`` with share in [0, 1].
+
+        Returns
+        -------
+        KeySession
+            This session, solved.
+        """
         if self.energy is None:
             self.energy, self.back, _ = solve_layers(
                 self.table, self.kmax, self.objective, constraints=self.constraints, progress=progress
@@ -193,7 +246,18 @@ class KeySession:
         return np.column_stack([ks, self.energy[ks, self.n_frames - 1]])
 
     def keys_for_count(self, k: int) -> I64:
-        """The DP keys for exactly ``k`` keys, traced back through the stored layers."""
+        """The DP keys for exactly ``k`` keys, traced back through the stored layers.
+
+        Parameters
+        ----------
+        k : int
+            The key count, 2 … :attr:`kmax`.
+
+        Returns
+        -------
+        ndarray
+            ``(k,)`` int64 key frames.
+        """
         lo, hi = self.key_range
         if not lo <= k <= hi:
             why = "" if not self.constraints else " with these pins and exclusions"
@@ -213,7 +277,20 @@ class KeySession:
         """Seed 003's keys with a price per key (total objective only). ``relative``: tau is a
         share of :attr:`two_key_error` (a key is kept when it saves at least that share of the
         error of keying the ends alone), so 0.01 means the same on a sway and on a 10⁸-unit
-        simulation; otherwise tau is seed 003's absolute price, in squared feature units."""
+        simulation; otherwise tau is seed 003's absolute price, in squared feature units.
+
+        Parameters
+        ----------
+        tau : float
+            The price of a key.
+        relative : bool, default True
+            ``tau`` is a share of :attr:`two_key_error`, not an absolute error.
+
+        Returns
+        -------
+        ndarray
+            int64 key frames.
+        """
         price = float(tau) * self.two_key_error if relative else float(tau)
         return select_keys(self.table, penalty=price, curve_keys=0, constraints=self.constraints).keys
 
@@ -240,7 +317,18 @@ class KeySession:
         return min(max(self.knee, lo), hi)
 
     def keys_for_budget(self, budget: float) -> I64:
-        """The fewest keys whose error (total, or worst frame) is within ``budget``."""
+        """The fewest keys whose error (total, or worst frame) is within ``budget``.
+
+        Parameters
+        ----------
+        budget : float
+            The error allowed.
+
+        Returns
+        -------
+        ndarray
+            int64 key frames.
+        """
         self.layers()
         e = self.energy[2 : self.kmax + 1, self.n_frames - 1]
         fits = np.flatnonzero(e <= budget)
@@ -255,7 +343,18 @@ class KeySession:
         """The DP keys the settings ask for (count, tau or budget, under their pins and exclusions).
 
         All or nothing: a ParameterError (a budget these pins and exclusions cannot meet) leaves
-        the session under its previous constraints, so a refused edit can be dropped whole."""
+        the session under its previous constraints, so a refused edit can be dropped whole.
+
+        Parameters
+        ----------
+        settings : KeySettings
+            The mode (count, tau or budget) and its value.
+
+        Returns
+        -------
+        ndarray
+            int64 key frames.
+        """
         before = (self.constraints, self.energy, self.back)
         try:
             self.constrain(settings.constraints)
@@ -273,7 +372,18 @@ class KeySession:
     def explain(self, sel: Selection) -> str | None:
         """Why a tau, budget or bound gave one of the two extremes (a key on every frame the
         constraints allow, or no keys but the ends and pins), in words a user can act on; None
-        otherwise (:func:`hairtool.keys.notes.explain`)."""
+        otherwise (:func:`hairtool.keys.notes.explain`).
+
+        Parameters
+        ----------
+        sel : Selection
+            A selection this session made.
+
+        Returns
+        -------
+        str or None
+            The reason, or None where the selection is not an extreme.
+        """
         return notes.explain(self.table, self.constraints, self.objective, sel)
 
     def select(
@@ -288,7 +398,22 @@ class KeySession:
     ) -> Selection:
         """Exactly one of ``keys``, ``penalty``, ``budget``, ``max_error`` (see
         :func:`hairtool.keys.dp.select_keys`), with uniform keys of the same count and the
-        error-vs-count curve up to ``curve_keys``: the record ``hairtool keys`` prints."""
+        error-vs-count curve up to ``curve_keys``: the record ``hairtool keys`` prints.
+
+        Parameters
+        ----------
+        keys, penalty, budget, max_error : optional
+            Exactly one, as :func:`~hairtool.keys.dp.select_keys` takes them.
+        curve_keys : int, default DEFAULT_CURVE_KEYS
+            The error curve covers K = 2 … this.
+        progress : callable, optional
+            ``progress(share)`` with share in [0, 1].
+
+        Returns
+        -------
+        Selection
+            The keys, their cost and the uniform keys' for comparison.
+        """
         sel = select_keys(
             self.table,
             keys=keys,
@@ -362,6 +487,32 @@ def solve(
     ``(frames, D)`` feature array used as is; ``table`` replaces the Gram cost table by one the
     caller built (seed 003's quaternion-distance table of a BVH capture); ``constraints`` pins
     and excludes frames (:mod:`hairtool.keys.constraints`; default: the settings' own).
+
+    Parameters
+    ----------
+    source : Animation or array_like
+        The animation, or ``(frames, D)`` features.
+    settings : KeySettings
+        Interpolation, objective, curvature and the feature options.
+    progress : callable, optional
+        ``progress(share, stage)`` as it goes.
+    cancelled : callable, optional
+        Asked between stages; True stops the solve.
+    features : FeatureOptions, optional
+        Overrides the settings' feature options.
+    table : array_like, optional
+        A cost table built by the caller.
+    layers : bool, default True
+        Solve the layered DP now.
+    kmax : int, default MAX_CURVE_KEYS
+        The most keys the DP solves for.
+    constraints : KeyConstraints, optional
+        Pinned and excluded frames (None: the settings').
+
+    Returns
+    -------
+    KeySession or None
+        The session, or None once cancelled.
     """
     settings.validate()
     progress = progress or (lambda *a, **k: None)
@@ -522,7 +673,28 @@ def analyse(
     progress: Progress | None = None,
     cancelled: CancelCheck | None = None,
 ) -> Analysis | None:
-    """Errors of the DP keys and of uniform keys of the same count (and the motion speed)."""
+    """Errors of the DP keys and of uniform keys of the same count (and the motion speed).
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    dp_keys : array_like
+        The optimal keys.
+    interp : str
+        The curve through the keys.
+    with_speed : bool, default True
+        Also measure the motion's speed per frame.
+    progress : callable, optional
+        ``progress(share, stage)`` as it goes.
+    cancelled : callable, optional
+        Asked between steps; True stops.
+
+    Returns
+    -------
+    Analysis or None
+        The errors of both key sets, or None once cancelled.
+    """
     k = check_keys(dp_keys, animation.n_frames)
     uni = uniform_keys(animation.n_frames, k.size)
     parts = []

@@ -72,6 +72,20 @@ def motion_features(motion: Motion, kind: str = "positions", weights: ArrayLike 
     - "rotations": D = 4J + 3. Local quaternions hemisphere-aligned frame to frame, each times
       sqrt(ω_j), then the root translation / L times sqrt(ω_root) (L = :func:`skeleton_size`).
       |q_a − q_b|² ≈ Dist² for small angles; the exact seed metric is :func:`rotation_cost_table`.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    kind : {"positions", "rotations"}, default "positions"
+        Which features, as above.
+    weights : array_like, optional
+        ``(J,)`` joint weights ω (None: the defaults by joint name).
+
+    Returns
+    -------
+    ndarray
+        ``(F, D)`` float64 features.
     """
     if kind not in KINDS:
         raise ParameterError("kind", kind, f"one of {', '.join(KINDS)}")
@@ -130,6 +144,26 @@ def rotation_cost_table(
     polynomials exact to a few units in the last place (:func:`acos2_reference`). With
     ``progress``, the table is made in :data:`PROGRESS_STEPS` row ranges of equal work, saying
     after each what share is done (the same numbers).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    weights : array_like, optional
+        ``(J,)`` joint weights ω (None: the defaults by joint name).
+    interp : {"slerp"}, default "slerp"
+        The curve between keys.
+    translation_weight : float, optional
+        ω_T (None: ω_root).
+    max_span : int, optional
+        Pairs further apart cost +inf (None: every pair).
+    progress : callable, optional
+        ``progress(share)`` after each row range.
+
+    Returns
+    -------
+    ndarray
+        ``(F, F)`` float64 costs.
     """
     if interp != "slerp":
         raise ParameterError("interp", interp, "'slerp'")
@@ -158,7 +192,24 @@ def rotation_cost_table_reference(
     translation_weight: float | None = None,
     max_span: int | None = None,
 ) -> F64:
-    """The numpy twin of :func:`rotation_cost_table` (slow: a Python loop over the pairs i < j)."""
+    """The numpy twin of :func:`rotation_cost_table` (slow: a Python loop over the pairs i < j).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    weights : array_like, optional
+        ``(J,)`` joint weights.
+    translation_weight : float, optional
+        ω_T (None: ω_root).
+    max_span : int, optional
+        Pairs further apart cost +inf.
+
+    Returns
+    -------
+    ndarray
+        ``(F, F)`` float64 costs, as :func:`rotation_cost_table` gives them.
+    """
     q, p, w, wt = _cost_inputs(motion, weights, translation_weight)
     n = len(q)
     cost = np.zeros((n, n))
@@ -614,6 +665,20 @@ def reconstruct_motion(motion: Motion, keys: ArrayLike, interp: str = "linear") 
     Rotations go back to Euler angles in each joint's channel order (nearest the original values
     by whole turns). Joints with one or two rotation channels interpolate their angles directly.
     Frames before the first key or after the last hold that key.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    keys : array_like
+        Key frame numbers, ascending.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The curve through the keys.
+
+    Returns
+    -------
+    Motion
+        Every frame rebuilt from the keys.
     """
     if interp not in INTERPS:
         raise ParameterError("interp", interp, f"one of {', '.join(INTERPS)}")
@@ -646,7 +711,18 @@ def reconstruct_motion(motion: Motion, keys: ArrayLike, interp: str = "linear") 
 
 
 def joint_position_errors(motion: Motion, reconstructed: Motion) -> F64:
-    """``(F, J)`` distances (scene units) between the joints of two motions of one skeleton."""
+    """``(F, J)`` distances (scene units) between the joints of two motions of one skeleton.
+
+    Parameters
+    ----------
+    motion, reconstructed : Motion
+        Two motions of one skeleton and frame count.
+
+    Returns
+    -------
+    ndarray
+        ``(F, J)`` float64 distances.
+    """
     if reconstructed.n_joints != motion.n_joints or reconstructed.n_frames != motion.n_frames:
         raise ParameterError(
             "reconstructed",

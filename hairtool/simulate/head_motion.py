@@ -78,7 +78,18 @@ MOTIONS: dict[str, Callable[[float], F64]] = {
 
 
 def parse_motion(spec: str | Sequence[str]) -> list[str]:
-    """ "turn,nod" or ["turn", "nod"] → the checked list of names."""
+    """ "turn,nod" or ["turn", "nod"] → the checked list of names.
+
+    Parameters
+    ----------
+    spec : str or sequence of str
+        Comma-separated names, or a list of them.
+
+    Returns
+    -------
+    list of str
+        The names, each one :mod:`hairtool.simulate.head_motion` knows (ParameterError otherwise).
+    """
     names = [s.strip() for s in spec.split(",")] if isinstance(spec, str) else [str(s).strip() for s in spec]
     if not names or any(n not in MOTIONS for n in names):
         raise ParameterError("motion", spec, f"names from {', '.join(MOTIONS)}, comma-separated")
@@ -135,6 +146,16 @@ def fit_head(roots: ArrayLike) -> tuple[F64, float]:
     Roots in one plane (a 2-D groom) give the circle in that plane. When the roots do not pin
     down a sphere (fewer than four, all on a line, or a fit larger than ten times their spread,
     as for a flat comb), the centre is their centroid and the radius half their spread.
+
+    Parameters
+    ----------
+    roots : array_like
+        ``(S, 3)`` root positions, finite.
+
+    Returns
+    -------
+    tuple of (ndarray, float)
+        The centre ``(3,)`` and the radius.
     """
     p = np.asarray(roots, dtype=np.float64).reshape(-1, 3)
     if p.shape[0] == 0 or not np.all(np.isfinite(p)):
