@@ -219,6 +219,24 @@ def forward_kinematics(
     """World positions from local translations ``(F, J, 3)`` and rotations ``(F, J, 4)``.
 
     P_j = P_parent + R_parent_world · t_j; parents come before children.
+
+    Parameters
+    ----------
+    parents : ndarray
+        ``(J,)`` int64 parent of each joint (−1 for a root), parents first.
+    translations : ndarray
+        ``(F, J, 3)`` local translations.
+    rotations : ndarray
+        ``(F, J, 4)`` local rotations (unit quaternions).
+    end_parents : ndarray, optional
+        ``(E,)`` the joint each End Site hangs from (None: no End Sites).
+    end_offsets : ndarray, optional
+        ``(E, 3)`` the End Sites' offsets.
+
+    Returns
+    -------
+    ndarray
+        ``(F, J, 3)`` float64 world positions, ``(F, J + E, 3)`` with the End Sites last.
     """
     f, j = translations.shape[:2]
     world_q = np.empty((f, j, 4))
