@@ -34,6 +34,18 @@ def joint_weights(motion: Motion, falloff: float = 0.5) -> F64:
     """``(J,)`` ω_j = falloff^depth_j, normalised to sum 1.
 
     A parent's rotation moves all its children, so the trunk weighs most (seed 003, §3.2).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    falloff : float, default 0.5
+        The weight's factor per level of depth.
+
+    Returns
+    -------
+    ndarray
+        ``(J,)`` float64, summing to 1.
     """
     if not (np.isfinite(falloff) and 0.0 < falloff <= 1.0):
         raise ParameterError("falloff", falloff, "a number in (0, 1]")
@@ -57,6 +69,16 @@ def skeleton_size(motion: Motion) -> float:
 
     Translation errors enter the rotation costs as (|Δp| / L)², so one skeleton size of drift
     weighs like one radian of joint rotation.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+
+    Returns
+    -------
+    float
+        L, in the capture's units.
     """
     rest = motion.with_values(np.zeros((1, motion.n_channels)))
     p = rest.joint_positions(end_sites=True)[0]
@@ -103,7 +125,22 @@ def motion_features(motion: Motion, kind: str = "positions", weights: ArrayLike 
 def bvh_features(
     path: str | os.PathLike[str], kind: str = "positions", weights: ArrayLike | None = None
 ) -> F64:
-    """:func:`motion_features` of a BVH file."""
+    """:func:`motion_features` of a BVH file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A BVH file.
+    kind : {"positions", "rotations"}, default "positions"
+        Which features.
+    weights : array_like, optional
+        ``(J,)`` joint weights.
+
+    Returns
+    -------
+    ndarray
+        ``(F, D)`` float64.
+    """
     return motion_features(read_bvh(path), kind, weights)
 
 
@@ -302,7 +339,18 @@ def _acos2_far(u):
 
 def acos2_reference(u: ArrayLike) -> F64:
     """arccos(1 − u)², the numpy twin of the kernel's three polynomials (:func:`_acos2_near`, …),
-    written (2·arcsin √(u/2))² so that it keeps its digits for small u too."""
+    written (2·arcsin √(u/2))² so that it keeps its digits for small u too.
+
+    Parameters
+    ----------
+    u : array_like
+        1 − cos, in [0, 1].
+
+    Returns
+    -------
+    ndarray
+        float64, radians squared.
+    """
     return (2.0 * np.arcsin(np.sqrt(np.asarray(u, dtype=np.float64) / 2.0))) ** 2
 
 
