@@ -437,6 +437,16 @@ def knee_count(curve: ArrayLike) -> int:
     the straight line from (0, 1) to (1, 0), i.e. maximises (1 − x) − y (Satopää et al. 2011,
     "Kneedle"): past it, each added key buys less than its share. A flat or straight curve gives
     its first count. ``curve``: ``(m, 2)`` rows (K, error), K increasing, errors finite.
+
+    Parameters
+    ----------
+    curve : array_like
+        Errors by key count.
+
+    Returns
+    -------
+    int
+        The key count at the knee.
     """
     c = np.asarray(curve, dtype=np.float64)
     if c.ndim != 2 or c.shape[0] == 0 or c.shape[1] != 2:
@@ -459,7 +469,22 @@ def work_estimate(shape: tuple[int, int], settings: KeySettings, kmax: int) -> t
     """Rough operation counts of the cost table and the all-K DP for ``(n, D)`` features, so
     that the progress bar moves in proportion to the time: the Gram product n²D/2 (the worst
     frame: plus n³/6 segment scans; fitted handles: a running solve per segment, n²D), the DP
-    about K·n²/2."""
+    about K·n²/2.
+
+    Parameters
+    ----------
+    shape : tuple of (int, int)
+        ``(n, D)`` of the features.
+    settings : KeySettings
+        The interpolation and objective.
+    kmax : int
+        The most keys the DP solves for.
+
+    Returns
+    -------
+    tuple of (float, float)
+        The table's and the DP's operation counts.
+    """
     n, d = shape
     table = n * n * d / 2.0
     if settings.objective == "worst":
@@ -646,7 +671,24 @@ def frame_errors(
     cancelled: CancelCheck | None = None,
     progress: Callable[[float], None] | None = None,
 ) -> FrameErrors | None:
-    """Mean, tip-mean and max vertex error per frame of the key curve."""
+    """Mean, tip-mean and max vertex error per frame of the key curve.
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    kp : KeyPoses
+        Its key poses.
+    cancelled : callable, optional
+        Asked between chunks; True stops.
+    progress : callable, optional
+        ``progress(share)`` after each chunk.
+
+    Returns
+    -------
+    FrameErrors or None
+        The errors, or None once cancelled.
+    """
     err = key_curve_errors(animation, kp, cancelled=cancelled, progress=progress)
     if err is None:
         return None
@@ -654,13 +696,41 @@ def frame_errors(
 
 
 def vertex_errors(animation: Animation, kp: KeyPoses, frame: int) -> F32:
-    """``(V,)`` distance of each vertex from the key curve at one frame."""
+    """``(V,)`` distance of each vertex from the key curve at one frame.
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    kp : KeyPoses
+        Its key poses.
+    frame : int
+        The frame.
+
+    Returns
+    -------
+    ndarray
+        ``(V,)`` float32 distances.
+    """
     d = animation.frames[frame].astype(np.float64) - interpolate_at(kp, [frame])[0]
     return np.sqrt(np.einsum("vi,vi->v", d, d)).astype(np.float32)
 
 
 def speed(animation: Animation, cancelled: CancelCheck | None = None) -> F64 | None:
-    """``(F,)`` mean vertex speed in units/s (:func:`hairtool.keys.reconstruct.motion_speed`)."""
+    """``(F,)`` mean vertex speed in units/s (:func:`hairtool.keys.reconstruct.motion_speed`).
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    cancelled : callable, optional
+        Asked between chunks; True stops.
+
+    Returns
+    -------
+    ndarray or None
+        ``(F,)`` float64, or None once cancelled.
+    """
     return motion_speed(animation.frames, animation.fps, cancelled)
 
 
@@ -712,7 +782,22 @@ def analyse(
 
 def key_poses_of(animation: Animation, keys: ArrayLike, interp: str) -> KeyPoses:
     """Key poses (and Hermite tangents) of an animation, stored as float32 to halve their size
-    (a studio holds two sets for the whole session); evaluated in float64 all the same."""
+    (a studio holds two sets for the whole session); evaluated in float64 all the same.
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    keys : array_like
+        Its key frames.
+    interp : str
+        The curve through the keys.
+
+    Returns
+    -------
+    KeyPoses
+        float32 key poses and tangents.
+    """
     kp = key_poses(animation.frames, keys, interp)
     tangents = None if kp.tangents is None else kp.tangents.astype(np.float32)
     arriving = None if kp.tangents_in is None else kp.tangents_in.astype(np.float32)
@@ -728,6 +813,24 @@ def key_edit_block(
     An edit changes only the frames between the key's neighbouring keys, so the editor runs on
     that stretch plus one frame each side (which keeps the Hermite tangents at the neighbouring
     keys those of the whole animation): the result equals editing the whole animation.
+
+    Parameters
+    ----------
+    frames : ndarray
+        ``(F, ...)`` the animation's frames.
+    keys : array_like
+        Its key frames.
+    interp : str
+        The key curve.
+    key_frame : int
+        The key edited.
+    pose : array_like
+        Its new pose.
+
+    Returns
+    -------
+    tuple of (int, ndarray)
+        The first frame changed and the changed frames.
     """
     n = frames.shape[0]
     k = check_keys(keys, n)
