@@ -81,7 +81,22 @@ class WaveParams:
 
 
 def wave(x: ArrayLike, t: ArrayLike, params: WaveParams) -> F64:
-    """f(x, t) of eq. (1), broadcast over ``x`` (in [0, π], root to tip) and ``t`` (seconds)."""
+    """f(x, t) of eq. (1), broadcast over ``x`` (in [0, π], root to tip) and ``t`` (seconds).
+
+    Parameters
+    ----------
+    x : array_like
+        Positions along the chain, in [0, π].
+    t : array_like
+        Times in seconds.
+    params : WaveParams
+        The wave.
+
+    Returns
+    -------
+    ndarray
+        f(x, t), float64.
+    """
     xa = np.asarray(x, dtype=np.float64)
     ta = np.asarray(t, dtype=np.float64)
     if not np.all(np.isfinite(xa)) or np.any(xa < 0.0) or np.any(xa > np.pi):
@@ -97,6 +112,18 @@ def segment_angles(chains: Groom, y: ArrayLike) -> F64:
 
     ``y``: ``(..., V)`` wave values at the nodes. The relative rotation of node j is θ_j − θ_{j−1}
     (θ before the first segment is 0, the rest direction); bending by θ_j applies their sum.
+
+    Parameters
+    ----------
+    chains : Groom
+        The chains at rest.
+    y : array_like
+        ``(..., V)`` wave values.
+
+    Returns
+    -------
+    ndarray
+        ``(..., V−S)`` float64 radians.
     """
     end = chains.topology.segment_end
     x = wave_x(chains)
@@ -105,7 +132,20 @@ def segment_angles(chains: Groom, y: ArrayLike) -> F64:
 
 
 def node_rotations(chains: Groom, y: ArrayLike) -> F64:
-    """``(..., V−S)`` the paper's per-node rotations relative to the parent: θ_j − θ_{j−1}."""
+    """``(..., V−S)`` the paper's per-node rotations relative to the parent: θ_j − θ_{j−1}.
+
+    Parameters
+    ----------
+    chains : Groom
+        The chains at rest.
+    y : array_like
+        ``(..., V)`` wave values.
+
+    Returns
+    -------
+    ndarray
+        ``(..., V−S)`` float64 radians.
+    """
     theta = segment_angles(chains, y)
     first = np.zeros(chains.topology.segment_end.size, dtype=bool)
     first[chains.topology.root_indices - np.arange(chains.strand_count)] = True
@@ -238,6 +278,26 @@ def cycle_pictures(
 
     ``bunches`` (from :func:`make_bunches`) or the keywords of :func:`make_bunches` (guides,
     sway, amplitude_scale, phase, amplitude_spread, phase_spread, seed) set the variation.
+
+    Parameters
+    ----------
+    groom : Groom
+        The rest pose.
+    params : WaveParams, optional
+        The wave (None: the defaults).
+    fps : float, default 24.0
+        Frames per second.
+    hold : int, default 2
+        Frames each picture is held.
+    bunches : Bunches, optional
+        Grouping and variation.
+    **variation
+        :func:`make_bunches`'s keywords, where ``bunches`` is not given.
+
+    Returns
+    -------
+    tuple of (Schedule, list of Groom)
+        The schedule and one groom per picture.
     """
     params = WaveParams() if params is None else params
     sched = schedule(params.period, fps, hold)
