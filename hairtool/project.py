@@ -191,7 +191,18 @@ def _json_object(name: str, value: Any) -> dict:
 
 
 def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
-    """The manifest (JSON-ready) and the arrays, by member name, that :func:`save` writes."""
+    """The manifest (JSON-ready) and the arrays, by member name, that :func:`save` writes.
+
+    Parameters
+    ----------
+    project : Project
+        The project.
+
+    Returns
+    -------
+    tuple of (dict, dict of str to ndarray)
+        The manifest and the arrays.
+    """
     arrays: dict[str, np.ndarray] = {}
     manifest: dict[str, Any] = {
         "format": FORMAT,

@@ -80,7 +80,28 @@ def gust_schedule(
     """``count`` seeded gusts with horizontal directions, starting after the first tenth of the clip.
 
     ``frame``: the scene's axes (:attr:`hairtool.metadata.Metadata.frame`; default Y-up), so
-    "horizontal" is across the stage's up axis."""
+    "horizontal" is across the stage's up axis.
+
+    Parameters
+    ----------
+    count : int
+        Gusts, ≥ 0.
+    clip_duration : float
+        The clip's length in seconds.
+    strength : float
+        Each gust's strength in units/s².
+    duration : float
+        Each gust's length in seconds.
+    seed : int
+        The draws' seed.
+    frame : array_like, optional
+        ``(3, 3)`` the scene's axes (None: Y-up).
+
+    Returns
+    -------
+    list of Gust
+        The gusts, by start time.
+    """
     if int(count) != count or not 0 <= count <= 10_000:
         raise ParameterError("gusts", count, "a whole number in [0, 10000]")
     if not (np.isfinite(strength) and strength >= 0):
@@ -107,7 +128,22 @@ def scaled_accelerations(factor: float, gust_strength: float, wind: ArrayLike = 
     """Gust strength and the wind vector (units/s²) for a head ``factor`` times larger: they
     scale with the head, so hair on the larger head moves as it did on the smaller one (gravity
     is physical, in m/s², and needs no scaling). The keyword arguments of :func:`simulate` (the
-    wind as a vector) that change with scale."""
+    wind as a vector) that change with scale.
+
+    Parameters
+    ----------
+    factor : float
+        The new head radius over the old.
+    gust_strength : float
+        The gusts' strength before.
+    wind : array_like, default (0, 0, 0)
+        The wind vector before.
+
+    Returns
+    -------
+    dict
+        ``gust_strength`` and ``wind`` scaled.
+    """
     return {
         "gust_strength": float(gust_strength) * factor,
         "wind": tuple(float(v) * factor for v in np.asarray(wind, dtype=np.float64).reshape(3)),
