@@ -207,12 +207,40 @@ class ChildBinding:
 
 
 def check_k(k: int, guide_count: int) -> int:
+    """``k`` as an int, or a ParameterError unless it is a whole number in [1, guide_count].
+
+    Parameters
+    ----------
+    k : int
+        Guides per child.
+    guide_count : int
+        G.
+
+    Returns
+    -------
+    int
+        ``k``.
+    """
     if isinstance(k, bool) or int(k) != k or not 1 <= k <= guide_count:
         raise ParameterError("guides_per_child", k, f"a whole number in [1, {guide_count}] (the guide count)")
     return int(k)
 
 
 def check_count(count: int, name: str = "count") -> int:
+    """``count`` as an int, or a ParameterError unless it is a whole number in [1, MAX_CHILDREN].
+
+    Parameters
+    ----------
+    count : int
+        Children.
+    name : str, default "count"
+        The parameter, named in a refusal.
+
+    Returns
+    -------
+    int
+        ``count``.
+    """
     if isinstance(count, bool) or int(count) != count or not 1 <= count <= MAX_CHILDREN:
         raise ParameterError(name, count, f"a whole number of children in [1, {MAX_CHILDREN}]")
     return int(count)
@@ -267,7 +295,13 @@ def _bind(
 def curl(b: ChildBinding) -> None:
     """``b.local`` from its frizz: a helix across the nearest guide's frames whose radius grows
     from 0 at the root to ``frizz`` × the child's rest length at the tip. A few numbers per child
-    make it, so a project stores those and curls the children again on loading."""
+    make it, so a project stores those and curls the children again on loading.
+
+    Parameters
+    ----------
+    b : ChildBinding
+        A binding whose ``local`` is set here.
+    """
     n = int(b.counts[0])
     count = b.child_count
     b.local = None
@@ -519,7 +553,15 @@ def bind_exactly(b: ChildBinding, points: np.ndarray) -> None:
     exactly: each vertex's offset from the blend in its nearest guide's frames (``local``), the
     float64 blend at rest those offsets give (``exact_blend``) and the points themselves. The
     first two follow from the points and the rest guides, so a project stores the points alone
-    and binds them again on loading."""
+    and binds them again on loading.
+
+    Parameters
+    ----------
+    b : ChildBinding
+        One child per dense strand, no offsets yet.
+    points : ndarray
+        ``(V, 3)`` the dense strands' points.
+    """
     guides = b.rest_guides
     b.local = b.exact_points = b.exact_blend = None  # the plain blend first
     q = _children.build_points(b, guides, np.float64)
@@ -537,5 +579,16 @@ def bind_exactly(b: ChildBinding, points: np.ndarray) -> None:
 def clumps_by_default(binding: ChildBinding) -> bool:
     """Whether render hair of ``binding`` runs ClumpWithGaps among its children unless told
     otherwise: grown children do (interpolated hair without adhesion reads as a fuzz of
-    parallel strands), authored ones (:attr:`ChildBinding.authored`) do not."""
+    parallel strands), authored ones (:attr:`ChildBinding.authored`) do not.
+
+    Parameters
+    ----------
+    binding : ChildBinding
+        The children.
+
+    Returns
+    -------
+    bool
+        True for grown children.
+    """
     return not binding.authored
