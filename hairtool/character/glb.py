@@ -130,7 +130,7 @@ class BufferWriter:
         values : ndarray
             Rows of ``kind`` width.
         kind : str
-            The accessor type (``SCALAR``, ``VEC3``, ``VEC4``, ``MAT4``).
+            The accessor type, a key of :data:`TYPE_WIDTH` (``SCALAR``, ``VEC3``, ``MAT4``…).
         target : int, optional
             The buffer view's target.
         bounds : bool, default False
