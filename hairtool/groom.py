@@ -490,7 +490,20 @@ class Groom(_Attributes):
 
 
 def vertex_ids_of(topology: Topology, strand_ids: NDArray[np.int64]) -> I64:
-    """Vertex indices of the given strands, concatenated in the given order."""
+    """Vertex indices of the given strands, concatenated in the given order.
+
+    Parameters
+    ----------
+    topology : Topology
+        The strands.
+    strand_ids : ndarray
+        int64 strand indices.
+
+    Returns
+    -------
+    ndarray
+        int64 vertex indices.
+    """
     counts = topology.counts[strand_ids]
     starts = topology.offsets[strand_ids]
     local = np.arange(int(counts.sum()), dtype=np.int64) - np.repeat(np.cumsum(counts) - counts, counts)

@@ -139,14 +139,44 @@ def time_warp(frames: ArrayLike, keys_now: ArrayLike, keys_then: ArrayLike) -> F
     """The (fractional) frame of the motion as keyed before that each frame shows now: the
     piecewise-linear map taking each key's frame now back to its frame before, so a key moved
     in time takes the frames between its neighbouring keys with it (stretched on one side,
-    squeezed on the other); the identity wherever no key moved."""
+    squeezed on the other); the identity wherever no key moved.
+
+    Parameters
+    ----------
+    frames : array_like
+        Frame numbers now.
+    keys_now : array_like
+        The keys' frames now.
+    keys_then : array_like
+        Their frames before.
+
+    Returns
+    -------
+    ndarray
+        float64 frames before.
+    """
     return np.interp(np.asarray(frames, dtype=np.float64), keys_now, keys_then)
 
 
 def residual_at(values: NDArray, base_at: Callable[[I64], NDArray], at: ArrayLike) -> F64:
     """The residual ``values − base_at(frames)`` (``values`` ``(F, ...)``, ``base_at`` the key
     curve at whole frames) at fractional frames ``at``, linear between the frames either side;
-    at a whole frame, that frame's residual exactly."""
+    at a whole frame, that frame's residual exactly.
+
+    Parameters
+    ----------
+    values : ndarray
+        ``(F, ...)`` the frames.
+    base_at : callable
+        The key curve at whole frames.
+    at : array_like
+        Fractional frames.
+
+    Returns
+    -------
+    ndarray
+        ``(len(at), ...)`` float64.
+    """
     u = np.asarray(at, dtype=np.float64).reshape(-1)
     n = values.shape[0]
     i0 = np.clip(np.floor(u).astype(np.int64), 0, max(n - 2, 0))
@@ -160,7 +190,24 @@ def residual_at(values: NDArray, base_at: Callable[[I64], NDArray], at: ArrayLik
 def check_retime(keys: ArrayLike, n_frames: int, key_frame: int, new_frame: int) -> tuple[int, I64]:
     """``(key index, keys after)`` for moving the key at ``key_frame`` to ``new_frame``: an inner
     key (the first and last frame are always keys) to a frame strictly between its neighbouring
-    keys (a key never passes another); :class:`ParameterError` naming the allowed frames."""
+    keys (a key never passes another); :class:`ParameterError` naming the allowed frames.
+
+    Parameters
+    ----------
+    keys : array_like
+        The key frames.
+    n_frames : int
+        Frames.
+    key_frame : int
+        The key moved.
+    new_frame : int
+        Where it goes.
+
+    Returns
+    -------
+    tuple of (int, ndarray)
+        The key's index and the keys after.
+    """
     k = check_keys(keys, n_frames)
     hit = np.flatnonzero(k == int(key_frame))
     if hit.size == 0:
@@ -185,7 +232,26 @@ def retime_key(
     keys gets the curve there plus the residual of the frame it now shows, r(w(t)) with w
     :func:`time_warp` (the captured detail moves with the key). So the pose at the key is the
     key pose exactly, with linear keys the stretch is the old motion retimed, and frames
-    outside ``start .. start + len(block) − 1`` (strictly between the neighbours) are untouched."""
+    outside ``start .. start + len(block) − 1`` (strictly between the neighbours) are untouched.
+
+    Parameters
+    ----------
+    frames : ndarray
+        ``(F, ...)`` the frames.
+    keys : array_like
+        The key frames.
+    interp : str
+        The key curve.
+    key_frame : int
+        The key moved.
+    new_frame : int
+        Where it goes.
+
+    Returns
+    -------
+    tuple of (int, ndarray, ndarray)
+        The first frame changed, the changed frames and the keys after.
+    """
     f = np.asarray(frames)
     n = f.shape[0]
     a, after = check_retime(keys, n, key_frame, new_frame)
@@ -231,7 +297,28 @@ def key_slope_block(
     the residual-keeping edit of the key's tangents, Δ(t) = h10·L·δ_out + h11·L·δ_in between
     the neighbouring keys (the key poses stay); the tangents read back from the edited frames
     are affine in (δ_out, δ_in), so two trial edits give the δ that reads back ``slope``. Only
-    that component changes; linear keys have no handles (ParameterError)."""
+    that component changes; linear keys have no handles (ParameterError).
+
+    Parameters
+    ----------
+    frames : ndarray
+        ``(F, ...)`` the frames.
+    keys : array_like
+        The key frames.
+    interp : str
+        The key curve (Hermite).
+    key_frame : int
+        The key whose handle turns.
+    index : int
+        The component.
+    slope : float
+        The new slope, per frame.
+
+    Returns
+    -------
+    tuple of (int, ndarray)
+        The first frame changed and the changed frames.
+    """
     if interp == "linear":
         raise ParameterError("interp", interp, "hermite or hermite-fit (linear keys have no handles)")
     f = np.asarray(frames)

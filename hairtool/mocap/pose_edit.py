@@ -149,7 +149,22 @@ def parse_edits(data: object, motion: Motion, source: str = "edits") -> list[Pos
     """Edits from JSON data (a list of objects, or ``{"edits": [...]}``), checked against the
     skeleton: known joint, three finite numbers, a chain of 1 up to the joint's ancestors with
     rotation channels to turn. Key frames are checked by :meth:`PoseEditor.apply`. Any fault
-    raises :class:`FormatError` naming ``source`` and the edit (counted from 1)."""
+    raises :class:`FormatError` naming ``source`` and the edit (counted from 1).
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON.
+    motion : Motion
+        The capture.
+    source : str, default "edits"
+        The file, named in a refusal.
+
+    Returns
+    -------
+    list of PoseEdit
+        The edits.
+    """
     if isinstance(data, dict) and set(data) == {"edits"}:
         data = data["edits"]
     if not isinstance(data, list):
@@ -195,7 +210,22 @@ def parse_edit_list(data: object, motion: Motion, source: str = "edits") -> list
     handle edits ``{"frame", "joint", "channel", "slope"}`` and key moves ``{"frame", "to"}`` in
     one list, in order (what a
     studio project keeps); faults raise :class:`FormatError` naming ``source`` and the edit
-    (counted from 1)."""
+    (counted from 1).
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON.
+    motion : Motion
+        The capture.
+    source : str, default "edits"
+        The file, named in a refusal.
+
+    Returns
+    -------
+    list of Edit
+        The edits, in order.
+    """
     if isinstance(data, dict) and set(data) == {"edits"}:
         data = data["edits"]
     if not isinstance(data, list):
@@ -269,7 +299,18 @@ def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
 
 
 def read_json(path: str | os.PathLike[str]) -> object:
-    """A JSON file's data; unreadable or invalid JSON raises :class:`FormatError` naming it."""
+    """A JSON file's data; unreadable or invalid JSON raises :class:`FormatError` naming it.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    object
+        Its data.
+    """
     # every user text limit, as jobs files get; a project's capture section (an edit file
     # too) carries the capture's BVH text whole
     return user_text.read(path, "an edit file", "json", texts=frozenset({"bvh"}))
@@ -281,7 +322,22 @@ def apply_edits(editor, edits: list, method: str = "auto") -> list[EditReport]:
     key's value (``apply_channel``), its handle (``apply_tangent``), a key moved in time of the
     kind that editor keys (``editor.RETIME``: the pose key, or one channel's key;
     ``apply_retime``), an IK pose edit (``apply``). Another kind raises
-    :class:`ParameterError` naming it, so no edit is read as another."""
+    :class:`ParameterError` naming it, so no edit is read as another.
+
+    Parameters
+    ----------
+    editor : PoseEditor or ChannelEditor
+        The editor.
+    edits : list
+        The edits.
+    method : str, default "auto"
+        The IK solver.
+
+    Returns
+    -------
+    list of EditReport
+        One per edit.
+    """
     out = []
     for e in edits:
         if isinstance(e, ChannelEdit):
