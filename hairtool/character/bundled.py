@@ -147,6 +147,24 @@ def tube(centres: np.ndarray, radii: np.ndarray, sides: int) -> tuple[np.ndarray
 
 
 def sphere(centre: np.ndarray, radius: float, rings: int = 8, sides: int = 12):
+    """A UV sphere's positions, normals and triangles (the bundled character's head).
+
+    Parameters
+    ----------
+    centre : ndarray
+        ``(3,)``.
+    radius : float
+        Its radius.
+    rings : int, default 8
+        Rings from pole to pole.
+    sides : int, default 12
+        Vertices per ring.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        Positions, normals and triangles.
+    """
     pos, nor = [], []
     for i in range(rings + 1):
         el = math.pi / 2 - math.pi * i / rings

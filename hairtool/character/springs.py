@@ -259,6 +259,13 @@ class PackedSprings:
     """:class:`SpringBones` as flat arrays, stepped by the numba kernel (same formulas)."""
 
     def __init__(self, springs: SpringBones) -> None:
+        """``springs``' chains, joints and colliders packed into the kernel's arrays.
+
+        Parameters
+        ----------
+        springs : SpringBones
+            The springs, at rest.
+        """
         from hairtool.character.springs_kernel import collider_arrays
 
         self.springs = springs
@@ -283,6 +290,20 @@ class PackedSprings:
         self.col_tail = np.array([c.offset if c.tail is None else c.tail for c in cols]).reshape(-1, 3)
 
     def step(self, local: F64, dt: float) -> F64:
+        """:meth:`SpringBones.step` by the numba kernel.
+
+        Parameters
+        ----------
+        local : ndarray
+            ``(J, 4)`` the driven pose.
+        dt : float
+            Seconds.
+
+        Returns
+        -------
+        ndarray
+            ``(J, 4)`` float64 posed local rotations.
+        """
         from hairtool.character.springs_kernel import spring_step_kernel
 
         sb = self.springs

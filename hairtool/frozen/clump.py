@@ -811,7 +811,32 @@ def clump(
 def gap_factors_reference(i, j, r, P, dp, h, seed, it, gap_mode) -> np.ndarray:
     """The gap-keeping factor λ per vertex (eqs. 17-18) of one iteration, from the pairs
     ``(i, j)`` at distances ``r`` and the adhesion steps ``dp``: each vertex's nearest pair
-    (ties: the lowest index) before and after the step; 1 where gaps are off or no pair."""
+    (ties: the lowest index) before and after the step; 1 where gaps are off or no pair.
+
+    Parameters
+    ----------
+    i, j : ndarray
+        The pairs' vertices.
+    r : ndarray
+        Their distances.
+    P : ndarray
+        ``(V, 3)`` the iterate.
+    dp : ndarray
+        ``(V, 3)`` the adhesion steps.
+    h : float
+        The clump radius.
+    seed : int
+        The seed of ζ.
+    it : int
+        The iteration.
+    gap_mode : str
+        The gap rule.
+
+    Returns
+    -------
+    ndarray
+        ``(V,)`` float64 λ.
+    """
     lam = np.ones(len(P))
     if gap_mode != "off" and len(i):
         first = np.lexsort((j, r, i))  # per vertex: nearest, then lowest index
