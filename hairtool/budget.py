@@ -72,14 +72,31 @@ def factor() -> float:
 
 
 def set_factor(value: float) -> None:
-    """Raise (or lower) every limit by ``value`` for this process and the commands it starts."""
+    """Raise (or lower) every limit by ``value`` for this process and the commands it starts.
+
+    Parameters
+    ----------
+    value : float
+        A finite factor > 0 (BudgetError otherwise).
+    """
     if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
         raise BudgetError(f"--raise-limits={value!r} is invalid: expected a positive factor")
     os.environ[ENV] = repr(float(value))
 
 
 def limit(kind: str) -> float:
-    """The limit of ``kind`` (a key of :data:`LIMITS`) after the factor."""
+    """The limit of ``kind`` (a key of :data:`LIMITS`) after the factor.
+
+    Parameters
+    ----------
+    kind : str
+        ``"memory"``, ``"points"``, ``"pairs"`` or ``"steps"`` (a key of :data:`LIMITS`).
+
+    Returns
+    -------
+    float
+        The limit in its unit (bytes, points, pairs, steps).
+    """
     return LIMITS[kind].value * factor()
 
 
@@ -95,7 +112,22 @@ def _size(n: float, unit: str) -> str:
 def check(kind: str, size: float, what: str) -> None:
     """Refuse (:class:`BudgetError`) when ``size`` (in the limit's unit; may be inf or nan, an
     estimate that overflowed) exceeds the limit of ``kind``; ``what`` names the parameter or
-    file that asked ("radius=1e+06", "capture.bvh")."""
+    file that asked ("radius=1e+06", "capture.bvh").
+
+    Parameters
+    ----------
+    kind : str
+        Which limit (a key of :data:`LIMITS`).
+    size : float
+        The estimate, in the limit's unit.
+    what : str
+        The parameter or file that asked, as the line shows it.
+
+    Raises
+    ------
+    BudgetError
+        Where the estimate is past the limit, or not a number.
+    """
     lim = limit(kind)
     if size <= lim:  # False for nan: an estimate that is not a number is refused too
         return
@@ -108,5 +140,18 @@ def check(kind: str, size: float, what: str) -> None:
 
 
 def check_bytes(size: float, what: str) -> None:
-    """:func:`check` of memory in bytes."""
+    """:func:`check` of memory in bytes.
+
+    Parameters
+    ----------
+    size : float
+        The estimated allocation in bytes.
+    what : str
+        The parameter or file that asked.
+
+    Raises
+    ------
+    BudgetError
+        Past the memory limit.
+    """
     check("memory", size, what)

@@ -14,6 +14,15 @@ class FormatError(HairtoolError):
     """A file could not be read or written; the message names the file."""
 
     def __init__(self, path: str | os.PathLike[str], reason: str) -> None:
+        """The message is ``PATH: reason``.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file that could not be read or written.
+        reason : str
+            What is wrong with it, one line.
+        """
         self.path = os.fspath(path)
         self.reason = reason
         super().__init__(f"{self.path}: {reason}")
@@ -23,6 +32,17 @@ class ParameterError(HairtoolError, ValueError):
     """A parameter is out of range; the message names it and its valid range."""
 
     def __init__(self, name: str, value: object, expected: str) -> None:
+        """The message is ``NAME=VALUE is invalid: expected EXPECTED``.
+
+        Parameters
+        ----------
+        name : str
+            The parameter as the caller knows it (an option, a field, a file's key).
+        value : object
+            The value refused (shown with ``repr``, so one line stays one line).
+        expected : str
+            The valid range or kinds, in words.
+        """
         self.name = name
         self.value = value
         super().__init__(f"{name}={value!r} is invalid: expected {expected}")

@@ -37,6 +37,18 @@ class Topology:
     """Per-strand vertex counts and the index arrays derived from them (shared, immutable)."""
 
     def __init__(self, counts: ArrayLike) -> None:
+        """Check the counts and derive the offsets once.
+
+        Parameters
+        ----------
+        counts : array_like
+            ``(S,)`` whole numbers, each strand's vertex count.
+
+        Raises
+        ------
+        GroomError
+            For counts that are not a 1-D array of whole numbers of at least one strand.
+        """
         c = np.asarray(counts)
         if c.ndim != 1:
             raise GroomError(f"strand counts must be a 1-D array, got shape {c.shape}")
@@ -243,7 +255,20 @@ class Groom(_Attributes):
 
     @classmethod
     def from_strands(cls, strands: Sequence[ArrayLike], **attributes: ArrayLike | None) -> Groom:
-        """Build from a list of ``(N_s, 3)`` polylines (2-D ``(N_s, 2)`` ones get z = 0)."""
+        """Build from a list of ``(N_s, 3)`` polylines (2-D ``(N_s, 2)`` ones get z = 0).
+
+        Parameters
+        ----------
+        strands : sequence of array_like
+            One ``(N_s, 3)`` or ``(N_s, 2)`` polyline per strand, root first.
+        **attributes : array_like, optional
+            Per-vertex attributes (``widths``, ``colors``...) over all vertices, in strand order.
+
+        Returns
+        -------
+        Groom
+            The strands as one float32 points array with their counts.
+        """
         if len(strands) == 0:
             raise GroomError("a groom needs at least one strand")
         arrays = []
@@ -258,7 +283,18 @@ class Groom(_Attributes):
         return cls(np.concatenate(arrays), counts, **attributes)
 
     def with_points(self, points: ArrayLike) -> Groom:
-        """The same strands, attributes and metadata at new positions."""
+        """The same strands, attributes and metadata at new positions.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(V, 3)`` new positions, one per vertex (cast to float32).
+
+        Returns
+        -------
+        Groom
+            A groom sharing this one's topology, attributes and metadata.
+        """
         return Groom(points, self.topology, **self.attributes, metadata=self.metadata)
 
     def with_moved_rows(self, points: NDArray[np.float32], rows: ArrayLike) -> Groom:
@@ -267,7 +303,20 @@ class Groom(_Attributes):
         nobody writes afterwards (it is made read-only, not copied); ``rows`` alone are checked,
         and the attributes are shared. A brush move on millions of vertices changes a few
         thousand, and a copy and a check of all of them would cost more than the move. Anything
-        else goes through :meth:`with_points`."""
+        else goes through :meth:`with_points`.
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(V, 3)`` float32 C-ordered positions, handed over (not copied).
+        rows : array_like
+            The vertex ids whose values may differ from the ones this groom holds.
+
+        Returns
+        -------
+        Groom
+            The groom at ``points``; only ``rows`` are checked for finite values.
+        """
         if not (
             isinstance(points, np.ndarray)
             and points.dtype == np.float32
@@ -309,7 +358,18 @@ class Groom(_Attributes):
         return self.points[self.topology.tip_indices]
 
     def strand(self, s: int) -> F32:
-        """Read-only ``(N_s, 3)`` view of one strand."""
+        """Read-only ``(N_s, 3)`` view of one strand.
+
+        Parameters
+        ----------
+        s : int
+            The strand's index.
+
+        Returns
+        -------
+        ndarray
+            ``(N_s, 3)`` float32, read-only: a view, not a copy.
+        """
         o = self.offsets
         return self.points[o[s] : o[s + 1]]
 
@@ -318,13 +378,37 @@ class Groom(_Attributes):
             yield self.strand(s)
 
     def with_metadata(self, metadata: Metadata) -> Groom:
-        """The same groom with another source record (up axis, unit, prims)."""
+        """The same groom with another source record (up axis, unit, prims).
+
+        Parameters
+        ----------
+        metadata : Metadata
+            The new source record.
+
+        Returns
+        -------
+        Groom
+            The same points and attributes with ``metadata``.
+        """
         return Groom(self.points, self.topology, **self.attributes, metadata=metadata)
 
     def animate(self, frames: ArrayLike, fps: float) -> Animation:
         """An animation of these strands (a simulation, a cycle): their attributes and source
         record by construction, frames at time codes from the source's start (0 by default),
-        so an engine that makes frames cannot drop the scene's space, unit or prims."""
+        so an engine that makes frames cannot drop the scene's space, unit or prims.
+
+        Parameters
+        ----------
+        frames : array_like
+            ``(F, V, 3)`` positions of these strands at each frame.
+        fps : float
+            Frames per second.
+
+        Returns
+        -------
+        Animation
+            The frames with this groom's attributes and source record.
+        """
         n = int(np.shape(frames)[0]) if np.ndim(frames) == 3 else 0
         first = self.metadata.first_time_code()
         codes = None if first == 0.0 or n == 0 else first + np.arange(n, dtype=np.float64)
@@ -333,7 +417,18 @@ class Groom(_Attributes):
 
     def subset(self, strand_ids: ArrayLike) -> Groom:
         """A groom of the chosen strands, in the given order; its record holds each source prim's
-        chosen strands (:meth:`~hairtool.metadata.Metadata.subset`)."""
+        chosen strands (:meth:`~hairtool.metadata.Metadata.subset`).
+
+        Parameters
+        ----------
+        strand_ids : array_like
+            Indices of the strands to keep, in the order wanted (repeats allowed).
+
+        Returns
+        -------
+        Groom
+            The chosen strands with their attributes and record.
+        """
         ids = np.asarray(strand_ids, dtype=np.int64).reshape(-1)
         if ids.size == 0:
             raise GroomError("a subset needs at least one strand")
@@ -395,7 +490,20 @@ class Groom(_Attributes):
 
 
 def vertex_ids_of(topology: Topology, strand_ids: NDArray[np.int64]) -> I64:
-    """Vertex indices of the given strands, concatenated in the given order."""
+    """Vertex indices of the given strands, concatenated in the given order.
+
+    Parameters
+    ----------
+    topology : Topology
+        The strands.
+    strand_ids : ndarray
+        int64 strand indices.
+
+    Returns
+    -------
+    ndarray
+        int64 vertex indices.
+    """
     counts = topology.counts[strand_ids]
     starts = topology.offsets[strand_ids]
     local = np.arange(int(counts.sum()), dtype=np.int64) - np.repeat(np.cumsum(counts) - counts, counts)
@@ -462,7 +570,20 @@ class Animation(_Attributes):
 
     @classmethod
     def from_grooms(cls, grooms: Sequence[Groom], fps: float = 24.0) -> Animation:
-        """Stack grooms of one topology into frames; attributes come from the first."""
+        """Stack grooms of one topology into frames; attributes come from the first.
+
+        Parameters
+        ----------
+        grooms : sequence of Groom
+            The frames, all with the same strand counts.
+        fps : float, default 24.0
+            Frames per second.
+
+        Returns
+        -------
+        Animation
+            One frame per groom.
+        """
         if len(grooms) == 0:
             raise GroomError("an animation needs at least one frame")
         top = grooms[0].topology
@@ -478,7 +599,22 @@ class Animation(_Attributes):
         self, frames: ArrayLike, fps: float | None = None, time_codes: ArrayLike | None = None
     ) -> Animation:
         """New frames of the same strands; the time codes are kept while the frame count is,
-        else they are ``time_codes`` (None: 0…F−1)."""
+        else they are ``time_codes`` (None: 0…F−1).
+
+        Parameters
+        ----------
+        frames : array_like
+            ``(F, V, 3)`` positions of the same strands.
+        fps : float, optional
+            Frames per second (None: this animation's).
+        time_codes : array_like, optional
+            ``(F,)`` time codes where the frame count changes (None: 0…F−1).
+
+        Returns
+        -------
+        Animation
+            The new frames with this animation's strands, attributes and record.
+        """
         n = np.shape(frames)[0] if np.ndim(frames) else 0
         codes = self.metadata.time_codes if time_codes is None and n == self.n_frames else time_codes
         codes = None if codes is None else tuple(np.asarray(codes, dtype=np.float64).reshape(-1).tolist())
@@ -491,7 +627,18 @@ class Animation(_Attributes):
         )
 
     def with_metadata(self, metadata: Metadata) -> Animation:
-        """The same animation with another source record (up axis, unit, time codes, prims)."""
+        """The same animation with another source record (up axis, unit, time codes, prims).
+
+        Parameters
+        ----------
+        metadata : Metadata
+            The new source record.
+
+        Returns
+        -------
+        Animation
+            The same frames with ``metadata``.
+        """
         return Animation(self.frames, self.topology, self.fps, **self.attributes, metadata=metadata)
 
     @property
@@ -514,7 +661,18 @@ class Animation(_Attributes):
         return np.arange(self.n_frames, dtype=np.float64) if codes is None else np.array(codes)
 
     def frame(self, f: int) -> Groom:
-        """Frame ``f`` as a groom (negative indices count from the end)."""
+        """Frame ``f`` as a groom (negative indices count from the end).
+
+        Parameters
+        ----------
+        f : int
+            The frame's index (negative: from the end).
+
+        Returns
+        -------
+        Groom
+            The strands at that frame, with the animation's attributes.
+        """
         if not -self.n_frames <= f < self.n_frames:
             raise IndexError(f"frame {f} is outside 0..{self.n_frames - 1}")
         return Groom(self.frames[f], self.topology, **self.attributes, metadata=self.metadata)

@@ -20,13 +20,37 @@ from hairtool.metadata import CurvesPrim, join_attributes
 
 
 def prim_paths(groom: Groom) -> list[str]:
-    """The paths of the groom's source prims, in order (empty for a groom of one default prim)."""
+    """The paths of the groom's source prims, in order (empty for a groom of one default prim).
+
+    Parameters
+    ----------
+    groom : Groom
+        A groom read from a scene.
+
+    Returns
+    -------
+    list of str
+        Its prims' paths.
+    """
     return [c.path for c in groom.metadata.for_strands(groom.strand_count).curves]
 
 
 def picked(groom: Groom, patterns: Sequence[str] | None) -> list[bool]:
     """Per source prim, whether one of ``patterns`` (globs over prim paths) picks it; None or
-    empty picks all. A pattern that picks no prim is refused, naming the prims there are."""
+    empty picks all. A pattern that picks no prim is refused, naming the prims there are.
+
+    Parameters
+    ----------
+    groom : Groom
+        A groom read from a scene.
+    patterns : sequence of str or None
+        fnmatch globs over prim paths (``--prim``).
+
+    Returns
+    -------
+    list of bool
+        One per prim (one for a groom of one default prim).
+    """
     paths = prim_paths(groom)
     if not patterns:
         return [True] * max(len(paths), 1)
@@ -40,7 +64,18 @@ def picked(groom: Groom, patterns: Sequence[str] | None) -> list[bool]:
 
 
 def split(groom: Groom) -> list[Groom]:
-    """The groom of each source prim, in order (the groom itself where it has one prim)."""
+    """The groom of each source prim, in order (the groom itself where it has one prim).
+
+    Parameters
+    ----------
+    groom : Groom
+        A groom read from a scene.
+
+    Returns
+    -------
+    list of Groom
+        One groom per prim.
+    """
     prims = groom.metadata.for_strands(groom.strand_count).curves
     if len(prims) <= 1:
         return [groom]
@@ -61,7 +96,20 @@ def _as_prim(source: Groom, result: Groom) -> CurvesPrim | None:
 def join(sources: Sequence[Groom], results: Sequence[Groom]) -> Groom:
     """The prims' results end to end as one groom, in the record of the first source, each
     result written as its source's prim. Attributes present in every source are joined; one a
-    result lacks is taken from nowhere, so the results must carry what their sources did."""
+    result lacks is taken from nowhere, so the results must carry what their sources did.
+
+    Parameters
+    ----------
+    sources : sequence of Groom
+        The prims' grooms as :func:`split` gave them.
+    results : sequence of Groom
+        What a command made of each, in the same order.
+
+    Returns
+    -------
+    Groom
+        One groom on the sources' prims.
+    """
     if len(results) == 1:
         prim = _as_prim(sources[0], results[0])
         meta = results[0].metadata.with_(curves=() if prim is None else (prim,))
@@ -84,7 +132,22 @@ def join(sources: Sequence[Groom], results: Sequence[Groom]) -> Groom:
 
 def per_prim(groom: Groom, work: Callable[[Groom], Groom], patterns: Sequence[str] | None = None) -> Groom:
     """``work`` run on the groom of each picked prim (:func:`picked`), the others passed through
-    as they were, laid back in the source's order (:func:`join`)."""
+    as they were, laid back in the source's order (:func:`join`).
+
+    Parameters
+    ----------
+    groom : Groom
+        A groom read from a scene.
+    work : callable
+        Groom → groom, run on each picked prim.
+    patterns : sequence of str, optional
+        fnmatch globs over prim paths (None: every prim).
+
+    Returns
+    -------
+    Groom
+        The results and the prims passed through, in the source's order.
+    """
     chosen = picked(groom, patterns)
     parts = split(groom)
     results = [work(g) if pick else g for g, pick in zip(parts, chosen, strict=True)]
@@ -95,7 +158,18 @@ def concat(parts: Sequence[Groom]) -> Groom:
     """Grooms each on prims of their own (render hair beside its guides, one part per source
     prim) end to end as one groom, every part's prims kept; an attribute some parts lack is
     filled with defaults there and those parts' prims say they lack it, so a writer leaves it
-    out of them again."""
+    out of them again.
+
+    Parameters
+    ----------
+    parts : sequence of Groom
+        Grooms, each on prims of its own.
+
+    Returns
+    -------
+    Groom
+        One groom holding every part's prims.
+    """
     if len(parts) == 1:
         return parts[0]
     meta = parts[0].metadata
@@ -117,7 +191,20 @@ def concat(parts: Sequence[Groom]) -> Groom:
 
 
 def shares(total: int, weights: Sequence[int]) -> list[int]:
-    """``total`` split in proportion to ``weights`` (largest remainders), each share at least 1."""
+    """``total`` split in proportion to ``weights`` (largest remainders), each share at least 1.
+
+    Parameters
+    ----------
+    total : int
+        What is shared out.
+    weights : sequence of int
+        One weight per share, > 0 in total.
+
+    Returns
+    -------
+    list of int
+        The shares, summing to ``total`` where it is at least their count.
+    """
     w = np.asarray(weights, np.float64)
     exact = total * w / w.sum()
     out = np.maximum(np.floor(exact).astype(np.int64), 1)

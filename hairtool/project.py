@@ -108,7 +108,20 @@ class Project:
 
     @classmethod
     def from_pipeline(cls, pipeline: FrozenPipeline, **fields: Any) -> Project:
-        """A project of the pipeline's rest groom, parameters and stroke snapshot."""
+        """A project of the pipeline's rest groom, parameters and stroke snapshot.
+
+        Parameters
+        ----------
+        pipeline : FrozenPipeline
+            The groom being worked on.
+        **fields : Any
+            The project's other fields (settings, head mesh, capture...).
+
+        Returns
+        -------
+        Project
+            The project.
+        """
         snap = pipeline.snapshot()
         # After a delete the stroked state has fewer strands than the rest groom: replayed on load.
         aligned = snap.aligned if snap.aligned.topology == pipeline.rest.topology else None
@@ -119,6 +132,16 @@ class Project:
 
         With ``aligned`` the snapshot matches the pipeline's fresh frozen state, so no stroke is
         replayed; without it the log is replayed.
+
+        Parameters
+        ----------
+        pipeline : FrozenPipeline
+            A pipeline built from this project's rest and params.
+
+        Returns
+        -------
+        FrozenSnapshot
+            The snapshot to restore.
         """
         current = pipeline.snapshot()
         if self.aligned is None:
@@ -168,7 +191,18 @@ def _json_object(name: str, value: Any) -> dict:
 
 
 def manifest_and_arrays(project: Project) -> tuple[dict, dict[str, np.ndarray]]:
-    """The manifest (JSON-ready) and the arrays, by member name, that :func:`save` writes."""
+    """The manifest (JSON-ready) and the arrays, by member name, that :func:`save` writes.
+
+    Parameters
+    ----------
+    project : Project
+        The project.
+
+    Returns
+    -------
+    tuple of (dict, dict of str to ndarray)
+        The manifest and the arrays.
+    """
     arrays: dict[str, np.ndarray] = {}
     manifest: dict[str, Any] = {
         "format": FORMAT,

@@ -69,6 +69,16 @@ def node_angle_errors(a: F64, b: F64) -> F64:
     seen from each chain's own parent frame (frames parallel-transported from the root, both
     starting from ``b``'s first segment), so a rigid turn of the whole chain about its root
     shows at node 0 only, and planar chains give |Δθ_a − Δθ_b| exactly.
+
+    Parameters
+    ----------
+    a, b : ndarray
+        ``(..., N, 3)`` chains.
+
+    Returns
+    -------
+    ndarray
+        ``(..., N−1)`` float64 radians.
     """
     da = normalize(np.diff(np.asarray(a, dtype=np.float64), axis=-2))
     db = normalize(np.diff(np.asarray(b, dtype=np.float64), axis=-2))
@@ -109,6 +119,16 @@ def chain_errors(generated: F64, reference: F64) -> ChainErrors:
     """Errors of ``generated`` ``(F, S, N, 3)`` chains against ``reference`` of the same shape.
 
     Means are over nodes and chains (float64), per frame, then over frames.
+
+    Parameters
+    ----------
+    generated, reference : ndarray
+        ``(F, S, N, 3)`` chains.
+
+    Returns
+    -------
+    ChainErrors
+        Mean angular error and node displacement, overall and per frame.
     """
     g = np.asarray(generated, dtype=np.float64)
     r = np.asarray(reference, dtype=np.float64)
@@ -144,6 +164,18 @@ def compare_cycle(generated: Animation | Groom, reference: Animation | Groom) ->
     one-frame animation) is compared with every generated frame. Chains are matched strand by
     strand; unless both have the same, uniform vertex count, every chain is first resampled by
     arc length to the largest vertex count (so a hand-drawn chain need not have the same nodes).
+
+    Parameters
+    ----------
+    generated : Animation or Groom
+        The cycle.
+    reference : Animation or Groom
+        The chains to compare with, the same strands.
+
+    Returns
+    -------
+    ChainErrors
+        The errors.
     """
     if generated.strand_count != reference.strand_count:
         raise ParameterError(

@@ -30,12 +30,36 @@ _DEGENERATE = 1e-6  # |sin| between a chord and the sway below which the sway gi
 
 
 def wave_x(groom: Groom) -> F64:
-    """``(V,)`` the wave's x at every node: π × arc length from the root / chain length, in [0, π]."""
+    """``(V,)`` the wave's x at every node: π × arc length from the root / chain length, in [0, π].
+
+    Parameters
+    ----------
+    groom : Groom
+        The chains at rest.
+
+    Returns
+    -------
+    ndarray
+        ``(V,)`` float64.
+    """
     return np.pi * np.clip(groom.arc_param, 0.0, 1.0)
 
 
 def check_guides(groom: Groom, guides: ArrayLike) -> I64:
-    """Validated, distinct guide strand ids, in the given order."""
+    """Validated, distinct guide strand ids, in the given order.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    guides : array_like
+        Guide strand ids.
+
+    Returns
+    -------
+    ndarray
+        int64 ids (ParameterError naming a bad or repeated one).
+    """
     g = np.asarray(guides)
     if g.ndim != 1 or g.size == 0 or not np.issubdtype(g.dtype, np.integer):
         raise ParameterError("guides", guides, "a non-empty list of strand ids")
@@ -51,6 +75,20 @@ def nearest_guide(groom: Groom, guides: I64, chunk: int = 4096) -> I64:
     """``(S,)`` the bunch of every strand: the index into ``guides`` of the nearest guide root.
 
     Ties go to the guide listed first; a guide is always its own bunch.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    guides : ndarray
+        Checked guide ids (:func:`check_guides`).
+    chunk : int, default 4096
+        Strands measured at once (bounds the distance table's memory).
+
+    Returns
+    -------
+    ndarray
+        ``(S,)`` int64.
     """
     roots = groom.roots.astype(np.float64)
     g_roots = roots[guides]
@@ -63,6 +101,18 @@ def nearest_guide(groom: Groom, guides: I64, chunk: int = 4096) -> I64:
 
 
 def check_sway(sway: ArrayLike | None) -> F64 | None:
+    """``sway`` as a float64 3-vector, or None; a ParameterError for a zero or non-finite one.
+
+    Parameters
+    ----------
+    sway : array_like or None
+        The direction the wave bends toward.
+
+    Returns
+    -------
+    ndarray or None
+        ``(3,)`` float64.
+    """
     if sway is None:
         return None
     w = np.asarray(sway, dtype=np.float64)
@@ -82,6 +132,22 @@ def bend_axes(
     2-D grooms always bend about ±z and stay planar. Chords parallel to the sway fall back to
     the view's horizontal (+x) as the sway, then to any perpendicular. ``planar`` defaults to
     ``chains.is_planar``.
+
+    Parameters
+    ----------
+    chains : Groom
+        One chain per bunch, at rest.
+    sway : array_like, optional
+        The direction positive y bends toward (None: up).
+    planar : bool, optional
+        The chains lie in a plane (None: ask the groom).
+    up : array_like, optional
+        The scene's up (None: the chains' scene's).
+
+    Returns
+    -------
+    ndarray
+        ``(S, 3)`` float64 unit axes.
     """
     w = check_sway(sway)
     up_dir = chains.metadata.up if up is None else np.asarray(up, dtype=np.float64)
@@ -114,6 +180,22 @@ def bunch_variation(
     """Per-bunch amplitude scale 1 ± ``amplitude_spread`` and phase offset in [0, ``phase_spread``) cycles.
 
     Bunch b's draws depend only on (seed, b), so adding bunches does not reshuffle the others.
+
+    Parameters
+    ----------
+    n_bunches : int
+        Bunches.
+    amplitude_spread : float, default 0.0
+        Each scale is 1 ± this.
+    phase_spread : float, default 0.0
+        Each phase is in [0, this) cycles.
+    seed : int, default 0
+        The draws' seed.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``(n_bunches,)`` scales and phases, float64.
     """
     for name, v in (("amplitude_spread", amplitude_spread), ("phase_spread", phase_spread)):
         if not np.isfinite(v) or not 0.0 <= v <= 1.0:
@@ -127,6 +209,23 @@ def bunch_variation(
 
 
 def check_per_bunch(name: str, values: ArrayLike, n_bunches: int) -> F64:
+    """One value, or one per bunch, as ``(n_bunches,)`` finite float64; a ParameterError naming
+    ``name`` otherwise.
+
+    Parameters
+    ----------
+    name : str
+        The parameter, named in a refusal.
+    values : array_like
+        A number or ``(n_bunches,)`` numbers.
+    n_bunches : int
+        Bunches.
+
+    Returns
+    -------
+    ndarray
+        ``(n_bunches,)`` float64.
+    """
     v = np.asarray(values, dtype=np.float64)
     if v.ndim == 0:
         v = np.full(n_bunches, float(v))
@@ -140,13 +239,42 @@ def bend_chains(groom: Groom, axes: ArrayLike, angles: ArrayLike) -> F64:
 
     ``axes``: ``(S, 3)`` unit axis per strand; ``angles``: ``(P, V−S)`` radians per segment and
     pose (θ_j, the absolute bend of segment j, i.e. the relative node rotations summed root to j).
+
+    Parameters
+    ----------
+    groom : Groom
+        The chains at rest.
+    axes : array_like
+        ``(S, 3)`` unit axes.
+    angles : array_like
+        ``(P, V−S)`` radians.
+
+    Returns
+    -------
+    ndarray
+        ``(P, V, 3)`` float64.
     """
     a = np.asarray(angles, dtype=np.float64)
     return bend_chains_cs(groom, axes, np.cos(a), np.sin(a))
 
 
 def bend_chains_cs(groom: Groom, axes: ArrayLike, cos: F64, sin: F64) -> F64:
-    """:func:`bend_chains` given cosθ and sinθ, ``(P, V−S)`` each (no trigonometry on the hot path)."""
+    """:func:`bend_chains` given cosθ and sinθ, ``(P, V−S)`` each (no trigonometry on the hot path).
+
+    Parameters
+    ----------
+    groom : Groom
+        The chains at rest.
+    axes : array_like
+        ``(S, 3)`` unit axes.
+    cos, sin : ndarray
+        ``(P, V−S)`` each.
+
+    Returns
+    -------
+    ndarray
+        ``(P, V, 3)`` float64.
+    """
     top = groom.topology
     seg_end = top.segment_end
     if cos.ndim != 2 or cos.shape[1] != seg_end.size or sin.shape != cos.shape:
@@ -174,7 +302,22 @@ def bend_chains_cs(groom: Groom, axes: ArrayLike, cos: F64, sin: F64) -> F64:
 
 
 def wave_values(x: ArrayLike, t: ArrayLike, a: float, k: float, s: float, p: float, period: float) -> F64:
-    """Eq. (1) without argument checks: −(a/s)(x/π)^p (cos(x/k − 2πt/T) + 1/s), broadcast."""
+    """Eq. (1) without argument checks: −(a/s)(x/π)^p (cos(x/k − 2πt/T) + 1/s), broadcast.
+
+    Parameters
+    ----------
+    x : array_like
+        Positions along the chain, in [0, π].
+    t : array_like
+        Times in seconds.
+    a, k, s, p, period : float
+        Amplitude, wavelength, gravity, profile and period T of eq. (1).
+
+    Returns
+    -------
+    ndarray
+        f(x, t), float64.
+    """
     x = np.asarray(x, dtype=np.float64)
     t = np.asarray(t, dtype=np.float64)
     return -(a / s) * (x / np.pi) ** p * (np.cos(x / k - 2.0 * np.pi * t / period) + 1.0 / s)
@@ -183,7 +326,26 @@ def wave_values(x: ArrayLike, t: ArrayLike, a: float, k: float, s: float, p: flo
 def pose_reference(
     groom: Groom, times: F64, axes: F64, scale: F64, shift: F64, wave: tuple[float, ...]
 ) -> F64:
-    """``(P, V, 3)`` float64 poses, plain numpy: the reference for :func:`pose_numba`."""
+    """``(P, V, 3)`` float64 poses, plain numpy: the reference for :func:`pose_numba`.
+
+    Parameters
+    ----------
+    groom : Groom
+        The chains at rest.
+    times : ndarray
+        ``(P,)`` seconds.
+    axes : ndarray
+        ``(S, 3)`` unit bend axes.
+    scale, shift : ndarray
+        ``(S,)`` each strand's amplitude scale and time shift (its bunch's).
+    wave : tuple of float
+        ``(a, k, s, p, period)``.
+
+    Returns
+    -------
+    ndarray
+        ``(P, V, 3)`` float64.
+    """
     top = groom.topology
     x = wave_x(groom)
     t_v = times[:, None] + shift[top.strand_index][None, :]
@@ -234,7 +396,18 @@ def _pose_kernel(
 
 
 def pose_numba(groom: Groom, times: F64, axes: F64, scale: F64, shift: F64, wave: tuple[float, ...]) -> F64:
-    """:func:`pose_reference` in one pass per strand, parallel over strands (same bits, any thread count)."""
+    """:func:`pose_reference` in one pass per strand, parallel over strands (same bits, any thread count).
+
+    Parameters
+    ----------
+    groom, times, axes, scale, shift, wave
+        As :func:`pose_reference` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(P, V, 3)`` float64, the same bits.
+    """
     a, k, s, p, period = (float(w) for w in wave)
     x = wave_x(groom)
     out = np.empty((times.size, groom.vertex_count, 3))

@@ -34,7 +34,18 @@ def _decimal(value: float) -> Decimal:
 
 
 def round_half_up(value: float) -> int:
-    """Nearest integer, halves away from zero: 12.5 → 13 (Python's ``round`` gives 12)."""
+    """Nearest integer, halves away from zero: 12.5 → 13 (Python's ``round`` gives 12).
+
+    Parameters
+    ----------
+    value : float
+        A finite number.
+
+    Returns
+    -------
+    int
+        The nearest integer.
+    """
     return int(_decimal(value).quantize(Decimal(1), rounding=ROUND_HALF_UP))
 
 
@@ -44,6 +55,18 @@ def frames_per_cycle(period: float, fps: float) -> int:
     A float product can land just below a half (0.58 × 25 is 14.499999999999998 in binary) and
     round the wrong way. The product of the typed decimals is exact, and snapping it to 1e-9
     frame first also rounds computed periods such as 1/48 s at 24 fps (0.4999…) to 1 frame.
+
+    Parameters
+    ----------
+    period : float
+        T in seconds.
+    fps : float
+        N_FPS.
+
+    Returns
+    -------
+    int
+        N_Frame.
     """
     n = _decimal(period) * _decimal(fps)
     if n > MAX_CYCLE_FRAMES * 10:  # far beyond any cycle: no rounding subtleties to settle
@@ -116,12 +139,34 @@ class Schedule:
         return self.n_frames / self.fps
 
     def shot_exposure(self, frames: int) -> NDArray[np.int64]:
-        """``(frames,)`` the picture on each frame of a shot that repeats the cycle."""
+        """``(frames,)`` the picture on each frame of a shot that repeats the cycle.
+
+        Parameters
+        ----------
+        frames : int
+            The shot's length in frames, 1 … ``MAX_SHOT_FRAMES``.
+
+        Returns
+        -------
+        ndarray
+            ``(frames,)`` int64 picture indices, the cycle's exposure repeated.
+        """
         n = _check_count("frames", frames, 1, MAX_SHOT_FRAMES, f"a whole number in [1, {MAX_SHOT_FRAMES}]")
         return self.exposure[np.arange(n) % self.n_frames]
 
     def to_dict(self, frames: int | None = None) -> dict:
-        """Plain JSON-ready numbers; ``exposure`` covers ``frames`` (default one cycle)."""
+        """Plain JSON-ready numbers; ``exposure`` covers ``frames`` (default one cycle).
+
+        Parameters
+        ----------
+        frames : int, optional
+            The shot's length the exposure covers (None: one cycle).
+
+        Returns
+        -------
+        dict
+            Period, fps, hold, counts, picture times and the exposure, as plain numbers and lists.
+        """
         exposure = self.exposure if frames is None else self.shot_exposure(frames)
         return {
             "period": self.period,
@@ -196,6 +241,15 @@ def write_sheet(path: str | os.PathLike[str], sched: Schedule, frames: int | Non
     """Write the exposure sheet as CSV: ``frame, picture, time`` (time = frame/fps, seconds).
 
     ``frames`` is the shot length (default one cycle). Written atomically.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file.
+    sched : Schedule
+        The cycle's schedule.
+    frames : int, optional
+        The shot's length (None: one cycle).
     """
     exposure = sched.exposure if frames is None else sched.shot_exposure(frames)
     with atomic_open(path, "w", newline="", encoding="utf-8") as f:

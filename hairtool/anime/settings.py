@@ -43,7 +43,18 @@ class AnimeSettings:
 
     @classmethod
     def from_dict(cls, d: dict) -> AnimeSettings:
-        """The inverse of :meth:`to_dict`; unknown keys are ParameterErrors naming them."""
+        """The inverse of :meth:`to_dict`; unknown keys are ParameterErrors naming them.
+
+        Parameters
+        ----------
+        d : dict
+            What :meth:`to_dict` wrote (a project's or a job's settings).
+
+        Returns
+        -------
+        AnimeSettings
+            The settings, checked.
+        """
         d = dict(d)
         try:
             w = WaveParams(**dict(d.pop("wave", {})))
@@ -60,7 +71,20 @@ class AnimeSettings:
 
 
 def wave_curves(settings: AnimeSettings, samples: int = CURVE_SAMPLES) -> tuple[Schedule, NDArray, NDArray]:
-    """``(schedule, x (n,), y (N_Pict, n))``: f(x, t_i) of eq. (1) at every picture time t_i."""
+    """``(schedule, x (n,), y (N_Pict, n))``: f(x, t_i) of eq. (1) at every picture time t_i.
+
+    Parameters
+    ----------
+    settings : AnimeSettings
+        The wave and its timing.
+    samples : int, default CURVE_SAMPLES
+        Points along x in [0, π] (the strand from root to tip).
+
+    Returns
+    -------
+    tuple of (Schedule, ndarray, ndarray)
+        The schedule, ``x`` and ``y`` as above: what the studio's wave preview draws.
+    """
     sched = schedule(settings.wave.period, settings.fps, settings.hold)
     x = np.linspace(0.0, np.pi, samples)
     y = wave(x[None, :], sched.picture_times[:, None], settings.wave)
@@ -69,7 +93,22 @@ def wave_curves(settings: AnimeSettings, samples: int = CURVE_SAMPLES) -> tuple[
 
 def cycle_for_groom(groom: Groom, settings: AnimeSettings, strand_ids: ArrayLike | None = None) -> Animation:
     """The groom waving for ``settings.cycles`` cycles; with ``strand_ids`` only those strands
-    move (each is a bunch) and the others hold their pose, so the animation keeps every strand."""
+    move (each is a bunch) and the others hold their pose, so the animation keeps every strand.
+
+    Parameters
+    ----------
+    groom : Groom
+        The rest pose.
+    settings : AnimeSettings
+        The wave, timing, cycle count and variation.
+    strand_ids : array_like, optional
+        The strands that move (None: every strand, grouped as :func:`make_bunches` does).
+
+    Returns
+    -------
+    Animation
+        ``settings.cycles`` cycles of held pictures at ``settings.fps``.
+    """
     kwargs = dict(fps=settings.fps, hold=settings.hold, cycles=settings.cycles, **settings.variation())
     if strand_ids is None:
         return cycle_animation(groom, settings.wave, **kwargs)

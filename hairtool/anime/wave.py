@@ -81,7 +81,22 @@ class WaveParams:
 
 
 def wave(x: ArrayLike, t: ArrayLike, params: WaveParams) -> F64:
-    """f(x, t) of eq. (1), broadcast over ``x`` (in [0, π], root to tip) and ``t`` (seconds)."""
+    """f(x, t) of eq. (1), broadcast over ``x`` (in [0, π], root to tip) and ``t`` (seconds).
+
+    Parameters
+    ----------
+    x : array_like
+        Positions along the chain, in [0, π].
+    t : array_like
+        Times in seconds.
+    params : WaveParams
+        The wave.
+
+    Returns
+    -------
+    ndarray
+        f(x, t), float64.
+    """
     xa = np.asarray(x, dtype=np.float64)
     ta = np.asarray(t, dtype=np.float64)
     if not np.all(np.isfinite(xa)) or np.any(xa < 0.0) or np.any(xa > np.pi):
@@ -97,6 +112,18 @@ def segment_angles(chains: Groom, y: ArrayLike) -> F64:
 
     ``y``: ``(..., V)`` wave values at the nodes. The relative rotation of node j is θ_j − θ_{j−1}
     (θ before the first segment is 0, the rest direction); bending by θ_j applies their sum.
+
+    Parameters
+    ----------
+    chains : Groom
+        The chains at rest.
+    y : array_like
+        ``(..., V)`` wave values.
+
+    Returns
+    -------
+    ndarray
+        ``(..., V−S)`` float64 radians.
     """
     end = chains.topology.segment_end
     x = wave_x(chains)
@@ -105,7 +132,20 @@ def segment_angles(chains: Groom, y: ArrayLike) -> F64:
 
 
 def node_rotations(chains: Groom, y: ArrayLike) -> F64:
-    """``(..., V−S)`` the paper's per-node rotations relative to the parent: θ_j − θ_{j−1}."""
+    """``(..., V−S)`` the paper's per-node rotations relative to the parent: θ_j − θ_{j−1}.
+
+    Parameters
+    ----------
+    chains : Groom
+        The chains at rest.
+    y : array_like
+        ``(..., V)`` wave values.
+
+    Returns
+    -------
+    ndarray
+        ``(..., V−S)`` float64 radians.
+    """
     theta = segment_angles(chains, y)
     first = np.zeros(chains.topology.segment_end.size, dtype=bool)
     first[chains.topology.root_indices - np.arange(chains.strand_count)] = True
@@ -139,6 +179,28 @@ def make_bunches(
     Without ``guides`` every strand is a bunch; with them each strand follows its nearest
     guide. ``amplitude_scale``/``phase`` (one value or one per bunch; phase in cycles) override
     the seeded draws of 1 ± ``amplitude_spread`` and [0, ``phase_spread``). Lock step: spreads 0.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands to group.
+    guides : array_like, optional
+        Indices of guide strands; each strand follows its nearest (None: every strand alone).
+    sway : array_like, optional
+        The direction the bunches bend in (None: each bunch's own, from its shape).
+    amplitude_scale, phase : array_like, optional
+        One value or one per bunch, overriding the seeded draws.
+    amplitude_spread : float, default 0.1
+        Each bunch's amplitude is 1 ± this, drawn from ``seed``.
+    phase_spread : float, default 0.25
+        Each bunch's phase offset is drawn from [0, this) cycles.
+    seed : int, default 0
+        The draws' seed: the same seed, the same bunches.
+
+    Returns
+    -------
+    Bunches
+        The bunch of every strand and each bunch's axis, scale and phase.
     """
     if guides is None:
         of_strand = np.arange(groom.strand_count, dtype=np.int64)
@@ -170,6 +232,24 @@ def pose_pictures(
     Each strand samples y = scale_b·f(x, t + phase_b·T) at its nodes; its segments turn by the
     sampled angles about its bunch's axis, so segment lengths are kept exactly.
     ``use_numba=False`` runs the plain numpy reference.
+
+    Parameters
+    ----------
+    groom : Groom
+        The rest pose.
+    params : WaveParams
+        The wave f of eq. (1).
+    times : array_like
+        ``(P,)`` wave times in seconds.
+    bunches : Bunches, optional
+        Grouping and variation (None: every strand a bunch, no variation).
+    use_numba : bool, default True
+        False runs the numpy twin (the tests' oracle).
+
+    Returns
+    -------
+    ndarray
+        ``(P, V, 3)`` float64 poses.
     """
     t = np.asarray(times, dtype=np.float64).reshape(-1)
     if t.size == 0 or not np.all(np.isfinite(t)):
@@ -198,6 +278,26 @@ def cycle_pictures(
 
     ``bunches`` (from :func:`make_bunches`) or the keywords of :func:`make_bunches` (guides,
     sway, amplitude_scale, phase, amplitude_spread, phase_spread, seed) set the variation.
+
+    Parameters
+    ----------
+    groom : Groom
+        The rest pose.
+    params : WaveParams, optional
+        The wave (None: the defaults).
+    fps : float, default 24.0
+        Frames per second.
+    hold : int, default 2
+        Frames each picture is held.
+    bunches : Bunches, optional
+        Grouping and variation.
+    **variation
+        :func:`make_bunches`'s keywords, where ``bunches`` is not given.
+
+    Returns
+    -------
+    tuple of (Schedule, list of Groom)
+        The schedule and one groom per picture.
     """
     params = WaveParams() if params is None else params
     sched = schedule(params.period, fps, hold)

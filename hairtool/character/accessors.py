@@ -20,7 +20,22 @@ MAX_BUFFER_BYTES = 2**31
 
 
 def buffers(path: str, gltf: GLTF2, glb_binary: bytes | None) -> list[bytes]:
-    """The bytes of every buffer: the GLB's BIN chunk, a base64 data URI, or a file beside ``path``."""
+    """The bytes of every buffer: the GLB's BIN chunk, a base64 data URI, or a file beside ``path``.
+
+    Parameters
+    ----------
+    path : str
+        The file, for relative URIs and refusals.
+    gltf : GLTF2
+        The document.
+    glb_binary : bytes or None
+        The GLB's BIN chunk.
+
+    Returns
+    -------
+    list of bytes
+        One per buffer.
+    """
     out = []
     for i, b in enumerate(gltf.buffers or []):
         uri = b.uri
@@ -57,7 +72,26 @@ def _index(path: str, what: str, value: object, count: int) -> int:
 
 
 def read(path: str, gltf: GLTF2, data: list[bytes], index: object, what: str) -> np.ndarray:
-    """``(count, width)`` (``(count,)`` for scalars) array of accessor ``index``; ``what`` names its use."""
+    """``(count, width)`` (``(count,)`` for scalars) array of accessor ``index``; ``what`` names its use.
+
+    Parameters
+    ----------
+    path : str
+        The file, named in a refusal.
+    gltf : GLTF2
+        The document.
+    data : list of bytes
+        Its buffers.
+    index : object
+        The accessor's index, as the document gives it.
+    what : str
+        Its use, named in a refusal.
+
+    Returns
+    -------
+    ndarray
+        The accessor's values.
+    """
     accessors = gltf.accessors or []
     a = accessors[_index(path, f"{what}: accessor", index, len(accessors))]
     if a.sparse is not None:

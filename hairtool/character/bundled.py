@@ -78,7 +78,20 @@ def _r(a: np.ndarray) -> np.ndarray:
 
 
 def hair_chain(azimuth: float, elevation: float, length: float) -> np.ndarray:
-    """``(5, 3)`` rest nodes of one bunch: out from the scalp, then hanging; clear of the head."""
+    """``(5, 3)`` rest nodes of one bunch: out from the scalp, then hanging; clear of the head.
+
+    Parameters
+    ----------
+    azimuth, elevation : float
+        Where the bunch leaves the scalp, degrees.
+    length : float
+        Its length.
+
+    Returns
+    -------
+    ndarray
+        ``(5, 3)`` float64.
+    """
     az, el = math.radians(azimuth), math.radians(elevation)
     out = np.array([math.sin(az), 0.0, math.cos(az)])
     root = HEAD_CENTRE + HEAD_RADIUS * (math.cos(el) * out + np.array([0.0, math.sin(el), 0.0]))
@@ -100,7 +113,22 @@ def _ring_frame(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def tube(centres: np.ndarray, radii: np.ndarray, sides: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Rings of ``sides`` vertices around a polyline, closed at the tip: positions, normals, triangles."""
+    """Rings of ``sides`` vertices around a polyline, closed at the tip: positions, normals, triangles.
+
+    Parameters
+    ----------
+    centres : ndarray
+        ``(N, 3)`` the polyline.
+    radii : ndarray
+        ``(N,)`` the radius at each point.
+    sides : int
+        Vertices per ring.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        Positions, normals and triangles.
+    """
     pos, nor = [], []
     for i, c in enumerate(centres):
         d = centres[min(i + 1, len(centres) - 1)] - centres[max(i - 1, 0)]
@@ -119,6 +147,24 @@ def tube(centres: np.ndarray, radii: np.ndarray, sides: int) -> tuple[np.ndarray
 
 
 def sphere(centre: np.ndarray, radius: float, rings: int = 8, sides: int = 12):
+    """A UV sphere's positions, normals and triangles (the bundled character's head).
+
+    Parameters
+    ----------
+    centre : ndarray
+        ``(3,)``.
+    radius : float
+        Its radius.
+    rings : int, default 8
+        Rings from pole to pole.
+    sides : int, default 12
+        Vertices per ring.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        Positions, normals and triangles.
+    """
     pos, nor = [], []
     for i in range(rings + 1):
         el = math.pi / 2 - math.pi * i / rings
@@ -167,7 +213,18 @@ def _one_joint(n: int, j: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def build(vrm: bool = True) -> tuple[dict, bytes]:
-    """The character's glTF document and binary buffer (with the VRM 1.0 extensions if ``vrm``)."""
+    """The character's glTF document and binary buffer (with the VRM 1.0 extensions if ``vrm``).
+
+    Parameters
+    ----------
+    vrm : bool, default True
+        Add the VRM 1.0 extensions.
+
+    Returns
+    -------
+    tuple of (dict, bytes)
+        The glTF JSON and the binary buffer.
+    """
     names, parents, local = [], [], []
     for name, parent, t in BODY:
         names.append(name)
@@ -377,7 +434,18 @@ def build_vrm0() -> tuple[dict, bytes]:
 
 
 def write(folder: str | Path) -> list[Path]:
-    """Write ``bunches.vrm`` and ``bunches.glb`` into ``folder`` (atomically); their paths."""
+    """Write ``bunches.vrm`` and ``bunches.glb`` into ``folder`` (atomically); their paths.
+
+    Parameters
+    ----------
+    folder : str or Path
+        Where the two files go.
+
+    Returns
+    -------
+    list of Path
+        Their paths.
+    """
     out = []
     for name, vrm in (("bunches.vrm", True), ("bunches.glb", False)):
         path = Path(folder) / name

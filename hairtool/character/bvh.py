@@ -25,7 +25,22 @@ ORDER = "ZXY"
 
 
 def chains_motion(character: Character, rotations: F64, fps: float) -> Motion:
-    """The hair chains of ``rotations`` ``(F, J, 4)`` (local, wxyz) as a BVH :class:`Motion`."""
+    """The hair chains of ``rotations`` ``(F, J, 4)`` (local, wxyz) as a BVH :class:`Motion`.
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+    rotations : ndarray
+        ``(F, J, 4)`` wxyz.
+    fps : float
+        Frames per second.
+
+    Returns
+    -------
+    Motion
+        The chains as a BVH motion.
+    """
     if not character.chains:
         raise ParameterError("chains", 0, f"at least one hair chain in {character.path}")
     if not np.isfinite(fps) or fps <= 0:
@@ -77,5 +92,17 @@ def chains_motion(character: Character, rotations: F64, fps: float) -> Motion:
 
 
 def write_chains_bvh(path: str | os.PathLike[str], character: Character, rotations: F64, fps: float) -> None:
-    """Write the hair chains of ``rotations`` as BVH (atomically)."""
+    """Write the hair chains of ``rotations`` as BVH (atomically).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.bvh`` file.
+    character : Character
+        The character.
+    rotations : ndarray
+        ``(F, J, 4)`` wxyz.
+    fps : float
+        Frames per second.
+    """
     write_bvh(path, chains_motion(character, rotations, fps))

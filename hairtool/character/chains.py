@@ -201,7 +201,22 @@ def _vrm0(path: str, ext: dict, nodes: Nodes) -> tuple[tuple[Chain, ...], tuple[
 
 
 def by_pattern(path: str, nodes: Nodes, pattern: str) -> tuple[Chain, ...]:
-    """Runs of nodes whose names match ``pattern``, parent to child, each a chain of ≥ 2 nodes."""
+    """Runs of nodes whose names match ``pattern``, parent to child, each a chain of ≥ 2 nodes.
+
+    Parameters
+    ----------
+    path : str
+        The file, named in a refusal.
+    nodes : Nodes
+        The character's nodes.
+    pattern : str
+        A regular expression on node names.
+
+    Returns
+    -------
+    tuple of Chain
+        The chains.
+    """
     try:
         rx = re.compile(pattern)
     except re.error as e:
@@ -236,7 +251,24 @@ def _follow_picked(nodes: Nodes, root: int, picked: np.ndarray) -> list[list[int
 def find_chains(
     path: str, doc: dict, nodes: Nodes, pattern: str | None = None
 ) -> tuple[str, tuple[Chain, ...], tuple[Collider, ...]]:
-    """VRM version ("1.0", "0.x" or ""), chains and colliders. ``pattern`` overrides the springs."""
+    """VRM version ("1.0", "0.x" or ""), chains and colliders. ``pattern`` overrides the springs.
+
+    Parameters
+    ----------
+    path : str
+        The file, named in a refusal.
+    doc : dict
+        The glTF JSON.
+    nodes : Nodes
+        The character's nodes.
+    pattern : str, optional
+        A regular expression on node names (None: the VRM springs).
+
+    Returns
+    -------
+    tuple of (str, tuple of Chain, tuple of Collider)
+        The VRM version, the chains and the colliders.
+    """
     ext = doc.get("extensions") or {}
     if not isinstance(ext, dict):
         raise FormatError(path, "its extensions must be an object")

@@ -20,7 +20,20 @@ F64 = NDArray[np.float64]
 
 
 def compare_motions(character: Character, motion: F64, reference: F64) -> dict:
-    """Angular and positional errors of ``motion`` against ``reference``, both ``(F, J, 4)`` rotations."""
+    """Angular and positional errors of ``motion`` against ``reference``, both ``(F, J, 4)`` rotations.
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+    motion, reference : ndarray
+        ``(F, J, 4)`` local rotations.
+
+    Returns
+    -------
+    dict
+        The errors.
+    """
     if motion.shape != reference.shape or motion.ndim != 3:
         raise ParameterError("reference", reference.shape, f"rotations of the motion's shape {motion.shape}")
     wa, wb = character.nodes.world(motion), character.nodes.world(reference)

@@ -37,7 +37,20 @@ class ChainWave:
 
 
 def world_rotations(character: Character, local: F64) -> F64:
-    """``(..., J, 4)`` world rotations (wxyz) from local ones, parents first (scales ignored)."""
+    """``(..., J, 4)`` world rotations (wxyz) from local ones, parents first (scales ignored).
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+    local : ndarray
+        ``(..., J, 4)`` wxyz.
+
+    Returns
+    -------
+    ndarray
+        ``(..., J, 4)`` float64.
+    """
     nodes = character.nodes
     out = np.empty_like(local)
     for j in nodes.order.tolist():
@@ -47,12 +60,41 @@ def world_rotations(character: Character, local: F64) -> F64:
 
 
 def chain_points(character: Character, chain: Chain, world: F64 | None = None) -> F64:
-    """``(..., N, 3)`` world positions of a chain's nodes (rest pose unless ``world`` matrices given)."""
+    """``(..., N, 3)`` world positions of a chain's nodes (rest pose unless ``world`` matrices given).
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+    chain : Chain
+        One of its hair chains.
+    world : ndarray, optional
+        ``(..., J, 4, 4)`` world matrices (None: the rest pose).
+
+    Returns
+    -------
+    ndarray
+        ``(..., N, 3)`` float64.
+    """
     w = character.nodes.world() if world is None else world
     return np.take(w[..., :3, 3], list(chain.nodes), axis=-2)
 
 
 def chain_axis(points: F64, wave: ChainWave) -> F64:
+    """The unit axis a chain's wave bends about: ``wave.axis`` where given, else from the chain's chord.
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(N, 3)`` the chain's rest positions.
+    wave : ChainWave
+        Its wave settings.
+
+    Returns
+    -------
+    ndarray
+        ``(3,)`` float64.
+    """
     if wave.axis is not None:
         a = np.asarray(wave.axis, dtype=np.float64)
         if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
@@ -66,7 +108,24 @@ def chain_axis(points: F64, wave: ChainWave) -> F64:
 
 
 def segment_angles(points: F64, params: WaveParams, times: F64, wave: ChainWave) -> F64:
-    """``(P, N−1)`` θ_j of each segment at each picture time (radians)."""
+    """``(P, N−1)`` θ_j of each segment at each picture time (radians).
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(N, 3)`` the chain's rest positions.
+    params : WaveParams
+        The wave.
+    times : ndarray
+        ``(P,)`` seconds.
+    wave : ChainWave
+        The chain's scale and phase.
+
+    Returns
+    -------
+    ndarray
+        ``(P, N−1)`` float64.
+    """
     seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
     arc = np.concatenate([[0.0], np.cumsum(seg)])
     x = np.pi * arc / arc[-1]
@@ -90,6 +149,22 @@ def picture_rotations(
 
     ``waves`` maps a chain's index to its :class:`ChainWave` (default: each chain's own chord axis,
     scale 1, phase 0).
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+    params : WaveParams
+        The wave.
+    times : ndarray
+        ``(P,)`` seconds.
+    waves : dict of int to ChainWave, optional
+        Per-chain settings.
+
+    Returns
+    -------
+    ndarray
+        ``(P, J, 4)`` float64.
     """
     rest = character.nodes.rotation
     rest_world = world_rotations(character, rest)
@@ -120,7 +195,18 @@ class CharacterCycle:
     pictures: F64
 
     def frames(self, count: int | None = None) -> F64:
-        """``(F, J, 4)`` local rotations on every frame: each drawing held as the sheet says."""
+        """``(F, J, 4)`` local rotations on every frame: each drawing held as the sheet says.
+
+        Parameters
+        ----------
+        count : int, optional
+            Frames (None: one cycle).
+
+        Returns
+        -------
+        ndarray
+            ``(F, J, 4)`` float64.
+        """
         exposure = self.schedule.exposure if count is None else self.schedule.shot_exposure(count)
         return self.pictures[exposure]
 
@@ -133,7 +219,26 @@ def character_cycle(
     hold: int = 2,
     waves: dict[int, ChainWave] | None = None,
 ) -> CharacterCycle:
-    """The limited-animation cycle of ``character``'s hair chains (the paper's Fig. 2 by default)."""
+    """The limited-animation cycle of ``character``'s hair chains (the paper's Fig. 2 by default).
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+    params : WaveParams, optional
+        The wave (None: the paper's Fig. 2).
+    fps : float, default 24.0
+        Frames per second.
+    hold : int, default 2
+        Frames each drawing is held.
+    waves : dict of int to ChainWave, optional
+        Per-chain settings.
+
+    Returns
+    -------
+    CharacterCycle
+        The schedule and the pictures' rotations.
+    """
     if not character.chains:
         raise ParameterError("chains", 0, f"at least one hair chain in {character.path}")
     params = WaveParams() if params is None else params

@@ -36,7 +36,20 @@ F64 = NDArray[np.float64]
 
 
 def key_times(frames: NDArray[np.int64], fps: float) -> NDArray[np.float32]:
-    """Float32 times of frame numbers, each the largest float32 ≤ frame/fps."""
+    """Float32 times of frame numbers, each the largest float32 ≤ frame/fps.
+
+    Parameters
+    ----------
+    frames : ndarray
+        int64 frame numbers.
+    fps : float
+        Frames per second.
+
+    Returns
+    -------
+    ndarray
+        float32 seconds.
+    """
     exact = np.asarray(frames, dtype=np.float64) / fps
     t = exact.astype(np.float32)
     over = t.astype(np.float64) > exact
@@ -45,13 +58,37 @@ def key_times(frames: NDArray[np.int64], fps: float) -> NDArray[np.float32]:
 
 
 def hold_keys(frames: F64) -> NDArray[np.int64]:
-    """Frame numbers where a node's pose changes (frame 0 always): the STEP keys of held drawings."""
+    """Frame numbers where a node's pose changes (frame 0 always): the STEP keys of held drawings.
+
+    Parameters
+    ----------
+    frames : ndarray
+        ``(F, J, 4)`` rotations of the animated nodes.
+
+    Returns
+    -------
+    ndarray
+        int64 frame numbers.
+    """
     change = np.any(frames[1:] != frames[:-1], axis=tuple(range(1, frames.ndim)))
     return np.concatenate([[0], 1 + np.flatnonzero(change)]).astype(np.int64)
 
 
 def animated_nodes(rotations: F64, rest: F64) -> list[int]:
-    """Nodes whose rotation differs from the rest pose on some frame."""
+    """Nodes whose rotation differs from the rest pose on some frame.
+
+    Parameters
+    ----------
+    rotations : ndarray
+        ``(F, J, 4)``.
+    rest : ndarray
+        ``(J, 4)``.
+
+    Returns
+    -------
+    list of int
+        Node indices.
+    """
     return np.flatnonzero(np.any(np.abs(rotations - rest[None]) > 0, axis=(0, 2))).tolist()
 
 
@@ -77,6 +114,29 @@ def add_animation(
     the nodes sharing a key set sharing its time accessor); with ``interp`` "hermite" or
     "hermite-fit" those keys are ``CUBICSPLINE`` with the keys module's tangents (the first and last
     frame must then be keys, as the DP's always are).
+
+    Parameters
+    ----------
+    document : dict
+        The glTF JSON, changed in place.
+    writer : BufferWriter
+        Where the keys' bytes go.
+    rotations : ndarray
+        ``(F, J, 4)`` wxyz.
+    fps : float
+        Frames per second.
+    nodes : list of int
+        The nodes animated.
+    name : str
+        The animation's name.
+    step : bool
+        Held drawings: ``STEP`` keys where the pose changes.
+    loop_frames : int, optional
+        A closing key at this frame showing frame 0.
+    key_frames : ndarray or dict, optional
+        Optimal keys, one set or per node.
+    interp : str, default "linear"
+        "linear", or "hermite"/"hermite-fit" for ``CUBICSPLINE``.
     """
     if interp != "linear" and (key_frames is None or step or loop_frames is not None):
         raise ParameterError(
@@ -156,7 +216,22 @@ def hermite_keys(rotations: F64, frames: NDArray[np.int64], interp: str) -> KeyP
     """The keys module's Hermite keys of ``rotations`` ``(F, J, 4)``: values and per-frame tangents
     of the quaternion components, aligned to one hemisphere along time first (as
     :func:`hairtool.mocap.costs.reconstruct_motion` does); the curve is
-    ``normalize(interpolate_keys(...))``."""
+    ``normalize(interpolate_keys(...))``.
+
+    Parameters
+    ----------
+    rotations : ndarray
+        ``(F, J, 4)`` wxyz.
+    frames : ndarray
+        int64 key frames.
+    interp : str
+        "hermite" or "hermite-fit".
+
+    Returns
+    -------
+    KeyPoses
+        Values and per-frame tangents.
+    """
     return key_poses(quat.align_hemisphere(rotations, axis=0), frames, interp)
 
 
@@ -207,7 +282,36 @@ def write_animated(
 ) -> dict:
     """Write ``source`` with its hair animated to ``out`` (.glb, .vrm or .gltf); a summary dict.
     ``key_frames``: optimal keys, one set or per node (a dict node → frames, every animated node
-    in it); ``interp``: "linear", or "hermite"/"hermite-fit" for ``CUBICSPLINE`` keys on them."""
+    in it); ``interp``: "linear", or "hermite"/"hermite-fit" for ``CUBICSPLINE`` keys on them.
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        The character read.
+    out : str or os.PathLike
+        ``.glb``, ``.vrm`` or ``.gltf``.
+    rotations : ndarray
+        ``(F, J, 4)`` wxyz local rotations.
+    rest : ndarray
+        ``(J, 4)`` the rest pose.
+    fps : float
+        Frames per second.
+    name : str
+        The animation's name.
+    step : bool
+        Held drawings.
+    loop_frames : int, optional
+        A closing key at this frame showing frame 0.
+    key_frames : ndarray or dict, optional
+        Optimal keys, one set or per node.
+    interp : str, default "linear"
+        The keys' interpolation.
+
+    Returns
+    -------
+    dict
+        The output, the animated nodes, the key count and the interpolation.
+    """
     path = os.fspath(out)
     suffix = Path(path).suffix.lower()
     if suffix not in (".glb", ".vrm", ".gltf"):

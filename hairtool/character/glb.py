@@ -37,7 +37,20 @@ def _pad(data: bytes, fill: bytes) -> bytes:
 
 
 def pack(document: dict, binary: bytes) -> bytes:
-    """A GLB file: ``document`` as compact JSON (padded with spaces), ``binary`` (padded with zeros)."""
+    """A GLB file: ``document`` as compact JSON (padded with spaces), ``binary`` (padded with zeros).
+
+    Parameters
+    ----------
+    document : dict
+        The glTF JSON.
+    binary : bytes
+        The BIN chunk.
+
+    Returns
+    -------
+    bytes
+        The GLB file.
+    """
     text = _pad(json.dumps(document, separators=(",", ":")).encode("utf-8"), b" ")
     chunks = struct.pack("<II", len(text), JSON_CHUNK) + text
     if binary:
@@ -47,7 +60,20 @@ def pack(document: dict, binary: bytes) -> bytes:
 
 
 def unpack(path: str, data: bytes) -> tuple[dict, bytes]:
-    """The JSON document and BIN chunk of GLB ``data``; a :class:`FormatError` naming ``path`` if broken."""
+    """The JSON document and BIN chunk of GLB ``data``; a :class:`FormatError` naming ``path`` if broken.
+
+    Parameters
+    ----------
+    path : str
+        The file, named in a refusal.
+    data : bytes
+        Its contents.
+
+    Returns
+    -------
+    tuple of (dict, bytes)
+        The JSON and the BIN chunk.
+    """
     if len(data) < 20 or data[:4] != MAGIC:
         raise FormatError(path, "not a GLB file (no 'glTF' header)")
     version, length = struct.unpack_from("<II", data, 4)
@@ -82,13 +108,39 @@ class BufferWriter:
     """
 
     def __init__(self, document: dict, offset: int = 0) -> None:
+        """Append buffer views and accessors to ``document`` for bytes collected here.
+
+        Parameters
+        ----------
+        document : dict
+            The glTF JSON, changed in place.
+        offset : int, default 0
+            Where the new bytes start in the buffer.
+        """
         self.document = document
         self.chunks: list[bytes] = []
         self.length = offset
         self.views = 0  # bufferViews this writer added
 
     def add(self, values: np.ndarray, kind: str, *, target: int | None = None, bounds: bool = False) -> int:
-        """Accessor index of ``values`` (float32, uint16, uint32 or uint8 rows of ``kind`` width)."""
+        """Accessor index of ``values`` (float32, uint16, uint32 or uint8 rows of ``kind`` width).
+
+        Parameters
+        ----------
+        values : ndarray
+            Rows of ``kind`` width.
+        kind : str
+            The accessor type, a key of :data:`TYPE_WIDTH` (``SCALAR``, ``VEC3``, ``MAT4``…).
+        target : int, optional
+            The buffer view's target.
+        bounds : bool, default False
+            Write min and max.
+
+        Returns
+        -------
+        int
+            The accessor's index.
+        """
         arr = np.ascontiguousarray(values)
         component = {
             np.dtype(np.float32): FLOAT,

@@ -18,7 +18,22 @@ I64 = NDArray[np.int64]
 
 
 def trs_matrices(translation: F64, rotation: F64, scale: F64) -> F64:
-    """``(..., 4, 4)`` T·R·S local matrices from ``(..., 3)``, wxyz ``(..., 4)``, ``(..., 3)``."""
+    """``(..., 4, 4)`` T·R·S local matrices from ``(..., 3)``, wxyz ``(..., 4)``, ``(..., 3)``.
+
+    Parameters
+    ----------
+    translation : ndarray
+        ``(..., 3)``.
+    rotation : ndarray
+        ``(..., 4)`` wxyz unit quaternions.
+    scale : ndarray
+        ``(..., 3)``.
+
+    Returns
+    -------
+    ndarray
+        ``(..., 4, 4)`` float64.
+    """
     m = np.zeros((*translation.shape[:-1], 4, 4))
     m[..., :3, :3] = quat.to_matrix(rotation) * scale[..., None, :]
     m[..., :3, 3] = translation
@@ -42,6 +57,18 @@ class Nodes:
         return len(self.names)
 
     def children(self, j: int) -> list[int]:
+        """The nodes whose parent is ``j``, in order.
+
+        Parameters
+        ----------
+        j : int
+            A node's index.
+
+        Returns
+        -------
+        list of int
+            Its children's indices.
+        """
         return [int(c) for c in np.flatnonzero(self.parents == j)]
 
     def world(self, rotation: F64 | None = None, root: F64 | None = None) -> F64:
@@ -49,6 +76,18 @@ class Nodes:
 
         ``root`` ``(..., 4, 4)``: a transform applied above every root node (a head turn on the
         whole character is better given as a rotation of its head node).
+
+        Parameters
+        ----------
+        rotation : ndarray, optional
+            ``(..., J, 4)`` local rotations (None: the rest pose).
+        root : ndarray, optional
+            ``(..., 4, 4)`` a transform above every root node.
+
+        Returns
+        -------
+        ndarray
+            ``(..., J, 4, 4)`` float64 world matrices.
         """
         r = self.rotation if rotation is None else rotation
         lead = r.shape[:-2]
@@ -118,7 +157,26 @@ class Chain:
 
 def cubic_spline(times: F64, values: F64, tangent_in: F64, tangent_out: F64, i: int, t: float) -> F64:
     """glTF's CUBICSPLINE between keys ``i`` and ``i + 1`` at time ``t``: a cubic Hermite whose
-    tangents (per second) are scaled by the key interval, the rotation normalised after."""
+    tangents (per second) are scaled by the key interval, the rotation normalised after.
+
+    Parameters
+    ----------
+    times : ndarray
+        ``(K,)`` key times in seconds.
+    values : ndarray
+        ``(K, 4)`` key rotations.
+    tangent_in, tangent_out : ndarray
+        ``(K, 4)`` per-second tangents.
+    i : int
+        The segment's first key.
+    t : float
+        The time, within the segment.
+
+    Returns
+    -------
+    ndarray
+        ``(4,)`` float64 unit quaternion.
+    """
     span = times[i + 1] - times[i]
     u = (t - times[i]) / span
     u2, u3 = u * u, u * u * u
@@ -151,7 +209,20 @@ class Clip:
 
     def sample(self, nodes: Nodes, t: float) -> F64:
         """``(J, 4)`` local rotations at time ``t`` (seconds): keys held, slerped or on their cubic
-        spline (normalised after, as glTF asks), rest where none."""
+        spline (normalised after, as glTF asks), rest where none.
+
+        Parameters
+        ----------
+        nodes : Nodes
+            The character's nodes.
+        t : float
+            Seconds.
+
+        Returns
+        -------
+        ndarray
+            ``(J, 4)`` float64.
+        """
         r = nodes.rotation.copy()
         for j, (times, q) in self.rotations.items():
             if t <= times[0] or t >= times[-1]:
@@ -169,7 +240,20 @@ class Clip:
         return r
 
     def frames(self, nodes: Nodes, fps: float) -> F64:
-        """``(F, J, 4)`` the clip sampled at every frame from 0 to its duration."""
+        """``(F, J, 4)`` the clip sampled at every frame from 0 to its duration.
+
+        Parameters
+        ----------
+        nodes : Nodes
+            The character's nodes.
+        fps : float
+            Frames per second.
+
+        Returns
+        -------
+        ndarray
+            ``(F, J, 4)`` float64.
+        """
         n = round(self.duration * fps) + 1
         return np.stack([self.sample(nodes, f / fps) for f in range(n)])
 

@@ -27,11 +27,34 @@ SUFFIXES = (".glb", ".gltf", ".vrm")
 
 
 def is_character_path(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` names a glTF, GLB or VRM file (by its suffix).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    bool
+        True for a character's suffix.
+    """
     return Path(path).suffix.lower() in SUFFIXES
 
 
 def load_document(path: str | os.PathLike[str]) -> tuple[dict, bytes | None]:
-    """The glTF JSON (as a dict) and the GLB binary chunk (None for ``.gltf`` text)."""
+    """The glTF JSON (as a dict) and the GLB binary chunk (None for ``.gltf`` text).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.glb``, ``.gltf`` or ``.vrm`` file.
+
+    Returns
+    -------
+    tuple of (dict, bytes or None)
+        The JSON and the binary chunk.
+    """
     p = os.fspath(path)
     try:
         size = os.path.getsize(p)
@@ -102,6 +125,20 @@ def _decompose(path: str, matrix, what: str) -> tuple[np.ndarray, np.ndarray, np
 
 
 def read_nodes(path: str, gltf: GLTF2) -> Nodes:
+    """The node tree of ``gltf``: names, parents (parents first) and rest transforms.
+
+    Parameters
+    ----------
+    path : str
+        The file, named in a refusal.
+    gltf : GLTF2
+        The document.
+
+    Returns
+    -------
+    Nodes
+        The nodes.
+    """
     nodes = gltf.nodes or []
     n = len(nodes)
     parents = np.full(n, -1, dtype=np.int64)
@@ -158,7 +195,24 @@ _attributes = _Attributes
 
 
 def read_meshes(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple[SkinnedMesh, ...]:
-    """Every triangle primitive of a node with a mesh and a skin."""
+    """Every triangle primitive of a node with a mesh and a skin.
+
+    Parameters
+    ----------
+    path : str
+        The file, named in a refusal.
+    gltf : GLTF2
+        The document.
+    data : list of bytes
+        Its buffers.
+    nodes : Nodes
+        Its nodes.
+
+    Returns
+    -------
+    tuple of SkinnedMesh
+        The skinned meshes.
+    """
     out = []
     skins, meshes = gltf.skins or [], gltf.meshes or []
     for j, node in enumerate(gltf.nodes or []):
@@ -229,7 +283,24 @@ def read_meshes(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tupl
 
 
 def read_clips(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple[Clip, ...]:
-    """Rotation channels of every animation (translations and scales are not posed here)."""
+    """Rotation channels of every animation (translations and scales are not posed here).
+
+    Parameters
+    ----------
+    path : str
+        The file, named in a refusal.
+    gltf : GLTF2
+        The document.
+    data : list of bytes
+        Its buffers.
+    nodes : Nodes
+        Its nodes.
+
+    Returns
+    -------
+    tuple of Clip
+        The clips.
+    """
     clips = []
     for a, anim in enumerate(gltf.animations or []):
         rot, step, cubic = {}, set(), {}
@@ -271,7 +342,20 @@ def read_clips(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple
 
 
 def load_character(path: str | os.PathLike[str], pattern: str | None = None) -> Character:
-    """Read a character; its hair chains from VRM springs, or ``pattern`` (a regex on node names)."""
+    """Read a character; its hair chains from VRM springs, or ``pattern`` (a regex on node names).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.glb``, ``.gltf`` or ``.vrm`` file.
+    pattern : str, optional
+        A regular expression on node names picking the hair chains (None: the VRM springs).
+
+    Returns
+    -------
+    Character
+        Its nodes, meshes, clips, chains and colliders.
+    """
     p = os.fspath(path)
     doc, binary = load_document(p)
     gltf = _gltf(p, doc)

@@ -31,7 +31,20 @@ VIRTUAL_TAIL = 0.07  # metres, VRM 0.x
 
 
 def forward(character: Character, local: F64) -> tuple[F64, F64]:
-    """World positions ``(J, 3)`` and rotations ``(J, 4)`` of local rotations ``(J, 4)`` (no scale)."""
+    """World positions ``(J, 3)`` and rotations ``(J, 4)`` of local rotations ``(J, 4)`` (no scale).
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+    local : ndarray
+        ``(J, 4)`` wxyz local rotations.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        World positions and rotations.
+    """
     nodes = character.nodes
     pos, rot = np.empty((nodes.count, 3)), np.empty((nodes.count, 4))
     for j in nodes.order.tolist():
@@ -45,7 +58,18 @@ def forward(character: Character, local: F64) -> tuple[F64, F64]:
 
 
 def from_to(a: F64, b: F64) -> F64:
-    """The least rotation (wxyz) taking unit ``a`` onto unit ``b``."""
+    """The least rotation (wxyz) taking unit ``a`` onto unit ``b``.
+
+    Parameters
+    ----------
+    a, b : ndarray
+        ``(3,)`` unit vectors.
+
+    Returns
+    -------
+    ndarray
+        ``(4,)`` wxyz.
+    """
     d = float(np.dot(a, b))
     if d < -1.0 + 1e-12:
         axis = np.cross(a, [1.0, 0.0, 0.0])
@@ -104,6 +128,17 @@ class SpringBones:
     """The spring state of a character's chains; :meth:`step` advances it on a driven pose."""
 
     def __init__(self, character: Character, local: F64, *, stale_lengths: bool = False) -> None:
+        """The character's spring chains at rest on the pose ``local``.
+
+        Parameters
+        ----------
+        character : Character
+            The character.
+        local : ndarray
+            ``(J, 4)`` the driven pose they start on.
+        stale_lengths : bool, default False
+            Measure bone lengths as three-vrm 3.x does.
+        """
         self.character = character
         self.stale_lengths = stale_lengths
         pos, rot = forward(character, local)
@@ -163,6 +198,18 @@ class SpringBones:
 
         Chains are independent: each starts from the driven pose of its parents (a chain hanging
         from another chain's node sees that node at rest).
+
+        Parameters
+        ----------
+        local : ndarray
+            ``(J, 4)`` the driven pose.
+        dt : float
+            Seconds.
+
+        Returns
+        -------
+        ndarray
+            ``(J, 4)`` float64 posed local rotations.
         """
         out = local.copy()
         for _, joints in self.chains:
@@ -212,6 +259,13 @@ class PackedSprings:
     """:class:`SpringBones` as flat arrays, stepped by the numba kernel (same formulas)."""
 
     def __init__(self, springs: SpringBones) -> None:
+        """``springs``' chains, joints and colliders packed into the kernel's arrays.
+
+        Parameters
+        ----------
+        springs : SpringBones
+            The springs, at rest.
+        """
         from hairtool.character.springs_kernel import collider_arrays
 
         self.springs = springs
@@ -236,6 +290,20 @@ class PackedSprings:
         self.col_tail = np.array([c.offset if c.tail is None else c.tail for c in cols]).reshape(-1, 3)
 
     def step(self, local: F64, dt: float) -> F64:
+        """:meth:`SpringBones.step` by the numba kernel.
+
+        Parameters
+        ----------
+        local : ndarray
+            ``(J, 4)`` the driven pose.
+        dt : float
+            Seconds.
+
+        Returns
+        -------
+        ndarray
+            ``(J, 4)`` float64 posed local rotations.
+        """
         from hairtool.character.springs_kernel import spring_step_kernel
 
         sb = self.springs
@@ -299,6 +367,26 @@ def simulate(
     world position as it was before this step moved the bone, so its bones stretch and shrink a
     little while the hair moves; the specification keeps them rigid (the default).
     ``use_numba=False`` steps with the numpy reference.
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+    driver : ndarray
+        ``(F, J, 4)`` the driven local rotations.
+    fps : float
+        Frames per second.
+    substeps : int, default 1
+        Spring steps per frame.
+    stale_lengths : bool, default False
+        Measure bone lengths as three-vrm 3.x does.
+    use_numba : bool, default True
+        False runs the numpy twin.
+
+    Returns
+    -------
+    ndarray
+        ``(F, J, 4)`` float64.
     """
     if driver.ndim != 3 or driver.shape[1:] != (character.nodes.count, 4):
         raise ParameterError("driver", driver.shape, f"(frames, {character.nodes.count}, 4) rotations")
@@ -323,7 +411,28 @@ def head_shake(
     period: float = 1.0,
     node: str = "Head",
 ) -> F64:
-    """``(F, J, 4)`` the rest pose, ``node`` turning ±``turn_deg`` about +Y, a shake every ``period`` s."""
+    """``(F, J, 4)`` the rest pose, ``node`` turning ±``turn_deg`` about +Y, a shake every ``period`` s.
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+    frames : int
+        Frames.
+    fps : float
+        Frames per second.
+    turn_deg : float, default 30.0
+        The turn's amplitude in degrees.
+    period : float, default 1.0
+        Seconds per shake.
+    node : str, default "Head"
+        The node turned.
+
+    Returns
+    -------
+    ndarray
+        ``(F, J, 4)`` float64.
+    """
     nodes = character.nodes
     if node not in nodes.names:
         raise ParameterError("node", node, f"a node of {character.path}")

@@ -147,7 +147,18 @@ def spring_step_kernel(
 
 
 def collider_arrays(character: Character) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Each chain's colliders: ``col_start (C+1,)``, ``col_index (M,)``, ``capsule (N,)``, ``radius (N,)``."""
+    """Each chain's colliders: ``col_start (C+1,)``, ``col_index (M,)``, ``capsule (N,)``, ``radius (N,)``.
+
+    Parameters
+    ----------
+    character : Character
+        The character.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``col_start``, ``col_index``, ``capsule`` and ``radius``.
+    """
     starts, index = [0], []
     for ch in character.chains:
         index.extend(ch.colliders)

@@ -126,6 +126,7 @@ def _say_notes(command: str):
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    interrupts.name(f"hairtool {args.command}")
     try:
         if args.raise_limits is not None:
             from hairtool import budget

@@ -105,7 +105,7 @@ def _workers_write_through_a_filter() -> Iterator[threading.Thread]:
     try:
         yield forward  # ends once every worker has closed the pipe (join it after the cluster)
     finally:
-        os.dup2(saved, 2)  # this process's own stderr again; the pipe stays the workers'
+        interrupts.restore_stderr(saved)  # this process's own stderr again; the pipe stays the workers'
         os.close(saved)
 
 

@@ -35,7 +35,24 @@ PAR_EPS = 1e-12  # |v × u| ≤ PAR_EPS·|v||u|: v ∥ u
 
 
 def check_align_params(cursor: ArrayLike, radius: float, intensity: float, mode: str) -> np.ndarray:
-    """Validate one align sample; returns the cursor as a float64 (3,) (a 2-D cursor gets z = 0)."""
+    """Validate one align sample; returns the cursor as a float64 (3,) (a 2-D cursor gets z = 0).
+
+    Parameters
+    ----------
+    cursor : array_like
+        The cursor, 2 or 3 finite numbers.
+    radius : float
+        The brush radius, > 0.
+    intensity : float
+        The strength, in [0, 1].
+    mode : str
+        ``"paper"`` or ``"preserve-length"``.
+
+    Returns
+    -------
+    ndarray
+        ``(3,)`` float64 cursor.
+    """
     c = np.asarray(cursor, dtype=np.float64).reshape(-1)
     if c.shape not in ((2,), (3,)):
         raise ParameterError("cursor", cursor, "a point (x, y) or (x, y, z)")
@@ -169,7 +186,26 @@ def align(
 def align_reference(
     groom: Groom, cursor: ArrayLike, radius: float, intensity: float = 0.8, mode: str = "paper"
 ) -> Groom:
-    """Plain numpy twin of :func:`align`."""
+    """Plain numpy twin of :func:`align`.
+
+    Parameters
+    ----------
+    groom : Groom
+        The groom.
+    cursor : array_like
+        The cursor.
+    radius : float
+        The brush radius.
+    intensity : float, default 0.8
+        The strength, in [0, 1].
+    mode : str, default "paper"
+        ``"paper"`` or ``"preserve-length"``.
+
+    Returns
+    -------
+    Groom
+        What :func:`align` gives.
+    """
     c = check_align_params(cursor, radius, intensity, mode)
     planar = groom.is_planar
     if planar:

@@ -65,6 +65,19 @@ STEP_FRACTION = 0.2  # auto Δt²/m = STEP_FRACTION·h / max(1, mean Σg at the 
 
 
 def check_clump_params(radius: float, iterations: int, step: float | None, gap_mode: str) -> None:
+    """A ParameterError naming the first of ClumpWithGaps' parameters out of its range.
+
+    Parameters
+    ----------
+    radius : float
+        The clump radius h, > 0.
+    iterations : int
+        Passes k, 0 … MAX_ITERATIONS.
+    step : float or None
+        Δt²/m, > 0 (None: automatic).
+    gap_mode : str
+        ``"printed"``, ``"text"`` or ``"off"``.
+    """
     h = float(radius)
     if not np.isfinite(h) or h <= 0:
         raise ParameterError("clump_radius", radius, "a positive finite distance")
@@ -78,7 +91,20 @@ def check_clump_params(radius: float, iterations: int, step: float | None, gap_m
 
 def vertex_strength(groom: Groom, strength: ArrayLike | None) -> np.ndarray:
     """``(V,)`` float64 clump strength of each vertex (its strand's), from ``(S,)`` values in
-    [0, 1] (None: all ones); ParameterError naming ``clump_strength`` otherwise."""
+    [0, 1] (None: all ones); ParameterError naming ``clump_strength`` otherwise.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    strength : array_like or None
+        ``(S,)`` each strand's clump strength.
+
+    Returns
+    -------
+    ndarray
+        ``(V,)`` float64.
+    """
     if strength is None:
         return np.ones(groom.vertex_count)
     s = np.asarray(strength, dtype=np.float64)
@@ -98,7 +124,22 @@ def keep_still(points, sv, out):
 
 
 def keep_still_reference(points: np.ndarray, sv: np.ndarray, out: np.ndarray) -> np.ndarray:
-    """Numpy twin of :func:`keep_still`."""
+    """Numpy twin of :func:`keep_still`.
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(V, 3)`` the points before clumping.
+    sv : ndarray
+        ``(V,)`` clump strengths.
+    out : ndarray
+        ``(V, 3)`` the clumped points.
+
+    Returns
+    -------
+    ndarray
+        ``out`` with the unclumped vertices put back.
+    """
     return np.where((sv == 0.0)[:, None], points, out).astype(out.dtype)
 
 
@@ -426,6 +467,15 @@ class ClumpRecord:
     neighbour counts and Σg (original vertex order)."""
 
     def __init__(self, vertices: int, iterations: int) -> None:
+        """Room for one run of ``iterations`` passes over ``vertices`` vertices (empty until a run fills it).
+
+        Parameters
+        ----------
+        vertices : int
+            V.
+        iterations : int
+            k.
+        """
         self.key: tuple = ()
         self.points = np.empty((vertices, 3), np.float32)
         self.result = np.empty((vertices, 3), np.float32)
@@ -439,12 +489,41 @@ class ClumpRecord:
         self.valid = False  # all of the above is one run's (False while being rewritten)
 
     def fits(self, vertices: int, iterations: int) -> bool:
+        """Whether this record has room for a run of that size.
+
+        Parameters
+        ----------
+        vertices : int
+            V.
+        iterations : int
+            k.
+
+        Returns
+        -------
+        bool
+            True where its arrays have that shape.
+        """
         return self.iterates.shape[:2] == (iterations, vertices)
 
 
 def auto_step(h: float, weight: np.ndarray, count: np.ndarray) -> float:
     """Default Δt²/m: STEP_FRACTION·h over the mean kernel weight Σg of the vertices that have
-    neighbours (at least 1), so that dense grooms, where (15) sums many terms, do not overshoot."""
+    neighbours (at least 1), so that dense grooms, where (15) sums many terms, do not overshoot.
+
+    Parameters
+    ----------
+    h : float
+        The clump radius.
+    weight : ndarray
+        ``(V,)`` Σg of each vertex.
+    count : ndarray
+        ``(V,)`` its neighbours.
+
+    Returns
+    -------
+    float
+        Δt²/m.
+    """
     has = count > 0
     mean_w = float(weight[has].sum()) / max(int(np.count_nonzero(has)), 1)
     return STEP_FRACTION * h / max(mean_w, 1.0)
@@ -473,6 +552,18 @@ class ClumpWorkspace:
         self._built = None
 
     def roots_mask(self, topology) -> np.ndarray:
+        """``(V,)`` bool, the root vertices of ``topology`` (kept between calls).
+
+        Parameters
+        ----------
+        topology : Topology
+            The strands.
+
+        Returns
+        -------
+        ndarray
+            ``(V,)`` bool.
+        """
         if self._mask_for is not topology:
             self._mask = np.zeros(topology.vertex_count, bool)
             self._mask[topology.root_indices] = True
@@ -484,7 +575,20 @@ class ClumpWorkspace:
         last one as it is when no point moved, brought up to date where some did
         (:mod:`hairtool.frozen.neighbour_update`: a stroke's release), built again otherwise.
         (A Verlet skin that lets a list outlive small moves was measured and left out: in a drag
-        the dragged strands move farther than a skin worth its cost on every move.)"""
+        the dragged strands move farther than a skin worth its cost on every move.)
+
+        Parameters
+        ----------
+        groom : Groom
+            The strands at their current points.
+        h : float
+            The clump radius.
+
+        Returns
+        -------
+        NeighbourList
+            The list.
+        """
         top = groom.topology
         radius = h * (1.0 + MARGIN)
         b = self._built
@@ -509,7 +613,18 @@ class ClumpWorkspace:
     def pair_buffers(self, nl: NeighbourList) -> tuple:
         """(bmap, r, weight) for the pairs of a row-grid list (one r and weight per forward
         entry, reused); empty arrays for the hashed grid's whole lists and for sparse ones
-        (below :data:`HALF_FROM`), where :func:`_force_kernel` computes each pair twice."""
+        (below :data:`HALF_FROM`), where :func:`_force_kernel` computes each pair twice.
+
+        Parameters
+        ----------
+        nl : NeighbourList
+            The list.
+
+        Returns
+        -------
+        tuple
+            ``(bmap, r, weight)``.
+        """
         if not nl.dense or nl.forward_entries < HALF_FROM * len(nl.order):
             return _NO_PAIRS
         n = nl.aflat.size
@@ -519,7 +634,18 @@ class ClumpWorkspace:
 
     def buffers(self, v: int) -> tuple:
         """Iterates, f, nearest neighbour, counts, Σg, hash heads and clump strengths for V
-        vertices, reused."""
+        vertices, reused.
+
+        Parameters
+        ----------
+        v : int
+            Vertices.
+
+        Returns
+        -------
+        tuple
+            The arrays, reused between runs.
+        """
         b = self._buffers
         if not b or len(b[0]) != v:
             self._buffers = (
@@ -546,7 +672,20 @@ def clump_points(
     keep_lengths: bool = False,
     strength: ArrayLike | None = None,
 ) -> np.ndarray:
-    """:func:`clump` returning float32 ``(V, 3)`` points instead of a groom."""
+    """:func:`clump` returning float32 ``(V, 3)`` points instead of a groom.
+
+    Parameters
+    ----------
+    groom, radius, iterations, step, gap_mode, seed, keep_lengths, strength
+        As :func:`clump` takes them.
+    workspace : ClumpWorkspace, optional
+        Buffers and the last neighbour list, reused between runs.
+
+    Returns
+    -------
+    ndarray
+        ``(V, 3)`` float32.
+    """
     check_clump_params(radius, iterations, step, gap_mode)
     seed = check_seed(seed)
     sv = vertex_strength(groom, strength)
@@ -588,7 +727,28 @@ def clump_points(
 def record_key(
     groom: Groom, h: float, iterations: int, step: float | None, gap_mode: str, seed: int
 ) -> tuple:
-    """What must be the same for a record to be updated rather than redone."""
+    """What must be the same for a record to be updated rather than redone.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    h : float
+        The clump radius.
+    iterations : int
+        Passes.
+    step : float or None
+        Δt²/m.
+    gap_mode : str
+        The gap rule.
+    seed : int
+        The seed.
+
+    Returns
+    -------
+    tuple
+        The key.
+    """
     return (groom.topology, float(h), int(iterations), step, gap_mode, int(seed))
 
 
@@ -651,7 +811,32 @@ def clump(
 def gap_factors_reference(i, j, r, P, dp, h, seed, it, gap_mode) -> np.ndarray:
     """The gap-keeping factor λ per vertex (eqs. 17-18) of one iteration, from the pairs
     ``(i, j)`` at distances ``r`` and the adhesion steps ``dp``: each vertex's nearest pair
-    (ties: the lowest index) before and after the step; 1 where gaps are off or no pair."""
+    (ties: the lowest index) before and after the step; 1 where gaps are off or no pair.
+
+    Parameters
+    ----------
+    i, j : ndarray
+        The pairs' vertices.
+    r : ndarray
+        Their distances.
+    P : ndarray
+        ``(V, 3)`` the iterate.
+    dp : ndarray
+        ``(V, 3)`` the adhesion steps.
+    h : float
+        The clump radius.
+    seed : int
+        The seed of ζ.
+    it : int
+        The iteration.
+    gap_mode : str
+        The gap rule.
+
+    Returns
+    -------
+    ndarray
+        ``(V,)`` float64 λ.
+    """
     lam = np.ones(len(P))
     if gap_mode != "off" and len(i):
         first = np.lexsort((j, r, i))  # per vertex: nearest, then lowest index
@@ -680,7 +865,18 @@ def clump_reference(
     keep_lengths: bool = False,
     strength: ArrayLike | None = None,
 ) -> Groom:
-    """Plain numpy twin of :func:`clump`: candidate pairs from the start, filtered each iteration."""
+    """Plain numpy twin of :func:`clump`: candidate pairs from the start, filtered each iteration.
+
+    Parameters
+    ----------
+    groom, radius, iterations, step, gap_mode, seed, keep_lengths, strength
+        As :func:`clump` takes them.
+
+    Returns
+    -------
+    Groom
+        What :func:`clump` gives.
+    """
     check_clump_params(radius, iterations, step, gap_mode)
     seed = check_seed(seed)
     sv = vertex_strength(groom, strength)

@@ -84,7 +84,26 @@ def escape(
 ) -> np.ndarray:
     """``(M, 3)`` points at ``length`` from ``prev`` (float32-exact), each outside the surface
     by at least ``margin`` and as near the direction toward ``want`` as found (module
-    docstring); where no tried direction is outside, the one farthest out."""
+    docstring); where no tried direction is outside, the one farthest out.
+
+    Parameters
+    ----------
+    prev : ndarray
+        ``(M, 3)`` the points before, each already outside.
+    want : ndarray
+        ``(M, 3)`` where each point would go.
+    length : ndarray
+        ``(M,)`` each segment's length.
+    surface : CollisionSurface
+        The head.
+    margin : float
+        How far outside, in the groom's units.
+
+    Returns
+    -------
+    ndarray
+        ``(M, 3)`` float32 points.
+    """
     m = len(prev)
     d0 = _unit(want - prev)
     _, _, n_p = surface.signed_distance(prev)
@@ -156,7 +175,26 @@ def keep_out(
     from before clumping. On a curved head a clump's pull can cut through it. A strand already
     inside before (a stroke with collision off put it there) is left as it is. ``margin`` is
     unused (kept for :func:`collide`'s signature). ``sd_before`` / ``sd_after``: the points'
-    signed distances where known (:class:`KeepOut`)."""
+    signed distances where known (:class:`KeepOut`).
+
+    Parameters
+    ----------
+    before : Groom
+        The strands before clumping.
+    after : Groom
+        The same strands clumped.
+    surface : CollisionSurface
+        The head.
+    margin : float
+        How far outside, in the groom's units.
+    sd_before, sd_after : ndarray, optional
+        Signed distances of their points, where the caller has them.
+
+    Returns
+    -------
+    Groom
+        ``after`` with the strands clumping pulled in clumped less.
+    """
     del margin
     top = before.topology
     if before.vertex_count == 0:
@@ -213,7 +251,15 @@ class KeepOut:
     def remember(self, before: Groom, after: Groom, surface: CollisionSurface) -> None:
         """Ask the head about ``before`` and ``after`` now, so that the next call asks only about
         the points that differ from them (the first stroke after an open would otherwise ask
-        about every point twice)."""
+        about every point twice).
+
+        Parameters
+        ----------
+        before, after : Groom
+            The strands before and after clumping.
+        surface : CollisionSurface
+            The head.
+        """
         for key, points in (("before", before.points), ("after", after.points)):
             sd = surface.signed_distance(points.astype(np.float64))[0]
             self._last[key] = (surface, points.copy(), sd)
@@ -239,7 +285,24 @@ class KeepOut:
 
 def collide(before: Groom, after: Groom, surface: CollisionSurface, margin: float) -> Groom:
     """``after`` (one sample's result on ``before``, same strands) with the strands it moved
-    pushed out of the head, lengths kept (module docstring)."""
+    pushed out of the head, lengths kept (module docstring).
+
+    Parameters
+    ----------
+    before : Groom
+        The strands before the sample.
+    after : Groom
+        The same strands after it.
+    surface : CollisionSurface
+        The head.
+    margin : float
+        How far outside, in the groom's units.
+
+    Returns
+    -------
+    Groom
+        ``after``, the strands it moved kept out of the head.
+    """
     top = after.topology
     o = top.offsets
     moved_v = np.any(after.points != before.points, axis=1)

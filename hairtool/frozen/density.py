@@ -51,7 +51,22 @@ def _thin_kernel(roots, fixed, spacing, keep):  # pragma: no cover - compiled
 
 
 def thin(roots: np.ndarray, fixed: np.ndarray, spacing: float) -> np.ndarray:
-    """``(R,)`` the roots kept (step 1 of the module docstring) (numba)."""
+    """``(R,)`` the roots kept (step 1 of the module docstring) (numba).
+
+    Parameters
+    ----------
+    roots : ndarray
+        ``(R, 3)`` float64 roots under the brush, in the order they are taken.
+    fixed : ndarray
+        ``(R,)`` bool, roots kept whatever their spacing (masked, back-facing).
+    spacing : float
+        The least distance between kept roots, > 0.
+
+    Returns
+    -------
+    ndarray
+        ``(R,)`` bool.
+    """
     n = float(len(roots))
     budget.check("steps", n * n, f"thinning {len(roots)} roots within the brush (spacing={spacing:g})")
     keep = np.empty(len(roots), np.bool_)
@@ -60,7 +75,18 @@ def thin(roots: np.ndarray, fixed: np.ndarray, spacing: float) -> np.ndarray:
 
 
 def thin_reference(roots: np.ndarray, fixed: np.ndarray, spacing: float) -> np.ndarray:
-    """Numpy twin of :func:`thin`."""
+    """Numpy twin of :func:`thin`.
+
+    Parameters
+    ----------
+    roots, fixed, spacing
+        As :func:`thin` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(R,)`` bool, as :func:`thin` gives it.
+    """
     r = np.asarray(roots, np.float64)
     keep = np.asarray(fixed, bool).copy()
     for i in np.flatnonzero(~keep):
@@ -93,7 +119,22 @@ def _accept_kernel(candidates, roots, spacing, out):  # pragma: no cover - compi
 
 def accept(candidates: np.ndarray, roots: np.ndarray, spacing: float) -> np.ndarray:
     """``(C,)`` the candidates accepted in turn: at least ``spacing`` from every root and every
-    candidate accepted before (numba)."""
+    candidate accepted before (numba).
+
+    Parameters
+    ----------
+    candidates : ndarray
+        ``(C, 3)`` float64 candidate roots, in the order they are tried.
+    roots : ndarray
+        ``(R, 3)`` float64 roots kept.
+    spacing : float
+        The least distance, > 0.
+
+    Returns
+    -------
+    ndarray
+        ``(C,)`` bool.
+    """
     out = np.zeros(len(candidates), np.bool_)
     c, r = np.ascontiguousarray(candidates, np.float64), np.ascontiguousarray(roots, np.float64)
     _accept_kernel(c, r, float(spacing), out)
@@ -101,7 +142,18 @@ def accept(candidates: np.ndarray, roots: np.ndarray, spacing: float) -> np.ndar
 
 
 def accept_reference(candidates: np.ndarray, roots: np.ndarray, spacing: float) -> np.ndarray:
-    """Numpy twin of :func:`accept`."""
+    """Numpy twin of :func:`accept`.
+
+    Parameters
+    ----------
+    candidates, roots, spacing
+        As :func:`accept` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(C,)`` bool, as :func:`accept` gives it.
+    """
     c, r = np.asarray(candidates, np.float64), np.asarray(roots, np.float64)
     out = np.zeros(len(c), bool)
     s2 = spacing * spacing
@@ -114,7 +166,20 @@ def accept_reference(candidates: np.ndarray, roots: np.ndarray, spacing: float) 
 
 def candidate_count(radius: float, spacing: float) -> float:
     """How many candidates :func:`disc_candidates` draws: the darts, and the grid's square
-    before it is cut to the disc (a float: inf or nan where the ratio overflows)."""
+    before it is cut to the disc (a float: inf or nan where the ratio overflows).
+
+    Parameters
+    ----------
+    radius : float
+        The brush radius.
+    spacing : float
+        The spacing asked for.
+
+    Returns
+    -------
+    float
+        The candidates' count.
+    """
     with np.errstate(all="ignore"):
         ratio = np.float64(radius) / np.float64(spacing)
         return float(DARTS * np.pi * ratio * ratio + (4.0 * ratio + 1.0) ** 2)
@@ -123,7 +188,20 @@ def candidate_count(radius: float, spacing: float) -> float:
 def check_candidates(radius: float, spacing: float) -> None:
     """Refuse (:class:`~hairtool.budget.BudgetError`) a radius and spacing whose candidates
     would not fit the budget, before any is drawn: their points, and the acceptance loop, which
-    tests each candidate against those accepted before it (about candidates² / 2 steps)."""
+    tests each candidate against those accepted before it (about candidates² / 2 steps).
+
+    Parameters
+    ----------
+    radius : float
+        The brush radius.
+    spacing : float
+        The spacing asked for.
+
+    Raises
+    ------
+    BudgetError
+        Naming both, where the candidates or the loop over them would not fit.
+    """
     what = f"density radius={radius:g}, spacing={spacing:g}"
     c = candidate_count(radius, spacing)
     budget.check("points", c, what)
@@ -133,7 +211,26 @@ def check_candidates(radius: float, spacing: float) -> None:
 
 def disc_candidates(centre: F64, normal: F64, radius: float, spacing: float, rng: np.random.Generator) -> F64:
     """Darts (uniform over the disc) then the grid of step spacing / 2, in the tangent plane at
-    ``centre`` (to be moved onto the head)."""
+    ``centre`` (to be moved onto the head).
+
+    Parameters
+    ----------
+    centre : ndarray
+        ``(3,)`` the head's point under the cursor.
+    normal : ndarray
+        ``(3,)`` the head's unit normal there.
+    radius : float
+        The brush radius.
+    spacing : float
+        The spacing asked for.
+    rng : numpy.random.Generator
+        The darts' generator (seeded from the sample's seed and cursor).
+
+    Returns
+    -------
+    ndarray
+        ``(C, 3)`` float64 candidates.
+    """
     a = np.eye(3)[int(np.argmin(np.abs(normal)))]
     u = np.cross(normal, a)
     u /= np.linalg.norm(u)

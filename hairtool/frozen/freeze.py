@@ -40,6 +40,20 @@ def strand_multipliers(strand_count: int, variation: float | ArrayLike, seed: in
 
     A number is a spread: multiplier = 2**(spread·U(−1,1)), seeded per strand (spread 1 gives
     ×0.5 … ×2). An array gives the multipliers directly (positive, one per strand).
+
+    Parameters
+    ----------
+    strand_count : int
+        S.
+    variation : float or array_like
+        A spread ≥ 0, or ``(S,)`` positive multipliers.
+    seed : int, default 0
+        The seed of the spread's draws.
+
+    Returns
+    -------
+    ndarray
+        ``(S,)`` float64 multipliers.
     """
     if np.ndim(variation) == 0:
         spread = float(variation)  # type: ignore[arg-type]
@@ -58,6 +72,17 @@ def strand_multipliers(strand_count: int, variation: float | ArrayLike, seed: in
 
 
 def check_freeze_params(stretch_stiffness: float, bend_stiffness: float, max_bend_angle: float) -> None:
+    """A ParameterError naming the first of FreezeDeform's parameters out of its range.
+
+    Parameters
+    ----------
+    stretch_stiffness : float
+        k_s of eq. 3, in [1, MAX_STIFFNESS].
+    bend_stiffness : float
+        k_b of eq. 4, in (0, MAX_STIFFNESS].
+    max_bend_angle : float
+        The largest turn in radians, in [0, π].
+    """
     ks, kb, th = float(stretch_stiffness), float(bend_stiffness), float(max_bend_angle)
     if not np.isfinite(ks) or not 1.0 <= ks <= MAX_STIFFNESS:
         # Below 1 a target length l0·(1 + eta/k_s) could turn negative.
@@ -197,7 +222,20 @@ def freeze_reference(
     seed: int = 0,
     strand_variation: float | ArrayLike = 0.0,
 ) -> Groom:
-    """Plain numpy twin of :func:`freeze` (same noise, same fallbacks), for tests and benchmarks."""
+    """Plain numpy twin of :func:`freeze` (same noise, same fallbacks), for tests and benchmarks.
+
+    Parameters
+    ----------
+    groom : Groom
+        The groom at rest.
+    stretch_stiffness, bend_stiffness, max_bend_angle, seed, strand_variation
+        As :func:`freeze` takes them.
+
+    Returns
+    -------
+    Groom
+        What :func:`freeze` gives, to the last bit.
+    """
     ks, kb, seed = _effective(
         groom, stretch_stiffness, bend_stiffness, max_bend_angle, seed, strand_variation
     )

@@ -20,7 +20,18 @@ from hairtool.groom import Groom
 
 
 def head_of(surface: object | None) -> CollisionSurface | None:
-    """The surface strokes collide with (one that tells signed distances), or None."""
+    """The surface strokes collide with (one that tells signed distances), or None.
+
+    Parameters
+    ----------
+    surface : object or None
+        The head a pipeline was given.
+
+    Returns
+    -------
+    CollisionSurface or None
+        It, where it tells signed distances.
+    """
     return surface if surface is not None and hasattr(surface, "signed_distance") else None  # type: ignore[return-value]
 
 
@@ -28,6 +39,13 @@ class HeadCollision:
     """Collision with the head for one rest groom (its margin, and the keep-out memory)."""
 
     def __init__(self, rest: Groom) -> None:
+        """Collision of a pipeline's strokes with the head, over the rest groom ``rest``.
+
+        Parameters
+        ----------
+        rest : Groom
+            The groom at rest.
+        """
         self._rest = rest
 
     @functools.cached_property
@@ -89,7 +107,17 @@ class HeadCollision:
         return self.keep_out(aligned, clumped, head, self.margin)
 
     def remember(self, surface: object | None, aligned: Groom, result: Groom) -> None:
-        """The head's distances a first collision asks for, now."""
+        """The head's distances a first collision asks for, now.
+
+        Parameters
+        ----------
+        surface : object or None
+            The head.
+        aligned : Groom
+            The strands before clumping.
+        result : Groom
+            The strands after.
+        """
         head = head_of(surface)
         if head is not None:
             self.keep_out.remember(aligned, result, head)

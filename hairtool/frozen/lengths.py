@@ -62,7 +62,26 @@ def restore_lengths(
 ) -> np.ndarray:
     """float32 ``(V, 3)``: ``after`` with every segment set back to its length in ``before``
     (directions from ``after``; float64 inside, roots as in ``after``). With ``strands`` (and
-    ``out`` holding the others) only those strands are written."""
+    ``out`` holding the others) only those strands are written.
+
+    Parameters
+    ----------
+    before : ndarray
+        ``(V, 3)`` the points whose segment lengths are kept.
+    after : ndarray
+        ``(V, 3)`` the moved points whose directions are kept.
+    topology : Topology
+        The strands of both.
+    strands : ndarray, optional
+        Only these strands are written (None: all).
+    out : ndarray, optional
+        ``(V, 3)`` float32, written in place; it holds the other strands.
+
+    Returns
+    -------
+    ndarray
+        ``(V, 3)`` float32 points.
+    """
     if out is None:
         out = np.empty((topology.vertex_count, 3), np.float32)
     picked = _ALL if strands is None else np.ascontiguousarray(strands, np.int64)
@@ -72,7 +91,20 @@ def restore_lengths(
 
 
 def restore_lengths_reference(before: np.ndarray, after: np.ndarray, topology: Topology) -> np.ndarray:
-    """Numpy twin of :func:`restore_lengths`: strand by strand, a cumulative sum of rescaled segments."""
+    """Numpy twin of :func:`restore_lengths`: strand by strand, a cumulative sum of rescaled segments.
+
+    Parameters
+    ----------
+    before, after : ndarray
+        ``(V, 3)`` as :func:`restore_lengths` takes them.
+    topology : Topology
+        The strands of both.
+
+    Returns
+    -------
+    ndarray
+        ``(V, 3)`` float32, as :func:`restore_lengths` gives them.
+    """
     out = np.empty((topology.vertex_count, 3), np.float32)
     for a, b in zip(topology.offsets[:-1], topology.offsets[1:], strict=True):
         p0 = before[a:b].astype(np.float64)

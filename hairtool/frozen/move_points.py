@@ -36,13 +36,37 @@ _ONE_HOLDER = _one_holder()
 
 def held_by_at_most(count: int, holders: int) -> bool:
     """Whether an object whose ``sys.getrefcount(x.attr)`` (read from an attribute, as the
-    calibration is) gave ``count`` has no more than ``holders`` references."""
+    calibration is) gave ``count`` has no more than ``holders`` references.
+
+    Parameters
+    ----------
+    count : int
+        What ``sys.getrefcount`` gave.
+    holders : int
+        The references allowed.
+
+    Returns
+    -------
+    bool
+        True where no one else holds it.
+    """
     return count - _ONE_HOLDER + 1 <= holders
 
 
 def may_write(a: np.ndarray) -> bool:
     """Whether ``a`` (read-only, as grooms' points are) can be made writable again: it owns its
-    memory (a view's flag cannot be set back)."""
+    memory (a view's flag cannot be set back).
+
+    Parameters
+    ----------
+    a : ndarray
+        A read-only array.
+
+    Returns
+    -------
+    bool
+        True where it owns its memory.
+    """
     return a.flags.owndata and a.flags.c_contiguous
 
 
@@ -55,6 +79,16 @@ class MovePoints:
     nothing)."""
 
     def __init__(self, last: np.ndarray, in_place: bool) -> None:
+        """One move of the points ``last``: written in place (its old rows logged) or into a
+        copy made at the first change.
+
+        Parameters
+        ----------
+        last : ndarray
+            ``(V, 3)`` the points before the move.
+        in_place : bool
+            Whether ``last`` may be written (no one else holds it).
+        """
         self.points = last
         self._last = last
         self._in_place = in_place
@@ -62,6 +96,15 @@ class MovePoints:
         self._log: list[tuple[np.ndarray, np.ndarray]] = []  # in place: (rows, their values before)
 
     def write(self, rows: np.ndarray, values: np.ndarray) -> None:
+        """Set ``rows`` to ``values``; a write that changes no bit copies nothing.
+
+        Parameters
+        ----------
+        rows : ndarray
+            Vertex ids.
+        values : ndarray
+            ``(len(rows), 3)`` float32.
+        """
         if not self._copied:
             if np.array_equal(self.points[rows].view(np.uint32), values.view(np.uint32)):
                 return  # (the brush reached strands but moved none of them)
@@ -74,7 +117,18 @@ class MovePoints:
         self.points[rows] = values
 
     def before(self, rows: np.ndarray) -> np.ndarray:
-        """The points of ``rows`` (vertex ids, increasing, unique) before this move."""
+        """The points of ``rows`` (vertex ids, increasing, unique) before this move.
+
+        Parameters
+        ----------
+        rows : ndarray
+            Vertex ids, increasing, unique.
+
+        Returns
+        -------
+        ndarray
+            ``(len(rows), 3)`` float32.
+        """
         if not self._in_place:
             return self._last[rows]
         out = self.points[rows]

@@ -45,7 +45,22 @@ PER_MOVED, PER_SPAN, FIXED_VERTICES = 6.0, 0.8, 3000.0
 
 def update_pays(moved_share: float, span_share: float, vertices: int) -> bool:
     """Whether an update that moves ``moved_share`` of the vertices and re-sorts ``span_share``
-    of them costs less than a build (the cost model above)."""
+    of them costs less than a build (the cost model above).
+
+    Parameters
+    ----------
+    moved_share : float
+        The share of the vertices that moved.
+    span_share : float
+        The share re-sorted.
+    vertices : int
+        V.
+
+    Returns
+    -------
+    bool
+        True where updating is cheaper.
+    """
     return PER_MOVED * moved_share + PER_SPAN * span_share + FIXED_VERTICES / max(vertices, 1) < 1.0
 
 
@@ -56,14 +71,38 @@ def _moved_mask(points, ref, mask):
 
 
 def moved_vertices(points: np.ndarray, ref: np.ndarray) -> np.ndarray:
-    """Indices of the vertices whose point differs from ``ref``'s (NaN counts as moved)."""
+    """Indices of the vertices whose point differs from ``ref``'s (NaN counts as moved).
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(V, 3)`` now.
+    ref : ndarray
+        ``(V, 3)`` before.
+
+    Returns
+    -------
+    ndarray
+        int64 indices, increasing.
+    """
     mask = np.empty(points.shape[0], np.bool_)
     _moved_mask(points, ref, mask)
     return np.flatnonzero(mask)
 
 
 def moved_vertices_reference(points: np.ndarray, ref: np.ndarray) -> np.ndarray:
-    """numpy twin of :func:`moved_vertices`."""
+    """numpy twin of :func:`moved_vertices`.
+
+    Parameters
+    ----------
+    points, ref : ndarray
+        As :func:`moved_vertices` takes them.
+
+    Returns
+    -------
+    ndarray
+        As :func:`moved_vertices` gives them.
+    """
     return np.flatnonzero(np.any(points != ref, axis=1))
 
 
@@ -285,7 +324,28 @@ def update_list(
     """Bring ``nl``, a row-grid list built for the same vertices (``strand``, ``skip`` as then)
     at its radius, up to date for ``points``, where only the vertices ``moved`` (indices,
     increasing) differ from ``before``, the points of its last build or update. False: not
-    updated, and ``nl`` is left for a build only."""
+    updated, and ``nl`` is left for a build only.
+
+    Parameters
+    ----------
+    nl : NeighbourList
+        A row-grid list.
+    points : ndarray
+        ``(V, 3)`` now.
+    before : ndarray
+        ``(V, 3)`` the points it was built for.
+    strand : ndarray
+        ``(V,)`` each vertex's strand.
+    skip : ndarray
+        ``(V,)`` bool, vertices left out.
+    moved : ndarray
+        The vertices that moved, increasing.
+
+    Returns
+    -------
+    bool
+        True where updated, False where a build is needed.
+    """
     v = len(nl.order)
     if not nl.dense or nl.chunks is None or points.shape[0] != v:
         return False

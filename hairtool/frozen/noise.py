@@ -48,26 +48,84 @@ _mix = njit(cache=True, inline="always")(_mix_py)
 @njit(cache=True, nogil=True, inline="always")
 def hash_head_nb(seed: np.uint64, a: int, channel: int) -> np.uint64:
     """The part of :func:`hash_u01_nb` that depends on (seed, a, channel) only: kernels that
-    draw many b for one a (a strand's vertices, a vertex's iterations) compute it once."""
+    draw many b for one a (a strand's vertices, a vertex's iterations) compute it once.
+
+    Parameters
+    ----------
+    seed : numpy.uint64
+        The seed.
+    a : int
+        The first index.
+    channel : int
+        The draw's channel.
+
+    Returns
+    -------
+    numpy.uint64
+        The head.
+    """
     h = _mix(seed ^ _mix(np.uint64(channel) ^ _GOLD))
     return _mix(h ^ _mix(np.uint64(a) + _GOLD))
 
 
 @njit(cache=True, nogil=True, inline="always")
 def hash_tail_u01_nb(head: np.uint64, b: int) -> float:
-    """Uniform [0, 1) from a :func:`hash_head_nb` and b: ``hash_u01_nb(seed, a, b, channel)``."""
+    """Uniform [0, 1) from a :func:`hash_head_nb` and b: ``hash_u01_nb(seed, a, b, channel)``.
+
+    Parameters
+    ----------
+    head : numpy.uint64
+        From :func:`hash_head_nb`.
+    b : int
+        The second index.
+
+    Returns
+    -------
+    float
+        In [0, 1).
+    """
     h = _mix(head ^ np.uint64(b))
     return float(h >> _S11) * _INV53
 
 
 @njit(cache=True, nogil=True, inline="always")
 def hash_u01_nb(seed: np.uint64, a: int, b: int, channel: int) -> float:
-    """Uniform [0, 1) from (seed, a, b, channel) inside kernels."""
+    """Uniform [0, 1) from (seed, a, b, channel) inside kernels.
+
+    Parameters
+    ----------
+    seed : numpy.uint64
+        The seed.
+    a, b : int
+        The indices.
+    channel : int
+        The draw's channel.
+
+    Returns
+    -------
+    float
+        In [0, 1).
+    """
     return hash_tail_u01_nb(hash_head_nb(seed, a, channel), b)
 
 
 def hash_u01(seed: int, a: ArrayLike, b: ArrayLike, channel: int) -> NDArray[np.float64]:
-    """The numpy twin of :func:`hash_u01_nb`: uniform [0, 1) per (a, b), broadcast."""
+    """The numpy twin of :func:`hash_u01_nb`: uniform [0, 1) per (a, b), broadcast.
+
+    Parameters
+    ----------
+    seed : int
+        The seed.
+    a, b : array_like
+        The indices, broadcast.
+    channel : int
+        The draw's channel.
+
+    Returns
+    -------
+    ndarray
+        float64 in [0, 1).
+    """
     a64, b64 = np.broadcast_arrays(np.atleast_1d(np.asarray(a, np.int64)), np.atleast_1d(np.asarray(b)))
     h = _hash_py(
         np.full(a64.shape, seed_u64(seed), np.uint64),
@@ -79,17 +137,54 @@ def hash_u01(seed: int, a: ArrayLike, b: ArrayLike, channel: int) -> NDArray[np.
 
 
 def seed_u64(seed: int) -> np.uint64:
+    """``seed`` as the uint64 the kernels hash (its low 64 bits).
+
+    Parameters
+    ----------
+    seed : int
+        The seed.
+
+    Returns
+    -------
+    numpy.uint64
+        The seed.
+    """
     return np.uint64(int(seed) & 0xFFFFFFFFFFFFFFFF)
 
 
 def draw_seed(seed: int, draw: int) -> int:
-    """The seed of the ``draw``-th noise redraw (draw 0 is ``seed`` itself)."""
+    """The seed of the ``draw``-th noise redraw (draw 0 is ``seed`` itself).
+
+    Parameters
+    ----------
+    seed : int
+        The seed.
+    draw : int
+        The redraw, ≥ 0.
+
+    Returns
+    -------
+    int
+        Its seed.
+    """
     if draw == 0:
         return int(seed)
     return int(hash_u01(seed, [draw], [0], CH_DRAW)[0] * 2.0**53)
 
 
 def check_seed(seed: object) -> int:
+    """``seed`` as an int, or a ParameterError unless it is a whole number in [0, 2**63).
+
+    Parameters
+    ----------
+    seed : object
+        The seed given.
+
+    Returns
+    -------
+    int
+        The seed.
+    """
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or not 0 <= int(seed) < 2**63:
         raise ParameterError("seed", seed, "a whole number in [0, 2**63)")
     return int(seed)

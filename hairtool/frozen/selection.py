@@ -52,7 +52,18 @@ class SelectionSample(NamedTuple):
 
 
 def check_selection(sample: SelectionSample) -> SelectionSample:
-    """The sample, or a ParameterError naming its bad field."""
+    """The sample, or a ParameterError naming its bad field.
+
+    Parameters
+    ----------
+    sample : SelectionSample
+        A selection step.
+
+    Returns
+    -------
+    SelectionSample
+        The same sample.
+    """
     if sample.op not in OPS:
         raise ParameterError("selection", sample.op, "one of " + ", ".join(OPS))
     if sample.op != "box":
@@ -70,7 +81,22 @@ def check_selection(sample: SelectionSample) -> SelectionSample:
 
 def in_box(groom: Groom, matrix, rect) -> np.ndarray:
     """``(S,)`` the strands with a vertex in front of the camera whose projection lies inside
-    ``rect`` (either corner order)."""
+    ``rect`` (either corner order).
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    matrix : array_like
+        16 numbers: the camera's projection × view, row-major.
+    rect : array_like
+        ``(x0, y0, x1, y1)`` in normalised device coordinates.
+
+    Returns
+    -------
+    ndarray
+        ``(S,)`` bool.
+    """
     m = np.asarray(matrix, np.float64).reshape(4, 4)
     p = groom.points.astype(np.float64)
     with np.errstate(all="ignore"):  # a huge camera overflows: inf and NaN fall outside the box
@@ -94,7 +120,24 @@ def apply_selection(
     away: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(selected, hidden)`` after one step (new arrays); ``away``: the strands facing away
-    from the sample's camera (a box leaves them as they are)."""
+    from the sample's camera (a box leaves them as they are).
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    sample : SelectionSample
+        The step.
+    selected, hidden : ndarray
+        ``(S,)`` bool, before the step.
+    away : ndarray, optional
+        ``(S,)`` bool, the strands facing away.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``selected`` and ``hidden`` after it.
+    """
     check_selection(sample)
     sel, hid = np.array(selected, dtype=bool), np.array(hidden, dtype=bool)
     op = sample.op

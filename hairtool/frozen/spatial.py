@@ -368,7 +368,22 @@ def transpose_reference(
     order_i: np.ndarray, order_j: np.ndarray, entry: np.ndarray, v: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """numpy twin of :func:`_transpose`: forward pairs (i finds j, at ``entry`` among the
-    forward entries) → (bstart, bflat, bmap), each j's finders in increasing i."""
+    forward entries) → (bstart, bflat, bmap), each j's finders in increasing i.
+
+    Parameters
+    ----------
+    order_i, order_j : ndarray
+        The forward pairs' finders and found.
+    entry : ndarray
+        Each pair's place among the forward entries.
+    v : int
+        Vertices.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        ``bstart``, ``bflat`` and ``bmap``.
+    """
     by_j = np.lexsort((order_i, order_j))
     bstart = np.zeros(v + 1, np.int64)
     np.cumsum(np.bincount(order_j, minlength=v), out=bstart[1:])
@@ -411,7 +426,18 @@ class NeighbourList:
         self.chunks: np.ndarray | None = None  # the row grid's search chunks (rows), kept for updates
 
     def of(self, k: int) -> np.ndarray:
-        """Sorted positions of the neighbours of the vertex at sorted position ``k``."""
+        """Sorted positions of the neighbours of the vertex at sorted position ``k``.
+
+        Parameters
+        ----------
+        k : int
+            A sorted position.
+
+        Returns
+        -------
+        ndarray
+            Sorted positions.
+        """
         a = self.aflat[self.aoff[k] : self.aoff[k] + self.acnt[k]]
         return np.concatenate([a, self.bflat[self.bstart[k] : self.bstart[k + 1]]])
 
@@ -450,7 +476,21 @@ class NeighbourList:
         radius: float,
         dense: bool | None = None,
     ) -> None:
-        """``dense``: force the row grid (True) or the hashed one (False); None picks by size."""
+        """``dense``: force the row grid (True) or the hashed one (False); None picks by size.
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(V, 3)``.
+        strand : ndarray
+            ``(V,)`` each vertex's strand.
+        skip : ndarray
+            ``(V,)`` bool, vertices left out (roots).
+        radius : float
+            The search radius.
+        dense : bool, optional
+            Force the row grid (True) or the hashed one (False); None picks by size.
+        """
         self.chunks = None
         lo, hi, dims = self._grid(points, radius, dense)
         if self.dense:
@@ -585,7 +625,26 @@ def _vertex_offsets(chunks, start, base, fcnt, off):
 def neighbour_list(
     points: np.ndarray, strand: np.ndarray, radius: float, skip=None, dense: bool | None = None
 ) -> NeighbourList:
-    """Build a :class:`NeighbourList` (``points`` (V,3), ``strand`` (V,) strand of each vertex)."""
+    """Build a :class:`NeighbourList` (``points`` (V,3), ``strand`` (V,) strand of each vertex).
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(V, 3)``.
+    strand : ndarray
+        ``(V,)`` each vertex's strand.
+    radius : float
+        The search radius.
+    skip : ndarray, optional
+        ``(V,)`` bool, vertices left out.
+    dense : bool, optional
+        Force the row grid or the hashed one.
+
+    Returns
+    -------
+    NeighbourList
+        The list (a BudgetError where its entries would not fit).
+    """
     nl = NeighbourList()
     skip = np.zeros(len(points), bool) if skip is None else skip
     nl.build(points, np.asarray(strand, np.int64), skip, radius, dense)
@@ -598,6 +657,20 @@ def pairs_within_reference(
     """All ordered pairs (i, j) of vertices of different strands closer than ``radius`` (numpy twin).
 
     Sorted cell keys and ``searchsorted`` per neighbour-cell offset; distances in float64.
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(V, 3)``.
+    strand : ndarray
+        ``(V,)`` each vertex's strand.
+    radius : float
+        The distance.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``i`` and ``j``.
     """
     p = np.asarray(points, dtype=np.float64)
     c = np.floor((p - p.min(axis=0)) / radius).astype(np.int64)

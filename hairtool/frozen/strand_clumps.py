@@ -27,12 +27,34 @@ def median_root_spacing(groom: Groom) -> float:
 
     The numba neighbour list over the roots (100,000 children's roots: ~10 ms, where
     :func:`median_root_spacing_reference` takes most of a second, a pause when Clump children
-    is switched on); the search radius doubles until most roots have a neighbour."""
+    is switched on); the search radius doubles until most roots have a neighbour.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+
+    Returns
+    -------
+    float
+        The median spacing, in the groom's units.
+    """
     return _median_root_spacing(groom, _nearest_roots)
 
 
 def median_root_spacing_reference(groom: Groom) -> float:
-    """Numpy twin of :func:`median_root_spacing`."""
+    """Numpy twin of :func:`median_root_spacing`.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+
+    Returns
+    -------
+    float
+        As :func:`median_root_spacing` gives it.
+    """
     return _median_root_spacing(groom, _nearest_roots_reference)
 
 
@@ -94,6 +116,16 @@ def auto_clump_radius(groom: Groom) -> float:
 
     Falls back to 2× the median rest segment length when the roots give no spacing (one strand,
     or all roots in one place).
+
+    Parameters
+    ----------
+    groom : Groom
+        The groom whose roots set the spacing.
+
+    Returns
+    -------
+    float
+        The radius h in the groom's units, > 0.
     """
     spacing = median_root_spacing(groom)
     if spacing > 0:
@@ -217,7 +249,20 @@ def _basins(sstrand, sroot, lists, strand_count, strong):
 
 def strand_clumps(groom: Groom, radius: float) -> np.ndarray:
     """``(S,)`` clump of each strand at the scale ``radius`` (see the module doc), numbered
-    0, 1, … in order of each clump's first strand. Deterministic (integer counts, index ties)."""
+    0, 1, … in order of each clump's first strand. Deterministic (integer counts, index ties).
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    radius : float
+        The clump scale, in the groom's units.
+
+    Returns
+    -------
+    ndarray
+        ``(S,)`` clump ids.
+    """
     top = groom.topology
     is_root = np.zeros(groom.vertex_count, bool)
     is_root[top.root_indices] = True
@@ -227,7 +272,20 @@ def strand_clumps(groom: Groom, radius: float) -> np.ndarray:
 
 
 def strand_clumps_reference(groom: Groom, radius: float) -> np.ndarray:
-    """Numpy twin of :func:`strand_clumps`."""
+    """Numpy twin of :func:`strand_clumps`.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    radius : float
+        The clump scale.
+
+    Returns
+    -------
+    ndarray
+        ``(S,)``, as :func:`strand_clumps` gives it.
+    """
     top = groom.topology
     strand, n = top.strand_index, groom.strand_count
     i, j = pairs_within_reference(groom.points, strand, radius)
@@ -261,13 +319,39 @@ def strand_clumps_reference(groom: Groom, radius: float) -> np.ndarray:
 
 def strand_components(groom: Groom, radius: float) -> np.ndarray:
     """``(S,)`` clump ids: connected components of strands linked by vertex pairs closer than
-    ``radius``, numbered 0, 1, … in order of each component's first strand."""
+    ``radius``, numbered 0, 1, … in order of each component's first strand.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    radius : float
+        The linking distance, in the groom's units.
+
+    Returns
+    -------
+    ndarray
+        ``(S,)`` component ids.
+    """
     nl = neighbour_list(groom.points, groom.topology.strand_index, radius)
     return _union_components(nl.strand, nl.aflat, nl.aoff, nl.acnt, groom.strand_count)
 
 
 def strand_components_reference(groom: Groom, radius: float) -> np.ndarray:
-    """Numpy twin of :func:`strand_components` (min-label propagation)."""
+    """Numpy twin of :func:`strand_components` (min-label propagation).
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    radius : float
+        The linking distance.
+
+    Returns
+    -------
+    ndarray
+        ``(S,)``, as :func:`strand_components` gives it.
+    """
     strand = groom.topology.strand_index
     i, j = pairs_within_reference(groom.points, strand, radius)
     a, b = strand[i], strand[j]

@@ -144,7 +144,19 @@ class Stroke:
         return self
 
     def pipeline_samples(self, default_mirror_x: float) -> list[AlignSample | BrushSample]:
-        """The samples a pipeline applies, mirrored ones right after their originals."""
+        """The samples a pipeline applies, mirrored ones right after their originals.
+
+        Parameters
+        ----------
+        default_mirror_x : float
+            The mirror plane's x where the stroke names none (the centre of the sphere fitted to the
+            roots).
+
+        Returns
+        -------
+        list of AlignSample or BrushSample
+            The samples, in the order the pipeline applies them.
+        """
         self.validate()
         out: list[AlignSample | BrushSample] = []
         mirror = self.mirror_x if self.mirror_x is not None else default_mirror_x
@@ -226,6 +238,18 @@ class SelectionStep:
         return self
 
     def pipeline_samples(self, default_mirror_x: float = 0.0) -> list[SelectionSample]:
+        """The step as the one sample a pipeline applies (checked first).
+
+        Parameters
+        ----------
+        default_mirror_x : float, default 0.0
+            Unused: a selection step has no mirror (the same call as :meth:`Stroke.pipeline_samples`).
+
+        Returns
+        -------
+        list of SelectionSample
+            One sample.
+        """
         return [self.validate().sample]
 
     def to_dict(self) -> dict:
@@ -243,7 +267,18 @@ def strokes_from_log(
 ) -> list[Stroke | SelectionStep]:
     """A pipeline's log as strokes that replay to the same bytes: runs of samples of one brush
     and falloff become one stroke, mirrored samples stay explicit (no symmetry flag); each
-    selection step stays one."""
+    selection step stays one.
+
+    Parameters
+    ----------
+    log : sequence of AlignSample, BrushSample or SelectionSample
+        A pipeline's samples, in order.
+
+    Returns
+    -------
+    list of Stroke or SelectionStep
+        What :func:`write_strokes` writes.
+    """
     runs: list[tuple[tuple, Stroke | SelectionStep]] = []
     for s in log:
         t = sample_type(s)
@@ -355,7 +390,20 @@ _STEP_SHAPES = {
 
 
 def selection_from_dict(d: dict, where: str = "stroke") -> SelectionStep:
-    """A :class:`SelectionStep` from its JSON form; ParameterError naming the field."""
+    """A :class:`SelectionStep` from its JSON form; ParameterError naming the field.
+
+    Parameters
+    ----------
+    d : dict
+        The step's JSON object.
+    where : str, default "stroke"
+        Where it is in the log (``stroke 3``), named in a refusal.
+
+    Returns
+    -------
+    SelectionStep
+        The step.
+    """
     op = d.get("selection")
     values: dict[str, Any] = {"op": op}
     for f in SELECTION.fields:
@@ -378,7 +426,20 @@ def selection_from_dict(d: dict, where: str = "stroke") -> SelectionStep:
 
 def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke | SelectionStep:
     """A :class:`Stroke` (or :class:`SelectionStep`) from its JSON form; ParameterError naming
-    the field on anything wrong."""
+    the field on anything wrong.
+
+    Parameters
+    ----------
+    d : Any
+        The stroke's JSON object.
+    where : str, default "stroke"
+        Where it is in the log, named in a refusal.
+
+    Returns
+    -------
+    Stroke or SelectionStep
+        The stroke, checked.
+    """
     if not isinstance(d, dict):
         raise ParameterError(where, type(d).__name__, "an object with brush and samples")
     if "selection" in d and "brush" not in d:

@@ -413,7 +413,22 @@ def list_frame(points: np.ndarray, radius: float, raw_box: tuple | None = None) 
     """The grid a full :meth:`~hairtool.frozen.spatial.NeighbourList.build` of ``points`` at
     ``radius`` lays out (its corner, rows, x quantisation, row or hashed), which decides the
     order of its lists: ``(dense, lo, inv_cell, ny, nz, inv_q, nq)``, computed as the build does.
-    ``raw_box``: the points' box in float64, where the caller keeps it (no pass over them)."""
+    ``raw_box``: the points' box in float64, where the caller keeps it (no pass over them).
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(V, 3)``.
+    radius : float
+        The list's radius.
+    raw_box : tuple, optional
+        The points' box, where known.
+
+    Returns
+    -------
+    tuple
+        The frame.
+    """
     v = points.shape[0]
     lo, hi = (b.astype(np.float64) for b in (box(points) if raw_box is None else raw_box))
     radius = float(radius)
@@ -444,6 +459,17 @@ class VertexGrid:
     """Every vertex of one topology in hashed cells ``cell`` wide (see the module doc)."""
 
     def __init__(self, points: np.ndarray, strand: np.ndarray, cell: float) -> None:
+        """A hashed grid of cell size ``cell`` over ``points``, kept up to date as vertices move.
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(V, 3)``.
+        strand : ndarray
+            ``(V,)`` each vertex's strand.
+        cell : float
+            The cell size, > 0.
+        """
         v = points.shape[0]
         self.cell = float(cell)
         self.inv = 1.0 / self.cell
@@ -465,7 +491,13 @@ class VertexGrid:
         return self.key.size
 
     def reserve(self, longest: int) -> None:
-        """Room in :meth:`lists` for lists of ``longest`` neighbours (it grows by itself too)."""
+        """Room in :meth:`lists` for lists of ``longest`` neighbours (it grows by itself too).
+
+        Parameters
+        ----------
+        longest : int
+            Neighbours.
+        """
         if longest + 1 >= self.capacity:
             self.capacity = (longest + 1 + 32) // 32 * 32
 
@@ -473,21 +505,52 @@ class VertexGrid:
         """Room in :meth:`lists` for the lists of this many vertices, its memory touched now: a
         buffer kept from move to move (a fresh one per move cost a move its page faults, ~13 ms
         for the bear's first region of 6,000 vertices). The lists :meth:`lists` returns live in it
-        until the next call."""
+        until the next call.
+
+        Parameters
+        ----------
+        vertices : int
+            Vertices.
+        """
         need = vertices * self.capacity
         if self._flat.size < need:
             self._flat = np.empty(max(need, int(1.5 * self._flat.size)), np.int64)
             self._flat.fill(0)
 
     def move(self, points: np.ndarray, vids: np.ndarray) -> int:
-        """The vertices ``vids`` now at ``points[vids]``; returns how many changed cell."""
+        """The vertices ``vids`` now at ``points[vids]``; returns how many changed cell.
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(V, 3)`` the points now.
+        vids : ndarray
+            The vertices that moved.
+
+        Returns
+        -------
+        int
+            The count that changed cell.
+        """
         ids = np.ascontiguousarray(vids, np.int64)
         grid = (self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
         return int(_move(points, ids, *grid, self.blocks))
 
     def strands_near(self, points: np.ndarray, queries: np.ndarray, radius: float, mark: np.ndarray) -> None:
         """Flag in ``mark`` ((S,) bool) the strands with a vertex of ``points`` (where the grid
-        holds them) closer than ``radius`` to one of ``queries`` ((n, 3))."""
+        holds them) closer than ``radius`` to one of ``queries`` ((n, 3)).
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(V, 3)``.
+        queries : ndarray
+            ``(n, 3)``.
+        radius : float
+            The distance.
+        mark : ndarray
+            ``(S,)`` bool, written.
+        """
         q = np.asarray(queries, np.float64).reshape(-1, 3)
         radius = _within_reach(points, q, float(radius), self.cell)
         r2 = radius**2
@@ -506,7 +569,24 @@ class VertexGrid:
         """``(flat, cnt, cap)``: the list of each vertex ``vids[n]`` (other strands within
         ``radius``, original indices) at ``flat[n·cap :][: cnt[n]]``, in the order of a full build
         whose grid is ``frame`` (:func:`list_frame`); ``radius`` must not exceed the cell.
-        ``flat`` is the grid's buffer: read it before the next call."""
+        ``flat`` is the grid's buffer: read it before the next call.
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(V, 3)``.
+        vids : ndarray
+            The vertices whose lists are wanted.
+        radius : float
+            The distance.
+        frame : tuple
+            The full build's grid (:func:`list_frame`).
+
+        Returns
+        -------
+        tuple
+            ``(flat, cnt, cap)``.
+        """
         dense, lo, inv_cell, ny, nz, inv_q, nq = frame
         ids = np.ascontiguousarray(vids, np.int64)
         r2 = float(radius) ** 2
@@ -552,7 +632,26 @@ def _cells_within(q: np.ndarray, radius: float, cell: float) -> int:
 def strands_near_reference(
     points: np.ndarray, strand: np.ndarray, queries: np.ndarray, radius: float, strand_count: int
 ) -> np.ndarray:
-    """Numpy twin of :meth:`VertexGrid.strands_near`: every vertex against every query."""
+    """Numpy twin of :meth:`VertexGrid.strands_near`: every vertex against every query.
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(V, 3)``.
+    strand : ndarray
+        ``(V,)`` each vertex's strand.
+    queries : ndarray
+        ``(n, 3)``.
+    radius : float
+        The distance.
+    strand_count : int
+        S.
+
+    Returns
+    -------
+    ndarray
+        ``(S,)`` bool.
+    """
     p = np.asarray(points, np.float64)
     mark = np.zeros(strand_count, bool)
     for q in np.asarray(queries, np.float64).reshape(-1, 3):
@@ -566,7 +665,24 @@ def lists_reference(
     points: np.ndarray, strand: np.ndarray, vids: np.ndarray, radius: float
 ) -> list[np.ndarray]:
     """Numpy twin of :meth:`VertexGrid.lists`: each vertex's list read off a full
-    :class:`~hairtool.frozen.spatial.NeighbourList` build (forward run, then backward, original indices)."""
+    :class:`~hairtool.frozen.spatial.NeighbourList` build (forward run, then backward, original indices).
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(V, 3)``.
+    strand : ndarray
+        ``(V,)`` each vertex's strand.
+    vids : ndarray
+        The vertices whose lists are wanted.
+    radius : float
+        The distance.
+
+    Returns
+    -------
+    list of ndarray
+        One list per vertex.
+    """
     from hairtool.frozen.spatial import neighbour_list
 
     nl = neighbour_list(points, strand, radius)

@@ -41,6 +41,17 @@ class RenderHairAnimation(StrandSizes):
     guides), made on demand; ``clump``: ClumpWithGaps among the children on every frame."""
 
     def __init__(self, binding: ChildBinding, guides: Animation, clump: ChildClump | None = None) -> None:
+        """Render hair following ``guides``, frame by frame.
+
+        Parameters
+        ----------
+        binding : ChildBinding
+            The children bound to the guides at rest.
+        guides : Animation
+            The guides' frames, the same strands.
+        clump : ChildClump, optional
+            The children's own clumping.
+        """
         _check(binding, guides)
         self.binding, self.guides = binding, guides
         self.render = RenderHair(binding, clump)
@@ -90,12 +101,36 @@ class RenderHairAnimation(StrandSizes):
         return self.vertex_count * 12
 
     def guides_frame(self, f: int) -> Groom:
-        """Frame ``f`` of the guides as a groom."""
+        """Frame ``f`` of the guides as a groom.
+
+        Parameters
+        ----------
+        f : int
+            The frame.
+
+        Returns
+        -------
+        Groom
+            The guides.
+        """
         return Groom(self.guides.frames[f], self.guides.topology, metadata=self.guides.metadata)
 
     def frame_points(self, f: int, out: np.ndarray | None = None) -> np.ndarray:
         """``(V, 3)`` float32 points of the children at frame ``f``: a new array, or written
-        into ``out`` (a C-contiguous float32 ``(V, 3)``, e.g. rows of a larger frame)."""
+        into ``out`` (a C-contiguous float32 ``(V, 3)``, e.g. rows of a larger frame).
+
+        Parameters
+        ----------
+        f : int
+            The frame.
+        out : ndarray, optional
+            Where to write.
+
+        Returns
+        -------
+        ndarray
+            ``(V, 3)`` float32.
+        """
         if out is not None and (out.shape != (self.vertex_count, 3) or out.dtype != np.float32):
             raise ParameterError("out", f"{out.dtype} {out.shape}", f"float32 ({self.vertex_count}, 3)")
         if out is not None and not out.flags.c_contiguous:
@@ -111,6 +146,18 @@ class RenderHairAnimation(StrandSizes):
         return out
 
     def frame(self, f: int) -> Groom:
+        """Frame ``f`` of the children as a groom, with their attributes.
+
+        Parameters
+        ----------
+        f : int
+            The frame.
+
+        Returns
+        -------
+        Groom
+            The children.
+        """
         return Groom(self.frame_points(f), self.topology, **self.attributes, metadata=self.metadata)
 
     def __iter__(self) -> Iterator[np.ndarray]:
@@ -123,7 +170,18 @@ class RenderHairAnimation(StrandSizes):
     def animation(self, progress: Callable[[int, int], object] | None = None) -> Animation:
         """Every frame in one Animation (F × V × 12 bytes, and a copy while it is checked: for
         formats that take the whole array; USD takes the frames one by one). ``progress(done,
-        total)`` after each frame; an exception it raises stops the build."""
+        total)`` after each frame; an exception it raises stops the build.
+
+        Parameters
+        ----------
+        progress : callable, optional
+            ``progress(done, total)`` after each frame.
+
+        Returns
+        -------
+        Animation
+            Every frame.
+        """
         frames = np.empty((self.n_frames, self.vertex_count, 3), np.float32)
         for f in range(self.n_frames):
             self.frame_points(f, frames[f])
@@ -134,7 +192,20 @@ class RenderHairAnimation(StrandSizes):
 
 def render_frames_reference(binding: ChildBinding, guides: Animation) -> np.ndarray:
     """``(F, V, 3)`` float32: :func:`~hairtool.guides.children.build_points_reference` on every
-    frame of the guides (no clumping), the numpy twin of :class:`RenderHairAnimation`."""
+    frame of the guides (no clumping), the numpy twin of :class:`RenderHairAnimation`.
+
+    Parameters
+    ----------
+    binding : ChildBinding
+        The children bound to the guides at rest.
+    guides : Animation
+        The guides' frames.
+
+    Returns
+    -------
+    ndarray
+        ``(F, V, 3)`` float32.
+    """
     _check(binding, guides)
     poses = (Groom(p, guides.topology, metadata=guides.metadata) for p in guides.frames)
     return np.stack([build_points_reference(binding, g) for g in poses])

@@ -44,7 +44,22 @@ _CHUNK = 8192  # children blended at a time (bounds the (chunk, k, n, 3) tempora
 
 def resampled_values(values: np.ndarray, guides: Groom, n: int) -> np.ndarray:
     """``(G, n, …)`` float64: every guide's per-vertex ``values`` at n evenly spaced vertex
-    parameters (i/(n − 1) of its vertices, linearly between them)."""
+    parameters (i/(n − 1) of its vertices, linearly between them).
+
+    Parameters
+    ----------
+    values : ndarray
+        One per guide vertex.
+    guides : Groom
+        The guides.
+    n : int
+        Samples per guide.
+
+    Returns
+    -------
+    ndarray
+        ``(G, n, …)`` float64.
+    """
     v = np.asarray(values, np.float64)
     out = np.empty((guides.strand_count, n, *v.shape[1:]))
     for m in np.unique(guides.counts):
@@ -63,7 +78,20 @@ def resampled_values(values: np.ndarray, guides: Groom, n: int) -> np.ndarray:
 
 def blend(values: np.ndarray, binding: ChildBinding) -> np.ndarray:
     """``(V_children, …)`` float32: the guides' ``values`` (one per rest-guide vertex) at every
-    child vertex, blended by the binding's weights."""
+    child vertex, blended by the binding's weights.
+
+    Parameters
+    ----------
+    values : ndarray
+        One per rest-guide vertex.
+    binding : ChildBinding
+        The children.
+
+    Returns
+    -------
+    ndarray
+        ``(V_children, …)`` float32.
+    """
     v = np.asarray(values)
     out = np.empty((binding.vertex_count, *v.shape[1:]), np.float64)
     for n in binding.vertex_counts:
@@ -79,7 +107,20 @@ def blend(values: np.ndarray, binding: ChildBinding) -> np.ndarray:
 
 
 def blend_reference(values: np.ndarray, binding: ChildBinding) -> np.ndarray:
-    """Child-by-child twin of :func:`blend`, with ``np.interp`` along each guide, for tests."""
+    """Child-by-child twin of :func:`blend`, with ``np.interp`` along each guide, for tests.
+
+    Parameters
+    ----------
+    values : ndarray
+        One per rest-guide vertex.
+    binding : ChildBinding
+        The children.
+
+    Returns
+    -------
+    ndarray
+        As :func:`blend` gives it.
+    """
     v = np.asarray(values, np.float64)
     guides = binding.rest_guides
     rows = []
@@ -99,7 +140,18 @@ def blend_reference(values: np.ndarray, binding: ChildBinding) -> np.ndarray:
 def child_attributes(binding: ChildBinding) -> dict[str, np.ndarray | None]:
     """Thickness, transparency and colours of every child vertex: a dense strand's own where
     the binding keeps them (``exact_attributes``), else the guides' blended (:func:`blend`);
-    None where neither has one."""
+    None where neither has one.
+
+    Parameters
+    ----------
+    binding : ChildBinding
+        The children.
+
+    Returns
+    -------
+    dict
+        ``thickness``, ``transparency`` and ``colors``, each an array or None.
+    """
     own = binding.exact_attributes or {}
     out: dict[str, np.ndarray | None] = {}
     for name in ATTRIBUTES:

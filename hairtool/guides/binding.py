@@ -99,12 +99,30 @@ class ChildBinding:
         return self.exact_points is not None
 
     def rest_tangents(self, n: int) -> np.ndarray:
-        """``(G, 3)`` the rest guides' root tangents at n vertices (cached)."""
+        """``(G, 3)`` the rest guides' root tangents at n vertices (cached).
+
+        Parameters
+        ----------
+        n : int
+            Vertices per guide the tangents are taken at.
+
+        Returns
+        -------
+        ndarray
+            ``(G, 3)`` float64 unit tangents.
+        """
         if n not in self._tangents:
             self._tangents[n] = _children.root_tangents_of(self.rest_guides, n)
         return self._tangents[n]
 
     def check_guides(self, guides: Groom) -> None:
+        """A ParameterError unless ``guides`` are the strands the children were bound to (same counts).
+
+        Parameters
+        ----------
+        guides : Groom
+            The guides about to drive the children.
+        """
         if guides.topology != self.rest_guides.topology:
             raise ParameterError(
                 "guides",
@@ -114,7 +132,18 @@ class ChildBinding:
 
     def subset(self, child_ids: np.ndarray) -> ChildBinding:
         """The children ``child_ids`` only (e.g. every tenth, for a display percentage while
-        dragging): they build to the same points as in the whole binding."""
+        dragging): they build to the same points as in the whole binding.
+
+        Parameters
+        ----------
+        child_ids : ndarray
+            Indices of the children to keep.
+
+        Returns
+        -------
+        ChildBinding
+            A binding of those children to the same guides.
+        """
         ids = np.asarray(child_ids, np.int64).reshape(-1)
         if ids.size == 0 or ids.min() < 0 or ids.max() >= self.child_count:
             raise ParameterError("children", f"{ids.size} ids", f"child indices in [0, {self.child_count})")
@@ -159,7 +188,18 @@ class ChildBinding:
 
     def build(self, guides: Groom | None = None) -> Groom:
         """The children from the guides' current shapes (the rest guides by default), with
-        their widths and colours (:attr:`attributes`) and the guides' scene (:attr:`metadata`)."""
+        their widths and colours (:attr:`attributes`) and the guides' scene (:attr:`metadata`).
+
+        Parameters
+        ----------
+        guides : Groom, optional
+            The guides' current shapes, the same strands as the rest guides (None: the rest guides).
+
+        Returns
+        -------
+        Groom
+            The children.
+        """
         pose = self.rest_guides if guides is None else guides
         return Groom(
             _children.build_points(self, pose), self.topology, **self.attributes, metadata=self.metadata
@@ -167,12 +207,40 @@ class ChildBinding:
 
 
 def check_k(k: int, guide_count: int) -> int:
+    """``k`` as an int, or a ParameterError unless it is a whole number in [1, guide_count].
+
+    Parameters
+    ----------
+    k : int
+        Guides per child.
+    guide_count : int
+        G.
+
+    Returns
+    -------
+    int
+        ``k``.
+    """
     if isinstance(k, bool) or int(k) != k or not 1 <= k <= guide_count:
         raise ParameterError("guides_per_child", k, f"a whole number in [1, {guide_count}] (the guide count)")
     return int(k)
 
 
 def check_count(count: int, name: str = "count") -> int:
+    """``count`` as an int, or a ParameterError unless it is a whole number in [1, MAX_CHILDREN].
+
+    Parameters
+    ----------
+    count : int
+        Children.
+    name : str, default "count"
+        The parameter, named in a refusal.
+
+    Returns
+    -------
+    int
+        ``count``.
+    """
     if isinstance(count, bool) or int(count) != count or not 1 <= count <= MAX_CHILDREN:
         raise ParameterError(name, count, f"a whole number of children in [1, {MAX_CHILDREN}]")
     return int(count)
@@ -227,7 +295,13 @@ def _bind(
 def curl(b: ChildBinding) -> None:
     """``b.local`` from its frizz: a helix across the nearest guide's frames whose radius grows
     from 0 at the root to ``frizz`` × the child's rest length at the tip. A few numbers per child
-    make it, so a project stores those and curls the children again on loading."""
+    make it, so a project stores those and curls the children again on loading.
+
+    Parameters
+    ----------
+    b : ChildBinding
+        A binding whose ``local`` is set here.
+    """
     n = int(b.counts[0])
     count = b.child_count
     b.local = None
@@ -271,7 +345,34 @@ def bind_roots(
     """Children at given ``roots`` ``(N, 3)``, or ``count`` of them around the guide roots,
     bound to their k nearest guide roots in space (along the surface of ``mesh`` if given);
     ``vertices`` per child (default: the guides' largest count). The children come in order
-    of their nearest guide (their roots are ``binding.roots``), not in the order of ``roots``."""
+    of their nearest guide (their roots are ``binding.roots``), not in the order of ``roots``.
+
+    Parameters
+    ----------
+    guides : Groom
+        The guides at rest.
+    roots : ndarray, optional
+        ``(N, 3)`` finite child roots.
+    count : int, optional
+        Without ``roots``: how many children to scatter around the guide roots.
+    k : int, default DEFAULT_K
+        Guides each child blends.
+    vertices : int, optional
+        Vertices per child (None: the guides' largest count).
+    seed : int, default 0
+        The seed of the scatter, the length variation and the frizz.
+    length_variation : float, default DEFAULT_LENGTH_VARIATION
+        v: child lengths × [1 − v, 1 + v].
+    frizz : float, default DEFAULT_FRIZZ
+        The curl radius at a child's tip, a share of its length.
+    mesh : Mesh, optional
+        The head: nearest guides are found along its surface.
+
+    Returns
+    -------
+    ChildBinding
+        The children's binding; :meth:`ChildBinding.build` makes their strands.
+    """
     k = check_k(k, guides.strand_count)
     seed = check_seed(seed)
     _check_variation(length_variation, frizz)
@@ -357,7 +458,22 @@ def bind_scalp(
 
 def choose_guides(dense: Groom, guide_count: int, seed: int = 0) -> np.ndarray:
     """``(G,)`` strands of ``dense`` to serve as guides: farthest-point sampling of the roots
-    from a seeded first strand."""
+    from a seeded first strand.
+
+    Parameters
+    ----------
+    dense : Groom
+        The render hair.
+    guide_count : int
+        G, 1 … the strand count.
+    seed : int, default 0
+        Picks the first strand.
+
+    Returns
+    -------
+    ndarray
+        ``(G,)`` int64 strand indices.
+    """
     s = dense.strand_count
     if isinstance(guide_count, bool) or int(guide_count) != guide_count or not 1 <= guide_count <= s:
         raise ParameterError("guides", guide_count, f"a whole number in [1, {s}] (the strand count)")
@@ -370,7 +486,26 @@ def bind_dense(
 ) -> tuple[Groom, ChildBinding]:
     """A dense groom as G guides and every strand bound to them (guides by root distance, along
     the surface of ``mesh`` if given): ``(guides, binding)``; the binding built on the guides
-    at rest gives back ``dense``'s points bit for bit."""
+    at rest gives back ``dense``'s points bit for bit.
+
+    Parameters
+    ----------
+    dense : Groom
+        The render hair.
+    guide_count : int
+        G, 1 … the strand count.
+    k : int, default DEFAULT_K
+        Guides each strand blends.
+    seed : int, default 0
+        Picks the first guide.
+    mesh : Mesh, optional
+        The head: nearest guides are found along its surface.
+
+    Returns
+    -------
+    tuple of (Groom, ChildBinding)
+        The guides and every strand's binding to them.
+    """
     guides = dense.subset(choose_guides(dense, guide_count, seed))
     return guides, bind_to_guides(dense, guides, k=k, mesh=mesh)
 
@@ -381,7 +516,24 @@ def bind_to_guides(
     """Every strand of ``hair`` bound to the given ``guides`` (its k nearest by root distance,
     along the surface of ``mesh`` if given), storing its offset from their blend: render hair
     read beside its guides (a USD file's guide prim) follows them, and comes back bit for bit
-    while they are untouched."""
+    while they are untouched.
+
+    Parameters
+    ----------
+    hair : Groom
+        The render hair.
+    guides : Groom
+        Its guides.
+    k : int, default DEFAULT_K
+        Guides each strand blends.
+    mesh : Mesh, optional
+        The head: nearest guides are found along its surface.
+
+    Returns
+    -------
+    ChildBinding
+        Every strand's binding; built on the guides at rest it gives ``hair`` back.
+    """
     k = check_k(k, guides.strand_count)
     roots = hair.roots.astype(np.float64)
     near, faces = _nearest(guides, roots, k, mesh)
@@ -401,7 +553,15 @@ def bind_exactly(b: ChildBinding, points: np.ndarray) -> None:
     exactly: each vertex's offset from the blend in its nearest guide's frames (``local``), the
     float64 blend at rest those offsets give (``exact_blend``) and the points themselves. The
     first two follow from the points and the rest guides, so a project stores the points alone
-    and binds them again on loading."""
+    and binds them again on loading.
+
+    Parameters
+    ----------
+    b : ChildBinding
+        One child per dense strand, no offsets yet.
+    points : ndarray
+        ``(V, 3)`` the dense strands' points.
+    """
     guides = b.rest_guides
     b.local = b.exact_points = b.exact_blend = None  # the plain blend first
     q = _children.build_points(b, guides, np.float64)
@@ -419,5 +579,16 @@ def bind_exactly(b: ChildBinding, points: np.ndarray) -> None:
 def clumps_by_default(binding: ChildBinding) -> bool:
     """Whether render hair of ``binding`` runs ClumpWithGaps among its children unless told
     otherwise: grown children do (interpolated hair without adhesion reads as a fuzz of
-    parallel strands), authored ones (:attr:`ChildBinding.authored`) do not."""
+    parallel strands), authored ones (:attr:`ChildBinding.authored`) do not.
+
+    Parameters
+    ----------
+    binding : ChildBinding
+        The children.
+
+    Returns
+    -------
+    bool
+        True for grown children.
+    """
     return not binding.authored

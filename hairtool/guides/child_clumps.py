@@ -48,7 +48,20 @@ _CELLS_PER_VERTEX = 4  # a clump's grid has at most this many cells per vertex (
 
 def clump_of_children(guide_ids: np.ndarray, guide_count: int) -> tuple[np.ndarray, np.ndarray]:
     """Children grouped by nearest guide: ``start`` (G+1,) into ``children`` (N,), each clump's
-    children in increasing order."""
+    children in increasing order.
+
+    Parameters
+    ----------
+    guide_ids : ndarray
+        ``(N,)`` each child's nearest guide.
+    guide_count : int
+        G.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``start`` and ``children``, int64.
+    """
     nearest = np.asarray(guide_ids)[:, 0]
     children = np.argsort(nearest, kind="stable").astype(np.int64)
     start = np.zeros(guide_count + 1, np.int64)
@@ -58,7 +71,20 @@ def clump_of_children(guide_ids: np.ndarray, guide_count: int) -> tuple[np.ndarr
 
 def clump_seeds(seed: int, guide_count: int) -> np.ndarray:
     """``(G,)`` the seed of each guide's clump (whole numbers below 2**53): ζ of different
-    clumps is drawn independently."""
+    clumps is drawn independently.
+
+    Parameters
+    ----------
+    seed : int
+        The user's seed.
+    guide_count : int
+        G.
+
+    Returns
+    -------
+    ndarray
+        ``(G,)`` int64.
+    """
     u = hash_u01(seed, np.arange(guide_count), 0, CH_CHILD_CLUMP)
     return (u * 2.0**53).astype(np.int64)
 
@@ -331,7 +357,22 @@ def clump_jobs(work: np.ndarray, clumps: np.ndarray, n: int) -> tuple[np.ndarray
     the lightest job so far), as a CSR ``(clump ids, job starts)``. prange hands each thread one
     block of consecutive iterations: over all clumps, with only a stroke's to redo (neighbours,
     so next to each other in the guides' order) one thread had nearly all of them. Each clump's
-    bytes are its own whatever job runs it."""
+    bytes are its own whatever job runs it.
+
+    Parameters
+    ----------
+    work : ndarray
+        ``(G,)`` each clump's work.
+    clumps : ndarray
+        The clumps to run.
+    n : int
+        Jobs.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        The clump ids by job and the jobs' starts.
+    """
     clumps = np.asarray(clumps, np.int64)
     n = max(1, min(int(n), clumps.size))
     job = np.zeros(clumps.size, np.int64)
@@ -363,6 +404,27 @@ class ChildClumps:
         seed: int = 0,
         keep_lengths: bool = True,
     ) -> None:
+        """ClumpWithGaps among the children of each guide, ready to run on their points.
+
+        Parameters
+        ----------
+        guide_ids : ndarray
+            ``(N,)`` each child's nearest guide.
+        guide_count : int
+            G.
+        radius : float
+            The clump radius h.
+        iterations : int, default 3
+            Clump passes k.
+        step : float, optional
+            The pass's step (None: from the radius).
+        gap_mode : str, default "printed"
+            ClumpWithGaps' gap rule.
+        seed : int, default 0
+            The clumps' seed.
+        keep_lengths : bool, default True
+            Give each segment back its length after clumping.
+        """
         check_clump_params(radius, iterations, step, gap_mode)
         self.guide_ids = np.asarray(guide_ids, np.int64)
         self.guide_count = int(guide_count)
@@ -384,7 +446,18 @@ class ChildClumps:
         return float(self.stats[:, 0].sum() / max(self.stats[:, 1].sum(), 1.0))
 
     def redo_for(self, moved_guides: np.ndarray) -> np.ndarray:
-        """``(G,)`` the clumps holding a child that follows one of ``moved_guides`` (G flags)."""
+        """``(G,)`` the clumps holding a child that follows one of ``moved_guides`` (G flags).
+
+        Parameters
+        ----------
+        moved_guides : ndarray
+            ``(G,)`` bool.
+
+        Returns
+        -------
+        ndarray
+            ``(G,)`` bool.
+        """
         follows = np.asarray(moved_guides, np.bool_)[self.guide_ids].any(axis=1)
         redo = np.zeros(self.guide_count, np.bool_)
         redo[self.guide_ids[follows, 0]] = True
@@ -393,7 +466,22 @@ class ChildClumps:
     def run(self, points: np.ndarray, topology, redo: np.ndarray | None = None) -> np.ndarray:
         """float32 ``(V, 3)``: the children at ``points`` clumped, in an array this object keeps
         and the next run rewrites (copy it to keep it). ``redo``: per guide, whether its clump is
-        run again; the others keep what the last run wrote (None, or a first run: all)."""
+        run again; the others keep what the last run wrote (None, or a first run: all).
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(V, 3)`` the children's points.
+        topology : Topology
+            Their strands.
+        redo : ndarray, optional
+            ``(G,)`` bool, the clumps to run again (None: all).
+
+        Returns
+        -------
+        ndarray
+            ``(V, 3)`` float32, this object's buffer.
+        """
         v = topology.vertex_count
         if self._work is None:
             total = np.zeros(self.children.size + 1)
@@ -442,7 +530,24 @@ def clump_children(
     keep_lengths: bool = True,
 ) -> np.ndarray:
     """float32 ``(V, 3)``: ClumpWithGaps among the children of each guide, once (see
-    :class:`ChildClumps`)."""
+    :class:`ChildClumps`).
+
+    Parameters
+    ----------
+    children : Groom
+        The children.
+    guide_ids : ndarray
+        ``(N,)`` each child's nearest guide.
+    guide_count : int
+        G.
+    radius, iterations, step, gap_mode, seed, keep_lengths
+        As :class:`ChildClumps` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(V, 3)`` float32.
+    """
     run = ChildClumps(guide_ids, guide_count, radius, iterations, step, gap_mode, seed, keep_lengths)
     return run.run(children.points, children.topology)
 
@@ -461,7 +566,20 @@ def clump_children_reference(
 ) -> np.ndarray:
     """The oracle of :func:`clump_children`: the whole-groom ClumpWithGaps run on each clump's
     children alone (``numpy``: its numpy twin :func:`~hairtool.frozen.clump.clump_reference`,
-    else the studio's numba path :func:`~hairtool.frozen.clump.clump_points`)."""
+    else the studio's numba path :func:`~hairtool.frozen.clump.clump_points`).
+
+    Parameters
+    ----------
+    children, guide_ids, guide_count, radius, iterations, step, gap_mode, seed, keep_lengths
+        As :func:`clump_children` takes them.
+    numpy : bool, default True
+        Use the whole-groom clump's numpy twin (else its numba path).
+
+    Returns
+    -------
+    ndarray
+        ``(V, 3)`` float32.
+    """
     start, kids = clump_of_children(guide_ids, guide_count)
     seeds = clump_seeds(seed, guide_count)
     out = children.points.astype(np.float32)

@@ -60,6 +60,17 @@ class GuideTables:
     ``base[n] + j·n + i`` (for the kernel); the rest root tangents come from the binding."""
 
     def __init__(self, guides: Groom, binding: ChildBinding, reference: bool = False) -> None:
+        """Tabulate ``guides`` at every vertex count of ``binding``'s children.
+
+        Parameters
+        ----------
+        guides : Groom
+            The guides' current shapes.
+        binding : ChildBinding
+            The children.
+        reference : bool, default False
+            Build the tables for the numpy twin.
+        """
         counts = list(binding.vertex_counts)
         self.base: dict[int, int] = {}
         rows = 0
@@ -82,7 +93,18 @@ class GuideTables:
                 guide_tables(guides, n, binding.rest_tangents(n), out, self.base[n], axes)
 
     def child_base(self, binding: ChildBinding) -> np.ndarray:
-        """``(N,)`` the first table row of each child's vertex count."""
+        """``(N,)`` the first table row of each child's vertex count.
+
+        Parameters
+        ----------
+        binding : ChildBinding
+            The children.
+
+        Returns
+        -------
+        ndarray
+            ``(N,)`` int64.
+        """
         if len(self.bases) == 1:
             return np.full(binding.child_count, self.bases[0], np.int64)
         return self.bases[np.searchsorted(self.counts, binding.counts)]
@@ -170,7 +192,29 @@ def build_points(
     x + (y − y⁰); ``out``: an array to write them into (reused between frames). ``moved``:
     per guide, whether it differs from the guides ``out`` holds the children of (see
     :func:`moved_guides`): then only the children that follow a moved guide are built again,
-    the others keep their points in ``out`` (a brush moves a few guides per mouse move)."""
+    the others keep their points in ``out`` (a brush moves a few guides per mouse move).
+
+    Parameters
+    ----------
+    binding : ChildBinding
+        The children.
+    guides : Groom
+        The guides' current shapes.
+    dtype : type, default numpy.float32
+        float32, or float64 for the rest blends.
+    exact : bool, default True
+        Add back a dense groom's own offsets where the binding keeps them.
+    out : ndarray, optional
+        Where to write.
+    moved : ndarray, optional
+        ``(G,)`` bool, the guides that moved since ``out`` was built (only their children are
+        rebuilt).
+
+    Returns
+    -------
+    ndarray
+        ``(V, 3)``.
+    """
     binding.check_guides(guides)
     fresh = out is None or out.shape != (binding.vertex_count, 3) or out.dtype != dtype
     if fresh:
@@ -194,7 +238,20 @@ def build_points(
 
 def moved_guides(guides: Groom, last: np.ndarray) -> np.ndarray:
     """``(G,)`` whether each guide has a point that differs, bit for bit, from ``last`` (the points
-    children were last built from; any other shape: every guide moved)."""
+    children were last built from; any other shape: every guide moved).
+
+    Parameters
+    ----------
+    guides : Groom
+        The guides now.
+    last : ndarray
+        The points the children were last built from.
+
+    Returns
+    -------
+    ndarray
+        ``(G,)`` bool.
+    """
     points = np.ascontiguousarray(guides.points, np.float32)
     last = np.asarray(last)
     if last.shape != points.shape or last.dtype != np.float32:
@@ -215,14 +272,40 @@ def _moved_kernel(points, last, offsets, out):
 
 
 def moved_guides_reference(guides: Groom, last: np.ndarray) -> np.ndarray:
-    """Numpy twin of :func:`moved_guides` (for ``last`` of the guides' shape)."""
+    """Numpy twin of :func:`moved_guides` (for ``last`` of the guides' shape).
+
+    Parameters
+    ----------
+    guides, last
+        As :func:`moved_guides` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(G,)`` bool.
+    """
     differs = (np.asarray(guides.points, np.float32).view(np.uint32) != last.view(np.uint32)).any(axis=1)
     return np.logical_or.reduceat(differs, guides.offsets[:-1])
 
 
 def build_points_reference(binding: ChildBinding, guides: Groom, chunk: int = 8192) -> np.ndarray:
     """Numpy twin of :func:`build_points`: the blend over whole arrays of children of one
-    vertex count (``chunk`` at a time), the root-to-tip sum by ``np.cumsum``."""
+    vertex count (``chunk`` at a time), the root-to-tip sum by ``np.cumsum``.
+
+    Parameters
+    ----------
+    binding : ChildBinding
+        The children.
+    guides : Groom
+        The guides' current shapes.
+    chunk : int, default 8192
+        Children blended at once.
+
+    Returns
+    -------
+    ndarray
+        ``(V, 3)`` float32.
+    """
     binding.check_guides(guides)
     tables = GuideTables(guides, binding, reference=True)
     out = np.empty((binding.vertex_count, 3), np.float32)
@@ -252,5 +335,18 @@ def build_points_reference(binding: ChildBinding, guides: Groom, chunk: int = 81
 
 
 def root_tangents_of(guides: Groom, n: int) -> np.ndarray:
-    """``(G, 3)`` rest root tangents of the guides at n vertices (for a binding to keep)."""
+    """``(G, 3)`` rest root tangents of the guides at n vertices (for a binding to keep).
+
+    Parameters
+    ----------
+    guides : Groom
+        The guides at rest.
+    n : int
+        Vertices per guide.
+
+    Returns
+    -------
+    ndarray
+        ``(G, 3)`` float64.
+    """
     return root_tangents(resampled(guides, n), n)

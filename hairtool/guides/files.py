@@ -37,7 +37,22 @@ def tapered_widths(
 ) -> np.ndarray:
     """``(V,)`` float32 widths from ``root`` at the root to ``tip`` at the tip, linear in t
     (of a groom's strands or of a topology's), in scene units; by default 80 µm → 16 µm in a
-    scene of ``meters_per_unit`` (a groom's own unit when a groom is given)."""
+    scene of ``meters_per_unit`` (a groom's own unit when a groom is given).
+
+    Parameters
+    ----------
+    groom : Groom or Topology
+        The strands.
+    root, tip : float, optional
+        Widths at the root and the tip in scene units (None: 80 µm and 16 µm).
+    meters_per_unit : float, default 0.01
+        The scene's unit, where a topology is given.
+
+    Returns
+    -------
+    ndarray
+        ``(V,)`` float32.
+    """
     if isinstance(groom, Groom):
         meters_per_unit = groom.metadata.meters_per_unit
     root = ROOT_WIDTH_M / meters_per_unit if root is None else root
@@ -62,7 +77,24 @@ def render_prims(hair: Metadata, hair_strands: int, guides: Metadata, guide_stra
     without prims of its own is named after the other: children of the guides at P go to
     ``P + "Render"`` (``/Groom/Hair`` beside hairtool's own ``/Groom/Guides``) and are drawn
     with the guides' basis (their points are interpolated control points); guides picked from
-    dense hair at H go to ``H + "Guides"``; with neither, ``/Groom/Hair`` and ``/Groom/Guides``."""
+    dense hair at H go to ``H + "Guides"``; with neither, ``/Groom/Hair`` and ``/Groom/Guides``.
+
+    Parameters
+    ----------
+    hair : Metadata
+        The render hair's record.
+    hair_strands : int
+        Its strands.
+    guides : Metadata
+        The guides' record.
+    guide_strands : int
+        Their strands.
+
+    Returns
+    -------
+    tuple of (tuple, tuple)
+        The hair's prims and the guides' prims.
+    """
     own_hair = _fitting(hair, hair_strands, guide=False)
     own_guides = tuple(replace(c, purpose="guide") for c in guides.for_strands(guide_strands).curves)
     if not own_guides:
@@ -85,7 +117,26 @@ def joined_attributes(hair, hair_topology: Topology, guides, meta: Metadata, pri
     """The per-vertex attributes of the hair then the guides, widths defaulted where a side has
     none (80 µm tapered to 16 µm for the hair, 80 µm for the guides, in ``meta``'s unit), a
     colour or transparency only one side has filled on the other (its prims then say they lack
-    it, so it is not written there); and the prims with those marks."""
+    it, so it is not written there); and the prims with those marks.
+
+    Parameters
+    ----------
+    hair : dict or Groom
+        The render hair's per-vertex attributes, or the render hair.
+    hair_topology : Topology
+        Its strands.
+    guides : Groom
+        The guides.
+    meta : Metadata
+        The record written (its unit for the default widths).
+    prims : tuple
+        The hair's and the guides' prims (:func:`render_prims`).
+
+    Returns
+    -------
+    tuple of (dict, tuple)
+        The joined attributes and the prims with their marks.
+    """
     mpu = meta.meters_per_unit
     h = dict(hair) if isinstance(hair, dict) else dict(hair.attributes)
     g = dict(guides.attributes)
@@ -101,7 +152,22 @@ def joined_attributes(hair, hair_topology: Topology, guides, meta: Metadata, pri
 def with_guides(hair: Groom, guides: Groom, metadata: Metadata | None = None) -> Groom:
     """One groom: the render strands then the guides (purpose ``guide``), each on its prims
     (:func:`render_prims`), with their widths, colours and transparency
-    (:func:`joined_attributes`); ``metadata``'s space and time codes (default: the guides')."""
+    (:func:`joined_attributes`); ``metadata``'s space and time codes (default: the guides').
+
+    Parameters
+    ----------
+    hair : Groom
+        The render strands.
+    guides : Groom
+        Their guides.
+    metadata : Metadata, optional
+        Space and time codes (None: the guides').
+
+    Returns
+    -------
+    Groom
+        Both, on their own prims.
+    """
     base = guides.metadata if metadata is None else metadata
     prims = render_prims(hair.metadata, hair.strand_count, guides.metadata, guides.strand_count)
     attrs, curves = joined_attributes(hair, hair.topology, guides, base, prims)
@@ -116,7 +182,18 @@ def with_guides(hair: Groom, guides: Groom, metadata: Metadata | None = None) ->
 def split_guides(groom: Groom | Animation) -> tuple[Groom | Animation, Groom | Animation | None]:
     """``(hair, guides)``: the strands of prims with purpose ``guide`` apart from the rest
     (``guides`` None when no prim is marked so); an animation splits into two animations. Each
-    part keeps the scene and its own prims (paths, basis, wrap)."""
+    part keeps the scene and its own prims (paths, basis, wrap).
+
+    Parameters
+    ----------
+    groom : Groom or Animation
+        Strands read from a file.
+
+    Returns
+    -------
+    tuple of (Groom or Animation, Groom or Animation or None)
+        The render hair and the guides.
+    """
     prims = groom.metadata.for_strands(groom.strand_count).curves
     marks = [np.full(c.strands, c.purpose == "guide") for c in prims]
     if not marks or not any(c.purpose == "guide" for c in prims):
@@ -148,6 +225,15 @@ class AnimationWithGuides(StrandSizes):
     (default: the guides animation's)."""
 
     def __init__(self, hair: RenderHairAnimation, metadata: Metadata | None = None) -> None:
+        """The frames of ``hair`` with its guides after them, made one at a time.
+
+        Parameters
+        ----------
+        hair : RenderHairAnimation
+            Render hair following its guides.
+        metadata : Metadata, optional
+            Space and time codes (None: the guides').
+        """
         self.hair, guides = hair, hair.guides
         self.guides = guides
         self.topology = Topology(np.concatenate([hair.counts, guides.counts]))
@@ -171,7 +257,18 @@ class AnimationWithGuides(StrandSizes):
         return self.guides.time_codes
 
     def frame_points(self, f: int) -> np.ndarray:
-        """``(V, 3)`` float32: the children at frame ``f``, then the guides."""
+        """``(V, 3)`` float32: the children at frame ``f``, then the guides.
+
+        Parameters
+        ----------
+        f : int
+            The frame.
+
+        Returns
+        -------
+        ndarray
+            ``(V, 3)`` float32.
+        """
         out = np.empty((self.vertex_count, 3), np.float32)
         n = self.hair.vertex_count
         self.hair.frame_points(f, out[:n])  # the children straight into their rows
@@ -181,7 +278,18 @@ class AnimationWithGuides(StrandSizes):
 
 def guides_path_for(path: str | os.PathLike[str]) -> Path:
     """Where the guides go beside render hair in a format that cannot mark them:
-    ``shot.npz`` → ``shot.guides.npz``."""
+    ``shot.npz`` → ``shot.guides.npz``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The render hair's file.
+
+    Returns
+    -------
+    Path
+        The guides' file beside it.
+    """
     p = Path(path)
     return p.with_name(f"{p.stem}.guides{p.suffix}")
 
@@ -201,7 +309,24 @@ def write_animation(
     (``.npz`` every frame, built whole in memory; ``.hair`` and ``.obj`` frame 0) and the guides
     animation goes to ``guides_path`` (default :func:`guides_path_for`). ``progress(done,
     total)`` after each frame; an exception it raises (Cancelled) stops the write, no file
-    left. Returns the paths written (``output``, ``guides_output``)."""
+    left. Returns the paths written (``output``, ``guides_output``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The render hair's file.
+    hair : RenderHairAnimation
+        Render hair following its guides.
+    guides_path : str or os.PathLike, optional
+        Where the guides go too (a USD file) or instead.
+    progress : callable, optional
+        ``progress(done, total)`` after each frame.
+
+    Returns
+    -------
+    dict of str to str
+        ``output`` and ``guides_output``.
+    """
     from hairtool import io
     from hairtool.io import usd
 

@@ -40,7 +40,22 @@ _SALT = 0xC41D  # the stream of planted children's roots
 def guides_now(rest: Groom, current: Groom, origin: np.ndarray) -> Groom:
     """The guides ``current`` with each kept strand's rest shape (``origin[i]`` ≥ 0: strand
     ``origin[i]`` of ``rest``) and each planted strand's (``origin[i]`` < 0) shape in ``current``:
-    the rest guides of :func:`follow_guides`' binding, with ``rest``'s metadata."""
+    the rest guides of :func:`follow_guides`' binding, with ``rest``'s metadata.
+
+    Parameters
+    ----------
+    rest : Groom
+        The guides at rest.
+    current : Groom
+        The guides now, strands kept, removed or planted.
+    origin : ndarray
+        ``(S,)`` each current strand's rest strand, −1 for a planted one.
+
+    Returns
+    -------
+    Groom
+        The rest guides of the following binding.
+    """
     origin = np.asarray(origin, np.int64)
     if origin.shape != (current.strand_count,) or np.any(origin >= rest.strand_count):
         where = f"a rest strand (or −1) for each of {current.strand_count}"
@@ -81,7 +96,26 @@ def _tangent_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def planted_roots(root: np.ndarray, normal: np.ndarray, count: int, radius: float, seed: int) -> np.ndarray:
     """``(count, 3)`` roots uniform on the disc of ``radius`` around ``root`` perpendicular to
-    ``normal``, drawn from ``seed`` and the root's bytes."""
+    ``normal``, drawn from ``seed`` and the root's bytes.
+
+    Parameters
+    ----------
+    root : ndarray
+        ``(3,)`` the planted guide's root.
+    normal : ndarray
+        ``(3,)`` the head's normal there.
+    count : int
+        Roots.
+    radius : float
+        The disc's radius.
+    seed : int
+        The draws' seed.
+
+    Returns
+    -------
+    ndarray
+        ``(count, 3)`` float64.
+    """
     bits = np.asarray(root, np.float64).view(np.uint32)
     rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, *(int(b) for b in bits), _SALT])
     n = np.asarray(normal, np.float64)
@@ -98,7 +132,26 @@ def follow_guides(
 ) -> ChildBinding:
     """The children of ``binding`` for the strands ``guides`` (their rest shapes, as
     :func:`guides_now` gives them) whose rest strands are ``origin`` (module docstring).
-    ``surface``: the head (anything with ``project(points) -> (points, normals)``), or None."""
+    ``surface``: the head (anything with ``project(points) -> (points, normals)``), or None.
+
+    Parameters
+    ----------
+    binding : ChildBinding
+        The children as they were bound.
+    guides : Groom
+        The guides now.
+    origin : ndarray
+        ``(S,)`` each guide's rest strand, −1 for a planted one.
+    surface : object, optional
+        The head, for the children of planted guides.
+    seed : int, default 0
+        The planted children's seed.
+
+    Returns
+    -------
+    ChildBinding
+        The children of the guides now.
+    """
     origin = np.asarray(origin, np.int64)
     g0 = binding.rest_guides.strand_count
     if origin.shape != (guides.strand_count,) or np.any(origin >= g0):

@@ -117,7 +117,28 @@ def guide_tables(
     vertices (``rest_tangent`` (G, 3): their rest root tangents), into rows ``row0 …`` of
     ``out`` when given; ``axes``: the scene's frame the root normals start from (default the
     guides' own, :attr:`hairtool.metadata.Metadata.frame`). The numpy twin is
-    :func:`guide_tables_reference`."""
+    :func:`guide_tables_reference`.
+
+    Parameters
+    ----------
+    guides : Groom
+        The guides.
+    n : int
+        Vertices per guide, ≥ 2.
+    rest_tangent : ndarray
+        ``(G, 3)`` rest root tangents.
+    out : tuple of ndarray, optional
+        Tables to write into.
+    row0 : int, default 0
+        The first row written.
+    axes : ndarray, optional
+        The scene's frame (None: x, y, z).
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        ``seg``, ``seglen`` and ``frames``.
+    """
     rows = guides.strand_count * n
     seg, seglen, frm = out if out is not None else (np.empty((rows, 3)), np.empty(rows), np.empty((rows, 9)))
     frame = guides.metadata.frame if axes is None else axes
@@ -133,7 +154,18 @@ def guide_tables_reference(
     guides: Groom, n: int, rest_tangent: np.ndarray, axes: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Numpy twin of :func:`guide_tables`: :func:`resampled`, whole-array differences and
-    :func:`frames_reference`."""
+    :func:`frames_reference`.
+
+    Parameters
+    ----------
+    guides, n, rest_tangent, axes
+        As :func:`guide_tables` takes them.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        As :func:`guide_tables` gives them.
+    """
     p = resampled(guides, n)
     s = np.zeros_like(p)
     s.reshape(-1, n, 3)[:, 1:] = np.diff(p.reshape(-1, n, 3), axis=1)
@@ -146,7 +178,20 @@ def guide_tables_reference(
 
 def root_tangents(points: np.ndarray, n: int) -> np.ndarray:
     """``(G, 3)`` unit tangents of the first segments of guides of n vertices (x where a first
-    segment has no length)."""
+    segment has no length).
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(G·n, 3)`` guides of n vertices each.
+    n : int
+        Vertices per guide.
+
+    Returns
+    -------
+    ndarray
+        ``(G, 3)`` float64.
+    """
     p = points.reshape(-1, n, 3)
     t = p[:, 1] - p[:, 0]
     d = np.linalg.norm(t, axis=1)
@@ -169,7 +214,24 @@ def frames_reference(
     points: np.ndarray, rest_tangent: np.ndarray, n: int, axes: np.ndarray | None = None
 ) -> np.ndarray:
     """Numpy twin of :func:`frames`, one guide and one vertex at a time (``axes``: the scene's
-    frame, default x, y, z)."""
+    frame, default x, y, z).
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(G·n, 3)`` guides of n vertices each.
+    rest_tangent : ndarray
+        ``(G, 3)`` rest root tangents.
+    n : int
+        Vertices per guide.
+    axes : ndarray, optional
+        The scene's frame.
+
+    Returns
+    -------
+    ndarray
+        ``(G·n, 9)`` float64 frames.
+    """
     p = np.asarray(points, np.float64).reshape(-1, n, 3)
     out = np.empty((p.shape[0], n, 9))
     f = np.eye(3) if axes is None else np.asarray(axes, np.float64)
@@ -196,7 +258,20 @@ def frames_reference(
 
 def resampled(guides: Groom, n: int) -> np.ndarray:
     """``(G·n, 3)`` float64: every guide at n vertices, evenly in vertex parameter (i/(n−1) of
-    its vertices, linearly between them); a guide of n vertices is taken as it is."""
+    its vertices, linearly between them); a guide of n vertices is taken as it is.
+
+    Parameters
+    ----------
+    guides : Groom
+        The guides.
+    n : int
+        Vertices per guide.
+
+    Returns
+    -------
+    ndarray
+        ``(G·n, 3)`` float64.
+    """
     g = guides.strand_count
     out = np.empty((g, n, 3))
     pts = guides.points.astype(np.float64)

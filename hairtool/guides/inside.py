@@ -24,6 +24,13 @@ class PseudoNormals:
     """The face, edge and corner normals of a mesh (float64, unit), for :meth:`side`."""
 
     def __init__(self, mesh: Mesh) -> None:
+        """The normals of every face, edge and corner of ``mesh``.
+
+        Parameters
+        ----------
+        mesh : Mesh
+            The head.
+        """
         v = mesh.vertices.astype(np.float64)
         f = mesh.faces.astype(np.int64)
         a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
@@ -53,7 +60,20 @@ class PseudoNormals:
         self.vertices = v
 
     def normals_at(self, q: np.ndarray, face: np.ndarray) -> np.ndarray:
-        """``(P, 3)`` the pseudo-normal of the feature of ``face`` that ``q`` (on it) lies on."""
+        """``(P, 3)`` the pseudo-normal of the feature of ``face`` that ``q`` (on it) lies on.
+
+        Parameters
+        ----------
+        q : ndarray
+            ``(P, 3)`` points on the mesh.
+        face : ndarray
+            ``(P,)`` the face each lies on.
+
+        Returns
+        -------
+        ndarray
+            ``(P, 3)`` float64 unit normals.
+        """
         f = self.faces[face]
         a, b, c = self.vertices[f[:, 0]], self.vertices[f[:, 1]], self.vertices[f[:, 2]]
         w = barycentric(q, a, b, c)  # (P, 3) weights of corners 0, 1, 2
@@ -72,7 +92,20 @@ class PseudoNormals:
 
 
 def barycentric(q: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """``(P, 3)`` weights of ``q`` on triangles ``abc`` (a third each where a triangle is degenerate)."""
+    """``(P, 3)`` weights of ``q`` on triangles ``abc`` (a third each where a triangle is degenerate).
+
+    Parameters
+    ----------
+    q : ndarray
+        ``(P, 3)`` points.
+    a, b, c : ndarray
+        ``(P, 3)`` the triangles' corners.
+
+    Returns
+    -------
+    ndarray
+        ``(P, 3)`` float64 weights.
+    """
     e0, e1, e2 = b - a, c - a, q - a
     d00, d01, d11 = (e0 * e0).sum(1), (e0 * e1).sum(1), (e1 * e1).sum(1)
     d20, d21 = (e2 * e0).sum(1), (e2 * e1).sum(1)

@@ -34,7 +34,22 @@ def euclidean_nearest(
     guide_roots: np.ndarray, child_roots: np.ndarray, k: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(N, k+1)`` nearest guides of each child root in space and their distances, sorted by
-    (distance, guide); −1 / inf past the last guide."""
+    (distance, guide); −1 / inf past the last guide.
+
+    Parameters
+    ----------
+    guide_roots : ndarray
+        ``(G, 3)``.
+    child_roots : ndarray
+        ``(N, 3)``.
+    k : int
+        Guides per child.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``(N, k+1)`` guides and distances.
+    """
     n = len(child_roots)
     out_g = np.empty((n, k + 1), np.int64)
     out_d = np.empty((n, k + 1))
@@ -48,7 +63,18 @@ def euclidean_nearest(
 def euclidean_nearest_reference(
     guide_roots: np.ndarray, child_roots: np.ndarray, k: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Numpy twin of :func:`euclidean_nearest`: all distances, then a stable sort."""
+    """Numpy twin of :func:`euclidean_nearest`: all distances, then a stable sort.
+
+    Parameters
+    ----------
+    guide_roots, child_roots, k
+        As :func:`euclidean_nearest` takes them.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        As :func:`euclidean_nearest` gives them.
+    """
     g = np.asarray(guide_roots, np.float64)
     c = np.asarray(child_roots, np.float64)
     d = np.sqrt(((g[None, :, :] - c[:, None, :]) ** 2).sum(axis=2))
@@ -62,7 +88,22 @@ def euclidean_nearest_reference(
 
 
 def weights(guide_ids: np.ndarray, dist: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(N, k)`` guides and float64 weights (sum 1) from the k+1 nearest (see the module)."""
+    """``(N, k)`` guides and float64 weights (sum 1) from the k+1 nearest (see the module).
+
+    Parameters
+    ----------
+    guide_ids : ndarray
+        ``(N, k+1)`` nearest guides.
+    dist : ndarray
+        ``(N, k+1)`` their distances.
+    k : int
+        Guides each child blends.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``(N, k)`` guides and weights.
+    """
     d = dist[:, :k]
     r = dist[:, k] if dist.shape[1] > k else np.full(len(d), np.inf)
     reached = np.where(np.isfinite(d), d, 0.0).max(axis=1)
@@ -102,14 +143,40 @@ def _fps_kernel(roots, first, count, out):
 
 def farthest_point_sampling(roots: np.ndarray, count: int, first: int) -> np.ndarray:
     """``count`` strand indices: ``first``, then each time the root farthest from those chosen
-    (ties: the lower index), in the order chosen."""
+    (ties: the lower index), in the order chosen.
+
+    Parameters
+    ----------
+    roots : ndarray
+        ``(S, 3)``.
+    count : int
+        Strands to choose.
+    first : int
+        The first one.
+
+    Returns
+    -------
+    ndarray
+        ``(count,)`` int64.
+    """
     out = np.empty(count, np.int64)
     _fps_kernel(np.ascontiguousarray(roots, np.float64), int(first), int(count), out)
     return out
 
 
 def farthest_point_sampling_reference(roots: np.ndarray, count: int, first: int) -> np.ndarray:
-    """Numpy twin of :func:`farthest_point_sampling`."""
+    """Numpy twin of :func:`farthest_point_sampling`.
+
+    Parameters
+    ----------
+    roots, count, first
+        As :func:`farthest_point_sampling` takes them.
+
+    Returns
+    -------
+    ndarray
+        As :func:`farthest_point_sampling` gives it.
+    """
     r = np.asarray(roots, np.float64)
     out = [int(first)]
     mind = np.full(len(r), np.inf)

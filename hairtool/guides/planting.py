@@ -48,7 +48,28 @@ class HeadSurface(MeshSurface):
     ) -> Groom | None:
         """``count`` new strands around the surface point closest to ``cursor`` (module
         docstring), or None where the surface there faces away from a camera looking along
-        ``view``."""
+        ``view``.
+
+        Parameters
+        ----------
+        groom : Groom
+            The strands the new ones are shaped like.
+        cursor : array_like
+            The brush's cursor.
+        radius : float
+            The brush radius.
+        count : int
+            New strands.
+        seed : int
+            The draws' seed (with the cursor's bytes).
+        view : array_like, optional
+            The camera's direction (None: no facing test).
+
+        Returns
+        -------
+        Groom or None
+            The new strands.
+        """
         if isinstance(count, bool) or int(count) != count or not 1 <= count <= MAX_PLANT:
             raise ParameterError("count", count, f"a whole number of strands in [1, {MAX_PLANT}]")
         c = np.asarray(cursor, np.float64).reshape(1, 3)
@@ -64,7 +85,20 @@ class HeadSurface(MeshSurface):
 
     def grow(self, groom: Groom, roots: np.ndarray) -> Groom:
         """New strands at ``roots`` shaped like the groom's strands around them (render-hair
-        children of them with no random length variation or frizz), in the order of ``roots``."""
+        children of them with no random length variation or frizz), in the order of ``roots``.
+
+        Parameters
+        ----------
+        groom : Groom
+            The strands the new ones are shaped like.
+        roots : ndarray
+            ``(N, 3)`` their roots.
+
+        Returns
+        -------
+        Groom
+            The new strands.
+        """
         roots = np.asarray(roots, np.float64)
         k = min(DEFAULT_K, groom.strand_count)
         binding = bind_roots(groom, roots, k=k, length_variation=0.0, frizz=0.0)

@@ -38,7 +38,18 @@ class ChildClump:
     def following(cls, params) -> ChildClump:
         """The children's ClumpWithGaps with an engine's clump passes, gap mode and length rule
         (``params``: a :class:`~hairtool.frozen.pipeline.FrozenParams`), at the children's own
-        automatic radius and step: what the studio's Clump children runs."""
+        automatic radius and step: what the studio's Clump children runs.
+
+        Parameters
+        ----------
+        params : FrozenParams
+            The engine's parameters.
+
+        Returns
+        -------
+        ChildClump
+            The children's clumping.
+        """
         return cls(
             iterations=params.clump_iterations, gap_mode=params.gap_mode, keep_lengths=params.keep_lengths
         )
@@ -59,6 +70,15 @@ class RenderHair:
     clumps again only the clumps holding them, with the bytes of a fresh run."""
 
     def __init__(self, binding: ChildBinding, clump: ChildClump | None = None) -> None:
+        """The render strands of ``binding``, clumped by ``clump`` where given.
+
+        Parameters
+        ----------
+        binding : ChildBinding
+            The children bound to their guides.
+        clump : ChildClump, optional
+            The children's own clumping (None: none).
+        """
         self.binding = binding
         self.clump = None if clump is None else clump.validate()
         self._radius: float | None = None
@@ -85,7 +105,18 @@ class RenderHair:
     def update_points(self, guides: Groom | None = None) -> np.ndarray:
         """float32 ``(V, 3)``: the render strands' points for the guides' current shapes (their
         rest shapes by default), in an array this object keeps and rewrites on the next update
-        (copy it to keep it)."""
+        (copy it to keep it).
+
+        Parameters
+        ----------
+        guides : Groom, optional
+            The guides' current shapes (None: at rest).
+
+        Returns
+        -------
+        ndarray
+            ``(V, 3)`` float32, this object's buffer.
+        """
         b = self.binding
         pose = b.rest_guides if guides is None else guides
         b.check_guides(pose)
@@ -107,7 +138,18 @@ class RenderHair:
         return self._clumps.run(self._children, b.topology, redo)
 
     def update(self, guides: Groom | None = None) -> Groom:
-        """The render strands for the guides' current shapes (their rest shapes by default)."""
+        """The render strands for the guides' current shapes (their rest shapes by default).
+
+        Parameters
+        ----------
+        guides : Groom, optional
+            The guides' current shapes (None: at rest).
+
+        Returns
+        -------
+        Groom
+            The render strands.
+        """
         b = self.binding
         points = self.update_points(guides).copy()
         return Groom(points, b.topology, **b.attributes, metadata=b.metadata)

@@ -30,11 +30,31 @@ FIT_ROOTS = 128
 
 
 def is_usd(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` names a USD file (by its suffix).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The scalp's path.
+
+    Returns
+    -------
+    bool
+        True for ``.usd``, ``.usda`` and ``.usdc``.
+    """
     return Path(path).suffix.lower() in USD_SUFFIXES
 
 
 def check_up_axis(path: str | os.PathLike[str] | None, up_axis: str | None) -> None:
-    """Refuse ``--scalp-up-axis`` without a scalp, or for a USD scalp (its stage says its own)."""
+    """Refuse ``--scalp-up-axis`` without a scalp, or for a USD scalp (its stage says its own).
+
+    Parameters
+    ----------
+    path : str or os.PathLike or None
+        The scalp (None: none given).
+    up_axis : str or None
+        ``"y"`` or ``"z"``, the OBJ's up axis (None: the groom's).
+    """
     if up_axis is None:
         return
     if path is None:
@@ -59,7 +79,22 @@ def _stage_frame(path: Path) -> Metadata:
 def to_frame(mesh: Mesh, source: Metadata, target: Metadata) -> Mesh:
     """``mesh`` in ``source``'s up axis and unit, turned and scaled into ``target``'s (through
     hairtool's reference frame, :attr:`~hairtool.metadata.Metadata.frame`); the same mesh when
-    both agree."""
+    both agree.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The scalp as read.
+    source : Metadata
+        Its up axis and unit.
+    target : Metadata
+        The groom's.
+
+    Returns
+    -------
+    Mesh
+        The scalp in the groom's frame.
+    """
     turn = source.frame @ target.frame.T  # scene rows -> reference -> the target's scene
     scale = source.meters_per_unit / target.meters_per_unit
     if source.up_axis == target.up_axis and scale == 1.0:
@@ -115,7 +150,20 @@ def _box(points: np.ndarray) -> str:
 
 
 def root_distances(mesh: Mesh, roots: np.ndarray) -> np.ndarray:
-    """Distances from (at most :data:`FIT_ROOTS`, evenly picked) ``roots`` to the mesh surface."""
+    """Distances from (at most :data:`FIT_ROOTS`, evenly picked) ``roots`` to the mesh surface.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The scalp, in the groom's frame.
+    roots : ndarray
+        ``(S, 3)`` guide roots.
+
+    Returns
+    -------
+    ndarray
+        Up to :data:`FIT_ROOTS` float64 distances.
+    """
     from hairtool.guides.surface import closest_points
 
     r = np.asarray(roots, np.float64).reshape(-1, 3)
@@ -127,7 +175,24 @@ def root_distances(mesh: Mesh, roots: np.ndarray) -> np.ndarray:
 
 def check_fit(path: str | os.PathLike[str], mesh: Mesh, points: np.ndarray, roots: np.ndarray) -> None:
     """Refuse a scalp whose surface lies farther from the guide ``roots`` (median) than
-    :data:`FAR_SHARE` of the size of the groom (``points``): one line with both boxes."""
+    :data:`FAR_SHARE` of the size of the groom (``points``): one line with both boxes.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The scalp, named in the refusal.
+    mesh : Mesh
+        The scalp, in the groom's frame.
+    points : ndarray
+        ``(V, 3)`` the groom's points (its size).
+    roots : ndarray
+        ``(S, 3)`` its guide roots.
+
+    Raises
+    ------
+    FormatError
+        Where the scalp lies too far from the roots.
+    """
     pts = np.asarray(points, np.float64).reshape(-1, 3)
     if len(pts) == 0 or len(mesh.faces) == 0:
         return
@@ -143,7 +208,22 @@ def check_fit(path: str | os.PathLike[str], mesh: Mesh, points: np.ndarray, root
 
 
 def load_scalp(path: str | os.PathLike[str], groom, up_axis: str | None = None) -> Mesh:
-    """:func:`read_scalp` in ``groom``'s frame, checked to lie where its roots are (:func:`check_fit`)."""
+    """:func:`read_scalp` in ``groom``'s frame, checked to lie where its roots are (:func:`check_fit`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A USD stage or an OBJ.
+    groom : Groom
+        The guides whose frame and roots the scalp must match.
+    up_axis : str, optional
+        An OBJ's up axis, ``"y"`` or ``"z"`` (None: the groom's).
+
+    Returns
+    -------
+    Mesh
+        The scalp in the groom's frame.
+    """
     mesh = read_scalp(path, groom.metadata, up_axis)
     check_fit(path, mesh, groom.points, groom.roots)
     return mesh

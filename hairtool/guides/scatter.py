@@ -29,10 +29,31 @@ CH_VARIATION = 2
 
 
 def generator(seed: int, channel: int) -> np.random.Generator:
+    """The random generator of one ``channel`` (scatter, lengths, frizz) of ``seed``.
+
+    Parameters
+    ----------
+    seed : int
+        The user's seed.
+    channel : int
+        Which draws.
+
+    Returns
+    -------
+    numpy.random.Generator
+        Seeded by the pair.
+    """
     return np.random.default_rng((int(seed), int(channel)))
 
 
 def check_mesh(mesh: Mesh) -> None:
+    """A ParameterError for a scalp with no faces or non-finite vertices.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The scalp.
+    """
     if len(mesh.faces) == 0:
         raise ParameterError("scalp", "a mesh without faces", "a mesh with at least one triangle")
     if not np.all(np.isfinite(mesh.vertices)):
@@ -41,7 +62,18 @@ def check_mesh(mesh: Mesh) -> None:
 
 def guide_spacing(guides: Groom) -> float:
     """The median distance between neighbouring guide roots (the groom's extent / √G if the
-    roots give none)."""
+    roots give none).
+
+    Parameters
+    ----------
+    guides : Groom
+        The guides.
+
+    Returns
+    -------
+    float
+        The spacing, in the groom's units.
+    """
     s = median_root_spacing(guides)
     if s > 0:
         return s
@@ -50,6 +82,18 @@ def guide_spacing(guides: Groom) -> float:
 
 
 def face_areas(mesh: Mesh) -> np.ndarray:
+    """``(F,)`` float64 area of each face.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The mesh.
+
+    Returns
+    -------
+    ndarray
+        ``(F,)`` float64.
+    """
     v = mesh.vertices.astype(np.float64)
     f = mesh.faces
     return 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
@@ -60,7 +104,24 @@ def default_region(
 ) -> np.ndarray:
     """``(F,)`` bool: the faces whose three corners lie on average within ``reach`` guide
     spacings of a guide root along the surface (of the guides flagged in ``near`` only, e.g.
-    those the artist painted, when given)."""
+    those the artist painted, when given).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The scalp.
+    guides : Groom
+        The guides.
+    reach : float, default DEFAULT_REACH
+        How many guide spacings from a root.
+    near : ndarray, optional
+        ``(G,)`` bool, the guides that count.
+
+    Returns
+    -------
+    ndarray
+        ``(F,)`` bool.
+    """
     check_mesh(mesh)
     if not np.isfinite(reach) or reach <= 0:
         raise ParameterError("reach", reach, "a positive number of guide spacings")
@@ -114,7 +175,26 @@ def scatter_on_mesh(
 ) -> tuple[np.ndarray, np.ndarray]:
     """``count`` roots on the ``region`` faces (mask, indices or a face set's name), uniform by
     area × density (a per-vertex density is averaged over each triangle's corners): ``(N, 3)``
-    float64 points and ``(N,)`` their faces."""
+    float64 points and ``(N,)`` their faces.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The scalp.
+    count : int
+        Roots.
+    seed : int
+        The draws' seed.
+    region : ndarray or str
+        Face mask, face indices or a face set's name.
+    density : ndarray, optional
+        ``(Vm,)`` per-vertex density.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        Roots and their faces.
+    """
     check_mesh(mesh)
     weight = face_areas(mesh) * _face_mask(mesh, region)
     if density is not None:
@@ -137,7 +217,22 @@ def scatter_around(guides: Groom, count: int, seed: int) -> np.ndarray:
     """``(N, 3)`` float64 roots without a mesh: around random guide roots, in the disc of one
     guide spacing across each root's tangent. The disc's axes start from the scene's axis
     least along the tangent (in the groom's frame, :attr:`hairtool.metadata.Metadata.frame`),
-    so the same groom in Y-up or Z-up gets the same roots."""
+    so the same groom in Y-up or Z-up gets the same roots.
+
+    Parameters
+    ----------
+    guides : Groom
+        The guides.
+    count : int
+        Roots.
+    seed : int
+        The draws' seed.
+
+    Returns
+    -------
+    ndarray
+        ``(N, 3)`` float64.
+    """
     rng = generator(seed, CH_SCATTER)
     g = rng.integers(0, guides.strand_count, count)
     radius = guide_spacing(guides) * np.sqrt(rng.random(count))

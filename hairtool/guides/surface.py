@@ -82,7 +82,20 @@ def _closest_kernel(points, vertices, faces, out, face_of):
 def usable_faces(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Indices of the faces with an area: a degenerate face (``f 1 1 4``, common in real heads,
     or three points on a line) has none, and the closest-point kernels would divide by its zero
-    edge or area. Skipping it loses nothing: its points lie on its neighbours' edges."""
+    edge or area. Skipping it loses nothing: its points lie on its neighbours' edges.
+
+    Parameters
+    ----------
+    vertices : ndarray
+        ``(Vm, 3)`` the mesh's vertices.
+    faces : ndarray
+        ``(F, 3)`` its triangles.
+
+    Returns
+    -------
+    ndarray
+        int64 face indices.
+    """
     v = np.asarray(vertices, np.float64)
     f = np.asarray(faces, np.int64)
     a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
@@ -92,7 +105,20 @@ def usable_faces(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 def finite_points(points: np.ndarray, what: str = "points") -> np.ndarray:
     """``points`` as a float64 ``(P, 3)`` array, or a :class:`ParameterError` where one is not
-    finite (no kernel is asked where NaN is closest)."""
+    finite (no kernel is asked where NaN is closest).
+
+    Parameters
+    ----------
+    points : ndarray
+        Points, reshaped to ``(P, 3)``.
+    what : str, default "points"
+        Their name in a refusal.
+
+    Returns
+    -------
+    ndarray
+        ``(P, 3)`` float64.
+    """
     pts = np.ascontiguousarray(points, np.float64).reshape(-1, 3)
     if not np.all(np.isfinite(pts)):
         raise ParameterError(what, "a non-finite point", "finite coordinates")
@@ -101,7 +127,20 @@ def finite_points(points: np.ndarray, what: str = "points") -> np.ndarray:
 
 def closest_points(mesh: Mesh, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(P, 3)`` float64 closest points on the mesh and ``(P,)`` the face of each (every face
-    with an area tried: meant for guide roots, a few thousand at most)."""
+    with an area tried: meant for guide roots, a few thousand at most).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The head.
+    points : ndarray
+        ``(P, 3)`` finite points.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        The closest points and their faces.
+    """
     pts = finite_points(points)
     out = np.empty_like(pts)
     face_of = np.empty(len(pts), np.int64)
@@ -115,7 +154,18 @@ def closest_points(mesh: Mesh, points: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def edge_graph(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The mesh's edges as CSR ``(indptr, neighbours, lengths)`` (float64 lengths, both ways,
-    each vertex's neighbours in increasing order)."""
+    each vertex's neighbours in increasing order).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The head.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        ``indptr``, ``neighbours`` and ``lengths``.
+    """
     f = mesh.faces.astype(np.int64)
     e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
     e = np.concatenate([e, e[:, ::-1]])
@@ -165,7 +215,24 @@ def nearest_sources(
     mesh: Mesh, roots: np.ndarray, faces: np.ndarray, k: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """For every mesh vertex its k nearest guides along the surface (ties: the lower guide):
-    ``(Vm, k)`` int64 guides (−1 where fewer are reachable) and float64 distances (inf there)."""
+    ``(Vm, k)`` int64 guides (−1 where fewer are reachable) and float64 distances (inf there).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The head.
+    roots : ndarray
+        ``(G, 3)`` guide roots.
+    faces : ndarray
+        ``(G,)`` the face each root lies on.
+    k : int
+        Guides per vertex.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``(Vm, k)`` guides and distances.
+    """
     indptr, nbr, length = edge_graph(mesh)
     sv, sg, sd = _seeds(mesh, roots, faces)
     nv = len(mesh.vertices)
@@ -179,7 +246,18 @@ def nearest_sources_reference(
     mesh: Mesh, roots: np.ndarray, faces: np.ndarray, k: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """Numpy twin of :func:`nearest_sources`: one full Dijkstra per guide, then the k smallest
-    (distance, guide) per vertex."""
+    (distance, guide) per vertex.
+
+    Parameters
+    ----------
+    mesh, roots, faces, k
+        As :func:`nearest_sources` takes them.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        As :func:`nearest_sources` gives them.
+    """
     indptr, nbr, length = edge_graph(mesh)
     sv, sg, sd = _seeds(mesh, roots, faces)
     nv, ng = len(mesh.vertices), len(roots)
@@ -230,7 +308,21 @@ def _child_kernel(points, cface, faces, vertices, label_g, label_d, groots, gfac
 @njit(cache=True, nogil=True)
 def insert_nearest(out_g, out_d, c, g, d, kk):
     """Put (d, g) into row c's sorted list of the kk best (a guide already there keeps the
-    smaller distance)."""
+    smaller distance).
+
+    Parameters
+    ----------
+    out_g, out_d : ndarray
+        ``(R, kk)`` the rows' guides and distances, sorted.
+    c : int
+        The row.
+    g : int
+        The guide.
+    d : float
+        Its distance.
+    kk : int
+        The list's length.
+    """
     for m in range(kk):
         if out_g[c, m] == g:
             if d >= out_d[c, m]:
@@ -263,7 +355,26 @@ def surface_nearest(
     k: int,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(N, k+1)`` the nearest guides of each child root (on face ``child_faces``) along the
-    surface, and their distances, sorted; −1 / inf where fewer are reachable."""
+    surface, and their distances, sorted; −1 / inf where fewer are reachable.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The head.
+    guide_roots : ndarray
+        ``(G, 3)``.
+    child_roots : ndarray
+        ``(N, 3)``.
+    child_faces : ndarray
+        ``(N,)`` the face each child root lies on.
+    k : int
+        Guides per child.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``(N, k+1)`` guides and distances.
+    """
     on_mesh, gface = closest_points(mesh, guide_roots)
     label_g, label_d = nearest_sources(mesh, on_mesh, gface, k + 1)
     n = len(child_roots)
@@ -278,7 +389,20 @@ def surface_nearest(
 
 
 def nearest_guide_distance(mesh: Mesh, guide_roots: np.ndarray) -> np.ndarray:
-    """``(Vm,)`` each mesh vertex's distance along the surface to the nearest guide root."""
+    """``(Vm,)`` each mesh vertex's distance along the surface to the nearest guide root.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The head.
+    guide_roots : ndarray
+        ``(G, 3)``.
+
+    Returns
+    -------
+    ndarray
+        ``(Vm,)`` float64.
+    """
     on_mesh, gface = closest_points(mesh, guide_roots)
     _, d = nearest_sources(mesh, on_mesh, gface, 1)
     return d[:, 0]
@@ -337,7 +461,20 @@ def _empty_rings_kernel(start, dims, rings):  # pragma: no cover - compiled
 
 
 def empty_rings_numpy(start: np.ndarray, dims: np.ndarray) -> np.ndarray:
-    """:func:`_empty_rings_kernel`'s twin: grow the non-empty cells one 3×3×3 dilation at a time."""
+    """:func:`_empty_rings_kernel`'s twin: grow the non-empty cells one 3×3×3 dilation at a time.
+
+    Parameters
+    ----------
+    start : ndarray
+        ``(C + 1,)`` the grid's cell starts (a cell is empty where the next start is its own).
+    dims : ndarray
+        ``(3,)`` the grid's cells per axis.
+
+    Returns
+    -------
+    ndarray
+        ``(C,)`` int64 rings from each cell to a non-empty one (−1 where none is reached).
+    """
     shape = tuple(int(d) for d in dims)
     full = (np.diff(start) > 0).reshape(shape)
     rings = np.where(full, 0, -1)
@@ -442,6 +579,13 @@ class MeshSurface:
     cancel)."""
 
     def __init__(self, mesh: Mesh) -> None:
+        """A grid over the mesh's usable faces, for closest points and signed distances.
+
+        Parameters
+        ----------
+        mesh : Mesh
+            The head, with at least one face (ParameterError otherwise).
+        """
         if len(mesh.faces) == 0:
             raise ParameterError("scalp", "a mesh without faces", "a mesh with at least one triangle")
         if not np.all(np.isfinite(mesh.vertices)):
@@ -470,7 +614,18 @@ class MeshSurface:
     def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:func:`closest_points` through the grid of faces (the same bytes): ``(P, 3)`` points
         and ``(P,)`` faces, face −1 (and NaN points) for points outside the mesh's box (plus a
-        cell), which lie outside the head."""
+        cell), which lie outside the head.
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(P, 3)`` finite points.
+
+        Returns
+        -------
+        tuple of (ndarray, ndarray)
+            Closest points and faces.
+        """
         pts = finite_points(points)
         out = np.full_like(pts, np.nan)
         face_of = np.full(len(pts), -1, np.int64)
@@ -482,7 +637,18 @@ class MeshSurface:
         return out, np.where(face_of >= 0, self._keep[face_of], -1)
 
     def project(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(P, 3)`` float64 closest points on the mesh and ``(P, 3)`` unit normals there."""
+        """``(P, 3)`` float64 closest points on the mesh and ``(P, 3)`` unit normals there.
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(P, 3)`` finite points.
+
+        Returns
+        -------
+        tuple of (ndarray, ndarray)
+            Closest points and normals.
+        """
         q, face = self.nearest(points)
         far = face < 0
         if far.any():
@@ -493,7 +659,18 @@ class MeshSurface:
         """``(P,)`` signed distance to the head (< 0 inside: behind the pseudo-normal of the
         face, edge or corner the closest point lies on, :mod:`hairtool.guides.inside`), the
         closest points and those normals, the way out; points outside the mesh's box get +inf
-        (and NaN points and normals)."""
+        (and NaN points and normals).
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(P, 3)`` finite points.
+
+        Returns
+        -------
+        tuple of (ndarray, ndarray, ndarray)
+            Signed distances, closest points and normals.
+        """
         if self._pseudo is None:
             from hairtool.guides.inside import PseudoNormals
 
@@ -512,7 +689,20 @@ class MeshSurface:
     def ray_hit(self, origin, direction) -> np.ndarray | None:
         """The first point where the ray from ``origin`` along ``direction`` meets the mesh
         (Möller–Trumbore over every face, vectorised), or None: what a brush on the head
-        touches under the mouse."""
+        touches under the mouse.
+
+        Parameters
+        ----------
+        origin : array_like
+            ``(3,)`` the ray's start.
+        direction : array_like
+            ``(3,)`` its direction.
+
+        Returns
+        -------
+        ndarray or None
+            ``(3,)`` float64, or None for a miss.
+        """
         o, d = np.asarray(origin, np.float64), np.asarray(direction, np.float64)
         tri = self._f
         a, b, c = self._v[tri[:, 0]], self._v[tri[:, 1]], self._v[tri[:, 2]]

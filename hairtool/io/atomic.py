@@ -37,6 +37,8 @@ import stat
 from collections.abc import Iterator
 from pathlib import Path
 
+from hairtool import interrupts
+
 _CREATE_FLAGS = (
     os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_NOFOLLOW", 0)
 )
@@ -54,7 +56,22 @@ def host_tag() -> str:
 
 
 def temp_name(target: Path, pid: int, token: str) -> str:
-    """``.<name>.<host>-<pid>.<token>.tmp<suffix>``: hidden, beside the target, same suffix."""
+    """``.<name>.<host>-<pid>.<token>.tmp<suffix>``: hidden, beside the target, same suffix.
+
+    Parameters
+    ----------
+    target : Path
+        The file being written.
+    pid : int
+        The writer's process id.
+    token : str
+        A random part, so two writers of one process differ.
+
+    Returns
+    -------
+    str
+        The temporary's file name (no folder).
+    """
     return f".{target.name}.{host_tag()}-{pid}.{token}.tmp{target.suffix}"
 
 
@@ -67,7 +84,18 @@ def _temp_pattern(target: Path) -> re.Pattern[str]:
 
 def stale_temporaries(path: str | os.PathLike[str]) -> list[Path]:
     """Every temporary of ``path`` from any machine (``.<name>.<host>-<pid>.<random>.tmp…``);
-    only call this when no other writer of ``path`` is running."""
+    only call this when no other writer of ``path`` is running.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The target.
+
+    Returns
+    -------
+    list of Path
+        Its temporaries, sorted.
+    """
     target = Path(path)
     folder = target.parent if str(target.parent) else Path(".")
     name = re.escape(target.name)
@@ -98,7 +126,18 @@ def recording_writes() -> Iterator[list[Path]]:
 
 
 def process_alive(pid: int) -> bool:
-    """Whether process ``pid`` may still be writing; True whenever it cannot be ruled out."""
+    """Whether process ``pid`` may still be writing; True whenever it cannot be ruled out.
+
+    Parameters
+    ----------
+    pid : int
+        A process id of this host.
+
+    Returns
+    -------
+    bool
+        False only where the process is known to be gone.
+    """
     if pid == os.getpid():
         return True
     if os.name != "posix" or not 0 < pid < 2**31:
@@ -118,7 +157,18 @@ def process_alive(pid: int) -> bool:
 
 
 def remove_stale_temps(target: Path) -> list[Path]:
-    """Remove the temporaries of ``target`` left by writers of this host that no longer run."""
+    """Remove the temporaries of ``target`` left by writers of this host that no longer run.
+
+    Parameters
+    ----------
+    target : Path
+        The file about to be written.
+
+    Returns
+    -------
+    list of Path
+        The temporaries removed.
+    """
     folder = target.parent if str(target.parent) else Path(".")
     pattern = _temp_pattern(target)
     prefix = f".{target.name}."
@@ -192,6 +242,16 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     file it replaces; a new file gets 0o666 less the umask. Missing folders of ``path`` are
     created, and temporaries of ``path`` left by killed writers removed, first (see the module
     docstring).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The target.
+
+    Yields
+    ------
+    Path
+        The temporary path to write.
     """
     target = Path(path)
     _make_folder(target.parent if str(target.parent) else Path("."))
@@ -199,6 +259,8 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     tmp_path, new_file_mode = _create_temp(target)
     try:
         yield tmp_path
+        if interrupts.was_interrupted():  # a Ctrl+C a library swallowed (usd-core's plugin loading)
+            raise KeyboardInterrupt
         # After the writer: some (usd-core) replace the file at tmp_path with their own.
         os.chmod(tmp_path, _final_mode(target, new_file_mode))
         os.replace(tmp_path, target)
@@ -212,7 +274,22 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
 
 @contextlib.contextmanager
 def atomic_open(path: str | os.PathLike[str], mode: str = "wb", **kwargs) -> Iterator:
-    """Open a temporary file for writing; it replaces ``path`` only if the block finishes."""
+    """Open a temporary file for writing; it replaces ``path`` only if the block finishes.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The target.
+    mode : str, default "wb"
+        A writing mode of :func:`open`.
+    **kwargs
+        :func:`open`'s other keywords (``encoding``, ``newline``).
+
+    Yields
+    ------
+    file object
+        The temporary file, flushed and synced before the rename.
+    """
     with atomic_path(path) as tmp:
         with open(tmp, mode, **kwargs) as f:
             yield f

@@ -17,7 +17,19 @@ from hairtool.groom import MAX_STRAND_VERTICES
 
 
 def require_size(path: str | os.PathLike[str], data: bytes, min_size: int, what: str) -> None:
-    """An empty file, or one shorter than its ``what`` header of ``min_size`` bytes, is a FormatError."""
+    """An empty file, or one shorter than its ``what`` header of ``min_size`` bytes, is a FormatError.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, named in a refusal.
+    data : bytes
+        Its contents.
+    min_size : int
+        The header's size.
+    what : str
+        The header's name.
+    """
     if not data:
         raise FormatError(path, "the file is empty")
     if len(data) < min_size:
@@ -25,7 +37,24 @@ def require_size(path: str | os.PathLike[str], data: bytes, min_size: int, what:
 
 
 def read_bytes(path: Path, min_size: int, what: str, limit: int | None = None) -> bytes:
-    """The whole file (its first ``limit`` bytes with ``limit``), checked by :func:`require_size`."""
+    """The whole file (its first ``limit`` bytes with ``limit``), checked by :func:`require_size`.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+    min_size : int
+        The header's size.
+    what : str
+        The header's name.
+    limit : int, optional
+        Read at most this many bytes.
+
+    Returns
+    -------
+    bytes
+        The contents.
+    """
     if limit is None:
         data = path.read_bytes()
     else:
@@ -43,7 +72,28 @@ def array_at(
     count: int,
     what: str,
 ) -> np.ndarray:
-    """A read-only ``(count,)`` view of ``dtype`` at byte ``offset``; the range must lie in the file."""
+    """A read-only ``(count,)`` view of ``dtype`` at byte ``offset``; the range must lie in the file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, named in a refusal.
+    data : bytes
+        Its contents.
+    offset : int
+        Where the array starts.
+    dtype : str
+        Its numpy dtype.
+    count : int
+        Its length.
+    what : str
+        Its name in a refusal.
+
+    Returns
+    -------
+    ndarray
+        ``(count,)``, read-only.
+    """
     item = np.dtype(dtype).itemsize
     offset, count = int(offset), int(count)  # Python ints: products of header fields cannot overflow
     if count < 0 or offset < 0:
@@ -58,7 +108,17 @@ def array_at(
 
 
 def require_finite(path: str | os.PathLike[str], values: np.ndarray, what: str) -> None:
-    """Non-finite values in a file are corruption, not data."""
+    """Non-finite values in a file are corruption, not data.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, named in a refusal.
+    values : ndarray
+        Values read from it.
+    what : str
+        Their name in a refusal.
+    """
     finite = np.isfinite(values)
     if not finite.all():
         flat = np.flatnonzero(~finite.reshape(len(values), -1).all(axis=1))
@@ -66,7 +126,22 @@ def require_finite(path: str | os.PathLike[str], values: np.ndarray, what: str) 
 
 
 def float32_finite(path: str | os.PathLike[str], values: np.ndarray, what: str) -> np.ndarray:
-    """``values`` as float32, checked *after* the cast: a float64 of 1e39 is finite, its float32 is not."""
+    """``values`` as float32, checked *after* the cast: a float64 of 1e39 is finite, its float32 is not.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, named in a refusal.
+    values : ndarray
+        Values read from it.
+    what : str
+        Their name in a refusal.
+
+    Returns
+    -------
+    ndarray
+        float32.
+    """
     if values.dtype.kind not in "fiu":
         raise FormatError(path, f"{what} must hold numbers, not {values.dtype}")
     with np.errstate(over="ignore", invalid="ignore"):
@@ -90,6 +165,20 @@ def require_strand_counts(
 
     Bounding each count first keeps the int64 sum from wrapping around: counts of 2^62 whose sum
     wraps to the number of points in the file would otherwise pass the size checks.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, named in a refusal.
+    counts : ndarray
+        Each strand's vertex count.
+    points : int, optional
+        The points the header gives.
+
+    Returns
+    -------
+    int
+        The total.
     """
     counts = np.asarray(counts)
     if counts.size == 0:

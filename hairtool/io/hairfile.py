@@ -96,13 +96,35 @@ def _parse_header(path: Path, data: bytes) -> HairHeader:
 
 
 def read_header(path: str | os.PathLike[str]) -> HairHeader:
-    """The header alone: counts, array flags, defaults for absent arrays and the info string."""
+    """The header alone: counts, array flags, defaults for absent arrays and the info string.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A HAIR file.
+
+    Returns
+    -------
+    HairHeader
+        The header.
+    """
     p = Path(path)
     return _parse_header(p, read_bytes(p, HEADER_SIZE, "HAIR", limit=HEADER_SIZE))
 
 
 def read(path: Path) -> Groom:
-    """Read a HAIR file; every size is checked against the header before any array is read."""
+    """Read a HAIR file; every size is checked against the header before any array is read.
+
+    Parameters
+    ----------
+    path : Path
+        A HAIR file.
+
+    Returns
+    -------
+    Groom
+        The strands and the arrays it holds.
+    """
     data = read_bytes(path, HEADER_SIZE, "HAIR")
     h = _parse_header(path, data)
     flags = h.arrays
@@ -178,6 +200,17 @@ def write(
 
     ``info``: at most 87 UTF-8 bytes are kept (the field is NUL-terminated); ``None`` writes
     :data:`DEFAULT_INFO`.
+
+    Parameters
+    ----------
+    path : Path
+        The file, written atomically.
+    obj : Groom or Animation
+        What to write.
+    info : str, optional
+        The header's info string.
+    defaults : HairDefaults, optional
+        Values written for arrays left out.
     """
     groom = obj.rest if isinstance(obj, Animation) else obj
     d = defaults or HairDefaults()

@@ -65,6 +65,15 @@ _LOAD_ERRORS = (
 
 
 def write(path: Path, obj: Groom | Animation) -> None:
+    """Write a groom or an animation as hairtool's ``.npz`` cache (points, counts, attributes, record).
+
+    Parameters
+    ----------
+    path : Path
+        The file, written atomically.
+    obj : Groom or Animation
+        What to write.
+    """
     arrays: dict[str, np.ndarray] = {
         "format_version": np.array(FORMAT_VERSION, dtype=np.int64),
         "counts": np.asarray(obj.counts, dtype=np.int64),
@@ -137,6 +146,20 @@ def read_npy_header(path: str | os.PathLike[str], f, name: str) -> tuple[tuple[i
 
     The header's text is parsed here first: numpy falls back to a filter for Python 2 headers
     when its own parse fails, and that filter warns and lets ``tokenize.TokenError`` escape.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The archive, named in a refusal.
+    f : file object
+        The member, open at its start.
+    name : str
+        The member's name.
+
+    Returns
+    -------
+    tuple of (tuple of int, bool, numpy.dtype)
+        Its shape, whether it is Fortran-ordered, and its dtype.
     """
     start = f.tell()
     magic = f.read(8)
@@ -286,6 +309,19 @@ def _load_zip(path: Path, fh, single_npy: str):
 
 
 def read(path: Path) -> Groom | Animation:
+    """Read hairtool's ``.npz`` cache, every member's size checked against the bytes stored and
+    the budget before it is inflated.
+
+    Parameters
+    ----------
+    path : Path
+        The file.
+
+    Returns
+    -------
+    Groom or Animation
+        An Animation where the file holds frames.
+    """
     size = path.stat().st_size
     if size == 0:
         raise FormatError(path, "the file is empty")
@@ -355,7 +391,18 @@ def _zip_names(path: Path) -> list[str]:
 
 def holds_feature_array(path: str | os.PathLike[str]) -> bool:
     """Whether an ``.npz`` holds a raw feature array ``X`` rather than a hairtool cache (False for
-    anything that is not a zip archive: :func:`read` says what is wrong with it)."""
+    anything that is not a zip archive: :func:`read` says what is wrong with it).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    bool
+        True where it holds ``X``.
+    """
     p = Path(path)
     try:
         if not zipfile.is_zipfile(p):
@@ -373,6 +420,16 @@ def read_feature_array(path: str | os.PathLike[str]) -> np.ndarray:
     allocates), a numeric dtype, the cast to float64 *then* finiteness and float32's range, at
     least 2 frames and 1 dimension. A 1-D ``X`` is one value per frame (one column). Other
     members are ignored.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    ndarray
+        ``(frames, dims)`` float64.
     """
     p = Path(path)
     size = p.stat().st_size

@@ -117,7 +117,18 @@ def _indices(path: Path, tokens: list[str], known: np.ndarray, total: int, what:
 
 
 def read(path: Path) -> Groom:
-    """Every ``l`` record is one strand (at least 2 points)."""
+    """Every ``l`` record is one strand (at least 2 points).
+
+    Parameters
+    ----------
+    path : Path
+        An OBJ of polylines.
+
+    Returns
+    -------
+    Groom
+        One strand per ``l`` record.
+    """
     rec = _Records(path)
     if not rec.lines:
         hint = " (it holds faces: a mesh, see read_mesh)" if rec.faces else ""
@@ -199,7 +210,15 @@ def _scatter_sum(index: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
 
 
 def write(path: Path, obj: Groom | Animation) -> None:
-    """Vertices with ``%.9g`` (float32 round-trips exactly), then one ``l`` record per strand."""
+    """Vertices with ``%.9g`` (float32 round-trips exactly), then one ``l`` record per strand.
+
+    Parameters
+    ----------
+    path : Path
+        The file, written atomically.
+    obj : Groom or Animation
+        What to write (an animation's rest pose, :attr:`Animation.rest`).
+    """
     groom = obj.rest if isinstance(obj, Animation) else obj
     v = groom.vertex_count
     numbers = [str(i) for i in range(1, v + 1)]

@@ -17,6 +17,16 @@ def load_groom(spec: str) -> Groom:
     """A groom from a file (an animation's first frame) or ``sample:NAME[:STRANDS[:VERTICES]]``.
 
     Samples use seed 0 and their own default sizes where STRANDS or VERTICES is left out.
+
+    Parameters
+    ----------
+    spec : str
+        A path, or ``sample:NAME[:STRANDS[:VERTICES]]``.
+
+    Returns
+    -------
+    Groom
+        The groom.
     """
     if spec.startswith(SAMPLE_PREFIX):
         from hairtool.samples import sample

@@ -54,7 +54,18 @@ _CHUNK = 1 << 22  # brackets summed at a time: 16 MB of int32 steps, however lar
 
 
 def nesting_depth(structure: str) -> int:
-    """The deepest nesting of ``[`` and ``{`` in text whose strings are emptied."""
+    """The deepest nesting of ``[`` and ``{`` in text whose strings are emptied.
+
+    Parameters
+    ----------
+    structure : str
+        The text, strings emptied.
+
+    Returns
+    -------
+    int
+        The depth.
+    """
     brackets = _NOT_BRACKET.sub("", structure).encode("ascii")
     depth = deepest = 0
     for start in range(0, len(brackets), _CHUNK):
@@ -71,7 +82,21 @@ def check_text(
 ) -> None:
     """Refuse a ``kind`` ("json" or "toml") document nested deeper than ``max_depth`` or holding
     a number of more than :data:`MAX_DIGITS` digits (a :class:`FormatError` naming ``path``
-    and ``what`` the file is, such as "a jobs file")."""
+    and ``what`` the file is, such as "a jobs file").
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file, named in a refusal.
+    text : str
+        Its text.
+    kind : {"json", "toml"}
+        Its language.
+    what : str
+        What the file is.
+    max_depth : int, default MAX_DEPTH
+        The deepest nesting allowed.
+    """
     structure = _structure(text, kind)
     depth = nesting_depth(structure)
     if depth > max_depth:

@@ -97,6 +97,17 @@ def _read_v3(path: Path, data: bytes) -> Groom:
 
 
 def read(path: Path) -> Groom:
-    """Read the guide strands of a TressFX 3 or 4 file (follow strands are generated at runtime)."""
+    """Read the guide strands of a TressFX 3 or 4 file (follow strands are generated at runtime).
+
+    Parameters
+    ----------
+    path : Path
+        A ``.tfx`` file.
+
+    Returns
+    -------
+    Groom
+        Its guide strands.
+    """
     data = read_bytes(path, 12, "TressFX")
     return _read_v4(path, data) if _version(path, data) == 4 else _read_v3(path, data)

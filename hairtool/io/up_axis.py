@@ -19,7 +19,18 @@ MIN_DROP = 0.02
 
 def root_drops(groom: Groom) -> dict[str, float]:
     """Per axis of :data:`~hairtool.metadata.UP_AXES`: the strands' mean (root − tip) along it,
-    of the groom's largest side (positive: the roots are above the tips)."""
+    of the groom's largest side (positive: the roots are above the tips).
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+
+    Returns
+    -------
+    dict of str to float
+        The drop per axis name.
+    """
     lo, hi = groom.bounds
     size = max(float(np.max(hi.astype(np.float64) - lo)), 1e-30)
     drop = (groom.roots.astype(np.float64) - groom.tips).mean(axis=0) / size
@@ -28,7 +39,20 @@ def root_drops(groom: Groom) -> dict[str, float]:
 
 def infer_up_axis(groom: Groom, default: str = "Y") -> tuple[str, bool]:
     """``(axis, inferred)``: the axis the hair hangs along (``inferred`` True), or ``default``
-    (False) where it hangs along neither."""
+    (False) where it hangs along neither.
+
+    Parameters
+    ----------
+    groom : Groom
+        The strands.
+    default : str, default "Y"
+        The axis where the hair hangs along neither.
+
+    Returns
+    -------
+    tuple of (str, bool)
+        The axis and whether it was inferred.
+    """
     drops = root_drops(groom)
     axis = max(UP_AXES, key=lambda a: drops[a])
     if drops[axis] < MIN_DROP:

@@ -29,7 +29,20 @@ INT32_MAX = 2**31 - 1
 
 def strand_counts(path: Path, data: bytes) -> np.ndarray:
     """``(S,)`` points per strand (a bald scalp sample's one included), walking the file's
-    counts; each one is checked against what is left of the file before the next is read."""
+    counts; each one is checked against what is left of the file before the next is read.
+
+    Parameters
+    ----------
+    path : Path
+        The file, named in a refusal.
+    data : bytes
+        Its contents.
+
+    Returns
+    -------
+    ndarray
+        ``(S,)`` int64.
+    """
     (n,) = struct.unpack_from("<i", data, 0)
     if n <= 0:
         raise FormatError(path, f"the strand count is {n}; a .data file holds at least one strand")
@@ -56,7 +69,18 @@ def strand_counts(path: Path, data: bytes) -> np.ndarray:
 
 
 def read(path: Path) -> Groom:
-    """Read a ``.data`` file (see the module docstring)."""
+    """Read a ``.data`` file (see the module docstring).
+
+    Parameters
+    ----------
+    path : Path
+        A ``.data`` file.
+
+    Returns
+    -------
+    Groom
+        Its strands of at least two points (the others dropped with a :class:`~hairtool.errors.ReaderNote`).
+    """
     data = read_bytes(path, 4, "USC-HairSalon .data")
     counts = strand_counts(path, data)
     hair = counts >= 2
@@ -81,7 +105,15 @@ def read(path: Path) -> Groom:
 
 
 def write(path: Path, obj: Groom | Animation) -> None:
-    """Write a groom (an animation's first frame) as ``.data``: its points only."""
+    """Write a groom (an animation's first frame) as ``.data``: its points only.
+
+    Parameters
+    ----------
+    path : Path
+        The file, written atomically.
+    obj : Groom or Animation
+        What to write.
+    """
     groom = obj.rest if isinstance(obj, Animation) else obj
     if groom.strand_count > INT32_MAX:
         raise FormatError(path, "too many strands for the .data format's 32-bit count")

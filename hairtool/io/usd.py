@@ -49,6 +49,7 @@ from typing import Protocol
 
 import numpy as np
 
+from hairtool import interrupts
 from hairtool.bounds import box
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom, Topology
@@ -82,7 +83,20 @@ class FrameStream(Protocol):
     def n_frames(self) -> int: ...
     @property
     def time_codes(self) -> np.ndarray: ...
-    def frame_points(self, f: int) -> np.ndarray: ...
+    def frame_points(self, f: int) -> np.ndarray:
+        """``(V, 3)`` the points of frame ``f``, made when asked.
+
+        Parameters
+        ----------
+        f : int
+            The frame's index.
+
+        Returns
+        -------
+        ndarray
+            ``(V, 3)`` float32 points.
+        """
+        ...
 
 
 Curves = Groom | Animation | FrameStream
@@ -308,6 +322,17 @@ def write(
     poses at their time codes, and USD readers interpolate linearly between. ``progress(done,
     total)`` after every frame; an exception it raises (e.g. Cancelled) stops the write and
     leaves no file.
+
+    Parameters
+    ----------
+    path : Path
+        The stage, written atomically.
+    obj : Groom, Animation or FrameStream
+        What to write.
+    time_codes : sequence of float, optional
+        One per frame, strictly increasing (None: the animation's own).
+    progress : callable, optional
+        ``progress(done, total)`` after every frame.
     """
     times = _time_codes(obj, time_codes)
     prims = _prims(obj)
@@ -808,7 +833,7 @@ def _usd_diagnostics(notes: list[str]):
         try:
             yield
         finally:
-            os.dup2(saved, 2)
+            interrupts.restore_stderr(saved)
             os.close(saved)
             f.seek(0)
             text = f.read().decode("utf-8", "replace")
@@ -846,12 +871,34 @@ def _diagnosed(path: Path, work: Callable[[], object]):
 
 
 def read(path: Path) -> Groom | Animation:
-    """Merge every BasisCurves prim; time-sampled points or transforms make an Animation."""
+    """Merge every BasisCurves prim; time-sampled points or transforms make an Animation.
+
+    Parameters
+    ----------
+    path : Path
+        A ``.usd``, ``.usda`` or ``.usdc`` stage.
+
+    Returns
+    -------
+    Groom or Animation
+        Every hair prim of the stage, with its scene record.
+    """
     return _diagnosed(path, lambda: _read_stage(path, _open_stage(path)))
 
 
 def time_codes(path: str | os.PathLike[str]) -> list[float]:
-    """The authored time codes of the file's hair: its points' and transforms' samples (empty when static)."""
+    """The authored time codes of the file's hair: its points' and transforms' samples (empty when static).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A USD stage.
+
+    Returns
+    -------
+    list of float
+        The time codes, ascending.
+    """
     from pxr import UsdGeom
 
     p = Path(path)

@@ -18,7 +18,22 @@ I64 = NDArray[np.int64]
 
 
 def fits(counts: I64, basis: str, wrap: str) -> bool:
-    """Whether every curve has a vertex count the basis can draw (e.g. 4 + 3k for a bezier)."""
+    """Whether every curve has a vertex count the basis can draw (e.g. 4 + 3k for a bezier).
+
+    Parameters
+    ----------
+    counts : ndarray
+        Each curve's vertex count.
+    basis : str
+        The curves' basis (``linear``, ``bezier``, ``bspline``, ``catmullRom``).
+    wrap : str
+        Their wrap (``nonperiodic``, ``periodic``, ``pinned``).
+
+    Returns
+    -------
+    bool
+        True where every curve fits.
+    """
     n = np.asarray(counts, dtype=np.int64)
     if basis == "linear":
         return bool(np.all(n >= 2))
@@ -35,6 +50,16 @@ def varying_layout(counts: I64, basis: str, wrap: str) -> tuple[I64, I64, I64]:
     """Per curve: the control point of its first varying value, the step between them, and how many.
 
     The counts must fit the basis (:func:`fits`).
+
+    Parameters
+    ----------
+    counts, basis, wrap
+        As :func:`fits` takes them.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        Starts, steps and counts, int64.
     """
     n = np.asarray(counts, dtype=np.int64)
     zero, one = np.zeros_like(n), np.ones_like(n)
@@ -49,7 +74,20 @@ def varying_layout(counts: I64, basis: str, wrap: str) -> tuple[I64, I64, I64]:
 
 
 def expected_count(interpolation: str, counts: I64, basis: str, wrap: str) -> int | None:
-    """How many values a primvar of this interpolation needs (None for an unknown interpolation)."""
+    """How many values a primvar of this interpolation needs (None for an unknown interpolation).
+
+    Parameters
+    ----------
+    interpolation : str
+        ``constant``, ``uniform``, ``varying``, ``vertex`` or ``faceVarying``.
+    counts, basis, wrap
+        As :func:`fits` takes them.
+
+    Returns
+    -------
+    int or None
+        The count.
+    """
     n = np.asarray(counts, dtype=np.int64)
     if interpolation == "constant":
         return 1
@@ -66,6 +104,20 @@ def per_vertex(values: np.ndarray, interpolation: str, counts: I64, basis: str, 
     """``(V, ...)`` one value per control point from ``values`` of ``interpolation`` (float64).
 
     ``values`` must hold :func:`expected_count` rows.
+
+    Parameters
+    ----------
+    values : ndarray
+        The primvar's values.
+    interpolation : str
+        Their interpolation.
+    counts, basis, wrap
+        As :func:`fits` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(V, ...)`` float64.
     """
     a = np.asarray(values, dtype=np.float64)
     n = np.asarray(counts, dtype=np.int64)
@@ -94,7 +146,18 @@ def per_vertex(values: np.ndarray, interpolation: str, counts: I64, basis: str, 
 
 
 def per_vertex_reference(values, interpolation: str, counts, basis: str, wrap: str) -> np.ndarray:
-    """Curve-by-curve twin of :func:`per_vertex`, for tests."""
+    """Curve-by-curve twin of :func:`per_vertex`, for tests.
+
+    Parameters
+    ----------
+    values, interpolation, counts, basis, wrap
+        As :func:`per_vertex` takes them.
+
+    Returns
+    -------
+    ndarray
+        As :func:`per_vertex` gives it.
+    """
     a = np.asarray(values, dtype=np.float64)
     out, at = [], 0
     for s, c in enumerate(np.asarray(counts, dtype=np.int64).tolist()):

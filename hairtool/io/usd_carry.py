@@ -44,7 +44,20 @@ USD_SUFFIXES = (".usd", ".usda", ".usdc")
 
 
 def carry_between(source: str | os.PathLike[str], written: str | os.PathLike[str]) -> list[str]:
-    """:func:`carry_scene` when both are USD files (a command's IN and OUT); else nothing."""
+    """:func:`carry_scene` when both are USD files (a command's IN and OUT); else nothing.
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        The command's input.
+    written : str or os.PathLike
+        Its output.
+
+    Returns
+    -------
+    list of str
+        The prim paths carried.
+    """
     src, out = Path(source), Path(written)
     if src.suffix.lower() not in USD_SUFFIXES or out.suffix.lower() not in USD_SUFFIXES or not src.is_file():
         return []
@@ -56,7 +69,20 @@ def carry_between(source: str | os.PathLike[str], written: str | os.PathLike[str
 def carry_scene(source: str | os.PathLike[str], written: str | os.PathLike[str]) -> list[str]:
     """Copy into the USD file ``written`` (rewritten atomically, untouched when there is nothing
     to carry) what its USD ``source`` holds beside the hair (module doc); returns the paths
-    carried."""
+    carried.
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        A USD stage.
+    written : str or os.PathLike
+        The USD file written from it.
+
+    Returns
+    -------
+    list of str
+        The prim paths carried.
+    """
     from pxr import Sdf
 
     from hairtool.io.usd import _open_stage

@@ -28,7 +28,15 @@ def _dependencies(layer) -> list[str]:
 
 def check_dependencies(path: Path, layer) -> None:
     """Refuse (:class:`FormatError` naming ``path`` and the layer) a stage whose layers bring
-    in anything that is not a regular file."""
+    in anything that is not a regular file.
+
+    Parameters
+    ----------
+    path : Path
+        The stage, named in a refusal.
+    layer : Sdf.Layer
+        Its root layer.
+    """
     from pxr import Sdf
 
     seen = {os.path.realpath(layer.realPath)} if layer.realPath else set()

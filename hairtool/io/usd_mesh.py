@@ -59,7 +59,20 @@ def _prim_mesh(path: Path, prim, xforms) -> tuple[np.ndarray, np.ndarray, np.nda
 
 
 def fan_triangles(sizes: np.ndarray, corners: np.ndarray) -> np.ndarray:
-    """``(T, 3)`` triangles (0, j, j+1) of each polygon of ``sizes`` corners listed in ``corners``."""
+    """``(T, 3)`` triangles (0, j, j+1) of each polygon of ``sizes`` corners listed in ``corners``.
+
+    Parameters
+    ----------
+    sizes : ndarray
+        Each polygon's corner count.
+    corners : ndarray
+        The corners, polygon after polygon.
+
+    Returns
+    -------
+    ndarray
+        ``(T, 3)`` int64.
+    """
     start = np.cumsum(sizes) - sizes
     n_tri = sizes - 2
     first = np.repeat(start, n_tri)
@@ -68,7 +81,20 @@ def fan_triangles(sizes: np.ndarray, corners: np.ndarray) -> np.ndarray:
 
 
 def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Unit area-weighted vertex normals (zero where no face touches a vertex)."""
+    """Unit area-weighted vertex normals (zero where no face touches a vertex).
+
+    Parameters
+    ----------
+    vertices : ndarray
+        ``(Vm, 3)``.
+    faces : ndarray
+        ``(F, 3)``.
+
+    Returns
+    -------
+    ndarray
+        ``(Vm, 3)`` float64.
+    """
     a, b, c = (vertices[faces[:, k]] for k in range(3))
     face_normals = np.cross(b - a, c - a)  # length = twice the area: area weighting for free
     flat = faces.reshape(-1)
@@ -80,7 +106,18 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 def read_mesh(path: str | os.PathLike[str]) -> Mesh | None:
-    """The stage's Mesh prims merged into one triangle mesh, or None when it has none."""
+    """The stage's Mesh prims merged into one triangle mesh, or None when it has none.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A USD stage.
+
+    Returns
+    -------
+    Mesh or None
+        The mesh.
+    """
     from pxr import Usd, UsdGeom
 
     p = Path(path)
@@ -115,7 +152,17 @@ def read_mesh(path: str | os.PathLike[str]) -> Mesh | None:
 
 
 def add_mesh(path: str | os.PathLike[str], mesh: Mesh, prim_path: str = MESH_PATH) -> None:
-    """Add ``mesh`` as one Mesh prim to the USD file at ``path`` (rewritten atomically)."""
+    """Add ``mesh`` as one Mesh prim to the USD file at ``path`` (rewritten atomically).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The USD file.
+    mesh : Mesh
+        The mesh.
+    prim_path : str, default MESH_PATH
+        Where the prim goes.
+    """
     from pxr import Sdf, UsdGeom, Vt
 
     p = Path(path)

@@ -113,7 +113,13 @@ def _blocks(text: bytes) -> list[tuple[int, int]]:
 
 def check(path: Path) -> None:
     """Raise FormatError when a curves prim's array holds more values than its points can use,
-    or when the layer nests deeper than :data:`MAX_DEPTH` (any size of file)."""
+    or when the layer nests deeper than :data:`MAX_DEPTH` (any size of file).
+
+    Parameters
+    ----------
+    path : Path
+        A ``.usda`` file.
+    """
     with open(path, "rb") as f:
         if f.read(len(MAGIC)) != MAGIC:
             return

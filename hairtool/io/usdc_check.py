@@ -67,7 +67,13 @@ def _u64(data: bytes, at: int) -> int:
 
 
 def check(path: Path) -> None:
-    """Raise FormatError if the crate's table of contents or section counts cannot be true."""
+    """Raise FormatError if the crate's table of contents or section counts cannot be true.
+
+    Parameters
+    ----------
+    path : Path
+        A ``.usdc`` file.
+    """
     with open(path, "rb") as f:
         head = f.read(24)
         if len(head) < 24 or head[:8] != MAGIC:

@@ -40,7 +40,28 @@ def parse(
     :class:`FormatError` naming ``source`` and ``what`` the document is ("a stroke log").
     ``texts``: the places (``"settings.capture.bvh"``) that hold a whole file's text, such as a
     capture's BVH a project carries: their lines and length are that file's, bounded by the
-    document's size, and the reader of that text checks it."""
+    document's size, and the reader of that text checks it.
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        The file the text came from, named in a refusal.
+    text : str
+        The document.
+    kind : {"json", "toml"}
+        Its language.
+    what : str
+        What the document is, in words.
+    max_depth : int, default MAX_DEPTH
+        The deepest nesting allowed.
+    texts : frozenset of str, default frozenset()
+        The dotted places holding embedded files.
+
+    Returns
+    -------
+    object
+        The parsed document.
+    """
     check_text(source, text, kind, what, max_depth)
     unreadable = f"not a readable {what.split(' ', 1)[-1]}"  # "a stroke log" -> "stroke log"
     try:
@@ -61,7 +82,22 @@ def check_strings(
 ) -> None:
     """Refuse a string or key in ``data`` longer than :data:`MAX_STRING` or holding a control
     character, naming where it is (walked without recursion); the strings at ``texts`` are
-    embedded files (see :func:`parse`)."""
+    embedded files (see :func:`parse`).
+
+    Parameters
+    ----------
+    source : str or os.PathLike
+        The file, named in a refusal.
+    data : object
+        A parsed document.
+    texts : frozenset of str, default frozenset()
+        The dotted places holding embedded files.
+
+    Raises
+    ------
+    FormatError
+        For a string too long or holding a control character.
+    """
     stack: list[tuple[str, object]] = [("", data)]
     while stack:
         where, v = stack.pop()
@@ -90,7 +126,22 @@ def _check_string(source, where: str, s: object, kind: str) -> None:
 
 def read_text(path: str | os.PathLike[str], what: str, max_bytes: int = MAX_BYTES) -> str:
     """A regular file's UTF-8 text, at most ``max_bytes`` long (a FIFO or a device is refused
-    before it is opened for reading, so it cannot block)."""
+    before it is opened for reading, so it cannot block).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    what : str
+        What it is, in words (a refusal says so).
+    max_bytes : int, default MAX_BYTES
+        The largest file read.
+
+    Returns
+    -------
+    str
+        Its text.
+    """
     p = os.fspath(path)
     try:
         st = os.stat(p)
@@ -120,7 +171,28 @@ def read(
 ) -> object:
     """A JSON or TOML file (``kind``, else its suffix: ``.toml`` is TOML, anything else JSON)
     read and parsed under every limit (``texts`` as :func:`parse`'s); a :class:`FormatError`
-    names the file."""
+    names the file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    what : str
+        What it is, in words.
+    kind : {"json", "toml"}, optional
+        Its language (None: by its suffix).
+    max_bytes : int, default MAX_BYTES
+        The largest file read.
+    max_depth : int, default MAX_DEPTH
+        The deepest nesting allowed.
+    texts : frozenset of str, default frozenset()
+        The dotted places holding embedded files.
+
+    Returns
+    -------
+    object
+        The parsed document.
+    """
     p = os.fspath(path)
     kind = kind or ("toml" if p.lower().endswith(".toml") else "json")
     return parse(p, read_text(p, what, max_bytes), kind, what, max_depth, texts)

@@ -50,7 +50,26 @@ def per_channel_keys(
     relative: bool = False,
 ) -> ChannelKeys:
     """Every column of ``(n_frames, D)`` features keyed on its own, at its own price tau_d per key
-    (with ``relative``, tau_d is a share of that channel's two-key error)."""
+    (with ``relative``, tau_d is a share of that channel's two-key error).
+
+    Parameters
+    ----------
+    x : array_like
+        ``(n_frames, D)`` features, one channel a column.
+    penalty : float or array_like
+        tau per key: one for every channel, or ``(D,)``.
+    interp : {"hermite", "linear", "hermite-fit"}, default "hermite"
+        The curve between a channel's keys.
+    curvature : float, default 0.0
+        Weight of the curvature term in each segment's cost (≥ 0).
+    relative : bool, default False
+        tau is a share of each channel's two-key error instead of an absolute price.
+
+    Returns
+    -------
+    ChannelKeys
+        Each channel's keys, its error and the price it was keyed at.
+    """
     x = raw_features(x)
     d = x.shape[1]
     if interp not in INTERPOLATIONS:

@@ -47,13 +47,37 @@ class KeyConstraints:
 
     @classmethod
     def parse(cls, pins: str | None = None, excludes: str | None = None) -> KeyConstraints:
-        """From command-line lists such as ``"10,55"`` and ``"30-34,40"`` (ranges inclusive)."""
+        """From command-line lists such as ``"10,55"`` and ``"30-34,40"`` (ranges inclusive).
+
+        Parameters
+        ----------
+        pins : str, optional
+            Frames that must be keys.
+        excludes : str, optional
+            Frames that must not be keys.
+
+        Returns
+        -------
+        KeyConstraints
+            The constraints (not yet checked against an animation: :meth:`check`).
+        """
         return cls(parse_frames("pin", pins), parse_frames("exclude", excludes))
 
     def check(self, n_frames: int) -> KeyConstraints:
         """Frames inside the animation; the first and last frame are always keys, so they cannot
         be excluded; pins on every frame leave nothing to solve. Exclusions of every other frame
-        are fine: the ends alone (and the pins) are then the one answer, in every mode."""
+        are fine: the ends alone (and the pins) are then the one answer, in every mode.
+
+        Parameters
+        ----------
+        n_frames : int
+            The animation's frame count.
+
+        Returns
+        -------
+        KeyConstraints
+            These constraints (ParameterError naming the first bad frame otherwise).
+        """
         for name, frames in (("pin", self.pins), ("exclude", self.excludes)):
             if frames and frames[-1] >= n_frames:
                 raise ParameterError(name, list(frames), f"frames in [0, {n_frames - 1}]")
@@ -68,13 +92,35 @@ class KeyConstraints:
         return self
 
     def key_range(self, n_frames: int) -> tuple[int, int]:
-        """The fewest and the most keys a key set under these constraints can have."""
+        """The fewest and the most keys a key set under these constraints can have.
+
+        Parameters
+        ----------
+        n_frames : int
+            The animation's frame count.
+
+        Returns
+        -------
+        tuple of (int, int)
+            The fewest and the most keys.
+        """
         required = len({0, n_frames - 1} | set(self.pins))
         return required, n_frames - len(self.excludes)
 
     def apply(self, table: F64) -> F64:
         """A copy of the ``(n, n)`` segment table with the forbidden segments at +inf (or the
-        table itself when there is nothing to constrain)."""
+        table itself when there is nothing to constrain).
+
+        Parameters
+        ----------
+        table : ndarray
+            ``(n, n)`` segment costs.
+
+        Returns
+        -------
+        ndarray
+            ``(n, n)`` float64.
+        """
         if not self:
             return table
         n = table.shape[0]
@@ -96,7 +142,18 @@ class KeyConstraints:
         return c
 
     def allows(self, keys: ArrayLike) -> bool:
-        """Whether a key set meets the constraints."""
+        """Whether a key set meets the constraints.
+
+        Parameters
+        ----------
+        keys : array_like
+            Key frames.
+
+        Returns
+        -------
+        bool
+            True where every pin is a key and no excluded frame is.
+        """
         k = set(np.asarray(keys, dtype=np.int64).tolist())
         return set(self.pins) <= k and not (set(self.excludes) & k)
 
@@ -105,7 +162,20 @@ class KeyConstraints:
 
 
 def parse_frames(name: str, text: str | None) -> tuple[int, ...]:
-    """``"3,10-12"`` → (3, 10, 11, 12); empty or None → ()."""
+    """``"3,10-12"`` → (3, 10, 11, 12); empty or None → ().
+
+    Parameters
+    ----------
+    name : str
+        The option, named in a refusal.
+    text : str or None
+        The list.
+
+    Returns
+    -------
+    tuple of int
+        The frames, ascending, each once.
+    """
     if text is None or not text.strip():
         return ()
     out: set[int] = set()

@@ -31,7 +31,18 @@ TABLES = 3
 
 def check_frame_count(n: int) -> int:
     """``n`` when its n × n tables fit the budget's memory, else one clear error (a hostile
-    616-byte file can hold 50,000 frames of zeros, whose table alone is 18.6 GiB)."""
+    616-byte file can hold 50,000 frames of zeros, whose table alone is 18.6 GiB).
+
+    Parameters
+    ----------
+    n : int
+        Frames.
+
+    Returns
+    -------
+    int
+        ``n`` (a ParameterError past the limit).
+    """
     most = int((budget.limit("memory") / (8 * TABLES)) ** 0.5)
     if n > most:
         gib = 8.0 * TABLES * n * n / 1024**3
@@ -42,7 +53,26 @@ def check_frame_count(n: int) -> int:
 
 
 def total_table(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear", use_numba: bool = True) -> F64:
-    """``(n, n)`` Σ-of-frame-costs table from a centred Gram matrix (see the module docstring)."""
+    """``(n, n)`` Σ-of-frame-costs table from a centred Gram matrix (see the module docstring).
+
+    Parameters
+    ----------
+    g : ndarray
+        ``(n, n)`` centred Gram matrix.
+    curv : ndarray
+        ``(n,)`` curvature terms.
+    lam : float, default 0.0
+        The curvature weight λ.
+    interp : str, default "linear"
+        The curve.
+    use_numba : bool, default True
+        False runs the numpy twin.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     g, curv = check_gram(g, curv, lam)
     if interp == "linear":
         return linear_table(g, curv, lam) if use_numba else linear_table_reference(g, curv, lam)
@@ -60,7 +90,26 @@ def cost_table(
     use_numba: bool = True,
 ) -> F64:
     """``(n, n)`` segment costs of ``(n, D)`` features: O(n²D) Gram product, then O(n²) (total)
-    or O(n³) (worst) from the Gram matrix. Entries i < j are meaningful; the rest are 0."""
+    or O(n³) (worst) from the Gram matrix. Entries i < j are meaningful; the rest are 0.
+
+    Parameters
+    ----------
+    x : ndarray
+        ``(n, D)`` float64 frame features.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The curve a segment is judged by.
+    curvature : float, default 0.0
+        Weight of the curvature term (≥ 0).
+    objective : {"total", "worst"}, default "total"
+        Sum over a segment's frames, or its worst frame.
+    use_numba : bool, default True
+        False runs the numpy twin (the tests' oracle).
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64 costs; ``[i, j]`` for i < j is keying i and j and interpolating between.
+    """
     if interp not in INTERPOLATIONS:
         raise ParameterError("interp", interp, " or ".join(INTERPOLATIONS))
     if objective not in OBJECTIVES:

@@ -88,7 +88,24 @@ def _layers_in_blocks(
 
 
 def layers_reference(c: F64, kmax: int, use_max: bool = False, stop: float = -np.inf):
-    """Numpy twin of the layered DP (same sums, same first-minimum tie-break)."""
+    """Numpy twin of the layered DP (same sums, same first-minimum tie-break).
+
+    Parameters
+    ----------
+    c : ndarray
+        ``(n, n)`` segment costs.
+    kmax : int
+        The most keys.
+    use_max : bool, default False
+        Worst-frame objective (maximum instead of sum).
+    stop : float, default -inf
+        Stop once a layer's best error is at most this.
+
+    Returns
+    -------
+    tuple
+        As the kernel gives them: energies, back-pointers and the last K computed.
+    """
     n = c.shape[0]
     e = np.full((kmax + 1, n), np.inf)
     back = np.full((kmax + 1, n), -1, dtype=np.int64)
@@ -131,7 +148,20 @@ def _penalty_kernel(ct, tau):  # pragma: no cover - compiled
 
 
 def penalty_reference(c: F64, tau: float):
-    """Numpy twin of the per-key-price DP."""
+    """Numpy twin of the per-key-price DP.
+
+    Parameters
+    ----------
+    c : ndarray
+        ``(n, n)`` segment costs.
+    tau : float
+        The price of a key.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``(n,)`` best errors and back-pointers, as the kernel gives them.
+    """
     n = c.shape[0]
     e = np.full(n, np.inf)
     back = np.full(n, -1, dtype=np.int64)
@@ -152,12 +182,40 @@ def _trace(back_row_of, n: int) -> I64:
 
 # -- public ------------------------------------------------------------------------------------
 def uniform_keys(n: int, k: int) -> I64:
-    """K keys spread evenly over n frames (rounded; first and last included)."""
+    """K keys spread evenly over n frames (rounded; first and last included).
+
+    Parameters
+    ----------
+    n : int
+        Frames.
+    k : int
+        Keys wanted (≥ 2; past n, rounding merges some).
+
+    Returns
+    -------
+    ndarray
+        ``(k,)`` int64 frame numbers, ascending (fewer where k > n).
+    """
     return np.unique(np.round(np.linspace(0, n - 1, k)).astype(np.int64))
 
 
 def keys_cost(table: F64, keys: ArrayLike, objective: str = "total") -> float:
-    """The table's cost of a key set: sum (total) or maximum (worst) over its segments."""
+    """The table's cost of a key set: sum (total) or maximum (worst) over its segments.
+
+    Parameters
+    ----------
+    table : ndarray
+        ``(n, n)`` segment costs.
+    keys : array_like
+        Key frames.
+    objective : {"total", "worst"}, default "total"
+        Sum or maximum.
+
+    Returns
+    -------
+    float
+        The cost.
+    """
     k = np.asarray(keys, dtype=np.int64)
     seg = np.asarray(table)[k[:-1], k[1:]]
     if seg.size == 0:
@@ -200,7 +258,20 @@ class Selection:
 def uniform_constraints(pins: ArrayLike, excludes: ArrayLike) -> dict:
     """What the uniform baseline does not honour, for its record: ``{}`` without constraints,
     else the counts it ignores and a note. The baseline stays the papers' (evenly spread keys),
-    so under pins a DP cost above it compares two different problems, not a worse solve."""
+    so under pins a DP cost above it compares two different problems, not a worse solve.
+
+    Parameters
+    ----------
+    pins : array_like
+        Pinned frames.
+    excludes : array_like
+        Excluded frames.
+
+    Returns
+    -------
+    dict
+        What the baseline ignores.
+    """
     n_pins, n_excl = len(pins), len(excludes)
     if not (n_pins or n_excl):
         return {}
@@ -213,6 +284,19 @@ def uniform_constraints(pins: ArrayLike, excludes: ArrayLike) -> dict:
 
 
 def check_table(table: ArrayLike) -> F64:
+    """``table`` as float64, or a ParameterError: not square, fewer than 2 frames, or a
+    non-finite cost above the diagonal.
+
+    Parameters
+    ----------
+    table : array_like
+        ``(n, n)`` segment costs.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     c = np.asarray(table, dtype=np.float64)
     if c.ndim != 2 or c.shape[0] != c.shape[1]:
         raise ParameterError("table", f"shape {c.shape}", "a square (n, n) segment cost table")
@@ -235,7 +319,30 @@ def solve_layers(
 ):
     """Layered DP: ``(E (kmax+1, n), back, last K computed)``; E[K, n−1] is the curve (+inf for
     a count no key set under the constraints reaches). ``progress(share)`` after each block of
-    layers, for a long animation's progress bar."""
+    layers, for a long animation's progress bar.
+
+    Parameters
+    ----------
+    table : array_like
+        ``(n, n)`` segment costs.
+    kmax : int
+        The most keys.
+    objective : {"total", "worst"}, default "total"
+        Sum or maximum.
+    stop : float, default -inf
+        Stop once a layer's best error is at most this.
+    use_numba : bool, default True
+        False runs the numpy twin.
+    constraints : KeyConstraints, optional
+        Pinned and excluded frames.
+    progress : callable, optional
+        ``progress(share)``.
+
+    Returns
+    -------
+    tuple
+        ``(E, back, last K computed)``.
+    """
     c = check_table(table)
     if constraints:
         c = constraints.apply(c)
@@ -270,7 +377,31 @@ def select_keys(
     ``curve_keys``: the curve covers K = 2..min(n, curve_keys) (and at least the chosen K), the
     counts no key set under the constraints reaches left out. ``constraints``: pinned frames are
     keys and excluded frames are not, in an exact optimum (:mod:`hairtool.keys.constraints`).
-    ``progress(share)`` after each block of the DP's layers."""
+    ``progress(share)`` after each block of the DP's layers.
+
+    Parameters
+    ----------
+    table : array_like
+        ``(n, n)`` segment costs (:func:`~hairtool.keys.costs.cost_table`).
+    keys, penalty, budget, max_error : optional
+        Exactly one: the key count K, the price tau per key, the total error allowed, or the
+        worst frame's error allowed.
+    objective : {"total", "worst"}, default "total"
+        What the table's entries are.
+    curve_keys : int, default DEFAULT_CURVE_KEYS
+        The error curve covers K = 2 … this.
+    constraints : KeyConstraints, optional
+        Pinned and excluded frames.
+    use_numba : bool, default True
+        False runs the numpy twin.
+    progress : callable, optional
+        ``progress(share)`` with share in [0, 1].
+
+    Returns
+    -------
+    Selection
+        The keys, their cost, uniform keys of the same count and theirs, and the error curve.
+    """
     c = check_table(table)
     n = c.shape[0]
     cons = (constraints or KeyConstraints()).check(n)
@@ -352,7 +483,22 @@ def select_keys(
 
 
 def brute_force_keys(table: ArrayLike, k: int, objective: str = "total") -> tuple[float, I64]:
-    """Best cost and keys over all C(n−2, K−2) key sets (the exactness oracle for small n)."""
+    """Best cost and keys over all C(n−2, K−2) key sets (the exactness oracle for small n).
+
+    Parameters
+    ----------
+    table : array_like
+        ``(n, n)`` segment costs.
+    k : int
+        Keys.
+    objective : {"total", "worst"}, default "total"
+        Sum or maximum.
+
+    Returns
+    -------
+    tuple of (float, ndarray)
+        The best cost and its keys.
+    """
     from itertools import combinations
 
     c = check_table(table)

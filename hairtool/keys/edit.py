@@ -27,6 +27,17 @@ class KeyEditor:
     """Original frames ``(F, ...)``, their keys, and the key poses as edited so far."""
 
     def __init__(self, frames: ArrayLike, keys: ArrayLike, interp: str = "linear") -> None:
+        """Take the key poses out of ``frames``; the residuals are what the key curve misses.
+
+        Parameters
+        ----------
+        frames : array_like
+            ``(F, ...)`` the animation's frames (points or channels), kept as given.
+        keys : array_like
+            Key frame numbers, ascending, first and last frame included.
+        interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+            The key curve.
+        """
         self.original = np.asarray(frames)
         self._base = key_poses(self.original, keys, interp)
         self._base_frames = interpolate_keys(self._base)
@@ -42,14 +53,33 @@ class KeyEditor:
         return self.original.astype(np.float64) - self._base_frames
 
     def set_key_pose(self, key_frame: int, pose: ArrayLike) -> None:
-        """Replace the pose at a key frame (the frames follow on the next :meth:`frames`)."""
+        """Replace the pose at a key frame (the frames follow on the next :meth:`frames`).
+
+        Parameters
+        ----------
+        key_frame : int
+            A frame that is a key.
+        pose : array_like
+            The new pose, shaped as one frame.
+        """
         self.key_poses = self.key_poses.with_pose(key_frame, pose)
 
     def reset(self) -> None:
         self.key_poses = self._base
 
     def affected_frames(self, key_frame: int) -> tuple[int, int]:
-        """``(lo, hi)``: an edit of this key changes frames lo < f < hi only (−1 / F at the ends)."""
+        """``(lo, hi)``: an edit of this key changes frames lo < f < hi only (−1 / F at the ends).
+
+        Parameters
+        ----------
+        key_frame : int
+            A frame that is a key (ParameterError otherwise).
+
+        Returns
+        -------
+        tuple of (int, int)
+            ``(lo, hi)``, the neighbouring keys.
+        """
         k = self.keys
         hit = np.flatnonzero(k == key_frame)
         if hit.size == 0:
@@ -60,7 +90,18 @@ class KeyEditor:
         return lo, hi
 
     def frames(self, dtype: type | None = None) -> NDArray:
-        """``(F, ...)`` the edited animation: x̂_new + r, exactly the original where nothing moved."""
+        """``(F, ...)`` the edited animation: x̂_new + r, exactly the original where nothing moved.
+
+        Parameters
+        ----------
+        dtype : type, optional
+            The result's dtype (None: the original frames').
+
+        Returns
+        -------
+        ndarray
+            ``(F, ...)`` the edited frames.
+        """
         delta = interpolate_keys(self.key_poses) - self._base_frames
         out = self.original.astype(np.float64) + delta
         return out.astype(dtype or self.original.dtype)
@@ -69,7 +110,24 @@ class KeyEditor:
 def edit_animation(
     animation: Animation, keys: ArrayLike, edits: dict[int, ArrayLike], interp: str = "linear"
 ) -> Animation:
-    """The animation with the given key poses ``{key_frame: (V, 3) points}`` replaced."""
+    """The animation with the given key poses ``{key_frame: (V, 3) points}`` replaced.
+
+    Parameters
+    ----------
+    animation : Animation
+        The captured animation.
+    keys : array_like
+        Its key frames.
+    edits : dict of int to array_like
+        New ``(V, 3)`` points by key frame.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The key curve the edit is carried by.
+
+    Returns
+    -------
+    Animation
+        The edited animation: unchanged outside the edited keys' neighbours.
+    """
     editor = KeyEditor(animation.frames, keys, interp)
     for frame, pose in edits.items():
         editor.set_key_pose(int(frame), pose)
@@ -81,14 +139,44 @@ def time_warp(frames: ArrayLike, keys_now: ArrayLike, keys_then: ArrayLike) -> F
     """The (fractional) frame of the motion as keyed before that each frame shows now: the
     piecewise-linear map taking each key's frame now back to its frame before, so a key moved
     in time takes the frames between its neighbouring keys with it (stretched on one side,
-    squeezed on the other); the identity wherever no key moved."""
+    squeezed on the other); the identity wherever no key moved.
+
+    Parameters
+    ----------
+    frames : array_like
+        Frame numbers now.
+    keys_now : array_like
+        The keys' frames now.
+    keys_then : array_like
+        Their frames before.
+
+    Returns
+    -------
+    ndarray
+        float64 frames before.
+    """
     return np.interp(np.asarray(frames, dtype=np.float64), keys_now, keys_then)
 
 
 def residual_at(values: NDArray, base_at: Callable[[I64], NDArray], at: ArrayLike) -> F64:
     """The residual ``values − base_at(frames)`` (``values`` ``(F, ...)``, ``base_at`` the key
     curve at whole frames) at fractional frames ``at``, linear between the frames either side;
-    at a whole frame, that frame's residual exactly."""
+    at a whole frame, that frame's residual exactly.
+
+    Parameters
+    ----------
+    values : ndarray
+        ``(F, ...)`` the frames.
+    base_at : callable
+        The key curve at whole frames.
+    at : array_like
+        Fractional frames.
+
+    Returns
+    -------
+    ndarray
+        ``(len(at), ...)`` float64.
+    """
     u = np.asarray(at, dtype=np.float64).reshape(-1)
     n = values.shape[0]
     i0 = np.clip(np.floor(u).astype(np.int64), 0, max(n - 2, 0))
@@ -102,7 +190,24 @@ def residual_at(values: NDArray, base_at: Callable[[I64], NDArray], at: ArrayLik
 def check_retime(keys: ArrayLike, n_frames: int, key_frame: int, new_frame: int) -> tuple[int, I64]:
     """``(key index, keys after)`` for moving the key at ``key_frame`` to ``new_frame``: an inner
     key (the first and last frame are always keys) to a frame strictly between its neighbouring
-    keys (a key never passes another); :class:`ParameterError` naming the allowed frames."""
+    keys (a key never passes another); :class:`ParameterError` naming the allowed frames.
+
+    Parameters
+    ----------
+    keys : array_like
+        The key frames.
+    n_frames : int
+        Frames.
+    key_frame : int
+        The key moved.
+    new_frame : int
+        Where it goes.
+
+    Returns
+    -------
+    tuple of (int, ndarray)
+        The key's index and the keys after.
+    """
     k = check_keys(keys, n_frames)
     hit = np.flatnonzero(k == int(key_frame))
     if hit.size == 0:
@@ -127,7 +232,26 @@ def retime_key(
     keys gets the curve there plus the residual of the frame it now shows, r(w(t)) with w
     :func:`time_warp` (the captured detail moves with the key). So the pose at the key is the
     key pose exactly, with linear keys the stretch is the old motion retimed, and frames
-    outside ``start .. start + len(block) − 1`` (strictly between the neighbours) are untouched."""
+    outside ``start .. start + len(block) − 1`` (strictly between the neighbours) are untouched.
+
+    Parameters
+    ----------
+    frames : ndarray
+        ``(F, ...)`` the frames.
+    keys : array_like
+        The key frames.
+    interp : str
+        The key curve.
+    key_frame : int
+        The key moved.
+    new_frame : int
+        Where it goes.
+
+    Returns
+    -------
+    tuple of (int, ndarray, ndarray)
+        The first frame changed, the changed frames and the keys after.
+    """
     f = np.asarray(frames)
     n = f.shape[0]
     a, after = check_retime(keys, n, key_frame, new_frame)
@@ -173,7 +297,28 @@ def key_slope_block(
     the residual-keeping edit of the key's tangents, Δ(t) = h10·L·δ_out + h11·L·δ_in between
     the neighbouring keys (the key poses stay); the tangents read back from the edited frames
     are affine in (δ_out, δ_in), so two trial edits give the δ that reads back ``slope``. Only
-    that component changes; linear keys have no handles (ParameterError)."""
+    that component changes; linear keys have no handles (ParameterError).
+
+    Parameters
+    ----------
+    frames : ndarray
+        ``(F, ...)`` the frames.
+    keys : array_like
+        The key frames.
+    interp : str
+        The key curve (Hermite).
+    key_frame : int
+        The key whose handle turns.
+    index : int
+        The component.
+    slope : float
+        The new slope, per frame.
+
+    Returns
+    -------
+    tuple of (int, ndarray)
+        The first frame changed and the changed frames.
+    """
     if interp == "linear":
         raise ParameterError("interp", interp, "hermite or hermite-fit (linear keys have no handles)")
     f = np.asarray(frames)

@@ -107,6 +107,20 @@ def keys_record(
     "time"}``: its frame index, its time code in the source (``time_codes``, the animation's
     :attr:`~hairtool.groom.Animation.time_codes`, or ``result["time_codes"]``; default the frame
     index) and that time code in seconds on the source's clock (time code / fps).
+
+    Parameters
+    ----------
+    result : mapping
+        One solve as ``hairtool keys --json`` prints it.
+    source : str or os.PathLike, optional
+        The animation the keys are of, kept in the record.
+    time_codes : array_like, optional
+        The source's time code of every frame.
+
+    Returns
+    -------
+    dict
+        The record :func:`write_keys_json` writes.
     """
     try:
         n, fps = int(result["frames"]), float(result["fps"])
@@ -141,12 +155,31 @@ def _nesting(value: Any) -> int:
 
 
 def record_keys(record: Mapping[str, Any]) -> NDArray[np.int64]:
-    """The key frame numbers of a record, as int64."""
+    """The key frame numbers of a record, as int64.
+
+    Parameters
+    ----------
+    record : mapping
+        A keys record.
+
+    Returns
+    -------
+    ndarray
+        The key frames, int64.
+    """
     return np.array([k["frame"] for k in record["keys"]], dtype=np.int64)
 
 
 def write_keys_json(path: str | os.PathLike[str], record: Mapping[str, Any]) -> None:
-    """Write a record from :func:`keys_record`, atomically."""
+    """Write a record from :func:`keys_record`, atomically.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.json`` file.
+    record : mapping
+        A record from :func:`keys_record`.
+    """
     try:
         with atomic_open(path, "w", encoding="utf-8") as f:
             json.dump(_plain(record), f, indent=1, allow_nan=False)
@@ -162,6 +195,16 @@ def read_keys_json(path: str | os.PathLike[str]) -> dict:
 
     Records written before the format field existed (``hairtool keys --out`` of version 0.1)
     are accepted when their keys, frames and fps are valid.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A keys record.
+
+    Returns
+    -------
+    dict
+        The checked record.
     """
     record = user_text.read(path, "a keys record", "json", max_depth=MAX_NESTING)  # all text limits
     if not isinstance(record, dict):
@@ -228,6 +271,29 @@ def sheet_rows(
     h00 = 2s³ − 3s² + 1, h10 = s³ − 2s² + s, h01 = −2s³ + 3s², h11 = s³ − s². Tangents are per
     frame; seed 003's data tangents have in = out, fitted handles may break at a key. Numbers
     are written with all their digits (Python's repr), so they read back to the same float64.
+
+    Parameters
+    ----------
+    n_frames : int
+        Frames of the source.
+    fps : float
+        Its frames per second.
+    keys : array_like
+        The key frames.
+    uniform_keys : array_like, optional
+        Uniform keys of the same count, marked beside them.
+    curves : mapping, optional
+        The keys' channel values and Hermite slopes (``channels``, ``values``, ``out``,
+        ``in``), three columns per channel.
+    pins : sequence of int, default ()
+        Frames pinned as keys.
+    time_codes : array_like, optional
+        The source's time code of every frame (None: the frame).
+
+    Returns
+    -------
+    list of list
+        The rows, header first.
     """
     k = _check_keys(keys, n_frames)
     codes = _check_time_codes(time_codes, n_frames)
@@ -287,7 +353,20 @@ def sheet_time_codes(record: Mapping[str, Any], time_codes: ArrayLike | None = N
     """Every frame's time code for the sheet of ``record``: ``time_codes`` (the source's, checked
     against the record's keys), or without them the record's own, where its keys carry time
     codes one offset from their frames (a source at 1…48); the frame index for a record
-    without time codes."""
+    without time codes.
+
+    Parameters
+    ----------
+    record : mapping
+        A keys record.
+    time_codes : array_like, optional
+        The source's time codes.
+
+    Returns
+    -------
+    ndarray
+        ``(n_frames,)`` float64 time codes.
+    """
     n = int(record["frames"])
     keyed = [(int(k["frame"]), k["time_code"]) for k in record["keys"] if "time_code" in k]
     if not all(isinstance(c, int | float) and not isinstance(c, bool) and math.isfinite(c) for _, c in keyed):
@@ -310,7 +389,17 @@ def write_key_sheet(
     path: str | os.PathLike[str], record: Mapping[str, Any], time_codes: ArrayLike | None = None
 ) -> None:
     """Write the CSV key sheet of a record (one row per frame), atomically; ``time_codes``: the
-    source's time code of every frame (:func:`sheet_time_codes`)."""
+    source's time code of every frame (:func:`sheet_time_codes`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.csv`` file.
+    record : mapping
+        A keys record.
+    time_codes : array_like, optional
+        The source's time code of every frame.
+    """
     uniform = record.get("uniform", {}).get("keys") if isinstance(record.get("uniform"), dict) else None
     curves = record.get("tangents")
     keys = record_keys(record)
@@ -327,14 +416,40 @@ def write_key_sheet(
 def key_poses_only(animation: Animation, keys: Sequence[int] | ArrayLike) -> Animation:
     """The animation with only its key poses, each at its time code in the source; the poses
     keep the animation's metadata (up axis, unit, curve prims), so they land where the source's
-    frames are."""
+    frames are.
+
+    Parameters
+    ----------
+    animation : Animation
+        The source.
+    keys : sequence of int or array_like
+        The key frames.
+
+    Returns
+    -------
+    Animation
+        One frame per key.
+    """
     k = _check_keys(keys, animation.n_frames)
     return animation.with_frames(animation.frames[k], time_codes=animation.time_codes[k])
 
 
 def linear_playback(path: str | os.PathLike[str], interp: str) -> None:
     """Refuse key poses whose curve is not what USD plays: readers interpolate time samples
-    linearly, so Hermite keys written as poses would play as straight lines between them."""
+    linearly, so Hermite keys written as poses would play as straight lines between them.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The USD file asked for, named in a refusal.
+    interp : str
+        The keys' interpolation.
+
+    Raises
+    ------
+    FormatError
+        For an interpolation other than linear, naming the file.
+    """
     if interp != "linear":
         why = (
             f"USD plays key poses back linearly, not as their {interp} curve; "
@@ -350,7 +465,19 @@ def write_key_poses(
     interp: str = "linear",
 ) -> None:
     """Write USD with only the key poses (:func:`key_poses_only`), atomically; ``interp``, the
-    keys' interpolation, must be linear (:func:`linear_playback`)."""
+    keys' interpolation, must be linear (:func:`linear_playback`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The USD file.
+    animation : Animation
+        The source.
+    keys : sequence of int or array_like
+        The key frames.
+    interp : str, default "linear"
+        The keys' interpolation (linear only).
+    """
     from hairtool.io import usd
 
     if Path(path).suffix.lower() not in USD_SUFFIXES:
@@ -371,7 +498,19 @@ def export_keys(
 ) -> None:
     """Write keys in the format the suffix names: .json record, .csv sheet, .usd/.usda/.usdc poses
     (linear keys only). The sheet's time codes are ``time_codes``, else the animation's, else
-    the record's (:func:`sheet_time_codes`)."""
+    the record's (:func:`sheet_time_codes`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.json``, ``.csv``, ``.usd``, ``.usda`` or ``.usdc``.
+    record : mapping
+        A keys record.
+    animation : Animation, optional
+        The source, for key poses and time codes.
+    time_codes : array_like, optional
+        The source's time code of every frame.
+    """
     suffix = Path(path).suffix.lower()
     if suffix in JSON_SUFFIXES:
         write_keys_json(path, record)

@@ -62,6 +62,16 @@ def resample_frames_reference(frames: ArrayLike, counts: ArrayLike, m: int) -> F
     ``frames`` is ``(F, V, 3)``. One monotone key over all frames and strands (strand s of
     chunk frame f occupies [2(f·S+s), 2(f·S+s)+1]) turns the whole chunk into one
     ``searchsorted``; zero-length strands fall back to the vertex-index parameter.
+
+    Parameters
+    ----------
+    frames, counts, m
+        As :func:`resample_frames` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(F, S, m, 3)`` float64.
     """
     if not np.isfinite(m) or int(m) != m or m < 2:
         raise ParameterError("samples", m, "a whole number of at least 2")
@@ -149,6 +159,22 @@ def resample_frames(frames: ArrayLike, counts: ArrayLike, m: int, use_numba: boo
     ``frames`` is ``(F, V, 3)``; the points sit at arc-length fractions 0, 1/(m−1), …, 1 of each
     strand in each frame; strands of zero length fall back to the vertex-index parameter.
     One pass per strand (vertices and samples walked together), in parallel over frames.
+
+    Parameters
+    ----------
+    frames : array_like
+        ``(F, V, 3)`` points.
+    counts : array_like
+        ``(S,)`` vertices per strand.
+    m : int
+        Points per strand, ≥ 2.
+    use_numba : bool, default True
+        False runs the numpy twin.
+
+    Returns
+    -------
+    ndarray
+        ``(F, S, m, 3)`` float64.
     """
     if not use_numba:
         return resample_frames_reference(frames, counts, m)
@@ -164,14 +190,40 @@ def resample_frames(frames: ArrayLike, counts: ArrayLike, m: int, use_numba: boo
 
 
 def strand_weights(u: ArrayLike, options: FeatureOptions) -> F64:
-    """w(u) of seed 000's root–tip weighting at arc-length fractions u ∈ [0, 1]."""
+    """w(u) of seed 000's root–tip weighting at arc-length fractions u ∈ [0, 1].
+
+    Parameters
+    ----------
+    u : array_like
+        Arc-length fractions.
+    options : FeatureOptions
+        The weighting.
+
+    Returns
+    -------
+    ndarray
+        float64 weights.
+    """
     u = np.asarray(u, dtype=np.float64)
     o = options
     return o.root_weight + (o.tip_weight - o.root_weight) * u**o.exponent
 
 
 def hair_features(animation: Animation, options: FeatureOptions | None = None) -> F64:
-    """``(F, D)`` float64 frame vectors of an animation; D = S·M·3 (S·N·3 without resampling)."""
+    """``(F, D)`` float64 frame vectors of an animation; D = S·M·3 (S·N·3 without resampling).
+
+    Parameters
+    ----------
+    animation : Animation
+        The hair's frames.
+    options : FeatureOptions, optional
+        Resampling, root removal and weights (None: seed 000's defaults).
+
+    Returns
+    -------
+    ndarray
+        ``(F, D)`` float64 frame vectors.
+    """
     o = options or FeatureOptions()
     o.validate()
     if o.samples is not None:
@@ -208,7 +260,20 @@ def hair_features(animation: Animation, options: FeatureOptions | None = None) -
 
 
 def raw_features(x: ArrayLike, name: str = "X") -> F64:
-    """An ``(n_frames, D)`` array used as is (float64, checked for shape and NaN)."""
+    """An ``(n_frames, D)`` array used as is (float64, checked for shape and NaN).
+
+    Parameters
+    ----------
+    x : array_like
+        ``(n_frames, D)``.
+    name : str, default "X"
+        Its name in a refusal.
+
+    Returns
+    -------
+    ndarray
+        float64.
+    """
     a = np.asarray(x)
     if a.ndim == 1:
         a = a[:, None]
@@ -228,7 +293,20 @@ def raw_features(x: ArrayLike, name: str = "X") -> F64:
 
 
 def frame_features(source: Animation | ArrayLike, options: FeatureOptions | None = None) -> F64:
-    """Features of an animation (hair_features) or a raw ``(n_frames, D)`` array (as is)."""
+    """Features of an animation (hair_features) or a raw ``(n_frames, D)`` array (as is).
+
+    Parameters
+    ----------
+    source : Animation or array_like
+        An animation, or ``(n_frames, D)`` features used as they are.
+    options : FeatureOptions, optional
+        For an animation: see :func:`hair_features`.
+
+    Returns
+    -------
+    ndarray
+        ``(n_frames, D)`` float64.
+    """
     if isinstance(source, Animation):
         if source.n_frames < 2:
             raise GroomError(f"keyframes need an animation of at least 2 frames, got {source.n_frames}")
@@ -239,7 +317,22 @@ def frame_features(source: Animation | ArrayLike, options: FeatureOptions | None
 def strand_features(animation: Animation, strand: int, options: FeatureOptions | None = None) -> F64:
     """``(F, M, 3)`` one strand's part of :func:`hair_features` (its M points; its vertices
     without resampling), computed from that strand and the roots alone: what a graph editor
-    draws of the space the keys are fitted in."""
+    draws of the space the keys are fitted in.
+
+    Parameters
+    ----------
+    animation : Animation
+        The hair's frames.
+    strand : int
+        The strand.
+    options : FeatureOptions, optional
+        As :func:`hair_features` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(F, M, 3)`` float64.
+    """
     o = options or FeatureOptions()
     o.validate()
     topo = animation.topology

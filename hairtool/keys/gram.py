@@ -29,6 +29,18 @@ def centered_gram(x: F64, chunk_columns: int | None = None) -> F64:
     Centring first keeps |x_k|² close to the size of the errors, so the expansion loses little
     to cancellation. Columns are centred and multiplied in chunks of max(1024, n) columns (no
     second copy of X); near-square blocks stay in cache, much wider ones ran up to 2x slower.
+
+    Parameters
+    ----------
+    x : ndarray
+        ``(n, D)`` features.
+    chunk_columns : int, optional
+        Columns per chunk (None: max(1024, n)).
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
     """
     x = np.asarray(x)
     n, d = x.shape
@@ -45,7 +57,18 @@ def centered_gram(x: F64, chunk_columns: int | None = None) -> F64:
 
 
 def frame_curvature(x: F64) -> F64:
-    """``(n,)`` |x_{k+1} − 2x_k + x_{k−1}|² in float64 (0 at the first and last frame)."""
+    """``(n,)`` |x_{k+1} − 2x_k + x_{k−1}|² in float64 (0 at the first and last frame).
+
+    Parameters
+    ----------
+    x : ndarray
+        ``(n, D)`` features.
+
+    Returns
+    -------
+    ndarray
+        ``(n,)`` float64.
+    """
     x = np.asarray(x, dtype=np.float64)
     c = np.zeros(x.shape[0], dtype=np.float64)
     if x.shape[0] >= 3:
@@ -55,7 +78,18 @@ def frame_curvature(x: F64) -> F64:
 
 
 def tangent_stencil(n: int) -> tuple[NDArray[np.int64], NDArray[np.int64], F64]:
-    """m_c = w_c·(x_{hi_c} − x_{lo_c}): the averaged (one-sided at the ends) difference tangent."""
+    """m_c = w_c·(x_{hi_c} − x_{lo_c}): the averaged (one-sided at the ends) difference tangent.
+
+    Parameters
+    ----------
+    n : int
+        Frames.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        ``lo``, ``hi`` and ``w``.
+    """
     c = np.arange(n)
     lo = np.clip(c - 1, 0, n - 1)
     hi = np.clip(c + 1, 0, n - 1)
@@ -64,6 +98,23 @@ def tangent_stencil(n: int) -> tuple[NDArray[np.int64], NDArray[np.int64], F64]:
 
 
 def check_gram(g: F64, curv: F64, lam: float) -> tuple[F64, F64]:
+    """``g`` and ``curv`` as contiguous float64, or a ParameterError for a shape that does not
+    fit or a bad λ.
+
+    Parameters
+    ----------
+    g : ndarray
+        ``(n, n)`` centred Gram matrix.
+    curv : ndarray
+        ``(n,)`` curvature terms.
+    lam : float
+        The curvature weight λ, ≥ 0.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        ``g`` and ``curv``.
+    """
     g = np.ascontiguousarray(g, dtype=np.float64)
     if g.ndim != 2 or g.shape[0] != g.shape[1]:
         raise ParameterError("gram", f"shape {g.shape}", "a square (n, n) matrix")
@@ -76,7 +127,26 @@ def check_gram(g: F64, curv: F64, lam: float) -> tuple[F64, F64]:
 
 
 def frame_errors_reference(g: F64, curv: F64, lam: float, i: int, j: int, interp: str) -> F64:
-    """Per-frame costs e_k, i < k < j, from the Gram matrix: the plain form both twins share."""
+    """Per-frame costs e_k, i < k < j, from the Gram matrix: the plain form both twins share.
+
+    Parameters
+    ----------
+    g : ndarray
+        ``(n, n)`` centred Gram matrix.
+    curv : ndarray
+        ``(n,)`` curvature terms.
+    lam : float
+        The curvature weight λ.
+    i, j : int
+        The keys, i < j.
+    interp : str
+        The curve.
+
+    Returns
+    -------
+    ndarray
+        ``(j − i − 1,)`` float64.
+    """
     n = g.shape[0]
     k = np.arange(i + 1, j)
     el = float(j - i)

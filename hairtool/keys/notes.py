@@ -22,7 +22,22 @@ WHAT = {"penalty": "the price per key", "budget": "the error budget", "max_error
 
 def dropped_costs(table: F64, constraints: KeyConstraints, objective: str = "total") -> F64:
     """The error of the keys on every allowed frame with one unpinned inner key dropped, for
-    each such key in frame order (total: the sum over segments; worst: their maximum)."""
+    each such key in frame order (total: the sum over segments; worst: their maximum).
+
+    Parameters
+    ----------
+    table : ndarray
+        ``(n, n)`` segment costs.
+    constraints : KeyConstraints
+        Pins and exclusions.
+    objective : str, default "total"
+        Sum or maximum.
+
+    Returns
+    -------
+    ndarray
+        float64, one per droppable key.
+    """
     n = table.shape[0]
     keys = np.setdiff1d(np.arange(n), np.asarray(constraints.excludes, dtype=np.int64))
     seg = table[keys[:-1], keys[1:]]  # between neighbouring keys
@@ -40,7 +55,24 @@ def dropped_costs(table: F64, constraints: KeyConstraints, objective: str = "tot
 
 def explain(table: F64, constraints: KeyConstraints, objective: str, sel: Selection) -> str | None:
     """A note for a tau, budget or bound that gave the most or the fewest keys the constraints
-    allow (None otherwise, and for an exact count)."""
+    allow (None otherwise, and for an exact count).
+
+    Parameters
+    ----------
+    table : ndarray
+        ``(n, n)`` segment costs.
+    constraints : KeyConstraints
+        Pins and exclusions.
+    objective : str
+        Sum or maximum.
+    sel : Selection
+        The selection.
+
+    Returns
+    -------
+    str or None
+        The note.
+    """
     if sel.mode == "keys":
         return None
     n = table.shape[0]

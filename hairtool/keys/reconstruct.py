@@ -27,7 +27,20 @@ _CHUNK_VALUES = 8_000_000  # float64 values rebuilt per chunk of frames
 
 
 def check_keys(keys: ArrayLike, n_frames: int) -> I64:
-    """Strictly increasing whole frame numbers from 0 to n_frames − 1."""
+    """Strictly increasing whole frame numbers from 0 to n_frames − 1.
+
+    Parameters
+    ----------
+    keys : array_like
+        Key frames.
+    n_frames : int
+        The animation's frame count.
+
+    Returns
+    -------
+    ndarray
+        The keys, int64 (ParameterError otherwise).
+    """
     k = np.asarray(keys)
     if k.ndim != 1 or k.size < 2:
         raise ParameterError("keys", k.tolist() if k.size < 8 else "array", "at least 2 frame numbers")
@@ -57,7 +70,20 @@ class KeyPoses:
     tangents_in: F64 | None = None
 
     def with_pose(self, key_frame: int, pose: ArrayLike) -> KeyPoses:
-        """A copy with the pose at ``key_frame`` (a frame number that is a key) replaced."""
+        """A copy with the pose at ``key_frame`` (a frame number that is a key) replaced.
+
+        Parameters
+        ----------
+        key_frame : int
+            A frame that is a key.
+        pose : array_like
+            The new pose, shaped as one frame.
+
+        Returns
+        -------
+        KeyPoses
+            The copy; its tangents stay as they were.
+        """
         hit = np.flatnonzero(self.keys == key_frame)
         if hit.size == 0:
             raise ParameterError("key_frame", key_frame, f"one of the keys {self.keys.tolist()}")
@@ -72,7 +98,22 @@ class KeyPoses:
 def key_poses(frames: ArrayLike, keys: ArrayLike, interp: str = "linear") -> KeyPoses:
     """Take the key poses (and Hermite tangents) out of the full-rate frames; "hermite-fit"
     fits each segment's two handles to its frames by least squares
-    (:func:`hairtool.keys.segment_fit.fit_segment`)."""
+    (:func:`hairtool.keys.segment_fit.fit_segment`).
+
+    Parameters
+    ----------
+    frames : array_like
+        ``(F, ...)`` the full-rate frames.
+    keys : array_like
+        Key frame numbers, ascending, first and last frame included.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The curve through the keys.
+
+    Returns
+    -------
+    KeyPoses
+        The keys' poses and, for Hermite curves, their tangents.
+    """
     if interp not in INTERPOLATIONS:
         raise ParameterError("interp", interp, " or ".join(INTERPOLATIONS))
     f = np.asarray(frames)
@@ -104,7 +145,20 @@ def _fitted_key_poses(f: NDArray, k: I64) -> KeyPoses:
 
 
 def interpolate_keys(kp: KeyPoses, dtype: type = np.float64) -> NDArray:
-    """``(F, ...)`` frames rebuilt from the key poses; exact at the keys."""
+    """``(F, ...)`` frames rebuilt from the key poses; exact at the keys.
+
+    Parameters
+    ----------
+    kp : KeyPoses
+        The key poses and tangents.
+    dtype : type, default numpy.float64
+        The result's dtype.
+
+    Returns
+    -------
+    ndarray
+        ``(F, ...)`` frames.
+    """
     n = kp.n_frames
     out = np.empty((n, *kp.poses.shape[1:]), dtype=dtype)
     chunk = max(1, _CHUNK_VALUES // max(1, int(np.prod(kp.poses.shape[1:]))))
@@ -116,7 +170,22 @@ def interpolate_keys(kp: KeyPoses, dtype: type = np.float64) -> NDArray:
 
 def interpolate_at(kp: KeyPoses, frames: ArrayLike, dtype: type = np.float64) -> NDArray:
     """``(len(frames), ...)`` the key curve (linear or Hermite) at the given frame numbers only:
-    what a studio scrubbing through a long animation asks for, one frame at a time."""
+    what a studio scrubbing through a long animation asks for, one frame at a time.
+
+    Parameters
+    ----------
+    kp : KeyPoses
+        The key poses and tangents.
+    frames : array_like
+        Frame numbers, each in [0, F).
+    dtype : type, default numpy.float64
+        The result's dtype.
+
+    Returns
+    -------
+    ndarray
+        ``(len(frames), ...)``.
+    """
     t = np.asarray(frames, dtype=np.int64).reshape(-1)
     if t.size and (t.min() < 0 or t.max() >= kp.n_frames):
         raise ParameterError("frames", f"{t.min()}..{t.max()}", f"frame numbers in [0, {kp.n_frames - 1}]")
@@ -134,7 +203,22 @@ def interpolate_at(kp: KeyPoses, frames: ArrayLike, dtype: type = np.float64) ->
 
 
 def reconstruct(animation: Animation, keys: ArrayLike, interp: str = "linear") -> Animation:
-    """The full-rate animation rebuilt from its key poses (all original vertices)."""
+    """The full-rate animation rebuilt from its key poses (all original vertices).
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    keys : array_like
+        Its key frames.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The curve through the keys.
+
+    Returns
+    -------
+    Animation
+        Every frame rebuilt, float32 as a groom's points are.
+    """
     kp = key_poses(animation.frames, keys, interp)
     return animation.with_frames(interpolate_keys(kp, np.float32))
 
@@ -159,7 +243,20 @@ class PositionErrors:
 
 
 def position_errors(original: Animation, rebuilt: Animation | ArrayLike) -> PositionErrors:
-    """Distances between every original vertex and its rebuilt position (float64)."""
+    """Distances between every original vertex and its rebuilt position (float64).
+
+    Parameters
+    ----------
+    original : Animation
+        The full-rate animation.
+    rebuilt : Animation or array_like
+        ``(F, V, 3)`` its frames rebuilt.
+
+    Returns
+    -------
+    PositionErrors
+        Per-frame mean, worst and tip distances, in the groom's units.
+    """
     b = rebuilt.frames if isinstance(rebuilt, Animation) else np.asarray(rebuilt)
     if b.shape != original.frames.shape:
         raise ParameterError("rebuilt", f"shape {b.shape}", f"{original.frames.shape}")
@@ -221,7 +318,24 @@ def key_curve_errors(
     float32): what the CLI and the studio's timeline both report. None as soon as
     ``cancelled()`` turns True. The distances come from one kernel (:func:`_curve_distances`),
     the sums from numpy as :func:`key_curve_errors_reference` takes them; the two agree to
-    rounding (the kernel may fuse a multiply and an add)."""
+    rounding (the kernel may fuse a multiply and an add).
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    kp : KeyPoses
+        Its key poses.
+    cancelled : callable, optional
+        Asked between chunks; True stops.
+    progress : callable, optional
+        ``progress(share)`` after each chunk.
+
+    Returns
+    -------
+    PositionErrors or None
+        The errors, or None once cancelled.
+    """
     return _curve_errors(animation, kp, cancelled, progress, reference=False)
 
 
@@ -233,7 +347,18 @@ def key_curve_errors_reference(
     progress: Callable[[float], None] | None = None,
 ) -> PositionErrors | None:
     """The numpy twin of :func:`key_curve_errors`: each chunk of the curve rebuilt by
-    :func:`interpolate_at`, then its distances."""
+    :func:`interpolate_at`, then its distances.
+
+    Parameters
+    ----------
+    animation, kp, cancelled, progress
+        As :func:`key_curve_errors` takes them.
+
+    Returns
+    -------
+    PositionErrors or None
+        As :func:`key_curve_errors` gives them.
+    """
     return _curve_errors(animation, kp, cancelled, progress, reference=True)
 
 
@@ -271,7 +396,23 @@ def _curve_errors(animation, kp, cancelled, progress, reference: bool) -> Positi
 
 
 def compare_with_uniform(animation: Animation, keys: ArrayLike, interp: str = "linear") -> dict:
-    """Position errors of the given keys and of uniform keys of the same count."""
+    """Position errors of the given keys and of uniform keys of the same count.
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    keys : array_like
+        The key frames to judge.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The curve through the keys.
+
+    Returns
+    -------
+    dict
+        ``{"keys": ..., "uniform": ...}``: each set's frames and its mean, worst and tip
+        position errors, in the groom's units.
+    """
     k = check_keys(keys, animation.n_frames)
     uni = uniform_keys(animation.n_frames, k.size)
     out = {}
@@ -286,7 +427,22 @@ def motion_speed(
 ) -> F64 | None:
     """``(F,)`` mean speed of all points per second (central differences, one-sided at the ends),
     units/s, a chunk of frames at a time in float64. An ``(F, V, 3)`` array is V points; a flat
-    ``(F, D)`` feature array counts every dimension as a point on a line. None once ``cancelled()``."""
+    ``(F, D)`` feature array counts every dimension as a point on a line. None once ``cancelled()``.
+
+    Parameters
+    ----------
+    frames : array_like
+        ``(F, V, 3)`` points or ``(F, D)`` features.
+    fps : float, default 1.0
+        Frames per second.
+    cancelled : callable, optional
+        Asked between chunks; True stops.
+
+    Returns
+    -------
+    ndarray or None
+        ``(F,)`` float64 speeds, or None once cancelled.
+    """
     f = np.asarray(frames)
     n = f.shape[0]
     f = f.reshape(n, -1, 3) if f.ndim == 3 else f.reshape(n, -1, 1)
@@ -310,6 +466,22 @@ def key_distribution(frames: ArrayLike, keys: ArrayLike, fps: float = 1.0, windo
     ``speed`` per frame, the ``motion`` covered so far (cumulative path, 0 → 1), the fraction
     of motion at each key, and key density (keys per frame) in sliding windows; a good key
     set has keys where ``speed`` is high, and key fractions that track the motion fraction.
+
+    Parameters
+    ----------
+    frames : array_like
+        ``(F, V, 3)`` points or ``(F, D)`` features.
+    keys : array_like
+        Key frames.
+    fps : float, default 1.0
+        Frames per second.
+    window : int, optional
+        The sliding window's length in frames (None: max(3, F // 20)).
+
+    Returns
+    -------
+    dict
+        ``speed``, ``motion``, the keys' motion fractions and the key density, as lists.
     """
     f = np.asarray(frames)
     k = check_keys(keys, f.shape[0])

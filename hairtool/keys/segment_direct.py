@@ -13,7 +13,18 @@ F64 = NDArray[np.float64]
 
 
 def difference_tangents(x: F64) -> F64:
-    """m_c = ((x_c − x_{c−1}) + (x_{c+1} − x_c))/2, one-sided at the ends (seed 003)."""
+    """m_c = ((x_c − x_{c−1}) + (x_{c+1} − x_c))/2, one-sided at the ends (seed 003).
+
+    Parameters
+    ----------
+    x : ndarray
+        ``(n, D)`` frames.
+
+    Returns
+    -------
+    ndarray
+        ``(n, D)`` float64.
+    """
     x = np.asarray(x, dtype=np.float64)
     m = np.empty_like(x)
     m[0] = x[1] - x[0]
@@ -23,7 +34,24 @@ def difference_tangents(x: F64) -> F64:
 
 
 def interpolate_segment(x: F64, m: F64 | None, i: int, j: int, frames: NDArray) -> F64:
-    """Frames at times ``frames`` rebuilt from keys i, j (Hermite when tangents m are given)."""
+    """Frames at times ``frames`` rebuilt from keys i, j (Hermite when tangents m are given).
+
+    Parameters
+    ----------
+    x : ndarray
+        ``(n, D)`` frames.
+    m : ndarray or None
+        ``(n, D)`` tangents (None: linear).
+    i, j : int
+        The keys.
+    frames : ndarray
+        The frame numbers wanted.
+
+    Returns
+    -------
+    ndarray
+        ``(len(frames), D)`` float64.
+    """
     el = float(j - i)
     s = ((np.asarray(frames, dtype=np.float64) - i) / el)[:, None]
     if m is None:
@@ -38,7 +66,24 @@ def interpolate_segment(x: F64, m: F64 | None, i: int, j: int, frames: NDArray) 
 def direct_cost_table(
     x: F64, interp: str = "linear", curvature: float = 0.0, objective: str = "total"
 ) -> F64:
-    """``(n, n)``: for every pair i < j, the skipped frames' costs summed (or their maximum)."""
+    """``(n, n)``: for every pair i < j, the skipped frames' costs summed (or their maximum).
+
+    Parameters
+    ----------
+    x : ndarray
+        ``(n, D)`` frames.
+    interp : str, default "linear"
+        The curve.
+    curvature : float, default 0.0
+        The curvature weight.
+    objective : {"total", "worst"}, default "total"
+        Sum or maximum.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     x = np.asarray(x, dtype=np.float64)
     n = x.shape[0]
     m = difference_tangents(x) if interp == "hermite" else None

@@ -36,7 +36,18 @@ F64 = NDArray[np.float64]
 def fit_basis(n: int) -> F64:
     """``(n, 10)`` per segment length L: Σh00², Σh00h01, Σh01², Σαh00, Σαh01, Σβh00, Σβh01 and
     the inverse of M as (M⁻¹_aa, M⁻¹_ab, M⁻¹_bb); rows L < 3 hold zeros for M⁻¹ (one skipped
-    frame is fitted exactly, none needs no fit)."""
+    frame is fitted exactly, none needs no fit).
+
+    Parameters
+    ----------
+    n : int
+        Frames.
+
+    Returns
+    -------
+    ndarray
+        ``(n, 10)`` float64.
+    """
     q = hermite_quad_weights(max(n, 3))  # Q[L, a, b] over the basis (h00, h10, h01, h11)
     out = np.zeros((max(n, 3), 10))
     out[:, 0], out[:, 1], out[:, 2] = q[:, 0, 0], q[:, 0, 2], q[:, 2, 2]
@@ -53,7 +64,18 @@ def fit_basis(n: int) -> F64:
 def reduced_features(x: ArrayLike) -> F64:
     """The centred features, or, when they are wider than they are long, an ``(n, r)`` factor
     Y with Y·Yᵀ equal to their centred Gram matrix (r its rank, eigenvalues below 1e-13 of
-    the largest dropped): every fitted cost depends on inner products only."""
+    the largest dropped): every fitted cost depends on inner products only.
+
+    Parameters
+    ----------
+    x : array_like
+        ``(n, D)`` features.
+
+    Returns
+    -------
+    ndarray
+        ``(n, D)`` or ``(n, r)`` float64.
+    """
     x = np.asarray(x, dtype=np.float64)
     xc = x - x.mean(axis=0)
     n, d = xc.shape
@@ -161,7 +183,22 @@ def _fit_kernel(y, curv, lam, basis):  # pragma: no cover - compiled
 
 def fit_table(x: ArrayLike, curv: ArrayLike, lam: float = 0.0) -> F64:
     """``(n, n)`` total cost of each segment with fitted Hermite tangents (numba); entries i < j
-    meaningful. ``x``: ``(n, D)`` features; ``curv``: per-frame curvature terms, weighted by λ."""
+    meaningful. ``x``: ``(n, D)`` features; ``curv``: per-frame curvature terms, weighted by λ.
+
+    Parameters
+    ----------
+    x : array_like
+        ``(n, D)`` features.
+    curv : array_like
+        ``(n,)`` curvature terms.
+    lam : float, default 0.0
+        The curvature weight λ.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     y = reduced_features(x)
     curv = np.ascontiguousarray(curv, dtype=np.float64)
     if curv.shape != (y.shape[0],):
@@ -172,7 +209,20 @@ def fit_table(x: ArrayLike, curv: ArrayLike, lam: float = 0.0) -> F64:
 def fit_segment(x: ArrayLike, i: int, j: int) -> tuple[F64, F64, F64]:
     """``(a, b, residuals)`` of the least-squares handles of segment (i, j) of ``(n, D)`` frames,
     from the definition: ``a = L·m_i⁺``, ``b = L·m_j⁻``. One skipped frame: the exact fit
-    closest to the data tangents; none: the data tangents."""
+    closest to the data tangents; none: the data tangents.
+
+    Parameters
+    ----------
+    x : array_like
+        ``(n, D)`` frames.
+    i, j : int
+        The segment's keys, i < j.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray, ndarray)
+        The handles ``a`` and ``b`` and the skipped frames' residuals.
+    """
     x = np.asarray(x, dtype=np.float64)
     n, el = x.shape[0], j - i
     lo, hi, w = (a[[i, j]] for a in tangent_stencil(n))
@@ -194,7 +244,18 @@ def fit_segment(x: ArrayLike, i: int, j: int) -> tuple[F64, F64, F64]:
 
 
 def fit_table_reference(x: ArrayLike, curv: ArrayLike, lam: float = 0.0) -> F64:
-    """Numpy twin of :func:`fit_table`: a least-squares solve per segment (O(n³·D): tests only)."""
+    """Numpy twin of :func:`fit_table`: a least-squares solve per segment (O(n³·D): tests only).
+
+    Parameters
+    ----------
+    x, curv, lam
+        As :func:`fit_table` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     x = np.asarray(x, dtype=np.float64)
     curv = np.asarray(curv, dtype=np.float64)
     n = x.shape[0]

@@ -18,7 +18,18 @@ F64 = NDArray[np.float64]
 
 
 def hermite_quad_weights(n: int) -> F64:
-    """``(n, 4, 4)``: Q[L, a, b] = Σ_{d=1}^{L−1} P_a(d/L)·P_b(d/L) for the four Hermite basis P."""
+    """``(n, 4, 4)``: Q[L, a, b] = Σ_{d=1}^{L−1} P_a(d/L)·P_b(d/L) for the four Hermite basis P.
+
+    Parameters
+    ----------
+    n : int
+        Frames.
+
+    Returns
+    -------
+    ndarray
+        ``(n, 4, 4)`` float64.
+    """
     d = np.arange(n, dtype=np.float64)
     sums = np.zeros((n, 7))
     for p in range(7):
@@ -138,7 +149,22 @@ def _hermite_kernel(g, curv, lam, q):  # pragma: no cover - compiled
 
 
 def hermite_table_reference(g: F64, curv: F64, lam: float = 0.0) -> F64:
-    """Numpy twin of the Hermite kernel: per-pair sums of :func:`frame_errors_reference`."""
+    """Numpy twin of the Hermite kernel: per-pair sums of :func:`frame_errors_reference`.
+
+    Parameters
+    ----------
+    g : ndarray
+        ``(n, n)`` centred Gram matrix.
+    curv : ndarray
+        ``(n,)`` curvature terms.
+    lam : float, default 0.0
+        The curvature weight λ.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     n = g.shape[0]
     out = np.zeros((n, n))
     for i in range(n):
@@ -148,5 +174,20 @@ def hermite_table_reference(g: F64, curv: F64, lam: float = 0.0) -> F64:
 
 
 def hermite_table(g: F64, curv: F64, lam: float = 0.0) -> F64:
-    """``(n, n)`` Σ-of-frame-costs table for Hermite interpolation (numba)."""
+    """``(n, n)`` Σ-of-frame-costs table for Hermite interpolation (numba).
+
+    Parameters
+    ----------
+    g : ndarray
+        ``(n, n)`` centred Gram matrix.
+    curv : ndarray
+        ``(n,)`` curvature terms.
+    lam : float, default 0.0
+        The curvature weight λ.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     return _hermite_kernel(g, curv, float(lam), hermite_quad_weights(max(g.shape[0], 2)))

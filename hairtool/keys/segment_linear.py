@@ -55,7 +55,18 @@ def _linear_kernel(g, curv, lam):  # pragma: no cover - compiled
 
 
 def linear_table_reference(g: F64, curv: F64, lam: float = 0.0) -> F64:
-    """Numpy twin of the linear kernel, from global prefix sums (plain, less cancellation-proof)."""
+    """Numpy twin of the linear kernel, from global prefix sums (plain, less cancellation-proof).
+
+    Parameters
+    ----------
+    g, curv, lam
+        As :func:`linear_table` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     n = g.shape[0]
     k = np.arange(n, dtype=np.float64)
     p0 = np.zeros((n + 1, n))
@@ -81,5 +92,20 @@ def linear_table_reference(g: F64, curv: F64, lam: float = 0.0) -> F64:
 
 
 def linear_table(g: F64, curv: F64, lam: float = 0.0) -> F64:
-    """``(n, n)`` Σ-of-frame-costs table for linear interpolation (numba)."""
+    """``(n, n)`` Σ-of-frame-costs table for linear interpolation (numba).
+
+    Parameters
+    ----------
+    g : ndarray
+        ``(n, n)`` centred Gram matrix.
+    curv : ndarray
+        ``(n,)`` curvature terms.
+    lam : float, default 0.0
+        The curvature weight λ.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     return _linear_kernel(g, curv, float(lam))

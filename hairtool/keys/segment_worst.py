@@ -149,7 +149,18 @@ def _hermite_frame_cost(  # pragma: no cover - compiled
 
 
 def worst_table_reference(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear") -> F64:
-    """Numpy twin of the worst-frame kernel (per-pair maxima of :func:`frame_errors_reference`)."""
+    """Numpy twin of the worst-frame kernel (per-pair maxima of :func:`frame_errors_reference`).
+
+    Parameters
+    ----------
+    g, curv, lam, interp
+        As :func:`worst_table` takes them.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     n = g.shape[0]
     out = np.zeros((n, n))
     for i in range(n):
@@ -159,7 +170,26 @@ def worst_table_reference(g: F64, curv: F64, lam: float = 0.0, interp: str = "li
 
 
 def worst_table(g: F64, curv: F64, lam: float = 0.0, interp: str = "linear", use_numba: bool = True) -> F64:
-    """``(n, n)`` worst-frame table from a centred Gram matrix; entries i < j meaningful."""
+    """``(n, n)`` worst-frame table from a centred Gram matrix; entries i < j meaningful.
+
+    Parameters
+    ----------
+    g : ndarray
+        ``(n, n)`` centred Gram matrix.
+    curv : ndarray
+        ``(n,)`` curvature terms.
+    lam : float, default 0.0
+        The curvature weight λ.
+    interp : {"linear", "hermite"}, default "linear"
+        The curve.
+    use_numba : bool, default True
+        False runs the numpy twin.
+
+    Returns
+    -------
+    ndarray
+        ``(n, n)`` float64.
+    """
     g, curv = check_gram(g, curv, lam)
     if not use_numba:
         return worst_table_reference(g, curv, lam, interp)

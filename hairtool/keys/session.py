@@ -118,6 +118,18 @@ class KeySettings:
         return self
 
     def replace(self, **changes: object) -> KeySettings:
+        """These settings with ``changes``, checked again.
+
+        Parameters
+        ----------
+        **changes : object
+            New values by field name.
+
+        Returns
+        -------
+        KeySettings
+            The changed, validated copy.
+        """
         return replace(self, **changes).validate()
 
     @property
@@ -145,6 +157,25 @@ class KeySession:
         table_key: tuple = (),
         constraints: KeyConstraints | None = None,
     ) -> None:
+        """A session over ``table``; nothing is solved until :meth:`layers`.
+
+        Parameters
+        ----------
+        table : array_like
+            ``(n, n)`` segment costs.
+        objective : {"total", "worst"}, default "total"
+            What the table's entries are.
+        interp : str, default "linear"
+            The curve the table was built for (reported, and kept in :attr:`table_key`).
+        curvature : float, default 0.0
+            The table's curvature weight (reported likewise).
+        kmax : int, default MAX_CURVE_KEYS
+            The most keys the layered DP solves for.
+        table_key : tuple, default ()
+            What the table depends on (empty: built from the above).
+        constraints : KeyConstraints, optional
+            Pinned and excluded frames.
+        """
         self.table = check_table(table)
         if objective not in OBJECTIVES:
             raise ParameterError("objective", objective, " or ".join(OBJECTIVES))
@@ -162,7 +193,18 @@ class KeySession:
 
     def constrain(self, constraints: KeyConstraints | None) -> KeySession:
         """The same table under other pins and exclusions (the layers are solved again, the
-        table is not rebuilt): what a dope sheet edit asks for."""
+        table is not rebuilt): what a dope sheet edit asks for.
+
+        Parameters
+        ----------
+        constraints : KeyConstraints or None
+            The new pins and exclusions (None: none).
+
+        Returns
+        -------
+        KeySession
+            A session sharing this one's table.
+        """
         constraints = (constraints or KeyConstraints()).check(self.n_frames)
         if constraints != self.constraints:
             self.constraints, self.energy, self.back = constraints, None, None
@@ -176,7 +218,18 @@ class KeySession:
 
     def layers(self, progress: Callable[[float], None] | None = None) -> KeySession:
         """Solve the DP for every K up to ``kmax`` (once; later calls return at once);
-        ``progress(share)`` as it goes."""
+        ``progress(share)`` as it goes.
+
+        Parameters
+        ----------
+        progress : callable, optional
+            ``progress(share)`` with share in [0, 1].
+
+        Returns
+        -------
+        KeySession
+            This session, solved.
+        """
         if self.energy is None:
             self.energy, self.back, _ = solve_layers(
                 self.table, self.kmax, self.objective, constraints=self.constraints, progress=progress
@@ -193,7 +246,18 @@ class KeySession:
         return np.column_stack([ks, self.energy[ks, self.n_frames - 1]])
 
     def keys_for_count(self, k: int) -> I64:
-        """The DP keys for exactly ``k`` keys, traced back through the stored layers."""
+        """The DP keys for exactly ``k`` keys, traced back through the stored layers.
+
+        Parameters
+        ----------
+        k : int
+            The key count, 2 … :attr:`kmax`.
+
+        Returns
+        -------
+        ndarray
+            ``(k,)`` int64 key frames.
+        """
         lo, hi = self.key_range
         if not lo <= k <= hi:
             why = "" if not self.constraints else " with these pins and exclusions"
@@ -213,7 +277,20 @@ class KeySession:
         """Seed 003's keys with a price per key (total objective only). ``relative``: tau is a
         share of :attr:`two_key_error` (a key is kept when it saves at least that share of the
         error of keying the ends alone), so 0.01 means the same on a sway and on a 10⁸-unit
-        simulation; otherwise tau is seed 003's absolute price, in squared feature units."""
+        simulation; otherwise tau is seed 003's absolute price, in squared feature units.
+
+        Parameters
+        ----------
+        tau : float
+            The price of a key.
+        relative : bool, default True
+            ``tau`` is a share of :attr:`two_key_error`, not an absolute error.
+
+        Returns
+        -------
+        ndarray
+            int64 key frames.
+        """
         price = float(tau) * self.two_key_error if relative else float(tau)
         return select_keys(self.table, penalty=price, curve_keys=0, constraints=self.constraints).keys
 
@@ -240,7 +317,18 @@ class KeySession:
         return min(max(self.knee, lo), hi)
 
     def keys_for_budget(self, budget: float) -> I64:
-        """The fewest keys whose error (total, or worst frame) is within ``budget``."""
+        """The fewest keys whose error (total, or worst frame) is within ``budget``.
+
+        Parameters
+        ----------
+        budget : float
+            The error allowed.
+
+        Returns
+        -------
+        ndarray
+            int64 key frames.
+        """
         self.layers()
         e = self.energy[2 : self.kmax + 1, self.n_frames - 1]
         fits = np.flatnonzero(e <= budget)
@@ -255,7 +343,18 @@ class KeySession:
         """The DP keys the settings ask for (count, tau or budget, under their pins and exclusions).
 
         All or nothing: a ParameterError (a budget these pins and exclusions cannot meet) leaves
-        the session under its previous constraints, so a refused edit can be dropped whole."""
+        the session under its previous constraints, so a refused edit can be dropped whole.
+
+        Parameters
+        ----------
+        settings : KeySettings
+            The mode (count, tau or budget) and its value.
+
+        Returns
+        -------
+        ndarray
+            int64 key frames.
+        """
         before = (self.constraints, self.energy, self.back)
         try:
             self.constrain(settings.constraints)
@@ -273,7 +372,18 @@ class KeySession:
     def explain(self, sel: Selection) -> str | None:
         """Why a tau, budget or bound gave one of the two extremes (a key on every frame the
         constraints allow, or no keys but the ends and pins), in words a user can act on; None
-        otherwise (:func:`hairtool.keys.notes.explain`)."""
+        otherwise (:func:`hairtool.keys.notes.explain`).
+
+        Parameters
+        ----------
+        sel : Selection
+            A selection this session made.
+
+        Returns
+        -------
+        str or None
+            The reason, or None where the selection is not an extreme.
+        """
         return notes.explain(self.table, self.constraints, self.objective, sel)
 
     def select(
@@ -288,7 +398,22 @@ class KeySession:
     ) -> Selection:
         """Exactly one of ``keys``, ``penalty``, ``budget``, ``max_error`` (see
         :func:`hairtool.keys.dp.select_keys`), with uniform keys of the same count and the
-        error-vs-count curve up to ``curve_keys``: the record ``hairtool keys`` prints."""
+        error-vs-count curve up to ``curve_keys``: the record ``hairtool keys`` prints.
+
+        Parameters
+        ----------
+        keys, penalty, budget, max_error : optional
+            Exactly one, as :func:`~hairtool.keys.dp.select_keys` takes them.
+        curve_keys : int, default DEFAULT_CURVE_KEYS
+            The error curve covers K = 2 … this.
+        progress : callable, optional
+            ``progress(share)`` with share in [0, 1].
+
+        Returns
+        -------
+        Selection
+            The keys, their cost and the uniform keys' for comparison.
+        """
         sel = select_keys(
             self.table,
             keys=keys,
@@ -312,6 +437,16 @@ def knee_count(curve: ArrayLike) -> int:
     the straight line from (0, 1) to (1, 0), i.e. maximises (1 − x) − y (Satopää et al. 2011,
     "Kneedle"): past it, each added key buys less than its share. A flat or straight curve gives
     its first count. ``curve``: ``(m, 2)`` rows (K, error), K increasing, errors finite.
+
+    Parameters
+    ----------
+    curve : array_like
+        Errors by key count.
+
+    Returns
+    -------
+    int
+        The key count at the knee.
     """
     c = np.asarray(curve, dtype=np.float64)
     if c.ndim != 2 or c.shape[0] == 0 or c.shape[1] != 2:
@@ -334,7 +469,22 @@ def work_estimate(shape: tuple[int, int], settings: KeySettings, kmax: int) -> t
     """Rough operation counts of the cost table and the all-K DP for ``(n, D)`` features, so
     that the progress bar moves in proportion to the time: the Gram product n²D/2 (the worst
     frame: plus n³/6 segment scans; fitted handles: a running solve per segment, n²D), the DP
-    about K·n²/2."""
+    about K·n²/2.
+
+    Parameters
+    ----------
+    shape : tuple of (int, int)
+        ``(n, D)`` of the features.
+    settings : KeySettings
+        The interpolation and objective.
+    kmax : int
+        The most keys the DP solves for.
+
+    Returns
+    -------
+    tuple of (float, float)
+        The table's and the DP's operation counts.
+    """
     n, d = shape
     table = n * n * d / 2.0
     if settings.objective == "worst":
@@ -362,6 +512,32 @@ def solve(
     ``(frames, D)`` feature array used as is; ``table`` replaces the Gram cost table by one the
     caller built (seed 003's quaternion-distance table of a BVH capture); ``constraints`` pins
     and excludes frames (:mod:`hairtool.keys.constraints`; default: the settings' own).
+
+    Parameters
+    ----------
+    source : Animation or array_like
+        The animation, or ``(frames, D)`` features.
+    settings : KeySettings
+        Interpolation, objective, curvature and the feature options.
+    progress : callable, optional
+        ``progress(share, stage)`` as it goes.
+    cancelled : callable, optional
+        Asked between stages; True stops the solve.
+    features : FeatureOptions, optional
+        Overrides the settings' feature options.
+    table : array_like, optional
+        A cost table built by the caller.
+    layers : bool, default True
+        Solve the layered DP now.
+    kmax : int, default MAX_CURVE_KEYS
+        The most keys the DP solves for.
+    constraints : KeyConstraints, optional
+        Pinned and excluded frames (None: the settings').
+
+    Returns
+    -------
+    KeySession or None
+        The session, or None once cancelled.
     """
     settings.validate()
     progress = progress or (lambda *a, **k: None)
@@ -495,7 +671,24 @@ def frame_errors(
     cancelled: CancelCheck | None = None,
     progress: Callable[[float], None] | None = None,
 ) -> FrameErrors | None:
-    """Mean, tip-mean and max vertex error per frame of the key curve."""
+    """Mean, tip-mean and max vertex error per frame of the key curve.
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    kp : KeyPoses
+        Its key poses.
+    cancelled : callable, optional
+        Asked between chunks; True stops.
+    progress : callable, optional
+        ``progress(share)`` after each chunk.
+
+    Returns
+    -------
+    FrameErrors or None
+        The errors, or None once cancelled.
+    """
     err = key_curve_errors(animation, kp, cancelled=cancelled, progress=progress)
     if err is None:
         return None
@@ -503,13 +696,41 @@ def frame_errors(
 
 
 def vertex_errors(animation: Animation, kp: KeyPoses, frame: int) -> F32:
-    """``(V,)`` distance of each vertex from the key curve at one frame."""
+    """``(V,)`` distance of each vertex from the key curve at one frame.
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    kp : KeyPoses
+        Its key poses.
+    frame : int
+        The frame.
+
+    Returns
+    -------
+    ndarray
+        ``(V,)`` float32 distances.
+    """
     d = animation.frames[frame].astype(np.float64) - interpolate_at(kp, [frame])[0]
     return np.sqrt(np.einsum("vi,vi->v", d, d)).astype(np.float32)
 
 
 def speed(animation: Animation, cancelled: CancelCheck | None = None) -> F64 | None:
-    """``(F,)`` mean vertex speed in units/s (:func:`hairtool.keys.reconstruct.motion_speed`)."""
+    """``(F,)`` mean vertex speed in units/s (:func:`hairtool.keys.reconstruct.motion_speed`).
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    cancelled : callable, optional
+        Asked between chunks; True stops.
+
+    Returns
+    -------
+    ndarray or None
+        ``(F,)`` float64, or None once cancelled.
+    """
     return motion_speed(animation.frames, animation.fps, cancelled)
 
 
@@ -522,7 +743,28 @@ def analyse(
     progress: Progress | None = None,
     cancelled: CancelCheck | None = None,
 ) -> Analysis | None:
-    """Errors of the DP keys and of uniform keys of the same count (and the motion speed)."""
+    """Errors of the DP keys and of uniform keys of the same count (and the motion speed).
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    dp_keys : array_like
+        The optimal keys.
+    interp : str
+        The curve through the keys.
+    with_speed : bool, default True
+        Also measure the motion's speed per frame.
+    progress : callable, optional
+        ``progress(share, stage)`` as it goes.
+    cancelled : callable, optional
+        Asked between steps; True stops.
+
+    Returns
+    -------
+    Analysis or None
+        The errors of both key sets, or None once cancelled.
+    """
     k = check_keys(dp_keys, animation.n_frames)
     uni = uniform_keys(animation.n_frames, k.size)
     parts = []
@@ -540,7 +782,22 @@ def analyse(
 
 def key_poses_of(animation: Animation, keys: ArrayLike, interp: str) -> KeyPoses:
     """Key poses (and Hermite tangents) of an animation, stored as float32 to halve their size
-    (a studio holds two sets for the whole session); evaluated in float64 all the same."""
+    (a studio holds two sets for the whole session); evaluated in float64 all the same.
+
+    Parameters
+    ----------
+    animation : Animation
+        The full-rate animation.
+    keys : array_like
+        Its key frames.
+    interp : str
+        The curve through the keys.
+
+    Returns
+    -------
+    KeyPoses
+        float32 key poses and tangents.
+    """
     kp = key_poses(animation.frames, keys, interp)
     tangents = None if kp.tangents is None else kp.tangents.astype(np.float32)
     arriving = None if kp.tangents_in is None else kp.tangents_in.astype(np.float32)
@@ -556,6 +813,24 @@ def key_edit_block(
     An edit changes only the frames between the key's neighbouring keys, so the editor runs on
     that stretch plus one frame each side (which keeps the Hermite tangents at the neighbouring
     keys those of the whole animation): the result equals editing the whole animation.
+
+    Parameters
+    ----------
+    frames : ndarray
+        ``(F, ...)`` the animation's frames.
+    keys : array_like
+        Its key frames.
+    interp : str
+        The key curve.
+    key_frame : int
+        The key edited.
+    pose : array_like
+        Its new pose.
+
+    Returns
+    -------
+    tuple of (int, ndarray)
+        The first frame changed and the changed frames.
     """
     n = frames.shape[0]
     k = check_keys(keys, n)

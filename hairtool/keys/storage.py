@@ -19,7 +19,22 @@ from hairtool.groom import Animation
 
 def keys_only_bytes(animation: Animation, keys: Sequence[int], suffix: str) -> int | None:
     """Bytes of the key poses written as a ``suffix`` file (``.usdc``, ``.npz``, …); None for a
-    format that cannot hold an animation."""
+    format that cannot hold an animation.
+
+    Parameters
+    ----------
+    animation : Animation
+        The animation.
+    keys : sequence of int
+        Its key frames.
+    suffix : str
+        The format's suffix.
+
+    Returns
+    -------
+    int or None
+        Bytes.
+    """
     from hairtool.io import format_for, write
     from hairtool.keys.export import key_poses_only
 
@@ -35,7 +50,22 @@ def keys_only_bytes(animation: Animation, keys: Sequence[int], suffix: str) -> i
 
 def storage(animation: Animation, keys: Sequence[int], source: str | os.PathLike[str]) -> dict | None:
     """``{"format", "keys_only_bytes", "input_bytes", "ratio"}``: the key poses in ``source``'s
-    format against ``source`` itself; None when that format holds no animation."""
+    format against ``source`` itself; None when that format holds no animation.
+
+    Parameters
+    ----------
+    animation : Animation
+        The animation.
+    keys : sequence of int
+        Its key frames.
+    source : str or os.PathLike
+        The file it was read from.
+
+    Returns
+    -------
+    dict or None
+        The comparison.
+    """
     suffix = Path(source).suffix.lower()
     keys_only = keys_only_bytes(animation, keys, suffix)
     full = os.path.getsize(source)

@@ -117,7 +117,18 @@ class Motion:
         return d
 
     def with_values(self, values: ArrayLike) -> Motion:
-        """The same skeleton with new channel values (same frame time)."""
+        """The same skeleton with new channel values (same frame time).
+
+        Parameters
+        ----------
+        values : array_like
+            ``(F, C)`` channel values, in the file's channel order.
+
+        Returns
+        -------
+        Motion
+            A motion sharing this one's joints, offsets and channels.
+        """
         return Motion(
             list(self.joint_names),
             self.parents,
@@ -157,7 +168,18 @@ class Motion:
         return self.local_translations()[:, 0].copy()
 
     def world_rotations(self, local: F64 | None = None) -> F64:
-        """``(F, J, 4)`` rotations of each joint's frame in the world."""
+        """``(F, J, 4)`` rotations of each joint's frame in the world.
+
+        Parameters
+        ----------
+        local : ndarray, optional
+            ``(F, J, 4)`` local rotations to chain (None: the motion's own).
+
+        Returns
+        -------
+        ndarray
+            ``(F, J, 4)`` float64 unit quaternions.
+        """
         q = self.local_rotations() if local is None else local
         w = np.empty_like(q)
         for j in range(self.n_joints):
@@ -166,7 +188,18 @@ class Motion:
         return w
 
     def joint_positions(self, end_sites: bool = False) -> F64:
-        """``(F, J, 3)`` world positions by forward kinematics (``(F, J + E, 3)`` with End Sites last)."""
+        """``(F, J, 3)`` world positions by forward kinematics (``(F, J + E, 3)`` with End Sites last).
+
+        Parameters
+        ----------
+        end_sites : bool, default False
+            Also place the End Sites, after the joints.
+
+        Returns
+        -------
+        ndarray
+            ``(F, J, 3)`` or ``(F, J + E, 3)`` float64, in the capture's units.
+        """
         return forward_kinematics(
             self.parents,
             self.local_translations(),
@@ -186,6 +219,24 @@ def forward_kinematics(
     """World positions from local translations ``(F, J, 3)`` and rotations ``(F, J, 4)``.
 
     P_j = P_parent + R_parent_world · t_j; parents come before children.
+
+    Parameters
+    ----------
+    parents : ndarray
+        ``(J,)`` int64 parent of each joint (−1 for a root), parents first.
+    translations : ndarray
+        ``(F, J, 3)`` local translations.
+    rotations : ndarray
+        ``(F, J, 4)`` local rotations (unit quaternions).
+    end_parents : ndarray, optional
+        ``(E,)`` the joint each End Site hangs from (None: no End Sites).
+    end_offsets : ndarray, optional
+        ``(E, 3)`` the End Sites' offsets.
+
+    Returns
+    -------
+    ndarray
+        ``(F, J, 3)`` float64 world positions, ``(F, J + E, 3)`` with the End Sites last.
     """
     f, j = translations.shape[:2]
     world_q = np.empty((f, j, 4))

@@ -44,7 +44,18 @@ I64 = NDArray[np.int64]
 
 
 def channel_features(motion: Motion) -> F64:
-    """``(F, C)`` the capture's channels, rotation angles unwrapped along time (period 360°)."""
+    """``(F, C)`` the capture's channels, rotation angles unwrapped along time (period 360°).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+
+    Returns
+    -------
+    ndarray
+        ``(F, C)`` float64.
+    """
     x = motion.values.copy()
     rot = [c for j in range(motion.n_joints) for c in ik.rotation_columns(motion, j)[0]]
     if rot and motion.n_frames > 1:
@@ -67,7 +78,22 @@ def _check_channel_keys(motion: Motion, keys: list[ArrayLike]) -> list[I64]:
 
 def channel_key_curve(motion: Motion, keys: list[ArrayLike], interp: str = "hermite") -> Motion:
     """The reduced motion: every channel its key curve through its own keys (on the unwrapped
-    angles), the angles written back within whole turns of the capture's."""
+    angles), the angles written back within whole turns of the capture's.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    keys : list of array_like
+        Each channel's key frames.
+    interp : str, default "hermite"
+        The key curve.
+
+    Returns
+    -------
+    Motion
+        The reduced motion.
+    """
     if interp not in INTERPS:
         raise ParameterError("interp", interp, " or ".join(INTERPS))
     ks = _check_channel_keys(motion, keys)
@@ -99,7 +125,22 @@ ChannelKeyEdit = ChannelEdit | TangentEdit | ChannelRetimeEdit
 def parse_channel_edits(data: object, motion: Motion, source: str = "edits") -> list[ChannelKeyEdit]:
     """Per-channel key edits from JSON data (what a studio project keeps): value and handle
     edits as :func:`~hairtool.mocap.pose_edit.parse_edit_list` reads them, and key moves
-    ``{"frame", "joint", "channel", "to"}``; faults raise FormatError naming ``source``."""
+    ``{"frame", "joint", "channel", "to"}``; faults raise FormatError naming ``source``.
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON list.
+    motion : Motion
+        The capture.
+    source : str, default "edits"
+        The file, named in a refusal.
+
+    Returns
+    -------
+    list of ChannelKeyEdit
+        The edits, in order.
+    """
     if not isinstance(data, list):
         raise FormatError(source, "expected a list of per-channel key edits")
     out: list[ChannelKeyEdit] = []
@@ -196,6 +237,19 @@ class ChannelEditor:
         interp: str = "hermite",
         pose_keys: ArrayLike | None = None,
     ) -> None:
+        """Every channel of ``motion`` on its own key curve through ``keys``, ready for edits.
+
+        Parameters
+        ----------
+        motion : Motion
+            The capture.
+        keys : list of array_like
+            Each channel's key frames.
+        interp : str, default "hermite"
+            The key curve.
+        pose_keys : array_like, optional
+            The pose keys below this layer, where an IK pose may also be made.
+        """
         if interp not in INTERPS:
             raise ParameterError("interp", interp, " or ".join(INTERPS))
         self.original = motion
@@ -240,7 +294,18 @@ class ChannelEditor:
 
     def keys(self, channel: int) -> I64:
         """A channel's keys now: its solved keys, the frames edits added to it, moved ones where
-        they were moved to."""
+        they were moved to.
+
+        Parameters
+        ----------
+        channel : int
+            The channel's column.
+
+        Returns
+        -------
+        ndarray
+            int64 key frames.
+        """
         return self._channel(channel).all_keys
 
     @property
@@ -327,7 +392,18 @@ class ChannelEditor:
         return start, stop
 
     def pose(self, frame: int) -> F64:
-        """``(C,)`` the edited capture's channels at one frame."""
+        """``(C,)`` the edited capture's channels at one frame.
+
+        Parameters
+        ----------
+        frame : int
+            The frame.
+
+        Returns
+        -------
+        ndarray
+            ``(C,)`` float64.
+        """
         v = self.original.values[frame].astype(np.float64)
         for c in self._touched():
             v[c] = self._values(c, self._channel(c), np.array([frame]))[0]
@@ -335,7 +411,20 @@ class ChannelEditor:
 
     # -- what a graph editor draws -----------------------------------------------------------
     def column(self, joint: str, channel: str) -> int:
-        """The capture's column of a joint's channel (ParameterError naming the choices)."""
+        """The capture's column of a joint's channel (ParameterError naming the choices).
+
+        Parameters
+        ----------
+        joint : str
+            The joint's name.
+        channel : str
+            The channel's name (``Xrotation``...).
+
+        Returns
+        -------
+        int
+            The column.
+        """
         m = self.original
         if joint not in m.joint_names:
             raise ParameterError("joint", joint, "a joint of the skeleton")
@@ -345,7 +434,18 @@ class ChannelEditor:
         return int(m._starts[j]) + m.channels[j].index(channel)
 
     def key_curve(self, c: int) -> F64:
-        """``(F,)`` channel c's edited key curve alone (no residuals), within the capture's turns."""
+        """``(F,)`` channel c's edited key curve alone (no residuals), within the capture's turns.
+
+        Parameters
+        ----------
+        c : int
+            The channel's column.
+
+        Returns
+        -------
+        ndarray
+            ``(F,)`` float64.
+        """
         ch = self._channel(c)
         frames = np.arange(self.original.n_frames)
         curve = interpolate_at(self._edited_curve(c, ch), frames)[:, 0]
@@ -355,7 +455,18 @@ class ChannelEditor:
 
     def key_slopes(self, c: int) -> tuple[F64, F64] | None:
         """``(in, out)`` slopes (per frame) of channel c's key curve at its keys; None for linear.
-        A key added in a stretch has the slope the curve had there (its handle is not turned)."""
+        A key added in a stretch has the slope the curve had there (its handle is not turned).
+
+        Parameters
+        ----------
+        c : int
+            The channel's column.
+
+        Returns
+        -------
+        tuple of (ndarray, ndarray) or None
+            Slopes in and out, or None for linear keys.
+        """
         ch = self._channel(c)
         kp = self._edited_curve(c, ch)
         if kp.tangents is None:
@@ -386,7 +497,18 @@ class ChannelEditor:
         return EditReport(edit, [joint], method, 0, 0.0, 0.0, first, stop - 1)
 
     def apply_channel(self, edit: ChannelEdit) -> EditReport:
-        """Set one channel's key at ``edit.frame`` (a key of that channel) to ``edit.value``."""
+        """Set one channel's key at ``edit.frame`` (a key of that channel) to ``edit.value``.
+
+        Parameters
+        ----------
+        edit : ChannelEdit
+            The joint, channel, key frame and value.
+
+        Returns
+        -------
+        EditReport
+            What the edit changed.
+        """
         c = self.column(edit.joint, edit.channel)
         if not (math.isfinite(edit.value) and abs(edit.value) <= MAX_VALUE):
             raise ParameterError("value", edit.value, "a finite number")
@@ -407,7 +529,18 @@ class ChannelEditor:
     def apply_tangent(self, edit: TangentEdit) -> EditReport:
         """Set the slope (per frame) one channel's key curve passes its key at ``edit.frame``
         with (the leaving handle; the arriving one turns by as much, so seed 003's handles stay
-        aligned); linear keys have none (ParameterError)."""
+        aligned); linear keys have none (ParameterError).
+
+        Parameters
+        ----------
+        edit : TangentEdit
+            The joint, channel, key frame and slope.
+
+        Returns
+        -------
+        EditReport
+            What the edit changed.
+        """
         if self.interp == "linear":
             raise ParameterError("interp", self.interp, "hermite or hermite-fit (linear keys: no handles)")
         if not (math.isfinite(edit.slope) and abs(edit.slope) <= MAX_VALUE):
@@ -423,7 +556,18 @@ class ChannelEditor:
 
     def apply_retime(self, edit: ChannelRetimeEdit) -> EditReport:
         """Move one channel's key in time, strictly between that channel's neighbouring keys (the
-        first and last frame stay keys); ParameterError otherwise."""
+        first and last frame stay keys); ParameterError otherwise.
+
+        Parameters
+        ----------
+        edit : ChannelRetimeEdit
+            The joint, channel, key frame and where it goes.
+
+        Returns
+        -------
+        EditReport
+            What the edit changed.
+        """
         c = self.column(edit.joint, edit.channel)
         ch, a = self._knot(c, edit.frame, edit.channel)
         check_retime(ch.all_keys, self.original.n_frames, edit.frame, edit.to)  # never past a key
@@ -435,7 +579,20 @@ class ChannelEditor:
     def apply(self, edit: PoseEdit, method: str = "auto") -> EditReport:
         """Move ``edit.joint`` to its target at ``edit.frame`` (a key of some channel or a pose
         key, :attr:`pose_frames`) by IK on the pose shown there; each channel the solve turns
-        has its key there moved, or one added (module docstring)."""
+        has its key there moved, or one added (module docstring).
+
+        Parameters
+        ----------
+        edit : PoseEdit
+            The joint, frame, target and chain.
+        method : str, default "auto"
+            The IK solver.
+
+        Returns
+        -------
+        EditReport
+            What the edit changed.
+        """
         m = self.original
         frames = self.pose_frames
         if edit.frame not in frames:
@@ -479,7 +636,20 @@ class ChannelEditor:
         return step.report
 
     def apply_all(self, edits: list, method: str = "auto") -> list[EditReport]:
-        """Edits in order, each on what the ones before left (:func:`.pose_edit.apply_edits`)."""
+        """Edits in order, each on what the ones before left (:func:`.pose_edit.apply_edits`).
+
+        Parameters
+        ----------
+        edits : list
+            Pose and per-channel edits.
+        method : str, default "auto"
+            The IK solver.
+
+        Returns
+        -------
+        list of EditReport
+            One per edit.
+        """
         return apply_edits(self, edits, method)
 
     def undo(self) -> object | None:

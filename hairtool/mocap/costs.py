@@ -34,6 +34,18 @@ def joint_weights(motion: Motion, falloff: float = 0.5) -> F64:
     """``(J,)`` ω_j = falloff^depth_j, normalised to sum 1.
 
     A parent's rotation moves all its children, so the trunk weighs most (seed 003, §3.2).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    falloff : float, default 0.5
+        The weight's factor per level of depth.
+
+    Returns
+    -------
+    ndarray
+        ``(J,)`` float64, summing to 1.
     """
     if not (np.isfinite(falloff) and 0.0 < falloff <= 1.0):
         raise ParameterError("falloff", falloff, "a number in (0, 1]")
@@ -57,6 +69,16 @@ def skeleton_size(motion: Motion) -> float:
 
     Translation errors enter the rotation costs as (|Δp| / L)², so one skeleton size of drift
     weighs like one radian of joint rotation.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+
+    Returns
+    -------
+    float
+        L, in the capture's units.
     """
     rest = motion.with_values(np.zeros((1, motion.n_channels)))
     p = rest.joint_positions(end_sites=True)[0]
@@ -72,6 +94,20 @@ def motion_features(motion: Motion, kind: str = "positions", weights: ArrayLike 
     - "rotations": D = 4J + 3. Local quaternions hemisphere-aligned frame to frame, each times
       sqrt(ω_j), then the root translation / L times sqrt(ω_root) (L = :func:`skeleton_size`).
       |q_a − q_b|² ≈ Dist² for small angles; the exact seed metric is :func:`rotation_cost_table`.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    kind : {"positions", "rotations"}, default "positions"
+        Which features, as above.
+    weights : array_like, optional
+        ``(J,)`` joint weights ω (None: the defaults by joint name).
+
+    Returns
+    -------
+    ndarray
+        ``(F, D)`` float64 features.
     """
     if kind not in KINDS:
         raise ParameterError("kind", kind, f"one of {', '.join(KINDS)}")
@@ -89,7 +125,22 @@ def motion_features(motion: Motion, kind: str = "positions", weights: ArrayLike 
 def bvh_features(
     path: str | os.PathLike[str], kind: str = "positions", weights: ArrayLike | None = None
 ) -> F64:
-    """:func:`motion_features` of a BVH file."""
+    """:func:`motion_features` of a BVH file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A BVH file.
+    kind : {"positions", "rotations"}, default "positions"
+        Which features.
+    weights : array_like, optional
+        ``(J,)`` joint weights.
+
+    Returns
+    -------
+    ndarray
+        ``(F, D)`` float64.
+    """
     return motion_features(read_bvh(path), kind, weights)
 
 
@@ -130,6 +181,26 @@ def rotation_cost_table(
     polynomials exact to a few units in the last place (:func:`acos2_reference`). With
     ``progress``, the table is made in :data:`PROGRESS_STEPS` row ranges of equal work, saying
     after each what share is done (the same numbers).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    weights : array_like, optional
+        ``(J,)`` joint weights ω (None: the defaults by joint name).
+    interp : {"slerp"}, default "slerp"
+        The curve between keys.
+    translation_weight : float, optional
+        ω_T (None: ω_root).
+    max_span : int, optional
+        Pairs further apart cost +inf (None: every pair).
+    progress : callable, optional
+        ``progress(share)`` after each row range.
+
+    Returns
+    -------
+    ndarray
+        ``(F, F)`` float64 costs.
     """
     if interp != "slerp":
         raise ParameterError("interp", interp, "'slerp'")
@@ -158,7 +229,24 @@ def rotation_cost_table_reference(
     translation_weight: float | None = None,
     max_span: int | None = None,
 ) -> F64:
-    """The numpy twin of :func:`rotation_cost_table` (slow: a Python loop over the pairs i < j)."""
+    """The numpy twin of :func:`rotation_cost_table` (slow: a Python loop over the pairs i < j).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    weights : array_like, optional
+        ``(J,)`` joint weights.
+    translation_weight : float, optional
+        ω_T (None: ω_root).
+    max_span : int, optional
+        Pairs further apart cost +inf.
+
+    Returns
+    -------
+    ndarray
+        ``(F, F)`` float64 costs, as :func:`rotation_cost_table` gives them.
+    """
     q, p, w, wt = _cost_inputs(motion, weights, translation_weight)
     n = len(q)
     cost = np.zeros((n, n))
@@ -251,7 +339,18 @@ def _acos2_far(u):
 
 def acos2_reference(u: ArrayLike) -> F64:
     """arccos(1 − u)², the numpy twin of the kernel's three polynomials (:func:`_acos2_near`, …),
-    written (2·arcsin √(u/2))² so that it keeps its digits for small u too."""
+    written (2·arcsin √(u/2))² so that it keeps its digits for small u too.
+
+    Parameters
+    ----------
+    u : array_like
+        1 − cos, in [0, 1].
+
+    Returns
+    -------
+    ndarray
+        float64, radians squared.
+    """
     return (2.0 * np.arcsin(np.sqrt(np.asarray(u, dtype=np.float64) / 2.0))) ** 2
 
 
@@ -614,6 +713,20 @@ def reconstruct_motion(motion: Motion, keys: ArrayLike, interp: str = "linear") 
     Rotations go back to Euler angles in each joint's channel order (nearest the original values
     by whole turns). Joints with one or two rotation channels interpolate their angles directly.
     Frames before the first key or after the last hold that key.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    keys : array_like
+        Key frame numbers, ascending.
+    interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+        The curve through the keys.
+
+    Returns
+    -------
+    Motion
+        Every frame rebuilt from the keys.
     """
     if interp not in INTERPS:
         raise ParameterError("interp", interp, f"one of {', '.join(INTERPS)}")
@@ -646,7 +759,18 @@ def reconstruct_motion(motion: Motion, keys: ArrayLike, interp: str = "linear") 
 
 
 def joint_position_errors(motion: Motion, reconstructed: Motion) -> F64:
-    """``(F, J)`` distances (scene units) between the joints of two motions of one skeleton."""
+    """``(F, J)`` distances (scene units) between the joints of two motions of one skeleton.
+
+    Parameters
+    ----------
+    motion, reconstructed : Motion
+        Two motions of one skeleton and frame count.
+
+    Returns
+    -------
+    ndarray
+        ``(F, J)`` float64 distances.
+    """
     if reconstructed.n_joints != motion.n_joints or reconstructed.n_frames != motion.n_frames:
         raise ParameterError(
             "reconstructed",

@@ -89,7 +89,24 @@ def _kind(e: object) -> str | None:
 
 def parse_entry(e: object, motion: Motion, source: str, where: str) -> object:
     """One entry of an edit list (module docstring), checked against the skeleton; a fault or
-    an entry of no kind raises :class:`FormatError` naming ``source`` and ``where``."""
+    an entry of no kind raises :class:`FormatError` naming ``source`` and ``where``.
+
+    Parameters
+    ----------
+    e : object
+        The entry as parsed from JSON.
+    motion : Motion
+        The capture whose joints and channels it names.
+    source : str
+        The file, named in a refusal.
+    where : str
+        The entry's place (``edit 3``), named in a refusal.
+
+    Returns
+    -------
+    object
+        A PoseEdit, ChannelEdit, TangentEdit or RetimeEdit.
+    """
     kind = _kind(e)
     if kind is None:
         shown = str(e)[:80]
@@ -106,7 +123,22 @@ def parse_entry(e: object, motion: Motion, source: str, where: str) -> object:
 
 
 def parse_capture_edits(data: object, motion: Motion, source: str = "edits") -> CaptureEdits:
-    """A list of edits of the pose keys, or a project's capture object (module docstring)."""
+    """A list of edits of the pose keys, or a project's capture object (module docstring).
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON.
+    motion : Motion
+        The capture.
+    source : str, default "edits"
+        The file, named in a refusal.
+
+    Returns
+    -------
+    CaptureEdits
+        The pose-key edits and the per-channel edits.
+    """
     if isinstance(data, list):
         return CaptureEdits([parse_entry(e, motion, source, f"edit {i}") for i, e in enumerate(data, 1)])
     if not isinstance(data, dict):
@@ -131,14 +163,42 @@ def parse_capture_edits(data: object, motion: Motion, source: str = "edits") -> 
 
 
 def read_capture_edits(path: str | os.PathLike[str], motion: Motion) -> CaptureEdits:
-    """:func:`parse_capture_edits` of a JSON file (FormatError naming it)."""
+    """:func:`parse_capture_edits` of a JSON file (FormatError naming it).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The edit file.
+    motion : Motion
+        The capture.
+
+    Returns
+    -------
+    CaptureEdits
+        The edits.
+    """
     return parse_capture_edits(read_json(path), motion, os.fspath(path))
 
 
 def channel_keys(motion: Motion, interp: str, price: float = STUDIO_CHANNEL_PRICE) -> list:
     """Each channel's own keys as the studio's graph editor solves them: seed 003's per-channel
     DP on the capture's channels (angles unwrapped) at ``price`` per key, a share of each
-    channel's two-key error."""
+    channel's two-key error.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    interp : str
+        The key curve.
+    price : float, default STUDIO_CHANNEL_PRICE
+        A key's price, a share of each channel's two-key error.
+
+    Returns
+    -------
+    list
+        Each channel's key frames.
+    """
     x = channel_features(motion)
     return per_channel_keys(x, price, interp=interp, relative=True).keys
 
@@ -162,7 +222,26 @@ def _not_a_key(editor, e: object) -> str | None:
 
 def apply_each(editor, edits: list, source: str, label: str, method: str = "auto") -> list[EditReport]:
     """``editor.apply_all`` one edit at a time, a refusal raised as :class:`FormatError` naming
-    ``source`` and the entry (``label`` and its number from 1)."""
+    ``source`` and the entry (``label`` and its number from 1).
+
+    Parameters
+    ----------
+    editor : PoseEditor or ChannelEditor
+        The editor.
+    edits : list
+        Its edits.
+    source : str
+        The file, named in a refusal.
+    label : str
+        What an entry is called there (``edit``, ``channel edit``).
+    method : str, default "auto"
+        The IK solver.
+
+    Returns
+    -------
+    list of EditReport
+        One per edit.
+    """
     out = []
     for i, e in enumerate(edits, 1):
         why = _not_a_key(editor, e)
@@ -188,7 +267,30 @@ def replay(
     """The edited capture and one report per edit: ``edits.edits`` on the pose ``keys``, then
     ``edits.channel_edits`` on each channel's own keys (:func:`channel_keys` at ``price``) over
     the pose-edited capture (an IK pose there may be at a pose key as edited), as the studio
-    applies a project's edits."""
+    applies a project's edits.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    keys : array_like
+        Its pose keys.
+    interp : str
+        The key curve.
+    edits : CaptureEdits
+        The edits, as the studio keeps them.
+    price : float, default STUDIO_CHANNEL_PRICE
+        The per-channel keys' price.
+    source : str, default "edits"
+        The file, named in a refusal.
+    method : str, default "auto"
+        The IK solver.
+
+    Returns
+    -------
+    tuple of (Motion, list of EditReport)
+        The edited capture and the reports.
+    """
     pose = PoseEditor(motion, np.asarray(keys), interp)
     reports = apply_each(pose, edits.edits, source, "edit", method)
     out = pose.motion()

@@ -35,7 +35,18 @@ _MAX_STEP_DEGREES = 20.0  # per channel and iteration: keeps a far target from w
 
 def figure_height(motion: Motion) -> float:
     """The rest skeleton's (all channels 0) largest extent over joints and End Sites: a standing
-    figure's height, the length scale of the IK's tolerance."""
+    figure's height, the length scale of the IK's tolerance.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+
+    Returns
+    -------
+    float
+        The height, in the capture's units.
+    """
     rest = motion.with_values(np.zeros((1, motion.n_channels)))
     p = rest.joint_positions(end_sites=True)[0]
     h = float(np.max(p.max(axis=0) - p.min(axis=0)))
@@ -43,7 +54,22 @@ def figure_height(motion: Motion) -> float:
 
 
 def ancestors(motion: Motion, joint: int, n: int) -> list[int]:
-    """The ``n`` nearest ancestors of ``joint``, nearest first (its parent, its grandparent, …)."""
+    """The ``n`` nearest ancestors of ``joint``, nearest first (its parent, its grandparent, …).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    joint : int
+        The joint's index.
+    n : int
+        How many, at most the joint's ancestors (ParameterError otherwise).
+
+    Returns
+    -------
+    list of int
+        Their indices.
+    """
     out: list[int] = []
     j = int(motion.parents[joint])
     while j >= 0 and len(out) < n:
@@ -56,7 +82,20 @@ def ancestors(motion: Motion, joint: int, n: int) -> list[int]:
 
 
 def rotation_columns(motion: Motion, joint: int) -> tuple[list[int], str]:
-    """The value columns of a joint's rotation channels and their axis order (e.g. "ZXY")."""
+    """The value columns of a joint's rotation channels and their axis order (e.g. "ZXY").
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    joint : int
+        The joint's index.
+
+    Returns
+    -------
+    tuple of (list of int, str)
+        The columns and the axis order (empty for a joint without rotation channels).
+    """
     start = int(motion._starts[joint])
     chans = motion.channels[joint]
     cols = [start + k for k, c in enumerate(chans) if c.endswith("rotation")]
@@ -64,7 +103,20 @@ def rotation_columns(motion: Motion, joint: int) -> tuple[list[int], str]:
 
 
 def is_ball_joint(motion: Motion, joint: int) -> bool:
-    """Three rotation channels about three distinct axes: any orientation, a quaternion's worth."""
+    """Three rotation channels about three distinct axes: any orientation, a quaternion's worth.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    joint : int
+        The joint's index.
+
+    Returns
+    -------
+    bool
+        True for a ball joint.
+    """
     _, order = rotation_columns(motion, joint)
     return len(order) == 3 and len(set(order)) == 3
 
@@ -172,7 +224,30 @@ def solve_dls(
     Each step solves (JᵀJ + λ²I) δ = Jᵀ e; λ shrinks while steps reduce the miss and grows when
     one would not (Levenberg–Marquardt), so far from the target it walks and near it converges
     as fast as Gauss–Newton. Stops within ``tolerance`` (scene units) or when no step helps (a
-    target out of reach: the effector as near as the limb allows)."""
+    target out of reach: the effector as near as the limb allows).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    values : array_like
+        ``(C,)`` the pose's channel values, the start.
+    effector : int
+        The joint moved.
+    chain : list of int
+        The joints turned.
+    target : array_like
+        Three finite numbers, world space.
+    tolerance : float
+        How near is there, in scene units.
+    max_iterations : int, default 300
+        The most steps.
+
+    Returns
+    -------
+    Solve
+        The new values, the miss, the steps taken and the solver's name.
+    """
     t = _check_target(target)
     x = np.array(values, dtype=np.float64, copy=True)
     dofs = _dofs(motion, chain)
@@ -251,7 +326,26 @@ def solve_two_bone(
     effector distance is the top-to-target distance (law of cosines; clamped to the reach); the
     top joint then turns the effector onto the target by the shortest rotation and twists about
     the top-to-target axis to put the middle joint back on its side of it (the pole is the
-    current bend). Angles come back nearest ``reference`` (default: the given values)."""
+    current bend). Angles come back nearest ``reference`` (default: the given values).
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    values : array_like
+        ``(C,)`` the pose's channel values.
+    effector : int
+        The joint moved.
+    target : array_like
+        Three finite numbers, world space.
+    reference : array_like, optional
+        ``(C,)`` values the new angles are written nearest (None: ``values``).
+
+    Returns
+    -------
+    Solve or None
+        The solve, or None where it does not apply.
+    """
     t = _check_target(target)
     x = np.array(values, dtype=np.float64, copy=True)
     mid = int(motion.parents[effector])
@@ -309,7 +403,33 @@ def solve(
 
     ``method``: "auto" (two-bone where chain = 2 and it applies, then damped least squares to
     finish if the analytic pose misses by more than the tolerance; damped least squares
-    otherwise), "two-bone" or "dls". ``tolerance`` defaults to 1e-4 of the figure's height."""
+    otherwise), "two-bone" or "dls". ``tolerance`` defaults to 1e-4 of the figure's height.
+
+    Parameters
+    ----------
+    motion : Motion
+        The capture.
+    values : array_like
+        ``(C,)`` the pose's channel values.
+    effector : int
+        The joint moved.
+    chain : int
+        How many of its nearest ancestors turn.
+    target : array_like
+        Three finite numbers, world space.
+    tolerance : float, optional
+        How near is there (None: 1e-4 of the figure's height).
+    method : {"auto", "two-bone", "dls"}, default "auto"
+        The solver.
+    reference : array_like, optional
+        ``(C,)`` values the new angles are written nearest (None: ``values``).
+
+    Returns
+    -------
+    Solve
+        The new values, the miss (out of reach: as near as the chain allows), the steps and the
+        solver.
+    """
     tol = TOLERANCE * figure_height(motion) if tolerance is None else float(tolerance)
     joints = ancestors(motion, effector, chain)
     if method not in ("auto", "two-bone", "dls"):
@@ -338,7 +458,22 @@ def euler_nearest(q: ArrayLike, order: str, reference: ArrayLike) -> F64:
 
     A rotation has two Euler triples, (a, b, c) and (a + 180°, 180° − b, c + 180°), each up to
     whole turns per angle: of these, the one with the least squared distance to ``reference``.
-    Orders with fewer than three distinct axes take the nearest whole turns of their angles."""
+    Orders with fewer than three distinct axes take the nearest whole turns of their angles.
+
+    Parameters
+    ----------
+    q : array_like
+        ``(4,)`` a unit quaternion.
+    order : str
+        The axis order, e.g. "ZXY".
+    reference : array_like
+        ``(3,)`` angles in degrees.
+
+    Returns
+    -------
+    ndarray
+        ``(3,)`` float64 angles in degrees.
+    """
     ref = np.asarray(reference, dtype=np.float64)
     o = order.upper()
     if len(o) != 3 or len(set(o)) != 3:
@@ -364,7 +499,24 @@ def euler_follow(start: ArrayLike, q: ArrayLike, order: str, step_degrees: float
     following the shortest turn between the two rotations in small steps, each written nearest
     the last: the angles a joint's channels pass through as it turns continuously there. Where
     the turn passes near gimbal lock the first and last angles swing together, and the result
-    stays on the side of the lock the turn takes (the nearest triple to ``start`` may not)."""
+    stays on the side of the lock the turn takes (the nearest triple to ``start`` may not).
+
+    Parameters
+    ----------
+    start : array_like
+        ``(3,)`` angles in degrees, where the turn starts.
+    q : array_like
+        ``(4,)`` the rotation reached.
+    order : str
+        The axis order.
+    step_degrees : float, default 2.0
+        The largest turn between two steps.
+
+    Returns
+    -------
+    ndarray
+        ``(3,)`` float64 angles in degrees.
+    """
     a = np.asarray(start, dtype=np.float64)
     q0 = quat.from_euler(a, order)
     q1 = np.asarray(q, dtype=np.float64)

@@ -149,7 +149,22 @@ def parse_edits(data: object, motion: Motion, source: str = "edits") -> list[Pos
     """Edits from JSON data (a list of objects, or ``{"edits": [...]}``), checked against the
     skeleton: known joint, three finite numbers, a chain of 1 up to the joint's ancestors with
     rotation channels to turn. Key frames are checked by :meth:`PoseEditor.apply`. Any fault
-    raises :class:`FormatError` naming ``source`` and the edit (counted from 1)."""
+    raises :class:`FormatError` naming ``source`` and the edit (counted from 1).
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON.
+    motion : Motion
+        The capture.
+    source : str, default "edits"
+        The file, named in a refusal.
+
+    Returns
+    -------
+    list of PoseEdit
+        The edits.
+    """
     if isinstance(data, dict) and set(data) == {"edits"}:
         data = data["edits"]
     if not isinstance(data, list):
@@ -195,7 +210,22 @@ def parse_edit_list(data: object, motion: Motion, source: str = "edits") -> list
     handle edits ``{"frame", "joint", "channel", "slope"}`` and key moves ``{"frame", "to"}`` in
     one list, in order (what a
     studio project keeps); faults raise :class:`FormatError` naming ``source`` and the edit
-    (counted from 1)."""
+    (counted from 1).
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON.
+    motion : Motion
+        The capture.
+    source : str, default "edits"
+        The file, named in a refusal.
+
+    Returns
+    -------
+    list of Edit
+        The edits, in order.
+    """
     if isinstance(data, dict) and set(data) == {"edits"}:
         data = data["edits"]
     if not isinstance(data, list):
@@ -251,12 +281,36 @@ def _parse_retime(e: dict, motion: Motion, source: str, i: int) -> RetimeEdit:
 
 
 def read_edits(path: str | os.PathLike[str], motion: Motion) -> list[PoseEdit]:
-    """:func:`parse_edits` of a JSON file; unreadable or invalid JSON raises :class:`FormatError`."""
+    """:func:`parse_edits` of a JSON file; unreadable or invalid JSON raises :class:`FormatError`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The edit file (JSON).
+    motion : Motion
+        The capture whose joints the edits name.
+
+    Returns
+    -------
+    list of PoseEdit
+        The edits, in the file's order.
+    """
     return parse_edits(read_json(path), motion, os.fspath(path))
 
 
 def read_json(path: str | os.PathLike[str]) -> object:
-    """A JSON file's data; unreadable or invalid JSON raises :class:`FormatError` naming it."""
+    """A JSON file's data; unreadable or invalid JSON raises :class:`FormatError` naming it.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    object
+        Its data.
+    """
     # every user text limit, as jobs files get; a project's capture section (an edit file
     # too) carries the capture's BVH text whole
     return user_text.read(path, "an edit file", "json", texts=frozenset({"bvh"}))
@@ -268,7 +322,22 @@ def apply_edits(editor, edits: list, method: str = "auto") -> list[EditReport]:
     key's value (``apply_channel``), its handle (``apply_tangent``), a key moved in time of the
     kind that editor keys (``editor.RETIME``: the pose key, or one channel's key;
     ``apply_retime``), an IK pose edit (``apply``). Another kind raises
-    :class:`ParameterError` naming it, so no edit is read as another."""
+    :class:`ParameterError` naming it, so no edit is read as another.
+
+    Parameters
+    ----------
+    editor : PoseEditor or ChannelEditor
+        The editor.
+    edits : list
+        The edits.
+    method : str, default "auto"
+        The IK solver.
+
+    Returns
+    -------
+    list of EditReport
+        One per edit.
+    """
     out = []
     for e in edits:
         if isinstance(e, ChannelEdit):
@@ -293,6 +362,17 @@ class PoseEditor:
     KINDS = "an edit of the pose keys: an IK pose, a key's value, its handle or its move in time"
 
     def __init__(self, motion: Motion, keys: ArrayLike, interp: str = "linear") -> None:
+        """Take the key curve and the residuals out of ``motion``.
+
+        Parameters
+        ----------
+        motion : Motion
+            The capture.
+        keys : array_like
+            Its key frames, ascending, first and last frame included.
+        interp : {"linear", "hermite", "hermite-fit"}, default "linear"
+            The key curve.
+        """
         if interp not in INTERPS:
             raise ParameterError("interp", interp, " or ".join(INTERPS))
         self.original = motion
@@ -316,17 +396,51 @@ class PoseEditor:
 
     # -- keys ------------------------------------------------------------------------------
     def key_index(self, frame: int) -> int:
+        """The index of a key frame among the keys.
+
+        Parameters
+        ----------
+        frame : int
+            A frame that is a key (ParameterError naming the keys otherwise).
+
+        Returns
+        -------
+        int
+            Its index in :attr:`keys`.
+        """
         hit = np.flatnonzero(self.keys == frame)
         if hit.size == 0:
             raise ParameterError("frame", frame, f"a key frame: {' '.join(map(str, self.keys.tolist()))}")
         return int(hit[0])
 
     def key_pose(self, frame: int) -> F64:
-        """``(C,)`` channel values of the edited pose at a key frame."""
+        """``(C,)`` channel values of the edited pose at a key frame.
+
+        Parameters
+        ----------
+        frame : int
+            A key frame.
+
+        Returns
+        -------
+        ndarray
+            ``(C,)`` float64, a copy.
+        """
         return self._key_values[self.key_index(frame)].copy()
 
     def span(self, frame: int) -> tuple[int, int]:
-        """``(first, last)``: the frames an edit at this key changes (strictly between its neighbours)."""
+        """``(first, last)``: the frames an edit at this key changes (strictly between its neighbours).
+
+        Parameters
+        ----------
+        frame : int
+            A key frame.
+
+        Returns
+        -------
+        tuple of (int, int)
+            The first and last frame changed.
+        """
         a = self.key_index(frame)
         first = int(self.keys[a - 1]) + 1 if a > 0 else 0
         last = int(self.keys[a + 1]) - 1 if a < self.keys.size - 1 else self.original.n_frames - 1
@@ -338,7 +452,21 @@ class PoseEditor:
 
     # -- editing ---------------------------------------------------------------------------
     def apply(self, edit: PoseEdit, method: str = "auto") -> EditReport:
-        """Solve one edit on the current pose at its key and keep the new key pose."""
+        """Solve one edit on the current pose at its key and keep the new key pose.
+
+        Parameters
+        ----------
+        edit : PoseEdit
+            The joint, key frame, target and chain.
+        method : {"auto", "two-bone", "dls"}, default "auto"
+            The solver (:func:`hairtool.mocap.ik.solve`): "auto" is two-bone where the chain
+            is 2, else damped least squares.
+
+        Returns
+        -------
+        EditReport
+            The joints turned, the solver, the miss and the frames changed.
+        """
         m = self.original
         if edit.joint not in m.joint_names:
             raise ParameterError("joint", edit.joint, "a joint of the skeleton")
@@ -364,7 +492,18 @@ class PoseEditor:
     def apply_channel(self, edit: ChannelEdit) -> EditReport:
         """Set one rotation channel of a key pose (a key dragged in value): the key curve through
         the new pose plus the residuals, as for an IK edit. A ball joint's key quaternion is made
-        from its three angles at the key, so the other two keep their values there."""
+        from its three angles at the key, so the other two keep their values there.
+
+        Parameters
+        ----------
+        edit : ChannelEdit
+            The joint, key frame, channel and new value (degrees).
+
+        Returns
+        -------
+        EditReport
+            What the edit changed.
+        """
         m = self.original
         j, cols, order, i = self._channel(edit)
         if not (math.isfinite(edit.value) and abs(edit.value) <= MAX_VALUE):
@@ -386,7 +525,18 @@ class PoseEditor:
         frames between its neighbouring keys follow with the residuals retimed
         (:func:`hairtool.keys.edit.retime_key`, every channel of the pose, positions too, as
         pose keys are shared); ParameterError for an end key or a frame not strictly between
-        the neighbours."""
+        the neighbours.
+
+        Parameters
+        ----------
+        edit : RetimeEdit
+            The key frame and where it goes.
+
+        Returns
+        -------
+        EditReport
+            What the edit changed.
+        """
         a, after = check_retime(self.keys, self.original.n_frames, edit.frame, edit.to)
         saved = (a, self._key_values[a].copy(), self._key_q[a].copy())
         before, self.keys = self.keys, after
@@ -414,7 +564,18 @@ class PoseEditor:
         the key take it). A ball joint's curve is on quaternions: its tangent there moves along
         the quaternion's derivative with respect to that angle, J_c = ∂q/∂θ_c, by what the slope
         lacks (J⁺ t is the three angles' slope, so the other two keep theirs). Linear keys have
-        no handles (ParameterError)."""
+        no handles (ParameterError).
+
+        Parameters
+        ----------
+        edit : TangentEdit
+            The joint, key frame, channel and slope (degrees per frame).
+
+        Returns
+        -------
+        EditReport
+            What the edit changed.
+        """
         if self.interp == "linear":
             raise ParameterError(
                 "interp", self.interp, "hermite or hermite-fit (linear keys have no handles)"
@@ -444,7 +605,18 @@ class PoseEditor:
     def key_slopes(self, joint: int) -> tuple[F64, F64] | None:
         """``(in, out)``, each ``(K, n)``: the slopes (degrees per frame) a joint's key curve
         enters and leaves each key with, its rotation channels in channel order; None for
-        linear keys (no handles)."""
+        linear keys (no handles).
+
+        Parameters
+        ----------
+        joint : int
+            The joint's index.
+
+        Returns
+        -------
+        tuple of (ndarray, ndarray) or None
+            The slopes in and out, or None where the joint has no rotation channels.
+        """
         if self.interp == "linear":
             return None
         m = self.original
@@ -496,7 +668,20 @@ class PoseEditor:
         return np.flatnonzero(np.any(out != b_out, axis=1) | np.any(inn != b_in, axis=1))
 
     def apply_all(self, edits: list[Edit], method: str = "auto") -> list[EditReport]:
-        """Edits in order, each on the pose the ones before it left (:func:`apply_edits`)."""
+        """Edits in order, each on the pose the ones before it left (:func:`apply_edits`).
+
+        Parameters
+        ----------
+        edits : list of Edit
+            Pose, channel, tangent and retime edits.
+        method : str, default "auto"
+            The IK solver for pose edits (see :meth:`apply`).
+
+        Returns
+        -------
+        list of EditReport
+            One per edit.
+        """
         return apply_edits(self, edits, method)
 
     def undo(self) -> Edit | None:
@@ -642,7 +827,20 @@ class PoseEditor:
     def key_curve(self, joint: int, reference: F64 | None = None) -> F64:
         """``(F, n)`` a joint's rotation channels on its edited key curve alone (no residuals):
         the curve a graph editor draws through the keys. Angles are written nearest
-        ``reference`` (``(F, n)``, default the edited capture's), so the two overlay."""
+        ``reference`` (``(F, n)``, default the edited capture's), so the two overlay.
+
+        Parameters
+        ----------
+        joint : int
+            The joint's index.
+        reference : ndarray, optional
+            ``(F, n)`` angles to write nearest (None: the edited capture's).
+
+        Returns
+        -------
+        ndarray
+            ``(F, n)`` float64 angles in degrees.
+        """
         m = self.original
         cols, order = ik.rotation_columns(m, joint)
         frames = np.arange(m.n_frames)

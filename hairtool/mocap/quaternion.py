@@ -26,19 +26,54 @@ def _check_order(order: str) -> str:
 
 
 def identity(shape: tuple[int, ...] = ()) -> F64:
+    """Identity rotations ``[1, 0, 0, 0]`` (w first).
+
+    Parameters
+    ----------
+    shape : tuple of int, default ()
+        The leading shape.
+
+    Returns
+    -------
+    ndarray
+        ``(*shape, 4)`` float64.
+    """
     q = np.zeros((*shape, 4))
     q[..., 0] = 1.0
     return q
 
 
 def normalize(q: ArrayLike) -> F64:
+    """Quaternions scaled to unit length (a zero one stays zero).
+
+    Parameters
+    ----------
+    q : array_like
+        ``(..., 4)`` quaternions.
+
+    Returns
+    -------
+    ndarray
+        ``(..., 4)`` float64.
+    """
     a = np.asarray(q, dtype=np.float64)
     n = np.linalg.norm(a, axis=-1, keepdims=True)
     return a / np.maximum(n, 1e-300)
 
 
 def conjugate(q: ArrayLike) -> F64:
-    """The inverse of a unit quaternion."""
+    """The inverse of a unit quaternion.
+
+    Parameters
+    ----------
+    q : array_like
+        ``(..., 4)`` unit quaternions.
+
+    Returns
+    -------
+    ndarray
+        ``(..., 4)`` float64.
+    """
     a = np.array(q, dtype=np.float64, copy=True)
     a[..., 1:] *= -1.0
     return a
@@ -48,7 +83,18 @@ inverse = conjugate
 
 
 def multiply(a: ArrayLike, b: ArrayLike) -> F64:
-    """Hamilton product a ⊗ b (broadcast over leading axes)."""
+    """Hamilton product a ⊗ b (broadcast over leading axes).
+
+    Parameters
+    ----------
+    a, b : array_like
+        ``(..., 4)`` quaternions.
+
+    Returns
+    -------
+    ndarray
+        ``(..., 4)`` float64.
+    """
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
     aw, ax, ay, az = np.moveaxis(a, -1, 0)
@@ -65,14 +111,42 @@ def multiply(a: ArrayLike, b: ArrayLike) -> F64:
 
 
 def from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> F64:
-    """Rotation by ``angle`` radians about the unit ``axis``."""
+    """Rotation by ``angle`` radians about the unit ``axis``.
+
+    Parameters
+    ----------
+    axis : array_like
+        ``(..., 3)`` unit axes.
+    angle : array_like
+        ``(...)`` angles in radians.
+
+    Returns
+    -------
+    ndarray
+        ``(..., 4)`` float64.
+    """
     ax = np.asarray(axis, dtype=np.float64)
     half = 0.5 * np.asarray(angle, dtype=np.float64)[..., None]
     return np.concatenate([np.cos(half), np.sin(half) * ax], axis=-1)
 
 
 def from_euler(angles: ArrayLike, order: str, degrees: bool = True) -> F64:
-    """``(..., k)`` angles, one per letter of ``order``, → ``(..., 4)``: q = q_c1 ⊗ q_c2 ⊗ … (intrinsic)."""
+    """``(..., k)`` angles, one per letter of ``order``, → ``(..., 4)``: q = q_c1 ⊗ q_c2 ⊗ … (intrinsic).
+
+    Parameters
+    ----------
+    angles : array_like
+        ``(..., k)`` angles.
+    order : str
+        k axis letters, e.g. "ZXY".
+    degrees : bool, default True
+        The angles are degrees (else radians).
+
+    Returns
+    -------
+    ndarray
+        ``(..., 4)`` float64.
+    """
     o = _check_order(order)
     a = np.asarray(angles, dtype=np.float64)
     if a.shape[-1] != len(o):
@@ -90,7 +164,18 @@ def from_euler(angles: ArrayLike, order: str, degrees: bool = True) -> F64:
 
 
 def to_matrix(q: ArrayLike) -> F64:
-    """``(..., 4)`` → ``(..., 3, 3)`` rotation matrices (q need not be exactly unit)."""
+    """``(..., 4)`` → ``(..., 3, 3)`` rotation matrices (q need not be exactly unit).
+
+    Parameters
+    ----------
+    q : array_like
+        ``(..., 4)`` quaternions.
+
+    Returns
+    -------
+    ndarray
+        ``(..., 3, 3)`` float64.
+    """
     w, x, y, z = np.moveaxis(normalize(q), -1, 0)
     m = np.empty((*w.shape, 3, 3))
     m[..., 0, 0] = 1 - 2 * (y * y + z * z)
@@ -106,7 +191,20 @@ def to_matrix(q: ArrayLike) -> F64:
 
 
 def rotate(q: ArrayLike, v: ArrayLike) -> F64:
-    """Rotate vectors ``(..., 3)`` by quaternions ``(..., 4)`` (broadcast): q v q⁻¹."""
+    """Rotate vectors ``(..., 3)`` by quaternions ``(..., 4)`` (broadcast): q v q⁻¹.
+
+    Parameters
+    ----------
+    q : array_like
+        ``(..., 4)`` unit quaternions.
+    v : array_like
+        ``(..., 3)`` vectors.
+
+    Returns
+    -------
+    ndarray
+        ``(..., 3)`` float64.
+    """
     q = np.asarray(q, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)
     u = q[..., 1:]
@@ -134,7 +232,22 @@ def _euler_from_matrix(m: F64, order: str) -> F64:
 
 
 def to_euler(q: ArrayLike, order: str, degrees: bool = True) -> F64:
-    """Inverse of :func:`from_euler` for three distinct axes (e.g. "ZXY"); angles in (−180°, 180°]."""
+    """Inverse of :func:`from_euler` for three distinct axes (e.g. "ZXY"); angles in (−180°, 180°].
+
+    Parameters
+    ----------
+    q : array_like
+        ``(..., 4)`` unit quaternions.
+    order : str
+        Three distinct axis letters.
+    degrees : bool, default True
+        Give degrees (else radians).
+
+    Returns
+    -------
+    ndarray
+        ``(..., 3)`` float64 angles.
+    """
     o = _check_order(order)
     if len(o) != 3 or len(set(o)) != 3:
         raise ParameterError("order", order, "three distinct axes such as 'ZXY'")
@@ -147,6 +260,18 @@ def align_hemisphere(q: ArrayLike, axis: int = 0) -> F64:
 
     q and −q are the same rotation; aligned sequences interpolate the short way and can be
     compared component-wise.
+
+    Parameters
+    ----------
+    q : array_like
+        Quaternions, 4 components on the last axis.
+    axis : int, default 0
+        The time axis.
+
+    Returns
+    -------
+    ndarray
+        The aligned quaternions, float64.
     """
     a = np.moveaxis(np.array(q, dtype=np.float64, copy=True), axis, 0)
     if a.shape[0] > 1:
@@ -161,6 +286,16 @@ def distance(q1: ArrayLike, q2: ArrayLike) -> F64:
 
     For unit quaternions w of q2 q1⁻¹ equals the 4-D dot product q1·q2; |w| picks the shorter of
     q and −q. This is half the rotation angle between the two orientations.
+
+    Parameters
+    ----------
+    q1, q2 : array_like
+        ``(..., 4)`` unit quaternions.
+
+    Returns
+    -------
+    ndarray
+        ``(...)`` float64 radians.
     """
     q1 = np.asarray(q1, dtype=np.float64)
     q2 = np.asarray(q2, dtype=np.float64)
@@ -168,7 +303,20 @@ def distance(q1: ArrayLike, q2: ArrayLike) -> F64:
 
 
 def slerp(q1: ArrayLike, q2: ArrayLike, t: ArrayLike) -> F64:
-    """Spherical linear interpolation along the shorter arc; t = 0 gives q1, t = 1 gives q2 (or −q2)."""
+    """Spherical linear interpolation along the shorter arc; t = 0 gives q1, t = 1 gives q2 (or −q2).
+
+    Parameters
+    ----------
+    q1, q2 : array_like
+        ``(..., 4)`` unit quaternions.
+    t : array_like
+        ``(...)`` shares in [0, 1].
+
+    Returns
+    -------
+    ndarray
+        ``(..., 4)`` float64 unit quaternions.
+    """
     a = np.asarray(q1, dtype=np.float64)
     b = np.asarray(q2, dtype=np.float64)
     t = np.asarray(t, dtype=np.float64)[..., None]

@@ -53,7 +53,18 @@ class Gust:
     strength: float
 
     def envelope(self, times: ArrayLike) -> F64:
-        """sin²(π (t − start)/duration) inside the gust, 0 outside; ``times`` in seconds."""
+        """sin²(π (t − start)/duration) inside the gust, 0 outside; ``times`` in seconds.
+
+        Parameters
+        ----------
+        times : array_like
+            Times in seconds.
+
+        Returns
+        -------
+        ndarray
+            The envelope at each time, in [0, 1].
+        """
         u = (np.asarray(times, dtype=np.float64) - self.start) / self.duration
         return np.where((u > 0.0) & (u < 1.0), np.sin(np.pi * u) ** 2, 0.0)
 
@@ -69,7 +80,28 @@ def gust_schedule(
     """``count`` seeded gusts with horizontal directions, starting after the first tenth of the clip.
 
     ``frame``: the scene's axes (:attr:`hairtool.metadata.Metadata.frame`; default Y-up), so
-    "horizontal" is across the stage's up axis."""
+    "horizontal" is across the stage's up axis.
+
+    Parameters
+    ----------
+    count : int
+        Gusts, ≥ 0.
+    clip_duration : float
+        The clip's length in seconds.
+    strength : float
+        Each gust's strength in units/s².
+    duration : float
+        Each gust's length in seconds.
+    seed : int
+        The draws' seed.
+    frame : array_like, optional
+        ``(3, 3)`` the scene's axes (None: Y-up).
+
+    Returns
+    -------
+    list of Gust
+        The gusts, by start time.
+    """
     if int(count) != count or not 0 <= count <= 10_000:
         raise ParameterError("gusts", count, "a whole number in [0, 10000]")
     if not (np.isfinite(strength) and strength >= 0):
@@ -96,7 +128,22 @@ def scaled_accelerations(factor: float, gust_strength: float, wind: ArrayLike = 
     """Gust strength and the wind vector (units/s²) for a head ``factor`` times larger: they
     scale with the head, so hair on the larger head moves as it did on the smaller one (gravity
     is physical, in m/s², and needs no scaling). The keyword arguments of :func:`simulate` (the
-    wind as a vector) that change with scale."""
+    wind as a vector) that change with scale.
+
+    Parameters
+    ----------
+    factor : float
+        The new head radius over the old.
+    gust_strength : float
+        The gusts' strength before.
+    wind : array_like, default (0, 0, 0)
+        The wind vector before.
+
+    Returns
+    -------
+    dict
+        ``gust_strength`` and ``wind`` scaled.
+    """
     return {
         "gust_strength": float(gust_strength) * factor,
         "wind": tuple(float(v) * factor for v in np.asarray(wind, dtype=np.float64).reshape(3)),
@@ -178,20 +225,57 @@ def simulate(
 ) -> Animation:
     """Simulate ``groom`` (its pose at time 0) on a moving head; returns ``frames`` frames at ``fps``.
 
-    motion: names from :mod:`hairtool.simulate.head_motion` ("turn,nod" plays them in equal slots), placed
-        on the head sphere (``head_center``, ``head_radius``; :func:`~hairtool.simulate.head_motion.fit_head`
-        finds one for a real groom), or a callable t (s) → rigid 4×4 head transform (world from
-        head; the groom is posed at t = 0).
-    substeps: solver steps per frame. gravity: m/s² along the stage's −up (the groom's up axis),
-        g / metersPerUnit in scene units/s². damping: velocity decay per
-        second (v ← v·e^(−damping·Δt)). stiffness: fraction of each vertex's distance from its
-        rest position in the head frame removed per frame. ftl_damping: s_damping of Müller et al. eq. 9.
-    wind: (direction, strength in units/s²), constant. gusts: a count of seeded gusts
-        (:func:`gust_schedule`) or explicit :class:`Gust` objects.
-    collide: keep vertices outside the head sphere (centre, radius at t = 0, moving with the head);
-        a vertex whose rest pose is closer to the centre than the radius is held at that distance.
-    progress: called as ``progress(done, frames)`` after every frame, so a studio can show how far
-        the run is; an exception raised from it stops the simulation (how a studio cancels).
+    Parameters
+    ----------
+    groom : Groom
+        The hair at rest, posed at t = 0.
+    motion : str, sequence of str or callable, default "still"
+        Names from :mod:`hairtool.simulate.head_motion` ("turn,nod" plays them in equal slots),
+        placed on the head sphere, or a callable t (s) → rigid 4×4 head transform (world from
+        head).
+    frames : int, default 120
+        Frames to make, 1 … 1,000,000.
+    fps : float, default 24.0
+        Frames per second.
+    substeps : int, default 8
+        Solver steps per frame.
+    gravity : float, default GRAVITY
+        m/s² along the stage's −up (the groom's up axis): g / metersPerUnit in scene units/s².
+    damping : float, default 2.0
+        Velocity decay per second (v ← v·e^(−damping·Δt)).
+    stiffness : float, default 0.05
+        Share of each vertex's distance from its rest position in the head frame removed per
+        frame.
+    ftl_damping : float, default 0.9
+        s_damping of Müller et al. eq. 9.
+    wind : tuple of (array_like, float), optional
+        A constant wind: direction and strength in units/s².
+    gusts : int or sequence of Gust, default 0
+        A count of seeded gusts (:func:`gust_schedule`) or explicit :class:`Gust` objects.
+    gust_strength : float, default 300.0
+        A seeded gust's strength in units/s².
+    gust_duration : float, default 0.25
+        A seeded gust's length in seconds.
+    collide : bool, default True
+        Keep vertices outside the head sphere (moving with the head); a vertex whose rest pose
+        is closer to the centre than the radius is held at that distance.
+    head_center : array_like, default (0, 0, 0)
+        The head sphere's centre at t = 0 (:func:`~hairtool.simulate.head_motion.fit_head`
+        finds one for a real groom).
+    head_radius : float, default 1.0
+        Its radius.
+    seed : int, default 0
+        The seed of the gusts: the same seed, the same bytes.
+    backend : {"numba", "numpy"}, default "numba"
+        The kernel, or its numpy twin (the tests' oracle).
+    progress : callable, optional
+        ``progress(done, frames)`` after every frame; an exception raised from it stops the
+        simulation (how a studio cancels).
+
+    Returns
+    -------
+    Animation
+        ``frames`` frames of the groom's strands at ``fps``.
     """
     frames = _whole("frames", frames, 1, 1_000_000)
     substeps = _whole("substeps", substeps, 1, 1000)
@@ -292,7 +376,20 @@ def simulate(
 
 
 def simulate_reference(groom: Groom, **kwargs) -> Animation:
-    """:func:`simulate` with the numpy twin of the kernel (slow; the test oracle)."""
+    """:func:`simulate` with the numpy twin of the kernel (slow; the test oracle).
+
+    Parameters
+    ----------
+    groom : Groom
+        The hair at rest.
+    **kwargs
+        :func:`simulate`'s keywords, ``backend`` aside.
+
+    Returns
+    -------
+    Animation
+        What :func:`simulate` gives, computed by the numpy twin.
+    """
     return simulate(groom, backend="numpy", **kwargs)
 
 

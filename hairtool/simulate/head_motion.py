@@ -41,26 +41,82 @@ def _window(u: float) -> float:
 
 
 def still(u: float) -> F64:
+    """No motion: the rest pose throughout.
+
+    Parameters
+    ----------
+    u : float
+        The share of the motion's slot, in [0, 1].
+
+    Returns
+    -------
+    ndarray
+        ``(4, 4)`` the identity.
+    """
     return np.eye(4)
 
 
 def turn(u: float) -> F64:
-    """Look left then right (yaw about +y, up to about ±55°)."""
+    """Look left then right (yaw about +y, up to about ±55°).
+
+    Parameters
+    ----------
+    u : float
+        The share of the motion's slot, in [0, 1].
+
+    Returns
+    -------
+    ndarray
+        ``(4, 4)`` float64 rigid transform of the unit head.
+    """
     return _about_pivot((0.0, 1.0, 0.0), np.radians(70.0) * np.sin(2 * np.pi * u) * _window(u))
 
 
 def nod(u: float) -> F64:
-    """Nod down then up (pitch about +x, up to about ±30°)."""
+    """Nod down then up (pitch about +x, up to about ±30°).
+
+    Parameters
+    ----------
+    u : float
+        The share of the motion's slot, in [0, 1].
+
+    Returns
+    -------
+    ndarray
+        ``(4, 4)`` float64 rigid transform of the unit head.
+    """
     return _about_pivot((1.0, 0.0, 0.0), np.radians(40.0) * np.sin(2 * np.pi * u) * _window(u))
 
 
 def shake(u: float) -> F64:
-    """Three quick shakes of the head (yaw, up to ±30°)."""
+    """Three quick shakes of the head (yaw, up to ±30°).
+
+    Parameters
+    ----------
+    u : float
+        The share of the motion's slot, in [0, 1].
+
+    Returns
+    -------
+    ndarray
+        ``(4, 4)`` float64 rigid transform of the unit head.
+    """
     return _about_pivot((0.0, 1.0, 0.0), np.radians(30.0) * np.sin(6 * np.pi * u) * _window(u))
 
 
 def hop(u: float) -> F64:
-    """Stand, jump (0.6 head radii high, airborne for the middle 60 % of the slot), land and stop."""
+    """Stand, jump (0.6 head radii high, airborne for the middle 60 % of the slot), land and stop.
+
+    Parameters
+    ----------
+    u : float
+        The share of the motion's slot, in [0, 1].
+
+    Returns
+    -------
+    ndarray
+        ``(4, 4)`` float64 rigid transform of the unit head.
+    """
     m = np.eye(4)
     if 0.2 < u < 0.8:
         s = (u - 0.2) / 0.6
@@ -78,7 +134,18 @@ MOTIONS: dict[str, Callable[[float], F64]] = {
 
 
 def parse_motion(spec: str | Sequence[str]) -> list[str]:
-    """ "turn,nod" or ["turn", "nod"] → the checked list of names."""
+    """ "turn,nod" or ["turn", "nod"] → the checked list of names.
+
+    Parameters
+    ----------
+    spec : str or sequence of str
+        Comma-separated names, or a list of them.
+
+    Returns
+    -------
+    list of str
+        The names, each one :mod:`hairtool.simulate.head_motion` knows (ParameterError otherwise).
+    """
     names = [s.strip() for s in spec.split(",")] if isinstance(spec, str) else [str(s).strip() for s in spec]
     if not names or any(n not in MOTIONS for n in names):
         raise ParameterError("motion", spec, f"names from {', '.join(MOTIONS)}, comma-separated")
@@ -99,6 +166,24 @@ def head_motion(
     sits at ``centre + radius·PIVOT`` and a hop rises 0.6·``radius``; angles stay the same.
     ``frame``: the scene's axes as columns (lateral, up, front; default the identity, Y-up):
     each motion M of the reference head becomes frame·M·frameᵀ.
+
+    Parameters
+    ----------
+    spec : str or sequence of str
+        Motion names (:func:`parse_motion`).
+    duration : float
+        Seconds the motions share.
+    centre : array_like, default (0, 0, 0)
+        The head's centre.
+    radius : float, default 1.0
+        The head's radius.
+    frame : array_like, optional
+        ``(3, 3)`` the scene's axes (None: Y-up).
+
+    Returns
+    -------
+    HeadMotion
+        t → ``(4, 4)``.
     """
     names = parse_motion(spec)
     if not (np.isfinite(duration) and duration > 0):
@@ -135,6 +220,16 @@ def fit_head(roots: ArrayLike) -> tuple[F64, float]:
     Roots in one plane (a 2-D groom) give the circle in that plane. When the roots do not pin
     down a sphere (fewer than four, all on a line, or a fit larger than ten times their spread,
     as for a flat comb), the centre is their centroid and the radius half their spread.
+
+    Parameters
+    ----------
+    roots : array_like
+        ``(S, 3)`` root positions, finite.
+
+    Returns
+    -------
+    tuple of (ndarray, float)
+        The centre ``(3,)`` and the radius.
     """
     p = np.asarray(roots, dtype=np.float64).reshape(-1, 3)
     if p.shape[0] == 0 or not np.all(np.isfinite(p)):
@@ -160,7 +255,20 @@ def fit_head(roots: ArrayLike) -> tuple[F64, float]:
 
 
 def check_transform(m: object, t: float) -> F64:
-    """A head transform must be a finite rigid 4×4 (rotation + translation)."""
+    """A head transform must be a finite rigid 4×4 (rotation + translation).
+
+    Parameters
+    ----------
+    m : object
+        What a motion callable returned.
+    t : float
+        The time asked, named in a refusal.
+
+    Returns
+    -------
+    ndarray
+        ``(4, 4)`` float64 (ParameterError otherwise).
+    """
     a = np.asarray(m, dtype=np.float64)
     if a.shape != (4, 4) or not np.all(np.isfinite(a)):
         raise ParameterError("motion", f"value at t={t:g}", "a finite 4×4 matrix")

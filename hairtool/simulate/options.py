@@ -54,7 +54,18 @@ class SimulateOptions:
     def fitted_to(self, groom: Groom) -> SimulateOptions:
         """The head sphere fitted to ``groom``'s roots, with wind and gusts scaled by the change
         of head radius, so the hair moves alike on a head of any size (gravity is in m/s² and
-        follows the groom's unit by itself)."""
+        follows the groom's unit by itself).
+
+        Parameters
+        ----------
+        groom : Groom
+            The groom the head is fitted to.
+
+        Returns
+        -------
+        SimulateOptions
+            These options on that head.
+        """
         centre, radius = fit_head(groom.roots)
         radius = max(round(radius, 3), 0.001)  # what the dialog's fields hold
         scale = radius / self.head_radius if self.head_radius > 0 else radius
@@ -69,7 +80,20 @@ class SimulateOptions:
     def from_dict(cls, d: dict, units_per_meter: float = 1.0) -> SimulateOptions:
         """The options :meth:`to_dict` wrote. A gravity without ``gravity_unit`` is from a project
         saved when gravity was in scene units/s²: it is converted with the groom's
-        ``units_per_meter``, so a reopened simulation falls as it did."""
+        ``units_per_meter``, so a reopened simulation falls as it did.
+
+        Parameters
+        ----------
+        d : dict
+            What :meth:`to_dict` wrote.
+        units_per_meter : float, default 1.0
+            The groom's scene units per metre, for an old project's gravity.
+
+        Returns
+        -------
+        SimulateOptions
+            The options.
+        """
         d = dict(d)
         unit = d.pop("gravity_unit", None)
         if unit is None and "gravity" in d:
@@ -90,7 +114,24 @@ class SimulateOptions:
 def run_simulation(
     groom: Groom, options: SimulateOptions, progress: Callable[..., None], cancelled: Callable[[], bool]
 ) -> Animation:
-    """The job body: simulate ``groom``; raises :class:`Cancelled` soon after a cancel."""
+    """The job body: simulate ``groom``; raises :class:`Cancelled` soon after a cancel.
+
+    Parameters
+    ----------
+    groom : Groom
+        The hair at rest.
+    options : SimulateOptions
+        Everything :func:`~hairtool.simulate.dynamics.simulate` takes.
+    progress : callable
+        ``progress(share, words)`` after each frame.
+    cancelled : callable
+        Asked after each frame; True stops the run.
+
+    Returns
+    -------
+    Animation
+        The simulated frames.
+    """
 
     def per_frame(done: int, total: int) -> None:
         if cancelled():

@@ -28,6 +28,28 @@ def sway_animation(
     about its root by an angle growing as u² toward the tip (``sway`` radians at the tip,
     lagging behind the head), and at ``flick_frame`` a 3-frame flick of ``flick`` radians
     snaps the tips: the short, important deformation that uniform keys miss.
+
+    Parameters
+    ----------
+    groom : Groom
+        The hair at rest.
+    n_frames : int, default 120
+        Frames, ≥ 1.
+    fps : float, default 24.0
+        Frames per second.
+    turn : float, default 0.6
+        The head's turn, radians.
+    sway : float, default 0.35
+        The tips' sway, radians.
+    flick_frame : int, optional
+        Where the flick happens (None: no flick).
+    flick : float, default 0.8
+        The flick's angle at the tips, radians.
+
+    Returns
+    -------
+    Animation
+        ``n_frames`` frames at ``fps``.
     """
     if int(n_frames) != n_frames or n_frames < 1:
         raise ParameterError("n_frames", n_frames, "a whole number >= 1")

@@ -110,3 +110,43 @@ def test_the_site_builds_strict_without_the_network(tmp_path):
         assert (site / "images" / picture).is_file()
     api = (site / "api" / "io" / "index.html").read_text(encoding="utf-8")
     assert "Parameters" in api and "Returns" in api  # the docstrings' sections, rendered
+
+
+def test_a_new_brush_gets_its_section_and_the_prose_stays(monkeypatch):
+    """A registered brush the page does not know makes the page stale and gets a section of its
+    own (heading, facts from its spec, a picture line) with no edit of the page; every
+    hand-written paragraph of the committed page is still there."""
+    from hairtool.frozen.brushes import registry
+    from hairtool.frozen.brushes.spec import BrushSpec, Param, Studio
+
+    generate = _generator()
+    page = (DOCS / "studio" / "brushes.md").read_text(encoding="utf-8")
+    new = BrushSpec(
+        name="braid",
+        order=99,
+        signed=True,
+        studio=Studio("Braid", "Shift+B", "Braids them", 0.3, ("Braid", "Unbraid"), "Braid or unbraid"),
+        params=(Param("turns", int, 1, 12, 3, "turns", "a whole number of turns in [1, 12]"),),
+    )
+    specs = registry.specs()
+    monkeypatch.setattr(registry, "specs", lambda: (*specs, new))
+    text = generate.brushes_page()
+    assert text != page
+    section = text.split("{#brush-braid}", 1)[1].split("\n## ", 1)[0]
+    assert "`Shift+B`" in section and "starting at 0.3" in section and "Braid or unbraid" in section
+    assert "| `params.turns` | whole number | 1 … 12 | 3 |" in section
+    assert "](../images/figure-brush-braid.png)" in section
+    assert "| [Braid](#brush-braid) | `Shift+B` | signed | 0.3 | no | `braid` |" in text
+    sections = page.split(generate.SECTIONS_START)[1].split(generate.SECTIONS_END)[0]
+    for paragraph in generate.hand_prose(sections).values():
+        assert paragraph.strip() in text
+
+
+def test_the_prose_of_a_brush_no_longer_registered_is_not_dropped(monkeypatch):
+    from hairtool.frozen.brushes import registry
+
+    generate = _generator()
+    specs = registry.specs()
+    monkeypatch.setattr(registry, "specs", lambda: specs[1:])
+    with pytest.raises(SystemExit, match="align"):
+        generate.brushes_page()
