@@ -31,6 +31,7 @@ from hairtool.errors import ParameterError
 SOURCES = ("shake", "turn", "animation")  # what drives the spring bones
 VIEWS = ("cycle", "springs", "both")  # what the viewport shows on the chains
 DERIVED_KEPT = 16
+KEY_PENALTY = 0.02  # the springs' optimal keys: a key costs 2 % of the two-key error
 AMPLITUDE_SPREAD, PHASE_SPREAD = 0.1, 0.25  # a chain's first variation: hairtool anime's defaults
 
 
@@ -311,6 +312,17 @@ class CharacterDocument:
             raise ParameterError("motion", which, "animation, cycle or springs")
         f = frames()
         return f[int(np.clip(frame, 0, len(f) - 1))]
+
+    def spring_keys(self, penalty: float = KEY_PENALTY) -> np.ndarray:
+        """Optimal key frames of the springs (seeds 000 and 003 on the chains' BVH rotations,
+        ``penalty`` the price of a key as a share of the two-key error), first and last included."""
+        from hairtool.character.bvh import chains_motion
+        from hairtool.keys.session import find_keys
+        from hairtool.mocap.costs import motion_features
+
+        springs = self.springs()
+        x = motion_features(chains_motion(self.character, springs, self.state.cycle.fps), "rotations")
+        return np.asarray(find_keys(x, penalty=penalty).keys, dtype=np.int64)
 
     # -- files out -------------------------------------------------------------------------------
     def export(

@@ -28,6 +28,12 @@ from app.ui.qt_utils import signals_blocked
 from app.ui.widgets import SliderSpin
 
 VIEW_WORDS = {"cycle": "Anime cycle", "springs": "Spring bones", "both": "Both on the same chains"}
+AXES = (
+    ("its own axis", None),
+    ("X (left-right)", (1.0, 0.0, 0.0)),
+    ("Y (up)", (0.0, 1.0, 0.0)),
+    ("Z (front-back)", (0.0, 0.0, 1.0)),
+)
 SOURCE_WORDS = {"shake": "Head shake", "turn": "Head turn", "animation": "The character's animation"}
 
 
@@ -66,6 +72,14 @@ class CharacterDock(QDockWidget):
         self.phase.edited.connect(lambda v, drag: self._edited({"phase": v}, drag))
         self.amplitude.edited.connect(lambda v, drag: self._edited({"amplitude_scale": v}, drag))
         self.profile.valueChanged.connect(lambda v: self._edited({"profile": None if v < 0 else v}, None))
+        self.axis = QComboBox()
+        for words, axis in AXES:
+            self.axis.addItem(words, axis)
+        self.axis.setToolTip(
+            "The line this chain bends about: its own (across the chain, level), or a world axis"
+        )
+        self.axis.activated.connect(lambda i: self._edited({"axis": self.axis.itemData(i)}, None))
+        form.addRow("Bends about", self.axis)
         form.addRow("Phase", self.phase)
         form.addRow("Swing", self.amplitude)
         form.addRow("Root to tip", self.profile)
@@ -115,18 +129,20 @@ class CharacterDock(QDockWidget):
         if doc is None:
             return
         s = doc.state
-        with signals_blocked(self.chains, self.profile, self.view, self.source):
+        with signals_blocked(self.chains, self.profile, self.view, self.source, self.axis):
             self.chains.setCurrentRow(-1 if s.selected is None else s.selected)
             self.view.setCurrentIndex(VIEWS.index(s.view))
             self.source.setCurrentIndex(SOURCES.index(s.springs.source))
             chosen = s.selected is not None
-            for w in (self.phase, self.amplitude, self.profile):
+            for w in (self.phase, self.amplitude, self.profile, self.axis):
                 w.setEnabled(chosen)
             if chosen:
                 wave = s.cycle.chains[s.selected]
                 self.phase.set_value(wave.phase)
                 self.amplitude.set_value(wave.amplitude_scale)
                 self.profile.setValue(-0.01 if wave.profile is None else wave.profile)
+                known = [axis for _, axis in AXES]
+                self.axis.setCurrentIndex(known.index(wave.axis) if wave.axis in known else 0)
         self.undo_button.setEnabled(doc.stack.can_undo)
         self.redo_button.setEnabled(doc.stack.can_redo)
 

@@ -18,7 +18,7 @@ import os
 from typing import TYPE_CHECKING
 
 import numpy as np
-from PySide6.QtCore import QObject, Qt
+from PySide6.QtCore import QEvent, QObject, Qt
 from PySide6.QtWidgets import QMenu
 
 from app.document.character import CharacterDocument
@@ -30,6 +30,7 @@ from hairtool.anime.settings import AnimeSettings
 from hairtool.character.read import is_character_path, load_character
 from hairtool.errors import HairtoolError
 from hairtool.groom import Animation, Groom
+from hairtool.keys import session as ks
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
@@ -57,6 +58,7 @@ class CharacterStudio(QObject):
         self.dock.undo_requested.connect(lambda: self.doc is not None and self.doc.undo())
         self.dock.redo_requested.connect(lambda: self.doc is not None and self.doc.redo())
         window.animation.frame_changed.connect(self.show_frame)
+        window.viewport.installEventFilter(self)  # a click on a chain's bones selects the chain
 
     # -- opening -------------------------------------------------------------------------------
     @staticmethod
@@ -125,14 +127,29 @@ class CharacterStudio(QObject):
 
         return self._edit(change)
 
-    def pick(self, xy: tuple[float, float], size: tuple[int, int]) -> int | None:
-        """Select the chain whose bones pass under the pixel ``xy`` of the viewport (None: none)."""
+    def chain_at(self, xy: tuple[float, float]) -> int | None:
+        """The chain whose bones pass under the viewport's pixel ``xy`` on the frame shown."""
         if self.doc is None:
             return None
+        vp = self.window.viewport
         world = self.doc.character.nodes.world(self._pose(self.window.animation.frame))
-        chain = pick_chain(self.window.viewport.camera, size, chain_lines(self.doc.character, world), xy)
+        return pick_chain(vp.camera, (vp.width(), vp.height()), chain_lines(self.doc.character, world), xy)
+
+    def eventFilter(self, obj: QObject, event: QEvent) -> bool:
+        """A plain left click on a chain's bones selects it (and goes no further); anywhere else
+        the viewport gets the click as usual."""
+        if (
+            self.doc is None
+            or event.type() != QEvent.Type.MouseButtonPress
+            or event.button() != Qt.MouseButton.LeftButton
+            or event.modifiers() != Qt.KeyboardModifier.NoModifier
+        ):
+            return False
+        chain = self.chain_at((event.position().x(), event.position().y()))
+        if chain is None:
+            return False
         self.doc.select(chain)
-        return chain
+        return True
 
     # -- state → pictures ------------------------------------------------------------------------
     def _changed(self) -> None:
@@ -180,10 +197,24 @@ class CharacterStudio(QObject):
             self._shown = shown
             frame = model.frame if model.animation is not None else 0
             if len(frames) > 1:
-                model.load_animation(Animation(np.stack(frames), counts, fps=d.fps), SOURCE)
+                anim = Animation(np.stack(frames), counts, fps=d.fps)
+                model.load_animation(anim, SOURCE, settings=self._keys(len(frames)))
                 model.set_frame(min(frame, len(frames) - 1))
             self.dock.show_measure(d.measure() if s.view != "cycle" else None, d.drawing_frames())
         self.show_frame(model.frame if model.animation is not None else 0)
+
+    def _keys(self, count: int) -> ks.KeySettings | None:
+        """The applied cycle's keys are its drawings (each frame where one starts, and the last
+        frame): the timeline shows them as its keys. Other motions get the model's own solve."""
+        d = self.doc
+        if d.state.view != "cycle" or d.state.applied is None:
+            return None
+        n = d.cycle(d.state.applied).schedule.n_frames
+        starts = d.drawing_frames()
+        pins = sorted(
+            {int(f) for c in range(count // n + 1) for f in starts + c * n if f < count} | {count - 1}
+        )
+        return ks.KeySettings(count=len(pins), pins=tuple(pins))
 
     def show_frame(self, frame: int) -> None:
         if self.doc is None:
@@ -212,6 +243,7 @@ class CharacterStudio(QObject):
         for text, which in (
             ("Cycle as glTF/VRM (STEP keys at the drawings)…", "cycle"),
             ("Springs as glTF/VRM (LINEAR keys)…", "springs"),
+            ("Springs' optimal keys as glTF/VRM (CUBICSPLINE)…", "springs keys"),
             ("Cycle's chains as BVH…", "cycle bvh"),
             ("Springs' chains as BVH…", "springs bvh"),
         ):
@@ -224,7 +256,7 @@ class CharacterStudio(QObject):
         if self.doc is None:
             self.window.show_error("Cannot export", "open a character (.vrm, .glb, .gltf) first")
             return False
-        bvh = which.endswith("bvh")
+        bvh = which.endswith(" bvh")
         filters = "BVH (*.bvh)" if bvh else "glTF binary (*.glb);;VRM (*.vrm);;glTF (*.gltf)"
         path = self.window.ask_save_path(f"Export {which}", filters)
         if not path:
@@ -232,12 +264,15 @@ class CharacterStudio(QObject):
         return self.export(path, which)
 
     def export(self, path: str | os.PathLike[str], which: str) -> bool:
-        """``which``: "cycle" (STEP keys at the drawings), "springs" (LINEAR on every frame), or
-        either followed by " bvh" for the chains' BVH."""
-        motion, _, bvh = which.partition(" ")
+        """``which``: "cycle" (STEP keys at the drawings), "springs" (LINEAR on every frame),
+        "springs keys" (their optimal keys, CUBICSPLINE with fitted tangents), or "cycle bvh" /
+        "springs bvh" for the chains' BVH."""
+        motion, _, form = which.partition(" ")
         try:
-            if bvh:
+            if form == "bvh":
                 self.doc.export_bvh(path, motion)
+            elif form == "keys":
+                self.doc.export(path, motion, key_frames=self.doc.spring_keys(), interp="hermite-fit")
             else:
                 self.doc.export(path, motion)
         except HairtoolError as e:

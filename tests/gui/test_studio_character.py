@@ -10,7 +10,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from PySide6.QtCore import QPoint, Qt
 
+from app.render.character_bones import chain_lines
 from hairtool.character import load_character
 from hairtool.character.skinning import skin_matrices, skin_reference
 
@@ -60,6 +62,9 @@ def test_apply_makes_the_cycle_the_animation_and_the_timeline_scrubs_it(studio, 
         model.set_frame(frame)
         _gpu_matches_reference(studio, doc.pose(frame, "cycle"))
     assert "Drawings on frames 0, 2, 4" in studio.character.dock.measure.text()
+    qtbot.waitUntil(lambda: model.dp_keys is not None, timeout=60_000)
+    drawings = [f + c * n for c in range(studio.character.cycles) for f in doc.drawing_frames()]
+    assert model.dp_keys.tolist() == sorted({*drawings, model.animation.n_frames - 1})  # keys at the drawings
     assert doc.undo() and doc.state.applied is None  # Apply is one step of the document
 
 
@@ -72,20 +77,35 @@ def test_the_springs_show_beside_the_cycle_with_the_papers_measure(studio):
     assert "mean angular error" in dock.measure.text()
 
 
-def test_a_click_on_a_chain_selects_it_in_the_list(studio):
+def test_a_click_on_a_chain_selects_it_in_the_list(studio, qtbot):
     doc = studio.character.doc
     vp = studio.viewport
     size = (vp.width(), vp.height())
-    world = doc.character.nodes.world()
-    from app.render.character_bones import chain_lines
-
-    lines = chain_lines(doc.character, world)
-    xy = vp.camera.project(lines[5][1:3], *size).mean(axis=0)
-    chain = studio.character.pick(tuple(xy), size)
-    assert chain is not None and doc.state.selected == chain
-    assert studio.character.dock.chains.currentRow() == chain
-    studio.character.dock.chains.setCurrentRow(2)
+    lines = chain_lines(doc.character, doc.character.nodes.world())
+    mids = [vp.camera.project(line[1:3], *size).mean(axis=0) for line in lines]
+    clear = [
+        c for c, xy in enumerate(mids) if studio.character.chain_at(tuple(xy)) == c
+    ]  # not behind another
+    assert len(clear) >= 2
+    for c in clear[:2]:
+        qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, pos=QPoint(round(mids[c][0]), round(mids[c][1])))
+        assert doc.state.selected == c and studio.character.dock.chains.currentRow() == c
+    assert studio.character.chain_at((-50.0, -50.0)) is None
+    dock = studio.character.dock
+    dock.chains.setCurrentRow(2)
     assert doc.state.selected == 2
+    dock.axis.activated.emit(2)  # the selected chain bends about the world's up axis
+    dock.amplitude.edited.emit(1.5, "drag")
+    dock.amplitude.edited.emit(0.5, "drag")  # one drag: one step
+    assert (
+        doc.state.cycle.chains[2].axis == (0.0, 1.0, 0.0) and doc.state.cycle.chains[2].amplitude_scale == 0.5
+    )
+    dock.undo_button.click()
+    assert doc.state.cycle.chains[2].amplitude_scale != 0.5 and doc.state.cycle.chains[2].axis == (
+        0.0,
+        1.0,
+        0.0,
+    )
 
 
 def test_export_writes_the_cycle_and_the_chains(studio, tmp_path):
@@ -94,6 +114,11 @@ def test_export_writes_the_cycle_and_the_chains(studio, tmp_path):
     assert studio.character.export(out, "cycle")
     clip = load_character(out).clips[-1]
     assert clip.step and clip.frame_rate() == 24.0
+    assert studio.character.export(tmp_path / "keys.glb", "springs keys")
+    keyed = load_character(tmp_path / "keys.glb").clips[-1]
+    assert keyed.cubic and 2 <= len(next(iter(keyed.rotations.values()))[0]) < len(
+        studio.character.doc.springs()
+    )
     assert studio.character.export(tmp_path / "springs.bvh", "springs bvh")
     assert (tmp_path / "springs.bvh").read_text().startswith("HIERARCHY")
     assert not studio.character.export(tmp_path / "x.txt", "cycle")  # one line in a dialog
