@@ -59,6 +59,7 @@ class CharacterStudio(QObject):
         self.dock.redo_requested.connect(lambda: self.doc is not None and self.doc.redo())
         window.animation.frame_changed.connect(self.show_frame)
         window.viewport.installEventFilter(self)  # a click on a chain's bones selects the chain
+        window.scene.groom_loaded.connect(self._groom_loaded)
 
     # -- opening -------------------------------------------------------------------------------
     @staticmethod
@@ -82,7 +83,14 @@ class CharacterStudio(QObject):
         self.dock.show()
         self.dock.raise_()
         self._show_motion()
+        self._sync_actions()
         return True
+
+    def _groom_loaded(self) -> None:
+        """Another groom replaced the character's chains (a sample, a groom file): forget it."""
+        path = self.window.scene.path
+        if self.doc is not None and (path is None or os.fspath(path) != os.fspath(self.doc.character.path)):
+            self.close()
 
     def close(self) -> None:
         """Forget the character (another file was opened)."""
@@ -92,6 +100,7 @@ class CharacterStudio(QObject):
         self._with_renderer(lambda r: r.character.set_character(None))
         self.dock.set_document(None)
         self.dock.hide()
+        self._sync_actions()
 
     # -- edits ---------------------------------------------------------------------------------
     def _edit(self, change) -> bool:
@@ -248,7 +257,28 @@ class CharacterStudio(QObject):
             ("Springs' chains as BVH…", "springs bvh"),
         ):
             add_action(self, menu, text, lambda _=False, w=which: self.export_dialog(w))
+        menu.setToolTipsVisible(True)
         self.export_menu = menu
+        self._sync_actions()
+
+    def _sync_actions(self) -> None:
+        """The exports are greyed out, saying why, until a character is open; the anime dock's
+        Apply says what it applies to."""
+        sources = getattr(self.window, "sources", None)
+        if sources is not None:
+            button = sources.dock.apply_button
+            button.setText("Apply to character" if self.doc is not None else "Apply to groom")
+            button.setToolTip(
+                "Make the cycle the character's animation, on its hair chains"
+                if self.doc is not None
+                else "Make the cycle animation of the groom (or of the selected strands)"
+            )
+        menu = getattr(self, "export_menu", None)
+        if menu is None:
+            return
+        for action in menu.actions():
+            action.setEnabled(self.doc is not None)
+            action.setToolTip("" if self.doc is not None else "Open a character (.vrm, .glb, .gltf) first")
 
     # -- files out -------------------------------------------------------------------------------
     def export_dialog(self, which: str) -> bool:

@@ -53,7 +53,8 @@ def test_a_character_opens_skinned_with_its_chains_as_bones(studio):
 
 def test_apply_makes_the_cycle_the_animation_and_the_timeline_scrubs_it(studio, qtbot):
     doc = studio.character.doc
-    studio.sources.apply_anime()
+    assert studio.sources.dock.apply_button.text() == "Apply to character"
+    studio.sources.dock.apply_button.click()
     assert doc.state.applied is not None
     model = studio.animation
     n = doc.cycle().schedule.n_frames
@@ -66,6 +67,9 @@ def test_apply_makes_the_cycle_the_animation_and_the_timeline_scrubs_it(studio, 
     drawings = [f + c * n for c in range(studio.character.cycles) for f in doc.drawing_frames()]
     assert model.dp_keys.tolist() == sorted({*drawings, model.animation.n_frames - 1})  # keys at the drawings
     assert doc.undo() and doc.state.applied is None  # Apply is one step of the document
+    studio.new_from_sample("portrait")  # another groom: the character is closed
+    assert studio.character.doc is None and not studio.viewport.renderer.character.drawn
+    assert studio.sources.dock.apply_button.text() == "Apply to groom"
 
 
 def test_the_springs_show_beside_the_cycle_with_the_papers_measure(studio):
