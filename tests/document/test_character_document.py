@@ -107,7 +107,7 @@ class CharacterEdits(RuleBasedStateMachine):
             assert self.doc.drawing_frames()[0] == 0
 
 
-CharacterEdits.TestCase.settings = settings(max_examples=10, stateful_step_count=8, deadline=None)
+CharacterEdits.TestCase.settings = settings(max_examples=8, stateful_step_count=6, deadline=None)
 test_character_edits = CharacterEdits.TestCase
 
 
