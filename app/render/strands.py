@@ -51,6 +51,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from app.render.camera import Camera
+from app.render.character_skin import CharacterLayer
 from app.render.drawn import Drawn
 from app.render.hair_shading import DEFAULT_LOOK, HairLook, light_and_eye, shade
 from app.render.mesh_layer import MeshLayer
@@ -156,6 +157,7 @@ class StrandRenderer:
         self.ramp_texture.repeat_x = False
         self.ramp_texture.write(ramp_texture(self.ramp, RAMP_TEXELS).tobytes())
         self.mesh = MeshLayer(ctx)
+        self.character = CharacterLayer(ctx)  # a character's skinned meshes (app.ui.character_studio)
         self.overlay = CircleOverlay(ctx)
         self.outline = OutlineOverlay(ctx)
         self.topology: Topology | None = None
@@ -486,7 +488,7 @@ class StrandRenderer:
 
     def scene_bounds(self) -> tuple[NDArray[np.float32], NDArray[np.float32]] | None:
         """Box around the groom and the mesh, for :meth:`Camera.frame`."""
-        boxes = [b for b in (self.bounds, self.mesh.bounds) if b is not None]
+        boxes = [b for b in (self.bounds, self.mesh.bounds, self.character.bounds) if b is not None]
         if not boxes:
             return None
         return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
@@ -518,7 +520,7 @@ class StrandRenderer:
         samples = fbo.samples if samples is None else samples
         # CPU strands blitted over nothing but the background write every pixel: no GL clear.
         cpu_only = method == "cpu" and samples == 0 and self._main is not None
-        cpu_only = cpu_only and self.mesh.vao is None and self._ghost is None
+        cpu_only = cpu_only and self.mesh.vao is None and not self.character.drawn and self._ghost is None
         ctx = self.ctx
         fbo.use()
         ctx.viewport = (0, 0, w, h)
@@ -529,6 +531,7 @@ class StrandRenderer:
         view = camera.view_matrix()
         mvp = (view @ camera.projection_matrix(w / h)).astype(np.float32)
         self.mesh.render(mvp, view)
+        self.character.render(mvp, view)
         self._shade(camera)
         if self._main is not None:
             gl_method = self.gl_line_method()
@@ -576,7 +579,7 @@ class StrandRenderer:
         if self.raster is None:
             self.raster = RasterLayer(self.ctx)
         points, colors, starts = self._main.cpu_points(), self.cpu_colors(), self._segment_starts
-        mesh = self.mesh.vao is not None
+        mesh = self.mesh.vao is not None or self.character.drawn
         scale = self.segment_width_scale() if width > 1.0 else None
         self.raster.render(
             fbo, samples, points, starts, colors, mvp, size, width, background=background, read_depth=mesh,
@@ -713,6 +716,7 @@ class StrandRenderer:
         while self._kept:
             self._kept.pop().release()
         self.mesh.release()
+        self.character.release()
         self.overlay.release()
         self.outline.release()
         if self.raster is not None:

@@ -89,7 +89,11 @@ def dialog_filters(formats: Sequence[tuple[str, Sequence[str]]]) -> str:
 def open_filters() -> str:
     """Every readable groom/animation format and BVH."""
     formats = [(f.name, f.extensions) for f in io.FORMATS if f.readable]
-    extra = [("BVH motion capture (skeleton)", BVH_EXTENSIONS), ("Hairtool project", (PROJECT_SUFFIX,))]
+    extra = [
+        ("BVH motion capture (skeleton)", BVH_EXTENSIONS),
+        ("Character with hair bones", (".vrm", ".glb", ".gltf")),
+        ("Hairtool project", (PROJECT_SUFFIX,)),
+    ]
     return dialog_filters([*formats, *extra])
 
 

@@ -52,6 +52,9 @@ class AnimationSources(QObject):
     def apply_anime(self, settings: AnimeSettings | None = None) -> bool:
         """The cycle on the edited groom (or the selected strands) into the timeline."""
         s = self.dock.settings() if settings is None else settings
+        character = getattr(self.window, "character", None)
+        if character is not None and character.doc is not None:  # the cycle on its hair chains
+            return character.apply(s)
         if not self.may_replace():
             return False
         try:

@@ -434,10 +434,12 @@ class MainWindow(QMainWindow):
         from app.ui.animation_export import AnimationExporter
         from app.ui.animation_sources import AnimationSources
         from app.ui.capture_edit import CaptureEditor
+        from app.ui.character_studio import CharacterStudio
         from app.ui.graph_editor import GraphEditorDock
         from app.ui.project_ui import ProjectController
 
         self.sources = AnimationSources(self)
+        self.character = CharacterStudio(self)
         self.capture = CaptureEditor(self)
         self.graph_editor = GraphEditorDock(self)
         self.exporter = AnimationExporter(self)
@@ -465,6 +467,7 @@ class MainWindow(QMainWindow):
             file.insertAction(quit_action, action)
             made[text] = action
         self.exporter.bind_actions(made["Export &Animation…"], made["Export &Keys…"])
+        self.character.build_menus(file, quit_action, new_menu=menus["&File"].actions()[0].menu())
         file.setToolTipsVisible(True)  # a greyed-out entry's tooltip says why
         animation = menus["A&nimation"]
         animation.addSeparator()
@@ -782,6 +785,12 @@ class MainWindow(QMainWindow):
             if ok:
                 self._add_recent(path)
             return ok
+        if self.character.handles(path):  # a character with hair bones (app.ui.character_studio)
+            ok = self.character.open(path)
+            if ok:
+                self._add_recent(path)
+            return ok
+        self.character.close()
         try:
             obj, capture, notes = read_with_notes(path)
             mesh = surface_of(path)

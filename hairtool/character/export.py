@@ -163,7 +163,10 @@ def add_animation(
                 for k, node in enumerate(group)
             ]
             samplers += _samplers(writer, rotations, group, fps, step, loop_frames, np.array(frames), interp)
-    document.setdefault("animations", []).append({"name": name, "channels": channels, "samplers": samplers})
+    # glTF has no frame rate: declared in extras, a reader need not guess it from the key times
+    document.setdefault("animations", []).append(
+        {"name": name, "channels": channels, "samplers": samplers, "extras": {"fps": float(fps)}}
+    )
 
 
 def _samplers(

@@ -185,6 +185,37 @@ def cubic_spline(times: F64, values: F64, tangent_in: F64, tangent_out: F64, i: 
     return quat.normalize(p)
 
 
+def key_rate(times: F64, *, fallback: float = 24.0, highest: float = 1000.0) -> float:
+    """The lowest frame rate (up to ``highest``) on whose frames every key time lies.
+
+    Key times are frame / fps stored as float32, so the rate of the closest keys is not enough:
+    optimal keys three frames apart would be read at a third of the rate. The first whole
+    divisor ``n`` of the closest gap ``g`` that makes every gap a whole number of frames of
+    ``n / g`` gives the frames (a gcd of the gaps, within float32's error: each time may be off
+    by an ulp, so the gaps and ``n / g`` are too); the rate is then fitted to all keys at once,
+    and one within 0.1 % of a whole number is that number. ``fallback`` when fewer than two
+    distinct times say anything.
+    """
+    t = np.unique(np.asarray(times, dtype=np.float64))
+    if len(t) < 2 or not np.all(np.isfinite(t)):
+        return fallback
+    gaps = np.diff(t)
+    gap = float(np.min(gaps))
+    ulp = 2.0 * float(np.finfo(np.float32).eps) * float(np.max(np.abs(t)))  # a time's float32 error
+    frames = np.round(gaps / gap)
+    for n in range(1, max(1, int(gap * highest)) + 1):
+        rate = n / gap
+        tolerance = 1e-3 + 2.0 * ulp * rate * (1.0 + gaps / gap)
+        if np.all(np.abs(gaps * rate - np.round(gaps * rate)) <= tolerance):
+            frames = np.round(gaps * rate)
+            break
+    k = np.concatenate([[0.0], np.cumsum(frames)])
+    d = t - t[0]
+    rate = float(np.dot(k, k) / np.dot(k, d))  # least squares over every key
+    whole = round(rate)
+    return float(whole) if whole > 0 and abs(rate - whole) <= 1e-3 * rate else rate
+
+
 @dataclass(frozen=True)
 class Clip:
     """An animation in the file: per node, rotation keys (wxyz) on its own times."""
@@ -194,18 +225,18 @@ class Clip:
     step: frozenset[int] = frozenset()  # nodes whose keys hold (STEP) instead of slerping
     # CUBICSPLINE nodes → (in-tangents, out-tangents) ``(K, 4)`` wxyz, per second
     cubic: dict[int, tuple[F64, F64]] = field(default_factory=dict)
+    fps: float | None = None  # the rate the file declares (our exports write it), None if it does not
 
     @property
     def duration(self) -> float:
         return max((float(t[-1]) for t, _ in self.rotations.values()), default=0.0)
 
     def frame_rate(self) -> float:
-        """The rate of the closest keys, snapped to a whole number within 0.1 % (float32 times)."""
-        gaps = [np.diff(t) for t, _ in self.rotations.values() if len(t) > 1]
-        if not gaps:
-            return 24.0
-        rate = 1.0 / float(np.min(np.concatenate(gaps)))
-        return float(round(rate)) if round(rate) > 0 and abs(rate - round(rate)) <= 1e-3 * rate else rate
+        """The clip's frame rate: the one the file declares (``extras.fps``), else :func:`key_rate`
+        of all its key times."""
+        if self.fps is not None:
+            return self.fps
+        return key_rate(np.concatenate([t for t, _ in self.rotations.values()] or [np.zeros(0)]))
 
     def sample(self, nodes: Nodes, t: float) -> F64:
         """``(J, 4)`` local rotations at time ``t`` (seconds): keys held, slerped or on their cubic

@@ -282,6 +282,14 @@ def read_meshes(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tupl
     return tuple(out)
 
 
+def _declared_fps(extras: object) -> float | None:
+    """An animation's ``extras.fps`` when it is a positive finite number (hairtool writes it)."""
+    fps = extras.get("fps") if isinstance(extras, dict) else None
+    if isinstance(fps, (int, float)) and not isinstance(fps, bool) and np.isfinite(fps) and fps > 0:
+        return float(fps)
+    return None
+
+
 def read_clips(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple[Clip, ...]:
     """Rotation channels of every animation (translations and scales are not posed here).
 
@@ -337,7 +345,7 @@ def read_clips(path: str, gltf: GLTF2, data: list[bytes], nodes: Nodes) -> tuple
             if s.interpolation == "STEP":
                 step.add(j)
         name = anim.name if isinstance(anim.name, str) else f"animation{a}"
-        clips.append(Clip(name, rot, frozenset(step), cubic))
+        clips.append(Clip(name, rot, frozenset(step), cubic, _declared_fps(anim.extras)))
     return tuple(clips)
 
 

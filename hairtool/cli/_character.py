@@ -8,6 +8,8 @@ import json
 
 from hairtool.errors import ParameterError
 
+DEFAULT_FRAMES = 120  # hairtool simulate's --frames and --fps when neither IN's animation nor the user says
+DEFAULT_FPS = 24.0
 CHAIN_PATTERN_HELP = "a regular expression on node names picking the hair chains (default: the VRM springs)"
 BVH_HELP = "IN a character: also write its hair chains' motion as BVH here"
 
@@ -132,8 +134,37 @@ def run_anime(args: argparse.Namespace) -> int:
     return 0
 
 
+def _animation_driver(args: argparse.Namespace, character, name: str):
+    """The character's own animation (``name``, or its last) sampled at ``--fps`` (default its
+    own rate) for ``--frames`` (default its length; later frames hold its last pose)."""
+    import numpy as np
+
+    clips = character.clips
+    if not clips:
+        raise ParameterError("motion", args.motion, f"an animation in {args.input} (it has none)")
+    if name:
+        found = [c for c in clips if c.name == name]
+        if not found:
+            names = ", ".join(repr(c.name) for c in clips)
+            raise ParameterError(
+                "motion", args.motion, f"animation:NAME with a NAME of {args.input}: {names}"
+            )
+        clip = found[-1]
+    else:
+        clip = clips[-1]
+    args.fps = clip.frame_rate() if args.fps is None else args.fps
+    if not np.isfinite(args.fps) or args.fps <= 0:
+        raise ParameterError("fps", args.fps, "a positive frame rate")
+    frames = round(clip.duration * args.fps) + 1 if args.frames is None else args.frames
+    if frames < 1:
+        raise ParameterError("frames", frames, "at least 1 frame")
+    args.frames = frames
+    return np.stack([clip.sample(character.nodes, f / args.fps) for f in range(frames)])
+
+
 def run_springs(args: argparse.Namespace) -> int:
-    """``hairtool simulate CHARACTER OUT --springs``: VRM spring bones on a head shake, LINEAR keys."""
+    """``hairtool simulate CHARACTER OUT --springs``: VRM spring bones on a head shake or turn, or
+    driven by the character's own animation; LINEAR keys."""
     from hairtool.character.export import write_animated
     from hairtool.character.read import load_character
     from hairtool.character.springs import head_shake, simulate
@@ -143,11 +174,16 @@ def run_springs(args: argparse.Namespace) -> int:
     _refuse(args, "simulate", SIMULATE_OPTIONS)
     character = load_character(args.input, getattr(args, "chains", None))
     motion = args.motion
-    if motion not in ("shake", "turn", "still"):
-        raise ParameterError("motion", motion, "shake, turn or still for a character")
-    turn = 0.0 if motion == "still" else 30.0
-    period = 1.0 if motion == "shake" else args.frames / args.fps * 2
-    driver = head_shake(character, args.frames, args.fps, turn_deg=turn, period=period)
+    if motion == "animation" or motion.startswith("animation:"):
+        driver = _animation_driver(args, character, motion.partition(":")[2])
+    elif motion in ("shake", "turn", "still"):
+        args.frames = DEFAULT_FRAMES if args.frames is None else args.frames
+        args.fps = DEFAULT_FPS if args.fps is None else args.fps
+        turn = 0.0 if motion == "still" else 30.0
+        period = 1.0 if motion == "shake" else args.frames / args.fps * 2
+        driver = head_shake(character, args.frames, args.fps, turn_deg=turn, period=period)
+    else:
+        raise ParameterError("motion", motion, "shake, turn, still or animation[:NAME] for a character")
     rotations = simulate(character, driver, args.fps, 1 if args.substeps is None else args.substeps)
     report = {"character": args.input, "chains": len(character.chains), "motion": motion}
     report["written"] = write_animated(

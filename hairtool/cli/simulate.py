@@ -28,7 +28,7 @@ import json
 import time
 
 from hairtool.cli import _guides
-from hairtool.cli._character import BVH_HELP, CHAIN_PATTERN_HELP, run_springs
+from hairtool.cli._character import BVH_HELP, CHAIN_PATTERN_HELP, DEFAULT_FPS, DEFAULT_FRAMES, run_springs
 from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
 from hairtool.io.specs import load_groom
 
@@ -43,10 +43,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("output", metavar="OUT", help="animation file (.npz, .usda, …; others keep frame 0)")
     m = parser.add_argument_group("motion")
     m.add_argument(
-        "--motion", default="turn", help="still, turn, nod, shake, hop, comma-separated (default turn)"
+        "--motion",
+        default="turn",
+        help="still, turn, nod, shake, hop, comma-separated (default turn); a character: shake, turn, "
+        "still, or animation[:NAME] (its own animation, the last one unless NAME)",
     )
-    m.add_argument("--frames", type=int, default=120, help="frames to write (default 120)")
-    m.add_argument("--fps", type=float, default=24.0, help="frames per second (default 24)")
+    m.add_argument(
+        "--frames", type=int, help="frames to write (default 120; a character's animation: its length)"
+    )
+    m.add_argument(
+        "--fps", type=float, help="frames per second (default 24; a character's animation: its own rate)"
+    )
     m.add_argument(
         "--substeps",
         type=int,
@@ -100,6 +107,8 @@ def run(args: argparse.Namespace) -> int:
     fmt = format_for(args.output, writing=True)  # refuse a bad extension before simulating
     _guides.check(args, animated=True)
     motion = parse_motion(args.motion)
+    args.frames = DEFAULT_FRAMES if args.frames is None else args.frames
+    args.fps = DEFAULT_FPS if args.fps is None else args.fps
     wind = parse_vector("wind", args.wind) if args.wind is not None else (0.0, 0.0, 0.0)
     # With render hair (asked for, or the input's own), the guides are simulated.
     groom, binding, bind_ms = _guides.prepare(args, load_groom(args.input))

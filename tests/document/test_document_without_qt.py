@@ -24,6 +24,7 @@ SCRIPT = textwrap.dedent(
 
     from app.document import project_io
     from app.document.animation import Document
+    from app.document.character import CharacterDocument  # noqa: F401 (Qt-free too)
     from hairtool import samples
     from hairtool.mocap.bvh import read_bvh
     from hairtool.mocap.pose_edit import PoseEdit
