@@ -113,3 +113,18 @@ def test_simulate_and_anime_keep_the_head_root_and_custom_primvars(tmp_path):
             values(out, hair)["primvars:clump_weight"]
             == values(tmp_path / "g.usda", hair)["primvars:clump_weight"]
         )
+
+
+def test_a_keys_export_keeps_the_head_and_custom_primvars(tmp_path):
+    from .test_animated_interpolate import two_prims
+
+    write_stage(tmp_path / "g.usda", two_prims("points"))
+    for bake in ([], ["--bake"]):
+        out = tmp_path / f"k{len(bake)}.usda"
+        assert main(["keys", str(tmp_path / "g.usda"), "--export", str(out), *bake]) == 0
+        assert values(out, "/Head") == values(tmp_path / "g.usda", "/Head")
+        hair = "/Root0_0/Hair0"
+        assert (
+            values(out, hair)["primvars:clump_weight"]
+            == values(tmp_path / "g.usda", hair)["primvars:clump_weight"]
+        )
