@@ -296,7 +296,9 @@ def run(args: argparse.Namespace) -> int:
         result = freeze(groom)
     pipe = pipes[0] if pipes else None
     report = {}
+    pairs = _guides.primvar_pairs(groom, binding)  # (the source's guides: before strokes change them)
     if binding is not None and not np.array_equal(pipe.origin, np.arange(groom.strand_count)):
+        pairs = []  # guides planted or removed: the children follow other guides than the source's
         # add, delete or density strokes: the children follow the guides planted and removed
         from hairtool.guides.follow import follow_guides, guides_now
 
@@ -308,7 +310,7 @@ def run(args: argparse.Namespace) -> int:
         report |= {"guides": groom.strand_count, "children": binding.child_count, "bind_ms": bind_ms}
     else:
         io.write(args.output, result)
-    from hairtool.io.usd_carry import carry_between, keep_emptied
+    from hairtool.io.usd_carry import keep_emptied
 
     if emptied:
         import sys
@@ -320,7 +322,8 @@ def run(args: argparse.Namespace) -> int:
                 f"hairtool freeze: info: the strokes deleted every strand of {prim.path}; it is {how}",
                 file=sys.stderr,
             )
-    carry_between(args.input, args.output)  # USD to USD: the scene beside the hair
+    # USD to USD: the scene beside the hair, the guide prim's primvars on the children
+    _guides.carry(args, pairs)
     if args.json:
         one = len(pipes) == 1
         report |= {

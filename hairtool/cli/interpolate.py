@@ -73,38 +73,14 @@ def _several(args: argparse.Namespace, groom) -> dict:
         hair = _guides.render(one, binding).update(guides)
         out.append(with_guides(hair, guides) if _guides.is_usd(args.output) else hair)
         used.append(guides)
-        pairs += _pairs(guides, binding)
+        pairs += _guides.primvar_pairs(guides, binding)
         report["guides"] += guides.strand_count
         report["children"] += binding.child_count
     io.write(args.output, concat(out))
-    _carry(args, pairs)
+    _guides.carry(args, pairs)
     if args.guides_out:
         io.write(_guides.guides_path(args), concat(used))
     return report
-
-
-def _pairs(guides, binding) -> list:
-    """``(guide prim, render prim, binding)`` of one prim's children, for their primvars
-    (:mod:`hairtool.guides.child_primvars`); none for guides without a prim of their own."""
-    from hairtool.guides.files import render_prims
-
-    own = guides.metadata.for_strands(guides.strand_count).curves
-    if len(own) != 1:
-        return []
-    hair, _ = render_prims(binding.metadata, binding.child_count, guides.metadata, guides.strand_count)
-    return [(own[0].path, hair[0].path, binding)]
-
-
-def _carry(args: argparse.Namespace, pairs: list) -> None:
-    """USD to USD: the scene beside the hair, and the guide prims' primvars on their children."""
-    from hairtool.io.usd_carry import USD_SUFFIXES, carry_between
-
-    carry_between(args.input, args.output)
-    if all(Path(p).suffix.lower() in USD_SUFFIXES for p in (args.input, args.output)) and pairs:
-        from hairtool.guides.child_primvars import give_children_primvars
-        from hairtool.io.usd import _diagnosed
-
-        _diagnosed(Path(args.input), lambda: give_children_primvars(args.input, args.output, pairs))
 
 
 def _one_prim(args: argparse.Namespace, groom):
@@ -147,7 +123,7 @@ def _animated(args: argparse.Namespace, anim) -> dict:
         guides, binding, _ = _guides.prepare(args, rest)
         moving = anim if guide_prims is None else guide_prims
         report |= _guides.write_animation(args, binding, moving)
-        _carry(args, _pairs(guides, binding))
+        _guides.carry(args, _guides.primvar_pairs(guides, binding))
         return report | {"guides": guides.strand_count, "children": binding.child_count}
     parts, chosen = split_animation(anim), picked(rest, args.prim)
     counts = iter(shares(args.count, [p.strand_count for p, c in zip(parts, chosen, strict=True) if c]))
@@ -163,7 +139,7 @@ def _animated(args: argparse.Namespace, anim) -> dict:
         hair = RenderHairAnimation(binding, part, _guides.render(one, binding).clump)
         out.append(AnimationWithGuides(hair) if usd_out else hair)
         moved.append(part)
-        pairs += _pairs(guides, binding)
+        pairs += _guides.primvar_pairs(guides, binding)
         report["guides"] += guides.strand_count
         report["children"] += binding.child_count
     joined = JoinedFrames(out)
@@ -175,7 +151,7 @@ def _animated(args: argparse.Namespace, anim) -> dict:
         io.write(args.output, joined.animation())
     if args.guides_out or not usd_out:
         io.write(_guides.guides_path(args), JoinedFrames(moved).animation())
-    _carry(args, pairs)
+    _guides.carry(args, pairs)
     return report
 
 
@@ -209,7 +185,7 @@ def run(args: argparse.Namespace) -> int:
     out = hair.update(guides)
     build_ms = (time.perf_counter() - t0) * 1e3
     report = _guides.write(args, out, guides)
-    _carry(args, _pairs(guides, binding))
+    _guides.carry(args, _guides.primvar_pairs(guides, binding))
     if args.json:
         report |= {
             "guides": guides.strand_count,

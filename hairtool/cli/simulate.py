@@ -206,9 +206,7 @@ def run(args: argparse.Namespace) -> int:
         extra = _guides.write_animation(args, binding, anim) | {"bind_ms": round(bind_ms, 2)}
     else:
         write(args.output, anim)
-    from hairtool.io.usd_carry import carry_between
-
-    carry_between(args.input, args.output)  # USD to USD: the scene beside the hair
+    _guides.carry(args, _guides.primvar_pairs(groom, binding))  # USD to USD: the scene beside the hair
     report = {
         **extra,
         "output": args.output,

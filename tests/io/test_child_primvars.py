@@ -4,6 +4,8 @@ constants copied, on a static and an animated stage of two prims."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -61,3 +63,17 @@ def test_children_get_their_guides_primvars(tmp_path, animated):
     np.testing.assert_allclose(np.asarray(stiff), want, atol=1e-6)
     assert primvar(out, render, "groom_name") == ("curly", "constant")
     assert primvar(out, "/Brows1Render", "clump_weight") == (None, None)  # the brows had none
+
+
+@pytest.mark.parametrize("command", ["freeze", "simulate", "anime"])
+def test_the_render_hair_of_freeze_simulate_and_anime_gets_them_too(tmp_path, command):
+    scene = two_prims(None)
+    write_stage(tmp_path / "s.usda", replace(scene, prims=scene.prims[:1]))
+    add_primvars(tmp_path / "s.usda")
+    out = tmp_path / "k.usda"
+    extra = {"freeze": [], "simulate": ["--frames", "2", "--substeps", "1"], "anime": ["--frames", "2"]}
+    assert main([command, str(tmp_path / "s.usda"), str(out), "--count", "9", *extra[command]]) == 0
+    ids, interp = primvar(out, "/Root0_0/Hair0Render", "strand_id")
+    assert interp == "uniform" and len(ids) == 9 and set(ids) <= set(range(7, 13))
+    weight, _ = primvar(out, "/Root0_0/Hair0Render", "clump_weight")
+    assert weight is not None and 0 <= min(weight) and max(weight) <= 1
