@@ -130,16 +130,20 @@ def join(sources: Sequence[Groom], results: Sequence[Groom]) -> Groom:
     return Groom(points, counts, **attrs, metadata=meta)
 
 
-def per_prim(groom: Groom, work: Callable[[Groom], Groom], patterns: Sequence[str] | None = None) -> Groom:
+def per_prim(
+    groom: Groom, work: Callable[[Groom], Groom | None], patterns: Sequence[str] | None = None
+) -> Groom:
     """``work`` run on the groom of each picked prim (:func:`picked`), the others passed through
-    as they were, laid back in the source's order (:func:`join`).
+    as they were, laid back in the source's order (:func:`join`). ``work`` returns None for a
+    prim it emptied (every strand deleted): that prim is left out, the caller saying so; a
+    scene of none left is refused.
 
     Parameters
     ----------
     groom : Groom
         A groom read from a scene.
     work : callable
-        Groom → groom, run on each picked prim.
+        Groom → groom (or None: emptied), run on each picked prim.
     patterns : sequence of str, optional
         fnmatch globs over prim paths (None: every prim).
 
@@ -151,7 +155,12 @@ def per_prim(groom: Groom, work: Callable[[Groom], Groom], patterns: Sequence[st
     chosen = picked(groom, patterns)
     parts = split(groom)
     results = [work(g) if pick else g for g, pick in zip(parts, chosen, strict=True)]
-    return join(parts, results)
+    kept = [(g, r) for g, r in zip(parts, results, strict=True) if r is not None]
+    if not kept:
+        raise ParameterError(
+            "strokes", "every strand of every prim", "strokes that leave at least one strand"
+        )
+    return join([g for g, _ in kept], [r for _, r in kept])
 
 
 def concat(parts: Sequence[Groom]) -> Groom:

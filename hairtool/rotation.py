@@ -1,4 +1,5 @@
-"""Axis-angle rotations (Rodrigues' formula), batched over rows, in float64."""
+"""Axis-angle rotations (Rodrigues' formula), batched over rows, in float64; the best rigid
+motion between two point sets (:func:`rigid_fit`)."""
 
 from __future__ import annotations
 
@@ -89,3 +90,21 @@ def turn_between(vx, vy, vz, ax, ay, az, bx, by, bz):
         vy * c + (kz * vx - kx * vz) + ky * kv,
         vz * c + (kx * vy - ky * vx) + kz * kv,
     )
+
+
+def rigid_fit(a: ArrayLike, b: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(R, t)``: the rotation (3×3) and translation minimising Σ|R aᵢ + t − bᵢ|² over the rows
+    (Kabsch, the Gram sum in float64); the centroids' translation alone where ``a`` lies on a
+    line or a point (the turn about that line is not determined)."""
+    a = np.asarray(a, np.float64).reshape(-1, 3)
+    b = np.asarray(b, np.float64).reshape(-1, 3)
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    p, q = a - ca, b - cb
+    rot = np.eye(3)
+    if len(a) >= 3:
+        sv = np.linalg.svd(p, compute_uv=False)
+        if sv[0] > 0 and sv[1] > 1e-9 * sv[0]:
+            u, _, vt = np.linalg.svd(p.T @ q)
+            d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+            rot = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    return rot, cb - rot @ ca

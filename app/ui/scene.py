@@ -592,12 +592,14 @@ class Scene(QObject):
             clump = self._child_clump()
             # one of its own (the groom's keeps its last run): frame after frame redoes the
             # clumps of the guides that moved between them
-            frames = self.cached(("frames clumped", clump), lambda: RenderHair(b, clump))
+            # (the children's roots carried by the guides', as the exported frames' are)
+            frames = self.cached(("frames clumped", clump), lambda: RenderHair(b, clump, follow_roots=True))
             children = frames.update_points(g)  # (its own array: copied below)
             return np.concatenate([children, g.points]) if self.drawn_guides else children.copy()
         from hairtool.guides.children import build_points
+        from hairtool.guides.root_motion import following
 
-        children = build_points(b, g)
+        children = build_points(following(b, g), g)
         return np.concatenate([children, g.points]) if self.drawn_guides else children
 
     def render_hair(self) -> Groom | None:

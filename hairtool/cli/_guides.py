@@ -327,3 +327,29 @@ def write_animation(args: argparse.Namespace, binding: ChildBinding, guides: Ani
         "child_vertices": binding.vertex_count,
         "render_seconds": round(time.perf_counter() - t0, 4),
     }
+
+
+def primvar_pairs(guides: Groom, binding: ChildBinding | None) -> list:
+    """``(guide prim, render prim, binding)`` of one prim's children, for their primvars
+    (:mod:`hairtool.guides.child_primvars`); none without children or for guides without a
+    prim of their own."""
+    from hairtool.guides.files import render_prims
+
+    own = guides.metadata.for_strands(guides.strand_count).curves
+    if binding is None or len(own) != 1:
+        return []
+    hair, _ = render_prims(binding.metadata, binding.child_count, guides.metadata, guides.strand_count)
+    return [(own[0].path, hair[0].path, binding)]
+
+
+def carry(args: argparse.Namespace, pairs: list = ()) -> None:
+    """USD IN to USD OUT: the scene beside the hair (:mod:`hairtool.io.usd_carry`), and each
+    guide prim's primvars on its children (``pairs``: :func:`primvar_pairs`)."""
+    from hairtool.io.usd_carry import USD_SUFFIXES, carry_between
+
+    carry_between(args.input, args.output)
+    if pairs and all(Path(p).suffix.lower() in USD_SUFFIXES for p in (args.input, args.output)):
+        from hairtool.guides.child_primvars import give_children_primvars
+        from hairtool.io.usd import _diagnosed
+
+        _diagnosed(Path(args.input), lambda: give_children_primvars(args.input, args.output, list(pairs)))

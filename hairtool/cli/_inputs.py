@@ -23,3 +23,28 @@ def parse_vector(name: str, text: str) -> tuple[float, float, float]:
     if len(v) != 3:
         raise ParameterError(name, text, "three numbers x,y,z")
     return v  # type: ignore[return-value]
+
+
+def read_frames(spec: str, frame: int | None):
+    """IN for a command that carries an animation: a groom, an animation (a file with time
+    samples), or with ``frame`` (``--frame F``, 0 = the first) that frame's pose as a static
+    groom without the animation's time range. A frame outside the input is refused naming
+    ``--frame``."""
+    from hairtool.groom import Animation
+    from hairtool.io.specs import SAMPLE_PREFIX, load_groom
+
+    if spec.startswith(SAMPLE_PREFIX):
+        obj = load_groom(spec)
+    else:
+        from hairtool import io
+
+        obj = io.read(spec)
+    frames = obj.n_frames if isinstance(obj, Animation) else 1
+    if frame is None:
+        return obj
+    if not 0 <= frame < frames:
+        raise ParameterError("frame", frame, f"a frame of {spec} in [0, {frames - 1}]")
+    if not isinstance(obj, Animation):
+        return obj
+    pose = obj.frame(frame)
+    return pose.with_metadata(pose.metadata.derived())

@@ -175,6 +175,8 @@ def run(args: argparse.Namespace) -> int:
             write(args.output, anim)
             report["output"] = args.output
             report["output_frames"] = anim.n_frames if out_fmt.animated else 1
+        if args.output is not None:  # USD to USD: the scene beside the hair, primvars on children
+            _guides.carry(args, _guides.primvar_pairs(groom, binding) if render else [])
     if args.export_sheet is not None:
         write_sheet(args.export_sheet, sched, shot)
         report["sheet"] = args.export_sheet

@@ -272,15 +272,33 @@ def run(args: argparse.Namespace) -> int:
         pipes.append(pipe)
         return pipe.result
 
+    emptied = []
     if binding is None and groom is pose:  # each prim a groom of its own (hairtool.prims)
-        from hairtool.prims import per_prim
+        from hairtool.prims import per_prim, split
 
-        result = per_prim(groom, freeze, args.prim)
+        several = len(split(groom)) > 1
+
+        def freeze_or_empty(part):
+            """A prim whose strands a stroke deleted, every one, is kept empty (as Blender keeps
+            an empty Curves object) where the scene holds other prims."""
+            from hairtool.frozen.brushes.delete import EveryStrandGone
+
+            try:
+                return freeze(part)
+            except EveryStrandGone:
+                if not several:
+                    raise
+                emptied.extend(part.metadata.curves)
+                return None
+
+        result = per_prim(groom, freeze_or_empty, args.prim)
     else:
         result = freeze(groom)
     pipe = pipes[0] if pipes else None
     report = {}
+    pairs = _guides.primvar_pairs(groom, binding)  # (the source's guides: before strokes change them)
     if binding is not None and not np.array_equal(pipe.origin, np.arange(groom.strand_count)):
+        pairs = []  # guides planted or removed: the children follow other guides than the source's
         # add, delete or density strokes: the children follow the guides planted and removed
         from hairtool.guides.follow import follow_guides, guides_now
 
@@ -292,9 +310,20 @@ def run(args: argparse.Namespace) -> int:
         report |= {"guides": groom.strand_count, "children": binding.child_count, "bind_ms": bind_ms}
     else:
         io.write(args.output, result)
-    from hairtool.io.usd_carry import carry_between
+    from hairtool.io.usd_carry import keep_emptied
 
-    carry_between(args.input, args.output)  # USD to USD: the scene beside the hair
+    if emptied:
+        import sys
+
+        kept = keep_emptied(args.input, args.output, emptied)
+        for prim in emptied:
+            how = "kept empty" if prim.path in kept else "left out (the format holds no empty prim)"
+            print(
+                f"hairtool freeze: info: the strokes deleted every strand of {prim.path}; it is {how}",
+                file=sys.stderr,
+            )
+    # USD to USD: the scene beside the hair, the guide prim's primvars on the children
+    _guides.carry(args, pairs)
     if args.json:
         one = len(pipes) == 1
         report |= {

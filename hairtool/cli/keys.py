@@ -476,6 +476,10 @@ def _finish(args: argparse.Namespace, kind: str, data, n: int, sel, result: dict
             from hairtool.keys.export import write_key_poses
 
             write_key_poses(args.export, data, sel.keys, args.interp)  # linear keys only
+        if suffix not in JSON_SUFFIXES + CSV_SUFFIXES:
+            from hairtool.io.usd_carry import carry_between
+
+            carry_between(args.input, args.export)  # USD to USD: the scene beside the hair
     elif args.bake:
         raise ParameterError("bake", True, "an --export path to write the key curve to")
     uniform = f"uniform {sel.uniform_cost:.6g}"

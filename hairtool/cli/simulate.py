@@ -6,6 +6,10 @@ Motions (comma-separated, played in equal slots): still, turn, nod, shake, hop.
 
 IN is a groom or animation file (its first frame is the rest pose) or a built-in sample:
 sample:NAME[:STRANDS[:VERTICES]] with NAME portrait, scalp or comb, e.g. sample:scalp:500:24.
+An animated IN (time-sampled points, or hair under a moving parent, such as a head nodded by an
+armature) drives the simulation with its own motion, as Blender's hair dynamics follow their
+emitter: the roots follow IN's roots every frame and the head moves with their rigid motion;
+--motion is then refused, and --frames and --fps default to IN's (its time codes kept).
 Space: the groom's own (a USD stage's up axis and metersPerUnit; Y-up centimetres for
 formats that say nothing; the samples' head has radius 1 at the origin, 1 unit = 10 cm).
 Gravity is in m/s² along the stage's −up; turn and shake are about the up axis, nod about
@@ -30,7 +34,6 @@ import time
 from hairtool.cli import _guides
 from hairtool.cli._character import BVH_HELP, CHAIN_PATTERN_HELP, DEFAULT_FPS, DEFAULT_FRAMES, run_springs
 from hairtool.cli._inputs import GROOM_INPUT_HELP, parse_vector
-from hairtool.io.specs import load_groom
 
 HELP = "simulate hair dynamics on a moving head (turn, nod, shake, hop, wind gusts)"
 
@@ -44,15 +47,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     m = parser.add_argument_group("motion")
     m.add_argument(
         "--motion",
-        default="turn",
-        help="still, turn, nod, shake, hop, comma-separated (default turn); a character: shake, turn, "
-        "still, or animation[:NAME] (its own animation, the last one unless NAME)",
+        default=None,
+        help="still, turn, nod, shake, hop, comma-separated (default turn; an animated IN moves by itself); "
+        "a character: shake, turn, still, or animation[:NAME] (its own animation, the last one unless NAME)",
     )
     m.add_argument(
-        "--frames", type=int, help="frames to write (default 120; a character's animation: its length)"
+        "--frames",
+        type=int,
+        default=None,
+        help="frames to write (default 120, or an animated IN's; a character's animation: its length)",
     )
     m.add_argument(
-        "--fps", type=float, help="frames per second (default 24; a character's animation: its own rate)"
+        "--fps",
+        type=float,
+        default=None,
+        help="frames per second (default 24, or an animated IN's; a character's animation: its own rate)",
     )
     m.add_argument(
         "--substeps",
@@ -88,15 +97,62 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     c.add_argument("--bvh", metavar="BVH", help=BVH_HELP)
 
 
+def _driver(args: argparse.Namespace, source):
+    """For an animated IN: its own motion drives the roots (said in one line on stderr), and
+    --frames and --fps default to IN's; a named --motion beside it, or a dense groom to pick
+    guides from, is refused. None for a static IN (--frames 120 and --fps 24 by default)."""
+    import sys
+
+    from hairtool.errors import ParameterError
+    from hairtool.groom import Animation
+
+    if not isinstance(source, Animation) or source.n_frames < 2:
+        args.frames = DEFAULT_FRAMES if args.frames is None else args.frames
+        args.fps = DEFAULT_FPS if args.fps is None else args.fps
+        return None
+    if args.motion is not None:
+        raise ParameterError(
+            "motion", args.motion, f"none: {args.input} is animated ({source.n_frames} frames) and its "
+            "own root motion drives the hair (convert one frame to a static file to play a named motion)",
+        )  # fmt: skip
+    if args.from_dense:
+        raise ParameterError(
+            "from-dense", True, f"a static IN: {args.input} is animated (--count N grows children)"
+        )
+    args.frames = source.n_frames if args.frames is None else args.frames
+    args.fps = source.fps if args.fps is None else args.fps
+    codes = source.time_codes
+    print(
+        f"hairtool simulate: info: {args.input} is animated (time codes {codes[0]:g}…{codes[-1]:g}): "
+        "the roots follow its roots every frame and the head moves with them, as hair dynamics "
+        "follow their emitter",
+        file=sys.stderr,
+    )
+    return True
+
+
+def _driver_of(source, groom):
+    """The root driver of the strands simulated (``groom``: IN's strands or its guides)."""
+    from hairtool.guides.files import split_guides
+    from hairtool.simulate.driver import RootDriver
+
+    guides = split_guides(source)[1]
+    moving = source if guides is None or groom.strand_count != guides.strand_count else guides
+    return RootDriver(moving)
+
+
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from hairtool.character.read import is_character_path
 
     if is_character_path(args.input):
-        return run_springs(args)
+        args.motion = "turn" if args.motion is None else args.motion
+        return run_springs(args)  # --frames and --fps: its animation's, else the defaults
 
+    from hairtool.cli._inputs import read_frames
     from hairtool.errors import ParameterError
+    from hairtool.groom import Animation
     from hairtool.io import format_for, write
     from hairtool.simulate.dynamics import scaled_accelerations, simulate
     from hairtool.simulate.head_motion import fit_head, parse_motion
@@ -106,12 +162,15 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError(flag, getattr(args, flag), "a .vrm, .glb or .gltf character as IN")
     fmt = format_for(args.output, writing=True)  # refuse a bad extension before simulating
     _guides.check(args, animated=True)
-    motion = parse_motion(args.motion)
-    args.frames = DEFAULT_FRAMES if args.frames is None else args.frames
-    args.fps = DEFAULT_FPS if args.fps is None else args.fps
+    source = read_frames(args.input, None)
+    driver = _driver(args, source)
+    motion = parse_motion("turn" if args.motion is None else args.motion) if driver is None else "source"
     wind = parse_vector("wind", args.wind) if args.wind is not None else (0.0, 0.0, 0.0)
     # With render hair (asked for, or the input's own), the guides are simulated.
-    groom, binding, bind_ms = _guides.prepare(args, load_groom(args.input))
+    rest = source.rest if isinstance(source, Animation) else source
+    groom, binding, bind_ms = _guides.prepare(args, rest)
+    if driver is not None:
+        driver = _driver_of(source, groom)
     render = binding is not None
     if args.fit_head:
         if args.head_center is not None or args.head_radius is not None:
@@ -129,7 +188,8 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     anim = simulate(
         groom,
-        motion=motion,
+        motion="still" if driver is not None else motion,
+        driver=driver,
         frames=args.frames,
         fps=args.fps,
         substeps=8 if args.substeps is None else args.substeps,
@@ -151,6 +211,7 @@ def run(args: argparse.Namespace) -> int:
         extra = _guides.write_animation(args, binding, anim) | {"bind_ms": round(bind_ms, 2)}
     else:
         write(args.output, anim)
+    _guides.carry(args, _guides.primvar_pairs(groom, binding))  # USD to USD: the scene beside the hair
     report = {
         **extra,
         "output": args.output,

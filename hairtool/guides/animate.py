@@ -3,7 +3,8 @@ guides (a simulation, an anime cycle, recorded drags).
 
 Simulations, cycles and recordings run on the guides; a frame of render hair is the binding
 built on that frame's guides (:func:`hairtool.guides.children.build_points`, one thread per
-child, so the bytes do not depend on the thread count), then ClumpWithGaps among the children
+child, so the bytes do not depend on the thread count), the children's roots carried by their
+guides' roots (:mod:`hairtool.guides.root_motion`), then ClumpWithGaps among the children
 when switched on (:class:`~hairtool.guides.render.RenderHair`). Frames are made one at a time
 and never all held: 100,000 children × 16 vertices are 19 MB a frame and 1.9 GB over 100
 frames, so a writer takes them frame by frame (:func:`hairtool.io.usd.write` writes a time
@@ -22,6 +23,7 @@ from hairtool.groom import Animation, Groom, StrandSizes, Topology
 from hairtool.guides.binding import ChildBinding
 from hairtool.guides.children import build_points, build_points_reference
 from hairtool.guides.render import ChildClump, RenderHair
+from hairtool.guides.root_motion import following
 from hairtool.metadata import Metadata
 
 
@@ -54,7 +56,7 @@ class RenderHairAnimation(StrandSizes):
         """
         _check(binding, guides)
         self.binding, self.guides = binding, guides
-        self.render = RenderHair(binding, clump)
+        self.render = RenderHair(binding, clump, follow_roots=True)
 
     # -- what an Animation says about itself (writers read these) ---------------------------
     @property
@@ -138,7 +140,7 @@ class RenderHairAnimation(StrandSizes):
         g = self.guides_frame(f)
         c = self.render.clump
         if c is None or c.iterations == 0:
-            return build_points(self.binding, g, out=out)
+            return build_points(following(self.binding, g), g, out=out)
         points = self.render.update(g).points
         if out is None:
             return np.array(points)
@@ -208,4 +210,4 @@ def render_frames_reference(binding: ChildBinding, guides: Animation) -> np.ndar
     """
     _check(binding, guides)
     poses = (Groom(p, guides.topology, metadata=guides.metadata) for p in guides.frames)
-    return np.stack([build_points_reference(binding, g) for g in poses])
+    return np.stack([build_points_reference(following(binding, g), g) for g in poses])

@@ -20,6 +20,7 @@ from hairtool.groom import Groom
 from hairtool.guides.binding import ChildBinding
 from hairtool.guides.child_clumps import ChildClumps
 from hairtool.guides.children import build_points, moved_guides
+from hairtool.guides.root_motion import following
 
 
 @dataclass(frozen=True)
@@ -69,7 +70,9 @@ class RenderHair:
     update after another rebuilds only the children that follow a guide which moved since, and
     clumps again only the clumps holding them, with the bytes of a fresh run."""
 
-    def __init__(self, binding: ChildBinding, clump: ChildClump | None = None) -> None:
+    def __init__(
+        self, binding: ChildBinding, clump: ChildClump | None = None, *, follow_roots: bool = False
+    ) -> None:
         """The render strands of ``binding``, clumped by ``clump`` where given.
 
         Parameters
@@ -78,8 +81,15 @@ class RenderHair:
             The children bound to their guides.
         clump : ChildClump, optional
             The children's own clumping (None: none).
+        follow_roots : bool, default False
+            Carry the children's roots with their guides' roots (an animation's frames); a
+            static pose keeps the roots the children were bound at.
         """
         self.binding = binding
+        #: children's roots carried by their guides' roots (:mod:`hairtool.guides.root_motion`):
+        #: an animation's frames; a static pose keeps the roots the children were bound at
+        self.follow_roots = follow_roots
+        self._roots_from: np.ndarray | None = None  # the guide roots the children were built on
         self.clump = None if clump is None else clump.validate()
         self._radius: float | None = None
         self._clumps: ChildClumps | None = None
@@ -121,9 +131,14 @@ class RenderHair:
         pose = b.rest_guides if guides is None else guides
         b.check_guides(pose)
         moved = None
+        roots = np.array(pose.roots, np.float32)
         if self._children is not None:
             moved = moved_guides(pose, self._built_from)
-        self._children = build_points(b, pose, out=self._children, moved=moved)
+            if self.follow_roots and not np.array_equal(roots, self._roots_from):
+                moved = None  # the roots' rigid motion moves every child
+        built = following(b, pose) if self.follow_roots else b
+        self._children = build_points(built, pose, out=self._children, moved=moved)
+        self._roots_from = roots
         self._built_from = np.array(pose.points, np.float32)
         c = self.clump
         if c is None or c.iterations == 0:

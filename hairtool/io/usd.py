@@ -531,6 +531,19 @@ def _token(path: Path, attr, allowed: Sequence[str], what: str) -> str:
     return value
 
 
+def _empty(prim) -> bool:
+    """Whether a curves prim holds no curves, as written (Blender's empty Curves object, a prim
+    whose every strand was deleted): no groom to read, and the commands carry it through as it is
+    (:mod:`hairtool.io.usd_carry`)."""
+    from pxr import UsdGeom
+
+    attr = UsdGeom.BasisCurves(prim).GetCurveVertexCountsAttr()
+    if not attr.HasAuthoredValue():
+        return False
+    value = attr.Get()
+    return value is not None and len(value) == 0
+
+
 class _Curves:
     """One BasisCurves prim: its topology, basis, points attribute and transform."""
 
@@ -747,9 +760,9 @@ def _require_room(path: Path, frames: int, points: int) -> None:
 def _read_stage(path: Path, stage) -> Groom | Animation:
     from pxr import Usd, UsdGeom
 
-    prims = [p for p in stage.Traverse() if p.IsA(UsdGeom.BasisCurves)]
+    prims = [p for p in stage.Traverse() if p.IsA(UsdGeom.BasisCurves) and not _empty(p)]
     if not prims:
-        raise FormatError(path, "no BasisCurves prim on the stage")
+        raise FormatError(path, "no BasisCurves prim with curves on the stage")
     parts = [_Curves(path, p) for p in prims]
     counts = np.concatenate([c.counts for c in parts])
     stage_meta = _stage_metadata(path, stage)
@@ -905,7 +918,7 @@ def time_codes(path: str | os.PathLike[str]) -> list[float]:
 
     def work() -> list[float]:
         stage = _open_stage(p)
-        prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.BasisCurves)]
+        prims = [q for q in stage.Traverse() if q.IsA(UsdGeom.BasisCurves) and not _empty(q)]
         return _sample_times([_Curves(p, q) for q in prims])
 
     return _diagnosed(p, work)

@@ -7,7 +7,9 @@ marks its root with (without it a re-import nests ``/root/root``), the parents' 
 and, on a curves prim whose curves are the same ones (the same vertex counts), its other
 primvars (Blender's ``surface_uv_coordinate``, ``rest_position``…) and its material binding,
 and a parent's translate/rotate/scale ops where the writer put its static transform back as one
-matrix (the same transform). Each is copied spec for spec (its bytes as the source had them)
+matrix (the same transform), and a curves prim's authored points where the command left its
+strands as they were (the writer's are the same up to the rounding of the way back into the
+prim's space). Each is copied spec for spec (its bytes as the source had them)
 from the source's composed stage; nothing else the writer authored is overwritten.
 """
 
@@ -110,6 +112,7 @@ def carry_scene(source: str | os.PathLike[str], written: str | os.PathLike[str])
             if src.GetPrimAtPath(path).typeName == "BasisCurves" and _same_counts(src, dst, path):
                 kept = ("primvars:", "material:", "userProperties:")
                 carried.extend(_copy_missing_properties(src, dst, path, kept))
+                carried.extend(_untouched_points(src, dst, path))
                 schemas = src.GetPrimAtPath(path).GetInfo("apiSchemas")
                 if schemas and not mine.HasInfo("apiSchemas"):
                     mine.SetInfo("apiSchemas", schemas)
@@ -142,6 +145,59 @@ def carry_scene(source: str | os.PathLike[str], written: str | os.PathLike[str])
     return carried
 
 
+def keep_emptied(source: str | os.PathLike[str], written: str | os.PathLike[str], prims) -> list[str]:
+    """Prims whose every strand a command deleted, written into the USD file ``written`` as
+    empty curves prims (no curves, no points; their basis, wrap and purpose, and their parents'
+    transform ops from ``source``), as Blender keeps an empty Curves object; the paths kept
+    (none where ``written`` is not USD). Call before :func:`carry_between`, which then brings the
+    rest of their scene."""
+    out = Path(written)
+    if out.suffix.lower() not in USD_SUFFIXES:
+        return []
+    from hairtool.io.usd import _diagnosed
+
+    def work() -> list[str]:
+        from pxr import Sdf, Usd, UsdGeom, Vt
+
+        src = None
+        if Path(source).suffix.lower() in USD_SUFFIXES and Path(source).is_file():
+            from hairtool.io.usd import _open_stage
+
+            src = _open_stage(Path(source)).Flatten()
+        dst = Sdf.Layer.CreateAnonymous(out.suffix)
+        dst.TransferContent(Sdf.Layer.OpenAsAnonymous(str(out)))
+        stage = Usd.Stage.Open(dst)
+        kept = []
+        for c in prims:
+            for parent in Sdf.Path(c.path).GetParentPath().GetPrefixes():
+                if stage.GetPrimAtPath(parent):
+                    continue
+                UsdGeom.Xform.Define(stage, parent)
+                theirs = None if src is None else src.GetPrimAtPath(parent)
+                for prop in theirs.properties if theirs else ():
+                    if prop.name.startswith("xformOp"):
+                        Sdf.CopySpec(src, prop.path, dst, prop.path)
+            curves = UsdGeom.BasisCurves.Define(stage, c.path)
+            curves.CreateTypeAttr("linear" if c.basis == "linear" else "cubic")
+            if c.basis != "linear":
+                curves.CreateBasisAttr(c.basis)
+            if c.wrap != "nonperiodic":
+                curves.CreateWrapAttr(c.wrap)
+            if c.purpose != "default":
+                curves.CreatePurposeAttr(c.purpose)
+            curves.CreateCurveVertexCountsAttr(Vt.IntArray())
+            curves.CreatePointsAttr(Vt.Vec3fArray())
+            kept.append(c.path)
+        with atomic_path(out) as tmp:
+            if not dst.Export(str(tmp)):
+                from hairtool.errors import FormatError
+
+                raise FormatError(out, "usd-core could not write it")
+        return kept
+
+    return _diagnosed(out, work)
+
+
 def _same_counts(src, dst, path) -> bool:
     """Whether the curves prim at ``path`` holds the same curves (vertex counts) in both layers."""
     a = src.GetAttributeAtPath(path.AppendProperty("curveVertexCounts"))
@@ -149,13 +205,49 @@ def _same_counts(src, dst, path) -> bool:
     return a is not None and b is not None and list(a.default or []) == list(b.default or [])
 
 
+#: How far (in float32 spacings at the points' magnitude) the writer's points of a prim may lie
+#: from the source's and still be the source's own: the round trip into world space and back
+#: through the prim's transforms rounds each coordinate by an ULP or two.
+_ROUNDING_ULPS = 4
+
+
+def _untouched_points(src, dst, path) -> list[str]:
+    """Where the command left a prim's strands as they were (the points the writer wrote are the
+    source's, up to the rounding of the way back into the prim's own space), the source's
+    authored ``points`` and ``extent`` themselves, byte for byte; static points only."""
+    import numpy as np
+    from pxr import Sdf
+
+    done = []
+    a = src.GetAttributeAtPath(path.AppendProperty("points"))
+    b = dst.GetAttributeAtPath(path.AppendProperty("points"))
+    if a is None or b is None or a.default is None or b.default is None:
+        return done
+    if src.ListTimeSamplesForPath(a.path) or dst.ListTimeSamplesForPath(b.path):
+        return done
+    was, now = np.asarray(a.default, np.float32), np.asarray(b.default, np.float32)
+    if was.shape != now.shape or was.size == 0 or was.tobytes() == now.tobytes():
+        return done
+    ulp = np.spacing(np.float32(np.abs(was).max()))
+    if not np.all(np.isfinite(now)) or np.abs(now.astype(np.float64) - was).max() > _ROUNDING_ULPS * ulp:
+        return done
+    for name in ("points", "extent"):
+        prop = path.AppendProperty(name)
+        if src.GetAttributeAtPath(prop) is not None and Sdf.CopySpec(src, prop, dst, prop):
+            done.append(str(prop))
+    return done
+
+
 def _curves_paths(layer, under) -> list:
-    """The BasisCurves prim specs at and below ``under`` in ``layer``."""
+    """The BasisCurves prim specs at and below ``under`` in ``layer`` that hold curves (an empty
+    one, which no reader takes as hair, is carried as it is)."""
     found = []
 
     def look(p) -> None:
         if p.IsPrimPath() and layer.GetPrimAtPath(p).typeName == "BasisCurves":
-            found.append(p)
+            counts = layer.GetAttributeAtPath(p.AppendProperty("curveVertexCounts"))
+            if counts is None or counts.default is None or len(counts.default) > 0:
+                found.append(p)
 
     layer.Traverse(under, look)
     return found

@@ -5,7 +5,8 @@ predicts positions from velocities and forces, then walks every strand from root
 puts vertex i back at its rest distance L_i from vertex i−1 (the leader); the correction
 d_{i+1} applied to the next vertex is fed back into the velocity of vertex i (their eq. 9):
     v_i = (p_i − x_i)/Δt − s_damping · d_{i+1}/Δt.
-Roots follow the head rigidly. A light stiffness pulls every vertex toward its rest position
+Roots follow the head rigidly (or an animated groom's own roots, :mod:`hairtool.simulate.driver`).
+A light stiffness pulls every vertex toward its rest position
 carried by the head (shape matching in the head frame), so a groom keeps its style. (The other
 reading, a pull toward each segment's rest direction from its leader, trades energy with the
 DFTL velocity correction: still strands then oscillate by themselves. The pull toward a
@@ -35,6 +36,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation, Groom
+from hairtool.simulate.driver import RootDriver
 from hairtool.simulate.head_motion import check_transform, head_motion
 
 F64 = NDArray[np.float64]
@@ -222,6 +224,7 @@ def simulate(
     seed: int = 0,
     backend: str = "numba",
     progress: Callable[[int, int], object] | None = None,
+    driver: RootDriver | None = None,
 ) -> Animation:
     """Simulate ``groom`` (its pose at time 0) on a moving head; returns ``frames`` frames at ``fps``.
 
@@ -271,6 +274,10 @@ def simulate(
     progress : callable, optional
         ``progress(done, frames)`` after every frame; an exception raised from it stops the
         simulation (how a studio cancels).
+    driver : RootDriver, optional
+        An animated groom's own root motion (:class:`~hairtool.simulate.driver.RootDriver` of
+        the same strands): the roots follow it exactly and the head moves with its rigid fit;
+        it replaces ``motion``.
 
     Returns
     -------
@@ -319,7 +326,11 @@ def simulate(
             _number("gust strength", g.strength, -1e6, 1e6, "a finite acceleration in units/s²")
             _number("gust start", g.start, -1e9, 1e9, "a finite time in seconds")
 
-    if callable(motion):
+    if driver is not None:
+        if driver.strand_count != groom.strand_count:
+            raise ParameterError("driver", f"{driver.strand_count} roots", f"{groom.strand_count} roots")
+        transform = driver.transform
+    elif callable(motion):
         transform = motion
     else:
         scale = head_radius if head_radius > 0 else 1.0  # the named motions sized to the head
@@ -351,8 +362,11 @@ def simulate(
         decay = float(np.exp(-damping * dt))
         v = np.zeros_like(x)
         step = _frame_kernel if backend == "numba" else _frame_reference
+        held = np.zeros((1, 1, 3))  # (no driver: the roots are the rest roots carried by the head)
         for f in range(1, frames):
             k = slice((f - 1) * substeps, f * substeps)
+            if driver is not None:
+                held = np.ascontiguousarray(np.stack([driver.at(float(t)) for t in times[k]]))
             step(
                 x,
                 v,
@@ -368,6 +382,8 @@ def simulate(
                 bend,
                 ftl_damping,
                 decay,
+                held,
+                driver is not None,
             )
             out[f] = x
             if progress is not None:
@@ -398,9 +414,10 @@ def simulate_reference(groom: Groom, **kwargs) -> Animation:
 # ---------------------------------------------------------------------------------------
 @njit(cache=True, nogil=True, parallel=True)
 def _frame_kernel(
-    x, v, rest, offsets, seg_len, coll_r, centre, rot, trans, acc, dt, bend, ftl_damping, decay
+    x, v, rest, offsets, seg_len, coll_r, centre, rot, trans, acc, dt, bend, ftl_damping, decay, held, driven
 ):
-    """Advance positions ``x`` and velocities ``v`` (V, 3) in place through len(rot) substeps."""
+    """Advance positions ``x`` and velocities ``v`` (V, 3) in place through len(rot) substeps;
+    ``driven``: the roots at substep k are ``held[k]`` (S, 3), else the rest roots carried by the head."""
     n_strands = offsets.size - 1
     for s in prange(n_strands):
         a = offsets[s]
@@ -413,7 +430,10 @@ def _frame_kernel(
             cw1 = r[1, 0] * centre[0] + r[1, 1] * centre[1] + r[1, 2] * centre[2] + trans[k, 1]
             cw2 = r[2, 0] * centre[0] + r[2, 1] * centre[1] + r[2, 2] * centre[2] + trans[k, 2]
             for c in range(3):
-                p[0, c] = r[c, 0] * rest[a, 0] + r[c, 1] * rest[a, 1] + r[c, 2] * rest[a, 2] + trans[k, c]
+                if driven:
+                    p[0, c] = held[k, s, c]
+                else:
+                    p[0, c] = r[c, 0] * rest[a, 0] + r[c, 1] * rest[a, 1] + r[c, 2] * rest[a, 2] + trans[k, c]
             for i in range(1, n):
                 for c in range(3):
                     v[a + i, c] += dt * acc[k, c]
@@ -466,7 +486,7 @@ def _frame_kernel(
 
 
 def _frame_reference(
-    x, v, rest, offsets, seg_len, coll_r, centre, rot, trans, acc, dt, bend, ftl_damping, decay
+    x, v, rest, offsets, seg_len, coll_r, centre, rot, trans, acc, dt, bend, ftl_damping, decay, held, driven
 ):
     """The numpy twin of :func:`_frame_kernel`: vectorised over strands, one vertex index at a time."""
     counts = np.diff(offsets)
@@ -477,7 +497,7 @@ def _frame_reference(
         r, t = rot[k], trans[k]
         cw = r @ centre + t
         p = x.copy()
-        p[roots] = rest[roots] @ r.T + t
+        p[roots] = held[k] if driven else rest[roots] @ r.T + t
         v[free] += dt * acc[k]
         p[free] = x[free] + dt * v[free]
         d = np.zeros_like(x)

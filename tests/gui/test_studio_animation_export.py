@@ -203,12 +203,15 @@ def test_animation_export_writes_render_hair_when_the_groom_has_children(render_
 
     clump = w.scene.children_clump()
     assert clump is not None
-    clumped = RenderHair(binding, clump).update(anim.frame(6)).points
+    clumped = RenderHair(binding, clump, follow_roots=True).update(anim.frame(6)).points
     assert children.frames[6].tobytes() == clumped.tobytes()
     w.scene.set_clump_children(False)  # off: the interpolation itself
     _wait(w, w.exporter.export_animation(out / "plain.usdc"))
     plain = split_guides(io.read(out / "plain.usdc"))[0]
-    assert plain.frames[6].tobytes() == binding.build(anim.frame(6)).points.tobytes()
+    from hairtool.guides.root_motion import following
+
+    pose = anim.frame(6)  # the children's roots carried by the guides' (the head moves)
+    assert plain.frames[6].tobytes() == following(binding, pose).build(pose).points.tobytes()
     assert np.abs(plain.frames[6] - clumped).max() > 1e-4
     _wait(w, w.exporter.export_animation(out / "hair.npz"))
     assert io.read(out / "hair.npz").strand_count == 300
@@ -254,7 +257,7 @@ def test_a_video_of_render_hair_draws_the_children(render_hair_window, out):
     assert drawn.strand_count == w.scene.drawn_topology.strand_count
     from hairtool.guides.render import RenderHair
 
-    clumped = RenderHair(w.scene.binding, w.scene.children_clump()).update(anim.frame(6))
+    clumped = RenderHair(w.scene.binding, w.scene.children_clump(), follow_roots=True).update(anim.frame(6))
     assert drawn.points[: w.scene.binding.vertex_count].tobytes() == clumped.points.tobytes()
     again = hair.frame_groom(6)  # (the frames' clumper keeps its runs: the same bytes again)
     assert again.points.tobytes() == drawn.points.tobytes()
@@ -272,14 +275,16 @@ def test_a_playing_animation_draws_its_children_unclumped_and_the_frame_it_stops
 ):
     """Clumping every child on every frame would hold playback to a few frames a second on
     Sintel: while it plays the view draws them as interpolated, the frame it stops on (and any
-    exported frame, even during playback) clumped, as the groom's are."""
+    exported frame, even during playback) clumped, as the groom's are (the children's roots
+    carried by their guides' on every frame)."""
     from hairtool.guides.render import RenderHair
+    from hairtool.guides.root_motion import following
 
     w = render_hair_window
     s, v, model = w.scene, w.viewport, w.animation
     anim, b = model.animation, s.binding
     n = b.vertex_count
-    clumped = RenderHair(b, s.children_clump()).update(anim.frame(6)).points
+    clumped = RenderHair(b, s.children_clump(), follow_roots=True).update(anim.frame(6)).points
     model.set_frame(6)
     ui.grab(v)
     np.testing.assert_array_equal(v.drawn().points[:n], clumped)
@@ -287,7 +292,9 @@ def test_a_playing_animation_draws_its_children_unclumped_and_the_frame_it_stops
     assert s.frames_live
     model.set_frame(6)
     ui.grab(v)
-    np.testing.assert_array_equal(v.drawn().points[:n], b.build(anim.frame(6)).points)
+    np.testing.assert_array_equal(
+        v.drawn().points[:n], following(b, anim.frame(6)).build(anim.frame(6)).points
+    )
     frame = w.exporter.renderer(anim, (96, 64), render_hair=True).frame_groom(6)
     np.testing.assert_array_equal(frame.points[:n], clumped)  # exported: clumped all the same
     model.pause()
@@ -299,10 +306,12 @@ def test_a_playing_animation_draws_its_children_unclumped_and_the_frame_it_stops
     ui.send_mouse(view, "press", (view.frame_to_x(3), y), left, left)
     ui.send_mouse(view, "move", (view.frame_to_x(5), y), None, left)
     assert s.frames_live and model.frame == 5
-    np.testing.assert_array_equal(v.drawn().points[:n], b.build(anim.frame(5)).points)
+    np.testing.assert_array_equal(
+        v.drawn().points[:n], following(b, anim.frame(5)).build(anim.frame(5)).points
+    )
     ui.send_mouse(view, "release", (view.frame_to_x(5), y), left, None)  # … let go: clumped
     assert not s.frames_live
-    want = RenderHair(b, s.children_clump()).update(anim.frame(5)).points
+    want = RenderHair(b, s.children_clump(), follow_roots=True).update(anim.frame(5)).points
     np.testing.assert_array_equal(v.drawn().points[:n], want)
     model.play()  # a press while it plays: it pauses and stays live until the release
     live = []

@@ -1,5 +1,6 @@
 """Generated USD scenes (:mod:`usd_scenes`) through the commands: ``info``, ``convert``,
-``freeze``, ``interpolate``, and a log of every brush that needs no head replayed by
+``freeze``, ``interpolate`` (animated on an animated stage), ``simulate`` and ``anime`` (a few
+frames), and a log of every brush that needs no head replayed by
 ``freeze --strokes``. Prim paths, bases and the stage's conventions are kept, and the
 world-space results equal those of the scene's twin in the other up axis and unit.
 
@@ -152,6 +153,8 @@ def test_freeze_and_a_stroke_log_keep_prims_and_conventions(scene):
         want = [x for p in curve_paths(src) for x in ((p + "Render", "default"), (p, "guide"))]
         assert [(c.path, c.purpose) for c in kids.metadata.curves] == want
         assert (kids.metadata.up_axis, kids.metadata.meters_per_unit) == (scene.up, scene.meters_per_unit)
+        if isinstance(src, Animation):  # children on every frame, at the source's time codes
+            assert isinstance(kids, Animation) and list(kids.time_codes) == list(src.time_codes)
         # --prim: the first prim frozen, the others as they were
         assert (
             main(["freeze", str(d / "s.usda"), str(d / "p.usda"), "--prim", scene.prims[0].path, *pose]) == 0
@@ -182,3 +185,27 @@ def test_clumping_gives_the_same_world_hair_in_any_axes_and_unit(scene):
         a = world_metres(io.read(d / "s_f.usda"), scene.up, scene.meters_per_unit)
         b = world_metres(io.read(d / "t_f.usda"), twin_up, twin_mpu)
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-5 * max(1.0, float(np.abs(a).max())))
+
+
+@RUN
+@given(scene=scenes())
+def test_simulate_and_anime_keep_prims_conventions_and_the_source_start(scene):
+    """A few frames each; on an animated stage the simulation's roots are the source's."""
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        write_stage(d / "s.usda", scene)
+        src = io.read(d / "s.usda")
+        first = float(src.time_codes[0]) if isinstance(src, Animation) else 0.0
+        args = ["simulate", str(d / "s.usda"), str(d / "sim.usda"), "--fit-head", "--substeps", "1"]
+        assert main([*args, "--frames", "3"]) == 0
+        sim = io.read(d / "sim.usda")
+        check_kept(scene, src, sim)
+        assert isinstance(sim, Animation) and sim.time_codes[0] == first and sim.n_frames == 3
+        if isinstance(src, Animation):
+            idx = src.topology.root_indices
+            scale = max(1.0, float(np.abs(src.frames).max()))
+            np.testing.assert_allclose(sim.frames[:, idx], src.frames[:3, idx], rtol=0, atol=1e-6 * scale)
+        assert main(["anime", str(d / "s.usda"), str(d / "a.usda"), "--frames", "3"]) == 0
+        cycle = io.read(d / "a.usda")
+        check_kept(scene, src, cycle)
+        assert isinstance(cycle, Animation) and cycle.time_codes[0] == first

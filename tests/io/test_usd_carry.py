@@ -90,3 +90,41 @@ def test_a_parents_translate_rotate_scale_ops_are_kept_as_authored(tmp_path):
         assert ops[out] == ops[src] and any("rotateXYZ" in name for _, name, _ in ops[src])
     back, was = io.read(tmp_path / "convert.usda"), io.read(src)
     np.testing.assert_allclose(back.points, was.points, rtol=0, atol=1e-6)
+
+
+def test_simulate_and_anime_keep_the_head_root_and_custom_primvars(tmp_path):
+    """(They carried nothing before: the head mesh, Blender's root and custom primvars were dropped.)"""
+    from .test_animated_interpolate import two_prims
+
+    write_stage(tmp_path / "g.usda", two_prims(None))
+    for src, kept in (
+        (DATA / "b.usda", ("/root", "/root/Head", "/root/Head/Icosphere")),
+        (tmp_path / "g.usda", ("/Head",)),
+    ):
+        sim, cycle = tmp_path / f"s_{src.stem}.usda", tmp_path / f"a_{src.stem}.usda"
+        assert main(["simulate", str(src), str(sim), "--frames", "2", "--substeps", "1", "--fit-head"]) == 0
+        assert main(["anime", str(src), str(cycle), "--frames", "2"]) == 0
+        for out in (sim, cycle):
+            for prim in kept:
+                assert values(out, prim) == values(src, prim), (out.name, prim)
+    hair = "/Root0_0/Hair0"
+    for out in (tmp_path / "s_g.usda", tmp_path / "a_g.usda"):
+        assert (
+            values(out, hair)["primvars:clump_weight"]
+            == values(tmp_path / "g.usda", hair)["primvars:clump_weight"]
+        )
+
+
+def test_a_keys_export_keeps_the_head_and_custom_primvars(tmp_path):
+    from .test_animated_interpolate import two_prims
+
+    write_stage(tmp_path / "g.usda", two_prims("points"))
+    for bake in ([], ["--bake"]):
+        out = tmp_path / f"k{len(bake)}.usda"
+        assert main(["keys", str(tmp_path / "g.usda"), "--export", str(out), *bake]) == 0
+        assert values(out, "/Head") == values(tmp_path / "g.usda", "/Head")
+        hair = "/Root0_0/Hair0"
+        assert (
+            values(out, hair)["primvars:clump_weight"]
+            == values(tmp_path / "g.usda", hair)["primvars:clump_weight"]
+        )

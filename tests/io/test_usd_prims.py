@@ -97,15 +97,23 @@ def test_each_prim_is_frozen_as_a_groom_of_its_own(scenes):
     assert strand_lengths(brows).max() < 0.025  # brows stay brows (15 mm, some stretch noise)
 
 
+def authored_points(path, prim: str) -> bytes:
+    from pxr import Sdf
+
+    layer = Sdf.Layer.OpenAsAnonymous(str(path))  # (held: a spec of a freed layer is invalid)
+    return np.asarray(layer.GetAttributeAtPath(prim + ".points").default).tobytes()
+
+
 def test_prim_picks_prims_and_the_others_pass_through(scenes, capsys):
     d = scenes
     out = d / "brows_only.usda"
     assert main(["freeze", str(d / "both.usda"), str(out), "--prim", "/root/Face/*"]) == 0
     src_hair, src_brows = split(io.read(d / "both.usda"))
     hair, brows = split(io.read(out))
-    # untouched: the same world points, up to the float32 rounding of the way back into the
-    # prim's own space under its parent's scale and rotation (the writer's, not this command's)
-    np.testing.assert_allclose(hair.points, src_hair.points, rtol=0, atol=4e-7)
+    # untouched: the source's authored points, byte for byte (not rewritten through the
+    # parent's scale and rotation, which rounds them by an ULP)
+    np.testing.assert_array_equal(hair.points, src_hair.points)
+    assert authored_points(out, HAIR) == authored_points(d / "both.usda", HAIR)
     assert not np.array_equal(brows.points, src_brows.points)
     capsys.readouterr()
     assert main(["freeze", str(d / "both.usda"), str(d / "x.usda"), "--prim", "/root/Tail*"]) == 2
@@ -175,3 +183,42 @@ def test_interpolate_grows_each_prims_children_into_its_own_render_prim(scenes, 
     )
     err = capsys.readouterr().err
     assert "--prim" in err and HAIR in err and not (d / "x.usda").exists()
+
+
+def test_deleting_every_strand_of_a_prim_keeps_it_empty(scenes, capsys):
+    """As Blender keeps an empty Curves object: the brows' prim stays, with no curves, beside
+    the hair; the command says so in one line, and the next command carries it through."""
+    import json
+
+    d = scenes
+    brows = split(io.read(d / "both.usda"))[1]
+    centre = (brows.points.min(axis=0) + brows.points.max(axis=0)) / 2
+    sample = {"cursor": centre.tolist(), "direction": [0, 0, 0], "radius": 1.0, "strength": 1.0}
+    log = [{"brush": "delete", "falloff": "smooth", "symmetry": None, "params": {}, "samples": [sample]}]
+    (d / "gone.json").write_text(json.dumps(log))
+    out = d / "no_brows.usda"
+    capsys.readouterr()
+    args = [
+        "freeze",
+        str(d / "both.usda"),
+        str(out),
+        "--prim",
+        "/root/Face/*",
+        "--strokes",
+        str(d / "gone.json"),
+    ]
+    assert main(args) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and BROWS in err[0] and "kept empty" in err[0]
+    hair = io.read(out)
+    assert [c.path for c in hair.metadata.curves] == [HAIR]
+    assert hair.points.tobytes() == split(io.read(d / "both.usda"))[0].points.tobytes()
+    from pxr import Sdf
+
+    layer = Sdf.Layer.OpenAsAnonymous(str(out))
+    assert list(layer.GetAttributeAtPath(BROWS + ".curveVertexCounts").default) == []
+    assert main(["convert", str(out), str(d / "again.usdc")]) == 0
+    again = Sdf.Layer.OpenAsAnonymous(str(d / "again.usdc"))
+    assert list(again.GetAttributeAtPath(BROWS + ".curveVertexCounts").default) == []
+    # every prim emptied: refused in one line
+    assert main(["freeze", str(d / "both.usda"), str(d / "x.usda"), "--strokes", str(d / "gone.json")]) == 2

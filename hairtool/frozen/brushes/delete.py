@@ -120,13 +120,22 @@ def strands_to_delete_reference(groom: Groom, sample: BrushSample, locked: Array
     return inside & ~np.asarray(locked, bool) & (sample.strength > 0)
 
 
+class EveryStrandGone(ParameterError):
+    """A stroke that would delete every strand of the groom (a groom holds at least one). Where
+    the groom is one prim of a scene, the command keeps that prim empty instead
+    (:mod:`hairtool.prims`), as Blender keeps an empty Curves object."""
+
+    def __init__(self, brush: str) -> None:
+        super().__init__(brush, "every strand", "a stroke that leaves at least one strand")
+
+
 def remove(ctx: StrokeContext, g: Groom, gone: np.ndarray, brush: str) -> Groom:
     """``g`` without the strands ``gone`` (an ``(S,)`` mask), their state with them;
-    ParameterError naming ``brush`` where none would be left."""
+    :class:`EveryStrandGone` naming ``brush`` where none would be left."""
     if not gone.any():
         return g
     if gone.all():
-        raise ParameterError(brush, "every strand", "a stroke that leaves at least one strand")
+        raise EveryStrandGone(brush)
     return ctx.keep(g, np.flatnonzero(~gone))
 
 
