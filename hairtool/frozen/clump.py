@@ -188,7 +188,7 @@ def _pair_kernel(P, aflat, aoff, acnt, inv_h, pr, ps):
             ps[n] = t * t / (r + EPS)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _sum_run(P, flat, a, b, emap, pr, ps, px, py, pz, h, stats, acc):
     """:func:`vertex_force`'s sums with each entry's r and weight read from the pair arrays (entry n's at
     ``emap[n]``, or at n itself where ``emap`` is empty): the same sums in the same order."""
@@ -201,7 +201,7 @@ def _sum_run(P, flat, a, b, emap, pr, ps, px, py, pz, h, stats, acc):
     return acc
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _lowest_stored(flat, a, b, emap, pr, br, sorig, bj, bo):
     """:func:`_lowest_of_nearest` on the stored distances."""
     same = emap.size == 0
@@ -240,7 +240,7 @@ def _half_force_kernel(
             weight[i] = wsum
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def gap_lambda(ex, ey, ez, gx, gy, gz, step, zeta, h, gap):
     """λ (17)–(19) of a vertex whose nearest neighbour lies e away, the two forces differing by
     g (that neighbour's minus its own); ``gap`` 0 "printed", 1 "text"."""
@@ -256,7 +256,7 @@ def gap_lambda(ex, ey, ez, gx, gy, gz, step, zeta, h, gap):
     return (1.0 - delta) * zeta
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def moved_vertex(P, f, S, step, i, j, zeta, h, gap, Pout, o):
     """Vertex i's next iterate into ``Pout[o]``: (16) scaled by its clump strength S[i], with
     the gap correction (17)–(19) against its nearest neighbour j (−1: none) by the scaled steps
