@@ -23,11 +23,17 @@ does), ``kept_ms`` with the list of the last run (the studio's repeated runs on 
 points), ``stroke_ms`` the run after a comb stroke near the middle tip, its list that of the
 points before the stroke brought up to date (the studio's release,
 ``hairtool.bench.freeze.release_times``; Blender evaluates its node anew after any edit).
+``first_ms`` is the first run in a fresh process with an empty ``NUMBA_CACHE_DIR`` (compiling
+every kernel it runs, then building the list and clumping; the interpreter's start and imports
+aside), once per groom (``--no-first`` leaves it out), beside ``blender_first_ms``, the node's
+first evaluation in its fresh process.
 Both tools use every core. Each row is ``--rounds`` rounds of Blender then hairtool, each side's
 median over them, and the median of the rounds' speedups: the 2-core VM's speed drifts by tens
-of percent within minutes, and a round's two sides see about the same host. ClumpWithGaps does more than Blender's node (three iterations of an
-adhesion force over every pair within h, a gap correction, lengths kept), so the comparison is
-of what an artist waits for, not of equal work.
+of percent within minutes, and a round's two sides see about the same host. The rows come
+between two runs of ``hairtool bench host`` (its ``speed`` and ``scaling``) and the load
+average, printed first and last. ClumpWithGaps does more than Blender's node (three iterations
+of an adhesion force over every pair within h, a gap correction, lengths kept), so the
+comparison is of what an artist waits for, not of equal work.
 """
 
 from __future__ import annotations
@@ -44,6 +50,7 @@ from pathlib import Path
 import numpy as np
 
 WORKER_FLAG = "--blender-worker"
+FIRST_FLAG = "--first-worker"
 ASSET = "assets/nodes/procedural_hair_node_assets.blend"
 NODE_GROUP = "Clump Hair Curves"
 
@@ -101,7 +108,9 @@ def _blender_times(points: np.ndarray, sizes: np.ndarray, h: float, repeat: int)
             mod[sockets["Guide Distance"]] = float(h)
             mod[sockets["Existing Guide Map"]] = False
             mod[sockets["Factor"]] = 1.0
-        evaluate(0)  # the first evaluation builds what later ones keep (the node tree's code)
+        first = evaluate(0)  # the first evaluation builds what later ones keep (the node tree's code)
+        if group is clump:
+            out["first_ms"] = 1e3 * first
         out[f"{name}_ms"] = 1e3 * float(np.median([evaluate(1 + i) for i in range(repeat)]))
     depsgraph = bpy.context.evaluated_depsgraph_get()
     moved = np.empty(len(points) * 3, np.float32)
@@ -121,6 +130,46 @@ def _worker(argv: list[str]) -> None:
 # ---------------------------------------------------------------------------------------
 # The hairtool side
 # ---------------------------------------------------------------------------------------
+def _first_worker(argv: list[str]) -> None:
+    """``--first-worker GROOM.npz H``: the first ClumpWithGaps run of this process, in ms (the
+    parent gives it an empty ``NUMBA_CACHE_DIR``)."""
+    path, h = argv
+    from hairtool.frozen.clump import clump
+    from hairtool.io import read_groom
+
+    groom = read_groom(path)
+    t0 = time.perf_counter()
+    clump(groom, float(h), 3, None, "printed", 0)
+    print(json.dumps({"first_ms": 1e3 * (time.perf_counter() - t0)}))
+
+
+def first_ms(size: str, groom, h: float) -> float:
+    """:func:`_first_worker` in a child process with a new, empty numba cache."""
+    from hairtool.io import write
+
+    with tempfile.TemporaryDirectory(prefix="clump-first-") as tmp:
+        path = os.path.join(tmp, "groom.npz")
+        write(path, groom)
+        env = dict(os.environ, NUMBA_CACHE_DIR=os.path.join(tmp, "numba"))
+        done = subprocess.run(
+            [sys.executable, os.path.abspath(__file__), FIRST_FLAG, path, repr(h)],
+            capture_output=True, text=True, check=False, env=env,
+        )  # fmt: skip
+    if done.returncode != 0:
+        raise SystemExit(f"the first run failed on {size}:\n{done.stderr[-3000:]}")
+    return float(json.loads(done.stdout.strip().splitlines()[-1])["first_ms"])
+
+
+def host() -> dict:
+    """``hairtool bench host``'s speed and scaling, and the load average, now."""
+    from types import SimpleNamespace
+
+    from hairtool.bench import host as probe
+
+    (*_, summary) = probe.run(SimpleNamespace(quick=False, repeat=5, threads=None))
+    return {"host_speed": summary["speed"], "host_scaling": summary["scaling"], "load": os.getloadavg()[0]}
+
+
 def _hairtool_times(groom, h: float, repeat: int) -> dict:
     from hairtool.bench import median_ms
     from hairtool.frozen.clump import ClumpWorkspace, clump
@@ -154,7 +203,7 @@ def _blender(groom, h: float, bpy_python: str, repeat: int, size: str) -> dict:
         return {f"blender_{k}": v for k, v in json.loads(Path(dst).read_text()).items()}
 
 
-def compare(size: str, groom, bpy_python: str, repeat: int, rounds: int = 1) -> dict:
+def compare(size: str, groom, bpy_python: str, repeat: int, rounds: int = 1, first: bool = True) -> dict:
     """One row: each side's medians over ``rounds`` rounds of Blender then hairtool, and the
     median of the rounds' speedups (a host whose speed drifts moves both sides of a round)."""
     from hairtool.frozen.strand_clumps import auto_clump_radius
@@ -169,6 +218,9 @@ def compare(size: str, groom, bpy_python: str, repeat: int, rounds: int = 1) -> 
             run[f"speedup_{case}"] = run["blender_clump_ms"] / run[f"{case}_ms"]
         runs.append(run)
     row.update({k: float(np.median([r[k] for r in runs])) for k in runs[0]})
+    if first:
+        row["first_ms"] = first_ms(size, groom, h)
+        row["speedup_first"] = row["blender_first_ms"] / row["first_ms"]
     row["rounds"] = rounds
     return row
 
@@ -177,6 +229,9 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] == [WORKER_FLAG]:
         _worker(argv[1:])
+        return 0
+    if argv[:1] == [FIRST_FLAG]:
+        _first_worker(argv[1:])
         return 0
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--bpy", required=True, help="a Python that imports bpy 5.0")
@@ -189,6 +244,9 @@ def main(argv: list[str] | None = None) -> int:
         "--rounds", type=int, default=3, help="rounds of Blender then hairtool; the median speedup of them"
     )
     parser.add_argument("--out", type=Path, default=None, help="also write the rows as JSON")
+    parser.add_argument(
+        "--no-first", action="store_true", help="leave out the first run in a fresh process (first_ms)"
+    )
     args = parser.parse_args(argv)
     import numba
 
@@ -197,13 +255,18 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     from hairtool.bench.freeze import _grooms  # the sizes `hairtool bench freeze --sizes` takes
 
+    before = host()
+    print(json.dumps({"before": before}), flush=True)
     for size, groom in _grooms(args.sizes):
-        rows.append(compare(size, groom, args.bpy, args.repeat, args.rounds))
+        rows.append(compare(size, groom, args.bpy, args.repeat, args.rounds, not args.no_first))
         rows[-1]["threads"] = numba.get_num_threads()
         print(json.dumps(rows[-1]), flush=True)
+    after = host()
+    print(json.dumps({"after": after}), flush=True)
     print(format_table(rows))
+    print(f"host before: {before}\nhost after: {after}")
     if args.out is not None:
-        args.out.write_text(json.dumps(rows, indent=1))
+        args.out.write_text(json.dumps({"host_before": before, "host_after": after, "rows": rows}, indent=1))
     return 0
 
 

@@ -88,10 +88,10 @@ def test_a_twin_is_cached_apart_and_calls_serial_twins():
     twin = serial_twins.serial(clump._clump_run)
     assert twin.py_func.__qualname__ == "_clump_run" + serial_twins.SERIAL_SUFFIX
     assert twin._cache._cache_file._index_name != clump._clump_run._cache._cache_file._index_name
-    assert not twin.targetoptions.get("parallel") and clump._force_kernel.targetoptions["parallel"]
+    assert not twin.targetoptions.get("parallel") and clump._half_force_kernel.targetoptions["parallel"]
     # its callees are the serial twins; the parallel kernel's are the parallel kernels
-    assert twin.py_func.__globals__["_force_kernel"] is serial_twins.serial(clump._force_kernel)
-    assert clump._clump_run.py_func.__globals__["_force_kernel"] is clump._force_kernel
+    assert twin.py_func.__globals__["_half_force_kernel"] is serial_twins.serial(clump._half_force_kernel)
+    assert clump._clump_run.py_func.__globals__["_half_force_kernel"] is clump._half_force_kernel
     assert serial_twins.serial(twin) is twin and serial_twins.parallel_of(twin) is clump._clump_run
     assert serial_twins.serial(spatial._row_sort).py_func.__globals__["_row_keys"] is serial_twins.serial(
         spatial._row_keys
@@ -114,7 +114,7 @@ def test_use_parallel_points_every_modules_names_and_leaves_jitted_callees_alone
         assert freeze._freeze_kernel is serial_twins.serial(serial_twins.parallel_of(freeze._freeze_kernel))
         assert clump.keep_still.py_func.__qualname__.endswith(serial_twins.SERIAL_SUFFIX)
         assert importer.keep_still is clump.keep_still
-        assert clump._force_kernel.targetoptions["parallel"]  # only _clump_run calls it: left parallel
+        assert clump._half_force_kernel.targetoptions["parallel"]  # only _clump_run calls it: left parallel
     finally:
         serial_twins.use_parallel(True)
     assert clump.keep_still is serial_twins.parallel_of(clump.keep_still) is importer.keep_still

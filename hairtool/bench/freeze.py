@@ -1,7 +1,9 @@
 """Frozen-hair pipeline timings per groom size: each stage, the whole pipeline, the numpy twins.
 
 Sizes: the paper's Table 1 (100, 300, 500 strands × 20), 5,000 and 50,000 × 20 scalp samples,
-and the real grooms. Clump radius h = 2× the median root spacing, k = 3. ``pipeline_ms``: rest
+the real grooms, and the generated shapes they lack (:mod:`hairtool.guides.shapes`: a ponytail
+gathered into a tie, curls, a 10,000 × 16 straight cut, three hair systems). Clump radius
+h = 2× the median root spacing, k = 3. ``pipeline_ms``: rest
 groom → result (freeze + one align sample + clump), run again on the same input, so
 ClumpWithGaps keeps its neighbour list; ``cold_ms``: the same with the list built every time;
 ``clump_ms``: ClumpWithGaps alone with its list built, ``list_ms`` of it; ``update_ms``: one
@@ -36,7 +38,9 @@ from pathlib import Path
 HELP = "time FreezeDeform, UserAlign, ClumpWithGaps and the whole pipeline against numpy"
 
 PAPER_SIZES = ["100x20", "300x20", "500x20"]
-DEFAULT_SIZES = [*PAPER_SIZES, "5000x20", "50000x20", "real"]
+DEFAULT_SIZES = [*PAPER_SIZES, "5000x20", "50000x20", "real", "shapes"]
+#: The generated groom shapes (:mod:`hairtool.guides.shapes`), ``--sizes`` names.
+SHAPES = ("ponytail", "curls", "straight", "systems")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -46,7 +50,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="SIZE",
         help="STRANDSxVERTICES (scalp samples), 'real' (every groom in tests/data/grooms, "
-        "or $HAIRTOOL_BENCH_DATA/grooms) or a path",
+        "or $HAIRTOOL_BENCH_DATA/grooms), 'shapes' (the generated ponytail, curls, straight "
+        "cut and hair systems), one of those names, NAME:STRANDSxVERTICES, or a path",
     )
     parser.add_argument("--quick", action="store_true", help="100x20 and 500x20 only, fewer repeats")
     parser.add_argument("--repeat", type=int, default=15, help="timed runs per number (median)")
@@ -65,6 +70,8 @@ def _grooms(sizes: list[str]):
     for size in sizes:
         if size == "real":
             yield from _real_grooms(GROOMS_DIR)
+        elif size == "shapes" or size.split(":")[0] in SHAPES:
+            yield from _shapes(size)
         elif "x" in size and all(p.isdigit() for p in size.split("x")):
             s, v = (int(p) for p in size.split("x"))
             yield f"scalp {size}", scalp(s, v, seed=0)
@@ -72,6 +79,26 @@ def _grooms(sizes: list[str]):
             yield Path(size).stem, read_groom(size)
         else:
             raise ParameterError("sizes", size, "STRANDSxVERTICES, 'real' or a groom file")
+
+
+def _shapes(size: str):
+    """``shapes`` (every generated shape at its bench size), ``NAME`` or ``NAME:SxV`` (a shape of
+    :mod:`hairtool.guides.shapes` at S strands of V vertices)."""
+    from hairtool.errors import ParameterError
+    from hairtool.guides.shapes import SIZES, shape
+
+    if size == "shapes":
+        for name in SHAPES:
+            yield f"{name} {SIZES[name][0]}x{SIZES[name][1]}", shape(name)
+        return
+    name, _, dims = size.partition(":")
+    s, v = SIZES[name]
+    if dims:
+        parts = dims.split("x")
+        if len(parts) != 2 or not all(p.isdigit() for p in parts):
+            raise ParameterError("sizes", size, "NAME:STRANDSxVERTICES, e.g. ponytail:3066x16")
+        s, v = int(parts[0]), int(parts[1])
+    yield f"{name} {s}x{v}", shape(name, s, v)
 
 
 REAL_SUFFIXES = (".tfx", ".hair", ".usd", ".usda", ".usdc", ".npz")  # (.obj there are head meshes)

@@ -58,9 +58,6 @@ GAP_MODES = ("printed", "text", "off")
 _GAP_CODE = {"printed": 0, "text": 1, "off": 2}
 MAX_ITERATIONS = 100
 MARGIN = 0.1  # neighbour-list radius h·(1 + MARGIN)
-HALF_FROM = 4.0  # forward entries per vertex from which each pair's r and weight are computed once
-# (2-core VM, kept list, the force kernel: bear at 11.7 per vertex 1.5x faster, ratboy at 8.3 1.6x,
-# Sintel at 33 1.8x; the 100k-vertex scalp sample at 1.55 6 % slower, its pairs too few to pay a pass)
 STEP_FRACTION = 0.2  # auto Δt²/m = STEP_FRACTION·h / max(1, mean Σg at the first iteration)
 
 
@@ -144,18 +141,16 @@ def keep_still_reference(points: np.ndarray, sv: np.ndarray, out: np.ndarray) ->
 
 
 @twin_njit(nogil=True, parallel=True)
-def _gather_strength(sv, order, S):
-    for k in prange(order.size):
-        S[k] = sv[order[k]]
-
-
-@twin_njit(nogil=True, parallel=True)
-def _gather_points(points, order, P):
-    """The current points (float64) in the list's sorted order."""
+def _gather_inputs(points, sv, order, seed, gap, P, S, heads):
+    """The points (float64), clump strengths and, with gaps on, ζ's hash heads (per original
+    index) in the list's sorted order: one parallel loop (each is one more kernel to compile)."""
     for k in prange(order.size):
         i = order[k]
         for a in range(3):
             P[k, a] = points[i, a]
+        S[k] = sv[i]
+        if gap != 2:
+            heads[k] = hash_head_nb(seed, i, CH_CLUMP)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -217,27 +212,10 @@ def vertex_force(P, aflat, a0, a1, bflat, b0, b1, px, py, pz, root, h, inv_h, st
 
 
 @twin_njit(nogil=True, parallel=True)
-def _force_kernel(P, aflat, aoff, acnt, bflat, bstart, sroot, sorig, h, stats, f, best, count, weight):
-    """f (15) of every vertex from its two list runs and its nearest neighbour within h (ties:
-    the lower original index); with ``stats`` (the first iteration) also how many are within h
-    and Σg."""
-    inv_h = 1.0 / h
-    for i in prange(P.shape[0]):
-        fx, fy, fz, best[i], c, wsum = vertex_force(
-            P, aflat, aoff[i], aoff[i] + acnt[i], bflat, bstart[i], bstart[i + 1], P[i, 0], P[i, 1], P[i, 2],
-            sroot[i], h, inv_h, stats, sorig,
-        )  # fmt: skip
-        f[i, 0], f[i, 1], f[i, 2] = fx, fy, fz  # f (15); Δp = step·f (16)
-        if stats:
-            count[i] = c
-            weight[i] = wsum
-
-
-@twin_njit(nogil=True, parallel=True)
 def _pair_kernel(P, aflat, aoff, acnt, inv_h, pr, ps):
     """Each pair's distance r and weight g/(r + ε) (14)–(15), once, from its forward entry: a
     pair's two vertices compute the same r (their differences are each other's negatives), so
-    :func:`_half_force_kernel` reads it for both and sums what :func:`_force_kernel` sums."""
+    :func:`_half_force_kernel` reads it for both and sums what :func:`vertex_force` sums."""
     for i in prange(P.shape[0]):
         px, py, pz = P[i, 0], P[i, 1], P[i, 2]
         for n in range(aoff[i], aoff[i] + acnt[i]):
@@ -279,9 +257,11 @@ def _lowest_stored(flat, a, b, emap, pr, br, sorig, bj, bo):
 def _half_force_kernel(
     P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, sorig, h, stats, pr, ps, f, best, count, weight
 ):
-    """:func:`_force_kernel` from the pair arrays of :func:`_pair_kernel` (the row grid's lists:
-    forward runs, then backward runs whose pairs ``bmap`` finds among the forward entries), to
-    the bit: half the square roots and divisions."""
+    """f (15) of every vertex and its nearest neighbour within h (ties: the lower original
+    index), as :func:`vertex_force` sums them, from the pair arrays of :func:`_pair_kernel`
+    (the row grid's lists: forward runs, then backward runs whose pairs ``bmap`` finds among the
+    forward entries), to the bit: half the square roots and divisions. With ``stats`` (the first
+    iteration) also how many are within h and Σg."""
     none = np.empty(0, np.int64)
     for i in prange(P.shape[0]):
         acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
@@ -299,12 +279,6 @@ def _half_force_kernel(
         if stats:
             count[i] = c
             weight[i] = wsum
-
-
-@twin_njit(nogil=True, parallel=True)
-def _hash_heads(sorig, seed, heads):
-    for i in prange(sorig.size):
-        heads[i] = hash_head_nb(seed, sorig[i], CH_CLUMP)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -381,10 +355,15 @@ def _scatter(order, P, out):
 
 
 @twin_njit(nogil=True, parallel=True)
-def _scatter_stats(order, count, weight, out_count, out_weight):
+def _scatter_record(order, f, count, weight, stats, out_f, out_count, out_weight):
+    """An iteration's forces (and with ``stats`` the first one's counts and Σg) into a record."""
     for k in prange(order.size):
-        out_count[order[k]] = count[k]
-        out_weight[order[k]] = weight[k]
+        i = order[k]
+        for a in range(3):
+            out_f[i, a] = f[k, a]
+        if stats:
+            out_count[i] = count[k]
+            out_weight[i] = weight[k]
 
 
 @njit(cache=True, nogil=True)
@@ -402,60 +381,37 @@ def _clump_run(points, strength, order, lists, sroot, h, iterations, step, gap, 
     arrays: not recorded."""
     P, Pn, f, best, count, weight, heads, S = bufs
     aflat, aoff, acnt, bflat, bstart, bmap, pr, ps = lists
-    half = pr.size > 0  # the row grid's lists: each pair's r and weight once (_pair_kernel)
     rec_p, rec_f, rec_count, rec_weight = record
     keep = rec_p.shape[0] > 0
-    _gather_points(points, order, P)
-    _gather_strength(strength, order, S)
-    if gap != 2:
-        _hash_heads(order, seed, heads)
+    _gather_inputs(points, strength, order, seed, gap, P, S, heads)
     mean_nb = 0.0
     k_step = step
+    inv_h = 1.0 / h
     for it in range(iterations):
         if keep:
             _scatter(order, P, rec_p[it])
-        if half:
-            _pair_kernel(P, aflat, aoff, acnt, 1.0 / h, pr, ps)
-            _half_force_kernel(
-                P,
-                aflat,
-                aoff,
-                acnt,
-                bflat,
-                bstart,
-                bmap,
-                sroot,
-                order,
-                h,
-                it == 0,
-                pr,
-                ps,
-                f,
-                best,
-                count,
-                weight,
-            )
-        else:
-            _force_kernel(
-                P, aflat, aoff, acnt, bflat, bstart, sroot, order, h, it == 0, f, best, count, weight
-            )
+        _pair_kernel(P, aflat, aoff, acnt, inv_h, pr, ps)
+        _half_force_kernel(
+            P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, order, h, it == 0, pr, ps,
+            f, best, count, weight,
+        )  # fmt: skip
         if it == 0:
             pairs, moving, w_sum, w_count = _first_stats(count, weight, sroot)
             mean_nb = pairs / max(moving, 1)
             if step < 0.0:
                 k_step = step_from_stats(h, w_sum, w_count)
         if keep:
-            _scatter(order, f, rec_f[it])
-            if it == 0:
-                _scatter_stats(order, count, weight, rec_count, rec_weight)
+            _scatter_record(order, f, count, weight, it == 0, rec_f[it], rec_count, rec_weight)
         _gap_kernel(P, f, S, k_step, best, heads, h, gap, it, Pn)
         P, Pn = Pn, P
-    _scatter(order, P, out)
+    _scatter(order, P, Pn)  # float64, as the record's: one specialisation of the kernel to compile
+    for i in range(out.shape[0]):
+        for a in range(3):
+            out[i, a] = Pn[i, a]
     return mean_nb, k_step
 
 
 _NO_RECORD = (np.zeros((0, 0, 3)), np.zeros((0, 0, 3)), np.zeros(0, np.int64), np.zeros(0))
-_NO_PAIRS = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0))  # (bmap, r, weight): lists of the hashed grid
 RECORD_LIMIT = 12_000_000  # vertices × iterations at most in a record (2 × 24 bytes each): the
 # largest research grooms (3.4M vertices) at the default 3 iterations, 490 MB; without a record
 # every brush move redoes the whole groom (a 3.2M-vertex curly groom: 309 ms a move, not ~3)
@@ -611,9 +567,11 @@ class ClumpWorkspace:
         return self.neighbours
 
     def pair_buffers(self, nl: NeighbourList) -> tuple:
-        """(bmap, r, weight) for the pairs of a row-grid list (one r and weight per forward
-        entry, reused); empty arrays for the hashed grid's whole lists and for sparse ones
-        (below :data:`HALF_FROM`), where :func:`_force_kernel` computes each pair twice.
+        """(bmap, r, weight): one r and weight per forward entry of the list, reused. On the row
+        grid a pair's backward entry reads its forward one's (``bmap``); the hashed grid's lists
+        are whole (each pair in both, no backward runs), so there each entry has its own.
+        (Computing each pair from both ends, as sparse lists once did, was a second force kernel
+        to compile for the same bytes: 2.9 of the 14.7 CPU seconds ``_clump_run`` compiled.)
 
         Parameters
         ----------
@@ -625,12 +583,10 @@ class ClumpWorkspace:
         tuple
             ``(bmap, r, weight)``.
         """
-        if not nl.dense or nl.forward_entries < HALF_FROM * len(nl.order):
-            return _NO_PAIRS
         n = nl.aflat.size
         if self._pairs[0].size < n:
             self._pairs = (np.empty(n), np.empty(n))
-        return (nl.bmap, *self._pairs)
+        return (nl.bmap, *self._pairs)  # (the hashed grid's backward runs are empty: never read)
 
     def buffers(self, v: int) -> tuple:
         """Iterates, f, nearest neighbour, counts, Σg, hash heads and clump strengths for V

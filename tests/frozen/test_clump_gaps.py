@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import importlib
-
 import numba
 import numpy as np
 import pytest
@@ -11,7 +9,7 @@ import pytest
 from hairtool import samples
 from hairtool.errors import ParameterError
 from hairtool.frozen.clump import ClumpWorkspace, clump, clump_reference
-from hairtool.frozen.spatial import pairs_within_reference
+from hairtool.frozen.spatial import NeighbourList, pairs_within_reference
 from hairtool.frozen.strand_clumps import auto_clump_radius
 from hairtool.groom import Groom
 from hairtool.io import read_groom
@@ -162,38 +160,44 @@ def test_equally_near_partners_go_to_the_lower_vertex_index():
         np.testing.assert_allclose(a.points, b.points, atol=1e-7)
 
 
-@pytest.mark.parametrize("name", ["sintel_hair", "ponytail_back"])
-@pytest.mark.parametrize("n_threads", [1, 2])
-def test_each_pair_computed_once_gives_the_bytes_of_each_pair_computed_twice(
-    grooms_dir, name, n_threads, monkeypatch
-):
-    """Dense lists take each pair's r and weight from one pass over the forward entries
-    (clump.HALF_FROM); that sums the same numbers in the same order as the kernel that computes
-    each pair from both ends, so the result is the same to the bit, ties to the lower index too."""
-    clump_module = importlib.import_module("hairtool.frozen.clump")  # (the package's name is the function)
-    g = read_groom(grooms_dir / f"{name}.tfx")
+def test_both_grids_lists_go_through_the_pair_arrays_to_the_twins_pulls(grooms_dir, monkeypatch):
+    """Every list takes each entry's r and weight from the pair arrays: the row grid's (a
+    backward entry reads its pair's forward one through the map) and the hashed grid's (whole
+    lists, no map, even in a workspace whose last list was a row grid's) give the numpy twin,
+    the same bytes at 1 and 2 threads, and ties to the lower vertex index (the other partner
+    moves points by ~2e-5)."""
+    g = read_groom(grooms_dir / "sintel_hair.tfx")
     h = auto_clump_radius(g)
+    want = clump_reference(g, h, 3, None, "printed", 3).points
+    build = NeighbourList.build
+    grid = {"dense": True}
+
+    def one_grid(self, points, strand, skip, radius, _pick=None):
+        build(self, points, strand, skip, radius, grid["dense"])
+
+    monkeypatch.setattr(NeighbourList, "build", one_grid)
     before = numba.get_num_threads()
-    numba.set_num_threads(min(n_threads, numba.config.NUMBA_NUM_THREADS))
     try:
-        out = {}
-        for half, threshold in ((True, 0.0), (False, np.inf)):
-            monkeypatch.setattr(clump_module, "HALF_FROM", threshold)
+        for n in (1, 2):
+            numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
             ws = ClumpWorkspace()
-            pts = clump_module.clump_points(g, h, 3, None, "printed", 3, ws, keep_lengths=True)
-            assert (ws.pair_buffers(ws.neighbours)[1].size > 0) == half
-            out[half] = (pts, ws.step, ws.mean_neighbours)
+            runs = []
+            for dense in (True, False):
+                grid["dense"] = dense
+                ws.invalidate()
+                runs.append(clump(g, h, 3, None, "printed", 3, ws).points)
+                assert ws.neighbours.dense == dense
+                np.testing.assert_allclose(runs[-1], want, atol=1e-5 * h)
+            if n == 1:
+                first = runs
+            else:
+                assert [r.tobytes() for r in runs] == [r.tobytes() for r in first]
     finally:
         numba.set_num_threads(before)
-    assert out[True][0].tobytes() == out[False][0].tobytes() and out[True][1:] == out[False][1:]
-    # and ties: strands through one point, every neighbour of a vertex equally near
-    pts = np.zeros((6, 3, 3))
-    pts[:, :, 1] = np.linspace(0.0, -1.0, 3)
-    pts[:, 1:, 0] = np.cos(np.arange(6) * np.pi / 3)[:, None] * 0.05
-    pts[:, 1:, 2] = np.sin(np.arange(6) * np.pi / 3)[:, None] * 0.05
-    tied = Groom(pts.reshape(-1, 3), np.full(6, 3))
-    runs = []
-    for threshold in (0.0, np.inf):
-        monkeypatch.setattr(clump_module, "HALF_FROM", threshold)
-        runs.append(clump_module.clump_points(tied, 0.3, 2, 0.01, "printed", 1).tobytes())
-    assert runs[0] == runs[1]
+    y = np.linspace(0.0, -1.0, 6)
+    strand = lambda x: np.column_stack([np.full(6, x), y, np.zeros(6)])  # noqa: E731
+    tied = Groom.from_strands([strand(0.0), strand(0.25), strand(-0.25), strand(0.45)])
+    for gap_mode in ("printed", "text"):
+        a = clump(tied, 0.4, 3, 0.05, gap_mode, seed=2)
+        b = clump_reference(tied, 0.4, 3, 0.05, gap_mode, seed=2)
+        np.testing.assert_allclose(a.points, b.points, atol=1e-7)

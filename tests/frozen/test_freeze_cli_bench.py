@@ -105,3 +105,16 @@ def test_bench_freeze_skips_the_reference_above_the_limit(capsys):
     )
     (row,) = json.loads(capsys.readouterr().out)
     assert row["reference_ms"] is None and row["pipeline_ms"] > 0
+
+
+def test_bench_freeze_takes_the_generated_shapes_by_name_and_size(capsys):
+    argv = ["bench", "freeze", "--json", "--sizes", "ponytail:40x8", "systems:30x6", "--repeat", "1"]
+    assert main([*argv, "--reference-limit", "0"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [(r["groom"], r["strands"], r["vertices"]) for r in rows] == [
+        ("ponytail 40x8", 40, 320),
+        ("systems 30x6", 30, 180),
+    ]
+    assert all(r["drag_ms"] >= 0 and r["crop_ms"] >= 0 and 0 < r["crop_strands"] <= 40 for r in rows)
+    assert main(["bench", "freeze", "--sizes", "curls:lots", "--repeat", "1"]) == 2
+    assert "sizes" in capsys.readouterr().err
