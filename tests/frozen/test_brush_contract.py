@@ -130,22 +130,7 @@ def state_of(pipe: FrozenPipeline) -> StrandState:
     return StrandState(pipe.locked, pipe.clump_strength, pipe.origin, pipe.selected, pipe.hidden)
 
 
-#: Found by this test: comb's kernel and its twin differ in the last bits where a faint sample's
-#: length restore cancels to ~1e-19 (strength 1e-5); pinned until the two agree there.
-_TWIN_PINNED = {
-    "comb": "comb's kernel and twin differ in the last bits of values the length restore cancels"
-}
-
-
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=_TWIN_PINNED[n]))
-        if n in _TWIN_PINNED
-        else n
-        for n in TWINNED
-    ],
-)
+@pytest.mark.parametrize("name", TWINNED)
 @SETTINGS
 @given(data=st.data())
 def test_a_brush_kernel_equals_its_numpy_twin_with_one_and_two_threads(name, data):
@@ -352,4 +337,3 @@ def test_a_log_whose_delete_rule_is_not_true_or_false_is_refused_naming_it(value
            "samples": [{"cursor": [0, 0, 0], "radius": 0.1, "strength": 1.0}]}  # fmt: skip
     with pytest.raises(ParameterError, match=r"params\.any_segment"):
         stroke_from_dict(raw).pipeline_samples(0.0)
-

@@ -13,6 +13,7 @@ from hairtool.frozen.brushes.falloff import EPS, weight, weights_reference
 from hairtool.frozen.brushes.sample import BrushSample
 from hairtool.frozen.brushes.spec import BrushSpec, StrandMove, Studio
 from hairtool.frozen.brushes.strand_moves import checked, moved_groom
+from hairtool.frozen.brushes.twin_math import norm3, running_sum
 from hairtool.groom import Groom
 
 SPEC = BrushSpec(
@@ -103,9 +104,8 @@ def comb_reference(
         if not np.any(wm[1:] != 0):
             continue
         q = p.copy()
-        seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
-        u = np.concatenate([[0.0], np.cumsum(seg)]) / max(seg.sum(), EPS)
-        u = np.where(seg.sum() > EPS, u, 0.0)
+        run = running_sum(norm3(np.diff(p, axis=0)))
+        u = run / run[-1] if run[-1] > EPS else np.zeros_like(run)
         q[1:] = p[1:] + (wm * u)[1:, None] * d
         out[o:e] = follow_lengths_reference(q, p)
     return moved_groom(groom, out)

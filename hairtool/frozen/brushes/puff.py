@@ -12,6 +12,7 @@ from hairtool.frozen.brushes.falloff import EPS, weight, weights_reference
 from hairtool.frozen.brushes.sample import BrushSample
 from hairtool.frozen.brushes.spec import BrushSpec, StrandMove, Studio
 from hairtool.frozen.brushes.strand_moves import checked, moved_groom
+from hairtool.frozen.brushes.twin_math import dot3, norm3
 from hairtool.groom import Groom
 
 F64 = NDArray[np.float64]
@@ -118,23 +119,23 @@ def puff_reference(groom: Groom, sample: BrushSample, locked: ArrayLike, centre:
 
 
 def _puff_reference(p: F64, w: float, centre: F64) -> F64:
+    """Numpy twin of :func:`_puff_strand` on one strand, in the kernel's order of operations."""
     n, t = p[0] - centre, p[1] - p[0]
-    if np.linalg.norm(n) < EPS or np.linalg.norm(t) < EPS:
+    nn, tn = norm3(n), norm3(t)
+    if nn < EPS or tn < EPS:
         return p
-    n, t = n / np.linalg.norm(n), t / np.linalg.norm(t)
+    n, t = n / nn, t / tn
     axis = np.cross(t, n)
-    sin_a = np.linalg.norm(axis)
+    sin_a = norm3(axis)
     if sin_a < 1e-9:
         return p
     axis /= sin_a
-    angle = w * np.arctan2(sin_a, float(t @ n))
-    v = p - p[0]
-    rotated = (
-        v * np.cos(angle)
-        + np.cross(axis, v) * np.sin(angle)
-        + axis * (v @ axis)[:, None] * (1.0 - np.cos(angle))
-    )
-    return p[0] + rotated
+    angle = w * np.arctan2(sin_a, dot3(t, n))
+    cs, sn = np.cos(angle), np.sin(angle)
+    v = p[1:] - p[0]
+    out = p.copy()
+    out[1:] = p[0] + v * cs + np.cross(axis, v) * sn + axis * dot3(v, axis)[:, None] * (1.0 - cs)
+    return out
 
 
 class Puff(StrandMove):
