@@ -149,27 +149,47 @@ class FrozenParams:
 Sample = AlignSample | BrushSample | SelectionSample
 
 
+NO_MEMORY: tuple[tuple, int, bool] = ((), 0, False)  # a stroke memory with nothing kept
+REPLAY = ("replay",)  # the frozen groom no pipeline has: a snapshot made on it is replayed
+
+
 @dataclass(frozen=True)
 class FrozenSnapshot:
-    """Undo/redo state: the stroke log and the stroked points it produced (shared, read-only),
-    the mask and the clump strengths it painted (None: replay the log to find them), the rest
-    strand of each stroked strand (None: every rest strand, in order), a snake hook's state, the
-    selected and hidden strands (None: replay the log to find them), and the result shown then
-    with the parameters it was clumped with (a brush-local move's result is not a full run's:
-    undo and redo bring back what was shown)."""
+    """Undo/redo state: the stroke log, the per-strand state and the stroked points it left
+    (shared, read-only), and the result shown then (a brush-local move's result is not a full
+    run's: undo and redo bring back what was shown; None: clump the stroked points again).
+
+    ``memory``: what a stroke-keeping brush held (a snake hook's hooks,
+    :meth:`~hairtool.frozen.brushes.spec.StrokeMemory.frozen`). ``frozen_on``: the frozen groom
+    the log was stroked on (its freeze key and noise draw): a pipeline whose frozen groom is
+    another replays the log instead (:data:`REPLAY`, :meth:`replaying`: always).
+    ``clumped_on``: the parameters ``result`` was clumped with (others: clumped again)."""
 
     log: tuple[Sample, ...]
+    state: StrandState
     aligned: Groom
-    freeze_key: tuple
-    draw: int
-    locked: np.ndarray | None = None
-    clump_strength: np.ndarray | None = None
-    origin: np.ndarray | None = None
-    hooks: tuple[tuple, int, bool] = ((), 0, False)
-    selected: np.ndarray | None = None
-    hidden: np.ndarray | None = None
     result: Groom | None = None
-    clump_key: tuple = ()
+    memory: tuple[tuple, int, bool] = NO_MEMORY
+    frozen_on: tuple = REPLAY
+    clumped_on: tuple = ()
+
+    @classmethod
+    def replaying(cls, log: Sequence[Sample], rest: Groom) -> FrozenSnapshot:
+        """The strokes ``log`` alone: restoring it replays them on the pipeline's frozen groom.
+
+        Parameters
+        ----------
+        log : sequence of samples
+            The stroke log.
+        rest : Groom
+            The rest groom of the pipeline it will be restored on.
+
+        Returns
+        -------
+        FrozenSnapshot
+            A snapshot that is always replayed.
+        """
+        return cls(tuple(log), StrandState.fresh(rest.strand_count), rest)
 
 
 class FrozenPipeline:
@@ -531,19 +551,14 @@ class FrozenPipeline:
         return self._result
 
     def snapshot(self) -> FrozenSnapshot:
-        """Cheap state for undo/redo (no copies: grooms are immutable)."""
+        """Cheap state for undo/redo (grooms are immutable; the per-strand arrays are copied)."""
         return FrozenSnapshot(
             tuple(self._log),
+            self._state.copy(),
             self._aligned,
-            self._freeze_key or (),
-            self._draw,
-            self._state.locked.copy(),
-            self._state.clump_strength.copy(),
-            self._state.origin.copy(),
-            self._hook_state(),
-            self._state.selected.copy(),
-            self._state.hidden.copy(),
             self._result,
+            self._hook_state(),
+            self._frozen_on(),
             self._params._key,
         )
 
@@ -560,39 +575,19 @@ class FrozenPipeline:
     def _restore(self, snapshot: FrozenSnapshot) -> Groom:
         self._log = list(snapshot.log)
         self._timings = dict.fromkeys(self._timings, 0.0)
-        if (
-            snapshot.freeze_key == self._freeze_key
-            and snapshot.draw == self._draw
-            and (
-                (
-                    snapshot.locked is not None
-                    and snapshot.clump_strength is not None
-                    and snapshot.selected is not None
-                    and snapshot.hidden is not None
-                )
-                or all(isinstance(s, AlignSample) for s in snapshot.log)
-            )
-        ):
+        if snapshot.frozen_on == self._frozen_on():
             aligned = snapshot.aligned
             if aligned.metadata is not self._rest.metadata:  # a relabelled rest (its up axis): its record
                 aligned = aligned.with_metadata(self._rest.metadata)
             self._aligned = aligned
-            n = aligned.strand_count
-            cs, o, sel, hid = snapshot.clump_strength, snapshot.origin, snapshot.selected, snapshot.hidden
-            self._state = StrandState(
-                np.zeros(n, bool) if snapshot.locked is None else snapshot.locked.copy(),
-                np.ones(n) if cs is None else cs.astype(np.float64),
-                np.arange(n, dtype=np.int64) if o is None else o.astype(np.int64),
-                np.ones(n, bool) if sel is None else sel.astype(bool),
-                np.zeros(n, bool) if hid is None else hid.astype(bool),
-            )
-            self._set_hooks(snapshot.hooks)
+            self._state = snapshot.state.copy()
+            self._set_hooks(snapshot.memory)
             shown = snapshot.result
         else:
             self._replay()
             shown = None
         self._reclump()
-        if shown is not None and snapshot.clump_key == self._params._key and self._local is not None:
+        if shown is not None and snapshot.clumped_on == self._params._key and self._local is not None:
             if shown.metadata is not self._rest.metadata:
                 shown = shown.with_metadata(self._rest.metadata)
             if (
@@ -630,6 +625,10 @@ class FrozenPipeline:
         self._replay()
         self._timings["align"] = (time.perf_counter() - t1) * 1e3
 
+    def _frozen_on(self) -> tuple:
+        """What :attr:`FrozenSnapshot.frozen_on` holds for the frozen groom now."""
+        return (self._freeze_key or (), self._draw)
+
     def _away(self, view: tuple[float, float, float] | None) -> np.ndarray | None:
         """The strands facing away from a sample's camera (None: no view, none)."""
         if check_view(view) is None:
@@ -638,7 +637,7 @@ class FrozenPipeline:
 
     def _clear_state(self) -> None:
         self._state = StrandState.fresh(self._rest.strand_count)
-        self._set_hooks(((), 0, False))
+        self._set_hooks(NO_MEMORY)
 
     def _hook_state(self) -> tuple[tuple, int, bool]:
         return self._memory.frozen()
@@ -648,7 +647,7 @@ class FrozenPipeline:
 
     def _apply(self, g: Groom, sample: Sample) -> Groom:
         if isinstance(sample, SelectionSample):
-            self._set_hooks(((), 0, False))
+            self._set_hooks(NO_MEMORY)
             away = self._away(sample.view)
             st = self._state
             selected, hidden = apply_selection(g, sample, st.selected, st.hidden, away)
@@ -656,7 +655,7 @@ class FrozenPipeline:
             return g
         brush = registry.brush_of(registry.name_of(sample))
         if not brush.spec.keeps_stroke:
-            self._set_hooks(((), 0, False))  # another brush ends a stroke-keeping brush's stroke
+            self._set_hooks(NO_MEMORY)  # another brush ends a stroke-keeping brush's stroke
         ctx = self._context(self._away(sample.view))
         out = brush.apply(ctx, g, sample)
         self._state = ctx.state
@@ -875,7 +874,7 @@ class FrozenPipeline:
             return np.zeros(0, np.int64)
         brush = registry.brush_of(registry.name_of(sample))
         if not brush.spec.keeps_stroke:
-            self._set_hooks(((), 0, False))  # another brush ends a stroke-keeping brush's stroke
+            self._set_hooks(NO_MEMORY)  # another brush ends a stroke-keeping brush's stroke
         brush.check(sample)
         reach = float(sample.radius) * (1.0 + 1e-6)  # a little wider: the brush itself decides
         near = local.near(self._grid_points, np.asarray(sample.cursor, np.float64).reshape(1, 3), reach)

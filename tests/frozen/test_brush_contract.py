@@ -30,7 +30,7 @@ from hairtool.frozen.brushes import (
 )
 from hairtool.frozen.brushes.align import AlignSample
 from hairtool.frozen.brushes.spec import Brush, StrokeContext, StrokeMemory
-from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.frozen.strand_state import StrandState
 from hairtool.frozen.strokes import read_strokes, strokes_from_log, write_strokes
 from hairtool.groom import Groom
@@ -244,15 +244,24 @@ def test_undo_brings_back_the_bytes_and_a_replay_gives_the_same_bytes(name, data
     if refused_or(pipe, stroke(name, data)) is None:
         return
     settled = pipe.settle()
+    stroked = pipe.snapshot()
+    assert same_state(stroked.state, state_of(pipe)) and stroked.log == pipe.strokes
     replay = FrozenPipeline(GROOM, PARAMS, SURFACE)
     replay.apply_samples(pipe.strokes, local=False)
     assert replay.aligned.points.tobytes() == pipe.aligned.points.tobytes()
     assert replay.result.points.tobytes() == settled.points.tobytes()
     assert same_state(state_of(replay), state_of(pipe))
+    logged = FrozenPipeline(GROOM, PARAMS, SURFACE)  # the log alone (a project's strokes)
+    logged.restore(FrozenSnapshot.replaying(pipe.strokes, GROOM))
+    assert logged.result.points.tobytes() == settled.points.tobytes()
+    assert same_state(state_of(logged), state_of(pipe))
     pipe.restore(snap)
     assert pipe.result.points.tobytes() == start.points.tobytes()
     assert pipe.strokes == ()
     assert same_state(state_of(pipe), StrandState.fresh(GROOM.strand_count))
+    pipe.restore(stroked)  # redo: the snapshot's state, untouched by the undo
+    assert pipe.result.points.tobytes() == settled.points.tobytes()
+    assert same_state(state_of(pipe), stroked.state) and pipe.strokes == stroked.log
 
 
 @pytest.mark.parametrize("name", NAMES)
