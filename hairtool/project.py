@@ -635,10 +635,7 @@ def load(path: str | os.PathLike[str]) -> Project:
     p = Path(path)
     if not p.is_file():
         raise FormatError(path, "no such file" if not p.exists() else "not a regular file")
-    try:
-        data = p.read_bytes()
-    except OSError as e:
-        raise FormatError(path, f"cannot read: {e}") from None
+    data = user_text.read_bytes(path, "a hairtool project", max_bytes=None)
     if not data:
         raise FormatError(path, "the file is empty")
     if not zipfile.is_zipfile(io.BytesIO(data)):
