@@ -43,6 +43,7 @@ from hairtool.frozen.brushes import BrushSample, check_pressure, check_sample, c
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.frozen.sample_columns import ColumnError, read_columns, write_columns
 from hairtool.frozen.selection import SelectionSample, check_selection
+from hairtool.frozen.strand_state import StrandState
 from hairtool.groom import Animation, Groom
 from hairtool.guides.binding import MAX_FRIZZ, ChildBinding, bind_exactly, curl
 from hairtool.io import user_text
@@ -130,8 +131,9 @@ class Project:
     def stroke_snapshot(self, pipeline: FrozenPipeline) -> FrozenSnapshot:
         """The stroke snapshot to ``restore`` on a pipeline built from this project's rest and params.
 
-        With ``aligned`` the snapshot matches the pipeline's fresh frozen state, so no stroke is
-        replayed; without it the log is replayed.
+        With ``aligned`` and only align strokes (which leave every strand's state as it was)
+        the snapshot matches the pipeline's fresh frozen state, so no stroke is replayed;
+        otherwise the log is replayed (it alone gives the per-strand state).
 
         Parameters
         ----------
@@ -143,10 +145,11 @@ class Project:
         FrozenSnapshot
             The snapshot to restore.
         """
+        if self.aligned is None or not all(isinstance(s, AlignSample) for s in self.strokes):
+            return FrozenSnapshot.replaying(self.strokes, pipeline.rest)
         current = pipeline.snapshot()
-        if self.aligned is None:
-            return FrozenSnapshot(self.strokes, pipeline.rest, ("replay",), -1)
-        return FrozenSnapshot(self.strokes, self.aligned, current.freeze_key, current.draw)
+        state = StrandState.fresh(self.aligned.strand_count)
+        return FrozenSnapshot(self.strokes, state, self.aligned, frozen_on=current.frozen_on)
 
     def pipeline(self) -> FrozenPipeline:
         """A pipeline in the saved state: rest, parameters and strokes."""
@@ -666,10 +669,7 @@ def load(path: str | os.PathLike[str]) -> Project:
     p = Path(path)
     if not p.is_file():
         raise FormatError(path, "no such file" if not p.exists() else "not a regular file")
-    try:
-        data = p.read_bytes()
-    except OSError as e:
-        raise FormatError(path, f"cannot read: {e}") from None
+    data = user_text.read_bytes(path, "a hairtool project", max_bytes=None)
     if not data:
         raise FormatError(path, "the file is empty")
     if not zipfile.is_zipfile(io.BytesIO(data)):

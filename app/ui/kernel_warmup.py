@@ -258,8 +258,9 @@ def _raster_step() -> None:
 
 def _brushes_step() -> None:
     from hairtool import samples
-    from hairtool.frozen.brushes import BrushSample, falloff_lut, registry
+    from hairtool.frozen.brushes import falloff_lut, registry
     from hairtool.frozen.pipeline import FrozenPipeline
+    from hairtool.frozen.sample_schema import BRUSH
 
     class Flat:  # a surface for slide: the plane through each point, facing up
         def project(self, points):
@@ -275,7 +276,10 @@ def _brushes_step() -> None:
             continue
         strength = -0.5 if spec.signed else 0.5
         radius = float(np.max(hi - lo)) * (0.05 if spec.changes_strands else 1.0)  # not every strand
-        pipe.brush(BrushSample(spec.name, centre, (1.0, 0.0, 0.0), radius, strength, lut, start=True))
+        pipe.brush(  # (a stroke's first sample: a snake hook hooks there)
+            BRUSH.make(brush=spec.name, cursor=centre, direction=(1.0, 0.0, 0.0), radius=radius,
+                       strength=strength, lut=lut, view=None, start=True)
+        )  # fmt: skip
 
     from hairtool.frozen.density import accept, thin
 

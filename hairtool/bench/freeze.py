@@ -149,7 +149,7 @@ def _drag_ms(pipe, path, radius: float) -> tuple[float, float, float]:
     def move():
         pipe.align(next(moves), radius, 0.8)
         redone.append(pipe.clump_redone)
-        local = pipe._local
+        local = pipe.local_clump
         lists.append(0.0 if local is None or pipe.clump_redone >= 1.0 else local.lists_ms)
 
     move()

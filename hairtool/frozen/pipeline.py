@@ -1,5 +1,10 @@
 """The interactive frozen-hair pipeline: FreezeDeform → UserAlign → ClumpWithGaps (Kim 2026).
 
+This module is the stage engine: it keeps the frozen groom, the stroked state and the result,
+and decides what to redo. A sample's effect and a log's replay are functions of explicit state
+in :mod:`hairtool.frozen.replay`; brush-local moves are :mod:`hairtool.frozen.local_moves`;
+strokes against the head are :mod:`hairtool.frozen.head_collision`.
+
 Built for dragging in the studio:
 
 - FreezeDeform always starts from the rest groom with noise hashed from (seed, strand, vertex),
@@ -12,12 +17,13 @@ Built for dragging in the studio:
 - The clump brush paints a per-strand clump strength (1 everywhere until painted), kept with the
   mask in the state and the snapshots, which ClumpWithGaps scales each strand's step by.
 - Clumping is recomputed from the aligned state at every update and never accumulates.
-- Brush-local moves (:mod:`hairtool.frozen.local`): a sample of align, comb, smooth, length,
-  puff, pinch, clump or mask runs only on the strands with a vertex within its radius (found in a
-  vertex grid kept across moves), and ClumpWithGaps and the length pass only on those it changed
-  and the strands within the clump kernel's reach of them; the rest of the groom is read, never
-  written, and keeps its last result bit for bit. The other brushes, parameter changes, undo and
-  replays run on the whole groom (a full run, after which the grid follows what moved).
+- Brush-local moves (:mod:`hairtool.frozen.local_moves`, :mod:`hairtool.frozen.local`): a
+  sample of align, comb, smooth, length, puff, pinch, clump or mask runs only on the strands
+  with a vertex within its radius (found in a vertex grid kept across moves), and
+  ClumpWithGaps and the length pass only on those it changed and the strands within the clump
+  kernel's reach of them; the rest of the groom is read, never written, and keeps its last
+  result bit for bit. The other brushes, parameter changes, undo and replays run on the whole
+  groom (a full run, after which the grid follows what moved).
 - Delete (:mod:`hairtool.frozen.brushes.delete`) changes the strands: a stage like the others, applied
   to the stroked state, which takes the kept strands with their mask and clump strength; the
   pipeline records the rest strand each remaining strand comes from (:attr:`FrozenPipeline.origin`),
@@ -47,13 +53,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from hairtool.errors import ParameterError
+from hairtool.frozen import local_moves
 from hairtool.frozen.align import check_align_params
-from hairtool.frozen.brushes import registry
 from hairtool.frozen.brushes.align import AlignSample
 from hairtool.frozen.brushes.sample import BrushSample, check_view
-from hairtool.frozen.brushes.scalp import facing_away, root_normals, scalp_centre
+from hairtool.frozen.brushes.scalp import root_normals, scalp_centre
 from hairtool.frozen.brushes.slide import Surface
-from hairtool.frozen.brushes.spec import StrokeContext, StrokeMemory
+from hairtool.frozen.brushes.spec import StrokeMemory
 from hairtool.frozen.clump import (
     ClumpWorkspace,
     check_clump_params,
@@ -63,14 +69,14 @@ from hairtool.frozen.clump import (
 )
 from hairtool.frozen.freeze import MAX_VARIATION, check_freeze_params, freeze, strand_multipliers
 from hairtool.frozen.head_collision import HeadCollision
-from hairtool.frozen.lengths import restore_lengths
-from hairtool.frozen.local import LocalClump, strands_differing, threads_for
-from hairtool.frozen.move_points import MovePoints, held_by_at_most, may_write
+from hairtool.frozen.local import LocalClump
+from hairtool.frozen.local_moves import ClumpRun, LocalMoves
+from hairtool.frozen.move_points import held_by_at_most, may_write
 from hairtool.frozen.noise import check_seed, draw_seed
-from hairtool.frozen.selection import SelectionSample, apply_selection
+from hairtool.frozen.replay import NO_MEMORY, Sample, StrokeSetting, apply_sample, replay
 from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
 from hairtool.frozen.strand_state import StrandState
-from hairtool.groom import Groom, vertex_ids_of
+from hairtool.groom import Groom
 
 PREPARED_REGION = 0.05  # of the vertices: the region lists' room :meth:`FrozenPipeline.prepare_strokes`
 # makes (the studio's brush on the bear: regions of 3-4 %)
@@ -146,30 +152,46 @@ class FrozenParams:
         return replace(self, **changes)
 
 
-Sample = AlignSample | BrushSample | SelectionSample
+REPLAY = ("replay",)  # the frozen groom no pipeline has: a snapshot made on it is replayed
 
 
 @dataclass(frozen=True)
 class FrozenSnapshot:
-    """Undo/redo state: the stroke log and the stroked points it produced (shared, read-only),
-    the mask and the clump strengths it painted (None: replay the log to find them), the rest
-    strand of each stroked strand (None: every rest strand, in order), a snake hook's state, the
-    selected and hidden strands (None: replay the log to find them), and the result shown then
-    with the parameters it was clumped with (a brush-local move's result is not a full run's:
-    undo and redo bring back what was shown)."""
+    """Undo/redo state: the stroke log, the per-strand state and the stroked points it left
+    (shared, read-only), and the result shown then (a brush-local move's result is not a full
+    run's: undo and redo bring back what was shown; None: clump the stroked points again).
+
+    ``memory``: what a stroke-keeping brush held (a snake hook's hooks,
+    :meth:`~hairtool.frozen.brushes.spec.StrokeMemory.frozen`). ``frozen_on``: the frozen groom
+    the log was stroked on (its freeze key and noise draw): a pipeline whose frozen groom is
+    another replays the log instead (:data:`REPLAY`, :meth:`replaying`: always).
+    ``clumped_on``: the parameters ``result`` was clumped with (others: clumped again)."""
 
     log: tuple[Sample, ...]
+    state: StrandState
     aligned: Groom
-    freeze_key: tuple
-    draw: int
-    locked: np.ndarray | None = None
-    clump_strength: np.ndarray | None = None
-    origin: np.ndarray | None = None
-    hooks: tuple[tuple, int, bool] = ((), 0, False)
-    selected: np.ndarray | None = None
-    hidden: np.ndarray | None = None
     result: Groom | None = None
-    clump_key: tuple = ()
+    memory: tuple[tuple, int, bool] = NO_MEMORY
+    frozen_on: tuple = REPLAY
+    clumped_on: tuple = ()
+
+    @classmethod
+    def replaying(cls, log: Sequence[Sample], rest: Groom) -> FrozenSnapshot:
+        """The strokes ``log`` alone: restoring it replays them on the pipeline's frozen groom.
+
+        Parameters
+        ----------
+        log : sequence of samples
+            The stroke log.
+        rest : Groom
+            The rest groom of the pipeline it will be restored on.
+
+        Returns
+        -------
+        FrozenSnapshot
+            A snapshot that is always replayed.
+        """
+        return cls(tuple(log), StrandState.fresh(rest.strand_count), rest)
 
 
 class FrozenPipeline:
@@ -207,11 +229,7 @@ class FrozenPipeline:
         self._draw = 0
         self._workspace = ClumpWorkspace()
         self._workspace.record = True  # the record brush-local moves update
-        self._local: LocalClump | None = None  # brush-local state after a full, recorded run
-        self._grid_points: np.ndarray | None = None  # the clump input the grid holds
-        self._sv = np.zeros(0)  # (V,) clump strength per vertex of that input
-        self._kept = np.zeros((0, 3), np.float32)  # the last result's points, writable
-        self._nonplanar = 0  # vertices of the stroked state off z = 0
+        self._moves = LocalMoves()  # what brush-local moves start from (after a full, recorded run)
         self._redone = 1.0  # share of the vertices the last clumping computed
         self._region: np.ndarray | None = None  # strands the last update redid (None: all)
         self._unsettled = False  # brush-local moves since the last full run
@@ -289,15 +307,7 @@ class FrozenPipeline:
     def strand_normals(self) -> np.ndarray:
         """``(S', 3)`` :attr:`root_normals` of the strands of the stroked state and the result
         (a planted strand's: the surface normal at its root)."""
-        n = self.root_normals
-        origin = self._state.origin
-        if len(origin) == len(n) and origin.min(initial=0) >= 0:
-            return n  # (deletes keep the order, plants come last: this is every rest strand)
-        out = n[np.maximum(origin, 0)]
-        new = origin < 0
-        if new.any():
-            _, out[new] = self._surface.project(self._aligned.roots[new].astype(np.float64))  # type: ignore[union-attr]
-        return out
+        return self._setting().strand_normals(self._aligned, self._state)
 
     @property
     def scalp_centre(self) -> np.ndarray:
@@ -364,6 +374,12 @@ class FrozenPipeline:
         """Sorted ids of the strands of the result the last update may have changed (a brush-local
         move's region; the others keep their points bit for bit), or None: any strand (a full run)."""
         return None if self._region is None else self._region.copy()
+
+    @property
+    def local_clump(self) -> LocalClump | None:
+        """The brush-local clumping the next move starts from (:class:`~hairtool.frozen.local.LocalClump`:
+        its grid, record and list timings), or None where the next move runs in full."""
+        return self._moves.clump
 
     @property
     def mean_neighbours(self) -> float:
@@ -477,21 +493,25 @@ class FrozenPipeline:
             A sample is refused; none of ``samples`` is applied or logged.
         """
         self._timings = dict.fromkeys(self._timings, 0.0)
-        if local and samples and self._local_ready(samples):
+        if (
+            local
+            and samples
+            and local_moves.ready(
+                self._moves, self._aligned, samples, self._workspace.recorded, self._local_key
+            )
+        ):
             return self._apply_local(samples)
         t0 = time.perf_counter()
-        before = (self._aligned, self._state, len(self._log))
         hooks = self._hook_state()
+        setting, g, state, memory = self._setting(), self._aligned, self._state, self._memory
         try:
             for sample in samples:
-                self._aligned = self._apply(self._aligned, sample)
-                self._log.append(sample)
+                g, state, memory = apply_sample(setting, g, state, memory, sample)
         except BaseException:  # a refused sample: none of these samples happened
-            self._aligned = before[0]
-            self._state = before[1]
             self._set_hooks(hooks)
-            del self._log[before[-1] :]
             raise
+        self._aligned, self._state, self._memory = g, state, memory
+        self._log.extend(samples)
         self._timings["align"] = (time.perf_counter() - t0) * 1e3
         self._reclump()
         return self._result
@@ -531,19 +551,14 @@ class FrozenPipeline:
         return self._result
 
     def snapshot(self) -> FrozenSnapshot:
-        """Cheap state for undo/redo (no copies: grooms are immutable)."""
+        """Cheap state for undo/redo (grooms are immutable; the per-strand arrays are copied)."""
         return FrozenSnapshot(
             tuple(self._log),
+            self._state.copy(),
             self._aligned,
-            self._freeze_key or (),
-            self._draw,
-            self._state.locked.copy(),
-            self._state.clump_strength.copy(),
-            self._state.origin.copy(),
-            self._hook_state(),
-            self._state.selected.copy(),
-            self._state.hidden.copy(),
             self._result,
+            self._hook_state(),
+            self._frozen_on(),
             self._params._key,
         )
 
@@ -560,39 +575,19 @@ class FrozenPipeline:
     def _restore(self, snapshot: FrozenSnapshot) -> Groom:
         self._log = list(snapshot.log)
         self._timings = dict.fromkeys(self._timings, 0.0)
-        if (
-            snapshot.freeze_key == self._freeze_key
-            and snapshot.draw == self._draw
-            and (
-                (
-                    snapshot.locked is not None
-                    and snapshot.clump_strength is not None
-                    and snapshot.selected is not None
-                    and snapshot.hidden is not None
-                )
-                or all(isinstance(s, AlignSample) for s in snapshot.log)
-            )
-        ):
+        if snapshot.frozen_on == self._frozen_on():
             aligned = snapshot.aligned
             if aligned.metadata is not self._rest.metadata:  # a relabelled rest (its up axis): its record
                 aligned = aligned.with_metadata(self._rest.metadata)
             self._aligned = aligned
-            n = aligned.strand_count
-            cs, o, sel, hid = snapshot.clump_strength, snapshot.origin, snapshot.selected, snapshot.hidden
-            self._state = StrandState(
-                np.zeros(n, bool) if snapshot.locked is None else snapshot.locked.copy(),
-                np.ones(n) if cs is None else cs.astype(np.float64),
-                np.arange(n, dtype=np.int64) if o is None else o.astype(np.int64),
-                np.ones(n, bool) if sel is None else sel.astype(bool),
-                np.zeros(n, bool) if hid is None else hid.astype(bool),
-            )
-            self._set_hooks(snapshot.hooks)
+            self._state = snapshot.state.copy()
+            self._set_hooks(snapshot.memory)
             shown = snapshot.result
         else:
             self._replay()
             shown = None
         self._reclump()
-        if shown is not None and snapshot.clump_key == self._params._key and self._local is not None:
+        if shown is not None and snapshot.clumped_on == self._params._key and self._moves.clump is not None:
             if shown.metadata is not self._rest.metadata:
                 shown = shown.with_metadata(self._rest.metadata)
             if (
@@ -601,7 +596,7 @@ class FrozenPipeline:
             ):
                 # What was shown (the record is the full run's: later moves hold the rest to it).
                 self._result = self._aligned.with_points(shown.points)
-                self._kept = self._result.points.copy()
+                self._moves.kept = self._result.points.copy()
         return self._result
 
     def clump_ids(self) -> np.ndarray:
@@ -630,15 +625,13 @@ class FrozenPipeline:
         self._replay()
         self._timings["align"] = (time.perf_counter() - t1) * 1e3
 
-    def _away(self, view: tuple[float, float, float] | None) -> np.ndarray | None:
-        """The strands facing away from a sample's camera (None: no view, none)."""
-        if check_view(view) is None:
-            return None
-        return facing_away(self.strand_normals, view)
+    def _frozen_on(self) -> tuple:
+        """What :attr:`FrozenSnapshot.frozen_on` holds for the frozen groom now."""
+        return (self._freeze_key or (), self._draw)
 
     def _clear_state(self) -> None:
         self._state = StrandState.fresh(self._rest.strand_count)
-        self._set_hooks(((), 0, False))
+        self._set_hooks(NO_MEMORY)
 
     def _hook_state(self) -> tuple[tuple, int, bool]:
         return self._memory.frozen()
@@ -646,41 +639,15 @@ class FrozenPipeline:
     def _set_hooks(self, state: tuple[tuple, int, bool]) -> None:
         self._memory = StrokeMemory.of(state)
 
-    def _apply(self, g: Groom, sample: Sample) -> Groom:
-        if isinstance(sample, SelectionSample):
-            self._set_hooks(((), 0, False))
-            away = self._away(sample.view)
-            st = self._state
-            selected, hidden = apply_selection(g, sample, st.selected, st.hidden, away)
-            self._state = st.with_(selected=selected, hidden=hidden)
-            return g
-        brush = registry.brush_of(registry.name_of(sample))
-        if not brush.spec.keeps_stroke:
-            self._set_hooks(((), 0, False))  # another brush ends a stroke-keeping brush's stroke
-        ctx = self._context(self._away(sample.view))
-        out = brush.apply(ctx, g, sample)
-        self._state = ctx.state
-        if brush.spec.moves_points and sample.collide:
-            out = self._collision.collide(self._surface, g, out)
-        return out
-
-    def _context(self, away: np.ndarray | None, state: StrandState | None = None, planar: bool | None = None):
-        """What a sample works with (:class:`~hairtool.frozen.brushes.spec.StrokeContext`): the
-        pipeline's per-strand state (or ``state``), its surface, scalp centre and stroke memory."""
-        return StrokeContext(
-            self._state if state is None else state,
-            away,
-            self._surface,
-            lambda: self.scalp_centre,
-            self._memory,
-            planar,
+    def _setting(self) -> StrokeSetting:
+        """What a sample reads besides the stroked state (:mod:`hairtool.frozen.replay`)."""
+        return StrokeSetting(
+            lambda: self.root_normals, lambda: self.scalp_centre, self._surface, self._collision
         )
 
     def _replay(self) -> None:
-        self._aligned = self._frozen
-        self._clear_state()
-        for s in self._log:  # (the stroked state so far: planted strands' normals come from it)
-            self._aligned = self._apply(self._aligned, s)
+        """The log on the frozen groom (a refused sample leaves the stroked state as it was)."""
+        self._aligned, self._state, self._memory = replay(self._setting(), self._frozen, self._log)
 
     def _reclump(self) -> None:
         """A full run on the stroked state (recorded: brush-local moves start from it)."""
@@ -707,27 +674,28 @@ class FrozenPipeline:
             rec = ws.recorded
             key = record_key(g, h, p.clump_iterations, step, p.gap_mode, seed)
             if g.strand_count >= 2 and rec is not None and rec.valid and rec.key == key:
-                local = self._local
+                moves = self._moves
+                local = moves.clump
                 if (
                     local is not None
                     and local.topology is g.topology
                     and local.h == h
                     and local.record is rec
                 ):
-                    local.resync(g.points, self._grid_points)  # the grid follows what moved
+                    local.resync(g.points, moves.grid_points)  # the grid follows what moved
                 else:
                     longest = int(ws.neighbours.cnt.max(initial=0))
-                    self._local = LocalClump(g.points, g.topology, h, rec, longest)
-                self._grid_points = g.points
-                self._sv = vertex_strength(g, self._state.clump_strength)
-                self._kept = pts
-                self._nonplanar = int(np.count_nonzero(g.points[:, 2]))
+                    moves.clump = LocalClump(g.points, g.topology, h, rec, longest)
+                moves.grid_points = g.points
+                moves.sv = vertex_strength(g, self._state.clump_strength)
+                moves.kept = pts
+                moves.nonplanar = int(np.count_nonzero(g.points[:, 2]))
             else:
-                self._local = None
+                self._moves.clump = None
         else:
             self._workspace.mean_neighbours = 0.0
             self._result = g
-            self._local = None
+            self._moves.clump = None
         self._timings["clump"] = (time.perf_counter() - t0) * 1e3
         self._timings["total"] = self._timings["freeze"] + self._timings["align"] + self._timings["clump"]
 
@@ -737,8 +705,8 @@ class FrozenPipeline:
         region of ``region_share`` of the vertices, and (up to :data:`PREPARED_HEAD` vertices)
         each point's distance to the head, which keeping strokes out of it reads."""
         _ = self.root_normals, self.scalp_centre
-        if self._local is not None:
-            self._local.grid.prepare(int(region_share * self._aligned.vertex_count))
+        if self._moves.clump is not None:
+            self._moves.clump.grid.prepare(int(region_share * self._aligned.vertex_count))
         if self._aligned.vertex_count <= PREPARED_HEAD:
             self._collision.remember(
                 self._surface, self._aligned, self._result
@@ -748,168 +716,58 @@ class FrozenPipeline:
         """The clumped result kept out of the head where strokes collide with it."""
         return self._collision.kept_out(self._surface, self._log, self._aligned, clumped)
 
-    # -- brush-local moves (hairtool.frozen.local) ---------------------------------------
-    def _local_ready(self, samples: Sequence[Sample]) -> bool:
-        """Whether these samples can run on the strands under their brushes only."""
-        local, p = self._local, self._params
-        if local is None or self._grid_points is None or local.topology is not self._aligned.topology:
-            return False
-        if not all(
-            isinstance(s, SelectionSample) or registry.spec_of(registry.name_of(s)).local for s in samples
-        ):
-            return False
-        rec = self._workspace.recorded
+    # -- brush-local moves (hairtool.frozen.local_moves) ---------------------------------
+    def _local_key(self) -> tuple | None:
+        """The record key a full run would have now (None: no step known without one)."""
+        p = self._params
         h, seed = self.clump_radius, draw_seed(p.seed, self._draw)
         if self._auto_step is None and p.clump_step is None:
-            return False
-        step = self._step()
-        return (
-            rec is local.record
-            and rec.valid
-            and rec.key == record_key(self._aligned, h, p.clump_iterations, step, p.gap_mode, seed)
-        )
+            return None
+        return record_key(self._aligned, h, p.clump_iterations, self._step(), p.gap_mode, seed)
 
     def _owns_aligned(self) -> bool:
         """Whether the aligned groom and its points are held by the pipeline alone (as the
         grid's points too), so a move may write into them (:mod:`hairtool.frozen.move_points`).
         (Read before any local name holds them.)"""
         return (
-            self._grid_points is self._aligned.points
+            self._moves.grid_points is self._aligned.points
             and may_write(self._aligned.points)
             and held_by_at_most(sys.getrefcount(self._aligned), 1)
             and held_by_at_most(sys.getrefcount(self._aligned.points), 2)
         )
 
-    def _kept_writable(self) -> None:
-        """``_kept`` (the result's points as the moves leave them) ready for a move's rows: the
-        result handed out over it is written in place where the pipeline alone holds it, and
-        copied first where anything else does."""
-        if self._kept.flags.writeable:
-            return
-        if self._result.points is self._kept:
-            mine = held_by_at_most(sys.getrefcount(self._result), 1) and held_by_at_most(
-                sys.getrefcount(self._kept), 2
-            )
-        else:
-            mine = held_by_at_most(sys.getrefcount(self._kept), 1)
-        if mine and may_write(self._kept):
-            self._kept.flags.writeable = True
-        else:
-            self._kept = self._kept.copy()
-
     def _apply_local(self, samples: Sequence[Sample]) -> Groom:
+        """``samples`` as a brush-local move (:func:`~hairtool.frozen.local_moves.move`)."""
         t0 = time.perf_counter()
         in_place = self._owns_aligned()
-        g, top, local = self._aligned, self._aligned.topology, self._local
-        assert local is not None and self._grid_points is not None
-        cur = MovePoints(self._grid_points, in_place)
-        state = (self._state, self._hook_state())
-        touched = np.zeros(g.strand_count, bool)  # strands a sample of this batch ran on
-        painted = np.zeros(0, np.int64)  # strands whose clump strength changed
-        planar = self._nonplanar == 0
+        on_kept = self._result.points is self._moves.kept
+        alone = held_by_at_most(sys.getrefcount(self._result), 1)  # (read before a name holds it)
+        p = self._params
+        run = ClumpRun(
+            p.clump_iterations, self._step(), p.gap_mode, draw_seed(p.seed, self._draw), p.keep_lengths
+        )
+        hooks = self._hook_state()
         try:
-            for sample in samples:
-                painted = np.union1d(painted, self._local_sample(cur, sample, touched, planar))
+            moved = local_moves.move(
+                self._moves, self._setting(), self._aligned, self._state, self._memory, samples,
+                run, in_place, on_kept, alone,
+            )  # fmt: skip
         except BaseException:  # a refused sample: none of these samples happened
-            cur.undo()
-            self._state = state[0]
-            self._set_hooks(state[1])
+            self._set_hooks(hooks)
             raise
-        cur.done()
         self._log.extend(samples)
-        ran = np.flatnonzero(touched)
-        rv = vertex_ids_of(top, ran)
-        moved = strands_differing(cur.before(rv), cur.points[rv], top.counts[ran], ran)
-        seeds = np.union1d(moved, painted)
-        if moved.size:
-            mv = vertex_ids_of(top, moved)
-            was = cur.before(mv)
-            self._nonplanar += int(np.count_nonzero(cur.points[mv, 2])) - int(np.count_nonzero(was[:, 2]))
-            self._aligned = g.with_moved_rows(cur.points, mv)  # (the pipeline's own: a copy, or its last)
-        t1 = time.perf_counter()
-        self._timings["align"] = (t1 - t0) * 1e3
-        if seeds.size == 0:
-            local.lists_ms = 0.0
-            self._redone, self._region = 0.0, seeds
+        self._aligned, self._state, self._memory = moved.aligned, moved.state, moved.memory
+        self._timings["align"] = moved.align_ms
+        if moved.full:
+            self._reclump()
+        elif moved.clumped is not None:
+            self._unsettled = True
+            self._result = self._kept_out(moved.clumped)
+            self._redone, self._region = moved.redone, moved.region
+        else:
+            self._redone, self._region = 0.0, moved.region
             self._timings["total"] = self._timings["align"]
             return self._result
-        p = self._params
-        sv = self._sv
-        if painted.size:
-            pv = vertex_ids_of(top, painted)
-            sv[pv] = self._state.clump_strength[top.strand_index[pv]]
-        now = self._aligned.points
-        seed_ = draw_seed(p.seed, self._draw)
-        was = cur.before(vertex_ids_of(top, seeds))
-        done = local.update(was, now, seeds, sv, p.clump_iterations, self._step(), p.gap_mode, seed_)
-        if done is None:  # most of the groom: a full run costs less
-            self._reclump()
-            self._timings["clump"] = (time.perf_counter() - t1) * 1e3
-            self._timings["total"] = self._timings["align"] + self._timings["clump"]
-            return self._result
-        region, vids = done
-        self._unsettled = True
-        rec = local.record
-        self._kept_writable()
-        if p.keep_lengths:
-            restore_lengths(now, rec.result, top, region, self._kept)
-            still = vids[sv[vids] == 0.0]
-            self._kept[still] = now[still]
-        else:
-            self._kept[vids] = rec.result[vids]
-        self._grid_points = now
-        self._result = self._kept_out(self._aligned.with_moved_rows(self._kept, vids))  # (new: the region)
-        self._redone, self._region = vids.size / max(top.vertex_count, 1), region
-        self._timings["clump"] = (time.perf_counter() - t1) * 1e3
+        self._timings["clump"] = (time.perf_counter() - t0) * 1e3 - moved.align_ms
         self._timings["total"] = self._timings["align"] + self._timings["clump"]
         return self._result
-
-    def _local_sample(self, cur: MovePoints, sample: Sample, touched: np.ndarray, planar: bool) -> np.ndarray:
-        """One sample on the strands with a vertex within its radius (where the grid holds the
-        unmoved ones) and those this batch has moved, written into ``cur``; returns the strands
-        whose clump strength it changed."""
-        local, top = self._local, self._aligned.topology
-        assert local is not None and self._grid_points is not None
-        if isinstance(sample, SelectionSample):  # no strand moves: on the whole groom
-            self._apply(self._aligned.with_points(cur.points), sample)
-            return np.zeros(0, np.int64)
-        brush = registry.brush_of(registry.name_of(sample))
-        if not brush.spec.keeps_stroke:
-            self._set_hooks(((), 0, False))  # another brush ends a stroke-keeping brush's stroke
-        brush.check(sample)
-        reach = float(sample.radius) * (1.0 + 1e-6)  # a little wider: the brush itself decides
-        near = local.near(self._grid_points, np.asarray(sample.cursor, np.float64).reshape(1, 3), reach)
-        cand = np.union1d(near, np.flatnonzero(touched))
-        none = np.zeros(0, np.int64)
-        if cand.size == 0:
-            return none
-        vids = vertex_ids_of(top, cand)
-        with threads_for(vids.size):
-            meta = self._aligned.metadata.subset(cand)  # (in the scene's frame; its prims' share)
-            sub = Groom(cur.points[vids], top.counts[cand], metadata=meta)
-            out, painted = self._local_brush(brush, sub, cand, sample, planar)
-        if out is not None:
-            cur.write(vids, out.points)
-            touched[cand] = True
-        return painted
-
-    def _local_brush(
-        self, brush, sub: Groom, cand: np.ndarray, sample: Sample, planar: bool
-    ) -> tuple[Groom | None, np.ndarray]:
-        """One sample on the groom ``sub`` of the strands ``cand``, their state taken out and
-        written back: (the moved strands, or None for a brush that moves none; the strands
-        whose clump strength it changed)."""
-        away = (
-            None if check_view(sample.view) is None else facing_away(self.strand_normals[cand], sample.view)
-        )
-        was = self._state.subset(cand)
-        ctx = self._context(away, was, planar)
-        out = brush.apply(ctx, sub, sample)
-        self._state = self._state.scatter(cand, ctx.state, was)
-        now = ctx.state.clump_strength
-        painted = cand[now != was.clump_strength] if now is not was.clump_strength else np.zeros(0, np.int64)
-        if not brush.spec.moves_points:
-            return None, painted
-        if sample.collide:
-            out = self._collision.collide(self._surface, sub, out)
-        return out, painted

@@ -124,9 +124,49 @@ def _check_string(source, where: str, s: object, kind: str) -> None:
         )
 
 
+def read_bytes(path: str | os.PathLike[str], what: str, max_bytes: int | None = MAX_BYTES) -> bytes:
+    """A regular file's bytes, or a :class:`FormatError` naming it: the one way a reader of a
+    user's file opens it (a FIFO or a device is refused before it is opened for reading, so it
+    cannot block; an unreadable file is refused with the system's reason).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    what : str
+        What the file should be, for the refusal ("a stroke log").
+    max_bytes : int or None
+        The largest file read (None: any size).
+
+    Returns
+    -------
+    bytes
+        The file's contents.
+
+    Raises
+    ------
+    FormatError
+        Not a regular file, too large, or unreadable; the message names the file.
+    """
+    p = os.fspath(path)
+    limit = -1 if max_bytes is None else max_bytes + 1
+    try:
+        st = os.stat(p)
+        if not stat.S_ISREG(st.st_mode):
+            raise FormatError(p, f"not a regular file, so not {what}")
+        if max_bytes is not None and st.st_size > max_bytes:
+            raise FormatError(p, f"{st.st_size} bytes; {what} is at most {max_bytes >> 20} MB")
+        with open(p, "rb") as f:
+            raw = f.read(limit)
+    except OSError as e:
+        raise FormatError(p, f"cannot read: {e.strerror or e}") from None
+    if max_bytes is not None and len(raw) > max_bytes:  # grew since the stat
+        raise FormatError(p, f"more than {max_bytes >> 20} MB; {what} is at most that")
+    return raw
+
+
 def read_text(path: str | os.PathLike[str], what: str, max_bytes: int = MAX_BYTES) -> str:
-    """A regular file's UTF-8 text, at most ``max_bytes`` long (a FIFO or a device is refused
-    before it is opened for reading, so it cannot block).
+    """A regular file's UTF-8 text, at most ``max_bytes`` long (:func:`read_bytes`).
 
     Parameters
     ----------
@@ -142,23 +182,11 @@ def read_text(path: str | os.PathLike[str], what: str, max_bytes: int = MAX_BYTE
     str
         Its text.
     """
-    p = os.fspath(path)
-    try:
-        st = os.stat(p)
-        if not stat.S_ISREG(st.st_mode):
-            raise FormatError(p, f"not a regular file, so not {what}")
-        if st.st_size > max_bytes:
-            raise FormatError(p, f"{st.st_size} bytes; {what} is at most {max_bytes >> 20} MB")
-        with open(p, "rb") as f:
-            raw = f.read(max_bytes + 1)
-    except OSError as e:
-        raise FormatError(p, f"cannot read: {e.strerror or e}") from None
-    if len(raw) > max_bytes:  # grew since the stat
-        raise FormatError(p, f"more than {max_bytes >> 20} MB; {what} is at most that")
+    raw = read_bytes(path, what, max_bytes)
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as e:
-        raise FormatError(p, f"not UTF-8 text (byte {e.start})") from None
+        raise FormatError(os.fspath(path), f"not UTF-8 text (byte {e.start})") from None
 
 
 def read(

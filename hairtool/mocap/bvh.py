@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool import budget
 from hairtool.errors import FormatError, ParameterError, quoted
+from hairtool.io import user_text
 from hairtool.io.atomic import atomic_open
 from hairtool.mocap import quaternion as quat
 
@@ -385,11 +386,7 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
         The file is missing, malformed or truncated; the message names the file.
     """
     p = os.fspath(path)
-    try:
-        with open(p, "rb") as f:
-            raw = f.read()
-    except OSError as e:
-        raise FormatError(p, f"cannot read: {e.strerror or e}") from None
+    raw = user_text.read_bytes(p, "a BVH file", max_bytes=None)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:

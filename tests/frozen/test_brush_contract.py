@@ -30,7 +30,7 @@ from hairtool.frozen.brushes import (
 )
 from hairtool.frozen.brushes.align import AlignSample
 from hairtool.frozen.brushes.spec import Brush, StrokeContext, StrokeMemory
-from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.frozen.strand_state import StrandState
 from hairtool.frozen.strokes import read_strokes, strokes_from_log, write_strokes
 from hairtool.groom import Groom
@@ -130,22 +130,7 @@ def state_of(pipe: FrozenPipeline) -> StrandState:
     return StrandState(pipe.locked, pipe.clump_strength, pipe.origin, pipe.selected, pipe.hidden)
 
 
-#: Found by this test: comb's kernel and its twin differ in the last bits where a faint sample's
-#: length restore cancels to ~1e-19 (strength 1e-5); pinned until the two agree there.
-_TWIN_PINNED = {
-    "comb": "comb's kernel and twin differ in the last bits of values the length restore cancels"
-}
-
-
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=_TWIN_PINNED[n]))
-        if n in _TWIN_PINNED
-        else n
-        for n in TWINNED
-    ],
-)
+@pytest.mark.parametrize("name", TWINNED)
 @SETTINGS
 @given(data=st.data())
 def test_a_brush_kernel_equals_its_numpy_twin_with_one_and_two_threads(name, data):
@@ -259,15 +244,24 @@ def test_undo_brings_back_the_bytes_and_a_replay_gives_the_same_bytes(name, data
     if refused_or(pipe, stroke(name, data)) is None:
         return
     settled = pipe.settle()
+    stroked = pipe.snapshot()
+    assert same_state(stroked.state, state_of(pipe)) and stroked.log == pipe.strokes
     replay = FrozenPipeline(GROOM, PARAMS, SURFACE)
     replay.apply_samples(pipe.strokes, local=False)
     assert replay.aligned.points.tobytes() == pipe.aligned.points.tobytes()
     assert replay.result.points.tobytes() == settled.points.tobytes()
     assert same_state(state_of(replay), state_of(pipe))
+    logged = FrozenPipeline(GROOM, PARAMS, SURFACE)  # the log alone (a project's strokes)
+    logged.restore(FrozenSnapshot.replaying(pipe.strokes, GROOM))
+    assert logged.result.points.tobytes() == settled.points.tobytes()
+    assert same_state(state_of(logged), state_of(pipe))
     pipe.restore(snap)
     assert pipe.result.points.tobytes() == start.points.tobytes()
     assert pipe.strokes == ()
     assert same_state(state_of(pipe), StrandState.fresh(GROOM.strand_count))
+    pipe.restore(stroked)  # redo: the snapshot's state, untouched by the undo
+    assert pipe.result.points.tobytes() == settled.points.tobytes()
+    assert same_state(state_of(pipe), stroked.state) and pipe.strokes == stroked.log
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -352,4 +346,3 @@ def test_a_log_whose_delete_rule_is_not_true_or_false_is_refused_naming_it(value
            "samples": [{"cursor": [0, 0, 0], "radius": 0.1, "strength": 1.0}]}  # fmt: skip
     with pytest.raises(ParameterError, match=r"params\.any_segment"):
         stroke_from_dict(raw).pipeline_samples(0.0)
-

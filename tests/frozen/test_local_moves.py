@@ -236,7 +236,7 @@ def test_a_drag_on_dense_hair_equals_its_numpy_twin_and_leaves_the_rest_alone(ke
         outside[inside] = False
         assert same_bytes(out.points[outside], shown[outside])
         # Everything the move reaches within h·1.1 is in the region.
-        moved = np.flatnonzero(np.any(pipe.aligned.points != pipe._local.record.points, axis=1))
+        moved = np.flatnonzero(np.any(pipe.aligned.points != pipe.local_clump.record.points, axis=1))
         assert moved.size == 0  # (the record holds this input)
     assert local_moves >= 3
 
@@ -298,12 +298,12 @@ def test_the_region_lists_have_room_for_the_full_runs_longest_list_from_the_firs
     vertex used to pay twice (80 ms against 35 on the bear)."""
     g = bundles(spacing=0.6, per_side=8)  # dense bundles: every vertex has many neighbours
     pipe = FrozenPipeline(g, FrozenParams(clump_radius=1.0))
-    grid, longest = pipe._local.grid, int(pipe._workspace.neighbours.cnt.max())
+    grid, longest = pipe.local_clump.grid, int(pipe._workspace.neighbours.cnt.max())
     assert longest > 0 and grid.capacity > longest + 1
     before = grid.capacity
     ids = np.arange(g.vertex_count)
-    held = pipe._grid_points  # the points the grid and the full run's list were made of
-    _, cnt, _ = grid.lists(held, ids, pipe._local.radius, list_frame(held, pipe._local.radius))
+    held = pipe._moves.grid_points  # the points the grid and the full run's list were made of
+    _, cnt, _ = grid.lists(held, ids, pipe.local_clump.radius, list_frame(held, pipe.local_clump.radius))
     assert int(cnt.max()) == longest and grid.capacity == before
 
 
@@ -313,7 +313,7 @@ def test_strokes_prepared_ahead_give_the_same_bytes_and_the_first_move_uses_the_
     g = bundles(3.0)
     plain, prepared = (FrozenPipeline(g, FrozenParams(clump_radius=1.0, keep_lengths=True)) for _ in range(2))
     prepared.prepare_strokes(region_share=0.5)
-    grid = prepared._local.grid
+    grid = prepared.local_clump.grid
     room = grid._flat
     assert room.size >= 0.5 * g.vertex_count * grid.capacity
     assert prepared._root_normals is not None and prepared._scalp_centre is not None

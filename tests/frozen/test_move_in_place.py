@@ -186,7 +186,7 @@ def test_the_kept_box_gives_the_full_builds_grid_after_moves_of_extreme_tips():
     lo, hi = g.bounds
     extent = float(np.max(hi - lo))
     pipe.brush(comb(g.tips[0].astype(np.float64), (0.0, 0.0, 0.01), 0.03 * extent))  # (the box known)
-    frames = [pipe._local.frame(pipe.aligned.points)]
+    frames = [pipe.local_clump.frame(pipe.aligned.points)]
     for axis, sign in ((0, 1), (1, -1), *[(2, -1)] * 8):
         tips = pipe.aligned.tips.astype(np.float64)
         tip = tips[np.argmax(sign * tips[:, axis])]  # the tip farthest out along the axis
@@ -195,7 +195,7 @@ def test_the_kept_box_gives_the_full_builds_grid_after_moves_of_extreme_tips():
         pipe.brush(comb(tip, way, 0.03 * extent, 1.0))
         assert pipe.clump_redone < 0.5
         pts = pipe.aligned.points
-        got, want = pipe._local.frame(pts), list_frame(pts, pipe._local.radius)
+        got, want = pipe.local_clump.frame(pts), list_frame(pts, pipe.local_clump.radius)
         assert got[0] == want[0] and got[2:] == want[2:] and np.array_equal(got[1], want[1])
         frames.append(want)
     assert any(f[3:5] != frames[0][3:5] or not np.array_equal(f[1], frames[0][1]) for f in frames)

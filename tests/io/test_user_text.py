@@ -82,3 +82,36 @@ def test_quoted_is_always_one_printable_line(s):
     shown = quoted(s, 40)
     assert shown.isprintable()  # no newline, no control character: one line stays one line
     assert len(shown) <= 40 * 10 + 3  # repr escapes a character into at most 10
+
+
+@pytest.mark.parametrize("reader", ["bvh", "project", "stroke log"])
+def test_each_reader_of_a_users_file_refuses_through_read_bytes(tmp_path, reader, monkeypatch):
+    """The BVH reader, the project loader and the JSON readers open a user's file in one place
+    (:func:`user_text.read_bytes`): a FIFO is refused before it is opened (it would block),
+    a missing file names the system's reason, and none is read past that helper."""
+    from hairtool import project
+    from hairtool.frozen.strokes import read_strokes
+    from hairtool.mocap.bvh import read_bvh
+
+    read = {"bvh": read_bvh, "project": project.load, "stroke log": read_strokes}[reader]
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    with pytest.raises(FormatError, match="not a regular file"):
+        read(fifo)
+    asked = []
+    real = user_text.read_bytes
+
+    def spy(path, what, max_bytes=user_text.MAX_BYTES):
+        asked.append(what)
+        return real(path, what, max_bytes)
+
+    monkeypatch.setattr(user_text, "read_bytes", spy)
+    empty = tmp_path / "empty"
+    empty.write_bytes(b"")
+    with pytest.raises(FormatError):
+        read(empty)
+    assert len(asked) == 1
+    monkeypatch.setattr(user_text, "read_bytes", real)
+    if reader != "project":  # (the project loader says "no such file" first)
+        with pytest.raises(FormatError, match="cannot read: No such file"):
+            read(tmp_path / "absent")

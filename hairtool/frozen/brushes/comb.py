@@ -12,7 +12,8 @@ from hairtool.frozen.brushes.constraints import follow_lengths, follow_lengths_r
 from hairtool.frozen.brushes.falloff import EPS, weight, weights_reference
 from hairtool.frozen.brushes.sample import BrushSample
 from hairtool.frozen.brushes.spec import BrushSpec, StrandMove, Studio
-from hairtool.frozen.brushes.strand_moves import checked, moved_groom
+from hairtool.frozen.brushes.strand_moves import move_reference, run_move
+from hairtool.frozen.brushes.twin_math import norm3, running_sum
 from hairtool.groom import Groom
 
 SPEC = BrushSpec(
@@ -30,7 +31,7 @@ def _segment(p, i, j):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _comb_kernel(p, offsets, locked, c, direction, radius, strength, lut, out):  # pragma: no cover
+def _comb_kernel(p, offsets, locked, c, radius, strength, lut, direction, out):  # pragma: no cover
     for s in prange(offsets.size - 1):
         o, e = offsets[s], offsets[s + 1]
         n = e - o
@@ -75,40 +76,26 @@ def comb(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike
     Groom
         The groom after the sample (float32 points).
     """
-    checked(sample, "comb")
-    out = np.empty((groom.vertex_count, 3))
-    _comb_kernel(
-        groom.points.astype(np.float64), groom.offsets, np.asarray(locked, dtype=np.bool_),
-        np.asarray(sample.cursor, np.float64), np.asarray(sample.direction, np.float64),
-        float(sample.radius), float(sample.strength), np.asarray(sample.lut, np.float64), out,
-    )  # fmt: skip
-    return moved_groom(groom, out)
+    return run_move(_comb_kernel, groom, sample, "comb", locked, np.asarray(sample.direction, np.float64))
 
 
 def comb_reference(
     groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike | None = None
 ) -> Groom:
     """Numpy twin of :func:`comb`."""
-    checked(sample, "comb")
-    p_all = groom.points.astype(np.float64)
-    out = p_all.copy()
-    c, d = np.asarray(sample.cursor, np.float64), np.asarray(sample.direction, np.float64)
-    lut = np.asarray(sample.lut, np.float64)
-    locked = np.asarray(locked, dtype=bool)
-    for s, (o, e) in enumerate(zip(groom.offsets[:-1], groom.offsets[1:], strict=True)):
-        p = p_all[o:e]
-        if locked[s] or len(p) < 2:
-            continue
+    d = np.asarray(sample.direction, np.float64)
+
+    def strand(p, c, lut):
         wm = weights_reference(p, c, sample.radius, lut) * sample.strength
         if not np.any(wm[1:] != 0):
-            continue
+            return None
+        run = running_sum(norm3(np.diff(p, axis=0)))
+        u = run / run[-1] if run[-1] > EPS else np.zeros_like(run)
         q = p.copy()
-        seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
-        u = np.concatenate([[0.0], np.cumsum(seg)]) / max(seg.sum(), EPS)
-        u = np.where(seg.sum() > EPS, u, 0.0)
         q[1:] = p[1:] + (wm * u)[1:, None] * d
-        out[o:e] = follow_lengths_reference(q, p)
-    return moved_groom(groom, out)
+        return follow_lengths_reference(q, p)
+
+    return move_reference(groom, sample, "comb", locked, strand)
 
 
 class Comb(StrandMove):

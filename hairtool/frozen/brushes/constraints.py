@@ -14,6 +14,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from hairtool.frozen.brushes.falloff import EPS
+from hairtool.frozen.brushes.twin_math import norm3
 
 F64 = NDArray[np.float64]
 
@@ -55,10 +56,10 @@ def follow_lengths_reference(q: F64, p: F64) -> F64:
     for i in range(1, len(p)):
         seg = p[i] - p[i - 1]
         d = out[i] - out[i - 1]
-        if np.linalg.norm(d) < EPS:
+        if norm3(d) < EPS:
             d = seg
-        norm = np.linalg.norm(d)
-        out[i] = out[i - 1] + d * (np.linalg.norm(seg) / norm if norm >= EPS else 0.0)
+        norm = norm3(d)
+        out[i] = out[i - 1] + d * (norm3(seg) / norm if norm >= EPS else 0.0)
     return out
 
 
@@ -86,7 +87,7 @@ def place(q, i, j, length, fx, fy, fz):  # pragma: no cover - compiled
 def place_reference(q: F64, i: int, j: int, length: float, fallback: F64) -> None:
     """Numpy twin of :func:`place` (in place on ``q``)."""
     d = q[i] - q[j]
-    if np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) < EPS:
+    if norm3(d) < EPS:
         d = fallback
-    n = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+    n = norm3(d)
     q[i] = q[j] + d * (length / n if n >= EPS else 0.0)

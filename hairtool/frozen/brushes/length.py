@@ -3,14 +3,13 @@ strength > 0 grows, < 0 shrinks, as a fraction of the length, directions kept.""
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit, prange
 from numpy.typing import ArrayLike
 
 from hairtool.frozen.brushes.falloff import weight, weights_reference
 from hairtool.frozen.brushes.sample import BrushSample
 from hairtool.frozen.brushes.spec import BrushSpec, StrandMove, Studio
-from hairtool.frozen.brushes.strand_moves import checked, moved_groom
+from hairtool.frozen.brushes.strand_moves import move_reference, run_move
 from hairtool.groom import Groom
 
 SPEC = BrushSpec(
@@ -67,35 +66,25 @@ def length(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLi
     Groom
         The groom after the sample.
     """
-    checked(sample, "length")
-    out = np.empty((groom.vertex_count, 3))
-    _length_kernel(
-        groom.points.astype(np.float64), groom.offsets, np.asarray(locked, dtype=np.bool_),
-        np.asarray(sample.cursor, np.float64), float(sample.radius), float(sample.strength),
-        np.asarray(sample.lut, np.float64), out,
-    )  # fmt: skip
-    return moved_groom(groom, out)
+    return run_move(_length_kernel, groom, sample, "length", locked)
 
 
 def length_reference(
     groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike | None = None
 ) -> Groom:
     """Numpy twin of :func:`length`."""
-    checked(sample, "length")
-    p_all = groom.points.astype(np.float64)
-    out = p_all.copy()
-    c, lut = np.asarray(sample.cursor, np.float64), np.asarray(sample.lut, np.float64)
-    locked = np.asarray(locked, dtype=bool)
-    for s, (o, e) in enumerate(zip(groom.offsets[:-1], groom.offsets[1:], strict=True)):
-        p = p_all[o:e]
-        if locked[s] or len(p) < 2:
-            continue
+
+    def strand(p, c, lut):
         w = weights_reference(p, c, sample.radius, lut)
-        if w.max() > 0:
-            factor = max(1.0 + sample.strength * w.max(), 0.0)
-            for i in range(1, len(p)):
-                out[o + i] = out[o + i - 1] + factor * (p[i] - p[i - 1])
-    return moved_groom(groom, out)
+        if not w.max() > 0:
+            return None
+        factor = max(1.0 + sample.strength * w.max(), 0.0)
+        q = p.copy()
+        for i in range(1, len(p)):
+            q[i] = q[i - 1] + factor * (p[i] - p[i - 1])
+        return q
+
+    return move_reference(groom, sample, "length", locked, strand)
 
 
 class Length(StrandMove):

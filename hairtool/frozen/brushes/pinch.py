@@ -12,7 +12,7 @@ from hairtool.frozen.brushes.constraints import follow_lengths, follow_lengths_r
 from hairtool.frozen.brushes.falloff import weight, weights_reference
 from hairtool.frozen.brushes.sample import BrushSample
 from hairtool.frozen.brushes.spec import BrushSpec, StrandMove, Studio
-from hairtool.frozen.brushes.strand_moves import checked, moved_groom
+from hairtool.frozen.brushes.strand_moves import move_reference, run_move
 from hairtool.groom import Groom
 
 SPEC = BrushSpec(
@@ -55,36 +55,22 @@ def _pinch_kernel(p, offsets, locked, c, radius, strength, lut, out):  # pragma:
 def pinch(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike | None = None) -> Groom:
     """One pinch sample (numba): vertices toward the centre (away with strength < 0), roots
     fixed, lengths kept."""
-    checked(sample, "pinch")
-    out = np.empty((groom.vertex_count, 3))
-    _pinch_kernel(
-        groom.points.astype(np.float64), groom.offsets, np.asarray(locked, np.bool_),
-        np.asarray(sample.cursor, np.float64), float(sample.radius), float(sample.strength),
-        np.asarray(sample.lut, np.float64), out,
-    )  # fmt: skip
-    return moved_groom(groom, out)
+    return run_move(_pinch_kernel, groom, sample, "pinch", locked)
 
 
 def pinch_reference(
     groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike | None = None
 ) -> Groom:
     """Numpy twin of :func:`pinch`."""
-    checked(sample, "pinch")
-    p_all = groom.points.astype(np.float64)
-    out = p_all.copy()
-    c, lut = np.asarray(sample.cursor, np.float64), np.asarray(sample.lut, np.float64)
-    locked = np.asarray(locked, bool)
-    for s, (o, e) in enumerate(zip(groom.offsets[:-1], groom.offsets[1:], strict=True)):
-        p = p_all[o:e]
-        if locked[s] or len(p) < 2:
-            continue
+
+    def strand(p, c, lut):
         w = weights_reference(p, c, sample.radius, lut) * sample.strength
         w[0] = 0.0
         if not np.any(w != 0):
-            continue
-        q = p + w[:, None] * (c - p)
-        out[o:e] = follow_lengths_reference(q, p)
-    return moved_groom(groom, out)
+            return None
+        return follow_lengths_reference(p + w[:, None] * (c - p), p)
+
+    return move_reference(groom, sample, "pinch", locked, strand)
 
 
 class Pinch(StrandMove):

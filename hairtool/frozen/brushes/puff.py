@@ -11,7 +11,8 @@ from numpy.typing import ArrayLike, NDArray
 from hairtool.frozen.brushes.falloff import EPS, weight, weights_reference
 from hairtool.frozen.brushes.sample import BrushSample
 from hairtool.frozen.brushes.spec import BrushSpec, StrandMove, Studio
-from hairtool.frozen.brushes.strand_moves import checked, moved_groom
+from hairtool.frozen.brushes.strand_moves import move_reference, run_move
+from hairtool.frozen.brushes.twin_math import dot3, norm3
 from hairtool.groom import Groom
 
 F64 = NDArray[np.float64]
@@ -90,51 +91,38 @@ def puff(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike
     Groom
         The groom after the sample.
     """
-    checked(sample, "puff")
-    out = np.empty((groom.vertex_count, 3))
-    _puff_kernel(
-        groom.points.astype(np.float64), groom.offsets, np.asarray(locked, dtype=np.bool_),
-        np.asarray(sample.cursor, np.float64), float(sample.radius), float(sample.strength),
-        np.asarray(sample.lut, np.float64), np.asarray(centre, np.float64), out,
-    )  # fmt: skip
-    return moved_groom(groom, out)
+    return run_move(_puff_kernel, groom, sample, "puff", locked, np.asarray(centre, np.float64))
 
 
 def puff_reference(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike) -> Groom:
     """Numpy twin of :func:`puff`."""
-    checked(sample, "puff")
-    p_all = groom.points.astype(np.float64)
-    out = p_all.copy()
-    c, lut = np.asarray(sample.cursor, np.float64), np.asarray(sample.lut, np.float64)
-    locked = np.asarray(locked, dtype=bool)
-    for s, (o, e) in enumerate(zip(groom.offsets[:-1], groom.offsets[1:], strict=True)):
-        p = p_all[o:e]
-        if locked[s] or len(p) < 2:
-            continue
-        wr = weights_reference(p, c, sample.radius, lut)[0] * sample.strength
-        if wr > 0:
-            out[o:e] = _puff_reference(p, wr, np.asarray(centre, np.float64))
-    return moved_groom(groom, out)
+    centre = np.asarray(centre, np.float64)
+
+    def strand(p, c, lut):
+        w = weights_reference(p, c, sample.radius, lut)[0] * sample.strength
+        return _puff_reference(p, w, centre) if w > 0 else None
+
+    return move_reference(groom, sample, "puff", locked, strand)
 
 
 def _puff_reference(p: F64, w: float, centre: F64) -> F64:
+    """Numpy twin of :func:`_puff_strand` on one strand, in the kernel's order of operations."""
     n, t = p[0] - centre, p[1] - p[0]
-    if np.linalg.norm(n) < EPS or np.linalg.norm(t) < EPS:
+    nn, tn = norm3(n), norm3(t)
+    if nn < EPS or tn < EPS:
         return p
-    n, t = n / np.linalg.norm(n), t / np.linalg.norm(t)
+    n, t = n / nn, t / tn
     axis = np.cross(t, n)
-    sin_a = np.linalg.norm(axis)
+    sin_a = norm3(axis)
     if sin_a < 1e-9:
         return p
     axis /= sin_a
-    angle = w * np.arctan2(sin_a, float(t @ n))
-    v = p - p[0]
-    rotated = (
-        v * np.cos(angle)
-        + np.cross(axis, v) * np.sin(angle)
-        + axis * (v @ axis)[:, None] * (1.0 - np.cos(angle))
-    )
-    return p[0] + rotated
+    angle = w * np.arctan2(sin_a, dot3(t, n))
+    cs, sn = np.cos(angle), np.sin(angle)
+    v = p[1:] - p[0]
+    out = p.copy()
+    out[1:] = p[0] + v * cs + np.cross(axis, v) * sn + axis * dot3(v, axis)[:, None] * (1.0 - cs)
+    return out
 
 
 class Puff(StrandMove):

@@ -12,7 +12,7 @@ from hairtool.frozen.brushes.constraints import follow_lengths, follow_lengths_r
 from hairtool.frozen.brushes.falloff import weight, weights_reference
 from hairtool.frozen.brushes.sample import BrushSample
 from hairtool.frozen.brushes.spec import BrushSpec, StrandMove, Studio
-from hairtool.frozen.brushes.strand_moves import checked, moved_groom
+from hairtool.frozen.brushes.strand_moves import move_reference, run_move
 from hairtool.groom import Groom
 
 SPEC = BrushSpec(
@@ -70,36 +70,23 @@ def smooth(groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLi
     Groom
         The groom after the sample.
     """
-    checked(sample, "smooth")
-    out = np.empty((groom.vertex_count, 3))
-    _smooth_kernel(
-        groom.points.astype(np.float64), groom.offsets, np.asarray(locked, dtype=np.bool_),
-        np.asarray(sample.cursor, np.float64), float(sample.radius), float(sample.strength),
-        np.asarray(sample.lut, np.float64), out,
-    )  # fmt: skip
-    return moved_groom(groom, out)
+    return run_move(_smooth_kernel, groom, sample, "smooth", locked)
 
 
 def smooth_reference(
     groom: Groom, sample: BrushSample, locked: ArrayLike, centre: ArrayLike | None = None
 ) -> Groom:
     """Numpy twin of :func:`smooth`."""
-    checked(sample, "smooth")
-    p_all = groom.points.astype(np.float64)
-    out = p_all.copy()
-    c, lut = np.asarray(sample.cursor, np.float64), np.asarray(sample.lut, np.float64)
-    locked = np.asarray(locked, dtype=bool)
-    for s, (o, e) in enumerate(zip(groom.offsets[:-1], groom.offsets[1:], strict=True)):
-        p = p_all[o:e]
-        if locked[s] or len(p) < 2:
-            continue
+
+    def strand(p, c, lut):
         wm = weights_reference(p, c, sample.radius, lut) * sample.strength
         if not np.any(wm[1:] != 0):
-            continue
+            return None
         q = p.copy()
         q[1:-1] = p[1:-1] + 0.5 * wm[1:-1, None] * (0.5 * (p[:-2] + p[2:]) - p[1:-1])
-        out[o:e] = follow_lengths_reference(q, p)
-    return moved_groom(groom, out)
+        return follow_lengths_reference(q, p)
+
+    return move_reference(groom, sample, "smooth", locked, strand)
 
 
 class Smooth(StrandMove):
