@@ -149,6 +149,18 @@ class FrozenParams:
         return hash(self._key)
 
     def replace(self, **changes) -> FrozenParams:
+        """These parameters with some changed (they are frozen: a change is a new object).
+
+        Parameters
+        ----------
+        **changes
+            Field names and their new values.
+
+        Returns
+        -------
+        FrozenParams
+            The changed copy (not validated: :meth:`validate` does that).
+        """
         return replace(self, **changes)
 
 
@@ -400,7 +412,18 @@ class FrozenPipeline:
     def set_surface(self, surface: Surface | None) -> Groom:
         """A new head surface; strokes that slid roots on the old one or collided with it are
         replayed on it (a log with slide strokes refuses to go without one, and keeps the old
-        surface then)."""
+        surface then).
+
+        Parameters
+        ----------
+        surface : Surface or None
+            The head (None: no head).
+
+        Returns
+        -------
+        Groom
+            The clumped result.
+        """
         old, self._surface = self._surface, surface
         if self._log:
             try:
@@ -414,7 +437,18 @@ class FrozenPipeline:
 
     def set_params(self, params: FrozenParams) -> Groom:
         """New parameters; the frozen groom is re-derived only if a freeze parameter changed,
-        and the strokes are replayed on it."""
+        and the strokes are replayed on it.
+
+        Parameters
+        ----------
+        params : FrozenParams
+            The parameters (validated here).
+
+        Returns
+        -------
+        Groom
+            The clumped result.
+        """
         params.validate()
         strand_multipliers(self._rest.strand_count, params.strand_variation)
         self._params = params
@@ -465,7 +499,18 @@ class FrozenPipeline:
 
     def brush(self, sample: BrushSample) -> Groom:
         """One sample of a comb, smooth, length, puff, clump or mask brush; it persists (checked
-        where it is applied: a refused sample leaves no trace in the log)."""
+        where it is applied: a refused sample leaves no trace in the log).
+
+        Parameters
+        ----------
+        sample : BrushSample
+            The sample.
+
+        Returns
+        -------
+        Groom
+            The clumped result.
+        """
         return self.apply_samples([sample])
 
     def apply_samples(self, samples: Sequence[Sample], local: bool = True) -> Groom:
@@ -564,7 +609,18 @@ class FrozenPipeline:
 
     def restore(self, snapshot: FrozenSnapshot) -> Groom:
         """Back to a snapshot's strokes; replayed on the current frozen groom if it has changed
-        (a replay that fails, e.g. slide strokes without a surface, leaves the state as it was)."""
+        (a replay that fails, e.g. slide strokes without a surface, leaves the state as it was).
+
+        Parameters
+        ----------
+        snapshot : FrozenSnapshot
+            What :meth:`snapshot` returned, or :meth:`FrozenSnapshot.replaying`.
+
+        Returns
+        -------
+        Groom
+            The clumped result.
+        """
         now = self.snapshot()
         try:
             return self._restore(snapshot)
@@ -703,7 +759,13 @@ class FrozenPipeline:
         """What a first brush move would otherwise compute or allocate, now (the studio calls
         it while idle after an open): the scalp's normals and centre, room for the lists of a
         region of ``region_share`` of the vertices, and (up to :data:`PREPARED_HEAD` vertices)
-        each point's distance to the head, which keeping strokes out of it reads."""
+        each point's distance to the head, which keeping strokes out of it reads.
+
+        Parameters
+        ----------
+        region_share : float, default PREPARED_REGION
+            The share of the vertices a brush-local region is expected to reach.
+        """
         _ = self.root_normals, self.scalp_centre
         if self._moves.clump is not None:
             self._moves.clump.grid.prepare(int(region_share * self._aligned.vertex_count))

@@ -16,9 +16,7 @@ ROOT = Path(__file__).resolve().parent.parent.parent
 API = ROOT / "docs" / "api"
 BLOCK = re.compile(r"^::: ([\w.]+)\n((?:    .*\n)*)", re.M)
 MEMBERS = re.compile(r"^\s+members:\s*\[([^\]]*)\]", re.M)
-# Being refactored by another engineer (issue 42 point 2): closed when that lands.
-NOT_YET = ("hairtool.frozen.pipeline", "hairtool.frozen.local", "hairtool.frozen.replay")
-NOT_YET += ("hairtool.frozen.strand_state", "hairtool.frozen.brushes", "hairtool.frozen.sample_")
+NOT_YET: tuple[str, ...] = ()
 
 
 @pytest.fixture(scope="module")
