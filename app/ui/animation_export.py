@@ -384,18 +384,18 @@ class GuiFrameSource(QObject):
     def frames(
         self, n_frames: int, make: Callable[[int], Drawn], cancelled: CancelCheck = _never
     ) -> Iterator[NDArray]:
-        """The ``n_frames`` images, frame ``i`` drawn from ``make(i)`` (called in this thread)."""
+        """The ``n_frames`` images, frame ``i`` drawn from ``make(i)`` (called in this thread).
+        The first comes as soon as it can (the progress shows); from the second on, frame i + 1
+        is made and queued while the GUI thread draws frame i."""
         try:
             if n_frames > 0:
                 self._post(0, make(0))
             for i in range(n_frames):
-                ahead = None
-                if i + 1 < n_frames and not cancelled():
-                    ahead = make(i + 1)  # while the GUI thread draws frame i
-                image = self._take(i, cancelled)
-                if ahead is not None:
-                    self._post(i + 1, ahead)
-                yield image
+                if i > 0 and i + 1 < n_frames and not cancelled():
+                    self._post(i + 1, make(i + 1))  # while the GUI thread draws frame i
+                yield self._take(i, cancelled)
+                if i == 0 and n_frames > 1 and not cancelled():  # (the first frame is out)
+                    self._post(1, make(1))
         finally:
             if self._here():
                 self._close()

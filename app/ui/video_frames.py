@@ -10,6 +10,7 @@ returns reads nothing of the scene, so the worker may call it while the artist g
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 from collections.abc import Callable
 
@@ -37,7 +38,11 @@ def render_hair_frames(scene: Scene, animation: Animation, *, mask: bool = False
     # the view's colours hang on the strands, not the pose; the distances from rest are the
     # edit's, not the frame's
     colors = None if s.colour_mode == "displacement" else look.colors
-    clumper = RenderHair(binding, clump) if clump is not None else None
+    clumper = None
+    if clump is not None:
+        # a copy of the view's own (its neighbours and last clumps already made, so the first
+        # frame costs what the view's next one would), which the GUI thread goes on using
+        clumper = copy.deepcopy(s.cached(("frames clumped", clump), lambda: RenderHair(binding, clump)))
     topology = s.result.topology
 
     def frame(f: int) -> Drawn:
