@@ -6,11 +6,28 @@ ruler: per mouse move, the event (the model sets the frame, the viewport is give
 plus a synchronous paintGL with glFinish, so the frame is on the GPU when the clock stops
 (Qt's compositing onto the screen is not included); medians and 90th percentiles over the moves,
 in each view mode. The other rows time the model's work directly, on the GUI thread.
+
+``--sintel`` times Sintel with her render hair instead (the bundled scene: 228 guides, 30,000
+children, shaded as hair, Clump children on) under a generated sway of ``--sintel-frames``
+frames (default 22), beside ``hairtool bench host``'s speed (the first row):
+
+- ``scrub``: a left-drag across the ruler, one mouse move every 1/60 s with the event loop
+  running between them, as a hand drags: ``fps`` is the distinct frames the view drew per
+  second of the drag (target 24), ``behind_frames`` how far the frame on screen was behind the
+  frame under the mouse at each move (median), ``settle_ms`` from the last move until the view
+  shows that frame, ``paint_ms`` a paint of a scrubbed frame (upload and draw, median);
+  ``release_full_ms`` from the release until every child is on screen (target 500),
+  ``release_clumped_ms`` until they are clumped, as the groom's are; ``gui_max_gap_ms``: the
+  longest the GUI thread was away from its event loop meanwhile.
+- ``GIF at viewport size``: File ▸ Export animation to a GIF of every frame, the children
+  clumped on each (``s``: until the file is written; the issue measured 22.6 s);
+  ``view_paints``: the viewport's repaints meanwhile.
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import statistics
 import sys
@@ -27,6 +44,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--frames", type=int, default=240)
     parser.add_argument("--moves", type=int, default=60, help="mouse moves per scrub (default 60)")
     parser.add_argument("--size", type=int, nargs=2, default=(1280, 900), metavar=("W", "H"))
+    parser.add_argument("--sintel", action="store_true", help="scrub and export Sintel's render hair")
+    parser.add_argument("--sintel-frames", type=int, default=22, help="--sintel: frames of the sway")
     parser.add_argument("--json", action="store_true")
 
 
@@ -37,9 +56,112 @@ def _timed(fn) -> float:
 
 
 def run(args: argparse.Namespace) -> list[dict]:
-    from app.bench import in_studio_app
+    from app.bench import _host_speed, in_studio_app
 
-    return in_studio_app(lambda app, settings: _measure(app, args, settings))
+    if not args.sintel:
+        return in_studio_app(lambda app, settings: _measure(app, args, settings))
+    host = {"what": "hairtool bench host", "speed": _host_speed()}
+    return [host, *in_studio_app(lambda app, settings: _measure_sintel(app, args, settings))]
+
+
+def _until(app, done, timeout_s: float = 120.0) -> float:
+    """Run the event loop until ``done()``; the milliseconds it took."""
+    t0 = time.perf_counter()
+    while not done():
+        if time.perf_counter() - t0 > timeout_s:
+            raise TimeoutError("the studio did not get there in time")
+        app.processEvents()
+        time.sleep(0.001)
+    return (time.perf_counter() - t0) * 1e3
+
+
+def _measure_sintel(app, args: argparse.Namespace, settings) -> list[dict]:
+    import tempfile
+    from pathlib import Path
+
+    from PySide6.QtCore import Qt, QTimer
+
+    from app.ui.qt_utils import send_mouse
+    from app.ui.window import MainWindow
+    from hairtool.simulate.sway import sway_animation
+
+    window = MainWindow(settings=settings)
+    window.ask_save_changes = lambda: "discard"
+    window.resize(*args.size)
+    window.show()
+    window.open_bundled_sample()
+    for _ in range(20):
+        app.processEvents()
+    s, v, m, view = window.scene, window.viewport, window.animation, window.timeline.view
+    n = args.sintel_frames
+    anim = sway_animation(s.result, n, 24.0, flick_frame=int(n * 0.6))
+    m.load_animation(anim, "sway")
+    window.jobs.wait(600)
+    label = f"Sintel, {s.binding.child_count:,} children, {n} frames"
+    full = s.drawn_topology.strand_count
+    _until(app, lambda: not s.frames_live and v.shown_frame == m.frame)
+    # each paint: when, frame, clumped, strands, and its upload + draw milliseconds
+    drawn: list[tuple[float, int | None, bool, int, float]] = []
+
+    def on_paint() -> None:
+        strands = s.drawn_topology.strand_count
+        ms = v.last_upload_ms + v.last_draw_ms
+        drawn.append((time.perf_counter(), v.shown_frame, not s.frames_live, strands, ms))
+
+    v.frame_drawn.connect(on_paint)
+    ticks: list[float] = []
+    timer = QTimer()
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start(5)
+    left = Qt.MouseButton.LeftButton
+    y = view.height() - 4  # the ruler
+    xs = np.linspace(view.frame_to_x(0), view.frame_to_x(n - 1), args.moves)
+    send_mouse(view, "press", (xs[0], y), left, left)
+    behind = []
+    t_start = time.perf_counter()
+    for i, x in enumerate(xs[1:], 1):
+        send_mouse(view, "move", (x, y), None, left)
+        behind.append(abs(m.frame - (v.shown_frame if v.shown_frame is not None else 0)))
+        due = t_start + i / 60.0
+        while time.perf_counter() < due:
+            app.processEvents()
+            time.sleep(0.001)
+    t_end = time.perf_counter()
+    settle = _until(app, lambda: v.shown_frame == m.frame)
+    paint_ms = [d[4] for d in drawn if t_start <= d[0] and d[3] != full]  # the drag's paints
+    during = [d[1] for d in drawn if t_start <= d[0] <= t_end]
+    changes = sum(1 for a, b in itertools.pairwise(during) if a != b)
+    t0 = time.perf_counter()
+    send_mouse(view, "release", (xs[-1], y), left)
+    _until(app, lambda: drawn[-1][0] > t0 and drawn[-1][2] and drawn[-1][3] == full)
+    after = [d for d in drawn if d[0] > t0]
+    release_full = (next(d[0] for d in after if d[3] == full) - t0) * 1e3
+    release_clumped = (next(d[0] for d in after if d[2] and d[3] == full) - t0) * 1e3
+    timer.stop()
+    gaps = np.diff([t for t in ticks if t >= t_start]) * 1e3
+    rows = [
+        {
+            "what": "scrub, render hair", "animation": label, "fps": changes / (t_end - t_start),
+            "behind_frames": statistics.median(behind), "settle_ms": settle,
+            "release_full_ms": release_full, "release_clumped_ms": release_clumped,
+            "gui_max_gap_ms": float(gaps.max()) if gaps.size else 0.0,
+            "paint_ms": statistics.median(paint_ms) if paint_ms else None,
+        }
+    ]  # fmt: skip
+    paints = len(drawn)
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        job = window.exporter.export_animation(Path(tmp) / "shot.gif")
+        window.jobs.wait(900)
+        seconds = time.perf_counter() - t0
+    rows.append(
+        {"what": "GIF at viewport size", "animation": label, "s": seconds, "state": job.state,
+         "size": "x".join(str(c) for c in window.viewport_pixel_size()), "view_paints": len(drawn) - paints}
+    )  # fmt: skip
+    window.close()
+    window.deleteLater()
+    app.processEvents()
+    return rows
 
 
 def _stall(app, window, m) -> dict:

@@ -30,6 +30,7 @@ MAX_SIZE = 16384
 _lock = threading.Lock()
 _shared: dict[str, Any] = {}
 _parking: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_kept_mesh: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()  # a kept renderer's mesh
 
 
 class RenderError(HairtoolError):
@@ -192,12 +193,16 @@ def render_drawn(
     ctx: moderngl.Context | None = None,
     strand_raster: str | None = None,
     overlays: Overlays | None = None,
+    renderer: StrandRenderer | None = None,
 ) -> NDArray[np.uint8]:
     """Draw what the studio draws (:class:`~app.render.drawn.Drawn`) headless; ``(H, W, 4)``
     uint8 RGBA, top row first, no overlay unless ``overlays`` gives some.
 
     ``transparent`` gives alpha 0 wherever nothing is drawn (straight, not premultiplied,
-    alpha). ``ctx``: a current context to draw in (None: the process's headless one).
+    alpha). ``ctx``: a current context to draw in (None: the process's headless one);
+    ``renderer``: a :class:`StrandRenderer` of ``ctx`` kept by the caller across images (a
+    video's frames: its buffers and programs are made once, and only the points change), else
+    one is made and released for this image.
     ``strand_raster``: ``"gl"``, ``"cpu"`` or ``"auto"`` (see :mod:`app.render.strands`; None:
     the environment's default); strands rasterized on the CPU are not multisampled.
     """
@@ -216,27 +221,37 @@ def render_drawn(
     drawn.colors  # noqa: B018 - made (and checked) before any GL object is
     args = (drawn, camera, (w, h), bg, transparent, mesh, strand_raster, overlays or Overlays())
     if ctx is not None:
-        return _render_in(ctx, StrandRenderer(ctx), True, *args)
+        if renderer is not None:
+            if renderer.ctx is not ctx:
+                raise ParameterError("renderer", "a renderer of another context", "one of ctx")
+            return _render_in(ctx, renderer, "kept", *args)
+        return _render_in(ctx, StrandRenderer(ctx), "own", *args)
     ctx = shared_context()
     with ctx:  # current for this draw only: Qt may own the current context in the studio
-        return _render_in(ctx, _shared_renderer(ctx), False, *args)
+        return _render_in(ctx, _shared_renderer(ctx), "shared", *args)
 
 
-def _render_in(ctx, renderer, own, drawn, camera, size, bg, transparent, mesh, raster, overlays):
+def _render_in(ctx, renderer, whose, drawn, camera, size, bg, transparent, mesh, raster, overlays):
+    """``whose``: "own" (made for this image: released after it), "kept" (the caller's, left as
+    it is for its next image) or "shared" (the process's: left without mesh and overlays)."""
     try:
         renderer.strand_raster = raster
         renderer.show(drawn)
-        renderer.set_mesh(mesh)
+        if whose != "kept" or _kept_mesh.get(renderer, _kept_mesh) is not mesh:
+            renderer.set_mesh(mesh)  # (a kept renderer's mesh stays uploaded from image to image)
+            if whose == "kept":
+                _kept_mesh[renderer] = mesh
         centre, radius = overlays.circle or (None, 0.0)
         renderer.set_overlay_circle(centre, radius, size)
         renderer.set_overlay_outline(overlays.outline, size)
         renderer.background = (0.0, 0.0, 0.0, 0.0) if transparent else bg
         image = read_rgba(ctx, renderer, camera, size)
-        renderer.set_mesh(None)
-        renderer.set_overlay_circle(None)
-        renderer.set_overlay_outline(None)
+        if whose == "shared":
+            renderer.set_mesh(None)
+            renderer.set_overlay_circle(None)
+            renderer.set_overlay_outline(None)
     finally:
-        if own:
+        if whose == "own":
             renderer.release()
     return unpremultiply(image) if transparent else image
 

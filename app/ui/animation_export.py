@@ -1,10 +1,15 @@
 """Exporting the animation (USD, ``.npz``, MP4, GIF, a PNG sequence) and its keys (JSON, CSV, USD).
 
-Video frames are drawn like the viewport draws them, in the viewport's own GL context (the
-studio keeps to one context): a worker thread encodes while the GUI thread renders each frame
-on request (:class:`GuiFrameSource`), so the window keeps drawing and Cancel works between
-frames. Every file is written beside its target and renamed at the end: a cancelled or failed
-export leaves no partial file (a PNG sequence appears all at once, from a temporary folder).
+Video frames are drawn like the viewport draws them, off screen at the size chosen in the
+export dialog, in the viewport's own GL context (the studio keeps to one context; a second,
+headless one beside Qt's is unreliable) but never into the window: the export's worker thread
+makes each frame's strands (render hair built and clumped there:
+:mod:`app.ui.video_frames`) and encodes, while the GUI thread only draws each frame into an
+offscreen framebuffer on request, one frame a turn of its event loop, with one renderer kept for
+the whole export (:class:`GuiFrameSource`); the window keeps answering, its viewport is not
+repainted for the export, and Cancel works between frames. Every file is written beside its
+target and renamed at the end: a cancelled or failed export leaves no partial file (a PNG
+sequence appears all at once, from a temporary folder).
 
 With render hair (a groom with children) an animation of the guides is written as render hair
 by default: every child following the guides frame by frame, in USD with the guides as a second
@@ -36,9 +41,11 @@ from PySide6.QtWidgets import QCheckBox, QDialog, QDialogButtonBox, QLabel, QVBo
 from app.render.camera import Camera
 from app.render.drawn import Drawn
 from app.render.offscreen import Overlays, render_drawn
+from app.render.strands import StrandRenderer
 from app.ui.drawn import drawn
 from app.ui.jobs import Job
 from app.ui.qt_utils import set_available
+from app.ui.video_frames import render_hair_frames
 from hairtool import io
 from hairtool.errors import Cancelled, FormatError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom
@@ -306,38 +313,61 @@ class FrameRenderer:
 
     def render(self, frame: int, ctx: object | None = None) -> NDArray[np.uint8]:
         """``(H, W, 4)`` uint8 of one frame (``ctx``: a current moderngl context; None: headless)."""
+        return self.render_drawn(self.frame_drawn(frame), ctx)
+
+    def render_drawn(
+        self, d: Drawn, ctx: object | None = None, renderer: StrandRenderer | None = None
+    ) -> NDArray[np.uint8]:
+        """``(H, W, 4)`` uint8 of ``d`` (a frame's :meth:`frame_drawn`, made in any thread) with
+        this export's camera, size, mesh and overlays; ``renderer``: one of ``ctx`` kept across
+        the frames (:func:`~app.render.offscreen.render_drawn`)."""
         return render_drawn(
-            self.frame_drawn(frame), size=self.size, camera=self.camera, mesh=self.mesh, ctx=ctx,
-            overlays=self.overlays,
+            d, size=self.size, camera=self.camera, mesh=self.mesh, ctx=ctx, overlays=self.overlays,
+            renderer=renderer,
         )  # fmt: skip
 
 
 class GuiFrameSource(QObject):
-    """Frames rendered on the GUI thread for a worker thread that asks for them one by one.
+    """Frames drawn on the GUI thread for a worker thread that makes what they draw.
 
-    Create it on the GUI thread. :meth:`frames` yields the rendered frames; called on the GUI
-    thread itself it renders directly (synchronous exports and tests).
+    Create it on the GUI thread with ``render(drawn) → image``. :meth:`frames` (in the worker)
+    makes frame i + 1's :class:`Drawn` while the GUI thread draws frame i, so each side does its
+    part at once; the GUI thread draws one frame per request, between its other events. ``close``
+    runs on the GUI thread when the frames end (however they end): it frees what ``render`` kept.
+    Called on the GUI thread itself, everything runs there directly (synchronous use, tests).
     """
 
-    _requested = Signal(int)
+    _requested = Signal(int, object)
+    _closing = Signal()
 
-    def __init__(self, render: Callable[[int], NDArray]) -> None:
+    def __init__(self, render: Callable[[Drawn], NDArray], close: Callable[[], None] = _ignore) -> None:
         super().__init__()
-        self._render = render
+        self._render, self._close = render, close
         self._answers: queue.Queue = queue.Queue()
         self._requested.connect(self._on_request, Qt.ConnectionType.QueuedConnection)
+        self._closing.connect(self._on_close, Qt.ConnectionType.QueuedConnection)
 
-    @Slot(int)
-    def _on_request(self, frame: int) -> None:
+    def _here(self) -> bool:
+        return QThread.currentThread() == self.thread()
+
+    @Slot(int, object)
+    def _on_request(self, frame: int, d: Drawn) -> None:
         try:
-            self._answers.put((frame, self._render(frame), None))
+            self._answers.put((frame, self._render(d), None))
         except BaseException as e:  # handed to the worker, which raises it
             self._answers.put((frame, None, e))
 
-    def frame(self, index: int, cancelled: CancelCheck = _never) -> NDArray:
-        if QThread.currentThread() == self.thread():
-            return self._render(index)
-        self._requested.emit(index)
+    @Slot()
+    def _on_close(self) -> None:
+        self._close()
+
+    def _post(self, index: int, d: Drawn) -> None:
+        if self._here():
+            self._on_request(index, d)
+        else:
+            self._requested.emit(index, d)
+
+    def _take(self, index: int, cancelled: CancelCheck) -> NDArray:
         while True:
             try:
                 frame, image, error = self._answers.get(timeout=0.05)
@@ -351,9 +381,29 @@ class GuiFrameSource(QObject):
                 raise error
             return image
 
-    def frames(self, n_frames: int, cancelled: CancelCheck = _never) -> Iterator[NDArray]:
-        for i in range(n_frames):
-            yield self.frame(i, cancelled)
+    def frames(
+        self, n_frames: int, make: Callable[[int], Drawn], cancelled: CancelCheck = _never
+    ) -> Iterator[NDArray]:
+        """The ``n_frames`` images, frame ``i`` drawn from ``make(i)`` (called in this thread).
+        The first comes as soon as it can (the progress shows); from the second on, frame i + 1
+        is made and queued while the GUI thread draws frame i."""
+        try:
+            if n_frames > 0:
+                self._post(0, make(0))
+            for i in range(n_frames):
+                if i > 0 and i + 1 < n_frames and not cancelled():
+                    self._post(i + 1, make(i + 1))  # while the GUI thread draws frame i
+                yield self._take(i, cancelled)
+                if i == 0 and n_frames > 1 and not cancelled():  # (the first frame is out)
+                    self._post(1, make(1))
+        finally:
+            if self._here():
+                self._close()
+            else:
+                try:
+                    self._closing.emit()
+                except RuntimeError:  # the window (and this object) went meanwhile
+                    pass
 
 
 def keys_result(model: object) -> dict:
@@ -491,16 +541,10 @@ class AnimationExporter(QObject):
         w, scene = self.window, self.window.scene
         size = even_size(size or w.viewport_pixel_size())
         binding = self.render_hair_binding(animation) if render_hair else None
-        look = drawn(scene, mask=overlays)
-        if binding is not None:
-
-            def frame_drawn(f: int) -> Drawn:
-                d = drawn(scene, animation.frames[f], mask=overlays, kept=True)
-                if scene.colour_mode == "displacement":  # the edit's distances, not the pose's
-                    return dataclasses.replace(d, make_colors=lambda: None)
-                return d
-
+        if binding is not None:  # made in the export's worker thread (the children cost)
+            frame_drawn = render_hair_frames(scene, animation, mask=overlays)
         else:  # the animation's own strands (the guides alone, or another groom's)
+            look = drawn(scene, mask=overlays)
             same = animation.topology == scene.result.topology and not scene.has_children
             # the view's colours hang on the strands (ramp, per strand, clumps, mask), not the pose,
             # so they hold on every frame; the distances from rest are the edit's, not the frame's
@@ -561,15 +605,24 @@ class AnimationExporter(QObject):
             w.show_error("Cannot export animation", str(e))
             return False
 
-        def render(i: int) -> NDArray:
-            with w.viewport.current_context() as ctx:
-                return renderer.render(i, ctx)
+        kept: list[StrandRenderer] = []  # one renderer for every frame, made at the first
 
-        source = GuiFrameSource(render)
+        def render(d: Drawn) -> NDArray:
+            with w.viewport.current_context() as ctx:
+                if ctx is not None and not kept:
+                    kept.append(StrandRenderer(ctx))
+                return renderer.render_drawn(d, ctx, kept[0] if kept else None)
+
+        def close() -> None:
+            if kept and w.viewport.ctx is not None:
+                with w.viewport.current_context():
+                    kept.pop().release()
+
+        source = GuiFrameSource(render, close)
         n = anim.n_frames
 
         def work(progress: Progress, cancelled: CancelCheck) -> str:
-            frames = source.frames(n, cancelled)
+            frames = source.frames(n, renderer.frame_drawn, cancelled)
             if suffix in VIDEO_SUFFIXES:
                 write_video(path, frames, n, anim.fps, progress=progress, cancelled=cancelled)
             else:

@@ -17,6 +17,7 @@ from PySide6.QtWidgets import QLabel, QStyle, QWidget
 
 from app.ui.animation_model import VIEW_MODES, AnimationModel
 from app.ui.engine_start import WAIT_MESSAGE
+from app.ui.frame_children import FrameAsk, FrameChildren
 from app.ui.qt_utils import add_action, set_available
 from app.ui.recording import Recorder
 from hairtool.errors import HairtoolError
@@ -175,12 +176,17 @@ class AnimationController(QObject):
         model.animation_changed.connect(self._on_animation_changed)
         model.frame_changed.connect(self._update_fps_label)
         model.playing_changed.connect(self._on_playing)
-        model.scrubbing_changed.connect(self._frames_live)
+        model.scrubbing_changed.connect(self._on_scrubbing)
         model.fps_changed.connect(self._update_fps_label)
         self.viewport.frame_drawn.connect(self._on_frame_drawn)
         self.viewport.stroke_started.connect(self._on_stroke_started)
         self.scene.points_changed.connect(self._on_scene_points)
         self.viewport.stroke_finished.connect(self._on_stroke_finished)
+        # a scrubbed frame's render hair is built in a worker thread and shown when it lands
+        self.frames = FrameChildren(self)
+        self.frames.landed.connect(self._on_children_landed)
+        self._asks = 0  # frames shown or asked for (a landing older than the last is dropped)
+        self.scene.drawn_changed.connect(self._drop_frame_children)
         self.actions: dict[str, QAction] = {}
         self._update_fps_label()
 
@@ -214,11 +220,53 @@ class AnimationController(QObject):
 
     # -- model → viewport ------------------------------------------------------------------
     def refresh_display(self, *_: object) -> None:
+        """The current frame to the viewport: at once, or while the timeline is scrubbed with
+        render hair, once its children are built off the GUI thread (:meth:`_ask`)."""
         d = self.model.display() if self.recorder is None else None
+        self._asks += 1
         if d is None or len(d.points) != self.scene.result.vertex_count:
+            self.frames.cancel()
             self.viewport.clear_frame()
+        elif self.model.scrubbing and self.scene.has_children:
+            self._ask(d, clumped=False)
         else:
+            self.frames.cancel()
+            m = self.model
+            if self.scene.frames_live and not (m.playing or m.scrubbing):
+                self.scene.set_frames_live(False)  # a release's clumped frame was overtaken
             self.viewport.show_frame(d.points, d.colors, d.ghost, d.frame)
+
+    def _ask(self, d, *, clumped: bool) -> None:
+        """Build frame ``d``'s drawn children in the worker (the latest ask replaces a waiting one):
+        the share drawn now, clumped (as Clump children says) or interpolated only."""
+        s = self.scene
+        clump = s.children_clump() if clumped and s.children_clump_ready else None
+        self._asks += 1
+        ask = FrameAsk(
+            d.frame, d.points, s.result.topology, s.drawn_binding(), clump, bool(s.drawn_guides),
+            d.colors, d.ghost, self._asks,
+        )  # fmt: skip
+        self.frames.ask(ask)
+
+    def _on_children_landed(self, ask: FrameAsk) -> None:
+        """A frame's children are built: shown with their guides, unless a frame was shown or
+        asked for since (while scrubbing, the newest built is shown, on the way to the latest),
+        or the drawn strands changed meanwhile (another share, other children)."""
+        m, s = self.model, self.scene
+        if self.recorder is not None or m.animation is None:
+            return
+        if ask.number != self._asks and not m.scrubbing:
+            return
+        if ask.binding is not s.drawn_binding() or ask.vertex_count != s.drawn_topology.vertex_count:
+            return
+        if ask.clump is not None and not (m.playing or m.scrubbing):
+            s.set_frames_live(False)  # the clumped frame is on screen: the groom's look again
+        self.viewport.show_frame(ask.guides, ask.colors, ask.ghost, ask.frame, children=ask.points)
+
+    def _drop_frame_children(self) -> None:
+        """Other drawn strands (a share, Clump children, the guides shown): the frame's children
+        built for the old ones go; the view builds the frame's own at its next paint."""
+        self.viewport.frame_children = None
 
     def _on_animation_changed(self) -> None:
         anim = self.model.animation
@@ -251,6 +299,25 @@ class AnimationController(QObject):
         self._drawn.clear()
         self._frames_live()
         self._update_fps_label()
+
+    def _on_scrubbing(self, scrubbing: bool) -> None:
+        """The timeline's frame is dragged: render hair at the drag's display share, unclumped, as
+        a brush drag draws it. Let go: every child at once, interpolated (a cheap build), and
+        clumped when the worker has clumped them (about 2 s for Sintel's on a loaded host)."""
+        m, s = self.model, self.scene
+        s.set_dragging(scrubbing)
+        if scrubbing or m.playing:
+            self._frames_live()
+            return
+        d = m.display() if self.recorder is None else None
+        clumps = s.clump_children and s.children_clump_ready and s.has_children
+        if not s.frames_live or not clumps or d is None or len(d.points) != s.result.vertex_count:
+            self._frames_live()
+            self.refresh_display()  # the latest frame, whatever the worker still builds
+            return
+        self.frames.cancel()  # frames_live stays on: every child at once, interpolated …
+        self.viewport.show_frame(d.points, d.colors, d.ghost, d.frame)
+        self._ask(d, clumped=True)  # … and clumped when the worker has them
 
     def _frames_live(self, *_: object) -> None:
         """Playing or scrubbing, the children of the frames are drawn unclumped (Scene.set_frames_live)."""

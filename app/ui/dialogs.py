@@ -1,4 +1,4 @@
-"""The export dialogs' options: picture size (the viewport's, 1080p or custom), transparent
+"""The export dialogs' options: picture size (the viewport's, 720p, 1080p or custom), transparent
 background, working overlays, then the file name."""
 
 from __future__ import annotations
@@ -19,7 +19,9 @@ from PySide6.QtWidgets import (
 
 from app.render.offscreen import MAX_SIZE
 
+SIZE_720P = (1280, 720)
 SIZE_1080P = (1920, 1080)
+PRESETS = {"720p": SIZE_720P, "1080p": SIZE_1080P}
 OVERLAYS_TIP = (
     "Draw the brush circle, the X-mirror plane and the mask's tint as the viewport shows them "
     "(off: the picture shows the hair and the head alone)"
@@ -43,13 +45,15 @@ class PictureOptions:
 
 
 class SizeForm:
-    """Size rows for a form: a choice of the viewport's size, 1080p or custom (width × height)."""
+    """Size rows for a form: a choice of the viewport's size (the default), 720p, 1080p or custom
+    (width × height)."""
 
     def __init__(self, form: QFormLayout, viewport: tuple[int, int]) -> None:
         self.viewport = viewport
         self.choice = QComboBox()
         self.choice.addItem(f"Viewport ({viewport[0]} × {viewport[1]})", "viewport")
-        self.choice.addItem(f"1080p ({SIZE_1080P[0]} × {SIZE_1080P[1]})", "1080p")
+        for key, (w, h) in PRESETS.items():
+            self.choice.addItem(f"{key} ({w} × {h})", key)
         self.choice.addItem("Custom", "custom")
         self.width_box, self.height_box = QSpinBox(), QSpinBox()
         for box, value in ((self.width_box, viewport[0]), (self.height_box, viewport[1])):
@@ -69,7 +73,7 @@ class SizeForm:
         key = self.choice.currentData()
         custom = key == "custom"
         if not custom:
-            w, h = self.viewport if key == "viewport" else SIZE_1080P
+            w, h = self.viewport if key == "viewport" else PRESETS[key]
             self.width_box.setValue(w)
             self.height_box.setValue(h)
         self.width_box.setEnabled(custom)

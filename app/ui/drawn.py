@@ -20,6 +20,7 @@ def drawn(
     *,
     mask: bool = True,
     kept: bool = False,
+    children: np.ndarray | None = None,
 ) -> Drawn:
     """What the viewport draws of ``scene``: ``frame`` (``(V, 3)`` points of the groom's strands,
     an animation frame; None: the groom as edited) with render hair following it, coloured by the
@@ -27,16 +28,22 @@ def drawn(
     render hair is drawn over the frame); ``mask``: the working overlays, the mask brush's tint
     and the selection (unselected strands dimmed, hidden ones left out:
     :mod:`app.ui.selection_look`); ``kept``: a frame written out (an export), whose children
-    are clumped (with Clump children on) even while the animation plays."""
+    are clumped (with Clump children on) even while the animation plays; ``children``: the drawn
+    points already built for ``frame`` (:mod:`app.ui.frame_children`), used while they fit the
+    drawn strands (else they are built here)."""
     s = scene
     if frame is not None and len(frame) != s.result.vertex_count:
         frame = None  # another groom's frame: the scene's own strands are drawn
-    children = s.has_children
+    has_children = s.has_children
     if frame is None:
         points = s.drawn_points
+    elif not has_children:
+        points = np.asarray(frame, np.float32)
+    elif children is not None and not kept and len(children) == s.drawn_topology.vertex_count:
+        points = children
     else:
-        points = s.drawn_for(frame, kept=kept) if children else np.asarray(frame, np.float32)
-    if frame is not None and frame_colors is not None and not children:
+        points = s.drawn_for(frame, kept=kept)
+    if frame is not None and frame_colors is not None and not has_children:
         own = frame_colors
 
         def make_colors():
@@ -67,7 +74,7 @@ def drawn(
     return Drawn(
         points,
         topology,
-        guides=_shown_guides(s, topology) if children else 0,
+        guides=_shown_guides(s, topology) if has_children else 0,
         ramp=s.ramp,
         line_width=s.line_width,
         taper=HAIR_TAPER if hair else 0.0,

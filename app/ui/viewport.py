@@ -119,6 +119,7 @@ class Viewport(QOpenGLWidget):
         self.frame_points: np.ndarray | None = None
         self.frame_colors: np.ndarray | None = None
         self.ghost_points: np.ndarray | None = None
+        self.frame_children: np.ndarray | None = None  # its drawn children, built off the GUI thread
         self.shown_frame: int | None = None  # the frame number uploaded at the last paint
         self._pending_frame: int | None = None
         self.brush_target: BrushTarget | None = None
@@ -204,12 +205,16 @@ class Viewport(QOpenGLWidget):
         colors: np.ndarray | None = None,
         ghost: np.ndarray | None = None,
         frame: int | None = None,
+        children: np.ndarray | None = None,
     ) -> None:
         """Draw ``points`` ``(V, 3)`` (the groom's strands) instead of the scene's groom, with
         optional per-vertex ``colors`` (None: the scene's colouring) and a ``ghost`` drawn under
-        them; uploaded at the next paint, so calls faster than the screen refreshes cost nothing."""
+        them; uploaded at the next paint, so calls faster than the screen refreshes cost nothing.
+        ``children``: with render hair, the drawn points already built for ``points``
+        (:mod:`app.ui.frame_children`), drawn while they fit the drawn strands."""
         had_colors, had_ghost = self.frame_colors is not None, self.ghost_points is not None
         self.frame_points, self.frame_colors, self.ghost_points = points, colors, ghost
+        self.frame_children = children
         self._pending_frame = frame
         self._dirty.add("points")
         if colors is not None or had_colors:
@@ -222,7 +227,7 @@ class Viewport(QOpenGLWidget):
         """Back to drawing the scene's groom."""
         if self.frame_points is None and self.ghost_points is None:
             return
-        self.frame_points = self.frame_colors = self.ghost_points = None
+        self.frame_points = self.frame_colors = self.ghost_points = self.frame_children = None
         self._pending_frame = None
         self._mark("points", "colors", "ghost")
 
@@ -278,7 +283,8 @@ class Viewport(QOpenGLWidget):
     def drawn(self, mask: bool = True) -> Drawn:
         """What this view draws now: the scene's groom, or the animation frame it shows (with the
         render hair following it), as stills and videos draw it too (``mask``: the mask's tint)."""
-        return drawn(self.scene, self.frame_points, self.frame_colors, mask=mask)
+        children = self.frame_children
+        return drawn(self.scene, self.frame_points, self.frame_colors, mask=mask, children=children)
 
     def _upload(self) -> None:
         r, s, dirty = self.renderer, self.scene, self._dirty

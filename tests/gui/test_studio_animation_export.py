@@ -271,7 +271,7 @@ def test_a_video_of_render_hair_draws_the_children(render_hair_window, out):
 
 
 def test_a_playing_animation_draws_its_children_unclumped_and_the_frame_it_stops_on_clumped(
-    ui, render_hair_window, monkeypatch
+    ui, qtbot, render_hair_window, monkeypatch
 ):
     """Clumping every child on every frame would hold playback to a few frames a second on
     Sintel: while it plays the view draws them as interpolated, the frame it stops on (and any
@@ -306,11 +306,15 @@ def test_a_playing_animation_draws_its_children_unclumped_and_the_frame_it_stops
     ui.send_mouse(view, "press", (view.frame_to_x(3), y), left, left)
     ui.send_mouse(view, "move", (view.frame_to_x(5), y), None, left)
     assert s.frames_live and model.frame == 5
+    frames = w.animation_ui.frames  # (the drag's share of the children, built in its worker)
+    qtbot.waitUntil(lambda: not frames.busy and v.frame_children is not None, timeout=30_000)
+    share = s.drawn_binding()
+    assert share.child_count == 30
     np.testing.assert_array_equal(
-        v.drawn().points[:n], following(b, anim.frame(5)).build(anim.frame(5)).points
+        v.drawn().points[: share.vertex_count], following(share, anim.frame(5)).build(anim.frame(5)).points
     )
-    ui.send_mouse(view, "release", (view.frame_to_x(5), y), left, None)  # … let go: clumped
-    assert not s.frames_live
+    ui.send_mouse(view, "release", (view.frame_to_x(5), y), left, None)  # … let go: clumped …
+    qtbot.waitUntil(lambda: not s.frames_live, timeout=30_000)  # … once the worker has them
     want = RenderHair(b, s.children_clump(), follow_roots=True).update(anim.frame(5)).points
     np.testing.assert_array_equal(v.drawn().points[:n], want)
     model.play()  # a press while it plays: it pauses and stays live until the release
@@ -319,4 +323,4 @@ def test_a_playing_animation_draws_its_children_unclumped_and_the_frame_it_stops
     ui.send_mouse(view, "press", (view.frame_to_x(4), y), left, left)
     assert not model.playing and s.frames_live and live == []
     ui.send_mouse(view, "release", (view.frame_to_x(4), y), left, None)
-    assert live == [False]
+    qtbot.waitUntil(lambda: live == [False], timeout=30_000)  # (when its clumped frame lands)

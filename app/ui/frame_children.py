@@ -1,0 +1,145 @@
+"""The render hair of animation frames, built off the GUI thread while the timeline is scrubbed.
+
+Dragging the timeline's frame asks for one frame per mouse move; with render hair each frame's
+children must be interpolated from its guides (and, once the mouse is let go, clumped: about
+2 s for Sintel's 30,000 on a loaded 2-core host). One worker thread builds them: while it works,
+newer asks replace the waiting one (coalesced: the view never works through a queue of stale
+frames), and each result comes back to the GUI thread by a queued signal, which the view takes
+with its guides at once (:meth:`app.ui.viewport.Viewport.show_frame`'s ``children``).
+
+What a frame's children are is decided on the GUI thread when it is asked for (the drawn share
+of the children, Clump children, the guides drawn after them: :class:`FrameAsk`); the worker
+reads nothing of the scene, so the scene may change meanwhile (a landing that no longer fits the
+drawn strands is dropped by whoever takes it).
+"""
+
+from __future__ import annotations
+
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+from PySide6.QtCore import QObject, Qt, Signal
+
+from hairtool.groom import Groom, Topology
+from hairtool.guides.binding import ChildBinding
+from hairtool.guides.children import build_points
+from hairtool.guides.render import ChildClump, RenderHair
+from hairtool.guides.root_motion import following
+
+
+@dataclass(eq=False)
+class FrameAsk:
+    """One frame to show: its guides' points ``(V, 3)`` (of ``topology``), the view's colours and
+    ghost passed through, and what its drawn children are: ``binding`` (the drawn share),
+    ``clump`` (None: interpolated only) and ``with_guides`` (the guides drawn after them).
+    ``number`` orders the asks; ``points`` (the drawn children, then the guides) is the result."""
+
+    frame: int
+    guides: np.ndarray
+    topology: Topology
+    binding: ChildBinding
+    clump: ChildClump | None = None
+    with_guides: bool = True
+    colors: np.ndarray | None = None
+    ghost: np.ndarray | None = None
+    number: int = 0
+    points: np.ndarray | None = field(default=None, repr=False)
+    error: BaseException | None = field(default=None, repr=False)
+    ms: float = 0.0
+
+    @property
+    def vertex_count(self) -> int:
+        """The drawn vertices this ask gives (children, then the guides when drawn)."""
+        return self.binding.vertex_count + (self.topology.vertex_count if self.with_guides else 0)
+
+
+def frame_points(ask: FrameAsk, clumper: RenderHair | None = None) -> np.ndarray:
+    """The drawn points of ``ask``'s frame, as :meth:`app.ui.scene.Scene.drawn_for` makes them:
+    the children (clumped by ``clumper``, a :class:`RenderHair` of the ask's binding and clump,
+    when it has a clump), then the guides when drawn; the children's roots carried by their
+    guides' (:mod:`hairtool.guides.root_motion`), as the exported frames' are. A new array each call."""
+    g = Groom(ask.guides, ask.topology)
+    if ask.clump is not None:
+        children = (clumper or RenderHair(ask.binding, ask.clump, follow_roots=True)).update_points(g)
+    else:
+        children = build_points(following(ask.binding, g), g)
+    if ask.with_guides:
+        return np.concatenate([children, g.points])
+    return children.copy() if ask.clump is not None else children
+
+
+class FrameChildren(QObject):
+    """One worker thread building the asked frames' drawn points, the latest ask first (module
+    docstring). ``delay_s``: seconds each build waits first, an injected slow build (tests)."""
+
+    landed = Signal(object)  # a FrameAsk with its points (GUI thread)
+    _finished = Signal(object)  # from the worker, queued to the GUI thread
+
+    def __init__(self, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self.delay_s = 0.0
+        self.built = 0  # builds finished (fewer than the asks when asks were coalesced)
+        self._pending: FrameAsk | None = None
+        self._running: FrameAsk | None = None
+        self._clumper: tuple[tuple, RenderHair] | None = None  # the worker's own (never the scene's)
+        self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hairtool-frames")
+        self._finished.connect(self._on_finished, Qt.ConnectionType.QueuedConnection)
+
+    @property
+    def busy(self) -> bool:
+        """A build is under way or an ask waits for one."""
+        return self._running is not None or self._pending is not None
+
+    def ask(self, ask: FrameAsk) -> None:
+        """Build ``ask`` when the worker is free; an ask still waiting is dropped for it."""
+        self._pending = ask
+        if self._running is None:
+            self._launch()
+
+    def cancel(self) -> None:
+        """Drop the waiting ask (the one being built still lands; its taker may drop it)."""
+        self._pending = None
+
+    def _launch(self) -> None:
+        ask, self._pending = self._pending, None
+        self._running = ask
+        self._worker.submit(self._run, ask)
+
+    def _clumper_for(self, ask: FrameAsk) -> RenderHair:
+        key = (id(ask.binding), ask.clump)
+        if self._clumper is None or self._clumper[0] != key:
+            # frame after frame, it redoes the clumps of the guides that moved between them
+            self._clumper = (key, RenderHair(ask.binding, ask.clump, follow_roots=True))
+        return self._clumper[1]
+
+    def _run(self, ask: FrameAsk) -> None:
+        """In the worker thread."""
+        try:
+            t0 = time.perf_counter()
+            if self.delay_s > 0:
+                time.sleep(self.delay_s)
+            clumper = self._clumper_for(ask) if ask.clump is not None else None
+            ask.points = frame_points(ask, clumper)
+            ask.ms = (time.perf_counter() - t0) * 1e3
+        except BaseException as e:  # handed to the GUI thread, raised there
+            ask.error = e
+        try:
+            self._finished.emit(ask)
+        except RuntimeError:  # the window closed meanwhile, and this object with it
+            pass
+
+    def _on_finished(self, ask: FrameAsk) -> None:
+        self._running = None
+        self.built += 1
+        if self._pending is not None:
+            self._launch()
+        if ask.error is not None:
+            raise ask.error
+        self.landed.emit(ask)
+
+    def shutdown(self) -> None:
+        """No more asks; the worker ends after the build under way (the window closes)."""
+        self._pending = None
+        self._worker.shutdown(wait=True)
