@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from hairtool.errors import ParameterError
+from hairtool.frozen.root_grid import nearest_root
 from hairtool.groom import Groom
 from hairtool.guides.binding import DEFAULT_K, bind_roots
 from hairtool.guides.surface import MeshSurface
@@ -104,5 +105,5 @@ class HeadSurface(MeshSurface):
         binding = bind_roots(groom, roots, k=k, length_variation=0.0, frizz=0.0)
         built = binding.build(groom)
         # the binding orders children by their nearest strand: back to the order asked for
-        order = np.argsort(np.argmin(((binding.roots[:, None, :] - roots[None]) ** 2).sum(-1), axis=1))
+        order = np.argsort(nearest_root(roots, binding.roots))
         return built.subset(order)
