@@ -491,14 +491,14 @@ def test_ik_targets_out_of_reach_of_whole_chains_read_through_the_command_line(t
 
 @pytest.mark.skipif(
     not os.environ.get("HAIRTOOL_SLOW_REPRODUCERS"),
-    reason="about 12 s of the 20 s CPU cap, warm: HAIRTOOL_SLOW_REPRODUCERS=1",
+    reason="about 9 s of the 20 s CPU cap, warm: HAIRTOOL_SLOW_REPRODUCERS=1",
 )
 def test_one_add_stroke_of_50_samples_of_999_strands_freezes_or_is_refused(tmp_path):
     """The valid add stroke whose 49,950 strands, planted where the same seed and cursor plant
     them 50 times over, made clumping's neighbour search ask for 28 GiB: through ``freeze`` it
     ends in one line and exit 2 (the neighbour budget) under the cap. Planting once looked at
     every root for each new strand (55 s of CPU, 938 MB); through the root grid
-    (:mod:`hairtool.frozen.root_grid`) the stroke is refused after about 12 s of CPU at 430 MB,
+    (:mod:`hairtool.frozen.root_grid`) the stroke is refused after about 9 s of CPU at 340 MB,
     with warm kernels, so it runs only with ``HAIRTOOL_SLOW_REPRODUCERS=1``; CI runs
     :func:`test_planting_that_stroke_looks_at_a_bounded_share_of_the_roots` and the one-sample
     refusal below."""
