@@ -37,7 +37,8 @@ SPEC = BrushSpec(
 def append_strands(g: Groom, new: Groom) -> Groom:
     """``g`` with ``new``'s strands after its own; each per-vertex attribute of ``g`` taken for a
     new strand from the strand whose root is nearest (found through a grid of the roots), by
-    the vertex parameter; a new strand joins that strand's prim where it can (:meth:`~hairtool.metadata.Metadata.extended`)."""
+    the vertex parameter; a new strand joins that strand's prim where it can
+    (:meth:`~hairtool.metadata.Metadata.extended`)."""
     attrs = {}
     near = nearest_root(g.roots, new.roots)
     if any(a is not None for a in g.attributes.values()):
