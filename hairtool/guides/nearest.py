@@ -14,27 +14,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from hairtool.guides.surface import insert_nearest
-
-
-@njit(cache=True, nogil=True, parallel=True)
-def _euclid_kernel(groots, croots, kk, out_g, out_d):
-    for c in prange(croots.shape[0]):
-        for m in range(kk):
-            out_g[c, m] = -1
-            out_d[c, m] = np.inf
-        px, py, pz = croots[c, 0], croots[c, 1], croots[c, 2]
-        for g in range(groots.shape[0]):
-            d = np.sqrt((groots[g, 0] - px) ** 2 + (groots[g, 1] - py) ** 2 + (groots[g, 2] - pz) ** 2)
-            if d <= out_d[c, kk - 1]:
-                insert_nearest(out_g, out_d, c, g, d, kk)
+from hairtool.frozen.root_grid import nearest_roots
 
 
 def euclidean_nearest(
     guide_roots: np.ndarray, child_roots: np.ndarray, k: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(N, k+1)`` nearest guides of each child root in space and their distances, sorted by
-    (distance, guide); −1 / inf past the last guide.
+    (distance, guide); −1 / inf past the last guide (looked up through a grid of the guide
+    roots, :mod:`hairtool.frozen.root_grid`).
 
     Parameters
     ----------
@@ -50,14 +38,7 @@ def euclidean_nearest(
     tuple of (ndarray, ndarray)
         ``(N, k+1)`` guides and distances.
     """
-    n = len(child_roots)
-    out_g = np.empty((n, k + 1), np.int64)
-    out_d = np.empty((n, k + 1))
-    _euclid_kernel(
-        np.ascontiguousarray(guide_roots, np.float64), np.ascontiguousarray(child_roots, np.float64), k + 1,
-        out_g, out_d,
-    )  # fmt: skip
-    return out_g, out_d
+    return nearest_roots(guide_roots, child_roots, k + 1)
 
 
 def euclidean_nearest_reference(

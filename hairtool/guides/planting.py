@@ -15,8 +15,10 @@ from __future__ import annotations
 import numpy as np
 
 from hairtool.errors import ParameterError
+from hairtool.frozen.root_grid import nearest_root
 from hairtool.groom import Groom
 from hairtool.guides.binding import DEFAULT_K, bind_roots
+from hairtool.guides.nearest import euclidean_nearest
 from hairtool.guides.surface import MeshSurface
 
 MAX_PLANT = 1000  # strands one sample may plant
@@ -101,8 +103,15 @@ class HeadSurface(MeshSurface):
         """
         roots = np.asarray(roots, np.float64)
         k = min(DEFAULT_K, groom.strand_count)
-        binding = bind_roots(groom, roots, k=k, length_variation=0.0, frizz=0.0)
-        built = binding.build(groom)
+        # Only the strands some new root blends (or weighs against) are tabulated: building
+        # from the whole groom cost every strand's frames at each sample. Their order is kept,
+        # so each root finds the same nearest strands, ties and weights, and the same points.
+        near = euclidean_nearest(groom.roots, roots, k)[0]
+        used = np.unique(near[near >= 0])
+        guides = groom if len(used) == groom.strand_count else groom.subset(used)
+        n = int(groom.counts.max())
+        binding = bind_roots(guides, roots, k=k, vertices=n, length_variation=0.0, frizz=0.0)
+        built = binding.build(guides)
         # the binding orders children by their nearest strand: back to the order asked for
-        order = np.argsort(np.argmin(((binding.roots[:, None, :] - roots[None]) ** 2).sum(-1), axis=1))
+        order = np.argsort(nearest_root(roots, binding.roots))
         return built.subset(order)

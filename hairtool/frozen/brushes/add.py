@@ -8,6 +8,7 @@ import numpy as np
 from hairtool.errors import ParameterError
 from hairtool.frozen.brushes.sample import MAX_COUNT
 from hairtool.frozen.brushes.spec import Brush, BrushSpec, Param, StrokeContext, Studio
+from hairtool.frozen.root_grid import nearest_root
 from hairtool.groom import Groom
 
 SEED = Param("seed", int, 0, 2**32 - 1, 0, "seed", "a whole number in [0, 2^32)")
@@ -35,10 +36,11 @@ SPEC = BrushSpec(
 
 def append_strands(g: Groom, new: Groom) -> Groom:
     """``g`` with ``new``'s strands after its own; each per-vertex attribute of ``g`` taken for a
-    new strand from the strand whose root is nearest, by the vertex parameter; a new strand
-    joins that strand's prim where it can (:meth:`~hairtool.metadata.Metadata.extended`)."""
+    new strand from the strand whose root is nearest (found through a grid of the roots), by
+    the vertex parameter; a new strand joins that strand's prim where it can
+    (:meth:`~hairtool.metadata.Metadata.extended`)."""
     attrs = {}
-    near = np.argmin(((new.roots[:, None, :] - g.roots[None, :, :]) ** 2).sum(-1), axis=1)
+    near = nearest_root(g.roots, new.roots)
     if any(a is not None for a in g.attributes.values()):
         for name, a in g.attributes.items():
             if a is None:
