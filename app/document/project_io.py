@@ -1,6 +1,7 @@
 """The document written out, and read back: the project file (the same fields the studio
-writes: the animation, its source, the key settings, and the capture with its edits as
-``settings["capture"]``), the edited capture as BVH and the keys record.
+writes: the groom with its scene description, engine parameters, strokes, head mesh, render
+hair and view settings as ``display``; the animation, its source, the key settings, and the
+capture with its edits as ``settings["capture"]``), the edited capture as BVH and the keys record.
 
 Save is the state written whole and marks the stack clean; load is its inverse (a new document,
 nothing to undo). Files are written to a temporary name and renamed by the writers used here.
@@ -10,11 +11,13 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from types import MappingProxyType
 
 import numpy as np
 
 from app.document.animation import AnimationState, Document
 from app.document.capture import motion_from_text, motion_text
+from app.document.groom import GroomSide, GroomState
 from hairtool import project as pf
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.keys import session as ks
@@ -45,8 +48,20 @@ def to_project(doc: Document) -> pf.Project:
             "edits": [e.to_dict() for e in s.edits],
             "channel_edits": [],
         }
+    g = doc.hair.state
+    strokes = doc.hair.settled()
+    aligned = None
+    if strokes is not None and strokes.aligned.topology == g.rest.topology:
+        aligned = strokes.aligned.with_metadata(g.rest.metadata)
     return pf.Project(
-        rest=doc.groom,
+        rest=g.rest,
+        params=g.params,
+        strokes=() if strokes is None else strokes.log,
+        aligned=aligned,
+        display=dict(g.view),
+        groom_source=g.source,
+        children=g.children,
+        mesh=g.mesh,
         animation=s.animation,
         animation_source=s.source,
         key_settings=dataclasses.asdict(s.settings),
@@ -69,7 +84,26 @@ def from_project(project: pf.Project, where: str = "project") -> Document:
         lists = {k: saved[k] for k in ("edits", "channel_edits") if k in saved}
         edits = tuple(parse_capture_edits(lists, capture, where).edits)
     state = AnimationState(project.animation, project.animation_source, capture, settings, edits)
-    return Document(project.rest, state)
+    return Document(groom_of(project), state)
+
+
+def groom_of(project: pf.Project) -> GroomState:
+    """The groom side of a project, its strokes replayed (or taken as saved) on its engine."""
+    g = GroomState(
+        project.rest,
+        project.params,
+        None,
+        project.mesh,
+        project.children,
+        project.groom_source,
+        MappingProxyType(dict(project.display)),
+    )
+    if not project.strokes:
+        return g
+    side = GroomSide(None, g)
+    p = side.pipeline
+    p.restore(project.stroke_snapshot(p))
+    return dataclasses.replace(g, strokes=p.snapshot())
 
 
 def save(doc: Document, path: str | os.PathLike[str]) -> None:

@@ -1,17 +1,21 @@
 """Random sequences of the studio's actions on the Qt-free document (issue 43 point 4).
 
-Rules are the artist's actions on the animation side: open a capture (or another one), apply an
-anime cycle, simulate, close the animation (each answering the Save / Discard / Cancel question
-at random), key count, budget, price per key and interpolation switches, pins and exclusions,
-IK poses and graph-editor key edits (value, handle, move in time; drags of several moves),
-undo, redo, save and reload. After every step: save → load gives an equal document (every
-array's bytes), undo back to the start gives the start (and redo comes back), the keys record
-and the BVH read back and carry the edits, and every edit applies or has its line.
+Rules are the artist's actions. On the groom (a few dozen strands on a tiny head): strokes of
+every registered brush with random radius, strength, falloff, direction, symmetry, pen pressure
+and its toggles, front faces only and "affect selection only"; selection steps (all, none,
+invert, box, hide and reveal); the up axis; the head mesh taken off and put back; engine
+parameters; opening another groom. On the animation side: open a capture (or another one),
+apply an anime cycle, simulate, close the animation (each answering the Save / Discard / Cancel
+question at random), key count, budget, price per key and interpolation switches, pins and
+exclusions, IK poses and graph-editor key edits (value, handle, move in time; drags of several
+moves). And undo, redo, save and reload. After every step: save → load gives an equal document
+(every array's bytes: the file's, and the strokes' state replayed from it), undo back to the
+start gives the start (and redo comes back), the keys record and the BVH read back and carry
+the edits, and every edit applies or has its line.
 
-CI runs ``DOCUMENT_EXAMPLES`` sequences (default 50, about a minute on a loaded 2-core machine)
-of at least 30 steps from a seed that changes per run and is printed; ``DOCUMENT_SEED`` replays
-one. The issue's 200 sequences and longer runs: ``DOCUMENT_EXAMPLES=200`` (or 2000 with
-``DOCUMENT_STEPS=60``) ``pytest -n 0 -s tests/document/test_document_states.py``.
+CI runs ``DOCUMENT_EXAMPLES`` sequences (default 200) of at least 30 steps from a seed that
+changes per run and is printed; ``DOCUMENT_SEED`` replays one. Longer runs:
+``DOCUMENT_EXAMPLES=2000 DOCUMENT_STEPS=60 pytest -n 0 -s tests/document/test_document_states.py``.
 """
 
 from __future__ import annotations
@@ -37,9 +41,15 @@ from hypothesis.stateful import (
 
 from app.document import project_io
 from app.document.animation import AnimationState, Document
+from app.document.groom import GroomState
+from app.ui.brush_tool import FALLOFF_LABELS, BrushTool
+from hairtool import project as pf
 from hairtool import samples
 from hairtool.anime.settings import AnimeSettings, cycle_for_groom
 from hairtool.errors import HairtoolError, ParameterError
+from hairtool.frozen.brushes import registry
+from hairtool.frozen.selection import BOX_MODES, SelectionSample
+from hairtool.io.obj import Mesh
 from hairtool.keys import session as ks
 from hairtool.keys.export import read_keys_json, record_keys
 from hairtool.mocap import ik
@@ -59,18 +69,61 @@ def capture(which: int):
 
 
 @cache
-def groom():
-    return samples.portrait(strands=5, vertices=5)
+def groom(which: int = 0):
+    """Two tiny grooms on the sample head: a few dozen strands of a few vertices."""
+    return samples.scalp(strands=(24, 16)[which], vertices=(5, 4)[which], seed=which)
 
 
 @cache
-def cycle(seed_: int, cycles: int):
-    return cycle_for_groom(groom(), AnimeSettings(cycles=cycles, seed=seed_), None)
+def head(rings: int = 5, segments: int = 8) -> Mesh:
+    """A low sphere inside the sample head (its vertices on it, so its faces under the roots)."""
+    theta = np.linspace(0.0, np.pi, rings + 1)[1:-1]
+    phi = np.linspace(0.0, 2.0 * np.pi, segments, endpoint=False)
+    ring = np.stack([np.sin(theta)[:, None] * np.cos(phi), np.cos(theta)[:, None] + 0 * phi,
+                     np.sin(theta)[:, None] * np.sin(phi)], axis=-1).reshape(-1, 3)  # fmt: skip
+    v = np.concatenate([[[0.0, 1.0, 0.0]], ring, [[0.0, -1.0, 0.0]]]) * samples.HEAD_RADIUS
+    last, f = len(v) - 1, []
+    for j in range(segments):
+        k = (j + 1) % segments
+        f += [(0, 1 + k, 1 + j), (last, 1 + (rings - 2) * segments + j, 1 + (rings - 2) * segments + k)]
+        for i in range(rings - 2):
+            a, b = 1 + i * segments, 1 + (i + 1) * segments
+            f += [(a + j, a + k, b + k), (a + j, b + k, b + j)]
+    n = v / np.linalg.norm(v, axis=1, keepdims=True)
+    return Mesh(v.astype(np.float32), np.array(f, np.int32), n.astype(np.float32))
+
+
+def hair(which: int = 0) -> GroomState:
+    return GroomState(groom(which), mesh=head(), source=f"tiny{which}.tfx")
 
 
 @cache
-def simulation(frames: int):
-    return run_simulation(groom(), SimulateOptions(frames=frames, substeps=1), lambda *a: None, lambda: False)
+def cycle(seed_: int, cycles: int, which: int = 0):
+    return cycle_for_groom(groom(which), AnimeSettings(cycles=cycles, seed=seed_), None)
+
+
+@cache
+def simulation(frames: int, which: int = 0):
+    opts = SimulateOptions(frames=frames, substeps=1)
+    return run_simulation(groom(which), opts, lambda *a: None, lambda: False)
+
+
+def snapshot_arrays(s: GroomState) -> tuple:
+    """The groom side as bytes: groom, its metadata, parameters, head, view, and the strokes'
+    log, stroked points and per-strand state (mask, clump strength, origin, selection, hidden)."""
+    st_ = s.strokes
+    strokes = ()
+    if st_ is not None:
+        per_strand = (st_.locked, st_.clump_strength, st_.origin, st_.selected, st_.hidden)
+        strokes = (repr(st_.log), st_.aligned.points.tobytes(), st_.aligned.counts.tobytes(),
+                   *(None if a is None else a.tobytes() for a in per_strand))  # fmt: skip
+    mesh = None if s.mesh is None else (s.mesh.vertices.tobytes(), s.mesh.faces.tobytes())
+    return (s.rest.points.tobytes(), s.rest.counts.tobytes(), repr(s.rest.metadata), s.params,
+            mesh, s.source, dict(s.view), s.children is None, strokes)  # fmt: skip
+
+
+def same_groom(a: GroomState, b: GroomState) -> bool:
+    return a is b or snapshot_arrays(a) == snapshot_arrays(b)
 
 
 def same_state(a: AnimationState, b: AnimationState) -> bool:
@@ -100,6 +153,13 @@ def same_state(a: AnimationState, b: AnimationState) -> bool:
     )
 
 
+def written_out(doc: Document) -> tuple[dict, dict]:
+    """The project as the file holds it: its manifest (less the time of saving) and arrays."""
+    manifest, arrays = pf.manifest_and_arrays(project_io.to_project(doc))
+    manifest.pop("saved")
+    return manifest, arrays
+
+
 answers = st.sampled_from(["discard", "cancel", "save"])
 
 
@@ -107,8 +167,9 @@ class DocumentMachine(RuleBasedStateMachine):
     def __init__(self) -> None:
         super().__init__()
         self.dir = Path(tempfile.mkdtemp(prefix="document-"))
-        self.doc = Document(groom(), AnimationState(settings=START))
-        self.start = self.doc.state
+        self.doc = Document(hair(0), AnimationState(settings=START))
+        self.start, self.start_hair = self.doc.state, self.doc.hair.state
+        self.which = 0  # the groom open (its cycles and simulations are its own)
         self.drag = 0
         self.saved_checked = self.exports_checked = None
 
@@ -123,12 +184,13 @@ class DocumentMachine(RuleBasedStateMachine):
         self.open_capture(0, answer)
 
     # -- what refuses must leave everything as it was ----------------------------------------
-    def _try(self, action) -> None:
-        before, index = self.doc.state, self.doc.stack.index
+    def _try(self, action, refusals=ParameterError) -> None:
+        before, hair, index = self.doc.state, self.doc.hair.state, self.doc.stack.index
         try:
             action()
-        except ParameterError:
+        except refusals:
             assert self.doc.state is before and self.doc.stack.index == index
+            assert same_groom(self.doc.hair.state, hair)
 
     def _confirm(self, answer: str):
         def ask() -> bool:
@@ -146,6 +208,94 @@ class DocumentMachine(RuleBasedStateMachine):
         else:
             assert done and self.doc.changed and not self.doc.state.edits
 
+    # -- the groom ----------------------------------------------------------------------------
+    @rule(
+        data=st.data(),
+        brush=st.sampled_from(registry.names()),
+        moves=st.integers(1, 3),
+        radius=st.floats(0.1, 1.2),
+        strength=st.floats(0.05, 1.0),
+        falloff=st.sampled_from(list(FALLOFF_LABELS)),
+        symmetry=st.booleans(),
+        pressures=st.lists(st.floats(0.0, 1.0), min_size=3, max_size=3),
+        pressure_radius=st.booleans(),
+        pressure_strength=st.booleans(),
+        invert=st.booleans(),
+        front_only=st.booleans(),
+        only_selected=st.booleans(),
+    )
+    def stroke(self, data, brush, moves, radius, strength, falloff, symmetry, pressures,
+               pressure_radius, pressure_strength, invert, front_only, only_selected) -> None:  # fmt: skip
+        """One stroke of a brush: its moves as the studio samples them (BrushTool), one step."""
+        tool = BrushTool(brush=brush, falloff=falloff, symmetry=symmetry, front_only=front_only,
+                         only_selected=only_selected, add_count=data.draw(st.integers(1, 3)))  # fmt: skip
+        tool.reset_radius(radius)
+        tool.strength[brush] = strength
+        tool.pressure_radius[brush], tool.pressure_strength[brush] = pressure_radius, pressure_strength
+        tool.align_mode = data.draw(st.sampled_from(["paper", "preserve-length"]))
+        tool.delete_any_segment = data.draw(st.booleans())
+        side = self.doc.hair
+        pts = side.pipeline.aligned.points
+        at = pts[data.draw(st.integers(0, len(pts) - 1))].astype(np.float64)
+        view = data.draw(st.sampled_from([None, (0.0, 0.0, -1.0), (0.0, -1.0, 0.0)]))
+        self.drag += 1
+        before, index = side.state, self.doc.stack.index
+        for k in range(moves):
+            step = np.array(data.draw(st.tuples(*[st.floats(-0.3, 0.3)] * 3)))
+            moves_made = tool.samples(at, step, view, 0.0, invert, k == 0, pressures[k])
+            at = at + step
+            if not moves_made:
+                continue
+            try:
+                side.stroke(moves_made, stroke=self.drag, text=f"{brush} stroke")
+            except HairtoolError:  # refused (no head, no strand left …): nothing of it happened
+                assert side.state is before or k > 0
+                assert self.doc.stack.index == index or k > 0
+        side.end_stroke()
+        top = self.doc.stack.top
+        assert top is None or self.doc.stack.index <= index + 1  # a stroke is one step
+
+    @rule(
+        op=st.sampled_from(["all", "none", "invert", "box", "hide_selected", "hide_unselected", "reveal"]),
+        rect=st.tuples(*[st.floats(-1.0, 1.0)] * 4),
+        mode=st.sampled_from(BOX_MODES),
+        view=st.sampled_from([None, (0.0, 0.0, -1.0)]),
+    )
+    def select(self, op, rect, mode, view) -> None:
+        """A selection step: the box seen through a front camera (orthographic, the head in it)."""
+        x0, x1 = sorted(rect[::2])
+        y0, y1 = sorted(rect[1::2])
+        sample = SelectionSample(op)
+        if op == "box":
+            matrix = (0.4, 0, 0, 0, 0, 0.4, 0, -0.2, 0, 0, -0.1, 0, 0, 0, 0, 1)
+            sample = SelectionSample(op, tuple(float(m) for m in matrix), (x0, y0, x1, y1), mode, view)
+        self._try(lambda: self.doc.hair.select(sample))
+
+    @rule(axis=st.sampled_from(["Y", "Z"]))
+    def up_axis(self, axis: str) -> None:
+        self.doc.hair.set_up_axis(axis)
+        assert self.doc.groom.metadata.up_axis == axis
+
+    @rule(on=st.booleans())
+    def head_mesh(self, on: bool) -> None:
+        """The head taken off (refused while strokes need it) or put back."""
+        self._try(lambda: self.doc.hair.set_mesh(head() if on else None), HairtoolError)
+
+    @rule(stiffness=st.sampled_from([4.0, 7.0]), keep=st.booleans(), clump=st.booleans())
+    def engine_parameters(self, stiffness: float, keep: bool, clump: bool) -> None:
+        p = self.doc.hair.state.params.replace(bend_stiffness=stiffness, keep_lengths=keep, clump=clump)
+        self._try(lambda: self.doc.hair.set_params(p), HairtoolError)
+
+    @rule(which=st.integers(0, 1), answer=answers)
+    def open_groom(self, which: int, answer: str) -> None:
+        dirty, before = self.doc.changed, self.doc.hair.state
+        done = self.doc.open_groom(hair(which), confirm=self._confirm(answer))
+        if dirty and answer == "cancel":
+            assert not done and self.doc.hair.state is before
+        else:
+            assert done and self.doc.groom is groom(which)
+            self.which = which
+
     # -- animations -------------------------------------------------------------------------
     @rule(which=st.integers(0, 1), answer=answers)
     def open_capture(self, which: int, answer: str) -> None:
@@ -153,11 +303,11 @@ class DocumentMachine(RuleBasedStateMachine):
 
     @rule(seed_=st.integers(0, 3), cycles=st.integers(1, 2), answer=answers)
     def apply_cycle(self, seed_: int, cycles: int, answer: str) -> None:
-        self._replace(answer, animation=cycle(seed_, cycles), source="anime cycle")
+        self._replace(answer, animation=cycle(seed_, cycles, self.which), source="anime cycle")
 
     @rule(frames=st.integers(3, 6), answer=answers)
     def simulate(self, frames: int, answer: str) -> None:
-        self._replace(answer, animation=simulation(frames), source="simulation")
+        self._replace(answer, animation=simulation(frames, self.which), source="simulation")
 
     @precondition(lambda self: self.doc.state.animation is not None)
     @rule(answer=answers)
@@ -263,29 +413,40 @@ class DocumentMachine(RuleBasedStateMachine):
         project_io.save(self.doc, path)
         assert not self.doc.changed
         self.doc = project_io.load(path)
-        self.start = self.doc.state  # a reopened document starts here, with nothing to undo
+        # a reopened document starts here, with nothing to undo
+        self.start, self.start_hair = self.doc.state, self.doc.hair.state
 
     # -- after every step -----------------------------------------------------------------------
     @invariant()
     def saves_and_loads_the_same(self) -> None:
-        if self.doc.state is self.saved_checked:
+        now = (self.doc.state, self.doc.hair.state)
+        if self.saved_checked is not None and all(
+            a is b for a, b in zip(now, self.saved_checked, strict=True)
+        ):
             return  # the same state (an undo and redo came back to it): checked already
-        self.saved_checked = self.doc.state
         path = self.dir / "check.hairproj"
-        project_io.save(Document(self.doc.groom, self.doc.state), path)
+        project_io.save(Document(self.doc.hair.state, self.doc.state), path)
         back = project_io.load(path)
+        self.saved_checked = (self.doc.state, self.doc.hair.state)  # (saving settles the strokes)
         assert same_state(back.state, self.doc.state)
-        assert back.groom.points.tobytes() == self.doc.groom.points.tobytes()
+        assert same_groom(back.hair.state, self.doc.hair.state)
+        written, again = (written_out(d) for d in (self.doc, back))
+        assert written[0] == again[0] and written[1].keys() == again[1].keys()
+        for name, a in written[1].items():
+            assert a.dtype == again[1][name].dtype and a.tobytes() == again[1][name].tobytes(), name
 
     @invariant()
     def undo_to_the_start_gives_the_start(self) -> None:
         now, n = self.doc.state, self.doc.stack.index
+        hair = self.doc.hair.state
         while self.doc.undo():
             pass
         assert same_state(self.doc.state, self.start)
+        assert same_groom(self.doc.hair.state, self.start_hair)
         for _ in range(n):
             assert self.doc.redo()
         assert same_state(self.doc.state, now)
+        assert same_groom(self.doc.hair.state, hair)
 
     @invariant()
     def exports_read_back_with_the_edits(self) -> None:
