@@ -20,6 +20,7 @@ unchanged, as in Blender and Maya.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -52,16 +53,31 @@ class GroomState:
     view: Mapping[str, object] = field(default_factory=lambda: MappingProxyType({}))
 
 
+_SURFACES: dict[bytes, object] = {}  # the last heads' surfaces, by the mesh's content
+
+
 def surface_of(mesh: Mesh | None):
-    """The head mesh as the surface the brushes work on (None without a usable one)."""
+    """The head mesh as the surface the brushes work on (None without a usable one); made once
+    per head (a surface is read, never changed), so Undo of a head, an up axis or a reopened
+    project builds none."""
     from hairtool.guides.planting import HeadSurface
 
     if mesh is None:
         return None
-    try:
-        return HeadSurface(mesh)
-    except HairtoolError:
-        return None
+    digest = hashlib.blake2b(digest_size=16)
+    for a in (mesh.vertices, mesh.faces, mesh.normals):
+        digest.update(str((a.dtype, a.shape)).encode())
+        digest.update(np.ascontiguousarray(a).tobytes())
+    key = digest.digest()
+    if key not in _SURFACES:
+        try:
+            surface = HeadSurface(mesh)
+        except HairtoolError:
+            surface = None
+        if len(_SURFACES) >= 4:
+            _SURFACES.clear()
+        _SURFACES[key] = surface
+    return _SURFACES[key]
 
 
 class SetGroom(Command):
@@ -149,8 +165,8 @@ class GroomSide:
 
     def settled(self) -> FrozenSnapshot | None:
         """The strokes as a replay gives them (after brush-local moves, clumped once more)."""
-        p = self.pipeline
-        if p.unsettled:
+        p = self._pipeline
+        if p is not None and self._at is self.state.strokes and p.unsettled:
             p.settle()
             self._at = p.snapshot()
             self.state = dataclasses.replace(self.state, strokes=self._at)
@@ -183,8 +199,8 @@ class GroomSide:
     def record(self, before: GroomState, text: str = "Stroke") -> None:
         """A stroke the engine thread applied to :attr:`pipeline` from ``before``: one step."""
         done = 0 if before.strokes is None else len(before.strokes.log)
-        if self._pipeline is None or len(self._pipeline.strokes) == done:
-            return
+        if self._pipeline is None or self._at is not before.strokes or len(self._pipeline.strokes) == done:
+            return  # the engine was not at ``before`` (an undo since), or applied nothing
         self._strokes_now(text, before)
 
     def end_stroke(self) -> None:
