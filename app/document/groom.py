@@ -22,7 +22,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from types import MappingProxyType
 
 import numpy as np
@@ -42,7 +42,8 @@ STUDIO_PARAMS = FrozenParams(keep_lengths=True)  # the studio keeps strand lengt
 
 @dataclass(frozen=True, eq=False)
 class GroomState:
-    """What a project holds of the groom. ``strokes`` None: no stroke yet."""
+    """What a project holds of the groom, less the view (:attr:`GroomSide.view`: not an undo
+    step, so Undo never turns the camera back). ``strokes`` None: no stroke yet."""
 
     rest: Groom
     params: FrozenParams = STUDIO_PARAMS
@@ -50,7 +51,6 @@ class GroomState:
     mesh: Mesh | None = None
     children: ChildBinding | None = None
     source: str | None = None
-    view: Mapping[str, object] = field(default_factory=lambda: MappingProxyType({}))
 
 
 _SURFACES: dict[bytes, object] = {}  # the last heads' surfaces, by the mesh's content
@@ -120,12 +120,13 @@ class Steps(Command):
 class GroomSide:
     """The groom side of one document, on the document's undo stack; see the module docstring."""
 
-    def __init__(self, stack: UndoStack, state: GroomState) -> None:
+    def __init__(self, stack: UndoStack, state: GroomState, view: Mapping[str, object] | None = None) -> None:
         if not isinstance(state.rest, Groom):
             raise ParameterError("groom", type(state.rest).__name__, "a Groom")
         state.params.validate()
         self.stack = stack
         self.state = state
+        self.view: Mapping[str, object] = MappingProxyType(dict(view or {}))  # camera and view settings
         self._listeners: list[Callable[[], None]] = []
         self._pipeline: FrozenPipeline | None = None
         self._made: tuple = ()  # (rest, params, mesh) the pipeline was made of
@@ -169,7 +170,7 @@ class GroomSide:
         if p is not None and self._at is self.state.strokes and p.unsettled:
             p.settle()
             self._at = p.snapshot()
-            self.state = dataclasses.replace(self.state, strokes=self._at)
+            self._set(dataclasses.replace(self.state, strokes=self._at))
         return self.state.strokes
 
     # -- commands ------------------------------------------------------------------------------
@@ -268,7 +269,7 @@ class GroomSide:
 
     def set_view(self, **changes: object) -> None:
         """Camera and view settings (JSON values): kept and saved, not an undo step."""
-        self.state = dataclasses.replace(self.state, view=MappingProxyType({**self.state.view, **changes}))
+        self.view = MappingProxyType({**self.view, **changes})
 
     def replace(self, state: GroomState, text: str) -> Command:
         """A command that opens ``state`` (another groom), for the document to push."""

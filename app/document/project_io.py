@@ -60,7 +60,7 @@ def to_project(doc: Document) -> pf.Project:
         params=g.params,
         strokes=() if strokes is None else strokes.log,
         aligned=aligned,
-        display=dict(g.view),
+        display=dict(doc.hair.view),
         groom_source=g.source,
         children=g.children,
         mesh=g.mesh,
@@ -86,20 +86,14 @@ def from_project(project: pf.Project, where: str = "project") -> Document:
         lists = {k: saved[k] for k in ("edits", "channel_edits") if k in saved}
         edits = tuple(parse_capture_edits(lists, capture, where).edits)
     state = AnimationState(project.animation, project.animation_source, capture, settings, edits)
-    return Document(groom_of(project), state)
+    doc = Document(groom_of(project), state)
+    doc.hair.view = MappingProxyType(dict(project.display))
+    return doc
 
 
 def groom_of(project: pf.Project) -> GroomState:
     """The groom side of a project, its strokes replayed (or taken as saved) on its engine."""
-    g = GroomState(
-        project.rest,
-        project.params,
-        None,
-        project.mesh,
-        project.children,
-        project.groom_source,
-        MappingProxyType(dict(project.display)),
-    )
+    g = GroomState(project.rest, project.params, None, project.mesh, project.children, project.groom_source)
     if not project.strokes:
         return g
     key = _strokes_key(project)

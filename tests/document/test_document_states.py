@@ -4,7 +4,7 @@ Rules are the artist's actions. On the groom (a few dozen strands on a tiny head
 every registered brush with random radius, strength, falloff, direction, symmetry, pen pressure
 and its toggles, front faces only and "affect selection only"; selection steps (all, none,
 invert, box, hide and reveal); the up axis; the head mesh taken off and put back; engine
-parameters; opening another groom. On the animation side: open a capture (or another one),
+parameters; the camera; opening another groom. On the animation side: open a capture (or another one),
 apply an anime cycle, simulate, close the animation (each answering the Save / Discard / Cancel
 question at random), key count, budget, price per key and interpolation switches, pins and
 exclusions, IK poses and graph-editor key edits (value, handle, move in time; drags of several
@@ -119,7 +119,7 @@ def snapshot_arrays(s: GroomState) -> tuple:
                    *(None if a is None else a.tobytes() for a in per_strand))  # fmt: skip
     mesh = None if s.mesh is None else (s.mesh.vertices.tobytes(), s.mesh.faces.tobytes())
     return (s.rest.points.tobytes(), s.rest.counts.tobytes(), repr(s.rest.metadata), s.params,
-            mesh, s.source, dict(s.view), s.children is None, strokes)  # fmt: skip
+            mesh, s.source, s.children is None, strokes)  # fmt: skip
 
 
 def same_groom(a: GroomState, b: GroomState) -> bool:
@@ -179,8 +179,19 @@ class DocumentMachine(RuleBasedStateMachine):
         self.doc = Document(hair(0), AnimationState(settings=START))
         self.start, self.start_hair = self.doc.state, self.doc.hair.state
         self.which = 0  # the groom open (its cycles and simulations are its own)
+        self._listen()
         self.drag = 0
         self.saved_checked = self.exports_checked = None
+
+    def _listen(self) -> None:
+        """What a widget observing the document last heard (it must hear every change)."""
+        self.heard = (self.doc.state, self.doc.hair.state)
+
+        def hear() -> None:
+            self.heard = (self.doc.state, self.doc.hair.state)
+
+        self.doc.observe(hear)
+        self.doc.hair.observe(hear)
 
     def teardown(self) -> None:
         for p in self.dir.iterdir():
@@ -286,6 +297,13 @@ class DocumentMachine(RuleBasedStateMachine):
     def up_axis(self, axis: str) -> None:
         self.doc.hair.set_up_axis(axis)
         assert self.doc.groom.metadata.up_axis == axis
+
+    @rule(yaw=st.floats(-180.0, 180.0), ortho=st.booleans())
+    def view(self, yaw: float, ortho: bool) -> None:
+        """The camera turned: kept and saved, but neither a step nor a change."""
+        changed, index = self.doc.changed, self.doc.stack.index
+        self.doc.hair.set_view(camera={"yaw": yaw}, ortho=ortho)
+        assert self.doc.changed == changed and self.doc.stack.index == index
 
     @rule(on=st.booleans())
     def head_mesh(self, on: bool) -> None:
@@ -428,6 +446,7 @@ class DocumentMachine(RuleBasedStateMachine):
         self.doc = project_io.load(path)
         # a reopened document starts here, with nothing to undo
         self.start, self.start_hair = self.doc.state, self.doc.hair.state
+        self._listen()
 
     # -- after every step -----------------------------------------------------------------------
     @invariant()
@@ -438,15 +457,22 @@ class DocumentMachine(RuleBasedStateMachine):
         ):
             return  # the same state (an undo and redo came back to it): checked already
         path = self.dir / "check.hairproj"
-        project_io.save(Document(self.doc.hair.state, self.doc.state), path)
+        copy = Document(self.doc.hair.state, self.doc.state)
+        copy.hair.view = self.doc.hair.view
+        project_io.save(copy, path)
         back = project_io.load(path)
         self.saved_checked = (self.doc.state, self.doc.hair.state)  # (saving settles the strokes)
         assert same_state(back.state, self.doc.state)
         assert same_groom(back.hair.state, self.doc.hair.state)
+        assert dict(back.hair.view) == dict(self.doc.hair.view)
         written, again = (written_out(d) for d in (self.doc, back))
         assert written[0] == again[0] and written[1].keys() == again[1].keys()
         for name, a in written[1].items():
             assert a.dtype == again[1][name].dtype and a.tobytes() == again[1][name].tobytes(), name
+
+    @invariant()
+    def the_views_heard_every_change(self) -> None:
+        assert self.heard[0] is self.doc.state and self.heard[1] is self.doc.hair.state
 
     @invariant()
     def undo_to_the_start_gives_the_start(self) -> None:

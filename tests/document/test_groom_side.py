@@ -65,7 +65,7 @@ def test_view_settings_are_saved_but_not_a_step(tmp_path):
     assert doc.stack.index == 0 and not doc.changed
     project_io.save(doc, tmp_path / "v.hairproj")
     back = project_io.load(tmp_path / "v.hairproj")
-    assert dict(back.hair.state.view) == {"ortho": True, "camera": {"yaw": 30.0}}
+    assert dict(back.hair.view) == {"ortho": True, "camera": {"yaw": 30.0}}
 
 
 def test_refusals_change_nothing():
