@@ -308,7 +308,12 @@ class DocumentMachine(RuleBasedStateMachine):
     @rule(on=st.booleans())
     def head_mesh(self, on: bool) -> None:
         """The head taken off (refused while strokes need it) or put back."""
-        self._try(lambda: self.doc.hair.set_mesh(head() if on else None), HairtoolError)
+        side, asked = self.doc.hair, head() if on else None
+        before = side.state.mesh
+        taken = []
+        self._try(lambda: taken.append(side.set_mesh(asked)), HairtoolError)
+        assert side.state.mesh is (asked if taken else before)  # refused: the old head stays
+        assert (side.pipeline.surface is None) == (side.state.mesh is None)  # the engine's head is it
 
     @rule(stiffness=st.sampled_from([4.0, 7.0]), keep=st.booleans(), clump=st.booleans())
     def engine_parameters(self, stiffness: float, keep: bool, clump: bool) -> None:
@@ -476,16 +481,20 @@ class DocumentMachine(RuleBasedStateMachine):
 
     @invariant()
     def undo_to_the_start_gives_the_start(self) -> None:
-        now, n = self.doc.state, self.doc.stack.index
-        hair = self.doc.hair.state
+        """Every Undo lands where Redo climbing back passes (a step that undoes only part of
+        itself shows there, even where an earlier step's undo would hide it at the start)."""
+        n = self.doc.stack.index
+        down = [(self.doc.state, self.doc.hair.state)]
         while self.doc.undo():
-            pass
+            down.append((self.doc.state, self.doc.hair.state))
         assert same_state(self.doc.state, self.start)
         assert same_groom(self.doc.hair.state, self.start_hair)
-        for _ in range(n):
+        for k in range(n):
             assert self.doc.redo()
-        assert same_state(self.doc.state, now)
-        assert same_groom(self.doc.hair.state, hair)
+            state, hair = down[n - 1 - k]
+            if state is not self.doc.state:
+                assert same_state(self.doc.state, state)
+            assert same_groom(self.doc.hair.state, hair)
 
     @invariant()
     def exports_read_back_with_the_edits(self) -> None:
