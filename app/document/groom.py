@@ -263,7 +263,14 @@ class GroomSide:
         self._strokes_now(text, before, params=params)
 
     def set_children(self, children: ChildBinding | None, text: str = "Render hair") -> None:
-        """The render-hair definition (None: none)."""
+        """The render-hair definition (None: none); ParameterError for children whose guides are
+        not this groom's strands."""
+        rest = self.state.rest
+        if children is not None and (
+            children.rest_guides.topology != rest.topology
+            or not np.array_equal(children.rest_guides.points, rest.points)
+        ):
+            raise ParameterError("render hair", "children of another groom", "children of its strands")
         if children is not self.state.children:
             self._push(text, dataclasses.replace(self.state, children=children))
 

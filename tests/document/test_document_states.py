@@ -3,15 +3,15 @@
 Rules are the artist's actions. On the groom (a few dozen strands on a tiny head): strokes of
 every registered brush with random radius, strength, falloff, direction, symmetry, pen pressure
 and its toggles, front faces only and "affect selection only"; selection steps (all, none,
-invert, box, hide and reveal); the up axis; the head mesh taken off and put back; engine
-parameters; the camera; opening another groom. On the animation side: open a capture (or another one),
-apply an anime cycle, simulate, close the animation (each answering the Save / Discard / Cancel
-question at random), key count, budget, price per key and interpolation switches, pins and
-exclusions, IK poses and graph-editor key edits (value, handle, move in time; drags of several
-moves). And undo, redo, save and reload. After every step: save → load gives an equal document
-(every array's bytes: the file's, and the strokes' state replayed from it), undo back to the
-start gives the start (and redo comes back), the keys record and the BVH read back and carry
-the edits, and every edit applies or has its line.
+invert, box, hide and reveal); the up axis; the head mesh taken off and put back; render hair
+grown and removed; engine parameters; the camera; opening another groom. On the animation side:
+open a capture (or another one), apply an anime cycle, simulate, close the animation (each
+answering the Save / Discard / Cancel question at random), key count, budget, price per key and
+interpolation switches, pins and exclusions, IK poses and graph-editor key edits (value, handle,
+move in time; drags of several moves). And undo, redo, save and reload. After every step: save →
+load gives an equal document (every array's bytes: the file's, and the strokes' state replayed
+from it), undo back to the start gives the start (and redo comes back), the keys record and the
+BVH read back and carry the edits, and every edit applies or has its line.
 
 CI runs ``DOCUMENT_EXAMPLES`` sequences (default 200) of at least 30 steps from a seed that
 changes per run and is printed; ``DOCUMENT_SEED`` replays one. Longer runs:
@@ -49,6 +49,7 @@ from hairtool.anime.settings import AnimeSettings, cycle_for_groom
 from hairtool.errors import HairtoolError, ParameterError
 from hairtool.frozen.brushes import registry
 from hairtool.frozen.selection import BOX_MODES, SelectionSample
+from hairtool.guides.binding import bind_scalp
 from hairtool.io.obj import Mesh
 from hairtool.keys import session as ks
 from hairtool.keys.export import read_keys_json, record_keys
@@ -95,6 +96,12 @@ def head(rings: int = 5, segments: int = 8) -> Mesh:
 
 def hair(which: int = 0) -> GroomState:
     return GroomState(groom(which), mesh=head(), source=f"tiny{which}.tfx")
+
+
+@cache
+def children(which: int, count: int):
+    """Render hair of ``count`` children on the head, the groom's strands their guides."""
+    return bind_scalp(groom(which), head(), count, seed=count)
 
 
 @cache
@@ -178,10 +185,14 @@ class DocumentMachine(RuleBasedStateMachine):
         self.dir = Path(tempfile.mkdtemp(prefix="document-"))
         self.doc = Document(hair(0), AnimationState(settings=START))
         self.start, self.start_hair = self.doc.state, self.doc.hair.state
-        self.which = 0  # the groom open (its cycles and simulations are its own)
         self._listen()
         self.drag = 0
         self.saved_checked = self.exports_checked = None
+
+    @property
+    def which(self) -> int:
+        """The groom open (its cycles, simulations and render hair are its own)."""
+        return 0 if self.doc.groom.strand_count == groom(0).strand_count else 1
 
     def _listen(self) -> None:
         """What a widget observing the document last heard (it must hear every change)."""
@@ -298,6 +309,13 @@ class DocumentMachine(RuleBasedStateMachine):
         self.doc.hair.set_up_axis(axis)
         assert self.doc.groom.metadata.up_axis == axis
 
+    @precondition(lambda self: self.doc.stack.index % 4 == 1)  # (a project with render hair
+    @rule(count=st.sampled_from([0, 4]))  # binds it again on every load: a fourth of the time)
+    def render_hair(self, count: int) -> None:
+        """Render hair grown on the head from the groom's strands (0: removed)."""
+        self.doc.hair.set_children(children(self.which, count) if count else None)
+        assert (self.doc.hair.state.children is None) == (count == 0)
+
     @rule(yaw=st.floats(-180.0, 180.0), ortho=st.booleans())
     def view(self, yaw: float, ortho: bool) -> None:
         """The camera turned: kept and saved, but neither a step nor a change."""
@@ -328,7 +346,6 @@ class DocumentMachine(RuleBasedStateMachine):
             assert not done and self.doc.hair.state is before
         else:
             assert done and self.doc.groom is groom(which)
-            self.which = which
 
     # -- animations -------------------------------------------------------------------------
     @rule(which=st.integers(0, 1), answer=answers)
