@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from app.document.capture import edit_frames, skeleton_animation
+from app.document.groom import GroomSide, GroomState, Steps
 from app.document.undo import Command, UndoStack
 from hairtool.errors import GroomError, HairtoolError, ParameterError
 from hairtool.groom import Animation, Groom
@@ -108,22 +109,31 @@ Confirm = Callable[[], bool]  # asks Save / Discard / Cancel: True to go on (sav
 
 
 class Document:
-    """The studio's document (its animation side) over a groom; see the module docstring."""
+    """The studio's document: its groom side (:attr:`hair`, :mod:`app.document.groom`) and its
+    animation side (:attr:`state`, this module), on one undo stack."""
 
-    def __init__(self, groom: Groom, state: AnimationState | None = None) -> None:
-        if not isinstance(groom, Groom):
+    def __init__(self, groom: Groom | GroomState, state: AnimationState | None = None) -> None:
+        if isinstance(groom, Groom):
+            groom = GroomState(groom)
+        if not isinstance(groom, GroomState):
             raise GroomError(f"expected a Groom, got {type(groom).__name__}")
-        self.groom = groom
         self.state = state if state is not None else AnimationState()
         self.stack = UndoStack()
+        self.hair = GroomSide(self.stack, groom)
         self._listeners: list[Callable[[], None]] = []
         self._derived: OrderedDict[int, tuple[AnimationState, Keyed]] = OrderedDict()
         self._skeletons: OrderedDict[int, tuple[Motion, Animation]] = OrderedDict()
         self._solves: OrderedDict[tuple, tuple[Animation, ks.KeySession]] = OrderedDict()
 
     # -- observing -----------------------------------------------------------------------------
+    @property
+    def groom(self) -> Groom:
+        """The groom as authored (its metadata: the scene description and up axis)."""
+        return self.hair.state.rest
+
     def observe(self, callback: Callable[[], None]) -> None:
-        """``callback()`` after every change of the state (an edit, an undo, a redo)."""
+        """``callback()`` after every change of the animation side (an edit, an undo, a redo);
+        the groom side has its own (``hair.observe``)."""
         self._listeners.append(callback)
 
     def _set(self, state: AnimationState) -> None:
@@ -207,13 +217,30 @@ class Document:
             animation = self._skeleton(capture)
         if animation is not None and not isinstance(animation, Animation):
             raise GroomError(f"expected an Animation, got {type(animation).__name__}")
+        s = self._settings_for_new()
+        after = AnimationState(animation, str(source) if animation is not None else "", capture, s, ())
+        text = "Close animation" if animation is None else f"New animation ({source or 'untitled'})"
+        self._push(text, after)
+        return True
+
+    def _settings_for_new(self) -> ks.KeySettings:
         s = self.state.settings.replace(count=0, pins=(), excludes=())
         if s.mode == "budget":
             d = ks.KeySettings()
             s = s.replace(mode=d.mode, budget=d.budget)
-        after = AnimationState(animation, str(source) if animation is not None else "", capture, s, ())
-        text = "Close animation" if animation is None else f"New animation ({source or 'untitled'})"
-        self._push(text, after)
+        return s
+
+    def open_groom(self, groom: GroomState, confirm: Confirm | None = None, text: str = "") -> bool:
+        """Another groom (File ▸ Open a groom): one undo step, asked about first as Open asks
+        (False: Cancel). An animation made of the old groom's strands (a simulation, a cycle)
+        closes with it; a capture stays (its skeleton is not the groom's)."""
+        if self.changed and confirm is not None and not confirm():
+            return False
+        text = text or f"Open groom ({groom.source or 'untitled'})"
+        steps: list[Command] = [self.hair.replace(groom, text)]
+        if self.state.animation is not None and self.state.capture is None:
+            steps.append(SetState(self, "Close animation", AnimationState(settings=self._settings_for_new())))
+        self.stack.push(Steps(text, steps))
         return True
 
     def set_settings(self, text: str = "Key settings", **changes: object) -> None:

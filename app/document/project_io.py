@@ -1,6 +1,7 @@
 """The document written out, and read back: the project file (the same fields the studio
-writes: the animation, its source, the key settings, and the capture with its edits as
-``settings["capture"]``), the edited capture as BVH and the keys record.
+writes: the groom with its scene description, engine parameters, strokes, head mesh, render
+hair and view settings as ``display``; the animation, its source, the key settings, and the
+capture with its edits as ``settings["capture"]``), the edited capture as BVH and the keys record.
 
 Save is the state written whole and marks the stack clean; load is its inverse (a new document,
 nothing to undo). Files are written to a temporary name and renamed by the writers used here.
@@ -9,12 +10,16 @@ nothing to undo). Files are written to a temporary name and renamed by the write
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import os
+import sys
+from types import MappingProxyType
 
 import numpy as np
 
 from app.document.animation import AnimationState, Document
 from app.document.capture import motion_from_text, motion_text
+from app.document.groom import GroomSide, GroomState
 from hairtool import project as pf
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.keys import session as ks
@@ -45,8 +50,20 @@ def to_project(doc: Document) -> pf.Project:
             "edits": [e.to_dict() for e in s.edits],
             "channel_edits": [],
         }
+    g = doc.hair.state
+    strokes = doc.hair.settled()
+    aligned = None
+    if strokes is not None and strokes.aligned.topology == g.rest.topology:
+        aligned = strokes.aligned.with_metadata(g.rest.metadata)
     return pf.Project(
-        rest=doc.groom,
+        rest=g.rest,
+        params=g.params,
+        strokes=() if strokes is None else strokes.log,
+        aligned=aligned,
+        display=dict(doc.hair.view),
+        groom_source=g.source,
+        children=g.children,
+        mesh=g.mesh,
         animation=s.animation,
         animation_source=s.source,
         key_settings=dataclasses.asdict(s.settings),
@@ -69,7 +86,46 @@ def from_project(project: pf.Project, where: str = "project") -> Document:
         lists = {k: saved[k] for k in ("edits", "channel_edits") if k in saved}
         edits = tuple(parse_capture_edits(lists, capture, where).edits)
     state = AnimationState(project.animation, project.animation_source, capture, settings, edits)
-    return Document(project.rest, state)
+    doc = Document(groom_of(project), state)
+    doc.hair.view = MappingProxyType(dict(project.display))
+    return doc
+
+
+def groom_of(project: pf.Project) -> GroomState:
+    """The groom side of a project, its strokes replayed (or taken as saved) on its engine."""
+    g = GroomState(project.rest, project.params, None, project.mesh, project.children, project.groom_source)
+    if not project.strokes:
+        return g
+    key = _strokes_key(project)
+    strokes = _REPLAYED.get(key)
+    if strokes is None:
+        side = GroomSide(None, g)
+        p = side.pipeline
+        p.restore(project.stroke_snapshot(p))
+        strokes = p.snapshot()
+        if len(_REPLAYED) >= 8:
+            _REPLAYED.clear()
+        _REPLAYED[key] = strokes
+    return dataclasses.replace(g, strokes=strokes)
+
+
+_REPLAYED: dict[bytes, object] = {}  # the strokes of the last projects read, by what made them
+
+
+def _strokes_key(project: pf.Project) -> bytes:
+    """What a project's strokes state follows from (groom, parameters, head, log, stored points),
+    so that reopening the same strokes (Revert, a recovery) replays them once."""
+    h = hashlib.blake2b(digest_size=20)
+    mesh = project.mesh
+    arrays = [project.rest.points, project.rest.counts]
+    arrays += [] if mesh is None else [mesh.vertices, mesh.faces, mesh.normals]
+    arrays += [] if project.aligned is None else [project.aligned.points]
+    for a in arrays:
+        h.update(repr((a.dtype.str, a.shape)).encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+    with np.printoptions(threshold=sys.maxsize):  # (arrays in the metadata or params written whole)
+        h.update(repr((project.rest.metadata, project.params, project.strokes)).encode())
+    return h.digest()
 
 
 def save(doc: Document, path: str | os.PathLike[str]) -> None:

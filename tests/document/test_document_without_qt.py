@@ -1,5 +1,5 @@
 """The document works with Qt and OpenGL absent: its modules import, and a capture opened, posed
-by IK, saved and reopened gives the same document (the model tests need no display)."""
+by IK, a comb stroke, saved and reopened give the same document (the model tests need no display)."""
 
 from __future__ import annotations
 
@@ -38,11 +38,20 @@ SCRIPT = textwrap.dedent(
     j = m.joint_names.index("LeftWrist")
     target = tuple(float(v) for v in m.joint_positions()[f, j] + [2.0, 1.0, 0.0])
     doc.edit(PoseEdit(f, "LeftWrist", target, 2))
+    from app.ui.brush_tool import BrushTool  # the studio's sampling of a brush: no Qt either
+
+    tool = BrushTool(brush="comb", symmetry=True)
+    tool.reset_radius(1.0)
+    at = doc.hair.pipeline.aligned.points[2].astype(float)
+    doc.hair.stroke(tool.samples(at, (0.3, 0.0, 0.0), None, 0.0, start=True), stroke=1)
+    doc.hair.end_stroke()
     project_io.save(doc, out)
     assert not doc.changed
     back = project_io.load(out)
     assert back.state.edits == doc.state.edits
     assert back.keyed().motion.values.tobytes() == doc.keyed().motion.values.tobytes()
+    a, b = doc.hair.state.strokes, back.hair.state.strokes
+    assert a.log == b.log and a.aligned.points.tobytes() == b.aligned.points.tobytes()
     assert not any(n.split(".")[0] in BLOCKED for n in sys.modules), "a blocked module got in"
     """
 )
