@@ -240,7 +240,7 @@ class GroomSide:
         # of it gives when it is opened again.
         p = FrozenPipeline(rest, s.params, surface_of(s.mesh))
         if s.strokes is not None:
-            p.restore(FrozenSnapshot(s.strokes.log, rest, ("replay",), -1))
+            p.restore(FrozenSnapshot.replaying(s.strokes.log, rest))
         self._pipeline = p
         self._strokes_now(f"Up axis {axis}", s, rest=rest)
 

@@ -121,7 +121,8 @@ def snapshot_arrays(s: GroomState) -> tuple:
     st_ = s.strokes
     strokes = ()
     if st_ is not None:
-        per_strand = (st_.locked, st_.clump_strength, st_.origin, st_.selected, st_.hidden)
+        k = st_.state
+        per_strand = (k.locked, k.clump_strength, k.origin, k.selected, k.hidden)
         strokes = (repr(st_.log), st_.aligned.points.tobytes(), st_.aligned.counts.tobytes(),
                    *(None if a is None else a.tobytes() for a in per_strand))  # fmt: skip
     mesh = None if s.mesh is None else (s.mesh.vertices.tobytes(), s.mesh.faces.tobytes())
