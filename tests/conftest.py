@@ -110,6 +110,19 @@ def pytest_unconfigure(config: pytest.Config) -> None:
         _xvfb.wait(timeout=10)
 
 
+@pytest.fixture(autouse=True)
+def _budget_factor_restored():
+    """Each test starts with the budget's limits as set outside the suite: ``--raise-limits``
+    (``budget.set_factor``) writes the factor to the environment, and a test that raised it
+    in-process made a later one on the same worker pass its limits."""
+    before = os.environ.get("HAIRTOOL_BUDGET")
+    yield
+    if before is None:
+        os.environ.pop("HAIRTOOL_BUDGET", None)
+    else:
+        os.environ["HAIRTOOL_BUDGET"] = before
+
+
 @pytest.fixture(scope="session")
 def grooms_dir() -> Path:
     if not GROOMS.is_dir():

@@ -6,7 +6,7 @@ error dialog, a Python exception, a Qt warning, a stderr line no state explains,
 does not read back, a greyed-out action that does not say why, or the process dying.
 
 The walk runs in a subprocess, so a fatal error fails this test instead of ending pytest. After
-the four states, the capture state is walked twice more in the same process: it holds the
+the four states, the capture state is walked once more in the same process: it holds the
 sequence that once aborted the studio (File ▸ New from sample ▸ each entry, the capture reopened
 after each, the dope sheet of 1,064 frames repainted every time), and such crashes come from
 slips that accumulate; the walk ends with Ctrl+Q over an edit, answered Discard.
@@ -27,7 +27,7 @@ pytestmark = pytest.mark.gui
 
 WALK = Path(__file__).with_name("studio_walk.py")
 STATES = ("sample", "bear", "bvh", "simulation")
-REPEATED = ("bvh", "bvh")  # walked again after the four states, in the same process
+REPEATED = ("bvh",)  # walked again after the four states, in the same process
 
 #: (state, action) → why it fails today. The test fails while one of these passes, so whoever
 #: fixes it removes the entry.
