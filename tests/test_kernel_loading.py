@@ -4,6 +4,7 @@ source is loaded without compiling; anything else is left for the call."""
 from __future__ import annotations
 
 import importlib
+import os
 import sys
 import uuid
 
@@ -28,8 +29,16 @@ def module(tmp_path, monkeypatch):
     name = f"cached_kernel_{uuid.uuid4().hex}"
     path = tmp_path / f"{name}.py"
 
+    writes = [0]
+
     def make(op: str = "+"):
-        path.write_text(SOURCE.format(op=op))
+        text = SOURCE.format(op=op)
+        if not path.exists() or path.read_text() != text:
+            path.write_text(text)
+            # numba knows a source by its size and mtime: "+" and "-" are the same size, and two
+            # writes within one tick of a loaded host's clock left the same mtime
+            writes[0] += 1
+            os.utime(path, (1_700_000_000 + writes[0], 1_700_000_000 + writes[0]))
         sys.modules.pop(name, None)
         importlib.invalidate_caches()
         return importlib.import_module(name)
