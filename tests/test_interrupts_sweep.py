@@ -77,18 +77,31 @@ def _pythons_own(err: str) -> bool:
     )
 
 
+def _solo_seconds(script: Path, out: Path) -> float:
+    """How long the command takes uninterrupted, alone (the sweep's children, four at a time,
+    take longer)."""
+    t0 = time.perf_counter()
+    subprocess.run([script, "convert", USDA, out], check=True, capture_output=True, timeout=120,
+                   env={**os.environ, "PYTHONPATH": str(ROOT)})  # fmt: skip
+    return time.perf_counter() - t0
+
+
 def test_ctrl_c_at_any_moment_of_a_usd_command_is_one_line_and_130(tmp_path):
     script = _script(tmp_path)
+    (tmp_path / "solo").mkdir()
+    solo = _solo_seconds(script, tmp_path / "solo" / "o.npz")
     outs = [tmp_path / f"out{i}" / "o.npz" for i in range(len(DELAYS))]
     with ThreadPoolExecutor(4) as pool:
         results = list(pool.map(_interrupted_at, [script] * len(DELAYS), outs, DELAYS))
     said = 0
-    # well past Python's start-up, even on a loaded host, and before the command was done
-    late = [r[:3] for r in results if r[0] >= 1.5 and r[3]]
+    # well past Python's start-up, even on a loaded host, and well before the command is done
+    # (on an idle machine a signal near its end lands while the interpreter ends, its work written)
+    late = [r[:3] for r in results if 1.5 <= r[0] < 0.6 * solo and r[3]]
     for (delay, status, err, running), out in zip(results, outs, strict=True):
         where = f"SIGINT at {delay * 1000:.0f} ms: exit {status}, stderr {err[-1500:]!r}"
-        if not running:  # done before the signal: a whole, quiet run
-            assert status == 0 and err == "" and out.is_file(), where
+        done = status == 0 and err == "" and out.is_file()
+        if not running or (done and delay >= 0.6 * solo):  # done before the signal counted
+            assert done, where
             continue
         if err.endswith(": interrupted\n") and err.count("\n") == 1:
             assert status == 130, where
