@@ -96,8 +96,9 @@ def test_ctrl_c_at_any_moment_is_one_line_and_130(delay, tmp_path):
     time.sleep(delay)
     p.send_signal(signal.SIGINT)
     _, err = p.communicate(timeout=120)
-    if p.returncode == 0:  # finished before the signal came
-        assert err == b""
+    if p.returncode in (0, -signal.SIGINT) and err == b"" and (tmp_path / "o.npz").is_file():
+        # finished before the signal came, or as it came: the work written, the interpreter
+        # ending (a quiet CI machine converts the bear in under half a second)
         return
     assert p.returncode == 130 and _one_line(err).endswith(": interrupted\n")
     assert not list(tmp_path.iterdir())  # no partial output, no temporary file left
