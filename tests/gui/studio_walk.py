@@ -37,7 +37,8 @@ ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"
 STATES = ("sample", "bear", "bvh", "simulation")
 JOB_S = 1.5  # seconds a job may run before the walk cancels it …
-JOB_MORE_S = 12.0  # … or more, when a tenth of it is done by then (short videos, small solves)
+JOB_MORE_S = 60.0  # … or more, while it moves, once a tenth of it is done (short videos, small solves)
+JOB_STALL_S = 5.0  # … and cancelled when its bar has not moved for this long
 JOB_FIRST_S = 3.0  # … waiting this long at most for that tenth (a video's first frame, on a
 # loaded CI core beside the other test worker, came after 1.5 s and the export was cancelled)
 SIMULATION = {"frames": 8, "substeps": 2}  # the simulated state: a short simulation of the sample
@@ -202,8 +203,13 @@ class Walk:
                 if jobs.wait(0.1):
                     break
                 waited += 0.1
-            if tenth():
-                jobs.wait(JOB_MORE_S)
+            if tenth():  # as an artist waits while the bar moves
+                last, spent = -1.0, 0.0
+                while spent < JOB_MORE_S and not jobs.wait(JOB_STALL_S):
+                    now = min((j.fraction or 0.0) for j in jobs.active()) if jobs.active() else 1.0
+                    if now <= last:
+                        break
+                    last, spent = now, spent + JOB_STALL_S
             jobs.cancel()  # as the artist presses Cancel: it must leave no partial file
             jobs.wait(30.0)
         self.pump()
