@@ -35,6 +35,7 @@ class UndoStack:
         self._undone: list[Command] = []
         self._clean: int | None = 0
         self._listeners: list[Callable[[], None]] = []
+        self.edits = 0  # counts pushes (merged ones too), undos, redos and clears: the steps moved
 
     def observe(self, callback: Callable[[], None]) -> None:
         self._listeners.append(callback)
@@ -55,6 +56,7 @@ class UndoStack:
         top = self._done[-1] if self._done else None
         if top is None or len(self._done) == self._clean or not top.merge(command):
             self._done.append(command)
+        self.edits += 1
         self._tell()
 
     def undo(self) -> bool:
@@ -63,6 +65,7 @@ class UndoStack:
         command = self._done.pop()
         command.undo()
         self._undone.append(command)
+        self.edits += 1
         self._tell()
         return True
 
@@ -72,6 +75,7 @@ class UndoStack:
         command = self._undone.pop()
         command.do()
         self._done.append(command)
+        self.edits += 1
         self._tell()
         return True
 
@@ -81,12 +85,29 @@ class UndoStack:
         self._done.clear()
         self._undone.clear()
         self._clean = 0 if clean else None
+        self.edits += 1
         self._tell()
 
     # -- state ----------------------------------------------------------------------------------
     @property
     def index(self) -> int:
+        """Steps done (the position Undo takes back from)."""
         return len(self._done)
+
+    @property
+    def count(self) -> int:
+        """Steps held, done and undone."""
+        return len(self._done) + len(self._undone)
+
+    def command(self, i: int) -> Command:
+        """Step ``i`` in the order done (0: the oldest; from :attr:`index` on, the undone ones)."""
+        if not 0 <= i < self.count:
+            raise IndexError(f"no step {i}: the stack holds {self.count}")
+        return (
+            self._done[i]
+            if i < len(self._done)
+            else self._undone[len(self._undone) - 1 - (i - len(self._done))]
+        )
 
     @property
     def top(self) -> Command | None:

@@ -13,14 +13,15 @@ from typing import TYPE_CHECKING, Protocol
 
 if TYPE_CHECKING:
     from PySide6.QtCore import QSettings, Qt
-    from PySide6.QtGui import QUndoStack
     from PySide6.QtWidgets import QDockWidget, QMenuBar, QStatusBar, QStyle
 
+    from app.document.animation import Document
     from app.ui.animation_model import AnimationModel
     from app.ui.dialogs import PictureOptions
     from app.ui.jobs import JobRunner
     from app.ui.scene import Scene
     from app.ui.tool_dock import ToolDock
+    from app.ui.undo_view import UndoView
     from app.ui.viewport import Viewport
     from hairtool.simulate.options import SimulateOptions
 
@@ -33,7 +34,8 @@ class UnsavedWork(Protocol):
 
 class StudioHost(Protocol):
     settings: QSettings
-    undo_stack: QUndoStack
+    doc: Document
+    undo_stack: UndoView
     jobs: JobRunner
     scene: Scene
     viewport: Viewport

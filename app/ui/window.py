@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 from PySide6.QtCore import QEvent, QSettings, QSize, Qt
-from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QKeySequence, QUndoStack
+from PySide6.QtGui import QAction, QActionGroup, QDragEnterEvent, QDropEvent, QKeySequence
 from PySide6.QtWidgets import (
     QDockWidget,
     QFileDialog,
@@ -22,6 +22,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.document.animation import Document
 from app.ui import export
 from app.ui.animation_io import (
     PROJECT_SUFFIX,
@@ -52,6 +53,7 @@ from app.ui.status_line import ElidedLabel, StatusLine
 from app.ui.stroke_files import StrokeFiles
 from app.ui.timeline_dock import TimelineDock
 from app.ui.tool_dock import ToolDock
+from app.ui.undo_view import UndoView
 from app.ui.up_axis_guess import with_inferred_up_axis
 from app.ui.viewport import BRUSH_STEP, Viewport
 from app.ui.widgets import WheelGuard, keep_controls_put
@@ -93,13 +95,14 @@ class MainWindow(QMainWindow):
         self.setObjectName("HairtoolStudio")
         self.setStatusBar(StatusLine(self))  # first: messages are never painted over its widgets
         self.settings = settings if settings is not None else QSettings(SETTINGS_ORG, SETTINGS_APP)
-        self.undo_stack = QUndoStack(self)
+        start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
+        self.doc = Document(start)  # the document: every edit is a step on its one undo stack
+        self.undo_stack = UndoView(self.doc.stack, self)
         self._shown_once = False
         self._stroke_points: np.ndarray | None = None
         self._stroke_clump: np.ndarray | None = None  # clump strengths when a clump stroke began
         # long work (key solves, simulation, video export): window.jobs.run(title, fn, on_done)
         self.jobs = JobRunner(lambda title, message: self.show_error(title, message), self)
-        start = groom if groom is not None else samples.sample(samples.DEFAULT_SAMPLE)
         self.scene = Scene(start, parent=self, engine_ready=engine_ready)
         self.engine_start: EngineStart | None = None
         # the bundled sample's render hair, on a first start bound once its kernels are cached
