@@ -51,6 +51,7 @@ class GroomState:
     mesh: Mesh | None = None
     children: ChildBinding | None = None
     source: str | None = None
+    clump_children: bool = False  # ClumpWithGaps among the render hair (saved, exported)
 
 
 _SURFACES: dict[bytes, object] = {}  # the last heads' surfaces, by the mesh's content
@@ -149,7 +150,8 @@ class GroomSide:
         s = self.state
         p = self._pipeline
         made = self._made
-        if p is None or made[0] is not s.rest or made[1] != s.params or made[2] is not s.mesh:
+        new_params = made and made[1] is not s.params and made[1] != s.params
+        if p is None or made[0] is not s.rest or made[2] is not s.mesh or new_params:
             p = FrozenPipeline(s.rest, s.params, surface_of(s.mesh))
             self._pipeline, self._made, self._at = p, (s.rest, s.params, s.mesh), None
         if self._at is not s.strokes:
@@ -174,6 +176,17 @@ class GroomSide:
         return self.state.strokes
 
     # -- commands ------------------------------------------------------------------------------
+    def reset(self, state: GroomState) -> None:
+        """A new document's groom (a file opened, a project read): no step. The caller starts a
+        new history (the old steps hold states of the old groom)."""
+        state.params.validate()
+        self._set(state)
+
+    def _idle(self) -> bool:
+        """No engine made and no stroke to replay: a change needs no engine (a first start's
+        parameters, axis or head set before its kernels are compiled)."""
+        return self._pipeline is None and self.state.strokes is None
+
     def _push(
         self, text: str, after: GroomState, before: GroomState | None = None, stroke: object = None
     ) -> None:
@@ -236,6 +249,9 @@ class GroomSide:
         if axis == s.rest.metadata.up_axis:
             return
         rest = s.rest.with_metadata(s.rest.metadata.with_(up_axis=axis))
+        if self._idle():
+            self._push(f"Up axis {axis}", dataclasses.replace(s, rest=rest))
+            return
         # The strokes replayed on the relabelled groom (brushes read the up axis): what a save
         # of it gives when it is opened again.
         p = FrozenPipeline(rest, s.params, surface_of(s.mesh))
@@ -250,29 +266,51 @@ class GroomSide:
         if mesh is self.state.mesh:
             return
         before = self.state
+        if self._idle():
+            self._push(text, dataclasses.replace(before, mesh=mesh))
+            return
         p = self.pipeline
         p.set_surface(surface_of(mesh))  # replays; refused: the old surface stays
         self._strokes_now(text, before, mesh=mesh)
 
-    def set_params(self, params: FrozenParams, text: str = "Engine parameters") -> None:
-        """New engine parameters; the strokes are replayed on the new frozen groom."""
+    def set_params(self, params: FrozenParams, text: str = "Engine parameters", drag: object = None) -> None:
+        """New engine parameters; the strokes are replayed on the new frozen groom. Edits of one
+        slider drag (the same ``drag``, not None) are one step."""
         if params == self.state.params:
             return
+        params.validate()
         before = self.state
+        stroke = None if drag is None else ("parameters", drag)
+        if self._idle():
+            self._push(text, dataclasses.replace(before, params=params), stroke=stroke)
+            return
         self.pipeline.set_params(params)
-        self._strokes_now(text, before, params=params)
+        self._strokes_now(text, before, stroke, params=params)
 
-    def set_children(self, children: ChildBinding | None, text: str = "Render hair") -> None:
-        """The render-hair definition (None: none); ParameterError for children whose guides are
-        not this groom's strands."""
+    def set_children(
+        self, children: ChildBinding | None, text: str = "Render hair", clump: bool | None = None
+    ) -> None:
+        """The render-hair definition (None: none) and whether its children are clumped (None:
+        grown children are, authored ones not: :func:`~hairtool.guides.binding.clumps_by_default`);
+        ParameterError for children whose guides are not this groom's strands."""
         rest = self.state.rest
         if children is not None and (
             children.rest_guides.topology != rest.topology
             or not np.array_equal(children.rest_guides.points, rest.points)
         ):
             raise ParameterError("render hair", "children of another groom", "children of its strands")
-        if children is not self.state.children:
-            self._push(text, dataclasses.replace(self.state, children=children))
+        if clump is None:
+            from hairtool.guides.binding import clumps_by_default
+
+            clump = self.state.clump_children if children is None else clumps_by_default(children)
+        if children is not self.state.children or bool(clump) != self.state.clump_children:
+            self._push(text, dataclasses.replace(self.state, children=children, clump_children=bool(clump)))
+
+    def set_clump_children(self, on: bool) -> None:
+        """ClumpWithGaps among the render hair, on or off: one step."""
+        if bool(on) != self.state.clump_children:
+            text = "Clump children" if on else "Unclump children"
+            self._push(text, dataclasses.replace(self.state, clump_children=bool(on)))
 
     def set_view(self, **changes: object) -> None:
         """Camera and view settings (JSON values): kept and saved, not an undo step."""

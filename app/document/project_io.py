@@ -60,7 +60,7 @@ def to_project(doc: Document) -> pf.Project:
         params=g.params,
         strokes=() if strokes is None else strokes.log,
         aligned=aligned,
-        display=dict(doc.hair.view),
+        display={**doc.hair.view, "clump_children": g.clump_children},
         groom_source=g.source,
         children=g.children,
         mesh=g.mesh,
@@ -87,13 +87,16 @@ def from_project(project: pf.Project, where: str = "project") -> Document:
         edits = tuple(parse_capture_edits(lists, capture, where).edits)
     state = AnimationState(project.animation, project.animation_source, capture, settings, edits)
     doc = Document(groom_of(project), state)
-    doc.hair.view = MappingProxyType(dict(project.display))
+    doc.hair.view = MappingProxyType({k: v for k, v in project.display.items() if k != "clump_children"})
     return doc
 
 
 def groom_of(project: pf.Project) -> GroomState:
     """The groom side of a project, its strokes replayed (or taken as saved) on its engine."""
-    g = GroomState(project.rest, project.params, None, project.mesh, project.children, project.groom_source)
+    clump = bool(project.display.get("clump_children", False))  # (a project from before: off)
+    g = GroomState(
+        project.rest, project.params, None, project.mesh, project.children, project.groom_source, clump
+    )
     if not project.strokes:
         return g
     key = _strokes_key(project)

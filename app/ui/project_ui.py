@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, QSettings, QStandardPaths, QTimer, Signal
 
+from app.document.project_io import groom_of
 from app.render.camera import Camera
 from hairtool import project as pf
 from hairtool.errors import FormatError, HairtoolError
@@ -170,11 +171,9 @@ class ProjectController(QObject):
             w.jobs.cancel(job)
         model.reset()  # frame rate and key settings: the project's own, or the defaults
         w.undo_stack.clear()
-        scene.load(project.rest, path, params=project.params, mesh=project.mesh)
-        scene.restore(project.stroke_snapshot(scene.pipeline))
-        # Clump children as saved (a project from before the switch: off, as it looked then),
-        # given with the children so that they are not clumped first for nothing
-        scene.set_binding(project.children, clump=bool(project.display.get("clump_children", False)))
+        # the document's groom side: its strokes replayed (or taken as saved), its render hair
+        # clumped as saved (a project from before the switch: off, as it looked then)
+        scene.open(groom_of(project), path)
         _apply_each(
             w,
             (
@@ -187,7 +186,6 @@ class ProjectController(QObject):
                 lambda: scene.set_line_width(float(project.display["line_width"])),
                 lambda: w.viewport.set_ortho(bool(project.display["ortho"])),
                 lambda: scene.set_show_guides(bool(project.display.get("show_guides", True))),
-                lambda: scene.set_clump_children(bool(project.display.get("clump_children", False))),
                 lambda: scene.set_display_percent(
                     float(project.display.get("drag_percent", scene.drag_percent)),
                     float(project.display.get("release_percent", scene.release_percent)),

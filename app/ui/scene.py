@@ -1,4 +1,12 @@
-"""The studio's model: the rest groom, the frozen-hair pipeline over it, and the display settings.
+"""The studio's view of the groom side of the document: what the viewport draws of it (the
+frozen groom, its render hair at a display share, colours), the brush settings, and the live
+stroke on the document's engine.
+
+The groom, its parameters, strokes, per-strand state, head mesh and render hair are the
+document's (:class:`app.document.groom.GroomSide`, :attr:`Scene.hair`): every edit of them is a
+document step, and an Undo or Redo lands here through the document's callback
+(:meth:`Scene._on_hair`), which is the one place the views follow from. A stroke runs on the
+document's engine while the mouse moves and becomes one step on release (:meth:`end_stroke`).
 
 The scene knows nothing of widgets. Setters emit a signal only when the value really changes, so
 a widget that writes a value and listens for it cannot loop; the viewport and the dock listen.
@@ -17,17 +25,18 @@ from pathlib import Path
 import numpy as np
 from PySide6.QtCore import QObject, QTimer, Signal
 
+from app.document.groom import STUDIO_PARAMS, GroomSide, GroomState
+from app.document.undo import UndoStack
 from app.render.ramps import DEFAULT_RAMP
 from app.ui.brush_tool import LABELS, SIGNED, BrushTool, check_falloff
 from app.ui.engine_thread import MoveEngine
 from hairtool.errors import HairtoolError, ParameterError
-from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, facing_away, scalp_centre
+from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
-from hairtool.frozen.selection import SelectionSample, apply_selection
+from hairtool.frozen.selection import SelectionSample
 from hairtool.groom import Groom, Topology, vertex_ids_of
-from hairtool.guides.binding import ChildBinding, clumps_by_default
+from hairtool.guides.binding import ChildBinding
 from hairtool.io.obj import Mesh
-from hairtool.metadata import UP_AXES
 
 ALIGN_MODES = ("paper", "preserve-length")
 COLOUR_MODES = {
@@ -69,18 +78,25 @@ class Scene(QObject):
         parent: QObject | None = None,
         *,
         engine_ready: bool = True,
+        hair: GroomSide | None = None,
     ):
+        """``hair``: the document's groom side (the window's); None: one of the scene's own, on
+        an undo stack of its own. ``groom`` (and ``params``) replace its groom unless it is
+        ``groom`` already."""
         super().__init__(parent)
         self.engine_ready = engine_ready
         # The studio keeps strand lengths after clumping (FrozenParams' own default is the
         # paper's printed ClumpWithGaps, which stretches them).
-        self._params = params if params is not None else FrozenParams(keep_lengths=True)
-        self.binding: ChildBinding | None = None  # render hair interpolated from the groom (the guides)
+        params = params if params is not None else STUDIO_PARAMS
+        if hair is None:
+            hair = GroomSide(UndoStack(), GroomState(groom, params))
+        elif hair.state.rest is not groom:
+            hair.reset(GroomState(groom, params))
+        self.hair = hair
+        self._shown: GroomState | None = None  # the document's state the views show
+        self._seen_pipeline: FrozenPipeline | None = None
         self._followed: tuple | None = None  # (key, binding): the children of the guides planted / removed
         self.show_guides = True
-        # ClumpWithGaps among the children once the mouse is released (each binding's default
-        # on set_binding: on for grown children, off for authored ones)
-        self.clump_children = False
         # A first start clumps the children once the warm-up has cached their kernels (until
         # then the render hair shows unclumped, rather than the window freezing to compile them)
         self.children_clump_ready = engine_ready
@@ -95,7 +111,6 @@ class Scene(QObject):
         self.colour_mode = "root-to-tip"
         self.ramp = DEFAULT_RAMP
         self.line_width = 2.0
-        self.mesh: Mesh | None = None
         self.path: Path | None = None
         self.tool = BrushTool()
         self.locked = np.zeros(0, dtype=bool)  # the masked strands (a copy of the pipeline's)
@@ -108,31 +123,90 @@ class Scene(QObject):
         #: Callables naming what holds the strands as they are (e.g. an animation of them), or
         #: None: brushes that add or remove strands are refused while one names something.
         self.strand_holders: list = []
-        self.mesh_changed.connect(self._on_mesh_changed)
         # what a first stroke needs, prepared at the next idle turn after an engine is built
         self._prepare_timer = QTimer(self)
         self._prepare_timer.setSingleShot(True)
         self._prepare_timer.timeout.connect(self.prepare_strokes)
         # a stroke's moves run in a worker thread; whatever else uses the pipeline drains it first
         self.moves = MoveEngine(self, self)
-        self._set_groom(groom)
+        self._show_groom()
+        self._shown = hair.state
+        hair.observe(self._on_hair)
+
+    # -- the document ----------------------------------------------------------------------
+    @property
+    def rest(self) -> Groom:
+        """The groom as authored (the document's, with its metadata and up axis)."""
+        return self.hair.state.rest
+
+    @property
+    def pipeline(self) -> FrozenPipeline | None:
+        """The document's engine in the document's strokes (None until :meth:`start_engine` on a
+        first start). A new engine prepares what a first stroke needs at the next idle turn."""
+        if not self.engine_ready:
+            return None
+        p = self.hair.pipeline
+        if p is not self._seen_pipeline:
+            self._seen_pipeline = p
+            self._prepare_timer.start(0)
+        return p
+
+    @property
+    def mesh(self) -> Mesh | None:
+        """The groom's head or scalp mesh (None: none): drawn under the hair, the surface the
+        brushes slide on, plant on and collide with."""
+        return self.hair.state.mesh
+
+    @property
+    def binding(self) -> ChildBinding | None:
+        """Render hair interpolated from the groom (its strands the guides), or None."""
+        return self.hair.state.children
+
+    @property
+    def clump_children(self) -> bool:
+        """ClumpWithGaps among the children once the mouse is released."""
+        return self.hair.state.clump_children
+
+    def _on_hair(self) -> None:
+        """The document's groom side changed (an edit, an Undo, a Redo, a file opened): the views
+        follow, each signal only for what changed."""
+        new, old = self.hair.state, self._shown
+        if new is old:
+            return
+        self._shown = new
+        self.moves.drain()
+        relabel = (
+            new.rest is not old.rest
+            and new.rest.points is old.rest.points
+            and new.rest.topology == old.rest.topology
+        )
+        if new.rest is not old.rest and not relabel:
+            self._show_groom()
+            self.groom_loaded.emit()
+        elif relabel:
+            self.up_axis_changed.emit()
+        if new.params != old.params:
+            self.params_changed.emit(new.params)
+        if new.mesh is not old.mesh:
+            self.mesh_changed.emit()
+        if new.children is not old.children or new.clump_children != old.clump_children:
+            self._followed = None
+            self._subsets = {}
+            self._cache = {}
+            self._rebuild_drawn()
+            self.drawn_changed.emit()
+        if self.engine_ready:
+            self._stroke_step(lambda: self.pipeline.result)
+        else:
+            self.result = new.rest
+            self._children_moved()
+            self.points_changed.emit()
 
     # -- strands -----------------------------------------------------------------------
-    def _new_pipeline(self, rest: Groom, surface) -> FrozenPipeline:
-        """The engine on ``rest`` with the head ``surface``; what a first stroke needs is
-        prepared at the next idle turn."""
-        self.pipeline: FrozenPipeline | None = FrozenPipeline(rest, self._params, surface)
-        self._prepare_timer.start(0)
-        return self.pipeline
-
-    def _set_groom(self, groom: Groom) -> None:
-        self.moves.drain()
-        if self.engine_ready:
-            self.result: Groom = self._new_pipeline(groom, self._surface()).result
-        else:
-            self._params.validate()
-            self.pipeline, self.result = None, groom
-        self.rest = groom
+    def _show_groom(self) -> None:
+        """A new groom shown: its result, centre, brush size, per-strand state, drawn strands."""
+        groom = self.rest
+        self.result: Groom = self.pipeline.result if self.engine_ready else groom
         lo, hi = groom.bounds
         self.centre = ((lo.astype(np.float64) + hi) * 0.5).astype(np.float32)
         extent = float(np.max(hi - lo))
@@ -143,7 +217,7 @@ class Scene(QObject):
         self.selected = np.ones(groom.strand_count, dtype=bool)
         self.hidden = np.zeros(groom.strand_count, dtype=bool)
         self.hidden_version += 1
-        self.binding = None
+        self._followed = None
         self._subsets = {}
         self._cache = {}
         self._rebuild_drawn()
@@ -159,23 +233,23 @@ class Scene(QObject):
         ``params`` gives new ones, e.g. a project's, which may only fit the new strands). The
         head mesh is the new groom's own, ``mesh`` (None: it has none): a surface belongs to its
         groom, never to the window."""
-        old_params = self._params
-        if params is not None:
-            self._params = params
-        try:
-            self._set_groom(groom)
-        except BaseException:
-            self._params = old_params
-            raise
+        params = self.params if params is None else params
+        self.open(GroomState(groom, params, None, mesh), path)
+
+    def open(self, state: GroomState, path: str | Path | None = None) -> None:
+        """Show another document's groom side (a file or project opened): not an undo step; the
+        caller starts a new history."""
+        self.moves.drain()
         self.path = None if path is None else Path(path)
-        old_mesh, self.mesh = self.mesh, mesh
-        self.groom_loaded.emit()
-        if mesh is not old_mesh:
-            self.mesh_changed.emit()
+        same = state.rest is self.rest
+        self.hair.reset(state)  # (the views follow: see _on_hair)
+        if same:  # the same strands opened again: shown afresh all the same
+            self._show_groom()
+            self.groom_loaded.emit()
+            if self.engine_ready:
+                self._stroke_step(lambda: self.pipeline.result)
         self.tool_changed.emit()
         self.path_changed.emit()
-        if params is not None and params != old_params:
-            self.params_changed.emit(params)
 
     def set_path(self, path: str | Path | None) -> None:
         p = None if path is None else Path(path)
@@ -190,11 +264,16 @@ class Scene(QObject):
             return
         self.engine_starting.emit()
         t0 = time.perf_counter()
-        self.result = self._new_pipeline(self.rest, self._surface()).result
-        self._children_moved()  # the render hair follows the frozen guides
         self.engine_ready = True
+        try:
+            self.result = self.pipeline.result
+        except BaseException:
+            self.engine_ready = False
+            raise
+        self._children_moved()  # the render hair follows the frozen guides
+        self._sync_mask()
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
-        self.params_changed.emit(self._params)
+        self.params_changed.emit(self.params)
         self.points_changed.emit()
         self.engine_started.emit()
 
@@ -213,23 +292,10 @@ class Scene(QObject):
 
     def set_up_axis(self, axis: str) -> None:
         """Say which axis is up (the points stay where they are: a relabelling, as a USD stage's
-        upAxis is). The pipeline is rebuilt on the relabelled groom, its strokes kept."""
-        axis = str(axis).upper()
-        if axis not in UP_AXES:
-            raise ParameterError("up axis", axis, "Y or Z")
-        if axis == self.up_axis:
-            return
+        upAxis is): one document step; the strokes are replayed on the relabelled groom (brushes
+        read the up axis), so the groom looks as a save of it reopens."""
         self.moves.drain()
-        rest = self.rest.with_metadata(self.rest.metadata.with_(up_axis=axis))
-        self.rest = rest
-        if self.pipeline is None:
-            self.result = rest
-        else:
-            snap = self.pipeline.snapshot()
-            self.result = self._new_pipeline(rest, self.pipeline.surface).restore(snap)  # the same head
-        self._children_moved()
-        self.up_axis_changed.emit()
-        self.points_changed.emit()
+        self.hair.set_up_axis(axis)
 
     @property
     def is_planar(self) -> bool:
@@ -341,21 +407,17 @@ class Scene(QObject):
             self.hidden_version += hid
             self.selection_changed.emit(hid)
 
-    def selection_step(self, sample: SelectionSample) -> bool:
+    def selection_step(self, sample: SelectionSample, text: str = "") -> bool:
         """One selection step (:class:`~hairtool.frozen.selection.SelectionSample`: select all,
-        box, hide …) through the pipeline; False, logging nothing, where it changes nothing."""
+        box, hide …) as a document step named ``text``; False, logging nothing, where it changes
+        nothing or would hide every strand (the viewport draws at least one)."""
         self.moves.drain()
         self.start_engine()
-        p = self.pipeline
-        away = None if sample.view is None else facing_away(p.strand_normals, sample.view)
-        sel, hid = apply_selection(p.aligned, sample, self.selected, self.hidden, away)
-        if np.array_equal(sel, self.selected) and np.array_equal(hid, self.hidden):
-            return False
-        if hid.all():  # (the viewport draws at least one strand)
+        try:
+            return self.hair.select(sample, text)
+        except ParameterError:
             self.refused.emit("Hide: that would hide every strand, leaving nothing to see or groom")
             return False
-        self.apply_samples([sample])
-        return True
 
     def set_only_selected(self, on: bool) -> None:
         """Brushes keep to the selected strands (Blender's selection toggle of sculpt mode)."""
@@ -363,41 +425,50 @@ class Scene(QObject):
             self.tool.only_selected = bool(on)
             self.tool_changed.emit()
 
-    def snapshot(self) -> object:
-        """The pipeline's stroke state (for one undo step); strokes need the engine running.
-        After brush-local moves (a stroke just released) the whole groom is clumped once more
-        first (:meth:`~hairtool.frozen.pipeline.FrozenPipeline.settle`), so what is kept is what
-        a replay gives."""
+    def snapshot(self) -> GroomState:
+        """The document's groom state before a stroke (what :meth:`end_stroke` records from);
+        strokes need the engine running."""
         self.moves.drain()
         self.start_engine()
-        if self.pipeline.unsettled:
-            self._stroke_step(self.pipeline.settle)
-        return self.pipeline.snapshot()
+        return self.hair.state
 
-    def restore(self, snap: object) -> None:
+    def end_stroke(self, before: GroomState, text: str | None = None) -> GroomState:
+        """The stroke that ran on the engine since ``before`` becomes one document step (named
+        after the brush, or ``text``; none when nothing was applied), the whole groom clumped
+        once more after brush-local moves, as a replay clumps it; returns the state after."""
         self.moves.drain()
-        self._stroke_step(lambda: self.pipeline.restore(snap))
+        if text is None:
+            text = f"{LABELS.get(self.tool.brush, self.tool.brush)} stroke"
+        self.hair.record(before, text)
+        self.hair.end_stroke()
+        return self.hair.state
 
     # -- render hair ---------------------------------------------------------------------
-    def set_binding(self, binding: ChildBinding | None, clump: bool | None = None) -> None:
+    def set_binding(
+        self, binding: ChildBinding | None, clump: bool | None = None, text: str | None = None
+    ) -> None:
         """Render hair interpolated from the groom, which becomes its guides (None: no children).
         The engine and the brushes keep running on the guides; the children follow. ``clump``:
         Clump children for them; None: on for grown children, off for authored hair
-        (:func:`hairtool.guides.binding.clumps_by_default`)."""
+        (:func:`hairtool.guides.binding.clumps_by_default`). ``text``: an undo step of that
+        name; None: part of the document as opened (a sample's or a project's render hair),
+        which is a step only once the history holds others."""
         if binding is not None and binding.rest_guides.topology != self.rest.topology:
             raise ParameterError(
                 "binding",
                 f"children bound to {binding.rest_guides.strand_count} guides",
                 f"children bound to this groom's {self.rest.strand_count} strands",
             )
-        self.binding = binding
-        if binding is not None:
-            self.clump_children = clumps_by_default(binding) if clump is None else bool(clump)
-        self._followed = None
-        self._subsets = {}
-        self._cache = {}
-        self._rebuild_drawn()
-        self.drawn_changed.emit()
+        self.moves.drain()
+        if text is None and self.hair.stack.count == 0:
+            from hairtool.guides.binding import clumps_by_default
+
+            on = clump
+            if on is None:
+                on = self.clump_children if binding is None else clumps_by_default(binding)
+            self.hair.reset(dataclasses.replace(self.hair.state, children=binding, clump_children=bool(on)))
+        else:
+            self.hair.set_children(binding, text or "Render hair", clump)
 
     def children_binding(self) -> ChildBinding | None:
         """The render hair of the guides as they are now: :attr:`binding` itself while every
@@ -426,12 +497,10 @@ class Scene(QObject):
     def set_clump_children(self, on: bool) -> None:
         """ClumpWithGaps among the drawn children (at their own automatic radius, with the
         engine's passes, gaps and length rule) whenever the mouse is up, and in what a save
-        writes. Off while a brush drags: the preview shows them unclumped, as XGen's does."""
-        if bool(on) != self.clump_children:
-            self.clump_children = bool(on)  # (the drawn points are rebuilt; colours stay cached)
-            if self.binding is not None:
-                self._rebuild_drawn()
-                self.drawn_changed.emit()
+        writes (one document step). Off while a brush drags: the preview shows them unclumped,
+        as XGen's does."""
+        self.moves.drain()
+        self.hair.set_clump_children(on)
 
     def set_children_clump_ready(self) -> None:
         """The children's clumping kernels are cached now (a first start's warm-up): Clump
@@ -446,7 +515,7 @@ class Scene(QObject):
     def _child_clump(self):
         from hairtool.guides.render import ChildClump
 
-        return ChildClump.following(self._params)
+        return ChildClump.following(self.params)
 
     def children_clump(self):
         """The children's :class:`~hairtool.guides.render.ChildClump` as Clump children sets it
@@ -627,27 +696,23 @@ class Scene(QObject):
     # -- engine parameters ---------------------------------------------------------------
     @property
     def params(self) -> FrozenParams:
-        return self._params
+        return self.hair.state.params
 
-    def set_params(self, params: FrozenParams) -> None:
+    def set_params(self, params: FrozenParams, name: str = "", drag: object = None) -> None:
+        """New engine parameters: one document step (``name``: the field changed, in the step's
+        words; edits of one slider ``drag`` of that field are one step). On a first start they
+        are kept for the engine when it starts."""
         self.moves.drain()
-        if params == self._params:
-            return
-        if not self.engine_ready:  # kept for the engine when it starts
-            self._params = params.validate()
-            self.params_changed.emit(params)
+        if params == self.params:
             return
         t0 = time.perf_counter()
-        self.result = self.pipeline.set_params(params)
-        self._children_moved()
+        text = f"Change {name.replace('_', ' ')}" if name else "Engine parameters"
+        self.hair.set_params(params, text, None if drag is None else (name, drag))
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
-        self._params = params
-        self.params_changed.emit(params)
-        self.points_changed.emit()
 
     def with_param(self, name: str, value: object) -> FrozenParams:
         """The current parameters with one field changed; ParameterError names a bad value."""
-        return dataclasses.replace(self._params, **{name: value}).validate()
+        return dataclasses.replace(self.params, **{name: value}).validate()
 
     # -- brush ---------------------------------------------------------------------------
     @property
@@ -789,38 +854,17 @@ class Scene(QObject):
             self.line_width = float(width)
             self.display_changed.emit()
 
-    def set_mesh(self, mesh: Mesh | None) -> None:
-        """The groom's head or scalp mesh (None: none); drawn under the hair, kept in projects."""
-        if mesh is not self.mesh:
-            self.mesh = mesh
-            self.mesh_changed.emit()
-
-    def _on_mesh_changed(self) -> None:
-        """A new head mesh is also the surface the brushes slide on, plant on and collide with
-        (strokes are replayed on it; strokes that need a head keep the last one when the mesh is
-        cleared)."""
+    def set_mesh(self, mesh: Mesh | None, text: str = "Head mesh") -> bool:
+        """The groom's head or scalp mesh (None: none): one document step; the strokes are
+        replayed on it (slides, plants, collisions). Refused, saying why, when strokes need a head
+        and ``mesh`` is none or unusable: the old head stays (False)."""
         self.moves.drain()
-        if self.pipeline is None or getattr(self.pipeline.surface, "mesh", None) is self.mesh:
-            return
-        surface = self._surface()
-        needs = any(getattr(x, "brush", None) in NEED_SURFACE for x in self.pipeline.strokes)
-        if surface is None and needs:
-            self.refused.emit("the strokes that need a head keep the one they were made on")
-        elif self.pipeline.strokes:  # replayed on the new head (slides, plants, collisions)
-            self._stroke_step(lambda: self.pipeline.set_surface(surface))
-        else:
-            self.pipeline.set_surface(surface)
-
-    def _surface(self):
-        """The head mesh as the slide brush's surface (None without a usable one)."""
-        from hairtool.guides.planting import HeadSurface
-
-        if self.mesh is None:
-            return None
         try:
-            return HeadSurface(self.mesh)
-        except HairtoolError:
-            return None
+            self.hair.set_mesh(mesh, text)
+        except HairtoolError as e:
+            self.refused.emit(f"the strokes that need a head keep the one they were made on ({e})")
+            return False
+        return True
 
     def displacement(self) -> np.ndarray:
         """``(V,)`` float64 distance of each drawn vertex from its rest position (scene units)."""

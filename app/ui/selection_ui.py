@@ -10,7 +10,6 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QGridLayout, QGroupBox, QLabel, QMenu, QToolBar, QToolButton, QVBoxLayout
 
-from app.ui.commands import SelectionCommand
 from app.ui.engine_start import WAIT_MESSAGE
 from app.ui.qt_utils import add_action
 from hairtool.frozen.sample_schema import SELECTION
@@ -124,12 +123,7 @@ class SelectionUI:
     def apply(self, sample: SelectionSample) -> bool:
         if not self._ready():
             return False
-        before = self.scene.snapshot()
-        if not self.scene.selection_step(sample):
-            return False
-        after = self.scene.snapshot()
-        self.window.undo_stack.push(SelectionCommand(self.scene, before, after, UNDO_TEXT[sample.op]))
-        return True
+        return self.scene.selection_step(sample, UNDO_TEXT[sample.op])
 
     def arm_box(self) -> None:
         """B: the next left-drag in the viewport draws the box."""

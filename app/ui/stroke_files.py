@@ -7,7 +7,6 @@ from __future__ import annotations
 import os
 from typing import TYPE_CHECKING
 
-from app.ui.commands import StrokeCommand
 from hairtool.errors import HairtoolError
 from hairtool.frozen.strokes import read_strokes, strokes_from_log, write_strokes
 
@@ -61,7 +60,7 @@ class StrokeFiles:
         except HairtoolError as e:
             w.show_error("Cannot replay strokes", str(e))
             return False
-        w.undo_stack.push(StrokeCommand(scene, before, scene.snapshot(), "Replayed"))
+        scene.end_stroke(before, "Replayed strokes")
         w.remember_dir(path)
         w.statusBar().showMessage(f"replayed {len(strokes)} strokes ({len(samples)} moves) from {path}", 5000)
         return True

@@ -76,7 +76,8 @@ class BrushTarget(Protocol):
 
 
 class Viewport(QOpenGLWidget):
-    """Draws the scene's current groom; emits a finished stroke as (before, after) snapshots."""
+    """Draws the scene's current groom; emits a finished stroke as the document's groom states
+    (before, after) once it is a step."""
 
     stroke_finished = Signal(object, object)
     stroke_started = Signal()  # a left-drag on the scene's groom begins (before its first align)
@@ -667,9 +668,9 @@ class Viewport(QOpenGLWidget):
             before, self._stroke_before = self._stroke_before, None
             self.scene.moves.drain()  # every move of the stroke has run
             self.stroke_touched = self.scene.moves.touched
-            # the whole groom settled first (snapshot), so the full-density render hair is
-            # built (and clumped) once, from the settled guides, not once before and once after
-            after = self.scene.snapshot()
+            # one document step; the whole groom settled first, so the full-density render hair
+            # is built (and clumped) once, from the settled guides, not once before and once after
+            after = self.scene.end_stroke(before)
             self.scene.set_dragging(False)  # full density again
             self.stroke_finished.emit(before, after)
         self.update()

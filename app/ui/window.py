@@ -36,7 +36,6 @@ from app.ui.animation_model import AnimationModel
 from app.ui.animation_ui import AnimationController
 from app.ui.brush_tool import LABELS, SHORTCUTS, TIPS, brushes
 from app.ui.colouring import displacement_scale
-from app.ui.commands import MeshCommand, ParamCommand, RenderHairCommand, StrokeCommand, UpAxisCommand
 from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
 from app.ui.habits import install_habits
@@ -103,7 +102,7 @@ class MainWindow(QMainWindow):
         self._stroke_clump: np.ndarray | None = None  # clump strengths when a clump stroke began
         # long work (key solves, simulation, video export): window.jobs.run(title, fn, on_done)
         self.jobs = JobRunner(lambda title, message: self.show_error(title, message), self)
-        self.scene = Scene(start, parent=self, engine_ready=engine_ready)
+        self.scene = Scene(start, parent=self, engine_ready=engine_ready, hair=self.doc.hair)
         self.engine_start: EngineStart | None = None
         # the bundled sample's render hair, on a first start bound once its kernels are cached
         self._pending_render_hair: Callable[[], None] | None = None
@@ -534,9 +533,10 @@ class MainWindow(QMainWindow):
     def set_up_axis(self, axis: str) -> None:
         """View ▸ Up axis: which axis of this groom points up (one undo step; kept in projects
         and written to USD as the stage's upAxis)."""
-        before = self.scene.up_axis
-        if axis != before:
-            self.undo_stack.push(UpAxisCommand(self.scene, before, axis))
+        try:
+            self.scene.set_up_axis(axis)
+        except HairtoolError as e:
+            self.show_error("Cannot set the up axis", str(e))
         self._sync_view_menu()
 
     def _fill_recent_menu(self) -> None:
@@ -629,7 +629,7 @@ class MainWindow(QMainWindow):
         self._stroke_clump = self.scene.pipeline.clump_strength if self.scene.brush == "clump" else None
 
     def _on_stroke_finished(self, before: object, after: object) -> None:
-        self.undo_stack.push(StrokeCommand(self.scene, before, after, LABELS.get(self.scene.brush)))
+        """The stroke is a step of the document already: what it did is told in the status bar."""
         start, self._stroke_points = self._stroke_points, None
         moved = start is None or not np.array_equal(start, self.scene.result.points)
         if not moved and not self.viewport.stroke_touched:
@@ -648,7 +648,7 @@ class MainWindow(QMainWindow):
             self.dock.refresh_params()
             return
         if after != before:
-            self.undo_stack.push(ParamCommand(self.scene, name, before, after, drag))
+            self.scene.set_params(after, name, drag)
 
     # -- files ----------------------------------------------------------------------------------
     def set_groom(
@@ -760,16 +760,14 @@ class MainWindow(QMainWindow):
                 n, g = binding.child_count, guides.strand_count
                 self.statusBar().showMessage(f"{n:,} strands follow {g:,} guides picked among them", 5000)
             else:
-                step = RenderHairCommand(self.scene, self.scene.binding, binding, "Grow render hair")
-                self.undo_stack.push(step)
+                self.scene.set_binding(binding, text="Grow render hair")
             self.scene.set_colour_mode("hair")
 
         return self.jobs.run("Growing render hair", work, done, group="render-hair")
 
     def remove_render_hair(self) -> None:
         if self.scene.binding is not None:
-            step = RenderHairCommand(self.scene, self.scene.binding, None, "Remove render hair")
-            self.undo_stack.push(step)
+            self.scene.set_binding(None, text="Remove render hair")
 
     def open_dialog(self) -> None:
         """File ▸ Open: asks about changed work first (Cancel opens nothing)."""
@@ -875,13 +873,12 @@ class MainWindow(QMainWindow):
             self.show_error("Cannot load head mesh", str(e))
             return False
         self.remember_dir(path)
-        self.undo_stack.push(MeshCommand(self.scene, self.scene.mesh, mesh, "Load head mesh"))
-        return True
+        return self.scene.set_mesh(mesh, "Load head mesh")
 
     def remove_mesh(self) -> None:
         """Take the head mesh off this groom (undoable)."""
         if self.scene.mesh is not None:
-            self.undo_stack.push(MeshCommand(self.scene, self.scene.mesh, None, "Remove head mesh"))
+            self.scene.set_mesh(None, "Remove head mesh")
 
     # -- stills ----------------------------------------------------------------------------------
     def viewport_pixel_size(self) -> tuple[int, int]:

@@ -127,7 +127,7 @@ def snapshot_arrays(s: GroomState) -> tuple:
                    *(None if a is None else a.tobytes() for a in per_strand))  # fmt: skip
     mesh = None if s.mesh is None else (s.mesh.vertices.tobytes(), s.mesh.faces.tobytes())
     return (s.rest.points.tobytes(), s.rest.counts.tobytes(), repr(s.rest.metadata), s.params,
-            mesh, s.source, s.children is None, strokes)  # fmt: skip
+            mesh, s.source, s.children is None, s.clump_children, strokes)  # fmt: skip
 
 
 def same_groom(a: GroomState, b: GroomState) -> bool:
@@ -310,12 +310,18 @@ class DocumentMachine(RuleBasedStateMachine):
         self.doc.hair.set_up_axis(axis)
         assert self.doc.groom.metadata.up_axis == axis
 
-    @precondition(lambda self: self.doc.stack.index % 4 == 1)  # (a project with render hair
-    @rule(count=st.sampled_from([0, 4]))  # binds it again on every load: a fourth of the time)
-    def render_hair(self, count: int) -> None:
-        """Render hair grown on the head from the groom's strands (0: removed)."""
-        self.doc.hair.set_children(children(self.which, count) if count else None)
+    # (a fourth of the time: a project with render hair binds it again on every load)
+    @precondition(lambda self: self.doc.stack.index % 4 == 1)
+    @rule(count=st.sampled_from([0, 4]), clump=st.sampled_from([None, True, False]))
+    def render_hair(self, count: int, clump: bool | None) -> None:
+        """Render hair grown on the head from the groom's strands (0: removed), its children
+        clumped or not (None: the binding's default); then Clump children switched."""
+        self.doc.hair.set_children(children(self.which, count) if count else None, clump=clump)
         assert (self.doc.hair.state.children is None) == (count == 0)
+        if clump is not None:
+            assert self.doc.hair.state.clump_children == clump
+            self.doc.hair.set_clump_children(not clump)
+            assert self.doc.hair.state.clump_children != clump
 
     @rule(yaw=st.floats(-180.0, 180.0), ortho=st.booleans())
     def view(self, yaw: float, ortho: bool) -> None:

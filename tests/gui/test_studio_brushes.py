@@ -21,6 +21,7 @@ def plain(make_window, groom=None, **params):
     """A window on a small 3-D scalp with no noise and no clumps (unless ``params`` say)."""
     w = make_window(groom=groom if groom is not None else samples.scalp(strands=200, vertices=12))
     w.scene.set_params(w.scene.params.replace(**({"freeze": False, "clump": False} | params)))
+    w.undo_stack.clear()  # (the window as opened on these parameters: only the strokes are steps)
     return w
 
 

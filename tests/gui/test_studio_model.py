@@ -1,4 +1,4 @@
-"""The scene model and the undo commands without a window: signals only on change, clear errors."""
+"""The scene model and its document steps without a window: signals only on change, clear errors."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import json
 import numpy as np
 import pytest
 
-from app.ui.commands import ParamCommand, StrokeCommand
 from app.ui.scene import Scene
 from hairtool import samples
 from hairtool.errors import ParameterError
+from hairtool.frozen.pipeline import FrozenParams
 
 
 @pytest.fixture
@@ -51,40 +51,39 @@ def test_bad_engine_parameter_is_named(scene):
         scene.with_param("stretch_stiffness", 0.5)
 
 
-def test_stroke_command_is_applied_by_the_drag_not_by_push(scene):
-    from PySide6.QtGui import QUndoStack
-
-    stack = QUndoStack()
+def test_a_stroke_is_one_document_step_recorded_on_release(qapp):
+    """The drag runs on the document's engine; the release records it once, without applying it
+    again; Undo and Redo land back through the document."""
+    loose = FrozenParams(freeze=False, clump=False, keep_lengths=True)  # (the tips follow the cursor)
+    scene = Scene(samples.portrait(strands=20, vertices=8), loose)
+    stack = scene.hair.stack
     before_points = scene.result.points.copy()
     before = scene.snapshot()
-    tip = scene.result.tips[3].astype(np.float64)
-    scene.align(tip + np.array([0.5, 0.3, 0.0]))
+    tip = scene.result.tips[0].astype(np.float64)
+    scene.align(tip + np.array([0.6, 0.0, 0.0]))
+    scene.align(tip + np.array([0.6, 0.3, 0.0]))
+    assert stack.count == 0  # nothing recorded mid-stroke
+    scene.end_stroke(before)
     after_points = scene.result.points.copy()
-    stack.push(StrokeCommand(scene, before, scene.snapshot()))
-    assert np.array_equal(scene.result.points, after_points)  # push did not re-apply
+    assert stack.count == 1 and stack.undo_text == "Align stroke"
+    assert not np.array_equal(after_points, before_points)
     stack.undo()
     assert np.array_equal(scene.result.points, before_points)
     stack.redo()
     assert np.array_equal(scene.result.points, after_points)
+    scene.end_stroke(scene.snapshot())  # a release with nothing applied: no step
+    assert stack.count == 1
 
 
-def test_param_commands_merge_within_one_drag_only(scene):
-    from PySide6.QtGui import QUndoStack
-
-    stack = QUndoStack()
+def test_param_edits_merge_within_one_drag_only(scene):
+    stack = scene.hair.stack
     p0 = scene.params
     for i, k in enumerate((8.0, 9.0, 10.0)):
-        before = scene.params
-        stack.push(
-            ParamCommand(scene, "bend_stiffness", before, scene.with_param("bend_stiffness", k), drag=1)
-        )
-        assert stack.count() == 1, i
-    before = scene.params
-    stack.push(
-        ParamCommand(scene, "bend_stiffness", before, scene.with_param("bend_stiffness", 11.0), drag=2)
-    )
-    stack.push(ParamCommand(scene, "seed", scene.params, scene.with_param("seed", 5), drag=None))
-    assert stack.count() == 3 and scene.params.seed == 5
+        scene.set_params(scene.with_param("bend_stiffness", k), "bend_stiffness", drag=1)
+        assert stack.count == 1, i
+    scene.set_params(scene.with_param("bend_stiffness", 11.0), "bend_stiffness", drag=2)
+    scene.set_params(scene.with_param("seed", 5), "seed")
+    assert stack.count == 3 and scene.params.seed == 5 and stack.undo_text == "Change seed"
     stack.undo()
     stack.undo()
     assert scene.params.bend_stiffness == 10.0
