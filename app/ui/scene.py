@@ -31,7 +31,7 @@ from app.render.ramps import DEFAULT_RAMP
 from app.ui.brush_tool import LABELS, SIGNED, BrushTool, check_falloff
 from app.ui.engine_thread import MoveEngine
 from hairtool.errors import HairtoolError, ParameterError
-from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, scalp_centre
+from hairtool.frozen.brushes import CHANGE_STRANDS, NEED_SURFACE, registry, scalp_centre
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.selection import SelectionSample
 from hairtool.groom import Groom, Topology, vertex_ids_of
@@ -39,6 +39,7 @@ from hairtool.guides.binding import ChildBinding
 from hairtool.io.obj import Mesh
 
 ALIGN_MODES = ("paper", "preserve-length")
+FOLLOW_SELECTION = registry.names_where(follows_selection=True)
 COLOUR_MODES = {
     "root-to-tip": "Root to tip",
     "strand": "Per-strand random",
@@ -365,7 +366,7 @@ class Scene(QObject):
         label = LABELS.get(self.tool.brush, self.tool.brush)
         if self.tool.brush in NEED_SURFACE and (self.pipeline is None or self.pipeline.surface is None):
             return f"{label} works on the head's surface: load its mesh first (File → Load head mesh…)"
-        if self.tool.only_selected and self.tool.brush not in ("select", "add", "density"):
+        if self.tool.only_selected and self.tool.brush in FOLLOW_SELECTION:
             if not (self.selected & ~self.hidden).any():
                 return (f"{label}: no shown strand is selected: Select ▸ All (A) selects them, or "
                         "switch off Affect selection only")  # fmt: skip

@@ -58,6 +58,7 @@ def pen_drag(widget, start, end, pressures) -> None:
 def plain(make_window):
     w = make_window(groom=samples.scalp(strands=200, vertices=12))
     w.scene.set_params(w.scene.params.replace(freeze=False, clump=False))
+    w.undo_stack.clear()  # (the window as opened on these parameters: only the strokes are steps)
     return w
 
 

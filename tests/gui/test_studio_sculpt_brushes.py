@@ -23,6 +23,7 @@ pytestmark = pytest.mark.gui
 def plain(make_window, groom=None):
     w = make_window(groom=groom if groom is not None else samples.scalp(strands=200, vertices=12))
     w.scene.set_params(w.scene.params.replace(freeze=False, clump=False))
+    w.undo_stack.clear()  # (the window as opened on these parameters: only the strokes are steps)
     return w
 
 
@@ -187,6 +188,7 @@ def test_slide_moves_roots_along_the_head_and_waits_for_a_head_mesh(ui, make_win
     ui.drag(v, pos, pos + np.array([25.0, 0.0]), steps=3)
     assert w.undo_stack.count() == 0 and messages and "head mesh" in messages[-1][0]
     s.set_mesh(read_mesh(data / "sintel_head.obj"))
+    w.undo_stack.clear()  # (opened on this head)
     s.set_radius(2.0)
     ui.drag(v, pos, pos + np.array([25.0, 0.0]), steps=3)
     out = s.result
@@ -214,6 +216,7 @@ def test_brushes_keep_strands_out_of_the_head_unless_told_not_to(ui, make_window
     w = plain(make_window, groom=rest)
     s, v = w.scene, w.viewport
     s.set_mesh(read_mesh(data / "sintel_head.obj"))
+    w.undo_stack.clear()  # (opened on this head)
     w.brush_actions["comb"].trigger()
     assert w.dock.collide.isVisibleTo(w.dock) and w.dock.collide.isChecked()
     s.set_radius(6.0)
@@ -251,6 +254,7 @@ def test_add_plants_strands_on_the_head_and_undo_takes_them_away(ui, make_window
     ui.drag(v, pos, pos + np.array([10.0, 0.0]), steps=2)
     assert s.result.strand_count == rest.strand_count and "head" in messages[-1][0]
     s.set_mesh(read_mesh(data / "sintel_head.obj"))
+    w.undo_stack.clear()  # (opened on this head)
     w.dock.add_count.setValue(3)
     s.set_radius(1.5)
     eye, ray = v.camera.ray(pos[0], pos[1], v.width(), v.height())
@@ -276,6 +280,7 @@ def test_density_thins_under_the_brush_to_the_spacing_in_one_undo_step(ui, make_
     w = plain(make_window, groom=rest)
     s, v = w.scene, w.viewport
     s.set_mesh(read_mesh(data / "sintel_head.obj"))
+    w.undo_stack.clear()  # (opened on this head)
     w.brush_actions["density"].trigger()
     assert w.dock.spacing.isVisibleTo(w.dock) and not w.dock.add_count.isVisibleTo(w.dock)
     w.dock.spacing.setValue(2.5)  # wider than Sintel's guides are apart: thinning

@@ -20,6 +20,7 @@ SPEC = BrushSpec(
     changes_strands=True,
     needs_surface=True,
     takes_strength=False,
+    follows_selection=False,
     params=(
         Param("count", int, 1, MAX_COUNT, 1, "count", f"a whole number of strands in [1, {MAX_COUNT}]"),
         SEED,

@@ -31,6 +31,7 @@ SPEC = BrushSpec(
     changes_strands=True,
     needs_surface=True,
     takes_strength=False,
+    follows_selection=False,
     params=(SPACING, SEED),
     studio=Studio(
         "Density",

@@ -14,6 +14,7 @@ SPEC = BrushSpec(
     moves_points=False,
     local=True,
     takes_strength=False,
+    follows_selection=False,
     studio=Studio(
         "Select",
         "W",

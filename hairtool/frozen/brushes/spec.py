@@ -81,6 +81,8 @@ class BrushSpec:
     is an amount (not only a direction, on or off). ``uses_pressure``: a pen's pressure scales
     its strength by default. ``needs_direction``: a move without motion does nothing.
     ``keeps_stroke``: it remembers state over a stroke's samples (:class:`StrokeMemory`).
+    ``follows_selection``: "affect selection only" keeps it to the selected strands (the
+    selection brush makes the selection, and planting brushes make new strands).
     ``params``: its own sample fields."""
 
     name: str
@@ -95,6 +97,7 @@ class BrushSpec:
     uses_pressure: bool = True
     needs_direction: bool = False
     keeps_stroke: bool = False
+    follows_selection: bool = True
     params: tuple[Param, ...] = ()
 
 
