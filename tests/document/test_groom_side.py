@@ -95,3 +95,37 @@ def test_cancel_keeps_the_groom_and_opening_one_closes_its_simulation():
     assert doc.groom is other.rest and doc.state.animation is None
     doc.undo()  # one step brings both back
     assert doc.groom is g and doc.state.animation is sim
+
+
+def test_before_the_engine_is_built_edits_need_none_and_a_slider_drag_is_one_step():
+    """A first start edits parameters, the up axis and the head while its kernels compile: each
+    is a step that builds no engine; the engine made later is made on all of them."""
+    doc = Document(tiny())
+    side = doc.hair
+    for k in (4.0, 5.0, 6.0):  # one slider drag
+        side.set_params(side.state.params.replace(bend_stiffness=k), "Change bend stiffness", drag=1)
+    side.set_params(side.state.params.replace(seed=9), "Change seed", drag=2)
+    side.set_up_axis("Z")
+    side.set_mesh(None)
+    assert side._pipeline is None  # (nothing compiled or built)
+    assert doc.stack.index == 4 and doc.stack.undo_text == "Head mesh"
+    made = side.pipeline
+    assert made.rest.metadata.up_axis == "Z" and made.params.bend_stiffness == 6.0 and made.surface is None
+    for _ in range(3):
+        doc.undo()
+    assert side.state.params.bend_stiffness == 6.0 and side.state.params.seed != 9
+    doc.undo()
+    assert side.state.params == tiny().params and side.pipeline.params == tiny().params
+
+
+def test_a_document_opened_is_no_step_and_clump_children_is_one():
+    doc = Document(tiny())
+    other = GroomState(samples.scalp(strands=9, vertices=4, seed=3), mesh=head())
+    heard = []
+    doc.hair.observe(lambda: heard.append(doc.hair.state))
+    doc.hair.reset(other)
+    assert doc.hair.state is other and heard == [other] and doc.stack.count == 0
+    doc.hair.set_clump_children(True)
+    assert doc.hair.state.clump_children and doc.stack.undo_text == "Clump children"
+    doc.undo()
+    assert doc.hair.state is other
