@@ -167,9 +167,12 @@ class GroomSide:
         return self.pipeline.result
 
     def settled(self) -> FrozenSnapshot | None:
-        """The strokes as a replay gives them (after brush-local moves, clumped once more)."""
+        """The strokes as a replay gives them (after brush-local moves, clumped once more). In the
+        middle of a stroke (moves the engine applied that are no step yet) the state as it is: the
+        stroke settles as it is recorded."""
         p = self._pipeline
-        if p is not None and self._at is self.state.strokes and p.unsettled:
+        recorded = 0 if self._at is None else len(self._at.log)
+        if p is not None and self._at is self.state.strokes and p.unsettled and len(p.strokes) == recorded:
             p.settle()
             self._at = p.snapshot()
             self._set(dataclasses.replace(self.state, strokes=self._at))
@@ -212,9 +215,15 @@ class GroomSide:
 
     def record(self, before: GroomState, text: str = "Stroke") -> None:
         """A stroke the engine thread applied to :attr:`pipeline` from ``before``: one step."""
-        done = 0 if before.strokes is None else len(before.strokes.log)
-        if self._pipeline is None or self._at is not before.strokes or len(self._pipeline.strokes) == done:
-            return  # the engine was not at ``before`` (an undo since), or applied nothing
+        if self._pipeline is None:
+            return
+        if self._at is not before.strokes or self.state.strokes is not before.strokes:
+            # an Undo or Redo came mid-stroke: the document stays as it is, and the stroke's moves
+            # go (an engine is made afresh on the document's strokes when it is next used)
+            self._pipeline = None
+            return
+        if len(self._pipeline.strokes) == (0 if before.strokes is None else len(before.strokes.log)):
+            return  # it applied nothing
         self._strokes_now(text, before)
 
     def end_stroke(self) -> None:

@@ -440,8 +440,13 @@ class Scene(QObject):
         self.moves.drain()
         if text is None:
             text = f"{LABELS.get(self.tool.brush, self.tool.brush)} stroke"
+        p = self.pipeline
+        if p is not None and p.unsettled:
+            p.settle()  # (first: the views follow once, from the settled guides)
         self.hair.record(before, text)
         self.hair.end_stroke()
+        if self.engine_ready and self.pipeline.result is not self.result:  # (moves dropped)
+            self._stroke_step(lambda: self.pipeline.result)
         return self.hair.state
 
     # -- render hair ---------------------------------------------------------------------

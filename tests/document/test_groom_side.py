@@ -129,3 +129,23 @@ def test_a_document_opened_is_no_step_and_clump_children_is_one():
     assert doc.hair.state.clump_children and doc.stack.undo_text == "Clump children"
     doc.undo()
     assert doc.hair.state is other
+
+
+def test_an_undo_in_the_middle_of_a_stroke_drops_its_moves_not_the_document():
+    """Ctrl+Z while the mouse still drags: the step before is undone, the rest of the stroke's
+    moves are dropped on release, and the engine shows the document's state again."""
+    doc = Document(tiny())
+    first = doc.hair.state
+    doc.hair.stroke(moves("comb", doc, 1)[0], stroke="first")
+    shaped = doc.hair.state
+    before = doc.hair.state
+    doc.hair.pipeline.apply_samples(moves("length", doc, 1)[0])  # the engine thread's move
+    doc.undo()  # Ctrl+Z mid-drag
+    doc.hair.pipeline.apply_samples(moves("length", doc, 1)[0])  # a move after it
+    doc.hair.record(before, "Length stroke")
+    doc.hair.end_stroke()
+    assert doc.hair.state is first and doc.stack.count == 1 and doc.stack.can_redo
+    fresh = Document(first).hair.result
+    assert doc.hair.result.points.tobytes() == fresh.points.tobytes()
+    doc.redo()
+    assert doc.hair.state is shaped
