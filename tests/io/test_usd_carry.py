@@ -1,6 +1,7 @@
 """What a command leaves alone in a USD scene reaches the file it writes: the head mesh, the
 root's customData, the parents' properties, and a curves prim's other primvars where its curves
-are the same ones, each value byte for byte; a groom with nothing beside it is written as before."""
+are the same ones, each value byte for byte, and the points, widths and colour of a prim the
+command did not touch, every time sample; a groom with nothing beside it is written as before."""
 
 from __future__ import annotations
 
@@ -128,3 +129,42 @@ def test_a_keys_export_keeps_the_head_and_custom_primvars(tmp_path):
             values(out, hair)["primvars:clump_weight"]
             == values(tmp_path / "g.usda", hair)["primvars:clump_weight"]
         )
+
+
+def samples(path: Path, prim: str) -> dict[str, list]:
+    """Every authored attribute of ``prim``: ``(time, bytes)`` of each time sample, or of its
+    default where it has none."""
+    from pxr import Usd
+
+    stage = Usd.Stage.Open(str(path))
+    p = stage.GetPrimAtPath(prim)
+    assert p, prim
+    out = {}
+    for a in p.GetAuthoredAttributes():
+        times = a.GetTimeSamples() or [None]
+        out[a.GetName()] = [(t, np.asarray(a.Get() if t is None else a.Get(t)).tobytes()) for t in times]
+    return out
+
+
+@settings(max_examples=4, deadline=None, derandomize=True)
+@given(scene=scenes(motions=("points",)))
+def test_untouched_prims_keep_every_time_sample_byte_for_byte(scene):
+    """The first prim's points, widths and colour are time-sampled: ``convert`` copies them, and
+    the static prims beside it stay static (the writer had sampled them at every frame);
+    ``interpolate --prim`` of the last prim passes the others through the same way, and writes
+    its guides' points as they were."""
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        write_stage(d / "s.usda", scene)
+        for ext in ("usda", "usdc"):
+            assert main(["convert", str(d / "s.usda"), str(d / f"c.{ext}")]) == 0
+            for prim in scene.prims:
+                was, got = samples(d / "s.usda", prim.path), samples(d / f"c.{ext}", prim.path)
+                assert {k: got[k] for k in was if k in got} == was, (ext, prim.path)
+        last = scene.prims[-1].path
+        args = ["interpolate", str(d / "s.usda"), str(d / "k.usda"), "--count", "6", "--prim", last]
+        assert main(args) == 0
+        for prim in scene.prims:
+            was, got = samples(d / "s.usda", prim.path), samples(d / "k.usda", prim.path)
+            names = ["points"] if prim.path == last else list(was)
+            assert {k: got[k] for k in names} == {k: was[k] for k in names}, prim.path
