@@ -329,17 +329,18 @@ def write_animation(args: argparse.Namespace, binding: ChildBinding, guides: Ani
     }
 
 
-def primvar_pairs(guides: Groom, binding: ChildBinding | None) -> list:
+def primvar_pairs(guides: Groom, binding: ChildBinding | None, *, written: bool = False) -> list:
     """``(guide prim, render prim, binding)`` of one prim's children, for their primvars
     (:mod:`hairtool.guides.child_primvars`); none without children or for guides without a
-    prim of their own."""
+    prim of their own. ``written``: the guide prim as OUT holds it (where the guides' own
+    primvars were given to the strands strokes left: :func:`carry_planted`), not the source's."""
     from hairtool.guides.files import render_prims
 
     own = guides.metadata.for_strands(guides.strand_count).curves
     if binding is None or len(own) != 1:
         return []
-    hair, _ = render_prims(binding.metadata, binding.child_count, guides.metadata, guides.strand_count)
-    return [(own[0].path, hair[0].path, binding)]
+    hair, kept = render_prims(binding.metadata, binding.child_count, guides.metadata, guides.strand_count)
+    return [((kept[0] if written else own[0]).path, hair[0].path, binding)]
 
 
 def carry(args: argparse.Namespace, pairs: list = ()) -> None:
@@ -353,3 +354,27 @@ def carry(args: argparse.Namespace, pairs: list = ()) -> None:
         from hairtool.io.usd import _diagnosed
 
         _diagnosed(Path(args.input), lambda: give_children_primvars(args.input, args.output, list(pairs)))
+
+
+def carry_planted(args: argparse.Namespace, changed: list, pairs: list = ()) -> None:
+    """USD IN to USD OUT, after :func:`carry`: the primvars of each prim whose strands strokes
+    planted or removed (``changed``: ``(prim, strands before, pipeline)``), given to the strands
+    it has now (:mod:`hairtool.guides.strand_primvars`), then those of the guides OUT now holds
+    on their children (``pairs``: :func:`primvar_pairs` with ``written``)."""
+    from hairtool.io.usd_carry import USD_SUFFIXES
+
+    if not all(Path(p).suffix.lower() in USD_SUFFIXES for p in (args.input, args.output)):
+        return
+    from hairtool.guides.strand_primvars import give_strands_primvars
+    from hairtool.io.usd import _diagnosed
+
+    # (with children, the one prim's guides are where OUT holds them: its first pair's guide prim)
+    prims = [
+        (prim.path, pairs[0][0] if pairs else prim.path, pipe.origin, was, pipe.result)
+        for prim, was, pipe in changed
+    ]
+    _diagnosed(Path(args.input), lambda: give_strands_primvars(args.input, args.output, prims))
+    if pairs:
+        from hairtool.guides.child_primvars import give_children_primvars
+
+        _diagnosed(Path(args.output), lambda: give_children_primvars(args.output, args.output, list(pairs)))

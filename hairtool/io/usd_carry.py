@@ -4,14 +4,14 @@ The USD writer (:mod:`hairtool.io.usd`) authors the hair: its curves prims, thei
 transforms, the stage's axis, unit and time codes. A DCC's scene holds more, which a command
 that reads and writes USD must not drop: the head mesh, materials, the ``customData`` Blender
 marks its root with (without it a re-import nests ``/root/root``), the parents' own properties
-and, on a curves prim whose curves are the same ones (the same vertex counts), its other
-primvars (Blender's ``surface_uv_coordinate``, ``rest_position``…) and its material binding,
-and a parent's translate/rotate/scale ops where the writer put its static transform back as one
-matrix (the same transform), and a curves prim's authored points where the command left its
-strands as they were (the writer's are the same up to the rounding of the way back into the
-prim's space), every time sample of them, with its time-sampled widths and colour. Each is
-copied spec for spec (its bytes as the source had them)
-from the source's composed stage; nothing else the writer authored is overwritten.
+and, on a curves prim, its material binding and user properties and, where its curves are the
+same ones (the same vertex counts), its other primvars (Blender's ``surface_uv_coordinate``,
+``rest_position``…), and a parent's translate/rotate/scale ops where the writer put its static
+transform back as one matrix (the same transform), and a curves prim's authored points where
+the command left its strands as they were (the writer's are the same up to the rounding of the
+way back into the prim's space), every time sample of them, with its time-sampled widths and
+colour. Each is copied spec for spec (its bytes as the source had them) from the source's
+composed stage; nothing else the writer authored is overwritten.
 """
 
 from __future__ import annotations
@@ -110,10 +110,14 @@ def carry_scene(source: str | os.PathLike[str], written: str | os.PathLike[str])
             return
         carried.extend(_authored_ops(stage, src, dst, path))
         if path in curves:
-            if src.GetPrimAtPath(path).typeName == "BasisCurves" and _same_counts(src, dst, path):
-                kept = ("primvars:", "material:", "userProperties:")
+            if src.GetPrimAtPath(path).typeName == "BasisCurves":
+                # a material and user properties hold for any strands; primvars for the same ones
+                # (strokes that plant and delete: hairtool.guides.strand_primvars)
+                same = _same_counts(src, dst, path)
+                kept = ("material:", "userProperties:", *(("primvars:",) if same else ()))
                 carried.extend(_copy_missing_properties(src, dst, path, kept))
-                carried.extend(_untouched_points(src, dst, path))
+                if same:
+                    carried.extend(_untouched_points(src, dst, path))
                 schemas = src.GetPrimAtPath(path).GetInfo("apiSchemas")
                 if schemas and not mine.HasInfo("apiSchemas"):
                     mine.SetInfo("apiSchemas", schemas)
