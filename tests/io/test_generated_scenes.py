@@ -224,3 +224,8 @@ def test_simulate_and_anime_keep_prims_conventions_and_the_source_start(scene):
         cycle = io.read(d / "a.usda")
         check_kept(scene, src, cycle)
         assert isinstance(cycle, Animation) and cycle.time_codes[0] == first
+        # children: each prim's beside its own guides, as interpolate --count writes them
+        assert main([*args, "--frames", "2", "--count", "6", "--no-clump-children"]) == 0
+        kids = io.read(d / "sim.usda")
+        want = [x for p in curve_paths(src) for x in ((p + "Render", "default"), (p, "guide"))]
+        assert [(c.path, c.purpose) for c in kids.metadata.curves] == want
