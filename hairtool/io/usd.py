@@ -719,12 +719,13 @@ def _sample_times(parts: list[_Curves]) -> list[float]:
 
 
 def _static_xforms(parts: list[_Curves]) -> tuple:
-    """The curves prims' and their ancestors' local transforms (non-identity ones), when none is
-    animated: :attr:`hairtool.metadata.Metadata.xforms`, so a writer can put them back."""
+    """The curves prims' and their ancestors' local transforms (non-identity ones) that are not
+    time-sampled: :attr:`hairtool.metadata.Metadata.xforms`, so a writer can put them back. A
+    sampled one (a head that turns) is left out: the writer bakes it into the points of the hair
+    under it (written in the space of the static transforms it puts back), and the hair beside
+    it, under static parents, keeps them."""
     from pxr import Gf, Usd, UsdGeom
 
-    if any(c.transform_times for c in parts):
-        return ()
     table: dict[str, tuple[float, ...]] = {}
     for c in parts:
         for p in _lineage(c.prim):
@@ -733,6 +734,8 @@ def _static_xforms(parts: list[_Curves]) -> tuple:
                 continue
             if xf.GetResetXformStack():
                 return ()  # a prim that ignores its parents: not kept (the points stay world)
+            if any(op.GetAttr().GetNumTimeSamples() for op in xf.GetOrderedXformOps()):
+                continue
             m = xf.GetLocalTransformation(Usd.TimeCode.Default())
             if m != Gf.Matrix4d(1.0):
                 table[str(p.GetPath())] = tuple(float(v) for v in np.asarray(m, np.float64).reshape(-1))

@@ -334,17 +334,22 @@ def _transformed(stage, path) -> bool:
 
 
 def _authored_ops(stage, src, dst, path) -> list[str]:
-    """Where the writer put a prim's static source transform back as one matrix, the source's
-    own ops instead (translate, rotate, scale as authored: the same transform, and an artist's
-    channels kept); returns the ops carried."""
-    from pxr import Sdf, UsdGeom
+    """Where the writer put a prim's static source transform back as one matrix (or wrote none
+    for ops that come to the identity), the source's own ops instead (translate, rotate, scale
+    as authored: the same transform, and an artist's channels kept); returns the ops carried."""
+    from pxr import Gf, Sdf, Usd, UsdGeom
 
     mine, theirs = dst.GetPrimAtPath(path), src.GetPrimAtPath(path)
-    if "xformOpOrder" not in mine.properties or "xformOpOrder" not in theirs.properties:
+    if "xformOpOrder" not in theirs.properties:
         return []
     xf = UsdGeom.Xformable(stage.GetPrimAtPath(path))
     if not xf or xf.TransformMightBeTimeVarying() or xf.GetResetXformStack():
         return []
+    if "xformOpOrder" not in mine.properties:  # none written: the source's ops come to identity
+        ops = xf.GetOrderedXformOps()  # (a transform set at one time code is in the points)
+        identity = xf.GetLocalTransformation(Usd.TimeCode.Default()) == Gf.Matrix4d(1.0)
+        if not identity or any(op.GetAttr().GetNumTimeSamples() for op in ops):
+            return []
     ours = [p.name for p in mine.properties if p.name.startswith("xformOp")]
     for name in ours:
         mine.RemoveProperty(mine.properties[name])
