@@ -150,9 +150,9 @@ def give_strands_primvars(
     list of str
         The primvars given.
     """
-    from pxr import Sdf, Usd, UsdGeom, Vt
+    from pxr import Sdf, Usd, UsdGeom
 
-    from hairtool.guides.child_primvars import _as_vt
+    from hairtool.guides.child_primvars import as_vt
     from hairtool.io.usd import _open_stage
 
     stage = _open_stage(Path(source))
@@ -186,7 +186,7 @@ def give_strands_primvars(
                 mine.RemoveProperty(f"primvars:{name}:indices")
             made = api.CreatePrimvar(name, pv.GetTypeName(), interp)
             array = pv.GetTypeName().type.pythonClass
-            made.Set(values if interp == "constant" else _as_vt(array, values, Vt))
+            made.Set(values if interp == "constant" else as_vt(array, values))
             given.append(f"{path_now}.primvars:{name}")
     if given:
         with atomic_path(out) as tmp:
