@@ -21,7 +21,7 @@ from hairtool.groom import Animation, Groom
 from hairtool.guides.animate import RenderHairAnimation
 from hairtool.guides.animated_prims import JoinedFrames, split_animation
 from hairtool.guides.binding import ChildBinding
-from hairtool.guides.files import AnimationWithGuides
+from hairtool.guides.files import AnimationWithGuides, render_prims
 from hairtool.guides.render import ChildClump
 from hairtool.prims import shares, split
 
@@ -98,5 +98,28 @@ def prim_frames(
     out = []
     for part, b in zip(parts, bindings.bindings, strict=True):
         hair = RenderHairAnimation(b, part, clump(b))
-        out.append(AnimationWithGuides(hair) if with_guides else hair)
+        out.append(AnimationWithGuides(hair) if with_guides else OnRenderPrim(hair))
     return JoinedFrames(out), parts
+
+
+class OnRenderPrim:
+    """Render hair following one prim's guides, alone on that prim's render prim (``P`` →
+    ``PRender``, :func:`~hairtool.guides.files.render_prims`): a prim's part of the frames
+    written to a format that cannot hold the guides beside it (``.npz``). Everything else is
+    the render hair's own."""
+
+    def __init__(self, hair: RenderHairAnimation) -> None:
+        """``hair`` on its render prim.
+
+        Parameters
+        ----------
+        hair : RenderHairAnimation
+            One prim's children following its guides.
+        """
+        self.hair = hair
+        guides = hair.guides
+        prims = render_prims(hair.metadata, hair.strand_count, guides.metadata, guides.strand_count)[0]
+        self.metadata = hair.metadata.with_(curves=prims)
+
+    def __getattr__(self, name: str):
+        return getattr(self.hair, name)
