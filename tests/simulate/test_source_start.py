@@ -4,6 +4,7 @@ range at 0…N−1."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -42,7 +43,7 @@ def test_output_time_codes_start_where_the_source_did(tmp_path, command, start):
 
 
 @pytest.mark.parametrize("ends", ["start", "end"])
-def test_one_end_authored_alone_is_read_as_usd_reads_it(tmp_path, ends):
+def test_one_end_authored_alone_is_read_as_usd_reads_it(tmp_path, ends, capsys):
     """usd-core (and Blender's importer, which takes ``GetStartTimeCode`` as its first frame)
     starts a stage with ``startTimeCode = 101`` and no end at 101, and one with only an end at
     its fallback 0: the frames made from it start there too, and ``convert`` writes the end it
@@ -63,3 +64,7 @@ def test_one_end_authored_alone_is_read_as_usd_reads_it(tmp_path, ends):
     assert (layer.HasStartTimeCode(), layer.HasEndTimeCode()) == (ends == "start", ends == "end")
     kept = layer.startTimeCode if ends == "start" else layer.endTimeCode
     assert kept == (101.0 if ends == "start" else 124.0)
+    capsys.readouterr()
+    assert main(["info", str(src), "--json"]) == 0  # the end not authored is null
+    shown = json.loads(capsys.readouterr().out)["usd"]["time_code_range"]
+    assert shown == ([101.0, None] if ends == "start" else [None, 124.0])
