@@ -24,6 +24,7 @@ if TYPE_CHECKING:
 
     from hairtool.groom import Animation, Groom
     from hairtool.guides.binding import ChildBinding
+    from hairtool.guides.prim_bindings import PrimBindings
     from hairtool.guides.render import RenderHair
 
 
@@ -130,14 +131,17 @@ def input_groom(args: argparse.Namespace, groom: Groom) -> Groom:
 
 def prepare(
     args: argparse.Namespace, groom: Groom, *, keep_hair: bool = True
-) -> tuple[Groom, ChildBinding | None, float]:
+) -> tuple[Groom, ChildBinding | PrimBindings | None, float]:
     """What a command works on, from its input: :func:`input_groom`, then :func:`bind` where
     the options ask for render hair or the input brought its own (``keep_hair`` False: a run
-    that writes none, which works on the guides alone). ``(groom, binding or None, bind
-    milliseconds)``, the groom being the guides where there is a binding."""
+    that writes none, which works on the guides alone); guides on several hair prims are bound
+    prim by prim (:func:`bind_prims`). ``(groom, binding or None, bind milliseconds)``, the
+    groom being the guides where there is a binding."""
     groom = input_groom(args, groom)
     if not keep_hair:
         args.bound_hair = None
+    if _per_prim(args, groom):
+        return bind_prims(args, groom)
     if not wanted(args):
         if args.clump_children:  # (known only now: the input may have brought render hair)
             from hairtool.errors import ParameterError
@@ -149,6 +153,45 @@ def prepare(
             )
         return groom, None, 0.0
     return bind(args, groom)
+
+
+def _per_prim(args: argparse.Namespace, groom: Groom) -> bool:
+    """Whether ``--count`` grows each hair prim's children on its own (:mod:`hairtool.prims`):
+    guides on several prims, none of them guides already (render hair read beside its guides
+    keeps its binding), children grown around the guide roots."""
+    from hairtool.errors import ParameterError
+    from hairtool.prims import split
+
+    prims = groom.metadata.for_strands(groom.strand_count).curves
+    several = len(split(groom)) > 1 and all(c.purpose != "guide" for c in prims)
+    if not several or getattr(args, "bound_hair", None) is not None:
+        return False
+    if args.from_dense or args.scalp is not None:  # (interpolate and freeze pick the prim first)
+        flag = "--scalp" if args.scalp is not None else "--from-dense"
+        paths = ", ".join(c.path for c in prims[:4]) + (" …" if len(prims) > 4 else "")
+        raise ParameterError(
+            flag[2:], args.scalp if args.scalp is not None else True,
+            f"one hair prim for {flag}, which belongs to one ({args.input} holds {paths}; "
+            "interpolate --prim PATH grows one prim's children)",
+        )  # fmt: skip
+    return args.count is not None
+
+
+def bind_prims(args: argparse.Namespace, groom: Groom) -> tuple[Groom, PrimBindings, float]:
+    """``(guides, one binding per prim, milliseconds)``: each prim's children bound to its own
+    guides, ``--count`` shared between the prims (:mod:`hairtool.guides.prim_bindings`)."""
+    import copy
+
+    from hairtool.guides.prim_bindings import bind_per_prim
+
+    t0 = time.perf_counter()
+
+    def one(part: Groom, n: int) -> ChildBinding:
+        each = copy.copy(args)
+        each.count = n
+        return bind(each, part)[1]
+
+    return groom, bind_per_prim(groom, args.count, one), (time.perf_counter() - t0) * 1e3
 
 
 def guides_path(args: argparse.Namespace) -> Path:
@@ -316,7 +359,10 @@ def write_animation(args: argparse.Namespace, binding: ChildBinding, guides: Ani
     given)."""
     from hairtool.guides.animate import RenderHairAnimation
     from hairtool.guides.files import write_animation
+    from hairtool.guides.prim_bindings import PrimBindings
 
+    if isinstance(binding, PrimBindings):
+        return _write_prims_animation(args, binding, guides)
     hair = RenderHairAnimation(binding, guides, render(args, binding).clump)
     t0 = time.perf_counter()
     side = guides_path(args) if args.from_dense or args.guides_out or not is_usd(args.output) else None
@@ -329,17 +375,50 @@ def write_animation(args: argparse.Namespace, binding: ChildBinding, guides: Ani
     }
 
 
-def primvar_pairs(guides: Groom, binding: ChildBinding | None) -> list:
+def _write_prims_animation(args: argparse.Namespace, bindings: PrimBindings, guides: Animation) -> dict:
+    """:func:`write_animation` of children bound prim by prim: each prim's children follow its
+    own guides and go to its own render prim, the prims end to end in the source's order."""
+    from hairtool import io
+    from hairtool.guides.prim_bindings import prim_frames
+    from hairtool.io import usd
+
+    t0 = time.perf_counter()
+    usd_out = is_usd(args.output)
+    side = guides_path(args) if args.guides_out or not usd_out else None
+    if side is not None:
+        io.format_for(side, writing=True)  # refused before the long part
+    frames, _ = prim_frames(bindings, guides, lambda b: render(args, b).clump, with_guides=usd_out)
+    if usd_out:
+        usd.write(Path(args.output), frames)
+    else:
+        io.write(args.output, frames.animation())
+    report = {"output": str(args.output)}
+    if side is not None:
+        io.write(side, guides)
+        report["guides_output"] = str(side)
+    return report | {
+        "guides": guides.strand_count,
+        "children": bindings.child_count,
+        "child_vertices": bindings.vertex_count,
+        "render_seconds": round(time.perf_counter() - t0, 4),
+    }
+
+
+def primvar_pairs(guides: Groom, binding: ChildBinding | None, *, written: bool = False) -> list:
     """``(guide prim, render prim, binding)`` of one prim's children, for their primvars
     (:mod:`hairtool.guides.child_primvars`); none without children or for guides without a
-    prim of their own."""
+    prim of their own. ``written``: the guide prim as OUT holds it (where the guides' own
+    primvars were given to the strands strokes left: :func:`carry_planted`), not the source's."""
     from hairtool.guides.files import render_prims
+    from hairtool.guides.prim_bindings import PrimBindings
 
+    if isinstance(binding, PrimBindings):  # each prim's guides are its binding's rest guides
+        return [x for b in binding.bindings for x in primvar_pairs(b.rest_guides, b, written=written)]
     own = guides.metadata.for_strands(guides.strand_count).curves
     if binding is None or len(own) != 1:
         return []
-    hair, _ = render_prims(binding.metadata, binding.child_count, guides.metadata, guides.strand_count)
-    return [(own[0].path, hair[0].path, binding)]
+    hair, kept = render_prims(binding.metadata, binding.child_count, guides.metadata, guides.strand_count)
+    return [((kept[0] if written else own[0]).path, hair[0].path, binding)]
 
 
 def carry(args: argparse.Namespace, pairs: list = ()) -> None:
@@ -353,3 +432,27 @@ def carry(args: argparse.Namespace, pairs: list = ()) -> None:
         from hairtool.io.usd import _diagnosed
 
         _diagnosed(Path(args.input), lambda: give_children_primvars(args.input, args.output, list(pairs)))
+
+
+def carry_planted(args: argparse.Namespace, changed: list, pairs: list = ()) -> None:
+    """USD IN to USD OUT, after :func:`carry`: the primvars of each prim whose strands strokes
+    planted or removed (``changed``: ``(prim, strands before, pipeline)``), given to the strands
+    it has now (:mod:`hairtool.guides.strand_primvars`), then those of the guides OUT now holds
+    on their children (``pairs``: :func:`primvar_pairs` with ``written``)."""
+    from hairtool.io.usd_carry import USD_SUFFIXES
+
+    if not all(Path(p).suffix.lower() in USD_SUFFIXES for p in (args.input, args.output)):
+        return
+    from hairtool.guides.strand_primvars import give_strands_primvars
+    from hairtool.io.usd import _diagnosed
+
+    # (with children, the one prim's guides are where OUT holds them: its first pair's guide prim)
+    prims = [
+        (prim.path, pairs[0][0] if pairs else prim.path, pipe.origin, was, pipe.result)
+        for prim, was, pipe in changed
+    ]
+    _diagnosed(Path(args.input), lambda: give_strands_primvars(args.input, args.output, prims))
+    if pairs:
+        from hairtool.guides.child_primvars import give_children_primvars
+
+        _diagnosed(Path(args.output), lambda: give_children_primvars(args.output, args.output, list(pairs)))

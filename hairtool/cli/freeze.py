@@ -258,6 +258,7 @@ def run(args: argparse.Namespace) -> int:
     radius = float(np.linalg.norm(hi - lo)) if args.radius is None else args.radius
     timings: list[dict] = []
     pipes: list[FrozenPipeline] = []
+    changed: list[tuple] = []  # (prim, its strands before, the pipeline) where strokes planted or removed
 
     def freeze(part):
         pipe = FrozenPipeline(part, params, surface)
@@ -270,6 +271,9 @@ def run(args: argparse.Namespace) -> int:
             timings.append(pipe.timings)
         pipe.settle()  # the result of the whole groom's clumping, as the studio's after a release
         pipes.append(pipe)
+        prims = part.metadata.for_strands(part.strand_count).curves
+        if len(prims) == 1 and not np.array_equal(pipe.origin, np.arange(part.strand_count)):
+            changed.append((prims[0], part, pipe))
         return pipe.result
 
     emptied = []
@@ -324,6 +328,10 @@ def run(args: argparse.Namespace) -> int:
             )
     # USD to USD: the scene beside the hair, the guide prim's primvars on the children
     _guides.carry(args, pairs)
+    if changed and binding is not None:  # the written guides' primvars (just below) on the children
+        _guides.carry_planted(args, changed, _guides.primvar_pairs(pipe.result, binding, written=True))
+    elif changed:
+        _guides.carry_planted(args, changed)
     if args.json:
         one = len(pipes) == 1
         report |= {

@@ -36,8 +36,8 @@ def _usd_summary(obj) -> dict:
     """What the stage said about its space, time code range and curves."""
     m = obj.metadata
     out: dict = {"up_axis": m.up_axis, "meters_per_unit": m.meters_per_unit}
-    if m.start_time_code is not None:
-        out["time_code_range"] = [m.start_time_code, m.end_time_code]
+    if m.start_time_code is not None or m.end_time_code is not None:
+        out["time_code_range"] = [m.start_time_code, m.end_time_code]  # (null: that end not authored)
     out["curves"] = [
         {
             "path": c.path,

@@ -109,6 +109,7 @@ def _animated(args: argparse.Namespace, anim) -> dict:
     from hairtool.guides.animate import RenderHairAnimation
     from hairtool.guides.animated_prims import JoinedFrames, split_animation
     from hairtool.guides.files import AnimationWithGuides, split_guides
+    from hairtool.guides.prim_bindings import OnRenderPrim
     from hairtool.prims import picked, shares
 
     if args.from_dense:
@@ -137,7 +138,7 @@ def _animated(args: argparse.Namespace, anim) -> dict:
         one.count = next(counts)
         guides, binding, _ = _guides.prepare(one, part.rest)
         hair = RenderHairAnimation(binding, part, _guides.render(one, binding).clump)
-        out.append(AnimationWithGuides(hair) if usd_out else hair)
+        out.append(AnimationWithGuides(hair) if usd_out else OnRenderPrim(hair))
         moved.append(part)
         pairs += _guides.primvar_pairs(guides, binding)
         report["guides"] += guides.strand_count

@@ -76,7 +76,7 @@ def give_children_primvars(
     """For each ``(guide prim path in source, render prim path in written, binding)``, the guide
     prim's primvars on the render prim (module doc); ``written`` rewritten atomically when
     anything was added. Returns the primvars added (``path.primvars:name``). Both must be USD."""
-    from pxr import Sdf, Usd, UsdGeom, Vt
+    from pxr import Sdf, Usd, UsdGeom
 
     from hairtool.io.usd import _open_stage
 
@@ -107,7 +107,7 @@ def give_children_primvars(
             values, interp = got
             made = mine.CreatePrimvar(name, pv.GetTypeName(), interp)
             array = pv.GetTypeName().type.pythonClass
-            made.Set(values if interp == "constant" else _as_vt(array, values, Vt))
+            made.Set(values if interp == "constant" else as_vt(array, values))
             added.append(f"{render_path}.primvars:{name}")
     if added:
         with atomic_path(out) as tmp:
@@ -118,8 +118,21 @@ def give_children_primvars(
     return added
 
 
-def _as_vt(array_class, values: np.ndarray, vt):
-    """A Vt array of ``array_class`` holding ``values`` (through numpy where it can)."""
+def as_vt(array_class, values: np.ndarray):
+    """A Vt array of ``array_class`` holding ``values`` (through numpy where it can).
+
+    Parameters
+    ----------
+    array_class : type
+        The Vt array type a primvar's type name holds (``Vt.FloatArray``…).
+    values : ndarray
+        The values, one per element.
+
+    Returns
+    -------
+    object
+        The Vt array.
+    """
     if hasattr(array_class, "FromNumpy") and values.dtype.kind in "fiub":
         return array_class.FromNumpy(np.ascontiguousarray(values))
     return array_class([v.item() if hasattr(v, "item") else v for v in values])

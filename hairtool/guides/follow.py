@@ -40,7 +40,8 @@ _SALT = 0xC41D  # the stream of planted children's roots
 def guides_now(rest: Groom, current: Groom, origin: np.ndarray) -> Groom:
     """The guides ``current`` with each kept strand's rest shape (``origin[i]`` ≥ 0: strand
     ``origin[i]`` of ``rest``) and each planted strand's (``origin[i]`` < 0) shape in ``current``:
-    the rest guides of :func:`follow_guides`' binding, with ``rest``'s metadata.
+    the rest guides of :func:`follow_guides`' binding, with ``rest``'s metadata holding
+    ``current``'s prims.
 
     Parameters
     ----------
@@ -76,7 +77,9 @@ def guides_now(rest: Groom, current: Groom, origin: np.ndarray) -> Groom:
         both = np.array(a, np.float32)
         both[mine] = r[theirs]
         attrs[name] = both
-    return Groom(points, current.counts.copy(), **attrs, metadata=rest.metadata)
+    # rest's record holding the prims as they are now (a prim's strands planted and removed)
+    meta = rest.metadata.with_(curves=current.metadata.for_strands(current.strand_count).curves)
+    return Groom(points, current.counts.copy(), **attrs, metadata=meta.for_strands(current.strand_count))
 
 
 def _spacing(roots: np.ndarray) -> float:

@@ -11,7 +11,8 @@ test cases):
   head that turns) make an Animation sampled at every authored time code of the union, and the
   time codes themselves are kept (a stage sampled at 1…48 stays at 1…48);
 - the stage's ``upAxis``, ``metersPerUnit``, ``timeCodesPerSecond`` and start/end time codes
-  are kept as authored (nothing is rotated or scaled); the time code rate is the frame rate;
+  are kept as authored, one end without the other too (nothing is rotated or scaled); the time
+  code rate is the frame rate;
 - curves of any basis (linear, cubic bezier / bspline / catmullRom): the control points are the
   strand's points, the basis is remembered, and so is each prim's ``purpose`` (render hair
   beside its guide curves, purpose ``guide``: :mod:`hairtool.guides.files`);
@@ -301,8 +302,9 @@ def _write_stage_metadata(stage, obj: Curves, times) -> None:
         stage.SetFramesPerSecond(obj.fps)
     elif meta.time_codes_per_second is not None:
         stage.SetTimeCodesPerSecond(meta.time_codes_per_second)
-    if start is not None and end is not None:
+    if start is not None:  # (each end as the source authored it: one alone stays alone)
         stage.SetStartTimeCode(start)
+    if end is not None:
         stage.SetEndTimeCode(end)
 
 
@@ -682,12 +684,30 @@ def _stage_metadata(path: Path, stage) -> dict:
     out["time_codes_per_second"] = (
         fps if layer.HasTimeCodesPerSecond() or layer.HasFramesPerSecond() else None
     )
-    if stage.HasAuthoredTimeCodeRange():
-        start, end = float(stage.GetStartTimeCode()), float(stage.GetEndTimeCode())
-        if not (np.isfinite(start) and np.isfinite(end) and start <= end):
-            raise FormatError(path, f"the time code range {start}…{end} is not a range")
-        out.update(start_time_code=start, end_time_code=end)
+    start, end = _authored_range(stage)
+    for name, value in (("startTimeCode", start), ("endTimeCode", end)):
+        if value is not None and not np.isfinite(value):
+            raise FormatError(path, f"{name} is {value}; expected a finite number")
+    if start is not None and end is not None and start > end:
+        raise FormatError(path, f"the time code range {start}…{end} is not a range")
+    out.update(start_time_code=start, end_time_code=end)
     return out
+
+
+def _authored_range(stage) -> tuple[float | None, float | None]:
+    """The stage's start and end time codes, each as usd-core's stage reports it where a layer
+    it reads them from (the session or the root layer) authors it, None where neither does.
+
+    A stage may author one end alone (``startTimeCode = 1`` without an end): usd-core and
+    Blender's importer then still start it there (``Usd.Stage.GetStartTimeCode`` is 1, and so is
+    Blender's first frame), so the authored end is kept on its own and the other stays unset
+    (usd-core's fallback, 0, would turn a start after 0 into an empty range)."""
+    layers = [stage.GetRootLayer(), stage.GetSessionLayer()]
+    has_start = any(layer is not None and layer.HasStartTimeCode() for layer in layers)
+    has_end = any(layer is not None and layer.HasEndTimeCode() for layer in layers)
+    start = float(stage.GetStartTimeCode()) if has_start else None
+    end = float(stage.GetEndTimeCode()) if has_end else None
+    return start, end
 
 
 def _sample_times(parts: list[_Curves]) -> list[float]:
@@ -699,12 +719,13 @@ def _sample_times(parts: list[_Curves]) -> list[float]:
 
 
 def _static_xforms(parts: list[_Curves]) -> tuple:
-    """The curves prims' and their ancestors' local transforms (non-identity ones), when none is
-    animated: :attr:`hairtool.metadata.Metadata.xforms`, so a writer can put them back."""
+    """The curves prims' and their ancestors' local transforms (non-identity ones) that are not
+    time-sampled: :attr:`hairtool.metadata.Metadata.xforms`, so a writer can put them back. A
+    sampled one (a head that turns) is left out: the writer bakes it into the points of the hair
+    under it (written in the space of the static transforms it puts back), and the hair beside
+    it, under static parents, keeps them."""
     from pxr import Gf, Usd, UsdGeom
 
-    if any(c.transform_times for c in parts):
-        return ()
     table: dict[str, tuple[float, ...]] = {}
     for c in parts:
         for p in _lineage(c.prim):
@@ -713,6 +734,8 @@ def _static_xforms(parts: list[_Curves]) -> tuple:
                 continue
             if xf.GetResetXformStack():
                 return ()  # a prim that ignores its parents: not kept (the points stay world)
+            if any(op.GetAttr().GetNumTimeSamples() for op in xf.GetOrderedXformOps()):
+                continue
             m = xf.GetLocalTransformation(Usd.TimeCode.Default())
             if m != Gf.Matrix4d(1.0):
                 table[str(p.GetPath())] = tuple(float(v) for v in np.asarray(m, np.float64).reshape(-1))

@@ -4,13 +4,14 @@ The USD writer (:mod:`hairtool.io.usd`) authors the hair: its curves prims, thei
 transforms, the stage's axis, unit and time codes. A DCC's scene holds more, which a command
 that reads and writes USD must not drop: the head mesh, materials, the ``customData`` Blender
 marks its root with (without it a re-import nests ``/root/root``), the parents' own properties
-and, on a curves prim whose curves are the same ones (the same vertex counts), its other
-primvars (Blender's ``surface_uv_coordinate``, ``rest_position``…) and its material binding,
-and a parent's translate/rotate/scale ops where the writer put its static transform back as one
-matrix (the same transform), and a curves prim's authored points where the command left its
-strands as they were (the writer's are the same up to the rounding of the way back into the
-prim's space). Each is copied spec for spec (its bytes as the source had them)
-from the source's composed stage; nothing else the writer authored is overwritten.
+and, on a curves prim, its material binding and user properties and, where its curves are the
+same ones (the same vertex counts), its other primvars (Blender's ``surface_uv_coordinate``,
+``rest_position``…), and a parent's translate/rotate/scale ops where the writer put its static
+transform back as one matrix (the same transform), and a curves prim's authored points where
+the command left its strands as they were (the writer's are the same up to the rounding of the
+way back into the prim's space), every time sample of them, with its time-sampled widths and
+colour. Each is copied spec for spec (its bytes as the source had them) from the source's
+composed stage; nothing else the writer authored is overwritten.
 """
 
 from __future__ import annotations
@@ -109,10 +110,14 @@ def carry_scene(source: str | os.PathLike[str], written: str | os.PathLike[str])
             return
         carried.extend(_authored_ops(stage, src, dst, path))
         if path in curves:
-            if src.GetPrimAtPath(path).typeName == "BasisCurves" and _same_counts(src, dst, path):
-                kept = ("primvars:", "material:", "userProperties:")
+            if src.GetPrimAtPath(path).typeName == "BasisCurves":
+                # a material and user properties hold for any strands; primvars for the same ones
+                # (strokes that plant and delete: hairtool.guides.strand_primvars)
+                same = _same_counts(src, dst, path)
+                kept = ("material:", "userProperties:", *(("primvars:",) if same else ()))
                 carried.extend(_copy_missing_properties(src, dst, path, kept))
-                carried.extend(_untouched_points(src, dst, path))
+                if same:
+                    carried.extend(_untouched_points(src, dst, path))
                 schemas = src.GetPrimAtPath(path).GetInfo("apiSchemas")
                 if schemas and not mine.HasInfo("apiSchemas"):
                     mine.SetInfo("apiSchemas", schemas)
@@ -211,30 +216,92 @@ def _same_counts(src, dst, path) -> bool:
 _ROUNDING_ULPS = 4
 
 
+def _values_of(layer, attr) -> dict:
+    """``{time: value}`` of an attribute spec: its time samples, or its default at None."""
+    times = layer.ListTimeSamplesForPath(attr.path)
+    if times:
+        return {float(t): layer.QueryTimeSample(attr.path, t) for t in times}
+    return {} if attr.default is None else {None: attr.default}
+
+
+def _rounded_only(was, now) -> bool:
+    """Whether the points ``now`` are ``was`` up to the rounding of the way back into a prim's
+    own space (the same shape, within _ROUNDING_ULPS at ``was``'s magnitude)."""
+    import numpy as np
+
+    was, now = np.asarray(was, np.float32), np.asarray(now, np.float32)
+    if was.shape != now.shape or was.size == 0:
+        return False
+    ulp = np.spacing(np.float32(np.abs(was).max()))
+    off = np.abs(now.astype(np.float64) - was).max() if np.all(np.isfinite(now)) else np.inf
+    return bool(off <= _ROUNDING_ULPS * ulp)
+
+
 def _untouched_points(src, dst, path) -> list[str]:
     """Where the command left a prim's strands as they were (the points the writer wrote are the
-    source's, up to the rounding of the way back into the prim's own space), the source's
-    authored ``points`` and ``extent`` themselves, byte for byte; static points only."""
-    import numpy as np
+    source's at every time it wrote them, up to the rounding of the way back into the prim's own
+    space), the source's authored ``points`` and ``extent`` themselves, byte for byte, every
+    time sample with them; then the source's time-sampled widths and colour, which the writer
+    wrote once (:func:`_sampled_attributes`). A static prim the writer sampled at the source's
+    time codes (an animation beside it) is the source's static points again; frames a command
+    made (a simulation of a static groom) stay its own."""
     from pxr import Sdf
 
     done = []
     a = src.GetAttributeAtPath(path.AppendProperty("points"))
     b = dst.GetAttributeAtPath(path.AppendProperty("points"))
-    if a is None or b is None or a.default is None or b.default is None:
+    if a is None or b is None:
         return done
-    if src.ListTimeSamplesForPath(a.path) or dst.ListTimeSamplesForPath(b.path):
+    was, now = _values_of(src, a), _values_of(dst, b)
+    if not was or not now:
         return done
-    was, now = np.asarray(a.default, np.float32), np.asarray(b.default, np.float32)
-    if was.shape != now.shape or was.size == 0 or was.tobytes() == now.tobytes():
+    if list(was) == [None]:  # static in the source: every value written is that one, at the
+        if not set(now) <= {None, *map(float, src.ListAllTimeSamples())}:  # source's own times
+            return done  # (frames the command made, a simulation's: the points of an animation)
+        pairs = [(was[None], v) for v in now.values()]
+    elif set(was) == set(now):
+        pairs = [(was[t], now[t]) for t in was]
+    else:
         return done
-    ulp = np.spacing(np.float32(np.abs(was).max()))
-    if not np.all(np.isfinite(now)) or np.abs(now.astype(np.float64) - was).max() > _ROUNDING_ULPS * ulp:
+    if not all(_rounded_only(x, y) for x, y in pairs):
         return done
-    for name in ("points", "extent"):
+    same = list(was) == list(now) and all(_floats(x).tobytes() == _floats(y).tobytes() for x, y in pairs)
+    for name in () if same else ("points", "extent"):  # (written as the source has them already)
         prop = path.AppendProperty(name)
         if src.GetAttributeAtPath(prop) is not None and Sdf.CopySpec(src, prop, dst, prop):
             done.append(str(prop))
+    return done + _sampled_attributes(src, dst, path)
+
+
+def _floats(value):
+    import numpy as np
+
+    return np.ascontiguousarray(np.asarray(value, np.float32))
+
+
+#: A curves prim's attributes the writer authors once from what the reader took (the earliest
+#: value) that a source may time-sample.
+_SAMPLED = ("widths", "primvars:displayColor", "primvars:displayOpacity", "primvars:color")
+
+
+def _sampled_attributes(src, dst, path) -> list[str]:
+    """For a prim whose points are the source's: each of its time-sampled widths and colours
+    whose earliest sample is what the writer wrote (the command left it as it was read), the
+    source's attribute with every sample, byte for byte (written once, it would stand still)."""
+    from pxr import Sdf
+
+    done = []
+    for name in _SAMPLED:
+        a = src.GetAttributeAtPath(path.AppendProperty(name))
+        b = dst.GetAttributeAtPath(path.AppendProperty(name))
+        if a is None or b is None or b.default is None or not src.ListTimeSamplesForPath(a.path):
+            continue
+        first = min(src.ListTimeSamplesForPath(a.path))
+        value = src.QueryTimeSample(a.path, first)
+        if value is None or _floats(value).tobytes() != _floats(b.default).tobytes():
+            continue
+        if Sdf.CopySpec(src, a.path, dst, b.path):
+            done.append(str(a.path))
     return done
 
 
@@ -267,17 +334,22 @@ def _transformed(stage, path) -> bool:
 
 
 def _authored_ops(stage, src, dst, path) -> list[str]:
-    """Where the writer put a prim's static source transform back as one matrix, the source's
-    own ops instead (translate, rotate, scale as authored: the same transform, and an artist's
-    channels kept); returns the ops carried."""
-    from pxr import Sdf, UsdGeom
+    """Where the writer put a prim's static source transform back as one matrix (or wrote none
+    for ops that come to the identity), the source's own ops instead (translate, rotate, scale
+    as authored: the same transform, and an artist's channels kept); returns the ops carried."""
+    from pxr import Gf, Sdf, Usd, UsdGeom
 
     mine, theirs = dst.GetPrimAtPath(path), src.GetPrimAtPath(path)
-    if "xformOpOrder" not in mine.properties or "xformOpOrder" not in theirs.properties:
+    if "xformOpOrder" not in theirs.properties:
         return []
     xf = UsdGeom.Xformable(stage.GetPrimAtPath(path))
     if not xf or xf.TransformMightBeTimeVarying() or xf.GetResetXformStack():
         return []
+    if "xformOpOrder" not in mine.properties:  # none written: the source's ops come to identity
+        ops = xf.GetOrderedXformOps()  # (a transform set at one time code is in the points)
+        identity = xf.GetLocalTransformation(Usd.TimeCode.Default()) == Gf.Matrix4d(1.0)
+        if not identity or any(op.GetAttr().GetNumTimeSamples() for op in ops):
+            return []
     ours = [p.name for p in mine.properties if p.name.startswith("xformOp")]
     for name in ours:
         mine.RemoveProperty(mine.properties[name])

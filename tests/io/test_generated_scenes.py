@@ -1,8 +1,9 @@
 """Generated USD scenes (:mod:`usd_scenes`) through the commands: ``info``, ``convert``,
 ``freeze``, ``interpolate`` (animated on an animated stage), ``simulate`` and ``anime`` (a few
-frames), and a log of every brush that needs no head replayed by
-``freeze --strokes``. Prim paths, bases and the stage's conventions are kept, and the
-world-space results equal those of the scene's twin in the other up axis and unit.
+frames), and a log of every brush that needs no head replayed by ``freeze --strokes`` (a
+custom primvar then fits the strands delete left). Prim paths, bases and the stage's
+conventions are kept, and the world-space results equal those of the scene's twin in the other
+up axis and unit.
 
 CI runs a few examples (a minute at most); a longer run:
 ``HAIRTOOL_SCENE_EXAMPLES=200 pytest -n 0 tests/io/test_generated_scenes.py``.
@@ -87,6 +88,17 @@ def test_info_and_convert_keep_prims_conventions_and_world_points(scene):
         np.testing.assert_allclose(a, b, atol=2e-6 * max(1.0, np.abs(a).max()))
 
 
+def custom_primvar(path: Path, prim: str) -> tuple:
+    """``(clump_weight values or None, the prim's vertex count)``."""
+    from pxr import Usd, UsdGeom
+
+    stage = Usd.Stage.Open(str(path))  # (held: a prim of a freed stage is invalid)
+    p = stage.GetPrimAtPath(prim)
+    pv = UsdGeom.PrimvarsAPI(p).GetPrimvar("clump_weight")
+    counts = UsdGeom.BasisCurves(p).GetCurveVertexCountsAttr().Get()
+    return (list(pv.Get()) if pv else None), int(sum(counts))
+
+
 COMB = [{"brush": "comb", "falloff": "smooth", "symmetry": None, "params": {}, "samples": []}]
 
 
@@ -148,6 +160,9 @@ def test_freeze_and_a_stroke_log_keep_prims_and_conventions(scene):
         args = ["freeze", str(d / "s.usda"), str(d / "c.usda"), "--strokes", str(d / "comb.json"), *pose]
         assert main(args) == 0
         check_kept(scene, src, io.read(d / "c.usda"))
+        for prim in scene.prims:  # a custom primvar fits the strands the log left (delete's too)
+            got, vertices = custom_primvar(d / "c.usda", prim.path)
+            assert (got is not None) == prim.custom and (got is None or len(got) == vertices), prim.path
         assert main(["interpolate", str(d / "s.usda"), str(d / "k.usda"), "--count", "12"]) == 0
         kids = io.read(d / "k.usda")
         want = [x for p in curve_paths(src) for x in ((p + "Render", "default"), (p, "guide"))]
@@ -209,3 +224,8 @@ def test_simulate_and_anime_keep_prims_conventions_and_the_source_start(scene):
         cycle = io.read(d / "a.usda")
         check_kept(scene, src, cycle)
         assert isinstance(cycle, Animation) and cycle.time_codes[0] == first
+        # children: each prim's beside its own guides, as interpolate --count writes them
+        assert main([*args, "--frames", "2", "--count", "6", "--no-clump-children"]) == 0
+        kids = io.read(d / "sim.usda")
+        want = [x for p in curve_paths(src) for x in ((p + "Render", "default"), (p, "guide"))]
+        assert [(c.path, c.purpose) for c in kids.metadata.curves] == want

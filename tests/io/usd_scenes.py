@@ -4,10 +4,10 @@ and units.
 A scene: Y or Z up, 0.01 or 1 m per unit; 1-3 curve prims, each under its own chain of 0-2
 Xforms whose transforms are translate/rotate/scale ops or one matrix op; each prim linear,
 Catmull-Rom or B-spline, with widths, a colour and a custom primvar each present or absent; a
-mesh prim beside them; points or a parent's transform time-sampled, or neither. A scene is
-plain data (:class:`Scene`); :func:`write_stage` makes the file, ``twin=True`` the same hair in
-the other up axis and unit (points and translations turned and scaled), so that world-space
-results can be compared between the two.
+mesh prim beside them; points (with the prim's widths and colour) or a parent's transform
+time-sampled, or neither. A scene is plain data (:class:`Scene`); :func:`write_stage` makes
+the file, ``twin=True`` the same hair in the other up axis and unit (points and translations
+turned and scaled), so that world-space results can be compared between the two.
 """
 
 from __future__ import annotations
@@ -51,7 +51,8 @@ def _ops(draw) -> tuple[str, tuple[float, ...]]:
 
 
 @st.composite
-def scenes(draw, animated: bool = True) -> Scene:
+def scenes(draw, animated: bool = True, motions: tuple = (None, "points", "transform")) -> Scene:
+    """A scene (module doc); ``animated`` False: static, else one of ``motions``."""
     n = draw(st.integers(1, 3))
     prims = []
     for k in range(n):
@@ -80,7 +81,7 @@ def scenes(draw, animated: bool = True) -> Scene:
         draw(st.sampled_from((0.01, 1.0))),
         tuple(prims),
         draw(st.booleans()),
-        draw(st.sampled_from((None, "points", "transform"))) if animated else None,
+        draw(st.sampled_from(motions)) if animated else None,
     )
 
 
@@ -150,13 +151,21 @@ def write_stage(path, scene: Scene, *, twin: bool = False) -> None:
                 pts.Set(Vt.Vec3fArray.FromNumpy((local * (1 + 0.1 * f)).astype(np.float32)), t)
         else:
             pts.Set(Vt.Vec3fArray.FromNumpy(local))
+        # the time-sampled prim samples its widths and colour too, the first sample as a static one
+        sampled = times if scene.animated == "points" and k == 0 else (None,)
         if prim.widths:
-            curves.CreateWidthsAttr(Vt.FloatArray.FromNumpy(np.full(v, 8e-5 / mpu, np.float32)))
+            widths = curves.CreateWidthsAttr()
+            for f, t in enumerate(sampled):
+                at = () if t is None else (t,)
+                widths.Set(Vt.FloatArray.FromNumpy(np.full(v, 8e-5 * (1 + f) / mpu, np.float32)), *at)
             curves.SetWidthsInterpolation("vertex")
         pv = UsdGeom.PrimvarsAPI(curves.GetPrim())
         if prim.colour:
             colour = rng.uniform(0, 1, (v, 3)).astype(np.float32)
-            curves.CreateDisplayColorPrimvar("vertex").Set(Vt.Vec3fArray.FromNumpy(colour))
+            shown = curves.CreateDisplayColorPrimvar("vertex")
+            for f, t in enumerate(sampled):
+                at = () if t is None else (t,)
+                shown.Set(Vt.Vec3fArray.FromNumpy(colour * np.float32(1 - 0.2 * f)), *at)
         if prim.custom:
             pv.CreatePrimvar("clump_weight", Sdf.ValueTypeNames.FloatArray, "vertex").Set(
                 Vt.FloatArray.FromNumpy(rng.uniform(0, 1, v).astype(np.float32))
