@@ -216,8 +216,9 @@ def _one_prim(args: argparse.Namespace, groom):
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from hairtool import io, serial_twins
+    from hairtool import io
     from hairtool.errors import ParameterError
+    from hairtool.frozen.compile_plan import pipeline_kernels
     from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 
     params = FrozenParams(
@@ -273,8 +274,8 @@ def run(args: argparse.Namespace) -> int:
         return pipe.result
 
     emptied = []
-    # A small groom runs (and on a cold cache compiles) the serial kernels
-    with serial_twins.for_size(groom.vertex_count, ("hairtool.frozen",)):
+    # A small groom runs the serial kernels; on a cold cache a second process compiles some
+    with pipeline_kernels(groom.vertex_count):
         if binding is None and groom is pose:  # each prim a groom of its own (hairtool.prims)
             from hairtool.prims import per_prim, split
 
