@@ -53,8 +53,8 @@ def _argv(label: str, folder: Path) -> list[str] | None:
 def run(args: argparse.Namespace) -> list[dict]:
     repeat = setup(args)
     names = args.commands or (list(QUICK) if args.quick else [*first_runs.labels(), SINTEL])
-    if any(n != "sample" and n != SINTEL for n in names) and "sample" not in names:
-        names = ["sample", *names]  # the others read its groom
+    # the recipes that write what the chosen ones read first (most read sample's groom)
+    names = first_runs.with_inputs([n for n in names if n != SINTEL]) + [n for n in names if n == SINTEL]
     rows = []
     with tempfile.TemporaryDirectory(prefix="hairtool-cold-") as tmp:
         folder = Path(tmp)
