@@ -12,6 +12,7 @@ these types.
 from __future__ import annotations
 
 import contextlib
+import threading
 from collections.abc import Iterator
 
 from numba.core import types
@@ -57,9 +58,12 @@ def serial_plan() -> list[Entry]:
 def pipeline_kernels(vertices: int) -> Iterator[bool]:
     """Within the block, the pipeline's kernels for a groom of ``vertices`` (yields whether they
     run parallel): the serial twins on a small groom, with :func:`serial_plan` compiled in a
-    second process where the cache lacks it (and that process stopped at the block's end)."""
+    second process where the cache lacks it (and that process stopped at the block's end). Not
+    in a process that runs other threads (a farm's worker, which warms its cache at its start):
+    a fork copies the calling thread alone, and a lock another one held would stay taken."""
     with serial_twins.for_size(vertices, ("hairtool.frozen",)) as parallel:
-        ahead = None if parallel else compile_ahead.start(serial_plan())
+        alone = threading.active_count() == 1
+        ahead = compile_ahead.start(serial_plan()) if alone and not parallel else None
         try:
             yield parallel
         finally:

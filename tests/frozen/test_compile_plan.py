@@ -31,3 +31,20 @@ def test_a_groom_past_the_threshold_keeps_the_parallel_kernels():
     with serial_twins.for_size(serial_twins.PARALLEL_FROM_VERTICES - 1, ("hairtool.frozen",)) as parallel:
         assert not parallel and freeze._freeze_kernel is serial_twins.serial(kernel)
     assert freeze._freeze_kernel is kernel
+
+
+def test_the_plan_is_compiled_ahead_only_for_serial_kernels_in_a_process_of_one_thread(monkeypatch):
+    import threading
+
+    from hairtool import compile_ahead
+    from hairtool.frozen.compile_plan import pipeline_kernels
+
+    plans = []
+    monkeypatch.setattr(compile_ahead, "start", lambda plan: plans.append(plan))
+    for threads, vertices, forks in ((1, 100, 1), (2, 100, 0), (1, serial_twins.PARALLEL_FROM_VERTICES, 0)):
+        monkeypatch.setattr(threading, "active_count", lambda threads=threads: threads)
+        plans.clear()
+        with pipeline_kernels(vertices) as parallel:
+            assert parallel == (vertices >= serial_twins.PARALLEL_FROM_VERTICES)
+        assert len(plans) == forks, (threads, vertices)
+    assert serial_twins.parallel_in_use()
