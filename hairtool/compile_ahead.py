@@ -61,8 +61,9 @@ class Ahead:
             self.pid, self.status = None, os.waitstatus_to_exitcode(status)
 
     def close(self) -> None:
-        """Stop the forked process if it is still compiling (kernels the command did not need:
-        numba writes each cache file whole, under a temporary name), and reap it."""
+        """Stop the forked process if it is still compiling kernels the command did not need,
+        and reap it (numba writes a cache file under a temporary name and renames it, so a kill
+        leaves at most that temporary file; an index entry without its data is compiled anew)."""
         if self.pid is not None:
             try:
                 os.kill(self.pid, signal.SIGKILL)
