@@ -38,7 +38,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         nargs="+",
         metavar="LABEL",
         choices=names,
-        help=f"of: {', '.join(repr(n) for n in names)} (default all; 'sample' writes the others' input)",
+        help=f"of: {', '.join(repr(n) for n in names)} (default all; what a chosen one reads runs first)",
     )
     add_common_arguments(parser, quick="sample, freeze and freeze sintel only, one warm run", repeat=2)
 
