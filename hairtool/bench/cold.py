@@ -1,7 +1,8 @@
 """Each command's first run on an empty kernel cache, against its run on the cache it filled.
 
 One row per command line of :data:`hairtool.first_runs.RECIPES` (a seeded 2,000-strand scalp
-sample, its children and a hemisphere scalp), plus ``freeze sintel``, the bundled Sintel guides
+sample, its children and a hemisphere scalp; ``freeze large`` on 1,008,000 vertices, where freeze
+runs its parallel kernels), plus ``freeze sintel``, the bundled Sintel guides
 (``resources/`` of a checkout), the command the cold-start target is set on. Each run is a child
 process ``python -m hairtool …``: ``cold_s`` with ``NUMBA_CACHE_DIR`` a new empty folder,
 ``warm_s`` the same command again on the cache that run filled (the median of ``--repeat``);
