@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hairtool import first_runs
+from hairtool import first_runs, serial_twins
 from hairtool.cli import command_names, main
 from hairtool.samples import HEAD_RADIUS
 
@@ -46,6 +46,16 @@ def test_for_commands_keeps_recipe_order_and_what_each_reads(commands):
 
 def test_for_no_commands_given_is_every_recipe():
     assert first_runs.for_commands(None) == first_runs.labels()
+
+
+def test_with_inputs_adds_the_recipes_that_write_what_the_chosen_ones_read():
+    assert first_runs.with_inputs(["freeze large"]) == ["sample large", "freeze large"]
+    assert first_runs.with_inputs(["keys", "convert"]) == ["sample", "simulate", "keys", "convert"]
+    assert first_runs.with_inputs(["sample large"]) == ["sample large"]
+    assert first_runs.with_inputs([]) == []
+    large = dict(first_runs.RECIPES)["sample large"]
+    vertices = int(large[large.index("--strands") + 1]) * int(large[large.index("--vertices") + 1])
+    assert vertices >= serial_twins.PARALLEL_FROM_VERTICES  # its freeze runs the parallel kernels
 
 
 def test_the_scalp_mesh_is_a_closed_cap_of_the_sample_head(tmp_path):
