@@ -301,7 +301,7 @@ def _window_offsets(vlo, lo, hi, woff, wcnt, count, total):
     the windows before); their counts become offsets in chunk order, ``count[j]`` the sum,
     ``total[c]`` the chunk's."""
     for c in prange(vlo.size - 1):
-        total[c] = _chunk_offsets(c, vlo, lo, hi, woff, wcnt, count)
+        total[c] = _chunk_offsets(np.int64(c), vlo, lo, hi, woff, wcnt, count)  # one type: int64
 
 
 @twin_njit(nogil=True, parallel=True)
