@@ -108,11 +108,11 @@ def child_env(cache_dir: str | os.PathLike[str] | None = None) -> dict[str, str]
     return env
 
 
-def run_child(args: list[str], env: dict[str, str]) -> tuple[int, float, str]:
-    """``(exit status, wall seconds, last stderr line)`` of ``python -m hairtool ARGS``."""
+def run_child(args: list[str], env: dict[str, str], module: str = "hairtool") -> tuple[int, float, str]:
+    """``(exit status, wall seconds, last stderr line)`` of ``python -m MODULE ARGS``."""
     t0 = time.perf_counter()
     proc = subprocess.run(
-        [sys.executable, "-m", "hairtool", *args],
+        [sys.executable, "-m", module, *args],
         env=env,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
