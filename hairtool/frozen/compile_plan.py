@@ -20,9 +20,6 @@ from numba.core import types
 
 from hairtool import compile_ahead, serial_twins
 from hairtool.compile_ahead import Entry
-from hairtool.frozen.clump import _clump_run
-from hairtool.frozen.neighbour_update import _moved_mask
-from hairtool.frozen.vertex_grid import _build, _count_blocks
 
 
 def _array(dtype, ndim: int = 1, readonly: bool = False) -> types.Array:
@@ -35,7 +32,13 @@ _I32, _I64, _F64 = _array(types.int32), _array(types.int64), _array(types.float6
 
 
 def serial_plan() -> list[Entry]:
-    """(serial kernel, argument types) for the serial pipeline, the longest compile first."""
+    """(serial kernel, argument types) for the serial pipeline, the longest compile first. (The
+    kernels are imported here, not named by this module: the studio's warm-up lists every
+    kernel its modules name.)"""
+    from hairtool.frozen.clump import _clump_run
+    from hairtool.frozen.neighbour_update import _moved_mask
+    from hairtool.frozen.vertex_grid import _build, _count_blocks
+
     f64_2d = _array(types.float64, 2)
     lists = types.Tuple((_I32, _I64, _I64, _I32, _I64, _I64, _F64, _F64))  # pair lists, clump.py
     bufs = types.Tuple((f64_2d, f64_2d, f64_2d, _I64, _I64, _F64, _array(types.uint64), _F64))
