@@ -19,6 +19,7 @@ from __future__ import annotations
 import os
 import signal
 import sys
+import time
 
 from numba.core.caching import NullCache
 from numba.core.dispatcher import Dispatcher
@@ -27,6 +28,9 @@ from hairtool.kernel_loading import cached_signatures
 
 #: (kernel, argument types): one compile of a plan.
 Entry = tuple[Dispatcher, tuple]
+#: Seconds a call waits for the forked process before stopping it and compiling the kernel
+#: itself (the plan's 5 CPU seconds took under a minute on a VM loaded eightfold).
+WAIT_LIMIT_S = 300.0
 
 
 def cold_entries(plan: list[Entry]) -> list[Entry]:
@@ -52,13 +56,21 @@ class Ahead:
             kernel.compile = _Waiting(self, kernel)
 
     def wait(self) -> None:
-        """Wait for the forked process to finish (and let every kernel of the plan load or
-        compile as usual from then on)."""
+        """Wait for the forked process to finish, at most :data:`WAIT_LIMIT_S` (then stop it),
+        and let every kernel of the plan load or compile as usual from then on."""
         for kernel in self.kernels:
             kernel.__dict__.pop("compile", None)
-        if self.pid is not None:
+        if self.pid is None:
+            return
+        deadline = time.monotonic() + WAIT_LIMIT_S
+        done, status = os.waitpid(self.pid, os.WNOHANG)
+        while not done and time.monotonic() < deadline:
+            time.sleep(0.005)
+            done, status = os.waitpid(self.pid, os.WNOHANG)
+        if not done:
+            os.kill(self.pid, signal.SIGKILL)
             _, status = os.waitpid(self.pid, 0)
-            self.pid, self.status = None, os.waitstatus_to_exitcode(status)
+        self.pid, self.status = None, os.waitstatus_to_exitcode(status)
 
     def close(self) -> None:
         """Stop the forked process if it is still compiling kernels the command did not need,

@@ -60,3 +60,11 @@ def test_closing_stops_the_process_and_the_call_still_gets_its_kernel(kernel):
 def test_a_kernel_in_this_process_is_not_compiled_again(kernel):
     kernel(1.0)
     assert compile_ahead.start([(kernel, (types.float64,))]) is None
+
+
+def test_a_forked_process_past_the_wait_limit_is_stopped_and_the_call_compiles(kernel, monkeypatch):
+    monkeypatch.setattr(compile_ahead, "WAIT_LIMIT_S", 0.0)
+    ahead = compile_ahead.start([(kernel, (types.float64,))])
+    assert kernel(2.0) == 3.0  # the compile takes far longer than no time at all: stopped
+    assert ahead.status == -signal.SIGKILL and ahead.pid is None
+    assert sum(kernel._cache_misses.values()) == 1  # compiled here
