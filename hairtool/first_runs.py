@@ -6,7 +6,9 @@ A command's first run on an empty kernel cache spends nearly all its time compil
 with, and which kernels a command calls depends on its options and its input's size (a dense or
 hashed grid, children on a scalp or around the roots). So the surest list of what to compile is
 a run of each command, on inputs like a user's: :data:`RECIPES` are those runs, on a seeded
-scalp sample (a ``.hair`` file, as a user's grooms are files) and a hemisphere scalp mesh.
+scalp sample (a ``.hair`` file, as a user's grooms are files) and a hemisphere scalp mesh,
+and ``freeze`` once more on a sample large enough for its parallel kernels
+(:func:`hairtool.serial_twins.for_size`: a smaller groom runs their serial twins).
 
 ``hairtool cache warm`` runs them (a farm image's build step, a Dask worker's start), and
 ``hairtool bench cold`` times each one on an empty cache and again on the one it filled. Each run
@@ -28,6 +30,10 @@ from pathlib import Path
 #: Strands × vertices of the warm-up groom: the bundled Sintel guides' order of size, and the
 #: children's count of a typical ``--count`` (both pick the grids a user's grooms pick).
 STRANDS, VERTICES, CHILDREN = 2000, 24, 3000
+#: Strands of the large warm-up groom (× VERTICES: 1,008,000 vertices), past
+#: :data:`hairtool.serial_twins.PARALLEL_FROM_VERTICES`: ``freeze`` runs the serial twins on the
+#: small one and the parallel kernels on this one, and a warm-up compiles both.
+LARGE_STRANDS = 42_000
 
 _SCALP = ("--count", str(CHILDREN), "--scalp", "{d}/head.obj")
 #: (label, arguments): each a ``hairtool`` command line, in the order they run. ``{d}`` is the
@@ -37,6 +43,11 @@ RECIPES: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("freeze", ("freeze", "{d}/groom.hair", "{d}/frozen.hair")),
     ("freeze --keep-lengths", ("freeze", "{d}/groom.hair", "{d}/kept.hair", "--keep-lengths")),
     ("freeze --count --scalp", ("freeze", "{d}/groom.hair", "{d}/frozen-children.hair", *_SCALP)),
+    (
+        "sample large",
+        ("sample", "scalp", "{d}/large.hair", "--strands", str(LARGE_STRANDS), "--vertices", str(VERTICES)),
+    ),
+    ("freeze large", ("freeze", "{d}/large.hair", "{d}/large-frozen.hair", "--keep-lengths")),
     ("interpolate", ("interpolate", "{d}/groom.hair", "{d}/children.hair", "--count", str(CHILDREN))),
     ("interpolate --scalp", ("interpolate", "{d}/groom.hair", "{d}/scalp-children.hair", *_SCALP)),
     ("simulate", ("simulate", "{d}/groom.hair", "{d}/simulated.npz", "--frames", "12")),
@@ -97,11 +108,11 @@ def child_env(cache_dir: str | os.PathLike[str] | None = None) -> dict[str, str]
     return env
 
 
-def run_child(args: list[str], env: dict[str, str]) -> tuple[int, float, str]:
-    """``(exit status, wall seconds, last stderr line)`` of ``python -m hairtool ARGS``."""
+def run_child(args: list[str], env: dict[str, str], module: str = "hairtool") -> tuple[int, float, str]:
+    """``(exit status, wall seconds, last stderr line)`` of ``python -m MODULE ARGS``."""
     t0 = time.perf_counter()
     proc = subprocess.run(
-        [sys.executable, "-m", "hairtool", *args],
+        [sys.executable, "-m", module, *args],
         env=env,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
@@ -117,18 +128,27 @@ def prepare(folder: Path) -> None:
     write_scalp(folder / "head.obj")
 
 
-#: Recipes whose output a later recipe reads: what each needs run before it.
-NEEDS = {"keys": ("simulate",)}
+#: Recipes whose output a later recipe reads: what each needs run before it (besides
+#: ``sample``, whose groom most read: :func:`with_inputs`).
+NEEDS = {"keys": ("simulate",), "freeze large": ("sample large",)}
 
 
 def for_commands(commands: list[str] | tuple[str, ...] | None) -> list[str]:
     """The recipe labels that warm ``commands`` (command names; None: all), with what they read."""
     if commands is None:
         return labels()
-    wanted = {label for label, args in RECIPES if args[0] in commands}
-    for label in list(wanted):
+    return with_inputs(["sample", *(label for label, args in RECIPES if args[0] in commands)])
+
+
+def with_inputs(chosen: list[str]) -> list[str]:
+    """The recipe labels ``chosen`` with the ones that write what they read, in recipe order."""
+    wanted = set(chosen)
+    for label in chosen:
         wanted.update(NEEDS.get(label, ()))
-    return [label for label in labels() if label in wanted or label == "sample"]
+    recipes = dict(RECIPES)
+    if any(label != "sample" and "{d}/groom.hair" in recipes[label] for label in wanted):
+        wanted.add("sample")
+    return [label for label in labels() if label in wanted]
 
 
 def warm(

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hairtool import first_runs
+from hairtool import first_runs, serial_twins
 from hairtool.cli import command_names, main
 from hairtool.samples import HEAD_RADIUS
 
@@ -46,6 +46,16 @@ def test_for_commands_keeps_recipe_order_and_what_each_reads(commands):
 
 def test_for_no_commands_given_is_every_recipe():
     assert first_runs.for_commands(None) == first_runs.labels()
+
+
+def test_with_inputs_adds_the_recipes_that_write_what_the_chosen_ones_read():
+    assert first_runs.with_inputs(["freeze large"]) == ["sample large", "freeze large"]
+    assert first_runs.with_inputs(["keys", "convert"]) == ["sample", "simulate", "keys", "convert"]
+    assert first_runs.with_inputs(["sample large"]) == ["sample large"]
+    assert first_runs.with_inputs([]) == []
+    large = dict(first_runs.RECIPES)["sample large"]
+    vertices = int(large[large.index("--strands") + 1]) * int(large[large.index("--vertices") + 1])
+    assert vertices >= serial_twins.PARALLEL_FROM_VERTICES  # its freeze runs the parallel kernels
 
 
 def test_the_scalp_mesh_is_a_closed_cap_of_the_sample_head(tmp_path):
@@ -123,8 +133,21 @@ def test_cache_warm_without_a_writable_cache_folder_is_one_line_and_2(monkeypatc
 
 
 def test_bench_cold_times_a_command_cold_then_warm(capsys):
-    assert main(["bench", "cold", "--commands", "sample", "--repeat", "1", "--json"]) == 0
+    assert main(["bench", "cold", "--commands", "sample", "--repeat", "1", "--kernels", "2", "--json"]) == 0
     (row,) = json.loads(capsys.readouterr().out)
     assert row["command"] == "sample" and row["status"] == 0
     assert row["cold_s"] > 0 and row["warm_s"] > 0
     assert row["compile_share"] == pytest.approx(1 - row["warm_s"] / row["cold_s"])
+    assert row["compile_cpu_s"] >= 0 and isinstance(row["slowest"], str)  # (sample compiles nothing)
+
+
+def test_a_recorded_cold_run_times_each_kernel_it_compiles(tmp_path):
+    groom = tmp_path / "groom.hair"
+    assert main(["sample", "scalp", str(groom), "--strands", "20", "--vertices", "4"]) == 0
+    log = tmp_path / "kernels.json"
+    env = first_runs.child_env(tmp_path / "cache")  # empty: convert compiles the box kernel
+    args = [str(log), "convert", str(groom), str(tmp_path / "groom.usda")]
+    rc, _, message = first_runs.run_child(args, env, module="hairtool.bench.cold")
+    assert rc == 0, message
+    seconds = json.loads(log.read_text())
+    assert seconds["hairtool.bounds:_box"] > 0 and all(s >= 0 for s in seconds.values())

@@ -218,6 +218,7 @@ def run(args: argparse.Namespace) -> int:
 
     from hairtool import io
     from hairtool.errors import ParameterError
+    from hairtool.frozen.compile_plan import pipeline_kernels
     from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 
     params = FrozenParams(
@@ -277,27 +278,29 @@ def run(args: argparse.Namespace) -> int:
         return pipe.result
 
     emptied = []
-    if binding is None and groom is pose:  # each prim a groom of its own (hairtool.prims)
-        from hairtool.prims import per_prim, split
+    # A small groom runs the serial kernels; on a cold cache a second process compiles some
+    with pipeline_kernels(groom.vertex_count):
+        if binding is None and groom is pose:  # each prim a groom of its own (hairtool.prims)
+            from hairtool.prims import per_prim, split
 
-        several = len(split(groom)) > 1
+            several = len(split(groom)) > 1
 
-        def freeze_or_empty(part):
-            """A prim whose strands a stroke deleted, every one, is kept empty (as Blender keeps
-            an empty Curves object) where the scene holds other prims."""
-            from hairtool.frozen.brushes.delete import EveryStrandGone
+            def freeze_or_empty(part):
+                """A prim whose strands a stroke deleted, every one, is kept empty (as Blender keeps
+                an empty Curves object) where the scene holds other prims."""
+                from hairtool.frozen.brushes.delete import EveryStrandGone
 
-            try:
-                return freeze(part)
-            except EveryStrandGone:
-                if not several:
-                    raise
-                emptied.extend(part.metadata.curves)
-                return None
+                try:
+                    return freeze(part)
+                except EveryStrandGone:
+                    if not several:
+                        raise
+                    emptied.extend(part.metadata.curves)
+                    return None
 
-        result = per_prim(groom, freeze_or_empty, args.prim)
-    else:
-        result = freeze(groom)
+            result = per_prim(groom, freeze_or_empty, args.prim)
+        else:
+            result = freeze(groom)
     pipe = pipes[0] if pipes else None
     report = {}
     pairs = _guides.primvar_pairs(groom, binding)  # (the source's guides: before strokes change them)

@@ -219,6 +219,7 @@ def _search_vertex(
     si = sstrand[i]
     xb = px + reach
     q = np.int64(np.floor((px - reach - lo0) * inv_q)) - 1
+    first = np.int64(0)  # (not a literal 0: _scan_row as the full search compiled it)
     _, pos = _scan_row(
         sx, sy, sz, sstrand, i + 1, start[r + 1], px, py, pz, si, -np.inf, xb, r2, i + 1, flat, pos, lim
     )
@@ -235,7 +236,7 @@ def _search_vertex(
             continue
         a, e = start[row], start[row + 1]
         j = _first_at(order, qx, a, e, q)
-        _, pos = _scan_row(sx, sy, sz, sstrand, j, e, px, py, pz, si, -np.inf, xb, r2, 0, flat, pos, lim)
+        _, pos = _scan_row(sx, sy, sz, sstrand, j, e, px, py, pz, si, -np.inf, xb, r2, first, flat, pos, lim)
     return pos
 
 

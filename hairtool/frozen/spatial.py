@@ -215,6 +215,7 @@ def _forward_kernel(
     entries go to ``flat[base[c] + …]`` in the order found, ``fcnt[i]`` of them; ``used[c]``
     counts what chunk c needed (it overflowed when that exceeds its room)."""
     reach = search_reach(r2, slack, cell)  # windows a little longer, for the quantised order
+    first = np.int64(0)  # (a literal 0 would compile _scan_row once more, for Literal[int](0))
     for c in prange(chunks.size - 1):
         pos = base[c]
         lim = limit[c]  # the last slot is scratch for the branch-free writes
@@ -242,16 +243,16 @@ def _forward_kernel(
                     sx, sy, sz, sstrand, i + 1, b0, px, py, pz, si, -np.inf, xb, r2, i + 1, flat, pos, lim
                 )
                 j1, pos = _scan_row(
-                    sx, sy, sz, sstrand, j1, e1, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
+                    sx, sy, sz, sstrand, j1, e1, px, py, pz, si, sw, xb, r2, first, flat, pos, lim
                 )
                 j2, pos = _scan_row(
-                    sx, sy, sz, sstrand, j2, e2, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
+                    sx, sy, sz, sstrand, j2, e2, px, py, pz, si, sw, xb, r2, first, flat, pos, lim
                 )
                 j3, pos = _scan_row(
-                    sx, sy, sz, sstrand, j3, e3, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
+                    sx, sy, sz, sstrand, j3, e3, px, py, pz, si, sw, xb, r2, first, flat, pos, lim
                 )
                 j4, pos = _scan_row(
-                    sx, sy, sz, sstrand, j4, e4, px, py, pz, si, sw, xb, r2, 0, flat, pos, lim
+                    sx, sy, sz, sstrand, j4, e4, px, py, pz, si, sw, xb, r2, first, flat, pos, lim
                 )
                 fcnt[i] = pos - p0
         used[c] = pos - base[c]
@@ -300,7 +301,7 @@ def _window_offsets(vlo, lo, hi, woff, wcnt, count, total):
     the windows before); their counts become offsets in chunk order, ``count[j]`` the sum,
     ``total[c]`` the chunk's."""
     for c in prange(vlo.size - 1):
-        total[c] = _chunk_offsets(c, vlo, lo, hi, woff, wcnt, count)
+        total[c] = _chunk_offsets(np.int64(c), vlo, lo, hi, woff, wcnt, count)  # one type: int64
 
 
 @twin_njit(nogil=True, parallel=True)

@@ -59,7 +59,8 @@ def median_root_spacing_reference(groom: Groom) -> float:
 
 
 def _median_root_spacing(groom: Groom, nearest_roots) -> float:
-    roots = groom.roots.astype(np.float64)
+    roots32 = groom.roots
+    roots = roots32.astype(np.float64)
     s = len(roots)
     lo, hi = roots.min(axis=0), roots.max(axis=0)
     diag = float(np.linalg.norm(hi - lo))
@@ -67,16 +68,17 @@ def _median_root_spacing(groom: Groom, nearest_roots) -> float:
         return 0.0
     r = diag / np.sqrt(s)
     while True:
-        nearest = nearest_roots(roots, r, 1e-9 * diag)
+        nearest = nearest_roots(roots32, r, 1e-9 * diag)
         if np.count_nonzero(np.isinf(nearest)) < s // 2 or r > 2 * diag:
             m = float(np.median(nearest))
             return m if np.isfinite(m) else 0.0
         r *= 2.0
 
 
-def _nearest_roots_reference(roots: np.ndarray, r: float, tiny: float) -> np.ndarray:
+def _nearest_roots_reference(roots32: np.ndarray, r: float, tiny: float) -> np.ndarray:
     """``(S,)`` each root's distance to the nearest other root within ``r`` and beyond ``tiny``
-    (inf: none)."""
+    (inf: none), from the groom's float32 roots ``roots32``, in float64."""
+    roots = roots32.astype(np.float64)
     i, j = pairs_within_reference(roots, np.arange(len(roots)), r)
     e = roots[j] - roots[i]
     d = np.sqrt(e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1] + e[:, 2] * e[:, 2])
@@ -86,9 +88,15 @@ def _nearest_roots_reference(roots: np.ndarray, r: float, tiny: float) -> np.nda
     return nearest
 
 
-def _nearest_roots(roots: np.ndarray, r: float, tiny: float) -> np.ndarray:
-    nl = neighbour_list(roots, np.arange(len(roots)), r)
-    nearest = np.empty(len(roots))
+def _nearest_roots(roots32: np.ndarray, r: float, tiny: float) -> np.ndarray:
+    """The list from the float32 roots and read-only arrays, the types the clump's own list is
+    built from: its kernels compile once for both (the list sorts float64 copies of the
+    coordinates either way, so the distances are the same)."""
+    points = np.array(roots32, np.float32)
+    ids = np.arange(len(points))
+    points.flags.writeable = ids.flags.writeable = False
+    nl = neighbour_list(points, ids, r)
+    nearest = np.empty(len(points))
     lists = (nl.aflat, nl.aoff, nl.acnt, nl.bflat, nl.bstart)
     _nearest_kernel(nl.x, nl.y, nl.z, nl.order, *lists, tiny, nearest)
     return nearest
