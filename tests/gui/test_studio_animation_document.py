@@ -85,15 +85,21 @@ def test_key_settings_are_steps_and_a_slider_drag_is_one(make_window):
     w = make_window(groom=samples.portrait(strands=8, vertices=6))
     m, stack = w.animation, w.undo_stack
     assert _cycle(w)
+    slider = w.timeline.controls.count_slider
     before, steps = m.settings, stack.count()
-    for k in (4, 5, 6):
-        m.set_settings(drag="slider", mode="count", count=k)
-    assert stack.count() == steps + 1 and m.dp_keys.size == 6
+    for drag in ((4, 5, 6), (5, 4)):  # two drags of the key-count slider: a step each
+        slider.setSliderDown(True)
+        for k in drag:
+            slider.setValue(k)
+        slider.setSliderDown(False)
+    assert stack.count() == steps + 2 and m.dp_keys.size == 4 and stack.undoText() == "Key count"
     m.set_settings(interp="hermite")
-    assert stack.count() == steps + 2
+    assert stack.count() == steps + 3
     stack.undo()
     stack.undo()
-    assert m.settings == before and w.timeline.controls.count_slider.value() == m.dp_keys.size
+    assert m.dp_keys.size == 6 and slider.value() == 6
+    stack.undo()
+    assert m.settings == before and slider.value() == m.dp_keys.size
 
 
 def test_a_pose_edit_survives_hermite_and_the_bvh_reads_it_back(make_window, motion_dir, tmp_path):
