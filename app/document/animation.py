@@ -91,8 +91,8 @@ def derive(
             applied.append(True)
         except HairtoolError:
             applied.append(False)
-    motion = editor.motion()
-    return Keyed(keys, motion, skeleton_animation(motion), tuple(applied))
+    motion = editor.motion()  # the keys are the edited ones: a key moved in time is there
+    return Keyed(np.array(editor.keys), motion, skeleton_animation(motion), tuple(applied))
 
 
 def solving_settings(state: AnimationState) -> ks.KeySettings:

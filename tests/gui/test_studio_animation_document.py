@@ -56,6 +56,7 @@ def test_a_replaced_animation_comes_back_with_its_key_edits_and_their_steps(make
     stack.undo()  # the old cycle, with its key edit, its pin and the keys they made
     assert m.animation is edited and m.settings == settings
     np.testing.assert_array_equal(m.dp_keys, keys)
+    np.testing.assert_array_equal(w.doc.keys, keys)
     stack.undo()  # the pin's step still works on it
     assert 3 not in m.settings.pins
     stack.undo()  # and the key edit's
@@ -115,6 +116,7 @@ def test_a_pose_edit_survives_hermite_and_the_bvh_reads_it_back(make_window, mot
     assert c.commit(PoseEdit(frame, HAND, target, 2), "pose")
     m.set_settings(interp="hermite")
     assert c.applied == [True] and frame in m.dp_keys
+    np.testing.assert_array_equal(m.dp_keys, w.doc.keys)  # the document's keys, shown
     out = tmp_path / "edited.bvh"
     assert c.export_bvh(out)
     np.testing.assert_allclose(read_bvh(out).values[frame], c.motion().values[frame], atol=1e-4)

@@ -59,6 +59,7 @@ def test_a_key_dragged_sideways_moves_in_time_like_the_librarys_edit(ui, graph):
     ui.curves_match(view, lib, ARM)
     # the keys, the dope sheet, the errors and the viewport follow the moved key
     assert m.dp_keys.tolist() == lib.keys.tolist() and f0 + 3 in m.dp_keys and f0 not in m.dp_keys
+    assert m.dp_keys.tolist() == w.doc.keys.tolist()  # the document's keys
     assert np.array_equal(m.solved_keys, keys)
     assert w.timeline.view.drawn_keys["dp"] == lib.keys.tolist()
     assert m.analysis is not None and m.analysis.dp.keys.tolist() == lib.keys.tolist()
