@@ -17,6 +17,7 @@ excluded by the dope sheet, a key move its new neighbours block) waits, and
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import itertools
 from collections import OrderedDict
@@ -187,13 +188,19 @@ class Document:
         return hit[1]
 
     def _solve(self, animation: Animation, settings: ks.KeySettings) -> ks.KeySession:
-        """One solve per animation, cost table and constraints (undo and redo solve nothing)."""
+        """One solve per animation, cost table and constraints (undo and redo solve nothing); other
+        pins and exclusions on a table solved already share its table and solve only the layers."""
         what = (id(animation), settings.table_key, settings.constraints)
         hit = self._solves.get(what)
         if hit is not None and hit[0] is animation:
             self._solves.move_to_end(what)
             return hit[1]
-        session = ks.solve(animation, settings)
+        for (_, table_key, _), (solved, other) in reversed(self._solves.items()):
+            if solved is animation and table_key == settings.table_key:  # other pins: the same table
+                session = copy.copy(other).constrain(settings.constraints)
+                break
+        else:
+            session = ks.solve(animation, settings)
         self._solves[what] = (animation, session)
         while len(self._solves) > DERIVED_KEPT:
             self._solves.popitem(last=False)
