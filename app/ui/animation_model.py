@@ -210,8 +210,13 @@ class AnimationModel(QObject):
             settings = settings.validate()
             if animation is not None:
                 settings.constraints.check(animation.n_frames)
+        # solved here when small (the document's solve, shared: settings no keys meet are refused
+        # before anything changes); a long animation's in the background
+        inline = animation is not None and (
+            self.runner is None or animation.frames.size <= self.inline_values
+        )
         return self.doc.replace_animation(
-            animation, source, capture, confirm, settings, edits, channel_edits, check=False
+            animation, source, capture, confirm, settings, edits, channel_edits, check=inline
         )
 
     def _show_new_animation(self) -> None:

@@ -214,13 +214,15 @@ class ProjectController(QObject):
         model = self.window.animation
         try:
             state = project_io.animation_state(project, str(path or "project"))
-        except HairtoolError as e:
+        except HairtoolError:  # (reported by the caller) the animation comes without what failed
             model.load_animation(project.animation, project.animation_source)
-            raise e
-        model.load_animation(
-            state.animation, state.source, settings=state.settings, capture=state.capture,
-            edits=state.edits, channel_edits=state.channel_edits,
-        )  # fmt: skip
+            raise
+        what = {"capture": state.capture, "edits": state.edits, "channel_edits": state.channel_edits}
+        try:
+            model.load_animation(state.animation, state.source, settings=state.settings, **what)
+        except HairtoolError:  # settings no keys meet: the animation comes with ours
+            model.load_animation(state.animation, state.source, **what)
+            raise
         if state.held_keys:
             model.doc.edit_frames(state.animation, state.held_keys, "Keys held")
 

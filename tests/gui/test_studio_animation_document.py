@@ -139,3 +139,24 @@ def test_a_saved_project_reopens_to_the_same_animation_side(make_window, motion_
     assert w2.project.open_project(path)
     assert _side(w2.doc.state) == saved and w2.undo_stack.count() == 0
     np.testing.assert_array_equal(w2.animation.dp_keys, w.animation.dp_keys)
+
+
+def test_a_project_whose_key_settings_no_keys_meet_opens_its_animation_and_says_so(make_window, tmp_path):
+    import dataclasses
+
+    from hairtool import project as pf
+
+    w = make_window(groom=samples.portrait(strands=8, vertices=6))
+    assert _cycle(w)
+    path = tmp_path / "p.hairproj"
+    assert w.project.save_to(path)
+    project = pf.load(path)  # an error budget no key set reaches with frame 5 excluded
+    bad = project.key_settings | {"mode": "budget", "budget": 1e-12, "excludes": [5]}
+    pf.save(path, dataclasses.replace(project, key_settings=bad))
+    w2 = make_window()
+    assert w2.project.open_project(path)
+    m = w2.animation
+    assert m.animation.frames.tobytes() == w.animation.animation.frames.tobytes()
+    assert m.dp_keys is not None and m.settings.mode == "count"
+    assert [t for t, _ in w2.errors] == ["Some project settings were not applied"]
+    assert w2.undo_stack.count() == 0 and not w2.project.has_unsaved_changes()
