@@ -8,7 +8,10 @@ animation replaced, then brought back by Undo, brings its own edits and their st
 
 The keys are derived, never stored: one solve of the animation under the settings, with the
 frames of the capture's edits pinned (:func:`app.document.capture.edit_frames`), so an edit
-survives a change of interpolation or key count as a key the solve must keep. A change the
+survives a change of interpolation or key count as a key the solve must keep. A key edit of a
+hair animation's own frames (:meth:`Document.edit_frames`) holds the keys it was made on until
+the settings change. Per-channel edits of a capture are kept in order; the studio's layer
+applies them. A change the
 settings cannot meet (fewer keys than the pinned frames need, a budget no key set reaches) is
 refused with a ParameterError before anything changes. An edit that cannot apply (its frame
 excluded by the dope sheet, a key move its new neighbours block) waits, and
