@@ -231,8 +231,8 @@ def _measure(app, args: argparse.Namespace, settings) -> list[dict]:
     )  # fmt: skip
     start, block = ks.key_edit_block(anim.frames, m.dp_keys, "linear", key, pose)
     rows.append(
-        {"what": "key edit applied (new frames, key poses, errors)", "animation": label,
-         "ms": _timed(lambda: m.replace_frames(start, block))}
+        {"what": "key edit applied (a document step: new frames, key poses, errors)", "animation": label,
+         "ms": _timed(lambda: m.edit_frames(start, block, f"Edit key {key}"))}
     )  # fmt: skip
 
     rows.append({"what": "GUI stall during a background solve", "animation": label, **_stall(app, window, m)})

@@ -8,7 +8,10 @@ animation replaced, then brought back by Undo, brings its own edits and their st
 
 The keys are derived, never stored: one solve of the animation under the settings, with the
 frames of the capture's edits pinned (:func:`app.document.capture.edit_frames`), so an edit
-survives a change of interpolation or key count as a key the solve must keep. A change the
+survives a change of interpolation or key count as a key the solve must keep. A key edit of a
+hair animation's own frames (:meth:`Document.edit_frames`) holds the keys it was made on until
+the settings change. Per-channel edits of a capture are kept in order; the studio's layer
+applies them. A change the
 settings cannot meet (fewer keys than the pinned frames need, a budget no key set reaches) is
 refused with a ParameterError before anything changes. An edit that cannot apply (its frame
 excluded by the dope sheet, a key move its new neighbours block) waits, and
@@ -17,7 +20,9 @@ excluded by the dope sheet, a key move its new neighbours block) waits, and
 
 from __future__ import annotations
 
+import copy
 import dataclasses
+import itertools
 from collections import OrderedDict
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -33,6 +38,7 @@ from hairtool.keys import session as ks
 from hairtool.mocap.bvh import Motion
 from hairtool.mocap.pose_edit import Edit, PoseEditor
 
+_TAKES = itertools.count()
 DERIVED_KEPT = 64  # derived states (keys, edited capture) remembered for undo and redo
 
 
@@ -45,6 +51,13 @@ class AnimationState:
     capture: Motion | None = None  # the BVH the animation is the skeleton of, as captured
     settings: ks.KeySettings = field(default_factory=ks.KeySettings)
     edits: tuple[Edit, ...] = ()  # IK poses and graph-editor key edits, in the order made
+    channel_edits: tuple = ()  # per-channel key edits over the edited capture, in the order made
+    # the keys a key edit of the animation's own frames was made on (a hair animation's key pose
+    # dragged, a key moved in time): they stay the keys until the key settings change
+    held_keys: tuple[int, ...] = ()
+    # which animation this is: each new or closed one is another take; its edits, undo and redo
+    # keep it (a view tells a key edit from a new animation by it; never saved)
+    take: int = field(default_factory=lambda: next(_TAKES))
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,18 +75,19 @@ def derive(
 ) -> Keyed:
     """The keys and edited capture of ``state``; ParameterError when its settings cannot be met.
     ``solve`` may be a cached :func:`hairtool.keys.session.solve`."""
-    anim, s = state.animation, state.settings
+    anim = state.animation
     if anim is None or anim.n_frames < 2:
         return Keyed(None, state.capture, anim, (False,) * len(state.edits))
-    pins = set(s.pins) | (set(edit_frames(state.edits)) - set(s.excludes))
-    solving = s.replace(pins=tuple(sorted(pins)))
+    if state.held_keys and state.capture is None:
+        return Keyed(np.array(state.held_keys, dtype=np.int64), None, anim, ())
+    solving = solving_settings(state)
     solving.constraints.check(anim.n_frames)
     keys = solve(anim, solving).keys_for(solving)
     if state.capture is None:
         return Keyed(keys, None, anim, ())
     if not state.edits:  # the capture as captured: its skeleton is the animation
         return Keyed(keys, state.capture, anim, ())
-    editor = PoseEditor(state.capture, keys, s.interp)
+    editor = PoseEditor(state.capture, keys, state.settings.interp)
     applied = []
     for e in state.edits:
         try:
@@ -81,8 +95,16 @@ def derive(
             applied.append(True)
         except HairtoolError:
             applied.append(False)
-    motion = editor.motion()
-    return Keyed(keys, motion, skeleton_animation(motion), tuple(applied))
+    motion = editor.motion()  # the keys are the edited ones: a key moved in time is there
+    return Keyed(np.array(editor.keys), motion, skeleton_animation(motion), tuple(applied))
+
+
+def solving_settings(state: AnimationState) -> ks.KeySettings:
+    """The settings the keys are solved with: the state's, with the frames of the capture's
+    edits pinned (but those the dope sheet excludes), so every edit has its key."""
+    s = state.settings
+    pins = set(s.pins) | (set(edit_frames(state.edits)) - set(s.excludes))
+    return s.replace(pins=tuple(sorted(pins))) if pins != set(s.pins) else s
 
 
 class SetState(Command):
@@ -169,17 +191,28 @@ class Document:
         return hit[1]
 
     def _solve(self, animation: Animation, settings: ks.KeySettings) -> ks.KeySession:
-        """One solve per animation, cost table and constraints (undo and redo solve nothing)."""
+        """One solve per animation, cost table and constraints (undo and redo solve nothing); other
+        pins and exclusions on a table solved already share its table and solve only the layers."""
         what = (id(animation), settings.table_key, settings.constraints)
         hit = self._solves.get(what)
         if hit is not None and hit[0] is animation:
             self._solves.move_to_end(what)
             return hit[1]
-        session = ks.solve(animation, settings)
+        for (_, table_key, _), (solved, other) in reversed(self._solves.items()):
+            if solved is animation and table_key == settings.table_key:  # other pins: the same table
+                session = copy.copy(other).constrain(settings.constraints)
+                break
+        else:
+            session = ks.solve(animation, settings)
         self._solves[what] = (animation, session)
         while len(self._solves) > DERIVED_KEPT:
             self._solves.popitem(last=False)
         return session
+
+    def session(self, animation: Animation, settings: ks.KeySettings) -> ks.KeySession:
+        """The solve of ``animation`` under ``settings`` the document's keys come from (one per
+        animation, table and constraints; whoever shows the keys shares it)."""
+        return self._solve(animation, settings)
 
     @property
     def keys(self) -> np.ndarray | None:
@@ -196,8 +229,9 @@ class Document:
         ]
 
     # -- commands ------------------------------------------------------------------------------
-    def _push(self, text: str, after: AnimationState, drag: object = None) -> None:
-        self.keyed(after)  # refused (ParameterError) before anything changes
+    def _push(self, text: str, after: AnimationState, drag: object = None, check: bool = True) -> None:
+        if check:
+            self.keyed(after)  # refused (ParameterError) before anything changes
         self.stack.push(SetState(self, text, after, drag))
 
     def replace_animation(
@@ -206,21 +240,34 @@ class Document:
         source: str = "",
         capture: Motion | None = None,
         confirm: Confirm | None = None,
+        settings: ks.KeySettings | None = None,
+        edits: Iterable[Edit] = (),
+        channel_edits: Iterable = (),
+        check: bool = True,
     ) -> bool:
         """A new animation (a cycle, a simulation, a capture opened) or none (Close animation):
         one undo step. Unsaved work is asked about first (``confirm``), as Open does; False when
         the answer was Cancel. The key settings stay but for the count (back to the knee), the
-        pins and exclusions and an error budget (the last animation's units)."""
+        pins and exclusions and an error budget (the last animation's units); ``settings`` (a
+        project's, validated) replace them, and ``edits`` come with the capture (a project's).
+        ``check=False`` leaves the first solve to whoever shows the keys (a long animation's
+        solve in the background)."""
         if self.state.animation is not None and self.changed and confirm is not None and not confirm():
             return False
         if capture is not None:
             animation = self._skeleton(capture)
         if animation is not None and not isinstance(animation, Animation):
             raise GroomError(f"expected an Animation, got {type(animation).__name__}")
-        s = self._settings_for_new()
-        after = AnimationState(animation, str(source) if animation is not None else "", capture, s, ())
+        s = self._settings_for_new() if settings is None else settings.validate()
+        if settings is not None and animation is not None:
+            s.constraints.check(animation.n_frames)
+        after = AnimationState(
+            animation, str(source) if animation is not None else "", capture, s,
+            tuple(edits) if capture is not None else (),
+            tuple(channel_edits) if capture is not None else (),
+        )  # fmt: skip
         text = "Close animation" if animation is None else f"New animation ({source or 'untitled'})"
-        self._push(text, after)
+        self._push(text, after, check=check)
         return True
 
     def _settings_for_new(self) -> ks.KeySettings:
@@ -243,31 +290,70 @@ class Document:
         self.stack.push(Steps(text, steps))
         return True
 
-    def set_settings(self, text: str = "Key settings", **changes: object) -> None:
+    def set_settings(
+        self, text: str = "Key settings", drag: object = None, check: bool = True, **changes: object
+    ) -> None:
         """Key count, mode, budget, price per key, interpolation…: one step (refused when the
-        animation cannot be keyed so)."""
+        animation cannot be keyed so); the moves of one slider drag (the same ``drag``) are one
+        step. Keys held by a key edit give way to the solve's. ``check=False``: the keys are
+        solved elsewhere (in the background), which takes the step back if they cannot be."""
         s = self.state.settings.replace(**changes)
         if s != self.state.settings:
-            self._push(text, dataclasses.replace(self.state, settings=s))
+            if self.state.animation is not None:
+                s.constraints.check(max(self.state.animation.n_frames, 2))
+            after = dataclasses.replace(self.state, settings=s, held_keys=())
+            self._push(text, after, drag, check)
 
-    def steer(self, pins: Iterable[int], excludes: Iterable[int], text: str = "Steer keys") -> None:
+    def steer(
+        self, pins: Iterable[int], excludes: Iterable[int], text: str = "Steer keys", check: bool = True
+    ) -> None:
         """The dope sheet's pinned and excluded frames."""
-        self.set_settings(text, pins=tuple(pins), excludes=tuple(excludes))
+        self.set_settings(text, check=check, pins=tuple(pins), excludes=tuple(excludes))
 
-    def edit(self, edit: Edit, text: str = "", drag: object = None) -> None:
-        """A key edit of the capture (IK pose, key value, handle, move in time); moves of one
-        drag (the same ``drag``) are one undo step. Refused when it does not apply."""
-        if self.state.capture is None:
+    def edit_frames(self, animation: Animation, keys: Iterable[int], text: str = "Edit key") -> None:
+        """A key edit of the animation's own frames (a hair animation's key pose dragged, a key's
+        value, handle or time moved in the graph editor): the animation with the edited frames,
+        and ``keys``, the keys the edit was made on (or moved to), held until the key settings
+        change. A capture's frames follow from its edits (:meth:`edit`), never from this."""
+        old = self.state.animation
+        if old is None:
+            raise ParameterError("edit", text, "an edit of an animation: make or open one first")
+        if self.state.capture is not None:
+            raise ParameterError("edit", text, "a pose edit of the capture (its frames follow its edits)")
+        if not isinstance(animation, Animation) or animation.topology != old.topology:
+            raise GroomError("a key edit keeps the animation's strands")
+        if animation.n_frames != old.n_frames:
+            raise GroomError("a key edit keeps the animation's frames")
+        held = np.asarray(list(keys), dtype=np.int64)
+        if held.size < 2 or held[0] != 0 or held[-1] != old.n_frames - 1 or np.any(np.diff(held) <= 0):
+            raise ParameterError("keys", held.tolist(), "increasing frames from the first to the last")
+        after = dataclasses.replace(self.state, animation=animation, held_keys=tuple(int(k) for k in held))
+        self._push(text, after, check=False)
+
+    def edit(self, edit: Edit | list[Edit], text: str = "", drag: object = None) -> None:
+        """A key edit of the capture (IK pose, key value, handle, move in time; a list of them is
+        one step: a key moved in time and value); moves of one drag (the same ``drag``) are one
+        undo step. Refused when it does not apply."""
+        new = list(edit) if isinstance(edit, list) else [edit]
+        if self.state.capture is None or not new:
             raise ParameterError("edit", type(edit).__name__, "an edit of a capture: open a .bvh first")
         top = self.stack.top
         again = isinstance(top, SetState) and drag is not None and top.drag == drag
         again = again and top.after is self.state
-        edits = self.state.edits[:-1] if again else self.state.edits  # a drag's move replaces its last
-        state = dataclasses.replace(self.state, edits=(*edits, edit))
+        edits = self.state.edits[: -len(new)] if again else self.state.edits  # a drag's move replaces
+        state = dataclasses.replace(self.state, edits=(*edits, *new))
         k = self.keyed(state)
-        if not k.applied[-1]:
-            raise ParameterError("edit", repr(edit), "an edit at a key frame it can reach")
-        self._push(text or f"{type(edit).__name__} at frame {edit.frame}", state, drag)
+        if not all(k.applied[-len(new) :]):
+            raise ParameterError("edit", repr(new[-1]), "an edit at a key frame it can reach")
+        last = new[-1]
+        self._push(text or f"{type(last).__name__} at frame {last.frame}", state, drag)
+
+    def edit_channels(self, edits: list, text: str) -> None:
+        """Per-channel key edits of the capture (each channel on its own keys, over the edited
+        capture): one step. Whoever shows the layer checks that they apply."""
+        if self.state.capture is None:
+            raise ParameterError("edit", text, "an edit of a capture: open a .bvh first")
+        self._push(text, dataclasses.replace(self.state, channel_edits=(*self.state.channel_edits, *edits)))
 
     def undo(self) -> bool:
         return self.stack.undo()

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import itertools
 import os
 import sys
 from types import MappingProxyType
@@ -40,16 +41,54 @@ def _text(capture: Motion) -> str:
     return hit[1]
 
 
-def to_project(doc: Document) -> pf.Project:
-    s = doc.state
+def animation_settings(s: AnimationState) -> dict:
+    """The project's ``settings`` entries of the animation side: the capture with its edits, and
+    the keys a key edit holds (a hair animation's)."""
     settings: dict = {}
     if s.capture is not None:
         settings["capture"] = {
             "bvh": _text(s.capture),
             "source": s.source,
             "edits": [e.to_dict() for e in s.edits],
-            "channel_edits": [],
+            "channel_edits": [e.to_dict() for e in s.channel_edits],
         }
+    if s.held_keys and s.capture is None:
+        settings["held_keys"] = list(s.held_keys)
+    return settings
+
+
+def animation_state(project: pf.Project, where: str = "project") -> AnimationState:
+    """The animation side of a project; FormatError naming ``where`` for what it cannot use."""
+    try:
+        settings = ks.KeySettings(**project.key_settings).validate()
+    except (TypeError, ValueError, HairtoolError) as e:
+        raise FormatError(where, f"key settings: {e}") from None
+    capture, edits, channel_edits = None, (), ()
+    saved = project.settings.get("capture")
+    if saved is not None:
+        if not isinstance(saved, dict):
+            raise FormatError(where, "the capture is not an object with its BVH and edits")
+        capture = motion_from_text(saved.get("bvh"), where)
+        lists = {k: saved[k] for k in ("edits", "channel_edits") if k in saved}
+        read = parse_capture_edits(lists, capture, where)
+        edits, channel_edits = tuple(read.edits), tuple(read.channel_edits)
+    held: tuple[int, ...] = ()
+    saved_keys = project.settings.get("held_keys")
+    if saved_keys is not None and project.animation is not None and capture is None:
+        ok = isinstance(saved_keys, list) and all(type(k) is int for k in saved_keys)
+        n = project.animation.n_frames
+        ok = ok and len(saved_keys) >= 2 and saved_keys[0] == 0 and saved_keys[-1] == n - 1
+        if not ok or any(b <= a for a, b in itertools.pairwise(saved_keys)):
+            raise FormatError(where, "held_keys: expected increasing frames from the first to the last")
+        held = tuple(saved_keys)
+    return AnimationState(
+        project.animation, project.animation_source, capture, settings, edits, channel_edits, held
+    )
+
+
+def to_project(doc: Document) -> pf.Project:
+    s = doc.state
+    settings = animation_settings(s)
     g = doc.hair.state
     strokes = doc.hair.settled()
     aligned = None
@@ -73,20 +112,7 @@ def to_project(doc: Document) -> pf.Project:
 
 def from_project(project: pf.Project, where: str = "project") -> Document:
     """A document of a project; FormatError naming ``where`` for settings it cannot use."""
-    try:
-        settings = ks.KeySettings(**project.key_settings).validate()
-    except (TypeError, ValueError, HairtoolError) as e:
-        raise FormatError(where, f"key settings: {e}") from None
-    capture, edits = None, ()
-    saved = project.settings.get("capture")
-    if saved is not None:
-        if not isinstance(saved, dict):
-            raise FormatError(where, "the capture is not an object with its BVH and edits")
-        capture = motion_from_text(saved.get("bvh"), where)
-        lists = {k: saved[k] for k in ("edits", "channel_edits") if k in saved}
-        edits = tuple(parse_capture_edits(lists, capture, where).edits)
-    state = AnimationState(project.animation, project.animation_source, capture, settings, edits)
-    doc = Document(groom_of(project), state)
+    doc = Document(groom_of(project), animation_state(project, where))
     doc.hair.view = MappingProxyType({k: v for k, v in project.display.items() if k != "clump_children"})
     return doc
 

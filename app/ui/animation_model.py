@@ -1,15 +1,24 @@
-"""The studio's animation model: the loaded animation, playback, and the keyframe state.
+"""The studio's animation model: a view of the document's animation side, with playback.
+
+The animation, its source, the capture and the key settings are the document's
+(:class:`app.document.animation.Document`, ``window.doc``); every change of them is a command
+on its one undo stack, and this model follows the document through ``doc.observe`` (a new
+animation, a key edit, new settings, and their undo and redo alike). What it keeps itself is
+what a project does not hold: the frame, playback, scrubbing, the view mode, a dragged key
+pose's preview, and the key solve's jobs and caches.
 
 No widgets: the timeline dock and the viewport listen to its signals, which fire only when a
 value really changes. Key work follows the timeline's needs: one solve per animation and
 table setting (features, cost table, layered DP) gives the keys of every count, so the
 key-count slider answers at once; per-frame errors of the DP keys and of uniform keys of the
 same count follow. Work on large animations runs through the window's :class:`JobRunner`; a
-job the user cancels leaves the previous keys, settings and curves as they were.
+job the user cancels takes its settings step back, so the keys, settings and curves are the
+previous ones.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -17,10 +26,11 @@ from dataclasses import dataclass
 import numpy as np
 from PySide6.QtCore import QObject, Qt, QTimer, Signal
 
+from app.document.animation import Document, solving_settings
 from app.ui.jobs import Job, JobRunner
 from app.ui.legend import magnitude_colors
 from hairtool.errors import GroomError, HairtoolError, ParameterError
-from hairtool.groom import Animation
+from hairtool.groom import Animation, Groom
 from hairtool.keys import session as ks
 from hairtool.keys.dp import keys_cost, uniform_keys
 from hairtool.keys.reconstruct import KeyPoses, check_keys, interpolate_at
@@ -74,24 +84,26 @@ class AnimationModel(QObject):
     display_changed = Signal()  # what is drawn at the current frame changed (not the frame)
     busy_changed = Signal(bool)  # a solve or an error pass is running in the background
 
-    def __init__(self, runner: JobRunner | None = None, parent: QObject | None = None) -> None:
+    def __init__(
+        self, runner: JobRunner | None = None, parent: QObject | None = None, doc: Document | None = None
+    ) -> None:
         super().__init__(parent)
         self.runner = runner
+        # the document it shows (the window's); a model on its own keeps a document of its own
+        self.doc = doc if doc is not None else Document(_no_groom())
         self.inline_values = INLINE_VALUES  # tests set 0 to send every solve through the runner
         self.clock: Callable[[], float] = time.perf_counter
-        self.animation: Animation | None = None
-        # what the keys are solved on when not the animation itself: a capture's skeleton as
-        # captured, so its keys stay those of the capture while its key poses are edited
-        self.key_source: Animation | None = None
-        self.source = ""
-        self.generation = 0  # counts loaded animations (undo steps of an older one do nothing)
+        # what is shown: the document's animation, or a capture's skeleton with its edits
+        # (the capture editor shows those through :meth:`replace_frames`)
+        self.animation: Animation | None = self.doc.state.animation
         self.frame = 0
         self.fps = DEFAULT_FPS
         self.playing = False
         self.scrubbing = False
         self.loop = True
-        self.settings = ks.KeySettings()
         self.view_mode = "original"
+        self._seen = self.doc.state  # the document's state shown
+        self._pending = None  # the settings step a background solve is for (a cancel takes it back)
         self._clear_keys()
         self._committed: _Committed | None = None
         self._solve_job: Job | None = None
@@ -101,6 +113,48 @@ class AnimationModel(QObject):
         self._timer.setTimerType(Qt.TimerType.PreciseTimer)
         self._timer.timeout.connect(self._tick)
         self._play_start = (0.0, 0)
+        self.doc.observe(self._on_doc)
+
+    # -- the document ----------------------------------------------------------------------
+    @property
+    def settings(self) -> ks.KeySettings:
+        """The key settings (the document's)."""
+        return self.doc.state.settings
+
+    @property
+    def source(self) -> str:
+        return self.doc.state.source
+
+    @property
+    def key_source(self) -> Animation | None:
+        """A capture's skeleton as captured (its keys stay the capture's while its key poses are
+        edited); None for an animation keyed as it is."""
+        state = self.doc.state
+        return state.animation if state.capture is not None else None
+
+    def _solving(self) -> ks.KeySettings:
+        """The settings the keys are solved with (the capture's edit frames pinned)."""
+        return solving_settings(self.doc.state)
+
+    def _on_doc(self) -> None:
+        """The document changed (a command, an undo, a redo): follow it."""
+        old, new = self._seen, self.doc.state
+        if new is old:
+            return
+        self._seen = new
+        if new.settings != old.settings:
+            self.settings_changed.emit(new.settings)
+        if new.take != old.take:  # another animation, or none
+            self._show_new_animation()
+            return
+        if new.animation is not old.animation and new.capture is None:  # a key edit, or its undo
+            self._frames_moved(old.animation, new.animation)
+        if self.animation is None or self.n_frames < 2:
+            return
+        if solving_settings(new) != solving_settings(old) or (old.held_keys and not new.held_keys):
+            self._settings_moved()
+        elif new.held_keys != old.held_keys:
+            self.set_edited_keys(np.array(new.held_keys, dtype=np.int64))
 
     def _clear_keys(self) -> None:
         self.key_solve: ks.KeySession | None = None
@@ -127,9 +181,19 @@ class AnimationModel(QObject):
         return max(self.n_frames - 1, 0)
 
     def load_animation(
-        self, animation: Animation, source: str = "", *, settings: ks.KeySettings | None = None
-    ) -> None:
-        """Show ``animation`` in the timeline and viewport and solve its keys.
+        self,
+        animation: Animation | None,
+        source: str = "",
+        *,
+        settings: ks.KeySettings | None = None,
+        capture=None,
+        edits=(),
+        channel_edits=(),
+        confirm: Callable[[], bool] | None = None,
+    ) -> bool:
+        """Show ``animation`` (or a ``capture``'s skeleton, with its ``edits``) in the timeline and
+        viewport and solve its keys: one undo step of the document
+        (:meth:`Document.replace_animation`); None closes the animation.
 
         ``source`` says where it came from (a path, "recording", "anime cycle", …); the other
         docks call this through ``window.animation.load_animation``. Frame 0, playback stopped,
@@ -138,62 +202,57 @@ class AnimationModel(QObject):
         last animation, and an error budget (a figure in the last animation's units: the key mode
         goes back to the count); a reopened project passes its saved ``settings`` instead (one
         solve, with those). ParameterError for invalid settings, before anything changes.
+        ``confirm`` asks Save / Discard / Cancel over unsaved work: False on Cancel.
         """
-        if not isinstance(animation, Animation):
+        if animation is not None and not isinstance(animation, Animation):
             raise GroomError(f"expected an Animation, got {type(animation).__name__}")
         if settings is not None:
-            new_settings = settings.validate()
-            new_settings.constraints.check(animation.n_frames)
-        else:
-            new_settings = self.settings.replace(count=0, pins=(), excludes=())
-            if new_settings.mode == "budget":
-                d = ks.KeySettings()
-                new_settings = new_settings.replace(mode=d.mode, budget=d.budget)
+            settings = settings.validate()
+            if animation is not None:
+                settings.constraints.check(animation.n_frames)
+        # solved here when small (the document's solve, shared: settings no keys meet are refused
+        # before anything changes); a long animation's in the background
+        inline = animation is not None and (
+            self.runner is None or animation.frames.size <= self.inline_values
+        )
+        return self.doc.replace_animation(
+            animation, source, capture, confirm, settings, edits, channel_edits, check=inline
+        )
+
+    def _show_new_animation(self) -> None:
+        """The document's animation is another one (or none): frame 0, playback stopped, the
+        playback rate the animation's, its keys solved."""
         self.pause()
         self._cancel_jobs()
-        self.generation += 1
-        self.animation = animation
-        self.key_source = None
-        self.source = str(source)
+        self._pending = None
+        anim = self.doc.state.animation
+        self.animation = anim
         self.frame = 0
         self._preview = None
         self._clear_keys()
         self._committed = None
-        if new_settings != self.settings:
-            self.settings = new_settings
-            self.settings_changed.emit(new_settings)
-        if animation.fps != self.fps:
-            self.fps = float(animation.fps)
+        if anim is not None and anim.fps != self.fps:
+            self.fps = float(anim.fps)
             self.fps_changed.emit(self.fps)
         self._announce_new_animation()
-        if animation.n_frames >= 2:
+        if anim is not None and anim.n_frames >= 2:
             self.request_solve()
 
     def clear(self) -> None:
-        """No animation: the viewport shows the scene's groom again."""
-        if self.animation is None:
-            return
-        self.pause()
-        self._cancel_jobs()
-        self.generation += 1
-        self.animation, self.source, self.frame, self._preview = None, "", 0, None
-        self.key_source = None
-        self._clear_keys()
-        self._committed = None
-        self._announce_new_animation()
+        """No animation (one undo step): the viewport shows the scene's groom again."""
+        if self.animation is not None:
+            self.load_animation(None)
 
     def reset(self) -> None:
         """A new document: no animation, and the values that belong to a document back to their
         defaults: the frame rate (a BVH's 120 fps is not the next groom's) and the key mode with
         its error budget (a figure in the last animation's units). The method chosen stays
         (interpolation, objective, features, the price per key, which is relative); an
-        animation or a project brings its own values."""
-        self.clear()
+        animation or a project brings its own values. (The window then clears the undo stack.)"""
         d = ks.KeySettings()
         new = self.settings.replace(mode=d.mode, count=0, budget=d.budget, pins=(), excludes=())
-        if new != self.settings:
-            self.settings = new
-            self.settings_changed.emit(new)
+        if self.doc.state.animation is not None or new != self.settings:
+            self.doc.replace_animation(None, settings=new, check=False)
         if self.fps != DEFAULT_FPS:
             self.fps = DEFAULT_FPS
             self.fps_changed.emit(self.fps)
@@ -207,8 +266,28 @@ class AnimationModel(QObject):
         self.analysis_changed.emit()
         self.display_changed.emit()
 
+    def edit_frames(self, start: int, block: np.ndarray, text: str, keys: np.ndarray | None = None) -> None:
+        """A key edit of the animation's frames ``start .. start + len(block) − 1`` (one undo step
+        of the document, :meth:`Document.edit_frames`): the keys stay (or become ``keys``, a key
+        moved in time) until the key settings change."""
+        anim = self.doc.state.animation
+        if anim is None:
+            raise GroomError("no animation to edit")
+        frames = np.array(anim.frames)
+        frames[start : start + len(block)] = block
+        held = self.dp_keys if keys is None else keys
+        self.doc.edit_frames(anim.with_frames(frames), held.tolist(), text)
+
+    def _frames_moved(self, old: Animation | None, new: Animation | None) -> None:
+        """The document's frames changed by a key edit (or its undo, or redo)."""
+        rows = np.flatnonzero(np.any(new.frames != old.frames, axis=(1, 2)))
+        if rows.size:
+            self.replace_frames(int(rows[0]), new.frames[rows[0] : rows[-1] + 1])
+        self.animation = new
+
     def replace_frames(self, start: int, block: np.ndarray) -> None:
-        """Frames ``start .. start + len(block) − 1`` get new poses (a key edit or its undo).
+        """Frames ``start .. start + len(block) − 1`` are shown with new poses (a key edit of the
+        document, or a capture's edits, which the capture editor shows here).
 
         The keys stay; their poses and the error curves are refreshed; the cost table is marked
         stale and is solved again on the next change of the key settings.
@@ -330,44 +409,47 @@ class AnimationModel(QObject):
         self._go(target)
 
     # -- key settings ----------------------------------------------------------------------
-    def set_settings(self, **changes: object) -> None:
-        """Change key settings; keys follow at once where the existing solve covers them, else a
-        new solve starts. A ParameterError (a bad value, or pins and exclusions the mode cannot
-        meet, such as an error budget no key set reaches without an excluded frame) comes before
-        anything changes, so a refused edit leaves the keys, settings and curves as they were."""
+    def set_settings(self, text: str = "", drag: object = None, **changes: object) -> None:
+        """Change key settings: one undo step of the document (the moves of one slider drag,
+        the same ``drag``, are one step; ``text`` names it). Keys follow at once where the
+        existing solve covers them, else a new solve starts. A ParameterError (a bad value, or
+        pins and exclusions the mode cannot meet, such as an error budget no key set reaches
+        without an excluded frame) comes before anything changes, so a refused edit leaves the
+        keys, settings and curves as they were."""
         new = self.settings.replace(**changes)
         if new == self.settings:
             return
+        text = text or "Key settings: " + ", ".join(f"{k} {v}" for k, v in changes.items())
         if self.n_frames < 2:
-            self.settings = new
-            self.settings_changed.emit(new)
+            self.doc.set_settings(text, drag=drag, check=False, **changes)
             return
         new.constraints.check(self.n_frames)
+        solving = solving_settings(dataclasses.replace(self.doc.state, settings=new))
         solve = self.key_solve
-        if solve is None or self.solve_stale or new.table_key != solve.table_key:
-            if self._inline():  # solved here: a refusal can still leave everything as it was
-                solve = ks.solve(self.keyed, new)
-                keys = solve.keys_for(new)
-                self._commit_settings(new)
-                self._apply_solve(solve, keys)
-            else:
-                self._commit_settings(new)
-                self.request_solve()
+        covered = solve is not None and not self.solve_stale and solve.table_key == solving.table_key
+        covered = covered and solve.constraints == solving.constraints
+        if covered:
+            solve.keys_for(solving)  # all or nothing: a refusal here leaves everything as it was
+        inline = self._inline()
+        self.doc.set_settings(text, drag=drag, check=inline and not covered, **changes)
+        if not covered and not inline:
+            self._pending = self.doc.stack.top
+
+    def _settings_moved(self) -> None:
+        """The document's key settings (or the capture's edit frames) changed: the keys follow."""
+        solving = self._solving()
+        solve = self.key_solve
+        if solve is None or self.solve_stale or solving.table_key != solve.table_key or (
+            solving.constraints != solve.constraints
+        ):
+            self.request_solve()
             return
-        reshaped = new.constraints != solve.constraints
-        keys = solve.keys_for(new)  # all or nothing
-        self._commit_settings(new)
+        keys = solve.keys_for(solving)
         if self._solve_job is not None:  # back to the solved table: the pending solve is moot
             job, self._solve_job = self._solve_job, None
             job.cancel()
             self._busy_update()
-        if reshaped:  # the same table, other layers
-            self.curve_changed.emit()
         self._show_keys(keys)
-
-    def _commit_settings(self, new: ks.KeySettings) -> None:
-        self.settings = new
-        self.settings_changed.emit(new)
 
     def steered(
         self,
@@ -430,12 +512,13 @@ class AnimationModel(QObject):
         return self.runner is None or self.animation.frames.size <= self.inline_values
 
     def request_solve(self) -> None:
-        """Solve keys for the current animation and settings (in the background when large)."""
-        anim, settings = self.keyed, self.settings
+        """Solve keys for the current animation and settings (in the background when large; the
+        document's own solve, shared, when not)."""
+        anim, settings = self.keyed, self._solving()
         if anim is None or anim.n_frames < 2:
             return
         if self._inline():
-            solve = ks.solve(anim, settings)
+            solve = self.doc.session(anim, settings)
             self._apply_solve(solve, solve.keys_for(settings))
             return
 
@@ -461,7 +544,7 @@ class AnimationModel(QObject):
             self._busy_update()
             return
         try:
-            keys = result.keys_for(self.settings)
+            keys = result.keys_for(self._solving())
         except HairtoolError as e:  # e.g. a budget these pins cannot meet: back, and say why
             self._job_failed(job, e)
             return
@@ -476,11 +559,17 @@ class AnimationModel(QObject):
         self._show_keys(keys, force=True)
 
     def _show_keys(self, keys: np.ndarray, force: bool = False) -> None:
+        state = self.doc.state
+        hold = state.held_keys and state.capture is None
+        held = np.array(state.held_keys, dtype=np.int64) if hold else None
         if not force and self.solved_keys is not None and np.array_equal(keys, self.solved_keys):
-            if self.analysis is None and self._analysis_job is None:
+            if held is not None and not np.array_equal(held, self.dp_keys):
+                self.set_edited_keys(held)
+            elif self.analysis is None and self._analysis_job is None:
                 self.request_analysis()
             return
-        self.dp_keys = self.solved_keys = keys
+        self.solved_keys = keys
+        self.dp_keys = keys if held is None else held
         self.uniform_keys = uniform_keys(self.n_frames, keys.size)
         self._keys_set()
 
@@ -573,6 +662,9 @@ class AnimationModel(QObject):
             self.runner.report_error(job, error)
 
     def _revert(self) -> None:
+        pending, self._pending = self._pending, None
+        if pending is not None and self.doc.stack.top is pending:
+            self.doc.stack.undo()  # the settings step goes back (Redo asks for the solve again)
         c = self._committed
         if c is None:  # nothing complete yet for this animation: no keys
             if self.dp_keys is not None or self.key_solve is not None:
@@ -582,13 +674,7 @@ class AnimationModel(QObject):
                 self.analysis_changed.emit()
                 self.display_changed.emit()
             return
-        if c.settings != self.settings:
-            self.settings = c.settings
-            self.settings_changed.emit(c.settings)
-        steered = c.solve is not None and c.solve.constraints != c.settings.constraints
-        if c.solve is not self.key_solve or steered:
-            if steered:  # a later edit re-solved the same table under other pins
-                c.solve.constrain(c.settings.constraints)
+        if c.solve is not self.key_solve:
             self.key_solve = c.solve
             self.curve_changed.emit()
         if not np.array_equal(c.dp_keys, self.dp_keys):
@@ -664,3 +750,11 @@ class AnimationModel(QObject):
         d = np.sqrt(np.einsum("vi,vi->v", original - rebuilt, original - rebuilt))
         scale = self.error_scale or max(float(d.max()), 1e-12)
         return Display(f, original, colors=magnitude_colors(d / scale))
+
+
+def _no_groom() -> Groom:
+    """The groom of a model's own document (a model without a window: only its animation side
+    is used)."""
+    from hairtool import samples
+
+    return samples.comb(strands=1, vertices=2)

@@ -1,6 +1,6 @@
 """Glue between the animation model, the viewport and the window: what the viewport draws for
-the current frame, key edits by dragging (one undo step each), recording drags, the playback
-actions and the fps read-out."""
+the current frame, key edits by dragging and dope-sheet edits (each one step of the document's
+undo stack), recording drags, the playback actions and the fps read-out."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QObject, Qt
-from PySide6.QtGui import QAction, QActionGroup, QKeySequence, QUndoCommand
+from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import QLabel, QStyle, QWidget
 
 from app.ui.animation_model import VIEW_MODES, AnimationModel
@@ -31,65 +31,6 @@ KEY_EDIT_MISSED = (
 
 if TYPE_CHECKING:
     from app.ui.host import StudioHost
-
-
-class KeyEditCommand(QUndoCommand):
-    """A key pose edit spread over the frames between its neighbouring keys; stores only that
-    stretch of frames before and after (not two copies of the whole animation)."""
-
-    def __init__(
-        self,
-        model: AnimationModel,
-        generation: int,
-        frame: int,
-        start: int,
-        before: np.ndarray,
-        after: np.ndarray,
-    ) -> None:
-        super().__init__(f"Edit key {frame}")
-        self.model, self.generation, self.frame = model, generation, frame
-        self.start, self.before, self.after = start, before, after
-
-    def _apply(self, block: np.ndarray) -> None:
-        # an edit of an animation that has since been replaced is a no-op, never a wrong write
-        if self.model.generation == self.generation:
-            self.model.replace_frames(self.start, block)
-
-    def redo(self) -> None:
-        self._apply(self.after)
-
-    def undo(self) -> None:
-        self._apply(self.before)
-
-
-class SteerKeysCommand(QUndoCommand):
-    """A dope-sheet edit: the pinned and excluded frames before and after it. Pushed once the
-    edit is applied (a refused one is never pushed), so the first redo does nothing."""
-
-    def __init__(
-        self, model: AnimationModel, text: str, before: tuple, after: tuple, report: Callable[[str], None]
-    ) -> None:
-        super().__init__(text)
-        self.model, self.generation, self.report = model, model.generation, report
-        self.before, self.after = before, after
-        self._applied = True
-
-    def _apply(self, constraints: tuple) -> None:
-        if self.model.generation == self.generation:  # the pins of a replaced animation mean nothing
-            pins, excludes = constraints
-            try:  # the mode may have changed since (a tighter budget): refused, nothing changes
-                self.model.set_settings(pins=pins, excludes=excludes)
-            except HairtoolError as e:
-                self.report(refusal(self.text(), self.model, e))
-
-    def redo(self) -> None:
-        if self._applied:
-            self._applied = False
-            return
-        self._apply(self.after)
-
-    def undo(self) -> None:
-        self._apply(self.before)
 
 
 def refusal(text: str, model: AnimationModel, error: HairtoolError) -> str:
@@ -153,8 +94,7 @@ class KeyEditBrush:
         except HairtoolError as e:
             self.c.window.show_error("Cannot edit key", str(e))
             return
-        before = np.array(m.animation.frames[start : start + len(block)])
-        self.c.window.undo_stack.push(KeyEditCommand(m, m.generation, frame, start, before, block))
+        m.edit_frames(start, block, f"Edit key {frame}")
 
 
 class AnimationController(QObject):
@@ -192,28 +132,26 @@ class AnimationController(QObject):
 
     # -- the dope sheet ----------------------------------------------------------------------
     def steer_keys(self, text: str, **edit: object) -> bool:
-        """One undoable dope-sheet edit (see :meth:`AnimationModel.steered`); a refused one says
-        why in the status bar and changes nothing."""
+        """One dope-sheet edit, one step of the document (see :meth:`AnimationModel.steered`); a
+        refused one says why in the status bar and changes nothing."""
         m = self.model
         before = (m.settings.pins, m.settings.excludes)
         try:
             after = m.steered(**edit)
             if after == before:
                 return False
-            m.set_settings(pins=after[0], excludes=after[1])  # all or nothing
+            m.set_settings(text, pins=after[0], excludes=after[1])  # all or nothing
         except HairtoolError as e:
             self.show_status(refusal(text, m, e))
             return False
-        self.window.undo_stack.push(SteerKeysCommand(m, text, before, after, self.show_status))
         return True
 
     def close_animation(self) -> bool:
-        """Animation ▸ Close animation: unsaved work asks Save / Discard / Cancel first."""
-        if self.model.animation is None or not self.window.project.confirm_discard():
+        """Animation ▸ Close animation: one undo step (Undo brings the animation back with its
+        edits); unsaved work asks Save / Discard / Cancel first."""
+        if self.model.animation is None:
             return False
-        self.model.clear()
-        self.window.undo_stack.resetClean()  # the document lost its animation: a change to save
-        return True
+        return self.model.load_animation(None, confirm=self.window.project.confirm_discard)
 
     def show_status(self, message: str) -> None:
         self.window.statusBar().showMessage(message, 6000)
@@ -275,24 +213,11 @@ class AnimationController(QObject):
             # their undo steps belong to the old strands, as when a file is opened)
             self.window.undo_stack.clear()
             self.scene.load(anim.rest, self.scene.path)
-        self._drop_stale_steps()
         self.viewport.brush_target = self.brush if anim is not None and self.recorder is None else None
         if anim is not None:
             self.viewport.frame_all()  # the groom, not the empty space its whole motion spans
         self.refresh_display()
         self._update_fps_label()
-
-    def _drop_stale_steps(self) -> None:
-        """Undo steps that edited a replaced (or closed) animation would do nothing: the history
-        goes, with a line saying so; the work stays unsaved if it was."""
-        stack, g = self.window.undo_stack, self.model.generation
-        if not any(getattr(stack.command(i), "generation", g) != g for i in range(stack.count())):
-            return
-        dirty = not stack.isClean()
-        stack.clear()
-        if dirty:
-            stack.resetClean()
-        self.show_status("Undo history cleared: its steps edited the animation that was replaced")
 
     # -- playback read-out ------------------------------------------------------------------
     def _on_playing(self, playing: bool) -> None:

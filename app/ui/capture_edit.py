@@ -14,6 +14,11 @@ timeline's skeleton is the edited capture (the key curves plus the captured resi
 key errors and the viewport follow. File ▸ Export Animation writes it as BVH, and a project
 keeps the capture and its list of edits (the ``hairtool keys --edit`` EDITS.json dicts, plus the
 graph editor's key and handle edits) and applies them again on open.
+
+The capture and its edits are the document's (``window.doc.state``: ``capture``, ``edits``,
+``channel_edits``); a finished drag is :meth:`app.document.animation.Document.edit` (or
+``edit_channels``), and this editor follows the document: its PoseEditor and layer are rebuilt
+from the document's edits after every change, an undo and a redo alike.
 """
 
 from __future__ import annotations
@@ -23,16 +28,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QObject, QPointF, Qt, Signal
-from PySide6.QtGui import QUndoCommand
 from PySide6.QtWidgets import QFormLayout, QGroupBox, QLabel, QScrollArea, QSpinBox
 
-from app.document.capture import motion_from_text, motion_text, skeleton_animation
-from hairtool.errors import FormatError, HairtoolError
+from app.document.capture import skeleton_animation
+from app.document.project_io import animation_settings
+from hairtool.errors import HairtoolError
 from hairtool.keys.channels import per_channel_keys
 from hairtool.mocap import ik
 from hairtool.mocap.bvh import Motion, write_bvh
 from hairtool.mocap.channel_edit import ChannelEditor, ChannelRetimeEdit, channel_features
-from hairtool.mocap.edit_file import parse_capture_edits
 from hairtool.mocap.pose_edit import Edit, PoseEdit, PoseEditor, RetimeEdit
 
 if TYPE_CHECKING:
@@ -42,41 +46,6 @@ PICK_PX = 12.0  # a press this near a handle (widget pixels) takes that joint
 GHOSTS = 6  # neighbouring frames drawn faintly while a key pose is dragged
 NOT_A_KEY = "Capture poses are edited at a key frame: jump to one with ↑ / ↓"
 NO_HANDLE = "Drag a joint's handle (the dots) to pose the capture; Alt-drag moves the whole limb"
-
-
-class PoseEditCommand(QUndoCommand):
-    """One finished drag (or graph-editor key move): its edits (a key dragged in time and value
-    is two: the move, then the value at the new frame), applied on redo, taken back on undo."""
-
-    def __init__(self, capture: CaptureEditor, edit: Edit | list[Edit], text: str) -> None:
-        super().__init__(text)
-        self.capture, self.generation = capture, capture.generation
-        self.edits = list(edit) if isinstance(edit, list) else [edit]
-        self.edit = self.edits[-1]
-
-    def redo(self) -> None:
-        if self.capture.generation == self.generation and self.capture.attached:
-            self.capture.push(self.edits)
-
-    def undo(self) -> None:
-        if self.capture.generation == self.generation and self.capture.attached:
-            self.capture.pop(len(self.edits))
-
-
-class ChannelKeyCommand(QUndoCommand):
-    """A per-channel key dragged in the graph editor (its moves in time, value or slope)."""
-
-    def __init__(self, capture: CaptureEditor, edits: list, text: str) -> None:
-        super().__init__(text)
-        self.capture, self.generation, self.edits = capture, capture.generation, edits
-
-    def redo(self) -> None:
-        if self.capture.generation == self.generation and self.capture.attached:
-            self.capture.push_channel(self.edits)
-
-    def undo(self) -> None:
-        if self.capture.generation == self.generation and self.capture.attached:
-            self.capture.pop_channel(len(self.edits))
 
 
 class JointDrag:
@@ -150,11 +119,8 @@ class CaptureEditor(QObject):
     def __init__(self, window: StudioHost) -> None:
         super().__init__(window)
         self.window, self.model = window, window.animation
-        self.original: Motion | None = None
-        self.source = ""
-        self.generation = -1
+        self.doc = self.model.doc
         self.editor: PoseEditor | None = None
-        self.edits: list[Edit] = []
         self.applied: list[bool] = []
         self.chain = 2
         self.joint = ""  # the selected joint
@@ -162,22 +128,42 @@ class CaptureEditor(QObject):
         self._preview: tuple[int, np.ndarray] | None = None  # frame, (J, 3) joints being dragged
         self.drag = JointDrag(self)
         self._syncing = False  # the timeline's keys are being set to the edited ones
-        self.channel_edits: list = []  # per-channel key edits (and IK poses), over the pose edits
         self.per_channel = False  # the graph editor's "Per-channel keys" box
         self.channel_applied: list[bool] = []
         self._column_keys: dict = {}
         self._layer: ChannelEditor | None = None
+        self._seen = self.doc.state
         self.model.animation_changed.connect(self._on_animation_changed)
         self.model.keys_changed.connect(self._on_keys_changed)
+        self.doc.observe(self._on_doc)
         self.box = self._tool_box()
         from app.ui.joint_handles import JointHandles
 
         self.handles = JointHandles(self, window.viewport)
 
-    # -- state -------------------------------------------------------------------------------
+    # -- state (the document's) ---------------------------------------------------------------
+    @property
+    def original(self) -> Motion | None:
+        """The capture as captured."""
+        return self.doc.state.capture
+
+    @property
+    def source(self) -> str:
+        return self.doc.state.source
+
+    @property
+    def edits(self) -> list[Edit]:
+        """IK poses and graph-editor key edits, in the order made."""
+        return list(self.doc.state.edits)
+
+    @property
+    def channel_edits(self) -> list:
+        """Per-channel key edits (and IK poses on them), over the pose edits."""
+        return list(self.doc.state.channel_edits)
+
     @property
     def attached(self) -> bool:
-        return self.original is not None and self.generation == self.model.generation
+        return self.original is not None and self.model.animation is not None
 
     @property
     def layered(self) -> bool:
@@ -188,27 +174,27 @@ class CaptureEditor(QObject):
     def at_key(self) -> bool:
         return self.editor is not None and bool(np.any(self.editor.keys == self.model.frame))
 
-    def attach(self, motion: Motion, source: str = "") -> None:
-        """The animation just loaded is this capture's skeleton: keep the capture beside it."""
-        self.original, self.source = motion, str(source)
-        self.generation = self.model.generation
-        self.model.key_source = skeleton_animation(motion)  # keys of the capture as captured
-        self.edits, self.applied, self.joint = [], [], ""
-        self.channel_edits, self.channel_applied, self._column_keys, self._layer = [], [], {}, None
-        self.window.viewport.brush_target = self.drag
-        self._rebuild(show=False)
+    def _on_animation_changed(self) -> None:
+        """Another animation: a capture's is posed here, anything else is not."""
+        self.editor, self.applied, self.joint = None, [], ""
+        self.channel_applied, self._column_keys, self._layer = [], {}, None
+        self._preview, self.ghosts = None, []
+        if self.attached:
+            self.window.viewport.brush_target = self.drag
+            self._rebuild()
         self._sync_box()
         self.selection_changed.emit("")
         self.changed.emit()
 
-    def _on_animation_changed(self) -> None:
-        if self.original is not None and self.generation != self.model.generation:
-            self.original, self.editor, self.edits, self.applied = None, None, [], []
-            self.channel_edits, self.channel_applied, self._column_keys, self._layer = [], [], {}, None
-            self.joint, self._preview, self.ghosts = "", None, []
-            self._sync_box()
-            self.selection_changed.emit("")
-            self.changed.emit()
+    def _on_doc(self) -> None:
+        """The document's edits changed (an edit, its undo or redo): shown again."""
+        old, new = self._seen, self.doc.state
+        self._seen = new
+        if new.take != old.take or new.capture is None:
+            return  # another animation: :meth:`_on_animation_changed`
+        if new.edits != old.edits or new.channel_edits != old.channel_edits:
+            self._layer = None
+            self._rebuild()
 
     def _on_keys_changed(self) -> None:
         if self.attached and not self._syncing:
@@ -224,8 +210,9 @@ class CaptureEditor(QObject):
                 self._syncing = False
 
     def _rebuild(self, show: bool = True) -> None:
-        """A PoseEditor on the solved keys, with every edit at a frame that is still a key
-        (a key moved in time moves again where its neighbours still let it)."""
+        """A PoseEditor on the solved keys (whose frames include every edit's, pinned by the
+        document), with every edit that applies (an edit at a frame the dope sheet excludes, or a
+        key moved in time past its neighbours, waits, and the status bar says so)."""
         m = self.model
         keys = m.solved_keys if m.solved_keys is not None else m.dp_keys
         if keys is None:
@@ -234,41 +221,18 @@ class CaptureEditor(QObject):
         interp = m.dp_poses.interp if m.dp_poses is not None else m.settings.interp
         self.editor = PoseEditor(self.original, keys, interp)
         self._layer = None
-        self.applied = []
-        for e in self.edits:
-            self.applied.append(self._try(e))
-        if self._pin_waiting():
-            return  # the solve under the new pins rebuilt everything (or will, when it lands)
+        self.applied = [self._try(e) for e in self.doc.state.edits]
         self._sync_keys()
         waiting = self.applied.count(False)
         if waiting:
             self.window.statusBar().showMessage(
-                f"{waiting} pose edit(s) are at frames that are no longer keys: "
-                "they come back with those keys",
+                f"{waiting} pose edit(s) are at frames that are not keys now (excluded in the dope "
+                "sheet): they come back with those keys",
                 8000,
             )
         if show:
             self._show()
         self.changed.emit()
-
-    def _pin_waiting(self) -> bool:
-        """Edits at frames the keys lost (an interpolation or key-count change) pin those frames,
-        so the solve keeps them as keys and the edits stay in the capture. False when nothing
-        waits, or the settings refuse the pins (the edits then wait, and the status bar says so)."""
-        m = self.model
-        frames = {int(e.frame) for e, ok in zip(self.edits, self.applied, strict=True) if not ok}
-        pins = tuple(sorted(frames | set(m.settings.pins)))
-        if not frames or pins == m.settings.pins:
-            return False
-        try:
-            m.set_settings(pins=pins)
-        except HairtoolError:
-            return False
-        shown = ", ".join(str(f) for f in sorted(frames))
-        self.window.statusBar().showMessage(
-            f"Frame(s) {shown} pinned as keys: pose edits are there", 8000
-        )
-        return True
 
     def _apply(self, edit: Edit | list[Edit]) -> None:
         self.editor.apply_all(edit if isinstance(edit, list) else [edit])
@@ -298,7 +262,7 @@ class CaptureEditor(QObject):
         key (relative), angles unwrapped; cached per column until the price or interpolation
         changes."""
         interp = self.editor.interp if self.editor is not None else self.model.settings.interp
-        what = (self.generation, self.model.settings.tau, interp)
+        what = (id(self.original), self.model.settings.tau, interp)
         if self._column_keys.get("what") != what:
             self._column_keys = {"what": what}
             self._layer = None
@@ -346,19 +310,6 @@ class CaptureEditor(QObject):
         m = self.original
         return [c for a in ik.ancestors(m, joint, chain) for c in ik.rotation_columns(m, a)[0]]
 
-    def push_channel(self, edits: list) -> None:
-        """Per-channel key edits (the undo command's redo)."""
-        self.channel_edits.extend(edits)
-        self._layer = None
-        self._show()
-        self.changed.emit()
-
-    def pop_channel(self, count: int) -> None:
-        del self.channel_edits[len(self.channel_edits) - count :]
-        self._layer = None
-        self._show()
-        self.changed.emit()
-
     def commit_channel(self, edits: list, text: str) -> bool:
         """One undo step for a per-channel key dragged (refused with a message when it cannot be)."""
         self.column_keys(sorted({c for e in edits for c in self._columns(e)}))
@@ -379,7 +330,7 @@ class CaptureEditor(QObject):
             last = layer.reports[-1] if done else None
             for _ in range(done):
                 layer.undo()
-        self.window.undo_stack.push(ChannelKeyCommand(self, list(edits), text))
+        self.doc.edit_channels(list(edits), text)
         if isinstance(edits[-1], PoseEdit):
             self._say_reach(edits[-1], last, " on its channels' own keys")
         return True
@@ -414,27 +365,6 @@ class CaptureEditor(QObject):
             self.model.replace_frames(lo, frames[lo : hi + 1])
 
     # -- editing -----------------------------------------------------------------------------
-    def push(self, edits: Edit | list[Edit]) -> None:
-        """Apply more edits (the undo command's redo)."""
-        for edit in edits if isinstance(edits, list) else [edits]:
-            self.edits.append(edit)
-            self.applied.append(self._try(edit))
-        self._layer = None
-        self._sync_keys()
-        self._show()
-        self.changed.emit()
-
-    def pop(self, count: int = 1) -> None:
-        """Take back the last ``count`` edits (the undo command's undo)."""
-        for _ in range(min(count, len(self.edits))):
-            self.edits.pop()
-            if self.applied.pop():
-                self.editor.undo()
-        self._layer = None
-        self._sync_keys()
-        self._show()
-        self.changed.emit()
-
     def commit(self, edit: Edit | list[Edit], text: str) -> bool:
         """One undo step for ``edit`` (or a list of edits; refused with a message when one
         cannot be solved)."""
@@ -450,12 +380,17 @@ class CaptureEditor(QObject):
             self.window.show_error("Cannot pose the capture", str(e))
             return False
         finally:
+            last = self.editor.reports[-1] if done and self.editor.reports else None
             for _ in range(done):
                 self.editor.undo()
-        self.window.undo_stack.push(PoseEditCommand(self, list(edits), text))
+        try:
+            self.doc.edit(list(edits), text)
+        except HairtoolError as e:
+            self.window.show_error("Cannot pose the capture", str(e))
+            return False
         edit = edits[-1]
-        if isinstance(edit, PoseEdit) and self.editor.reports:
-            self._say_reach(edit, self.editor.reports[-1])
+        if isinstance(edit, PoseEdit):
+            self._say_reach(edit, last)
         return True
 
     def commit_pose(self, edit: PoseEdit, text: str) -> bool:
@@ -551,42 +486,17 @@ class CaptureEditor(QObject):
         return True
 
     def to_settings(self) -> dict | None:
-        """What a project keeps: the capture (BVH text), where it came from and its edits."""
+        """What a project keeps: the capture (BVH text), where it came from and its edits (the
+        document's, as :mod:`app.document.project_io` writes them), and the tool's chain."""
         if not self.attached:
             return None
-        return {
-            "bvh": motion_text(self.original),
-            "source": self.source,
-            "edits": [e.to_dict() for e in self.edits],
-            "channel_edits": [e.to_dict() for e in self.channel_edits],
-            "chain": self.chain,
-        }
+        return animation_settings(self.doc.state)["capture"] | {"chain": self.chain}
 
-    def apply_settings(self, saved: object, where: str = "project capture") -> None:
-        """Attach a project's capture to the animation it opened with and apply its edits again."""
-        if saved is None or self.model.animation is None:
-            return
-        try:
-            if not isinstance(saved, dict):
-                raise FormatError(where, "expected an object with the capture and its edits")
-            motion = motion_from_text(saved.get("bvh"), where)
-            if skeleton_animation(motion).topology != self.model.animation.topology:
-                raise FormatError(where, "the capture's skeleton is not the project's animation")
-            lists = {k: saved[k] for k in ("edits", "channel_edits") if k in saved}
-            read = parse_capture_edits(lists, motion, where)  # what `hairtool keys --edit` reads
-            edits, channel_edits = read.edits, read.channel_edits
-        except HairtoolError as e:
-            self.window.show_error("Some project settings were not applied", str(e))
-            return
-        self.attach(motion, str(saved.get("source", "")))
-        if isinstance(saved.get("chain"), int):
+    def apply_settings(self, saved: object) -> None:
+        """A project's tool setting (the chain length); its capture and edits came with the
+        document."""
+        if isinstance(saved, dict) and isinstance(saved.get("chain"), int):
             self.set_chain(saved["chain"])
-        self.edits = list(edits)
-        self.channel_edits = list(channel_edits)
-        if np.array_equal(self.model.key_source.frames, self.model.animation.frames):
-            self._rebuild()
-        else:  # the project's frames are the edited ones: key the capture (rebuilt on its keys)
-            self.model.request_solve()
 
     # -- the tool dock's box -----------------------------------------------------------------
     def _tool_box(self) -> QGroupBox:

@@ -207,7 +207,14 @@ class CharacterStudio(QObject):
             frame = model.frame if model.animation is not None else 0
             if len(frames) > 1:
                 anim = Animation(np.stack(frames), counts, fps=d.fps)
+                stack = self.window.doc.stack
+                clean = stack.is_clean
                 model.load_animation(anim, SOURCE, settings=self._keys(len(frames)))
+                # the motion is the character document's (its own undo, not in a project): no
+                # step of the window's document, which holds nothing else while it is shown
+                stack.clear()
+                if clean:
+                    stack.set_clean()
                 model.set_frame(min(frame, len(frames) - 1))
             self.dock.show_measure(d.measure() if s.view != "cycle" else None, d.drawing_frames())
         self.show_frame(model.frame if model.animation is not None else 0)

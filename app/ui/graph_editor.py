@@ -195,9 +195,9 @@ class GraphView(QWidget):
         else:
             self.curves = capture_curves(self.capture)
         if self.on_hair:
-            what = ("hair", self.capture.model.generation, self.hair.strand, self.hair.vertex)
+            what = ("hair", self.capture.doc.state.take, self.hair.strand, self.hair.vertex)
         else:
-            what = (self.capture.generation, self.capture.joint)
+            what = (self.capture.doc.state.take, self.capture.joint)
         if self.curves and what != self._framed_for:
             self._framed_for = what
             self.frame_all()

@@ -28,9 +28,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from PySide6.QtGui import QUndoCommand
 
-from app.ui.animation_ui import KeyEditCommand
 from hairtool.keys.edit import check_retime, key_slope_block, retime_key
 from hairtool.keys.features import strand_features
 from hairtool.keys.reconstruct import KeyPoses, interpolate_at, key_poses
@@ -192,14 +190,10 @@ class HairChannels:
         """One undo step: the key moved (in value, in time or both)."""
         m = self.model
         start, block, _, keys = self.edited_block(axis, key, value, to)
-        before = np.array(m.animation.frames[start : start + len(block)])
         if to is None or to == key:
-            command = KeyEditCommand(m, m.generation, key, start, before, block)
-            command.setText(f"Move vertex {AXES[axis]} key at {key}")
+            m.edit_frames(start, block, f"Move vertex {AXES[axis]} key at {key}")
         else:
-            command = HairKeyTimeCommand(m, start, before, block, m.dp_keys.copy(), keys)
-            command.setText(f"Move key {key} to {to}")
-        self.window.undo_stack.push(command)
+            m.edit_frames(start, block, f"Move key {key} to {to}", keys=np.array(keys))
 
     # -- handles --------------------------------------------------------------------------------
     def slope_block(self, axis: int, key: int, slope: float) -> tuple[int, np.ndarray]:
@@ -220,32 +214,4 @@ class HairChannels:
     def commit_slope(self, axis: int, key: int, slope: float) -> None:
         m = self.model
         start, block = self.slope_block(axis, key, slope)
-        before = np.array(m.animation.frames[start : start + len(block)])
-        command = KeyEditCommand(m, m.generation, key, start, before, block)
-        command.setText(f"Turn vertex {AXES[axis]} handle at {key}")
-        self.window.undo_stack.push(command)
-
-
-class HairKeyTimeCommand(QUndoCommand):
-    """A hair key moved in time (and maybe in value): the frames between its neighbours before
-    and after, and the keys before and after (the dope sheet, the reconstruction and the
-    errors follow the moved key)."""
-
-    def __init__(
-        self, model, start: int, before: np.ndarray, after: np.ndarray, keys_before, keys_after
-    ) -> None:
-        super().__init__("Move key")
-        self.model, self.generation, self.start = model, model.generation, start
-        self.before, self.after = before, after
-        self.keys_before, self.keys_after = keys_before, keys_after
-
-    def _apply(self, block: np.ndarray, keys: np.ndarray) -> None:
-        if self.model.generation == self.generation:  # an older animation's step does nothing
-            self.model.replace_frames(self.start, block)
-            self.model.set_edited_keys(keys)
-
-    def redo(self) -> None:
-        self._apply(self.after, self.keys_after)
-
-    def undo(self) -> None:
-        self._apply(self.before, self.keys_before)
+        m.edit_frames(start, block, f"Turn vertex {AXES[axis]} handle at {key}")

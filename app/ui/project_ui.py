@@ -2,10 +2,11 @@
 autosave to a recovery file, and the offer to restore it after a crash.
 
 The file format is :mod:`hairtool.project`. "Changed since the last save" has one meaning, the
-undo stack's clean state: strokes, parameter edits, key edits and dope-sheet steps are undo
-steps, and an animation made in the studio (anime cycle, simulation, recording) or restored
-from the recovery file leaves the clean state for good (``QUndoStack.resetClean``) until the
-next save. Saving, opening and New set it clean again.
+undo stack's clean state: strokes, parameter edits, key edits, dope-sheet steps and a new,
+replaced or closed animation are undo steps, and work restored from the recovery file leaves
+the clean state for good (``resetClean``) until the next save. Saving, opening and New set it
+clean again. The animation side of a project is the document's (``window.doc.state``, written
+and read by :mod:`app.document.project_io`).
 
 The recovery file lives beside the settings file (an INI file, as in tests) or in
 ``QStandardPaths.AppDataLocation``; it is written on a timer from a plain thread (the groom and
@@ -25,11 +26,10 @@ from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, QSettings, QStandardPaths, QTimer, Signal
 
-from app.document.project_io import groom_of
+from app.document import project_io
 from app.render.camera import Camera
 from hairtool import project as pf
 from hairtool.errors import FormatError, HairtoolError
-from hairtool.keys.session import KeySettings
 
 if TYPE_CHECKING:
     from app.ui.animation_sources import AnimationSources
@@ -37,7 +37,6 @@ if TYPE_CHECKING:
 
 RECOVERY_NAME = "recovery" + pf.SUFFIX
 AUTOSAVE_MS = 60_000
-MADE_IN_STUDIO = ("anime cycle", "simulation", "recording")
 PROJECT_FILTERS = f"Hairtool project (*{pf.SUFFIX})"
 
 
@@ -88,8 +87,6 @@ class ProjectController(QObject):
         # The project's path belongs to the document: another groom opened is not this project
         # (opening a project sets it again, after the groom is loaded).
         window.scene.groom_loaded.connect(self._forget_path)
-        model = window.animation
-        model.animation_changed.connect(self._on_animation_changed)
         self.autosave_failed.connect(self._show_autosave_failure)
         self.timer = QTimer(self)
         self.timer.setInterval(max(int(autosave_ms), 1000))
@@ -108,17 +105,10 @@ class ProjectController(QObject):
     def _changed(self, *_: object) -> None:
         self._changes += 1
 
-    def _mark_animation(self) -> None:
-        """Work no undo step holds (an animation made here): unsaved until the next save."""
+    def _mark_unsaved(self) -> None:
+        """Work no undo step holds (restored from the recovery file): unsaved until the next save."""
         self.window.undo_stack.resetClean()
         self._changed()
-
-    def _on_animation_changed(self) -> None:
-        model = self.window.animation
-        if model.animation is not None and model.source in MADE_IN_STUDIO:
-            self._mark_animation()
-        else:
-            self._changed()
 
     def has_unsaved_changes(self) -> bool:
         return not self.window.undo_stack.isClean()
@@ -137,9 +127,12 @@ class ProjectController(QObject):
             "timeline": {"frame": model.frame, "view_mode": model.view_mode, "loop": model.loop},
         }
         settings.update(self.sources.to_settings())
+        # the animation side: the document's (the capture with its edits, keys a key edit holds)
+        state = w.doc.state
+        settings.update(project_io.animation_settings(state))
         capture = getattr(w, "capture", None)
-        if capture is not None and capture.attached:  # the BVH and its pose edits
-            settings["capture"] = capture.to_settings()
+        if "capture" in settings and capture is not None:  # the pose tool's chain beside it
+            settings["capture"]["chain"] = capture.chain
         return pf.Project.from_pipeline(
             scene.pipeline,
             brush=_brush_settings(scene.tool),
@@ -154,9 +147,9 @@ class ProjectController(QObject):
                 "release_percent": scene.release_percent,
                 "camera": w.viewport.camera.state(),
             },
-            animation=model.animation,
-            animation_source=model.source,
-            key_settings=dataclasses.asdict(model.settings),
+            animation=state.animation,
+            animation_source=state.source,
+            key_settings=dataclasses.asdict(state.settings),
             settings=settings,
             groom_source=source,
             children=scene.binding,
@@ -173,7 +166,7 @@ class ProjectController(QObject):
         w.undo_stack.clear()
         # the document's groom side: its strokes replayed (or taken as saved), its render hair
         # clumped as saved (a project from before the switch: off, as it looked then)
-        scene.open(groom_of(project), path)
+        scene.open(project_io.groom_of(project), path)
         _apply_each(
             w,
             (
@@ -193,12 +186,11 @@ class ProjectController(QObject):
             ),
         )
         if project.animation is not None:
-            model.load_animation(project.animation, project.animation_source)
+            _apply_each(w, (lambda: self._apply_animation(project, path),))
             timeline = project.settings.get("timeline", {})
             _apply_each(
                 w,
                 (
-                    lambda: model.set_settings(**_key_settings(project.key_settings)),
                     lambda: model.set_view_mode(str(timeline["view_mode"])),
                     lambda: model.set_loop(bool(timeline["loop"])),
                     lambda: model.set_frame(int(timeline["frame"])),
@@ -209,7 +201,27 @@ class ProjectController(QObject):
             w.capture.apply_settings(project.settings.get("capture"))
         if "camera" in project.display:  # after everything that frames the view again
             _apply_each(w, (lambda: w.viewport.set_camera(Camera.from_state(project.display["camera"])),))
+        w.undo_stack.clear()  # an opened project: nothing to undo
         self._mark_saved()
+
+    def _apply_animation(self, project: pf.Project, path: str | os.PathLike[str] | None) -> None:
+        """The project's animation side becomes the document's (its settings, its capture with
+        the edits, the keys a key edit held); what the document cannot use is reported, and the
+        animation comes without it."""
+        model = self.window.animation
+        try:
+            state = project_io.animation_state(project, str(path or "project"))
+        except HairtoolError:  # (reported by the caller) the animation comes without what failed
+            model.load_animation(project.animation, project.animation_source)
+            raise
+        what = {"capture": state.capture, "edits": state.edits, "channel_edits": state.channel_edits}
+        try:
+            model.load_animation(state.animation, state.source, settings=state.settings, **what)
+        except HairtoolError:  # settings no keys meet: the animation comes with ours
+            model.load_animation(state.animation, state.source, **what)
+            raise
+        if state.held_keys:
+            model.doc.edit_frames(state.animation, state.held_keys, "Keys held")
 
     # -- save and open ---------------------------------------------------------------------
     def save_project(self) -> bool:
@@ -360,7 +372,7 @@ class ProjectController(QObject):
             return False
         self.apply(project, None)
         self.path = None
-        self._mark_animation()  # restored work is not saved anywhere yet
+        self._mark_unsaved()  # restored work is not saved anywhere yet
         self.window.statusBar().showMessage("restored the autosaved session; save it as a project", 8000)
         return True
 
@@ -428,11 +440,6 @@ def _brush_setters(scene, brush: dict) -> tuple:
         lambda: pens("pressure_radius"),
         lambda: pens("pressure_strength"),
     )
-
-
-def _key_settings(d: dict) -> dict:
-    fields = {f.name for f in dataclasses.fields(KeySettings)}
-    return {k: v for k, v in d.items() if k in fields}
 
 
 def _apply_each(window: StudioHost, setters) -> None:

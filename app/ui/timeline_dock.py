@@ -144,15 +144,21 @@ class KeyControls(QWidget):
         form.addRow(self.summary)
 
         self.mode.activated.connect(lambda _i: self._set_mode(self.mode.currentData()))
-        self.count_slider.valueChanged.connect(lambda v: self._set(mode="count", count=int(v)))
-        self.count_spin.valueChanged.connect(lambda v: self._set(mode="count", count=int(v)))
-        self.tau.edited.connect(lambda v, _d: self._set(mode="tau", tau=float(v)))
-        self.budget.edited.connect(lambda v, _d: self._set(mode="budget", budget=float(v)))
-        self.objective.activated.connect(lambda _i: self._set(objective=self.objective.currentData()))
-        self.interp.activated.connect(lambda _i: self._set(interp=self.interp.currentData()))
-        self.samples.valueChanged.connect(lambda v: self._set(samples=int(v)))
-        self.tip_weight.valueChanged.connect(lambda v: self._set(tip_weight=float(v)))
-        self.curvature.valueChanged.connect(lambda v: self._set(curvature=float(v)))
+        self._count_drags = 0  # one undo step per drag of the key-count slider
+        self.count_slider.sliderPressed.connect(self._count_drag)
+        self.count_slider.valueChanged.connect(
+            lambda v: self._set("Key count", self._count_dragged(), mode="count", count=int(v))
+        )
+        self.count_spin.valueChanged.connect(lambda v: self._set("Key count", mode="count", count=int(v)))
+        self.tau.edited.connect(lambda v, d: self._set("Price per key", d, mode="tau", tau=float(v)))
+        self.budget.edited.connect(lambda v, d: self._set("Error budget", d, mode="budget", budget=float(v)))
+        self.objective.activated.connect(
+            lambda _i: self._set("Objective", objective=self.objective.currentData())
+        )
+        self.interp.activated.connect(lambda _i: self._set("Interpolation", interp=self.interp.currentData()))
+        self.samples.valueChanged.connect(lambda v: self._set("Samples per strand", samples=int(v)))
+        self.tip_weight.valueChanged.connect(lambda v: self._set("Tip weight", tip_weight=float(v)))
+        self.curvature.valueChanged.connect(lambda v: self._set("Curvature", curvature=float(v)))
         self.view.activated.connect(lambda _i: self._set_view(self.view.currentData()))
         for signal in (
             model.settings_changed,
@@ -166,9 +172,17 @@ class KeyControls(QWidget):
         model.busy_changed.connect(self._refresh_summary)
         self.refresh()
 
-    def _set(self, **changes: object) -> None:
+    def _count_drag(self) -> None:
+        self._count_drags += 1
+
+    def _count_dragged(self) -> object:
+        """The drag the key-count slider's move belongs to (None: a click or a key press)."""
+        return ("key count", id(self), self._count_drags) if self.count_slider.isSliderDown() else None
+
+    def _set(self, text: str = "", drag: object = None, **changes: object) -> None:
+        """One step of the document (the moves of one slider drag merge into one)."""
         try:
-            self.model.set_settings(**changes)
+            self.model.set_settings(text, drag, **changes)
         except HairtoolError as e:
             self.report("Invalid key setting", str(e))
             self.refresh()
@@ -177,9 +191,9 @@ class KeyControls(QWidget):
         """Switching to the error budget starts from the current keys' error, so the keys stay."""
         solved = self.model.key_errors()
         if mode == "budget" and self.model.settings.mode != "budget" and solved is not None:
-            self._set(mode="budget", budget=solved[0])
+            self._set("Key mode", mode="budget", budget=solved[0])
         else:
-            self._set(mode=mode)
+            self._set("Key mode", mode=mode)
 
     def budget_shown(self) -> float:
         """The budget field: the budget itself in budget mode; otherwise the current keys' solved

@@ -416,7 +416,7 @@ class MainWindow(QMainWindow):
     def _build_animation_ui(self) -> None:
         """``self.animation`` (the model other docks load animations into), the timeline dock,
         the Animation menu and the fps read-out in the status bar."""
-        self.animation = AnimationModel(self.jobs, self)
+        self.animation = AnimationModel(self.jobs, self, doc=self.doc)
         self.animation_ui = AnimationController(self, self.animation)
         actions = self.animation_ui.build_menu()
         steer = self.animation_ui.steer_keys
@@ -800,10 +800,9 @@ class MainWindow(QMainWindow):
             return False
         if isinstance(obj, Animation):
             self.set_groom(obj.rest, path, mesh)
-            if obj.n_frames > 1:
-                self.animation.load_animation(obj, str(path))
-                if capture is not None:  # a BVH: its key poses are edited by IK
-                    self.capture.attach(capture, str(path))
+            if obj.n_frames > 1:  # (a BVH comes with its capture, whose key poses are edited by IK)
+                self.animation.load_animation(obj, str(path), capture=capture)
+                self.undo_stack.clear()  # a file opened: nothing to undo, nothing unsaved
         else:
             obj, said = with_inferred_up_axis(path, obj)
             hair, guides = split_guides(obj)

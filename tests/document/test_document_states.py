@@ -52,7 +52,9 @@ from hairtool.frozen.selection import BOX_MODES, SelectionSample
 from hairtool.guides.binding import bind_scalp
 from hairtool.io.obj import Mesh
 from hairtool.keys import session as ks
+from hairtool.keys.edit import retime_key
 from hairtool.keys.export import read_keys_json, record_keys
+from hairtool.keys.session import key_edit_block
 from hairtool.mocap import ik
 from hairtool.mocap.bvh import read_bvh
 from hairtool.mocap.pose_edit import ChannelEdit, PoseEdit, RetimeEdit, TangentEdit
@@ -158,6 +160,8 @@ def same_state(a: AnimationState, b: AnimationState) -> bool:
         and motion(a.capture, b.capture)
         and a.settings == b.settings
         and a.edits == b.edits
+        and a.channel_edits == b.channel_edits
+        and a.held_keys == b.held_keys
     )
 
 
@@ -457,6 +461,55 @@ class DocumentMachine(RuleBasedStateMachine):
             name = m.joint_names[j]
             edit = ChannelEdit(f, name, c, v) if kind == "value" else TangentEdit(f, name, c, v / 10)
             self._edit(edit)
+
+    @precondition(lambda self: self.doc.state.capture is not None)
+    @rule(data=st.data(), kind=st.sampled_from(["value", "slope"]))
+    def channel_edit(self, data, kind: str) -> None:
+        """A per-channel key edit (the graph editor with per-channel keys): the document keeps
+        it; the studio's layer applies it."""
+        m = self.doc.state.capture
+        j = int(data.draw(st.integers(1, m.n_joints - 1)))
+        rot = [c for c in m.channels[j] if c.endswith("rotation")]
+        if not rot:
+            return
+        f, c, v = (
+            data.draw(st.integers(0, m.n_frames - 1)),
+            data.draw(st.sampled_from(rot)),
+            data.draw(st.floats(-90, 90)),
+        )
+        edit = (
+            ChannelEdit(f, m.joint_names[j], c, v)
+            if kind == "value"
+            else TangentEdit(f, m.joint_names[j], c, v / 10)
+        )
+        self.doc.edit_channels([edit], f"Channel {kind}")
+
+    # -- key edits of a hair animation -------------------------------------------------------
+    @precondition(lambda self: self.doc.state.animation is not None and self.doc.state.capture is None)
+    @rule(data=st.data(), move=st.booleans(), lift=st.floats(-0.02, 0.02))
+    def hair_key_edit(self, data, move: bool, lift: float) -> None:
+        """A hair animation's key pose dragged (its frames between the neighbouring keys follow)
+        or a key moved in time: the edited frames, the keys held."""
+        keys, anim = self.doc.keys, self.doc.state.animation
+        if keys is None or keys.size < 3:
+            return
+        key = int(keys[data.draw(st.integers(1, keys.size - 2))])
+        interp = self.doc.state.settings.interp
+        if move:
+            to = key + data.draw(st.sampled_from([-1, 1]))
+            try:
+                start, block, held = retime_key(anim.frames, keys, interp, key, to)
+            except ParameterError:
+                return  # next to its neighbour: the graph editor stops it there
+        else:
+            pose = np.array(anim.frames[key])
+            tips = anim.topology.tip_indices
+            pose[tips] += np.float32(lift)
+            start, block = key_edit_block(anim.frames, keys, interp, key, pose)
+            held = keys
+        frames = np.array(anim.frames)
+        frames[start : start + len(block)] = block
+        self.doc.edit_frames(anim.with_frames(frames), held.tolist(), f"Edit key {key}")
 
     # -- history and files -------------------------------------------------------------------
     @rule()

@@ -242,7 +242,7 @@ def test_on_hair_the_graph_editor_moves_a_vertex_key_through_the_timelines_edit(
     key = int(keys[k])
     p = np.array(view.key_point(0, k))
     ui.drag(view, p, p + np.array([0, -40]))
-    assert w.undo_stack.count() == 1 and w.animation.frame == key
+    assert w.undo_stack.count() == 2 and w.animation.frame == key
     got = w.animation.animation.frames
     value = float(got[key, v, 0])
     assert value > float(anim.frames[key, v, 0])

@@ -59,6 +59,8 @@ def test_apply_makes_the_cycle_the_animation_and_the_timeline_scrubs_it(studio, 
     model = studio.animation
     n = doc.cycle().schedule.n_frames
     assert model.animation.n_frames == n * studio.character.cycles
+    # the character's motion is its own document's: no step (nor unsaved work) of the window's
+    assert studio.undo_stack.count() == 0 and not studio.project.has_unsaved_changes()
     for frame in (3, n + 4):
         model.set_frame(frame)
         _gpu_matches_reference(studio, doc.pose(frame, "cycle"))

@@ -59,6 +59,7 @@ def test_a_key_dragged_sideways_moves_in_time_like_the_librarys_edit(ui, graph):
     ui.curves_match(view, lib, ARM)
     # the keys, the dope sheet, the errors and the viewport follow the moved key
     assert m.dp_keys.tolist() == lib.keys.tolist() and f0 + 3 in m.dp_keys and f0 not in m.dp_keys
+    assert m.dp_keys.tolist() == w.doc.keys.tolist()  # the document's keys
     assert np.array_equal(m.solved_keys, keys)
     assert w.timeline.view.drawn_keys["dp"] == lib.keys.tolist()
     assert m.analysis is not None and m.analysis.dp.keys.tolist() == lib.keys.tolist()
@@ -121,7 +122,7 @@ def test_on_hair_a_key_dragged_sideways_is_the_librarys_retime(ui, make_window):
     to = f0 + 1 if keys[k + 1] - f0 > 2 else f0 - 1
     p = np.array(view.key_point(0, k))
     ui.drag(view, p, p + np.array([_frames_px(view, to - f0), 0.0]))
-    assert w.undo_stack.count() == 1
+    assert w.undo_stack.count() == 2  # (the new animation is the first step)
     start, block, new_keys = retime_key(anim.frames, keys, m.dp_poses.interp, f0, to)
     expected = np.array(anim.frames)
     expected[start : start + len(block)] = block
@@ -140,7 +141,7 @@ def _hair(make_window, interp="hermite"):
     w = make_window(groom=samples.comb(strands=6, vertices=5))
     anim = sway_animation(w.scene.result, 30, 24.0, flick_frame=20)
     w.animation.set_settings(interp=interp)
-    w.animation.load_animation(anim, "sway")
+    w.animation.load_animation(anim, "sway")  # (with the interpolation: the first two undo steps)
     w.graph_editor.show()
     view = w.graph_editor.view
     view.resize(700, 260)
@@ -162,7 +163,7 @@ def test_on_hair_a_handle_drag_is_the_librarys_slope_edit_and_stays_where_droppe
     before = float(view.curves[0].slope_out[k])
     p = np.array(view.handle_point(0, k, 1))
     ui.drag(view, p, p + np.array([0.0, -30.0]))
-    assert w.undo_stack.count() == 1 and len(asked) == 1
+    assert w.undo_stack.count() == 3 and len(asked) == 1
     slope = asked[0]
     assert slope > before
     v = int(anim.topology.offsets[1]) - 1  # strand 0's tip: the dock's default vertex
@@ -290,14 +291,14 @@ def test_on_hair_the_strands_feature_channels_are_read_only_views_of_the_key_cho
             break
     assert picked is not None
     ui.drag(view, picked, picked + np.array([0.0, -30.0]))
-    assert w.undo_stack.count() == 0 and view.refused == READ_ONLY
+    assert w.undo_stack.count() == 2 and view.refused == READ_ONLY
     np.testing.assert_array_equal(m.animation.frames, anim.frames)
     assert "read-only" in dock.features.toolTip().lower() or "not edited" in dock.features.toolTip()
     # a vertex key moved in value: the features follow the edited hair, the original stays
     k = 1
     p = np.array(view.key_point(1, k))
     ui.drag(view, p, p + np.array([0.0, -40.0]))
-    assert w.undo_stack.count() == 1
+    assert w.undo_stack.count() == 3
     edited = strand_features(m.animation, 0, options)[:, sample]
     assert not np.array_equal(edited, feats)
     for a, c in enumerate(view.curves[3:]):

@@ -126,7 +126,8 @@ def test_recording_a_drag_makes_an_animation_of_the_expected_length(ui, make_win
     np.testing.assert_array_equal(anim.frames[-1], scene.result.points)
     np.testing.assert_array_equal(anim.frames[-1], anim.frames[-5])  # the 0.2 s hold: 5 frames
     assert w.animation.dp_keys is not None  # keys are solved for the recording
-    assert w.undo_stack.count() == 1  # the drag itself is still one undo step
+    # the drag itself is still one undo step, and the recording, a new animation, the next
+    assert w.undo_stack.count() == 2 and w.undo_stack.undoText() == "New animation (recording)"
 
 
 def test_recording_nothing_says_so(make_window):

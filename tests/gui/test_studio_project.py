@@ -28,7 +28,8 @@ def _edit(ui, w):
     assert w.sources.apply_anime()
     w.animation.set_key_count(3)
     w.animation.set_frame(4)
-    assert w.undo_stack.count() == 2 and w.project.has_unsaved_changes()
+    # the parameter, the stroke, the cycle and the key count: one step each
+    assert w.undo_stack.count() == 4 and w.project.has_unsaved_changes()
 
 
 def test_saved_project_reopens_as_the_same_scene(ui, make_window, tmp_path):

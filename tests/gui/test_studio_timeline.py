@@ -238,7 +238,8 @@ def test_dragging_at_a_key_edits_it_spreads_through_the_residuals_and_undoes(ui,
     assert not np.array_equal(edited[(lo + key) // 2], anim.frames[(lo + key) // 2])
     np.testing.assert_array_equal(m.dp_keys, keys)  # the keys stay
     assert_drawn(ui, w, edited[key], anim.frames[key])
-    assert w.undo_stack.count() == 1 and w.undo_stack.undoText() == f"Edit key {key}"
+    # the new animation is the first step of the document, the key edit the second
+    assert w.undo_stack.count() == 2 and w.undo_stack.undoText() == f"Edit key {key}"
     w.undo_stack.undo()
     np.testing.assert_array_equal(m.animation.frames, anim.frames)
     w.undo_stack.redo()
@@ -253,7 +254,7 @@ def test_dragging_between_keys_edits_nothing(ui, studio):
     ui.grab(v)
     start = v.project(anim.frames[between][anim.topology.tip_indices[6]][None])[0]
     ui.drag(v, start, start + np.array([60.0, -40.0]))
-    assert m.animation is anim and w.undo_stack.count() == 0
+    assert m.animation is anim and w.undo_stack.count() == 1  # the new animation's step only
     assert "key frame" in w.statusBar().currentMessage()
 
 

@@ -91,7 +91,7 @@ def test_save_runs_the_normal_save_before_opening(ui, make_window, tmp_path):
 
 def test_opening_a_file_asks_nothing_afterwards(ui, make_window):
     w = make_window(groom=samples.portrait(strands=12, vertices=6))
-    w.sources.apply_anime()  # an animation made here: unsaved work, no undo step
+    w.sources.apply_anime()  # an animation made here: unsaved work, an undo step
     assert w.project.has_unsaved_changes() and "*" in w.windowTitle()
     asked = _answering(w, "discard")
     assert w.open_path(GROOM)
