@@ -23,6 +23,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.document.animation import Document
+from app.document.groom import GroomState
 from app.ui import export
 from app.ui.animation_io import (
     PROJECT_SUFFIX,
@@ -59,6 +60,7 @@ from app.ui.widgets import WheelGuard, keep_controls_put
 from hairtool import io, samples, serial_twins
 from hairtool.errors import FormatError, HairtoolError
 from hairtool.groom import Animation, Groom
+from hairtool.guides.binding import clumps_by_default
 from hairtool.guides.files import split_guides
 from hairtool.io.obj import Mesh
 from hairtool.simulate.options import SimulateOptions
@@ -738,8 +740,8 @@ class MainWindow(QMainWindow):
         return None if options is None else self.grow_render_hair(options)
 
     def grow_render_hair(self, options: GrowOptions) -> Job:
-        """Bind in a worker thread, then show the render hair. Grown from the strands, it is one
-        undo step; picked guides replace the groom (the strands follow them), like opening a file."""
+        """Bind in a worker thread, then show the render hair: one undo step, grown from the
+        strands, or picked guides that replace the groom (the strands their render hair)."""
         self.grow_options = options
         dense = options.mode == DENSE
         groom = self.scene.result if dense else self.scene.rest  # dense: the strands as edited
@@ -754,9 +756,12 @@ class MainWindow(QMainWindow):
             if self.scene.rest is not rest:
                 return  # another groom was opened meanwhile
             if dense:
-                self.set_groom(guides, mesh=mesh)  # the same head under the picked guides
-                self.scene.set_binding(binding)
-                self.undo_stack.resetClean()  # new guides, not saved anywhere yet
+                # one step: the picked guides on the same head, the strands their render hair
+                # (an animation of the old strands closes with them; Undo brings both back)
+                self.scene.moves.drain()
+                clump = clumps_by_default(binding)
+                picked = GroomState(guides, self.scene.params, None, mesh, binding, None, clump)
+                self.doc.open_groom(picked, text="Grow render hair (picked guides)")
                 n, g = binding.child_count, guides.strand_count
                 self.statusBar().showMessage(f"{n:,} strands follow {g:,} guides picked among them", 5000)
             else:

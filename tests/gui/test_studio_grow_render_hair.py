@@ -113,6 +113,12 @@ def test_picking_guides_among_a_dense_groom_keeps_its_strands(make_window):
     assert not s.clump_children  # an artist's own strands are not clumped by default …
     np.testing.assert_array_equal(s.render_hair().points, dense.points)  # … untouched: itself
     np.testing.assert_array_equal(s.drawn_points[: s.binding.vertex_count], dense.points)
+    # one step: Undo gives the dense groom back as it was, Redo the picked guides again
+    assert w.undo_stack.undoText() == "Grow render hair (picked guides)" and w.undo_stack.count() == 2
+    w.undo_stack.undo()
+    assert s.rest is dense and s.binding is None and s.result.strand_count == 400
+    w.undo_stack.redo()
+    assert s.rest.strand_count == 30 and s.binding.child_count == 400 and not s.clump_children
 
 
 def test_clump_children_follows_each_render_hairs_kind_and_the_artists_choice_through_undo(make_window):
