@@ -233,11 +233,10 @@ class LocalClump:
         qs = np.concatenate([strand[changed], strand[changed[went]]])
         layers, count = [changed], changed.size
         for _ in range(iterations * (1 if gap_mode == "off" else 2)):
-            fresh = self.grid.vertices_near(new, queries, qs, self.radius, skip)
+            fresh = self.grid.vertices_near(new, queries, qs, self.radius, skip)  # (flagged)
             count += fresh.size
             if fresh.size == 0 or count > most:
                 break
-            skip[fresh] = True
             layers.append(fresh)
             queries, qs = new[fresh], strand[fresh]
         return None if count > most else np.sort(np.concatenate(layers))

@@ -269,17 +269,17 @@ def _mark_near_wide(points, strand, px, py, pz, r2, inv, shift, key, head, nxt, 
         _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz, bs)
 
 
-@twin_njit(nogil=True, parallel=True)
-def _vertices_near(points, strand, qx, qy, qz, qs, r2, inv, shift, key, head, nxt, skip, cnt, off, out):
-    """The vertices not in ``skip`` of a strand other than ``qs[q]`` closer than sqrt(r2) to
-    query q, for a reach of at most one cell (the 27 cells around a query hold them): counted
-    into ``cnt[q]`` where ``out`` is empty, else written to ``out[off[q]:]`` (the same walk).
-    Nothing is written but each query's own slots: the same result in any thread order."""
-    fill = out.size > 0
-    for q in prange(qx.size):
+@njit(cache=True, nogil=True)
+def _vertices_near(points, strand, qx, qy, qz, qs, r2, inv, shift, key, head, nxt, skip, out):
+    """The vertices not flagged in ``skip`` of a strand other than ``qs[q]`` closer than
+    sqrt(r2) to a query q, for a reach of at most one cell (the 27 cells around a query hold
+    them), each written once into ``out`` and flagged; returns how many. Serial: a region's
+    queries find each vertex dozens of times on dense hair, and flagging it at once lets the
+    later finds pass it by (in parallel, their duplicates cost more to sort out than the walk)."""
+    m = 0
+    for q in range(qx.size):
         px, py, pz = qx[q], qy[q], qz[q]
         gx, gy, gz = _coord(px, inv), _coord(py, inv), _coord(pz, inv)
-        m = off[q] if fill else 0
         for cz in range(max(gz - 1, -_OFF), min(gz + 1, _OFF - 1) + 1):
             for cy in range(max(gy - 1, -_OFF), min(gy + 1, _OFF - 1) + 1):
                 for cx in range(max(gx - 1, -_OFF), min(gx + 1, _OFF - 1) + 1):
@@ -291,12 +291,11 @@ def _vertices_near(points, strand, qx, qy, qz, qs, r2, inv, shift, key, head, nx
                             ey = np.float64(points[j, 1]) - py
                             ez = np.float64(points[j, 2]) - pz
                             if ex * ex + ey * ey + ez * ez < r2:
-                                if fill:
-                                    out[m] = j
+                                skip[j] = True
+                                out[m] = j
                                 m += 1
                         j = nxt[j]
-        if not fill:
-            cnt[q] = m
+    return m
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -601,7 +600,7 @@ class VertexGrid:
         """Sorted ids of the vertices of ``points`` (where the grid holds them), not flagged in
         ``skip``, closer than ``radius`` (at most the cell) to one of ``queries`` and of a strand
         other than that query's: the vertices whose neighbour lists hold a point at a query's
-        place. (Two passes, one counting, one writing: no pass over all V vertices.)
+        place. They are flagged in ``skip`` too (no pass over all V vertices).
 
         Parameters
         ----------
@@ -614,7 +613,7 @@ class VertexGrid:
         radius : float
             The distance, at most :attr:`cell`.
         skip : ndarray
-            ``(V,)`` bool: the vertices left out.
+            ``(V,)`` bool: the vertices left out; written.
 
         Returns
         -------
@@ -626,16 +625,10 @@ class VertexGrid:
         q = np.asarray(queries, np.float64).reshape(-1, 3)
         xyz = np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1]), np.ascontiguousarray(q[:, 2])
         qs = np.ascontiguousarray(strands, np.int64)
-        grid = (float(radius) ** 2, self.inv, self.shift, self.key, self.head, self.nxt, skip)
-        cnt = np.zeros(len(q), np.int64)
-        none = np.zeros(0, np.int64)
-        _vertices_near(points, self.strand, *xyz, qs, *grid, cnt, none, none)
-        off = np.zeros(len(q), np.int64)
-        np.cumsum(cnt[:-1], out=off[1:])
-        out = np.empty(int(cnt.sum()), np.int64)
-        if out.size:
-            _vertices_near(points, self.strand, *xyz, qs, *grid, cnt, off, out)
-        return np.unique(out)
+        out = np.empty(self.vertex_count, np.int64)  # (untouched past what is found)
+        grid = (float(radius) ** 2, self.inv, self.shift, self.key, self.head, self.nxt, skip, out)
+        found = _vertices_near(points, self.strand, *xyz, qs, *grid)
+        return np.sort(out[:found])
 
     def lists(self, points: np.ndarray, vids: np.ndarray, radius: float, frame: tuple) -> tuple:
         """``(flat, cnt, cap)``: the list of each vertex ``vids[n]`` (other strands within

@@ -111,9 +111,12 @@ def test_the_vertices_near_queries_of_other_strands_match_the_reference(spacing)
         strands = top.strand_index[picked]
         skip = np.zeros(g.vertex_count, bool)
         skip[rng.choice(g.vertex_count, 20, replace=False)] = True
-        got = grid.vertices_near(g.points, queries, strands, r, skip)
         want = vertices_near_reference(g.points, top.strand_index, queries, strands, r, skip)
+        was = skip.copy()
+        got = grid.vertices_near(g.points, queries, strands, r, skip)
         assert want.size > 0 and np.array_equal(got, want)
+        was[want] = True
+        assert np.array_equal(skip, was)  # the vertices found are flagged, no other
         pts = g.points.copy()
         moved = vertex_ids_of(top, np.arange(k, g.strand_count, 7))
         pts[moved] += np.float32([0.9, -0.5, 0.3])
