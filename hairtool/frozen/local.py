@@ -7,11 +7,12 @@ input kept across moves. A move changes the input of some vertices (their points
 strength). In a full run that change travels along the neighbour lists (other strands within the
 list radius h·(1 + MARGIN)): a vertex's lists change where a changed vertex comes or goes within
 reach; its force reads the points of its list; its next point reads its force and the force and
-point of its nearest neighbour (the gap correction). So each iteration carries a change at most
-two list steps (one with gap mode "off"), and after k iterations it has reached at most the
-vertices 2k list steps from a changed vertex, counted on its lists before and after the move
-(:meth:`LocalClump.reach`). Those vertices are the move's: they are clumped again from the new
-input; every other vertex is where the last run had it at each iteration, and is read there.
+point of its nearest neighbour (the gap correction). So each iteration carries a change one
+list step (counted on the lists before and after the move), and on to the vertices whose
+nearest neighbour is one of those: a vertex with no changed point in its list has the last
+run's nearest neighbour, which the record keeps (:meth:`LocalClump.reach`). The vertices so
+reached in k iterations are the move's: they are clumped again from the new input; every other
+vertex is where the last run had it at each iteration, and is read there.
 
 So a move gives a full run's bytes, every vertex of them: each redone vertex's list comes in a
 full build's order (:mod:`hairtool.frozen.vertex_grid`) and the same kernels sum it, and every
@@ -209,6 +210,7 @@ class LocalClump:
             for it in range(iterations):
                 p, f = rec.iterates[it], rec.forces[it]
                 _local_force(p, flat, cap, cnt, vids, self.roots, self.h, self.ident, f, best)
+                rec.best[it][vids] = best
                 out = rec.iterates[it + 1] if it + 1 < iterations else rec.result
                 _local_gap(p, f, rec.strength, float(step), best, vids, self.h, gap, it, seed64, out)
         self.region = np.unique(top.strand_index[vids])
@@ -219,21 +221,34 @@ class LocalClump:
         self, was: np.ndarray, new: np.ndarray, changed: np.ndarray, iterations: int, gap_mode: str, most: int
     ) -> np.ndarray | None:
         """Sorted ids of every vertex whose clumping a change of the input on ``changed`` can
-        change (see the module doc), from the grid holding ``new``; None past ``most`` of them.
+        change (see the module doc), from the grid holding ``new`` and the record's nearest
+        neighbours; None past ``most`` of them.
 
-        A vertex's force in an iteration reads the vertices of its list; its next point reads
-        its force and its nearest neighbour's force and point (the gap correction, not with
-        gap mode "off"). So an iteration carries a change two list steps (one with "off"), and
-        the lists that changed are those of the vertices near a changed vertex before or after."""
+        In iteration it, the forces that can change are those of the vertices whose points can,
+        and of those with one of them in their lists (the lists that changed are those of the
+        vertices near a changed vertex, before or after). The points of the next iterate that can
+        change are those, and the points of the vertices whose nearest neighbour's force can (the
+        gap correction; not with gap mode "off"): a vertex whose list holds no changed point has
+        the record's nearest neighbour."""
         strand = self.topology.strand_index
+        best = self.record.best
         skip = np.zeros(self.topology.vertex_count, bool)
         skip[changed] = True
         went = np.any(was.view(np.uint32) != new[changed].view(np.uint32), axis=1)
         queries = np.concatenate([new[changed], was[went]])  # lists then and now
         qs = np.concatenate([strand[changed], strand[changed[went]]])
         layers, count = [changed], changed.size
-        for _ in range(iterations * (1 if gap_mode == "off" else 2)):
-            fresh = self.grid.vertices_near(new, queries, qs, self.radius, skip)  # (flagged)
+        for it in range(iterations):
+            forces = self.grid.vertices_near(new, queries, qs, self.radius, skip)  # (flagged)
+            grown = [forces]
+            if gap_mode != "off" and forces.size:
+                near = self.grid.vertices_near(new, new[forces], strand[forces], self.radius, skip)
+                skip[near] = False
+                b = best[it][near]
+                pulled = near[(b >= 0) & skip[np.maximum(b, 0)]]  # their nearest's force can change
+                skip[pulled] = True
+                grown.append(pulled)
+            fresh = np.concatenate(grown)
             count += fresh.size
             if fresh.size == 0 or count > most:
                 break
@@ -304,11 +319,18 @@ def clump_region_reference(
 
 
 def reach_reference(
-    was: np.ndarray, points: np.ndarray, strand: np.ndarray, changed: np.ndarray, radius: float, steps: int
+    was: np.ndarray,
+    points: np.ndarray,
+    strand: np.ndarray,
+    changed: np.ndarray,
+    radius: float,
+    best: np.ndarray,
+    gap_mode: str,
 ) -> np.ndarray:
     """Numpy twin of :meth:`LocalClump.reach` (without its limit): sorted ids of the vertices
-    at most ``steps`` list steps (other strands within ``radius``) from ``changed`` (the only
-    vertices that differ between ``was``, before the move, and ``points``), on the lists of both."""
+    whose clumping can change when the input changes on ``changed`` (the only vertices that
+    differ between ``was``, before the move, and ``points``), on the lists (other strands within
+    ``radius``) of both, with ``best`` ``(k, V)`` the last run's nearest neighbours."""
     changed = np.asarray(changed, np.int64)
     ci, cj = pairs_within_reference(was, strand, radius)  # the lists before
     p = np.asarray(points, np.float64)
@@ -320,8 +342,13 @@ def reach_reference(
         ni.append(c[a])
         nj.append(b)
     i, j = np.concatenate(ni + nj), np.concatenate(nj + ni)
-    mark = np.zeros(p.shape[0], bool)
-    mark[changed] = True
-    for _ in range(steps):
-        mark[i[mark[j]]] = True
-    return np.flatnonzero(mark)
+    points_change = np.zeros(p.shape[0], bool)
+    points_change[changed] = True
+    for it in range(best.shape[0]):
+        forces_change = points_change.copy()
+        forces_change[i[points_change[j]]] = True  # (15): a changed point in the list
+        points_change = forces_change.copy()
+        if gap_mode != "off":  # (17)-(19): the nearest neighbour's force
+            b = best[it]
+            points_change |= (b >= 0) & forces_change[np.maximum(b, 0)]
+    return np.flatnonzero(points_change)

@@ -104,6 +104,7 @@ def test_a_move_on_each_shape_changes_only_the_strands_it_reaches(name, pick, an
     tip = tips[min(int(pick * g.strand_count), g.strand_count - 1)]
     rec = pipe._workspace.recorded  # the full run's trajectories, which the rest is held to
     iterates, forces, result = rec.iterates.copy(), rec.forces.copy(), rec.result.copy()
+    best = rec.best.copy()
     shown = pipe.result.points.copy()
     before = pipe.aligned.points.copy()
     step = 0.05 * extent * np.array([np.cos(angle), np.sin(angle), 0.0])
@@ -116,8 +117,9 @@ def test_a_move_on_each_shape_changes_only_the_strands_it_reaches(name, pick, an
     hit = np.unique(g.topology.strand_index[brushed])
     under = np.linalg.norm(before - tip, axis=1) <= radius * (1 + 1e-6)
     assert np.logical_or.reduceat(under, g.offsets[:-1])[hit].all()  # only strands under the brush
-    local = pipe.local_clump  # redone: every vertex 2k list steps from the brushed ones, no other
-    reach = reach_reference(before, pipe.aligned.points, g.topology.strand_index, brushed, local.radius, 6)
+    local = pipe.local_clump  # redone: every vertex whose clumping the brushed ones can change, no other
+    strand = g.topology.strand_index
+    reach = reach_reference(before, pipe.aligned.points, strand, brushed, local.radius, best, "printed")
     assert np.array_equal(local.vertices, reach)
     sv = np.asarray(pipe.clump_strength)[g.topology.strand_index]
     want = clump_region_reference(
