@@ -1,27 +1,29 @@
 """Brush-local ClumpWithGaps: a move redoes the vertices whose clumping it can change, and no others.
 
 While a brush drags, a mouse move changes a few strands. :class:`LocalClump` keeps what the last
-run left (a :class:`~hairtool.frozen.clump.ClumpRecord`: each iteration's points and forces,
-every vertex's input and output) and a :class:`~hairtool.frozen.vertex_grid.VertexGrid` of the
-input kept across moves. A move changes the input of some vertices (their points, or their clump
-strength). In a full run that change travels along the neighbour lists (other strands within the
-list radius h·(1 + MARGIN)): a vertex's lists change where a changed vertex comes or goes within
-reach; its force reads the points of its list; its next point reads its force and the force and
-point of its nearest neighbour (the gap correction). So each iteration carries a change one
-list step (counted on the lists before and after the move), and on to the vertices whose
-nearest neighbour is one of those: a vertex with no changed point in its list has the last
-run's nearest neighbour, which the record keeps (:meth:`LocalClump.reach`). The vertices so
-reached in k iterations are the move's: they are clumped again from the new input; every other
-vertex is where the last run had it at each iteration, and is read there.
+run left (a :class:`~hairtool.frozen.clump.ClumpRecord`: each iteration's points, forces and
+nearest neighbours, every vertex's input and output) and a
+:class:`~hairtool.frozen.vertex_grid.VertexGrid` of the input kept across moves. A move changes
+the input of some vertices (their points, or their clump strength). In a full run that change
+travels along the neighbour lists (other strands within the list radius h·(1 + MARGIN)): a
+vertex's lists change where a changed vertex comes or goes within reach; its force reads the
+points of its list; its next point reads its force and the force and point of its nearest
+neighbour (the gap correction). So each iteration carries a change one list step (counted on the
+lists before and after the move), and on to the vertices whose nearest neighbour is one of
+those: a vertex with no changed point in its list has the last run's nearest neighbour, which
+the record keeps (:meth:`LocalClump.reach`). The vertices so reached in k iterations are the
+move's: they are clumped again from the new input; every other vertex is where the last run had
+it at each iteration, and is read there.
 
 So a move gives a full run's bytes, every vertex of them: each redone vertex's list comes in a
 full build's order (:mod:`hairtool.frozen.vertex_grid`) and the same kernels sum it, and every
 vertex outside the reach is, in a full run, where the last run had it. The record then holds a
 full run of the new input, and the next move starts from it. Where that cannot hold or would
 cost more, the move runs in full instead: a move that changes the frame of a full build's lists
-(every list's order; a tip moved past the snapped box), or whose change or reach is most of the
-groom (:data:`MAX_SEEDS`, :data:`MAX_REGION`). A ponytail, whose strands all meet in its tie,
-costs its brush: the reach follows the vertices that changed, not every vertex of their strands.
+(every list's order; a tip moved past the snapped box), or whose change or reach is a large
+share of the groom (:data:`MAX_SEEDS`, :data:`MAX_REGION`: a full run costs less then). A comb
+at a ponytail's tips costs its brush though every strand meets the others in the tie: the reach
+follows the vertices that changed, not every vertex of their strands.
 :func:`clump_region_reference` is the numpy twin (the same definition, pairs summed in another
 order: equal to about 1e-6 of h).
 """
