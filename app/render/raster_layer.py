@@ -13,9 +13,18 @@ Two ways, by the target framebuffer:
 
 Blitted, the strands leave the framebuffer's depth as GL left it: nothing after them (the brush
 circle) is depth-tested. Textures and images are kept between frames and remade only on resize.
+
+A multisampled draw can also be split across threads (an export's frames, whose raster is the
+frame's CPU cost: :mod:`app.ui.animation_export`): with :attr:`RasterLayer.defer` it keeps what
+it would raster as a :class:`RasterJob` and draws no strands; any thread rasters the job
+(:meth:`RasterJob.draw`, into a :class:`~app.render.soft_raster.StrandRaster` of its own); a
+second draw of the same strands with :attr:`RasterLayer.given` set to those images composites
+them instead of rastering again. The images are those the layer's own raster would make.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import moderngl
 import numpy as np
@@ -25,6 +34,53 @@ from app.render.shaders import load_program
 from app.render.soft_raster import StrandRaster
 
 COLOR_UNIT, DEPTH_UNIT = 3, 4  # texture units clear of the strand programs' 0–2
+
+
+def _owned(a: ArrayLike) -> np.ndarray:
+    """``a`` as it is now: itself where it is a read-only array of its own (the renderer's
+    segment starts and widths, fixed per topology), else a copy."""
+    a = np.asarray(a)
+    return a if not a.flags.writeable and a.base is None else a.copy()
+
+
+@dataclass(frozen=True, eq=False)
+class RasterJob:
+    """What one multisampled draw rasters on the CPU: its inputs, kept as they were."""
+
+    points: np.ndarray
+    starts: np.ndarray
+    colors: np.ndarray
+    mvp: np.ndarray
+    size: tuple[int, int]
+    width: float
+    scale: np.ndarray | None
+
+    @classmethod
+    def of(cls, points, starts, colors, mvp, size, width, scale) -> RasterJob:
+        """The job of a draw of these inputs (the points, colours and camera copied)."""
+        points, colors, mvp = (np.array(a, copy=True) for a in (points, colors, mvp))
+        scale = None if scale is None else _owned(scale)
+        return cls(points, _owned(starts), colors, mvp, tuple(size), float(width), scale)
+
+    def draw(self, raster: StrandRaster) -> tuple[np.ndarray, np.ndarray]:
+        """The colour and depth images (copies) ``raster`` makes of these strands."""
+        rgba, depth = raster.draw(
+            self.points, self.starts, self.colors, self.mvp, self.size, self.width, scale=self.scale
+        )
+        return rgba.copy(), depth.copy()
+
+    def same(self, points, starts, colors, mvp, size, width, scale) -> bool:
+        """Whether a draw of these inputs is this job."""
+        arrays = ((self.points, points), (self.starts, starts), (self.colors, colors), (self.mvp, mvp))
+        same_scale = (scale is None) == (self.scale is None) and (
+            scale is None or np.array_equal(self.scale, scale)
+        )
+        return (
+            tuple(size) == self.size
+            and float(width) == self.width
+            and same_scale
+            and all(a is b or (np.shape(a) == np.shape(b) and np.array_equal(a, b)) for a, b in arrays)
+        )
 
 
 class RasterLayer:
@@ -42,6 +98,9 @@ class RasterLayer:
         self.depth_texture: moderngl.Texture | None = None
         self._source: moderngl.Framebuffer | None = None  # the colour texture, to blit from
         self._texture_is_image = False  # the colour texture holds the raster's colour image
+        self.defer = False  # multisampled: keep the strands as :attr:`job`, draw none
+        self.job: RasterJob | None = None  # the last deferred draw's
+        self.given: tuple[RasterJob, np.ndarray, np.ndarray] | None = None  # a job's images
 
     def _resize(self, size: tuple[int, int]) -> None:
         if size == self.size:
@@ -113,7 +172,14 @@ class RasterLayer:
 
     def _composite(self, points, starts, colors, mvp, size, width, scale) -> None:
         self._texture_is_image = False
-        rgba, depth = self.raster.draw(points, starts, colors, mvp, size, width, scale=scale)
+        if self.defer:
+            self.job = RasterJob.of(points, starts, colors, mvp, size, width, scale)
+            return
+        given = self.given
+        if given is not None and given[0].same(points, starts, colors, mvp, size, width, scale):
+            rgba, depth = given[1], given[2]
+        else:
+            rgba, depth = self.raster.draw(points, starts, colors, mvp, size, width, scale=scale)
         self.color_texture.write(rgba)
         self.depth_texture.write(depth)
         self.color_texture.use(location=COLOR_UNIT)

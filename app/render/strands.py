@@ -575,9 +575,15 @@ class StrandRenderer:
         if method == "quads" and self.vertex_coloured:
             self._gpu.color_texture().use(location=2)
 
-    def _render_cpu(self, fbo, samples: int, mvp, size: tuple[int, int], width: float, background) -> None:
+    def cpu_raster_layer(self) -> RasterLayer:
+        """The layer strands rasterized on the CPU go through (made now where none is yet): an
+        export defers its raster to its worker there (:class:`~app.render.raster_layer.RasterJob`)."""
         if self.raster is None:
             self.raster = RasterLayer(self.ctx)
+        return self.raster
+
+    def _render_cpu(self, fbo, samples: int, mvp, size: tuple[int, int], width: float, background) -> None:
+        self.cpu_raster_layer()
         points, colors, starts = self._main.cpu_points(), self.cpu_colors(), self._segment_starts
         mesh = self.mesh.vao is not None or self.character.drawn
         scale = self.segment_width_scale() if width > 1.0 else None

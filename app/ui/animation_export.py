@@ -4,12 +4,13 @@ Video frames are drawn like the viewport draws them, off screen at the size chos
 export dialog, in the viewport's own GL context (the studio keeps to one context; a second,
 headless one beside Qt's is unreliable) but never into the window: the export's worker thread
 makes each frame's strands (render hair built and clumped there:
-:mod:`app.ui.video_frames`) and encodes, while the GUI thread only draws each frame into an
-offscreen framebuffer on request, one frame a turn of its event loop, with one renderer kept for
-the whole export (:class:`GuiFrameSource`); the window keeps answering, its viewport is not
-repainted for the export, and Cancel works between frames. Every file is written beside its
-target and renamed at the end: a cancelled or failed export leaves no partial file (a PNG
-sequence appears all at once, from a temporary folder).
+:mod:`app.ui.video_frames`), rasterizes them where strands are drawn on the CPU (software GL),
+and encodes, while the GUI thread only draws each frame into an offscreen framebuffer on
+request (uploading the worker's strand images, when it made them), one frame a turn of its
+event loop, with one renderer kept for the whole export (:class:`GuiFrameSource`); the window
+keeps answering, its viewport is not repainted for the export, and Cancel works between
+frames. Every file is written beside its target and renamed at the end: a cancelled or failed
+export leaves no partial file (a PNG sequence appears all at once, from a temporary folder).
 
 With render hair (a groom with children) an animation of the guides is written as render hair
 by default: every child following the guides frame by frame, in USD with the guides as a second
@@ -41,6 +42,8 @@ from PySide6.QtWidgets import QCheckBox, QDialog, QDialogButtonBox, QLabel, QVBo
 from app.render.camera import Camera
 from app.render.drawn import Drawn
 from app.render.offscreen import Overlays, render_drawn
+from app.render.raster_layer import RasterJob
+from app.render.soft_raster import StrandRaster
 from app.render.strands import StrandRenderer
 from app.ui.drawn import drawn
 from app.ui.jobs import Job
@@ -330,17 +333,25 @@ class FrameRenderer:
 class GuiFrameSource(QObject):
     """Frames drawn on the GUI thread for a worker thread that makes what they draw.
 
-    Create it on the GUI thread with ``render(drawn) → image``. :meth:`frames` (in the worker)
-    makes frame i + 1's :class:`Drawn` while the GUI thread draws frame i, so each side does its
-    part at once; the GUI thread draws one frame per request, between its other events. ``close``
+    Create it on the GUI thread with ``render(drawn, images) → image or job``. :meth:`frames`
+    (in the worker) makes frame i + 1's :class:`Drawn` while the GUI thread draws frame i, so
+    each side does its part at once; the GUI thread draws one frame per request, between its
+    other events. Where the strands are rasterized on the CPU, ``render(drawn, None)`` answers
+    the frame's :class:`~app.render.raster_layer.RasterJob` instead of an image: the worker
+    rasters it and asks again with ``images`` (the job, its colour and depth images), and the GUI
+    thread only composites them, so the frame's raster never holds up the window. ``close``
     runs on the GUI thread when the frames end (however they end): it frees what ``render`` kept.
     Called on the GUI thread itself, everything runs there directly (synchronous use, tests).
     """
 
-    _requested = Signal(int, object)
+    _requested = Signal(int, object, object)
     _closing = Signal()
 
-    def __init__(self, render: Callable[[Drawn], NDArray], close: Callable[[], None] = _ignore) -> None:
+    def __init__(
+        self,
+        render: Callable[[Drawn, tuple | None], NDArray | RasterJob],
+        close: Callable[[], None] = _ignore,
+    ) -> None:
         super().__init__()
         self._render, self._close = render, close
         self._answers: queue.Queue = queue.Queue()
@@ -350,10 +361,10 @@ class GuiFrameSource(QObject):
     def _here(self) -> bool:
         return QThread.currentThread() == self.thread()
 
-    @Slot(int, object)
-    def _on_request(self, frame: int, d: Drawn) -> None:
+    @Slot(int, object, object)
+    def _on_request(self, frame: int, d: Drawn, images: tuple | None) -> None:
         try:
-            self._answers.put((frame, self._render(d), None))
+            self._answers.put((frame, self._render(d, images), None))
         except BaseException as e:  # handed to the worker, which raises it
             self._answers.put((frame, None, e))
 
@@ -361,11 +372,11 @@ class GuiFrameSource(QObject):
     def _on_close(self) -> None:
         self._close()
 
-    def _post(self, index: int, d: Drawn) -> None:
+    def _post(self, index: int, d: Drawn, images: tuple | None = None) -> None:
         if self._here():
-            self._on_request(index, d)
+            self._on_request(index, d, images)
         else:
-            self._requested.emit(index, d)
+            self._requested.emit(index, d, images)
 
     def _take(self, index: int, cancelled: CancelCheck) -> NDArray:
         while True:
@@ -384,18 +395,22 @@ class GuiFrameSource(QObject):
     def frames(
         self, n_frames: int, make: Callable[[int], Drawn], cancelled: CancelCheck = _never
     ) -> Iterator[NDArray]:
-        """The ``n_frames`` images, frame ``i`` drawn from ``make(i)`` (called in this thread).
-        The first comes as soon as it can (the progress shows); from the second on, frame i + 1
-        is made and queued while the GUI thread draws frame i."""
+        """The ``n_frames`` images, frame ``i`` drawn from ``make(i)`` (called in this thread),
+        its CPU raster too where it has one. The first comes as soon as it can (the progress
+        shows); from the second on, frame i + 1 is made while the GUI thread draws frame i."""
+        raster = StrandRaster()  # this thread's: the frames' strands rasterized here
+        made: dict[int, Drawn] = {}
         try:
-            if n_frames > 0:
-                self._post(0, make(0))
             for i in range(n_frames):
+                d = made.pop(i) if i in made else make(i)
+                self._post(i, d)
                 if i > 0 and i + 1 < n_frames and not cancelled():
-                    self._post(i + 1, make(i + 1))  # while the GUI thread draws frame i
-                yield self._take(i, cancelled)
-                if i == 0 and n_frames > 1 and not cancelled():  # (the first frame is out)
-                    self._post(1, make(1))
+                    made[i + 1] = make(i + 1)  # while the GUI thread draws frame i
+                answer = self._take(i, cancelled)
+                if isinstance(answer, RasterJob):  # rasterized here, composited there
+                    self._post(i, d, (answer, *answer.draw(raster)))
+                    answer = self._take(i, cancelled)
+                yield answer
         finally:
             if self._here():
                 self._close()
@@ -607,11 +622,22 @@ class AnimationExporter(QObject):
 
         kept: list[StrandRenderer] = []  # one renderer for every frame, made at the first
 
-        def render(d: Drawn) -> NDArray:
+        def render(d: Drawn, images: tuple | None) -> NDArray | RasterJob:
+            """Frame ``d``; where its strands are rasterized on the CPU and ``images`` is None,
+            the raster's job instead (the worker makes the images: :class:`GuiFrameSource`)."""
             with w.viewport.current_context() as ctx:
-                if ctx is not None and not kept:
+                if ctx is None:
+                    return renderer.render_drawn(d, ctx)
+                if not kept:
                     kept.append(StrandRenderer(ctx))
-                return renderer.render_drawn(d, ctx, kept[0] if kept else None)
+                layer = kept[0].cpu_raster_layer()
+                layer.defer, layer.given, layer.job = images is None, images, None
+                try:
+                    image = renderer.render_drawn(d, ctx, kept[0])
+                    job = layer.job
+                finally:
+                    layer.defer, layer.given, layer.job = False, None, None
+                return job if images is None and job is not None else image
 
         def close() -> None:
             if kept and w.viewport.ctx is not None:

@@ -355,12 +355,14 @@ def _scatter(order, P, out):
 
 
 @twin_njit(nogil=True, parallel=True)
-def _scatter_record(order, f, count, weight, stats, out_f, out_count, out_weight):
-    """An iteration's forces (and with ``stats`` the first one's counts and Σg) into a record."""
+def _scatter_record(order, f, best, count, weight, stats, out_f, out_best, out_count, out_weight):
+    """An iteration's forces and nearest neighbours (and with ``stats`` the first one's counts
+    and Σg) into a record."""
     for k in prange(order.size):
         i = order[k]
         for a in range(3):
             out_f[i, a] = f[k, a]
+        out_best[i] = order[best[k]] if best[k] >= 0 else -1
         if stats:
             out_count[i] = count[k]
             out_weight[i] = weight[k]
@@ -377,11 +379,11 @@ def _clump_run(points, strength, order, lists, sroot, h, iterations, step, gap, 
     """The k Jacobi iterations on the cell-sorted list, one call (no Python between kernels).
     ``step`` < 0: automatic. Writes the result to ``out`` (original order, float32); returns
     (mean neighbours within h per moving vertex, the step used). ``record`` = (iterates (k, V, 3),
-    forces (k, V, 3), counts, Σg), in original order, for :mod:`hairtool.frozen.local`; empty
-    arrays: not recorded."""
+    forces (k, V, 3), nearest neighbours (k, V), counts, Σg), in original order, for
+    :mod:`hairtool.frozen.local`; empty arrays: not recorded."""
     P, Pn, f, best, count, weight, heads, S = bufs
     aflat, aoff, acnt, bflat, bstart, bmap, pr, ps = lists
-    rec_p, rec_f, rec_count, rec_weight = record
+    rec_p, rec_f, rec_best, rec_count, rec_weight = record
     keep = rec_p.shape[0] > 0
     _gather_inputs(points, strength, order, seed, gap, P, S, heads)
     mean_nb = 0.0
@@ -401,7 +403,9 @@ def _clump_run(points, strength, order, lists, sroot, h, iterations, step, gap, 
             if step < 0.0:
                 k_step = step_from_stats(h, w_sum, w_count)
         if keep:
-            _scatter_record(order, f, count, weight, it == 0, rec_f[it], rec_count, rec_weight)
+            _scatter_record(
+                order, f, best, count, weight, it == 0, rec_f[it], rec_best[it], rec_count, rec_weight
+            )
         _gap_kernel(P, f, S, k_step, best, heads, h, gap, it, Pn)
         P, Pn = Pn, P
     _scatter(order, P, Pn)  # float64, as the record's: one specialisation of the kernel to compile
@@ -411,16 +415,22 @@ def _clump_run(points, strength, order, lists, sroot, h, iterations, step, gap, 
     return mean_nb, k_step
 
 
-_NO_RECORD = (np.zeros((0, 0, 3)), np.zeros((0, 0, 3)), np.zeros(0, np.int64), np.zeros(0))
-RECORD_LIMIT = 12_000_000  # vertices × iterations at most in a record (2 × 24 bytes each): the
-# largest research grooms (3.4M vertices) at the default 3 iterations, 490 MB; without a record
+_NO_RECORD = (
+    np.zeros((0, 0, 3)),
+    np.zeros((0, 0, 3)),
+    np.zeros((0, 0), np.int64),
+    np.zeros(0, np.int64),
+    np.zeros(0),
+)
+RECORD_LIMIT = 12_000_000  # vertices × iterations at most in a record (2 × 24 + 8 bytes each): the
+# largest research grooms (3.4M vertices) at the default 3 iterations, 570 MB; without a record
 # every brush move redoes the whole groom (a 3.2M-vertex curly groom: 309 ms a move, not ~3)
 
 
 class ClumpRecord:
     """What a run leaves for :mod:`hairtool.frozen.local` to redo only where its input changed:
-    its parameters, input and output, and each iteration's points and forces, the first one's
-    neighbour counts and Σg (original vertex order)."""
+    its parameters, input and output, and each iteration's points, forces and nearest neighbours,
+    the first one's neighbour counts and Σg (original vertex order)."""
 
     def __init__(self, vertices: int, iterations: int) -> None:
         """Room for one run of ``iterations`` passes over ``vertices`` vertices (empty until a run fills it).
@@ -437,6 +447,7 @@ class ClumpRecord:
         self.result = np.empty((vertices, 3), np.float32)
         self.iterates = np.empty((iterations, vertices, 3))
         self.forces = np.empty((iterations, vertices, 3))
+        self.best = np.empty((iterations, vertices), np.int64)  # each vertex's nearest neighbour (−1: none)
         self.count = np.empty(vertices, np.int64)
         self.weight = np.empty(vertices)
         self.strength = np.empty(vertices)  # each vertex's clump strength in the run
@@ -664,7 +675,7 @@ def clump_points(
     ws.mean_neighbours, ws.step = _clump_run(
         groom.points, sv, nl.order, lists, nl.skip, h, k, -1.0 if step is None else float(step),
         _GAP_CODE[gap_mode], seed_u64(seed), ws.buffers(v), out,
-        _NO_RECORD if rec is None else (rec.iterates, rec.forces, rec.count, rec.weight),
+        _NO_RECORD if rec is None else (rec.iterates, rec.forces, rec.best, rec.count, rec.weight),
     )  # fmt: skip
     if rec is not None:
         rec.key = record_key(groom, h, k, step, gap_mode, seed)

@@ -1,22 +1,31 @@
-"""Brush-local ClumpWithGaps: a move redoes the strands under the brush and those their clumps reach.
+"""Brush-local ClumpWithGaps: a move redoes the vertices whose clumping it can change, and no others.
 
 While a brush drags, a mouse move changes a few strands. :class:`LocalClump` keeps what the last
-run left (a :class:`~hairtool.frozen.clump.ClumpRecord`: each iteration's points and forces,
-every vertex's input and output) and a :class:`~hairtool.frozen.vertex_grid.VertexGrid` of the
-input kept across moves. A move's *region* is the strands that changed (points or clump strength)
-and every strand with a vertex within the list radius h·(1 + MARGIN), the clump kernel's reach,
-of one of their vertices, before or after the move. The region is clumped again from its new
-input; every other vertex is held where the last run had it at each iteration (its points and
-forces), read-only, and its result stays bit for bit.
+run left (a :class:`~hairtool.frozen.clump.ClumpRecord`: each iteration's points, forces and
+nearest neighbours, every vertex's input and output) and a
+:class:`~hairtool.frozen.vertex_grid.VertexGrid` of the input kept across moves. A move changes
+the input of some vertices (their points, or their clump strength). In a full run that change
+travels along the neighbour lists (other strands within the list radius h·(1 + MARGIN)): a
+vertex's lists change where a changed vertex comes or goes within reach; its force reads the
+points of its list; its next point reads its force and the force and point of its nearest
+neighbour (the gap correction). So each iteration carries a change one list step (counted on the
+lists before and after the move), and on to the vertices whose nearest neighbour is one of
+those: a vertex with no changed point in its list has the last run's nearest neighbour, which
+the record keeps (:meth:`LocalClump.reach`). The vertices so reached in k iterations are the
+move's: they are clumped again from the new input; every other vertex is where the last run had
+it at each iteration, and is read there.
 
-So a region vertex ends where a full run would put it if the full run's clump reached no further
-than the region: where a move's effect stays inside it (strands farther than the reach from every
-other strand, or a first run) the bytes are a full run's, because each list comes in a full
-build's order (:mod:`hairtool.frozen.vertex_grid`) and the same kernels sum it. Beyond the region
-a full run would move a vertex by the changed pulls of its region neighbours too (the effect
-spreads two list steps per iteration); the local run leaves it be, which is what makes a move cost
-the brush and not the groom. :func:`clump_region_reference` is the numpy twin (the same
-definition, pairs summed in another order: equal to about 1e-6 of h).
+So a move gives a full run's bytes, every vertex of them: each redone vertex's list comes in a
+full build's order (:mod:`hairtool.frozen.vertex_grid`) and the same kernels sum it, and every
+vertex outside the reach is, in a full run, where the last run had it. The record then holds a
+full run of the new input, and the next move starts from it. Where that cannot hold or would
+cost more, the move runs in full instead: a move that changes the frame of a full build's lists
+(every list's order; a tip moved past the snapped box), or whose change or reach is a large
+share of the groom (:data:`MAX_SEEDS`, :data:`MAX_REGION`: a full run costs less then). A comb
+at a ponytail's tips costs its brush though every strand meets the others in the tie: the reach
+follows the vertices that changed, not every vertex of their strands.
+:func:`clump_region_reference` is the numpy twin (the same definition, pairs summed in another
+order: equal to about 1e-6 of h).
 """
 
 from __future__ import annotations
@@ -42,7 +51,7 @@ from hairtool.frozen.lengths import restore_lengths_reference
 from hairtool.frozen.noise import CH_CLUMP, hash_head_nb, hash_tail_u01_nb, seed_u64
 from hairtool.frozen.spatial import pairs_within_reference
 from hairtool.frozen.vertex_grid import VertexGrid, list_frame
-from hairtool.groom import Topology, vertex_ids_of
+from hairtool.groom import Topology
 from hairtool.serial_twins import twin_njit
 
 MAX_SEEDS = 0.1  # of the vertices: a move that changes more runs in full (cheaper then)
@@ -102,16 +111,9 @@ def _set_rows(dst, src, vids):
             dst[i, a] = src[i, a]
 
 
-def strands_differing(
-    before: np.ndarray, after: np.ndarray, counts: np.ndarray, strands: np.ndarray
-) -> np.ndarray:
-    """Of ``strands`` (``counts`` vertices each), those with a vertex whose bytes differ between
-    ``before`` and ``after``, their vertices' rows one strand after another."""
-    if strands.size == 0:
-        return strands
-    diff = np.any(before.view(np.uint32) != after.view(np.uint32), axis=1)
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    return strands[np.logical_or.reduceat(diff, starts)]
+def _same_frame(a: tuple, b: tuple) -> bool:
+    """Whether two :func:`~hairtool.frozen.vertex_grid.list_frame` results are the same grid."""
+    return all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
 
 
 class LocalClump:
@@ -133,14 +135,17 @@ class LocalClump:
         self.roots[topology.root_indices] = True
         self.ident = np.arange(topology.vertex_count, dtype=np.int64)
         self.region = np.zeros(0, np.int64)  # the strands the last update redid
+        self.vertices = np.zeros(0, np.int64)  # and its vertices
         self.lists_ms = 0.0  # of the last update: grid moves and neighbour lists
         self._box: tuple | None = None  # the grid's points' box (float64), None: not known
+        self._frame = self.frame(points)  # the full build's grid the record's lists were in
 
     def resync(self, points: np.ndarray, old: np.ndarray) -> None:
         """After another full run: the grid follows the vertices that moved since ``old``."""
         moved = np.flatnonzero(np.any(points.view(np.uint32) != old.view(np.uint32), axis=1))
         self.grid.move(points, moved)
         self._follow(old[moved], points[moved])
+        self._frame = self.frame(points)
 
     def _follow(self, old: np.ndarray, new: np.ndarray) -> None:
         """The box after the grid's points ``old`` moved to ``new`` (unknown where one held an
@@ -167,38 +172,37 @@ class LocalClump:
         self,
         was: np.ndarray,
         new: np.ndarray,
-        seeds: np.ndarray,
+        changed: np.ndarray,
         sv: np.ndarray,
         iterations: int,
         step: float,
         gap_mode: str,
         seed: int,
     ) -> tuple[np.ndarray, np.ndarray] | None:
-        """The input went to ``new`` on the strands ``seeds`` (those whose points or clump
-        strength ``sv`` (V,) changed), whose vertices were at ``was`` before. Returns the
-        region's strands and vertices, after writing their result rows into the record's
-        ``result``; None where the region would be most of the groom (:data:`MAX_SEEDS`,
-        :data:`MAX_REGION`: the caller runs in full; the grid holds ``new`` either way)."""
+        """The input changed on the vertices ``changed`` (sorted ids: their points, at ``was``
+        before, or their clump strength ``sv`` (V,)) and is now ``new``. Returns the region (the
+        strands with a vertex redone) and the vertices redone (:func:`reach`), after writing
+        their rows of the record; None where a full run must run instead: the change or its
+        reach is most of the groom (:data:`MAX_SEEDS`, :data:`MAX_REGION`: a full run costs
+        less), or the move changed the frame of a full build's lists (every list's order then
+        changes). The grid holds ``new`` either way."""
         import time
 
         t0 = time.perf_counter()
         top, rec = self.topology, self.record
-        seed_v = vertex_ids_of(top, seeds)
         v = top.vertex_count
-        self.grid.move(new, seed_v)
-        self._follow(was, new[seed_v])
-        if seed_v.size > MAX_SEEDS * v:
+        self.grid.move(new, changed)
+        self._follow(was, new[changed])
+        if changed.size > MAX_SEEDS * v:
             return None
-        # The strands whose lists held the seeds' vertices and those whose lists hold them now, in
-        # one query on the grid as it is now: a vertex within reach of a seed's old place that
-        # moved is a seed's own (in the region anyway); the others are where they were.
-        both = np.concatenate([was, new[seed_v]])
-        region = np.union1d(self.near(new, both, self.radius), seeds)
-        vids = vertex_ids_of(top, region)
-        if vids.size > MAX_REGION * v:
+        frame = self.frame(new)
+        if not _same_frame(frame, self._frame):
+            return None
+        vids = self.reach(was, new, changed, iterations, gap_mode, int(MAX_REGION * v))
+        if vids is None:
             return None
         with threads_for(vids.size):
-            flat, cnt, cap = self.grid.lists(new, vids, self.radius, self.frame(new))
+            flat, cnt, cap = self.grid.lists(new, vids, self.radius, frame)
             self.lists_ms = (time.perf_counter() - t0) * 1e3
             rec.points[vids] = new[vids]
             rec.strength[vids] = sv[vids]
@@ -208,18 +212,60 @@ class LocalClump:
             for it in range(iterations):
                 p, f = rec.iterates[it], rec.forces[it]
                 _local_force(p, flat, cap, cnt, vids, self.roots, self.h, self.ident, f, best)
+                rec.best[it][vids] = best
                 out = rec.iterates[it + 1] if it + 1 < iterations else rec.result
                 _local_gap(p, f, rec.strength, float(step), best, vids, self.h, gap, it, seed64, out)
-        self.region = region
-        return region, vids
+        self.region = np.unique(top.strand_index[vids])
+        self.vertices = vids
+        return self.region, vids
+
+    def reach(
+        self, was: np.ndarray, new: np.ndarray, changed: np.ndarray, iterations: int, gap_mode: str, most: int
+    ) -> np.ndarray | None:
+        """Sorted ids of every vertex whose clumping a change of the input on ``changed`` can
+        change (see the module doc), from the grid holding ``new`` and the record's nearest
+        neighbours; None past ``most`` of them.
+
+        In iteration it, the forces that can change are those of the vertices whose points can,
+        and of those with one of them in their lists (the lists that changed are those of the
+        vertices near a changed vertex, before or after). The points of the next iterate that can
+        change are those, and the points of the vertices whose nearest neighbour's force can (the
+        gap correction; not with gap mode "off"): a vertex whose list holds no changed point has
+        the record's nearest neighbour."""
+        strand = self.topology.strand_index
+        best = self.record.best
+        skip = np.zeros(self.topology.vertex_count, bool)
+        skip[changed] = True
+        went = np.any(was.view(np.uint32) != new[changed].view(np.uint32), axis=1)
+        queries = np.concatenate([new[changed], was[went]])  # lists then and now
+        qs = np.concatenate([strand[changed], strand[changed[went]]])
+        layers, count = [changed], changed.size
+        for it in range(iterations):
+            forces = self.grid.vertices_near(new, queries, qs, self.radius, skip)  # (flagged)
+            grown = [forces]
+            if gap_mode != "off" and forces.size:
+                near = self.grid.vertices_near(new, new[forces], strand[forces], self.radius, skip)
+                skip[near] = False
+                b = best[it][near]
+                pulled = near[(b >= 0) & skip[np.maximum(b, 0)]]  # their nearest's force can change
+                skip[pulled] = True
+                grown.append(pulled)
+            fresh = np.concatenate(grown)
+            count += fresh.size
+            if fresh.size == 0 or count > most:
+                break
+            layers.append(fresh)
+            queries, qs = new[fresh], strand[fresh]
+        return None if count > most else np.sort(np.concatenate(layers))
 
 
 def clump_region_reference(
     points: np.ndarray,
     topology: Topology,
-    region: np.ndarray,
+    vertices: np.ndarray,
     iterates: np.ndarray,
     forces: np.ndarray,
+    result: np.ndarray,
     sv: np.ndarray,
     h: float,
     iterations: int,
@@ -228,14 +274,15 @@ def clump_region_reference(
     seed: int,
     keep_lengths: bool = False,
 ) -> np.ndarray:
-    """Numpy twin of a :class:`LocalClump` update: ``(V, 3)`` float64, the region strands'
-    vertices clumped from ``points`` with every other vertex at ``iterates[it]`` and pulling
-    with ``forces[it]`` in iteration it (a previous run's); the rows outside the region are the
-    last iterate's. ``step`` None: :func:`~hairtool.frozen.clump.auto_step` of ``points``."""
+    """Numpy twin of a :class:`LocalClump` update: ``(V, 3)`` float64, the ``vertices`` (ids)
+    clumped from ``points`` with every other vertex at ``iterates[it]`` and pulling with
+    ``forces[it]`` in iteration it (a previous run's); the other rows are that run's ``result``
+    (with ``keep_lengths``, the lengths given back on every strand with a vertex redone).
+    ``step`` None: :func:`~hairtool.frozen.clump.auto_step` of ``points``."""
     strand = topology.strand_index
     v = topology.vertex_count
     inside = np.zeros(v, bool)
-    inside[vertex_ids_of(topology, np.asarray(region, np.int64))] = True
+    inside[np.asarray(vertices, np.int64)] = True
     moving = np.ones(v, bool)
     moving[topology.root_indices] = False
     ci, cj = pairs_within_reference(points, strand, h * (1.0 + MARGIN))
@@ -263,8 +310,47 @@ def clump_region_reference(
         lam = gap_factors_reference(i, j, r, P, dp, h, seed, it, gap_mode)
         step_all = np.where(inside[:, None] & moving[:, None], lam[:, None] * dp, 0.0)
         P = P + step_all
+    P = np.where(inside[:, None], P, np.asarray(result, np.float64))
     if keep_lengths and iterations > 0:
         kept = restore_lengths_reference(points, P.astype(np.float32), topology).astype(np.float64)
         kept = np.where((sv == 0.0)[:, None], points, kept)
-        P = np.where(inside[:, None], kept, P)
+        whole = np.zeros(topology.strand_count, bool)
+        whole[strand[inside]] = True
+        P = np.where(whole[strand][:, None], kept, P)
     return P
+
+
+def reach_reference(
+    was: np.ndarray,
+    points: np.ndarray,
+    strand: np.ndarray,
+    changed: np.ndarray,
+    radius: float,
+    best: np.ndarray,
+    gap_mode: str,
+) -> np.ndarray:
+    """Numpy twin of :meth:`LocalClump.reach` (without its limit): sorted ids of the vertices
+    whose clumping can change when the input changes on ``changed`` (the only vertices that
+    differ between ``was``, before the move, and ``points``), on the lists (other strands within
+    ``radius``) of both, with ``best`` ``(k, V)`` the last run's nearest neighbours."""
+    changed = np.asarray(changed, np.int64)
+    ci, cj = pairs_within_reference(was, strand, radius)  # the lists before
+    p = np.asarray(points, np.float64)
+    ni, nj = [ci], [cj]
+    for c in np.array_split(changed, max(1, changed.size // 64)):  # their lists after
+        d = p[c][:, None, :] - p[None, :, :]
+        near = (np.einsum("ijk,ijk->ij", d, d) < radius * radius) & (strand[c][:, None] != strand)
+        a, b = np.nonzero(near)
+        ni.append(c[a])
+        nj.append(b)
+    i, j = np.concatenate(ni + nj), np.concatenate(nj + ni)
+    points_change = np.zeros(p.shape[0], bool)
+    points_change[changed] = True
+    for it in range(best.shape[0]):
+        forces_change = points_change.copy()
+        forces_change[i[points_change[j]]] = True  # (15): a changed point in the list
+        points_change = forces_change.copy()
+        if gap_mode != "off":  # (17)-(19): the nearest neighbour's force
+            b = best[it]
+            points_change |= (b >= 0) & forces_change[np.maximum(b, 0)]
+    return np.flatnonzero(points_change)

@@ -23,7 +23,7 @@ from hairtool.frozen.brushes import registry
 from hairtool.frozen.brushes.spec import StrokeMemory
 from hairtool.frozen.clump import ClumpRecord
 from hairtool.frozen.lengths import restore_lengths
-from hairtool.frozen.local import LocalClump, strands_differing, threads_for
+from hairtool.frozen.local import LocalClump, threads_for
 from hairtool.frozen.move_points import MovePoints, held_by_at_most, may_write
 from hairtool.frozen.replay import Sample, StrokeSetting, apply_sample, memory_for
 from hairtool.frozen.selection import SelectionSample
@@ -195,38 +195,38 @@ def move(
     cur.done()
     ran = np.flatnonzero(touched)
     rv = vertex_ids_of(top, ran)
-    moved = strands_differing(cur.before(rv), cur.points[rv], top.counts[ran], ran)
-    seeds = np.union1d(moved, painted)
+    went = rv[np.any(cur.before(rv).view(np.uint32) != cur.points[rv].view(np.uint32), axis=1)]
+    pv = vertex_ids_of(top, painted)
+    changed = np.union1d(went, pv)  # the vertices whose clump input changed
     now_aligned = aligned
-    if moved.size:
-        mv = vertex_ids_of(top, moved)
-        was = cur.before(mv)
-        moves.nonplanar += int(np.count_nonzero(cur.points[mv, 2])) - int(np.count_nonzero(was[:, 2]))
-        now_aligned = aligned.with_moved_rows(cur.points, mv)  # (the pipeline's own: a copy, or its last)
+    if went.size:
+        was = cur.before(went)
+        moves.nonplanar += int(np.count_nonzero(cur.points[went, 2])) - int(np.count_nonzero(was[:, 2]))
+        now_aligned = aligned.with_moved_rows(cur.points, went)  # (the pipeline's own: a copy, or its last)
     align_ms = (time.perf_counter() - t0) * 1e3
-    if seeds.size == 0:
+    if changed.size == 0:
         local.lists_ms = 0.0
-        return Moved(now_aligned, state, memory, None, seeds, 0.0, False, align_ms)
+        return Moved(now_aligned, state, memory, None, np.zeros(0, np.int64), 0.0, False, align_ms)
     sv = moves.sv
-    if painted.size:
-        pv = vertex_ids_of(top, painted)
-        sv[pv] = state.clump_strength[top.strand_index[pv]]
+    sv[pv] = state.clump_strength[top.strand_index[pv]]
     now = now_aligned.points
-    was = cur.before(vertex_ids_of(top, seeds))
-    done = local.update(was, now, seeds, sv, run.iterations, run.step, run.gap_mode, run.seed)
-    if done is None:  # most of the groom: a full run costs less
+    was = cur.before(changed)
+    done = local.update(was, now, changed, sv, run.iterations, run.step, run.gap_mode, run.seed)
+    if done is None:  # most of the groom, or every list's order changed: a full run
         return Moved(now_aligned, state, memory, None, None, 1.0, True, align_ms)
     region, vids = done
     rec = local.record
     _kept_writable(moves, result_on_kept, result_alone)
-    if run.keep_lengths:
+    if run.keep_lengths:  # whole strands: a segment's length is given back from the root on
+        rows = vertex_ids_of(top, region)
         restore_lengths(now, rec.result, top, region, moves.kept)
-        still = vids[sv[vids] == 0.0]
+        still = rows[sv[rows] == 0.0]
         moves.kept[still] = now[still]
     else:
+        rows = vids
         moves.kept[vids] = rec.result[vids]
     moves.grid_points = now
-    clumped = now_aligned.with_moved_rows(moves.kept, vids)  # (new: the region)
+    clumped = now_aligned.with_moved_rows(moves.kept, rows)  # (new: the region)
     return Moved(
         now_aligned, state, memory, clumped, region, vids.size / max(top.vertex_count, 1), False, align_ms
     )

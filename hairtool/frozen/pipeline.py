@@ -20,10 +20,10 @@ Built for dragging in the studio:
 - Brush-local moves (:mod:`hairtool.frozen.local_moves`, :mod:`hairtool.frozen.local`): a
   sample of align, comb, smooth, length, puff, pinch, clump or mask runs only on the strands
   with a vertex within its radius (found in a vertex grid kept across moves), and
-  ClumpWithGaps and the length pass only on those it changed and the strands within the clump
-  kernel's reach of them; the rest of the groom is read, never written, and keeps its last
-  result bit for bit. The other brushes, parameter changes, undo and replays run on the whole
-  groom (a full run, after which the grid follows what moved).
+  ClumpWithGaps only on the vertices whose clumping the change can reach (the length pass on
+  their strands), so the result is a full run's bytes; the rest of the groom is read, never
+  written, and keeps its last result bit for bit. The other brushes, parameter changes, undo
+  and replays run on the whole groom (a full run, after which the grid follows what moved).
 - Delete (:mod:`hairtool.frozen.brushes.delete`) changes the strands: a stage like the others, applied
   to the stroked state, which takes the kept strands with their mask and clump strength; the
   pipeline records the rest strand each remaining strand comes from (:attr:`FrozenPipeline.origin`),
@@ -568,9 +568,9 @@ class FrozenPipeline:
 
     def settle(self) -> Groom:
         """After brush-local moves, ClumpWithGaps once more on the whole groom: the result any
-        replay of the strokes gives (the studio does it when the mouse is released; the
-        strokes' points are the same either way, only the clumping of the strands near the
-        moved ones differs a little). Without local moves since the last full run: the result."""
+        replay of the strokes gives (the studio does it when the mouse is released). A move
+        redoes every vertex its change can reach, so these are the bytes the moves left, made
+        once more from the whole groom. Without local moves since the last full run: the result."""
         if self._unsettled:
             self._timings = dict.fromkeys(self._timings, 0.0)
             self._reclump()

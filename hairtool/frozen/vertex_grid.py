@@ -1,13 +1,13 @@
 """A grid of every vertex of a groom, kept across brush moves and updated where strands moved.
 
 The brush-local engine (:mod:`hairtool.frozen.local`) asks it three things on each mouse move:
-which strands have a vertex within a brush's radius, which strands have a vertex within the
-clump kernel's reach (h·(1 + MARGIN)) of the vertices that moved, and the neighbour list of
-each vertex it redoes. Cells are cubes one list radius wide, hashed into about 2V buckets, each
-a doubly linked list of vertices, so that moving a vertex to another cell costs O(1) and the
-grid never has to be rebuilt while the strands stay the same (a candidate counts only where its
-exact cell matches, so hash collisions never count twice). Cell coordinates are clipped to
-±2**20, which only makes far-away cells share a list.
+which strands have a vertex within a brush's radius, which vertices of other strands lie within
+the clump kernel's reach (h·(1 + MARGIN)) of the vertices whose clumping may change, and the
+neighbour list of each vertex it redoes. Cells are cubes one list radius wide, hashed into about
+2V buckets, each a doubly linked list of vertices, so that moving a vertex to another cell costs
+O(1) and the grid never has to be rebuilt while the strands stay the same (a candidate counts
+only where its exact cell matches, so hash collisions never count twice). Cell coordinates are
+clipped to ±2**20, which only makes far-away cells share a list.
 
 A vertex's list comes in the order a full build of :class:`hairtool.frozen.spatial.NeighbourList`
 gives it (:func:`list_frame` names that build's grid): the neighbours after the vertex in the
@@ -267,6 +267,35 @@ def _mark_near_wide(points, strand, px, py, pz, r2, inv, shift, key, head, nxt, 
     z0, z1 = _coord(pz - reach, inv), _coord(pz + reach, inv)
     for cz in prange(z0, z1 + 1):
         _mark_slab(points, strand, px, py, pz, r2, shift, key, head, nxt, mark, x0, x1, y0, y1, cz, bs)
+
+
+@njit(cache=True, nogil=True)
+def _vertices_near(points, strand, qx, qy, qz, qs, r2, inv, shift, key, head, nxt, skip, out):
+    """The vertices not flagged in ``skip`` of a strand other than ``qs[q]`` closer than
+    sqrt(r2) to a query q, for a reach of at most one cell (the 27 cells around a query hold
+    them), each written once into ``out`` and flagged; returns how many. Serial: a region's
+    queries find each vertex dozens of times on dense hair, and flagging it at once lets the
+    later finds pass it by (in parallel, their duplicates cost more to sort out than the walk)."""
+    m = 0
+    for q in range(qx.size):
+        px, py, pz = qx[q], qy[q], qz[q]
+        gx, gy, gz = _coord(px, inv), _coord(py, inv), _coord(pz, inv)
+        for cz in range(max(gz - 1, -_OFF), min(gz + 1, _OFF - 1) + 1):
+            for cy in range(max(gy - 1, -_OFF), min(gy + 1, _OFF - 1) + 1):
+                for cx in range(max(gx - 1, -_OFF), min(gx + 1, _OFF - 1) + 1):
+                    k = _pack(cx, cy, cz)
+                    j = head[_bucket(k, shift)]
+                    while j >= 0:
+                        if key[j] == k and not skip[j] and strand[j] != qs[q]:
+                            ex = np.float64(points[j, 0]) - px
+                            ey = np.float64(points[j, 1]) - py
+                            ez = np.float64(points[j, 2]) - pz
+                            if ex * ex + ey * ey + ez * ez < r2:
+                                skip[j] = True
+                                out[m] = j
+                                m += 1
+                        j = nxt[j]
+    return m
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -565,6 +594,42 @@ class VertexGrid:
         else:
             _mark_near(points, self.strand, *xyz, r2, *grid, self.blocks)
 
+    def vertices_near(
+        self, points: np.ndarray, queries: np.ndarray, strands: np.ndarray, radius: float, skip: np.ndarray
+    ) -> np.ndarray:
+        """Sorted ids of the vertices of ``points`` (where the grid holds them), not flagged in
+        ``skip``, closer than ``radius`` (at most the cell) to one of ``queries`` and of a strand
+        other than that query's: the vertices whose neighbour lists hold a point at a query's
+        place. They are flagged in ``skip`` too (no pass over all V vertices).
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(V, 3)``.
+        queries : ndarray
+            ``(n, 3)``.
+        strands : ndarray
+            ``(n,)`` each query's strand.
+        radius : float
+            The distance, at most :attr:`cell`.
+        skip : ndarray
+            ``(V,)`` bool: the vertices left out; written.
+
+        Returns
+        -------
+        ndarray
+            int64 vertex ids.
+        """
+        if float(radius) > self.cell:
+            raise ValueError(f"radius {radius} beyond the grid's cell {self.cell}")
+        q = np.asarray(queries, np.float64).reshape(-1, 3)
+        xyz = np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1]), np.ascontiguousarray(q[:, 2])
+        qs = np.ascontiguousarray(strands, np.int64)
+        out = np.empty(self.vertex_count, np.int64)  # (untouched past what is found)
+        grid = (float(radius) ** 2, self.inv, self.shift, self.key, self.head, self.nxt, skip, out)
+        found = _vertices_near(points, self.strand, *xyz, qs, *grid)
+        return np.sort(out[:found])
+
     def lists(self, points: np.ndarray, vids: np.ndarray, radius: float, frame: tuple) -> tuple:
         """``(flat, cnt, cap)``: the list of each vertex ``vids[n]`` (other strands within
         ``radius``, original indices) at ``flat[n·cap :][: cnt[n]]``, in the order of a full build
@@ -659,6 +724,45 @@ def strands_near_reference(
         d2 = e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1] + e[:, 2] * e[:, 2]
         mark[strand[d2 < float(radius) ** 2]] = True
     return mark
+
+
+def vertices_near_reference(
+    points: np.ndarray,
+    strand: np.ndarray,
+    queries: np.ndarray,
+    strands: np.ndarray,
+    radius: float,
+    skip: np.ndarray,
+) -> np.ndarray:
+    """Numpy twin of :meth:`VertexGrid.vertices_near`: every vertex against every query.
+
+    Parameters
+    ----------
+    points : ndarray
+        ``(V, 3)``.
+    strand : ndarray
+        ``(V,)`` each vertex's strand.
+    queries : ndarray
+        ``(n, 3)``.
+    strands : ndarray
+        ``(n,)`` each query's strand.
+    radius : float
+        The distance.
+    skip : ndarray
+        ``(V,)`` bool: the vertices left out.
+
+    Returns
+    -------
+    ndarray
+        Sorted int64 vertex ids.
+    """
+    p = np.asarray(points, np.float64)
+    mark = np.zeros(p.shape[0], bool)
+    for q, s in zip(np.asarray(queries, np.float64).reshape(-1, 3), np.asarray(strands), strict=True):
+        e = p - q
+        d2 = e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1] + e[:, 2] * e[:, 2]
+        mark |= (d2 < float(radius) ** 2) & (strand != s)
+    return np.flatnonzero(mark & ~np.asarray(skip, bool)).astype(np.int64)
 
 
 def lists_reference(

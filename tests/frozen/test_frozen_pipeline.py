@@ -186,10 +186,9 @@ def test_the_automatic_step_is_the_frozen_grooms_and_a_drag_is_redone_near_the_b
         redone.append(pipe.clump_redone)
     assert pipe.clump_step == frozen_step
     expect = clump(pipe.aligned, h, 3, frozen_step, "printed", 0)
-    assert pipe.unsettled and out.points.tobytes() != expect.points.tobytes()  # brush-local moves
-    np.testing.assert_allclose(out.points, expect.points, atol=0.05 * h)  # ... near a full run
-    assert pipe.settle().points.tobytes() == expect.points.tobytes()  # the release: a full run's bytes
+    assert out.points.tobytes() == expect.points.tobytes()  # local or not, a drag gives a full run's bytes
+    assert pipe.settle().points.tobytes() == expect.points.tobytes()  # and so does the release
     other = ClumpWorkspace()
     clump(pipe.aligned, h, 1, None, "off", 0, other)
     assert other.step != frozen_step  # what the aligned groom alone would have given
-    assert redone[0] < 1.0 and max(redone) < 0.5  # redone near the brush only
+    assert 0.0 < min(r for r in redone if r > 0.0) < 0.5  # redone near the brush only

@@ -12,14 +12,15 @@ from hypothesis import strategies as st
 
 from hairtool.errors import ParameterError
 from hairtool.frozen.brushes import BrushSample, falloff_lut
-from hairtool.frozen.local import clump_region_reference
+from hairtool.frozen.clump import clump_points
+from hairtool.frozen.local import clump_region_reference, reach_reference
 from hairtool.frozen.noise import draw_seed
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.groom import vertex_ids_of
 from hairtool.guides import shapes
 from hairtool.prims import split
 
-SMALL = {"ponytail": (160, 12), "curls": (120, 16), "straight": (300, 8), "systems": (240, 8)}
+SMALL = {"ponytail": (700, 12), "curls": (500, 16), "straight": (300, 8), "systems": (800, 8)}
 
 
 def small(name: str, seed: int = 0):
@@ -69,6 +70,14 @@ def test_unknown_shapes_and_sizes_are_refused_by_name():
         shapes.shape("systems", 3, 8)
 
 
+def full_run(pipe: FrozenPipeline) -> np.ndarray:
+    p = pipe.params
+    return clump_points(
+        pipe.aligned, pipe.clump_radius, p.clump_iterations, pipe.clump_step, p.gap_mode,
+        draw_seed(p.seed, 0), None, p.keep_lengths, pipe.clump_strength,
+    )  # fmt: skip
+
+
 def _comb(cursor, direction, radius):
     lut = tuple(falloff_lut("smooth").tolist())
     return BrushSample(
@@ -76,18 +85,7 @@ def _comb(cursor, direction, radius):
     )
 
 
-# The ponytail's moves run on the whole groom: a comb at its tips moves 1-5 % of the vertices, but
-# hairtool.frozen.local counts the strands they belong to (9-33 % of the vertices, above MAX_SEEDS)
-# and takes the clump's reach from every vertex of those strands, and every strand meets the others
-# in the tie (the region is then all of it; from the moved vertices alone it would be 23-58 %).
-PONYTAIL_IN_FULL = pytest.mark.xfail(
-    strict=True, reason="ponytail moves run in full: the local region is reached through the tie"
-)
-
-
-@pytest.mark.parametrize(
-    "name", [pytest.param(n, marks=PONYTAIL_IN_FULL) if n == "ponytail" else n for n in shapes.SHAPES]
-)
+@pytest.mark.parametrize("name", list(shapes.SHAPES))
 @settings(
     max_examples=3,
     deadline=None,
@@ -105,7 +103,8 @@ def test_a_move_on_each_shape_changes_only_the_strands_it_reaches(name, pick, an
     tips = g.tips.astype(np.float64)
     tip = tips[min(int(pick * g.strand_count), g.strand_count - 1)]
     rec = pipe._workspace.recorded  # the full run's trajectories, which the rest is held to
-    iterates, forces = rec.iterates.copy(), rec.forces.copy()
+    iterates, forces, result = rec.iterates.copy(), rec.forces.copy(), rec.result.copy()
+    best = rec.best.copy()
     shown = pipe.result.points.copy()
     before = pipe.aligned.points.copy()
     step = 0.05 * extent * np.array([np.cos(angle), np.sin(angle), 0.0])
@@ -118,10 +117,14 @@ def test_a_move_on_each_shape_changes_only_the_strands_it_reaches(name, pick, an
     hit = np.unique(g.topology.strand_index[brushed])
     under = np.linalg.norm(before - tip, axis=1) <= radius * (1 + 1e-6)
     assert np.logical_or.reduceat(under, g.offsets[:-1])[hit].all()  # only strands under the brush
+    local = pipe.local_clump  # redone: every vertex whose clumping the brushed ones can change, no other
+    strand = g.topology.strand_index
+    reach = reach_reference(before, pipe.aligned.points, strand, brushed, local.radius, best, "printed")
+    assert np.array_equal(local.vertices, reach)
     sv = np.asarray(pipe.clump_strength)[g.topology.strand_index]
     want = clump_region_reference(
-        pipe.aligned.points, g.topology, region, iterates, forces, sv, pipe.clump_radius, 3,
-        pipe.clump_step, "printed", draw_seed(4, 0),
+        pipe.aligned.points, g.topology, local.vertices, iterates, forces, result, sv,
+        pipe.clump_radius, 3, pipe.clump_step, "printed", draw_seed(4, 0),
     )  # fmt: skip
     # the twin sums the pulls in another order (np.bincount): float32 results agree to an ulp or two
     np.testing.assert_allclose(out.points[inside], want[inside], rtol=0, atol=2e-6 * extent)
@@ -129,3 +132,4 @@ def test_a_move_on_each_shape_changes_only_the_strands_it_reaches(name, pick, an
     outside[inside] = False
     assert outside.any()
     assert out.points[outside].tobytes() == shown[outside].tobytes()  # the rest untouched, bit for bit
+    assert out.points.tobytes() == full_run(pipe).tobytes()  # and all of it a full run's bytes

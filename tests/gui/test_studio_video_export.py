@@ -99,3 +99,42 @@ def test_the_export_dialog_offers_the_viewport_720p_1080p_and_custom(qtbot):
     video.size_form.set_choice("custom")
     video.size_form.width_box.setValue(333)
     assert video.options().size == (333, 1080)
+
+
+def test_each_frames_cpu_raster_is_made_in_the_worker_while_the_window_keeps_ticking(
+    hair_window, tmp_path, monkeypatch
+):
+    """Strands rasterized on the CPU (software GL): the export's worker rasters every frame and
+    the GUI thread only composites, so its timer keeps ticking; the frames are the stills."""
+    import threading
+
+    from PySide6.QtCore import QTimer
+
+    from app.render.soft_raster import StrandRaster
+
+    monkeypatch.setenv("HAIRTOOL_STRAND_RASTER", "cpu")
+    w = hair_window
+    gui = threading.get_ident()
+    rasters: list[int] = []
+    draw = StrandRaster.draw
+
+    def traced(self, *args, **kwargs):
+        rasters.append(threading.get_ident())
+        return draw(self, *args, **kwargs)
+
+    monkeypatch.setattr(StrandRaster, "draw", traced)
+    ticks = []  # the GUI thread's timer, while the export runs
+    timer = QTimer()
+    timer.timeout.connect(lambda: w.jobs.busy and ticks.append(1))
+    timer.start(1)
+    try:
+        paints = _export(w, tmp_path / "shot.png", (64, 48))
+    finally:
+        timer.stop()
+    assert paints <= 1
+    assert len(rasters) == FRAMES and gui not in rasters  # every frame's raster, none on the GUI thread
+    assert len(ticks) > FRAMES  # the GUI thread answered its timer all along
+    stills = _stills(w, (64, 48))  # (drawn the way every frame was before: on the GUI thread)
+    assert rasters.count(gui) == FRAMES
+    for i, path in enumerate(sequence_paths(tmp_path / "shot.png", FRAMES)):
+        np.testing.assert_array_equal(imageio.imread(path)[..., :3], stills[i])
