@@ -42,7 +42,8 @@ def serial_plan() -> list[Entry]:
     f64_2d = _array(types.float64, 2)
     lists = types.Tuple((_I32, _I64, _I64, _I32, _I64, _I64, _F64, _F64))  # pair lists, clump.py
     bufs = types.Tuple((f64_2d, f64_2d, f64_2d, _I64, _I64, _F64, _array(types.uint64), _F64))
-    record = types.Tuple((_array(types.float64, 3), _array(types.float64, 3), _array(types.int64, 2), _I64, _F64))
+    f64_3d = _array(types.float64, 3)
+    record = types.Tuple((f64_3d, f64_3d, _array(types.int64, 2), _I64, _F64))  # iterates, forces, nearest
     run = (
         _POINTS, _F64, _I64, lists, _array(types.boolean), types.float64, types.int64, types.float64,
         types.int64, types.uint64, bufs, _array(types.float32, 2), record,
