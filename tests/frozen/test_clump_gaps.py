@@ -24,6 +24,23 @@ def _nearest_other(g: Groom, reach: float) -> np.ndarray:
     return np.delete(out, g.topology.root_indices)
 
 
+def _median_nearest_other(g: Groom, reach: float) -> float:
+    """The median of :func:`_nearest_other` within ``reach``, searched first within a third of it:
+    a vertex found there has its exact distance, every other one is farther than all of those,
+    so when more than half are found the median is already exact (a ninth of the pairs to list;
+    the comb's 6.8 million pairs within ``reach`` took 14 s of CPU for the four medians)."""
+    near = _nearest_other(g, reach / 3)
+    if np.count_nonzero(np.isfinite(near)) > len(near) // 2:  # both middle places are found ones
+        return float(np.median(near))
+    return float(np.median(_nearest_other(g, reach)))
+
+
+@pytest.mark.parametrize("reach", [0.3, 1.0])  # a fifth found within reach / 3, then nearly all
+def test_the_median_searched_within_a_third_first_is_the_median_within_reach(reach):
+    g = samples.scalp(80, 8, seed=2)
+    assert _median_nearest_other(g, reach) == np.median(_nearest_other(g, reach))
+
+
 def test_two_close_strands_pull_together_and_an_isolated_strand_stays():
     a = np.linspace([0, 0, 0], [0, -1, 0], 11)
     b = a + np.array([0.05, 0, 0])
@@ -54,14 +71,13 @@ def test_vertices_of_the_same_strand_do_not_attract_each_other():
     np.testing.assert_array_equal(clump(g, 1.0, 5, 0.1, "off").points, g.points)
 
 
-@pytest.mark.slow(seconds=29)
 def test_gap_correction_keeps_more_space_than_plain_adhesion():
     for g in (samples.scalp(600, 20, seed=1), read_groom_or_scalp()):
         h = auto_clump_radius(g)
-        before = np.median(_nearest_other(g, 3 * h))
-        off = np.median(_nearest_other(clump(g, h, 3, None, "off", 0), 3 * h))
-        printed = np.median(_nearest_other(clump(g, h, 3, None, "printed", 0), 3 * h))
-        text = np.median(_nearest_other(clump(g, h, 3, None, "text", 0), 3 * h))
+        before = _median_nearest_other(g, 3 * h)
+        off = _median_nearest_other(clump(g, h, 3, None, "off", 0), 3 * h)
+        printed = _median_nearest_other(clump(g, h, 3, None, "printed", 0), 3 * h)
+        text = _median_nearest_other(clump(g, h, 3, None, "text", 0), 3 * h)
         assert off < before  # adhesion pulls strands together
         assert printed > 1.1 * off and text > 1.1 * off
 
