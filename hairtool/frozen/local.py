@@ -240,9 +240,12 @@ class LocalClump:
         queries = np.concatenate([new[changed], was[went]])  # lists then and now
         qs = np.concatenate([strand[changed], strand[changed[went]]])
         layers, count = [changed], changed.size
+        known = np.zeros(0, np.int64)  # of the next forces: those the gap search already found
         for it in range(iterations):
             forces = self.grid.vertices_near(new, queries, qs, self.radius, skip)  # (flagged)
-            grown = [forces]
+            if known.size:
+                forces = np.union1d(known, forces)
+            grown, known = [forces], np.zeros(0, np.int64)
             if gap_mode != "off" and forces.size:
                 near = self.grid.vertices_near(new, new[forces], strand[forces], self.radius, skip)
                 skip[near] = False
@@ -250,12 +253,17 @@ class LocalClump:
                 pulled = near[(b >= 0) & skip[np.maximum(b, 0)]]  # their nearest's force can change
                 skip[pulled] = True
                 grown.append(pulled)
+                # The next forces are the vertices near these forces or the pulled ones: those
+                # near the forces are ``near`` less the pulled; only the pulled are searched again.
+                known = near[~skip[near]]
+                skip[known] = True
             fresh = np.concatenate(grown)
             count += fresh.size
             if fresh.size == 0 or count > most:
                 break
             layers.append(fresh)
-            queries, qs = new[fresh], strand[fresh]
+            searched = pulled if gap_mode != "off" else fresh
+            queries, qs = new[searched], strand[searched]
         return None if count > most else np.sort(np.concatenate(layers))
 
 
