@@ -273,28 +273,36 @@ def _mark_near_wide(points, strand, px, py, pz, r2, inv, shift, key, head, nxt, 
 def _vertices_near(points, strand, qx, qy, qz, qs, r2, inv, shift, key, head, nxt, skip, out):
     """The vertices not flagged in ``skip`` of a strand other than ``qs[q]`` closer than
     sqrt(r2) to a query q, for a reach of at most one cell (the 27 cells around a query hold
-    them), each written once into ``out`` and flagged; returns how many. Serial: a region's
-    queries find each vertex dozens of times on dense hair, and flagging it at once lets the
-    later finds pass it by (in parallel, their duplicates cost more to sort out than the walk)."""
+    them), each written once into ``out`` and flagged; returns how many. The queries go by grid
+    cell (:func:`_cell_groups`): a group reads the 27 cells around its own from the grid once for
+    all its queries (a region's queries are a few per cell on dense hair). Serial: they find each
+    vertex dozens of times, and flagging it at once lets the later finds pass it by (in
+    parallel, their duplicates cost more to sort out than the walk)."""
+    order, starts = _cell_groups(qx, qy, qz, inv)
+    scratch = np.empty(_BLOCK_ROOM, np.int64)
     m = 0
-    for q in range(qx.size):
-        px, py, pz = qx[q], qy[q], qz[q]
-        gx, gy, gz = _coord(px, inv), _coord(py, inv), _coord(pz, inv)
-        for cz in range(max(gz - 1, -_OFF), min(gz + 1, _OFF - 1) + 1):
-            for cy in range(max(gy - 1, -_OFF), min(gy + 1, _OFF - 1) + 1):
-                for cx in range(max(gx - 1, -_OFF), min(gx + 1, _OFF - 1) + 1):
-                    k = _pack(cx, cy, cz)
-                    j = head[_bucket(k, shift)]
-                    while j >= 0:
-                        if key[j] == k and not skip[j] and strand[j] != qs[q]:
-                            ex = np.float64(points[j, 0]) - px
-                            ey = np.float64(points[j, 1]) - py
-                            ez = np.float64(points[j, 2]) - pz
-                            if ex * ex + ey * ey + ez * ez < r2:
-                                skip[j] = True
-                                out[m] = j
-                                m += 1
-                        j = nxt[j]
+    for g in range(starts.size - 1):
+        q0 = order[starts[g]]
+        gx, gy, gz = _coord(qx[q0], inv), _coord(qy[q0], inv), _coord(qz[q0], inv)
+        block = _block_in(gx, gy, gz, shift, key, head, nxt, scratch)
+        for c in range(block.size):
+            j = block[c]
+            if skip[j]:
+                continue
+            x, y, z = np.float64(points[j, 0]), np.float64(points[j, 1]), np.float64(points[j, 2])
+            sj = strand[j]
+            for e in range(starts[g], starts[g + 1]):
+                q = order[e]
+                if qs[q] == sj:
+                    continue
+                ex = x - qx[q]
+                ey = y - qy[q]
+                ez = z - qz[q]
+                if ex * ex + ey * ey + ez * ez < r2:
+                    skip[j] = True
+                    out[m] = j
+                    m += 1
+                    break
     return m
 
 
