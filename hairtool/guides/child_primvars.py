@@ -20,7 +20,7 @@ import numpy as np
 
 from hairtool.guides.attributes import blend
 from hairtool.io import usd_basis
-from hairtool.io.atomic import atomic_path
+from hairtool.io.usd_carry import export_stage
 
 #: Primvars the writer makes from the groom: never taken from the guides.
 _OWN = ("displayColor", "displayOpacity", "color", "widths", "normals")
@@ -110,11 +110,7 @@ def give_children_primvars(
             made.Set(values if interp == "constant" else as_vt(array, values))
             added.append(f"{render_path}.primvars:{name}")
     if added:
-        with atomic_path(out) as tmp:
-            if not dst.Export(str(tmp)):
-                from hairtool.errors import FormatError
-
-                raise FormatError(out, "usd-core could not write it")
+        export_stage(dst, out)
     return added
 
 

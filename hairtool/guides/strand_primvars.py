@@ -30,7 +30,7 @@ import numpy as np
 from hairtool.frozen.root_grid import nearest_root
 from hairtool.groom import Groom
 from hairtool.io import usd_basis
-from hairtool.io.atomic import atomic_path
+from hairtool.io.usd_carry import export_stage
 
 #: Primvars the writer makes from the groom: never taken from the source.
 _OWN = ("displayColor", "displayOpacity", "color", "widths", "normals")
@@ -189,9 +189,5 @@ def give_strands_primvars(
             made.Set(values if interp == "constant" else as_vt(array, values))
             given.append(f"{path_now}.primvars:{name}")
     if given:
-        with atomic_path(out) as tmp:
-            if not dst.Export(str(tmp)):
-                from hairtool.errors import FormatError
-
-                raise FormatError(out, "usd-core could not write it")
+        export_stage(dst, out)
     return given

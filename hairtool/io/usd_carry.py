@@ -25,6 +25,16 @@ from hairtool.io.atomic import atomic_path
 _OWN = ("points", "extent", "curveVertexCounts", "widths", "type", "basis", "wrap", "purpose")
 
 
+def export_stage(stage, out: str | os.PathLike[str]) -> None:
+    """Write ``stage`` to ``out`` whole or not at all (a temporary name, renamed); FormatError
+    naming ``out`` when usd-core cannot write it."""
+    with atomic_path(Path(out)) as tmp:
+        if not stage.Export(str(tmp)):
+            from hairtool.errors import FormatError
+
+            raise FormatError(Path(out), "usd-core could not write it")
+
+
 def _copy_missing_properties(src, dst, path, prefixes: tuple[str, ...] | None) -> list[str]:
     """The properties of ``src``'s prim at ``path`` that ``dst``'s lacks (those starting with one
     of ``prefixes``, or any with None), copied; their names."""
@@ -142,11 +152,7 @@ def carry_scene(source: str | os.PathLike[str], written: str | os.PathLike[str])
         carried.append("customLayerData")
     if not carried:
         return carried
-    with atomic_path(Path(written)) as tmp:
-        if not dst.Export(str(tmp)):
-            from hairtool.errors import FormatError
-
-            raise FormatError(Path(written), "usd-core could not write it")
+    export_stage(dst, written)
     return carried
 
 
@@ -193,11 +199,7 @@ def keep_emptied(source: str | os.PathLike[str], written: str | os.PathLike[str]
             curves.CreateCurveVertexCountsAttr(Vt.IntArray())
             curves.CreatePointsAttr(Vt.Vec3fArray())
             kept.append(c.path)
-        with atomic_path(out) as tmp:
-            if not dst.Export(str(tmp)):
-                from hairtool.errors import FormatError
-
-                raise FormatError(out, "usd-core could not write it")
+        export_stage(dst, out)
         return kept
 
     return _diagnosed(out, work)
