@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import shutil
 import subprocess
@@ -60,7 +61,20 @@ def missing_system_packages() -> str | None:
     return done.stdout.strip() or None
 
 
+def _register_xdist_recovery(config: pytest.Config) -> None:
+    """Where xdist runs the suite, its file scheduling that finishes after a worker dies
+    (``tests/xdist_recovery.py`` says why)."""
+    if not config.pluginmanager.hasplugin("xdist") or config.pluginmanager.has_plugin("xdist-recovery"):
+        return
+    path = Path(__file__).with_name("xdist_recovery.py")
+    spec = importlib.util.spec_from_file_location("hairtool_xdist_recovery", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    config.pluginmanager.register(module.Plugin(), "xdist-recovery")
+
+
 def pytest_configure(config: pytest.Config) -> None:
+    _register_xdist_recovery(config)
     config.missing_system_packages = missing_system_packages()
     if config.missing_system_packages is not None and os.environ.get("CI"):
         # CI runs the GUI and render tests for real: a missing package fails the run, loudly

@@ -84,6 +84,7 @@ class FrameChildren(QObject):
         self._pending: FrameAsk | None = None
         self._running: FrameAsk | None = None
         self._clumper: tuple[tuple, RenderHair] | None = None  # the worker's own (never the scene's)
+        self._closed = False  # shut down: a build that lands later is dropped
         self._worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="hairtool-frames")
         self._finished.connect(self._on_finished, Qt.ConnectionType.QueuedConnection)
 
@@ -94,6 +95,8 @@ class FrameChildren(QObject):
 
     def ask(self, ask: FrameAsk) -> None:
         """Build ``ask`` when the worker is free; an ask still waiting is dropped for it."""
+        if self._closed:
+            return
         self._pending = ask
         if self._running is None:
             self._launch()
@@ -131,6 +134,8 @@ class FrameChildren(QObject):
             pass
 
     def _on_finished(self, ask: FrameAsk) -> None:
+        if self._closed:  # the window closed meanwhile: its view has no GL to draw it with
+            return
         self._running = None
         self.built += 1
         if self._pending is not None:
@@ -140,6 +145,8 @@ class FrameChildren(QObject):
         self.landed.emit(ask)
 
     def shutdown(self) -> None:
-        """No more asks; the worker ends after the build under way (the window closes)."""
+        """No more asks; the worker ends after the build under way, which is dropped (the window
+        closes)."""
+        self._closed = True
         self._pending = None
         self._worker.shutdown(wait=True)

@@ -276,6 +276,9 @@ class MainWindow(QMainWindow):
             event.ignore()
             return
         self.jobs.shutdown()
+        # the brush and frame workers end with the window: none of them emits to a closed one
+        self.scene.moves.shutdown()
+        self.animation_ui.frames.shutdown()
         if self.engine_start is not None:
             self.engine_start.stop()
         self.project.shutdown()

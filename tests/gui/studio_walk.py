@@ -16,7 +16,8 @@ message box is an error dialog. Each action runs in its state: when an action re
 or the animation (New from sample, Open, Close animation …), the state is rebuilt before the next
 one, so in the capture state every File ▸ New from sample entry is followed by reopening the
 capture (the sequence that once aborted the process in a ``paintEvent``). Long jobs are given
-:data:`JOB_S` seconds, then cancelled as a user would, and must leave no partial file. File ▸ Quit
+:data:`JOB_S` seconds, then cancelled as a user would, and must leave no partial file (a video
+export, which the test reads back, runs to its end). File ▸ Quit
 comes last, as Ctrl+Q over an edit answered Discard: the process must then end cleanly.
 """
 
@@ -41,6 +42,8 @@ JOB_MORE_S = 60.0  # … or more, while it moves, once a tenth of it is done (sh
 JOB_STALL_S = 5.0  # … and cancelled when its bar has not moved for this long
 JOB_FIRST_S = 3.0  # … waiting this long at most for that tenth (a video's first frame, on a
 # loaded CI core beside the other test worker, came after 1.5 s and the export was cancelled)
+JOB_VIDEO_S = 240.0  # a video export (8 frames, read back by the test) runs to its end: a loaded
+# CI core once drew no frame for 5 s, and the walk cancelled the file the test reads back
 SIMULATION = {"frames": 8, "substeps": 2}  # the simulated state: a short simulation of the sample
 SELF_EXPLAINED = ("Edit ▸ Undo", "Edit ▸ Redo")  # Qt greys these itself; their text says why
 
@@ -193,6 +196,8 @@ class Walk:
     def settle(self) -> None:
         """Let jobs finish (cancel those still running after JOB_S), then draw."""
         jobs = self.window.jobs
+        if any(j.title.endswith((".mp4", ".gif")) for j in jobs.active()):
+            jobs.wait(JOB_VIDEO_S)
         if not jobs.wait(JOB_S):
 
             def tenth() -> bool:
