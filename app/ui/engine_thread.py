@@ -21,7 +21,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
-from PySide6.QtCore import QObject, Qt, Signal
+from PySide6.QtCore import QObject, Qt, Signal, Slot
 
 from app.ui.brush_tool import LABELS
 from hairtool.errors import HairtoolError
@@ -153,6 +153,7 @@ class MoveEngine(QObject):
             tool.touches(points, m.cursor, m.plane_x, m.pressure) for m in batch.moves if m.check_touch
         )
 
+    @Slot(object)  # (a receiver of a signal from another thread is a declared slot: PYSIDE-3124)
     def _on_finished(self, batch: Batch) -> None:
         if batch is self._running:  # (not landed already by drain)
             self._land(batch)

@@ -20,7 +20,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
-from PySide6.QtCore import QObject, Qt, Signal
+from PySide6.QtCore import QObject, Qt, Signal, Slot
 
 from hairtool.groom import Groom, Topology
 from hairtool.guides.binding import ChildBinding
@@ -133,6 +133,7 @@ class FrameChildren(QObject):
         except RuntimeError:  # the window closed meanwhile, and this object with it
             pass
 
+    @Slot(object)  # (a receiver of a signal from another thread is a declared slot: PYSIDE-3124)
     def _on_finished(self, ask: FrameAsk) -> None:
         if self._closed:  # the window closed meanwhile: its view has no GL to draw it with
             return

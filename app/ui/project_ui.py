@@ -24,7 +24,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import QObject, QSettings, QStandardPaths, QTimer, Signal
+from PySide6.QtCore import QObject, QSettings, QStandardPaths, QTimer, Signal, Slot
 
 from app.document import project_io
 from app.render.camera import Camera
@@ -351,6 +351,7 @@ class ProjectController(QObject):
             self._join_autosave()
         return True
 
+    @Slot(str)  # (emitted by the autosave thread: a declared slot, PYSIDE-3124)
     def _show_autosave_failure(self, message: str) -> None:
         self.window.statusBar().showMessage(f"Autosave failed: {message}")
 

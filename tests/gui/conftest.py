@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QSettings
+from PySide6.QtCore import QEvent, QSettings
 from PySide6.QtWidgets import QApplication
 
 from app.surface import configure_gl
@@ -66,6 +66,8 @@ def make_window(qapp, qtbot, settings_path):
         window.close()
         window.deleteLater()
     QApplication.processEvents()
+    # deleted now, on this thread, not whenever a later test's event loop happens to run
+    QApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete)
     leaked = [w for w in QApplication.topLevelWidgets() if w.isVisible()]
     assert not leaked, f"windows left open: {leaked}"
 

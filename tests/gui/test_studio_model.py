@@ -13,9 +13,21 @@ from hairtool.errors import ParameterError
 from hairtool.frozen.pipeline import FrozenParams
 
 
+def _deleted(scene: Scene) -> None:
+    """Delete a window-less scene on this thread: left to the garbage collector, its Qt objects
+    could be deleted on whichever thread collects them (a later window's worker)."""
+    from PySide6.QtCore import QCoreApplication, QEvent
+
+    scene.moves.shutdown()
+    scene.deleteLater()
+    QCoreApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete)
+
+
 @pytest.fixture
 def scene(qapp):
-    return Scene(samples.portrait(strands=20, vertices=8))
+    made = Scene(samples.portrait(strands=20, vertices=8))
+    yield made
+    _deleted(made)
 
 
 def test_setters_emit_only_when_the_value_changes(ui, scene):
@@ -73,6 +85,7 @@ def test_a_stroke_is_one_document_step_recorded_on_release(qapp):
     assert np.array_equal(scene.result.points, after_points)
     scene.end_stroke(scene.snapshot())  # a release with nothing applied: no step
     assert stack.count == 1
+    _deleted(scene)
 
 
 def test_param_edits_merge_within_one_drag_only(scene):
