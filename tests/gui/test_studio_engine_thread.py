@@ -129,3 +129,23 @@ def test_a_threaded_stroke_logs_and_gives_what_the_same_moves_give_one_by_one(
     assert np.array_equal(after1, after0)
     assert touched1 == touched0
     w.close()
+
+
+def test_a_window_closed_mid_stroke_ends_its_engine_thread_before_it_goes(ui, make_window):
+    """Quit in the middle of a drag: the close lands the run under way and ends the worker, so
+    no thread is left to hand a result to a window being deleted (a worker that emitted while
+    its window was deleted crashed a CI run)."""
+    import threading
+
+    w = small(make_window)
+    v, s = w.viewport, w.scene
+    s.moves.delay_s = SLOW_S
+    points = path(v, 3)
+    ui.send_mouse(v, "press", points[0], LEFT, LEFT)
+    ui.send_mouse(v, "move", points[1], None, LEFT)
+    assert s.moves.busy  # the engine is still at it
+    assert any(t.name.startswith("hairtool-moves") for t in threading.enumerate())
+    w.close()  # (the fixture answers Discard)
+    assert not s.moves.busy
+    alive = [t.name for t in threading.enumerate() if t.name.startswith(("hairtool-moves", "hairtool-frames"))]
+    assert alive == []  # every window closed so far in this process ended its workers
