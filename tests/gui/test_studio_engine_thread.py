@@ -147,5 +147,6 @@ def test_a_window_closed_mid_stroke_ends_its_engine_thread_before_it_goes(ui, ma
     assert any(t.name.startswith("hairtool-moves") for t in threading.enumerate())
     w.close()  # (the fixture answers Discard)
     assert not s.moves.busy
-    alive = [t.name for t in threading.enumerate() if t.name.startswith(("hairtool-moves", "hairtool-frames"))]
+    workers = ("hairtool-moves", "hairtool-frames")
+    alive = [t.name for t in threading.enumerate() if t.name.startswith(workers)]
     assert alive == []  # every window closed so far in this process ended its workers
