@@ -161,18 +161,19 @@ def _machine(make_window, ui, grooms_dir, tmp_path):
             assert w.undo_action.text().replace("&", "").strip() == f"Undo {w.undo_stack.undoText()}".strip()
 
         def teardown(self) -> None:
-            """Undo to the start gives the start; Redo all the way gives the last state back."""
+            """Undo to the start gives the start; Redo back to where the sequence ended gives its
+            last state back (steps it ended by undoing stay undone: redoing them changes it)."""
             if not hasattr(self, "w"):
                 return
             w, stack = self.w, self.w.doc.stack
-            last = w.scene.result.points.tobytes()
+            last, at = w.scene.result.points.tobytes(), stack.index
             while stack.can_undo:
                 w.undo_action.trigger()
             assert w.doc.hair.state is self.start
             assert (
                 w.scene.result.points.tobytes() == GroomSide(UndoStack(), self.start).result.points.tobytes()
             )
-            while stack.can_redo:
+            while stack.index < at:
                 w.redo_action.trigger()
             assert w.scene.result.points.tobytes() == last
             w.close()
