@@ -85,8 +85,9 @@ class BrushSpec:
     selection brush makes the selection, and planting brushes make new strands).
     ``starts_anew``: a plain stroke replaces what the brush paints (Blender's Selection Paint:
     the selection is cleared at the stroke's first sample, then what it touches is selected), so
-    its effect reaches every shown strand, not only those under it. ``params``: its own sample
-    fields."""
+    its effect reaches every shown strand, not only those under it. ``straightens``: it takes
+    out bends (smooth): on straight strands it has nothing to do, as in Blender. ``params``: its
+    own sample fields."""
 
     name: str
     order: int
@@ -102,6 +103,7 @@ class BrushSpec:
     keeps_stroke: bool = False
     follows_selection: bool = True
     starts_anew: bool = False
+    straightens: bool = False
     params: tuple[Param, ...] = ()
 
 
