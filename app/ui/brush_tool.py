@@ -103,6 +103,11 @@ class BrushTool:
             self._lut = (self.falloff, tuple(falloff_lut(self.falloff).tolist()))
         return self._lut[1]
 
+    def shift_adds(self) -> bool:
+        """Shift+drag adds with the current brush (select: a plain drag starts a new selection,
+        Shift+drag adds to it, as in Blender) instead of panning the view."""
+        return bool(registry.spec_of(self.brush).starts_anew)
+
     def radius_at(self, pressure: float = 1.0) -> float:
         """The current brush's radius under a pen's ``pressure`` (the radius itself with the
         brush's radius toggle off, or at full pressure)."""
@@ -134,13 +139,15 @@ class BrushTool:
         invert: bool = False,
         start: bool = False,
         pressure: float = 1.0,
+        add: bool = False,
     ) -> list[AlignSample | BrushSample]:
         """The samples of one mouse move at ``cursor`` (groom units), mirrored one right after it
         with symmetry on. ``direction``: the mouse's motion in the world (comb needs one: none
         while it stands still). ``view``: the camera's direction, given to the engine with
         "front faces only". ``start``: the stroke's first move (a snake hook hooks there).
         ``pressure``: a pen's, in [0, 1] (1 for a mouse), scaling the radius and the strength as
-        the brush's toggles say; the samples carry it for the stroke log."""
+        the brush's toggles say; the samples carry it for the stroke log. ``add``: Shift held,
+        so a brush that starts anew (select: a plain stroke is a new selection) adds instead."""
         p = min(max(float(pressure), 0.0), 1.0)
         c = tuple(float(x) for x in cursor)
         d = tuple(float(x) for x in direction)
@@ -161,9 +168,11 @@ class BrushTool:
         if spec.needs_direction and math.hypot(*d) == 0.0:
             return []
         strength = self.signed_strength(invert, p)
+        anew = start and spec.starts_anew and strength > 0 and not add
         first = BRUSH.make(
             brush=name, direction=d, strength=strength, lut=self.lut(), start=start,
-            count=self.add_count, spacing=self.spacing, any_segment=self.delete_any_segment, **common,
+            count=self.add_count, spacing=self.spacing, any_segment=self.delete_any_segment,
+            new_selection=anew, **common,
         )  # fmt: skip
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 

@@ -30,7 +30,8 @@ def shortcut_sheet(window) -> str:
             rows.append(f"<tr><th colspan='2' align='left'>{html.escape(top)}</th></tr>")
         rows.append(f"<tr><td>{html.escape(rest)}</td><td><b>{html.escape(keys)}</b></td></tr>")
     mouse = (
-        ("Left-drag", "the current brush (Ctrl inverts it)"),
+        ("Left-drag", "the current brush (Ctrl inverts it; with Select, a new selection)"),
+        ("Shift+left-drag", "pan (with Select: add to the selection)"),
         ("Middle-drag or Alt+left-drag", "orbit (Shift: pan)"),
         ("Wheel", "zoom (Ctrl: brush size)"),
     )

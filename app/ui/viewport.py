@@ -2,7 +2,8 @@
 
 Navigation follows Blender/Maya: middle-drag or Alt+left-drag orbits (pans in 2-D), Shift with
 either pans, the wheel zooms, Ctrl+wheel resizes the brush. A plain left-drag is the current
-brush (Ctrl+left-drag inverts it, as in Blender: shrink for grow, erase for paint): the cursor is
+brush (Ctrl+left-drag inverts it, as in Blender: shrink for grow, erase for paint; with the Select
+brush a plain drag starts a new selection and Shift+left-drag adds to it instead of panning): the cursor is
 unprojected onto a plane facing the camera, through the hair under the mouse at the press (the
 vertex nearest to it on screen within the brush circle, of a front-facing strand with "front
 faces only"; the groom's centre when the circle holds none), so that a brush reaches the hair the
@@ -113,6 +114,7 @@ class Viewport(QOpenGLWidget):
         self._stroke_cursor: np.ndarray | None = None  # the last move's cursor (for the direction)
         self._stroke_depth: np.ndarray | None = None  # the stroke's cursor plane passes through it
         self._stroke_invert = False  # Ctrl held at the press
+        self._stroke_add = False  # Shift held at the press (select adds to the selection)
         self.stroke_touched = False  # the brush reached a strand during the current / last stroke
         self._hover: QPointF | None = None
         self._auto_frame = True  # follow the widget's size with frame-all until the user navigates
@@ -483,11 +485,15 @@ class Viewport(QOpenGLWidget):
         alt = bool(mods & Qt.KeyboardModifier.AltModifier)
         if button == Qt.MouseButton.MiddleButton or (button == Qt.MouseButton.LeftButton and alt):
             return "pan" if shift or self.camera.ortho else "orbit"
-        if button == Qt.MouseButton.LeftButton and shift:
+        if button == Qt.MouseButton.LeftButton and shift and not self._shift_adds():
             return "pan"
         if button == Qt.MouseButton.LeftButton:
             return "align"
         return None
+
+    def _shift_adds(self) -> bool:
+        """Shift+left-drag is the brush's "add" (select), not a pan: no target edits a pose."""
+        return self.brush_target is None and self.scene.tool.shift_adds()
 
     def is_dragging(self) -> bool:
         """A button is held for a stroke, a box or navigation."""
@@ -570,6 +576,7 @@ class Viewport(QOpenGLWidget):
             self._stroke_cursor = None
             self._stroke_depth = self.hair_under(event.position())
             self._stroke_invert = bool(event.modifiers() & Qt.KeyboardModifier.ControlModifier)
+            self._stroke_add = bool(event.modifiers() & Qt.KeyboardModifier.ShiftModifier)
             self.stroke_touched = False
             self.scene.moves.begin()
             self.stroke_started.emit()
@@ -648,7 +655,9 @@ class Viewport(QOpenGLWidget):
         direction = np.zeros(3) if last is None else cursor - last
         view = self.view_at(pos)
         # the engine runs it off this thread (app.ui.engine_thread): the circle moves on now
-        self.scene.moves.move(cursor, direction, view, self._stroke_invert, last is None, self.pressure)
+        self.scene.moves.move(
+            cursor, direction, view, self._stroke_invert, last is None, self.pressure, self._stroke_add
+        )
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         if self._from_pen(event):

@@ -249,12 +249,14 @@ def _sample(
     after it, the strands whose clump strength it changed). ``aligned``: the stroked groom
     before the batch (its topology, metadata and normals)."""
     none = np.zeros(0, np.int64)
-    if isinstance(sample, SelectionSample):  # no strand moves: on the whole groom
+    # a selection step, or a sample that reaches past its brush (a new selection): on the whole
+    # groom (they move no strand)
+    brush = None if isinstance(sample, SelectionSample) else registry.brush_of(registry.name_of(sample))
+    if brush is None or brush.reaches_every_strand(sample):
         _, state, memory = apply_sample(setting, aligned.with_points(cur.points), state, memory, sample)
         return state, memory, none
     local, top = moves.clump, aligned.topology
     assert local is not None and moves.grid_points is not None
-    brush = registry.brush_of(registry.name_of(sample))
     memory = memory_for(brush, memory)
     brush.check(sample)
     reach = float(sample.radius) * (1.0 + 1e-6)  # a little wider: the brush itself decides

@@ -128,6 +128,8 @@ BRUSH = SampleType("brush", BrushSample, "brush", (
     Field("view", "view", None, "view", column="view"),
     Field("pressure", "number", 1.0, "pressure", column="pressure", low=0.0, high=1.0),
     Field("start", "flag", False, "start", column="start", used_by=("snake_hook",)),
+    Field("new_selection", "flag", False, "new_selection", column="new_selection", used_by=("select",),
+          quiet=True),
 ))  # fmt: skip
 
 #: The paper's align samples: ``intensity`` is a stroke log's ``strength``, ``mode`` its params'.

@@ -22,8 +22,10 @@ A stroke log is a JSON list of strokes, in groom units::
   nearest the cursor, drawn from ``params.seed``, default 0, and the cursor; needs a head) or
   ``density`` (removes and plants strands under the brush until the roots are
   ``params.spacing`` apart, in groom units; ``params.seed`` as add's; needs a head) or
-  ``select`` (> 0 selects the strands touched, < 0 deselects them; hidden strands stay as
-  they are).
+  ``select`` (> 0 selects the strands touched, < 0 deselects them; a sample with
+  ``"new_selection": true``, a plain stroke's first, deselects every shown strand first, as
+  Blender's Selection Paint starts a new selection; without it the stroke adds, as every log
+  before it meant; hidden strands stay as they are).
 - ``only_selected`` (per stroke, optional, default false): the stroke leaves the strands that
   are not selected as they are (the studio's "Affect selection only"). Hidden strands are left
   alone by every stroke.
@@ -32,6 +34,9 @@ A stroke log is a JSON list of strokes, in groom units::
 - ``start`` (per sample, optional): true where a stroke begins (a snake hook hooks its strands
   there); missing: true for a stroke's first sample only. Written for snake hooks, whose
   mirrored first sample is a start too.
+- ``new_selection`` (per sample, optional, default false; select only): true where a select
+  stroke starts a new selection (the studio's plain drag, at its first sample): every shown
+  strand is deselected before the sample selects. Written only where true.
 - ``pressure`` (per sample, optional, default 1.0): the pen's pressure in [0, 1] at that
   sample (a mouse presses 1.0). ``radius`` and ``strength`` are what the brush used there, the
   pressure already applied (the studio scales them by it where the brush's pressure toggles
@@ -116,6 +121,7 @@ class StrokeSample:
     view: tuple[float, float, float] | None = None
     start: bool | None = None  # None: the stroke's first sample starts it
     pressure: float = 1.0  # the pen's, already applied to radius and strength (1: a mouse's)
+    new_selection: bool = False  # a select sample starts a new selection (False: it adds)
 
 
 @dataclass(frozen=True)
@@ -174,7 +180,8 @@ class Stroke:
         for i, s in enumerate(self.samples):
             values = dict(shared)
             for f in t.at("sample"):
-                values[f.name] = getattr(s, f.json)
+                value = getattr(s, f.json)
+                values[f.name] = f.default if value is None and f.quiet else value
             if "start" in values:  # missing: the stroke's first sample starts it
                 values["start"] = (i == 0) if s.start is None else s.start
             sample = t.make(**{k: v for k, v in values.items() if k in _names(t)})
@@ -217,11 +224,12 @@ LOG_SAMPLE = BRUSH.at("sample")
 
 
 def _sample_dict(s: StrokeSample) -> dict:
-    """A log sample's JSON object: every field, a start only where one is stated."""
+    """A log sample's JSON object: every field, a start only where one is stated, a quiet flag
+    only where it is not its default."""
     out: dict[str, Any] = {}
     for f in LOG_SAMPLE:
         value = getattr(s, f.json)
-        if f.kind == "flag" and value is None:
+        if f.kind == "flag" and (value is None or (f.quiet and value == f.default)):
             continue
         out[f.json] = list(value) if f.kind in ("vector", "view") and value is not None else value
     return out
@@ -301,9 +309,11 @@ def strokes_from_log(
         falloff = _falloff_of(s.lut) if t is BRUSH else "smooth"
         flags = {f.json: getattr(s, f.name) for f in t.at("stroke") if f.kind == "flag"}
         start = Stroke(by, (sample,), falloff=falloff, params=params_of(t, by, s), **flags)
-        # a snake hook's start (not its mirror's) begins a new stroke, with its own strands
+        # a snake hook's start (not its mirror's) begins a new stroke, with its own strands; so
+        # does a new selection
         last = runs[-1][1] if runs else None
         split = bool(sample.start) and isinstance(last, Stroke) and not last.samples[-1].start
+        split = split or bool(sample.new_selection)
         if runs and runs[-1][0] == key and not split:
             last = runs[-1][1]
             runs[-1] = (key, replace(last, samples=(*last.samples, sample)))

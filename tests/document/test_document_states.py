@@ -2,7 +2,8 @@
 
 Rules are the artist's actions. On the groom (a few dozen strands on a tiny head): strokes of
 every registered brush with random radius, strength, falloff, direction, symmetry, pen pressure
-and its toggles, front faces only and "affect selection only"; selection steps (all, none,
+and its toggles, front faces only, "affect selection only" and Ctrl or Shift held (a select
+stroke: deselect, or add instead of a new selection); selection steps (all, none,
 invert, box, hide and reveal); the up axis; the head mesh taken off and put back; render hair
 grown and removed; engine parameters; the camera; opening another groom. On the animation side:
 open a capture (or another one), apply an anime cycle, simulate, close the animation (each
@@ -257,12 +258,15 @@ class DocumentMachine(RuleBasedStateMachine):
         pressure_radius=st.booleans(),
         pressure_strength=st.booleans(),
         invert=st.booleans(),
+        add=st.booleans(),
         front_only=st.booleans(),
         only_selected=st.booleans(),
     )
     def stroke(self, data, brush, moves, radius, strength, falloff, symmetry, pressures,
-               pressure_radius, pressure_strength, invert, front_only, only_selected) -> None:  # fmt: skip
-        """One stroke of a brush: its moves as the studio samples them (BrushTool), one step."""
+               pressure_radius, pressure_strength, invert, add, front_only,
+               only_selected) -> None:  # fmt: skip
+        """One stroke of a brush: its moves as the studio samples them (BrushTool), one step
+        (``add``: Shift held, so a select stroke adds instead of starting a new selection)."""
         tool = BrushTool(brush=brush, falloff=falloff, symmetry=symmetry, front_only=front_only,
                          only_selected=only_selected, add_count=data.draw(st.integers(1, 3)))  # fmt: skip
         tool.reset_radius(radius)
@@ -280,7 +284,7 @@ class DocumentMachine(RuleBasedStateMachine):
         before, index = side.state, self.doc.stack.index
         for k in range(moves):
             step = np.array(data.draw(st.tuples(*[st.floats(-0.3, 0.3)] * 3)))
-            moves_made = tool.samples(at, step, view, 0.0, invert, k == 0, pressures[k])
+            moves_made = tool.samples(at, step, view, 0.0, invert, k == 0, pressures[k], add)
             at = at + step
             if not moves_made:
                 continue

@@ -54,6 +54,10 @@ def moves(groom):
     out.append([SelectionSample("hide_selected")])
     out.append([b("comb", at[1], (0.02 * ext, 0.0, 0.0), 0.8)])  # the hidden ones stay
     out.append([SelectionSample("reveal"), SelectionSample("all")])
+    anew = b("select", at[3], s=1.0, new_selection=True)  # a plain stroke: a new selection,
+    out.append([anew, anew.mirrored(0.0)])  # which reaches the strands away from the brush too
+    out.append([b("comb", at[3], (0.02 * ext, 0.0, 0.0), 0.8, only_selected=True)])
+    out.append([SelectionSample("all")])
     out.append([b("mask", at[2], s=-1.0)])
     out.append([b("smooth", at[2], s=0.9)])
     return out

@@ -279,3 +279,60 @@ def test_the_selection_survives_a_project_round_trip(tmp_path):
     pf.save(tmp_path / "o.hairproj", pf.Project.from_pipeline(older))
     with zipfile.ZipFile(tmp_path / "o.hairproj") as z:
         assert json.loads(z.read("manifest.json"))["version"] == 2
+
+
+def test_a_new_selection_keeps_only_what_its_stroke_touches(comb):
+    """Blender's Selection Paint: a plain stroke's first sample (``new_selection``) deselects
+    every shown strand, then selects what it touches; its later samples, its mirrored first
+    sample and a stroke without the flag (Shift, every older log) add; hidden strands stay."""
+    pipe = FrozenPipeline(comb, PLAIN)
+    pipe.apply_samples([box(0.9, -1.0, 1.1, 0.1), SelectionSample("hide_selected"), SelectionSample("all")])
+    hidden = pipe.hidden
+    assert hidden.sum() == 5 and (pipe.selected == ~hidden).all()
+    first = replace(brush("select", (0.4, -0.25, 0.4), 0.05, 1.0), new_selection=True)
+    pipe.brush(first)
+    one = np.hypot(comb.roots[:, 0] - 0.4, comb.roots[:, 2] - 0.4) < 0.05
+    np.testing.assert_array_equal(pipe.selected, one)
+    mirror = first.mirrored(0.5)  # (0.6, 0.4): the same move's second sample adds
+    assert not mirror.new_selection
+    pipe.brush(mirror)
+    np.testing.assert_array_equal(
+        pipe.selected, one | (np.hypot(comb.roots[:, 0] - 0.6, comb.roots[:, 2] - 0.4) < 0.05)
+    )
+    pipe.brush(brush("select", (0.5, -0.25, 0.4), 2.0, 1.0))  # over everything: the shown only
+    np.testing.assert_array_equal(pipe.selected, ~hidden)
+    pipe.brush(replace(brush("select", (1.0, -0.25, 0.4), 0.05, 1.0), new_selection=True))  # on hidden ones
+    assert not pipe.selected.any() and (pipe.hidden == hidden).all()
+
+
+def test_a_new_selection_is_written_on_its_first_sample_only_and_older_logs_add(tmp_path):
+    from hairtool import project as pf
+
+    groom = samples.scalp(40, 6, seed=3)
+    c = tuple(float(x) for x in groom.tips[7])
+    first = BrushSample("select", c, (0.0, 0.0, 0.0), 0.3, 1.0, LUT, new_selection=True)
+    pipe = FrozenPipeline(groom, PLAIN)
+    log = [first, first.mirrored(0.0), replace(first, cursor=(c[0] + 0.1, c[1], c[2]), new_selection=False)]
+    again = replace(first, cursor=(c[0], c[1] + 0.1, c[2]))  # a second plain stroke right after
+    pipe.apply_samples([*log, again])
+    steps = strokes_from_log(pipe.strokes)
+    assert [len(s.samples) for s in steps] == [3, 1]  # each new selection begins a stroke
+    write_strokes(tmp_path / "s.json", steps)
+    raw = json.loads((tmp_path / "s.json").read_text())
+    assert [[x.get("new_selection") for x in r["samples"]] for r in raw] == [[True, None, None], [True]]
+    replayed = [s for st in read_strokes(tmp_path / "s.json") for s in st.pipeline_samples(0.0)]
+    assert tuple(replayed) == pipe.strokes
+    del raw[0]["samples"][0]["new_selection"]  # as a log written before the choice: it adds
+    older = stroke_from_dict(raw[0]).pipeline_samples(0.0)
+    assert not any(s.new_selection for s in older)
+    pf.save(tmp_path / "p.hairproj", pf.Project.from_pipeline(pipe))
+    back = pf.load(tmp_path / "p.hairproj")
+    assert back.strokes == pipe.strokes
+    np.testing.assert_array_equal(back.pipeline().selected, pipe.selected)
+
+
+def test_a_new_selection_that_is_not_true_or_false_is_refused_naming_it(tmp_path):
+    sample = {"cursor": [0, 0, 0], "radius": 1.0, "strength": 1.0, "new_selection": "yes"}
+    (tmp_path / "bad.json").write_text(json.dumps([{"brush": "select", "samples": [sample]}]))
+    with pytest.raises(FormatError, match=r"strokes\[0\]\.samples\[0\]\.new_selection"):
+        read_strokes(tmp_path / "bad.json")

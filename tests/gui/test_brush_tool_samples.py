@@ -38,8 +38,8 @@ def moves(draw):
     per_move = []
     for i in range(draw(st.integers(1, 3))):
         cursor, direction, view = draw(_vector), draw(_vector), draw(_vector)
-        invert, pressure = draw(st.booleans()), draw(st.floats(0.0, 1.0))
-        per_move.append(tool.samples(cursor, direction, view, draw(_coord), invert, i == 0, pressure))
+        invert, pressure, add = draw(st.booleans()), draw(st.floats(0.0, 1.0)), draw(st.booleans())
+        per_move.append(tool.samples(cursor, direction, view, draw(_coord), invert, i == 0, pressure, add))
     return per_move
 
 
@@ -60,3 +60,23 @@ def test_the_studios_samples_follow_their_description_and_round_trip(tmp_path_fa
     assert pf.load(folder / "p.hairproj").strokes == log
     write_strokes(folder / "s.json", strokes_from_log(log))
     assert tuple(s for stroke in read_strokes(folder / "s.json") for s in stroke.pipeline_samples(0.0)) == log
+
+
+def test_a_plain_select_drag_starts_a_new_selection_shift_adds_and_ctrl_deselects():
+    """As Blender's Selection Paint: the first move of a plain drag starts a new selection (not
+    its mirror, nor the later moves); Shift+drag adds, Ctrl+drag deselects. Only a brush whose
+    spec starts anew takes Shift from the view's pan."""
+    tool = BrushTool(symmetry=True)
+    tool.reset_radius(0.1)
+    tool.set_brush("select")
+    assert tool.shift_adds()
+    at, d = (0.3, 0.0, 0.0), (0.1, 0.0, 0.0)
+    first, mirror = tool.samples(at, d, None, 0.0, start=True)
+    assert first.new_selection and first.strength > 0 and not mirror.new_selection
+    assert not any(s.new_selection for s in tool.samples(at, d, None, 0.0))
+    shift = tool.samples(at, d, None, 0.0, start=True, add=True)[0]
+    assert shift.strength > 0 and not shift.new_selection
+    ctrl = tool.samples(at, d, None, 0.0, invert=True, start=True)[0]
+    assert ctrl.strength < 0 and not ctrl.new_selection
+    tool.set_brush("mask")
+    assert not tool.shift_adds() and not tool.samples(at, d, None, 0.0, start=True)[0].new_selection

@@ -29,6 +29,7 @@ from hypothesis.stateful import (
     rule,
     run_state_machine_as_test,
 )
+from PySide6.QtCore import Qt
 
 from app.document.groom import GroomSide
 from app.document.undo import UndoStack
@@ -67,12 +68,16 @@ def _machine(make_window, ui, grooms_dir, tmp_path):
 
         # -- the artist's actions ----------------------------------------------------------
         @rule(
-            brush=st.sampled_from(["align", "comb", "length", "mask", "clump", "smooth", "puff", "cut"]),
+            brush=st.sampled_from(
+                ["align", "comb", "length", "mask", "clump", "smooth", "puff", "cut", "select"]
+            ),
             strand=st.integers(0, 29),
             offset=st.tuples(st.floats(-40, 40), st.floats(-40, 40)),
+            held=st.sampled_from([None, "shift", "ctrl"]),
         )
-        def stroke(self, brush, strand, offset) -> None:
-            """A left-drag in the viewport from a strand's tip (the engine thread runs it)."""
+        def stroke(self, brush, strand, offset, held) -> None:
+            """A left-drag in the viewport from a strand's tip (the engine thread runs it); a
+            select drag with Shift (add) or Ctrl (deselect) held, or neither (a new selection)."""
             assert brush in brushes()
             w = self.w
             w.scene.set_brush(brush)
@@ -80,7 +85,9 @@ def _machine(make_window, ui, grooms_dir, tmp_path):
                 w.scene.result.tips[strand % w.scene.result.strand_count : 1 + strand]
             )[0]
             index = w.undo_stack.count()
-            ui.drag(w.viewport, start, start + np.array(offset), steps=3)
+            mods = {"shift": Qt.KeyboardModifier.ShiftModifier, "ctrl": Qt.KeyboardModifier.ControlModifier}
+            modifiers = mods.get(held) if brush == "select" else None
+            ui.drag(w.viewport, start, start + np.array(offset), steps=3, modifiers=modifiers)
             assert w.undo_stack.count() <= index + 1  # one stroke, one step at most
 
         @rule(op=st.sampled_from(OPS))
@@ -161,18 +168,19 @@ def _machine(make_window, ui, grooms_dir, tmp_path):
             assert w.undo_action.text().replace("&", "").strip() == f"Undo {w.undo_stack.undoText()}".strip()
 
         def teardown(self) -> None:
-            """Undo to the start gives the start; Redo all the way gives the last state back."""
+            """Undo to the start gives the start; Redo back to where the sequence ended gives its
+            last state back (steps it ended by undoing stay undone: redoing them changes it)."""
             if not hasattr(self, "w"):
                 return
             w, stack = self.w, self.w.doc.stack
-            last = w.scene.result.points.tobytes()
+            last, at = w.scene.result.points.tobytes(), stack.index
             while stack.can_undo:
                 w.undo_action.trigger()
             assert w.doc.hair.state is self.start
             assert (
                 w.scene.result.points.tobytes() == GroomSide(UndoStack(), self.start).result.points.tobytes()
             )
-            while stack.can_redo:
+            while stack.index < at:
                 w.redo_action.trigger()
             assert w.scene.result.points.tobytes() == last
             w.close()

@@ -1,8 +1,9 @@
-"""Selection and hiding through the studio: the Select brush paints the selection (Ctrl
-deselects), B then a drag box-selects, A / Alt+A / Ctrl+I select all, none and invert, H /
-Shift+H / Alt+H hide and reveal (hidden strands are not drawn, unselected ones dimmed), a brush
-with Affect selection only leaves the unselected strands alone, each step is one undo step, and
-a saved project reopens with the same selection, hiding and toggle."""
+"""Selection and hiding through the studio: the Select brush paints the selection (a plain
+drag starts a new one, Shift adds, Ctrl deselects), B then a drag box-selects, A / Alt+A /
+Ctrl+I select all, none and invert, H / Shift+H / Alt+H hide and reveal (hidden strands are not
+drawn, unselected ones dimmed), a brush with Affect selection only leaves the unselected strands
+alone, each step is one undo step, and a saved project reopens with the same selection, hiding
+and toggle."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from hairtool import samples
 pytestmark = pytest.mark.gui
 
 CTRL = Qt.KeyboardModifier.ControlModifier
+SHIFT = Qt.KeyboardModifier.ShiftModifier
 
 
 def flat(make_window):
@@ -114,6 +116,39 @@ def test_paint_select_and_brush_only_the_selection(ui, make_window):
     ui.drag(v, start, start + np.array([60.0, 0.0]), steps=6)
     moved = np.any(s.result.points != before, axis=1)
     assert np.maximum.reduceat(moved, s.result.offsets[:-1]).all()
+
+
+def test_a_select_drag_starts_a_new_selection_shift_adds_and_ctrl_deselects(ui, make_window):
+    """Blender's Selection Paint on a new groom (every strand selected): a plain drag leaves only
+    the strands it touched selected, Shift+drag adds others without panning the view, Ctrl+drag
+    takes some away; each drag one undo step, undone in turn."""
+    w = flat(make_window)
+    s, v = w.scene, w.viewport
+    s.set_brush("select")
+    x = columns(w)
+    mid = v.project(s.result.points[s.result.offsets[:-1] + 5])
+    s.set_radius(0.2 * float(np.ptp(s.result.roots[:, 0])))
+    left, right = mid[int(np.argmin(x))], mid[int(np.argmax(x))]
+    assert s.selected.all()
+    ui.drag(v, left, left + np.array([1.0, 0.0]), steps=2)
+    first = s.selected.copy()
+    assert 0 < first.sum() < 0.5 * s.result.strand_count
+    assert first[int(np.argmin(x))] and not first[int(np.argmax(x))]
+    eye = v.camera.view_projection(v.width(), v.height()).copy()
+    ui.drag(v, right, right + np.array([1.0, 0.0]), steps=2, modifiers=SHIFT)
+    assert np.array_equal(v.camera.view_projection(v.width(), v.height()), eye)  # no pan
+    both = s.selected.copy()
+    assert (both >= first).all() and both[int(np.argmax(x))] and both.sum() < s.result.strand_count
+    ui.drag(v, left, left + np.array([1.0, 0.0]), steps=2, modifiers=CTRL)
+    assert not s.selected[int(np.argmin(x))] and s.selected[int(np.argmax(x))]
+    assert w.undo_stack.undoText() == "Select stroke"
+    for was in (both, first):
+        w.undo_action.trigger()
+        np.testing.assert_array_equal(s.selected, was)
+    s.set_brush("comb")  # any other brush: Shift+left-drag pans, as before
+    ui.drag(v, left, left + np.array([30.0, 0.0]), steps=2, modifiers=SHIFT)
+    assert not np.array_equal(v.camera.view_projection(v.width(), v.height()), eye)
+    np.testing.assert_array_equal(s.selected, first)
 
 
 def test_unselected_strands_are_dimmed_and_a_brush_with_nothing_selected_says_why(ui, make_window):

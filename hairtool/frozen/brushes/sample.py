@@ -31,7 +31,10 @@ class BrushSample:
     (1 for a mouse), already applied to ``radius`` and ``strength`` where the brush's pressure
     toggles said so: kept so a stroke log records it. ``any_segment``: a delete sample removes
     the strands with any segment under it (Blender's rule), else those whose root is (the rule
-    of every log written before the choice, so its default)."""
+    of every log written before the choice, so its default). ``new_selection``: a select sample
+    that starts a new selection: the shown strands are deselected before it selects (a plain
+    stroke's first sample, as Blender's Selection Paint; not its mirror, which adds to what the
+    first selected); False adds to the selection (what every log written before it meant)."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -48,11 +51,15 @@ class BrushSample:
     only_selected: bool = False
     pressure: float = 1.0
     any_segment: bool = False
+    new_selection: bool = False
 
     def mirrored(self, plane_x: float) -> BrushSample:
+        """The sample across the plane x = ``plane_x``, the second sample of the same move (so
+        it never starts a new selection: that would clear what the first one selected)."""
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
-        return replace(self, cursor=cursor, direction=direction, view=mirrored_view(self.view))
+        view = mirrored_view(self.view)
+        return replace(self, cursor=cursor, direction=direction, view=view, new_selection=False)
 
 
 def mirrored_view(view: tuple[float, float, float] | None) -> tuple[float, float, float] | None:

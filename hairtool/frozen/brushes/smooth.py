@@ -19,11 +19,12 @@ SPEC = BrushSpec(
     name="smooth",
     order=2,
     local=True,
+    straightens=True,
     studio=Studio(
         "Smooth",
         "S",
         "Takes out kinks and curls; roots stay put (a Laplacian step, lengths kept)",
-        0.5,
+        1.0,  # the full step at the brush's centre (0.5 took out a fifth of a crinkle per drag)
         place=2,
     ),
 )

@@ -83,7 +83,11 @@ class BrushSpec:
     ``keeps_stroke``: it remembers state over a stroke's samples (:class:`StrokeMemory`).
     ``follows_selection``: "affect selection only" keeps it to the selected strands (the
     selection brush makes the selection, and planting brushes make new strands).
-    ``params``: its own sample fields."""
+    ``starts_anew``: a plain stroke replaces what the brush paints (Blender's Selection Paint:
+    the selection is cleared at the stroke's first sample, then what it touches is selected), so
+    its effect reaches every shown strand, not only those under it. ``straightens``: it takes
+    out bends (smooth): on straight strands it has nothing to do, as in Blender. ``params``: its
+    own sample fields."""
 
     name: str
     order: int
@@ -98,6 +102,8 @@ class BrushSpec:
     needs_direction: bool = False
     keeps_stroke: bool = False
     follows_selection: bool = True
+    starts_anew: bool = False
+    straightens: bool = False
     params: tuple[Param, ...] = ()
 
 
@@ -168,6 +174,11 @@ class Brush:
 
     def reference(self, ctx: StrokeContext, g: Groom, sample) -> Groom | None:
         return None
+
+    def reaches_every_strand(self, sample) -> bool:
+        """Whether ``sample`` changes strands beyond those under it (a new selection clears the
+        others): a brush-local move then runs it on the whole groom."""
+        return False
 
 
 class StrandMove(Brush):
