@@ -35,6 +35,7 @@ from app.document.groom import GroomSide
 from app.document.undo import UndoStack
 from app.ui.brush_tool import brushes
 from hairtool import samples
+from hairtool.errors import ParameterError
 from hairtool.guides.binding import bind_scalp
 from hairtool.io.obj import read_mesh
 
@@ -119,7 +120,12 @@ def _machine(make_window, ui, grooms_dir, tmp_path):
         def render_hair(self, on, clump) -> None:
             s = self.w.scene
             if on and s.mesh is not None and s.result.topology == s.rest.topology:
-                s.set_binding(bind_scalp(s.rest, s.mesh, 40, seed=1), clump=clump, text="Grow render hair")
+                try:  # (the head is Sintel's: an up-axis switch can leave no scalp near the roots,
+                    # which the studio refuses with a line and this rule skips)
+                    binding = bind_scalp(s.rest, s.mesh, 40, seed=1)
+                except ParameterError:
+                    return
+                s.set_binding(binding, clump=clump, text="Grow render hair")
             else:
                 self.w.remove_render_hair()
 
