@@ -8,7 +8,9 @@ the manifest's ``strokes`` section names the groups stored: ``brushes`` (the bru
 and falloff columns, with ``falloffs``, the table of distinct falloff curves), ``views``,
 ``collide``, ``plants`` (add and density's count, seed and spacing), ``starts``,
 ``only_selected``, ``pressure``, ``any_segment`` (a delete's rule: stored only where a
-sample takes Blender's, so older projects, which meant the root rule, read as they did) and
+sample takes Blender's, so older projects, which meant the root rule, read as they did),
+``visible`` (front faces only by sight: stored only where a sample judges so, so older
+projects, which judged by the root normal, read as they did) and
 ``selection`` (a step's op, and a box's matrix, rectangle
 and mode in ``box``). Choices are stored as indices into a list: the align modes in ``modes``,
 the brushes in ``brushes``, the steps in ``selection``.
@@ -57,11 +59,13 @@ COLUMNS = (
     Column("only_selected", "only_selected", np.int64, 0, 0),
     Column("pressure", "pressure", np.float64, 0, 1.0),
     Column("any_segment", "any_segment", np.int64, 0, 0),
+    Column("visible", "visible", np.int64, 0, 0),
     Column("selection", "selection", np.int64, 0, -1),
     Column("box", "selection", np.float64, BOX_WIDTH, (0.0,) * BOX_WIDTH),
 )
 GROUPS = (
-    "brushes", "views", "collide", "plants", "starts", "only_selected", "pressure", "any_segment", "selection"
+    "brushes", "views", "collide", "plants", "starts", "only_selected", "pressure", "any_segment", "visible",
+    "selection",
 )  # fmt: skip
 
 

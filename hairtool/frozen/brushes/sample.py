@@ -31,7 +31,11 @@ class BrushSample:
     (1 for a mouse), already applied to ``radius`` and ``strength`` where the brush's pressure
     toggles said so: kept so a stroke log records it. ``any_segment``: a delete sample removes
     the strands with any segment under it (Blender's rule), else those whose root is (the rule
-    of every log written before the choice, so its default)."""
+    of every log written before the choice, so its default). ``visible``: with a ``view``,
+    the strands kept are those the head does not hide from the camera under the brush
+    (:mod:`~hairtool.frozen.brushes.sight`: the studio's rule, needing a head mesh), else those
+    whose root normal faces the camera (the rule of every log written before it, so its
+    default; the rule without a head mesh too)."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -48,6 +52,7 @@ class BrushSample:
     only_selected: bool = False
     pressure: float = 1.0
     any_segment: bool = False
+    visible: bool = False
 
     def mirrored(self, plane_x: float) -> BrushSample:
         c, d = self.cursor, self.direction
@@ -111,7 +116,15 @@ def check_sample(sample: BrushSample) -> BrushSample:
     if len(sample.lut) != LUT_SIZE:
         raise ParameterError("falloff", f"{len(sample.lut)} samples", f"{LUT_SIZE}")
     check_pressure(sample.pressure)
+    check_flag("visible", sample.visible)
     return sample
+
+
+def check_flag(name: str, value: object) -> bool:
+    """True or False (ParameterError naming ``name`` for anything else)."""
+    if not isinstance(value, bool | np.bool_):
+        raise ParameterError(name, value, "true or false")
+    return bool(value)
 
 
 def check_pressure(pressure: object) -> float:
