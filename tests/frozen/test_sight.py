@@ -1,10 +1,12 @@
 """Front faces only by sight (:mod:`hairtool.frozen.brushes.sight`): on a round head, a mask
 dab never paints a strand the head hides from the camera and paints every one in sight under
 the brush, whichever way the camera looks; a sample without ``visible`` keeps the root-normal
-rule (older logs replay as they did); the kernel equals its numpy twin."""
+rule (older logs replay as they did) and a stroke log names the rule only where it is by sight;
+the kernels equal their numpy twins."""
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -19,6 +21,7 @@ from hairtool.frozen.brushes.sight import (
     hidden_strands_reference,
 )
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+from hairtool.frozen.strokes import stroke_from_dict, strokes_from_log
 from hairtool.groom import Groom
 from hairtool.guides.planting import HeadSurface
 from hairtool.io.obj import Mesh
@@ -132,3 +135,13 @@ def test_a_sample_without_visible_keeps_the_root_normal_rule():
     new.brush(replace(dab, visible=True))
     # on a round head a root facing the camera is in sight; by sight, the silhouette's too
     assert not (old.locked & ~new.locked).any() and new.locked.sum() > old.locked.sum()
+
+
+def test_a_stroke_log_says_visible_only_where_a_stroke_judges_by_sight():
+    dab = BrushSample("mask", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.5, 1.0, LUT, (0.0, 0.0, -1.0))
+    old, new = strokes_from_log([dab]), strokes_from_log([replace(dab, visible=True)])
+    assert "visible" not in old[0].to_dict()  # a log without it writes as before the field
+    assert new[0].to_dict()["visible"] is True
+    back = stroke_from_dict(json.loads(json.dumps(new[0].to_dict())))
+    assert [s.visible for s in back.pipeline_samples(0.0)] == [True]
+    assert [s.visible for s in stroke_from_dict(old[0].to_dict()).pipeline_samples(0.0)] == [False]
