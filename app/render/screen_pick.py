@@ -10,6 +10,8 @@ choice: the smallest distance, ties to the lower vertex index).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from numba import prange
 from numpy.typing import ArrayLike
@@ -73,3 +75,28 @@ def nearest_on_screen_reference(
     if skip is not None:
         near &= ~np.asarray(skip)[strand]
     return int(np.argmin(np.where(near, d2, np.inf))) if near.any() else -1
+
+
+PICKS = 16  # the strands a press tries, nearest first, for one the head does not hide
+
+
+def nearest_in_sight(
+    points: np.ndarray,
+    view_projection: ArrayLike,
+    size: tuple[float, float],
+    cursor: tuple[float, float],
+    radius_px: float,
+    strand: np.ndarray,
+    hidden: Callable[[np.ndarray], bool],
+) -> int:
+    """:func:`nearest_on_screen` over the vertices in sight: where ``hidden(point)`` says the
+    head hides the nearest vertex from the camera, its strand is left out and the next nearest
+    tried, at most :data:`PICKS` strands (a press on the crown seen from the face finds the
+    crown's hair, not the hair behind the head); −1 for none."""
+    skip = np.zeros(int(strand[-1]) + 1 if len(strand) else 0, np.bool_)
+    for _ in range(PICKS):
+        i = nearest_on_screen(points, view_projection, size, cursor, radius_px, strand, skip)
+        if i < 0 or not hidden(points[i]):
+            return i
+        skip[strand[i]] = True
+    return -1

@@ -158,7 +158,11 @@ class BrushTool:
         # the sample's fields by name (hairtool.frozen.sample_schema): those a brush does not
         # use (add's count, density's spacing, delete's rule, a snake hook's start) keep their
         # defaults there
-        common = {"cursor": c, "radius": r, "view": v, "collide": hit, "only_selected": only, "pressure": p}
+        # front faces only by sight (the head hides what lies behind it; hairtool.frozen.brushes.sight)
+        common = {
+            "cursor": c, "radius": r, "view": v, "collide": hit, "only_selected": only, "pressure": p,
+            "visible": v is not None,
+        }  # fmt: skip
         if name == "align":
             first = ALIGN.make(intensity=self.strength_at(p), mode=self.align_mode, **common)
             if not self.symmetry:

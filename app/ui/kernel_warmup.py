@@ -184,10 +184,12 @@ def _engine_step() -> None:
 
 def _press_step(pipe) -> None:
     """What a press asks before a stroke: the vertex nearest the mouse on screen, front faces
-    only or not (the viewport's hair_under, without a viewport)."""
+    only (by root normal, or by sight on a head) or not (the viewport's hair_under, without a
+    viewport)."""
     from app.render.camera import Camera
     from app.render.screen_pick import nearest_on_screen
     from hairtool.frozen.brushes import facing_away
+    from hairtool.frozen.brushes.sight import hidden_points
 
     result = pipe.result
     view = Camera().view_projection(640, 480)
@@ -196,6 +198,9 @@ def _press_step(pipe) -> None:
         nearest_on_screen(
             result.points, view, (640, 480), (320.0, 240.0), 40.0, result.topology.strand_index, skip
         )
+    grid = getattr(pipe.surface, "face_grid", None)
+    if grid is not None:
+        hidden_points(result.points[:1], (0.0, 0.0, -1.0), grid)
 
 
 def _head_step() -> None:

@@ -47,12 +47,13 @@ from app.render.camera import Camera
 from app.render.drawn import Drawn
 from app.render.last_image import LastImage
 from app.render.offscreen import Overlays
-from app.render.screen_pick import nearest_on_screen
+from app.render.screen_pick import nearest_in_sight, nearest_on_screen
 from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.brush_sizing import CanvasSizing, pen_pressure
 from app.ui.drawn import drawn
 from app.ui.scene import Scene
 from hairtool.frozen.brushes import NEED_SURFACE, facing_away
+from hairtool.frozen.brushes.sight import hidden_points
 from hairtool.frozen.sample_schema import SELECTION
 from hairtool.frozen.selection import SelectionSample
 
@@ -639,12 +640,19 @@ class Viewport(QOpenGLWidget):
                 return hit
         pts = s.result.points
         r_px = s.radius * self.camera.pixels_per_unit_at(s.centre, self.height())
-        away = None
-        if s.tool.front_only and s.pipeline is not None:
-            away = facing_away(s.pipeline.strand_normals, self.view_at(pos))
-        size = (self.width(), self.height())
+        size, mouse = (self.width(), self.height()), (pos.x(), pos.y())
+        strand = s.result.topology.strand_index
         vp = self.camera.view_projection(*size)
-        i = nearest_on_screen(pts, vp, size, (pos.x(), pos.y()), r_px, s.result.topology.strand_index, away)
+        grid = getattr(surface, "face_grid", None)
+        if s.tool.front_only and grid is not None:  # by sight, as the stroke's samples judge
+            view = self.view_at(pos)
+            hides = lambda p: bool(hidden_points(p[None], view, grid)[0])  # noqa: E731
+            i = nearest_in_sight(pts, vp, size, mouse, r_px, strand, hides)
+        else:
+            away = None
+            if s.tool.front_only and s.pipeline is not None:
+                away = facing_away(s.pipeline.strand_normals, self.view_at(pos))
+            i = nearest_on_screen(pts, vp, size, mouse, r_px, strand, away)
         if i < 0:
             return np.asarray(s.centre, np.float64)
         return pts[i].astype(np.float64)

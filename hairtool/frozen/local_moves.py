@@ -268,7 +268,7 @@ def _sample(
     with threads_for(vids.size):
         meta = aligned.metadata.subset(cand)  # (in the scene's frame; its prims' share)
         sub = Groom(cur.points[vids], top.counts[cand], metadata=meta)
-        away = setting.away(sample.view, lambda: normals[cand])  # type: ignore[index]
+        away = setting.away(sample, sub, lambda: normals[cand])  # type: ignore[index]
         was = state.subset(cand)
         ctx = setting.context(was, memory, away, planar)
         out = brush.apply(ctx, sub, sample)

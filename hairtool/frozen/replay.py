@@ -21,6 +21,7 @@ from hairtool.frozen.brushes import registry
 from hairtool.frozen.brushes.align import AlignSample
 from hairtool.frozen.brushes.sample import BrushSample, check_view
 from hairtool.frozen.brushes.scalp import facing_away
+from hairtool.frozen.brushes.sight import hidden_strands
 from hairtool.frozen.brushes.spec import StrokeContext, StrokeMemory
 from hairtool.frozen.head_collision import HeadCollision
 from hairtool.frozen.selection import SelectionSample, apply_selection
@@ -69,11 +70,19 @@ class StrokeSetting:
             _, out[new] = self.surface.project(aligned.roots[new].astype(np.float64))  # type: ignore[union-attr]
         return out
 
-    def away(self, view, normals: Callable[[], np.ndarray]) -> np.ndarray | None:
-        """``(S,)`` the strands facing away from a sample's camera ``view`` (None: no view, none);
-        ``normals`` gives their root normals when asked."""
-        if check_view(view) is None:
+    def away(self, sample: Sample, g: Groom, normals: Callable[[], np.ndarray]) -> np.ndarray | None:
+        """``(S,)`` the strands of ``g`` a sample's camera does not face (None: no view, none).
+
+        A sample that says ``visible``, on a head mesh: the strands the head hides under its
+        brush (:func:`~hairtool.frozen.brushes.sight.hidden_strands`). Otherwise, as every log
+        before that field: the strands whose root normal (``normals``, asked only then) faces
+        away from the camera."""
+        view = check_view(sample.view)
+        if view is None:
             return None
+        grid = getattr(self.surface, "face_grid", None)
+        if getattr(sample, "visible", False) and grid is not None:
+            return hidden_strands(g.points, g.offsets, sample.cursor, sample.radius, view, grid)  # type: ignore[union-attr]
         return facing_away(normals(), view)
 
     def context(
@@ -121,12 +130,12 @@ def apply_sample(
     """
     if isinstance(sample, SelectionSample):
         memory = memory_for(None, memory)
-        away = setting.away(sample.view, lambda: setting.strand_normals(g, state))
+        away = setting.away(sample, g, lambda: setting.strand_normals(g, state))
         selected, hidden = apply_selection(g, sample, state.selected, state.hidden, away)
         return g, state.with_(selected=selected, hidden=hidden), memory
     brush = registry.brush_of(registry.name_of(sample))
     memory = memory_for(brush, memory)
-    ctx = setting.context(state, memory, setting.away(sample.view, lambda: setting.strand_normals(g, state)))
+    ctx = setting.context(state, memory, setting.away(sample, g, lambda: setting.strand_normals(g, state)))
     out = brush.apply(ctx, g, sample)
     if brush.spec.moves_points and sample.collide:
         out = setting.collision.collide(setting.surface, g, out)

@@ -10,7 +10,9 @@ and falloff columns, with ``falloffs``, the table of distinct falloff curves), `
 ``only_selected``, ``pressure``, ``any_segment`` (a delete's rule: stored only where a
 sample takes Blender's, so older projects, which meant the root rule, read as they did),
 ``new_selection`` (a select sample that starts a new selection: stored only where one does, so
-older projects, whose select strokes added, read as they did) and
+older projects, whose select strokes added, read as they did), ``visible`` (front faces only by
+sight: stored only where a sample judges so, so older projects, which judged by the root normal,
+read as they did) and
 ``selection`` (a step's op, and a box's matrix, rectangle
 and mode in ``box``). Choices are stored as indices into a list: the align modes in ``modes``,
 the brushes in ``brushes``, the steps in ``selection``.
@@ -60,12 +62,13 @@ COLUMNS = (
     Column("pressure", "pressure", np.float64, 0, 1.0),
     Column("any_segment", "any_segment", np.int64, 0, 0),
     Column("new_selection", "new_selection", np.int64, 0, 0),
+    Column("visible", "visible", np.int64, 0, 0),
     Column("selection", "selection", np.int64, 0, -1),
     Column("box", "selection", np.float64, BOX_WIDTH, (0.0,) * BOX_WIDTH),
 )
 GROUPS = (
     "brushes", "views", "collide", "plants", "starts", "only_selected", "pressure", "any_segment",
-    "new_selection", "selection",
+    "new_selection", "visible", "selection",
 )  # fmt: skip
 
 

@@ -44,6 +44,10 @@ A stroke log is a JSON list of strokes, in groom units::
   the stroke was drawn.
 - ``view`` (per sample, optional): the camera's viewing direction, from the eye into the scene;
   only the strands facing that camera are touched. null or missing (older logs): every strand.
+- ``visible`` (per stroke, optional, default false): how a ``view`` judges which strands face
+  the camera. true (the studio writes it): those the head mesh does not hide from the camera
+  under the brush (:mod:`hairtool.frozen.brushes.sight`); false or missing (older logs, and
+  every log without a head mesh): those whose root's outward normal faces the camera.
 - ``falloff``: ``smooth``, ``linear``, ``constant``, or a curve ``[[t, w], ...]`` over t =
   distance / radius from 0 to 1 (align keeps the paper's own weighting and ignores it).
 - ``symmetry``: ``"x"`` mirrors every sample across the plane x = ``mirror_x`` (default: the
@@ -136,6 +140,7 @@ class Stroke:
     params: dict = field(default_factory=dict)
     collision: bool = True  # with a head surface, no vertex the stroke moves ends inside it
     only_selected: bool = False  # the unselected strands are left as they are
+    visible: bool = False  # front faces only by sight (else by root normal, as logs before it)
 
     def validate(self) -> Stroke:
         if self.brush not in BRUSHES:
@@ -486,6 +491,7 @@ def stroke_from_dict(d: Any, where: str = "stroke") -> Stroke | SelectionStep:
         params=params,
         collision=_flag(f"{where}.collision", d.get("collision")) is not False,
         only_selected=_flag(f"{where}.only_selected", d.get("only_selected")) is True,
+        visible=_flag(f"{where}.visible", d.get("visible")) is True,
     )
     try:
         stroke.pipeline_samples(0.0)  # every sample checked (radius, strength range) as it will run

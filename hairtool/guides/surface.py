@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.errors import ParameterError
+from hairtool.frozen.brushes.sight import FaceGrid
 from hairtool.guides.inside import barycentric
 from hairtool.io.obj import Mesh
 from hairtool.serial_twins import twin_njit
@@ -592,6 +593,7 @@ class MeshSurface:
             raise ParameterError("scalp", "a mesh with non-finite vertices", "finite vertex coordinates")
         self.mesh = mesh
         self._pseudo = None  # the inside test's normals, made when first asked
+        self._face_grid: FaceGrid | None = None
         self._v = mesh.vertices.astype(np.float64)
         self._n = mesh.normals.astype(np.float64)
         self._f = mesh.faces.astype(np.int64)
@@ -610,6 +612,16 @@ class MeshSurface:
         _bin_faces(self._v, self._kf, self.lo, self.cell, self.dims, self._start, self._items)
         self._rings = np.empty(int(np.prod(self.dims)), np.int64)
         _empty_rings_kernel(self._start, self.dims, self._rings)
+
+    @property
+    def face_grid(self) -> FaceGrid:
+        """The usable faces in this surface's grid, as the brushes' sight test walks them
+        (:mod:`hairtool.frozen.brushes.sight`)."""
+        if self._face_grid is None:
+            self._face_grid = FaceGrid(
+                self._v, self._kf, self.lo, self.cell, self.dims, self._start, self._items
+            )
+        return self._face_grid
 
     def nearest(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """:func:`closest_points` through the grid of faces (the same bytes): ``(P, 3)`` points

@@ -38,6 +38,7 @@ class AlignSample(NamedTuple):
     collide: bool = True  # as BrushSample's
     only_selected: bool = False  # as BrushSample's
     pressure: float = 1.0  # as BrushSample's (already applied to radius and intensity)
+    visible: bool = False  # as BrushSample's (front faces only by sight, not by root normal)
 
 
 def _locked_back(g: Groom, out: Groom, locked) -> Groom:

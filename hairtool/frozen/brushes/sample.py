@@ -34,7 +34,11 @@ class BrushSample:
     of every log written before the choice, so its default). ``new_selection``: a select sample
     that starts a new selection: the shown strands are deselected before it selects (a plain
     stroke's first sample, as Blender's Selection Paint; not its mirror, which adds to what the
-    first selected); False adds to the selection (what every log written before it meant)."""
+    first selected); False adds to the selection (what every log written before it meant).
+    ``visible``: with a ``view``, the strands kept are those the head does not hide from the
+    camera under the brush (:mod:`~hairtool.frozen.brushes.sight`: the studio's rule, needing a
+    head mesh), else those whose root normal faces the camera (the rule of every log written
+    before it, so its default; the rule without a head mesh too)."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -52,6 +56,7 @@ class BrushSample:
     pressure: float = 1.0
     any_segment: bool = False
     new_selection: bool = False
+    visible: bool = False
 
     def mirrored(self, plane_x: float) -> BrushSample:
         """The sample across the plane x = ``plane_x``, the second sample of the same move (so
@@ -118,7 +123,15 @@ def check_sample(sample: BrushSample) -> BrushSample:
     if len(sample.lut) != LUT_SIZE:
         raise ParameterError("falloff", f"{len(sample.lut)} samples", f"{LUT_SIZE}")
     check_pressure(sample.pressure)
+    check_flag("visible", sample.visible)
     return sample
+
+
+def check_flag(name: str, value: object) -> bool:
+    """True or False (ParameterError naming ``name`` for anything else)."""
+    if not isinstance(value, bool | np.bool_):
+        raise ParameterError(name, value, "true or false")
+    return bool(value)
 
 
 def check_pressure(pressure: object) -> float:
