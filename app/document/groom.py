@@ -167,7 +167,7 @@ class GroomSide:
         return self.pipeline.result
 
     def settled(self) -> FrozenSnapshot | None:
-        """The strokes as a replay gives them (after brush-local moves, clumped once more). In the
+        """The strokes as a replay gives them (brush-local moves settled: their bytes). In the
         middle of a stroke (moves the engine applied that are no step yet) the state as it is: the
         stroke settles as it is recorded."""
         p = self._pipeline

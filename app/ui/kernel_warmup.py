@@ -178,7 +178,7 @@ def _engine_step() -> None:
         cursor = centre + np.array([0.05 * i * extent, 0.0, 0.0])
         pipe.apply_samples(tool.samples(cursor, (1.0, 0.0, 0.0), (0.0, 0.0, -1.0), plane))
         tool.touches(pipe.aligned.points, cursor, plane)
-    pipe.settle()  # the release: its neighbour list brought up to date where the drag moved strands
+    pipe.update()  # a full run after the drag (an undo's): its neighbour list brought up to date
     _press_step(pipe)
 
 

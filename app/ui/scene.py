@@ -437,14 +437,15 @@ class Scene(QObject):
 
     def end_stroke(self, before: GroomState, text: str | None = None) -> GroomState:
         """The stroke that ran on the engine since ``before`` becomes one document step (named
-        after the brush, or ``text``; none when nothing was applied), the whole groom clumped
-        once more after brush-local moves, as a replay clumps it; returns the state after."""
+        after the brush, or ``text``; none when nothing was applied), its brush-local moves
+        settled (they left the bytes a replay gives: nothing is clumped again); returns the
+        state after."""
         self.moves.drain()
         if text is None:
             text = f"{LABELS.get(self.tool.brush, self.tool.brush)} stroke"
         p = self.pipeline
         if p is not None and p.unsettled:
-            p.settle()  # (first: the views follow once, from the settled guides)
+            p.settle()  # (first: the document's step holds the settled strokes)
         self.hair.record(before, text)
         self.hair.end_stroke()
         if self.engine_ready and self.pipeline.result is not self.result:  # (moves dropped)

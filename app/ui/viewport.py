@@ -685,8 +685,8 @@ class Viewport(QOpenGLWidget):
             before, self._stroke_before = self._stroke_before, None
             self.scene.moves.drain()  # every move of the stroke has run
             self.stroke_touched = self.scene.moves.touched
-            # one document step; the whole groom settled first, so the full-density render hair
-            # is built (and clumped) once, from the settled guides, not once before and once after
+            # one document step, its moves settled first; then the full-density render hair is
+            # built (and clumped) once, from the settled guides
             after = self.scene.end_stroke(before)
             self.scene.set_dragging(False)  # full density again
             self.stroke_finished.emit(before, after)

@@ -121,21 +121,21 @@ def test_the_first_screen_compiles_nothing_after_the_startup_steps(mode):
         )
 
 
-def test_the_engine_step_releases_on_an_updated_list(monkeypatch):
-    """The warm-up's engine step ends with a release whose neighbour list is updated, not built
+def test_the_engine_step_ends_with_a_full_run_on_an_updated_list(monkeypatch):
+    """The warm-up's engine step ends with a full run whose neighbour list is updated, not built
     (neighbour_update's cost model could make it build): so the update's kernels are among
-    those it compiles, for the first release on any groom."""
+    those it compiles, for the first full run after a stroke (an undo, a parameter) on any groom."""
     from app.ui import kernel_warmup
     from hairtool.frozen.pipeline import FrozenPipeline
 
-    settled = []
-    settle = FrozenPipeline.settle
+    updated = []
+    update = FrozenPipeline.update
 
     def spy(self):
-        out = settle(self)
-        settled.append(self.neighbour_updates)
+        out = update(self)
+        updated.append(self.neighbour_updates)
         return out
 
-    monkeypatch.setattr(FrozenPipeline, "settle", spy)
+    monkeypatch.setattr(FrozenPipeline, "update", spy)
     kernel_warmup._engine_step()
-    assert settled and settled[-1] >= 1
+    assert updated and updated[-1] >= 1

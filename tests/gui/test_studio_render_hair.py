@@ -215,8 +215,9 @@ def test_clumping_the_children_is_a_switch_applied_on_release_and_saved(make_win
 
 
 def test_a_release_clumps_the_render_hair_once_from_the_settled_guides(ui, make_window, monkeypatch):
-    """The release settles the groom (the whole-groom clump after brush-local moves) before the
-    full-density children are built, so Clump children runs once per release, on what is kept."""
+    """The release settles the groom (its brush-local moves, already the whole groom's clump
+    bytes) before the full-density children are built, so Clump children runs once per
+    release, on what is kept."""
     from hairtool.guides.child_clumps import ChildClumps
 
     w = make_window(groom=samples.scalp(strands=600, vertices=10, seed=4))
