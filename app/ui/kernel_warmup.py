@@ -178,7 +178,12 @@ def _engine_step() -> None:
         cursor = centre + np.array([0.05 * i * extent, 0.0, 0.0])
         pipe.apply_samples(tool.samples(cursor, (1.0, 0.0, 0.0), (0.0, 0.0, -1.0), plane))
         tool.touches(pipe.aligned.points, cursor, plane)
-    pipe.update()  # a full run after the drag (an undo's): its neighbour list brought up to date
+    pipe.update()  # a full run after the drag (an undo's)
+    # and one after a short drag on the front hair, whose list is brought up to date, not built
+    # (the drag above reaches strands all round the head by sight: the cost model builds it)
+    front = np.array([centre[0], centre[1], float(hi[2]) - 0.1 * extent])
+    pipe.apply_samples(tool.samples(front, (1.0, 0.0, 0.0), (0.0, 0.0, -1.0), plane))
+    pipe.update()
     _press_step(pipe)
 
 
