@@ -124,3 +124,15 @@ def test_any_drag_ends_on_its_last_frame_at_the_share(ui, qtbot, hair_window, pa
     _settle(qtbot, w)
     ui.grab(v)
     assert v.shown_frame == path[-1] and v.drawn().strand_count == CHILDREN + 20
+
+
+def test_the_kernel_preload_waits_while_the_frame_is_dragged(ui, hair_window):
+    w = hair_window
+    view = w.timeline.view
+    y = view.height() - 4
+    assert not w.preload_waits()
+    ui.send_mouse(view, "press", (_x(view, 2), y), LEFT, LEFT)
+    ui.send_mouse(view, "move", (_x(view, 5), y), None, LEFT)
+    assert w.animation.scrubbing and w.preload_waits()
+    ui.send_mouse(view, "release", (_x(view, 5), y), LEFT, None)
+    assert not w.preload_waits()
