@@ -23,7 +23,8 @@ frames (default 22), beside ``hairtool bench host``'s speed (the first row):
   ``release_full_ms`` from the release until every child is on screen (target 500),
   ``release_clumped_ms`` until they are clumped, as the groom's are; ``gui_max_gap_ms``: the
   longest the GUI thread was away from its event loop meanwhile. The drag starts once the
-  studio has loaded its cached kernels (:mod:`app.ui.kernel_preload`), as ``app.bench``'s does.
+  studio has loaded its cached kernels (:mod:`app.ui.kernel_preload`), as ``app.bench``'s does;
+  ``--drag-percent`` sets the share of the children drawn while dragging (default the studio's).
 - ``GIF at viewport size``: File ▸ Export animation to a GIF of every frame, the children
   clumped on each (``s``: until the file is written; the issue measured 22.6 s);
   ``view_paints``: the viewport's repaints meanwhile (``--no-gif`` leaves the export out).
@@ -53,6 +54,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sintel-frames", type=int, default=22, help="--sintel: frames of the sway")
     parser.add_argument(
         "--scrub-rate", type=float, default=48.0, help="--sintel: frames the drag crosses per second"
+    )
+    parser.add_argument(
+        "--drag-percent", type=float, help="--sintel: the children drawn while dragging, in %% (default 10)"
     )
     parser.add_argument("--no-gif", action="store_true", help="--sintel: time the scrub only")
     parser.add_argument("--json", action="store_true")
@@ -103,11 +107,13 @@ def _measure_sintel(app, args: argparse.Namespace, settings) -> list[dict]:
     for _ in range(20):
         app.processEvents()
     s, v, m, view = window.scene, window.viewport, window.animation, window.timeline.view
+    if args.drag_percent is not None:
+        s.set_display_percent(drag=args.drag_percent)
     n = args.sintel_frames
     anim = sway_animation(s.result, n, 24.0, flick_frame=int(n * 0.6))
     m.load_animation(anim, "sway")
     window.jobs.wait(600)
-    label = f"Sintel, {s.binding.child_count:,} children, {n} frames"
+    label = f"Sintel, {s.binding.child_count:,} children ({s.drag_percent:g} % dragged), {n} frames"
     full = s.drawn_topology.strand_count
     _until(app, lambda: not s.frames_live and v.shown_frame == m.frame)
     deadline = time.perf_counter() + PRELOAD_WAIT_S  # (an artist's drag comes later than that)
@@ -319,8 +325,12 @@ def main(argv: list[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 2
+    drag = args.drag_percent
     if not (np.isfinite(args.scrub_rate) and args.scrub_rate > 0) or args.sintel_frames < 2:
         print("app.bench_timeline: --scrub-rate > 0 and --sintel-frames >= 2", file=sys.stderr)
+        return 2
+    if drag is not None and not (np.isfinite(drag) and 0 < drag <= 100):
+        print(f"app.bench_timeline: --drag-percent must be in (0, 100], got {drag}", file=sys.stderr)
         return 2
     rows = run(args)
     print(json.dumps(rows, indent=2) if args.json else format_table(rows))
