@@ -137,6 +137,9 @@ class FrameChildren(QObject):
         """Keep an interpolated build (its guides copied: the caller's may change in place)."""
         if ask.clump is not None or ask.points is None or ask.points.nbytes > KEPT_BYTES:
             return
+        if self._kept and next(iter(self._kept.values())).binding is not ask.binding:
+            self._kept.clear()  # other drawn children: the kept frames are no one's now
+            self._kept_bytes = 0
         old = self._kept.pop(ask.frame, None)
         if old is not None:
             self._kept_bytes -= old.points.nbytes

@@ -166,3 +166,17 @@ def test_a_frame_scrubbed_again_lands_at_once_from_its_last_build(ui, qtbot, hai
     _settle(qtbot, w)
     assert frames.built == built + 2
     ui.send_mouse(view, "release", (_x(view, 6), y), LEFT, None)
+
+
+def test_the_kept_frames_go_with_their_drawn_children(ui, qtbot, hair_window):
+    w = hair_window
+    view, frames, s = w.timeline.view, w.animation_ui.frames, w.scene
+    y = view.height() - 4
+    ui.send_mouse(view, "press", (_x(view, 3), y), LEFT, LEFT)
+    _settle(qtbot, w)
+    assert list(frames._kept) == [3]
+    s.set_display_percent(drag=20.0)  # another share: frame 3's build is no one's now
+    ui.send_mouse(view, "move", (_x(view, 5), y), None, LEFT)
+    _settle(qtbot, w)
+    assert list(frames._kept) == [5] and frames._kept[5].binding is s.drawn_binding()
+    ui.send_mouse(view, "release", (_x(view, 5), y), LEFT, None)
