@@ -14,6 +14,12 @@ Two ways, by the target framebuffer:
 Blitted, the strands leave the framebuffer's depth as GL left it: nothing after them (the brush
 circle) is depth-tested. Textures and images are kept between frames and remade only on resize.
 
+What GL drew under single-sampled strands (the head mesh) is kept as the *backdrop* of a key
+the caller gives (the camera, the size, the mesh and its colour): a frame of the same key
+copies it instead of reading the framebuffer back, and its caller need not draw it again
+(:meth:`RasterLayer.holds_backdrop`). Scrubbing an animation changes only the strands, and
+the two read-backs waited for GL to clear and draw the head each frame.
+
 A multisampled draw can also be split across threads (an export's frames, whose raster is the
 frame's CPU cost: :mod:`app.ui.animation_export`): with :attr:`RasterLayer.defer` it keeps what
 it would raster as a :class:`RasterJob` and draws no strands; any thread rasters the job
@@ -101,6 +107,12 @@ class RasterLayer:
         self.defer = False  # multisampled: keep the strands as :attr:`job`, draw none
         self.job: RasterJob | None = None  # the last deferred draw's
         self.given: tuple[RasterJob, np.ndarray, np.ndarray] | None = None  # a job's images
+        self._backdrop: tuple[tuple, np.ndarray, np.ndarray] | None = None  # (key, colour, depth)
+
+    def holds_backdrop(self, key: tuple) -> bool:
+        """Whether the images GL drew under the strands for ``key`` are kept (see the module doc):
+        a single-sampled :meth:`render` with that ``backdrop`` then needs none drawn in ``fbo``."""
+        return self._backdrop is not None and self._backdrop[0] == key
 
     def _resize(self, size: tuple[int, int]) -> None:
         if size == self.size:
@@ -129,6 +141,7 @@ class RasterLayer:
         background: tuple[float, float, float, float] | None = None,
         read_depth: bool = False,
         scale: ArrayLike | None = None,
+        backdrop: tuple | None = None,
     ) -> None:
         """Draw the strands into ``fbo`` (bound, viewport ``size``, with ``samples`` per pixel).
 
@@ -136,6 +149,9 @@ class RasterLayer:
         a frame GL drew nothing into; without it what GL drew is read back, its depth too with
         ``read_depth`` (the head mesh). Multisampled, strands go over what is there.
         ``scale``: per segment, its width factor (a tapering width; None: none).
+        ``backdrop``: single-sampled without ``background``, the key of what GL drew under the
+        strands (None: no key); the images of a key read back once are kept, and a later frame
+        of that key starts from them instead of reading ``fbo`` (which it then need not draw).
         """
         self._resize(size)
         if samples > 0:
@@ -147,12 +163,17 @@ class RasterLayer:
             self._upload(rgba, self.raster.changed)
         else:
             rgba, depth = self.raster.images(size)
-            viewport = (0, 0, *size)
-            if read_depth:  # first: moderngl leaves the read buffer at GL_NONE after a depth read
-                fbo.read_into(depth, viewport=viewport, attachment=-1, dtype="f4")
+            if backdrop is not None and self.holds_backdrop(backdrop):
+                np.copyto(rgba, self._backdrop[1])
+                np.copyto(depth, self._backdrop[2])
             else:
-                depth.fill(1.0)
-            fbo.read_into(rgba, viewport=viewport, components=4)
+                viewport = (0, 0, *size)
+                if read_depth:  # first: moderngl leaves the read buffer at GL_NONE after a depth read
+                    fbo.read_into(depth, viewport=viewport, attachment=-1, dtype="f4")
+                else:
+                    depth.fill(1.0)
+                fbo.read_into(rgba, viewport=viewport, components=4)
+                self._backdrop = None if backdrop is None else (backdrop, rgba.copy(), depth.copy())
             self.raster.draw(points, starts, colors, mvp, size, width, clear=None, scale=scale)
             self._upload(rgba, self.raster.changed)
         self.ctx.copy_framebuffer(fbo, self._source)

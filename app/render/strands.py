@@ -524,14 +524,17 @@ class StrandRenderer:
         ctx = self.ctx
         fbo.use()
         ctx.viewport = (0, 0, w, h)
-        if not cpu_only:
+        view = camera.view_matrix()
+        mvp = (view @ camera.projection_matrix(w / h)).astype(np.float32)
+        backdrop = self._backdrop_key(method, samples, cpu_only, mvp, view, (w, h))
+        kept = backdrop is not None and self.cpu_raster_layer().holds_backdrop(backdrop)
+        if not (cpu_only or kept):
             fbo.clear(*self.background, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
-        view = camera.view_matrix()
-        mvp = (view @ camera.projection_matrix(w / h)).astype(np.float32)
-        self.mesh.render(mvp, view)
-        self.character.render(mvp, view)
+        if not kept:  # (kept: the raster layer has what these draw, and the strands cover it)
+            self.mesh.render(mvp, view)
+            self.character.render(mvp, view)
         self._shade(camera)
         if self._main is not None:
             gl_method = self.gl_line_method()
@@ -541,7 +544,8 @@ class StrandRenderer:
                 self._render_ghost(fbo, gl_method)
             if method == "cpu":
                 width = 1.0 if gl_method == "thin" else width
-                self._render_cpu(fbo, samples, mvp, (w, h), width, self.background if cpu_only else None)
+                background = self.background if cpu_only else None
+                self._render_cpu(fbo, samples, mvp, (w, h), width, background, backdrop)
             else:
                 self.programs[method]["u_use_flat_color"].value = False
                 self._draw(method, self._main, ghost=False)
@@ -582,14 +586,28 @@ class StrandRenderer:
             self.raster = RasterLayer(self.ctx)
         return self.raster
 
-    def _render_cpu(self, fbo, samples: int, mvp, size: tuple[int, int], width: float, background) -> None:
+    def _backdrop_key(self, method: str, samples: int, cpu_only: bool, mvp, view, size) -> tuple | None:
+        """The key of what GL draws under CPU strands in a single-sampled frame, when only the
+        head mesh is (no ghost, no character): the raster layer keeps it by this key
+        (:meth:`RasterLayer.holds_backdrop`), so a frame where only the strands changed (a
+        scrubbed animation) neither draws the mesh nor reads the frame back. None otherwise."""
+        if method != "cpu" or samples != 0 or cpu_only or self._main is None:
+            return None
+        if self._ghost is not None or self.character.drawn or self.mesh.vao is None:
+            return None
+        mesh = (self.mesh.vao, tuple(float(c) for c in self.mesh.color))
+        return (tuple(size), tuple(self.background), mesh, mvp.tobytes(), view.tobytes())
+
+    def _render_cpu(
+        self, fbo, samples: int, mvp, size: tuple[int, int], width: float, background, backdrop=None
+    ) -> None:
         self.cpu_raster_layer()
         points, colors, starts = self._main.cpu_points(), self.cpu_colors(), self._segment_starts
         mesh = self.mesh.vao is not None or self.character.drawn
         scale = self.segment_width_scale() if width > 1.0 else None
         self.raster.render(
             fbo, samples, points, starts, colors, mvp, size, width, background=background, read_depth=mesh,
-            scale=scale,
+            scale=scale, backdrop=backdrop,
         )  # fmt: skip
 
     def _checked_taper(self) -> float:

@@ -124,3 +124,59 @@ def test_any_drag_ends_on_its_last_frame_at_the_share(ui, qtbot, hair_window, pa
     _settle(qtbot, w)
     ui.grab(v)
     assert v.shown_frame == path[-1] and v.drawn().strand_count == CHILDREN + 20
+
+
+def test_the_kernel_preload_waits_while_the_frame_is_dragged(ui, hair_window):
+    w = hair_window
+    view = w.timeline.view
+    y = view.height() - 4
+    assert not w.preload_waits()
+    ui.send_mouse(view, "press", (_x(view, 2), y), LEFT, LEFT)
+    ui.send_mouse(view, "move", (_x(view, 5), y), None, LEFT)
+    assert w.animation.scrubbing and w.preload_waits()
+    ui.send_mouse(view, "release", (_x(view, 5), y), LEFT, None)
+    assert not w.preload_waits()
+
+
+def test_a_frame_scrubbed_again_lands_at_once_from_its_last_build(ui, qtbot, hair_window):
+    w = hair_window
+    v, view, m = w.viewport, w.timeline.view, w.animation
+    frames = w.animation_ui.frames
+    y = view.height() - 4
+    ui.send_mouse(view, "press", (_x(view, 2), y), LEFT, LEFT)
+    _settle(qtbot, w)  # frame 2 built, and kept
+    frames.delay_s = 0.3
+    ui.send_mouse(view, "move", (_x(view, 6), y), None, LEFT)  # a slow build of frame 6 starts
+    built, reused = frames.built, frames.reused
+    ui.send_mouse(view, "move", (_x(view, 2), y), None, LEFT)  # back to 2: its build, at once
+    assert frames.reused == reused + 1
+    ui.grab(v)
+    assert v.shown_frame == 2
+    np.testing.assert_array_equal(v.drawn().points, _share_points(w, 2))
+    _settle(qtbot, w)  # frame 6 lands for nobody: the view stays on the frame under the mouse
+    ui.grab(v)
+    assert v.shown_frame == m.frame == 2 and frames.built == built + 1
+    np.testing.assert_array_equal(v.drawn().points, _share_points(w, 2))
+    ui.send_mouse(view, "move", (_x(view, 6), y), None, LEFT)  # 6 was kept when it landed
+    assert frames.reused == reused + 2 and not frames.busy
+    ui.grab(v)
+    assert v.shown_frame == 6
+    np.testing.assert_array_equal(v.drawn().points, _share_points(w, 6))
+    m.set_view_mode("reconstruction")  # other guides for frame 6: built again
+    _settle(qtbot, w)
+    assert frames.built == built + 2
+    ui.send_mouse(view, "release", (_x(view, 6), y), LEFT, None)
+
+
+def test_the_kept_frames_go_with_their_drawn_children(ui, qtbot, hair_window):
+    w = hair_window
+    view, frames, s = w.timeline.view, w.animation_ui.frames, w.scene
+    y = view.height() - 4
+    ui.send_mouse(view, "press", (_x(view, 3), y), LEFT, LEFT)
+    _settle(qtbot, w)
+    assert list(frames._kept) == [3]
+    s.set_display_percent(drag=20.0)  # another share: frame 3's build is no one's now
+    ui.send_mouse(view, "move", (_x(view, 5), y), None, LEFT)
+    _settle(qtbot, w)
+    assert list(frames._kept) == [5] and frames._kept[5].binding is s.drawn_binding()
+    ui.send_mouse(view, "release", (_x(view, 5), y), LEFT, None)

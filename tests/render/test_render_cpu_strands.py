@@ -7,6 +7,8 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from app.render.camera import Camera
 from app.render.offscreen import read_rgba, render_image
@@ -232,3 +234,70 @@ def test_ghost_under_cpu_strands_is_drawn_by_gl(renderer, gl_ctx):
     assert (ghosted[changed][:, 1].astype(int) > ghosted[changed][:, 0].astype(int)).mean() > 0.5
     strands = _lit(plain)
     np.testing.assert_array_equal(ghosted[strands], plain[strands])  # strands drawn over the ghost
+
+
+def _head(radius: float = 0.6):
+    """A coarse sphere of ``radius`` at the origin, standing in for a head mesh."""
+    u, v = np.meshgrid(np.linspace(0, np.pi, 7), np.linspace(0, 2 * np.pi, 9), indexing="ij")
+    vertices = radius * np.stack([np.sin(u) * np.cos(v), np.cos(u), np.sin(u) * np.sin(v)], -1).reshape(-1, 3)
+    i = np.arange(6)[:, None] * 9 + np.arange(8)
+    faces = np.concatenate([np.stack([i, i + 9, i + 10], -1), np.stack([i, i + 10, i + 1], -1)])
+    return SimpleNamespace(
+        vertices=vertices.astype(np.float32), faces=faces.reshape(-1, 3).astype(np.int32), normals=None
+    )
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    steps=st.lists(
+        st.tuples(st.sampled_from(["move", "orbit", "colour", "ghost", "mesh"]), st.integers(0, 2**16)),
+        min_size=1,
+        max_size=5,
+    )
+)
+def test_frames_over_a_kept_head_are_the_frames_drawn_afresh(gl_ctx, steps):
+    """Over a head mesh, a frame whose camera, size and mesh are the last frame's starts from the
+    kept image of the head instead of drawing and reading it back (an animation scrubbed): every
+    frame, byte for byte, what a renderer with no history draws; the head is drawn once per key."""
+    g = samples.scalp(strands=60, vertices=8, seed=2)
+    cam = Camera.for_groom(g, aspect=SIZE[0] / SIZE[1])
+    head = _head()
+    points, ghost = g.points, None
+    kept = StrandRenderer(gl_ctx)
+    heads = []
+    kept.mesh.render = lambda mvp, view, draw=kept.mesh.render: (heads.append(1), draw(mvp, view))
+    try:
+        kept.set_mesh(head)
+        kept.set_groom(g)
+        kept.background, kept.line_width = BG, 3.0
+        _draw(kept, gl_ctx, cam, raster="cpu")
+        _draw(kept, gl_ctx, cam, raster="cpu")
+        assert len(heads) == 1  # the same camera and head: drawn once
+        for what, seed in [("move", 0), *steps]:
+            rng = np.random.default_rng(seed)
+            if what == "move":
+                points = (points + rng.normal(0.0, 0.02, points.shape)).astype(np.float32)
+                kept.update_points(points)
+            elif what == "orbit":
+                cam.orbit(float(rng.uniform(-20, 20)), float(rng.uniform(-10, 10)))
+            elif what == "colour":
+                kept.mesh.color = tuple(float(c) for c in rng.uniform(0.2, 1.0, 3))
+            elif what == "ghost":
+                ghost = None if ghost is not None else points + np.float32(0.03)
+                kept.set_ghost_points(ghost)
+            else:
+                head = _head(float(rng.uniform(0.4, 0.7)))
+                kept.set_mesh(head)
+            image = _draw(kept, gl_ctx, cam, raster="cpu")
+            fresh = StrandRenderer(gl_ctx)
+            try:
+                fresh.set_mesh(head)
+                fresh.set_groom(Groom(points, g.topology))
+                fresh.background, fresh.line_width, fresh.mesh.color = BG, 3.0, kept.mesh.color
+                if ghost is not None:
+                    fresh.set_ghost_points(ghost)
+                np.testing.assert_array_equal(image, _draw(fresh, gl_ctx, cam, raster="cpu"), what)
+            finally:
+                fresh.release()
+    finally:
+        kept.release()
