@@ -40,7 +40,7 @@ def serial_plan() -> list[Entry]:
     from hairtool.frozen.vertex_grid import _build, _count_blocks
 
     f64_2d = _array(types.float64, 2)
-    lists = types.Tuple((_I32, _I64, _I64, _I32, _I64, _I64, _F64, _F64))  # pair lists, clump.py
+    lists = types.Tuple((_I32, _I64, _I64, _I32, _I64, _I64, f64_2d))  # pair lists, clump.py
     bufs = types.Tuple((f64_2d, f64_2d, f64_2d, _I64, _I64, _F64, _array(types.uint64), _F64))
     f64_3d = _array(types.float64, 3)
     record = types.Tuple((f64_3d, f64_3d, _array(types.int64, 2), _I64, _F64))  # iterates, forces, nearest
