@@ -34,13 +34,17 @@ FIRST_MODULES = (
     "hairtool.frozen.freeze",
     "app.render.hair_shading",
 )
+#: Modules whose serial twins a parallel process calls too: the brush-local engine runs them on
+#: regions below :data:`hairtool.frozen.local.SERIAL_BELOW` (the bear's comb, for one).
+SERIAL_TOO = ("hairtool.frozen.local", "hairtool.frozen.vertex_grid", "hairtool.frozen.lengths")
 BUSY_RETRY_MS = 100  # a button is held: look again after this long
 INDEXES_PER_TURN = 8  # cache indexes read in one turn at most, looking for something to load
 
 
 def kernels_in_use() -> list:
     """The kernels the studio's Python calls now, :data:`FIRST_MODULES`' first: the parallel
-    kernels, or the serial twins while the process runs on them (a first start)."""
+    kernels (and the serial twins of :data:`SERIAL_TOO`), or the serial twins while the process
+    runs on them (a first start)."""
     from app.ui.kernel_warmup import _dispatchers
 
     parallel = serial_twins.parallel_in_use()
@@ -48,7 +52,8 @@ def kernels_in_use() -> list:
     picked = []
     for name, kernel in _dispatchers().items():
         module = name.split(":")[0]
-        if serial_twins.is_twinned(kernel) and name.endswith(serial_twins.SERIAL_SUFFIX) == parallel:
+        twin = name.endswith(serial_twins.SERIAL_SUFFIX)
+        if serial_twins.is_twinned(kernel) and twin == parallel and not (twin and module in SERIAL_TOO):
             continue  # the twin not in use
         package = module.rpartition(".")[0]  # (a brush module ranks as its package)
         picked.append((rank.get(module, rank.get(package, len(rank))), name, kernel))

@@ -47,6 +47,7 @@ class HeadCollision:
             The groom at rest.
         """
         self._rest = rest
+        self._scanned: tuple[Sequence | None, int, bool] = (None, 0, False)  # (log, read, any collides)
 
     @functools.cached_property
     def margin(self) -> float:
@@ -100,11 +101,32 @@ class HeadCollision:
         head = head_of(surface)
         if head is None:
             return clumped
-        if not any(
-            getattr(s, "collide", False) and registry.spec_of(registry.name_of(s)).moves_points for s in log
-        ):
+        if not self.strokes_collide(log):
             return clumped
         return self.keep_out(aligned, clumped, head, self.margin)
+
+    def strokes_collide(self, log: Sequence) -> bool:
+        """Whether a sample of ``log`` moves points with ``collide``. The log asked about last
+        time, grown since (a pipeline's log grows in place, or is replaced by another), is read on
+        from where that look stopped: a move reads its own samples, not the whole session's.
+
+        Parameters
+        ----------
+        log : sequence of samples
+            The stroke log.
+
+        Returns
+        -------
+        bool
+            True where one collides.
+        """
+        seen, read, hit = self._scanned
+        if seen is not log or read > len(log):
+            read, hit = 0, False
+        if not hit:
+            hit = any(_collides(log[k]) for k in range(read, len(log)))
+        self._scanned = (log, len(log), hit)
+        return hit
 
     def remember(self, surface: object | None, aligned: Groom, result: Groom) -> None:
         """The head's distances a first collision asks for, now.
@@ -121,3 +143,8 @@ class HeadCollision:
         head = head_of(surface)
         if head is not None:
             self.keep_out.remember(aligned, result, head)
+
+
+def _collides(sample: object) -> bool:
+    """Whether ``sample`` moves points and collides with the head."""
+    return bool(getattr(sample, "collide", False)) and registry.spec_of(registry.name_of(sample)).moves_points

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
+from hairtool import serial_twins
 from hairtool.groom import Topology
 from hairtool.serial_twins import twin_njit
 
@@ -59,6 +60,7 @@ def restore_lengths(
     topology: Topology,
     strands: np.ndarray | None = None,
     out: np.ndarray | None = None,
+    parallel: bool = True,
 ) -> np.ndarray:
     """float32 ``(V, 3)``: ``after`` with every segment set back to its length in ``before``
     (directions from ``after``; float64 inside, roots as in ``after``). With ``strands`` (and
@@ -76,6 +78,8 @@ def restore_lengths(
         Only these strands are written (None: all).
     out : ndarray, optional
         ``(V, 3)`` float32, written in place; it holds the other strands.
+    parallel : bool, default True
+        Run the parallel kernel (False: its serial twin, for a few strands; the same bytes).
 
     Returns
     -------
@@ -86,7 +90,8 @@ def restore_lengths(
         out = np.empty((topology.vertex_count, 3), np.float32)
     picked = _ALL if strands is None else np.ascontiguousarray(strands, np.int64)
     if strands is None or picked.size > 0:
-        _restore_kernel(before, after, topology.offsets, picked, out)
+        kernel = _restore_kernel if parallel else serial_twins.serial(_restore_kernel)
+        kernel(before, after, topology.offsets, picked, out)
     return out
 
 

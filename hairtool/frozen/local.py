@@ -36,6 +36,7 @@ import numba
 import numpy as np
 from numba import prange
 
+from hairtool import serial_twins
 from hairtool.bounds import box, moved_box
 from hairtool.frozen.clump import (
     _GAP_CODE,
@@ -57,18 +58,27 @@ from hairtool.serial_twins import twin_njit
 MAX_SEEDS = 0.1  # of the vertices: a move that changes more runs in full (cheaper then)
 MAX_REGION = 0.25  # of the vertices: a region larger than this, too (measured on ratboy_mohawk: a
 # local move at 15 % of the vertices cost 0.6× a full run, at 35 % 1.2×; break-even near 25 %)
-SERIAL_BELOW = 4_000  # vertices: fewer run on one thread (waking the others costs more than the
-# work). Measured on the 2-core VM (comb at the studio's brush on the bear, regions of 2-4 %:
-# 8k vertices): per move 30.7 → 24.9 ms median, 56 → 44 p90 against the former 50,000; ratboy's
-# drag (3k-vertex regions) 16.4 → 11.7 ms; smaller regions unchanged
+SERIAL_BELOW = 4_000  # vertices: fewer run on the serial twins (:mod:`hairtool.serial_twins`;
+# waking the pool's threads costs more than the work). Measured on the 2-core VM (comb at the
+# studio's brush on the bear, regions of 2-4 %: 8k vertices): per move 30.7 → 24.9 ms median, 56
+# → 44 p90 against 50,000; ratboy's drag (3k-vertex regions) 16.4 → 11.7 ms. The studio's
+# threads wait passively (``OMP_WAIT_POLICY``, :mod:`app`): with spinning ones, as in a script
+# that leaves it unset, a loaded host's parallel launches cost ~8 ms each, whatever their work
+
+
+def parallel_for(vertices: int) -> bool:
+    """Whether work on this many vertices runs the parallel kernels (from :data:`SERIAL_BELOW`
+    on, and while the process runs parallel at all); else their serial twins, which give the
+    same bytes."""
+    return vertices >= SERIAL_BELOW and serial_twins.parallel_in_use()
 
 
 @contextmanager
 def threads_for(vertices: int):
-    """numba threads for work on this many vertices: one below :data:`SERIAL_BELOW`, else all
-    (the kernels' results do not depend on the count)."""
+    """numba threads for kernels without a serial twin (a brush's) on this many vertices: one
+    below :data:`SERIAL_BELOW`, else all (the kernels' results do not depend on the count)."""
     threads = numba.get_num_threads()
-    if vertices < SERIAL_BELOW:
+    if not parallel_for(vertices):
         numba.set_num_threads(1)
     try:
         yield
@@ -77,38 +87,48 @@ def threads_for(vertices: int):
 
 
 @twin_njit(nogil=True, parallel=True)
-def _local_force(P, flat, cap, cnt, vids, roots, h, ident, F, best):
-    """f (15) and the nearest neighbour of each vertex ``vids[n]``, its list at
-    ``flat[n·cap :][: cnt[n]]`` (original indices; ``P``, ``F`` in original order)."""
+def _local_run(new, sv, flat, cap, cnt, vids, roots, h, ident, step, gap, seed, iterations, rec, near):
+    """Every iteration of the vertices ``vids`` (lists at ``flat[n·cap :][: cnt[n]]``, original
+    indices) from their new input (points ``new``, clump strength ``sv``), written into the
+    record ``rec`` = (points, strength, iterates, forces, best, result); the other vertices are
+    read where the record has them. One launch for the move: f (15) and the nearest neighbour of
+    each vertex, then its next iterate (or the float32 result) with the gap correction.
+    ``near``: (vids.size,) scratch for the nearest neighbours."""
+    points, strength, iterates, forces, best, result = rec
     inv_h = 1.0 / h
     for n in prange(vids.size):
         i = vids[n]
-        a0 = n * cap
-        a1 = a0 + cnt[n]
-        fx, fy, fz, best[n], _, _ = vertex_force(
-            P, flat, a0, a1, flat, a1, a1, P[i, 0], P[i, 1], P[i, 2], roots[i], h, inv_h, False, ident
-        )
-        F[i, 0], F[i, 1], F[i, 2] = fx, fy, fz
+        for a in range(3):
+            points[i, a] = new[i, a]
+            iterates[0, i, a] = points[i, a]
+        strength[i] = sv[i]
+    for it in range(iterations):
+        P, F = iterates[it], forces[it]
+        for n in prange(vids.size):
+            i = vids[n]
+            a0 = n * cap
+            a1 = a0 + cnt[n]
+            fx, fy, fz, near[n], _, _ = vertex_force(
+                P, flat, a0, a1, flat, a1, a1, P[i, 0], P[i, 1], P[i, 2], roots[i], h, inv_h, False, ident
+            )
+            F[i, 0], F[i, 1], F[i, 2] = fx, fy, fz
+            best[it, i] = near[n]
+        if it + 1 < iterations:
+            _gap_rows(P, F, strength, step, near, vids, h, gap, it, seed, iterates[it + 1])
+        else:
+            _gap_rows(P, F, strength, step, near, vids, h, gap, it, seed, result)
 
 
 @twin_njit(nogil=True, parallel=True)
-def _local_gap(P, F, S, step, best, vids, h, gap, it, seed, out):
+def _gap_rows(P, F, S, step, near, vids, h, gap, it, seed, out):
     """The next iterate (or the float32 result) of each vertex ``vids[n]`` into ``out``."""
     for n in prange(vids.size):
         i = vids[n]
-        j = best[n]
+        j = near[n]
         zeta = 0.0
         if gap != 2 and j >= 0:
             zeta = hash_tail_u01_nb(hash_head_nb(seed, i, CH_CLUMP), it)
         moved_vertex(P, F, S, step, i, j, zeta, h, gap, out, i)
-
-
-@twin_njit(nogil=True, parallel=True)
-def _set_rows(dst, src, vids):
-    for n in prange(vids.size):
-        i = vids[n]
-        for a in range(3):
-            dst[i, a] = src[i, a]
 
 
 def _same_frame(a: tuple, b: tuple) -> bool:
@@ -139,6 +159,13 @@ class LocalClump:
         self.lists_ms = 0.0  # of the last update: grid moves and neighbour lists
         self._box: tuple | None = None  # the grid's points' box (float64), None: not known
         self._frame = self.frame(points)  # the full build's grid the record's lists were in
+        self._nearest = np.empty(0, np.int64)  # scratch of :func:`_local_run`, kept across moves
+
+    def _near(self, n: int) -> np.ndarray:
+        """Room for ``n`` nearest neighbours (grown, never shrunk)."""
+        if self._nearest.size < n:
+            self._nearest = np.empty(max(n, int(1.5 * self._nearest.size)), np.int64)
+        return self._nearest[:n]
 
     def resync(self, points: np.ndarray, old: np.ndarray) -> None:
         """After another full run: the grid follows the vertices that moved since ``old``."""
@@ -162,10 +189,12 @@ class LocalClump:
 
     def near(self, points: np.ndarray, queries: np.ndarray, radius: float) -> np.ndarray:
         """Sorted ids of the strands with a vertex of ``points`` (as the grid holds them) closer
-        than ``radius`` to one of ``queries``."""
+        than ``radius`` to one of ``queries`` (on the serial kernels where the queries' boxes
+        span fewer than :data:`SERIAL_BELOW` cells: the walk's work)."""
         mark = np.zeros(self.topology.strand_count, bool)
         if len(queries):
-            self.grid.strands_near(points, queries, radius, mark)
+            cells = len(queries) * (2.0 * radius / self.grid.cell + 1.0) ** 3
+            self.grid.strands_near(points, queries, radius, mark, parallel_for(int(min(cells, 2**62))))
         return np.flatnonzero(mark)
 
     def update(
@@ -201,20 +230,14 @@ class LocalClump:
         vids = self.reach(was, new, changed, iterations, gap_mode, int(MAX_REGION * v))
         if vids is None:
             return None
-        with threads_for(vids.size):
-            flat, cnt, cap = self.grid.lists(new, vids, self.radius, frame)
-            self.lists_ms = (time.perf_counter() - t0) * 1e3
-            rec.points[vids] = new[vids]
-            rec.strength[vids] = sv[vids]
-            _set_rows(rec.iterates[0], rec.points, vids)
-            best = np.empty(vids.size, np.int64)
-            gap, seed64 = _GAP_CODE[gap_mode], seed_u64(seed)
-            for it in range(iterations):
-                p, f = rec.iterates[it], rec.forces[it]
-                _local_force(p, flat, cap, cnt, vids, self.roots, self.h, self.ident, f, best)
-                rec.best[it][vids] = best
-                out = rec.iterates[it + 1] if it + 1 < iterations else rec.result
-                _local_gap(p, f, rec.strength, float(step), best, vids, self.h, gap, it, seed64, out)
+        parallel = parallel_for(vids.size)
+        flat, cnt, cap = self.grid.lists(new, vids, self.radius, frame, parallel)
+        self.lists_ms = (time.perf_counter() - t0) * 1e3
+        run = _local_run if parallel else serial_twins.serial(_local_run)
+        fields = (rec.points, rec.strength, rec.iterates, rec.forces, rec.best, rec.result)
+        gap, seed64 = _GAP_CODE[gap_mode], seed_u64(seed)
+        run(new, sv, flat, cap, cnt, vids, self.roots, self.h, self.ident, float(step), gap, seed64,
+            iterations, fields, self._near(vids.size))  # fmt: skip
         self.region = np.unique(top.strand_index[vids])
         self.vertices = vids
         return self.region, vids

@@ -23,7 +23,7 @@ from hairtool.frozen.brushes import registry
 from hairtool.frozen.brushes.spec import StrokeMemory
 from hairtool.frozen.clump import ClumpRecord
 from hairtool.frozen.lengths import restore_lengths
-from hairtool.frozen.local import LocalClump, threads_for
+from hairtool.frozen.local import LocalClump, parallel_for, threads_for
 from hairtool.frozen.move_points import MovePoints, held_by_at_most, may_write
 from hairtool.frozen.replay import Sample, StrokeSetting, apply_sample, memory_for
 from hairtool.frozen.selection import SelectionSample
@@ -219,7 +219,7 @@ def move(
     _kept_writable(moves, result_on_kept, result_alone)
     if run.keep_lengths:  # whole strands: a segment's length is given back from the root on
         rows = vertex_ids_of(top, region)
-        restore_lengths(now, rec.result, top, region, moves.kept)
+        restore_lengths(now, rec.result, top, region, moves.kept, parallel_for(rows.size))
         still = rows[sv[rows] == 0.0]
         moves.kept[still] = now[still]
     else:

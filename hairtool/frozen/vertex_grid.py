@@ -22,6 +22,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
+from hairtool import serial_twins
 from hairtool.bounds import box
 from hairtool.serial_twins import twin_njit
 
@@ -573,7 +574,9 @@ class VertexGrid:
         grid = (self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
         return int(_move(points, ids, *grid, self.blocks))
 
-    def strands_near(self, points: np.ndarray, queries: np.ndarray, radius: float, mark: np.ndarray) -> None:
+    def strands_near(
+        self, points: np.ndarray, queries: np.ndarray, radius: float, mark: np.ndarray, parallel: bool = True
+    ) -> None:
         """Flag in ``mark`` ((S,) bool) the strands with a vertex of ``points`` (where the grid
         holds them) closer than ``radius`` to one of ``queries`` ((n, 3)).
 
@@ -587,6 +590,8 @@ class VertexGrid:
             The distance.
         mark : ndarray
             ``(S,)`` bool, written.
+        parallel : bool, default True
+            Run the parallel kernels (False: their serial twins; the same flags).
         """
         q = np.asarray(queries, np.float64).reshape(-1, 3)
         radius = _within_reach(points, q, float(radius), self.cell)
@@ -594,13 +599,16 @@ class VertexGrid:
         grid = (self.inv, self.shift, self.key, self.head, self.nxt, mark)
         if len(q) == 1 and _cells_within(q[0], float(radius), self.cell) <= self.vertex_count:
             x, y, z = float(q[0, 0]), float(q[0, 1]), float(q[0, 2])
-            _mark_near_wide(points, self.strand, x, y, z, r2, *grid, self.blocks)
+            wide = _mark_near_wide if parallel else serial_twins.serial(_mark_near_wide)
+            wide(points, self.strand, x, y, z, r2, *grid, self.blocks)
             return
         xyz = np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(q[:, 1]), np.ascontiguousarray(q[:, 2])
         if float(radius) <= self.cell:
-            _mark_near_grouped(points, self.strand, *xyz, r2, *grid)
+            grouped = _mark_near_grouped if parallel else serial_twins.serial(_mark_near_grouped)
+            grouped(points, self.strand, *xyz, r2, *grid)
         else:
-            _mark_near(points, self.strand, *xyz, r2, *grid, self.blocks)
+            each = _mark_near if parallel else serial_twins.serial(_mark_near)
+            each(points, self.strand, *xyz, r2, *grid, self.blocks)
 
     def vertices_near(
         self, points: np.ndarray, queries: np.ndarray, strands: np.ndarray, radius: float, skip: np.ndarray
@@ -638,7 +646,9 @@ class VertexGrid:
         found = _vertices_near(points, self.strand, *xyz, qs, *grid)
         return np.sort(out[:found])
 
-    def lists(self, points: np.ndarray, vids: np.ndarray, radius: float, frame: tuple) -> tuple:
+    def lists(
+        self, points: np.ndarray, vids: np.ndarray, radius: float, frame: tuple, parallel: bool = True
+    ) -> tuple:
         """``(flat, cnt, cap)``: the list of each vertex ``vids[n]`` (other strands within
         ``radius``, original indices) at ``flat[n·cap :][: cnt[n]]``, in the order of a full build
         whose grid is ``frame`` (:func:`list_frame`); ``radius`` must not exceed the cell.
@@ -654,6 +664,8 @@ class VertexGrid:
             The distance.
         frame : tuple
             The full build's grid (:func:`list_frame`).
+        parallel : bool, default True
+            Run the parallel kernel (False: its serial twin; the same lists).
 
         Returns
         -------
@@ -663,12 +675,13 @@ class VertexGrid:
         dense, lo, inv_cell, ny, nz, inv_q, nq = frame
         ids = np.ascontiguousarray(vids, np.int64)
         r2 = float(radius) ** 2
+        kernel = _region_lists if parallel else serial_twins.serial(_region_lists)
         while True:
             cap = self.capacity
             self.prepare(ids.size)
             flat = self._flat[: ids.size * cap]
             cnt = np.empty(ids.size, np.int64)
-            _region_lists(
+            kernel(
                 points, self.strand, ids, r2, self.inv, self.shift, self.key, self.head, self.nxt, dense, lo,
                 inv_cell, ny, nz, inv_q, nq, cap, flat, cnt,
             )  # fmt: skip

@@ -276,20 +276,29 @@ def test_a_drag_on_dense_hair_equals_its_numpy_twin_and_leaves_the_rest_alone(ke
     assert local_moves >= 3
 
 
-def test_local_moves_are_deterministic_at_1_and_2_threads(threads):
+def test_local_moves_are_deterministic_at_1_and_2_threads_and_on_the_serial_twins(threads, monkeypatch):
+    """A region below SERIAL_BELOW runs the serial twins, a larger one the parallel kernels:
+    the same bytes either way (here the threshold moves so that both run the same drag)."""
+    from hairtool.frozen import local
+
     g = samples.scalp(400, 12, seed=5)
     lo, hi = g.bounds
     extent = float(np.max(hi - lo))
     tip = g.tips[100].astype(np.float64)
+    runs = []  # each choice of the kernels: parallel or not
+    monkeypatch.setattr(local, "parallel_for", lambda n, f=local.parallel_for: runs.append(f(n)) or runs[-1])
     results = []
-    for n in (1, 2):
+    for n, serial_below in ((1, 0), (2, 0), (2, 10**9)):
         threads(n)
+        monkeypatch.setattr(local, "SERIAL_BELOW", serial_below)
+        runs.clear()
         pipe = FrozenPipeline(g, FrozenParams(keep_lengths=True))
         for k in range(4):
             pipe.align(tip + 0.04 * extent * np.array([np.cos(k), np.sin(k), 0.0]), 0.12 * extent, 0.8)
         assert pipe.clump_redone < 1.0
+        assert runs and set(runs) == {serial_below == 0}  # the parallel kernels ran, or their twins
         results.append(pipe.result.points.copy())
-    assert same_bytes(*results)
+    assert same_bytes(*results[:2]) and same_bytes(*results[1:])
 
 
 def test_undo_and_redo_bring_back_the_moves_result_and_a_replay_runs_in_full():
