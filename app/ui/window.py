@@ -25,7 +25,7 @@ from PySide6.QtWidgets import (
 
 from app.document.animation import Document
 from app.document.groom import GroomState
-from app.document.groom_file import write_groom
+from app.document.groom_file import write_groom_apart
 from app.ui import export
 from app.ui.animation_io import (
     PROJECT_SUFFIX,
@@ -898,7 +898,7 @@ class MainWindow(QMainWindow):
         item = self.writes.queue(
             f"{'Saving' if adopt else 'Exporting'} {Path(path).name}",
             Path(path),
-            lambda: write_groom(path, build(), mesh),
+            lambda: write_groom_apart(path, build(), mesh),  # (usd-core holds the GIL: apart)
             written,
             lambda e: self.show_error("Cannot write file", save_failure(path, e)),
         )

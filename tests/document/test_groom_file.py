@@ -61,3 +61,19 @@ def test_a_file_that_cannot_be_written_is_named_and_the_old_one_stays(tmp_path, 
         write_groom(kept, samples.portrait(strands=3, vertices=4), head)
     assert str(caught.value).startswith(f"{kept}: ") and kept.read_bytes() == old
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []
+
+
+def test_written_apart_it_is_the_same_file_and_a_failure_names_it(tmp_path):
+    """The helper process writes the bytes :func:`write_groom` writes here; its failure comes
+    back as a FormatError naming the file."""
+    from app.document.groom_file import write_groom_apart
+
+    groom, head = samples.portrait(strands=6, vertices=4), _head()
+    write_groom(tmp_path / "here.usda", groom, head)
+    write_groom_apart(tmp_path / "apart.usda", groom, head)
+    assert (tmp_path / "apart.usda").read_bytes() == (tmp_path / "here.usda").read_bytes()
+    blocker = tmp_path / "gone"
+    blocker.write_text("a file where the folder should be")
+    with pytest.raises(FormatError) as caught:
+        write_groom_apart(blocker / "groom.usda", groom, head)
+    assert str(caught.value).startswith(f"{blocker / 'groom.usda'}: cannot write")

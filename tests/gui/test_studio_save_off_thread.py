@@ -54,7 +54,7 @@ def gate(monkeypatch):
 
     held = Gate()
     monkeypatch.setattr(pf, "save", held.wrap(pf.save))
-    monkeypatch.setattr(window_module, "write_groom", held.wrap(window_module.write_groom))
+    monkeypatch.setattr(window_module, "write_groom_apart", held.wrap(window_module.write_groom_apart))
     yield held
     held.open()  # a writer still held never outlives the test
 
