@@ -162,6 +162,17 @@ def test_quit_during_a_write_waits_for_it_and_says_so(ui, make_window, gate, tmp
     assert pf.load(path).params.bend_stiffness == 5.0
 
 
+def test_a_document_replaced_while_its_save_writes_does_not_take_the_file(make_window, gate, tmp_path):
+    w = _window(make_window)
+    _stiffness(w, 5.0)
+    path = tmp_path / "old.hairproj"
+    assert w.project.save_to(path, wait=False) and gate.entered.wait(10)
+    w.new_from_sample("comb")  # another document while the old one is written
+    gate.open()
+    assert w.writes.wait() and pf.load(path).params.bend_stiffness == 5.0
+    assert w.project.path is None and w.scene.path is None and not w.project.has_unsaved_changes()
+
+
 OPS = st.lists(
     st.one_of(
         st.tuples(st.just("edit"), st.integers(1, 12)),
