@@ -8,7 +8,9 @@ animation made here, a step undone past the save and replaced).
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
+from dataclasses import dataclass
 
 
 class Command:
@@ -27,6 +29,16 @@ class Command:
         return False
 
 
+@dataclass(frozen=True, eq=False)
+class SaveMark:
+    """Where the stack stood when a save took its snapshot (:meth:`UndoStack.mark`): the save
+    that finishes later makes that state, not the one reached meanwhile, the clean one."""
+
+    index: int
+    top: Command | None
+    generation: int
+
+
 class UndoStack:
     """Commands done (undoable) and undone (redoable); callbacks hear every change."""
 
@@ -34,6 +46,8 @@ class UndoStack:
         self._done: list[Command] = []
         self._undone: list[Command] = []
         self._clean: int | None = 0
+        self._kept: weakref.WeakSet[Command] = weakref.WeakSet()  # saves' snapshots: no merges
+        self._generation = 0  # moves on when the document's states no step holds change
         self._listeners: list[Callable[[], None]] = []
         self.edits = 0  # counts pushes (merged ones too), undos, redos and clears: the steps moved
 
@@ -54,7 +68,8 @@ class UndoStack:
                 self._clean = None  # the saved state was a step undone: it cannot come back
             self._undone.clear()
         top = self._done[-1] if self._done else None
-        if top is None or len(self._done) == self._clean or not top.merge(command):
+        kept = len(self._done) == self._clean or top in self._kept
+        if top is None or kept or not top.merge(command):
             self._done.append(command)
         self.edits += 1
         self._tell()
@@ -85,6 +100,8 @@ class UndoStack:
         self._done.clear()
         self._undone.clear()
         self._clean = 0 if clean else None
+        self._kept.clear()
+        self._generation += 1
         self.edits += 1
         self._tell()
 
@@ -142,4 +159,28 @@ class UndoStack:
     def mark_changed(self) -> None:
         """Work no step holds was added: unsaved until the next save."""
         self._clean = None
+        self._generation += 1
         self._tell()
+
+    def mark(self) -> SaveMark:
+        """The state a save's snapshot holds; the step there takes no later merge, so the state
+        at that index stays the snapshot's while the write runs."""
+        if self.top is not None:
+            self._kept.add(self.top)
+        return SaveMark(len(self._done), self.top, self._generation)
+
+    def holds(self, mark: SaveMark) -> bool:
+        """Whether ``mark``'s state is still a state of this stack: not cleared or replaced since
+        (a step undone past it and another pushed), no work outside the steps added."""
+        if mark.generation != self._generation or mark.index > self.count:
+            return False
+        return mark.index == 0 or self.command(mark.index - 1) is mark.top
+
+    def set_clean_at(self, mark: SaveMark) -> bool:
+        """A save of ``mark``'s snapshot was written: that state is the saved one (edits made
+        since stay unsaved). False, and nothing changes, when the stack no longer holds it."""
+        if not self.holds(mark):
+            return False
+        self._clean = mark.index
+        self._tell()
+        return True

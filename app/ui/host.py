@@ -18,6 +18,7 @@ if TYPE_CHECKING:
     from app.document.animation import Document
     from app.ui.animation_model import AnimationModel
     from app.ui.dialogs import PictureOptions
+    from app.ui.file_writes import FileWrites
     from app.ui.jobs import JobRunner
     from app.ui.scene import Scene
     from app.ui.tool_dock import ToolDock
@@ -37,6 +38,7 @@ class StudioHost(Protocol):
     doc: Document
     undo_stack: UndoView
     jobs: JobRunner
+    writes: FileWrites
     scene: Scene
     viewport: Viewport
     dock: ToolDock
@@ -53,7 +55,7 @@ class StudioHost(Protocol):
     def ask_picture_options(self) -> PictureOptions | None: ...
 
     # -- the window's own file actions ------------------------------------------------------
-    def save(self) -> bool: ...
+    def save(self, wait: bool = True) -> bool: ...
 
     # -- the window's places ---------------------------------------------------------------------
     def remember_dir(self, path: str | os.PathLike[str]) -> None: ...

@@ -21,6 +21,8 @@ Usage (the window owns one runner, ``window.jobs``)::
   ``show_error``: one dialog, no traceback). ``on_cancelled()`` (GUI thread) is optional.
 - ``group``: a new job of the same group cancels the running one first (e.g. re-solving keys
   while a slider moves); jobs of different groups run side by side.
+- ``cancellable=False``: a job that must run to its end (a file being written: it is renamed
+  into place whole or not at all); Cancel is not offered and ``cancel`` passes it by.
 - ``runner.wait()`` blocks while processing events until no job runs (tests, closing).
 """
 
@@ -54,6 +56,7 @@ class Job:
     on_done: Callable[[Any], None] | None
     on_error: Callable[[BaseException], None] | None
     on_cancelled: Callable[[], None] | None
+    cancellable: bool = True
     state: str = "running"
     fraction: float | None = None
     text: str = ""
@@ -127,12 +130,13 @@ class JobRunner(QObject):
         on_error: Callable[[BaseException], None] | None = None,
         on_cancelled: Callable[[], None] | None = None,
         group: str | None = None,
+        cancellable: bool = True,
     ) -> Job:
         """Start ``fn(progress, cancelled)`` in a worker thread; returns the :class:`Job` at once."""
         if group is not None:
             for old in self.active(group):
                 self.cancel(old)
-        job = Job(title, group, on_done, on_error, on_cancelled)
+        job = Job(title, group, on_done, on_error, on_cancelled, cancellable)
         self._jobs.append(job)
         self.pool.start(_Runnable(job, fn, self._bridge))
         self.job_started.emit(job)
@@ -147,9 +151,10 @@ class JobRunner(QObject):
         return bool(self.active())
 
     def cancel(self, job: Job | None = None) -> None:
-        """Cancel one job (all when None); their results will be dropped."""
+        """Cancel one job (all when None); their results will be dropped. A job that is not
+        ``cancellable`` runs on."""
         for j in [job] if job is not None else list(self._jobs):
-            if j.state == "running" and not j.cancelled:
+            if j.state == "running" and not j.cancelled and j.cancellable:
                 j.cancel()
                 self.job_finished.emit(j)  # the bar goes away now; the thread ends on its own
 
@@ -250,6 +255,7 @@ class JobStatus(QWidget):
         else:
             self.bar.setRange(0, 1000)
             self.bar.setValue(round(job.fraction * 1000))
+        self.cancel_button.setVisible(job.cancellable)
         self.setVisible(True)
 
     def _cancel_shown(self) -> None:

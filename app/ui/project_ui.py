@@ -28,6 +28,7 @@ from PySide6.QtCore import QObject, QSettings, QStandardPaths, QTimer, Signal, S
 
 from app.document import project_io
 from app.render.camera import Camera
+from app.ui.file_writes import save_failure
 from hairtool import project as pf
 from hairtool.errors import FormatError, HairtoolError
 
@@ -59,12 +60,6 @@ def recovery_question(path: str | os.PathLike[str], now: datetime | None = None)
         f"Hairtool Studio did not close properly last time. Its work was autosaved {when}.\n"
         f"Restore it? Discard deletes the autosave.\n\n{path}"
     )
-
-
-def save_failure(path: str | os.PathLike[str], error: BaseException) -> str:
-    """Why a save of ``path`` failed, in one line that names the file."""
-    reason = str(error) if isinstance(error, HairtoolError) else f"{type(error).__name__}: {error}"
-    return reason if str(path) in reason else f"{path}: {reason}"
 
 
 class ProjectController(QObject):
@@ -224,36 +219,51 @@ class ProjectController(QObject):
             model.doc.edit_frames(state.animation, state.held_keys, "Keys held")
 
     # -- save and open ---------------------------------------------------------------------
-    def save_project(self) -> bool:
+    def save_project(self, wait: bool = True) -> bool:
         if self.path is None:
-            return self.save_project_as()
-        return self.save_to(self.path)
+            return self.save_project_as(wait)
+        return self.save_to(self.path, wait)
 
-    def save_project_as(self) -> bool:
+    def save_project_as(self, wait: bool = True) -> bool:
         stem = self.window.scene.path.stem if self.window.scene.path is not None else "project"
         path = self.window.ask_save_path("Save project", PROJECT_FILTERS, stem + pf.SUFFIX)
         if not path:
             return False
         if Path(path).suffix.lower() != pf.SUFFIX:
             path = str(path) + pf.SUFFIX
-        return self.save_to(path)
+        return self.save_to(path, wait)
 
-    def save_to(self, path: str | os.PathLike[str]) -> bool:
-        """Write the project (atomically); the window adopts it as its current file. A save that
-        fails, for whatever reason, says so in a dialog naming the file and returns False: the
-        work stays unsaved and whoever asked (Quit, Open) stays too."""
+    def save_to(self, path: str | os.PathLike[str], wait: bool = True) -> bool:
+        """Write the project (atomically, in a worker after the writes already queued: the
+        snapshot is taken now); once written, the window adopts it as its current file and the
+        snapshot's state is the saved one (edits made meanwhile stay unsaved). A save that fails,
+        for whatever reason, says so in a dialog naming the file: the work stays unsaved.
+        ``wait``: return once written (True) or failed (False), the window answering meanwhile,
+        so that whoever asked (Quit, Open) stays on a failure; else True once queued."""
+        w = self.window
         try:
-            pf.save(path, self.current_project())
-        except Exception as e:  # (a fault in the writer too: never a silent loss of the work)
-            self.window.show_error("Cannot save project", save_failure(path, e))
+            project = self.current_project()
+        except Exception as e:  # (a fault in the snapshot too: never a silent loss of the work)
+            w.show_error("Cannot save project", save_failure(path, e))
             return False
-        self.path = Path(path)
-        self._mark_saved()
-        self.window.scene.set_path(self.path)
-        self.window.remember_dir(path)
-        self.window.statusBar().showMessage(f"saved {path}", 5000)
-        self.saved.emit(str(path))
-        return True
+        mark = w.undo_stack.mark()
+
+        def written() -> None:
+            if w.undo_stack.setCleanAt(mark):  # (not when the document was replaced meanwhile)
+                self.path = Path(path)
+                w.scene.set_path(self.path)
+            w.remember_dir(path)
+            w.statusBar().showMessage(f"saved {path}", 5000)
+            self.saved.emit(str(path))
+
+        item = w.writes.queue(
+            f"Saving {Path(path).name}",
+            Path(path),
+            lambda: pf.save(path, project),
+            written,
+            lambda e: w.show_error("Cannot save project", save_failure(path, e)),
+        )
+        return w.writes.wait(item) if wait else True
 
     def open_project_dialog(self) -> bool:
         if not self.confirm_discard():

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -695,12 +696,25 @@ class Scene(QObject):
     def export_groom(self) -> Groom:
         """What a save or export writes: the edited groom, or with children the render hair
         (tapered widths) and the guides as a second prim of purpose "guide"."""
-        hair = self.render_hair()
-        if hair is None:
-            return self.result
-        from hairtool.guides.files import with_guides
+        return self.export_snapshot()()
 
-        return with_guides(hair, self.result, self.rest.metadata)
+    def export_snapshot(self) -> Callable[[], Groom]:
+        """:meth:`export_groom` in two halves: the immutable inputs taken now (cheap, on the GUI
+        thread), the returned function building the groom from them later (in a save's worker),
+        whatever the document becomes meanwhile."""
+        result, binding = self.result, self.children_binding()
+        if binding is None:
+            return lambda: result
+        clump, metadata = self.children_clump(), self.rest.metadata
+
+        def build() -> Groom:
+            from hairtool.guides.files import with_guides
+            from hairtool.guides.render import RenderHair
+
+            hair = binding.build(result) if clump is None else RenderHair(binding, clump).update(result)
+            return with_guides(hair, result, metadata)
+
+        return build
 
     # -- engine parameters ---------------------------------------------------------------
     @property

@@ -14,7 +14,7 @@ from __future__ import annotations
 from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QAction, QUndoCommand
 
-from app.document.undo import Command, UndoStack
+from app.document.undo import Command, SaveMark, UndoStack
 
 
 class QtStep(Command):
@@ -98,6 +98,14 @@ class UndoView(QObject):
 
     def setClean(self) -> None:
         self._stack.set_clean()
+
+    def mark(self) -> SaveMark:
+        """The state a save's snapshot holds (see :meth:`UndoStack.mark`)."""
+        return self._stack.mark()
+
+    def setCleanAt(self, mark: SaveMark) -> bool:
+        """That snapshot was written: its state is the saved one; False when no longer held."""
+        return self._stack.set_clean_at(mark)
 
     def resetClean(self) -> None:
         """Work no step holds: unsaved until the next save."""

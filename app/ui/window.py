@@ -7,6 +7,7 @@ them (monkeypatch) and never block.
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -24,10 +25,10 @@ from PySide6.QtWidgets import (
 
 from app.document.animation import Document
 from app.document.groom import GroomState
+from app.document.groom_file import write_groom_apart
 from app.ui import export
 from app.ui.animation_io import (
     PROJECT_SUFFIX,
-    USD_EXTENSIONS,
     open_filters,
     read_with_notes,
     save_filters,
@@ -39,6 +40,7 @@ from app.ui.brush_tool import LABELS, SHORTCUTS, TIPS, brushes
 from app.ui.colouring import displacement_scale
 from app.ui.dialogs import PictureOptions, StillOptions, ask_picture_options, ask_still_options
 from app.ui.engine_start import WAIT_MESSAGE, EngineStart
+from app.ui.file_writes import FileWrites, save_failure
 from app.ui.habits import install_habits
 from app.ui.jobs import Job, JobRunner, JobStatus
 from app.ui.kernel_preload import KernelPreload
@@ -104,6 +106,10 @@ class MainWindow(QMainWindow):
         self._stroke_clump: np.ndarray | None = None  # clump strengths when a clump stroke began
         # long work (key solves, simulation, video export): window.jobs.run(title, fn, on_done)
         self.jobs = JobRunner(lambda title, message: self.show_error(title, message), self)
+        # saves and exports of the groom and the project: written in turn, off the GUI thread
+        self.writes = FileWrites(self.jobs, self)
+        self.last_snapshot_ms = 0.0  # what the last groom save's snapshot cost the GUI thread
+        self._waiting_for_writes = False
         self.scene = Scene(start, parent=self, engine_ready=engine_ready, hair=self.doc.hair)
         self.engine_start: EngineStart | None = None
         # the bundled sample's render hair, on a first start bound once its kernels are cached
@@ -267,6 +273,9 @@ class MainWindow(QMainWindow):
         self.settings.sync()
 
     def closeEvent(self, event) -> None:
+        if not self.wait_for_writes("quitting"):  # a Quit during this wait: the first one goes on
+            event.ignore()
+            return
         try:
             go_on = self.project.confirm_discard()  # False: Cancel, or a save that failed
         except Exception as e:  # a fault while saving: the window and its work stay
@@ -286,6 +295,23 @@ class MainWindow(QMainWindow):
         self.viewport.release_gl()
         super().closeEvent(event)
 
+    def wait_for_writes(self, before: str) -> bool:
+        """Let the saves still writing end first, saying so in the status bar (the window still
+        answers); False while another caller is already waiting for them."""
+        pending = self.writes.pending
+        if not pending:
+            return True
+        if self._waiting_for_writes:
+            return False
+        names = ", ".join(dict.fromkeys(w.path.name for w in pending))
+        self.statusBar().showMessage(f"Waiting for {names} to be written before {before}…")
+        self._waiting_for_writes = True
+        try:
+            self.writes.wait()
+        finally:
+            self._waiting_for_writes = False
+        return True
+
     # -- menus -------------------------------------------------------------------------------
     def _build_menus(self) -> None:
         bar = self.menuBar()
@@ -300,11 +326,11 @@ class MainWindow(QMainWindow):
         self.recent_menu = file.addMenu("Open &Recent")
         self.recent_menu.aboutToShow.connect(self._fill_recent_menu)
         file.addSeparator()
-        add_action(self, file, "&Save", self.save, QKeySequence.StandardKey.Save)
-        add_action(self, file, "Save &As…", self.save_as, QKeySequence.StandardKey.SaveAs)
+        add_action(self, file, "&Save", lambda: self.save(wait=False), QKeySequence.StandardKey.Save)
+        add_action(self, file, "Save &As…", lambda: self.save_as(wait=False), QKeySequence.StandardKey.SaveAs)
         file.addSeparator()
         add_action(self, file, "&Export still…", self.export_still_dialog, "Ctrl+E")
-        add_action(self, file, "Export &groom…", self.export_groom_dialog, "Ctrl+Shift+E")
+        add_action(self, file, "Export &groom…", lambda: self.export_groom_dialog(wait=False), "Ctrl+Shift+E")
         file.addSeparator()
         self.stroke_files = StrokeFiles(self)
         add_action(self, file, "Export S&trokes…", lambda: self.stroke_files.export_dialog())
@@ -457,8 +483,8 @@ class MainWindow(QMainWindow):
         made: dict[str, QAction] = {}
         for text, slot, key in (
             ("Open &Project…", self.project.open_project_dialog, "Ctrl+Shift+O"),
-            ("Save Pro&ject", self.project.save_project, "Ctrl+Alt+S"),
-            ("Save Project As…", self.project.save_project_as, None),
+            ("Save Pro&ject", lambda: self.project.save_project(wait=False), "Ctrl+Alt+S"),
+            ("Save Project As…", lambda: self.project.save_project_as(wait=False), None),
             (None, None, None),
             ("Export &Animation…", self.exporter.export_animation_dialog, "Ctrl+Alt+E"),
             ("Export &Keys…", self.exporter.export_keys_dialog, None),
@@ -830,43 +856,53 @@ class MainWindow(QMainWindow):
         self._add_recent(path)
         return True
 
-    def save(self) -> bool:
+    def save(self, wait: bool = True) -> bool:
+        """Write the groom to its own file (Save As for a format that cannot be written). The
+        snapshot is taken now and written in a worker; ``wait``: return once it is written (True)
+        or has failed (False), the window answering meanwhile; else True once it is queued."""
         path = self.scene.path
         if path is None or not any(path.suffix.lower() in f.extensions and f.writable for f in io.FORMATS):
-            return self.save_as()
-        return self._write_groom(path, adopt=True)
+            return self.save_as(wait)
+        return self._write_groom(path, adopt=True, wait=wait)
 
-    def save_as(self) -> bool:
+    def save_as(self, wait: bool = True) -> bool:
         stem = self.scene.path.stem if self.scene.path is not None else "groom"
         path = self.ask_save_path("Save groom as", save_filters(), f"{stem}.usda")
-        return bool(path) and self._write_groom(path, adopt=True)
+        return bool(path) and self._write_groom(path, adopt=True, wait=wait)
 
-    def export_groom_dialog(self) -> bool:
+    def export_groom_dialog(self, wait: bool = True) -> bool:
         stem = self.scene.path.stem if self.scene.path is not None else "groom"
         path = self.ask_save_path("Export edited groom", save_filters(), f"{stem}_edited.usda")
-        return bool(path) and self.export_groom(path)
+        return bool(path) and self.export_groom(path, wait)
 
-    def export_groom(self, path: str | os.PathLike[str]) -> bool:
+    def export_groom(self, path: str | os.PathLike[str], wait: bool = True) -> bool:
         """Write the edited groom to any writable format; the current file stays the same."""
-        return self._write_groom(path, adopt=False)
+        return self._write_groom(path, adopt=False, wait=wait)
 
-    def _write_groom(self, path: str | os.PathLike[str], *, adopt: bool) -> bool:
-        try:
-            io.write(path, self.scene.export_groom())
-            if self.scene.mesh is not None and Path(path).suffix.lower() in USD_EXTENSIONS:
-                from hairtool.io.usd_mesh import add_mesh
+    def _write_groom(self, path: str | os.PathLike[str], *, adopt: bool, wait: bool) -> bool:
+        """Snapshot the groom (and head) now, write it after the writes already queued. Once
+        written, a Save makes the snapshot's state the saved one (edits made meanwhile stay
+        unsaved) and adopts the file, unless the document was replaced meanwhile."""
+        t0 = time.perf_counter()
+        build, mesh = self.scene.export_snapshot(), self.scene.mesh
+        mark = self.undo_stack.mark() if adopt else None
+        self.last_snapshot_ms = (time.perf_counter() - t0) * 1e3
 
-                add_mesh(path, self.scene.mesh)  # the head goes with the groom (a Mesh prim beside)
-        except HairtoolError as e:
-            self.show_error("Cannot write file", str(e))
-            return False
-        self.remember_dir(path)
-        if adopt:
-            self.scene.set_path(path)
-            self.undo_stack.setClean()
-            self._add_recent(path)
-        self.statusBar().showMessage(f"wrote {path}", 5000)
-        return True
+        def written() -> None:
+            self.remember_dir(path)
+            if mark is not None and self.undo_stack.setCleanAt(mark):
+                self.scene.set_path(path)
+                self._add_recent(path)
+            self.statusBar().showMessage(f"wrote {path}", 5000)
+
+        item = self.writes.queue(
+            f"{'Saving' if adopt else 'Exporting'} {Path(path).name}",
+            Path(path),
+            lambda: write_groom_apart(path, build(), mesh),  # (usd-core holds the GIL: apart)
+            written,
+            lambda e: self.show_error("Cannot write file", save_failure(path, e)),
+        )
+        return self.writes.wait(item) if wait else True
 
     def load_mesh_dialog(self) -> None:
         path = self.ask_open_path("Load head mesh", "Wavefront OBJ (*.obj);;USD meshes (*.usda *.usdc *.usd)")

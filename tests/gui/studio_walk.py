@@ -216,6 +216,7 @@ class Walk:
                         break
                     last, spent = now, spent + JOB_STALL_S
             jobs.cancel()  # as the artist presses Cancel: it must leave no partial file
+            self.window.writes.wait()  # a file being saved has no Cancel: it ends whole (or fails)
             jobs.wait(30.0)
         self.pump()
 
