@@ -15,7 +15,8 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QPoint, Qt
+from PySide6.QtGui import QImage, QPainter
 from PySide6.QtOpenGL import QOpenGLWindow
 from PySide6.QtWidgets import QVBoxLayout, QWidget
 
@@ -61,3 +62,16 @@ def hold_surface(widget: QWidget, surface: GLSurface) -> QWidget:
     layout.setContentsMargins(0, 0, 0, 0)
     layout.addWidget(container)
     return container
+
+
+def grab_with_view(window: QWidget, view: QWidget) -> QImage:
+    """``window`` as it looks, as an image: its widgets (``QWidget.grab``, which sees no native
+    GL window) with ``view``'s own image (its ``grabFramebuffer()``) painted in its place."""
+    image = window.grab().toImage()
+    drawn = view.grabFramebuffer()
+    if not drawn.isNull():
+        drawn.setDevicePixelRatio(view.devicePixelRatioF())
+        painter = QPainter(image)
+        painter.drawImage(view.mapTo(window, QPoint(0, 0)), drawn)
+        painter.end()
+    return image
