@@ -41,13 +41,14 @@ from typing import Protocol
 import moderngl
 import numpy as np
 from PySide6.QtCore import QCoreApplication, QEvent, QEventLoop, QPointF, Qt, Signal
-from PySide6.QtGui import QImage, QKeyEvent, QMouseEvent, QTabletEvent, QWheelEvent
+from PySide6.QtGui import QImage, QKeyEvent, QMouseEvent, QPainter, QTabletEvent, QWheelEvent
 from PySide6.QtWidgets import QWidget
 
 from app.render.camera import Camera
 from app.render.drawn import Drawn
 from app.render.last_image import LastImage
 from app.render.offscreen import Overlays
+from app.render.painted_layer import PaintedLayer
 from app.render.screen_pick import nearest_in_sight, nearest_on_screen
 from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.brush_sizing import CanvasSizing, pen_pressure
@@ -110,6 +111,10 @@ class Viewport(QWidget):
         self.last_draw_ms = 0.0
         self._dirty = {"groom", "colors", "display", "mesh"}
         self.last_image: LastImage | None = None  # the scene drawn last, without its overlays
+        # painted with QPainter over the view at each paint (the joint handles): ``shown()`` and
+        # ``paint(painter)``; the GL window would cover a widget placed over it
+        self.painted_over: list = []
+        self.painted_layer: PaintedLayer | None = None
         self._scene_stale = True  # something other than an overlay changed since the last paint
         self.scene_draws = 0  # paints that drew the scene (the others copied the last image)
         self._drag: str | None = None  # "align" | "orbit" | "pan" while a button is held
@@ -271,6 +276,7 @@ class Viewport(QWidget):
         self.ctx = moderngl.create_context()
         self.renderer = StrandRenderer(self.ctx)
         self.last_image = LastImage(self.ctx)
+        self.painted_layer = PaintedLayer(self.ctx)
         if not self.raster_ready:  # the CPU rasterizer's kernels are still compiling
             self.renderer.strand_raster = "gl"
         self._dirty = {"groom", "colors", "display", "mesh"}
@@ -395,12 +401,30 @@ class Viewport(QWidget):
         else:
             self.last_image.put(fbo)
         self.renderer.render_overlays(fbo, (w, h))
+        self._paint_over(fbo, (w, h))
         if self.finish_frames:
             self.ctx.finish()
         t2 = time.perf_counter()
         self.last_upload_ms = (t1 - t0) * 1e3
         self.last_draw_ms = (t2 - t1) * 1e3
         self.frame_drawn.emit()
+
+    def _paint_over(self, fbo: moderngl.Framebuffer, size: tuple[int, int]) -> None:
+        """What the painters show, painted into an image of the frame's ``size`` and drawn over it."""
+        shown = [p for p in self.painted_over if p.shown()]
+        if not shown:
+            return
+        w, h = size
+        image = QImage(w, h, QImage.Format.Format_RGBA8888_Premultiplied)
+        image.fill(0)
+        image.setDevicePixelRatio(self.devicePixelRatioF())
+        painter = QPainter(image)
+        for p in shown:
+            p.paint(painter)
+        painter.end()
+        line = image.bytesPerLine()
+        rgba = np.frombuffer(image.constBits(), np.uint8, count=line * h).reshape(h, line)[:, : w * 4]
+        self.painted_layer.draw(fbo, rgba.reshape(h, w, 4))
 
     def makeCurrent(self) -> None:
         """The surface's GL context current, its framebuffer bound (as QOpenGLWidget's)."""
@@ -471,6 +495,7 @@ class Viewport(QWidget):
             self.renderer.release()
             self.renderer = None
             self.last_image.release()
+            self.painted_layer.release()
             self.doneCurrent()
 
     # -- box select ----------------------------------------------------------------------------
