@@ -8,14 +8,16 @@ drawn and swapped on its own, and the widgets flush as a plain raster image.
 
 The surface takes no input: it is transparent to the mouse and the pen and never takes the
 keyboard focus, so every event reaches the widget that holds it (the viewport) exactly as a
-widget's own events do: its cursor, its focus, the window's shortcuts and event filters.
+widget's own events do: its cursor, its focus, the window's shortcuts and event filters. Input a
+platform gives the surface anyway (one that cannot make a child window transparent to input) is
+passed on to that widget.
 """
 
 from __future__ import annotations
 
 from typing import Protocol
 
-from PySide6.QtCore import QPoint, Qt
+from PySide6.QtCore import QCoreApplication, QEvent, QPoint, Qt
 from PySide6.QtGui import QImage, QPainter
 from PySide6.QtOpenGL import QOpenGLWindow
 from PySide6.QtWidgets import QVBoxLayout, QWidget
@@ -31,6 +33,13 @@ class Painter(Protocol):
     def paintGL(self) -> None: ...
 
 
+_T = QEvent.Type
+INPUT = frozenset(
+    (_T.MouseButtonPress, _T.MouseButtonRelease, _T.MouseButtonDblClick, _T.MouseMove, _T.Wheel,
+     _T.TabletPress, _T.TabletMove, _T.TabletRelease, _T.KeyPress, _T.KeyRelease, _T.Enter, _T.Leave)
+)  # fmt: skip
+
+
 class GLSurface(QOpenGLWindow):
     """Calls ``painter``'s GL methods; Qt keeps the image in a framebuffer object of the
     window's size (``defaultFramebufferObject``) and copies it to the window when painted."""
@@ -41,6 +50,14 @@ class GLSurface(QOpenGLWindow):
         self.setFlags(
             self.flags() | Qt.WindowType.WindowTransparentForInput | Qt.WindowType.WindowDoesNotAcceptFocus
         )
+
+    def event(self, event: QEvent) -> bool:
+        if event.type() in INPUT and isinstance(self._painter, QWidget):
+            if event.type() == QEvent.Type.MouseButtonPress:
+                self._painter.setFocus(Qt.FocusReason.MouseFocusReason)
+            QCoreApplication.sendEvent(self._painter, event)
+            return True
+        return super().event(event)
 
     def initializeGL(self) -> None:
         self._painter.initializeGL()
