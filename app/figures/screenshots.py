@@ -51,8 +51,10 @@ def settle(app, rounds: int = 30) -> None:
 
 
 def save(window, path: Path) -> None:
+    from app.ui.gl_surface import grab_with_view
+
     window.statusBar().clearMessage()  # a stroke's passing remark is no part of the picture
-    if not window.grab().save(str(path)):
+    if not grab_with_view(window, window.viewport).save(str(path)):
         raise OSError(f"could not write {path}")
     print(f"wrote {path}")
 

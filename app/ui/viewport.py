@@ -1,4 +1,5 @@
-"""The GL viewport: moderngl inside a QOpenGLWidget, camera navigation and the brushes.
+"""The GL viewport: moderngl in a native GL window (:mod:`app.ui.gl_surface`), camera navigation
+and the brushes.
 
 Navigation follows Blender/Maya: middle-drag or Alt+left-drag orbits (pans in 2-D), Shift with
 either pans, the wheel zooms, Ctrl+wheel resizes the brush. A plain left-drag is the current
@@ -39,18 +40,20 @@ from typing import Protocol
 
 import moderngl
 import numpy as np
-from PySide6.QtCore import QEvent, QPointF, Qt, Signal
-from PySide6.QtGui import QKeyEvent, QMouseEvent, QTabletEvent, QWheelEvent
-from PySide6.QtOpenGLWidgets import QOpenGLWidget
+from PySide6.QtCore import QCoreApplication, QEvent, QEventLoop, QPointF, Qt, Signal
+from PySide6.QtGui import QImage, QKeyEvent, QMouseEvent, QPainter, QTabletEvent, QWheelEvent
+from PySide6.QtWidgets import QWidget
 
 from app.render.camera import Camera
 from app.render.drawn import Drawn
 from app.render.last_image import LastImage
 from app.render.offscreen import Overlays
+from app.render.painted_layer import PaintedLayer
 from app.render.screen_pick import nearest_in_sight, nearest_on_screen
 from app.render.strands import StrandRenderer, default_strand_raster
 from app.ui.brush_sizing import CanvasSizing, pen_pressure
 from app.ui.drawn import drawn
+from app.ui.gl_surface import GLSurface, hold_surface
 from app.ui.scene import Scene
 from hairtool.frozen.brushes import NEED_SURFACE, facing_away
 from hairtool.frozen.brushes.sight import hidden_points
@@ -77,7 +80,7 @@ class BrushTarget(Protocol):
     def end(self) -> None: ...
 
 
-class Viewport(QOpenGLWidget):
+class Viewport(QWidget):
     """Draws the scene's current groom; emits a finished stroke as the document's groom states
     (before, after) once it is a step."""
 
@@ -91,6 +94,8 @@ class Viewport(QOpenGLWidget):
     def __init__(self, scene: Scene, parent=None) -> None:
         super().__init__(parent)
         self.scene = scene
+        self.surface = GLSurface(self)  # draws; this widget takes the input (see gl_surface)
+        hold_surface(self, self.surface)
         self.camera = self._fresh_camera()
         self.ctx: moderngl.Context | None = None
         self.renderer: StrandRenderer | None = None
@@ -101,11 +106,15 @@ class Viewport(QOpenGLWidget):
         self.finish_frames = False  # glFinish after upload and draw, so timings are real (benchmark)
         # Samples per pixel of Qt's framebuffer: the requested format's (format() reports the
         # context's, 0, once GL is up), since moderngl cannot tell for a framebuffer it did not make.
-        self.samples = max(self.format().samples(), 0)
+        self.samples = max(self.surface.format().samples(), 0)
         self.last_upload_ms = 0.0
         self.last_draw_ms = 0.0
         self._dirty = {"groom", "colors", "display", "mesh"}
         self.last_image: LastImage | None = None  # the scene drawn last, without its overlays
+        # painted with QPainter over the view at each paint (the joint handles): ``shown()`` and
+        # ``paint(painter)``; the GL window would cover a widget placed over it
+        self.painted_over: list = []
+        self.painted_layer: PaintedLayer | None = None
         self._scene_stale = True  # something other than an overlay changed since the last paint
         self.scene_draws = 0  # paints that drew the scene (the others copied the last image)
         self._drag: str | None = None  # "align" | "orbit" | "pan" while a button is held
@@ -153,14 +162,14 @@ class Viewport(QOpenGLWidget):
 
     # -- scene → view ----------------------------------------------------------------------
     def update(self, *args) -> None:
-        """Repaint, drawing the scene again (QWidget.update's arguments)."""
+        """Repaint, drawing the scene again (QWidget.update's arguments: the whole view is drawn)."""
         self._scene_stale = True
-        super().update(*args)
+        self.surface.update()
 
     def update_overlays(self) -> None:
         """Repaint the overlays only (the circle, the sizing ring, the box): over the last image,
         at the input's rate, unless something else asked for the scene meanwhile."""
-        super().update()
+        self.surface.update()
 
     def _mark(self, *what: str) -> None:
         self._dirty.update(what)
@@ -267,6 +276,7 @@ class Viewport(QOpenGLWidget):
         self.ctx = moderngl.create_context()
         self.renderer = StrandRenderer(self.ctx)
         self.last_image = LastImage(self.ctx)
+        self.painted_layer = PaintedLayer(self.ctx)
         if not self.raster_ready:  # the CPU rasterizer's kernels are still compiling
             self.renderer.strand_raster = "gl"
         self._dirty = {"groom", "colors", "display", "mesh"}
@@ -391,12 +401,72 @@ class Viewport(QOpenGLWidget):
         else:
             self.last_image.put(fbo)
         self.renderer.render_overlays(fbo, (w, h))
+        self._paint_over(fbo, (w, h))
         if self.finish_frames:
             self.ctx.finish()
         t2 = time.perf_counter()
         self.last_upload_ms = (t1 - t0) * 1e3
         self.last_draw_ms = (t2 - t1) * 1e3
         self.frame_drawn.emit()
+
+    def _paint_over(self, fbo: moderngl.Framebuffer, size: tuple[int, int]) -> None:
+        """What the painters show, painted into an image of the frame's ``size`` and drawn over it."""
+        shown = [p for p in self.painted_over if p.shown()]
+        if not shown:
+            return
+        w, h = size
+        image = QImage(w, h, QImage.Format.Format_RGBA8888_Premultiplied)
+        image.fill(0)
+        image.setDevicePixelRatio(self.devicePixelRatioF())
+        painter = QPainter(image)
+        for p in shown:
+            p.paint(painter)
+        painter.end()
+        line = image.bytesPerLine()
+        rgba = np.frombuffer(image.constBits(), np.uint8, count=line * h).reshape(h, line)[:, : w * 4]
+        self.painted_layer.draw(fbo, rgba.reshape(h, w, 4))
+
+    def makeCurrent(self) -> None:
+        """The surface's GL context current, its framebuffer bound (as QOpenGLWidget's)."""
+        self.surface.makeCurrent()
+
+    def doneCurrent(self) -> None:
+        self.surface.doneCurrent()
+
+    def defaultFramebufferObject(self) -> int:
+        return self.surface.defaultFramebufferObject()
+
+    def gl_ready(self) -> bool:
+        """Whether GL is up. Qt starts it at the surface's first paint, once the window system
+        shows it, a moment after the window: a view shown but not yet painted waits for that
+        (a second at most), as a GL widget would start its GL on demand."""
+        if self.renderer is None and self.isVisible():
+            deadline = time.perf_counter() + 1.0
+            while self.renderer is None and time.perf_counter() < deadline:
+                QCoreApplication.processEvents(QEventLoop.ProcessEventsFlag.ExcludeUserInputEvents, 10)
+        return self.renderer is not None
+
+    def grabFramebuffer(self) -> QImage:
+        """The view drawn now, as an image (as QOpenGLWidget's: painted afresh, then read; a
+        multisampled framebuffer resolved first, since GL reads none)."""
+        if not self.gl_ready():
+            return QImage()
+        self.makeCurrent()
+        try:
+            self.paintGL()
+            fbo = self.ctx.detect_framebuffer(self.defaultFramebufferObject())
+            w, h = fbo.size
+            if self.samples > 0:
+                plain = self.ctx.simple_framebuffer((w, h))
+                self.ctx.copy_framebuffer(plain, fbo)
+                data = plain.read(components=4)
+                plain.release()
+            else:
+                data = fbo.read(components=4)
+        finally:
+            self.doneCurrent()
+        # GL's rows run bottom-up; flipped() makes the image its own copy of the bytes
+        return QImage(data, w, h, 4 * w, QImage.Format.Format_RGBA8888).flipped(Qt.Orientation.Vertical)
 
     def draw_now(self) -> None:
         """Paint synchronously into the widget's framebuffer (Qt's own repaint may be deferred),
@@ -409,7 +479,7 @@ class Viewport(QOpenGLWidget):
     def current_context(self) -> Iterator[moderngl.Context | None]:
         """This widget's context made current (None before the first paint), for offscreen draws:
         the studio keeps to one GL context, since a second (EGL) one beside Qt's is unreliable."""
-        if self.ctx is None:
+        if not self.gl_ready():
             yield None
             return
         self.makeCurrent()
@@ -425,6 +495,7 @@ class Viewport(QOpenGLWidget):
             self.renderer.release()
             self.renderer = None
             self.last_image.release()
+            self.painted_layer.release()
             self.doneCurrent()
 
     # -- box select ----------------------------------------------------------------------------

@@ -55,6 +55,7 @@ def make_window(qapp, qtbot, settings_path):
         window.resize(*size)
         window.show()
         qtbot.waitExposed(window)
+        window.viewport.gl_ready()  # its GL window is painted a moment after the window
         if path is not None:
             window.open_path(path)
         window.viewport.frame_all()

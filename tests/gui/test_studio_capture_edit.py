@@ -69,6 +69,22 @@ def test_a_joint_drag_at_a_key_solves_ik_like_the_library_and_undoes(ui, capture
     assert np.array_equal(c.motion().values, expected.values)
 
 
+def test_the_joint_handles_are_drawn_in_the_view_at_a_key_only(ui, capture):
+    # painted into the GL view's frames: a widget over the native GL window would be covered
+    w, _ = capture
+    colours = np.array([(255, 200, 60), (255, 90, 60)])  # a handle, the chosen joint's
+
+    def handle_pixels() -> int:
+        image = ui.grab(w.viewport).astype(int)
+        x, y = np.round(_handle(w, HAND)).astype(int)
+        patch = image[y - 2 : y + 3, x - 2 : x + 3].reshape(-1, 1, 3)
+        return int((np.abs(patch - colours).max(axis=2) < 30).any(axis=1).sum())
+
+    assert w.capture.handles.shown() and handle_pixels() > 4
+    w.animation.set_frame(w.animation.frame + 1)  # between keys: no handles
+    assert not w.capture.handles.shown() and handle_pixels() == 0
+
+
 def test_alt_drag_turns_the_whole_limb_and_a_chain_follows_the_tool_dock(ui, capture):
     w, motion = capture
     c = w.capture
