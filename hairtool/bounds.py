@@ -37,6 +37,10 @@ def box(points: ArrayLike) -> tuple[NDArray, NDArray]:
         raise GroomError(f"a box needs (V, 3) points with V ≥ 1, got shape {p.shape}")
     if p.dtype not in (np.float32, np.float64):
         p = p.astype(np.float64)
+    # one compiled signature per dtype: C order and read-only, whatever the caller holds (numba
+    # types the layout and the write flag, and each variant compiles on its own)
+    p = np.ascontiguousarray(p).view()
+    p.flags.writeable = False
     lo = np.empty(3, p.dtype)
     hi = np.empty(3, p.dtype)
     _box(p, lo, hi)

@@ -1,5 +1,5 @@
 """Arrays for numba kernels whose hot loops slice: views without reference counting, rows on
-cache lines.
+cache lines; and read-only views that keep a kernel to one compiled signature.
 
 Every view numba makes of an array (``a[lo:hi]``, ``g[k]``) takes a reference to the array's
 buffer and drops it again, two atomic operations, and when two threads slice the same array they
@@ -41,3 +41,14 @@ def borrowed(typingctx, arr):
         return view._getvalue()
 
     return arr(arr), codegen
+
+
+def readonly(a: np.ndarray) -> np.ndarray:
+    """``a`` as a read-only view (no copy). numba types an array's write flag: a kernel given a
+    groom's read-only points once and a writable copy of them another time compiles twice, each
+    a compile of its own (seconds for a parallel kernel, on a studio's first run and in every
+    fresh test run). Inputs passed through this compile one signature whatever the caller holds.
+    """
+    view = a.view()
+    view.flags.writeable = False
+    return view

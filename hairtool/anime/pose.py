@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Groom
+from hairtool.kernel_arrays import readonly
 from hairtool.rotation import any_perpendicular, normalize
 
 F64 = NDArray[np.float64]
@@ -418,7 +419,7 @@ def pose_numba(groom: Groom, times: F64, axes: F64, scale: F64, shift: F64, wave
         (x / np.pi) ** p,  # the root-to-tip envelope (x/π)^p and cos, sin of x/k: the same every pose
         np.cos(x / k),
         np.sin(x / k),
-        np.ascontiguousarray(times, dtype=np.float64),
+        readonly(np.ascontiguousarray(times, dtype=np.float64)),
         np.ascontiguousarray(axes, dtype=np.float64),
         np.ascontiguousarray(scale, dtype=np.float64),
         np.ascontiguousarray(shift, dtype=np.float64),

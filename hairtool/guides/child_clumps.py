@@ -40,6 +40,7 @@ from hairtool.frozen.clump import (
 from hairtool.frozen.lengths import restore_lengths
 from hairtool.frozen.noise import CH_CLUMP, EPS, check_seed, hash_head_nb, hash_tail_u01_nb, hash_u01
 from hairtool.groom import Groom
+from hairtool.kernel_arrays import readonly
 
 CH_CHILD_CLUMP = 6  # noise channel of the clumps' seeds (hairtool.frozen.noise uses 1-5)
 _GAP_CODE = {"printed": 0, "text": 1, "off": 2}
@@ -506,9 +507,9 @@ class ChildClumps:
         todo = todo[np.diff(self.start)[todo] > 0]
         jobs, job_start = clump_jobs(self._work, todo, numba.get_num_threads())
         _clumps_kernel(
-            points, topology.offsets, self.start, self.children, self.seeds, jobs, job_start, self.radius,
-            self.iterations, -1.0 if self.step is None else float(self.step), _GAP_CODE[self.gap_mode],
-            self.raw, self.out, self.stats,
+            readonly(points), readonly(topology.offsets), self.start, self.children, self.seeds, jobs,
+            job_start, self.radius, self.iterations, -1.0 if self.step is None else float(self.step),
+            _GAP_CODE[self.gap_mode], self.raw, self.out, self.stats,
         )  # fmt: skip
         if self.keep_lengths:
             kids = self._clumped_kids

@@ -25,6 +25,7 @@ import numpy as np
 from numba import prange
 
 from hairtool.guides.frames import TINY, guide_tables, guide_tables_reference, resampled, root_tangents
+from hairtool.kernel_arrays import readonly
 from hairtool.serial_twins import twin_njit
 
 if TYPE_CHECKING:
@@ -230,8 +231,8 @@ def build_points(
     _children_kernel(
         binding.offsets, tbase, binding.roots, binding.guide_ids, binding.weights, binding.scale,
         _NONE32 if binding.local is None else binding.local, tables.seg, tables.seglen, tables.frames,
-        binding.exact_points if use_exact else _NONE32, binding.exact_blend if use_exact else _NONE64,
-        flags, out,
+        readonly(binding.exact_points if use_exact else _NONE32),
+        binding.exact_blend if use_exact else _NONE64, flags, out,
     )  # fmt: skip
     return out
 

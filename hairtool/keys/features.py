@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Animation
+from hairtool.kernel_arrays import readonly
 
 F64 = NDArray[np.float64]
 
@@ -180,7 +181,7 @@ def resample_frames(frames: ArrayLike, counts: ArrayLike, m: int, use_numba: boo
         return resample_frames_reference(frames, counts, m)
     if not np.isfinite(m) or int(m) != m or m < 2:
         raise ParameterError("samples", m, "a whole number of at least 2")
-    p = np.ascontiguousarray(frames)
+    p = readonly(np.ascontiguousarray(frames))
     c = np.asarray(counts, dtype=np.int64)
     off = np.zeros(c.size + 1, dtype=np.int64)
     np.cumsum(c, out=off[1:])
