@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import ctypes
 import importlib.util
 import os
 import shutil
+import signal
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -25,6 +28,15 @@ _xvfb: subprocess.Popen | None = None
 _OWN_DISPLAY = "HAIRTOOL_TEST_XVFB"  # set where this conftest started the display
 
 
+def _end_with_parent() -> None:
+    """In the Xvfb child before it starts (Linux): SIGTERM when the process that started it
+    ends, so the display outlives the tests' QApplication, which Qt tears down only as the
+    interpreter exits: a display ended in ``pytest_unconfigure`` broke its X connection first
+    ("The X11 connection broke", and a segfault of a single-process run at exit)."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+
+
 def _start_xvfb() -> None:
     """Start ``Xvfb -displayfd`` and export DISPLAY, so plain ``pytest`` runs the GUI tests, on a
     1366×768 screen: the laptop size the studio must fit. Each xdist worker gets a display of
@@ -38,6 +50,7 @@ def _start_xvfb() -> None:
     _xvfb = subprocess.Popen(
         ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1366x768x24", "-nolisten", "tcp"],
         pass_fds=(write_fd,),
+        preexec_fn=_end_with_parent if sys.platform.startswith("linux") else None,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
@@ -119,7 +132,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
-    if _xvfb is not None:
+    if _xvfb is not None and not sys.platform.startswith("linux"):  # on Linux: it ends with us
         _xvfb.terminate()
         _xvfb.wait(timeout=10)
 
