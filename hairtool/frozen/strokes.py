@@ -47,7 +47,9 @@ A stroke log is a JSON list of strokes, in groom units::
 - ``visible`` (per stroke, optional, default false): how a ``view`` judges which strands face
   the camera. true (the studio writes it): those the head mesh does not hide from the camera
   under the brush (:mod:`hairtool.frozen.brushes.sight`); false or missing (older logs, and
-  every log without a head mesh): those whose root's outward normal faces the camera.
+  every log without a head mesh): those whose root's outward normal faces the camera. Add and
+  density with it plant only roots the head does not hide from the camera; without it, nothing
+  where the head under the cursor faces away, and only where the surface faces the camera.
 - ``falloff``: ``smooth``, ``linear``, ``constant``, or a curve ``[[t, w], ...]`` over t =
   distance / radius from 0 to 1 (align keeps the paper's own weighting and ignores it).
 - ``symmetry``: ``"x"`` mirrors every sample across the plane x = ``mirror_x`` (default: the
