@@ -29,9 +29,8 @@ import numpy as np
 
 from app.document.undo import Command, UndoStack
 from hairtool.errors import HairtoolError, ParameterError
-from hairtool.frozen.brushes import facing_away
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline, FrozenSnapshot
-from hairtool.frozen.selection import SelectionSample, apply_selection
+from hairtool.frozen.selection import SelectionSample
 from hairtool.groom import Groom
 from hairtool.guides.binding import ChildBinding
 from hairtool.io.obj import Mesh
@@ -239,9 +238,8 @@ class GroomSide:
         """One selection step (select all, box, hide, reveal …); False where it changes nothing.
         Refused (ParameterError) where it would hide every strand."""
         p = self.pipeline
-        away = None if sample.view is None else facing_away(p.strand_normals, sample.view)
         selected, hidden = p.selected, p.hidden
-        sel, hid = apply_selection(p.aligned, sample, selected, hidden, away)
+        sel, hid = p.selection_after(sample)
         if np.array_equal(sel, selected) and np.array_equal(hid, hidden):
             return False
         if hid.all():

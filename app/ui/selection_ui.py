@@ -21,7 +21,8 @@ STEPS = (
     ("none", "Select &None", "Alt+A", "Deselect every strand"),
     ("invert", "&Invert Selection", "Ctrl+I", "Select the shown strands not selected, and only them"),
     ("box", "&Box Select", "B", "Drag a box: the strands with a point inside it are selected (Ctrl+drag "
-     "deselects them; with Front faces only, only the strands facing you; Esc cancels)"),
+     "deselects them; with Front faces only, only the strands you can see, not those behind the head; "
+     "Esc cancels)"),
     None,
     ("hide_selected", "&Hide Selected", "H", "Hide the selected strands: no brush touches them till "
      "revealed"),
@@ -134,4 +135,6 @@ class SelectionUI:
             )
 
     def box(self, sample: SelectionSample) -> None:
-        self.apply(sample)
+        """The box the viewport drew: with Front faces only (a ``view``), judged by sight, as
+        the brushes judge (the head hides what lies behind it; the root normal without one)."""
+        self.apply(sample._replace(visible=sample.view is not None))

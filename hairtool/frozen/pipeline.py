@@ -73,7 +73,8 @@ from hairtool.frozen.local import LocalClump
 from hairtool.frozen.local_moves import ClumpRun, LocalMoves
 from hairtool.frozen.move_points import held_by_at_most, may_write
 from hairtool.frozen.noise import check_seed, draw_seed
-from hairtool.frozen.replay import NO_MEMORY, Sample, StrokeSetting, apply_sample, replay
+from hairtool.frozen.replay import NO_MEMORY, Sample, StrokeSetting, apply_sample, replay, selection_after
+from hairtool.frozen.selection import SelectionSample
 from hairtool.frozen.strand_clumps import auto_clump_radius, strand_clumps
 from hairtool.frozen.strand_state import StrandState
 from hairtool.groom import Groom
@@ -320,6 +321,11 @@ class FrozenPipeline:
         """``(S', 3)`` :attr:`root_normals` of the strands of the stroked state and the result
         (a planted strand's: the surface normal at its root)."""
         return self._setting().strand_normals(self._aligned, self._state)
+
+    def selection_after(self, sample: SelectionSample) -> tuple[np.ndarray, np.ndarray]:
+        """``(selected, hidden)`` the selection step ``sample`` would leave, by the rule a
+        replay applies (nothing changed here: the studio asks first whether it changes anything)."""
+        return selection_after(self._setting(), self._aligned, self._state, sample)
 
     @property
     def scalp_centre(self) -> np.ndarray:

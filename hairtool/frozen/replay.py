@@ -100,6 +100,20 @@ def memory_for(brush, memory: StrokeMemory) -> StrokeMemory:
     return memory
 
 
+def selection_after(
+    setting: StrokeSetting, g: Groom, state: StrandState, sample: SelectionSample
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(selected, hidden)`` after the selection step ``sample`` on ``g``: a box that says
+    ``visible``, on a head mesh, judges each vertex inside it by sight; any other box with a
+    view, each strand by its root normal (as every log before ``visible``)."""
+    grid = getattr(setting.surface, "face_grid", None) if sample.visible else None
+    if grid is not None:
+        sample, away = sample._replace(view=check_view(sample.view)), None
+    else:
+        away = setting.away(sample, g, lambda: setting.strand_normals(g, state))
+    return apply_selection(g, sample, state.selected, state.hidden, away, grid)
+
+
 def apply_sample(
     setting: StrokeSetting, g: Groom, state: StrandState, memory: StrokeMemory, sample: Sample
 ) -> tuple[Groom, StrandState, StrokeMemory]:
@@ -130,8 +144,7 @@ def apply_sample(
     """
     if isinstance(sample, SelectionSample):
         memory = memory_for(None, memory)
-        away = setting.away(sample, g, lambda: setting.strand_normals(g, state))
-        selected, hidden = apply_selection(g, sample, state.selected, state.hidden, away)
+        selected, hidden = selection_after(setting, g, state, sample)
         return g, state.with_(selected=selected, hidden=hidden), memory
     brush = registry.brush_of(registry.name_of(sample))
     memory = memory_for(brush, memory)

@@ -153,6 +153,7 @@ SELECTION = SampleType("selection", SelectionSample, "op", (
     Field("matrix", "matrix", None, "matrix", "step", "box", used_by=("box",)),
     Field("rect", "rect", None, "rect", "step", "box", used_by=("box",)),
     Field("view", "view", None, "view", "step", "view", used_by=("box",)),
+    Field("visible", "flag", False, "visible", "step", "visible", used_by=("box",), quiet=True),
 ))  # fmt: skip
 
 TYPES = (ALIGN, BRUSH, SELECTION)

@@ -17,7 +17,11 @@ samples, so undo, projects and a replayed log see the same selection at every st
 - ``box``: the shown strands with a vertex inside a screen rectangle (``rect`` x0, y0, x1, y1
   in normalised device coordinates, −1 … 1, y up) of a camera (``matrix``: its 4×4
   world-to-clip matrix, row-major); ``mode`` "set" (only those), "add" or "subtract"; with a
-  ``view``, only the strands facing that camera (as the brushes' front faces only).
+  ``view``, only the strands facing that camera (the brushes' front faces only): with
+  ``visible`` and a head mesh, those with a vertex inside the rectangle that the head does not
+  hide from the camera (:mod:`~hairtool.frozen.brushes.sight`, the studio's rule), else those
+  whose root normal faces it (the rule of every log written before ``visible``, so its
+  default, and the rule without a head mesh).
 - ``hide_selected``: the selected strands hidden (and deselected, as Blender hides);
   ``hide_unselected``: the unselected shown strands hidden; ``reveal``: every hidden strand
   shown again, selected.
@@ -34,6 +38,8 @@ from typing import NamedTuple
 import numpy as np
 
 from hairtool.errors import ParameterError
+from hairtool.frozen.brushes.sample import check_flag
+from hairtool.frozen.brushes.sight import FaceGrid, hidden_points
 from hairtool.groom import Groom
 
 OPS = ("all", "none", "invert", "box", "hide_selected", "hide_unselected", "reveal")
@@ -42,13 +48,15 @@ BOX_MODES = ("set", "add", "subtract")
 
 class SelectionSample(NamedTuple):
     """One selection step (module docstring); ``matrix`` (16 floats), ``rect`` and ``mode``
-    only for ``box``; ``view`` as a brush sample's (None: every strand)."""
+    only for ``box``; ``view`` and ``visible`` as a brush sample's (None: every strand; with
+    ``visible`` front faces only by sight, else by root normal)."""
 
     op: str
     matrix: tuple[float, ...] | None = None
     rect: tuple[float, float, float, float] | None = None
     mode: str = "set"
     view: tuple[float, float, float] | None = None
+    visible: bool = False
 
 
 def check_selection(sample: SelectionSample) -> SelectionSample:
@@ -68,6 +76,7 @@ def check_selection(sample: SelectionSample) -> SelectionSample:
         raise ParameterError("selection", sample.op, "one of " + ", ".join(OPS))
     if sample.op != "box":
         return sample
+    check_flag("visible", sample.visible)
     if sample.mode not in BOX_MODES:
         raise ParameterError("mode", sample.mode, " or ".join(BOX_MODES))
     m = np.asarray(sample.matrix if sample.matrix is not None else (), dtype=np.float64)
@@ -79,9 +88,10 @@ def check_selection(sample: SelectionSample) -> SelectionSample:
     return sample
 
 
-def in_box(groom: Groom, matrix, rect) -> np.ndarray:
+def in_box(groom: Groom, matrix, rect, view=None, grid: FaceGrid | None = None) -> np.ndarray:
     """``(S,)`` the strands with a vertex in front of the camera whose projection lies inside
-    ``rect`` (either corner order).
+    ``rect`` (either corner order); with ``view`` and ``grid``, a vertex there the head does not
+    hide from a camera looking along ``view`` (only the vertices inside are traced).
 
     Parameters
     ----------
@@ -91,6 +101,10 @@ def in_box(groom: Groom, matrix, rect) -> np.ndarray:
         16 numbers: the camera's projection × view, row-major.
     rect : array_like
         ``(x0, y0, x1, y1)`` in normalised device coordinates.
+    view : array_like, optional
+        ``(3,)`` the camera's viewing direction (with ``grid``: front faces only by sight).
+    grid : FaceGrid, optional
+        The head's faces.
 
     Returns
     -------
@@ -107,6 +121,9 @@ def in_box(groom: Groom, matrix, rect) -> np.ndarray:
         safe = np.where(ok, w, 1.0)
         x, y = clip[:, 0] / safe, clip[:, 1] / safe
     inside = ok & (x >= min(x0, x1)) & (x <= max(x0, x1)) & (y >= min(y0, y1)) & (y <= max(y0, y1))
+    if view is not None and grid is not None:
+        at = np.flatnonzero(inside)
+        inside[at[hidden_points(p[at], view, grid)]] = False
     if groom.strand_count == 0:
         return np.zeros(0, bool)
     return np.maximum.reduceat(inside, groom.offsets[:-1]).astype(bool)
@@ -118,9 +135,11 @@ def apply_selection(
     selected: np.ndarray,
     hidden: np.ndarray,
     away: np.ndarray | None = None,
+    grid: FaceGrid | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(selected, hidden)`` after one step (new arrays); ``away``: the strands facing away
-    from the sample's camera (a box leaves them as they are).
+    from the sample's camera (a box leaves them as they are); ``grid``: the head, which a box
+    that says ``visible`` judges by sight instead (``away`` then unused).
 
     Parameters
     ----------
@@ -132,6 +151,8 @@ def apply_selection(
         ``(S,)`` bool, before the step.
     away : ndarray, optional
         ``(S,)`` bool, the strands facing away.
+    grid : FaceGrid, optional
+        The head's faces.
 
     Returns
     -------
@@ -148,7 +169,11 @@ def apply_selection(
     elif op == "invert":
         sel = ~sel & ~hid
     elif op == "box":
-        touched = in_box(groom, sample.matrix, sample.rect) & ~hid
+        if sample.visible and sample.view is not None and grid is not None:
+            touched = in_box(groom, sample.matrix, sample.rect, sample.view, grid) & ~hid
+            away = None
+        else:
+            touched = in_box(groom, sample.matrix, sample.rect) & ~hid
         if away is not None:
             touched &= ~np.asarray(away, dtype=bool)
         if sample.mode == "set":

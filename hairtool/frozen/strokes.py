@@ -47,7 +47,9 @@ A stroke log is a JSON list of strokes, in groom units::
 - ``visible`` (per stroke, optional, default false): how a ``view`` judges which strands face
   the camera. true (the studio writes it): those the head mesh does not hide from the camera
   under the brush (:mod:`hairtool.frozen.brushes.sight`); false or missing (older logs, and
-  every log without a head mesh): those whose root's outward normal faces the camera.
+  every log without a head mesh): those whose root's outward normal faces the camera. Add and
+  density with it plant only roots the head does not hide from the camera; without it, nothing
+  where the head under the cursor faces away, and only where the surface faces the camera.
 - ``falloff``: ``smooth``, ``linear``, ``constant``, or a curve ``[[t, w], ...]`` over t =
   distance / radius from 0 to 1 (align keeps the paper's own weighting and ignores it).
 - ``symmetry``: ``"x"`` mirrors every sample across the plane x = ``mirror_x`` (default: the
@@ -59,11 +61,14 @@ object with a ``selection`` field instead of ``brush``::
     {"selection": "all"}  {"selection": "none"}  {"selection": "invert"}
     {"selection": "hide_selected"}  {"selection": "hide_unselected"}  {"selection": "reveal"}
     {"selection": "box", "mode": "set", "matrix": [16 numbers], "rect": [x0, y0, x1, y1],
-     "view": [vx, vy, vz]}
+     "view": [vx, vy, vz], "visible": true}
 
 - ``box``: the strands with a point inside the rectangle ``rect`` (normalised device
   coordinates, −1 … 1, y up) of the camera whose world-to-clip matrix is ``matrix`` (4×4,
-  row-major); ``mode`` ``set`` (default), ``add`` or ``subtract``; ``view`` as a sample's.
+  row-major); ``mode`` ``set`` (default), ``add`` or ``subtract``; ``view`` as a sample's;
+  ``visible`` (optional, default false, written only where true) as a stroke's: with a head
+  mesh, only the strands with a point inside the rectangle that the head does not hide from
+  the camera; false or missing (older logs): those whose root normal faces the camera.
 
 Fields a reader does not know are ignored and missing optional ones take their defaults, so
 logs written by older and newer versions stay readable.
@@ -269,8 +274,8 @@ class SelectionStep:
         """The step's fields its op uses (a box's camera, rectangle, mode and view), by log name."""
         s, out = self.sample, {}
         for f in SELECTION.fields:
-            if f.used(s.op):
-                value = getattr(s, f.name)
+            value = getattr(s, f.name)
+            if f.used(s.op) and not (f.quiet and value == f.default):  # (logs before it stay)
                 out[f.json] = list(value) if isinstance(value, tuple) else value
         return out
 
@@ -432,6 +437,8 @@ def selection_from_dict(d: dict, where: str = "stroke") -> SelectionStep:
             value = tuple(_number(f"{where}.{f.json}", v) for v in value)
         elif f.kind == "view":
             value = None if value is None else _vector(f"{where}.{f.json}", value)
+        elif f.kind == "flag":
+            value = _flag(f"{where}.{f.json}", value) is True
         values[f.name] = value
     try:
         return SelectionStep(SELECTION.make(**values)).validate()

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from hairtool.errors import ParameterError
+from hairtool.frozen.brushes.sight import hidden_points
 from hairtool.frozen.root_grid import nearest_root
 from hairtool.groom import Groom
 from hairtool.guides.binding import DEFAULT_K, bind_roots
@@ -47,10 +48,13 @@ class HeadSurface(MeshSurface):
         count: int,
         seed: int,
         view=None,
+        visible: bool = False,
     ) -> Groom | None:
         """``count`` new strands around the surface point closest to ``cursor`` (module
         docstring), or None where the surface there faces away from a camera looking along
-        ``view``.
+        ``view``. With ``visible``, front faces only by sight instead: the same roots are drawn
+        and those the head hides from the camera are left out (None where it hides them all),
+        whichever way the surface faces (:mod:`hairtool.frozen.brushes.sight`).
 
         Parameters
         ----------
@@ -66,6 +70,9 @@ class HeadSurface(MeshSurface):
             The draws' seed (with the cursor's bytes).
         view : array_like, optional
             The camera's direction (None: no facing test).
+        visible : bool, default False
+            Judge the roots by sight (True) or the surface point under the cursor by its
+            normal (False: every log written before the choice).
 
         Returns
         -------
@@ -76,13 +83,18 @@ class HeadSurface(MeshSurface):
             raise ParameterError("count", count, f"a whole number of strands in [1, {MAX_PLANT}]")
         c = np.asarray(cursor, np.float64).reshape(1, 3)
         q, n = self.project(c)
-        if view is not None and float(n[0] @ np.asarray(view, np.float64)) > 0:
+        by_sight = view is not None and visible
+        if view is not None and not by_sight and float(n[0] @ np.asarray(view, np.float64)) > 0:
             return None
         u, v = _basis(n[0])
         rng = _generator(seed, cursor)
         r = radius * np.sqrt(rng.random(int(count)))
         t = 2.0 * np.pi * rng.random(int(count))
         roots, _ = self.project(q[0] + r[:, None] * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v))
+        if by_sight:
+            roots = roots[~hidden_points(roots, view, self.face_grid)]
+            if len(roots) == 0:
+                return None
         return self.grow(groom, roots)
 
     def grow(self, groom: Groom, roots: np.ndarray) -> Groom:

@@ -302,15 +302,18 @@ class DocumentMachine(RuleBasedStateMachine):
         rect=st.tuples(*[st.floats(-1.0, 1.0)] * 4),
         mode=st.sampled_from(BOX_MODES),
         view=st.sampled_from([None, (0.0, 0.0, -1.0)]),
+        visible=st.booleans(),
     )
-    def select(self, op, rect, mode, view) -> None:
-        """A selection step: the box seen through a front camera (orthographic, the head in it)."""
+    def select(self, op, rect, mode, view, visible) -> None:
+        """A selection step: the box seen through a front camera (orthographic, the head in it),
+        front faces only by sight (``visible``, the studio's) or by root normal (older files)."""
         x0, x1 = sorted(rect[::2])
         y0, y1 = sorted(rect[1::2])
         sample = SelectionSample(op)
         if op == "box":
             matrix = (0.4, 0, 0, 0, 0, 0.4, 0, -0.2, 0, 0, -0.1, 0, 0, 0, 0, 1)
-            sample = SelectionSample(op, tuple(float(m) for m in matrix), (x0, y0, x1, y1), mode, view)
+            m = tuple(float(v) for v in matrix)
+            sample = SelectionSample(op, m, (x0, y0, x1, y1), mode, view, visible)
         self._try(lambda: self.doc.hair.select(sample))
 
     @rule(axis=st.sampled_from(["Y", "Z"]))

@@ -89,6 +89,23 @@ def test_ctrl_box_deselects_and_escape_cancels(ui, make_window):
     assert not v.box_armed
 
 
+def test_a_box_with_front_faces_only_judges_by_sight(ui, make_window, monkeypatch):
+    """The studio's box says ``visible`` where Front faces only gives it a camera, as its
+    brushes do (the step itself: hairtool's tests/frozen/test_sight_box_plant.py)."""
+    w = flat(make_window)
+    s, v = w.scene, w.viewport
+    x = columns(w)
+    ys = v.project(s.result.points)[:, 1]
+    a, b = (x.min() - 5.0, ys.min() - 5.0), (np.median(x) - 1.0, ys.max() + 5.0)
+    steps = []
+    monkeypatch.setattr(s, "selection_step", lambda sample, text="": steps.append(sample) or True)
+    for front in (True, False):
+        s.set_front_only(front)
+        w.selection.actions["box"].trigger()
+        ui.drag(v, a, b, steps=3)
+    assert [(t.view is not None, t.visible) for t in steps] == [(True, True), (False, False)]
+
+
 def test_paint_select_and_brush_only_the_selection(ui, make_window):
     w = flat(make_window)
     s, v = w.scene, w.viewport

@@ -1,5 +1,8 @@
 """Add: plants new strands on the head under the brush, shaped like their neighbours (the
-surface's ``plant``); they come unmasked, with clump strength 1, selected and shown."""
+surface's ``plant``); they come unmasked, with clump strength 1, selected and shown. Front faces
+only: a sample that says ``visible`` plants only the roots the head does not hide from the
+camera; one that does not (every log before it) plants nothing where the head under the cursor
+faces away."""
 
 from __future__ import annotations
 
@@ -68,7 +71,8 @@ class Add(Brush):
         surface = ctx.surface
         if surface is None or not hasattr(surface, "plant"):
             raise ParameterError("scalp", None, "a head mesh for the add brush (--scalp MESH.obj)")
-        new = surface.plant(g, sample.cursor, sample.radius, sample.count, sample.seed, sample.view)
+        s = sample
+        new = surface.plant(g, s.cursor, s.radius, s.count, s.seed, s.view, s.visible)
         if new is None:
             return g
         out = append_strands(g, new)

@@ -1,6 +1,9 @@
 """Density: under the brush the roots end up a given spacing apart, by removing strands where
 they are too dense and planting where they are too sparse (:mod:`hairtool.frozen.density`
-holds the thinning and the dart throwing, with their numpy twins)."""
+holds the thinning and the dart throwing, with their numpy twins). Front faces only: a sample
+that says ``visible`` keeps (as if locked) the strands the head hides under the brush and plants
+no root the head hides from the camera; one that does not (every log before it) does nothing
+where the head under the cursor faces away and plants only where the surface faces the camera."""
 
 from __future__ import annotations
 
@@ -9,6 +12,7 @@ import numpy as np
 from hairtool.errors import ParameterError
 from hairtool.frozen.brushes.add import SEED, append_strands
 from hairtool.frozen.brushes.delete import remove
+from hairtool.frozen.brushes.sight import hidden_points
 from hairtool.frozen.brushes.spec import Brush, BrushSpec, Param, StrokeContext, Studio
 from hairtool.frozen.density import accept, accept_reference, disc_candidates, thin, thin_reference
 from hairtool.groom import Groom
@@ -54,7 +58,8 @@ def _density(ctx: StrokeContext, g: Groom, sample, thin_, accept_) -> Groom:
     locked = ctx.lock(sample)
     q, n = surface.project(np.asarray(sample.cursor, np.float64).reshape(1, 3))
     q, n = q[0], n[0]
-    if sample.view is not None and float(n @ np.asarray(sample.view, np.float64)) > 0:
+    grid = getattr(surface, "face_grid", None) if sample.view is not None and sample.visible else None
+    if sample.view is not None and grid is None and float(n @ np.asarray(sample.view, np.float64)) > 0:
         return g
     spacing, r = float(sample.spacing), float(sample.radius)
     roots = g.roots.astype(np.float64)
@@ -68,7 +73,9 @@ def _density(ctx: StrokeContext, g: Groom, sample, thin_, accept_) -> Groom:
     rng = np.random.default_rng([int(sample.seed), *(int(b) for b in bits), 0xDE5])
     cands, cn = surface.project(disc_candidates(q, n, r, spacing, rng))
     ok = np.linalg.norm(cands - q, axis=1) < r
-    if sample.view is not None:
+    if grid is not None:  # front faces only by sight: the darts the head hides are not thrown
+        ok[ok] = ~hidden_points(cands[ok], sample.view, grid)
+    elif sample.view is not None:  # by the normal, as every log before visible
         ok &= cn @ np.asarray(sample.view, np.float64) <= 0
     cands = cands[ok]
     roots = g.roots.astype(np.float64)
