@@ -44,11 +44,12 @@ def borrowed(typingctx, arr):
 
 
 def readonly(a: np.ndarray) -> np.ndarray:
-    """``a`` as a read-only view (no copy). numba types an array's write flag: a kernel given a
-    groom's read-only points once and a writable copy of them another time compiles twice, each
-    a compile of its own (seconds for a parallel kernel, on a studio's first run and in every
-    fresh test run). Inputs passed through this compile one signature whatever the caller holds.
+    """``a`` as a read-only, C-ordered view (a copy only where ``a`` is not C-contiguous). numba
+    types an array's write flag and memory order: a kernel given a groom's read-only points once
+    and a writable (or Fortran-ordered) copy of them another time compiles twice, each a compile
+    of its own (seconds for a parallel kernel, on a studio's first run and in every fresh test
+    run). Inputs passed through this compile one signature per dtype whatever the caller holds.
     """
-    view = a.view()
+    view = np.ascontiguousarray(a).view()
     view.flags.writeable = False
     return view

@@ -1,11 +1,11 @@
-"""Arrays for kernels that slice in hot loops: borrowed views and cache-line rows."""
+"""Arrays for kernels: borrowed views, cache-line rows and read-only inputs."""
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit
 
-from hairtool.kernel_arrays import aligned_rows, borrowed
+from hairtool.kernel_arrays import aligned_rows, borrowed, readonly
 
 
 @njit(cache=True)
@@ -34,3 +34,18 @@ def test_aligned_rows_start_on_cache_lines():
         rows = _rows(5, length)
         assert rows.shape[0] == 5 and rows.shape[1] >= length and not rows.any()
         assert all(rows[c].ctypes.data % 64 == 0 for c in range(5))
+
+
+def test_a_readonly_input_is_a_view_of_a_c_ordered_array_and_a_c_ordered_copy_of_another():
+    """The brush's hot paths pass their live points through ``readonly`` at every move: a
+    C-contiguous array (writable or not, or a contiguous slice) is viewed, never copied."""
+    a = np.arange(24, dtype=np.float32).reshape(8, 3)
+    for held in (a, a[2:6], readonly(a)):
+        view = readonly(held)
+        assert view.ctypes.data == held.ctypes.data and np.shares_memory(view, a)
+        assert not view.flags.writeable and view.flags.c_contiguous
+    assert a.flags.writeable  # the caller's array keeps its flag
+    fortran = np.asfortranarray(a)
+    copy = readonly(fortran)
+    assert copy.flags.c_contiguous and not copy.flags.writeable and not np.shares_memory(copy, fortran)
+    np.testing.assert_array_equal(copy, a)

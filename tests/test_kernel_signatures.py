@@ -11,11 +11,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hairtool import samples
+from app.render import screen_pick
+from hairtool import samples, serial_twins
 from hairtool.anime import pose
 from hairtool.anime.schedule import schedule
 from hairtool.anime.wave import WaveParams, make_bunches, pose_pictures
 from hairtool.bounds import _box, box
+from hairtool.frozen import freeze, lengths, neighbour_update, spatial, vertex_grid
+from hairtool.frozen.freeze import _freeze_kernel
 from hairtool.guides import child_clumps, children
 from hairtool.guides.binding import bind_roots
 from hairtool.keys import features
@@ -36,6 +39,20 @@ def assert_one_signature(kernel, index: int) -> None:
     kinds = argument_types(kernel, index)
     assert kinds, "the kernel ran"
     assert all(t.layout == "C" and not t.mutable for t in kinds), kinds
+
+
+def assert_one_signature_each_twin(kernel, *indexes: int, callee: bool = False) -> None:
+    """:func:`assert_one_signature` at each argument of ``indexes``, for a twinned kernel its
+    parallel kernel and its serial twin both (whichever this process runs). A ``callee`` (a
+    kernel only other kernels call) holds signatures only where its callers compiled, not where
+    they came from the cache: its callers' types are its own."""
+    twinned = serial_twins.is_twinned(kernel)
+    pair = (serial_twins.parallel_of(kernel), serial_twins.serial(kernel)) if twinned else (kernel,)
+    assert callee or any(k.signatures for k in pair), "the kernel ran"
+    for k in pair:
+        for i in indexes:
+            kinds = argument_types(k, i)
+            assert all(t.layout == "C" and not t.mutable for t in kinds), (k, i, kinds)
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
@@ -76,3 +93,88 @@ def test_children_and_their_clumps():
     assert_one_signature(child_clumps._clumps_kernel, 0)
     assert_one_signature(child_clumps._clumps_kernel, 1)
     assert_one_signature(children._children_kernel, 10)
+
+
+def test_freeze_of_a_y_up_and_a_z_up_groom():
+    """A Y-up groom's points reach the kernel as the groom holds them (read-only), a Z-up
+    groom's as a fresh array in the reference axes."""
+    g = samples.scalp(5, 4, seed=3)
+    for groom in (g, g.with_metadata(g.metadata.with_(up_axis="Z"))):
+        freeze(groom, seed=2)
+    assert_one_signature_each_twin(_freeze_kernel, 0, 1)
+
+
+def test_restored_lengths():
+    g = samples.scalp(5, 4, seed=3)
+    moved = g.points + np.float32(0.01) * np.random.default_rng(5).standard_normal(g.points.shape, np.float32)
+    got = [
+        lengths.restore_lengths(b, a, g.topology, parallel=parallel)
+        for b, a in zip(variants(g.points), variants(moved), strict=True)
+        for parallel in (True, False)
+    ]
+    assert all(np.array_equal(x, got[0]) for x in got)
+    assert_one_signature_each_twin(lengths._restore_kernel, 0, 1, 2)
+
+
+def test_moved_vertices():
+    before = samples.scalp(5, 4, seed=3).points
+    now = before.copy()
+    now[[3, 7]] += np.float32(0.5)
+    got = [
+        neighbour_update.moved_vertices(p, r) for p, r in zip(variants(now), variants(before), strict=True)
+    ]
+    assert all(np.array_equal(x, [3, 7]) for x in got)
+    assert_one_signature_each_twin(neighbour_update._moved_mask, 0, 1)
+
+
+def test_the_vertex_grid_built_moved_and_searched():
+    g = samples.scalp(6, 5, seed=3)
+    strand = g.topology.strand_index
+    moved = g.points.copy()
+    moved[[4, 11]] += np.float32(0.3)
+    one, many = g.points[[2]].astype(np.float64), g.points[[2, 9, 20]].astype(np.float64)
+    got = []
+    for p, q in zip(variants(g.points), variants(moved), strict=True):
+        grid = vertex_grid.VertexGrid(p, strand, 1.0)
+        changed = grid.move(q, np.array([4, 11]))
+        marks = []
+        for queries, radius in ((one, 0.6), (many, 1.5), (many, 0.5)):  # wide, each, grouped
+            for parallel in (True, False):
+                mark = np.zeros(6, np.bool_)
+                grid.strands_near(q, queries, radius, mark, parallel)
+                marks.append(mark)
+        got.append((changed, grid.key.copy(), np.array(marks)))
+    assert all(x[0] == got[0][0] and np.array_equal(x[1], got[0][1]) for x in got)
+    assert all(np.array_equal(x[2], got[0][2]) for x in got)
+    for kernel in (vertex_grid._build, vertex_grid._move, vertex_grid._mark_near_grouped):
+        assert_one_signature_each_twin(kernel, 0)
+    for kernel in (vertex_grid._mark_near_wide, vertex_grid._mark_near):
+        assert_one_signature_each_twin(kernel, 0, 1)
+    assert_one_signature_each_twin(vertex_grid._mark_slab, 0, 1, callee=True)
+
+
+@pytest.mark.parametrize("dense", [True, False])
+def test_neighbour_lists(dense):
+    g = samples.scalp(6, 5, seed=3)
+    got = []
+    for p, s in zip(variants(g.points), variants(g.topology.strand_index), strict=True):
+        nl = spatial.neighbour_list(p, s, 0.3, dense=dense)
+        got.append((nl.order.copy(), nl.x.copy(), nl.acnt.copy()))
+    assert all(all(np.array_equal(a, b) for a, b in zip(x, got[0], strict=True)) for x in got)
+    assert_one_signature_each_twin(spatial._row_sort if dense else spatial._cell_keys, 0)
+    assert_one_signature_each_twin(spatial._row_keys, 0, callee=True)
+    gather = spatial._gather if dense else spatial._gather_hashed
+    assert_one_signature_each_twin(gather, 1, 2, 3)
+
+
+def test_nearest_on_screen():
+    g = samples.scalp(6, 5, seed=3)
+    view = np.eye(4)
+    skip = np.zeros(6, np.bool_)
+    skip[1] = True
+    got = [
+        screen_pick.nearest_on_screen(p, view, (200.0, 100.0), (100.0, 50.0), 80.0, s, k)
+        for p, s, k in zip(variants(g.points), variants(g.topology.strand_index), variants(skip), strict=True)
+    ]
+    assert got[0] >= 0 and all(x == got[0] for x in got)
+    assert_one_signature_each_twin(screen_pick._nearest_kernel, 0, 7, 8)

@@ -16,6 +16,7 @@ import numpy as np
 from numba import prange
 from numpy.typing import ArrayLike
 
+from hairtool.kernel_arrays import readonly
 from hairtool.serial_twins import twin_njit
 
 CHUNKS = 64  # parallel tasks (each keeps its nearest; the first of equals wins, as in the twin)
@@ -56,8 +57,8 @@ def nearest_on_screen(
     m = np.ascontiguousarray(view_projection, np.float64)
     best_d, best_i = np.empty(CHUNKS), np.empty(CHUNKS, np.int64)
     _nearest_kernel(
-        points, m, float(size[0]), float(size[1]), float(cursor[0]), float(cursor[1]),
-        float(radius_px) ** 2, strand, _NO_SKIP if skip is None else skip, best_d, best_i,
+        readonly(points), m, float(size[0]), float(size[1]), float(cursor[0]), float(cursor[1]),
+        float(radius_px) ** 2, readonly(strand), readonly(_NO_SKIP if skip is None else skip), best_d, best_i,
     )  # fmt: skip
     found = np.flatnonzero(best_i >= 0)
     if found.size == 0:

@@ -54,7 +54,7 @@ def serial_plan() -> list[Entry]:
         (_count_blocks, (_I64, _I64, _I64, types.int64, _array(types.int32))),
         (
             serial_twins.serial(_moved_mask),
-            (_POINTS, _array(types.float32, 2), _array(types.boolean)),
+            (_POINTS, _POINTS, _array(types.boolean)),
         ),
     ]
 

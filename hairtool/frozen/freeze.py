@@ -27,6 +27,7 @@ from hairtool.frozen.noise import (
     seed_u64,
 )
 from hairtool.groom import Groom
+from hairtool.kernel_arrays import readonly
 from hairtool.rotation import any_perpendicular, normalize, perpendicular_axis, rotate
 from hairtool.serial_twins import twin_njit
 
@@ -199,7 +200,8 @@ def freeze(
     )
     points, back = _in_reference_axes(groom)
     out = np.empty_like(points)
-    _freeze_kernel(points, groom.offsets, ks, kb, float(max_bend_angle), seed_u64(seed), groom.is_planar, out)
+    rest, offsets = readonly(points), readonly(groom.offsets)  # one signature: Y-up or Z-up
+    _freeze_kernel(rest, offsets, ks, kb, float(max_bend_angle), seed_u64(seed), groom.is_planar, out)
     return groom.with_points(back(out))
 
 

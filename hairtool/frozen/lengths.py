@@ -16,6 +16,7 @@ from numba import prange
 
 from hairtool import serial_twins
 from hairtool.groom import Topology
+from hairtool.kernel_arrays import readonly
 from hairtool.serial_twins import twin_njit
 
 
@@ -91,7 +92,7 @@ def restore_lengths(
     picked = _ALL if strands is None else np.ascontiguousarray(strands, np.int64)
     if strands is None or picked.size > 0:
         kernel = _restore_kernel if parallel else serial_twins.serial(_restore_kernel)
-        kernel(before, after, topology.offsets, picked, out)
+        kernel(readonly(before), readonly(after), readonly(topology.offsets), picked, out)
     return out
 
 

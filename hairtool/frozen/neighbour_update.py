@@ -28,6 +28,7 @@ from numba import njit, prange
 
 from hairtool.bounds import moved_box
 from hairtool.frozen.spatial import NeighbourList, _gather, _scan_row, search_reach
+from hairtool.kernel_arrays import readonly
 from hairtool.serial_twins import twin_njit
 
 BACKWARD_BLOCKS = 16  # tasks of the backward lists' transpose at most (the lists do not depend on them)
@@ -86,7 +87,7 @@ def moved_vertices(points: np.ndarray, ref: np.ndarray) -> np.ndarray:
         int64 indices, increasing.
     """
     mask = np.empty(points.shape[0], np.bool_)
-    _moved_mask(points, ref, mask)
+    _moved_mask(readonly(points), readonly(ref), mask)
     return np.flatnonzero(mask)
 
 
@@ -401,7 +402,8 @@ def _resort(nl, points, strand, skip, moved, old_key, new_key, new_qx, ra, rb):
     sort = (is_moved, arrivals, arr_start, nl._qx)
     _resort_rows(ra, rb, old_start, start, old_order, *sort, nl.order, came, mold)
     k = slice(p0, p1)
-    _gather(nl.order[k], points, strand, skip, nl.x[k], nl.y[k], nl.z[k], nl.strand[k], nl.skip[k])
+    inputs = readonly(points), readonly(strand), readonly(skip)  # the build's signature
+    _gather(nl.order[k], *inputs, nl.x[k], nl.y[k], nl.z[k], nl.strand[k], nl.skip[k])
     to_new = np.empty(p1 - p0, np.int64)
     _inverse(came, p0, to_new)
     return came, mold, to_new

@@ -24,6 +24,7 @@ from numba import njit, prange
 from hairtool import budget
 from hairtool.bounds import box
 from hairtool.errors import GroomError, ParameterError
+from hairtool.kernel_arrays import readonly
 from hairtool.serial_twins import for_run, twin_njit
 
 _BITS = 21  # bits per cell coordinate in a packed 64-bit cell key
@@ -493,6 +494,8 @@ class NeighbourList:
             Force the row grid (True) or the hashed one (False); None picks by size.
         """
         self.chunks = None
+        # read-only and C-ordered: the kernels compile one signature per dtype whoever holds them
+        points, strand, skip = readonly(points), readonly(strand), readonly(skip)
         lo, hi, dims = self._grid(points, radius, dense)
         if self.dense:
             self._sort_rows(points, strand, skip, lo, hi, dims)

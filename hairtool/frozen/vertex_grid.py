@@ -24,6 +24,7 @@ from numba import njit, prange
 
 from hairtool import serial_twins
 from hairtool.bounds import box
+from hairtool.kernel_arrays import readonly
 from hairtool.serial_twins import twin_njit
 
 _OFF = 1 << 20  # cell coordinates are clipped to [−_OFF, _OFF − 1]
@@ -520,7 +521,7 @@ class VertexGrid:
         self.strand = np.ascontiguousarray(strand, np.int64)
         self.capacity = 64  # list slots per vertex (grows to the longest list + 1)
         self._flat = np.empty(0, np.int64)  # the lists' buffer (:meth:`prepare`)
-        _build(points, self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
+        _build(readonly(points), self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
         self.blocks = _blocks_over(points, self.inv)  # vertices per block of cells (_mark_slab skips)
         _count_blocks(self.key, *self.blocks)
 
@@ -572,7 +573,7 @@ class VertexGrid:
         """
         ids = np.ascontiguousarray(vids, np.int64)
         grid = (self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
-        return int(_move(points, ids, *grid, self.blocks))
+        return int(_move(readonly(points), ids, *grid, self.blocks))
 
     def strands_near(
         self, points: np.ndarray, queries: np.ndarray, radius: float, mark: np.ndarray, parallel: bool = True
@@ -594,6 +595,7 @@ class VertexGrid:
             Run the parallel kernels (False: their serial twins; the same flags).
         """
         q = np.asarray(queries, np.float64).reshape(-1, 3)
+        points = readonly(points)  # the kernels' one signature, whoever holds the points
         radius = _within_reach(points, q, float(radius), self.cell)
         r2 = radius**2
         grid = (self.inv, self.shift, self.key, self.head, self.nxt, mark)

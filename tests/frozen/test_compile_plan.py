@@ -13,7 +13,9 @@ def test_the_serial_pipeline_calls_each_planned_kernel_with_the_planned_types():
     groom = samples.scalp(strands=40, vertices=8, seed=2)
     with serial_twins.for_size(groom.vertex_count, ("hairtool.frozen",)) as parallel:
         assert not parallel and not serial_twins.parallel_in_use()
-        FrozenPipeline(groom, FrozenParams(keep_lengths=True)).settle()
+        pipeline = FrozenPipeline(groom, FrozenParams(keep_lengths=True, redraw_noise=True))
+        pipeline.settle()
+        pipeline.update()  # new noise: the neighbour list brought up to date (_moved_mask)
         plan = serial_plan()
     assert serial_twins.parallel_in_use()
     for kernel, sig in plan:
