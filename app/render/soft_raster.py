@@ -80,6 +80,46 @@ def _unit(c):
     return min(max(np.float64(c), 0.0), 1.0)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _setup_one(i, points, starts, colors, m, w, h, scale, seg, box, nearest, width, weight):
+    """Segment i's row of :func:`_setup_kernel`."""
+    box[0, i], box[1, i], box[2, i], box[3, i] = 0, -1, 0, -1
+    seg[i, 12] = scale[i] if scale.size else 1.0
+    if weight.size:
+        weight[i] = 1.0 + width * seg[i, 12]
+    a = np.uint64(starts[i])  # unsigned: no wrap-around test at every access (10 % of the set-up)
+    b = a + np.uint64(1)
+    ax, ay, az, aw = _project(points, a, m)
+    bx, by, bz, bw = _project(points, b, m)
+    if aw < W_MIN and bw < W_MIN:
+        return
+    cr, cg, cb = _unit(colors[a, 0]), _unit(colors[a, 1]), _unit(colors[a, 2])
+    dr, dg, db = _unit(colors[b, 0]), _unit(colors[b, 1]), _unit(colors[b, 2])
+    if aw < W_MIN:  # cut the end behind the eye (at most one end is)
+        s = (W_MIN - aw) / (bw - aw)
+        ax, ay, az, aw = ax + s * (bx - ax), ay + s * (by - ay), az + s * (bz - az), aw + s * (bw - aw)
+        cr, cg, cb = cr + s * (dr - cr), cg + s * (dg - cg), cb + s * (db - cb)
+    elif bw < W_MIN:
+        s = (W_MIN - bw) / (aw - bw)
+        bx, by, bz, bw = bx + s * (ax - bx), by + s * (ay - by), bz + s * (az - bz), bw + s * (aw - bw)
+        dr, dg, db = dr + s * (cr - dr), dg + s * (cg - dg), db + s * (cb - db)
+    ia, ib = 1.0 / aw, 1.0 / bw
+    xa, ya = (ax * ia + 1.0) * 0.5 * w, (ay * ia + 1.0) * 0.5 * h
+    xb, yb = (bx * ib + 1.0) * 0.5 * w, (by * ib + 1.0) * 0.5 * h
+    seg[i, 0], seg[i, 1], seg[i, 2] = xa, ya, (az * ia + 1.0) * 0.5
+    seg[i, 3], seg[i, 4], seg[i, 5] = xb, yb, (bz * ib + 1.0) * 0.5
+    # Every fragment's z lies between the ends' (to within rounding: hence the margin).
+    nearest[i] = np.float32(min(seg[i, 2], seg[i, 5]) - 1e-9)
+    seg[i, 6], seg[i, 7], seg[i, 8] = 255.0 * cr, 255.0 * cg, 255.0 * cb
+    seg[i, 9], seg[i, 10], seg[i, 11] = 255.0 * dr, 255.0 * dg, 255.0 * db
+    reach = SQRT2 * 0.5 * width * seg[i, 12] + 0.25 if width > 0.0 else 1.0
+    x0, x1 = min(xa, xb) - reach, max(xa, xb) + reach
+    y0, y1 = min(ya, yb) - reach, max(ya, yb) + reach
+    if x1 >= 0.0 and x0 <= w and y1 >= 0.0 and y0 <= h:
+        box[0, i], box[1, i] = int(max(y0, 0.0)), int(min(y1, h - 1.0))
+        box[2, i], box[3, i] = int(max(x0, 0.0)), int(min(x1, w - 1.0))
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def _setup_kernel(points, starts, colors, m, w, h, scale, seg, box, nearest, which, width, weight):
     """Window coordinates and colours of every segment's ends and its width ``scale`` (none
@@ -97,41 +137,17 @@ def _setup_kernel(points, starts, colors, m, w, h, scale, seg, box, nearest, whi
     for i in prange(starts.size):
         if which.size and not which[i]:
             continue
-        box[0, i], box[1, i], box[2, i], box[3, i] = 0, -1, 0, -1
-        seg[i, 12] = scale[i] if scale.size else 1.0
-        if weight.size:
-            weight[i] = 1.0 + width * seg[i, 12]
-        a = np.uint64(starts[i])  # unsigned: no wrap-around test at every access (10 % of the set-up)
-        b = a + np.uint64(1)
-        ax, ay, az, aw = _project(points, a, m)
-        bx, by, bz, bw = _project(points, b, m)
-        if aw < W_MIN and bw < W_MIN:
-            continue
-        cr, cg, cb = _unit(colors[a, 0]), _unit(colors[a, 1]), _unit(colors[a, 2])
-        dr, dg, db = _unit(colors[b, 0]), _unit(colors[b, 1]), _unit(colors[b, 2])
-        if aw < W_MIN:  # cut the end behind the eye (at most one end is)
-            s = (W_MIN - aw) / (bw - aw)
-            ax, ay, az, aw = ax + s * (bx - ax), ay + s * (by - ay), az + s * (bz - az), aw + s * (bw - aw)
-            cr, cg, cb = cr + s * (dr - cr), cg + s * (dg - cg), cb + s * (db - cb)
-        elif bw < W_MIN:
-            s = (W_MIN - bw) / (aw - bw)
-            bx, by, bz, bw = bx + s * (ax - bx), by + s * (ay - by), bz + s * (az - bz), bw + s * (aw - bw)
-            dr, dg, db = dr + s * (cr - dr), dg + s * (cg - dg), db + s * (cb - db)
-        ia, ib = 1.0 / aw, 1.0 / bw
-        xa, ya = (ax * ia + 1.0) * 0.5 * w, (ay * ia + 1.0) * 0.5 * h
-        xb, yb = (bx * ib + 1.0) * 0.5 * w, (by * ib + 1.0) * 0.5 * h
-        seg[i, 0], seg[i, 1], seg[i, 2] = xa, ya, (az * ia + 1.0) * 0.5
-        seg[i, 3], seg[i, 4], seg[i, 5] = xb, yb, (bz * ib + 1.0) * 0.5
-        # Every fragment's z lies between the ends' (to within rounding: hence the margin).
-        nearest[i] = np.float32(min(seg[i, 2], seg[i, 5]) - 1e-9)
-        seg[i, 6], seg[i, 7], seg[i, 8] = 255.0 * cr, 255.0 * cg, 255.0 * cb
-        seg[i, 9], seg[i, 10], seg[i, 11] = 255.0 * dr, 255.0 * dg, 255.0 * db
-        reach = SQRT2 * 0.5 * width * seg[i, 12] + 0.25 if width > 0.0 else 1.0
-        x0, x1 = min(xa, xb) - reach, max(xa, xb) + reach
-        y0, y1 = min(ya, yb) - reach, max(ya, yb) + reach
-        if x1 >= 0.0 and x0 <= w and y1 >= 0.0 and y0 <= h:
-            box[0, i], box[1, i] = int(max(y0, 0.0)), int(min(y1, h - 1.0))
-            box[2, i], box[3, i] = int(max(x0, 0.0)), int(min(x1, w - 1.0))
+        _setup_one(i, points, starts, colors, m, w, h, scale, seg, box, nearest, width, weight)
+
+
+@njit(cache=True, nogil=True)
+def _setup_listed(points, starts, colors, m, w, h, scale, seg, box, nearest, ids, width):
+    """:func:`_setup_kernel` for the segments ``ids`` alone, on the calling thread: a brush
+    move's few thousand cost less than waking the thread pool (on a loaded host the parallel
+    set-up, looking at every segment's flag, took 7 ms a bear comb move)."""
+    none = np.zeros(0)
+    for n in range(ids.size):
+        _setup_one(ids[n], points, starts, colors, m, w, h, scale, seg, box, nearest, width, none)
 
 
 @njit(cache=True, nogil=True)
@@ -729,13 +745,16 @@ class StrandRaster:
             self._last = key
         return rgba, depth
 
-    def _setup(self, p, s, c, m, half, which, weight=_NO_SCALE) -> None:
+    def _setup(self, p, s, c, m, half, which, weight=_NO_SCALE, ids=None) -> None:
         """The segments' window coordinates, colours and boxes (those flagged in ``which``, or all
-        for an empty mask), the boxes widened for quads of half-width ``half``; into a non-empty
-        ``weight``, each segment's work per row."""
+        for an empty mask; or those listed in ``ids``, on this thread), the boxes widened for
+        quads of half-width ``half``; into a non-empty ``weight``, each segment's work per row."""
         h, w = self.depth.shape
         sc = self._last_scale if self._last_scale.ndim else _NO_SCALE
         p, s, c, m, sc = (_read_only(a) for a in (p, s, c, m, sc))
+        if ids is not None:
+            _setup_listed(p, s, c, m, w, h, sc, self._seg, self._box, self._nearest, ids, 2.0 * half)
+            return
         _setup_kernel(p, s, c, m, w, h, sc, self._seg, self._box, self._nearest, which, 2.0 * half, weight)
 
     def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
@@ -815,6 +834,7 @@ class StrandRaster:
             _changed_vertices(_read_only(p), _read_only(c), self._last_points, self._last_colors, self._flags)
             changed = _changed_ends(_read_only(s), self._flags, self._which)
         self._kept_current = True
+        ids = np.flatnonzero(self._which) if runs is not None else None
         if changed == 0:
             self._plan_searches(in_full=False)
             self.changed, self.tiles_redrawn = None, 0
@@ -825,7 +845,7 @@ class StrandRaster:
         h, w = depth.shape
         dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
         _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # where they were,
-        self._setup(p, s, c, m, half, self._which)
+        self._setup(p, s, c, m, half, self._which, ids=ids)
         _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # and where they are
         if self._counts.size != dirty.size + 1:
             self._counts = np.zeros(dirty.size + 1, np.int64)
