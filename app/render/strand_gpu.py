@@ -283,8 +283,8 @@ class PointSet:
         runs = None if moved is None else vertex_runs(offsets, moved)
         if runs is None:
             self.cpu_runs = None
-        else:
-            self.cpu_runs = kept_runs(self.cpu_runs, runs)
+        else:  # the CPU raster compares what it is told, vertex by vertex: no gaps filled
+            self.cpu_runs = kept_runs(self.cpu_runs, vertex_runs(offsets, moved, gap=1))
         for name in self._stale:
             if runs is None or name != form or not partial:
                 self._stale[name] = True
