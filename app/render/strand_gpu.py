@@ -280,10 +280,10 @@ class PointSet:
         elif partial or find:
             moved = changed_strands(self._points, points, self.gpu.topology)
         self._points[:] = points
-        runs = None if moved is None else vertex_runs(offsets, moved)
-        if runs is None:
+        runs = None if moved is None or not partial else vertex_runs(offsets, moved)  # for the form in use
+        if moved is None:
             self.cpu_runs = None
-        else:  # the CPU raster compares what it is told, vertex by vertex: no gaps filled
+        elif self.cpu_runs is not None:  # the CPU raster compares what it is told: no gaps filled
             self.cpu_runs = kept_runs(self.cpu_runs, vertex_runs(offsets, moved, gap=1))
         for name in self._stale:
             if runs is None or name != form or not partial:
