@@ -142,6 +142,7 @@ class RasterLayer:
         read_depth: bool = False,
         scale: ArrayLike | None = None,
         backdrop: tuple | None = None,
+        changed: ArrayLike | None = None,
     ) -> None:
         """Draw the strands into ``fbo`` (bound, viewport ``size``, with ``samples`` per pixel).
 
@@ -152,6 +153,8 @@ class RasterLayer:
         ``backdrop``: single-sampled without ``background``, the key of what GL drew under the
         strands (None: no key); the images of a key read back once are kept, and a later frame
         of that key starts from them instead of reading ``fbo`` (which it then need not draw).
+        ``changed``: the only vertex ranges whose points or colours may differ from the last
+        call's (:meth:`StrandRaster.draw`; None: any).
         """
         self._resize(size)
         if samples > 0:
@@ -159,7 +162,9 @@ class RasterLayer:
             return
         if background is not None:
             clear = tuple(int(np.floor(c * 255.0 + 0.5)) for c in background)  # as GL stores it
-            rgba, _ = self.raster.draw(points, starts, colors, mvp, size, width, clear=clear, scale=scale)
+            rgba, _ = self.raster.draw(
+                points, starts, colors, mvp, size, width, clear=clear, scale=scale, changed=changed
+            )
             self._upload(rgba, self.raster.changed)
         else:
             rgba, depth = self.raster.images(size)

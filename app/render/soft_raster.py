@@ -80,6 +80,46 @@ def _unit(c):
     return min(max(np.float64(c), 0.0), 1.0)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _setup_one(i, points, starts, colors, m, w, h, scale, seg, box, nearest, width, weight):
+    """Segment i's row of :func:`_setup_kernel`."""
+    box[0, i], box[1, i], box[2, i], box[3, i] = 0, -1, 0, -1
+    seg[i, 12] = scale[i] if scale.size else 1.0
+    if weight.size:
+        weight[i] = 1.0 + width * seg[i, 12]
+    a = np.uint64(starts[i])  # unsigned: no wrap-around test at every access (10 % of the set-up)
+    b = a + np.uint64(1)
+    ax, ay, az, aw = _project(points, a, m)
+    bx, by, bz, bw = _project(points, b, m)
+    if aw < W_MIN and bw < W_MIN:
+        return
+    cr, cg, cb = _unit(colors[a, 0]), _unit(colors[a, 1]), _unit(colors[a, 2])
+    dr, dg, db = _unit(colors[b, 0]), _unit(colors[b, 1]), _unit(colors[b, 2])
+    if aw < W_MIN:  # cut the end behind the eye (at most one end is)
+        s = (W_MIN - aw) / (bw - aw)
+        ax, ay, az, aw = ax + s * (bx - ax), ay + s * (by - ay), az + s * (bz - az), aw + s * (bw - aw)
+        cr, cg, cb = cr + s * (dr - cr), cg + s * (dg - cg), cb + s * (db - cb)
+    elif bw < W_MIN:
+        s = (W_MIN - bw) / (aw - bw)
+        bx, by, bz, bw = bx + s * (ax - bx), by + s * (ay - by), bz + s * (az - bz), bw + s * (aw - bw)
+        dr, dg, db = dr + s * (cr - dr), dg + s * (cg - dg), db + s * (cb - db)
+    ia, ib = 1.0 / aw, 1.0 / bw
+    xa, ya = (ax * ia + 1.0) * 0.5 * w, (ay * ia + 1.0) * 0.5 * h
+    xb, yb = (bx * ib + 1.0) * 0.5 * w, (by * ib + 1.0) * 0.5 * h
+    seg[i, 0], seg[i, 1], seg[i, 2] = xa, ya, (az * ia + 1.0) * 0.5
+    seg[i, 3], seg[i, 4], seg[i, 5] = xb, yb, (bz * ib + 1.0) * 0.5
+    # Every fragment's z lies between the ends' (to within rounding: hence the margin).
+    nearest[i] = np.float32(min(seg[i, 2], seg[i, 5]) - 1e-9)
+    seg[i, 6], seg[i, 7], seg[i, 8] = 255.0 * cr, 255.0 * cg, 255.0 * cb
+    seg[i, 9], seg[i, 10], seg[i, 11] = 255.0 * dr, 255.0 * dg, 255.0 * db
+    reach = SQRT2 * 0.5 * width * seg[i, 12] + 0.25 if width > 0.0 else 1.0
+    x0, x1 = min(xa, xb) - reach, max(xa, xb) + reach
+    y0, y1 = min(ya, yb) - reach, max(ya, yb) + reach
+    if x1 >= 0.0 and x0 <= w and y1 >= 0.0 and y0 <= h:
+        box[0, i], box[1, i] = int(max(y0, 0.0)), int(min(y1, h - 1.0))
+        box[2, i], box[3, i] = int(max(x0, 0.0)), int(min(x1, w - 1.0))
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def _setup_kernel(points, starts, colors, m, w, h, scale, seg, box, nearest, which, width, weight):
     """Window coordinates and colours of every segment's ends and its width ``scale`` (none
@@ -97,41 +137,17 @@ def _setup_kernel(points, starts, colors, m, w, h, scale, seg, box, nearest, whi
     for i in prange(starts.size):
         if which.size and not which[i]:
             continue
-        box[0, i], box[1, i], box[2, i], box[3, i] = 0, -1, 0, -1
-        seg[i, 12] = scale[i] if scale.size else 1.0
-        if weight.size:
-            weight[i] = 1.0 + width * seg[i, 12]
-        a = np.uint64(starts[i])  # unsigned: no wrap-around test at every access (10 % of the set-up)
-        b = a + np.uint64(1)
-        ax, ay, az, aw = _project(points, a, m)
-        bx, by, bz, bw = _project(points, b, m)
-        if aw < W_MIN and bw < W_MIN:
-            continue
-        cr, cg, cb = _unit(colors[a, 0]), _unit(colors[a, 1]), _unit(colors[a, 2])
-        dr, dg, db = _unit(colors[b, 0]), _unit(colors[b, 1]), _unit(colors[b, 2])
-        if aw < W_MIN:  # cut the end behind the eye (at most one end is)
-            s = (W_MIN - aw) / (bw - aw)
-            ax, ay, az, aw = ax + s * (bx - ax), ay + s * (by - ay), az + s * (bz - az), aw + s * (bw - aw)
-            cr, cg, cb = cr + s * (dr - cr), cg + s * (dg - cg), cb + s * (db - cb)
-        elif bw < W_MIN:
-            s = (W_MIN - bw) / (aw - bw)
-            bx, by, bz, bw = bx + s * (ax - bx), by + s * (ay - by), bz + s * (az - bz), bw + s * (aw - bw)
-            dr, dg, db = dr + s * (cr - dr), dg + s * (cg - dg), db + s * (cb - db)
-        ia, ib = 1.0 / aw, 1.0 / bw
-        xa, ya = (ax * ia + 1.0) * 0.5 * w, (ay * ia + 1.0) * 0.5 * h
-        xb, yb = (bx * ib + 1.0) * 0.5 * w, (by * ib + 1.0) * 0.5 * h
-        seg[i, 0], seg[i, 1], seg[i, 2] = xa, ya, (az * ia + 1.0) * 0.5
-        seg[i, 3], seg[i, 4], seg[i, 5] = xb, yb, (bz * ib + 1.0) * 0.5
-        # Every fragment's z lies between the ends' (to within rounding: hence the margin).
-        nearest[i] = np.float32(min(seg[i, 2], seg[i, 5]) - 1e-9)
-        seg[i, 6], seg[i, 7], seg[i, 8] = 255.0 * cr, 255.0 * cg, 255.0 * cb
-        seg[i, 9], seg[i, 10], seg[i, 11] = 255.0 * dr, 255.0 * dg, 255.0 * db
-        reach = SQRT2 * 0.5 * width * seg[i, 12] + 0.25 if width > 0.0 else 1.0
-        x0, x1 = min(xa, xb) - reach, max(xa, xb) + reach
-        y0, y1 = min(ya, yb) - reach, max(ya, yb) + reach
-        if x1 >= 0.0 and x0 <= w and y1 >= 0.0 and y0 <= h:
-            box[0, i], box[1, i] = int(max(y0, 0.0)), int(min(y1, h - 1.0))
-            box[2, i], box[3, i] = int(max(x0, 0.0)), int(min(x1, w - 1.0))
+        _setup_one(i, points, starts, colors, m, w, h, scale, seg, box, nearest, width, weight)
+
+
+@njit(cache=True, nogil=True)
+def _setup_listed(points, starts, colors, m, w, h, scale, seg, box, nearest, ids, width):
+    """:func:`_setup_kernel` for the segments ``ids`` alone, on the calling thread: a brush
+    move's few thousand cost less than waking the thread pool (on a loaded host the parallel
+    set-up, looking at every segment's flag, took 7 ms a bear comb move)."""
+    none = np.zeros(0)
+    for n in range(ids.size):
+        _setup_one(ids[n], points, starts, colors, m, w, h, scale, seg, box, nearest, width, none)
 
 
 @njit(cache=True, nogil=True)
@@ -412,6 +428,66 @@ def _changed_vertices(points, colors, last_points, last_colors, flags):
                 b[i, k], d[i, k] = a[i, k], c[i, k]
 
 
+@njit(cache=True, nogil=True)
+def _changed_in_runs(points, colors, last_points, last_colors, starts, runs, seg_runs, flags, which):
+    """:func:`_changed_vertices` and :func:`_changed_ends` for the vertices of ``runs`` alone
+    (``(R, 2)`` sorted disjoint ranges [a, b) outside which nothing changed), each run's segments
+    ``seg_runs[r, 0] … seg_runs[r, 1] − 1`` (those with an end in it; ``starts`` increasing):
+    ``which`` (all False before) flags the changed ones; returns how many. Serial: a brush's
+    region is a few thousand vertices, fewer than a thread start is worth."""
+    a32, b32 = points.view(np.uint32), last_points.view(np.uint32)
+    c32, d32 = colors.view(np.uint32), last_colors.view(np.uint32)
+    n = 0
+    for r in range(runs.shape[0]):
+        a, b = runs[r, 0], runs[r, 1]
+        for v in range(a, b):
+            differ = False
+            for k in range(3):
+                differ |= (a32[v, k] != b32[v, k]) | (c32[v, k] != d32[v, k])
+            flags[v] = differ
+            if differ:
+                for k in range(3):
+                    b32[v, k], d32[v, k] = a32[v, k], c32[v, k]
+        for i in range(seg_runs[r, 0], seg_runs[r, 1]):
+            s = starts[i]
+            changed = (s >= a and flags[s]) or (s + 1 < b and flags[s + 1])
+            if changed and not which[i]:
+                which[i] = True
+                n += 1
+    return n
+
+
+def changed_in_runs_reference(points, colors, last_points, last_colors, starts, runs):
+    """:func:`_changed_in_runs` in numpy over the whole groom: the segments with an end inside
+    ``runs`` whose position or colour differs bit for bit; the last arrays brought up to date
+    there. Returns the flags (the oracle of the tests)."""
+    inside = np.zeros(len(points) + 1, np.int64)
+    for a, b in runs:
+        inside[a] += 1
+        inside[b] -= 1
+    inside = np.cumsum(inside)[:-1] > 0
+    bits = [np.ascontiguousarray(x).view(np.uint32) for x in (points, last_points, colors, last_colors)]
+    differ = inside & ((bits[0] != bits[1]).any(axis=1) | (bits[2] != bits[3]).any(axis=1))
+    last_points[differ], last_colors[differ] = points[differ], colors[differ]
+    return differ[starts] | differ[starts + 1]
+
+
+def merged_runs(runs: ArrayLike, v: int) -> NDArray[np.int64]:
+    """``(R, 2)`` vertex ranges [a, b) of ``v`` vertices, sorted and those that overlap or touch
+    merged; a range outside [0, v] or reversed is refused, naming ``changed``."""
+    r = np.asarray(runs, np.int64).reshape(-1, 2) if np.size(runs) else np.zeros((0, 2), np.int64)
+    if r.size and (r.min() < 0 or r[:, 1].max() > v or np.any(r[:, 1] < r[:, 0])):
+        raise ParameterError("changed", "a vertex range out of order or out of range", f"[a, b) in [0, {v}]")
+    r = r[np.argsort(r[:, 0], kind="stable")]
+    if len(r) < 2:
+        return r
+    reach = np.maximum.accumulate(r[:, 1])
+    first = np.concatenate([[True], r[1:, 0] > reach[:-1]])
+    starts_at = np.flatnonzero(first)
+    ends = reach[np.concatenate([starts_at[1:] - 1, [len(r) - 1]])]
+    return np.stack([r[starts_at, 0], ends], axis=1)
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def _changed_ends(starts, flags, which):
     """Flag the segments with an end among the flagged vertices; returns how many."""
@@ -580,6 +656,8 @@ class StrandRaster:
         self._last_points = np.zeros((0, 3), np.float32)
         self._last_colors = np.zeros((0, 3), np.float32)
         self._last_scale = np.float64(1.0)
+        self._kept_current = False  # the last points and colours are those of the last draw
+        self._increasing_starts: tuple[np.ndarray, bool] | None = None  # (kept starts, increasing)
         self._flags = np.zeros(0, np.bool_)
         self._which = np.zeros(0, np.bool_)
         self._all = np.zeros(0, np.bool_)  # an empty mask: every segment
@@ -591,6 +669,7 @@ class StrandRaster:
         self._next_unsearched = 0
         self.changed: tuple[int, int, int, int] | None = None  # (row0, row1, col0, col1) or None
         self.tiles_redrawn = 0  # in the last draw; −1: all of the image
+        self.draws = 0  # calls of draw so far
 
     def _view(self, name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
         """A C-contiguous ``shape`` array of ``dtype`` in the memory kept as ``name`` (grown when
@@ -626,13 +705,18 @@ class StrandRaster:
         width: float,
         clear: tuple[int, int, int, int] | None = (0, 0, 0, 0),
         scale: ArrayLike | None = None,
+        changed: ArrayLike | None = None,
     ) -> tuple[NDArray[np.uint8], NDArray[np.float32]]:
         """Segments ``starts[i] → starts[i] + 1`` of ``points`` ``(V, 3)``, coloured by per-vertex
         RGB ``colors`` in [0, 1], seen through ``mvp``, into ``size = (W, H)`` images; ``width``
         in pixels (≤ 1: 1-px lines). The images are first cleared to the RGBA bytes ``clear`` and
         depth 1.0, or with ``clear=None`` drawn over as they are (see :meth:`images`).
         ``scale``: per segment, a factor in [0, 1] of its quad's width (None: 1, no taper).
-        Returns :meth:`images`; the next draw overwrites them."""
+        ``changed``: ``(R, 2)`` vertex ranges [a, b) outside which points and colours are those
+        of the last draw, bit for bit (the caller knows what a brush move redid): a redraw of
+        the changed tiles then compares only those vertices (None: any may differ; a draw that
+        is not such a redraw ignores it). Returns :meth:`images`; the next draw overwrites them."""
+        self.draws += 1
         fixed = self._same("starts", starts) and self._last_points.shape == np.shape(points)
         p, s, c, m, w, h, width = _check(points, starts, colors, mvp, size, width, check_starts=not fixed)
         sc = scale if self._same("scale", scale) else _check_scale(scale, s.size)
@@ -654,19 +738,23 @@ class StrandRaster:
             self._unsearched = self._next_unsearched = 0
         elif self._unsearched > 0:  # the last frames changed nearly all: so will this one
             same, self._unsearched = False, self._unsearched - 1
-        if not (same and self._redraw_changed(p, s, c, m, half, fill, depth)):
+        runs = None if changed is None else merged_runs(changed, p.shape[0])
+        if not (same and self._redraw_changed(p, s, c, m, half, fill, depth, runs)):
             self._draw_all(p, s, c, m, half, clear is not None, fill, depth, sc)
         if clear is not None:
             self._last = key
         return rgba, depth
 
-    def _setup(self, p, s, c, m, half, which, weight=_NO_SCALE) -> None:
+    def _setup(self, p, s, c, m, half, which, weight=_NO_SCALE, ids=None) -> None:
         """The segments' window coordinates, colours and boxes (those flagged in ``which``, or all
-        for an empty mask), the boxes widened for quads of half-width ``half``; into a non-empty
-        ``weight``, each segment's work per row."""
+        for an empty mask; or those listed in ``ids``, on this thread), the boxes widened for
+        quads of half-width ``half``; into a non-empty ``weight``, each segment's work per row."""
         h, w = self.depth.shape
         sc = self._last_scale if self._last_scale.ndim else _NO_SCALE
         p, s, c, m, sc = (_read_only(a) for a in (p, s, c, m, sc))
+        if ids is not None:
+            _setup_listed(p, s, c, m, w, h, sc, self._seg, self._box, self._nearest, ids, 2.0 * half)
+            return
         _setup_kernel(p, s, c, m, w, h, sc, self._seg, self._box, self._nearest, which, 2.0 * half, weight)
 
     def _draw_all(self, p, s, c, m, half, clear, fill, depth, scale) -> None:
@@ -687,7 +775,8 @@ class StrandRaster:
         )
         self.changed, self.tiles_redrawn = (0, h, 0, w), -1
         self._last_mvp, self._last_starts = m.copy(), self._kept("starts", s, fixed=True)
-        if self._unsearched == 0:  # the next draw may look for changes against what this one drew
+        self._kept_current = self._unsearched == 0
+        if self._kept_current:  # the next draw may look for changes against what this one drew
             self._last_points, self._last_colors = self._kept("points", p), self._kept("colors", c)
         # (else it draws in full too, and so on up to one that keeps them: copying a drag frame's
         # 350,000 points and colours had cost 0.8 ms a frame)
@@ -719,12 +808,33 @@ class StrandRaster:
         self._next_unsearched = min(2 * self._next_unsearched + 1, MAX_UNSEARCHED) if in_full else 0
         self._unsearched = self._next_unsearched
 
-    def _redraw_changed(self, p, s, c, m, half, fill, depth) -> bool:
-        """Redraw the tiles the changed segments touch; False when a full draw is cheaper."""
+    def _increasing(self, s: np.ndarray) -> bool:
+        """Whether the segment starts increase (the renderer's do), remembered for kept ones."""
+        if self._increasing_starts is not None and self._increasing_starts[0] is s:
+            return self._increasing_starts[1]
+        up = bool(np.all(s[1:] > s[:-1]))
+        if self._same("starts", s):
+            self._increasing_starts = (s, up)
+        return up
+
+    def _redraw_changed(self, p, s, c, m, half, fill, depth, runs=None) -> bool:
+        """Redraw the tiles the changed segments touch; False when a full draw is cheaper.
+        ``runs``: the only vertex ranges that may differ from the last draw (None: any)."""
         n, v = s.size, p.shape[0]
         self._flags, self._which = self._view("flags", (v,), np.bool_), self._view("which", (n,), np.bool_)
-        _changed_vertices(_read_only(p), _read_only(c), self._last_points, self._last_colors, self._flags)
-        changed = _changed_ends(_read_only(s), self._flags, self._which)
+        if runs is not None and self._kept_current and self._increasing(s):
+            # only the runs' vertices are compared, and their segments flagged
+            seg_runs = np.stack([np.searchsorted(s, runs[:, 0] - 1), np.searchsorted(s, runs[:, 1])], axis=1)
+            self._which[:] = False
+            changed = _changed_in_runs(
+                _read_only(p), _read_only(c), self._last_points, self._last_colors, _read_only(s),
+                runs, seg_runs, self._flags, self._which,
+            )  # fmt: skip
+        else:
+            _changed_vertices(_read_only(p), _read_only(c), self._last_points, self._last_colors, self._flags)
+            changed = _changed_ends(_read_only(s), self._flags, self._which)
+        self._kept_current = True
+        ids = np.flatnonzero(self._which) if runs is not None else None
         if changed == 0:
             self._plan_searches(in_full=False)
             self.changed, self.tiles_redrawn = None, 0
@@ -735,7 +845,7 @@ class StrandRaster:
         h, w = depth.shape
         dirty = np.zeros(((h + TILE - 1) // TILE, (w + TILE - 1) // TILE), np.bool_)
         _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # where they were,
-        self._setup(p, s, c, m, half, self._which)
+        self._setup(p, s, c, m, half, self._which, ids=ids)
         _mark_tiles(self._box, self._which, dirty, TILE_SHIFT)  # and where they are
         if self._counts.size != dirty.size + 1:
             self._counts = np.zeros(dirty.size + 1, np.int64)

@@ -145,6 +145,7 @@ class StrandGPU:
         self._color_buffer_stale = False
         self._color_runs: list[NDArray] = []  # rows written since the last upload, per GL form
         self._color_texture_runs: list[NDArray] = []
+        self.cpu_color_runs: list[NDArray] | None = None  # rows written since the last CPU draw (None: any)
         self._index: dict[str, moderngl.Buffer] = {}
         self.uploaded_bytes = 0  # colours uploaded so far (all written through write_buffer)
 
@@ -190,7 +191,9 @@ class StrandGPU:
             self._color_buffer_stale = self._color_texture_stale = True
             self._color_runs.clear()
             self._color_texture_runs.clear()
+            self.cpu_color_runs = None
             return
+        self.cpu_color_runs = kept_runs(self.cpu_color_runs, runs)
         if not self._color_buffer_stale:
             self._color_runs.append(runs)
         if not self._color_texture_stale:
@@ -239,6 +242,7 @@ class PointSet:
         self._texture: moderngl.Texture | None = None
         self._stale = {"buffer": True, "texture": True}
         self._runs: dict[str, list[NDArray]] = {"buffer": [], "texture": []}  # rows to upload
+        self.cpu_runs: list[NDArray] | None = None  # rows written since the last CPU draw (None: any)
         self.last_used = "buffer"  # the form the last draw read ("buffer", "texture", "cpu")
         self.uploaded_bytes = 0  # points uploaded to the vertex buffer so far
 
@@ -276,7 +280,11 @@ class PointSet:
         elif partial or find:
             moved = changed_strands(self._points, points, self.gpu.topology)
         self._points[:] = points
-        runs = None if moved is None else vertex_runs(offsets, moved)
+        runs = None if moved is None or not partial else vertex_runs(offsets, moved)  # for the form in use
+        if moved is None:
+            self.cpu_runs = None
+        elif self.cpu_runs is not None:  # the CPU raster compares what it is told: no gaps filled
+            self.cpu_runs = kept_runs(self.cpu_runs, vertex_runs(offsets, moved, gap=1))
         for name in self._stale:
             if runs is None or name != form or not partial:
                 self._stale[name] = True
@@ -336,6 +344,16 @@ class PointSet:
             self._texture.release()
             self._texture = None
             self._texels = None
+
+
+def kept_runs(parts: list[NDArray] | None, runs: NDArray) -> list[NDArray] | None:
+    """``parts`` (rows written since the last CPU draw) with ``runs`` too; None (any) stays
+    None, and so does a list longer than :data:`MAX_WRITES` (no CPU draw is reading them: the
+    GL methods draw)."""
+    if parts is None or len(parts) >= MAX_WRITES:
+        return None
+    parts.append(runs)
+    return parts
 
 
 def merged_runs(parts: list[NDArray]) -> NDArray[np.int64]:

@@ -184,6 +184,8 @@ class StrandRenderer:
         # Strands moved since the last shade by update_points alone (None: shade them all).
         self._reshade: NDArray[np.int64] | None = None
         self.last_moved: NDArray[np.int64] | None = None  # the strands the last update_points changed
+        # (point set, colours, the raster's draw count) after the last CPU draw told what changed
+        self._cpu_drawn: tuple | None = None
 
     # -- what is drawn and how -------------------------------------------------------
     def line_method(self) -> str:
@@ -605,10 +607,32 @@ class StrandRenderer:
         points, colors, starts = self._main.cpu_points(), self.cpu_colors(), self._segment_starts
         mesh = self.mesh.vao is not None or self.character.drawn
         scale = self.segment_width_scale() if width > 1.0 else None
+        changed = self._cpu_changed(colors, samples == 0 and background is not None)
         self.raster.render(
             fbo, samples, points, starts, colors, mvp, size, width, background=background, read_depth=mesh,
-            scale=scale, backdrop=backdrop,
+            scale=scale, backdrop=backdrop, changed=changed,
         )  # fmt: skip
+
+    def _cpu_changed(self, colors: NDArray[np.float32], told: bool) -> NDArray[np.int64] | None:
+        """The vertex ranges whose points or colours were written since the raster's last draw,
+        when that draw was the last CPU draw and was told them too (``told``: this one is, a
+        single-sampled draw over the background) of these same points and colours; else None:
+        unknown, the raster compares them all. The count starts afresh."""
+        main, gpu, raster = self._main, self._gpu, self.raster.raster
+        last = self._cpu_drawn
+        known = last is not None and last[0] is main and last[1] is colors and last[2] == raster.draws
+        known = (
+            known
+            and main.cpu_runs is not None
+            and (colors is not gpu.colors or gpu.cpu_color_runs is not None)
+        )
+        runs = None
+        if known:
+            parts = list(main.cpu_runs) + (list(gpu.cpu_color_runs) if colors is gpu.colors else [])
+            runs = np.concatenate(parts) if parts else np.zeros((0, 2), np.int64)
+        main.cpu_runs, gpu.cpu_color_runs = [], []
+        self._cpu_drawn = (main, colors, raster.draws + 1) if told else None
+        return runs
 
     def _checked_taper(self) -> float:
         t = float(self.taper)

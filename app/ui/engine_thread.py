@@ -48,6 +48,7 @@ class Batch:
     touched: bool = False
     ms: float = 0.0
     ran: bool = False  # some samples reached the pipeline (its result is new)
+    changed: np.ndarray | None = None  # the strands the run may have moved (None: any)
     error: BaseException | None = None  # anything but a refusal: raised again on the GUI thread
     done: threading.Event = field(default_factory=threading.Event)
 
@@ -138,6 +139,7 @@ class MoveEngine(QObject):
             try:
                 pipeline.apply_samples(samples)
                 batch.ran = True
+                batch.changed = pipeline.changed  # one call: its region is the batch's
             except HairtoolError:
                 # a refused move changes nothing: the others go through one by one, as they came
                 label = LABELS.get(tool.brush, tool.brush)
@@ -170,7 +172,7 @@ class MoveEngine(QObject):
         s = self.scene
         if batch.ran:
             result = s.pipeline.result
-            s._stroke_step(lambda: result)
+            s._stroke_step(lambda: result, moved=batch.changed)
         else:  # a comb standing still: nothing ran; the view still follows the cursor
             s.points_changed.emit()
         s.last_update_ms = batch.ms

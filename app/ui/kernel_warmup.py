@@ -264,6 +264,8 @@ def _raster_step() -> None:
         moved = points.copy()
         moved[3] += 0.01
         raster.draw(moved, starts, colors, mvp, (64, 48), width)  # the tiles-only redraw
+        moved[4] += 0.01
+        raster.draw(moved, starts, colors, mvp, (64, 48), width, changed=[[4, 5]])  # told what moved
 
 
 def _brushes_step() -> None:

@@ -106,6 +106,9 @@ class Scene(QObject):
         self.release_percent = RELEASE_PERCENT
         self.dragging = False
         self.frames_live = False  # an animation plays or is scrubbed: its children drawn unclumped
+        # While points_changed is heard: the only strands of the result that moved since the
+        # last points_changed (a brush move's region); None: any.
+        self.moved: np.ndarray | None = None
         self._subsets: dict[float, ChildBinding] = {}
         self._cache: dict = {}  # per drawn density: its topology and colours (see cached)
         self._rest_drawn: np.ndarray | None = None
@@ -380,9 +383,11 @@ class Scene(QObject):
             return None
         return f"{label} changes the strands, but {' and '.join(reasons)}: remove it first"
 
-    def _stroke_step(self, step) -> None:
+    def _stroke_step(self, step, moved: np.ndarray | None = None) -> None:
         """``step()`` (a pipeline call that changes strokes, so maybe the mask or the strands)
-        on the running engine, timed; the render hair, the mask and the views follow."""
+        on the running engine, timed; the render hair, the mask and the views follow.
+        ``moved``: the only strands of the result the step may have changed (None: any), told
+        to the views as :attr:`moved` while they hear :attr:`points_changed`."""
         self.start_engine()
         t0 = time.perf_counter()
         topology, children = self.result.topology, self.children_binding()
@@ -397,7 +402,12 @@ class Scene(QObject):
         self._children_moved()
         self._sync_mask()
         self.last_update_ms = (time.perf_counter() - t0) * 1e3
-        self.points_changed.emit()
+        same = self.result.topology == topology and not self.has_children
+        self.moved = moved if same else None
+        try:
+            self.points_changed.emit()
+        finally:
+            self.moved = None
 
     def _sync_mask(self) -> None:
         locked, clump = self.pipeline.locked, self.pipeline.clump_strength

@@ -110,6 +110,7 @@ class Viewport(QWidget):
         self.last_upload_ms = 0.0
         self.last_draw_ms = 0.0
         self._dirty = {"groom", "colors", "display", "mesh"}
+        self._moved: np.ndarray | None = None  # with "points" dirty: the only strands moved (None: any)
         self.last_image: LastImage | None = None  # the scene drawn last, without its overlays
         # painted with QPainter over the view at each paint (the joint handles): ``shown()`` and
         # ``paint(painter)``; the GL window would cover a widget placed over it
@@ -172,6 +173,8 @@ class Viewport(QWidget):
         self.surface.update()
 
     def _mark(self, *what: str) -> None:
+        if "points" in what:
+            self._moved = None
         self._dirty.update(what)
         self.update()
 
@@ -207,6 +210,13 @@ class Viewport(QWidget):
     def _on_points_changed(self) -> None:
         if self.frame_points is not None:
             return  # an animation frame is on screen; the groom's edits show when it goes
+        known = self.scene.moved
+        if known is None:
+            self._moved = None
+        elif "points" not in self._dirty:
+            self._moved = known
+        elif self._moved is not None:
+            self._moved = np.union1d(self._moved, known)
         self._dirty.add("points")
         if self.scene.colour_mode in ("displacement", "clump"):
             self._dirty.add("colors")
@@ -230,6 +240,7 @@ class Viewport(QWidget):
         self.frame_children = children
         self._pending_frame = frame
         self._dirty.add("points")
+        self._moved = None
         if colors is not None or had_colors:
             self._dirty.add("colors")
         if ghost is not None or had_ghost:
@@ -310,7 +321,9 @@ class Viewport(QWidget):
             dirty.discard("points")
             dirty.update(("ghost",) if shown or self.ghost_points is not None else ())
         if "points" in dirty:
-            r.update_points(d.points)
+            # the engine's region, where the drawn strands are the groom's own
+            mine = self._moved is not None and d.topology.strand_count == s.result.strand_count
+            r.update_points(d.points, self._moved if mine else None)
         if "groom" in dirty or "points" in dirty:
             self.shown_frame = self._pending_frame if shown else None
         if "display" in dirty:

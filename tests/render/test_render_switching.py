@@ -112,7 +112,13 @@ def test_the_studio_warm_up_compiles_the_raster_kernels_its_draws_use():
     from app.ui.kernel_warmup import _raster_step
 
     _raster_step()
-    kernels = (soft_raster._setup_kernel, soft_raster._changed_vertices, soft_raster._changed_ends)
+    kernels = (
+        soft_raster._setup_kernel,
+        soft_raster._changed_vertices,
+        soft_raster._changed_ends,
+        soft_raster._changed_in_runs,
+        soft_raster._setup_listed,
+    )
     before = [set(k.signatures) for k in kernels]
     g = samples.scalp(strands=30, vertices=6, seed=1)
     points = g.points.copy()
@@ -133,4 +139,8 @@ def test_the_studio_warm_up_compiles_the_raster_kernels_its_draws_use():
                 rgba, rasterize(view, starts, colours, mvp, (64, 48), 2.0, scale=scale)[0]
             )
             points[3] += np.float32(0.01)
+        rgba, _ = raster.draw(view, starts, colours, mvp, (64, 48), 2.0, scale=scale, changed=[[3, 4]])
+        np.testing.assert_array_equal(
+            rgba, rasterize(view, starts, colours, mvp, (64, 48), 2.0, scale=scale)[0]
+        )
     assert [set(k.signatures) for k in kernels] == before
