@@ -116,14 +116,29 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def _end_with_parent() -> None:
+    """In the Xvfb child (Linux): SIGTERM when the benchmark's process ends. Qt tears its
+    QApplication and the view's native GL window down only as the interpreter exits; a display
+    ended before that broke their X connection (an abort in GLX after the table was printed)."""
+    import ctypes
+    import signal
+
+    ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+
+
+_ENDS_WITH_US = sys.platform.startswith("linux")
+
+
 def _ensure_display() -> subprocess.Popen | None:
-    """Start ``Xvfb -displayfd`` when no display is set (headless machines, CI)."""
+    """Start ``Xvfb -displayfd`` when no display is set (headless machines, CI); on Linux it
+    ends with this process, elsewhere the caller ends it (:func:`_end_display`)."""
     if os.environ.get("DISPLAY") or shutil.which("Xvfb") is None:
         return None
     read_fd, write_fd = os.pipe()
     proc = subprocess.Popen(
         ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
         pass_fds=(write_fd,),
+        preexec_fn=_end_with_parent if _ENDS_WITH_US else None,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
@@ -131,6 +146,13 @@ def _ensure_display() -> subprocess.Popen | None:
     with os.fdopen(read_fd) as f:
         os.environ["DISPLAY"] = f":{f.readline().strip()}"
     return proc
+
+
+def _end_display(xvfb: subprocess.Popen | None) -> None:
+    """Where the display does not end with this process by itself, end it now."""
+    if xvfb is not None and not _ENDS_WITH_US:
+        xvfb.terminate()
+        xvfb.wait(timeout=10)
 
 
 def _grooms(args: argparse.Namespace) -> list[tuple[str, object]]:
@@ -258,9 +280,7 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     lines = _line_method(v.renderer)
     brush = window.scene.brush + (" x2" if window.scene.tool.symmetry else "")
     window.ask_save_changes = lambda: "discard"  # the benchmark's strokes are not work to keep
-    window.close()
-    window.deleteLater()
-    app.processEvents()
+    close_window(app, window)
     row = {
         "groom": name,
         "brush": brush,
@@ -295,6 +315,18 @@ def _time_groom(app, name: str, groom, args: argparse.Namespace, settings) -> di
     return row
 
 
+def close_window(app, window) -> None:
+    """Close ``window`` and delete it now, on this thread: a ``deleteLater`` outside a running
+    event loop waited for the interpreter's exit, where the view's native GL window was torn down
+    after its display connection (a segfault after the table was printed)."""
+    from PySide6.QtCore import QEvent
+
+    window.close()
+    window.deleteLater()
+    app.sendPostedEvents(None, QEvent.Type.DeferredDelete)
+    app.processEvents()
+
+
 def in_studio_app(measure):
     """``measure(app, settings)`` with a QApplication on a display (Xvfb started when there is
     none) and throw-away studio settings, so a benchmark never touches the user's."""
@@ -311,9 +343,7 @@ def in_studio_app(measure):
             settings = QSettings(os.path.join(tmp, "bench.ini"), QSettings.Format.IniFormat)
             return measure(app, settings)
     finally:
-        if xvfb is not None:
-            xvfb.terminate()
-            xvfb.wait(timeout=10)
+        _end_display(xvfb)
 
 
 def run(args: argparse.Namespace) -> list[dict]:
@@ -391,9 +421,7 @@ def cold_start(timeout: float) -> list[dict]:
                 pass
             proc.wait(timeout=30)
     finally:
-        if xvfb is not None:
-            xvfb.terminate()
-            xvfb.wait(timeout=10)
+        _end_display(xvfb)
     rows: list[dict] = [{"moment": "host speed", "label": "", "wall_s": None, "cpu_s": None,
                          "step_cpu_s": None, "speed": speed}]  # fmt: skip
     latest: dict[int, float] = {}  # CPU seconds of each process (studio, warm-ups) so far

@@ -94,7 +94,7 @@ def _measure_sintel(app, args: argparse.Namespace, settings) -> list[dict]:
 
     from PySide6.QtCore import Qt, QTimer
 
-    from app.bench import PRELOAD_WAIT_S
+    from app.bench import PRELOAD_WAIT_S, close_window
     from app.ui.qt_utils import send_mouse
     from app.ui.window import MainWindow
     from hairtool.simulate.sway import sway_animation
@@ -170,9 +170,7 @@ def _measure_sintel(app, args: argparse.Namespace, settings) -> list[dict]:
         }
     ]  # fmt: skip
     if args.no_gif:
-        window.close()
-        window.deleteLater()
-        app.processEvents()
+        close_window(app, window)
         return rows
     paints = len(drawn)
     with tempfile.TemporaryDirectory() as tmp:
@@ -184,9 +182,7 @@ def _measure_sintel(app, args: argparse.Namespace, settings) -> list[dict]:
         {"what": "GIF at viewport size", "animation": label, "s": seconds, "state": job.state,
          "size": "x".join(str(c) for c in window.viewport_pixel_size()), "view_paints": len(drawn) - paints}
     )  # fmt: skip
-    window.close()
-    window.deleteLater()
-    app.processEvents()
+    close_window(app, window)
     return rows
 
 
@@ -221,6 +217,7 @@ def _stall(app, window, m) -> dict:
 def _measure(app, args: argparse.Namespace, settings) -> list[dict]:
     from PySide6.QtCore import Qt
 
+    from app.bench import close_window
     from app.ui.qt_utils import send_mouse
     from app.ui.window import MainWindow
     from hairtool import samples
@@ -307,9 +304,7 @@ def _measure(app, args: argparse.Namespace, settings) -> list[dict]:
                 "draw_ms": statistics.median(draw),
             }
         )
-    window.close()
-    window.deleteLater()
-    app.processEvents()
+    close_window(app, window)
     return rows
 
 
