@@ -41,7 +41,6 @@ import numpy as np
 from numba import njit, prange
 from numpy.typing import ArrayLike
 
-from hairtool import serial_twins
 from hairtool.errors import ParameterError
 from hairtool.frozen.lengths import restore_lengths, restore_lengths_reference
 from hairtool.frozen.neighbour_update import moved_vertices, update_list
@@ -569,9 +568,6 @@ class ClumpWorkspace:
         radius = h * (1.0 + MARGIN)
         b = self._built
         if b is not None and b[0] is top and b[1] == radius:
-            small = groom.vertex_count < serial_twins.CLUMP_PARALLEL_FROM_VERTICES
-            if small and np.array_equal(groom.points, b[2]):  # NaN: unequal, as it counts as moved
-                return self.neighbours  # (a run on the serial twins: no parallel check to wake threads)
             moved = moved_vertices(groom.points, b[2])  # against a copy: any array may be passed in
             if moved.size == 0:
                 return self.neighbours
