@@ -40,14 +40,6 @@ SERIAL_SUFFIX = "_serial"
 #: 7,296 vertices 28 ms against 304; 192,000: 166 against 338; 720,000: 755 against 918;
 #: 2,400,000: 3,055 against 2,229), and they compile in half the time.
 PARALLEL_FROM_VERTICES = 1_000_000
-#: Vertices from which one ClumpWithGaps run (its neighbour list and iterations) takes the
-#: parallel kernels while the library runs parallel (:func:`for_run`). Below it a run is a few
-#: milliseconds of work in about twenty kernel launches, and waking the second thread for each
-#: costs more than it saves. On the 2-core VM at load 5-9, cold: Sintel (7,296 vertices) 65-115
-#: ms serially against 520-570 in parallel, the ponytail pieces 46-74 against 390-660, ratboy
-#: (71,232) 310-330 against 400-470; the bear (192,452) 390-920 against 670-840, either way.
-CLUMP_PARALLEL_FROM_VERTICES = 100_000
-_every_size = False  # for_run keeps the parallel kernels at any size (within runs_parallel)
 
 
 class _Twin:
@@ -149,27 +141,6 @@ def for_size(vertices: int, packages: tuple[str, ...]) -> Iterator[bool]:
         yield False
     finally:
         use_parallel(True)
-
-
-def for_run(kernel: Dispatcher, vertices: int) -> Dispatcher:
-    """``kernel`` (a twinned kernel, as its module names it) for one run over ``vertices``
-    vertices: its serial twin below :data:`CLUMP_PARALLEL_FROM_VERTICES` or while the library
-    runs serial, the kernel as named otherwise (the same bytes either way)."""
-    if not _parallel or (vertices < CLUMP_PARALLEL_FROM_VERTICES and not _every_size):
-        return serial(kernel)
-    return kernel
-
-
-@contextlib.contextmanager
-def runs_parallel() -> Iterator[None]:
-    """Within the block, :func:`for_run` keeps the parallel kernels at any size (the studio's
-    warm-up compiles them on its small groom, for the large ones)."""
-    global _every_size
-    _every_size = True
-    try:
-        yield
-    finally:
-        _every_size = False
 
 
 def _read_by_jitted_code() -> set[int]:

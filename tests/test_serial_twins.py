@@ -45,9 +45,8 @@ def _drag(groom):
     return pipe.result.points.copy(), pipe.clump_redone
 
 
-def test_the_engine_on_the_serial_twins_gives_the_parallel_engines_bytes(monkeypatch):
+def test_the_engine_on_the_serial_twins_gives_the_parallel_engines_bytes():
     groom = samples.scalp(strands=300, vertices=10, seed=4)
-    monkeypatch.setattr(serial_twins, "CLUMP_PARALLEL_FROM_VERTICES", 0)  # clump's parallel kernels too
     parallel, _ = _drag(groom)
     _modules()
     serial_twins.use_parallel(False)
@@ -58,22 +57,6 @@ def test_the_engine_on_the_serial_twins_gives_the_parallel_engines_bytes(monkeyp
         serial_twins.use_parallel(True)
     assert redone == 1.0  # the last move ran in full
     assert serial.tobytes() == parallel.tobytes()
-
-
-def test_a_clump_run_takes_the_serial_twins_on_a_small_groom_or_in_serial_mode(monkeypatch):
-    from hairtool.frozen import spatial
-
-    kernel = spatial._forward_kernel
-    limit = serial_twins.CLUMP_PARALLEL_FROM_VERTICES
-    assert serial_twins.for_run(kernel, limit - 1) is serial_twins.serial(kernel)
-    assert serial_twins.for_run(kernel, limit) is kernel
-    with serial_twins.runs_parallel():
-        assert serial_twins.for_run(kernel, 1) is kernel
-    assert serial_twins.for_run(kernel, 1) is serial_twins.serial(kernel)
-    monkeypatch.setattr(serial_twins, "_parallel", False)
-    assert serial_twins.for_run(kernel, limit) is serial_twins.serial(kernel)
-    with serial_twins.runs_parallel():
-        assert serial_twins.for_run(kernel, limit) is serial_twins.serial(kernel)
 
 
 def test_render_hair_on_the_serial_twins_gives_the_same_bytes(serial_mode):

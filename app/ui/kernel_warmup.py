@@ -412,12 +412,8 @@ def _serially(step: Callable[[], None]) -> Callable[[], None]:
 
 
 def _parallel_engine_step() -> None:
-    from hairtool import serial_twins
-
     _head_step()
-    with serial_twins.runs_parallel():  # the clump kernels a groom of any size runs
-        _engine_step()
-    _engine_step()  # and the serial twins a small groom's runs take (serial_twins.for_run)
+    _engine_step()
 
 
 #: (label, step) in the order a single process runs them: the engine for the first groom, the

@@ -18,10 +18,7 @@ are the candidates for all k iterations; each iteration uses those of them that 
 within h. (A pair farther apart than 1.1·h at the start never interacts in that update.)
 :func:`clump` runs numba kernels on a cell-sorted list of them, built when the points change
 (an update on the points of the last one, e.g. a clump-only parameter change or a cursor held
-still, reuses it); a groom under :data:`hairtool.serial_twins.CLUMP_PARALLEL_FROM_VERTICES`
-vertices builds and runs on the kernels' serial twins (the same bytes: there the parallel
-kernels' thread wake-ups cost more than their work). :func:`clump_reference` is the plain numpy
-twin of the same definition.
+still, reuses it). :func:`clump_reference` is the plain numpy twin of the same definition.
 While a brush drags, :mod:`hairtool.frozen.local` redoes a run only on the strands near the brush.
 
 ``keep_lengths``: after the k iterations every segment is set back to its length before
@@ -55,7 +52,7 @@ from hairtool.frozen.noise import (
 )
 from hairtool.frozen.spatial import NeighbourList, pairs_within_reference
 from hairtool.groom import Groom
-from hairtool.serial_twins import for_run, twin_njit
+from hairtool.serial_twins import twin_njit
 
 GAP_MODES = ("printed", "text", "off")
 _GAP_CODE = {"printed": 0, "text": 1, "off": 2}
@@ -680,7 +677,7 @@ def clump_points(
     rec = None
     if ws.record and v * k <= RECORD_LIMIT:
         rec = last if last is not None and last.fits(v, k) else ClumpRecord(v, k)
-    ws.mean_neighbours, ws.step = for_run(_clump_run, v)(
+    ws.mean_neighbours, ws.step = _clump_run(
         groom.points, sv, nl.order, lists, nl.skip, h, k, -1.0 if step is None else float(step),
         _GAP_CODE[gap_mode], seed_u64(seed), ws.buffers(v), out,
         _NO_RECORD if rec is None else (rec.iterates, rec.forces, rec.best, rec.count, rec.weight),

@@ -25,7 +25,7 @@ from hairtool import budget
 from hairtool.bounds import box
 from hairtool.errors import GroomError, ParameterError
 from hairtool.kernel_arrays import readonly
-from hairtool.serial_twins import for_run, twin_njit
+from hairtool.serial_twins import twin_njit
 
 _BITS = 21  # bits per cell coordinate in a packed 64-bit cell key
 _MAXC = (1 << _BITS) - 2
@@ -532,13 +532,11 @@ class NeighbourList:
         # x quantised to 1/64 of a cell (at most 2**16 steps): the sweep allows for that slack.
         nq = int(min(1 << 16, max(64 * dims[0], 1)))
         width = max(float(hi[0] - lo[0]), 1e-300)
-        for_run(_row_sort, points.shape[0])(
+        _row_sort(
             points, lo, 1.0 / self.radius, dims[1], dims[2], nq / width, nq, self.keys, self._qx, start,
             self.order, self._tmp,
         )  # fmt: skip
-        for_run(_gather, points.shape[0])(
-            self.order, points, strand, skip, self.x, self.y, self.z, self.strand, self.skip
-        )
+        _gather(self.order, points, strand, skip, self.x, self.y, self.z, self.strand, self.skip)
         self.slack = width / nq
         self.nq, self.inv_q = nq, nq / width
         self.dims = dims
@@ -560,7 +558,7 @@ class NeighbourList:
             if self.aflat.size < total:
                 self.aflat = np.empty(int(total * 1.25), np.int32)
             used = np.empty(room.size, np.int64)
-            for_run(_forward_kernel, v)(
+            _forward_kernel(
                 self.x, self.y, self.z, self.strand, start, dims[1], dims[2], cell, r2, self.slack,
                 chunks, base, base + room - 1, self.aflat, self.acnt, used,
             )  # fmt: skip
@@ -578,7 +576,7 @@ class NeighbourList:
         if self.bflat.size < backward:  # so the transpose always has its room, in one pass
             self.bflat = np.empty(int(backward * 1.25) + 16, np.int32)
             self.bmap = np.empty(self.bflat.size, np.int64)
-        for_run(_transpose, v)(
+        _transpose(
             chunks, start, self.dims[1], base, self.aflat, self.acnt, self.bstart, self.bflat, self.bmap
         )
 
