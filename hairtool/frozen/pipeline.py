@@ -324,7 +324,18 @@ class FrozenPipeline:
 
     def selection_after(self, sample: SelectionSample) -> tuple[np.ndarray, np.ndarray]:
         """``(selected, hidden)`` the selection step ``sample`` would leave, by the rule a
-        replay applies (nothing changed here: the studio asks first whether it changes anything)."""
+        replay applies (nothing changed here: the studio asks first whether it changes anything).
+
+        Parameters
+        ----------
+        sample : SelectionSample
+            The step: a box, an inversion, a hide or reveal, with its view and front-faces flag.
+
+        Returns
+        -------
+        tuple of ndarray
+            ``(S,)`` bool each: the strands selected and the strands hidden after the step.
+        """
         return selection_after(self._setting(), self._aligned, self._state, sample)
 
     @property
