@@ -412,6 +412,19 @@ def draw_bands(seg, box, nearest, bounds, half, clear, background, rgba, depth, 
     return hidden.sum()
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _sync_vertex(a, b, c, d, i):
+    """Whether vertex ``i``'s position ``a`` or colour ``c`` differs from the last (``b``, ``d``;
+    all viewed as uint32: bit for bit), the last brought up to date where it does."""
+    differ = False
+    for k in range(3):
+        differ |= (a[i, k] != b[i, k]) | (c[i, k] != d[i, k])
+    if differ:
+        for k in range(3):
+            b[i, k], d[i, k] = a[i, k], c[i, k]
+    return differ
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def _changed_vertices(points, colors, last_points, last_colors, flags):
     """Flag the vertices whose position or colour differs from the last, bit for bit, and
@@ -419,13 +432,7 @@ def _changed_vertices(points, colors, last_points, last_colors, flags):
     a, b = points.view(np.uint32), last_points.view(np.uint32)
     c, d = colors.view(np.uint32), last_colors.view(np.uint32)
     for i in prange(points.shape[0]):
-        differ = False
-        for k in range(3):
-            differ |= (a[i, k] != b[i, k]) | (c[i, k] != d[i, k])
-        flags[i] = differ
-        if differ:
-            for k in range(3):
-                b[i, k], d[i, k] = a[i, k], c[i, k]
+        flags[i] = _sync_vertex(a, b, c, d, i)
 
 
 @njit(cache=True, nogil=True)
@@ -441,13 +448,7 @@ def _changed_in_runs(points, colors, last_points, last_colors, starts, runs, seg
     for r in range(runs.shape[0]):
         a, b = runs[r, 0], runs[r, 1]
         for v in range(a, b):
-            differ = False
-            for k in range(3):
-                differ |= (a32[v, k] != b32[v, k]) | (c32[v, k] != d32[v, k])
-            flags[v] = differ
-            if differ:
-                for k in range(3):
-                    b32[v, k], d32[v, k] = a32[v, k], c32[v, k]
+            flags[v] = _sync_vertex(a32, b32, c32, d32, v)
         for i in range(seg_runs[r, 0], seg_runs[r, 1]):
             s = starts[i]
             changed = (s >= a and flags[s]) or (s + 1 < b and flags[s + 1])
