@@ -78,6 +78,7 @@ def _parser_section(parser: argparse.ArgumentParser, level: int) -> list[str]:
                 continue
             invocation = _formatter(parser)._format_action_invocation(action)
             text = _formatter(parser)._expand_help(action) if action.help else ""
+            text = text.replace(str(ROOT) + "/", "")  # before escaping: a checkout's path may hold "_"
             rows.append(f"`{invocation}`\n:   {_escape(' '.join(text.split()))}\n")
         if rows:
             out.append(f"{'#' * (level + 1)} {group.title[0].upper()}{group.title[1:]}\n")

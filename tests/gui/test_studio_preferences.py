@@ -114,7 +114,11 @@ def test_the_dialog_stores_and_applies_what_it_says(make_window, monkeypatch):
 
 def test_the_cache_folder_is_used_from_the_next_start_unless_the_environment_names_one(scratch, monkeypatch):
     s = scratch()
-    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    # set, then removed: monkeypatch then restores the worker's own value (or none) afterwards,
+    # where a bare delenv of an absent name records nothing and the folder chosen below would
+    # stay in the environment for every later compile in this process
+    monkeypatch.setenv("NUMBA_CACHE_DIR", "")
+    monkeypatch.delenv("NUMBA_CACHE_DIR")
     assert use_preferred_cache_folder(s) is None
     s.setValue(KEY, "/somewhere/kernels")
     assert use_preferred_cache_folder(s) == "/somewhere/kernels"
