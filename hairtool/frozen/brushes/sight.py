@@ -151,20 +151,21 @@ def _side(x, low, cell, i, n, tol):  # pragma: no cover - compiled
     return 0
 
 
-@njit(cache=True, nogil=True)
-def _beside(
-    o, d, t, ci, skip, frame, vertices, faces, lo, cell, dims, start, items, tmin, far
-):  # pragma: no cover
-    """Whether the ray meets a face of the cells that share its point at ``t`` with cell ``ci``
-    (within ``SIDE`` of a cell of a side, edge or corner: rounding in the walk or the binning
-    cannot lose a face there), other than across axis ``skip`` (where the walk itself goes).
-    Away from the sides there is nothing to try."""
-    tol = SIDE * cell
+@njit(cache=True, nogil=True, inline="always")
+def _sides(o, d, t, ci, skip, lo, cell, dims, tol):  # pragma: no cover - compiled
+    """Per axis (:func:`_side`), where the ray's point at ``t`` lies on cell ``ci``'s sides; 0
+    across ``skip`` (the axis the walk itself crosses there)."""
     s0 = 0 if skip == 0 else _side(o[0] + t * d[0], lo[0] + ci[0] * cell, cell, ci[0], dims[0], tol)
     s1 = 0 if skip == 1 else _side(o[1] + t * d[1], lo[1] + ci[1] * cell, cell, ci[1], dims[1], tol)
     s2 = 0 if skip == 2 else _side(o[2] + t * d[2], lo[2] + ci[2] * cell, cell, ci[2], dims[2], tol)
-    if s0 == 0 and s1 == 0 and s2 == 0:
-        return False
+    return s0, s1, s2
+
+
+@njit(cache=True, nogil=True)
+def _beside(s0, s1, s2, ci, frame, o, vertices, faces, dims, start, items, tmin, far):  # pragma: no cover
+    """Whether the ray meets a face of the cells beyond cell ``ci`` across the sides ``s0, s1,
+    s2`` (:func:`_sides`) that its point lies on, edges and corners included: rounding in the
+    walk or in the binning cannot lose a face there."""
     kx, ky, kz, sx, sy, sz = frame
     for m0 in range(2 if s0 else 1):
         for m1 in range(2 if s1 else 1):
@@ -180,10 +181,10 @@ def _beside(
 @njit(cache=True, nogil=True)
 def _blocked(o, d, vertices, faces, lo, cell, dims, start, items, tmin, far):  # pragma: no cover
     """Whether the ray from ``o`` along the unit ``d`` meets a face between ``tmin`` and ``far``
-    (the eye, or inf): the cells it crosses
-    inside the grid's box, in order (Amanatides and Woo), each face tried where it is met, and
-    where the ray passes a cell's side, edge or corner the cells beyond it too
-    (:func:`_beside`)."""
+    (the eye, or inf): the cells it crosses inside the grid's box, in order (Amanatides and
+    Woo), each face tried where it is met, and where the ray passes within ``SIDE`` of a cell
+    of a side, edge or corner, the cells beyond it too (:func:`_beside`: around the cell it
+    leaves and the one it enters, which share the point's other sides)."""
     t0, t1 = 0.0, np.inf
     for a in range(3):
         hi = lo[a] + dims[a] * cell
@@ -200,6 +201,7 @@ def _blocked(o, d, vertices, faces, lo, cell, dims, start, items, tmin, far):  #
         return False
     frame = ray_frame(d)
     kx, ky, kz, sx, sy, sz = frame
+    tol = SIDE * cell
     ci = np.empty(3, np.int64)
     step = np.empty(3, np.int64)
     tmax = np.empty(3, np.float64)
@@ -215,13 +217,14 @@ def _blocked(o, d, vertices, faces, lo, cell, dims, start, items, tmin, far):  #
             tmax[a] = (lo[a] + ci[a] * cell - o[a]) / d[a]
         else:
             step[a], tdelta[a], tmax[a] = 0, np.inf, np.inf
-    t, came = t0, -1
+    s0, s1, s2 = _sides(o, d, t0, ci, -1, lo, cell, dims, tol)  # where the walk starts
     while True:
         c = (ci[0] * dims[1] + ci[1]) * dims[2] + ci[2]
         for n in range(start[c], start[c + 1]):
             if _meets(o, kx, ky, kz, sx, sy, sz, vertices, faces, items[n], tmin, far):
                 return True
-        if _beside(o, d, t, ci, came, frame, vertices, faces, lo, cell, dims, start, items, tmin, far):
+        near = s0 != 0 or s1 != 0 or s2 != 0  # the point the walk entered by
+        if near and _beside(s0, s1, s2, ci, frame, o, vertices, faces, dims, start, items, tmin, far):
             return True
         a = 0
         if tmax[1] < tmax[a]:
@@ -229,17 +232,15 @@ def _blocked(o, d, vertices, faces, lo, cell, dims, start, items, tmin, far):  #
         if tmax[2] < tmax[a]:
             a = 2
         leaves = tmax[a] > t1
-        t = t1 if leaves else tmax[a]
-        if _beside(
-            o, d, t, ci, -1 if leaves else a, frame, vertices, faces, lo, cell, dims, start, items, tmin, far
-        ):
+        s0, s1, s2 = _sides(o, d, t1 if leaves else tmax[a], ci, -1 if leaves else a, lo, cell, dims, tol)
+        near = s0 != 0 or s1 != 0 or s2 != 0  # the point it leaves by (the next cell's entry)
+        if near and _beside(s0, s1, s2, ci, frame, o, vertices, faces, dims, start, items, tmin, far):
             return True
         if leaves:
             return False
         ci[a] += step[a]
         if ci[a] < 0 or ci[a] >= dims[a]:
             return False
-        came = a
         tmax[a] += tdelta[a]
 
 
