@@ -82,6 +82,7 @@ def check_selection(sample: SelectionSample) -> SelectionSample:
     if sample.op != "box":
         return sample
     check_flag("visible", sample.visible)
+    check_flag("to_eye", sample.to_eye)
     if sample.mode not in BOX_MODES:
         raise ParameterError("mode", sample.mode, " or ".join(BOX_MODES))
     m = np.asarray(sample.matrix if sample.matrix is not None else (), dtype=np.float64)

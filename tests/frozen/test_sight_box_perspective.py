@@ -10,13 +10,15 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from hairtool.errors import ParameterError
 from hairtool.frozen.brushes.sight import hidden_points
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 from hairtool.frozen.sample_columns import read_columns, write_columns
-from hairtool.frozen.selection import SelectionSample, in_box, matrix_eye
+from hairtool.frozen.selection import SelectionSample, check_selection, in_box, matrix_eye
 from hairtool.frozen.strokes import stroke_from_dict, strokes_from_log
 
 from .test_sight import HEAD, INNER, MARGIN, hair, views
@@ -122,6 +124,10 @@ def test_a_log_and_a_project_name_to_eye_only_where_a_box_says_it():
     written = [s.to_dict() for s in strokes_from_log([old, new])]
     assert "to_eye" not in written[0] and written[1]["to_eye"] is True
     assert [stroke_from_dict(json.loads(json.dumps(d))).sample for d in written] == [old, new]
+    with pytest.raises(ParameterError, match="to_eye"):
+        stroke_from_dict({**written[1], "to_eye": "yes"})
+    with pytest.raises(ParameterError, match="to_eye"):
+        check_selection(new._replace(to_eye=1))
     for log, stored in (([old], False), ([old, new], True)):
         arrays: dict[str, np.ndarray] = {}
         info = write_columns(log, arrays)
