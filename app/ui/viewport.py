@@ -538,7 +538,12 @@ class Viewport(QWidget):
         vp = cam.view_matrix().astype(np.float64) @ cam.projection_matrix(w / h).astype(np.float64)
         rect = (2.0 * a.x() / w - 1.0, 1.0 - 2.0 * a.y() / h, 2.0 * b.x() / w - 1.0, 1.0 - 2.0 * b.y() / h)
         view = tuple(float(v) for v in cam.forward()) if self.scene.tool.front_only else None
-        return SELECTION.make(op="box", matrix=tuple(vp.T.ravel().tolist()), rect=rect, mode=mode, view=view)
+        # by sight under perspective, each point's ray goes to the eye (a wide box's corners
+        # are seen along their own lines of sight)
+        to_eye = view is not None and not cam.ortho
+        return SELECTION.make(
+            op="box", matrix=tuple(vp.T.ravel().tolist()), rect=rect, mode=mode, view=view, to_eye=to_eye
+        )
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
         if self.sizing.active and self.sizing.key_press(event):

@@ -12,7 +12,9 @@ sample takes Blender's, so older projects, which meant the root rule, read as th
 ``new_selection`` (a select sample that starts a new selection: stored only where one does, so
 older projects, whose select strokes added, read as they did), ``visible`` (front faces only by
 sight: stored only where a sample judges so, so older projects, which judged by the root normal,
-read as they did) and
+read as they did), ``to_eye`` (a box judged by sight along each point's own line to a
+perspective camera's eye: stored only where a box does, so older projects, whose boxes traced
+every ray along the view, read as they did) and
 ``selection`` (a step's op, and a box's matrix, rectangle
 and mode in ``box``). Choices are stored as indices into a list: the align modes in ``modes``,
 the brushes in ``brushes``, the steps in ``selection``.
@@ -65,10 +67,11 @@ COLUMNS = (
     Column("visible", "visible", np.int64, 0, 0),
     Column("selection", "selection", np.int64, 0, -1),
     Column("box", "selection", np.float64, BOX_WIDTH, (0.0,) * BOX_WIDTH),
+    Column("to_eye", "to_eye", np.int64, 0, 0),
 )
 GROUPS = (
     "brushes", "views", "collide", "plants", "starts", "only_selected", "pressure", "any_segment",
-    "new_selection", "visible", "selection",
+    "new_selection", "visible", "selection", "to_eye",
 )  # fmt: skip
 
 

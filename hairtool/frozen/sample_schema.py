@@ -154,6 +154,7 @@ SELECTION = SampleType("selection", SelectionSample, "op", (
     Field("rect", "rect", None, "rect", "step", "box", used_by=("box",)),
     Field("view", "view", None, "view", "step", "view", used_by=("box",)),
     Field("visible", "flag", False, "visible", "step", "visible", used_by=("box",), quiet=True),
+    Field("to_eye", "flag", False, "to_eye", "step", "to_eye", used_by=("box",), quiet=True),
 ))  # fmt: skip
 
 TYPES = (ALIGN, BRUSH, SELECTION)

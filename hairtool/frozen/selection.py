@@ -21,7 +21,10 @@ samples, so undo, projects and a replayed log see the same selection at every st
   ``visible`` and a head mesh, those with a vertex inside the rectangle that the head does not
   hide from the camera (:mod:`~hairtool.frozen.brushes.sight`, the studio's rule), else those
   whose root normal faces it (the rule of every log written before ``visible``, so its
-  default, and the rule without a head mesh).
+  default, and the rule without a head mesh). By sight, the rays go against ``view`` (one
+  direction for the whole box, as a camera without perspective sees), or with ``to_eye`` from
+  each vertex to the eye of ``matrix`` (:func:`matrix_eye`): a perspective camera sees a wide
+  box's corners along their own lines of sight, not the view's centre line.
 - ``hide_selected``: the selected strands hidden (and deselected, as Blender hides);
   ``hide_unselected``: the unselected shown strands hidden; ``reveal``: every hidden strand
   shown again, selected.
@@ -49,7 +52,8 @@ BOX_MODES = ("set", "add", "subtract")
 class SelectionSample(NamedTuple):
     """One selection step (module docstring); ``matrix`` (16 floats), ``rect`` and ``mode``
     only for ``box``; ``view`` and ``visible`` as a brush sample's (None: every strand; with
-    ``visible`` front faces only by sight, else by root normal)."""
+    ``visible`` front faces only by sight, else by root normal); ``to_eye``: by sight, each
+    ray goes to the eye of a perspective ``matrix`` (else along ``view``, as before it)."""
 
     op: str
     matrix: tuple[float, ...] | None = None
@@ -57,6 +61,7 @@ class SelectionSample(NamedTuple):
     mode: str = "set"
     view: tuple[float, float, float] | None = None
     visible: bool = False
+    to_eye: bool = False
 
 
 def check_selection(sample: SelectionSample) -> SelectionSample:
@@ -77,6 +82,7 @@ def check_selection(sample: SelectionSample) -> SelectionSample:
     if sample.op != "box":
         return sample
     check_flag("visible", sample.visible)
+    check_flag("to_eye", sample.to_eye)
     if sample.mode not in BOX_MODES:
         raise ParameterError("mode", sample.mode, " or ".join(BOX_MODES))
     m = np.asarray(sample.matrix if sample.matrix is not None else (), dtype=np.float64)
@@ -88,10 +94,37 @@ def check_selection(sample: SelectionSample) -> SelectionSample:
     return sample
 
 
-def in_box(groom: Groom, matrix, rect, view=None, grid: FaceGrid | None = None) -> np.ndarray:
+def matrix_eye(matrix) -> np.ndarray | None:
+    """``(3,)`` the eye of a perspective camera's world-to-clip ``matrix`` (16 numbers,
+    row-major): the point its x, y and w rows all send to 0. None for a camera without
+    perspective (w does not depend on the point: its eye is at infinity) or a degenerate one.
+    Plain 3 × 3 determinants (Cramer's rule), the same bits on every machine."""
+    m = np.asarray(matrix, np.float64).reshape(4, 4)[[0, 1, 3]]
+    if not m[2, :3].any():
+        return None
+    a, b = m[:, :3], -m[:, 3]
+
+    def det(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> float:
+        return float(
+            c0[0] * (c1[1] * c2[2] - c1[2] * c2[1])
+            - c1[0] * (c0[1] * c2[2] - c0[2] * c2[1])
+            + c2[0] * (c0[1] * c1[2] - c0[2] * c1[1])
+        )
+
+    d = det(a[:, 0], a[:, 1], a[:, 2])
+    if d == 0.0 or not np.isfinite(d):
+        return None
+    eye = np.array([det(b, a[:, 1], a[:, 2]), det(a[:, 0], b, a[:, 2]), det(a[:, 0], a[:, 1], b)]) / d
+    return eye if np.all(np.isfinite(eye)) else None
+
+
+def in_box(
+    groom: Groom, matrix, rect, view=None, grid: FaceGrid | None = None, to_eye: bool = False
+) -> np.ndarray:
     """``(S,)`` the strands with a vertex in front of the camera whose projection lies inside
     ``rect`` (either corner order); with ``view`` and ``grid``, a vertex there the head does not
-    hide from a camera looking along ``view`` (only the vertices inside are traced).
+    hide from a camera looking along ``view``, or with ``to_eye`` from the eye of a perspective
+    ``matrix`` (only the vertices inside are traced).
 
     Parameters
     ----------
@@ -105,6 +138,9 @@ def in_box(groom: Groom, matrix, rect, view=None, grid: FaceGrid | None = None) 
         ``(3,)`` the camera's viewing direction (with ``grid``: front faces only by sight).
     grid : FaceGrid, optional
         The head's faces.
+    to_eye : bool, default False
+        By sight, each ray goes from its vertex to the eye of ``matrix`` where it has one
+        (perspective; :func:`matrix_eye`), else against ``view``.
 
     Returns
     -------
@@ -123,7 +159,8 @@ def in_box(groom: Groom, matrix, rect, view=None, grid: FaceGrid | None = None) 
     inside = ok & (x >= min(x0, x1)) & (x <= max(x0, x1)) & (y >= min(y0, y1)) & (y <= max(y0, y1))
     if view is not None and grid is not None:
         at = np.flatnonzero(inside)
-        inside[at[hidden_points(p[at], view, grid)]] = False
+        eye = matrix_eye(m) if to_eye else None
+        inside[at[hidden_points(p[at], view, grid, eye)]] = False
     if groom.strand_count == 0:
         return np.zeros(0, bool)
     return np.maximum.reduceat(inside, groom.offsets[:-1]).astype(bool)
@@ -170,7 +207,7 @@ def apply_selection(
         sel = ~sel & ~hid
     elif op == "box":
         if sample.visible and sample.view is not None and grid is not None:
-            touched = in_box(groom, sample.matrix, sample.rect, sample.view, grid) & ~hid
+            touched = in_box(groom, sample.matrix, sample.rect, sample.view, grid, sample.to_eye) & ~hid
             away = None
         else:
             touched = in_box(groom, sample.matrix, sample.rect) & ~hid

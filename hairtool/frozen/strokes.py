@@ -69,6 +69,9 @@ object with a ``selection`` field instead of ``brush``::
   ``visible`` (optional, default false, written only where true) as a stroke's: with a head
   mesh, only the strands with a point inside the rectangle that the head does not hide from
   the camera; false or missing (older logs): those whose root normal faces the camera.
+  ``to_eye`` (optional, default false, written only where true): by sight, each point's ray
+  goes to the eye of ``matrix`` (a perspective camera's; the studio writes it there) instead
+  of along ``view`` (every log before it).
 
 Fields a reader does not know are ignored and missing optional ones take their defaults, so
 logs written by older and newer versions stay readable.

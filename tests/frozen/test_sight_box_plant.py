@@ -23,10 +23,6 @@ from .test_sight import HEAD, LUT, hair, truth, views
 PLAIN = FrozenParams(freeze=False, clump=False)
 SCALE = 0.5  # the box camera's clip units per groom unit
 FACING = 0.3  # a root on the ball this far (cosine) to either side of the silhouette is decided
-#: added to a drawn camera direction: hypothesis favours round numbers, and a ray from a root on
-#: a mesh vertex through another vertex exactly (view (1, -1, 0) on the ball) grazes every face
-#: there, which the sight kernel may miss to the last bit
-TILT = np.array([0.0123, 0.0071, -0.0093])
 
 
 def _unit(v) -> np.ndarray:
@@ -93,7 +89,7 @@ def test_a_box_without_visible_keeps_the_root_normal_rule_and_a_log_names_it_onl
 @given(seed=st.integers(0, 2**16), view=views, at=views, radius=st.floats(0.2, 1.5),
        count=st.integers(1, 20))  # fmt: skip
 def test_add_plants_every_drawn_root_in_sight_and_none_the_head_hides(seed, view, at, radius, count):
-    groom, view = hair(seed, 30), tuple((_unit(view) + TILT).tolist())
+    groom, view = hair(seed, 30), tuple(_unit(view).tolist())
     cursor = tuple((1.05 * _unit(at)).tolist())
     dab = BrushSample(
         "add", cursor, (0.0, 0.0, 0.0), radius, 1.0, LUT, view, count=count, seed=seed, visible=True
@@ -112,7 +108,7 @@ def test_add_plants_every_drawn_root_in_sight_and_none_the_head_hides(seed, view
 @given(seed=st.integers(0, 2**16), view=views, at=views, radius=st.floats(0.3, 1.0),
        spacing=st.floats(0.1, 0.3))  # fmt: skip
 def test_density_plants_in_sight_only_and_leaves_no_gap_there(seed, view, at, radius, spacing):
-    groom, view = hair(seed, 30), tuple((_unit(view) + TILT).tolist())
+    groom, view = hair(seed, 30), tuple(_unit(view).tolist())
     cursor = tuple((1.05 * _unit(at)).tolist())
     dab = BrushSample(
         "density", cursor, (0.0, 0.0, 0.0), radius, 1.0, LUT, view, spacing=spacing, seed=seed, visible=True

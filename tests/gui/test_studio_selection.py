@@ -91,7 +91,8 @@ def test_ctrl_box_deselects_and_escape_cancels(ui, make_window):
 
 def test_a_box_with_front_faces_only_judges_by_sight(ui, make_window, monkeypatch):
     """The studio's box says ``visible`` where Front faces only gives it a camera, as its
-    brushes do (the step itself: hairtool's tests/frozen/test_sight_box_plant.py)."""
+    brushes do, and ``to_eye`` in the 3-D (perspective) view only (the step itself: hairtool's
+    tests/frozen/test_sight_box_plant.py and test_sight_box_perspective.py)."""
     w = flat(make_window)
     s, v = w.scene, w.viewport
     x = columns(w)
@@ -103,7 +104,16 @@ def test_a_box_with_front_faces_only_judges_by_sight(ui, make_window, monkeypatc
         s.set_front_only(front)
         w.selection.actions["box"].trigger()
         ui.drag(v, a, b, steps=3)
-    assert [(t.view is not None, t.visible) for t in steps] == [(True, True), (False, False)]
+    persp = not v.camera.ortho
+    assert [(t.view is not None, t.visible, t.to_eye) for t in steps] == [
+        (True, True, persp),
+        (False, False, False),
+    ]
+    s.set_front_only(True)
+    v.set_ortho(persp)  # the other camera
+    w.selection.actions["box"].trigger()
+    ui.drag(v, a, b, steps=3)
+    assert len(steps) == 3 and steps[-1].visible and steps[-1].to_eye is not persp
 
 
 def test_paint_select_and_brush_only_the_selection(ui, make_window):
