@@ -61,6 +61,7 @@ MOSTLY_CHANGED = 0.25  # … or at once when more than this share of the segment
 MAX_UNSEARCHED = 3
 HIDDEN_SHIFT = 2  # a band's farthest depth is kept per cell of 2**2 = 4 pixels a side (8: 3-9 % slower)
 REFRESH_EVERY = 4096  # drawn segments between updates of the cells' farthest depths (1,024: slower)
+TILE_REFRESH_EVERY = 64  # the same in a redrawn tile (replayed bear comb frames: 16-128 alike, 4 slower)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -567,23 +568,91 @@ def _bin_segments(box, dirty, shift, counts, entries, near):
     return total
 
 
+@njit(cache=True, nogil=True)
+def _refresh_tile(bits, r0, r1, c0, c1, farthest, stale):
+    """``farthest``: the largest depth in each ``stale`` cell (2**HIDDEN_SHIFT pixels a side) of
+    the tile at rows [r0, r1), columns [c0, c1) of the depth image's int32 view ``bits``, compared
+    as integers (see :func:`_refresh_farthest`)."""
+    w = bits.shape[1]
+    cell = 1 << HIDDEN_SHIFT
+    flat = bits.reshape(-1)
+    for ty in range(farthest.shape[0]):
+        ra, rb = r0 + (ty << HIDDEN_SHIFT), min(r0 + ((ty + 1) << HIDDEN_SHIFT), r1)
+        for tx in range(farthest.shape[1]):
+            if not stale[ty, tx]:
+                continue
+            stale[ty, tx] = False
+            ca = c0 + (tx << HIDDEN_SHIFT)
+            m = np.int32(0)
+            if rb - ra == cell and ca + cell <= c1:
+                base = np.uint64(ra * w + ca)
+                for r in range(cell):
+                    for c in range(cell):
+                        m = max(m, flat[base + np.uint64(r * w + c)])
+            else:
+                for r in range(ra, rb):
+                    for c in range(ca, min(ca + cell, c1)):
+                        m = max(m, bits[r, c])
+            farthest[ty, tx] = m
+
+
 @njit(cache=True, nogil=True, parallel=True)
-def _draw_tiles(seg, jobs, job_start, counts, entries, shift, half, background, rgba, depth):
+def _draw_tiles(
+    seg, jobs, job_start, counts, entries, shift, half, background, rgba, depth, box, nearest, refresh_every
+):
     """Each job's tiles (row-major tile indices ``jobs[job_start[j]:job_start[j + 1]]``):
-    cleared, then their segments (``entries`` of the CSR ``counts``) in index order."""
+    cleared, then their segments (``entries`` of the CSR ``counts``) in index order. Returns how
+    many (segment, tile) entries were skipped as hidden.
+
+    As :func:`draw_bands` does per band, a tile keeps the farthest depth of each of its cells
+    (2**HIDDEN_SHIFT pixels a side; all 1.0 once cleared), brought up to date every
+    ``refresh_every`` drawn segments for the cells they touched: a segment whose nearer end
+    (``nearest``) lies beyond the farthest depth of every cell of the tile its box touches would
+    fail the depth test at each of its pixels there, and is skipped (the bytes are the same)."""
     h, w = depth.shape
     tile = 1 << shift
     tiles_x = (w + tile - 1) >> shift
+    cells = max(tile >> HIDDEN_SHIFT, 1)
     flat_rgba, flat_depth = rgba.reshape(-1), depth.reshape(-1)
+    bits = depth.view(np.int32)
+    hidden = np.zeros(max(job_start.size - 1, 0), np.int64)
     for j in prange(job_start.size - 1):
+        farthest = np.empty((cells, cells), np.int32)
+        far_of = farthest.view(np.float32)
+        stale = np.zeros((cells, cells), np.bool_)
+        skipped = 0
         for n in range(job_start[j], job_start[j + 1]):
             k = jobs[n]
             r0, c0 = (k // tiles_x) * tile, (k % tiles_x) * tile
             r1, c1 = min(r0 + tile, h), min(c0 + tile, w)
             rgba[r0:r1, c0:c1] = background
             depth[r0:r1, c0:c1] = 1.0
+            far_of[:] = 1.0
+            stale[:] = False
+            drawn = 0
             for e in range(counts[k], counts[k + 1]):
-                _segment(seg, entries[e], half, r0, r1, c0, c1, flat_rgba, flat_depth, w)
+                i = entries[e]
+                ty0 = (max(box[0, i], r0) - r0) >> HIDDEN_SHIFT
+                ty1 = (min(box[1, i], r1 - 1) - r0) >> HIDDEN_SHIFT
+                tx0 = (max(box[2, i], c0) - c0) >> HIDDEN_SHIFT
+                tx1 = (min(box[3, i], c1 - 1) - c0) >> HIDDEN_SHIFT
+                far = np.float32(0.0)
+                for ty in range(ty0, ty1 + 1):
+                    for tx in range(tx0, tx1 + 1):
+                        far = max(far, far_of[ty, tx])
+                if nearest[i] >= far:
+                    skipped += 1
+                    continue
+                _segment(seg, i, half, r0, r1, c0, c1, flat_rgba, flat_depth, w)
+                for ty in range(ty0, ty1 + 1):
+                    for tx in range(tx0, tx1 + 1):
+                        stale[ty, tx] = True
+                drawn += 1
+                if drawn == refresh_every:
+                    _refresh_tile(bits, r0, r1, c0, c1, farthest, stale)
+                    drawn = 0
+        hidden[j] = skipped
+    return hidden.sum()
 
 
 def _balanced_jobs(work: NDArray[np.int64], n: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
@@ -670,6 +739,7 @@ class StrandRaster:
         self._next_unsearched = 0
         self.changed: tuple[int, int, int, int] | None = None  # (row0, row1, col0, col1) or None
         self.tiles_redrawn = 0  # in the last draw; −1: all of the image
+        self.tiles_hidden = 0  # (segment, tile) entries of the last tile redraw skipped as hidden
         self.draws = 0  # calls of draw so far
 
     def _view(self, name: str, shape: tuple[int, ...], dtype: type) -> np.ndarray:
@@ -863,7 +933,7 @@ class StrandRaster:
         work = np.diff(self._counts)
         work[dirty.reshape(-1)] += 1  # a dirty tile without segments is still cleared
         jobs, job_start = _balanced_jobs(work, numba.get_num_threads())
-        _draw_tiles(
+        self.tiles_hidden = _draw_tiles(
             self._seg,
             jobs,
             job_start,
@@ -874,6 +944,9 @@ class StrandRaster:
             fill,
             self._rgba32,
             depth,
+            self._box,
+            self._nearest,
+            TILE_REFRESH_EVERY,
         )
         rows, cols = np.flatnonzero(dirty.any(axis=1)), np.flatnonzero(dirty.any(axis=0))
         if rows.size == 0:  # the changed segments are off the image, before and after

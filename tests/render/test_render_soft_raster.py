@@ -164,6 +164,52 @@ def test_hidden_segments_are_skipped_without_changing_a_byte(width):
         assert hidden[1] > len(one) // 2
 
 
+@pytest.mark.parametrize("width", [1.0, 9.0])
+def test_hidden_segments_are_skipped_in_redrawn_tiles_without_changing_a_byte(width):
+    # The same dense groom drawn thrice over, every tile of the image redrawn (tiles of 16 px,
+    # the edge ones cut short): each tile keeps its cells' farthest depths as a band does, and
+    # the segments it skips as hidden change nothing, whether its depths are brought up to date
+    # after every drawn segment, every 7 or never.
+    from hairtool import samples
+
+    g = samples.scalp(strands=400, vertices=12, seed=5)
+    size = (90, 70)
+    cam = Camera.for_groom(g, aspect=size[0] / size[1])
+    mvp = np.ascontiguousarray(cam.view_matrix() @ cam.projection_matrix(size[0] / size[1]), np.float64)
+    points = np.concatenate([g.points] * 3).astype(np.float32)
+    colors = np.random.default_rng(3).random((len(points), 3)).astype(np.float32)
+    one = g.topology.segment_end - 1
+    starts = np.concatenate([one + c * g.vertex_count for c in range(3)]).astype(np.int64)
+    ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, size, width)
+    e, (w, h) = len(starts), size
+    seg, box, nearest = _tables(e)
+    soft_raster._setup_kernel(
+        points, starts, colors, mvp, w, h, np.zeros(0), seg, box, nearest,
+        np.zeros(0, bool), width, np.zeros(0)
+    )
+    half = 0.0 if width <= 1.0 else width / 2
+    dirty = np.ones(((h + 15) // 16, (w + 15) // 16), bool)
+    counts, near = np.zeros(dirty.size + 1, np.int64), np.zeros(e, np.int64)
+    total = soft_raster._bin_segments(box, dirty, 4, counts, np.zeros(0, np.int64), near)
+    entries = np.zeros(total, np.int64)
+    soft_raster._bin_segments(box, dirty, 4, counts, entries, near)
+    hidden = {}
+    for refresh in (1, 7, 10**9):
+        for jobs in (1, 3):
+            tiles, job_start = soft_raster._balanced_jobs(np.diff(counts) + 1, jobs)
+            rgba, depth = np.full((h, w), 5, np.uint32), np.zeros((h, w), np.float32)  # all overwritten
+            hidden[refresh] = soft_raster._draw_tiles(
+                seg, tiles, job_start, counts, entries, 4, half, np.uint32(0), rgba, depth,
+                box, nearest, refresh,
+            )  # fmt: skip
+            np.testing.assert_array_equal(rgba.view(np.uint8).reshape(ref_rgba.shape), ref_rgba)
+            np.testing.assert_array_equal(depth, ref_depth)
+    assert hidden[10**9] == 0  # never brought up to date: the cleared depth hides nothing
+    assert hidden[1] >= hidden[7] > 0
+    if width > 1.0:  # quads cover the scalp: most copies are skipped
+        assert hidden[1] > counts[-1] // 3
+
+
 @pytest.mark.parametrize("width", [2.5, 8.0])
 def test_tapered_quads_split_into_bands_give_the_bytes_of_the_numpy_definition(width):
     # Each box is widened by its own quad's reach: narrow tips get narrow boxes, which must
@@ -270,7 +316,7 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
         entries = np.zeros(total, np.int64)
         soft_raster._bin_segments(box, dirty, 4, counts, entries, near)
         jobs, job_start = soft_raster._balanced_jobs(np.diff(counts) + 1, 3)
-        tiles(seg, jobs, job_start, counts, entries, 4, 1.5, np.uint32(7), *images[4:])
+        tiles(seg, jobs, job_start, counts, entries, 4, 1.5, np.uint32(7), *images[4:], box, nearest, 2)
         out.append((seg, box, cover(box[0], box[1], h, np.linspace(1.0, 3.0, e)), *images))
     for compiled, python in zip(*out, strict=True):
         np.testing.assert_array_equal(compiled, python)
