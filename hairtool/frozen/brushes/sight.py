@@ -92,7 +92,8 @@ def _product_error(a, b):  # pragma: no cover - compiled
 def _edge(ax, ay, bx, by):  # pragma: no cover - compiled
     """ax·by − ay·bx with its exact sign: rounding keeps the order of two products, so a
     nonzero float difference has the right sign, and where it is exactly 0 (the rounded
-    products equal) the sign comes from their rounding errors. Swapping the two points negates
+    products equal) the sign comes from their rounding errors (exact wherever neither product
+    underflows: a head's coordinates are far from 1e-150). Swapping the two points negates
     it exactly, so two faces sharing an edge always judge the ray on opposite sides of it or
     both on it."""
     e = ax * by - ay * bx
