@@ -250,22 +250,31 @@ def _more_engine_step() -> None:
     pipe.align((lo.astype(np.float64) + hi) * 0.5, float(np.max(hi - lo)), 0.5, "preserve-length")
 
 
-def _raster_step() -> None:
+def _raster_step() -> list[int]:
+    """Draw, redraw the changed tiles, and redraw told what moved: the tiles it redrew each
+    time (a tile redraw needs few changed tiles: short strands on an image of many tiles)."""
     from app.render.soft_raster import StrandRaster
 
     rng = np.random.default_rng(0)
-    points = rng.uniform(-0.5, 0.5, (40, 3)).astype(np.float32)
-    starts = np.arange(0, 39, dtype=np.int64)
-    colors = rng.uniform(0.0, 1.0, (40, 3)).astype(np.float32)
+    strands, per = 24, 4
+    roots = rng.uniform(-0.8, 0.8, (strands, 3))
+    rise = np.linspace(0.0, 0.06, per)[None, :, None] * np.array([0.0, 1.0, 0.0])
+    points = (roots[:, None, :] + rise).reshape(-1, 3).astype(np.float32)
+    starts = (np.arange(strands)[:, None] * per + np.arange(per - 1)).reshape(-1).astype(np.int64)
+    colors = rng.uniform(0.0, 1.0, (points.shape[0], 3)).astype(np.float32)
     mvp = np.eye(4)
+    redrawn = []
     for width in (2.0, 1.0):
         raster = StrandRaster()
-        raster.draw(points, starts, colors, mvp, (64, 48), width)
+        raster.draw(points, starts, colors, mvp, (256, 192), width)
         moved = points.copy()
-        moved[3] += 0.01
-        raster.draw(moved, starts, colors, mvp, (64, 48), width)  # the tiles-only redraw
-        moved[4] += 0.01
-        raster.draw(moved, starts, colors, mvp, (64, 48), width, changed=[[4, 5]])  # told what moved
+        moved[1] += 0.01
+        raster.draw(moved, starts, colors, mvp, (256, 192), width)  # the tiles-only redraw
+        redrawn.append(raster.tiles_redrawn)
+        moved[per + 1] += 0.01
+        raster.draw(moved, starts, colors, mvp, (256, 192), width, changed=[[per, 2 * per]])  # told
+        redrawn.append(raster.tiles_redrawn)
+    return redrawn
 
 
 def _brushes_step() -> None:

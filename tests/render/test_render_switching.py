@@ -111,13 +111,17 @@ def test_the_studio_warm_up_compiles_the_raster_kernels_its_draws_use():
     from app.render import soft_raster
     from app.ui.kernel_warmup import _raster_step
 
-    _raster_step()
+    # its redraws go through the tiles, plain and told what moved (or nothing warms those)
+    assert all(n > 0 for n in _raster_step())
     kernels = (
         soft_raster._setup_kernel,
         soft_raster._changed_vertices,
         soft_raster._changed_ends,
         soft_raster._changed_in_runs,
         soft_raster._setup_listed,
+        soft_raster._mark_tiles,
+        soft_raster._bin_segments,
+        soft_raster._draw_tiles,
     )
     before = [set(k.signatures) for k in kernels]
     g = samples.scalp(strands=30, vertices=6, seed=1)
