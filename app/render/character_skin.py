@@ -20,6 +20,11 @@ from hairtool.character.model import Character, SkinnedMesh
 from hairtool.character.skinning import skin_matrices
 
 
+def _released(obj) -> bool:
+    """Whether a moderngl object was released (its handle replaced by an ``InvalidObject``)."""
+    return isinstance(getattr(obj, "mglo", None), moderngl.InvalidObject)
+
+
 @dataclass
 class _Skin:
     """One skinned mesh on the GPU: its buffers, its joint texture and its vertex arrays."""
@@ -121,8 +126,8 @@ class CharacterLayer:
             s.capture.transform(buffer, mode=moderngl.POINTS, vertices=v)
             out.append(np.frombuffer(buffer.read(), dtype="f4").reshape(v, 3).copy())
             buffer.release()
-        if before is not None and before is not self._tiny:
-            before.use()
+        if before is not None and before is not self._tiny and not _released(before):
+            before.use()  # (a framebuffer released while bound, e.g. on a resize, is left alone)
         return out
 
     def _free(self) -> None:

@@ -95,3 +95,14 @@ def test_a_click_on_a_chains_bones_selects_it():
         near = cam.project(lines[got][1:3], *size).mean(axis=0)
         assert got == c or np.linalg.norm(near - mid) < 1.0  # or a chain drawn over it there
     assert pick_chain(cam, size, lines, (-50.0, -50.0)) is None
+
+
+def test_a_capture_after_the_bound_framebuffer_was_released(gl_ctx, layer):
+    """Another drawing released the framebuffer it left bound (a resize does): the capture still
+    runs, and leaves its own bound."""
+    gone = gl_ctx.simple_framebuffer((4, 4))
+    gone.use()
+    gone.release()
+    layer.pose(CHARACTER.nodes.world())
+    for mesh, got in zip(CHARACTER.meshes, layer.captured(), strict=True):
+        np.testing.assert_allclose(got, mesh.positions, rtol=0, atol=4e-6)
