@@ -15,14 +15,10 @@ import moderngl
 import numpy as np
 from numpy.typing import NDArray
 
+from app.render.gl_objects import alive
 from app.render.shaders import load_program, stage_sources
 from hairtool.character.model import Character, SkinnedMesh
 from hairtool.character.skinning import skin_matrices
-
-
-def _released(obj) -> bool:
-    """Whether a moderngl object was released (its handle replaced by an ``InvalidObject``)."""
-    return isinstance(getattr(obj, "mglo", None), moderngl.InvalidObject)
 
 
 @dataclass
@@ -126,7 +122,7 @@ class CharacterLayer:
             s.capture.transform(buffer, mode=moderngl.POINTS, vertices=v)
             out.append(np.frombuffer(buffer.read(), dtype="f4").reshape(v, 3).copy())
             buffer.release()
-        if before is not None and before is not self._tiny and not _released(before):
+        if alive(before) and before is not self._tiny:
             before.use()  # (a framebuffer released while bound, e.g. on a resize, is left alone)
         return out
 

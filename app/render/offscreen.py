@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from app.render.camera import Camera
 from app.render.drawn import Drawn
+from app.render.gl_objects import alive
 from app.render.strands import DEFAULT_BACKGROUND, STRAND_RASTERS, StrandRenderer, default_strand_raster
 from hairtool.errors import FormatError, HairtoolError, ParameterError
 from hairtool.groom import Groom
@@ -68,11 +69,6 @@ def _check_size(size: tuple[int, int]) -> tuple[int, int]:
     return w, h
 
 
-def _alive(obj: Any) -> bool:
-    """False for None and for released moderngl objects (whose ``mglo`` is an InvalidObject)."""
-    return obj is not None and type(obj.mglo).__name__ != "InvalidObject"
-
-
 def _parking_framebuffer(ctx: moderngl.Context) -> moderngl.Framebuffer:
     """A 1×1 framebuffer kept bound between offscreen draws.
 
@@ -108,7 +104,7 @@ def read_rgba(
             target = resolved
         data = target.read(viewport=(0, 0, w, h), components=4, dtype="f1")
     finally:
-        if _alive(previous) and all(previous is not obj for obj in objects):
+        if alive(previous) and all(previous is not obj for obj in objects):
             previous.use()  # e.g. the Qt widget's framebuffer
         else:
             _parking_framebuffer(ctx).use()
