@@ -214,24 +214,78 @@ def vertex_force(P, aflat, a0, a1, bflat, b0, b1, px, py, pz, root, h, inv_h, st
     return fx, fy, fz, bj, c, wsum
 
 
+BLOCKS = 64  # runs of vertices of about equal work that the pair and force passes share out
+
+
+@njit(cache=True, nogil=True)
+def work_blocks(acnt, bstart, both, n, blocks):
+    """``blocks`` (n + 1,): bounds of n runs of consecutive vertices with about equal list
+    entries (forward ones, with ``both`` backward ones too; one more per vertex). A parallel
+    loop over vertices gives each thread an equal count of them, and the dense part of a groom
+    sits in one part of the cell order (ponytail_back's second half holds 65 % of its entries:
+    one thread did two thirds of the work); each thread's share of equal blocks is equal work."""
+    v = acnt.size
+    total = 0
+    for i in range(v):
+        total += acnt[i] + 1 + (bstart[i + 1] - bstart[i] if both else 0)
+    blocks[0] = 0
+    k = 1
+    run = 0
+    for i in range(v):
+        run += acnt[i] + 1 + (bstart[i + 1] - bstart[i] if both else 0)
+        while k < n and run * n >= total * k:
+            blocks[k] = i + 1
+            k += 1
+    while k <= n:
+        blocks[k] = v
+        k += 1
+
+
+def work_blocks_reference(acnt: np.ndarray, bstart: np.ndarray, both: bool, n: int) -> np.ndarray:
+    """Numpy twin of :func:`work_blocks`.
+
+    Parameters
+    ----------
+    acnt : ndarray
+        ``(V,)`` forward entries per vertex.
+    bstart : ndarray
+        ``(V + 1,)`` backward run starts.
+    both : bool
+        Count the backward entries too.
+    n : int
+        Blocks.
+
+    Returns
+    -------
+    ndarray
+        ``(n + 1,)`` int64 bounds.
+    """
+    w = acnt.astype(np.int64) + 1 + (np.diff(bstart) if both else 0)
+    run = np.cumsum(w)
+    first = np.searchsorted(run * n, run[-1] * np.arange(1, n), side="left") + 1
+    return np.concatenate([[0], first, [len(w)]]).astype(np.int64)
+
+
 @twin_njit(nogil=True, parallel=True)
-def _pair_kernel(P, aflat, aoff, acnt, inv_h, rs):
+def _pair_kernel(P, aflat, aoff, acnt, inv_h, blocks, rs):
     """Each pair's distance r and weight g/(r + ε) (14)–(15), once, from its forward entry: a
     pair's two vertices compute the same r (their differences are each other's negatives), so
     :func:`_half_force_kernel` reads it for both and sums what :func:`vertex_force` sums. Side
     by side in ``rs`` (n, 2): a backward entry reads its pair's at a place in no order, one cache
-    line for both (two arrays: two misses, and Sintel's half-force pass 1.23× slower)."""
-    for i in prange(P.shape[0]):
-        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
-        for n in range(aoff[i], aoff[i] + acnt[i]):
-            j = aflat[n]
-            ex = P[j, 0] - px
-            ey = P[j, 1] - py
-            ez = P[j, 2] - pz
-            r = np.sqrt(ex * ex + ey * ey + ez * ez)
-            t = max(1.0 - r * inv_h, 0.0)
-            rs[n, 0] = r
-            rs[n, 1] = t * t / (r + EPS)
+    line for both (two arrays: two misses, and Sintel's half-force pass 1.23× slower). Over
+    ``blocks`` of vertices of about equal work (:func:`work_blocks`)."""
+    for blk in prange(blocks.size - 1):
+        for i in range(blocks[blk], blocks[blk + 1]):
+            px, py, pz = P[i, 0], P[i, 1], P[i, 2]
+            for n in range(aoff[i], aoff[i] + acnt[i]):
+                j = aflat[n]
+                ex = P[j, 0] - px
+                ey = P[j, 1] - py
+                ez = P[j, 2] - pz
+                r = np.sqrt(ex * ex + ey * ey + ez * ez)
+                t = max(1.0 - r * inv_h, 0.0)
+                rs[n, 0] = r
+                rs[n, 1] = t * t / (r + EPS)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -260,30 +314,31 @@ def _lowest_stored(flat, a, b, emap, rs, br, sorig, bj, bo):
 
 @twin_njit(nogil=True, parallel=True)
 def _half_force_kernel(
-    P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, sorig, h, stats, rs, f, best, count, weight
+    P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, sorig, h, stats, blocks, rs, f, best, count, weight
 ):
     """f (15) of every vertex and its nearest neighbour within h (ties: the lower original
     index), as :func:`vertex_force` sums them, from the pair arrays of :func:`_pair_kernel`
     (the row grid's lists: forward runs, then backward runs whose pairs ``bmap`` finds among the
     forward entries), to the bit: half the square roots and divisions. With ``stats`` (the first
-    iteration) also how many are within h and Σg."""
+    iteration) also how many are within h and Σg. Over ``blocks`` of about equal work."""
     none = np.empty(0, np.int64)
-    for i in prange(P.shape[0]):
-        acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
-        a0, a1, b0, b1 = aoff[i], aoff[i] + acnt[i], bstart[i], bstart[i + 1]
-        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
-        if not sroot[i]:
-            acc = _sum_run(P, aflat, a0, a1, none, rs, px, py, pz, h, stats, acc)
-            acc = _sum_run(P, bflat, b0, b1, bmap, rs, px, py, pz, h, stats, acc)
-        fx, fy, fz, br, bj, tie, c, wsum = acc
-        if tie and bj >= 0:
-            bj, bo = _lowest_stored(aflat, a0, a1, none, rs, br, sorig, bj, sorig[bj])
-            bj, bo = _lowest_stored(bflat, b0, b1, bmap, rs, br, sorig, bj, bo)
-        f[i, 0], f[i, 1], f[i, 2] = fx, fy, fz
-        best[i] = bj
-        if stats:
-            count[i] = c
-            weight[i] = wsum
+    for blk in prange(blocks.size - 1):
+        for i in range(blocks[blk], blocks[blk + 1]):
+            acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
+            a0, a1, b0, b1 = aoff[i], aoff[i] + acnt[i], bstart[i], bstart[i + 1]
+            px, py, pz = P[i, 0], P[i, 1], P[i, 2]
+            if not sroot[i]:
+                acc = _sum_run(P, aflat, a0, a1, none, rs, px, py, pz, h, stats, acc)
+                acc = _sum_run(P, bflat, b0, b1, bmap, rs, px, py, pz, h, stats, acc)
+            fx, fy, fz, br, bj, tie, c, wsum = acc
+            if tie and bj >= 0:
+                bj, bo = _lowest_stored(aflat, a0, a1, none, rs, br, sorig, bj, sorig[bj])
+                bj, bo = _lowest_stored(bflat, b0, b1, bmap, rs, br, sorig, bj, bo)
+            f[i, 0], f[i, 1], f[i, 2] = fx, fy, fz
+            best[i] = bj
+            if stats:
+                count[i] = c
+                weight[i] = wsum
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -417,12 +472,17 @@ def _clump_run(points, strength, order, lists, sroot, h, iterations, step, gap, 
     mean_nb = 0.0
     k_step = step
     inv_h = 1.0 / h
+    nblk = max(1, min(BLOCKS, P.shape[0]))
+    pair_blocks = np.empty(nblk + 1, np.int64)
+    force_blocks = np.empty(nblk + 1, np.int64)
+    work_blocks(acnt, bstart, False, nblk, pair_blocks)
+    work_blocks(acnt, bstart, True, nblk, force_blocks)
     for it in range(iterations):
         if keep:
             _scatter(order, P, rec_p[it])
-        _pair_kernel(P, aflat, aoff, acnt, inv_h, rs)
+        _pair_kernel(P, aflat, aoff, acnt, inv_h, pair_blocks, rs)
         _half_force_kernel(
-            P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, order, h, it == 0, rs,
+            P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, order, h, it == 0, force_blocks, rs,
             f, best, count, weight,
         )  # fmt: skip
         if it == 0:
