@@ -214,37 +214,78 @@ def vertex_force(P, aflat, a0, a1, bflat, b0, b1, px, py, pz, root, h, inv_h, st
     return fx, fy, fz, bj, c, wsum
 
 
+BLOCKS = 64  # runs of vertices of about equal work that the pair and force passes share out
+
+
+@njit(cache=True, nogil=True)
+def work_blocks(acnt, bstart, both, n, blocks):
+    """``blocks`` (n + 1,): bounds of n runs of consecutive vertices with about equal list
+    entries (forward ones, with ``both`` backward ones too; one more per vertex). A parallel
+    loop over vertices gives each thread an equal count of them, and the dense part of a groom
+    sits in one part of the cell order (ponytail_back's second half holds 65 % of its entries:
+    one thread did two thirds of the work); each thread's share of equal blocks is equal work."""
+    v = acnt.size
+    total = 0
+    for i in range(v):
+        total += acnt[i] + 1 + (bstart[i + 1] - bstart[i] if both else 0)
+    blocks[0] = 0
+    k = 1
+    run = 0
+    for i in range(v):
+        run += acnt[i] + 1 + (bstart[i + 1] - bstart[i] if both else 0)
+        while k < n and run * n >= total * k:
+            blocks[k] = i + 1
+            k += 1
+    while k <= n:
+        blocks[k] = v
+        k += 1
+
+
+def work_blocks_reference(acnt: np.ndarray, bstart: np.ndarray, both: bool, n: int) -> np.ndarray:
+    """Numpy twin of :func:`work_blocks`.
+
+    Parameters
+    ----------
+    acnt : ndarray
+        ``(V,)`` forward entries per vertex.
+    bstart : ndarray
+        ``(V + 1,)`` backward run starts.
+    both : bool
+        Count the backward entries too.
+    n : int
+        Blocks.
+
+    Returns
+    -------
+    ndarray
+        ``(n + 1,)`` int64 bounds.
+    """
+    w = acnt.astype(np.int64) + 1 + (np.diff(bstart) if both else 0)
+    run = np.cumsum(w)
+    first = np.searchsorted(run * n, run[-1] * np.arange(1, n), side="left") + 1
+    return np.concatenate([[0], first, [len(w)]]).astype(np.int64)
+
+
 @twin_njit(nogil=True, parallel=True)
-def _pair_kernel(P, aflat, aoff, acnt, inv_h, rs):
+def _pair_kernel(P, aflat, aoff, acnt, inv_h, blocks, rs):
     """Each pair's distance r and weight g/(r + ε) (14)–(15), once, from its forward entry: a
     pair's two vertices compute the same r (their differences are each other's negatives), so
     :func:`_half_force_kernel` reads it for both and sums what :func:`vertex_force` sums. Side
     by side in ``rs`` (n, 2): a backward entry reads its pair's at a place in no order, one cache
-    line for both (two arrays: two misses, and Sintel's half-force pass 1.23× slower)."""
-    for i in prange(P.shape[0]):
-        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
-        for n in range(aoff[i], aoff[i] + acnt[i]):
-            j = aflat[n]
-            ex = P[j, 0] - px
-            ey = P[j, 1] - py
-            ez = P[j, 2] - pz
-            r = np.sqrt(ex * ex + ey * ey + ez * ez)
-            t = max(1.0 - r * inv_h, 0.0)
-            rs[n, 0] = r
-            rs[n, 1] = t * t / (r + EPS)
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _sum_run(P, flat, a, b, emap, rs, px, py, pz, h, stats, acc):
-    """:func:`vertex_force`'s sums with each entry's r and weight read from the pair arrays (entry n's at
-    ``emap[n]``, or at n itself where ``emap`` is empty): the same sums in the same order."""
-    same = emap.size == 0
-    inv_h = 1.0 / h
-    for n in range(a, b):
-        j = flat[n]
-        m = n if same else emap[n]
-        acc = _take(acc, j, rs[m, 0], rs[m, 1], P[j, 0] - px, P[j, 1] - py, P[j, 2] - pz, h, inv_h, stats)
-    return acc
+    line for both (two arrays: two misses, and Sintel's half-force pass 1.23× slower). Over
+    ``blocks`` of vertices of about equal work (:func:`work_blocks`)."""
+    for blk in prange(blocks.size - 1):
+        for i in range(blocks[blk], blocks[blk + 1]):
+            px, py, pz = P[i, 0], P[i, 1], P[i, 2]
+            for n in range(aoff[i], aoff[i] + acnt[i]):
+                j = aflat[n]
+                ex = P[j, 0] - px
+                ey = P[j, 1] - py
+                ez = P[j, 2] - pz
+                r = np.sqrt(ex * ex + ey * ey + ez * ez)
+                t = max(1.0 - r * inv_h, 0.0)
+                rs[n, 0] = r
+                rs[n, 1] = t * t / (r + EPS)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -260,30 +301,41 @@ def _lowest_stored(flat, a, b, emap, rs, br, sorig, bj, bo):
 
 @twin_njit(nogil=True, parallel=True)
 def _half_force_kernel(
-    P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, sorig, h, stats, rs, f, best, count, weight
+    P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, sorig, h, stats, blocks, rs, f, best, count, weight
 ):
     """f (15) of every vertex and its nearest neighbour within h (ties: the lower original
     index), as :func:`vertex_force` sums them, from the pair arrays of :func:`_pair_kernel`
     (the row grid's lists: forward runs, then backward runs whose pairs ``bmap`` finds among the
     forward entries), to the bit: half the square roots and divisions. With ``stats`` (the first
-    iteration) also how many are within h and Σg."""
+    iteration) also how many are within h and Σg. Over ``blocks`` of about equal work. The
+    runs are summed here, not by a helper that takes the arrays: in this loop nest that helper
+    made ratboy's serial pass 1.6× slower (numba's reference counting of the arrays passed)."""
     none = np.empty(0, np.int64)
-    for i in prange(P.shape[0]):
-        acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
-        a0, a1, b0, b1 = aoff[i], aoff[i] + acnt[i], bstart[i], bstart[i + 1]
-        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
-        if not sroot[i]:
-            acc = _sum_run(P, aflat, a0, a1, none, rs, px, py, pz, h, stats, acc)
-            acc = _sum_run(P, bflat, b0, b1, bmap, rs, px, py, pz, h, stats, acc)
-        fx, fy, fz, br, bj, tie, c, wsum = acc
-        if tie and bj >= 0:
-            bj, bo = _lowest_stored(aflat, a0, a1, none, rs, br, sorig, bj, sorig[bj])
-            bj, bo = _lowest_stored(bflat, b0, b1, bmap, rs, br, sorig, bj, bo)
-        f[i, 0], f[i, 1], f[i, 2] = fx, fy, fz
-        best[i] = bj
-        if stats:
-            count[i] = c
-            weight[i] = wsum
+    inv_h = 1.0 / h
+    for blk in prange(blocks.size - 1):
+        for i in range(blocks[blk], blocks[blk + 1]):
+            acc = (0.0, 0.0, 0.0, h, np.int64(-1), False, np.int64(0), 0.0)
+            a0, a1, b0, b1 = aoff[i], aoff[i] + acnt[i], bstart[i], bstart[i + 1]
+            px, py, pz = P[i, 0], P[i, 1], P[i, 2]
+            if not sroot[i]:
+                for n in range(a0, a1):
+                    j = aflat[n]
+                    ex, ey, ez = P[j, 0] - px, P[j, 1] - py, P[j, 2] - pz
+                    acc = _take(acc, j, rs[n, 0], rs[n, 1], ex, ey, ez, h, inv_h, stats)
+                for n in range(b0, b1):
+                    j = bflat[n]
+                    m = bmap[n]
+                    ex, ey, ez = P[j, 0] - px, P[j, 1] - py, P[j, 2] - pz
+                    acc = _take(acc, j, rs[m, 0], rs[m, 1], ex, ey, ez, h, inv_h, stats)
+            fx, fy, fz, br, bj, tie, c, wsum = acc
+            if tie and bj >= 0:
+                bj, bo = _lowest_stored(aflat, a0, a1, none, rs, br, sorig, bj, sorig[bj])
+                bj, bo = _lowest_stored(bflat, b0, b1, bmap, rs, br, sorig, bj, bo)
+            f[i, 0], f[i, 1], f[i, 2] = fx, fy, fz
+            best[i] = bj
+            if stats:
+                count[i] = c
+                weight[i] = wsum
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -303,36 +355,59 @@ def gap_lambda(ex, ey, ez, gx, gy, gz, step, zeta, h, gap):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def moved_vertex(P, f, S, step, i, j, zeta, h, gap, Pout, o):
-    """Vertex i's next iterate into ``Pout[o]``: (16) scaled by its clump strength S[i], with
-    the gap correction (17)–(19) against its nearest neighbour j (−1: none) by the scaled steps
-    of both (S all ones: the printed arithmetic, bit for bit). S[i] = 0: not moved at all."""
-    si = S[i]
+def next_iterate(px, py, pz, fx, fy, fz, si, ex, ey, ez, gx, gy, gz, near, step, zeta, h, gap):
+    """A vertex's next iterate from its point p and force f: (16) scaled by its clump strength
+    si, with the gap correction (17)–(19) against its nearest neighbour (``near``; e its offset,
+    g the difference of the two scaled forces, that neighbour's minus its own; si all ones: the
+    printed arithmetic, bit for bit). si = 0: not moved at all. Scalars only: numba counts
+    references to each array passed to an inlined helper at every call, and a kernel that
+    called :func:`moved_vertex` per vertex spent most of its time there (the serial gap pass on
+    ratboy's 71,232 vertices: 4.5 ms, 1.0 with the arrays read in the kernel)."""
     if si == 0.0:
-        for a in range(3):
-            Pout[o, a] = P[i, a]
-        return
+        return px, py, pz
     lam = 1.0
-    if gap != 2 and j >= 0:
-        sj = S[j]
-        lam = gap_lambda(
-            P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2],
-            sj * f[j, 0] - si * f[i, 0], sj * f[j, 1] - si * f[i, 1], sj * f[j, 2] - si * f[i, 2],
-            step, zeta, h, gap,
-        )  # fmt: skip
+    if gap != 2 and near:
+        lam = gap_lambda(ex, ey, ez, gx, gy, gz, step, zeta, h, gap)
     lam *= si
-    for a in range(3):
-        Pout[o, a] = P[i, a] + lam * (step * f[i, a])  # (16), (19)
+    return px + lam * (step * fx), py + lam * (step * fy), pz + lam * (step * fz)  # (16), (19)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def moved_vertex(P, f, S, step, i, j, zeta, h, gap, Pout, o):
+    """Vertex i's next iterate into ``Pout[o]`` (:func:`next_iterate`) against its nearest
+    neighbour j (−1: none)."""
+    si = S[i]
+    near = gap != 2 and j >= 0 and si != 0.0
+    ex = ey = ez = gx = gy = gz = 0.0
+    if near:
+        sj = S[j]
+        ex, ey, ez = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
+        gx, gy, gz = sj * f[j, 0] - si * f[i, 0], sj * f[j, 1] - si * f[i, 1], sj * f[j, 2] - si * f[i, 2]
+    Pout[o, 0], Pout[o, 1], Pout[o, 2] = next_iterate(
+        P[i, 0], P[i, 1], P[i, 2], f[i, 0], f[i, 1], f[i, 2], si,
+        ex, ey, ez, gx, gy, gz, near, step, zeta, h, gap,
+    )  # fmt: skip
 
 
 @twin_njit(nogil=True, parallel=True)
 def _gap_kernel(P, f, S, step, best, heads, h, gap, it, Pout):
+    """Every vertex's next iterate (:func:`next_iterate`), its ζ hashed from its original index
+    and the iteration. The arrays are read here, not in an inlined helper (see there)."""
     for i in prange(P.shape[0]):
         j = best[i]
+        si = S[i]
+        near = gap != 2 and j >= 0 and si != 0.0
         zeta = 0.0
-        if gap != 2 and j >= 0:
+        ex = ey = ez = gx = gy = gz = 0.0
+        if near:
             zeta = hash_tail_u01_nb(heads[i], it)  # = hash_u01(seed, original index, it, CH_CLUMP)
-        moved_vertex(P, f, S, step, i, j, zeta, h, gap, Pout, i)
+            sj = S[j]
+            ex, ey, ez = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
+            gx, gy, gz = sj * f[j, 0] - si * f[i, 0], sj * f[j, 1] - si * f[i, 1], sj * f[j, 2] - si * f[i, 2]
+        Pout[i, 0], Pout[i, 1], Pout[i, 2] = next_iterate(
+            P[i, 0], P[i, 1], P[i, 2], f[i, 0], f[i, 1], f[i, 2], si,
+            ex, ey, ez, gx, gy, gz, near, step, zeta, h, gap,
+        )  # fmt: skip
 
 
 @njit(cache=True, nogil=True)
@@ -394,12 +469,17 @@ def _clump_run(points, strength, order, lists, sroot, h, iterations, step, gap, 
     mean_nb = 0.0
     k_step = step
     inv_h = 1.0 / h
+    nblk = max(1, min(BLOCKS, P.shape[0]))
+    pair_blocks = np.empty(nblk + 1, np.int64)
+    force_blocks = np.empty(nblk + 1, np.int64)
+    work_blocks(acnt, bstart, False, nblk, pair_blocks)
+    work_blocks(acnt, bstart, True, nblk, force_blocks)
     for it in range(iterations):
         if keep:
             _scatter(order, P, rec_p[it])
-        _pair_kernel(P, aflat, aoff, acnt, inv_h, rs)
+        _pair_kernel(P, aflat, aoff, acnt, inv_h, pair_blocks, rs)
         _half_force_kernel(
-            P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, order, h, it == 0, rs,
+            P, aflat, aoff, acnt, bflat, bstart, bmap, sroot, order, h, it == 0, force_blocks, rs,
             f, best, count, weight,
         )  # fmt: skip
         if it == 0:
