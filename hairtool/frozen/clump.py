@@ -361,7 +361,7 @@ def next_iterate(px, py, pz, fx, fy, fz, si, ex, ey, ez, gx, gy, gz, near, step,
     g the difference of the two scaled forces, that neighbour's minus its own; si all ones: the
     printed arithmetic, bit for bit). si = 0: not moved at all. Scalars only: numba counts
     references to each array passed to an inlined helper at every call, and a kernel that
-    called :func:`moved_vertex` per vertex spent most of its time there (the serial gap pass on
+    called such a helper per vertex spent most of its time there (the serial gap pass on
     ratboy's 71,232 vertices: 4.5 ms, 1.0 with the arrays read in the kernel)."""
     if si == 0.0:
         return px, py, pz
@@ -370,23 +370,6 @@ def next_iterate(px, py, pz, fx, fy, fz, si, ex, ey, ez, gx, gy, gz, near, step,
         lam = gap_lambda(ex, ey, ez, gx, gy, gz, step, zeta, h, gap)
     lam *= si
     return px + lam * (step * fx), py + lam * (step * fy), pz + lam * (step * fz)  # (16), (19)
-
-
-@njit(cache=True, nogil=True, inline="always")
-def moved_vertex(P, f, S, step, i, j, zeta, h, gap, Pout, o):
-    """Vertex i's next iterate into ``Pout[o]`` (:func:`next_iterate`) against its nearest
-    neighbour j (−1: none)."""
-    si = S[i]
-    near = gap != 2 and j >= 0 and si != 0.0
-    ex = ey = ez = gx = gy = gz = 0.0
-    if near:
-        sj = S[j]
-        ex, ey, ez = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
-        gx, gy, gz = sj * f[j, 0] - si * f[i, 0], sj * f[j, 1] - si * f[i, 1], sj * f[j, 2] - si * f[i, 2]
-    Pout[o, 0], Pout[o, 1], Pout[o, 2] = next_iterate(
-        P[i, 0], P[i, 1], P[i, 2], f[i, 0], f[i, 1], f[i, 2], si,
-        ex, ey, ez, gx, gy, gz, near, step, zeta, h, gap,
-    )  # fmt: skip
 
 
 @twin_njit(nogil=True, parallel=True)

@@ -45,7 +45,7 @@ from hairtool.frozen.clump import (
     ClumpRecord,
     auto_step,
     gap_factors_reference,
-    moved_vertex,
+    next_iterate,
     vertex_force,
 )
 from hairtool.frozen.lengths import restore_lengths_reference
@@ -121,14 +121,26 @@ def _local_run(new, sv, flat, cap, cnt, vids, roots, h, ident, step, gap, seed, 
 
 @twin_njit(nogil=True, parallel=True)
 def _gap_rows(P, F, S, step, near, vids, h, gap, it, seed, out):
-    """The next iterate (or the float32 result) of each vertex ``vids[n]`` into ``out``."""
+    """The next iterate (or the float32 result) of each vertex ``vids[n]`` into ``out``, as the
+    full run's gap pass: its arrays read here and the scalar
+    :func:`~hairtool.frozen.clump.next_iterate` called (numba counted references to arrays
+    handed to an inlined helper at every vertex)."""
     for n in prange(vids.size):
         i = vids[n]
         j = near[n]
+        si = S[i]
+        close = gap != 2 and j >= 0 and si != 0.0
         zeta = 0.0
-        if gap != 2 and j >= 0:
+        ex = ey = ez = gx = gy = gz = 0.0
+        if close:
             zeta = hash_tail_u01_nb(hash_head_nb(seed, i, CH_CLUMP), it)
-        moved_vertex(P, F, S, step, i, j, zeta, h, gap, out, i)
+            sj = S[j]
+            ex, ey, ez = P[j, 0] - P[i, 0], P[j, 1] - P[i, 1], P[j, 2] - P[i, 2]
+            gx, gy, gz = sj * F[j, 0] - si * F[i, 0], sj * F[j, 1] - si * F[i, 1], sj * F[j, 2] - si * F[i, 2]
+        out[i, 0], out[i, 1], out[i, 2] = next_iterate(
+            P[i, 0], P[i, 1], P[i, 2], F[i, 0], F[i, 1], F[i, 2], si,
+            ex, ey, ez, gx, gy, gz, close, step, zeta, h, gap,
+        )  # fmt: skip
 
 
 def _same_frame(a: tuple, b: tuple) -> bool:
