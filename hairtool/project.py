@@ -327,21 +327,59 @@ def save(path: str | os.PathLike[str], project: Project, *, compress: bool = Fal
         The settings are not plain JSON, or the file cannot be written; the message names it.
     """
     manifest, arrays = manifest_and_arrays(project)
+    text = _manifest_text(path, manifest)
     try:
-        text = json.dumps(manifest, indent=1, allow_nan=False)
-    except (TypeError, ValueError) as e:
-        raise FormatError(path, f"the settings are not plain JSON: {e}") from None
-    method = zipfile.ZIP_DEFLATED if compress else zipfile.ZIP_STORED
-    try:
-        with atomic_open(path, "wb") as f, zipfile.ZipFile(f, "w", method, compresslevel=1) as zf:
-            zf.writestr(MANIFEST, text, compress_type=zipfile.ZIP_DEFLATED)
-            for name, array in arrays.items():
-                info = zipfile.ZipInfo(name, date_time=time.localtime()[:6])
-                info.compress_type = method
-                with zf.open(info, "w", force_zip64=array.nbytes > 2**31) as member:
-                    np.lib.format.write_array(member, np.ascontiguousarray(array), allow_pickle=False)
+        with atomic_open(path, "wb") as f:
+            _write_archive(f, text, arrays, compress)
     except OSError as e:
         raise FormatError(path, f"cannot write: {e}") from None
+
+
+def to_bytes(project: Project, *, compress: bool = False) -> bytes:
+    """The archive :func:`save` writes, in memory (a round trip through :func:`from_bytes` runs
+    the file's whole schema without the disk: the document's state-machine test checks every
+    step so).
+
+    Parameters
+    ----------
+    project
+        The document.
+    compress
+        Deflate the array members as well as the manifest.
+
+    Returns
+    -------
+    bytes
+        The ``.hairproj`` file's bytes.
+
+    Raises
+    ------
+    FormatError
+        The settings are not plain JSON.
+    """
+    manifest, arrays = manifest_and_arrays(project)
+    buffer = io.BytesIO()
+    _write_archive(buffer, _manifest_text("<memory>", manifest), arrays, compress)
+    return buffer.getvalue()
+
+
+def _manifest_text(path: str | os.PathLike[str], manifest: dict) -> str:
+    try:
+        return json.dumps(manifest, indent=1, allow_nan=False)
+    except (TypeError, ValueError) as e:
+        raise FormatError(path, f"the settings are not plain JSON: {e}") from None
+
+
+def _write_archive(f, text: str, arrays: dict[str, np.ndarray], compress: bool) -> None:
+    """The zip archive into the open binary file ``f``: the manifest, then each array."""
+    method = zipfile.ZIP_DEFLATED if compress else zipfile.ZIP_STORED
+    with zipfile.ZipFile(f, "w", method, compresslevel=1) as zf:
+        zf.writestr(MANIFEST, text, compress_type=zipfile.ZIP_DEFLATED)
+        for name, array in arrays.items():
+            info = zipfile.ZipInfo(name, date_time=time.localtime()[:6])
+            info.compress_type = method
+            with zf.open(info, "w", force_zip64=array.nbytes > 2**31) as member:
+                np.lib.format.write_array(member, np.ascontiguousarray(array), allow_pickle=False)
 
 
 # -- reading ---------------------------------------------------------------------------------
@@ -669,7 +707,30 @@ def load(path: str | os.PathLike[str]) -> Project:
     p = Path(path)
     if not p.is_file():
         raise FormatError(path, "no such file" if not p.exists() else "not a regular file")
-    data = user_text.read_bytes(path, "a hairtool project", max_bytes=None)
+    return from_bytes(user_text.read_bytes(path, "a hairtool project", max_bytes=None), path)
+
+
+def from_bytes(data: bytes, where: str | os.PathLike[str]) -> Project:
+    """:func:`load` of a file's bytes held in memory (from :func:`to_bytes`, or read elsewhere).
+
+    Parameters
+    ----------
+    data
+        The ``.hairproj`` file's bytes.
+    where
+        The file or place they come from, named in a refusal.
+
+    Returns
+    -------
+    Project
+        The document as it was saved; render hair is bound again from its definition.
+
+    Raises
+    ------
+    FormatError
+        The bytes are not a valid project (as :func:`load`); the message names ``where``.
+    """
+    path, p = where, Path(where)
     if not data:
         raise FormatError(path, "the file is empty")
     if not zipfile.is_zipfile(io.BytesIO(data)):

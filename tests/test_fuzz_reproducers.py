@@ -537,6 +537,7 @@ def test_planting_that_stroke_looks_at_a_bounded_share_of_the_roots():
         assert work < 0.05 * len(grown), (copies, work, len(grown))
 
 
+@pytest.mark.slow(seconds=7)
 def test_one_sample_of_that_add_stroke_is_refused_by_the_neighbour_budget(tmp_path):
     """999 strands planted at once on Sintel: clumping's neighbour search asks for 4.4e8 pairs
     and ``freeze`` refuses it in one line before allocating them. The same stroke planting one

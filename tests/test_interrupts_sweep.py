@@ -86,6 +86,7 @@ def _solo_seconds(script: Path, out: Path) -> float:
     return time.perf_counter() - t0
 
 
+@pytest.mark.slow(seconds=30)
 def test_ctrl_c_at_any_moment_of_a_usd_command_is_one_line_and_130(tmp_path):
     script = _script(tmp_path)
     (tmp_path / "solo").mkdir()

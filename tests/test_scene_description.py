@@ -329,6 +329,7 @@ def test_child_attribute_blend_matches_its_reference():
     assert b.build().colors is not None and b.build().thickness is None  # the guides had no widths
 
 
+@pytest.mark.slow(seconds=8)
 def test_a_batch_of_commands_keeps_the_scene_as_the_commands_do(scenes, tmp_path, capsys):
     pytest.importorskip("distributed", reason="the farm extra (dask[distributed]) is not installed")
     import json

@@ -3,15 +3,13 @@ BVH text, and keyed so that every edit of its key poses has its frame as a key."
 
 from __future__ import annotations
 
-import tempfile
 from collections.abc import Iterable
-from pathlib import Path
 
 import numpy as np
 
 from hairtool.errors import FormatError
 from hairtool.groom import Animation
-from hairtool.mocap.bvh import Motion, read_bvh, write_bvh
+from hairtool.mocap.bvh import Motion, bvh_from_bytes, bvh_text
 from hairtool.mocap.pose_edit import Edit, RetimeEdit
 
 
@@ -28,24 +26,15 @@ def skeleton_animation(motion: Motion) -> Animation:
 
 
 def motion_text(motion: Motion) -> str:
-    """The capture as BVH text (what a project keeps)."""
-    with tempfile.TemporaryDirectory() as d:
-        p = Path(d) / "capture.bvh"
-        write_bvh(p, motion)
-        return p.read_text(encoding="utf-8")
+    """The capture as BVH text (what a project keeps), as a BVH file of it holds it."""
+    return bvh_text(motion)
 
 
 def motion_from_text(text: str, source: str) -> Motion:
     """A capture from BVH text; :class:`FormatError` naming ``source`` when it does not read."""
     if not isinstance(text, str):
         raise FormatError(source, "the capture is not BVH text")
-    with tempfile.TemporaryDirectory() as d:
-        p = Path(d) / "capture.bvh"
-        p.write_text(text, encoding="utf-8")
-        try:
-            return read_bvh(p)
-        except FormatError as e:
-            raise FormatError(source, e.reason) from None
+    return bvh_from_bytes(text.encode("utf-8"), source)
 
 
 def edit_frames(edits: Iterable[Edit]) -> tuple[int, ...]:

@@ -18,6 +18,8 @@ without it read as Y-up centimetres.
 from __future__ import annotations
 
 import ast
+import functools
+import io
 import json
 import os
 import struct
@@ -161,7 +163,6 @@ def read_npy_header(path: str | os.PathLike[str], f, name: str) -> tuple[tuple[i
     tuple of (tuple of int, bool, numpy.dtype)
         Its shape, whether it is Fortran-ordered, and its dtype.
     """
-    start = f.tell()
     magic = f.read(8)
     if len(magic) < 8 or magic[:6] != b"\x93NUMPY":
         raise FormatError(path, f"member {name!r} is not a .npy array")
@@ -173,19 +174,34 @@ def read_npy_header(path: str | os.PathLike[str], f, name: str) -> tuple[tuple[i
     if len(size_bytes) < (2 if version == (1, 0) else 4) or header_len > _MAX_NPY_HEADER:
         raise FormatError(path, f"member {name!r} has a corrupt .npy header")
     try:
-        header = f.read(header_len).decode("utf-8" if version == (3, 0) else "latin-1")
-        ast.literal_eval(header)
-    except (SyntaxError, ValueError, UnicodeDecodeError, MemoryError, RecursionError):
+        shape, fortran, dtype = _parsed_header(magic + size_bytes + f.read(header_len))
+    except _CorruptHeader:
         raise FormatError(path, f"member {name!r} has a corrupt .npy header") from None
-    f.seek(start)
-    read_magic = np.lib.format.read_magic(f)
-    if read_magic == (1, 0):
-        shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
-    else:
-        shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
     if dtype.hasobject:
         raise FormatError(path, f"member {name!r} holds Python objects")
     return shape, fortran, dtype
+
+
+class _CorruptHeader(Exception):
+    """A header whose text is no Python literal (or not in its encoding)."""
+
+
+@functools.lru_cache(maxsize=256)
+def _parsed_header(head: bytes) -> tuple[tuple[int, ...], bool, np.dtype]:
+    """``(shape, fortran_order, dtype)`` of a whole ``.npy`` header (magic to its last byte),
+    parsed once per distinct header: a project's members and a state's saves repeat a few
+    headers many times, and each parse is two ``literal_eval`` (ours first, then numpy's).
+    Numpy's own errors pass through; a refused header is parsed again when met again."""
+    version = (head[6], head[7])
+    try:
+        text = head[10 if version == (1, 0) else 12 :].decode("utf-8" if version == (3, 0) else "latin-1")
+        ast.literal_eval(text)
+    except (SyntaxError, ValueError, UnicodeDecodeError, MemoryError, RecursionError):
+        raise _CorruptHeader from None
+    f = io.BytesIO(head)
+    if np.lib.format.read_magic(f) == (1, 0):
+        return np.lib.format.read_array_header_1_0(f)
+    return np.lib.format.read_array_header_2_0(f)
 
 
 def _member(path: Path, z, name: str) -> np.ndarray:

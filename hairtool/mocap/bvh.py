@@ -386,7 +386,31 @@ def read_bvh(path: str | os.PathLike[str]) -> Motion:
         The file is missing, malformed or truncated; the message names the file.
     """
     p = os.fspath(path)
-    raw = user_text.read_bytes(p, "a BVH file", max_bytes=None)
+    return bvh_from_bytes(user_text.read_bytes(p, "a BVH file", max_bytes=None), p)
+
+
+def bvh_from_bytes(raw: bytes, where: str) -> Motion:
+    """:func:`read_bvh` of a file's bytes held in memory (a project keeps its capture as BVH
+    text); a :class:`FormatError` names ``where``.
+
+    Parameters
+    ----------
+    raw
+        The BVH file's bytes (UTF-8, or Latin-1 where they are not UTF-8).
+    where
+        The file or place the bytes come from, named in a refusal.
+
+    Returns
+    -------
+    Motion
+        The skeleton and its channel values per frame, with the frame time.
+
+    Raises
+    ------
+    FormatError
+        The bytes are not a well-formed BVH file; the message names ``where``.
+    """
+    p = where
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
@@ -492,6 +516,24 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion) -> None:
     OSError
         The file cannot be written; an earlier file at ``path`` is left as it was.
     """
+    text = bvh_text(motion)
+    with atomic_open(path, "w", encoding="utf-8", newline="\n") as f:
+        f.write(text)
+
+
+def bvh_text(motion: Motion) -> str:
+    """The text :func:`write_bvh` writes (a project keeps its capture as this text).
+
+    Parameters
+    ----------
+    motion
+        The skeleton and its channel values.
+
+    Returns
+    -------
+    str
+        The BVH file's text, lines ended by ``\\n``.
+    """
     children: list[list[int]] = [[] for _ in range(motion.n_joints)]
     for j in range(1, motion.n_joints):
         children[motion.parents[j]].append(j)
@@ -526,5 +568,4 @@ def write_bvh(path: str | os.PathLike[str], motion: Motion) -> None:
 
     out += ["MOTION", f"Frames: {motion.n_frames}", f"Frame Time: {motion.frame_time:.7g}"]
     out += [" ".join(_fmt(v) for v in row) for row in motion.values]
-    with atomic_open(path, "w", encoding="utf-8", newline="\n") as f:
-        f.write("\n".join(out) + "\n")
+    return "\n".join(out) + "\n"

@@ -6,7 +6,8 @@ instead of killing pytest): ``python tests/gui/studio_walk.py OUT_DIR [--states 
 the states in the order given (a state named twice is walked twice, in the same process).
 It prints one JSON report as its last line: the problems it met (error dialogs, Python
 exceptions, Qt warnings, dialogs that refused their defaults, exported files that do not read
-back, disabled actions that do not say why), what it triggered and the files it read back.
+back, disabled actions that do not say why), what it triggered and the files it read back,
+and the wall and CPU seconds of each action and of building each state (how often).
 
 How it answers: ``QDialog.exec`` presses the dialog's own OK button (its checks run; a dialog
 still open afterwards refused its defaults); file dialogs return the state's own file (a copy in
@@ -62,7 +63,10 @@ class Walk:
         self.triggered: dict[str, list[list[str]]] = {}  # state: the actions of each walk
         self.disabled: dict[str, list[str]] = {}
         self.read_back: list[str] = []
-        self.timings: dict[str, float] = {}
+        self.timings: dict[str, float] = {}  # wall seconds of each action and of entering each state
+        self.cpu: dict[str, float] = {}  # … and the process's CPU seconds there (all its threads):
+        # where wall runs far past CPU, the walk waited (a helper process, another test worker)
+        self.entered: dict[str, int] = {}  # how often each state was built
         self._read_ok: set[str] = set()  # digests of the files that read back
         self.where = ("start", "")
         self.app = QApplication.instance()
@@ -225,12 +229,16 @@ class Walk:
         return (id(w.scene.rest), id(w.animation.animation), w.scene.binding is not None)
 
     def enter(self, state: str) -> None:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         try:
             self._enter(state)
         finally:
-            key = f"enter {state}"
-            self.timings[key] = round(self.timings.get(key, 0.0) + time.perf_counter() - t0, 2)
+            self._spent(f"enter {state}", t0, c0)
+            self.entered[state] = self.entered.get(state, 0) + 1
+
+    def _spent(self, key: str, t0: float, c0: float) -> None:
+        self.timings[key] = round(self.timings.get(key, 0.0) + time.perf_counter() - t0, 2)
+        self.cpu[key] = round(self.cpu.get(key, 0.0) + time.process_time() - c0, 2)
 
     def _enter(self, state: str) -> None:
         from app.ui.simulate_dialog import SOURCE
@@ -316,7 +324,7 @@ class Walk:
                     self.problem("disabled-silently", "greyed out without a tooltip saying why")
                 continue
             before = {p: p.stat().st_mtime_ns for p in self.exports.rglob("*") if p.is_file()}
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             action.trigger()
             self.settle()
             if action.isCheckable() and action.actionGroup() is None and action.isEnabled():
@@ -324,8 +332,7 @@ class Walk:
                 self.settle()
             self.check_exports(before)
             names.append(key)
-            spent = self.timings.get(f"{state}: {key}", 0.0) + time.perf_counter() - t0
-            self.timings[f"{state}: {key}"] = round(spent, 2)
+            self._spent(f"{state}: {key}", t0, c0)
         self.triggered.setdefault(state, []).append(names)
         self.where = (state, "")
 
@@ -419,6 +426,8 @@ class Walk:
             "read_back": self.read_back,
             "seconds": round(seconds, 1),
             "slowest": sorted(self.timings.items(), key=lambda kv: -kv[1]),
+            "cpu": self.cpu,
+            "entered": self.entered,
         }
 
 

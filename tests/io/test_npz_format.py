@@ -277,3 +277,27 @@ def test_render_hair_and_its_guides_stay_apart_through_a_cache(tmp_path):
     anim = Animation(np.stack([both.points, both.points + 1]), both.counts, 24.0, metadata=both.metadata)
     write(p, anim)
     assert read(p).metadata.curves == both.metadata.curves
+
+
+def test_a_header_met_again_reads_as_the_first_time_and_a_corrupt_one_is_refused_each_time():
+    """read_npy_header parses each distinct header once: the second member with the same
+    header gets the same shape, order and dtype, left at its first data byte; a corrupt one
+    (a Python 2 header, a truncated one) is refused however often it comes."""
+    from hairtool.io.npz import read_npy_header
+
+    good = io.BytesIO()
+    np.lib.format.write_array(good, np.arange(12, dtype=np.float32).reshape(3, 4))
+    data = good.getvalue()
+    starts = []
+    for _ in range(2):
+        f = io.BytesIO(data)
+        assert read_npy_header("x.npz", f, "a") == ((3, 4), False, np.dtype("<f4"))
+        starts.append(f.tell())
+    assert starts[0] == starts[1] == len(data) - 48
+    corrupt = data.replace(b"'descr'", b"u'descr", 1)
+    for _ in range(2):
+        with pytest.raises(FormatError, match=r"corrupt \.npy header"):
+            read_npy_header("x.npz", io.BytesIO(corrupt), "a")
+    for _ in range(2):
+        with pytest.raises(ValueError, match="EOF"):
+            read_npy_header("x.npz", io.BytesIO(data[:10] + b"{}"), "a")  # cut short

@@ -52,6 +52,27 @@ def test_round_trip_restores_the_same_scene(tmp_path, edited):
         assert getattr(back, name) == getattr(proj, name)
 
 
+def test_the_archive_in_memory_is_the_files_and_reads_as_the_file(tmp_path, edited, monkeypatch):
+    """to_bytes is save's bytes and from_bytes is load's project (the state-machine test checks
+    its steps in memory); a refusal names the place given."""
+    monkeypatch.setattr(project.time, "localtime", lambda *a: (2026, 1, 2, 3, 4, 5, 0, 2, 0))
+    monkeypatch.setattr(project.time, "strftime", lambda *a: "2026-01-02T03:04:05+0000")
+    _, proj = edited
+    path = tmp_path / "a.hairproj"
+    for compress in (False, True):
+        project.save(path, proj, compress=compress)
+        assert project.to_bytes(proj, compress=compress) == path.read_bytes()
+    written = project.manifest_and_arrays(project.load(path))
+    again = project.manifest_and_arrays(project.from_bytes(path.read_bytes(), "kept"))
+    assert written[0] == again[0] and written[1].keys() == again[1].keys()
+    for name, a in written[1].items():
+        assert a.dtype == again[1][name].dtype and a.tobytes() == again[1][name].tobytes(), name
+    for data in (b"", path.read_bytes()[:-9]):
+        with pytest.raises(FormatError) as e:
+            project.from_bytes(data, "a recovery")
+        assert e.value.path == "a recovery"
+
+
 def test_replaying_the_log_gives_the_same_result_as_the_saved_snapshot(tmp_path, edited):
     pipe, proj = edited
     bare = project.Project(rest=proj.rest, params=proj.params, strokes=proj.strokes)

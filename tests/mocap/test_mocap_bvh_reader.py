@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from hairtool.errors import FormatError
-from hairtool.mocap.bvh import read_bvh, write_bvh
+from hairtool.mocap.bvh import bvh_from_bytes, bvh_text, read_bvh, write_bvh
 
 from .conftest import CHAIN
 
@@ -126,6 +126,24 @@ def test_write_read_round_trip(tmp_path, motion_dir, name):
     np.testing.assert_allclose(back.end_offsets, m.end_offsets, atol=1e-6)
     np.testing.assert_array_equal(back.end_parents, m.end_parents)
     assert back.frame_time == pytest.approx(m.frame_time, rel=1e-6)
+
+
+@pytest.mark.parametrize("name", ["mocapbank_walk.bvh", "freebvh.bvh"])
+def test_the_text_in_memory_is_the_files_and_its_bytes_read_as_the_file(tmp_path, motion_dir, name):
+    """A project keeps its capture as text: bvh_text is write_bvh's bytes, bvh_from_bytes is
+    read_bvh's motion, and a refusal names the place given (never a temporary file)."""
+    m = read_bvh(motion_dir / name)
+    out = tmp_path / "copy.bvh"
+    write_bvh(out, m)
+    assert bvh_text(m).encode("utf-8") == out.read_bytes()
+    back, again = read_bvh(out), bvh_from_bytes(out.read_bytes(), "kept")
+    assert again.joint_names == back.joint_names and again.channels == back.channels
+    for field in ("parents", "offsets", "values", "end_parents", "end_offsets"):
+        np.testing.assert_array_equal(getattr(again, field), getattr(back, field))
+    assert again.frame_time == back.frame_time
+    with pytest.raises(FormatError, match="no MOTION") as e:
+        bvh_from_bytes(out.read_bytes().split(b"MOTION")[0], "a project's capture")
+    assert e.value.path == "a project's capture"
 
 
 def test_fps_snaps_only_printed_whole_rates(tmp_path):
