@@ -43,6 +43,8 @@ def _order() -> list[str]:
 
 
 @pytest.mark.slow(seconds=130)
+@pytest.mark.timeout(960)  # past the walk's own 900 s, which then fails with its output (the run's
+# 600 s default ended the whole worker silently on a host loaded to 10)
 def test_every_action_in_every_state(tmp_path):
     order = _order()
     command = [sys.executable, "-X", "faulthandler", str(WALK), str(tmp_path / "walk"), "--states", *order]
