@@ -342,6 +342,12 @@ class GuiFrameSource(QObject):
     thread only composites them, so the frame's raster never holds up the window. ``close``
     runs on the GUI thread when the frames end (however they end): it frees what ``render`` kept.
     Called on the GUI thread itself, everything runs there directly (synchronous use, tests).
+
+    ``parent`` (a QObject of the GUI thread, the exporter) owns the source, which deletes itself
+    there once its frames have ended (one run of frames a source). The worker holds the last
+    Python reference to a source: owned by Python, it was deleted in the worker as the job
+    ended, while the GUI thread could still be delivering its last request or ``close`` to it
+    (a segfault inside the GUI thread's event processing).
     """
 
     _requested = Signal(int, object, object)
@@ -351,8 +357,10 @@ class GuiFrameSource(QObject):
         self,
         render: Callable[[Drawn, tuple | None], NDArray | RasterJob],
         close: Callable[[], None] = _ignore,
+        *,
+        parent: QObject,
     ) -> None:
-        super().__init__()
+        super().__init__(parent)
         self._render, self._close = render, close
         self._answers: queue.Queue = queue.Queue()
         self._requested.connect(self._on_request, Qt.ConnectionType.QueuedConnection)
@@ -370,7 +378,10 @@ class GuiFrameSource(QObject):
 
     @Slot()
     def _on_close(self) -> None:
-        self._close()
+        try:
+            self._close()
+        finally:
+            self.deleteLater()  # here, once this event is delivered; never by the worker
 
     def _post(self, index: int, d: Drawn, images: tuple | None = None) -> None:
         if self._here():
@@ -413,7 +424,7 @@ class GuiFrameSource(QObject):
                 yield answer
         finally:
             if self._here():
-                self._close()
+                self._on_close()
             else:
                 try:
                     self._closing.emit()
@@ -644,7 +655,7 @@ class AnimationExporter(QObject):
                 with w.viewport.current_context():
                     kept.pop().release()
 
-        source = GuiFrameSource(render, close)
+        source = GuiFrameSource(render, close, parent=self)
         n = anim.n_frames
 
         def work(progress: Progress, cancelled: CancelCheck) -> str:
