@@ -106,12 +106,16 @@ def test_ctrl_c_at_any_moment_is_one_line_and_130(delay, tmp_path):
 
 @pytest.fixture(scope="module")
 def shots(tmp_path_factory) -> Path:
-    """Six captures whose keys take a batch of two workers about 25 s here."""
+    """Thirty-six captures (six files, each also under five more names: hard links, no more
+    disk) whose keys keep a batch of two workers busy far past the tests' latest Ctrl+C (six
+    alone finished before the 8 s one on a quiet moment)."""
     root = tmp_path_factory.mktemp("shots")
     frames = np.cumsum(np.random.default_rng(0).normal(size=(120, 1000 * 8, 3)), axis=0)
     a = Animation(frames.astype(np.float32), np.full(1000, 8), 24)
     for name in "abcdef":
         write(root / f"{name}.npz", a)
+        for copy in range(1, 6):
+            os.link(root / f"{name}.npz", root / f"{name}{copy}.npz")
     jobs = {"jobs": [{"glob": "*.npz", "command": "keys", "args": ["{path}", "--keys", "3"]}]}
     (root / "jobs.json").write_text(json.dumps(jobs))
     return root
@@ -126,6 +130,7 @@ def test_ctrl_c_during_a_batch_is_one_line_from_the_command_alone(shots, delay):
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, cwd=shots, start_new_session=True,
     )  # fmt: skip
     time.sleep(delay)
+    assert p.poll() is None, "the batch ended before its Ctrl+C: give it more work"
     os.killpg(p.pid, signal.SIGINT)
     _, err = p.communicate(timeout=120)
     assert p.returncode == 130 and _one_line(err).endswith(": interrupted\n"), err.decode()[-2000:]
