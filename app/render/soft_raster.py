@@ -314,34 +314,10 @@ def _segment(seg, i, half, r0, r1, c0, c1, rgba, depth, w):
 
 @njit(cache=True, nogil=True)
 def _refresh_farthest(bits, r0, r1, farthest, stale):
-    """``farthest[ty, tx]``: the largest depth in each ``stale`` cell (2**HIDDEN_SHIFT pixels a
-    side, rows from ``r0``, not past ``r1``) of the depth image's int32 view ``bits``, compared as
-    integers: depths are ≥ 0 (or −0), whose bit patterns order as the floats, and an integer
-    maximum vectorises where a float one (NaN-aware) does not. Whole cells are read with fixed
-    loops and unsigned indices (no wrap-around tests), which the compiler unrolls."""
-    w = bits.shape[1]
-    cell = 1 << HIDDEN_SHIFT
-    flat, far, todo = bits.reshape(-1), farthest.reshape(-1), stale.reshape(-1)
-    nx = farthest.shape[1]
-    for ty in range(farthest.shape[0]):
-        ra, rb = r0 + (ty << HIDDEN_SHIFT), min(r0 + ((ty + 1) << HIDDEN_SHIFT), r1)
-        for tx in range(nx):
-            k = np.uint64(ty * nx + tx)
-            if not todo[k]:
-                continue
-            todo[k] = False
-            ca = tx << HIDDEN_SHIFT
-            m = np.int32(0)
-            if rb - ra == cell and ca + cell <= w:
-                base = np.uint64(ra * w + ca)
-                for r in range(cell):
-                    for c in range(cell):
-                        m = max(m, flat[base + np.uint64(r * w + c)])
-            else:
-                for r in range(ra, rb):
-                    for c in range(ca, min(ca + cell, w)):
-                        m = max(m, bits[r, c])
-            far[k] = m
+    """``farthest[ty, tx]``: the largest depth in each ``stale`` cell of the band of rows from
+    ``r0``, not past ``r1``, of the depth image's int32 view ``bits`` (:func:`_refresh_tile` over
+    the whole width)."""
+    _refresh_tile(bits, r0, r1, 0, bits.shape[1], farthest, stale)
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -572,7 +548,9 @@ def _bin_segments(box, dirty, shift, counts, entries, near):
 def _refresh_tile(bits, r0, r1, c0, c1, farthest, stale):
     """``farthest``: the largest depth in each ``stale`` cell (2**HIDDEN_SHIFT pixels a side) of
     the tile at rows [r0, r1), columns [c0, c1) of the depth image's int32 view ``bits``, compared
-    as integers (see :func:`_refresh_farthest`)."""
+    as integers: depths are ≥ 0 (or −0), whose bit patterns order as the floats, and an integer
+    maximum vectorises where a float one (NaN-aware) does not. Whole cells are read with fixed
+    loops and unsigned indices (no wrap-around tests), which the compiler unrolls."""
     w = bits.shape[1]
     cell = 1 << HIDDEN_SHIFT
     flat = bits.reshape(-1)
