@@ -124,31 +124,35 @@ def test_any_split_into_bands_gives_the_same_bytes(width):
         np.testing.assert_array_equal(depth, ref_depth)
 
 
+def _dense_thrice(size, width, colour_seed):
+    """A dense scalp drawn three times over in random colours (every copy ties with the first in
+    depth): its one-copy segment starts, the reference images, and the set-up tables."""
+    from hairtool import samples
+
+    g = samples.scalp(strands=400, vertices=12, seed=5)
+    cam = Camera.for_groom(g, aspect=size[0] / size[1])
+    mvp = np.ascontiguousarray(cam.view_matrix() @ cam.projection_matrix(size[0] / size[1]), np.float64)
+    points = np.concatenate([g.points] * 3).astype(np.float32)
+    colors = np.random.default_rng(colour_seed).random((len(points), 3)).astype(np.float32)
+    one = g.topology.segment_end - 1
+    starts = np.concatenate([one + c * g.vertex_count for c in range(3)]).astype(np.int64)
+    seg, box, nearest = _tables(len(starts))
+    soft_raster._setup_kernel(
+        points, starts, colors, mvp, size[0], size[1], np.zeros(0), seg, box, nearest,
+        np.zeros(0, bool), width, np.zeros(0)
+    )  # fmt: skip
+    return one, rasterize_reference(points, starts, colors, mvp, size, width), (seg, box, nearest)
+
+
 @pytest.mark.parametrize("width", [1.0, 2.5, 9.0])
 def test_hidden_segments_are_skipped_without_changing_a_byte(width):
     # A dense groom drawn twice over in other colours (every copy ties with the first, and the
     # depth test keeps the first), its cells' farthest depths brought up to date after every
     # drawn segment, every 50 and never: the skipped segments change nothing. (Wide quads'
     # boxes span more than 3 × 3 cells, the others' fewer: both ways of reading them.)
-    from hairtool import samples
-
-    g = samples.scalp(strands=400, vertices=12, seed=5)
     size = (80, 60)
-    cam = Camera.for_groom(g, aspect=size[0] / size[1])
-    mvp = np.ascontiguousarray(cam.view_matrix() @ cam.projection_matrix(size[0] / size[1]), np.float64)
-    rng = np.random.default_rng(1)
-    points = np.concatenate([g.points] * 3).astype(np.float32)
-    colors = rng.random((len(points), 3)).astype(np.float32)
-    one = g.topology.segment_end - 1
-    starts = np.concatenate([one + c * g.vertex_count for c in range(3)]).astype(np.int64)
-    ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, size, width)
-    e, (w, h) = len(starts), size
-    seg, box, nearest = _tables(e)
-    soft_raster._setup_kernel(
-        points, starts, colors, mvp, w, h, np.zeros(0), seg, box, nearest,
-        np.zeros(0, bool), width, np.zeros(0)
-    )
-    half = 0.0 if width <= 1.0 else width / 2
+    one, (ref_rgba, ref_depth), (seg, box, nearest) = _dense_thrice(size, width, colour_seed=1)
+    (w, h), half = size, (0.0 if width <= 1.0 else width / 2)
     hidden = {}
     for refresh in (1, 50, 10**9):
         for bounds in (np.array([0, h]), soft_raster.band_bounds(box[0], box[1], h, 3)):
@@ -170,24 +174,9 @@ def test_hidden_segments_are_skipped_in_redrawn_tiles_without_changing_a_byte(wi
     # the edge ones cut short): each tile keeps its cells' farthest depths as a band does, and
     # the segments it skips as hidden change nothing, whether its depths are brought up to date
     # after every drawn segment, every 7 or never.
-    from hairtool import samples
-
-    g = samples.scalp(strands=400, vertices=12, seed=5)
     size = (90, 70)
-    cam = Camera.for_groom(g, aspect=size[0] / size[1])
-    mvp = np.ascontiguousarray(cam.view_matrix() @ cam.projection_matrix(size[0] / size[1]), np.float64)
-    points = np.concatenate([g.points] * 3).astype(np.float32)
-    colors = np.random.default_rng(3).random((len(points), 3)).astype(np.float32)
-    one = g.topology.segment_end - 1
-    starts = np.concatenate([one + c * g.vertex_count for c in range(3)]).astype(np.int64)
-    ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, size, width)
-    e, (w, h) = len(starts), size
-    seg, box, nearest = _tables(e)
-    soft_raster._setup_kernel(
-        points, starts, colors, mvp, w, h, np.zeros(0), seg, box, nearest,
-        np.zeros(0, bool), width, np.zeros(0)
-    )
-    half = 0.0 if width <= 1.0 else width / 2
+    _, (ref_rgba, ref_depth), (seg, box, nearest) = _dense_thrice(size, width, colour_seed=3)
+    e, (w, h), half = len(nearest), size, (0.0 if width <= 1.0 else width / 2)
     dirty = np.ones(((h + 15) // 16, (w + 15) // 16), bool)
     counts, near = np.zeros(dirty.size + 1, np.int64), np.zeros(e, np.int64)
     total = soft_raster._bin_segments(box, dirty, 4, counts, np.zeros(0, np.int64), near)
