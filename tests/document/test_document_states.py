@@ -307,17 +307,24 @@ class DocumentMachine(RuleBasedStateMachine):
         mode=st.sampled_from(BOX_MODES),
         view=st.sampled_from([None, (0.0, 0.0, -1.0)]),
         visible=st.booleans(),
+        perspective=st.booleans(),
+        to_eye=st.booleans(),
     )
-    def select(self, op, rect, mode, view, visible) -> None:
-        """A selection step: the box seen through a front camera (orthographic, the head in it),
-        front faces only by sight (``visible``, the studio's) or by root normal (older files)."""
+    def select(self, op, rect, mode, view, visible, perspective, to_eye) -> None:
+        """A selection step: the box seen through a front camera (orthographic, or with
+        ``perspective`` from an eye at z = 4; the head in it), front faces only by sight
+        (``visible``, the studio's; ``to_eye``: rays to the eye, the studio's in 3-D) or by root
+        normal (older files)."""
         x0, x1 = sorted(rect[::2])
         y0, y1 = sorted(rect[1::2])
         sample = SelectionSample(op)
         if op == "box":
             matrix = (0.4, 0, 0, 0, 0, 0.4, 0, -0.2, 0, 0, -0.1, 0, 0, 0, 0, 1)
+            if perspective:  # focal 1.5, near 0.1, far 100, the eye at (0, 0.5, 4) looking down -z
+                a, b = -100.1 / 99.9, -20.0 / 99.9
+                matrix = (1.5, 0, 0, 0, 0, 1.5, 0, -0.75, 0, 0, a, b - 4 * a, 0, 0, -1, 4)
             m = tuple(float(v) for v in matrix)
-            sample = SelectionSample(op, m, (x0, y0, x1, y1), mode, view, visible)
+            sample = SelectionSample(op, m, (x0, y0, x1, y1), mode, view, visible, to_eye)
         self._try(lambda: self.doc.hair.select(sample))
 
     @rule(axis=st.sampled_from(["Y", "Z"]))
