@@ -140,6 +140,7 @@ class BrushTool:
         start: bool = False,
         pressure: float = 1.0,
         add: bool = False,
+        eye: Sequence[float] | None = None,
     ) -> list[AlignSample | BrushSample]:
         """The samples of one mouse move at ``cursor`` (groom units), mirrored one right after it
         with symmetry on. ``direction``: the mouse's motion in the world (comb needs one: none
@@ -147,7 +148,10 @@ class BrushTool:
         "front faces only". ``start``: the stroke's first move (a snake hook hooks there).
         ``pressure``: a pen's, in [0, 1] (1 for a mouse), scaling the radius and the strength as
         the brush's toggles say; the samples carry it for the stroke log. ``add``: Shift held,
-        so a brush that starts anew (select: a plain stroke is a new selection) adds instead."""
+        so a brush that starts anew (select: a plain stroke is a new selection) adds instead.
+        ``eye``: a perspective camera's eye (None: orthographic), which a brush sample records:
+        by sight its rays go there, and add and density plant on the line from it through the
+        cursor (:class:`~hairtool.frozen.brushes.BrushSample`)."""
         p = min(max(float(pressure), 0.0), 1.0)
         c = tuple(float(x) for x in cursor)
         d = tuple(float(x) for x in direction)
@@ -176,7 +180,7 @@ class BrushTool:
         first = BRUSH.make(
             brush=name, direction=d, strength=strength, lut=self.lut(), start=start,
             count=self.add_count, spacing=self.spacing, any_segment=self.delete_any_segment,
-            new_selection=anew, **common,
+            new_selection=anew, eye=None if eye is None else tuple(float(x) for x in eye), **common,
         )  # fmt: skip
         return [first, first.mirrored(plane_x)] if self.symmetry else [first]
 
