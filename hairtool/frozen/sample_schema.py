@@ -146,6 +146,7 @@ ALIGN = SampleType("align", AlignSample, None, (
     Field("intensity", "number", json="strength", column="intensity", low=0.0, high=1.0),
     Field("view", "view", None, "view", column="view"),
     Field("pressure", "number", 1.0, "pressure", column="pressure", low=0.0, high=1.0),
+    Field("eye", "point", None, "eye", column="eye", quiet=True),
 ))  # fmt: skip
 
 #: Selection steps; a box's camera, rectangle, mode and view mean nothing to the others.

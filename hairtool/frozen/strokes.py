@@ -106,10 +106,12 @@ from hairtool.frozen.brushes import (
     BRUSHES,
     MAX_FALLOFF_POINTS,
     BrushSample,
+    check_eye,
     check_pressure,
     check_sample,
     check_view,
     falloff_lut,
+    mirrored_eye,
     mirrored_view,
 )
 from hairtool.frozen.pipeline import AlignSample
@@ -206,11 +208,13 @@ class Stroke:
                 values["start"] = (i == 0) if s.start is None else s.start
             sample = t.make(**{k: v for k, v in values.items() if k in _names(t)})
             if t is ALIGN:
-                sample = sample._replace(view=check_view(s.view), pressure=check_pressure(s.pressure))
+                view, eye = check_view(s.view), check_eye(s.eye)
+                sample = sample._replace(view=view, pressure=check_pressure(s.pressure), eye=eye)
                 out.append(sample)
                 if self.symmetry == "x":
                     cursor = (2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])
-                    out.append(sample._replace(cursor=cursor, view=mirrored_view(s.view)))
+                    across = {"view": mirrored_view(view), "eye": mirrored_eye(eye, mirror)}
+                    out.append(sample._replace(cursor=cursor, **across))
                 continue
             sample = check_sample(sample)
             out.append(sample)

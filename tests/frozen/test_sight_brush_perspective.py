@@ -3,8 +3,8 @@
 vertex's own ray to the eye says are hidden (the numpy twin), which the view's one direction
 gets wrong toward the edge of the view; Add and Density plant around the point where the line
 from the eye through the cursor meets the head, never on roots the eye cannot see; a sample
-without an eye judges and plants as before; and a log or a project names the eye only where a
-sample has one."""
+without an eye judges and plants as before; an align sample judges by its eye as a brush sample
+does; and a log or a project names the eye only where a sample has one."""
 
 from __future__ import annotations
 
@@ -17,9 +17,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from hairtool.errors import ParameterError
-from hairtool.frozen.brushes import BrushSample, check_sample
+from hairtool.frozen.brushes import BrushSample, check_sample, root_normals
+from hairtool.frozen.brushes.align import AlignSample
 from hairtool.frozen.brushes.sight import hidden_strands, hidden_strands_reference
 from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+from hairtool.frozen.replay import StrokeSetting
 from hairtool.frozen.sample_columns import read_columns, write_columns
 from hairtool.frozen.strokes import stroke_from_dict, strokes_from_log
 
@@ -99,6 +101,18 @@ def test_at_the_side_of_the_head_the_eye_hides_what_the_view_would_keep():
     assert (by_view.locked & hid_from_eye).sum() >= 3  # the view keeps hair the eye cannot see
     assert not by_eye.locked[np.logical_and.reduceat(blocked, groom.offsets[:-1])].any()
     assert (by_eye.locked != by_view.locked).any()
+
+
+def test_an_align_sample_judges_by_its_eye_as_a_brush_sample_does():
+    groom, f, eye = hair(5, 1000), (0.0, 0.0, -1.0), (0.0, 0.0, 2.0)
+    cursor, radius = (1.1, 0.0, -0.1), 0.25
+    setting = StrokeSetting(lambda: root_normals(groom), lambda: np.zeros(3), HEAD, None)
+    dab = AlignSample(cursor, radius, 1.0, "paper", f, visible=True, eye=eye)
+    want = hidden_strands_reference(groom.points, groom.offsets, cursor, radius, f, HEAD.face_grid, eye)
+    np.testing.assert_array_equal(setting.away(dab, groom, lambda: None), want)
+    old = hidden_strands_reference(groom.points, groom.offsets, cursor, radius, f, HEAD.face_grid)
+    np.testing.assert_array_equal(setting.away(dab._replace(eye=None), groom, lambda: None), old)
+    assert (want != old).any()
 
 
 def _sphere_hit(eye: np.ndarray, through: np.ndarray) -> np.ndarray:

@@ -69,13 +69,18 @@ class BrushSample:
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
         view = mirrored_view(self.view)
-        eye = None if self.eye is None else (2.0 * plane_x - self.eye[0], self.eye[1], self.eye[2])
+        eye = mirrored_eye(self.eye, plane_x)
         return replace(self, cursor=cursor, direction=direction, view=view, new_selection=False, eye=eye)
 
 
 def mirrored_view(view: tuple[float, float, float] | None) -> tuple[float, float, float] | None:
     """A viewing direction mirrored across a plane x = const (None stays None)."""
     return None if view is None else (-view[0], view[1], view[2])
+
+
+def mirrored_eye(eye: tuple[float, float, float] | None, plane_x: float) -> tuple[float, float, float] | None:
+    """An eye mirrored across the plane x = ``plane_x`` (None stays None)."""
+    return None if eye is None else (2.0 * plane_x - eye[0], eye[1], eye[2])
 
 
 def check_view(view: object) -> tuple[float, float, float] | None:
