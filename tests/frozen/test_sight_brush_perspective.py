@@ -156,6 +156,24 @@ def test_add_and_density_under_perspective_plant_where_the_eye_ray_meets_the_hea
         assert len(roots) == 0 or np.linalg.norm(roots - hit, axis=1).max() >= radius + SAG
 
 
+@pytest.mark.parametrize("brush", ["add", "density"])
+def test_near_the_rim_seen_from_a_close_eye_no_root_goes_beyond_it(brush):
+    """Aimed at the ball's side just inside the rim an eye 2 units away sees (z = 0.55; its
+    rim is at z = 0.5, the view's at z = 0), a wide brush plants no root the eye cannot see,
+    though the view's one direction would see the roots down to z = 0."""
+    groom, eye = hair(3, 30), np.array([0.0, 0.0, 2.0])
+    target = np.array([np.sqrt(1.0 - 0.55**2), 0.0, 0.55])
+    cursor = tuple((eye + 1.2 * (target - eye)).tolist())
+    dab = BrushSample(brush, cursor, (0.0, 0.0, 0.0), 0.5, 1.0, LUT, (0.0, 0.0, -1.0), count=60, seed=4,
+                      spacing=0.04, visible=True, eye=tuple(eye.tolist()))  # fmt: skip
+    pipe = FrozenPipeline(groom, PLAIN, HEAD)
+    pipe.brush(dab)
+    planted = pipe.aligned.roots[pipe.origin < 0].astype(np.float64)
+    assert len(planted) >= 5
+    _, blocked = truth_from(planted, eye)
+    assert not blocked.any()
+
+
 def test_a_log_and_a_project_name_the_eye_only_where_a_sample_has_one():
     old = BrushSample("mask", (1.0, 0.0, 0.0), (0.0, 0.0, 0.0), 0.3, 1.0, LUT, (0.0, 0.0, -1.0), visible=True)
     new = replace(old, eye=(0.0, 0.0, 2.0))
