@@ -39,7 +39,7 @@ import numpy as np
 
 import hairtool
 from hairtool.errors import FormatError, GroomError, HairtoolError, ParameterError
-from hairtool.frozen.brushes import BrushSample, check_pressure, check_sample, check_view
+from hairtool.frozen.brushes import BrushSample, check_eye, check_pressure, check_sample, check_view
 from hairtool.frozen.pipeline import AlignSample, FrozenParams, FrozenPipeline, FrozenSnapshot
 from hairtool.frozen.sample_columns import ColumnError, read_columns, write_columns
 from hairtool.frozen.selection import SelectionSample, check_selection
@@ -538,7 +538,9 @@ def _read_strokes(r: _Reader, info: dict, rest: Groom) -> tuple[tuple, Groom | N
             elif isinstance(s, SelectionSample):
                 s = check_selection(s)
             else:
-                s = s._replace(view=check_view(s.view), pressure=check_pressure(s.pressure))
+                s = s._replace(
+                    view=check_view(s.view), pressure=check_pressure(s.pressure), eye=check_eye(s.eye)
+                )
         except HairtoolError as e:
             raise FormatError(r.path, f"stroke {k}: {e}") from None
         strokes.append(s)

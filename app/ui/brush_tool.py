@@ -14,7 +14,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from hairtool.errors import ParameterError
-from hairtool.frozen.brushes import BrushSample, any_within, falloff_lut, mirrored_view, registry
+from hairtool.frozen.brushes import (
+    BrushSample,
+    any_within,
+    falloff_lut,
+    mirrored_eye,
+    mirrored_view,
+    registry,
+)
 from hairtool.frozen.pipeline import AlignSample
 from hairtool.frozen.sample_schema import ALIGN, BRUSH
 
@@ -140,6 +147,7 @@ class BrushTool:
         start: bool = False,
         pressure: float = 1.0,
         add: bool = False,
+        eye: Sequence[float] | None = None,
     ) -> list[AlignSample | BrushSample]:
         """The samples of one mouse move at ``cursor`` (groom units), mirrored one right after it
         with symmetry on. ``direction``: the mouse's motion in the world (comb needs one: none
@@ -147,7 +155,10 @@ class BrushTool:
         "front faces only". ``start``: the stroke's first move (a snake hook hooks there).
         ``pressure``: a pen's, in [0, 1] (1 for a mouse), scaling the radius and the strength as
         the brush's toggles say; the samples carry it for the stroke log. ``add``: Shift held,
-        so a brush that starts anew (select: a plain stroke is a new selection) adds instead."""
+        so a brush that starts anew (select: a plain stroke is a new selection) adds instead.
+        ``eye``: a perspective camera's eye (None: orthographic), which every sample records:
+        by sight its rays go there, and add and density plant on the line from it through the
+        cursor (:class:`~hairtool.frozen.brushes.BrushSample`)."""
         p = min(max(float(pressure), 0.0), 1.0)
         c = tuple(float(x) for x in cursor)
         d = tuple(float(x) for x in direction)
@@ -159,15 +170,17 @@ class BrushTool:
         # use (add's count, density's spacing, delete's rule, a snake hook's start) keep their
         # defaults there
         # front faces only by sight (the head hides what lies behind it; hairtool.frozen.brushes.sight)
+        e = None if eye is None else tuple(float(x) for x in eye)
         common = {
             "cursor": c, "radius": r, "view": v, "collide": hit, "only_selected": only, "pressure": p,
-            "visible": v is not None,
+            "visible": v is not None, "eye": e,
         }  # fmt: skip
         if name == "align":
             first = ALIGN.make(intensity=self.strength_at(p), mode=self.align_mode, **common)
             if not self.symmetry:
                 return [first]
-            return [first, first._replace(cursor=(2.0 * plane_x - c[0], c[1], c[2]), view=mirrored_view(v))]
+            mirror = (2.0 * plane_x - c[0], c[1], c[2])
+            return [first, first._replace(cursor=mirror, view=mirrored_view(v), eye=mirrored_eye(e, plane_x))]
         spec = registry.spec_of(name)
         if spec.needs_direction and math.hypot(*d) == 0.0:
             return []

@@ -94,18 +94,21 @@ class MoveEngine(QObject):
         start: bool,
         pressure: float,
         add: bool = False,
+        eye: np.ndarray | None = None,
     ) -> None:
         """One mouse move of the current brush (as :meth:`app.ui.scene.Scene.brush_move`): its
         samples are made now; the engine runs them when it is free."""
         s = self.scene
         if not self.threaded or s.tool.brush in CHANGE_STRANDS or not s.engine_ready:
             self.drain()
-            touched = s.brush_move(cursor, direction, view, invert, not self.touched, start, pressure, add)
+            touched = s.brush_move(
+                cursor, direction, view, invert, not self.touched, start, pressure, add, eye
+            )
             self.touched = self.touched or touched
             self.runs += 1
             return
         plane = s.mirror_plane_x()
-        samples = s.tool.samples(cursor, direction, view, plane, invert, start, pressure, add)
+        samples = s.tool.samples(cursor, direction, view, plane, invert, start, pressure, add, eye)
         cursor = np.asarray(cursor, np.float64)
         self._pending.append(Move(samples, cursor, plane, pressure, not self.touched))
         if self._running is None:

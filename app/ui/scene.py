@@ -337,19 +337,21 @@ class Scene(QObject):
         start: bool = False,
         pressure: float = 1.0,
         add: bool = False,
+        eye: np.ndarray | None = None,
     ) -> bool:
         """One mouse move of the current brush (its mirror too with symmetry on), applied through
         the pipeline in one call; ``direction`` the mouse's motion in the world, ``view`` the
         camera's direction at the cursor, ``invert`` Ctrl held. Returns whether the brush
         reached a strand (its circle held a vertex; False unchecked with ``check_touch`` off).
         ``start``: the stroke's first move; ``pressure`` a pen's (1 for a mouse); ``add`` Shift
-        held (select adds to the selection instead of starting a new one). A move the
+        held (select adds to the selection instead of starting a new one); ``eye`` a perspective
+        camera's eye (None: orthographic), recorded by the samples. A move the
         engine refuses (a delete that would leave no strand) changes nothing and says why
         (``refused``)."""
         self.moves.drain()
         self.start_engine()
         plane = self.mirror_plane_x()
-        samples = self.tool.samples(cursor, direction, view, plane, invert, start, pressure, add)
+        samples = self.tool.samples(cursor, direction, view, plane, invert, start, pressure, add, eye)
         if samples:
             try:
                 self.apply_samples(samples)

@@ -716,6 +716,11 @@ class Viewport(QWidget):
         """The camera's viewing direction through ``pos`` (from the eye into the scene)."""
         return self.camera.ray(pos.x(), pos.y(), self.width(), self.height())[1]
 
+    def eye(self) -> np.ndarray | None:
+        """A perspective camera's eye, which the brushes' lines of sight go to; None for the
+        orthographic 2-D view, whose lines of sight all run along the view."""
+        return None if self.camera.ortho else self.camera.eye().astype(np.float64)
+
     def hair_under(self, pos: QPointF) -> np.ndarray:
         """The point a stroke starting at ``pos`` keeps its cursor level with (module docstring);
         for the brushes that work on the head's surface (slide, add, density), the head mesh
@@ -735,7 +740,8 @@ class Viewport(QWidget):
         grid = getattr(surface, "face_grid", None)
         if s.tool.front_only and grid is not None:  # by sight, as the stroke's samples judge
             view = self.view_at(pos)
-            hides = lambda p: bool(hidden_points(p[None], view, grid)[0])  # noqa: E731
+            eye = self.eye()
+            hides = lambda p: bool(hidden_points(p[None], view, grid, eye)[0])  # noqa: E731
             i = nearest_in_sight(pts, vp, size, mouse, r_px, strand, hides)
         else:
             away = None
@@ -753,8 +759,9 @@ class Viewport(QWidget):
         view = self.view_at(pos)
         # the engine runs it off this thread (app.ui.engine_thread): the circle moves on now
         self.scene.moves.move(
-            cursor, direction, view, self._stroke_invert, last is None, self.pressure, self._stroke_add
-        )
+            cursor, direction, view, self._stroke_invert, last is None, self.pressure, self._stroke_add,
+            self.eye(),
+        )  # fmt: skip
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         if self._from_pen(event):

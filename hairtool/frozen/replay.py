@@ -74,7 +74,8 @@ class StrokeSetting:
         """``(S,)`` the strands of ``g`` a sample's camera does not face (None: no view, none).
 
         A sample that says ``visible``, on a head mesh: the strands the head hides under its
-        brush (:func:`~hairtool.frozen.brushes.sight.hidden_strands`). Otherwise, as every log
+        brush (:func:`~hairtool.frozen.brushes.sight.hidden_strands`; each vertex's ray to the
+        sample's ``eye`` where it has one, a perspective camera's). Otherwise, as every log
         before that field: the strands whose root normal (``normals``, asked only then) faces
         away from the camera."""
         view = check_view(sample.view)
@@ -82,7 +83,8 @@ class StrokeSetting:
             return None
         grid = getattr(self.surface, "face_grid", None)
         if getattr(sample, "visible", False) and grid is not None:
-            return hidden_strands(g.points, g.offsets, sample.cursor, sample.radius, view, grid)  # type: ignore[union-attr]
+            eye = getattr(sample, "eye", None)
+            return hidden_strands(g.points, g.offsets, sample.cursor, sample.radius, view, grid, eye)  # type: ignore[union-attr]
         return facing_away(normals(), view)
 
     def context(

@@ -14,7 +14,9 @@ older projects, whose select strokes added, read as they did), ``visible`` (fron
 sight: stored only where a sample judges so, so older projects, which judged by the root normal,
 read as they did), ``to_eye`` (a box judged by sight along each point's own line to a
 perspective camera's eye: stored only where a box does, so older projects, whose boxes traced
-every ray along the view, read as they did) and
+every ray along the view, read as they did), ``eye`` (a perspective camera's eye, in ``eye``
+with ``has_eye`` saying which samples hold one: stored only where a sample does, so older
+projects, whose samples had none, read as they did) and
 ``selection`` (a step's op, and a box's matrix, rectangle
 and mode in ``box``). Choices are stored as indices into a list: the align modes in ``modes``,
 the brushes in ``brushes``, the steps in ``selection``.
@@ -68,11 +70,16 @@ COLUMNS = (
     Column("selection", "selection", np.int64, 0, -1),
     Column("box", "selection", np.float64, BOX_WIDTH, (0.0,) * BOX_WIDTH),
     Column("to_eye", "to_eye", np.int64, 0, 0),
+    Column("eye", "eye", np.float64, 3, (0.0, 0.0, 0.0)),
+    Column("has_eye", "eye", np.int64, 0, 0),
 )
 GROUPS = (
     "brushes", "views", "collide", "plants", "starts", "only_selected", "pressure", "any_segment",
-    "new_selection", "visible", "selection", "to_eye",
+    "new_selection", "visible", "selection", "to_eye", "eye",
 )  # fmt: skip
+
+#: The columns that say which samples hold a field of a kind that may be None (``view``, ``point``)
+_PRESENT = {"has_view": "view", "has_eye": "eye"}
 
 
 def _differs(log: Sequence, name: str, fill: Any) -> bool:
@@ -85,6 +92,8 @@ def _stored(group: str, log: Sequence, types: list[SampleType]) -> bool:
         return any(t is not ALIGN for t in types)
     if group == "views":
         return any(s.view is not None for s in log)
+    if group == "eye":
+        return any(getattr(s, "eye", None) is not None for s in log)
     if group == "plants":  # a brush that plants strands, whatever its numbers
         pairs = zip(log, types, strict=True)
         return any(t.by_column("seed") and t.field("seed").used(t.which(s)) for s, t in pairs)
@@ -112,8 +121,8 @@ class _Tables:
 
 def _cell(column: Column, s: Any, t: SampleType, tables: _Tables) -> Any:
     """Sample ``s``'s entry in ``column``."""
-    if column.name == "has_view":
-        return int(s.view is not None)
+    if column.name in _PRESENT:
+        return int(getattr(s, _PRESENT[column.name], None) is not None)
     fields = t.by_column(column.name)
     if not fields:
         return column.fill
@@ -128,7 +137,7 @@ def _cell(column: Column, s: Any, t: SampleType, tables: _Tables) -> Any:
     value = getattr(s, f.name)
     if f.kind in ("choice", "falloff"):
         return tables.index(f, t, value)
-    if f.kind == "view":
+    if f.kind in ("view", "point"):
         return column.fill if value is None else value
     return int(value) if f.kind == "flag" else value
 
@@ -230,8 +239,8 @@ def _sample(k: int, cols: dict[str, np.ndarray], tables: dict, luts: np.ndarray)
             values[f.name] = tuple(_choice(k, list(luts), int(cell), "falloff").tolist())
         elif f.kind == "vector":
             values[f.name] = tuple(float(x) for x in cell)
-        elif f.kind == "view":
-            values[f.name] = tuple(float(x) for x in cell) if cols["has_view"][k] else None
+        elif f.kind in ("view", "point"):
+            values[f.name] = tuple(float(x) for x in cell) if cols[f"has_{f.column}"][k] else None
         elif f.kind == "flag":
             values[f.name] = bool(cell)
         elif f.kind == "whole":

@@ -30,7 +30,8 @@ class Field:
     """One field of a sample type.
 
     ``kind``: ``vector`` (three floats), ``number``, ``whole``, ``flag``, ``choice`` (one of
-    ``choices``), ``view`` (a vector or None), ``falloff`` (a falloff table), ``matrix`` (16
+    ``choices``), ``view`` (a vector or None, not zero), ``point`` (a vector or None: a
+    place, so zero too), ``falloff`` (a falloff table), ``matrix`` (16
     floats or None) or ``rect`` (four floats or None). ``low``/``high``: the closed range of a
     number or whole number (``low_open``: ``low`` itself refused). ``json``: its name in a stroke
     log, kept at ``level`` ``sample`` (each sample), ``stroke`` (once per stroke), ``params``
@@ -131,6 +132,7 @@ BRUSH = SampleType("brush", BrushSample, "brush", (
     Field("start", "flag", False, "start", column="start", used_by=("snake_hook",)),
     Field("new_selection", "flag", False, "new_selection", column="new_selection", used_by=("select",),
           quiet=True),
+    Field("eye", "point", None, "eye", column="eye", quiet=True),
 ))  # fmt: skip
 
 #: The paper's align samples: ``intensity`` is a stroke log's ``strength``, ``mode`` its params'.
@@ -144,6 +146,7 @@ ALIGN = SampleType("align", AlignSample, None, (
     Field("intensity", "number", json="strength", column="intensity", low=0.0, high=1.0),
     Field("view", "view", None, "view", column="view"),
     Field("pressure", "number", 1.0, "pressure", column="pressure", low=0.0, high=1.0),
+    Field("eye", "point", None, "eye", column="eye", quiet=True),
 ))  # fmt: skip
 
 #: Selection steps; a box's camera, rectangle, mode and view mean nothing to the others.

@@ -44,6 +44,12 @@ A stroke log is a JSON list of strokes, in groom units::
   the stroke was drawn.
 - ``view`` (per sample, optional): the camera's viewing direction, from the eye into the scene;
   only the strands facing that camera are touched. null or missing (older logs): every strand.
+- ``eye`` (per sample, optional, written only where set): a perspective camera's eye, which the
+  studio records in its 3-D view. By sight, each vertex's ray goes to it instead of against
+  ``view`` (a wide brush near the edge of a perspective view judges each strand along its own
+  line of sight), and add and density plant where the line from it through ``cursor`` first
+  meets the head (else, as every log before it and every orthographic camera: around the head's
+  point nearest the cursor, rays along ``view``).
 - ``visible`` (per stroke, optional, default false): how a ``view`` judges which strands face
   the camera. true (the studio writes it): those the head mesh does not hide from the camera
   under the brush (:mod:`hairtool.frozen.brushes.sight`); false or missing (older logs, and
@@ -100,10 +106,12 @@ from hairtool.frozen.brushes import (
     BRUSHES,
     MAX_FALLOFF_POINTS,
     BrushSample,
+    check_eye,
     check_pressure,
     check_sample,
     check_view,
     falloff_lut,
+    mirrored_eye,
     mirrored_view,
 )
 from hairtool.frozen.pipeline import AlignSample
@@ -134,6 +142,7 @@ class StrokeSample:
     start: bool | None = None  # None: the stroke's first sample starts it
     pressure: float = 1.0  # the pen's, already applied to radius and strength (1: a mouse's)
     new_selection: bool = False  # a select sample starts a new selection (False: it adds)
+    eye: tuple[float, float, float] | None = None  # a perspective camera's eye (None: orthographic)
 
 
 @dataclass(frozen=True)
@@ -199,11 +208,13 @@ class Stroke:
                 values["start"] = (i == 0) if s.start is None else s.start
             sample = t.make(**{k: v for k, v in values.items() if k in _names(t)})
             if t is ALIGN:
-                sample = sample._replace(view=check_view(s.view), pressure=check_pressure(s.pressure))
+                view, eye = check_view(s.view), check_eye(s.eye)
+                sample = sample._replace(view=view, pressure=check_pressure(s.pressure), eye=eye)
                 out.append(sample)
                 if self.symmetry == "x":
                     cursor = (2.0 * mirror - s.cursor[0], s.cursor[1], s.cursor[2])
-                    out.append(sample._replace(cursor=cursor, view=mirrored_view(s.view)))
+                    across = {"view": mirrored_view(view), "eye": mirrored_eye(eye, mirror)}
+                    out.append(sample._replace(cursor=cursor, **across))
                 continue
             sample = check_sample(sample)
             out.append(sample)
@@ -242,9 +253,9 @@ def _sample_dict(s: StrokeSample) -> dict:
     out: dict[str, Any] = {}
     for f in LOG_SAMPLE:
         value = getattr(s, f.json)
-        if f.kind == "flag" and (value is None or (f.quiet and value == f.default)):
+        if (f.kind == "flag" and value is None) or (f.quiet and value == f.default):
             continue
-        out[f.json] = list(value) if f.kind in ("vector", "view") and value is not None else value
+        out[f.json] = list(value) if f.kind in ("vector", "view", "point") and value is not None else value
     return out
 
 
@@ -313,9 +324,11 @@ def strokes_from_log(
         for f in t.at("sample"):
             if f.used(by):
                 value = getattr(s, f.name)
-                fields[f.json] = (
-                    _view_of(value) if f.kind == "view" else tuple(value) if f.kind == "vector" else value
-                )
+                if f.kind in ("view", "point"):
+                    value = _view_of(value)
+                elif f.kind == "vector":
+                    value = tuple(value)
+                fields[f.json] = value
         if "start" in fields:
             fields["start"] = bool(fields["start"])
         sample = StrokeSample(**fields)
@@ -345,7 +358,7 @@ def _log_value(f: Field, raw: dict, at: str) -> Any:
     if f.kind == "vector":
         default = None if f.log_default is REQUIRED else f.log_default
         return _vector(where, value, default)
-    if f.kind == "view":
+    if f.kind in ("view", "point"):
         return None if value is None else _vector(where, value)
     if f.kind == "flag":
         return _flag(where, value)

@@ -8,6 +8,12 @@ nearest strands' shapes carried in their root frames, blended by inverse distanc
 random length variation or frizz, so its length is the neighbours' (interpolated as the shape
 is). The draws come from the seed and the cursor's bytes, so one sample always plants the same
 strands and a replay the same bytes.
+
+Under a perspective camera (a sample's ``eye``) the disc is centred instead where the line from
+the eye through the cursor first meets the head (:meth:`HeadSurface.aimed`): the spot the artist
+sees under the mouse, which the closest point misses where the head turns away from the eye
+(the closest point to a cursor held at the stroke's depth slides off along the surface, and
+toward the edge of a wide view the line of sight is far from the camera's axis).
 """
 
 from __future__ import annotations
@@ -49,6 +55,7 @@ class HeadSurface(MeshSurface):
         seed: int,
         view=None,
         visible: bool = False,
+        eye=None,
     ) -> Groom | None:
         """``count`` new strands around the surface point closest to ``cursor`` (module
         docstring), or None where the surface there faces away from a camera looking along
@@ -73,6 +80,10 @@ class HeadSurface(MeshSurface):
         visible : bool, default False
             Judge the roots by sight (True) or the surface point under the cursor by its
             normal (False: every log written before the choice).
+        eye : array_like, optional
+            A perspective camera's eye: the disc's centre is on the line from it through the
+            cursor (:meth:`aimed`), and by sight each root's ray goes to it. None: an
+            orthographic camera (the closest point, rays against ``view``).
 
         Returns
         -------
@@ -81,8 +92,7 @@ class HeadSurface(MeshSurface):
         """
         if isinstance(count, bool) or int(count) != count or not 1 <= count <= MAX_PLANT:
             raise ParameterError("count", count, f"a whole number of strands in [1, {MAX_PLANT}]")
-        c = np.asarray(cursor, np.float64).reshape(1, 3)
-        q, n = self.project(c)
+        q, n = self.aimed(cursor, eye)
         by_sight = view is not None and visible
         if view is not None and not by_sight and float(n[0] @ np.asarray(view, np.float64)) > 0:
             return None
@@ -92,10 +102,22 @@ class HeadSurface(MeshSurface):
         t = 2.0 * np.pi * rng.random(int(count))
         roots, _ = self.project(q[0] + r[:, None] * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v))
         if by_sight:
-            roots = roots[~hidden_points(roots, view, self.face_grid)]
+            roots = roots[~hidden_points(roots, view, self.face_grid, eye)]
             if len(roots) == 0:
                 return None
         return self.grow(groom, roots)
+
+    def aimed(self, cursor, eye=None) -> tuple[np.ndarray, np.ndarray]:
+        """``(1, 3)`` the head's point a brush at ``cursor`` works around and ``(1, 3)`` its
+        normal: where the line from a perspective camera's ``eye`` through the cursor first meets
+        the head, or (no eye, or a line that misses the head) the point closest to the cursor."""
+        c = np.asarray(cursor, np.float64).reshape(1, 3)
+        if eye is not None:
+            e = np.asarray(eye, np.float64).reshape(3)
+            hit = self.ray_hit(e, c[0] - e)
+            if hit is not None:
+                c = hit.reshape(1, 3)
+        return self.project(c)
 
     def grow(self, groom: Groom, roots: np.ndarray) -> Groom:
         """New strands at ``roots`` shaped like the groom's strands around them (render-hair

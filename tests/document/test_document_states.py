@@ -2,7 +2,8 @@
 
 Rules are the artist's actions. On the groom (a few dozen strands on a tiny head): strokes of
 every registered brush with random radius, strength, falloff, direction, symmetry, pen pressure
-and its toggles, front faces only, "affect selection only" and Ctrl or Shift held (a select
+and its toggles, front faces only, an orthographic or a perspective camera (whose eye the
+samples record), "affect selection only" and Ctrl or Shift held (a select
 stroke: deselect, or add instead of a new selection); selection steps (all, none,
 invert, box, hide and reveal); the up axis; the head mesh taken off and put back; render hair
 grown and removed; engine parameters; the camera; opening another groom. On the animation side:
@@ -265,12 +266,15 @@ class DocumentMachine(RuleBasedStateMachine):
         add=st.booleans(),
         front_only=st.booleans(),
         only_selected=st.booleans(),
+        perspective=st.booleans(),
     )
     def stroke(self, data, brush, moves, radius, strength, falloff, symmetry, pressures,
                pressure_radius, pressure_strength, invert, add, front_only,
-               only_selected) -> None:  # fmt: skip
+               only_selected, perspective) -> None:  # fmt: skip
         """One stroke of a brush: its moves as the studio samples them (BrushTool), one step
-        (``add``: Shift held, so a select stroke adds instead of starting a new selection)."""
+        (``add``: Shift held, so a select stroke adds instead of starting a new selection;
+        ``perspective``: the camera's eye 4 units back along the view, which the samples record,
+        else an orthographic camera's none)."""
         tool = BrushTool(brush=brush, falloff=falloff, symmetry=symmetry, front_only=front_only,
                          only_selected=only_selected, add_count=data.draw(st.integers(1, 3)))  # fmt: skip
         tool.reset_radius(radius)
@@ -284,11 +288,14 @@ class DocumentMachine(RuleBasedStateMachine):
         pts = side.pipeline.aligned.points
         at = pts[data.draw(st.integers(0, len(pts) - 1))].astype(np.float64)
         view = data.draw(st.sampled_from([None, (0.0, 0.0, -1.0), (0.0, -1.0, 0.0)]))
+        eye = None
+        if perspective:  # from the front (no view: front faces only off) or from above
+            eye = (0.0, 4.0, 0.0) if view == (0.0, -1.0, 0.0) else (0.0, 0.5, 4.0)
         self.drag += 1
         before, index = side.state, self.doc.stack.index
         for k in range(moves):
             step = np.array(data.draw(st.tuples(*[st.floats(-0.3, 0.3)] * 3)))
-            moves_made = tool.samples(at, step, view, 0.0, invert, k == 0, pressures[k], add)
+            moves_made = tool.samples(at, step, view, 0.0, invert, k == 0, pressures[k], add, eye)
             at = at + step
             if not moves_made:
                 continue

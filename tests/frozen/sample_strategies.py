@@ -43,6 +43,8 @@ def _field(f: Field, by: str) -> st.SearchStrategy[Any]:
         return _vector
     if kind == "view":
         return st.none() | _view
+    if kind == "point":
+        return st.none() | _vector
     if kind == "number":
         return _number(f, by)
     if kind == "whole":

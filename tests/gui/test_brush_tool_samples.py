@@ -36,10 +36,12 @@ def moves(draw):
     tool.pressure_radius[tool.brush] = draw(st.booleans())
     tool.pressure_strength[tool.brush] = draw(st.booleans())
     per_move = []
+    eye = draw(st.none() | _vector)  # a perspective camera's, or none (orthographic)
     for i in range(draw(st.integers(1, 3))):
         cursor, direction, view = draw(_vector), draw(_vector), draw(_vector)
         invert, pressure, add = draw(st.booleans()), draw(st.floats(0.0, 1.0)), draw(st.booleans())
-        per_move.append(tool.samples(cursor, direction, view, draw(_coord), invert, i == 0, pressure, add))
+        plane = draw(_coord)
+        per_move.append(tool.samples(cursor, direction, view, plane, invert, i == 0, pressure, add, eye))
     return per_move
 
 

@@ -25,9 +25,11 @@ from hairtool.frozen.brushes.mask import paint_mask
 from hairtool.frozen.brushes.sample import (
     MAX_COUNT,
     BrushSample,
+    check_eye,
     check_pressure,
     check_sample,
     check_view,
+    mirrored_eye,
     mirrored_view,
 )
 from hairtool.frozen.brushes.scalp import (
@@ -93,8 +95,8 @@ def apply_brush_reference(groom, sample: BrushSample, locked, centre):
 __all__ = [
     "BRUSHES", "CHANGE_STRANDS", "EPS", "FALLOFFS", "LOCAL_BRUSHES", "LUT_SIZE", "MAX_COUNT",
     "MAX_FALLOFF_POINTS", "MOVE_NONE", "NEED_SURFACE", "PLANAR_RATIO", "SIGNED", "BrushSample",
-    "any_within", "any_within_reference", "apply_brush", "apply_brush_reference", "check_pressure",
-    "check_sample", "check_view", "facing_away", "facing_away_reference", "falloff_lut",
-    "mirrored_view", "paint_clump", "paint_clump_reference", "paint_mask", "registry", "root_normals",
-    "scalp_centre",
+    "any_within", "any_within_reference", "apply_brush", "apply_brush_reference", "check_eye",
+    "check_pressure", "check_sample", "check_view", "facing_away", "facing_away_reference",
+    "falloff_lut", "mirrored_eye", "mirrored_view", "paint_clump", "paint_clump_reference", "paint_mask",
+    "registry", "root_normals", "scalp_centre",
 ]  # fmt: skip

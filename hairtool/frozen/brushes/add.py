@@ -72,7 +72,7 @@ class Add(Brush):
         if surface is None or not hasattr(surface, "plant"):
             raise ParameterError("scalp", None, "a head mesh for the add brush (--scalp MESH.obj)")
         s = sample
-        new = surface.plant(g, s.cursor, s.radius, s.count, s.seed, s.view, s.visible)
+        new = surface.plant(g, s.cursor, s.radius, s.count, s.seed, s.view, s.visible, s.eye)
         if new is None:
             return g
         out = append_strands(g, new)

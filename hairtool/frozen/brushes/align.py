@@ -39,6 +39,7 @@ class AlignSample(NamedTuple):
     only_selected: bool = False  # as BrushSample's
     pressure: float = 1.0  # as BrushSample's (already applied to radius and intensity)
     visible: bool = False  # as BrushSample's (front faces only by sight, not by root normal)
+    eye: tuple[float, float, float] | None = None  # as BrushSample's (a perspective camera's eye)
 
 
 def _locked_back(g: Groom, out: Groom, locked) -> Groom:

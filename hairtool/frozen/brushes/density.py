@@ -3,7 +3,10 @@ they are too dense and planting where they are too sparse (:mod:`hairtool.frozen
 holds the thinning and the dart throwing, with their numpy twins). Front faces only: a sample
 that says ``visible`` keeps (as if locked) the strands the head hides under the brush and plants
 no root the head hides from the camera; one that does not (every log before it) does nothing
-where the head under the cursor faces away and plants only where the surface faces the camera."""
+where the head under the cursor faces away and plants only where the surface faces the camera.
+Under a perspective camera (a sample's ``eye``) the brush works around the head's point on the
+line from the eye through the cursor (:meth:`~hairtool.guides.planting.HeadSurface.aimed`), and
+by sight each dart's ray goes to the eye."""
 
 from __future__ import annotations
 
@@ -51,12 +54,12 @@ SPEC = BrushSpec(
 def _density(ctx: StrokeContext, g: Groom, sample, thin_, accept_) -> Groom:
     """One density sample: thinned, then planted (``thin_``, ``accept_``: the kernels or their twins)."""
     surface = ctx.surface
-    if surface is None or not hasattr(surface, "grow"):
+    if surface is None or not hasattr(surface, "aimed"):
         raise ParameterError("scalp", None, "a head mesh for the density brush (--scalp MESH.obj)")
     if sample.strength <= 0:
         return g
     locked = ctx.lock(sample)
-    q, n = surface.project(np.asarray(sample.cursor, np.float64).reshape(1, 3))
+    q, n = surface.aimed(sample.cursor, sample.eye)
     q, n = q[0], n[0]
     grid = getattr(surface, "face_grid", None) if sample.view is not None and sample.visible else None
     if sample.view is not None and grid is None and float(n @ np.asarray(sample.view, np.float64)) > 0:
@@ -74,7 +77,7 @@ def _density(ctx: StrokeContext, g: Groom, sample, thin_, accept_) -> Groom:
     cands, cn = surface.project(disc_candidates(q, n, r, spacing, rng))
     ok = np.linalg.norm(cands - q, axis=1) < r
     if grid is not None:  # front faces only by sight: the darts the head hides are not thrown
-        ok[ok] = ~hidden_points(cands[ok], sample.view, grid)
+        ok[ok] = ~hidden_points(cands[ok], sample.view, grid, sample.eye)
     elif sample.view is not None:  # by the normal, as every log before visible
         ok &= cn @ np.asarray(sample.view, np.float64) <= 0
     cands = cands[ok]

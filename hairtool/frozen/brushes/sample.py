@@ -38,7 +38,11 @@ class BrushSample:
     ``visible``: with a ``view``, the strands kept are those the head does not hide from the
     camera under the brush (:mod:`~hairtool.frozen.brushes.sight`: the studio's rule, needing a
     head mesh), else those whose root normal faces the camera (the rule of every log written
-    before it, so its default; the rule without a head mesh too)."""
+    before it, so its default; the rule without a head mesh too). ``eye``: a perspective
+    camera's eye (the studio records it in its 3-D view; None for an orthographic camera, and
+    in every log written before it): by sight, each vertex's ray goes to it rather than against
+    ``view``, and add and density plant where the line from it through ``cursor`` meets the
+    head."""
 
     brush: str
     cursor: tuple[float, float, float]
@@ -57,6 +61,7 @@ class BrushSample:
     any_segment: bool = False
     new_selection: bool = False
     visible: bool = False
+    eye: tuple[float, float, float] | None = None
 
     def mirrored(self, plane_x: float) -> BrushSample:
         """The sample across the plane x = ``plane_x``, the second sample of the same move (so
@@ -64,12 +69,18 @@ class BrushSample:
         c, d = self.cursor, self.direction
         cursor, direction = (2.0 * plane_x - c[0], c[1], c[2]), (-d[0], d[1], d[2])
         view = mirrored_view(self.view)
-        return replace(self, cursor=cursor, direction=direction, view=view, new_selection=False)
+        eye = mirrored_eye(self.eye, plane_x)
+        return replace(self, cursor=cursor, direction=direction, view=view, new_selection=False, eye=eye)
 
 
 def mirrored_view(view: tuple[float, float, float] | None) -> tuple[float, float, float] | None:
     """A viewing direction mirrored across a plane x = const (None stays None)."""
     return None if view is None else (-view[0], view[1], view[2])
+
+
+def mirrored_eye(eye: tuple[float, float, float] | None, plane_x: float) -> tuple[float, float, float] | None:
+    """An eye mirrored across the plane x = ``plane_x`` (None stays None)."""
+    return None if eye is None else (2.0 * plane_x - eye[0], eye[1], eye[2])
 
 
 def check_view(view: object) -> tuple[float, float, float] | None:
@@ -82,6 +93,19 @@ def check_view(view: object) -> tuple[float, float, float] | None:
         v = np.zeros(0)
     if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.any(v != 0):
         raise ParameterError("view", view, "null or three finite numbers, not all zero")
+    return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def check_eye(eye: object) -> tuple[float, float, float] | None:
+    """None, or three finite numbers: a perspective camera's eye (ParameterError naming ``eye``)."""
+    if eye is None:
+        return None
+    try:
+        v = np.asarray(eye, dtype=np.float64) if not isinstance(eye, str | bytes) else np.zeros(0)
+    except (TypeError, ValueError):
+        v = np.zeros(0)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ParameterError("eye", eye, "null or three finite numbers")
     return (float(v[0]), float(v[1]), float(v[2]))
 
 
@@ -124,6 +148,7 @@ def check_sample(sample: BrushSample) -> BrushSample:
         raise ParameterError("falloff", f"{len(sample.lut)} samples", f"{LUT_SIZE}")
     check_pressure(sample.pressure)
     check_flag("visible", sample.visible)
+    check_eye(sample.eye)
     return sample
 
 

@@ -28,7 +28,8 @@ otherwise step past at a corner. So a point inside or behind a closed head is al
 even from a view whose ray runs exactly through the head's vertices.
 
 Rays go against the sample's ``view`` (an orthographic camera), or, given a perspective
-camera's ``eye``, from each vertex to the eye (and only faces before it hide).
+camera's ``eye`` (a sample's ``eye``, which the studio records in its 3-D view), from each
+vertex to the eye (and only faces before it hide).
 
 :func:`hidden_strands` judges a brush sample's strands, :func:`hidden_points` single points
 (the vertex a press starts a stroke on); each has a numpy twin (``*_reference``) that tries
