@@ -266,40 +266,12 @@ class LocalClump:
         vertices near a changed vertex, before or after). The points of the next iterate that can
         change are those, and the points of the vertices whose nearest neighbour's force can (the
         gap correction; not with gap mode "off"): a vertex whose list holds no changed point has
-        the record's nearest neighbour."""
-        strand = self.topology.strand_index
-        best = self.record.best
-        skip = np.zeros(self.topology.vertex_count, bool)
-        skip[changed] = True
-        went = np.any(was.view(np.uint32) != new[changed].view(np.uint32), axis=1)
-        queries = np.concatenate([new[changed], was[went]])  # lists then and now
-        qs = np.concatenate([strand[changed], strand[changed[went]]])
-        layers, count = [changed], changed.size
-        known = np.zeros(0, np.int64)  # of the next forces: those the gap search already found
-        for it in range(iterations):
-            forces = self.grid.vertices_near(new, queries, qs, self.radius, skip)  # (flagged)
-            if known.size:
-                forces = np.union1d(known, forces)
-            grown, known = [forces], np.zeros(0, np.int64)
-            if gap_mode != "off" and forces.size:
-                near = self.grid.vertices_near(new, new[forces], strand[forces], self.radius, skip)
-                skip[near] = False
-                b = best[it][near]
-                pulled = near[(b >= 0) & skip[np.maximum(b, 0)]]  # their nearest's force can change
-                skip[pulled] = True
-                grown.append(pulled)
-                # The next forces are the vertices near these forces or the pulled ones: those
-                # near the forces are ``near`` less the pulled; only the pulled are searched again.
-                known = near[~skip[near]]
-                skip[known] = True
-            fresh = np.concatenate(grown)
-            count += fresh.size
-            if fresh.size == 0 or count > most:
-                break
-            layers.append(fresh)
-            searched = pulled if gap_mode != "off" else fresh
-            queries, qs = new[searched], strand[searched]
-        return None if count > most else np.sort(np.concatenate(layers))
+        the record's nearest neighbour. The grid walks it all in one compiled call
+        (:meth:`~hairtool.frozen.vertex_grid.VertexGrid.reach`: flags, not numpy's set
+        operations between six calls)."""
+        return self.grid.reach(
+            new, was, changed, self.record.best, gap_mode != "off", iterations, self.radius, most
+        )
 
 
 def clump_region_reference(
