@@ -91,12 +91,13 @@ def _local_run(new, sv, flat, cap, cnt, vids, roots, h, ident, step, gap, seed, 
     """Every iteration of the vertices ``vids`` (lists at ``flat[n·cap :][: cnt[n]]``, original
     indices) from their new input (points ``new``, clump strength ``sv``), written into the
     record ``rec`` = (points, strength, iterates, forces, best, result); the other vertices are
-    read where the record has them. One launch for the move: f (15) and the nearest neighbour of
-    each vertex, then its next iterate (or the float32 result) with the gap correction.
+    read where the record has them. One call for the move: the input copied in, then per
+    iteration f (15) and the nearest neighbour of each vertex, then its next iterate (or the
+    float32 result) with the gap correction: two parallel loops an iteration.
     ``near``: (vids.size,) scratch for the nearest neighbours."""
     points, strength, iterates, forces, best, result = rec
     inv_h = 1.0 / h
-    for n in prange(vids.size):
+    for n in range(vids.size):  # (serial: a copy costs less than waking the threads for it)
         i = vids[n]
         for a in range(3):
             points[i, a] = new[i, a]
