@@ -54,6 +54,7 @@ from hairtool.frozen.spatial import pairs_within_reference
 from hairtool.frozen.vertex_grid import VertexGrid, list_frame
 from hairtool.groom import Topology
 from hairtool.serial_twins import twin_njit
+from hairtool.sorted_ids import distinct_sorted
 
 MAX_SEEDS = 0.1  # of the vertices: a move that changes more runs in full (cheaper then)
 MAX_REGION = 0.25  # of the vertices: a region larger than this, too (measured on ratboy_mohawk: a
@@ -251,7 +252,7 @@ class LocalClump:
         gap, seed64 = _GAP_CODE[gap_mode], seed_u64(seed)
         run(new, sv, flat, cap, cnt, vids, self.roots, self.h, self.ident, float(step), gap, seed64,
             iterations, fields, self._near(vids.size))  # fmt: skip
-        self.region = np.unique(top.strand_index[vids])
+        self.region = distinct_sorted(top.strand_index[vids])  # (vids ascending: their strands too)
         self.vertices = vids
         return self.region, vids
 
