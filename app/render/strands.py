@@ -71,6 +71,7 @@ from app.render.strand_gpu import (
 from hairtool.bounds import box
 from hairtool.errors import GroomError, ParameterError
 from hairtool.groom import Groom, Topology
+from hairtool.sorted_ids import distinct, union
 
 __all__ = [
     "RESTART_INDEX",
@@ -357,7 +358,7 @@ class StrandRenderer:
             raise GroomError("update_points needs a groom: call set_groom first")
         p, self.bounds = self._checked_points(points, self.topology.vertex_count, "points")
         if changed is not None:
-            changed = np.unique(np.asarray(changed, np.int64))
+            changed = distinct(np.asarray(changed, np.int64))
             if changed.size and (changed[0] < 0 or changed[-1] >= self.topology.strand_count):
                 raise ParameterError(
                     "changed", "a strand id out of range", f"ids in [0, {self.topology.strand_count})"
@@ -365,7 +366,7 @@ class StrandRenderer:
         moved = self._main.write(p, changed, find=self.hair_shading)
         self.last_moved = moved
         if self._reshade is not None:
-            self._reshade = None if moved is None else np.union1d(self._reshade, moved)
+            self._reshade = None if moved is None else union(self._reshade, moved)
         self._version += 1
 
     def set_ghost_points(
@@ -459,7 +460,7 @@ class StrandRenderer:
                 self._gpu.colors[a:b] = c[a:b]
             self._gpu.colors_written(runs)
         elif self._reshade is not None:
-            self._reshade = np.union1d(self._reshade, moved)
+            self._reshade = union(self._reshade, moved)
         self._version += 1
 
     def set_ramp(self, name: str) -> None:

@@ -54,6 +54,7 @@ from hairtool.frozen.spatial import pairs_within_reference
 from hairtool.frozen.vertex_grid import VertexGrid, list_frame
 from hairtool.groom import Topology
 from hairtool.serial_twins import twin_njit
+from hairtool.sorted_ids import distinct_sorted
 
 MAX_SEEDS = 0.1  # of the vertices: a move that changes more runs in full (cheaper then)
 MAX_REGION = 0.25  # of the vertices: a region larger than this, too (measured on ratboy_mohawk: a
@@ -91,12 +92,13 @@ def _local_run(new, sv, flat, cap, cnt, vids, roots, h, ident, step, gap, seed, 
     """Every iteration of the vertices ``vids`` (lists at ``flat[n·cap :][: cnt[n]]``, original
     indices) from their new input (points ``new``, clump strength ``sv``), written into the
     record ``rec`` = (points, strength, iterates, forces, best, result); the other vertices are
-    read where the record has them. One launch for the move: f (15) and the nearest neighbour of
-    each vertex, then its next iterate (or the float32 result) with the gap correction.
+    read where the record has them. One call for the move: the input copied in, then per
+    iteration f (15) and the nearest neighbour of each vertex, then its next iterate (or the
+    float32 result) with the gap correction: two parallel loops an iteration.
     ``near``: (vids.size,) scratch for the nearest neighbours."""
     points, strength, iterates, forces, best, result = rec
     inv_h = 1.0 / h
-    for n in prange(vids.size):
+    for n in range(vids.size):  # (serial: a copy costs less than waking the threads for it)
         i = vids[n]
         for a in range(3):
             points[i, a] = new[i, a]
@@ -250,7 +252,7 @@ class LocalClump:
         gap, seed64 = _GAP_CODE[gap_mode], seed_u64(seed)
         run(new, sv, flat, cap, cnt, vids, self.roots, self.h, self.ident, float(step), gap, seed64,
             iterations, fields, self._near(vids.size))  # fmt: skip
-        self.region = np.unique(top.strand_index[vids])
+        self.region = distinct_sorted(top.strand_index[vids])  # (vids ascending: their strands too)
         self.vertices = vids
         return self.region, vids
 
@@ -266,40 +268,12 @@ class LocalClump:
         vertices near a changed vertex, before or after). The points of the next iterate that can
         change are those, and the points of the vertices whose nearest neighbour's force can (the
         gap correction; not with gap mode "off"): a vertex whose list holds no changed point has
-        the record's nearest neighbour."""
-        strand = self.topology.strand_index
-        best = self.record.best
-        skip = np.zeros(self.topology.vertex_count, bool)
-        skip[changed] = True
-        went = np.any(was.view(np.uint32) != new[changed].view(np.uint32), axis=1)
-        queries = np.concatenate([new[changed], was[went]])  # lists then and now
-        qs = np.concatenate([strand[changed], strand[changed[went]]])
-        layers, count = [changed], changed.size
-        known = np.zeros(0, np.int64)  # of the next forces: those the gap search already found
-        for it in range(iterations):
-            forces = self.grid.vertices_near(new, queries, qs, self.radius, skip)  # (flagged)
-            if known.size:
-                forces = np.union1d(known, forces)
-            grown, known = [forces], np.zeros(0, np.int64)
-            if gap_mode != "off" and forces.size:
-                near = self.grid.vertices_near(new, new[forces], strand[forces], self.radius, skip)
-                skip[near] = False
-                b = best[it][near]
-                pulled = near[(b >= 0) & skip[np.maximum(b, 0)]]  # their nearest's force can change
-                skip[pulled] = True
-                grown.append(pulled)
-                # The next forces are the vertices near these forces or the pulled ones: those
-                # near the forces are ``near`` less the pulled; only the pulled are searched again.
-                known = near[~skip[near]]
-                skip[known] = True
-            fresh = np.concatenate(grown)
-            count += fresh.size
-            if fresh.size == 0 or count > most:
-                break
-            layers.append(fresh)
-            searched = pulled if gap_mode != "off" else fresh
-            queries, qs = new[searched], strand[searched]
-        return None if count > most else np.sort(np.concatenate(layers))
+        the record's nearest neighbour. The grid walks it all in one compiled call
+        (:meth:`~hairtool.frozen.vertex_grid.VertexGrid.reach`: flags, not numpy's set
+        operations between six calls)."""
+        return self.grid.reach(
+            new, was, changed, self.record.best, gap_mode != "off", iterations, self.radius, most
+        )
 
 
 def clump_region_reference(

@@ -29,6 +29,7 @@ from hairtool.frozen.replay import Sample, StrokeSetting, apply_sample, memory_f
 from hairtool.frozen.selection import SelectionSample
 from hairtool.frozen.strand_state import StrandState
 from hairtool.groom import Groom, vertex_ids_of
+from hairtool.sorted_ids import union
 
 
 @dataclass(eq=False)
@@ -188,7 +189,7 @@ def move(
             state, memory, more = _sample(
                 moves, setting, aligned, state, memory, cur, sample, touched, planar, normals
             )
-            painted = np.union1d(painted, more)
+            painted = union(painted, more)
     except BaseException:  # a refused sample: none of these samples happened
         cur.undo()
         raise
@@ -197,7 +198,7 @@ def move(
     rv = vertex_ids_of(top, ran)
     went = rv[np.any(cur.before(rv).view(np.uint32) != cur.points[rv].view(np.uint32), axis=1)]
     pv = vertex_ids_of(top, painted)
-    changed = np.union1d(went, pv)  # the vertices whose clump input changed
+    changed = union(went, pv)  # the vertices whose clump input changed
     now_aligned = aligned
     if went.size:
         was = cur.before(went)
@@ -261,7 +262,7 @@ def _sample(
     brush.check(sample)
     reach = float(sample.radius) * (1.0 + 1e-6)  # a little wider: the brush itself decides
     near = local.near(moves.grid_points, np.asarray(sample.cursor, np.float64).reshape(1, 3), reach)
-    cand = np.union1d(near, np.flatnonzero(touched))
+    cand = union(near, np.flatnonzero(touched))
     if cand.size == 0:
         return state, memory, none
     vids = vertex_ids_of(top, cand)

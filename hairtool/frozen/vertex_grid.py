@@ -1,13 +1,14 @@
 """A grid of every vertex of a groom, kept across brush moves and updated where strands moved.
 
 The brush-local engine (:mod:`hairtool.frozen.local`) asks it three things on each mouse move:
-which strands have a vertex within a brush's radius, which vertices of other strands lie within
-the clump kernel's reach (h·(1 + MARGIN)) of the vertices whose clumping may change, and the
-neighbour list of each vertex it redoes. Cells are cubes one list radius wide, hashed into about
-2V buckets, each a doubly linked list of vertices, so that moving a vertex to another cell costs
-O(1) and the grid never has to be rebuilt while the strands stay the same (a candidate counts
-only where its exact cell matches, so hash collisions never count twice). Cell coordinates are
-clipped to ±2**20, which only makes far-away cells share a list.
+which strands have a vertex within a brush's radius, which vertices a change can reach through
+the clump kernel's lists (other strands within h·(1 + MARGIN)) and nearest neighbours, walked
+in one call (:meth:`VertexGrid.reach`), and the neighbour list of each vertex it redoes. Cells
+are cubes one list radius wide, hashed into about 2V buckets, each a doubly linked list of
+vertices, so that moving a vertex to another cell costs O(1) and the grid never has to be
+rebuilt while the strands stay the same (a candidate counts only where its exact cell matches,
+so hash collisions never count twice). Cell coordinates are clipped to ±2**20, which only makes
+far-away cells share a list.
 
 A vertex's list comes in the order a full build of :class:`hairtool.frozen.spatial.NeighbourList`
 gives it (:func:`list_frame` names that build's grid): the neighbours after the vertex in the
@@ -308,6 +309,101 @@ def _vertices_near(points, strand, qx, qy, qz, qs, r2, inv, shift, key, head, nx
     return m
 
 
+@njit(cache=True, nogil=True)
+def _near_ids(points, strand, ids, r2, inv, shift, key, head, nxt, skip, out):
+    """:func:`_vertices_near` with the vertices ``ids`` (their points and strands) as queries."""
+    n = ids.size
+    qx, qy, qz, qs = np.empty(n), np.empty(n), np.empty(n), np.empty(n, np.int64)
+    for q in range(n):
+        i = ids[q]
+        qx[q], qy[q], qz[q] = points[i, 0], points[i, 1], points[i, 2]
+        qs[q] = strand[i]
+    return _vertices_near(points, strand, qx, qy, qz, qs, r2, inv, shift, key, head, nxt, skip, out)
+
+
+@njit(cache=True, nogil=True)
+def _reach_walks(new, was, new_bits, was_bits, strand, changed, best, gap, iterations, most, r2, inv, shift,
+                 key, head, nxt, skip, out, known):  # fmt: skip
+    """:meth:`hairtool.frozen.local.LocalClump.reach` in one call, on flags instead of sets:
+    the reached vertices, unsorted, into ``out`` (V,); returns how many, or −1 past ``most``.
+    ``skip`` (V,) is all False on entry and on return (only what a call flags is cleared: no
+    pass over V); ``known`` (V,) is scratch. Each layer is a set, so the order the walks find
+    its vertices in changes nothing the caller sorts."""
+    nc = changed.size
+    for c in range(nc):
+        skip[changed[c]] = True
+        out[c] = changed[c]
+    nw = 0  # lists then and now: the changed points where they are, and where they were
+    for c in range(nc):
+        for a in range(3):
+            if was_bits[c, a] != new_bits[changed[c], a]:
+                nw += 1
+                break
+    m = nc + nw
+    qx, qy, qz, qs = np.empty(m), np.empty(m), np.empty(m), np.empty(m, np.int64)
+    w = nc
+    for c in range(nc):
+        i = changed[c]
+        qx[c], qy[c], qz[c], qs[c] = new[i, 0], new[i, 1], new[i, 2], strand[i]
+        for a in range(3):
+            if was_bits[c, a] != new_bits[i, a]:
+                qx[w], qy[w], qz[w], qs[w] = was[c, 0], was[c, 1], was[c, 2], strand[i]
+                w += 1
+                break
+    pos = nc  # out[:pos]: the layers so far
+    count = nc
+    nk = 0  # known[:nk]: next forces the gap search already found (flagged)
+    pulled0 = pulled1 = 0
+    over = False
+    grid = (r2, inv, shift, key, head, nxt, skip)
+    for it in range(iterations):
+        if it == 0:
+            found = _vertices_near(new, strand, qx, qy, qz, qs, *grid, out[pos:])
+        else:  # the pulled of the last iteration (or its fresh without the gap), searched
+            found = _near_ids(new, strand, out[pulled0:pulled1], *grid, out[pos:])
+        for k in range(nk):
+            out[pos + found + k] = known[k]
+        nf = found + nk
+        forces = out[pos : pos + nf]
+        nk = 0
+        npull = 0
+        if gap and nf > 0:
+            near = known  # scratch until the known are picked from it
+            nn = _near_ids(new, strand, forces, *grid, near)
+            for k in range(nn):
+                skip[near[k]] = False
+            pull = np.empty(nn, np.bool_)
+            for k in range(nn):  # their nearest's force can change (read before any is flagged)
+                b = best[it, near[k]]
+                pull[k] = b >= 0 and skip[b]
+            for k in range(nn):
+                j = near[k]
+                skip[j] = True  # pulled, or known (the next forces): flagged either way
+                if pull[k]:
+                    out[pos + nf + npull] = j
+                    npull += 1
+            for k in range(nn):  # the known, kept in order in the scratch's front
+                if not pull[k]:
+                    known[nk] = near[k]
+                    nk += 1
+        fresh = nf + npull
+        count += fresh
+        if fresh == 0 or count > most:
+            over = count > most
+            pos += fresh  # (flagged: cleared below)
+            break
+        if gap:
+            pulled0, pulled1 = pos + nf, pos + fresh
+        else:
+            pulled0, pulled1 = pos, pos + fresh
+        pos += fresh
+    for k in range(pos):
+        skip[out[k]] = False
+    for k in range(nk):
+        skip[known[k]] = False
+    return -1 if over else pos
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _order_key(x, y, z, i, dense, lo, inv_cell, ny, nz, inv_q, nq, ox, oy, oz):
     """Where vertex i comes in the list build's order: row grid (``dense``): (row, quantised x,
@@ -521,6 +617,8 @@ class VertexGrid:
         self.strand = np.ascontiguousarray(strand, np.int64)
         self.capacity = 64  # list slots per vertex (grows to the longest list + 1)
         self._flat = np.empty(0, np.int64)  # the lists' buffer (:meth:`prepare`)
+        self._flags = np.zeros(0, np.bool_)  # :meth:`reach`'s, kept all False between calls
+        self._found = self._known = np.empty(0, np.int64)  # and its scratch
         _build(readonly(points), self.inv, self.shift, self.key, self.head, self.nxt, self.prv)
         self.blocks = _blocks_over(points, self.inv)  # vertices per block of cells (_mark_slab skips)
         _count_blocks(self.key, *self.blocks)
@@ -647,6 +745,63 @@ class VertexGrid:
         grid = (float(radius) ** 2, self.inv, self.shift, self.key, self.head, self.nxt, skip, out)
         found = _vertices_near(points, self.strand, *xyz, qs, *grid)
         return np.sort(out[:found])
+
+    def reach(
+        self,
+        points: np.ndarray,
+        was: np.ndarray,
+        changed: np.ndarray,
+        best: np.ndarray,
+        gap: bool,
+        iterations: int,
+        radius: float,
+        most: int,
+    ) -> np.ndarray | None:
+        """Sorted ids of the vertices a change on ``changed`` (now at ``points``, before at
+        ``was``) can reach in ``iterations`` list steps and, with ``gap``, through the nearest
+        neighbours ``best`` ``(k, V)``: :meth:`hairtool.frozen.local.LocalClump.reach`, walked
+        in one compiled call on flags kept between calls (None past ``most`` of them).
+
+        Parameters
+        ----------
+        points : ndarray
+            ``(V, 3)`` float32, where the grid holds them.
+        was : ndarray
+            ``(len(changed), 3)`` float32: the changed vertices before.
+        changed : ndarray
+            Sorted int64 ids.
+        best : ndarray
+            ``(k, V)`` int64, each iteration's nearest neighbours (−1: none).
+        gap : bool
+            Whether the gap correction reads the nearest neighbour's force.
+        iterations : int
+            List steps.
+        radius : float
+            The list radius, at most :attr:`cell`.
+        most : int
+            The largest answer wanted.
+
+        Returns
+        -------
+        ndarray or None
+            int64 ids.
+        """
+        if float(radius) > self.cell:
+            raise ValueError(f"radius {radius} beyond the grid's cell {self.cell}")
+        v = self.vertex_count
+        if self._flags.size != v:
+            self._flags = np.zeros(v, np.bool_)  # all False between calls
+            self._found = np.empty(v, np.int64)
+            self._known = np.empty(v, np.int64)
+        new = readonly(np.asarray(points, np.float32))  # (one compiled signature, whoever holds them)
+        was = readonly(np.asarray(was, np.float32))
+        changed, best = readonly(np.asarray(changed, np.int64)), readonly(np.asarray(best, np.int64))
+        grid = (float(radius) ** 2, self.inv, self.shift, self.key, self.head, self.nxt)
+        n = _reach_walks(
+            new, was, new.view(np.uint32), was.view(np.uint32), self.strand, changed, best, bool(gap),
+            int(iterations), int(most), *grid, self._flags, self._found, self._known,
+        )  # fmt: skip
+        return None if n < 0 else np.sort(self._found[:n])
 
     def lists(
         self, points: np.ndarray, vids: np.ndarray, radius: float, frame: tuple, parallel: bool = True
