@@ -55,6 +55,7 @@ from app.ui.brush_sizing import CanvasSizing, pen_pressure
 from app.ui.drawn import drawn
 from app.ui.gl_surface import GLSurface, hold_surface
 from app.ui.scene import Scene
+from hairtool import sorted_ids
 from hairtool.frozen.brushes import NEED_SURFACE, facing_away
 from hairtool.frozen.brushes.sight import hidden_points
 from hairtool.frozen.sample_schema import SELECTION
@@ -216,7 +217,7 @@ class Viewport(QWidget):
         elif "points" not in self._dirty:
             self._moved = known
         elif self._moved is not None:
-            self._moved = np.union1d(self._moved, known)
+            self._moved = sorted_ids.union(self._moved, known)
         self._dirty.add("points")
         if self.scene.colour_mode in ("displacement", "clump"):
             self._dirty.add("colors")
