@@ -83,30 +83,29 @@ def mirrored_eye(eye: tuple[float, float, float] | None, plane_x: float) -> tupl
     return None if eye is None else (2.0 * plane_x - eye[0], eye[1], eye[2])
 
 
-def check_view(view: object) -> tuple[float, float, float] | None:
-    """None, or three finite numbers not all zero (ParameterError naming ``view``)."""
-    if view is None:
+def _check_vector(name: str, value: object, nonzero: bool) -> tuple[float, float, float] | None:
+    """None, or three finite numbers (not all zero where ``nonzero``); else a ParameterError
+    naming ``name``."""
+    if value is None:
         return None
     try:
-        v = np.asarray(view, dtype=np.float64) if not isinstance(view, str | bytes) else np.zeros(0)
+        v = np.asarray(value, dtype=np.float64) if not isinstance(value, str | bytes) else np.zeros(0)
     except (TypeError, ValueError):
         v = np.zeros(0)
-    if v.shape != (3,) or not np.all(np.isfinite(v)) or not np.any(v != 0):
-        raise ParameterError("view", view, "null or three finite numbers, not all zero")
+    if v.shape != (3,) or not np.all(np.isfinite(v)) or (nonzero and not np.any(v != 0)):
+        what = "null or three finite numbers" + (", not all zero" if nonzero else "")
+        raise ParameterError(name, value, what)
     return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def check_view(view: object) -> tuple[float, float, float] | None:
+    """None, or three finite numbers not all zero (ParameterError naming ``view``)."""
+    return _check_vector("view", view, nonzero=True)
 
 
 def check_eye(eye: object) -> tuple[float, float, float] | None:
     """None, or three finite numbers: a perspective camera's eye (ParameterError naming ``eye``)."""
-    if eye is None:
-        return None
-    try:
-        v = np.asarray(eye, dtype=np.float64) if not isinstance(eye, str | bytes) else np.zeros(0)
-    except (TypeError, ValueError):
-        v = np.zeros(0)
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise ParameterError("eye", eye, "null or three finite numbers")
-    return (float(v[0]), float(v[1]), float(v[2]))
+    return _check_vector("eye", eye, nonzero=False)
 
 
 def check_sample(sample: BrushSample) -> BrushSample:
