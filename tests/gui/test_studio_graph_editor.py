@@ -48,7 +48,7 @@ def _library(w, motion, edits):
     return lib
 
 
-@pytest.mark.slow(seconds=17)
+@pytest.mark.slow(seconds=12)
 def test_a_key_dragged_sideways_moves_in_time_like_the_librarys_edit(ui, graph):
     w, view, motion = graph
     c, m = w.capture, w.animation
@@ -76,7 +76,7 @@ def test_a_key_dragged_sideways_moves_in_time_like_the_librarys_edit(ui, graph):
     assert m.dp_keys.tolist() == lib.keys.tolist()
 
 
-@pytest.mark.slow(seconds=23)
+@pytest.mark.slow(seconds=12)
 def test_a_key_dragged_in_time_and_value_is_one_step_and_stops_before_its_neighbour(ui, graph):
     w, view, motion = graph
     c = w.capture
@@ -239,7 +239,7 @@ def test_per_channel_keys_show_each_channels_own_keys_and_drag_like_the_library(
     assert all(np.array_equal(cv.keys, c.editor.keys) for cv in view.curves)
 
 
-@pytest.mark.slow(seconds=16)
+@pytest.mark.slow(seconds=9)
 def test_a_project_keeps_the_moved_keys(ui, graph, make_window, tmp_path):
     w, view, _ = graph
     c = w.capture
@@ -321,7 +321,7 @@ def test_on_hair_the_strands_feature_channels_are_read_only_views_of_the_key_cho
     assert [c.name for c in view.curves] == ["x", "y", "z"]
 
 
-@pytest.mark.slow(seconds=15)
+@pytest.mark.slow(seconds=9)
 def test_a_projects_capture_edits_replay_through_the_cli_to_the_studios_motion(ui, graph, tmp_path, capsys):
     """Issue 30: ``hairtool keys --edit`` reads what the studio keeps of a capture (an IK drag, a
     pose key moved in time and value, a per-channel key moved in time and value) and writes the
