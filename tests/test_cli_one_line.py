@@ -129,6 +129,7 @@ def shots(tmp_path_factory) -> Path:
     return root
 
 
+@pytest.mark.slow(seconds=12)  # each delay: its sleep, then Dask and the workers winding down
 @pytest.mark.parametrize("delay", (2.5, 4.0, 5.0, 8.0))  # importing Dask, starting workers, running jobs
 def test_ctrl_c_during_a_batch_is_one_line_from_the_command_alone(shots, delay):
     """The terminal sends SIGINT to the whole process group: the workers' tracebacks go nowhere."""

@@ -8,6 +8,8 @@ import subprocess
 import sys
 import textwrap
 
+import pytest
+
 SCRIPT = textwrap.dedent(
     """
     import sys
@@ -48,6 +50,7 @@ SCRIPT = textwrap.dedent(
 )
 
 
+@pytest.mark.slow(seconds=20)  # a fresh clone: the child compiles the kernels freeze and anime run
 def test_core_imports_and_cli_run_without_qt_or_gl(tmp_path):
     r = subprocess.run(
         [sys.executable, "-c", SCRIPT, str(tmp_path / "s.npz")],

@@ -131,6 +131,7 @@ def _fake_warm_up(monkeypatch, labels: list[str], pause_s: float = 0.2) -> None:
     monkeypatch.setattr(EngineStart, "start", lambda self: self.process.start(sys.executable, ["-c", script]))
 
 
+@pytest.mark.slow(seconds=12)
 def test_a_first_start_shows_sintels_guides_and_binds_her_render_hair_when_its_kernels_are_ready(
     make_window, qtbot, monkeypatch
 ):

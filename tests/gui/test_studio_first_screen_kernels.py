@@ -98,6 +98,7 @@ def _run(what: str, mode: str, env: dict) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+@pytest.mark.slow(seconds=12)
 @pytest.mark.parametrize("mode", ["serial", "parallel"])
 def test_the_first_screen_compiles_nothing_after_the_startup_steps(mode):
     """Both processes use the same cache (the worktree's, usually warm: then both load, and the

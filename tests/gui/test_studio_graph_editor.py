@@ -16,6 +16,10 @@ from hairtool.mocap.pose_edit import ChannelEdit, PoseEditor, RetimeEdit
 pytestmark = pytest.mark.gui
 
 ARM = "mixamorig:LeftForeArm"
+#: mouse moves in a drag of a capture's key: each move previews the edited capture (about a second
+#: of CPU on the 69 frames here), and what these tests check is where the key lands and that the
+#: moves make one undo step, which a move halfway and one at the end show as eight moves do
+CAPTURE_STEPS = 2
 
 
 @pytest.fixture
@@ -44,7 +48,7 @@ def _library(w, motion, edits):
     return lib
 
 
-@pytest.mark.slow(seconds=17)
+@pytest.mark.slow(seconds=12)
 def test_a_key_dragged_sideways_moves_in_time_like_the_librarys_edit(ui, graph):
     w, view, motion = graph
     c, m = w.capture, w.animation
@@ -52,7 +56,7 @@ def test_a_key_dragged_sideways_moves_in_time_like_the_librarys_edit(ui, graph):
     k = 2
     f0 = int(keys[k])
     p = np.array(view.key_point(1, k))
-    ui.drag(view, p, p + np.array([_frames_px(view, 3), 0.0]))
+    ui.drag(view, p, p + np.array([_frames_px(view, 3), 0.0]), steps=CAPTURE_STEPS)
     assert w.undo_stack.count() == 1 and c.edits == [RetimeEdit(f0, f0 + 3)]
     lib = _library(w, motion, c.edits)
     assert np.array_equal(c.motion().values, lib.motion().values)
@@ -72,7 +76,7 @@ def test_a_key_dragged_sideways_moves_in_time_like_the_librarys_edit(ui, graph):
     assert m.dp_keys.tolist() == lib.keys.tolist()
 
 
-@pytest.mark.slow(seconds=23)
+@pytest.mark.slow(seconds=12)
 def test_a_key_dragged_in_time_and_value_is_one_step_and_stops_before_its_neighbour(ui, graph):
     w, view, motion = graph
     c = w.capture
@@ -80,7 +84,8 @@ def test_a_key_dragged_in_time_and_value_is_one_step_and_stops_before_its_neighb
     k = 1
     f0, nxt = int(keys[k]), int(keys[k + 1])
     p = np.array(view.key_point(0, k))
-    ui.drag(view, p, p + np.array([_frames_px(view, nxt - f0 + 5), -30.0]))  # past the next key
+    past = p + np.array([_frames_px(view, nxt - f0 + 5), -30.0])  # past the next key
+    ui.drag(view, p, past, steps=CAPTURE_STEPS)
     assert w.undo_stack.count() == 1
     move, value = c.edits
     assert move == RetimeEdit(f0, nxt - 1)  # a key never passes its neighbour
@@ -93,7 +98,8 @@ def test_a_key_dragged_in_time_and_value_is_one_step_and_stops_before_its_neighb
     assert c.edits == [] and np.array_equal(c.motion().values, motion.values)
     # Shift keeps one axis: a mostly sideways drag moves the key in time only
     p = np.array(view.key_point(0, k))
-    ui.drag(view, p, p + np.array([_frames_px(view, -2), -6.0]), modifiers=Qt.KeyboardModifier.ShiftModifier)
+    shift = Qt.KeyboardModifier.ShiftModifier
+    ui.drag(view, p, p + np.array([_frames_px(view, -2), -6.0]), steps=CAPTURE_STEPS, modifiers=shift)
     assert c.edits == [RetimeEdit(f0, f0 - 2)]
 
 
@@ -233,16 +239,17 @@ def test_per_channel_keys_show_each_channels_own_keys_and_drag_like_the_library(
     assert all(np.array_equal(cv.keys, c.editor.keys) for cv in view.curves)
 
 
-@pytest.mark.slow(seconds=16)
+@pytest.mark.slow(seconds=9)
 def test_a_project_keeps_the_moved_keys(ui, graph, make_window, tmp_path):
     w, view, _ = graph
     c = w.capture
     keys = c.editor.keys.copy()
     p = np.array(view.key_point(1, 2))
-    ui.drag(view, p, p + np.array([_frames_px(view, 2), 0.0]))  # a pose key moved in time
+    # a pose key moved in time
+    ui.drag(view, p, p + np.array([_frames_px(view, 2), 0.0]), steps=CAPTURE_STEPS)
     w.graph_editor.per_channel.setChecked(True)
     p = np.array(view.key_point(0, 1))
-    ui.drag(view, p, p + np.array([0.0, -20.0]))  # a per-channel key moved in value
+    ui.drag(view, p, p + np.array([0.0, -20.0]), steps=CAPTURE_STEPS)  # a per-channel key moved in value
     assert c.edits and c.channel_edits
     edited = c.motion().values
     path = tmp_path / "moved.hairproj"
@@ -314,7 +321,7 @@ def test_on_hair_the_strands_feature_channels_are_read_only_views_of_the_key_cho
     assert [c.name for c in view.curves] == ["x", "y", "z"]
 
 
-@pytest.mark.slow(seconds=15)
+@pytest.mark.slow(seconds=9)
 def test_a_projects_capture_edits_replay_through_the_cli_to_the_studios_motion(ui, graph, tmp_path, capsys):
     """Issue 30: ``hairtool keys --edit`` reads what the studio keeps of a capture (an IK drag, a
     pose key moved in time and value, a per-channel key moved in time and value) and writes the
@@ -334,13 +341,14 @@ def test_a_projects_capture_edits_replay_through_the_cli_to_the_studios_motion(u
     keys = c.editor.keys.copy()
     k = 2
     p = np.array(view.key_point(1, k))
-    ui.drag(view, p, p + np.array([_frames_px(view, 1), -20.0]))  # a pose key in time and value
+    # a pose key in time and value
+    ui.drag(view, p, p + np.array([_frames_px(view, 1), -20.0]), steps=CAPTURE_STEPS)
     w.graph_editor.per_channel.setChecked(True)
     i = 2
     own = view.curves[i].keys
     k = int(np.argmax(np.minimum(np.diff(own)[:-1], np.diff(own)[1:]))) + 1
     p = np.array(view.key_point(i, k))
-    ui.drag(view, p, p + np.array([_frames_px(view, -1), 25.0]))  # one channel's key
+    ui.drag(view, p, p + np.array([_frames_px(view, -1), 25.0]), steps=CAPTURE_STEPS)  # one channel's key
     assert len(c.edits) == 3 and len(c.channel_edits) == 2 and w.undo_stack.count() == 3
     studio = tmp_path / "studio.bvh"
     write_bvh(studio, c.motion())

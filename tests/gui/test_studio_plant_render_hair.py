@@ -17,6 +17,7 @@ def front_root(w) -> np.ndarray:
     return v.project(s.result.roots[int(np.argmin(facing))])[0]
 
 
+@pytest.mark.slow(seconds=13)
 def test_sintel_with_render_hair_takes_delete_add_and_density_and_undo_gives_it_back(
     ui, make_window, tmp_path
 ):

@@ -181,6 +181,7 @@ def test_every_brushs_log_replays_on_a_usd_groom(scene, brush):
         assert not np.array_equal(usd.points, before.points)
 
 
+@pytest.mark.slow(seconds=15)
 def test_a_batch_job_replays_a_comb_log_on_a_usd_groom(scene):
     d, _ = scene
     job = Job(0, "freeze", (str(DATA / "b.usda"), "batch_out.usda", "--strokes", "comb.json"), str(d))
