@@ -209,7 +209,7 @@ def _press_step(pipe) -> None:
 
 
 def _head_step() -> None:
-    """Sintel's head as the engine's strokes meet it (closest points, inside test), compiled
+    """Sintel's head as the engine's strokes meet it (closest points, inside test, first hit), compiled
     apart from the engine's step so that the other process can do it first: the largest of
     the drag's kernels, and one whose types do not depend on the groom's (float64 always)."""
     from hairtool.guides.planting import HeadSurface
@@ -221,6 +221,8 @@ def _head_step() -> None:
     for ask in (points, few):  # a whole groom on every thread, a stroke's few on this one
         surface.project(ask)
         surface.signed_distance(ask)
+    # the head under the mouse: a press's and a perspective Add or Density sample's aim
+    surface.ray_hit(points[0] + 1e3, -1e3 * np.ones(3))
 
 
 def _scalp_engine_step() -> None:

@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.errors import ParameterError
+from hairtool.frozen.brushes.first_hit import face_ts_reference, first_hit
 from hairtool.frozen.brushes.sight import FaceGrid
 from hairtool.guides.inside import barycentric
 from hairtool.io.obj import Mesh
@@ -594,6 +595,7 @@ class MeshSurface:
         self.mesh = mesh
         self._pseudo = None  # the inside test's normals, made when first asked
         self._face_grid: FaceGrid | None = None
+        self._corners: tuple | None = None  # the faces' corners for ray_hit_reference, made when first asked
         self._v = mesh.vertices.astype(np.float64)
         self._n = mesh.normals.astype(np.float64)
         self._f = mesh.faces.astype(np.int64)
@@ -699,39 +701,41 @@ class MeshSurface:
         return sd, q, n
 
     def ray_hit(self, origin, direction) -> np.ndarray | None:
-        """The first point where the ray from ``origin`` along ``direction`` meets the mesh
-        (Möller–Trumbore over every face, vectorised), or None: what a brush on the head
-        touches under the mouse.
+        """The first point where the ray from ``origin`` along ``direction`` meets the mesh, or
+        None: what a brush on the head touches under the mouse. The ray walks the grid of faces
+        (:func:`~hairtool.frozen.brushes.first_hit.first_hit`, watertight: a ray through an edge
+        or a corner meets the faces there), trying only the faces of the cells it crosses up to
+        the first face met.
 
         Parameters
         ----------
         origin : array_like
             ``(3,)`` the ray's start.
         direction : array_like
-            ``(3,)`` its direction.
+            ``(3,)`` its direction (not zero).
 
         Returns
         -------
         ndarray or None
-            ``(3,)`` float64, or None for a miss.
+            ``(3,)`` float64 ``origin + t · direction`` at the nearest ``t > 0``, or None for a
+            miss.
         """
-        o, d = np.asarray(origin, np.float64), np.asarray(direction, np.float64)
-        tri = self._f
-        a, b, c = self._v[tri[:, 0]], self._v[tri[:, 1]], self._v[tri[:, 2]]
-        e1, e2 = b - a, c - a
-        p = np.cross(d, e2)
-        det = np.einsum("ij,ij->i", e1, p)
-        ok = np.abs(det) > 1e-12
-        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-        t0 = o - a
-        u = np.einsum("ij,ij->i", t0, p) * inv
-        q = np.cross(t0, e1)
-        v = (q @ d) * inv
-        t = np.einsum("ij,ij->i", e2, q) * inv
-        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
-        if not hit.any():
+        t, _ = first_hit(self.face_grid, origin, direction)
+        return self._ray_point(origin, direction, t)
+
+    def ray_hit_reference(self, origin, direction) -> np.ndarray | None:
+        """Numpy twin of :meth:`ray_hit`: every face tried, each face's corners gathered once
+        per surface."""
+        if self._corners is None:
+            self._corners = tuple(np.ascontiguousarray(self._v[self._kf[:, j]]) for j in range(3))
+        ts = face_ts_reference(self._corners, origin, direction)
+        return self._ray_point(origin, direction, float(ts.min()))
+
+    @staticmethod
+    def _ray_point(origin, direction, t: float) -> np.ndarray | None:
+        if not np.isfinite(t):
             return None
-        return o + float(t[hit].min()) * d
+        return np.asarray(origin, np.float64).reshape(3) + t * np.asarray(direction, np.float64).reshape(3)
 
     def _normals(self, q: np.ndarray, face: np.ndarray) -> np.ndarray:
         tri = self._f[face]

@@ -236,6 +236,7 @@ def test_the_head_step_compiles_the_drags_closest_points_kernel():
     """The other lane takes the align drag's head kernel off the engine's lane: its step must
     reach it (its types are float64 whatever the groom, so the drag then loads it)."""
     from hairtool import serial_twins
+    from hairtool.frozen.brushes import first_hit
     from hairtool.guides import surface
 
     dict(kernel_warmup.STEPS)[kernel_warmup.HEAD_STEP]()
@@ -243,6 +244,7 @@ def test_the_head_step_compiles_the_drags_closest_points_kernel():
     # parallel kernel's signatures came only from tests run before this one in the process)
     grid_closest = serial_twins.serial(serial_twins.parallel_of(surface._grid_closest_kernel))
     assert grid_closest.signatures and surface._bin_faces.signatures
+    assert first_hit._first_hit_kernel.signatures  # the head under the mouse
 
 
 def test_clump_children_on_a_first_start_waits_for_its_kernels_and_the_parallel_ones(
