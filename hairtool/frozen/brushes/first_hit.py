@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hairtool.frozen.brushes.sight import SIDE, FaceGrid, _edge, _edge_numpy, _sides, ray_frame
+from hairtool.frozen.brushes.sight import SIDE, FaceGrid, _edge, _edge_numpy, _sides, ray_frame, walk_start
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -77,38 +77,17 @@ def _first_hit_kernel(o, d, vertices, faces, lo, cell, dims, start, items, tmin)
     beyond the sides its entry and exit points lie within ``SIDE`` of, until the nearest ``t``
     found lies before the exit of the cell just searched by more than the side tolerance."""
     best, face = np.inf, -1
-    t0, t1 = 0.0, np.inf
-    for a in range(3):
-        hi = lo[a] + dims[a] * cell
-        if d[a] == 0.0:
-            if o[a] < lo[a] or o[a] > hi:
-                return best, face
-        else:
-            ta, tb = (lo[a] - o[a]) / d[a], (hi - o[a]) / d[a]
-            if ta > tb:
-                ta, tb = tb, ta
-            t0, t1 = max(t0, ta), min(t1, tb)
+    ci = np.empty(3, np.int64)
+    step = np.empty(3, np.int64)
+    tmax = np.empty(3, np.float64)
+    tdelta = np.empty(3, np.float64)
+    t0, t1 = walk_start(o, d, lo, cell, dims, ci, step, tmax, tdelta)
     if t0 > t1:
         return best, face
     frame = ray_frame(d)
     tol = SIDE * cell
     # the side tolerance in t, and the walk's own rounding where the origin is far from the box
     slack = tol / np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) + 1e-12 * t1
-    ci = np.empty(3, np.int64)
-    step = np.empty(3, np.int64)
-    tmax = np.empty(3, np.float64)
-    tdelta = np.empty(3, np.float64)
-    for a in range(3):
-        x = o[a] + t0 * d[a]
-        ci[a] = min(max(int(np.floor((x - lo[a]) / cell)), 0), dims[a] - 1)
-        if d[a] > 0.0:
-            step[a], tdelta[a] = 1, cell / d[a]
-            tmax[a] = (lo[a] + (ci[a] + 1) * cell - o[a]) / d[a]
-        elif d[a] < 0.0:
-            step[a], tdelta[a] = -1, -cell / d[a]
-            tmax[a] = (lo[a] + ci[a] * cell - o[a]) / d[a]
-        else:
-            step[a], tdelta[a], tmax[a] = 0, np.inf, np.inf
     s0, s1, s2 = _sides(o, d, t0, ci, -1, lo, cell, dims, tol)  # where the walk starts
     while True:
         c = (ci[0] * dims[1] + ci[1]) * dims[2] + ci[2]

@@ -154,6 +154,39 @@ def _side(x, low, cell, i, n, tol):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, inline="always")
+def walk_start(o, d, lo, cell, dims, ci, step, tmax, tdelta):  # pragma: no cover - compiled
+    """Where the ray from ``o`` along ``d`` is inside the grid's box, ``(t0, t1)`` (``t0 > t1``:
+    it misses the box), and the walk's state at ``t0`` filled in (Amanatides and Woo): the cell
+    ``ci``, each axis's ``step``, the ``t`` of its next side ``tmax`` and between sides
+    ``tdelta``."""
+    t0, t1 = 0.0, np.inf
+    for a in range(3):
+        hi = lo[a] + dims[a] * cell
+        if d[a] == 0.0:
+            if o[a] < lo[a] or o[a] > hi:
+                return 1.0, 0.0
+        else:
+            ta, tb = (lo[a] - o[a]) / d[a], (hi - o[a]) / d[a]
+            if ta > tb:
+                ta, tb = tb, ta
+            t0, t1 = max(t0, ta), min(t1, tb)
+    if t0 > t1:
+        return t0, t1
+    for a in range(3):
+        x = o[a] + t0 * d[a]
+        ci[a] = min(max(int(np.floor((x - lo[a]) / cell)), 0), dims[a] - 1)
+        if d[a] > 0.0:
+            step[a], tdelta[a] = 1, cell / d[a]
+            tmax[a] = (lo[a] + (ci[a] + 1) * cell - o[a]) / d[a]
+        elif d[a] < 0.0:
+            step[a], tdelta[a] = -1, -cell / d[a]
+            tmax[a] = (lo[a] + ci[a] * cell - o[a]) / d[a]
+        else:
+            step[a], tdelta[a], tmax[a] = 0, np.inf, np.inf
+    return t0, t1
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _sides(o, d, t, ci, skip, lo, cell, dims, tol):  # pragma: no cover - compiled
     """Per axis (:func:`_side`), where the ray's point at ``t`` lies on cell ``ci``'s sides; 0
     across ``skip`` (the axis the walk itself crosses there)."""
@@ -187,38 +220,17 @@ def _blocked(o, d, vertices, faces, lo, cell, dims, start, items, tmin, far):  #
     Woo), each face tried where it is met, and where the ray passes within ``SIDE`` of a cell
     of a side, edge or corner, the cells beyond it too (:func:`_beside`: around the cell it
     leaves and the one it enters, which share the point's other sides)."""
-    t0, t1 = 0.0, np.inf
-    for a in range(3):
-        hi = lo[a] + dims[a] * cell
-        if d[a] == 0.0:
-            if o[a] < lo[a] or o[a] > hi:
-                return False
-        else:
-            ta, tb = (lo[a] - o[a]) / d[a], (hi - o[a]) / d[a]
-            if ta > tb:
-                ta, tb = tb, ta
-            t0, t1 = max(t0, ta), min(t1, tb)
+    ci = np.empty(3, np.int64)
+    step = np.empty(3, np.int64)
+    tmax = np.empty(3, np.float64)
+    tdelta = np.empty(3, np.float64)
+    t0, t1 = walk_start(o, d, lo, cell, dims, ci, step, tmax, tdelta)
     t1 = min(t1, far)
     if t0 > t1:
         return False
     frame = ray_frame(d)
     kx, ky, kz, sx, sy, sz = frame
     tol = SIDE * cell
-    ci = np.empty(3, np.int64)
-    step = np.empty(3, np.int64)
-    tmax = np.empty(3, np.float64)
-    tdelta = np.empty(3, np.float64)
-    for a in range(3):
-        x = o[a] + t0 * d[a]
-        ci[a] = min(max(int(np.floor((x - lo[a]) / cell)), 0), dims[a] - 1)
-        if d[a] > 0.0:
-            step[a], tdelta[a] = 1, cell / d[a]
-            tmax[a] = (lo[a] + (ci[a] + 1) * cell - o[a]) / d[a]
-        elif d[a] < 0.0:
-            step[a], tdelta[a] = -1, -cell / d[a]
-            tmax[a] = (lo[a] + ci[a] * cell - o[a]) / d[a]
-        else:
-            step[a], tdelta[a], tmax[a] = 0, np.inf, np.inf
     s0, s1, s2 = _sides(o, d, t0, ci, -1, lo, cell, dims, tol)  # where the walk starts
     while True:
         c = (ci[0] * dims[1] + ci[1]) * dims[2] + ci[2]
