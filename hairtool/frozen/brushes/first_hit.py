@@ -20,25 +20,24 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hairtool.frozen.brushes.sight import SIDE, FaceGrid, _edge, _edge_numpy, _sides, ray_frame, walk_start
+from hairtool.frozen.brushes.sight import (
+    SIDE,
+    FaceGrid,
+    _edge_numpy,
+    _sides,
+    face_det_t,
+    ray_frame,
+    walk_start,
+)
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _face_t(o, kx, ky, kz, sx, sy, sz, vertices, faces, f, tmin):  # pragma: no cover - compiled
     """``t`` where the ray from ``o`` meets face ``f`` past ``tmin``, or inf: the sight test's
     watertight verdict (:func:`~hairtool.frozen.brushes.sight._meets`, no far end)."""
-    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-    az, bz, cz = vertices[a, kz] - o[kz], vertices[b, kz] - o[kz], vertices[c, kz] - o[kz]
-    ax, ay = vertices[a, kx] - o[kx] - sx * az, vertices[a, ky] - o[ky] - sy * az
-    bx, by = vertices[b, kx] - o[kx] - sx * bz, vertices[b, ky] - o[ky] - sy * bz
-    cx, cy = vertices[c, kx] - o[kx] - sx * cz, vertices[c, ky] - o[ky] - sy * cz
-    u, v, w = _edge(cx, cy, bx, by), _edge(ax, ay, cx, cy), _edge(bx, by, ax, ay)
-    if (u < 0.0 or v < 0.0 or w < 0.0) and (u > 0.0 or v > 0.0 or w > 0.0):
-        return np.inf
-    det = u + v + w
+    det, t = face_det_t(o, kx, ky, kz, sx, sy, sz, vertices, faces, f)
     if det == 0.0:
         return np.inf
-    t = sz * (u * az + v * bz + w * cz)  # t · det
     if (det > 0.0 and t > tmin * det) or (det < 0.0 and t < tmin * det):
         return t / det
     return np.inf

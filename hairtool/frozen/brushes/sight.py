@@ -104,11 +104,10 @@ def _edge(ax, ay, bx, by):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _meets(o, kx, ky, kz, sx, sy, sz, vertices, faces, f, tmin, far):  # pragma: no cover - compiled
-    """Whether the ray from ``o`` meets face ``f`` at some tmin < t < far, watertight (Woop, Benthin
-    and Wald 2013): the face's corners are moved to the ray's frame (:func:`ray_frame`) one
-    corner at a time, so neighbouring faces see a shared corner at the same place, and each
-    edge's side is :func:`_edge`'s. A ray through an edge or a corner meets a face there."""
+def face_det_t(o, kx, ky, kz, sx, sy, sz, vertices, faces, f):  # pragma: no cover - compiled
+    """``(det, t · det)`` of the ray from ``o`` (in its frame, :func:`ray_frame`) against face
+    ``f``, with ``det`` 0 where the ray passes outside the face or the face is edge-on: the
+    watertight test's one computation, which :func:`_meets` and the first hit's walk judge."""
     a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
     az, bz, cz = vertices[a, kz] - o[kz], vertices[b, kz] - o[kz], vertices[c, kz] - o[kz]
     ax, ay = vertices[a, kx] - o[kx] - sx * az, vertices[a, ky] - o[ky] - sy * az
@@ -116,11 +115,19 @@ def _meets(o, kx, ky, kz, sx, sy, sz, vertices, faces, f, tmin, far):  # pragma:
     cx, cy = vertices[c, kx] - o[kx] - sx * cz, vertices[c, ky] - o[ky] - sy * cz
     u, v, w = _edge(cx, cy, bx, by), _edge(ax, ay, cx, cy), _edge(bx, by, ax, ay)
     if (u < 0.0 or v < 0.0 or w < 0.0) and (u > 0.0 or v > 0.0 or w > 0.0):
-        return False
-    det = u + v + w
+        return 0.0, 0.0
+    return u + v + w, sz * (u * az + v * bz + w * cz)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _meets(o, kx, ky, kz, sx, sy, sz, vertices, faces, f, tmin, far):  # pragma: no cover - compiled
+    """Whether the ray from ``o`` meets face ``f`` at some tmin < t < far, watertight (Woop, Benthin
+    and Wald 2013): the face's corners are moved to the ray's frame (:func:`ray_frame`) one
+    corner at a time, so neighbouring faces see a shared corner at the same place, and each
+    edge's side is :func:`_edge`'s. A ray through an edge or a corner meets a face there."""
+    det, t = face_det_t(o, kx, ky, kz, sx, sy, sz, vertices, faces, f)
     if det == 0.0:
         return False
-    t = sz * (u * az + v * bz + w * cz)  # t · det
     if det > 0.0:
         return t > tmin * det and t < far * det
     return t < tmin * det and t > far * det
