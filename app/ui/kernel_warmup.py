@@ -423,8 +423,16 @@ def _serially(step: Callable[[], None]) -> Callable[[], None]:
 
 
 def _parallel_engine_step() -> None:
+    """The first screen's engine on the parallel kernels, then its drags again with every
+    brush-local move on them too: a dense groom's regions (the bear's: 4,000-9,000 vertices a
+    comb move) take the parallel kernels that Sintel's small regions never reach, and without
+    this the first stroke on such a groom compiled them (about 13 s on a quiet 2-core host)."""
+    from hairtool.frozen import local
+
     _head_step()
     _engine_step()
+    with local.parallel_from(0):
+        _engine_step()
 
 
 #: (label, step) in the order a single process runs them: the engine for the first groom, the

@@ -75,6 +75,19 @@ def parallel_for(vertices: int) -> bool:
 
 
 @contextmanager
+def parallel_from(vertices: int):
+    """Brush-local work on ``vertices`` or more runs the parallel kernels while inside: the
+    studio's warm-up compiles the kernels a dense groom's moves take (regions of
+    :data:`SERIAL_BELOW` vertices and more, the bear's) with a small groom's moves."""
+    global SERIAL_BELOW
+    saved, SERIAL_BELOW = SERIAL_BELOW, int(vertices)
+    try:
+        yield
+    finally:
+        SERIAL_BELOW = saved
+
+
+@contextmanager
 def threads_for(vertices: int):
     """numba threads for kernels without a serial twin (a brush's) on this many vertices: one
     below :data:`SERIAL_BELOW`, else all (the kernels' results do not depend on the count)."""
