@@ -9,6 +9,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -140,3 +141,55 @@ def test_the_engine_step_ends_with_a_full_run_on_an_updated_list(monkeypatch):
     monkeypatch.setattr(FrozenPipeline, "update", spy)
     kernel_warmup._engine_step()
     assert updated and updated[-1] >= 1
+
+
+#: The warm-up's parallel engine step, then the bear (a dense real groom) opened with the studio's
+#: engine parameters and dragged with a brush whose moves' regions reach the parallel kernels:
+#: prints the moves' region sizes and the kernel signatures the moves added to the process.
+DENSE = r"""
+import gc, json, sys
+import numpy as np
+from numba.core.dispatcher import Dispatcher
+from app.ui import kernel_warmup
+from hairtool import io
+from hairtool.frozen import local
+from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+
+def sigs():
+    return {
+        f"{d.py_func.__module__}:{d.py_func.__qualname__} {s}"
+        for d in gc.get_objects() if isinstance(d, Dispatcher) for s in d.signatures
+    }
+
+for label, step in kernel_warmup.STEPS:
+    if label == kernel_warmup.PARALLEL_ENGINE_STEP:
+        step()
+g = io.read_groom(sys.argv[1])
+pipe = FrozenPipeline(g, FrozenParams(**kernel_warmup.STUDIO_PARAMS))
+pipe.update()
+before = sigs()
+lo, hi = g.bounds
+extent = float(np.max(hi - lo))
+tips = g.tips.astype(np.float64)
+tip = tips[np.argmin(np.linalg.norm(tips - (lo + hi) / 2.0, axis=1))]
+regions = []
+for i in range(2):
+    pipe.align(tip + np.array([0.01 * i * extent, 0.0, 0.0]), 0.08 * extent, 0.8)
+    regions.append(pipe.clump_redone * g.vertex_count)
+print(json.dumps({"regions": regions, "serial_below": local.SERIAL_BELOW, "new": sorted(sigs() - before)}))
+"""
+
+
+@pytest.mark.slow(seconds=10)
+def test_a_dense_grooms_first_strokes_need_no_kernel_the_warm_up_left_out():
+    """The bear's brush-local moves (regions of 4,000-5,000 vertices) run the parallel kernels
+    that Sintel's small regions never reach; the warm-up's parallel engine step compiles them,
+    so the first stroke on such a groom loads them instead of compiling (13 s on a quiet host)."""
+    bear = Path(__file__).parents[1] / "data" / "grooms" / "bear.tfx"
+    out = subprocess.run(
+        [sys.executable, "-c", DENSE, str(bear)], capture_output=True, text=True, timeout=900, check=False
+    )
+    assert out.returncode == 0, out.stderr[-3000:]
+    report = json.loads(out.stdout.strip().splitlines()[-1])
+    assert all(r >= report["serial_below"] for r in report["regions"]), report["regions"]
+    assert not report["new"], "kernels the warm-up does not compile:\n" + "\n".join(report["new"])
