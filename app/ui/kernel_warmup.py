@@ -303,6 +303,13 @@ def _brushes_step() -> None:
             BRUSH.make(brush=spec.name, cursor=centre, direction=(1.0, 0.0, 0.0), radius=radius,
                        strength=strength, lut=lut, view=None, start=True)
         )  # fmt: skip
+    # Delete's studio default, Blender's rule (any segment under the brush: its own kernel); the
+    # samples above take the schema's default, the root rule of older logs
+    radius = 0.05 * float(np.max(hi - lo))
+    pipe.brush(
+        BRUSH.make(brush="delete", cursor=centre, direction=(1.0, 0.0, 0.0), radius=radius, strength=0.5,
+                   lut=lut, view=None, start=True, any_segment=True)
+    )  # fmt: skip
 
     from hairtool.frozen.density import accept, thin
 

@@ -146,20 +146,28 @@ def test_the_engine_step_ends_with_a_full_run_on_an_updated_list(monkeypatch):
 #: The warm-up's parallel engine step, then the bear (a dense real groom) opened with the studio's
 #: engine parameters and dragged with a brush whose moves' regions reach the parallel kernels:
 #: prints the moves' region sizes and the kernel signatures the moves added to the process.
-DENSE = r"""
-import gc, json, sys
-import numpy as np
+#: What both scripts below start with: ``sigs()``, the kernel signatures loaded in the process.
+SIGNATURES = r"""
+import gc
 from numba.core.dispatcher import Dispatcher
-from app.ui import kernel_warmup
-from hairtool import io
-from hairtool.frozen import local
-from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
 
 def sigs():
     return {
         f"{d.py_func.__module__}:{d.py_func.__qualname__} {s}"
         for d in gc.get_objects() if isinstance(d, Dispatcher) for s in d.signatures
     }
+"""
+
+DENSE = (
+    SIGNATURES
+    + r"""
+import json, sys
+import numpy as np
+from app.ui import kernel_warmup
+from hairtool import io
+from hairtool.frozen import local
+from hairtool.frozen.pipeline import FrozenParams, FrozenPipeline
+
 
 for label, step in kernel_warmup.STEPS:
     if label == kernel_warmup.PARALLEL_ENGINE_STEP:
@@ -178,6 +186,15 @@ for i in range(2):
     regions.append(pipe.clump_redone * g.vertex_count)
 print(json.dumps({"regions": regions, "serial_below": local.SERIAL_BELOW, "new": sorted(sigs() - before)}))
 """
+)
+
+
+def _report(script: str, *args) -> dict:
+    """The JSON line ``script`` prints last, run in a fresh process (no kernel loaded before)."""
+    command = [sys.executable, "-c", script, *map(str, args)]
+    out = subprocess.run(command, capture_output=True, text=True, timeout=900, check=False)
+    assert out.returncode == 0, out.stderr[-3000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 @pytest.mark.slow(seconds=10)
@@ -185,11 +202,48 @@ def test_a_dense_grooms_first_strokes_need_no_kernel_the_warm_up_left_out():
     """The bear's brush-local moves (regions of 4,000-5,000 vertices) run the parallel kernels
     that Sintel's small regions never reach; the warm-up's parallel engine step compiles them,
     so the first stroke on such a groom loads them instead of compiling (13 s on a quiet host)."""
-    bear = Path(__file__).parents[1] / "data" / "grooms" / "bear.tfx"
-    out = subprocess.run(
-        [sys.executable, "-c", DENSE, str(bear)], capture_output=True, text=True, timeout=900, check=False
-    )
-    assert out.returncode == 0, out.stderr[-3000:]
-    report = json.loads(out.stdout.strip().splitlines()[-1])
+    report = _report(DENSE, Path(__file__).parents[1] / "data" / "grooms" / "bear.tfx")
     assert all(r >= report["serial_below"] for r in report["regions"]), report["regions"]
+    assert not report["new"], "kernels the warm-up does not compile:\n" + "\n".join(report["new"])
+
+
+#: The warm-up's brushes step, then a Delete stroke with the studio's default rule (any segment
+#: under the brush, Blender's): prints the strands before and after and the signatures it added.
+DELETE = (
+    SIGNATURES
+    + r"""
+import json
+import numpy as np
+from app.ui import kernel_warmup
+from app.ui.brush_tool import BrushTool
+from hairtool import samples
+from hairtool.frozen.brushes import falloff_lut
+from hairtool.frozen.pipeline import FrozenPipeline
+from hairtool.frozen.sample_schema import BRUSH
+
+
+kernel_warmup._brushes_step()
+before = sigs()
+groom = samples.scalp(strands=40, vertices=8)
+pipe = FrozenPipeline(groom)
+lo, hi = groom.bounds
+tool = BrushTool()
+sample = BRUSH.make(
+    brush="delete", cursor=tuple(float(v) for v in groom.points[groom.offsets[5] + 4]),
+    direction=(1.0, 0.0, 0.0), radius=0.05 * float(np.max(hi - lo)), strength=0.5,
+    lut=tuple(falloff_lut("smooth").tolist()), view=None, start=True, any_segment=tool.delete_any_segment,
+)
+pipe.brush(sample)
+print(json.dumps({"strands": [groom.strand_count, pipe.result.strand_count], "new": sorted(sigs() - before)}))
+"""
+)
+
+
+def test_the_studios_default_delete_needs_no_kernel_the_warm_up_left_out():
+    """The studio's Delete removes every strand with a segment under the brush (its default, a
+    kernel of its own); the brushes step's samples take the schema's default (the root rule of
+    older logs), so the step deletes once more by the studio's rule."""
+    report = _report(DELETE)
+    before, after = report["strands"]
+    assert after < before  # the stroke deleted strands
     assert not report["new"], "kernels the warm-up does not compile:\n" + "\n".join(report["new"])
