@@ -26,6 +26,7 @@ from hairtool.frozen.brushes.sight import (
     _edge_numpy,
     _sides,
     face_det_t,
+    next_side,
     ray_frame,
     walk_start,
 )
@@ -95,12 +96,7 @@ def _first_hit_kernel(o, d, vertices, faces, lo, cell, dims, start, items, tmin)
             best, face = _beside(
                 s0, s1, s2, ci, frame, o, vertices, faces, dims, start, items, tmin, best, face
             )
-        a = 0
-        if tmax[1] < tmax[a]:
-            a = 1
-        if tmax[2] < tmax[a]:
-            a = 2
-        leaves = tmax[a] > t1
+        a, leaves = next_side(tmax, t1)
         exit_t = t1 if leaves else tmax[a]
         s0, s1, s2 = _sides(o, d, exit_t, ci, -1 if leaves else a, lo, cell, dims, tol)
         if s0 != 0 or s1 != 0 or s2 != 0:  # the point it leaves by (the next cell's entry)

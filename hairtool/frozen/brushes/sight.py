@@ -194,6 +194,18 @@ def walk_start(o, d, lo, cell, dims, ci, step, tmax, tdelta):  # pragma: no cove
 
 
 @njit(cache=True, nogil=True, inline="always")
+def next_side(tmax, t1):  # pragma: no cover - compiled
+    """The axis whose cell side the walk crosses next (the nearest of ``tmax``), and whether the
+    ray leaves the grid's box (past ``t1``) before it."""
+    a = 0
+    if tmax[1] < tmax[a]:
+        a = 1
+    if tmax[2] < tmax[a]:
+        a = 2
+    return a, tmax[a] > t1
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _sides(o, d, t, ci, skip, lo, cell, dims, tol):  # pragma: no cover - compiled
     """Per axis (:func:`_side`), where the ray's point at ``t`` lies on cell ``ci``'s sides; 0
     across ``skip`` (the axis the walk itself crosses there)."""
@@ -247,12 +259,7 @@ def _blocked(o, d, vertices, faces, lo, cell, dims, start, items, tmin, far):  #
         near = s0 != 0 or s1 != 0 or s2 != 0  # the point the walk entered by
         if near and _beside(s0, s1, s2, ci, frame, o, vertices, faces, dims, start, items, tmin, far):
             return True
-        a = 0
-        if tmax[1] < tmax[a]:
-            a = 1
-        if tmax[2] < tmax[a]:
-            a = 2
-        leaves = tmax[a] > t1
+        a, leaves = next_side(tmax, t1)
         s0, s1, s2 = _sides(o, d, t1 if leaves else tmax[a], ci, -1 if leaves else a, lo, cell, dims, tol)
         near = s0 != 0 or s1 != 0 or s2 != 0  # the point it leaves by (the next cell's entry)
         if near and _beside(s0, s1, s2, ci, frame, o, vertices, faces, dims, start, items, tmin, far):
