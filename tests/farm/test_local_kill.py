@@ -80,6 +80,11 @@ def test_a_local_batch_survives_a_worker_killed_mid_job_and_resumes(made_shots, 
     results = []
     with _logged_here() as here, open_client(None, 2) as client:
         pids = client.run(os.getpid)
+        # Unpickling ``_executing`` imports this module (and hairtool's CLI) in each worker: done
+        # here, while the workers are idle. Polled first while a job imports its command's modules
+        # on the worker's other thread, the two imports could meet halfway (Python then hands one
+        # thread a partly initialised module: an ImportError that is the test's, not the batch's).
+        client.run(_executing)
         thread = threading.Thread(target=lambda: results.append(run_batch(jobs, client=client, threads=1)))
         thread.start()
         try:
