@@ -1,10 +1,11 @@
 """A pytest plugin that records each test's CPU and wall seconds (set-up, call and tear-down
 together; CPU includes the children a test waited for) and the seconds numba spent compiling
 kernels in the test's own process (a cold cache's share: a fresh clone compiles what the
-studio's warm-up did not), to a JSON file, for finding what makes the suite slow:
+studio's warm-up did not), with each kernel and the argument types it was compiled for, to a
+JSON file, for finding what makes the suite slow:
 ``python -m pytest -n 0 -p tests.cpu_times tests/io`` writes ``$HAIRTOOL_TEST_TIMES`` (default
 ``test-times.json``; under xdist one file per worker, ``test-times.gw0.json`` …) and prints the
-files by CPU."""
+files by CPU and the longest compiles."""
 
 from __future__ import annotations
 
@@ -36,6 +37,7 @@ class _Compiles:
     def __init__(self) -> None:
         self.seconds = 0.0
         self.count = 0
+        self.kernels: list[tuple[str, float]] = []  # (kernel and argument types, seconds)
         self._lock = threading.Lock()
         self._local = threading.local()
 
@@ -43,14 +45,18 @@ class _Compiles:
         depth = getattr(self._local, "depth", 0)
         if depth == 0:
             self._local.started = time.perf_counter()
+            func = event.data["dispatcher"].py_func
+            self._local.name = f"{func.__module__}.{func.__qualname__} {event.data['args']}"
         self._local.depth = depth + 1
 
     def on_end(self, event) -> None:
         self._local.depth -= 1
         if self._local.depth == 0:
+            took = time.perf_counter() - self._local.started
             with self._lock:
-                self.seconds += time.perf_counter() - self._local.started
+                self.seconds += took
                 self.count += 1
+                self.kernels.append((self._local.name, took))
 
 
 _compiles = _Compiles()
@@ -68,13 +74,14 @@ def pytest_configure(config):
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item, nextitem):
     cpu, wall = _cpu(), time.perf_counter()
-    compiled, kernels = _compiles.seconds, _compiles.count
+    compiled, kernels, named = _compiles.seconds, _compiles.count, len(_compiles.kernels)
     yield
     _rows[item.nodeid] = {
         "cpu": _cpu() - cpu,
         "wall": time.perf_counter() - wall,
         "compile": _compiles.seconds - compiled,
         "kernels": _compiles.count - kernels,
+        "compiled": _compiles.kernels[named:],
     }
 
 
@@ -117,6 +124,12 @@ def pytest_terminal_summary(terminalreporter):
         terminalreporter.write_line(f"{cpu:8.1f} {wall:8.1f} {compiled:8.1f} ({kernels:3d})  {name}")
     total = [sum(f[i] for f in files.values()) for i in range(4)]
     terminalreporter.write_line(f"{total[0]:8.1f} {total[1]:8.1f} {total[2]:8.1f} ({total[3]:3d})  all")
+    compiled = [(t, k, node) for node, row in _rows.items() for k, t in row.get("compiled", [])]
+    compiled.sort(reverse=True)
+    if compiled:
+        terminalreporter.write_sep("-", "the longest compiles: seconds, kernel and argument types, test")
+        for took, kernel, node in compiled[:25]:
+            terminalreporter.write_line(f"{took:8.1f}  {kernel[:160]}  {node}")
     slow = sorted(_rows.items(), key=lambda kv: -kv[1]["cpu"])[:15]
     terminalreporter.write_sep("-", "slowest tests by CPU")
     for node, row in slow:

@@ -14,6 +14,7 @@ from app.render.ramps import ramp_texture, sample_linear
 from app.render.soft_raster import StrandRaster, rasterize, rasterize_reference
 from hairtool.errors import ParameterError
 from hairtool.groom import Groom
+from hairtool.kernel_arrays import readonly
 
 SIZE = (61, 47)
 
@@ -98,6 +99,14 @@ def test_thread_counts_give_the_same_bytes_on_a_dense_groom(threads):
         np.testing.assert_array_equal(images[0][0], ref[0])
 
 
+def _setup_kernel(points, starts, colors, mvp, w, h, scale, *tables):
+    """The set-up kernel on read-only, C-ordered inputs, as the renderer calls it: the kernel
+    then loads the studio warm-up's compilation instead of compiling a variant of its own for
+    the test's writable arrays (seconds each, on every fresh clone)."""
+    inputs = (readonly(a) for a in (points, starts, colors, mvp))
+    soft_raster._setup_kernel(*inputs, w, h, readonly(scale), *tables)
+
+
 def _tables(e: int):
     """Empty set-up outputs for e segments: the segment table (width scale 1), boxes, nearest depths."""
     return np.ones((e, soft_raster._SEG)), np.zeros((4, e), np.int32), np.zeros(e, np.float32)
@@ -110,7 +119,7 @@ def test_any_split_into_bands_gives_the_same_bytes(width):
     ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, width)
     e, h = len(starts), SIZE[1]
     seg, box, nearest = _tables(e)
-    soft_raster._setup_kernel(
+    _setup_kernel(
         points, starts, colors, mvp, SIZE[0], h, np.zeros(0), seg, box, nearest,
         np.zeros(0, bool), width, np.zeros(0)
     )
@@ -137,7 +146,7 @@ def _dense_thrice(size, width, colour_seed):
     one = g.topology.segment_end - 1
     starts = np.concatenate([one + c * g.vertex_count for c in range(3)]).astype(np.int64)
     seg, box, nearest = _tables(len(starts))
-    soft_raster._setup_kernel(
+    _setup_kernel(
         points, starts, colors, mvp, size[0], size[1], np.zeros(0), seg, box, nearest,
         np.zeros(0, bool), width, np.zeros(0)
     )  # fmt: skip
@@ -210,7 +219,7 @@ def test_tapered_quads_split_into_bands_give_the_bytes_of_the_numpy_definition(w
     ref_rgba, ref_depth = rasterize_reference(points, starts, colors, mvp, SIZE, width, scale=scale)
     e, h = len(starts), SIZE[1]
     seg, box, nearest = _tables(e)
-    soft_raster._setup_kernel(
+    _setup_kernel(
         points, starts, colors, mvp, SIZE[0], h, scale, seg, box, nearest,
         np.zeros(0, bool), width, np.zeros(0)
     )
@@ -239,7 +248,7 @@ def test_a_hidden_test_reads_the_third_row_and_column_of_cells(transpose):
     back = np.isclose(ref_depth, 0.5).T if transpose else np.isclose(ref_depth, 0.5)
     assert back[28:].any() and not back[:28].any()
     seg, box, nearest = _tables(len(starts))
-    soft_raster._setup_kernel(
+    _setup_kernel(
         points, starts, colors, np.eye(4), *size, np.zeros(0), seg, box, nearest,
         np.zeros(0, bool), 2.0, np.zeros(0)
     )
@@ -262,7 +271,7 @@ def test_a_box_holds_the_pixel_at_its_quads_farthest_corner():
     ref_rgba, _ = rasterize_reference(points, starts, colors, mvp, size, 2.0 * h)
     assert ref_rgba[10, 12, 3] == 255 and not ref_rgba[:10, :, 3].any()  # the corner's pixel, lowest
     seg, box, nearest = _tables(1)
-    soft_raster._setup_kernel(
+    _setup_kernel(
         points, starts, colors, mvp, *size, np.zeros(0), seg, box, nearest,
         np.zeros(0, bool), 2 * h, np.zeros(0)
     )
@@ -289,9 +298,8 @@ def test_kernel_bodies_as_plain_python_match_the_compiled_ones():
         )
         seg, box, nearest = _tables(e)
         weight = np.zeros(e)
-        setup(
-            points, starts, colors, mvp, w, h, np.zeros(0), seg, box, nearest, np.zeros(0, bool), 3.0, weight
-        )
+        inputs = (readonly(a) for a in (points, starts, colors, mvp))  # read-only, as the renderer's
+        setup(*inputs, w, h, readonly(np.zeros(0)), seg, box, nearest, np.zeros(0, bool), 3.0, weight)
         np.testing.assert_array_equal(weight, 1.0 + 3.0 * seg[:, 12])
         bounds = soft_raster.band_bounds(box[0], box[1], h, 3, weight)
         images = [np.zeros((h, w), np.uint32), np.ones((h, w), np.float32)] * 3
