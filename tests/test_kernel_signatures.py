@@ -201,3 +201,21 @@ def test_nearest_on_screen():
     ]
     assert got[0] >= 0 and all(x == got[0] for x in got)
     assert_one_signature_each_twin(screen_pick._nearest_kernel, 0, 7, 8)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_guide_frame_tables(dtype):
+    # A video of render hair hands the tables each frame's guides as a float64 copy (writable):
+    # the kernel then compiled a second time at the first export (12 s on a fresh clone).
+    from hairtool.groom import Groom
+    from hairtool.guides import frames
+
+    g = samples.scalp(10, 6, seed=5)
+    tangent = np.tile([0.0, -1.0, 0.0], (g.strand_count, 1))
+    got = [
+        frames.guide_tables(Groom(p, g.counts), 4, t)
+        for p in variants(g.points.astype(dtype))
+        for t in variants(tangent, fortran=False)
+    ]
+    assert all(np.array_equal(a, b) for x in got for a, b in zip(x, got[0], strict=True))
+    assert_one_signature_each_twin(frames._tables_kernel, 0, 4, 5)

@@ -16,6 +16,7 @@ import numpy as np
 from numba import njit, prange
 
 from hairtool.groom import Groom
+from hairtool.kernel_arrays import readonly
 from hairtool.rotation import turn_between
 from hairtool.serial_twins import twin_njit
 
@@ -142,10 +143,11 @@ def guide_tables(
     rows = guides.strand_count * n
     seg, seglen, frm = out if out is not None else (np.empty((rows, 3)), np.empty(rows), np.empty((rows, 9)))
     frame = guides.metadata.frame if axes is None else axes
+    # read-only inputs: one compilation whatever the guides hold (a video's frames are copies)
     _tables_kernel(
-        np.ascontiguousarray(guides.points, np.float32), guides.offsets[:-1].astype(np.int64),
-        guides.counts.astype(np.int64), int(n), np.ascontiguousarray(rest_tangent, np.float64),
-        np.ascontiguousarray(frame, np.float64), int(row0), seg, seglen, frm,
+        readonly(np.ascontiguousarray(guides.points, np.float32)), guides.offsets[:-1].astype(np.int64),
+        guides.counts.astype(np.int64), int(n), readonly(np.ascontiguousarray(rest_tangent, np.float64)),
+        readonly(np.ascontiguousarray(frame, np.float64)), int(row0), seg, seglen, frm,
     )  # fmt: skip
     return seg, seglen, frm
 

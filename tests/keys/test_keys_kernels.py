@@ -6,6 +6,7 @@ import numba
 import numpy as np
 import pytest
 
+from hairtool.kernel_arrays import readonly
 from hairtool.keys.costs import cost_table
 from hairtool.keys.dp import _layer_block, _penalty_kernel
 from hairtool.keys.features import _resample_kernel
@@ -43,7 +44,7 @@ def test_python_bodies_match_the_compiled_kernels():
         np.testing.assert_array_equal(a[0], b[0])
         np.testing.assert_array_equal(a[1], b[1])
     np.testing.assert_array_equal(_penalty_kernel.py_func(ct, 1.0)[1], _penalty_kernel(ct, 1.0)[1])
-    frames = np.random.default_rng(2).normal(size=(3, 12, 3)).astype(np.float32)
+    frames = readonly(np.random.default_rng(2).normal(size=(3, 12, 3)).astype(np.float32))  # as features'
     off = np.array([0, 5, 12])
     out_py, out_jit = np.empty((3, 2, 4, 3)), np.empty((3, 2, 4, 3))
     _resample_kernel.py_func(frames, off, np.linspace(0, 1, 4), out_py)
