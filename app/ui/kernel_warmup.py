@@ -479,8 +479,8 @@ _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
 #: parallel kernels and the rest (CPU seconds on a quiet two-core host, empty cache: engine 12.5
 #: serial, 25.6 parallel; head 2.9 / 4.4; render hair 5.8 / 11.6; strand drawing 10.7). The
 #: studio actions' steps close the render hair's lane, the one that ended first (CPU seconds on a
-#: loaded host: character spring bones 12.9, colour by clump 2.7, picked guides 1.1): after
-#: ./dev's warm-up the lanes ended 8 s apart, 116 and 108 s.
+#: loaded host: character spring bones 12.9, colour by clump 2.7, picked guides 1.1); in the
+#: quietest run of ``python -m app.ui.warm_cache`` the lanes ended 8 s apart, at 116 and 108 s.
 LANES: tuple[tuple[str, ...], ...] = (
     (ENGINE_STEP, PARALLEL_ENGINE_STEP, "brush modes and settings", "engine defaults", "grooming brushes"),
     (HEAD_STEP, RENDER_HAIR_STEP, RASTER_STEP, PARALLEL_RENDER_HAIR_STEP, CLUMPED_HAIR_STEP,
