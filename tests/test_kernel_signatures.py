@@ -8,6 +8,8 @@ the answers agree bit for bit."""
 
 from __future__ import annotations
 
+from dataclasses import astuple
+
 import numpy as np
 import pytest
 
@@ -19,9 +21,11 @@ from hairtool.anime.wave import WaveParams, make_bunches, pose_pictures
 from hairtool.bounds import _box, box
 from hairtool.frozen import freeze, lengths, neighbour_update, spatial, vertex_grid
 from hairtool.frozen.freeze import _freeze_kernel
+from hairtool.groom import Animation
 from hairtool.guides import child_clumps, children
 from hairtool.guides.binding import bind_roots
 from hairtool.keys import features
+from hairtool.keys.reconstruct import _curve_distances, key_curve_errors, key_poses
 
 
 def variants(a: np.ndarray, fortran: bool = True) -> list[np.ndarray]:
@@ -219,3 +223,17 @@ def test_guide_frame_tables(dtype):
     ]
     assert all(np.array_equal(a, b) for x in got for a, b in zip(x, got[0], strict=True))
     assert_one_signature_each_twin(frames._tables_kernel, 0, 4, 5)
+
+
+def test_key_curve_errors_of_a_strided_animation():
+    """An Animation keeps the memory order of the frames it was given (a capture's bones are a
+    gather along the vertex axis: strided, as ``app.document.capture.skeleton_animation`` makes
+    them); the key-curve distances see C-ordered read-only frames whatever it is."""
+    frames = np.random.default_rng(4).standard_normal((5, 9, 3))
+    strided = np.ascontiguousarray(frames.transpose(1, 0, 2)).transpose(1, 0, 2)
+    anims = [Animation(f, np.full(3, 3)) for f in (frames, strided)]
+    assert anims[0].frames.flags.c_contiguous and not anims[1].frames.flags.c_contiguous
+    for interp in ("linear", "hermite"):
+        c, f = (key_curve_errors(a, key_poses(a.frames, [0, 2, 4], interp)) for a in anims)
+        assert all(np.array_equal(x, y) for x, y in zip(astuple(c), astuple(f), strict=True))
+    assert_one_signature(_curve_distances, 0)

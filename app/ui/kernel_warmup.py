@@ -41,10 +41,11 @@ from pathlib import Path
 
 import numpy as np
 
-from app.ui import startup_trace
+from app.ui import action_warmup, startup_trace
 
 #: Packages and modules whose kernels the warm-up's steps compile (searched for numba dispatchers).
 KERNEL_PACKAGES = (
+    "hairtool.character",
     "hairtool.frozen",
     "hairtool.frozen.brushes",
     "hairtool.guides",
@@ -386,6 +387,8 @@ def _animation_step() -> None:
         session = ks.solve(anim, ks.KeySettings(objective=objective, interp=interp))
         keys = session.keys_for_count(4)
         ks.analyse(anim, keys, interp)
+    # a price per key (the timeline's tau mode, a capture's per-channel keys): a DP of its own
+    ks.solve(anim, ks.KeySettings()).keys_for_tau(0.05)
 
 
 #: The step after which the bundled sample's render hair can be bound and shaded without compiling.
@@ -413,6 +416,10 @@ PARALLEL_ENGINE_STEP = "hair engine, parallel"
 PARALLEL_RENDER_HAIR_STEP = "render hair, parallel"
 #: The steps after which the studio switches from the serial twins to the parallel kernels.
 PARALLEL_STEPS = (PARALLEL_ENGINE_STEP, PARALLEL_RENDER_HAIR_STEP)
+#: Studio actions past the first screen with kernels of their own (:mod:`app.ui.action_warmup`).
+CHARACTER_STEP = "character spring bones"
+CLUMP_COLOURS_STEP = "colour by clump"
+PICKED_GUIDES_STEP = "picked guides"
 
 
 def _serially(step: Callable[[], None]) -> Callable[[], None]:
@@ -445,9 +452,10 @@ def _parallel_engine_step() -> None:
 #: (label, step) in the order a single process runs them: the engine for the first groom, the
 #: render hair (the bundled sample's children wait for it), the rasterizer for software GL, the
 #: same engine and render hair on the parallel kernels, then what other brush modes and settings
-#: reach, the other brushes, and what opening an animation needs (simulation, anime waves,
-#: keys): without these, the first use of each compiled it inside the studio, on a job or the
-#: GUI thread.
+#: reach, the other brushes, what opening an animation needs (simulation, anime waves, keys),
+#: and the studio actions with kernels of their own (a character's spring bones, colours by
+#: clump, picked guides): without these, the first use of each compiled it inside the studio,
+#: on a job or the GUI thread.
 _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
     (HEAD_STEP, _serially(_head_step)),
     (ENGINE_STEP, _serially(_engine_step)),
@@ -460,17 +468,23 @@ _STEPS: tuple[tuple[str, Callable[[], None]], ...] = (
     (CLUMPED_HAIR_STEP, _clumped_hair_step),
     ("grooming brushes", _brushes_step),
     ("animation and keys", _animation_step),
+    (CHARACTER_STEP, action_warmup.character_step),
+    (CLUMP_COLOURS_STEP, action_warmup.clump_colours_step),
+    (PICKED_GUIDES_STEP, action_warmup.picked_guides_step),
 )
 
 #: The studio's warm-up processes, one per core of the two-core reference machine, each a list
 #: of step labels: the engine in one, the head surface (part of the engine's align drag) and
 #: the render hair in the other, so the first screen's compiles run side by side, then the
 #: parallel kernels and the rest (CPU seconds on a quiet two-core host, empty cache: engine 12.5
-#: serial, 25.6 parallel; head 2.9 / 4.4; render hair 5.8 / 11.6; strand drawing 10.7).
+#: serial, 25.6 parallel; head 2.9 / 4.4; render hair 5.8 / 11.6; strand drawing 10.7). The
+#: studio actions' steps close the render hair's lane, the one that ended first (CPU seconds on a
+#: loaded host: character spring bones 12.9, colour by clump 2.7, picked guides 1.1); in the
+#: quietest run of ``python -m app.ui.warm_cache`` the lanes ended 8 s apart, at 116 and 108 s.
 LANES: tuple[tuple[str, ...], ...] = (
     (ENGINE_STEP, PARALLEL_ENGINE_STEP, "brush modes and settings", "engine defaults", "grooming brushes"),
     (HEAD_STEP, RENDER_HAIR_STEP, RASTER_STEP, PARALLEL_RENDER_HAIR_STEP, CLUMPED_HAIR_STEP,
-     "animation and keys"),
+     PICKED_GUIDES_STEP, "animation and keys", CHARACTER_STEP, CLUMP_COLOURS_STEP),
 )  # fmt: skip
 
 

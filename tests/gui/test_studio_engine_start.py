@@ -217,7 +217,8 @@ def test_the_warm_up_runs_its_steps_and_records_the_kernels(tmp_path, monkeypatc
     assert lines == [f"step {i + 1} {n} {label}" for i, (label, _) in enumerate(kernel_warmup.STEPS)]
     names = json.loads(kernel_warmup.record_path().read_text())["kernels"]
     assert "app.render.soft_raster:draw_bands" in names and "hairtool.frozen.clump:_clump_run" in names
-    # what an artist reaches after the first groom: other brushes, render hair, keys, waves, sims
+    # what an artist reaches after the first groom: other brushes, render hair, keys, waves, sims,
+    # a character's springs, clump colours, picked guides, a price per key
     for kernel in (
         "hairtool.frozen.brushes.comb:_comb_kernel",
         "hairtool.guides.children:_children_kernel",
@@ -227,6 +228,10 @@ def test_the_warm_up_runs_its_steps_and_records_the_kernels(tmp_path, monkeypatc
         "hairtool.keys.segment_fit:_fit_kernel",
         "hairtool.anime.pose:_pose_kernel",
         "hairtool.simulate.dynamics:_frame_kernel",
+        "hairtool.character.springs_kernel:spring_step_kernel",
+        "hairtool.frozen.strand_clumps:_basins",
+        "hairtool.guides.nearest:_fps_kernel",
+        "hairtool.keys.dp:_penalty_kernel",
     ):
         assert kernel in names
     assert kernel_warmup.kernels_cached()
