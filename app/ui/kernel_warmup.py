@@ -312,11 +312,18 @@ def _brushes_step() -> None:
                    lut=lut, view=None, start=True, any_segment=True)
     )  # fmt: skip
 
+    from hairtool.frozen.brushes.add import append_strands
     from hairtool.frozen.density import accept, thin
+    from hairtool.frozen.root_grid import nearest_root
 
     pts = groom.roots.astype(np.float64)
     accept(pts[:8], pts[8:], 0.1)  # density's own kernels
     thin(pts, np.zeros(len(pts), bool), 0.1)
+    # Add and Density on a groom without render hair: new strands take their nearest old root's
+    # look, a root search in the groom's own precision (float32 here), and Add plants on the head
+    # with one in float64 (the render hair's too)
+    append_strands(groom, samples.scalp(strands=4, vertices=8, seed=3))
+    nearest_root(pts, pts[:4])
 
 
 def _render_hair_step() -> None:

@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from hairtool.kernel_arrays import readonly
+
 PER_CELL = 4.0  # roots a root sees in its cell, on average, that the cell size aims at
 _MAX_HALVINGS = 24  # halvings of the cell size at most
 _MAX_DIM = 1 << 20  # cells along an axis at most
@@ -147,7 +149,10 @@ def _search(roots: np.ndarray, queries: np.ndarray, kk: int, take_sqrt: bool) ->
     else:  # one cell: every query scans every root, as the all-pairs search did
         keys, starts = np.zeros(1, np.int64), np.array([0, len(roots)], np.int64)
         pts, ids, lo, h, dims = roots, np.arange(len(roots)), np.zeros(3), 1.0, np.ones(3, np.int64)
-    _kernel(keys, starts, pts, ids, lo, h, dims, queries, kk, take_sqrt, out_g, out_d, out_n)
+    # read-only inputs: one compilation per precision, whoever made the arrays (a groom's own
+    # read-only roots, a brush's fresh queries)
+    inputs = (readonly(a) for a in (keys, starts, pts, ids, lo))
+    _kernel(*inputs, h, readonly(dims), readonly(queries), kk, take_sqrt, out_g, out_d, out_n)
     return out_g, out_d, out_n
 
 
