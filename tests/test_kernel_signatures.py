@@ -237,3 +237,32 @@ def test_key_curve_errors_of_a_strided_animation():
         c, f = (key_curve_errors(a, key_poses(a.frames, [0, 2, 4], interp)) for a in anims)
         assert all(np.array_equal(x, y) for x, y in zip(astuple(c), astuple(f), strict=True))
     assert_one_signature(_curve_distances, 0)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_sight_of_points_and_strands(dtype):
+    # A box selection, Add and Density ask about fresh float64 copies, a press about the groom's
+    # own read-only points: each dtype compiles once (a writable float64 copy had compiled the
+    # sight kernel again at the studio's first box selection by sight).
+    from hairtool.frozen.brushes import sight
+    from hairtool.frozen.brushes.sight import hidden_points, hidden_strands
+    from hairtool.guides.planting import HeadSurface
+    from hairtool.io.obj import Mesh
+
+    v = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]], np.float32) * 0.5
+    f = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    grid = HeadSurface(Mesh(v, f.astype(np.int32), v)).face_grid
+    g = samples.scalp(10, 6, seed=2)
+    pts = g.points.astype(dtype) - g.points.mean(axis=0).astype(dtype)
+    view = (0.0, 0.0, -1.0)
+    seen = [hidden_points(p, view, grid) for p in variants(pts)]
+    assert all(np.array_equal(s, seen[0]) for s in seen)
+    whole = [
+        hidden_strands(p, o, (0.0, 0.0, 0.0), 9.0, view, grid)
+        for p in variants(pts)
+        for o in variants(g.offsets, fortran=False)
+    ]
+    assert all(np.array_equal(s, whole[0]) for s in whole)
+    assert_one_signature(sight._points_kernel, 0)
+    assert_one_signature(sight._hidden_kernel, 0)
+    assert_one_signature(sight._hidden_kernel, 1)

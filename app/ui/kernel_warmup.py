@@ -205,8 +205,9 @@ def _press_step(pipe) -> None:
             result.points, view, (640, 480), (320.0, 240.0), 40.0, result.topology.strand_index, skip
         )
     grid = getattr(pipe.surface, "face_grid", None)
-    if grid is not None:
+    if grid is not None:  # the press's vertex; a box selection's, Add's and Density's float64 points
         hidden_points(result.points[:1], (0.0, 0.0, -1.0), grid)
+        hidden_points(result.points[:1].astype(np.float64), (0.0, 0.0, -1.0), grid)
 
 
 def _head_step() -> None:

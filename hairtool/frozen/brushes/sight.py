@@ -44,6 +44,8 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike
 
+from hairtool.kernel_arrays import readonly
+
 #: a ray starts counting faces this share of the mesh's size from its vertex
 START = 1e-6
 
@@ -362,8 +364,10 @@ def hidden_strands(
     """
     toward, at, persp = _camera(view, eye)
     out = np.empty(len(offsets) - 1, np.bool_)
+    # read-only inputs: one compilation per dtype, whoever made them
     _hidden_kernel(
-        points, np.asarray(offsets, np.int64), np.asarray(cursor, np.float64), float(radius) ** 2,
+        readonly(points), readonly(np.asarray(offsets, np.int64)), np.asarray(cursor, np.float64),
+        float(radius) ** 2,
         toward, at, persp, grid.vertices, grid.faces, grid.lo, grid.cell, grid.dims, grid.start,
         grid.items, START * grid.size, out,
     )  # fmt: skip
@@ -413,8 +417,9 @@ def hidden_points(
     meets a face of ``grid`` (the vertex a press starts a stroke on is one in sight)."""
     toward, at, persp = _camera(view, eye)
     out = np.empty(len(points), np.bool_)
+    # read-only points: one compilation per dtype (a box's float64 copies, a groom's own)
     _points_kernel(
-        points, toward, at, persp, grid.vertices, grid.faces, grid.lo, grid.cell, grid.dims,
+        readonly(points), toward, at, persp, grid.vertices, grid.faces, grid.lo, grid.cell, grid.dims,
         grid.start, grid.items, START * grid.size, out,
     )  # fmt: skip
     return out
