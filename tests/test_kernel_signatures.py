@@ -161,8 +161,10 @@ def test_the_vertex_grid_built_moved_and_searched():
     moved[[4, 11]] += np.float32(0.3)
     one, many = g.points[[2]].astype(np.float64), g.points[[2, 9, 20]].astype(np.float64)
     got = []
-    for p, q in zip(variants(g.points), variants(moved), strict=True):
-        grid = vertex_grid.VertexGrid(p, strand, 1.0)
+    # the strands as a topology holds them (read-only) or as a caller made them (writable)
+    strands = variants(strand, fortran=False) + [strand]
+    for p, q, s in zip(variants(g.points), variants(moved), strands, strict=True):
+        grid = vertex_grid.VertexGrid(p, s, 1.0)
         changed = grid.move(q, np.array([4, 11]))
         marks = []
         for queries, radius in ((one, 0.6), (many, 1.5), (many, 0.5)):  # wide, each, grouped

@@ -614,7 +614,7 @@ class VertexGrid:
         self.head = np.empty(1 << bits, np.int64)
         self.nxt = np.empty(v, np.int64)
         self.prv = np.empty(v, np.int64)
-        self.strand = np.ascontiguousarray(strand, np.int64)
+        self.strand = readonly(np.asarray(strand, np.int64))  # as a topology holds it: one signature
         self.capacity = 64  # list slots per vertex (grows to the longest list + 1)
         self._flat = np.empty(0, np.int64)  # the lists' buffer (:meth:`prepare`)
         self._flags = np.zeros(0, np.bool_)  # :meth:`reach`'s, kept all False between calls
