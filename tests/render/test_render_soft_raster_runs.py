@@ -14,6 +14,7 @@ from app.render.soft_raster import StrandRaster, changed_in_runs_reference, merg
 from app.render.strand_gpu import vertex_runs
 from hairtool import samples
 from hairtool.errors import ParameterError
+from hairtool.kernel_arrays import readonly
 
 SIZE = (256, 192)
 GROOM = samples.scalp(strands=120, vertices=8, seed=4)
@@ -121,7 +122,8 @@ def test_the_runs_kernel_flags_what_its_numpy_reference_does(python):
     )
     which, flags = np.zeros(STARTS.size, bool), np.zeros(v, bool)
     kernel = soft_raster._changed_in_runs.py_func if python else soft_raster._changed_in_runs
-    n = kernel(p, c, last_p, last_c, STARTS, runs, seg_runs, flags, which)
+    # read-only inputs, as the raster passes them (the warm-up's compilation, not one of the test's own)
+    n = kernel(readonly(p), readonly(c), last_p, last_c, readonly(STARTS), runs, seg_runs, flags, which)
     np.testing.assert_array_equal(which, want)
     assert n == want.sum() > 0
     np.testing.assert_array_equal(last_p, want_p)
