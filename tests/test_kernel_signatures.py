@@ -162,7 +162,7 @@ def test_the_vertex_grid_built_moved_and_searched():
     one, many = g.points[[2]].astype(np.float64), g.points[[2, 9, 20]].astype(np.float64)
     got = []
     # the strands as a topology holds them (read-only) or as a caller made them (writable)
-    strands = variants(strand, fortran=False) + [strand]
+    strands = [*variants(strand, fortran=False), strand]
     for p, q, s in zip(variants(g.points), variants(moved), strands, strict=True):
         grid = vertex_grid.VertexGrid(p, s, 1.0)
         changed = grid.move(q, np.array([4, 11]))
