@@ -1,4 +1,4 @@
-"""Colour ramps and palettes for strands (numpy only; RGB in [0, 1], float32).
+"""Colour ramps and palettes for strands (RGB in [0, 1], float32).
 
 A ramp is a list of evenly spaced stops, interpolated linearly in RGB. "root-tip" is the default
 strand colouring (dark brown roots, light blonde tips); "red-blue" is the frozen-hair paper's
@@ -10,9 +10,11 @@ from __future__ import annotations
 import colorsys
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
+from hairtool.kernel_arrays import readonly
 
 F32 = NDArray[np.float32]
 
@@ -60,9 +62,39 @@ def ramp_texture(name: str, width: int = 256) -> F32:
     return ramp_colors(np.linspace(0.0, 1.0, width), name)
 
 
+@njit(cache=True, nogil=True)
+def _sample_kernel(tex, t, out):  # pragma: no cover - compiled
+    """:func:`sample_linear_reference`'s arithmetic per coordinate, in the same order (float64,
+    then rounded to float32 once): the same bytes."""
+    w = tex.shape[0]
+    for k in range(t.shape[0]):  # (on one thread: memory-bound, 5-8 ms a million)
+        x = t[k]
+        if x == x:  # NaN stays NaN, as np.clip leaves it
+            x = min(max(x, 0.0), 1.0)
+        x = x * w - 0.5
+        i = np.floor(x)
+        f = x - i
+        i0 = min(max(int(i), 0), w - 1)
+        i1 = min(max(int(i) + 1, 0), w - 1)
+        for c in range(3):
+            out[k, c] = np.float32(tex[i0, c] * (1.0 - f) + tex[i1, c] * f)
+
+
 def sample_linear(texels: ArrayLike, t: ArrayLike) -> F32:
     """``(n, 3)`` colours of a ``(width, 3)`` 1-D texture at coordinates ``t`` (clamped to [0, 1]),
-    as GL samples it with LINEAR filtering and CLAMP_TO_EDGE: between texel centres (i + ½)/width."""
+    as GL samples it with LINEAR filtering and CLAMP_TO_EDGE: between texel centres (i + ½)/width.
+    Compiled: a million render-hair vertices took 0.23 s in numpy at every colouring."""
+    tex = readonly(np.asarray(texels, dtype=np.float64))
+    if tex.ndim != 2 or tex.shape[0] < 1 or tex.shape[1] != 3:
+        raise ParameterError("texels", tex.shape, "(width, 3) colours, width at least 1")
+    x = readonly(np.asarray(t, dtype=np.float64).reshape(-1))
+    out = np.empty((x.size, 3), np.float32)
+    _sample_kernel(tex, x, out)
+    return out
+
+
+def sample_linear_reference(texels: ArrayLike, t: ArrayLike) -> F32:
+    """Numpy twin of :func:`sample_linear`."""
     tex = np.asarray(texels, dtype=np.float64)
     x = np.clip(np.asarray(t, dtype=np.float64).reshape(-1), 0.0, 1.0) * len(tex) - 0.5
     i = np.floor(x)

@@ -55,6 +55,7 @@ KERNEL_PACKAGES = (
 )
 KERNEL_MODULES = (
     "hairtool.bounds",
+    "app.render.ramps",
     "app.render.soft_raster",
     "app.render.hair_shading",
     "app.render.screen_pick",
@@ -257,8 +258,11 @@ def _more_engine_step() -> None:
 def _raster_step() -> list[int]:
     """Draw, redraw the changed tiles, and redraw told what moved: the tiles it redrew each
     time (a tile redraw needs few changed tiles: short strands on an image of many tiles)."""
+    from app.render.ramps import ramp_texture, sample_linear
     from app.render.soft_raster import StrandRaster
+    from app.render.strands import RAMP_TEXELS
 
+    sample_linear(ramp_texture("root-tip", RAMP_TEXELS), np.linspace(0.0, 1.0, 8))  # the strands' colours
     rng = np.random.default_rng(0)
     strands, per = 24, 4
     roots = rng.uniform(-0.8, 0.8, (strands, 3))

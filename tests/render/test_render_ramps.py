@@ -4,12 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from app.render.ramps import (
     RAMPS,
     categorical_colors,
     per_strand_random_colors,
     ramp_colors,
+    sample_linear,
+    sample_linear_reference,
     strand_to_vertex_colors,
 )
 from hairtool import samples
@@ -69,3 +73,24 @@ def test_strand_to_vertex_colors():
     v = strand_to_vertex_colors(per_strand, g.topology)
     assert v.shape == (12, 3)
     np.testing.assert_array_equal(v[3:6], np.repeat(per_strand[1:2], 3, axis=0))
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(
+    width=st.integers(1, 300),
+    t=st.lists(st.floats(allow_nan=True, allow_infinity=True, width=64), min_size=0, max_size=40),
+    seed=st.integers(0, 2**16),
+)
+def test_sampling_a_ramp_is_its_numpy_twin_bit_for_bit(width, t, seed):
+    texels = np.random.default_rng(seed).random((width, 3))
+    coords = np.array([*t, 0.0, 1.0, 0.5 / width, 1.0 - 0.5 / width, -1e300, 1e300])  # edges, centres
+    with np.errstate(invalid="ignore"):  # the twin casts NaN to an index (clamped, as the kernel's)
+        want = sample_linear_reference(texels, coords)
+    got = sample_linear(texels, coords)
+    assert got.dtype == np.float32 and np.array_equal(got.view(np.uint32), want.view(np.uint32))
+
+
+def test_sampling_refuses_a_texture_without_three_channels():
+    for bad in (np.zeros((0, 3)), np.zeros((4, 4)), np.zeros(3)):
+        with pytest.raises(ParameterError, match="texels"):
+            sample_linear(bad, [0.5])
