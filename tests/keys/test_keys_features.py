@@ -49,7 +49,7 @@ def test_batched_resampling_handles_mixed_counts_and_zero_length_strands(monkeyp
     frames = []
     for f in range(5):
         pts = [s + np.array([0.1 * f, 0.0, 0.0]) * np.linspace(0, 1, len(s))[:, None] for s in strands]
-        frames.append(np.concatenate(pts))
+        frames.append(np.concatenate(pts).astype(np.float32))  # as an Animation holds them
     from hairtool.groom import Groom
 
     counts = [len(s) for s in strands]
