@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit, prange
 from numpy.typing import NDArray
 
+from hairtool.kernel_arrays import readonly
 from hairtool.serial_twins import twin_njit
 
 LIGHT_IN_VIEW = (-0.35, 0.6, 0.72)  # toward the key light: (right, up, toward the viewer)
@@ -134,17 +135,6 @@ def _half(light: NDArray, eye: NDArray) -> NDArray[np.float64]:
     return h / n if n > 0 else np.asarray(light, np.float64)
 
 
-def _read_only(a: NDArray) -> NDArray:
-    """``a`` as the kernels always see it, read-only (a view when it is writable): numba
-    compiles writable and read-only arrays apart, and the renderer's arrays are read-only, so
-    one specialisation serves every caller (a first start compiles half as much)."""
-    if not a.flags.writeable:
-        return a
-    view = a.view()
-    view.flags.writeable = False
-    return view
-
-
 def shade(
     points: NDArray,
     offsets: NDArray,
@@ -158,8 +148,8 @@ def shade(
     S + 1 strand starts) with per-vertex ``base`` colours, unit ``light`` and ``eye`` directions."""
     if out is None or out.shape != (len(points), 3):
         out = np.empty((len(points), 3), np.float32)
-    points, base = _read_only(np.ascontiguousarray(points)), np.ascontiguousarray(base)
-    offsets = _read_only(np.ascontiguousarray(offsets, np.int64))
+    points, base = readonly(points), np.ascontiguousarray(base)
+    offsets = readonly(np.asarray(offsets, np.int64))
     light, half = np.asarray(light, np.float64), _half(light, eye)
     terms = (float(look.ambient), float(look.diffuse), float(look.specular))
     e = 0.5 * float(look.exponent)

@@ -42,6 +42,7 @@ from numba import njit, prange
 from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
+from hairtool.kernel_arrays import readonly
 
 W_MIN = 1e-5  # as the geometry shader: an end nearer the eye plane than this is cut there
 DIR_EPS = 1e-6  # as the geometry shader: shorter segments are drawn in direction (1, 0)
@@ -647,14 +648,6 @@ def _balanced_jobs(work: NDArray[np.int64], n: int) -> tuple[NDArray[np.int64], 
     return tiles[order], np.searchsorted(job[order], np.arange(n + 1)).astype(np.int64)
 
 
-def _read_only(a: np.ndarray) -> np.ndarray:
-    """A read-only view: the kernels always see read-only inputs (a type of their own in numba),
-    however the caller made them, so one compilation (the studio's warm-up) serves every caller."""
-    view = a.view()
-    view.flags.writeable = False
-    return view
-
-
 def _check(points, starts, colors, mvp, size, width, check_starts=True):
     p = np.ascontiguousarray(points, np.float32)
     s = np.ascontiguousarray(starts, np.int64)
@@ -800,7 +793,7 @@ class StrandRaster:
         quads of half-width ``half``; into a non-empty ``weight``, each segment's work per row."""
         h, w = self.depth.shape
         sc = self._last_scale if self._last_scale.ndim else _NO_SCALE
-        p, s, c, m, sc = (_read_only(a) for a in (p, s, c, m, sc))
+        p, s, c, m, sc = (readonly(a) for a in (p, s, c, m, sc))
         if ids is not None:
             _setup_listed(p, s, c, m, w, h, sc, self._seg, self._box, self._nearest, ids, 2.0 * half)
             return
@@ -876,12 +869,12 @@ class StrandRaster:
             seg_runs = np.stack([np.searchsorted(s, runs[:, 0] - 1), np.searchsorted(s, runs[:, 1])], axis=1)
             self._which[:] = False
             changed = _changed_in_runs(
-                _read_only(p), _read_only(c), self._last_points, self._last_colors, _read_only(s),
+                readonly(p), readonly(c), self._last_points, self._last_colors, readonly(s),
                 runs, seg_runs, self._flags, self._which,
             )  # fmt: skip
         else:
-            _changed_vertices(_read_only(p), _read_only(c), self._last_points, self._last_colors, self._flags)
-            changed = _changed_ends(_read_only(s), self._flags, self._which)
+            _changed_vertices(readonly(p), readonly(c), self._last_points, self._last_colors, self._flags)
+            changed = _changed_ends(readonly(s), self._flags, self._which)
         self._kept_current = True
         ids = np.flatnonzero(self._which) if runs is not None else None
         if changed == 0:

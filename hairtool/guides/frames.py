@@ -145,9 +145,9 @@ def guide_tables(
     frame = guides.metadata.frame if axes is None else axes
     # read-only inputs: one compilation whatever the guides hold (a video's frames are copies)
     _tables_kernel(
-        readonly(np.ascontiguousarray(guides.points, np.float32)), guides.offsets[:-1].astype(np.int64),
-        guides.counts.astype(np.int64), int(n), readonly(np.ascontiguousarray(rest_tangent, np.float64)),
-        readonly(np.ascontiguousarray(frame, np.float64)), int(row0), seg, seglen, frm,
+        readonly(np.asarray(guides.points, np.float32)), guides.offsets[:-1].astype(np.int64),
+        guides.counts.astype(np.int64), int(n), readonly(np.asarray(rest_tangent, np.float64)),
+        readonly(np.asarray(frame, np.float64)), int(row0), seg, seglen, frm,
     )  # fmt: skip
     return seg, seglen, frm
 

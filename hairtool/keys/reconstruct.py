@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from hairtool.errors import ParameterError
 from hairtool.groom import Animation
+from hairtool.kernel_arrays import readonly
 from hairtool.keys.costs import INTERPOLATIONS
 from hairtool.keys.dp import uniform_keys
 from hairtool.keys.gram import tangent_stencil
@@ -362,18 +363,6 @@ def key_curve_errors_reference(
     return _curve_errors(animation, kp, cancelled, progress, reference=True)
 
 
-def _c_read_only(a: NDArray) -> NDArray:
-    """``a`` C-contiguous and read-only, as :func:`_curve_distances` always sees a chunk of frames:
-    numba compiles per layout and per writability, and an Animation's frames are read-only but
-    not always C-contiguous (a capture's bones are a strided gather: opening a BVH in the studio
-    compiled the kernel a second time). A C-contiguous chunk is a view; another is copied."""
-    c = np.ascontiguousarray(a)
-    if c.flags.writeable:
-        c = c.view()
-        c.flags.writeable = False
-    return c
-
-
 def _curve_errors(animation, kp, cancelled, progress, reference: bool) -> PositionErrors | None:
     f = animation.frames
     n, v = f.shape[0], f.shape[1]
@@ -398,7 +387,8 @@ def _curve_errors(animation, kp, cancelled, progress, reference: bool) -> Positi
         else:
             e = buffer[: t.size]
             a, w = _segment_weights(kp, t)
-            _curve_distances(_c_read_only(f[f0 : f0 + t.size]), 0, a, w, poses, out_t, in_t, hermite, e)
+            # C-ordered, read-only: one compilation (a capture's frames are a strided gather)
+            _curve_distances(readonly(f[f0 : f0 + t.size]), 0, a, w, poses, out_t, in_t, hermite, e)
         mean[t], tip[t], worst[t] = e.mean(axis=1), e[:, tips].mean(axis=1), e.max(axis=1)
         v_sum += e.sum(axis=0)
         np.maximum(v_max, e.max(axis=0), out=v_max)
