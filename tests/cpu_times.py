@@ -30,13 +30,12 @@ def _cpu() -> float:
 
 
 class _Compiles:
-    """Seconds and count of numba's compilations (cache misses only: a kernel loaded from the
+    """Seconds and kernels of numba's compilations (cache misses only: a kernel loaded from the
     cache sends no event), outermost ones per thread, so a kernel compiling its callees counts
     once."""
 
     def __init__(self) -> None:
         self.seconds = 0.0
-        self.count = 0
         self.kernels: list[tuple[str, float]] = []  # (kernel and argument types, seconds)
         self._lock = threading.Lock()
         self._local = threading.local()
@@ -55,7 +54,6 @@ class _Compiles:
             took = time.perf_counter() - self._local.started
             with self._lock:
                 self.seconds += took
-                self.count += 1
                 self.kernels.append((self._local.name, took))
 
 
@@ -74,13 +72,13 @@ def pytest_configure(config):
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item, nextitem):
     cpu, wall = _cpu(), time.perf_counter()
-    compiled, kernels, named = _compiles.seconds, _compiles.count, len(_compiles.kernels)
+    compiled, named = _compiles.seconds, len(_compiles.kernels)
     yield
     _rows[item.nodeid] = {
         "cpu": _cpu() - cpu,
         "wall": time.perf_counter() - wall,
         "compile": _compiles.seconds - compiled,
-        "kernels": _compiles.count - kernels,
+        "kernels": len(_compiles.kernels) - named,
         "compiled": _compiles.kernels[named:],
     }
 
